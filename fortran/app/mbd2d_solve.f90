@@ -1,0 +1,142 @@
+!> mbd2d-solve: run a model file written by `mbd2d export`, without Python.
+!!
+!!   mbd2d-solve MODEL.mbd OUT.csv
+!! Writes the CSV the Python path writes (t, then NAME.x ... NAME.theta_ddot per body).
+!! Exit codes: 0 ok, 2 bad input, 3 singular configuration (partial output written),
+!! 4 other numerical failure (partial output written).
+program mbd2d_solve
+  use mbd_kinds, only: wp
+  use mbd_status, only: MBD_OK, MBD_SINGULAR_CONFIG, MSG_LEN
+  use mbd_mbdfile, only: mbd_spec_t, mbd_read
+  use mbd_constraints, only: con_nrow
+  use mbd_api, only: NINFO, api_sizes, api_kinematics
+  implicit none
+  type(mbd_spec_t) :: spec
+  character(len=1024) :: model_path, out_path
+  character(len=MSG_LEN) :: msg
+  integer :: status, bad, nq, neq, k, iinfo(NINFO)
+  real(wp) :: rinfo(NINFO)
+  real(wp), allocatable :: q0(:), qout(:, :), qdout(:, :), qddout(:, :), qsing(:)
+  integer, allocatable :: dep(:)
+
+  if (command_argument_count() /= 2) then
+    write (*, '(a)') 'usage: mbd2d-solve MODEL.mbd OUT.csv'
+    write (*, '(a)') '  runs the analysis in a model file written by `mbd2d export` and writes a CSV'
+    if (command_argument_count() == 1) then
+      call get_command_argument(1, model_path)
+      if (model_path == '-h' .or. model_path == '--help') stop
+    end if
+    error stop 2
+  end if
+  call get_command_argument(1, model_path)
+  call get_command_argument(2, out_path)
+
+  call mbd_read(trim(model_path), spec, status, msg)
+  if (status /= MBD_OK) call die(2, trim(msg))
+  if (spec%analysis /= 'kinematics') call die(2, 'analysis "' // trim(spec%analysis) // &
+    '" is not supported by mbd2d-solve (kinematics only)')
+  call api_sizes(spec%nb, spec%ctab, spec%rpar, nq, neq, status, msg, bad)
+  if (status /= MBD_OK) call die(2, trim(where(bad)) // trim(msg))
+
+  allocate (q0(nq), qout(nq, spec%steps + 1), qdout(nq, spec%steps + 1), &
+            qddout(nq, spec%steps + 1), qsing(nq), dep(neq))
+  q0 = 0.0_wp
+  q0(1:3 * spec%nb) = reshape(spec%q0, [3 * spec%nb])
+  call api_kinematics(spec%nb, spec%ctab, spec%rpar, q0, spec%t0, spec%t_end, spec%steps, &
+                      spec%tol, spec%maxit, spec%tmin, qout, qdout, qddout, iinfo, rinfo, &
+                      qsing, dep, status, msg)
+  if (status < 0) call die(2, trim(where(iinfo(2))) // trim(msg))
+  call write_csv(trim(out_path), iinfo(1))
+  if (status == MBD_SINGULAR_CONFIG) then
+    call die(3, trim(singular_message()))
+  else if (status /= MBD_OK) then
+    call die(4, trim(msg) // trim(worst()) // '. ' // trim(rows_written()))
+  end if
+
+contains
+
+  function where(k) result(s)
+    integer, intent(in) :: k
+    character(len=MSG_LEN) :: s
+    s = ''
+    if (k > 0) s = 'constraint "' // trim(spec%con_names(k)) // '": '
+  end function where
+
+  function worst() result(s)
+    character(len=MSG_LEN) :: s
+    s = ''
+    if (iinfo(4) > 0) s = ' ("' // trim(spec%con_names(iinfo(4))) // '")'
+  end function worst
+
+  function rows_written() result(s)
+    character(len=MSG_LEN) :: s
+    write (s, '(a,i0,a,a)') 'Wrote ', iinfo(1), ' rows to ', trim(out_path)
+  end function rows_written
+
+  !> One paragraph: when, which driver, which constraints, what to do.
+  function singular_message() result(s)
+    character(len=4 * MSG_LEN) :: s
+    character(len=2 * MSG_LEN) :: names
+    character(len=32) :: ts
+    integer :: c, r0, nr
+    names = ''
+    r0 = 1
+    do c = 1, spec%nc
+      nr = con_nrow(spec%ctab(1, c))
+      if (any(dep(r0:r0 + nr - 1) == 1)) names = trim(names) // ' ' // trim(spec%con_names(c))
+      r0 = r0 + nr
+    end do
+    write (ts, '(f0.10)') rinfo(1)
+    s = 'Singular configuration (dead centre) at t = ' // trim(ts) // ' s: '
+    if (iinfo(3) > 0) then
+      s = trim(s) // ' driver "' // trim(spec%con_names(iinfo(3))) // &
+          '" can no longer be met, because the constraints' // trim(names) // &
+          ' became dependent (J lost rank).'
+    else
+      s = trim(s) // ' the constraints' // trim(names) // ' became dependent (J lost rank).'
+    end if
+    s = trim(s) // ' The mechanism cannot move further as driven; change the driver range or ' // &
+        'the link lengths. ' // trim(rows_written()) // '.'
+  end function singular_message
+
+  subroutine write_csv(path, nrows)
+    character(len=*), intent(in) :: path
+    integer, intent(in) :: nrows
+    integer :: u, ios, i, b
+    character(len=*), parameter :: sfx(9) = [character(len=12) :: '.x', '.y', '.theta', &
+      '.x_dot', '.y_dot', '.theta_dot', '.x_ddot', '.y_ddot', '.theta_ddot']
+    real(wp) :: t
+    open (newunit=u, file=path, status='replace', action='write', iostat=ios)
+    if (ios /= 0) call die(2, 'cannot write ' // path)
+    write (u, '(a)', advance='no') 't'
+    do b = 1, spec%nb
+      do i = 1, 9
+        write (u, '(a)', advance='no') ',' // trim(spec%body_names(b)) // trim(sfx(i))
+      end do
+    end do
+    write (u, '(a)') ''
+    do k = 1, nrows
+      t = spec%t0 + (spec%t_end - spec%t0) * (real(k - 1, wp) / max(spec%steps, 1))
+      if (k == spec%steps + 1) t = spec%t_end
+      write (u, '(es24.16e3)', advance='no') t
+      do b = 1, spec%nb
+        write (u, '(9(",",es24.16e3))', advance='no') qout(3 * b - 2:3 * b, k), &
+          qdout(3 * b - 2:3 * b, k), qddout(3 * b - 2:3 * b, k)
+      end do
+      write (u, '(a)') ''
+    end do
+    close (u)
+  end subroutine write_csv
+
+  subroutine die(code, text)
+    integer, intent(in) :: code
+    character(len=*), intent(in) :: text
+    write (*, '(a)') 'mbd2d-solve: ' // text
+    select case (code)
+    case (2); error stop 2
+    case (3); error stop 3
+    case default; error stop 4
+    end select
+  end subroutine die
+
+end program mbd2d_solve

@@ -1,0 +1,154 @@
+!> mbd_constraints: the one interface every constraint family answers.
+!!
+!! How many rows and extra coordinates it has, how its raw parameters are checked and
+!! prepared, its rows of Phi, J, nu and gamma at a state, and a starting value for its
+!! extra coordinates. The assembly loop calls only these; a new joint adds a case here.
+!! Kind codes (the flat model table, column 1):
+!!   1 revolute  2 translational  3 cam
+!!   101 absolute driver  102 relative-angle driver  103 relative-distance driver
+module mbd_constraints
+  use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+  use mbd_kinds, only: wp
+  use mbd_status, only: MBD_OK, MBD_BAD_INPUT, MBD_BAD_PARAM, MSG_LEN
+  use mbd_points, only: NLOC
+  use mbd_functions, only: fun_length, fun_check
+  use mbd_joint_revolute, only: revolute_prepare, revolute_eval
+  use mbd_joint_translational, only: translational_prepare, translational_eval
+  use mbd_joint_cam, only: cam_raw_length, cam_prepare, cam_eval, cam_init_alpha, ALPHA_SLOT
+  use mbd_drivers, only: driver_eval, DRV_ABS, DRV_REL_ANGLE, DRV_REL_DIST
+  implicit none
+  private
+  public :: CON_REVOLUTE, CON_TRANSLATIONAL, CON_CAM, DRV_ABS, DRV_REL_ANGLE, DRV_REL_DIST
+  public :: con_known, con_nrow, con_nextra, con_is_driver, con_raw_length, con_prepare
+  public :: con_eval, con_init_extra, con_name
+
+  integer, parameter :: CON_REVOLUTE = 1, CON_TRANSLATIONAL = 2, CON_CAM = 3
+
+contains
+
+  pure logical function con_known(kind)
+    integer, intent(in) :: kind   !! kind code
+    select case (kind)
+    case (CON_REVOLUTE, CON_TRANSLATIONAL, CON_CAM, DRV_ABS, DRV_REL_ANGLE, DRV_REL_DIST)
+      con_known = .true.
+    case default
+      con_known = .false.
+    end select
+  end function con_known
+
+  !> A short name of the kind, for messages.
+  pure function con_name(kind) result(name)
+    integer, intent(in) :: kind   !! kind code
+    character(len=24) :: name
+    select case (kind)
+    case (CON_REVOLUTE); name = 'revolute'
+    case (CON_TRANSLATIONAL); name = 'translational'
+    case (CON_CAM); name = 'cam'
+    case (DRV_ABS); name = 'absolute driver'
+    case (DRV_REL_ANGLE); name = 'relative-angle driver'
+    case (DRV_REL_DIST); name = 'relative-distance driver'
+    case default; name = 'unknown'
+    end select
+  end function con_name
+
+  !> Number of constraint rows.
+  pure integer function con_nrow(kind)
+    integer, intent(in) :: kind   !! kind code
+    select case (kind)
+    case (CON_REVOLUTE, CON_TRANSLATIONAL, CON_CAM); con_nrow = 2
+    case default; con_nrow = 1
+    end select
+  end function con_nrow
+
+  !> Number of extra coordinates the constraint adds.
+  pure integer function con_nextra(kind)
+    integer, intent(in) :: kind   !! kind code
+    con_nextra = 0
+    if (kind == CON_CAM) con_nextra = 1
+  end function con_nextra
+
+  pure logical function con_is_driver(kind)
+    integer, intent(in) :: kind   !! kind code
+    con_is_driver = kind > 100
+  end function con_is_driver
+
+  !> Expected raw length given the data, or -1 when malformed.
+  pure integer function con_raw_length(kind, suba, raw)
+    integer, intent(in) :: kind, suba  !! kind and first sub-kind
+    real(wp), intent(in) :: raw(:)     !! the raw parameter slice
+    select case (kind)
+    case (CON_REVOLUTE); con_raw_length = 4
+    case (CON_TRANSLATIONAL); con_raw_length = 8
+    case (CON_CAM); con_raw_length = cam_raw_length(suba, raw)
+    case default; con_raw_length = fun_length(raw)
+    end select
+  end function con_raw_length
+
+  !> Check raw parameters and build the prepared ones. ref: the prepared parameters of
+  !! the translational joint a relative-distance driver refers to.
+  subroutine con_prepare(kind, suba, subb, raw, ref, prep, status, msg)
+    integer, intent(in) :: kind, suba, subb        !! kind and sub-kinds
+    real(wp), intent(in) :: raw(:)                 !! raw parameters (exact length)
+    real(wp), intent(in) :: ref(:)                 !! referenced joint (or empty)
+    real(wp), allocatable, intent(out) :: prep(:)  !! prepared parameters
+    integer, intent(out) :: status                 !! MBD_OK or < 0
+    character(len=MSG_LEN), intent(out) :: msg     !! what is wrong
+    status = MBD_OK; msg = ''
+    if (.not. all(ieee_is_finite(raw))) then
+      status = MBD_BAD_PARAM; msg = 'a parameter is not a finite number'; return
+    end if
+    select case (kind)
+    case (CON_REVOLUTE)
+      call revolute_prepare(raw, prep, status, msg)
+    case (CON_TRANSLATIONAL)
+      call translational_prepare(raw, prep, status, msg)
+    case (CON_CAM)
+      call cam_prepare(suba, subb, raw, prep, status, msg)
+    case (DRV_ABS, DRV_REL_ANGLE)
+      call fun_check(raw, status, msg)
+      if (status == MBD_OK) prep = raw
+    case (DRV_REL_DIST)
+      call fun_check(raw, status, msg)
+      if (status == MBD_OK) prep = [ref, raw]
+    case default
+      status = MBD_BAD_INPUT; msg = 'unknown constraint kind'
+    end select
+  end subroutine con_prepare
+
+  !> Rows of Phi, the local J block, nu and gamma.
+  pure subroutine con_eval(kind, suba, subb, p, si, sj, ql, qdl, t, phi, jl, nu, gam)
+    integer, intent(in) :: kind, suba, subb  !! kind and sub-kinds
+    real(wp), intent(in) :: p(:)             !! prepared parameters
+    integer, intent(in) :: si, sj            !! slot ids of the two bodies (0 = ground)
+    real(wp), intent(in) :: ql(NLOC)         !! local coordinates
+    real(wp), intent(in) :: qdl(NLOC)        !! local velocities
+    real(wp), intent(in) :: t                !! time
+    real(wp), intent(inout) :: phi(:)        !! rows of Phi
+    real(wp), intent(inout) :: jl(:, :)      !! rows x NLOC block of J
+    real(wp), intent(inout) :: nu(:)         !! rows of nu
+    real(wp), intent(inout) :: gam(:)        !! rows of gamma
+    select case (kind)
+    case (CON_REVOLUTE)
+      call revolute_eval(p, si, sj, ql, qdl, phi, jl, gam)
+      nu(1:2) = 0.0_wp
+    case (CON_TRANSLATIONAL)
+      call translational_eval(p, si, sj, ql, qdl, phi, jl, gam)
+      nu(1:2) = 0.0_wp
+    case (CON_CAM)
+      call cam_eval(suba, subb, p, si, sj, ql, qdl, phi, jl, gam)
+      nu(1:2) = 0.0_wp
+    case default
+      call driver_eval(kind, suba, p, si, sj, ql, qdl, t, phi(1), jl(1, :), nu(1), gam(1))
+    end select
+  end subroutine con_eval
+
+  !> Starting values of the extra coordinates in ql (slot 7), from the body slots.
+  pure subroutine con_init_extra(kind, suba, subb, p, si, sj, ql)
+    integer, intent(in) :: kind, suba, subb  !! kind and sub-kinds
+    real(wp), intent(in) :: p(:)             !! prepared parameters
+    integer, intent(in) :: si, sj            !! slot ids
+    real(wp), intent(inout) :: ql(NLOC)      !! local coordinates
+    if (kind == CON_CAM) ql(ALPHA_SLOT) = cam_init_alpha(suba, subb, p, si, sj, ql)
+  end subroutine con_init_extra
+
+end module mbd_constraints

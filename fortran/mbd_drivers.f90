@@ -1,0 +1,55 @@
+!> mbd_drivers: driving constraints Phi^D(q, t) = g(q) - f(t) = 0.
+!!
+!! nu = -Phi_t = f'(t);  gamma = -(ar of g) + f''(t).
+!!   absolute           g = x, y or theta of one body             (sub-kind 1, 2, 3)
+!!   relative-angle     g = theta_j - theta_i
+!!   relative-distance  g = (P_j - P_i) . A_i u'_i, the slide along a translational joint
+!! Raw parameters: the encoded function (mbd_functions); the distance driver is prepared
+!! with the joint's prepared parameters in front: [joint prep(9), function].
+module mbd_drivers
+  use mbd_kinds, only: wp
+  use mbd_points, only: NLOC, kscal, body_angle, ssub, put_scal
+  use mbd_functions, only: fun_eval
+  use mbd_joint_translational, only: slide_distance
+  implicit none
+  private
+  public :: DRV_ABS, DRV_REL_ANGLE, DRV_REL_DIST, TRANS_PREP_LEN
+  public :: driver_eval
+
+  integer, parameter :: DRV_ABS = 101, DRV_REL_ANGLE = 102, DRV_REL_DIST = 103
+  integer, parameter :: TRANS_PREP_LEN = 9   !! length of a prepared translational joint
+
+contains
+
+  !> Row of Phi, J (local block), nu and gamma of a driver.
+  pure subroutine driver_eval(kind, sub, p, si, sj, ql, qdl, t, phi, jl, nu, gam)
+    integer, intent(in) :: kind, sub        !! driver kind; absolute: coordinate 1..3
+    real(wp), intent(in) :: p(:)            !! prepared parameters
+    integer, intent(in) :: si, sj           !! slot ids of the bodies
+    real(wp), intent(in) :: ql(NLOC)        !! local coordinates
+    real(wp), intent(in) :: qdl(NLOC)       !! local velocities
+    real(wp), intent(in) :: t               !! time
+    real(wp), intent(inout) :: phi          !! row of Phi
+    real(wp), intent(inout) :: jl(:)        !! row of the local J block
+    real(wp), intent(inout) :: nu           !! row of nu
+    real(wp), intent(inout) :: gam          !! row of gamma
+    type(kscal) :: g
+    real(wp) :: f, f1, f2
+    select case (kind)
+    case (DRV_ABS)
+      g%v = ql(sub); g%d(sub) = 1.0_wp; g%vd = qdl(sub)
+      call fun_eval(p, t, f, f1, f2)
+    case (DRV_REL_ANGLE)
+      g = ssub(body_angle(ql, qdl, sj), body_angle(ql, qdl, si))
+      call fun_eval(p, t, f, f1, f2)
+    case default  ! DRV_REL_DIST
+      g = slide_distance(p(1:TRANS_PREP_LEN), si, sj, ql, qdl)
+      call fun_eval(p(TRANS_PREP_LEN + 1:), t, f, f1, f2)
+    end select
+    call put_scal(g, phi, jl, gam)
+    phi = phi - f
+    nu = f1
+    gam = gam + f2
+  end subroutine driver_eval
+
+end module mbd_drivers

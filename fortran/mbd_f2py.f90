@@ -1,0 +1,54 @@
+! mbd_f2py: the only file f2py reads. Plain subroutines with C kinds (f2py maps real(real64)
+! to float), no derived types; each forwards to mbd_api. Status 0 ok, < 0 bad input,
+! > 0 numerical failure; msg explains.
+
+subroutine core_sizes(nb, nc, ctab, np, rpar, nq, neq, status, msg, bad)
+  use iso_c_binding, only: c_double, c_int
+  use mbd_api, only: api_sizes
+  implicit none
+  integer(c_int), intent(in) :: nb, nc, np
+  integer(c_int), intent(in) :: ctab(8, nc)
+  real(c_double), intent(in) :: rpar(np)
+  integer(c_int), intent(out) :: nq, neq, status, bad
+  character(len=512), intent(out) :: msg
+  !f2py intent(hide) :: nc, np
+  call api_sizes(nb, ctab, rpar, nq, neq, status, msg, bad)
+end subroutine core_sizes
+
+subroutine core_eval(nb, nc, ctab, np, rpar, nq, neq, q, qd, t, phi, jac, nu, gam, &
+                     status, msg, bad)
+  use iso_c_binding, only: c_double, c_int
+  use mbd_api, only: api_eval
+  implicit none
+  integer(c_int), intent(in) :: nb, nc, np, nq, neq
+  integer(c_int), intent(in) :: ctab(8, nc)
+  real(c_double), intent(in) :: rpar(np), q(nq), qd(nq), t
+  real(c_double), intent(out) :: phi(neq), jac(neq, nq), nu(neq), gam(neq)
+  integer(c_int), intent(out) :: status, bad
+  character(len=512), intent(out) :: msg
+  !f2py intent(hide) :: nc, np, nq
+  call api_eval(nb, ctab, rpar, q, qd, t, phi, jac, nu, gam, status, msg, bad)
+end subroutine core_eval
+
+subroutine core_kinematics(nb, nc, ctab, np, rpar, nq, neq, q0, t0, t1, nsteps, tol, &
+                           maxit, tmin, qout, qdout, qddout, iinfo, rinfo, qsing, dep, &
+                           status, msg)
+  use iso_c_binding, only: c_double, c_int
+  use mbd_api, only: api_kinematics
+  implicit none
+  integer(c_int), intent(in) :: nb, nc, np, nq, neq, nsteps, maxit
+  integer(c_int), intent(in) :: ctab(8, nc)
+  real(c_double), intent(in) :: rpar(np), q0(nq), t0, t1, tol, tmin
+  real(c_double), intent(out) :: qout(nq, nsteps + 1), qdout(nq, nsteps + 1)
+  real(c_double), intent(out) :: qddout(nq, nsteps + 1)
+  integer(c_int), intent(out) :: iinfo(10)
+  real(c_double), intent(out) :: rinfo(10)
+  real(c_double), intent(out) :: qsing(nq)
+  integer(c_int), intent(out) :: dep(neq)
+  integer(c_int), intent(out) :: status
+  character(len=512), intent(out) :: msg
+  !f2py intent(hide) :: nc, np, nq
+  !f2py threadsafe
+  call api_kinematics(nb, ctab, rpar, q0, t0, t1, nsteps, tol, maxit, tmin, qout, qdout, &
+                      qddout, iinfo, rinfo, qsing, dep, status, msg)
+end subroutine core_kinematics

@@ -1,0 +1,82 @@
+!> mbd_functions: driver functions of time, f(t) = sum_k c_k t**k + sum_h A_h sin(omega_h t + phi_h).
+!!
+!! Encoding in a real array p: [np, c_0 .. c_{np-1}, nh, (A, omega, phi) x nh].
+!! Returns f, df/dt and d2f/dt2 (the driver's nu = f' and its time term in gamma = f'').
+module mbd_functions
+  use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+  use mbd_kinds, only: wp, zero
+  use mbd_status, only: MBD_OK, MBD_BAD_PARAM, MSG_LEN
+  implicit none
+  private
+  public :: fun_eval, fun_check, fun_length
+
+contains
+
+  !> Length of the encoded function starting at p(1), or -1 when malformed.
+  pure integer function fun_length(p)
+    real(wp), intent(in) :: p(:)   !! encoded function (possibly followed by other data)
+    integer :: np, nh
+    fun_length = -1
+    if (size(p) < 2) return
+    if (.not. is_count(p(1))) return
+    np = nint(p(1))
+    if (size(p) < np + 2) return
+    if (.not. is_count(p(np + 2))) return
+    nh = nint(p(np + 2))
+    if (size(p) < np + 2 + 3 * nh) return
+    fun_length = np + 2 + 3 * nh
+  end function fun_length
+
+  pure logical function is_count(x)
+    real(wp), intent(in) :: x
+    is_count = ieee_is_finite(x)
+    if (is_count) is_count = x >= zero .and. x < 1.0e6_wp .and. abs(x - anint(x)) <= 1.0e-9_wp
+  end function is_count
+
+  !> Check an encoded function: well formed and all values finite.
+  subroutine fun_check(p, status, msg)
+    real(wp), intent(in) :: p(:)              !! encoded function
+    integer, intent(out) :: status            !! MBD_OK or MBD_BAD_PARAM
+    character(len=MSG_LEN), intent(out) :: msg !! what is wrong
+    integer :: n
+    status = MBD_OK; msg = ''
+    n = fun_length(p)
+    if (n < 0) then
+      status = MBD_BAD_PARAM
+      msg = 'function of time is malformed (expected [np, coefficients, nh, (A, omega, phase)...])'
+      return
+    end if
+    if (.not. all(ieee_is_finite(p(1:n)))) then
+      status = MBD_BAD_PARAM; msg = 'function of time has a non-finite coefficient'
+    end if
+  end subroutine fun_check
+
+  !> f(t), f'(t), f''(t).
+  pure subroutine fun_eval(p, t, f, f1, f2)
+    real(wp), intent(in) :: p(:)   !! encoded function
+    real(wp), intent(in) :: t      !! time
+    real(wp), intent(out) :: f     !! f(t)
+    real(wp), intent(out) :: f1    !! df/dt
+    real(wp), intent(out) :: f2    !! d2f/dt2
+    integer :: np, nh, k, o
+    real(wp) :: a, w, ph, s, c
+    np = nint(p(1))
+    f = zero; f1 = zero; f2 = zero
+    ! Horner for c_0 + c_1 t + ... and its two derivatives
+    do k = np, 1, -1
+      f2 = f2 * t + 2 * f1
+      f1 = f1 * t + f
+      f = f * t + p(1 + k)
+    end do
+    nh = nint(p(np + 2))
+    do k = 1, nh
+      o = np + 2 + 3 * (k - 1)
+      a = p(o + 1); w = p(o + 2); ph = p(o + 3)
+      s = sin(w * t + ph); c = cos(w * t + ph)
+      f = f + a * s
+      f1 = f1 + a * w * c
+      f2 = f2 - a * w * w * s
+    end do
+  end subroutine fun_eval
+
+end module mbd_functions

@@ -1,0 +1,147 @@
+!> mbd_joint_cam: a cam profile c(alpha) on body i in contact with a follower on body j.
+!!
+!! The contact parameter alpha is an extra coordinate (local slot 7).
+!! Point (knife-edge) and roller followers: the follower point F = r_j + A_j f' stays on the
+!! profile offset by the roller radius rho along the outward normal n(alpha):
+!!   Phi = r_i + A_i (c + rho n)(alpha) - r_j - A_j f' = 0                       (2 rows)
+!! Flat-faced follower, face through f' with normal m' (pointing toward the cam):
+!!   Phi_1 = (A_j m') . (r_i + A_i c(alpha) - r_j - A_j f') = 0   contact point on the face
+!!   Phi_2 = (A_j m') . (A_i c'(alpha)) = 0                        profile tangent along the face
+!! J and gamma come from the product rule on curve points (mbd_points).
+!! Raw parameters: [follower(4), profile raw...]; follower = point [fx, fy, 0, 0],
+!! roller [fx, fy, rho, 0], flat [fx, fy, mx, my]. Sub-kinds: profile kind, follower kind.
+module mbd_joint_cam
+  use mbd_kinds, only: wp, zero, two, pi
+  use mbd_status, only: MBD_OK, MBD_BAD_PARAM, MSG_LEN
+  use mbd_points, only: NLOC, kvec, body_point, body_vector, curve_point, curve_vector, &
+                        vsub, vdot, put_vec, put_scal
+  use mbd_profiles, only: profile_raw_length, profile_prepare, profile_eval, profile_normal, &
+                          profile_check
+  implicit none
+  private
+  public :: FOL_POINT, FOL_ROLLER, FOL_FLAT, ALPHA_SLOT
+  public :: cam_raw_length, cam_prepare, cam_eval, cam_init_alpha
+
+  integer, parameter :: FOL_POINT = 1, FOL_ROLLER = 2, FOL_FLAT = 3
+  integer, parameter :: ALPHA_SLOT = 7
+  integer, parameter :: NSAMPLE = 720   !! samples of alpha for the starting estimate
+
+contains
+
+  !> Number of raw parameters, or -1 when malformed.
+  pure integer function cam_raw_length(prof, raw)
+    integer, intent(in) :: prof      !! profile kind
+    real(wp), intent(in) :: raw(:)   !! raw parameters
+    integer :: n
+    cam_raw_length = -1
+    if (size(raw) < 5) return
+    n = profile_raw_length(prof, raw(5:))
+    if (n > 0) cam_raw_length = 4 + n
+  end function cam_raw_length
+
+  !> Check the follower, prepare the profile, check the contact curve.
+  subroutine cam_prepare(prof, fol, raw, prep, status, msg)
+    integer, intent(in) :: prof, fol               !! profile and follower kinds
+    real(wp), intent(in) :: raw(:)                 !! raw parameters (exact length)
+    real(wp), allocatable, intent(out) :: prep(:)  !! prepared parameters
+    integer, intent(out) :: status                 !! MBD_OK or MBD_BAD_PARAM
+    character(len=MSG_LEN), intent(out) :: msg     !! what is wrong
+    real(wp), allocatable :: pp(:)
+    real(wp) :: f(4), nm
+    status = MBD_OK; msg = ''
+    f = raw(1:4)
+    select case (fol)
+    case (FOL_POINT)
+      f(3:4) = zero
+    case (FOL_ROLLER)
+      if (.not. (f(3) > zero)) then
+        status = MBD_BAD_PARAM; msg = 'roller follower radius must be positive'; return
+      end if
+    case (FOL_FLAT)
+      nm = hypot(f(3), f(4))
+      if (.not. (nm > zero)) then
+        status = MBD_BAD_PARAM; msg = 'flat follower normal has zero length'; return
+      end if
+      f(3:4) = f(3:4) / nm
+    case default
+      status = MBD_BAD_PARAM; msg = 'unknown follower kind'; return
+    end select
+    call profile_prepare(prof, raw(5:), pp, status, msg)
+    if (status /= MBD_OK) return
+    if (fol == FOL_ROLLER) then
+      call profile_check(prof, pp, f(3), status, msg)
+    else
+      call profile_check(prof, pp, zero, status, msg)
+    end if
+    if (status /= MBD_OK) return
+    prep = [f, pp]
+  end subroutine cam_prepare
+
+  !> Contact curve point and its alpha derivatives (profile offset by the roller radius).
+  pure subroutine contact_curve(prof, fol, p, alpha, d0, d1, d2, c3)
+    integer, intent(in) :: prof, fol
+    real(wp), intent(in) :: p(:), alpha
+    real(wp), intent(out) :: d0(2), d1(2), d2(2), c3(2)
+    real(wp) :: n0(2), n1(2), n2(2)
+    call profile_eval(prof, p(5:), alpha, d0, d1, d2, c3)
+    if (fol == FOL_ROLLER) then
+      call profile_normal(d1, d2, c3, n0, n1, n2)
+      d0 = d0 + p(3) * n0; d1 = d1 + p(3) * n1; d2 = d2 + p(3) * n2
+    end if
+  end subroutine contact_curve
+
+  !> Rows of Phi, J (local block) and gamma.
+  pure subroutine cam_eval(prof, fol, p, si, sj, ql, qdl, phi, jl, gam)
+    integer, intent(in) :: prof, fol        !! profile and follower kinds
+    real(wp), intent(in) :: p(:)            !! prepared parameters
+    integer, intent(in) :: si, sj           !! slot ids of cam and follower bodies
+    real(wp), intent(in) :: ql(NLOC)        !! local coordinates (alpha in slot 7)
+    real(wp), intent(in) :: qdl(NLOC)       !! local velocities
+    real(wp), intent(inout) :: phi(:)       !! 2 rows of Phi
+    real(wp), intent(inout) :: jl(:, :)     !! 2 x NLOC block of J
+    real(wp), intent(inout) :: gam(:)       !! 2 rows of gamma
+    real(wp) :: c0(2), c1(2), c2(2), c3(2)
+    type(kvec) :: cp, m
+    call contact_curve(prof, fol, p, ql(ALPHA_SLOT), c0, c1, c2, c3)
+    cp = curve_point(ql, qdl, si, ALPHA_SLOT, c0, c1, c2)
+    if (fol == FOL_FLAT) then
+      m = body_vector(ql, qdl, sj, p(3:4))
+      call put_scal(vdot(m, vsub(cp, body_point(ql, qdl, sj, p(1:2)))), phi(1), jl(1, :), gam(1))
+      call put_scal(vdot(m, curve_vector(ql, qdl, si, ALPHA_SLOT, c1, c2, c3)), &
+                    phi(2), jl(2, :), gam(2))
+    else
+      call put_vec(vsub(cp, body_point(ql, qdl, sj, p(1:2))), phi, jl, gam)
+    end if
+  end subroutine cam_eval
+
+  !> Starting estimate of alpha at the local coordinates ql (slot 7 ignored):
+  !! the nearest contact-curve point to the follower point, or for a flat face the
+  !! profile point deepest along -m (where the outward normal is -m).
+  pure real(wp) function cam_init_alpha(prof, fol, p, si, sj, ql) result(alpha)
+    integer, intent(in) :: prof, fol        !! profile and follower kinds
+    real(wp), intent(in) :: p(:)            !! prepared parameters
+    integer, intent(in) :: si, sj           !! slot ids
+    real(wp), intent(in) :: ql(NLOC)        !! local coordinates
+    real(wp) :: qz(NLOC), a, best, val, c0(2), c1(2), c2(2), c3(2), fpt(2), mv(2)
+    type(kvec) :: cp, fk
+    integer :: k
+    qz = zero
+    fk = body_point(ql, qz, sj, p(1:2)); fpt = fk%v
+    fk = body_vector(ql, qz, sj, p(3:4)); mv = fk%v
+    alpha = zero; best = huge(1.0_wp)
+    do k = 0, NSAMPLE - 1
+      a = two * pi * k / NSAMPLE
+      call contact_curve(prof, fol, p, a, c0, c1, c2, c3)
+      cp = curve_point(ql, qz, si, 0, c0, c1, c2)
+      if (fol == FOL_FLAT) then
+        val = dot_product(mv, cp%v)
+      else
+        val = sum((cp%v - fpt)**2)
+      end if
+      if (val < best) then
+        best = val; alpha = a
+      end if
+    end do
+  end function cam_init_alpha
+
+end module mbd_joint_cam

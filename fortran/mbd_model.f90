@@ -1,0 +1,198 @@
+!> mbd_model: the model built from the flat tables that Python and the .mbd file hand over.
+!!
+!! Flat tables (the contract with the front ends):
+!!   nb               number of moving bodies; q = [x1 y1 th1 ... x_nb y_nb th_nb, extras]
+!!   ctab(NCT, nc)    one column per constraint (joints and drivers, in row order):
+!!                    1 kind, 2 body i, 3 body j (1-based, 0 = ground), 4 sub-kind a,
+!!                    5 sub-kind b, 6 offset of its raw parameters in rpar (1-based),
+!!                    7 number of raw parameters, 8 reserved (0)
+!!                    sub-kind a: cam profile kind, absolute-driver coordinate (1 x, 2 y,
+!!                    3 theta), relative-distance driver: the index of its translational joint
+!!                    sub-kind b: cam follower kind
+!!   rpar(:)          raw real parameters (layouts in each joint module's banner)
+!! Extra coordinates (cam contact parameters) follow the body coordinates in constraint order.
+module mbd_model
+  use mbd_kinds, only: wp, one
+  use mbd_status, only: MBD_OK, MBD_BAD_INPUT, MBD_BAD_BODY, MBD_BAD_PARAM, MSG_LEN
+  use mbd_points, only: NLOC
+  use mbd_constraints, only: con_known, con_nrow, con_nextra, con_raw_length, &
+                             con_prepare, con_name, CON_REVOLUTE, CON_TRANSLATIONAL, CON_CAM, &
+                             DRV_ABS, DRV_REL_DIST
+  implicit none
+  private
+  public :: NCT, model_t, model_build, model_slots
+
+  integer, parameter :: NCT = 8   !! rows of the constraint table
+
+  !> A built model: constraint data in prepared form and the row and column maps.
+  type :: model_t
+    integer :: nb = 0                     !! moving bodies
+    integer :: nc = 0                     !! constraints (joints and drivers)
+    integer :: nq = 0                     !! coordinates, body and extra
+    integer :: neq = 0                    !! constraint equations
+    integer, allocatable :: kind(:)       !! kind code of each constraint
+    integer, allocatable :: suba(:), subb(:)  !! sub-kinds
+    integer, allocatable :: bi(:), bj(:)  !! body indices (0 = ground)
+    integer, allocatable :: row0(:)       !! first row of each constraint
+    integer, allocatable :: nrow(:)       !! rows of each constraint
+    integer, allocatable :: loc(:, :)     !! (NLOC, nc) local slot -> global coordinate, 0 none
+    integer, allocatable :: po(:), pn(:)  !! prepared parameters: offset and length in p
+    integer, allocatable :: con_of_row(:) !! constraint owning each row
+    real(wp), allocatable :: p(:)         !! prepared parameter pool
+    real(wp) :: lscale = one              !! length scale of the model (tolerances)
+  end type model_t
+
+contains
+
+  !> Slot ids of a constraint's two bodies (0 = ground, 1, 2).
+  pure subroutine model_slots(m, k, si, sj)
+    type(model_t), intent(in) :: m    !! model
+    integer, intent(in) :: k          !! constraint index
+    integer, intent(out) :: si, sj    !! slot ids
+    si = 0; sj = 0
+    if (m%bi(k) > 0) si = 1
+    if (m%bj(k) > 0) sj = 2
+  end subroutine model_slots
+
+  !> Validate the flat tables and build the model.
+  !! bad returns the 1-based index of the offending constraint (0 when none or global).
+  subroutine model_build(nb, ctab, rpar, m, status, msg, bad)
+    integer, intent(in) :: nb                   !! number of moving bodies
+    integer, intent(in) :: ctab(:, :)           !! constraint table (NCT x nc)
+    real(wp), intent(in) :: rpar(:)             !! raw parameters
+    type(model_t), intent(out) :: m             !! the built model
+    integer, intent(out) :: status              !! MBD_OK or < 0
+    character(len=MSG_LEN), intent(out) :: msg  !! what is wrong
+    integer, intent(out) :: bad                 !! offending constraint, or 0
+    integer :: nc, k, kind, bi, bj, off, len, nexp, row, extra, ref, total
+    real(wp), allocatable :: prep(:), pool(:), refp(:)
+    character(len=MSG_LEN) :: sub
+    character(len=16) :: ks
+
+    status = MBD_OK; msg = ''; bad = 0
+    if (size(ctab, 1) /= NCT) then
+      status = MBD_BAD_INPUT; write (msg, '(a,i0,a)') 'constraint table must have ', NCT, ' rows'
+      return
+    end if
+    nc = size(ctab, 2)
+    if (nb < 1) then
+      status = MBD_BAD_INPUT; msg = 'the model has no moving bodies'; return
+    end if
+    if (nc < 1) then
+      status = MBD_BAD_INPUT; msg = 'the model has no joints or drivers'; return
+    end if
+    m%nb = nb; m%nc = nc
+    allocate (m%kind(nc), m%suba(nc), m%subb(nc), m%bi(nc), m%bj(nc), m%row0(nc), &
+              m%nrow(nc), m%loc(NLOC, nc), m%po(nc), m%pn(nc))
+    allocate (pool(0))
+    row = 0; extra = 0; total = 0
+    do k = 1, nc
+      kind = ctab(1, k); bi = ctab(2, k); bj = ctab(3, k)
+      off = ctab(6, k); len = ctab(7, k)
+      write (ks, '(i0)') k
+      bad = k
+      if (.not. con_known(kind)) then
+        status = MBD_BAD_INPUT; write (msg, '(a,i0)') 'unknown constraint kind ', kind; return
+      end if
+      ! bodies
+      if (bi < 0 .or. bi > nb .or. bj < 0 .or. bj > nb) then
+        status = MBD_BAD_BODY
+        write (msg, '(a,i0,a,i0,a,i0)') 'body index out of range: ', bi, ', ', bj, &
+          '; bodies are 0 (ground) to ', nb
+        return
+      end if
+      select case (kind)
+      case (DRV_ABS)
+        if (bi == 0) then
+          status = MBD_BAD_BODY; msg = 'an absolute driver needs a moving body, not ground'
+          return
+        end if
+        if (ctab(4, k) < 1 .or. ctab(4, k) > 3) then
+          status = MBD_BAD_PARAM; msg = 'absolute driver coordinate must be 1 (x), 2 (y) or 3 (theta)'
+          return
+        end if
+        bj = 0
+      case (DRV_REL_DIST)
+        ref = ctab(4, k)
+        if (ref < 1 .or. ref > nc) then
+          status = MBD_BAD_INPUT; msg = 'relative-distance driver refers to no joint'; return
+        end if
+        if (ctab(1, ref) /= CON_TRANSLATIONAL) then
+          status = MBD_BAD_INPUT
+          msg = 'relative-distance driver must refer to a translational joint'; return
+        end if
+        bi = ctab(2, ref); bj = ctab(3, ref)
+      case default
+        if (bi == bj) then
+          status = MBD_BAD_BODY
+          if (bi == 0) then
+            msg = 'both bodies are ground'
+          else
+            msg = 'a body is joined to itself'
+          end if
+          return
+        end if
+      end select
+      if (kind == CON_CAM) then
+        if (ctab(4, k) < 1 .or. ctab(4, k) > 3 .or. ctab(5, k) < 1 .or. ctab(5, k) > 3) then
+          status = MBD_BAD_PARAM; msg = 'cam profile or follower kind out of range'; return
+        end if
+      end if
+      ! parameters
+      if (off < 1 .or. len < 0 .or. off + len - 1 > size(rpar)) then
+        status = MBD_BAD_INPUT; msg = 'parameter slice outside the parameter array'; return
+      end if
+      nexp = con_raw_length(kind, ctab(4, k), rpar(off:off + len - 1))
+      if (nexp /= len) then
+        status = MBD_BAD_PARAM
+        write (msg, '(a,i0,a,i0,a)') 'has ', len, ' parameters, expected ', nexp, &
+          ' (-1: malformed)'
+        msg = trim(con_name(kind)) // ' ' // trim(msg)
+        return
+      end if
+      if (kind == DRV_REL_DIST) then
+        ! prepare the referenced joint again to read its prepared parameters
+        call con_prepare(CON_TRANSLATIONAL, 0, 0, rpar(ctab(6, ref):ctab(6, ref) + 7), &
+                         [real(wp) ::], refp, status, sub)
+        if (status == MBD_OK) then
+          call con_prepare(kind, ctab(4, k), ctab(5, k), rpar(off:off + len - 1), refp, prep, &
+                           status, sub)
+        end if
+      else
+        call con_prepare(kind, ctab(4, k), ctab(5, k), rpar(off:off + len - 1), &
+                         [real(wp) ::], prep, status, sub)
+      end if
+      if (status /= MBD_OK) then
+        msg = trim(con_name(kind)) // ': ' // trim(sub); return
+      end if
+      ! length scale from joint points (cam: the follower point)
+      if (kind == CON_REVOLUTE .or. kind == CON_TRANSLATIONAL) then
+        m%lscale = max(m%lscale, maxval(abs(rpar(off:off + 3))))
+      else if (kind == CON_CAM) then
+        m%lscale = max(m%lscale, maxval(abs(rpar(off:off + 1))))
+      end if
+      m%kind(k) = kind; m%suba(k) = ctab(4, k); m%subb(k) = ctab(5, k)
+      m%bi(k) = bi; m%bj(k) = bj
+      m%row0(k) = row + 1; m%nrow(k) = con_nrow(kind); row = row + m%nrow(k)
+      m%po(k) = total + 1; m%pn(k) = size(prep); total = total + size(prep)
+      pool = [pool, prep]
+      ! local slots -> global coordinates
+      m%loc(:, k) = 0
+      if (bi > 0) m%loc(1:3, k) = [3 * bi - 2, 3 * bi - 1, 3 * bi]
+      if (bj > 0) m%loc(4:6, k) = [3 * bj - 2, 3 * bj - 1, 3 * bj]
+      if (con_nextra(kind) > 0) then
+        extra = extra + 1
+        m%loc(7, k) = 3 * nb + extra
+      end if
+    end do
+    bad = 0
+    m%neq = row
+    m%nq = 3 * nb + extra
+    call move_alloc(pool, m%p)
+    allocate (m%con_of_row(m%neq))
+    do k = 1, nc
+      m%con_of_row(m%row0(k):m%row0(k) + m%nrow(k) - 1) = k
+    end do
+  end subroutine model_build
+
+end module mbd_model

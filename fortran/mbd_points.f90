@@ -1,0 +1,274 @@
+!> mbd_points: kinematic quantities that every joint is built from.
+!!
+!! A constraint sees a few "local" coordinates: slots 1-3 are (x, y, theta) of its first body,
+!! slots 4-6 those of its second body, slot 7 an extra coordinate of its own (a cam's contact
+!! parameter alpha). Ground has no slots (slot id 0).
+!!
+!! A `kvec` is a 2-vector v(q) carried with everything the constraint rows need:
+!!   v        value
+!!   d        dv/dq_loc                       (2 x NLOC, a block of J)
+!!   vd       dv/dt = d q_dot                 (velocity)
+!!   ar       d2v/dt2 - d q_ddot              (quadratic velocity remainder)
+!! For a body point P = r + A(theta) s' (Haug, Computer-Aided Kinematics and Dynamics, ch. 3):
+!!   d = [I, B s'],  vd = r_dot + B s' theta_dot,  ar = -A s' theta_dot**2.
+!! A constraint Phi = f(v, ...) then has J = df, gamma = -(ar of Phi) (+ time terms for drivers).
+!! A `kscal` is the same for a scalar. The operations below are the product rules.
+module mbd_points
+  use mbd_kinds, only: wp, zero, one, two, half
+  implicit none
+  private
+  public :: NLOC, MAXROW, kvec, kscal
+  public :: rot, drot, perp
+  public :: body_point, body_vector, curve_point, curve_vector, body_angle, const_vec
+  public :: vsub, vadd, vscale, vdot, vcross, ssub, sadd, sscale, ssqrt, sconst
+  public :: put_vec, put_scal
+
+  integer, parameter :: NLOC = 7    !! local coordinate slots: body i (1-3), body j (4-6), extra (7)
+  integer, parameter :: MAXROW = 3  !! most rows any constraint writes
+
+  !> A 2-vector quantity and its derivatives.
+  type :: kvec
+    real(wp) :: v(2) = zero         !! value
+    real(wp) :: d(2, NLOC) = zero   !! Jacobian with respect to the local slots
+    real(wp) :: vd(2) = zero        !! time derivative
+    real(wp) :: ar(2) = zero        !! acceleration remainder: v_ddot = d q_ddot + ar
+  end type kvec
+
+  !> A scalar quantity and its derivatives.
+  type :: kscal
+    real(wp) :: v = zero
+    real(wp) :: d(NLOC) = zero
+    real(wp) :: vd = zero
+    real(wp) :: ar = zero
+  end type kscal
+
+contains
+
+  !> A(theta), the planar rotation matrix.
+  pure function rot(th) result(a)
+    real(wp), intent(in) :: th  !! angle
+    real(wp) :: a(2, 2)
+    real(wp) :: c, s
+    c = cos(th); s = sin(th)
+    a(1, 1) = c; a(2, 1) = s; a(1, 2) = -s; a(2, 2) = c
+  end function rot
+
+  !> B(theta) = dA/dtheta.
+  pure function drot(th) result(b)
+    real(wp), intent(in) :: th  !! angle
+    real(wp) :: b(2, 2)
+    real(wp) :: c, s
+    c = cos(th); s = sin(th)
+    b(1, 1) = -s; b(2, 1) = c; b(1, 2) = -c; b(2, 2) = -s
+  end function drot
+
+  !> The vector turned by +90 degrees: perp(u) = (-u_y, u_x).
+  pure function perp(u) result(w)
+    real(wp), intent(in) :: u(2)  !! vector
+    real(wp) :: w(2)
+    w = [-u(2), u(1)]
+  end function perp
+
+  !> A constant vector (a point or a direction fixed in ground).
+  pure function const_vec(u) result(a)
+    real(wp), intent(in) :: u(2)  !! global components
+    type(kvec) :: a
+    a%v = u
+  end function const_vec
+
+  !> Body vector A(theta) u(alpha) with u depending on the extra slot (aslot > 0) or not.
+  !! v = A u, d_theta = B u, d_alpha = A u1,
+  !! ar = -A u thd**2 + 2 B u1 thd ald + A u2 ald**2.
+  pure function curve_vector(ql, qdl, slot, aslot, u, u1, u2) result(a)
+    real(wp), intent(in) :: ql(NLOC)   !! local coordinates
+    real(wp), intent(in) :: qdl(NLOC)  !! local velocities
+    integer, intent(in) :: slot        !! 0 ground, 1 first body, 2 second body
+    integer, intent(in) :: aslot       !! 0, or the slot of the curve parameter
+    real(wp), intent(in) :: u(2)       !! vector in the body frame
+    real(wp), intent(in) :: u1(2)      !! du/dalpha
+    real(wp), intent(in) :: u2(2)      !! d2u/dalpha2
+    type(kvec) :: a
+    real(wp) :: am(2, 2), bm(2, 2), thd, ald, au(2), bu(2), au1(2), bu1(2)
+    integer :: c
+    if (slot == 0) then
+      a%v = u
+      if (aslot > 0) then
+        ald = qdl(aslot)
+        a%d(:, aslot) = u1
+        a%vd = u1 * ald
+        a%ar = u2 * ald**2
+      end if
+      return
+    end if
+    c = 3 * (slot - 1)
+    am = rot(ql(c + 3)); bm = drot(ql(c + 3)); thd = qdl(c + 3)
+    au = matmul(am, u); bu = matmul(bm, u)
+    a%v = au
+    a%d(:, c + 3) = bu
+    a%vd = bu * thd
+    a%ar = -au * thd**2
+    if (aslot > 0) then
+      ald = qdl(aslot)
+      au1 = matmul(am, u1); bu1 = matmul(bm, u1)
+      a%d(:, aslot) = au1
+      a%vd = a%vd + au1 * ald
+      a%ar = a%ar + two * bu1 * thd * ald + matmul(am, u2) * ald**2
+    end if
+  end function curve_vector
+
+  !> Body point r + A(theta) s(alpha) on a curve fixed in the body.
+  pure function curve_point(ql, qdl, slot, aslot, s, s1, s2) result(a)
+    real(wp), intent(in) :: ql(NLOC)   !! local coordinates
+    real(wp), intent(in) :: qdl(NLOC)  !! local velocities
+    integer, intent(in) :: slot        !! 0 ground, 1 first body, 2 second body
+    integer, intent(in) :: aslot       !! slot of the curve parameter
+    real(wp), intent(in) :: s(2)       !! point in the body frame
+    real(wp), intent(in) :: s1(2)      !! ds/dalpha
+    real(wp), intent(in) :: s2(2)      !! d2s/dalpha2
+    type(kvec) :: a
+    integer :: c
+    a = curve_vector(ql, qdl, slot, aslot, s, s1, s2)
+    if (slot == 0) return
+    c = 3 * (slot - 1)
+    a%v = a%v + ql(c + 1:c + 2)
+    a%d(1, c + 1) = one; a%d(2, c + 2) = one
+    a%vd = a%vd + qdl(c + 1:c + 2)
+  end function curve_point
+
+  !> Body point P = r + A s':  d = [I, B s'], ar = -A s' thd**2.
+  pure function body_point(ql, qdl, slot, s) result(a)
+    real(wp), intent(in) :: ql(NLOC)   !! local coordinates
+    real(wp), intent(in) :: qdl(NLOC)  !! local velocities
+    integer, intent(in) :: slot        !! 0 ground (s is global), 1 or 2
+    real(wp), intent(in) :: s(2)       !! point in the body frame
+    type(kvec) :: a
+    a = curve_point(ql, qdl, slot, 0, s, [zero, zero], [zero, zero])
+  end function body_point
+
+  !> Body-fixed direction u = A u':  d_theta = B u', ar = -A u' thd**2.
+  pure function body_vector(ql, qdl, slot, u) result(a)
+    real(wp), intent(in) :: ql(NLOC)   !! local coordinates
+    real(wp), intent(in) :: qdl(NLOC)  !! local velocities
+    integer, intent(in) :: slot        !! 0 ground, 1 or 2
+    real(wp), intent(in) :: u(2)       !! vector in the body frame
+    type(kvec) :: a
+    a = curve_vector(ql, qdl, slot, 0, u, [zero, zero], [zero, zero])
+  end function body_vector
+
+  !> The absolute angle theta of a body (zero for ground).
+  pure function body_angle(ql, qdl, slot) result(a)
+    real(wp), intent(in) :: ql(NLOC)   !! local coordinates
+    real(wp), intent(in) :: qdl(NLOC)  !! local velocities
+    integer, intent(in) :: slot        !! 0 ground, 1 or 2
+    type(kscal) :: a
+    integer :: c
+    if (slot == 0) return
+    c = 3 * (slot - 1)
+    a%v = ql(c + 3); a%d(c + 3) = one; a%vd = qdl(c + 3)
+  end function body_angle
+
+  !> a - b.
+  pure function vsub(a, b) result(c)
+    type(kvec), intent(in) :: a, b  !! operands
+    type(kvec) :: c
+    c%v = a%v - b%v; c%d = a%d - b%d; c%vd = a%vd - b%vd; c%ar = a%ar - b%ar
+  end function vsub
+
+  !> a + b.
+  pure function vadd(a, b) result(c)
+    type(kvec), intent(in) :: a, b  !! operands
+    type(kvec) :: c
+    c%v = a%v + b%v; c%d = a%d + b%d; c%vd = a%vd + b%vd; c%ar = a%ar + b%ar
+  end function vadd
+
+  !> s a for a constant s.
+  pure function vscale(s, a) result(c)
+    real(wp), intent(in) :: s      !! constant factor
+    type(kvec), intent(in) :: a    !! vector
+    type(kvec) :: c
+    c%v = s * a%v; c%d = s * a%d; c%vd = s * a%vd; c%ar = s * a%ar
+  end function vscale
+
+  !> a . b:  d = a^T db + b^T da,  ar = a.ar_b + b.ar_a + 2 a_dot.b_dot.
+  pure function vdot(a, b) result(c)
+    type(kvec), intent(in) :: a, b  !! operands
+    type(kscal) :: c
+    c%v = dot_product(a%v, b%v)
+    c%d = a%v(1) * b%d(1, :) + a%v(2) * b%d(2, :) + b%v(1) * a%d(1, :) + b%v(2) * a%d(2, :)
+    c%vd = dot_product(a%v, b%vd) + dot_product(a%vd, b%v)
+    c%ar = dot_product(a%v, b%ar) + dot_product(b%v, a%ar) + two * dot_product(a%vd, b%vd)
+  end function vdot
+
+  !> a x b = a1 b2 - a2 b1, with the same product rule.
+  pure function vcross(a, b) result(c)
+    type(kvec), intent(in) :: a, b  !! operands
+    type(kscal) :: c
+    c%v = cross(a%v, b%v)
+    c%d = a%v(1) * b%d(2, :) - a%v(2) * b%d(1, :) + b%v(2) * a%d(1, :) - b%v(1) * a%d(2, :)
+    c%vd = cross(a%v, b%vd) + cross(a%vd, b%v)
+    c%ar = cross(a%v, b%ar) + cross(a%ar, b%v) + two * cross(a%vd, b%vd)
+  contains
+    pure real(wp) function cross(x, y)
+      real(wp), intent(in) :: x(2), y(2)
+      cross = x(1) * y(2) - x(2) * y(1)
+    end function cross
+  end function vcross
+
+  !> a - b for scalars.
+  pure function ssub(a, b) result(c)
+    type(kscal), intent(in) :: a, b  !! operands
+    type(kscal) :: c
+    c%v = a%v - b%v; c%d = a%d - b%d; c%vd = a%vd - b%vd; c%ar = a%ar - b%ar
+  end function ssub
+
+  !> a + b for scalars.
+  pure function sadd(a, b) result(c)
+    type(kscal), intent(in) :: a, b  !! operands
+    type(kscal) :: c
+    c%v = a%v + b%v; c%d = a%d + b%d; c%vd = a%vd + b%vd; c%ar = a%ar + b%ar
+  end function sadd
+
+  !> s a for a constant s.
+  pure function sscale(s, a) result(c)
+    real(wp), intent(in) :: s      !! constant factor
+    type(kscal), intent(in) :: a   !! scalar
+    type(kscal) :: c
+    c%v = s * a%v; c%d = s * a%d; c%vd = s * a%vd; c%ar = s * a%ar
+  end function sscale
+
+  !> A constant scalar.
+  pure function sconst(s) result(c)
+    real(wp), intent(in) :: s   !! value
+    type(kscal) :: c
+    c%v = s
+  end function sconst
+
+  !> sqrt(a):  d = a_d / (2 v),  ar = a_ar / (2 v) - a_dot**2 / (4 v**3).
+  pure function ssqrt(a) result(c)
+    type(kscal), intent(in) :: a   !! argument (> 0)
+    type(kscal) :: c
+    c%v = sqrt(a%v)
+    c%d = a%d * (half / c%v)
+    c%vd = a%vd * (half / c%v)
+    c%ar = a%ar * (half / c%v) - a%vd**2 / (4.0_wp * c%v**3)
+  end function ssqrt
+
+  !> Write a vector quantity as two constraint rows: Phi = v, J = d, gamma = -ar.
+  pure subroutine put_vec(a, phi, jl, gam)
+    type(kvec), intent(in) :: a           !! the constraint vector
+    real(wp), intent(inout) :: phi(:)     !! rows of Phi (2)
+    real(wp), intent(inout) :: jl(:, :)   !! local Jacobian rows (2 x NLOC)
+    real(wp), intent(inout) :: gam(:)     !! rows of gamma (2)
+    phi(1:2) = a%v; jl(1:2, :) = a%d; gam(1:2) = -a%ar
+  end subroutine put_vec
+
+  !> Write a scalar quantity as one constraint row.
+  pure subroutine put_scal(a, phi, jl, gam)
+    type(kscal), intent(in) :: a          !! the constraint scalar
+    real(wp), intent(inout) :: phi        !! row of Phi
+    real(wp), intent(inout) :: jl(:)      !! local Jacobian row (NLOC)
+    real(wp), intent(inout) :: gam        !! row of gamma
+    phi = a%v; jl = a%d; gam = -a%ar
+  end subroutine put_scal
+
+end module mbd_points
