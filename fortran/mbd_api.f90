@@ -13,9 +13,10 @@ module mbd_api
   use mbd_model, only: model_t, model_build
   use mbd_assemble, only: assemble_dense
   use mbd_kinematics, only: kin_opts_t, kin_report_t, kin_run
+  use mbd_profiles, only: profile_raw_length, profile_prepare, profile_eval
   implicit none
   private
-  public :: NINFO, api_sizes, api_eval, api_kinematics
+  public :: NINFO, api_sizes, api_eval, api_kinematics, api_profile
 
   integer, parameter :: NINFO = 10   !! length of the report arrays
 
@@ -110,5 +111,27 @@ contains
     if (allocated(rep%qsing)) qsing = rep%qsing
     if (allocated(rep%dep)) dep = rep%dep
   end subroutine api_kinematics
+
+  !> Points c(alpha) of a cam profile in its body frame (for drawing), from raw parameters.
+  subroutine api_profile(kind, raw, alpha, pts, status, msg)
+    integer, intent(in) :: kind                 !! profile kind
+    real(wp), intent(in) :: raw(:)              !! raw parameters
+    real(wp), intent(in) :: alpha(:)            !! parameters to evaluate at
+    real(wp), intent(out) :: pts(:, :)          !! (2, size(alpha)) points
+    integer, intent(out) :: status              !! MBD_OK or < 0
+    character(len=MSG_LEN), intent(out) :: msg  !! what is wrong
+    real(wp), allocatable :: prep(:)
+    real(wp) :: c1(2), c2(2), c3(2)
+    integer :: i
+    pts = zero
+    if (profile_raw_length(kind, raw) /= size(raw)) then
+      status = MBD_BAD_COUNT; msg = 'profile parameters are malformed'; return
+    end if
+    call profile_prepare(kind, raw, prep, status, msg)
+    if (status /= MBD_OK) return
+    do i = 1, size(alpha)
+      call profile_eval(kind, prep, alpha(i), pts(:, i), c1, c2, c3)
+    end do
+  end subroutine api_profile
 
 end module mbd_api

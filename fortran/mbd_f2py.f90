@@ -52,3 +52,16 @@ subroutine core_kinematics(nb, nc, ctab, np, rpar, nq, neq, q0, t0, t1, nsteps, 
   call api_kinematics(nb, ctab, rpar, q0, t0, t1, nsteps, tol, maxit, tmin, qout, qdout, &
                       qddout, iinfo, rinfo, qsing, dep, status, msg)
 end subroutine core_kinematics
+
+subroutine core_profile(kind, np, raw, na, alpha, pts, status, msg)
+  use iso_c_binding, only: c_double, c_int
+  use mbd_api, only: api_profile
+  implicit none
+  integer(c_int), intent(in) :: kind, np, na
+  real(c_double), intent(in) :: raw(np), alpha(na)
+  real(c_double), intent(out) :: pts(2, na)
+  integer(c_int), intent(out) :: status
+  character(len=512), intent(out) :: msg
+  !f2py intent(hide) :: np, na
+  call api_profile(kind, raw, alpha, pts, status, msg)
+end subroutine core_profile

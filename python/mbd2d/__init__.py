@@ -1,0 +1,25 @@
+"""mbd2d: planar multibody kinematics with a Fortran core.
+
+Examples
+--------
+>>> import mbd2d
+>>> model = mbd2d.load("examples/fourbar_grashof.toml")
+>>> res = model.kinematics(t_end=1.0, steps=100)
+>>> res.body("coupler").theta.shape
+(101,)
+"""
+from __future__ import annotations
+
+from .errors import (AnalysisError, AssemblyError, ConvergenceError, CoreError, MbdError,
+                     ModelError, SingularConfigurationError, SingularJacobianError, ToggleError)
+from .functions import Harmonic, TimeFunction
+from .model import Model
+from .results import BodyResult, KinematicsResult
+from .toml_io import load, loads
+
+__version__ = "0.1.0"
+
+__all__ = ["load", "loads", "Model", "TimeFunction", "Harmonic", "KinematicsResult",
+           "BodyResult", "MbdError", "ModelError", "AnalysisError", "AssemblyError",
+           "ConvergenceError", "SingularJacobianError", "SingularConfigurationError",
+           "ToggleError", "CoreError", "__version__"]

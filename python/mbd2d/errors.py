@@ -1,0 +1,101 @@
+"""Typed exceptions of mbd2d.
+
+Every failure the engine knows of maps to one class here. Input mistakes raise
+:class:`ModelError` (a :class:`ValueError`); numerical failures raise a subclass of
+:class:`AnalysisError`, which carries the results computed before the failure.
+"""
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:  # pragma: no cover
+    from .results import KinematicsResult
+
+
+class MbdError(Exception):
+    """Base class of every mbd2d error."""
+
+
+class ModelError(MbdError, ValueError):
+    """The model or the call is malformed; the message names the entry and what to do.
+
+    Parameters
+    ----------
+    message : str
+        What is wrong and how to fix it.
+    entry : str, optional
+        The offending entry, such as ``"joint 'O2'"``.
+    """
+
+    def __init__(self, message: str, entry: str | None = None) -> None:
+        self.entry = entry
+        super().__init__(f"{entry}: {message}" if entry else message)
+
+
+class AnalysisError(MbdError):
+    """A numerical failure during an analysis.
+
+    Attributes
+    ----------
+    t : float or None
+        Time of the failure.
+    results : KinematicsResult or None
+        The rows computed before the failure (possibly only t0, or none).
+    status : int
+        The core's status code.
+    """
+
+    def __init__(self, message: str, *, t: float | None = None,
+                 results: "KinematicsResult | None" = None, status: int = 0,
+                 **details: Any) -> None:
+        super().__init__(message)
+        self.t = t
+        self.results = results
+        self.status = status
+        for key, value in details.items():
+            setattr(self, key, value)
+
+
+class AssemblyError(AnalysisError):
+    """No configuration satisfies the constraints near the given estimates ``q0``."""
+
+
+class ConvergenceError(AnalysisError):
+    """Newton-Raphson did not converge at a regular configuration."""
+
+
+class SingularJacobianError(AnalysisError):
+    """The constraint Jacobian is singular where a solve needed it (e.g. assembled at a
+    dead centre)."""
+
+
+class SingularConfigurationError(AnalysisError):
+    """The mechanism reached a singular (dead-centre, toggle) configuration.
+
+    Attributes
+    ----------
+    t : float
+        Located time of the singular configuration (to about 1e-10 s).
+    driver : str or None
+        Name of the driver that can no longer be met, if one.
+    dependent : list of str
+        Names of the constraints whose rows became dependent.
+    q : numpy.ndarray
+        The configuration there.
+    sigma_min, sigma_max : float
+        Extreme singular values of J there.
+    results : KinematicsResult
+        Every output row up to the singular time.
+    """
+
+
+#: Another name for the dead-centre error, as mechanism engineers say it.
+ToggleError = SingularConfigurationError
+
+
+class CoreError(MbdError):
+    """The Fortran core reported an internal error (a LAPACK argument error); a bug."""
+
+
+__all__ = ["MbdError", "ModelError", "AnalysisError", "AssemblyError", "ConvergenceError",
+           "SingularJacobianError", "SingularConfigurationError", "ToggleError", "CoreError"]

@@ -1,0 +1,108 @@
+"""The TOML model format (a public contract; see README)::
+
+    [model]            name, gravity
+    [[body]]           name, q0, mass, inertia
+    [[joint]]          name, type, bodies, points, axes, profile, follower
+    [[driver]]         name, type, body, coordinate, bodies, joint, f
+
+Every key goes through the builder methods of :class:`mbd2d.model.Model`, so a TOML model
+and a model built in code are checked the same way.
+"""
+from __future__ import annotations
+
+import tomllib
+from pathlib import Path
+from typing import Any, Mapping
+
+from .errors import ModelError
+from .model import Model
+from .validate import only_keys, table
+
+SECTIONS = {"model", "body", "joint", "driver", "force"}
+
+
+def load(path: str | Path) -> Model:
+    """Read a model from a TOML file.
+
+    Parameters
+    ----------
+    path : str or Path
+        The .toml file.
+
+    Returns
+    -------
+    Model
+
+    Raises
+    ------
+    ModelError
+        If the file is missing, is not valid TOML, or describes an invalid model; the message
+        names the entry and the key.
+
+    Examples
+    --------
+    >>> import mbd2d
+    >>> mbd2d.load("examples/fourbar_seed.toml")
+    Model('seed-four-bar': 3 bodies, 4 joints, 1 drivers)
+    """
+    p = Path(path)
+    try:
+        text = p.read_text()
+    except OSError as exc:
+        raise ModelError(f"cannot read the model file: {exc.strerror}", str(p)) from None
+    return loads(text, source=str(p))
+
+
+def loads(text: str, source: str = "<string>") -> Model:
+    """Read a model from TOML text; see :func:`load`."""
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ModelError(f"not valid TOML: {exc}", source) from None
+    return from_dict(data, source)
+
+
+def _entries(data: Mapping[str, Any], key: str, source: str) -> list[Mapping[str, Any]]:
+    v = data.get(key, [])
+    if isinstance(v, Mapping):
+        raise ModelError(f"write [[{key}]] (an array of tables), not [{key}]", source)
+    if not isinstance(v, list):
+        raise ModelError(f"'{key}' must be an array of tables [[{key}]]", source)
+    return v
+
+
+def from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Model:
+    """Build a model from parsed TOML (nested dicts and lists)."""
+    if not isinstance(data, Mapping):
+        raise ModelError("a model must be a table", source)
+    unknown = set(data) - SECTIONS
+    if unknown:
+        raise ModelError(f"unknown section(s) {sorted(unknown)}; sections are "
+                         "[model], [[body]], [[joint]], [[driver]]", source)
+    head = table(data.get("model", {}), "[model]", source)
+    only_keys(head, {"name", "gravity"}, "[model]")
+    name = head.get("name", Path(source).stem if source.endswith(".toml") else "model")
+    if not isinstance(name, str):
+        raise ModelError(f"name must be a string, got {name!r}", "[model]")
+    model = Model(name, head.get("gravity", (0.0, -9.81)))
+    for i, b in enumerate(_entries(data, "body", source)):
+        entry = f"[[body]] #{i + 1}" + (f" {b.get('name')!r}" if isinstance(b, Mapping) else "")
+        b = table(b, "[[body]]", entry)
+        only_keys(b, {"name", "q0", "mass", "inertia", "v0"}, entry, required=["name", "q0"])
+        model.add_body(b["name"], b["q0"], b.get("mass"), b.get("inertia"))
+    for i, j in enumerate(_entries(data, "joint", source)):
+        entry = f"[[joint]] #{i + 1}" + (f" {j.get('name')!r}" if isinstance(j, Mapping) else "")
+        j = dict(table(j, "[[joint]]", entry))
+        if "type" not in j:
+            raise ModelError("missing key 'type' (revolute, translational or cam)", entry)
+        model.add_joint(**j)
+    for i, d in enumerate(_entries(data, "driver", source)):
+        entry = f"[[driver]] #{i + 1}" + (f" {d.get('name')!r}" if isinstance(d, Mapping) else "")
+        d = dict(table(d, "[[driver]]", entry))
+        only_keys(d, {"name", "type", "body", "coordinate", "bodies", "joint", "f"}, entry,
+                  required=["type", "f"])
+        model.add_driver(**d)
+    if data.get("force"):
+        raise ModelError("[[force]] entries need dynamics, which this version does not have yet",
+                         source)
+    return model

@@ -1,0 +1,83 @@
+"""Small checks shared by the builder and the TOML loader; each raises ModelError naming
+the entry."""
+from __future__ import annotations
+
+import math
+import re
+from typing import Any, Mapping, Sequence
+
+from .errors import ModelError
+
+NAME_RE = re.compile(r"^[A-Za-z_][A-Za-z0-9_\-]{0,62}$")
+GROUND = "ground"
+
+
+def check_name(name: Any, entry: str) -> str:
+    """A name usable in messages, CSV headers and model files."""
+    if not isinstance(name, str) or not NAME_RE.match(name):
+        raise ModelError(f"name {name!r} is not valid: use letters, digits, '_' or '-', "
+                         "starting with a letter or '_' (at most 63 characters)", entry)
+    return name
+
+
+def number(x: Any, what: str, entry: str) -> float:
+    """A finite real number."""
+    if isinstance(x, bool) or not isinstance(x, (int, float)):
+        raise ModelError(f"{what} must be a number, got {x!r}", entry)
+    if not math.isfinite(x):
+        raise ModelError(f"{what} must be finite, got {x!r}", entry)
+    return float(x)
+
+
+def positive(x: Any, what: str, entry: str) -> float:
+    """A finite number > 0."""
+    v = number(x, what, entry)
+    if not v > 0.0:
+        raise ModelError(f"{what} must be positive, got {x!r}", entry)
+    return v
+
+
+def vector(x: Any, n: int, what: str, entry: str) -> tuple[float, ...]:
+    """A list of n finite numbers."""
+    try:
+        import numpy as np
+        if isinstance(x, np.ndarray):
+            x = x.tolist()
+    except ImportError:  # pragma: no cover
+        pass
+    if isinstance(x, (str, bytes)) or not isinstance(x, Sequence) or len(x) != n:
+        raise ModelError(f"{what} must be a list of {n} numbers, got {x!r}", entry)
+    return tuple(number(v, f"{what}[{i}]", entry) for i, v in enumerate(x))
+
+
+def nonzero_vector(x: Any, what: str, entry: str) -> tuple[float, float]:
+    """A 2-vector of non-zero length."""
+    v = vector(x, 2, what, entry)
+    if math.hypot(*v) == 0.0:
+        raise ModelError(f"{what} has zero length; give a direction such as [1.0, 0.0]", entry)
+    return v  # type: ignore[return-value]
+
+
+def pairs(x: Any, n: int, what: str, entry: str) -> tuple[tuple[float, float], ...]:
+    """n points [x, y]."""
+    if isinstance(x, (str, bytes)) or not isinstance(x, Sequence) or len(x) != n:
+        raise ModelError(f"{what} must be a list of {n} [x, y] pairs, got {x!r}", entry)
+    return tuple(vector(p, 2, f"{what}[{i}]", entry) for i, p in enumerate(x))  # type: ignore
+
+
+def table(x: Any, what: str, entry: str) -> Mapping[str, Any]:
+    """A TOML table (mapping)."""
+    if not isinstance(x, Mapping):
+        raise ModelError(f"{what} must be a table, got {x!r}", entry)
+    return x
+
+
+def only_keys(d: Mapping[str, Any], allowed: set[str], entry: str,
+              required: Sequence[str] = ()) -> None:
+    """Reject unknown keys and report missing ones."""
+    unknown = set(d) - allowed
+    if unknown:
+        raise ModelError(f"unknown key(s) {sorted(unknown)}; allowed: {sorted(allowed)}", entry)
+    for key in required:
+        if key not in d:
+            raise ModelError(f"missing key '{key}'", entry)
