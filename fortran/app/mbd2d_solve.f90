@@ -3,7 +3,7 @@
 !!   mbd2d-solve MODEL.mbd OUT.csv
 !! Writes the CSV the Python path writes (t, then NAME.x ... NAME.theta_ddot per body).
 !! Exit codes: 0 ok, 2 bad input, 3 singular configuration (partial output written),
-!! 4 other numerical failure (partial output written).
+!! 4 other numerical failure (partial output written). Messages go to standard output.
 program mbd2d_solve
   use mbd_kinds, only: wp
   use mbd_status, only: MBD_OK, MBD_SINGULAR_CONFIG, MSG_LEN
@@ -26,7 +26,7 @@ program mbd2d_solve
       call get_command_argument(1, model_path)
       if (model_path == '-h' .or. model_path == '--help') stop
     end if
-    error stop 2
+    stop 2, quiet=.true.
   end if
   call get_command_argument(1, model_path)
   call get_command_argument(2, out_path)
@@ -87,6 +87,8 @@ contains
       r0 = r0 + nr
     end do
     write (ts, '(f0.10)') rinfo(1)
+    if (ts(1:1) == '.') ts = '0' // ts
+    if (ts(1:2) == '-.') ts = '-0' // ts(2:)
     s = 'Singular configuration (dead centre) at t = ' // trim(ts) // ' s: '
     if (iinfo(3) > 0) then
       s = trim(s) // ' driver "' // trim(spec%con_names(iinfo(3))) // &
@@ -133,9 +135,9 @@ contains
     character(len=*), intent(in) :: text
     write (*, '(a)') 'mbd2d-solve: ' // text
     select case (code)
-    case (2); error stop 2
-    case (3); error stop 3
-    case default; error stop 4
+    case (2); stop 2, quiet=.true.
+    case (3); stop 3, quiet=.true.
+    case default; stop 4, quiet=.true.
     end select
   end subroutine die
 

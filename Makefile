@@ -1,0 +1,44 @@
+# mbd2d: `make demo` and `make test` set up everything that is missing (system packages,
+# a .venv with the build and test tools, the package itself) and then do their job.
+SHELL := /bin/bash
+VENV ?= .venv
+PYTHON ?= python3
+PY := $(VENV)/bin/python
+export PATH := $(abspath $(VENV))/bin:$(PATH)
+
+PYDEPS := numpy meson meson-python ninja pytest hypothesis matplotlib
+SOURCES := $(wildcard fortran/*.f90 fortran/app/*.f90 python/mbd2d/*.py) meson.build pyproject.toml
+
+.PHONY: demo test bench system install clean help
+
+help:
+	@echo "make demo   - set up and run the examples (pictures in examples/output/)"
+	@echo "make test   - set up and run the test suite"
+	@echo "make bench  - set up and run the benchmarks"
+
+system:
+	@./tools/system-deps.sh
+
+$(VENV)/.deps-ok:
+	$(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install -q --disable-pip-version-check $(PYDEPS)
+	touch $@
+
+# a real (non-editable) install, as a user gets from `pip install .`
+$(VENV)/.install-ok: $(VENV)/.deps-ok $(SOURCES)
+	$(PY) -m pip install -q --disable-pip-version-check --no-build-isolation --no-deps .
+	touch $@
+
+install: system $(VENV)/.install-ok
+
+demo: install
+	$(PY) examples/demo.py
+
+test: install
+	$(PY) -m pytest tests
+
+bench: install
+	$(PY) bench/run.py
+
+clean:
+	rm -rf build build-editable examples/output $(VENV)
