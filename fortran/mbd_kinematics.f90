@@ -2,7 +2,8 @@
 !! the time loop, and the location of singular (dead-centre) configurations.
 !!
 !! Per output time (Haug, ch. 3-4; Nikravesh, ch. 5):
-!!   predictor    q = q_k + h q_dot_k + h**2/2 q_ddot_k
+!!   predictor    q = q_k + h q_dot_k + h**2/2 q_ddot_k + h**3/6 q_dddot_k,
+!!                q_dddot_k from the last two accelerations
 !!   position     J(q) dq = -Phi(q, t),  q <- q + dq   until ||Phi||_inf <= tol   (dgetrf/dgetrs)
 !!   velocity     J q_dot = nu                              (the last factorization is reused)
 !!   acceleration J q_ddot = gamma(q, q_dot, t)             (same factorization)
@@ -265,7 +266,7 @@ contains
     integer, intent(out) :: status             !! MBD_OK or the failure
     character(len=MSG_LEN), intent(out) :: msg !! explanation
     type(kin_work_t) :: w
-    real(wp), allocatable :: q(:), qd(:), qdd(:), qn(:)
+    real(wp), allocatable :: q(:), qd(:), qdd(:), qn(:), q3(:), qddn(:)
     real(wp) :: t, h, hcur, hh, tt, target, lscale
     integer :: k, st, detprev
     logical :: last
@@ -283,7 +284,7 @@ contains
     call kin_work_init(m, w)
     lscale = max(m%lscale, maxval(abs(q0(1:3 * m%nb)), mask=mod([(k, k=1, 3 * m%nb)], 3) /= 0))
     w%tol = opts%tol * lscale
-    allocate (q(m%nq), qd(m%nq), qdd(m%nq), qn(m%nq))
+    allocate (q(m%nq), qd(m%nq), qdd(m%nq), qn(m%nq), q3(m%nq), qddn(m%nq))
     q = q0
     call kin_assemble(m, w, q, t0, opts, rep, status, msg)
     if (status /= MBD_OK) then
@@ -293,6 +294,7 @@ contains
     qout(:, 1) = q; qdout(:, 1) = qd; qddout(:, 1) = qdd
     rep%ndone = 1
     detprev = w%detsign
+    q3 = zero
     t = t0
     if (nsteps == 0) then
       call count_work(); return
@@ -303,19 +305,22 @@ contains
       target = t0 + (t1 - t0) * (real(k, wp) / nsteps)
       if (k == nsteps) target = t1
       do
-        hh = min(hcur, target - t)
-        last = hh >= target - t
-        tt = t + hh
-        if (last) tt = target
-        qn = q + hh * qd + (half * hh * hh) * qdd
+        ! land exactly on the output time (no sliver step from rounding of t)
+        last = hcur >= (target - t) * (one - 1.0e-9_wp)
+        hh = merge(target - t, hcur, last)
+        tt = merge(target, t + hh, last)
+        qn = q + hh * (qd + (half * hh) * (qdd + (hh / 3.0_wp) * q3))
         call kin_newton(m, w, qn, tt, opts%maxit, st)
         if (st == MBD_OK .and. w%detsign == detprev) then
-          t = tt; q = qn
-          call kin_vel_acc(m, w, q, t, qd, qdd)
+          q = qn
+          call kin_vel_acc(m, w, q, tt, qd, qddn)
+          q3 = (qddn - qdd) / hh
+          qdd = qddn; t = tt
           if (last) exit
           hcur = min(2 * hh, h)
         else
           rep%rejected = rep%rejected + 1
+          q3 = zero
           hcur = half * hh
           if (hcur < opts%tmin * max(one, abs(t))) then
             call kin_singular_report(m, w, q, t, rep, st, msg)

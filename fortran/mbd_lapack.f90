@@ -3,7 +3,7 @@ module mbd_lapack
   use mbd_kinds, only: wp
   implicit none
   private
-  public :: dgetrf, dgetrs, dgesvd, dgels, dgtsv
+  public :: dgetrf, dgetf2, dgetrs, dgesvd, dgels, dgtsv
 
   interface
     !> LU factorization with partial pivoting.
@@ -14,6 +14,14 @@ module mbd_lapack
       integer, intent(out) :: ipiv(*)
       integer, intent(out) :: info
     end subroutine dgetrf
+    !> Unblocked LU factorization (faster for small matrices).
+    pure subroutine dgetf2(m, n, a, lda, ipiv, info)
+      import :: wp
+      integer, intent(in) :: m, n, lda
+      real(wp), intent(inout) :: a(lda, *)
+      integer, intent(out) :: ipiv(*)
+      integer, intent(out) :: info
+    end subroutine dgetf2
     !> Solve with the LU factors.
     pure subroutine dgetrs(trans, n, nrhs, a, lda, ipiv, b, ldb, info)
       import :: wp

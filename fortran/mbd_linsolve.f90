@@ -1,16 +1,18 @@
 !> mbd_linsolve: the LAPACK calls, and the one place LAPACK's info becomes a status.
 !!
-!!   lu_factor   A = P L U               (dgetrf)
+!!   lu_factor   A = P L U               (dgetf2 up to SMALL_N, else dgetrf)
 !!   lu_solve    A x = b from the factors (dgetrs)
 !!   lu_det_sign sign of det A from the factors: prod(sign U_ii) * (-1)**(row swaps)
 !!   svd_null    singular values of A and the singular vectors of the smallest one (dgesvd)
 module mbd_linsolve
   use mbd_kinds, only: wp, zero
   use mbd_status, only: MBD_OK, MBD_SINGULAR, MBD_LAPACK, MSG_LEN
-  use mbd_lapack, only: dgetrf, dgetrs, dgesvd
+  use mbd_lapack, only: dgetrf, dgetf2, dgetrs, dgesvd
   implicit none
   private
   public :: lapack_status, lu_factor, lu_solve, lu_det_sign, svd_null
+
+  integer, parameter :: SMALL_N = 48   !! below this the unblocked dgetf2 is faster
 
 contains
 
@@ -45,8 +47,13 @@ contains
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
     integer :: n, info
     n = size(a, 1)
-    call dgetrf(n, n, a, n, ipiv, info)
-    call lapack_status('dgetrf', info, status, msg)
+    if (n <= SMALL_N) then
+      call dgetf2(n, n, a, n, ipiv, info)
+      call lapack_status('dgetf2', info, status, msg)
+    else
+      call dgetrf(n, n, a, n, ipiv, info)
+      call lapack_status('dgetrf', info, status, msg)
+    end if
   end subroutine lu_factor
 
   !> Solve A x = b with the LU factors; b is overwritten by x.
