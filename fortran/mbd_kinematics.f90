@@ -27,6 +27,8 @@ module mbd_kinematics
   public :: kin_work_init, kin_assemble, kin_vel_acc, kin_newton, kin_run, kin_singular_report
 
   real(wp), parameter :: DEP_TOL = 1.0e-3_wp  !! |u_r| / max|u| above which a row is dependent
+  !> sigma_min / sigma_max of the column-scaled J below which a configuration is singular
+  real(wp), parameter :: SING_RATIO = 1.0e-3_wp
 
   !> Settings of a kinematic analysis.
   type :: kin_opts_t
@@ -219,6 +221,11 @@ contains
     character(len=MSG_LEN) :: rows
     allocate (sv(min(m%neq, m%nq)), u(m%neq), v(m%nq))
     call assemble_dense(m, q, w%qz, t, w%phi, w%nu, w%gam, w%jb, w%jac)
+    ! columns to unit length, so lengths and angles weigh alike: J D, D = diag(1/|J_k|)
+    do k = 1, m%nq
+      umax = norm2(w%jac(:, k))
+      if (umax > zero) w%jac(:, k) = w%jac(:, k) / umax
+    end do
     call svd_null(w%jac, sv, u, v, status, msg)
     if (status /= MBD_OK) return
     rep%qsing = q
@@ -325,7 +332,16 @@ contains
           if (hcur < opts%tmin * max(one, abs(t))) then
             call kin_singular_report(m, w, q, t, rep, st, msg)
             status = MBD_SINGULAR_CONFIG
-            if (st /= MBD_OK) status = MBD_LAPACK
+            if (st /= MBD_OK) then
+              status = MBD_LAPACK
+            else if (rep%smin > SING_RATIO * rep%smax) then
+              ! J is regular here: not a dead centre but a failed step
+              status = MBD_NO_CONVERGENCE
+              rep%dep = 0; rep%driver = 0; rep%deficiency = 0
+              write (msg, '(a,es22.15,a,es9.2,a)') 'no solution could be followed past t = ', t, &
+                ' although J is regular there (sigma_min/sigma_max = ', rep%smin / rep%smax, &
+                '): a driver may jump or grow too fast for the step'
+            end if
             call count_work(); return
           end if
         end if

@@ -21,7 +21,7 @@ module mbd_profiles
   public :: profile_raw_length, profile_prepare, profile_eval, profile_normal, profile_check
 
   integer, parameter :: PROF_CIRCLE = 1, PROF_SPLINE = 2, PROF_FOURIER = 3
-  integer, parameter :: NCHECK = 720   !! samples for the validity checks
+  integer, parameter :: NCHECK = 512   !! samples for the validity checks
 
 contains
 
@@ -235,7 +235,8 @@ contains
     integer, intent(out) :: status              !! MBD_OK or MBD_BAD_PARAM
     character(len=MSG_LEN), intent(out) :: msg  !! what is wrong
     real(wp) :: pts(2, NCHECK), c0(2), c1(2), c2(2), c3(2), n0(2), n1(2), n2(2), a, speed
-    integer :: i, k
+    real(wp) :: lo(2, NCHECK), hi(2, NCHECK), area, diag
+    integer :: i, k, ip, kp
     status = MBD_OK; msg = ''
     if (.not. all(ieee_is_finite(p))) then
       status = MBD_BAD_PARAM; msg = 'profile has a non-finite parameter'; return
@@ -261,10 +262,27 @@ contains
         pts(:, i) = c0
       end if
     end do
+    ! a simple closed curve run counterclockwise encloses a positive area (shoelace)
+    area = zero
     do i = 1, NCHECK
+      ip = mod(i, NCHECK) + 1
+      area = area + half * (pts(1, i) * pts(2, ip) - pts(1, ip) * pts(2, i))
+      lo(:, i) = min(pts(:, i), pts(:, ip)); hi(:, i) = max(pts(:, i), pts(:, ip))
+    end do
+    diag = hypot(maxval(pts(1, :)) - minval(pts(1, :)), maxval(pts(2, :)) - minval(pts(2, :)))
+    if (.not. (area > 1.0e-6_wp * diag**2)) then
+      status = MBD_BAD_PARAM
+      msg = 'profile encloses no area (points on a line, or running back over itself)'
+      return
+    end if
+    do i = 1, NCHECK
+      ip = mod(i, NCHECK) + 1
       do k = i + 2, NCHECK
         if (i == 1 .and. k == NCHECK) cycle
-        if (segments_cross(pts(:, i), pts(:, mod(i, NCHECK) + 1), pts(:, k), pts(:, mod(k, NCHECK) + 1))) then
+        ! bounding boxes first: most pairs are far apart
+        if (any(lo(:, k) > hi(:, i)) .or. any(hi(:, k) < lo(:, i))) cycle
+        kp = mod(k, NCHECK) + 1
+        if (segments_cross(pts(:, i), pts(:, ip), pts(:, k), pts(:, kp))) then
           status = MBD_BAD_PARAM
           if (offset > zero) then
             msg = 'the roller''s path around the profile crosses itself: the roller is larger '// &

@@ -12,6 +12,7 @@ from .errors import (AssemblyError, ConvergenceError, CoreError, ModelError,
                      SingularConfigurationError, SingularJacobianError)
 from .pack import Packed, decode, pack
 from .results import KinematicsResult
+from .validate import is_number, number, whole
 
 if TYPE_CHECKING:  # pragma: no cover
     from .model import Model
@@ -20,16 +21,30 @@ if TYPE_CHECKING:  # pragma: no cover
 OK, SINGULAR, NO_CONVERGENCE, SINGULAR_CONFIG, ASSEMBLY_FAILED, LAPACK = 0, 1, 2, 3, 4, 5
 
 
+MAX_STEPS = 10**9      # output rows are held in memory; the core counts in 32-bit integers
+MIN_TOL = 1e-15        # below this a residual test cannot pass in double precision
+
+
 def check_span(t0: Any, t_end: Any, steps: Any) -> tuple[float, float, int]:
     """Validate an output time grid."""
     for name, v in (("t0", t0), ("t_end", t_end)):
-        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+        if not is_number(v) or not math.isfinite(v):
             raise ModelError(f"{name} must be a finite number, got {v!r}", "analysis")
-    if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or steps < 1:
-        raise ModelError(f"steps must be a whole number >= 1, got {steps!r}", "analysis")
+    t0, t_end = float(t0), float(t_end)
+    steps = whole(steps, "steps", "analysis", 1, MAX_STEPS)
     if not t_end > t0:
         raise ModelError(f"t_end ({t_end}) must be greater than t0 ({t0})", "analysis")
-    return float(t0), float(t_end), int(steps)
+    return t0, t_end, steps
+
+
+def check_solver(tol: Any, maxit: Any) -> tuple[float, int]:
+    """Validate Newton settings; 0 means the core's default."""
+    t = 0.0 if tol is None else number(tol, "tol", "analysis")
+    if tol is not None and not MIN_TOL <= t < 1.0:
+        raise ModelError(f"tol must be from {MIN_TOL:g} to below 1 (it is relative to the "
+                         f"model's length scale), got {tol!r}", "analysis")
+    it = 0 if maxit is None else whole(maxit, "maxit", "analysis", 1, 10**6)
+    return t, it
 
 
 def require_determined(p: Packed, model: "Model") -> None:
@@ -52,6 +67,7 @@ def require_determined(p: Packed, model: "Model") -> None:
 def evaluate(model: "Model", q: Any, qd: Any, t: float) -> tuple[np.ndarray, ...]:
     """Phi, J, nu and gamma at a state, from the core."""
     p = pack(model)
+    t = number(t, "t", "state")
     qv = _state(q, p.nq, "q")
     qdv = np.zeros(p.nq) if qd is None else _state(qd, p.nq, "qd")
     phi, jac, nu, gam, status, msg, bad = _core.core_eval(p.nb, p.ctab, p.rpar, p.neq, qv, qdv,
@@ -62,7 +78,10 @@ def evaluate(model: "Model", q: Any, qd: Any, t: float) -> tuple[np.ndarray, ...
 
 
 def _state(x: Any, n: int, what: str) -> np.ndarray:
-    v = np.asarray(x, dtype=float)
+    try:
+        v = np.asarray(x, dtype=float)
+    except (TypeError, ValueError):
+        raise ModelError(f"{what} must be an array of {n} numbers", "state") from None
     if v.shape != (n,):
         raise ModelError(f"{what} must have {n} entries (the model's coordinates), "
                          f"got shape {v.shape}", "state")
@@ -76,14 +95,11 @@ def run_kinematics(model: "Model", t_end: float, steps: int, t0: float = 0.0,
                    tmin: float | None = None) -> KinematicsResult:
     """Run a kinematic analysis in one core call; see :meth:`Model.kinematics`."""
     t0, t_end, steps = check_span(t0, t_end, steps)
-    if tol is not None and not (isinstance(tol, (int, float)) and 0 < tol < 1):
-        raise ModelError(f"tol must be a number in (0, 1), got {tol!r}", "analysis")
-    if maxit is not None and not (isinstance(maxit, int) and maxit >= 1):
-        raise ModelError(f"maxit must be a whole number >= 1, got {maxit!r}", "analysis")
+    tol_v, maxit_v = check_solver(tol, maxit)
     p = pack(model)
     require_determined(p, model)
     out = _core.core_kinematics(p.nb, p.ctab, p.rpar, p.neq, p.q0, t0, t_end, steps,
-                                float(tol or 0.0), int(maxit or 0), float(tmin or 0.0))
+                                tol_v, maxit_v, float(tmin or 0.0))
     qout, qdout, qddout, iinfo, rinfo, qsing, dep, status, msg = out
     n = int(iinfo[0])
     t = t0 + (t_end - t0) * (np.arange(steps + 1) / steps)
@@ -144,6 +160,7 @@ def _failure(model: "Model", p: Packed, status: int, msg: str, iinfo: np.ndarray
             t=t, results=res, status=status, residual=float(rinfo[3]),
             constraint=cons[worst - 1].name if worst > 0 else None)
     if status == NO_CONVERGENCE:
-        return ConvergenceError(f"Newton-Raphson did not converge at t = {t:.6g} s: {msg}. "
-                                "Try more steps.", t=t, results=res, status=status)
+        return ConvergenceError(f"Newton-Raphson failed after t = {t:.6g} s: {msg}. Results up "
+                                f"to {last} are kept in the exception's .results.", t=t,
+                                results=res, status=status)
     return CoreError(f"internal error in the core (status {status}): {msg}")

@@ -4,11 +4,11 @@ The core evaluates them; this module only checks and encodes the description.
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from typing import Any, Mapping, Sequence
 
 from .errors import ModelError
+from .validate import as_list, is_number, number
 
 
 @dataclass(frozen=True)
@@ -49,11 +49,7 @@ class TimeFunction:
 
 
 def _finite(x: Any, what: str, entry: str) -> float:
-    if isinstance(x, bool) or not isinstance(x, (int, float)):
-        raise ModelError(f"{what} must be a number, got {x!r}", entry)
-    if not math.isfinite(x):
-        raise ModelError(f"{what} must be finite, got {x!r}", entry)
-    return float(x)
+    return number(x, what, entry)
 
 
 def as_function(spec: Any, entry: str, what: str = "f") -> TimeFunction:
@@ -79,7 +75,7 @@ def as_function(spec: Any, entry: str, what: str = "f") -> TimeFunction:
     """
     if isinstance(spec, TimeFunction):
         return spec
-    if isinstance(spec, (int, float)) and not isinstance(spec, bool):
+    if is_number(spec):
         return TimeFunction(poly=(_finite(spec, what, entry),))
     if not isinstance(spec, Mapping):
         raise ModelError(f"{what} must be a number or a table like "
@@ -89,8 +85,8 @@ def as_function(spec: Any, entry: str, what: str = "f") -> TimeFunction:
     if unknown:
         raise ModelError(f"{what} has unknown key(s) {sorted(unknown)}; "
                          "use 'poly' and 'harmonic'", entry)
-    poly_in = spec.get("poly", [0.0])
-    if isinstance(poly_in, (int, float)) and not isinstance(poly_in, bool):
+    poly_in = as_list(spec.get("poly", [0.0]))
+    if is_number(poly_in):
         poly_in = [poly_in]
     if not isinstance(poly_in, Sequence) or isinstance(poly_in, str) or len(poly_in) == 0:
         raise ModelError(f"{what}.poly must be a non-empty list of coefficients", entry)

@@ -9,7 +9,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from .analysis import check_span, require_determined
+from .analysis import check_solver, check_span, require_determined
 from .pack import NCT, pack
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -58,11 +58,12 @@ def export(model: "Model", path: str | Path, t_end: float, steps: int, t0: float
         If the model or the settings are invalid (checked as for a Python run).
     """
     t0, t_end, steps = check_span(t0, t_end, steps)
+    tol_v, maxit_v = check_solver(tol, maxit)
     p = pack(model)
     require_determined(p, model)
     lines = [HEADER.rstrip("\n"), "mbd2d 1", f"name {model.name.replace(' ', '_') or 'model'}",
              "analysis kinematics", f"t0 {_r(t0)}", f"t_end {_r(t_end)}", f"steps {steps}",
-             f"tol {_r(float(tol or 0.0))}", f"maxit {int(maxit or 0)}", f"tmin {_r(0.0)}",
+             f"tol {_r(tol_v)}", f"maxit {maxit_v}", f"tmin {_r(0.0)}",
              f"bodies {p.nb}"]
     for name, b in zip(p.body_names, model.bodies):
         lines.append(f"{name} {_r(b.q0[0])} {_r(b.q0[1])} {_r(b.q0[2])}")

@@ -19,8 +19,8 @@ import numpy as np
 
 from .errors import ModelError
 from .functions import TimeFunction, as_function
-from .validate import (GROUND, check_name, nonzero_vector, only_keys, pairs, positive, table,
-                       vector)
+from .validate import (GROUND, as_list, check_name, choice, nonzero_vector, only_keys, pairs,
+                       positive, table, vector)
 
 if TYPE_CHECKING:  # pragma: no cover
     from .results import KinematicsResult
@@ -209,6 +209,7 @@ class Model:
         return name
 
     def _two_bodies(self, bodies: Any, entry: str) -> tuple[str, str]:
+        bodies = as_list(bodies)
         if isinstance(bodies, (str, bytes)) or not isinstance(bodies, Sequence) \
                 or len(bodies) != 2:
             raise ModelError(f"bodies must be a list of two names, got {bodies!r}", entry)
@@ -281,6 +282,7 @@ class Model:
         entry = f"joint {name!r} (translational)"
         bb = self._two_bodies(bodies, entry)
         pts = pairs(points, 2, "points", entry)
+        axes = as_list(axes)
         if isinstance(axes, (str, bytes)) or not isinstance(axes, Sequence) or len(axes) != 2:
             raise ModelError(f"axes must be a list of two [x, y] directions, got {axes!r}", entry)
         ax = (nonzero_vector(axes[0], "axes[0]", entry), nonzero_vector(axes[1], "axes[1]", entry))
@@ -320,7 +322,7 @@ class Model:
                                       {"bodies", "points", "axes", "name"}),
                     "cam": (self.add_cam, {"bodies", "profile", "follower", "name"})}
         entry = self._entry(str(type), kw.get("name"))
-        if type not in builders:
+        if not isinstance(type, str) or type not in builders:
             raise ModelError(f"unknown joint type {type!r}; known: {sorted(builders)}", entry)
         fn, allowed = builders[type]
         only_keys(kw, allowed, entry, required=[k for k in allowed if k != "name"])
@@ -351,9 +353,7 @@ class Model:
             if not isinstance(body, str):
                 raise ModelError(f"body must be a name, got {body!r}", entry)
             self.body_index(body, entry, allow_ground=False)
-            if coordinate not in COORDINATES:
-                raise ModelError(f"coordinate must be 'x', 'y' or 'theta', got {coordinate!r}",
-                                 entry)
+            choice(coordinate, COORDINATES, "coordinate", entry)
             d = Driver(name, (body, GROUND), fun, "absolute", coordinate)
         elif type == "relative-angle":
             if bodies is None or body is not None or coordinate is not None or joint is not None:
@@ -492,7 +492,7 @@ def _profile(spec: Any, entry: str) -> tuple[str, tuple[float, ...]]:
         return kind, (*c, r)
     if kind == "spline":
         only_keys(body, {"points"}, entry + " profile.spline", ["points"])
-        pts = body["points"]
+        pts = as_list(body["points"])
         if isinstance(pts, (str, bytes)) or not isinstance(pts, Sequence) or len(pts) < 4:
             raise ModelError("profile.spline.points must be a list of at least 4 [x, y] points "
                              "around the closed profile", entry)
@@ -501,12 +501,12 @@ def _profile(spec: Any, entry: str) -> tuple[str, tuple[float, ...]]:
         return kind, (float(len(pp)), *flat)
     only_keys(body, {"center", "a", "b"}, entry + " profile.fourier", ["a"])
     c = vector(body.get("center", [0.0, 0.0]), 2, "profile.fourier.center", entry)
-    a = body["a"]
+    a = as_list(body["a"])
     if isinstance(a, (str, bytes)) or not isinstance(a, Sequence) or len(a) < 1:
         raise ModelError("profile.fourier.a must be a list [a0, a1, ...]", entry)
     av = vector(a, len(a), "profile.fourier.a", entry)
     k = len(av) - 1
-    b = body.get("b", [0.0] * k)
+    b = as_list(body.get("b", [0.0] * k))
     if isinstance(b, (str, bytes)) or not isinstance(b, Sequence):
         raise ModelError("profile.fourier.b must be a list [b1, ..., bK]", entry)
     bv = vector(b, len(b), "profile.fourier.b", entry)

@@ -47,9 +47,12 @@ def load(path: str | Path) -> Model:
     """
     p = Path(path)
     try:
-        text = p.read_text()
+        text = p.read_text(encoding="utf-8")
     except OSError as exc:
         raise ModelError(f"cannot read the model file: {exc.strerror}", str(p)) from None
+    except UnicodeDecodeError as exc:
+        raise ModelError(f"the model file is not UTF-8 text (byte {exc.start}); save it as "
+                         "UTF-8", str(p)) from None
     return loads(text, source=str(p))
 
 

@@ -3,8 +3,11 @@ the entry."""
 from __future__ import annotations
 
 import math
+import numbers
 import re
 from typing import Any, Mapping, Sequence
+
+import numpy as np
 
 from .errors import ModelError
 
@@ -20,9 +23,19 @@ def check_name(name: Any, entry: str) -> str:
     return name
 
 
+def is_number(x: Any) -> bool:
+    """A real number (Python or NumPy), not a bool."""
+    return isinstance(x, numbers.Real) and not isinstance(x, (bool, np.bool_))
+
+
+def as_list(x: Any) -> Any:
+    """NumPy arrays as nested lists; anything else unchanged."""
+    return x.tolist() if isinstance(x, np.ndarray) else x
+
+
 def number(x: Any, what: str, entry: str) -> float:
     """A finite real number."""
-    if isinstance(x, bool) or not isinstance(x, (int, float)):
+    if not is_number(x):
         raise ModelError(f"{what} must be a number, got {x!r}", entry)
     if not math.isfinite(x):
         raise ModelError(f"{what} must be finite, got {x!r}", entry)
@@ -39,12 +52,7 @@ def positive(x: Any, what: str, entry: str) -> float:
 
 def vector(x: Any, n: int, what: str, entry: str) -> tuple[float, ...]:
     """A list of n finite numbers."""
-    try:
-        import numpy as np
-        if isinstance(x, np.ndarray):
-            x = x.tolist()
-    except ImportError:  # pragma: no cover
-        pass
+    x = as_list(x)
     if isinstance(x, (str, bytes)) or not isinstance(x, Sequence) or len(x) != n:
         raise ModelError(f"{what} must be a list of {n} numbers, got {x!r}", entry)
     return tuple(number(v, f"{what}[{i}]", entry) for i, v in enumerate(x))
@@ -60,9 +68,26 @@ def nonzero_vector(x: Any, what: str, entry: str) -> tuple[float, float]:
 
 def pairs(x: Any, n: int, what: str, entry: str) -> tuple[tuple[float, float], ...]:
     """n points [x, y]."""
+    x = as_list(x)
     if isinstance(x, (str, bytes)) or not isinstance(x, Sequence) or len(x) != n:
         raise ModelError(f"{what} must be a list of {n} [x, y] pairs, got {x!r}", entry)
     return tuple(vector(p, 2, f"{what}[{i}]", entry) for i, p in enumerate(x))  # type: ignore
+
+
+def choice(x: Any, options: Any, what: str, entry: str) -> str:
+    """One of a set of keywords."""
+    if not isinstance(x, str) or x not in options:
+        raise ModelError(f"{what} must be one of {sorted(options)}, got {x!r}", entry)
+    return x
+
+
+def whole(x: Any, what: str, entry: str, lo: int, hi: int) -> int:
+    """A whole number in [lo, hi]."""
+    if not (isinstance(x, numbers.Integral) and not isinstance(x, (bool, np.bool_))) \
+            or not lo <= int(x) <= hi:
+        raise ModelError(f"{what} must be a whole number >= {lo} (at most {hi}), got {x!r}",
+                         entry)
+    return int(x)
 
 
 def table(x: Any, what: str, entry: str) -> Mapping[str, Any]:
