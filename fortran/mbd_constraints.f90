@@ -4,7 +4,9 @@
 !! prepared, its rows of Phi, J, nu and gamma at a state, and a starting value for its
 !! extra coordinates. The assembly loop calls only these; a new joint adds a case here.
 !! Kind codes (the flat model table, column 1):
-!!   1 revolute  2 translational  3 cam
+!!   1 revolute  2 translational  3 cam (and point on curve)  4 distance
+!!   5 point on line (pin in slot)  6 weld  7 gear pair  8 rack and pinion  9 rolling disc
+!!   10 absolute constraint (fix x, y or theta of a body)
 !!   101 absolute driver  102 relative-angle driver  103 relative-distance driver
 module mbd_constraints
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
@@ -15,21 +17,29 @@ module mbd_constraints
   use mbd_joint_revolute, only: revolute_prepare, revolute_eval
   use mbd_joint_translational, only: translational_prepare, translational_eval
   use mbd_joint_cam, only: cam_raw_length, cam_prepare, cam_eval, cam_init_alpha, ALPHA_SLOT
+  use mbd_joint_distance, only: distance_prepare, distance_eval
+  use mbd_joint_point_line, only: point_line_prepare, point_line_eval
+  use mbd_joint_weld, only: weld_prepare, weld_eval
+  use mbd_joint_gear, only: gear_prepare, gear_eval
+  use mbd_joint_rolling, only: rolling_prepare, rolling_eval
   use mbd_drivers, only: driver_eval, DRV_ABS, DRV_REL_ANGLE, DRV_REL_DIST
   implicit none
   private
-  public :: CON_REVOLUTE, CON_TRANSLATIONAL, CON_CAM, DRV_ABS, DRV_REL_ANGLE, DRV_REL_DIST
+  public :: CON_REVOLUTE, CON_TRANSLATIONAL, CON_CAM, CON_DISTANCE, CON_POINT_LINE, CON_WELD, &
+            CON_GEAR, CON_RACK, CON_ROLLING, CON_ABSOLUTE, DRV_ABS, DRV_REL_ANGLE, DRV_REL_DIST
   public :: con_known, con_nrow, con_nextra, con_is_driver, con_raw_length, con_prepare
   public :: con_eval, con_init_extra, con_name
 
-  integer, parameter :: CON_REVOLUTE = 1, CON_TRANSLATIONAL = 2, CON_CAM = 3
+  integer, parameter :: CON_REVOLUTE = 1, CON_TRANSLATIONAL = 2, CON_CAM = 3, CON_DISTANCE = 4
+  integer, parameter :: CON_POINT_LINE = 5, CON_WELD = 6, CON_GEAR = 7, CON_RACK = 8
+  integer, parameter :: CON_ROLLING = 9, CON_ABSOLUTE = 10
 
 contains
 
   pure logical function con_known(kind)
     integer, intent(in) :: kind   !! kind code
     select case (kind)
-    case (CON_REVOLUTE, CON_TRANSLATIONAL, CON_CAM, DRV_ABS, DRV_REL_ANGLE, DRV_REL_DIST)
+    case (CON_REVOLUTE:CON_ABSOLUTE, DRV_ABS, DRV_REL_ANGLE, DRV_REL_DIST)
       con_known = .true.
     case default
       con_known = .false.
@@ -44,6 +54,13 @@ contains
     case (CON_REVOLUTE); name = 'revolute'
     case (CON_TRANSLATIONAL); name = 'translational'
     case (CON_CAM); name = 'cam'
+    case (CON_DISTANCE); name = 'distance'
+    case (CON_POINT_LINE); name = 'point-on-line'
+    case (CON_WELD); name = 'weld'
+    case (CON_GEAR); name = 'gear'
+    case (CON_RACK); name = 'rack-and-pinion'
+    case (CON_ROLLING); name = 'rolling disc'
+    case (CON_ABSOLUTE); name = 'absolute constraint'
     case (DRV_ABS); name = 'absolute driver'
     case (DRV_REL_ANGLE); name = 'relative-angle driver'
     case (DRV_REL_DIST); name = 'relative-distance driver'
@@ -55,7 +72,8 @@ contains
   pure integer function con_nrow(kind)
     integer, intent(in) :: kind   !! kind code
     select case (kind)
-    case (CON_REVOLUTE, CON_TRANSLATIONAL, CON_CAM); con_nrow = 2
+    case (CON_REVOLUTE, CON_TRANSLATIONAL, CON_CAM, CON_ROLLING); con_nrow = 2
+    case (CON_WELD); con_nrow = 3
     case default; con_nrow = 1
     end select
   end function con_nrow
@@ -80,6 +98,11 @@ contains
     case (CON_REVOLUTE); con_raw_length = 4
     case (CON_TRANSLATIONAL); con_raw_length = 8
     case (CON_CAM); con_raw_length = cam_raw_length(suba, raw)
+    case (CON_DISTANCE, CON_WELD); con_raw_length = 5
+    case (CON_POINT_LINE); con_raw_length = 7
+    case (CON_GEAR); con_raw_length = 3
+    case (CON_RACK, CON_ROLLING); con_raw_length = 8
+    case (CON_ABSOLUTE); con_raw_length = 1
     case default; con_raw_length = fun_length(raw)
     end select
   end function con_raw_length
@@ -104,6 +127,18 @@ contains
       call translational_prepare(raw, prep, status, msg)
     case (CON_CAM)
       call cam_prepare(suba, subb, raw, prep, status, msg)
+    case (CON_DISTANCE)
+      call distance_prepare(raw, prep, status, msg)
+    case (CON_POINT_LINE)
+      call point_line_prepare(raw, prep, status, msg)
+    case (CON_WELD)
+      call weld_prepare(raw, prep, status, msg)
+    case (CON_GEAR)
+      call gear_prepare(subb, raw, prep, status, msg)
+    case (CON_RACK, CON_ROLLING)
+      call rolling_prepare(raw, prep, status, msg)
+    case (CON_ABSOLUTE)
+      prep = [1.0_wp, raw(1), 0.0_wp]     ! the constant function f = value
     case (DRV_ABS, DRV_REL_ANGLE)
       call fun_check(raw, status, msg)
       if (status == MBD_OK) prep = raw
@@ -137,6 +172,26 @@ contains
     case (CON_CAM)
       call cam_eval(suba, subb, p, si, sj, ql, qdl, phi, jl, gam)
       nu(1:2) = 0.0_wp
+    case (CON_DISTANCE)
+      call distance_eval(p, si, sj, ql, qdl, phi, jl, gam)
+      nu(1) = 0.0_wp
+    case (CON_POINT_LINE)
+      call point_line_eval(p, si, sj, ql, qdl, phi, jl, gam)
+      nu(1) = 0.0_wp
+    case (CON_WELD)
+      call weld_eval(p, si, sj, ql, qdl, phi, jl, gam)
+      nu(1:3) = 0.0_wp
+    case (CON_GEAR)
+      call gear_eval(subb, p, si, sj, ql, qdl, phi, jl, gam)
+      nu(1) = 0.0_wp
+    case (CON_RACK)
+      call rolling_eval(.false., p, si, sj, ql, qdl, phi, jl, gam)
+      nu(1) = 0.0_wp
+    case (CON_ROLLING)
+      call rolling_eval(.true., p, si, sj, ql, qdl, phi, jl, gam)
+      nu(1:2) = 0.0_wp
+    case (CON_ABSOLUTE)
+      call driver_eval(DRV_ABS, suba, p, si, sj, ql, qdl, t, phi(1), jl(1, :), nu(1), gam(1))
     case default
       call driver_eval(kind, suba, p, si, sj, ql, qdl, t, phi(1), jl(1, :), nu(1), gam(1))
     end select

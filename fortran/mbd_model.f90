@@ -6,9 +6,10 @@
 !!                    1 kind, 2 body i, 3 body j (1-based, 0 = ground), 4 sub-kind a,
 !!                    5 sub-kind b, 6 offset of its raw parameters in rpar (1-based),
 !!                    7 number of raw parameters, 8 reserved (0)
-!!                    sub-kind a: cam profile kind, absolute-driver coordinate (1 x, 2 y,
-!!                    3 theta), relative-distance driver: the index of its translational joint
-!!                    sub-kind b: cam follower kind
+!!                    sub-kind a: cam profile kind; absolute driver or constraint: coordinate
+!!                    (1 x, 2 y, 3 theta); relative-distance driver: the index of its
+!!                    translational joint; gear: the carrier body (0 ground)
+!!                    sub-kind b: cam follower kind; gear: 1 external, 2 internal
 !!   rpar(:)          raw real parameters (layouts in each joint module's banner)
 !! Extra coordinates (cam contact parameters) follow the body coordinates in constraint order.
 module mbd_model
@@ -17,7 +18,8 @@ module mbd_model
   use mbd_points, only: NLOC
   use mbd_constraints, only: con_known, con_nrow, con_nextra, con_raw_length, &
                              con_prepare, con_name, CON_REVOLUTE, CON_TRANSLATIONAL, CON_CAM, &
-                             DRV_ABS, DRV_REL_DIST
+                             CON_GEAR, CON_ABSOLUTE, CON_POINT_LINE, DRV_ABS, DRV_REL_DIST
+  use mbd_joint_gear, only: CARRIER_SLOT
   implicit none
   private
   public :: NCT, model_t, model_build, model_slots
@@ -102,13 +104,14 @@ contains
         return
       end if
       select case (kind)
-      case (DRV_ABS)
+      case (DRV_ABS, CON_ABSOLUTE)
         if (bi == 0) then
-          status = MBD_BAD_BODY; msg = 'an absolute driver needs a moving body, not ground'
+          status = MBD_BAD_BODY; msg = trim(con_name(kind)) // ' needs a moving body, not ground'
           return
         end if
         if (ctab(4, k) < 1 .or. ctab(4, k) > 3) then
-          status = MBD_BAD_PARAM; msg = 'absolute driver coordinate must be 1 (x), 2 (y) or 3 (theta)'
+          status = MBD_BAD_PARAM
+          msg = trim(con_name(kind)) // ' coordinate must be 1 (x), 2 (y) or 3 (theta)'
           return
         end if
         bj = 0
@@ -133,6 +136,14 @@ contains
           return
         end if
       end select
+      if (kind == CON_GEAR) then
+        if (ctab(4, k) < 0 .or. ctab(4, k) > nb) then
+          status = MBD_BAD_BODY; msg = 'gear carrier body index out of range'; return
+        end if
+        if (ctab(4, k) > 0 .and. (ctab(4, k) == bi .or. ctab(4, k) == bj)) then
+          status = MBD_BAD_BODY; msg = 'a gear cannot be its own carrier'; return
+        end if
+      end if
       if (kind == CON_CAM) then
         if (ctab(4, k) < 1 .or. ctab(4, k) > 3 .or. ctab(5, k) < 1 .or. ctab(5, k) > 3) then
           status = MBD_BAD_PARAM; msg = 'cam profile or follower kind out of range'; return
@@ -166,7 +177,7 @@ contains
         msg = trim(con_name(kind)) // ': ' // trim(sub); return
       end if
       ! length scale from joint points (cam: the follower point)
-      if (kind == CON_REVOLUTE .or. kind == CON_TRANSLATIONAL) then
+      if (kind == CON_REVOLUTE .or. kind == CON_TRANSLATIONAL .or. kind == CON_POINT_LINE) then
         m%lscale = max(m%lscale, maxval(abs(rpar(off:off + 3))))
       else if (kind == CON_CAM) then
         m%lscale = max(m%lscale, maxval(abs(rpar(off:off + 1))))
@@ -184,6 +195,7 @@ contains
         extra = extra + 1
         m%loc(7, k) = 3 * nb + extra
       end if
+      if (kind == CON_GEAR .and. ctab(4, k) > 0) m%loc(CARRIER_SLOT, k) = 3 * ctab(4, k)
     end do
     bad = 0
     m%neq = row

@@ -19,7 +19,7 @@ module mbd_points
   private
   public :: NLOC, MAXROW, kvec, kscal
   public :: rot, drot, perp
-  public :: body_point, body_vector, curve_point, curve_vector, body_angle, const_vec
+  public :: body_point, body_vector, curve_point, curve_vector, body_angle, slot_value, const_vec
   public :: vsub, vadd, vscale, vdot, vcross, ssub, sadd, sscale, ssqrt, sconst
   public :: put_vec, put_scal
 
@@ -166,6 +166,15 @@ contains
     c = 3 * (slot - 1)
     a%v = ql(c + 3); a%d(c + 3) = one; a%vd = qdl(c + 3)
   end function body_angle
+
+  !> A local coordinate as a scalar quantity (0 when the slot maps to nothing).
+  pure function slot_value(ql, qdl, s) result(a)
+    real(wp), intent(in) :: ql(NLOC)   !! local coordinates
+    real(wp), intent(in) :: qdl(NLOC)  !! local velocities
+    integer, intent(in) :: s           !! slot
+    type(kscal) :: a
+    a%v = ql(s); a%d(s) = one; a%vd = qdl(s)
+  end function slot_value
 
   !> a - b.
   pure function vsub(a, b) result(c)

@@ -209,8 +209,8 @@ CASES = {
         r"model 'bad'.*10 equations for 9 coordinates"),
     # ---- types and keys
     "unknown joint type": (
-        BODIES + joint("weld", 'type = "weld"\nbodies = ["crank", "rod"]'),
-        r"joint 'weld'.*unknown joint type 'weld'"),
+        BODIES + joint("scissor", 'type = "scissor"\nbodies = ["crank", "rod"]'),
+        r"joint 'scissor'.*unknown joint type 'scissor'"),
     "unknown driver type": (
         BODIES + driver("motor", 'type = "torque"\nbody = "crank"\nf = 1.0'),
         r"driver 'motor'.*unknown driver type 'torque'"),

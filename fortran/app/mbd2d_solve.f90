@@ -87,7 +87,7 @@ contains
       r0 = r0 + nr
     end do
     write (ts, '(f0.10)') rinfo(1)
-    if (ts(1:1) == '.') ts = '0' // ts
+    if (ts(1:1) == '.') ts = '0' // trim(ts)
     if (ts(1:2) == '-.') ts = '-0' // ts(2:)
     s = 'Singular configuration (dead centre) at t = ' // trim(ts) // ' s: '
     if (iinfo(3) > 0) then

@@ -12,136 +12,21 @@ or from TOML with :func:`mbd2d.load`, which calls the same methods.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Mapping, Sequence
 
 import numpy as np
 
 from .errors import ModelError
-from .functions import TimeFunction, as_function
-from .validate import (GROUND, as_list, check_name, choice, nonzero_vector, only_keys, pairs,
-                       positive, table, vector)
+from .functions import as_function
+from .joints import (COORDINATES, Absolute, AbsoluteDriver, Body, Cam, Constraint, Distance,
+                     Driver, Gear, PinInSlot, PointOnCurve, PointOnLine, RackPinion,
+                     RelativeAngleDriver, RelativeDistanceDriver, Revolute, RollingDisc,
+                     Translational, Weld, joint_keys, parse_follower, parse_profile)
+from .validate import (GROUND, as_list, check_name, choice, nonzero_vector, number, only_keys,
+                       pairs, positive, vector)
 
 if TYPE_CHECKING:  # pragma: no cover
     from .results import KinematicsResult
-
-# kind codes of the flat table (mbd_constraints.f90)
-REVOLUTE, TRANSLATIONAL, CAM = 1, 2, 3
-DRV_ABS, DRV_REL_ANGLE, DRV_REL_DIST = 101, 102, 103
-PROFILE_KINDS = {"circle": 1, "spline": 2, "fourier": 3}
-FOLLOWER_KINDS = {"point": 1, "roller": 2, "flat": 3}
-COORDINATES = {"x": 1, "y": 2, "theta": 3}
-
-
-@dataclass
-class Body:
-    """A moving rigid body; its origin is its centre of mass.
-
-    Parameters
-    ----------
-    name : str
-        Unique name.
-    q0 : tuple of float
-        Rough estimate of (x, y, theta); assembly refines it.
-    mass, inertia : float or None
-        Mass and moment of inertia about the centre of mass (dynamics only).
-    """
-
-    name: str
-    q0: tuple[float, float, float]
-    mass: float | None = None
-    inertia: float | None = None
-
-
-@dataclass
-class Constraint:
-    """Common part of joints and drivers."""
-
-    name: str
-    bodies: tuple[str, str]
-
-    type = "constraint"
-    nrow = 1
-
-    def describe(self) -> str:
-        """How messages name this entry."""
-        return f"{self.type} '{self.name}'"
-
-    def rows(self) -> list[str]:
-        """What each of its equations stands for."""
-        return [f"{self.name}"] * self.nrow
-
-
-@dataclass
-class Revolute(Constraint):
-    """Revolute joint: the two points coincide (2 equations)."""
-
-    points: tuple[tuple[float, float], tuple[float, float]] = ((0.0, 0.0), (0.0, 0.0))
-    type = "revolute"
-    nrow = 2
-
-    def pack(self) -> tuple[int, int, int, list[float]]:
-        """Kind, sub-kinds and raw parameters of the flat table."""
-        return REVOLUTE, 0, 0, [*self.points[0], *self.points[1]]
-
-    def rows(self) -> list[str]:
-        return [f"{self.name}.x", f"{self.name}.y"]
-
-
-@dataclass
-class Translational(Constraint):
-    """Translational joint: point j stays on the line of body i; axes stay parallel."""
-
-    points: tuple[tuple[float, float], tuple[float, float]] = ((0.0, 0.0), (0.0, 0.0))
-    axes: tuple[tuple[float, float], tuple[float, float]] = ((1.0, 0.0), (1.0, 0.0))
-    type = "translational"
-    nrow = 2
-
-    def pack(self) -> tuple[int, int, int, list[float]]:
-        """Kind, sub-kinds and raw parameters of the flat table."""
-        return TRANSLATIONAL, 0, 0, [*self.points[0], *self.points[1],
-                                     *self.axes[0], *self.axes[1]]
-
-    def rows(self) -> list[str]:
-        return [f"{self.name}.normal", f"{self.name}.angle"]
-
-
-@dataclass
-class Cam(Constraint):
-    """Cam profile on body 1 in contact with a follower on body 2 (2 equations, 1 extra
-    coordinate: the contact parameter alpha)."""
-
-    profile_kind: str = "circle"
-    profile: tuple[float, ...] = ()
-    follower_kind: str = "point"
-    follower: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0)
-    type = "cam"
-    nrow = 2
-
-    def pack(self) -> tuple[int, int, int, list[float]]:
-        """Kind, sub-kinds and raw parameters of the flat table."""
-        return (CAM, PROFILE_KINDS[self.profile_kind], FOLLOWER_KINDS[self.follower_kind],
-                [*self.follower, *self.profile])
-
-    def rows(self) -> list[str]:
-        if self.follower_kind == "flat":
-            return [f"{self.name}.on_face", f"{self.name}.tangent"]
-        return [f"{self.name}.x", f"{self.name}.y"]
-
-
-@dataclass
-class Driver(Constraint):
-    """A driving constraint g(q) - f(t) = 0."""
-
-    f: TimeFunction = TimeFunction()
-    driver_type: str = "absolute"
-    coordinate: str = "theta"
-    joint: str | None = None
-    type = "driver"
-
-    def describe(self) -> str:
-        return f"driver '{self.name}'"
-
 
 class Model:
     """A planar multibody model.
@@ -256,43 +141,43 @@ class Model:
         self.bodies.append(b)
         return b
 
+    def _add(self, joint: Constraint) -> Constraint:
+        self.joints.append(joint)
+        return joint
+
+    def _start(self, kind: str, name: str | None) -> tuple[str, str]:
+        """Settle the name of a new joint; return (name, entry for messages)."""
+        entry = self._entry(kind, name)
+        name = self._new_name(name, kind.replace("-", "_"), entry)
+        return name, f"joint '{name}' ({kind})"
+
     def add_revolute(self, bodies: Sequence[str], points: Sequence[Sequence[float]],
                      name: str | None = None) -> Revolute:
-        """Add a revolute joint: points[0] on bodies[0] coincides with points[1] on bodies[1].
+        """Revolute joint: points[0] on bodies[0] coincides with points[1] on bodies[1].
 
         Points are in each body's frame (a ground point is global).
         """
-        entry = self._entry("revolute", name)
-        name = self._new_name(name, "revolute", entry)
-        entry = f"joint {name!r} (revolute)"
-        j = Revolute(name, self._two_bodies(bodies, entry), pairs(points, 2, "points", entry))
-        self.joints.append(j)
-        return j
+        name, entry = self._start("revolute", name)
+        return self._add(Revolute(name, self._two_bodies(bodies, entry),
+                                  pairs(points, 2, "points", entry)))  # type: ignore[return-value]
 
     def add_translational(self, bodies: Sequence[str], points: Sequence[Sequence[float]],
                           axes: Sequence[Sequence[float]],
                           name: str | None = None) -> Translational:
-        """Add a translational joint.
-
-        The point on bodies[1] slides along the line through points[0] with direction
-        axes[0] fixed in bodies[0]; axes[1] (in bodies[1]) stays parallel to axes[0].
-        """
-        entry = self._entry("translational", name)
-        name = self._new_name(name, "translational", entry)
-        entry = f"joint {name!r} (translational)"
+        """Translational joint: the point on bodies[1] slides along the line through points[0]
+        with direction axes[0] (in bodies[0]); axes[1] (in bodies[1]) stays parallel to it."""
+        name, entry = self._start("translational", name)
         bb = self._two_bodies(bodies, entry)
         pts = pairs(points, 2, "points", entry)
         axes = as_list(axes)
         if isinstance(axes, (str, bytes)) or not isinstance(axes, Sequence) or len(axes) != 2:
             raise ModelError(f"axes must be a list of two [x, y] directions, got {axes!r}", entry)
         ax = (nonzero_vector(axes[0], "axes[0]", entry), nonzero_vector(axes[1], "axes[1]", entry))
-        j = Translational(name, bb, pts, ax)
-        self.joints.append(j)
-        return j
+        return self._add(Translational(name, bb, pts, ax))  # type: ignore[return-value]
 
     def add_cam(self, bodies: Sequence[str], profile: Mapping[str, Any],
                 follower: Mapping[str, Any], name: str | None = None) -> Cam:
-        """Add a cam: a profile on bodies[0] touching a follower on bodies[1].
+        """Cam: a profile on bodies[0] touching a follower on bodies[1].
 
         Parameters
         ----------
@@ -305,28 +190,138 @@ class Model:
             ``{point = [x, y]}``, ``{roller = {center, radius}}`` or
             ``{flat = {point, normal}}`` (normal pointing toward the cam), in the follower's frame.
         """
-        entry = self._entry("cam", name)
-        name = self._new_name(name, "cam", entry)
-        entry = f"joint {name!r} (cam)"
+        name, entry = self._start("cam", name)
         bb = self._two_bodies(bodies, entry)
-        pkind, pparams = _profile(profile, entry)
-        fkind, fparams = _follower(follower, entry)
-        j = Cam(name, bb, pkind, pparams, fkind, fparams)
-        self.joints.append(j)
-        return j
+        pkind, pparams = parse_profile(profile, entry)
+        fkind, fparams = parse_follower(follower, entry)
+        return self._add(Cam(name, bb, pkind, pparams, fkind, fparams))  # type: ignore
+
+    def add_point_on_curve(self, bodies: Sequence[str], curve: Mapping[str, Any],
+                           point: Sequence[float], name: str | None = None) -> PointOnCurve:
+        """A point of bodies[1] on a closed curve of bodies[0] (a pin in a curved slot); the
+        curve takes the cam profile forms. Adds the curve parameter alpha as a coordinate."""
+        name, entry = self._start("point-on-curve", name)
+        bb = self._two_bodies(bodies, entry)
+        pkind, pparams = parse_profile(curve, entry, key="curve")
+        p = vector(point, 2, "point", entry)
+        return self._add(PointOnCurve(name, bb, pkind, pparams, "point",  # type: ignore
+                                      (p[0], p[1], 0.0, 0.0)))
+
+    def add_distance(self, bodies: Sequence[str], points: Sequence[Sequence[float]],
+                     distance: float, name: str | None = None) -> Distance:
+        """Distance constraint (revolute-revolute composite): the points stay ``distance``
+        apart."""
+        name, entry = self._start("distance", name)
+        return self._add(Distance(name, self._two_bodies(bodies, entry),  # type: ignore
+                                  pairs(points, 2, "points", entry),
+                                  positive(distance, "distance", entry)))
+
+    def add_point_on_line(self, bodies: Sequence[str], points: Sequence[Sequence[float]],
+                          axis: Sequence[float], offset: float = 0.0,
+                          name: str | None = None) -> PointOnLine:
+        """The point points[1] of bodies[1] stays on the line through points[0] with direction
+        ``axis`` fixed in bodies[0] (at a signed normal ``offset``)."""
+        return self._line_joint(PointOnLine, "point-on-line", bodies, points, axis, offset, name)
+
+    def add_pin_in_slot(self, bodies: Sequence[str], points: Sequence[Sequence[float]],
+                        axis: Sequence[float], offset: float = 0.0,
+                        name: str | None = None) -> PinInSlot:
+        """Revolute-translational composite: the pin points[1] of bodies[1] runs in the straight
+        slot of bodies[0] through points[0] along ``axis``."""
+        return self._line_joint(PinInSlot, "revolute-translational", bodies, points, axis,
+                                offset, name)
+
+    def _line_joint(self, cls: Any, kind: str, bodies: Any, points: Any, axis: Any,
+                    offset: Any, name: str | None) -> Any:
+        name, entry = self._start(kind, name)
+        return self._add(cls(name, self._two_bodies(bodies, entry),
+                             pairs(points, 2, "points", entry),
+                             nonzero_vector(axis, "axis", entry), number(offset, "offset", entry)))
+
+    def add_weld(self, bodies: Sequence[str], points: Sequence[Sequence[float]],
+                 angle: float = 0.0, name: str | None = None) -> Weld:
+        """Weld: the points coincide and theta_j - theta_i = ``angle``."""
+        name, entry = self._start("weld", name)
+        return self._add(Weld(name, self._two_bodies(bodies, entry),  # type: ignore
+                              pairs(points, 2, "points", entry), number(angle, "angle", entry)))
+
+    def add_gear(self, bodies: Sequence[str], radii: Sequence[float], internal: bool = False,
+                 carrier: str = "ground", phase: float | None = None,
+                 name: str | None = None) -> Gear:
+        """Gear pair whose centres are held by ``carrier`` (ground by default):
+        R_i (theta_i - theta_c) + R_j (theta_j - theta_c) = phase (external), with a minus for
+        an internal pair (bodies[1] is the ring). The phase defaults to its value at the q0
+        estimates."""
+        name, entry = self._start("gear", name)
+        bb = self._two_bodies(bodies, entry)
+        r = vector(radii, 2, "radii", entry)
+        for i in range(2):
+            positive(r[i], f"radii[{i}]", entry)
+        if not isinstance(internal, bool):
+            raise ModelError(f"internal must be true or false, got {internal!r}", entry)
+        if internal and not r[1] > r[0]:
+            raise ModelError("an internal pair needs the ring (second body) larger than the "
+                             "pinion", entry)
+        if not isinstance(carrier, str):
+            raise ModelError(f"carrier must be a body name, got {carrier!r}", entry)
+        self.body_index(carrier, entry)
+        if carrier in bb:
+            raise ModelError(f"the carrier {carrier!r} cannot be one of the gears", entry)
+        ph = None if phase is None else number(phase, "phase", entry)
+        return self._add(Gear(name, bb, (r[0], r[1]), internal, carrier, ph))  # type: ignore
+
+    def add_rack_pinion(self, bodies: Sequence[str], center: Sequence[float],
+                        point: Sequence[float], axis: Sequence[float], radius: float,
+                        phase: float | None = None, name: str | None = None) -> RackPinion:
+        """Rack and pinion: the pinion bodies[0] (pitch circle at ``center``, ``radius``) rolls
+        without slip along the rack line of bodies[1] (through ``point`` along ``axis``). The
+        centre distance is held by the other joints. The phase defaults to its q0 value."""
+        return self._rolling(RackPinion, "rack-pinion", bodies, center, point, axis, radius,
+                             phase, name)
+
+    def add_rolling_disc(self, bodies: Sequence[str], center: Sequence[float],
+                         point: Sequence[float], axis: Sequence[float], radius: float,
+                         phase: float | None = None, name: str | None = None) -> RollingDisc:
+        """A disc bodies[0] (centre ``center``, ``radius``) rolling without slip on the line of
+        bodies[1] through ``point`` along ``axis``: contact and no slip (2 equations)."""
+        return self._rolling(RollingDisc, "rolling-disc", bodies, center, point, axis, radius,
+                             phase, name)
+
+    def _rolling(self, cls: Any, kind: str, bodies: Any, center: Any, point: Any, axis: Any,
+                 radius: Any, phase: Any, name: str | None) -> Any:
+        name, entry = self._start(kind, name)
+        return self._add(cls(name, self._two_bodies(bodies, entry),
+                             vector(center, 2, "center", entry), vector(point, 2, "point", entry),
+                             nonzero_vector(axis, "axis", entry),
+                             positive(radius, "radius", entry),
+                             None if phase is None else number(phase, "phase", entry)))
+
+    def add_absolute(self, body: str, coordinate: str, value: float | None = None,
+                     name: str | None = None) -> Absolute:
+        """Absolute constraint: fix x, y or theta of a body (at ``value``, by default its q0
+        estimate)."""
+        name, entry = self._start("absolute", name)
+        if not isinstance(body, str):
+            raise ModelError(f"body must be a name, got {body!r}", entry)
+        b = self.bodies[self.body_index(body, entry, allow_ground=False) - 1]
+        choice(coordinate, COORDINATES, "coordinate", entry)
+        v = b.q0[COORDINATES[coordinate] - 1] if value is None else number(value, "value", entry)
+        return self._add(Absolute(name, (body, GROUND), coordinate, v))  # type: ignore
 
     def add_joint(self, type: str, **kw: Any) -> Constraint:
-        """Add a joint by type name with the TOML keys as keyword arguments."""
-        builders = {"revolute": (self.add_revolute, {"bodies", "points", "name"}),
-                    "translational": (self.add_translational,
-                                      {"bodies", "points", "axes", "name"}),
-                    "cam": (self.add_cam, {"bodies", "profile", "follower", "name"})}
+        """Add a joint by its TOML type name, with the TOML keys as keyword arguments."""
+        builders = {"revolute": self.add_revolute, "translational": self.add_translational,
+                    "cam": self.add_cam, "point-on-curve": self.add_point_on_curve,
+                    "distance": self.add_distance, "point-on-line": self.add_point_on_line,
+                    "revolute-translational": self.add_pin_in_slot, "weld": self.add_weld,
+                    "gear": self.add_gear, "rack-pinion": self.add_rack_pinion,
+                    "rolling-disc": self.add_rolling_disc, "absolute": self.add_absolute}
         entry = self._entry(str(type), kw.get("name"))
         if not isinstance(type, str) or type not in builders:
-            raise ModelError(f"unknown joint type {type!r}; known: {sorted(builders)}", entry)
-        fn, allowed = builders[type]
-        only_keys(kw, allowed, entry, required=[k for k in allowed if k != "name"])
-        return fn(**kw)
+            raise ModelError(f"unknown joint type {type!r}; known: {', '.join(builders)}", entry)
+        allowed, required = joint_keys()[type]
+        only_keys(kw, allowed | {"name"}, entry, required=sorted(required))
+        return builders[type](**kw)
 
     def add_driver(self, type: str, f: Any, name: str | None = None, body: str | None = None,
                    coordinate: str | None = None, bodies: Sequence[str] | None = None,
@@ -344,8 +339,9 @@ class Model:
         """
         entry = self._entry("driver", name)
         name = self._new_name(name, "driver", entry)
-        entry = f"driver {name!r}"
+        entry = f"driver '{name}'"
         fun = as_function(f, entry)
+        d: Driver
         if type == "absolute":
             if body is None or coordinate is None or bodies is not None or joint is not None:
                 raise ModelError("an absolute driver needs 'body' and 'coordinate' (and not "
@@ -354,12 +350,12 @@ class Model:
                 raise ModelError(f"body must be a name, got {body!r}", entry)
             self.body_index(body, entry, allow_ground=False)
             choice(coordinate, COORDINATES, "coordinate", entry)
-            d = Driver(name, (body, GROUND), fun, "absolute", coordinate)
+            d = AbsoluteDriver(name, (body, GROUND), fun, coordinate)
         elif type == "relative-angle":
             if bodies is None or body is not None or coordinate is not None or joint is not None:
                 raise ModelError("a relative-angle driver needs 'bodies' = [i, j] (theta_j - "
                                  "theta_i = f(t)) and no 'body', 'coordinate' or 'joint'", entry)
-            d = Driver(name, self._two_bodies(bodies, entry), fun, "relative-angle")
+            d = RelativeAngleDriver(name, self._two_bodies(bodies, entry), fun)
         elif type == "relative-distance":
             if joint is None or body is not None or bodies is not None or coordinate is not None:
                 raise ModelError("a relative-distance driver needs 'joint' (a translational "
@@ -371,7 +367,7 @@ class Model:
             if not isinstance(target, Translational):
                 raise ModelError(f"joint {joint!r} is a {target.type} joint; a "
                                  "relative-distance driver needs a translational joint", entry)
-            d = Driver(name, target.bodies, fun, "relative-distance", joint=joint)
+            d = RelativeDistanceDriver(name, target.bodies, fun, joint)
         else:
             raise ModelError(f"unknown driver type {type!r}; use 'absolute', 'relative-angle' "
                              "or 'relative-distance'", entry)
@@ -400,7 +396,8 @@ class Model:
         return pack(self).coordinate_names
 
     def constraint_rows(self) -> list[str]:
-        """A label for each row of Phi: the joint or driver name and the equation."""
+        """A label for each row of Phi: ``NAME.equation`` (for example ``O2.x``,
+        ``guide.angle``, ``motor.crank.theta``)."""
         return [r for c in self.constraints for r in c.rows()]
 
     # ------------------------------------------------------------------ analyses
@@ -478,71 +475,4 @@ class Model:
                 f"{len(self.drivers)} drivers)")
 
 
-def _profile(spec: Any, entry: str) -> tuple[str, tuple[float, ...]]:
-    spec = table(spec, "profile", entry)
-    if len(spec) != 1 or next(iter(spec)) not in PROFILE_KINDS:
-        raise ModelError(f"profile must be one of {{circle = ...}}, {{spline = ...}}, "
-                         f"{{fourier = ...}}, got keys {sorted(spec)}", entry)
-    kind, body = next(iter(spec.items()))
-    body = table(body, f"profile.{kind}", entry)
-    if kind == "circle":
-        only_keys(body, {"center", "radius"}, entry + " profile.circle", ["center", "radius"])
-        c = vector(body["center"], 2, "profile.circle.center", entry)
-        r = positive(body["radius"], "profile.circle.radius", entry)
-        return kind, (*c, r)
-    if kind == "spline":
-        only_keys(body, {"points"}, entry + " profile.spline", ["points"])
-        pts = as_list(body["points"])
-        if isinstance(pts, (str, bytes)) or not isinstance(pts, Sequence) or len(pts) < 4:
-            raise ModelError("profile.spline.points must be a list of at least 4 [x, y] points "
-                             "around the closed profile", entry)
-        pp = pairs(pts, len(pts), "profile.spline.points", entry)
-        flat = [v for p in pp for v in p]
-        return kind, (float(len(pp)), *flat)
-    only_keys(body, {"center", "a", "b"}, entry + " profile.fourier", ["a"])
-    c = vector(body.get("center", [0.0, 0.0]), 2, "profile.fourier.center", entry)
-    a = as_list(body["a"])
-    if isinstance(a, (str, bytes)) or not isinstance(a, Sequence) or len(a) < 1:
-        raise ModelError("profile.fourier.a must be a list [a0, a1, ...]", entry)
-    av = vector(a, len(a), "profile.fourier.a", entry)
-    k = len(av) - 1
-    b = as_list(body.get("b", [0.0] * k))
-    if isinstance(b, (str, bytes)) or not isinstance(b, Sequence):
-        raise ModelError("profile.fourier.b must be a list [b1, ..., bK]", entry)
-    bv = vector(b, len(b), "profile.fourier.b", entry)
-    if len(bv) == k + 1:
-        if bv[0] != 0.0:
-            raise ModelError("profile.fourier.b has a b0 term; sin(0) = 0, so give [b1, ...]",
-                             entry)
-        bv = bv[1:]
-    if len(bv) > k:
-        k = len(bv)
-        av = av + (0.0,) * (k + 1 - len(av))
-    bv = bv + (0.0,) * (k - len(bv))
-    if not av[0] > 0.0:
-        raise ModelError("profile.fourier.a[0] (the mean radius) must be positive", entry)
-    coeffs = [v for i in range(1, k + 1) for v in (av[i], bv[i - 1])]
-    return "fourier", (*c, float(k), av[0], *coeffs)
-
-
-def _follower(spec: Any, entry: str) -> tuple[str, tuple[float, float, float, float]]:
-    spec = table(spec, "follower", entry)
-    if len(spec) != 1 or next(iter(spec)) not in FOLLOWER_KINDS:
-        raise ModelError(f"follower must be one of {{point = [x, y]}}, {{roller = ...}}, "
-                         f"{{flat = ...}}, got keys {sorted(spec)}", entry)
-    kind, body = next(iter(spec.items()))
-    if kind == "point":
-        p = vector(body, 2, "follower.point", entry)
-        return kind, (p[0], p[1], 0.0, 0.0)
-    body = table(body, f"follower.{kind}", entry)
-    if kind == "roller":
-        only_keys(body, {"center", "radius"}, entry + " follower.roller", ["center", "radius"])
-        c = vector(body["center"], 2, "follower.roller.center", entry)
-        return kind, (c[0], c[1], positive(body["radius"], "follower.roller.radius", entry), 0.0)
-    only_keys(body, {"point", "normal"}, entry + " follower.flat", ["point", "normal"])
-    p = vector(body["point"], 2, "follower.flat.point", entry)
-    n = nonzero_vector(body["normal"], "follower.flat.normal", entry)
-    return kind, (p[0], p[1], n[0], n[1])
-
-
-__all__ = ["Model", "Body", "Revolute", "Translational", "Cam", "Driver"]
+__all__ = ["Model"]

@@ -8,7 +8,6 @@ import numpy as np
 
 from . import _core
 from .errors import ModelError
-from .model import (COORDINATES, DRV_ABS, DRV_REL_ANGLE, DRV_REL_DIST, Cam, Driver)
 
 if TYPE_CHECKING:  # pragma: no cover
     from .model import Model
@@ -31,6 +30,7 @@ class Packed:
     driver_flags: list[bool]
     coordinate_names: list[str]
     row_owner: list[int] = field(default_factory=list)   # constraint index of each row
+    row_labels: list[str] = field(default_factory=list)
 
     @property
     def nc(self) -> int:
@@ -47,6 +47,9 @@ def decode(raw: bytes | str) -> str:
 def pack(model: "Model") -> Packed:
     """Flat tables of a model, checked by the core.
 
+    Constants left open (the phase of a gear, rack or rolling disc) are set so that their
+    equation holds at the q0 estimates; the core evaluates that equation.
+
     Raises
     ------
     ModelError
@@ -60,36 +63,37 @@ def pack(model: "Model") -> Packed:
                          "model")
     body_idx = {b.name: i + 1 for i, b in enumerate(model.bodies)}
     body_idx["ground"] = 0
-    joint_idx = {c.name: k + 1 for k, c in enumerate(cons)}
+    con_idx = {c.name: k + 1 for k, c in enumerate(cons)}
     cols: list[list[int]] = []
     rpar: list[float] = []
     for c in cons:
-        bi, bj = body_idx[c.bodies[0]], body_idx[c.bodies[1]]
-        if isinstance(c, Driver):
-            params = c.f.encode()
-            if c.driver_type == "absolute":
-                kind, suba, subb = DRV_ABS, COORDINATES[c.coordinate], 0
-            elif c.driver_type == "relative-angle":
-                kind, suba, subb = DRV_REL_ANGLE, 0, 0
-            else:
-                kind, suba, subb = DRV_REL_DIST, joint_idx[c.joint], 0  # type: ignore[index]
-        else:
-            kind, suba, subb, params = c.pack()  # type: ignore[attr-defined]
-        cols.append([kind, bi, bj, suba, subb, len(rpar) + 1, len(params), 0])
+        params = c.raw()
+        suba, subb = c.subkinds(body_idx.__getitem__, con_idx.__getitem__)
+        cols.append([c.kind, body_idx[c.bodies[0]], body_idx[c.bodies[1]], suba, subb,
+                     len(rpar) + 1, len(params), 0])
         rpar.extend(params)
     ctab = np.asfortranarray(np.array(cols, dtype=np.int32).T)
-    rp = np.ascontiguousarray(rpar, dtype=np.float64)
-    if rp.size == 0:
-        rp = np.zeros(1)
+    rp = np.array(rpar if rpar else [0.0], dtype=np.float64)
     nq, neq, status, msg, bad = _core.core_sizes(len(model.bodies), ctab, rp)
     if status != 0:
         entry = cons[bad - 1].describe() if bad > 0 else "model"
         raise ModelError(decode(msg), entry)
-    names = [f"{b.name}.{s}" for b in model.bodies for s in ("x", "y", "theta")]
-    names += [f"{c.name}.alpha" for c in cons if isinstance(c, Cam)]
     q0 = np.zeros(nq)
     q0[:3 * len(model.bodies)] = np.array([b.q0 for b in model.bodies], dtype=float).ravel()
+    rows = [0]
+    for c in cons:
+        rows.append(rows[-1] + c.nrow)
+    open_phase = [k for k, c in enumerate(cons)
+                  if c.phase_row is not None and getattr(c, "phase", 0.0) is None]
+    if open_phase:
+        phi = _core.core_eval(len(model.bodies), ctab, rp, neq, q0, np.zeros(nq), 0.0)[0]
+        for k in open_phase:
+            # the phase is the last raw parameter; Phi = g(q0) - 0 gives it
+            rp[ctab[5, k] - 1 + ctab[6, k] - 1] = phi[rows[k] + cons[k].phase_row]
+    names = [f"{b.name}.{s}" for b in model.bodies for s in ("x", "y", "theta")]
+    names += [n for c in cons for n in c.extra_names()]
     owner = [k for k, c in enumerate(cons) for _ in range(c.nrow)]
+    labels = [r for c in cons for r in c.rows()]
     return Packed(len(model.bodies), ctab, rp, q0, int(nq), int(neq),
                   [b.name for b in model.bodies], [c.name for c in cons],
-                  [isinstance(c, Driver) for c in cons], names, owner)
+                  [c.is_driver for c in cons], names, owner, labels)

@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING, Any, Sequence
 
 import numpy as np
 
-from .model import PROFILE_KINDS, Cam, Revolute, Translational
+from .joints import PROFILE_KINDS, Cam, Revolute, Translational
 from .validate import GROUND
 
 if TYPE_CHECKING:  # pragma: no cover

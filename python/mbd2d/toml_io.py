@@ -97,7 +97,7 @@ def from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Model:
         entry = f"[[joint]] #{i + 1}" + (f" {j.get('name')!r}" if isinstance(j, Mapping) else "")
         j = dict(table(j, "[[joint]]", entry))
         if "type" not in j:
-            raise ModelError("missing key 'type' (revolute, translational or cam)", entry)
+            raise ModelError("missing key 'type' (revolute, translational, cam, ...)", entry)
         model.add_joint(**j)
     for i, d in enumerate(_entries(data, "driver", source)):
         entry = f"[[driver]] #{i + 1}" + (f" {d.get('name')!r}" if isinstance(d, Mapping) else "")

@@ -1,0 +1,40 @@
+!> mbd_joint_distance: the distance (revolute-revolute composite) constraint.
+!!
+!! d = P_j - P_i,   Phi = d . d - L**2 = 0                          (1 row)
+!! J = 2 d^T (J_Pj - J_Pi),  gamma = -(2 d . ar_d + 2 d_dot . d_dot)   (Haug 3.4.1)
+!! Raw parameters: [s'_i(2), s'_j(2), L], L > 0.
+module mbd_joint_distance
+  use mbd_kinds, only: wp, zero
+  use mbd_status, only: MBD_OK, MBD_BAD_PARAM, MSG_LEN
+  use mbd_points, only: NLOC, kvec, body_point, vsub, vdot, sconst, ssub, put_scal
+  implicit none
+  private
+  public :: distance_prepare, distance_eval
+
+contains
+
+  !> Check L > 0.
+  subroutine distance_prepare(raw, prep, status, msg)
+    real(wp), intent(in) :: raw(:)                 !! [s'_i, s'_j, L]
+    real(wp), allocatable, intent(out) :: prep(:)  !! same
+    integer, intent(out) :: status                 !! MBD_OK or MBD_BAD_PARAM
+    character(len=MSG_LEN), intent(out) :: msg     !! what is wrong
+    status = MBD_OK; msg = ''
+    if (.not. (raw(5) > zero)) then
+      status = MBD_BAD_PARAM; msg = 'distance must be positive'; return
+    end if
+    prep = raw(1:5)
+  end subroutine distance_prepare
+
+  !> Row of Phi, J (local block) and gamma.
+  pure subroutine distance_eval(p, si, sj, ql, qdl, phi, jl, gam)
+    real(wp), intent(in) :: p(:)            !! prepared parameters
+    integer, intent(in) :: si, sj           !! slot ids of the two bodies (0 = ground)
+    real(wp), intent(in) :: ql(NLOC), qdl(NLOC)  !! local coordinates and velocities
+    real(wp), intent(inout) :: phi(:), jl(:, :), gam(:)  !! 1 row
+    type(kvec) :: d
+    d = vsub(body_point(ql, qdl, sj, p(3:4)), body_point(ql, qdl, si, p(1:2)))
+    call put_scal(ssub(vdot(d, d), sconst(p(5)**2)), phi(1), jl(1, :), gam(1))
+  end subroutine distance_eval
+
+end module mbd_joint_distance

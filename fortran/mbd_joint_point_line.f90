@@ -1,0 +1,44 @@
+!> mbd_joint_point_line: a point of body j on a line fixed in body i (point on line; the
+!! revolute-translational composite, a pin in a straight slot).
+!!
+!! h_i = A_i perp(u'_i) (unit normal of the line),  d = P_j - P_i
+!! Phi = h_i . d - c = 0        c: offset of the pin from the slot centre line   (1 row)
+!! J and gamma by the product rule, as in the translational joint's first row (Haug 3.4.3).
+!! Raw parameters: [s'_i(2), s'_j(2), u'_i(2), c]; prepared: [s'_i, s'_j, perp(unit u'_i), c].
+module mbd_joint_point_line
+  use mbd_kinds, only: wp, zero
+  use mbd_status, only: MBD_OK, MBD_BAD_PARAM, MSG_LEN
+  use mbd_points, only: NLOC, body_point, body_vector, vsub, vdot, ssub, sconst, put_scal, perp
+  implicit none
+  private
+  public :: point_line_prepare, point_line_eval
+
+contains
+
+  !> Normalize the line direction and store its normal.
+  subroutine point_line_prepare(raw, prep, status, msg)
+    real(wp), intent(in) :: raw(:)                 !! [s'_i, s'_j, u'_i, c]
+    real(wp), allocatable, intent(out) :: prep(:)  !! [s'_i, s'_j, h'_i, c]
+    integer, intent(out) :: status                 !! MBD_OK or MBD_BAD_PARAM
+    character(len=MSG_LEN), intent(out) :: msg     !! what is wrong
+    real(wp) :: n
+    status = MBD_OK; msg = ''
+    n = hypot(raw(5), raw(6))
+    if (.not. (n > zero)) then
+      status = MBD_BAD_PARAM; msg = 'line direction has zero length'; return
+    end if
+    prep = [raw(1:4), perp(raw(5:6) / n), raw(7)]
+  end subroutine point_line_prepare
+
+  !> Row of Phi, J (local block) and gamma.
+  pure subroutine point_line_eval(p, si, sj, ql, qdl, phi, jl, gam)
+    real(wp), intent(in) :: p(:)            !! prepared parameters
+    integer, intent(in) :: si, sj           !! slot ids (i carries the line)
+    real(wp), intent(in) :: ql(NLOC), qdl(NLOC)  !! local coordinates and velocities
+    real(wp), intent(inout) :: phi(:), jl(:, :), gam(:)  !! 1 row
+    call put_scal(ssub(vdot(body_vector(ql, qdl, si, p(5:6)), &
+                            vsub(body_point(ql, qdl, sj, p(3:4)), body_point(ql, qdl, si, p(1:2)))), &
+                       sconst(p(7))), phi(1), jl(1, :), gam(1))
+  end subroutine point_line_eval
+
+end module mbd_joint_point_line

@@ -1,0 +1,38 @@
+!> mbd_joint_weld: the weld (fixed) joint.
+!!
+!! Phi_1,2 = P_i - P_j = 0                    the points coincide (as the revolute joint)
+!! Phi_3   = theta_j - theta_i - phi0 = 0      the relative angle is fixed      (3 rows)
+!! Raw parameters: [s'_i(2), s'_j(2), phi0].
+module mbd_joint_weld
+  use mbd_kinds, only: wp
+  use mbd_status, only: MBD_OK, MSG_LEN
+  use mbd_points, only: NLOC, body_angle, ssub, sconst, put_scal
+  use mbd_joint_revolute, only: revolute_eval
+  implicit none
+  private
+  public :: weld_prepare, weld_eval
+
+contains
+
+  !> Copy the parameters.
+  subroutine weld_prepare(raw, prep, status, msg)
+    real(wp), intent(in) :: raw(:)                 !! [s'_i, s'_j, phi0]
+    real(wp), allocatable, intent(out) :: prep(:)  !! same
+    integer, intent(out) :: status                 !! MBD_OK
+    character(len=MSG_LEN), intent(out) :: msg     !! empty
+    status = MBD_OK; msg = ''
+    prep = raw(1:5)
+  end subroutine weld_prepare
+
+  !> Rows of Phi, J (local block) and gamma.
+  pure subroutine weld_eval(p, si, sj, ql, qdl, phi, jl, gam)
+    real(wp), intent(in) :: p(:)            !! prepared parameters
+    integer, intent(in) :: si, sj           !! slot ids
+    real(wp), intent(in) :: ql(NLOC), qdl(NLOC)  !! local coordinates and velocities
+    real(wp), intent(inout) :: phi(:), jl(:, :), gam(:)  !! 3 rows
+    call revolute_eval(p(1:4), si, sj, ql, qdl, phi(1:2), jl(1:2, :), gam(1:2))
+    call put_scal(ssub(ssub(body_angle(ql, qdl, sj), body_angle(ql, qdl, si)), sconst(p(5))), &
+                  phi(3), jl(3, :), gam(3))
+  end subroutine weld_eval
+
+end module mbd_joint_weld

@@ -1,0 +1,397 @@
+"""Model entries: bodies, joints and drivers, each able to pack itself into the flat table.
+
+Every constraint class knows its kind code (``fortran/mbd_constraints.f90``), how many rows it
+adds, what each row stands for, and its raw parameters. The numerics live in Fortran.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Callable, ClassVar, Mapping, Sequence
+
+from .errors import ModelError
+from .functions import TimeFunction
+from .validate import as_list, nonzero_vector, only_keys, pairs, positive, table, vector
+
+PROFILE_KINDS = {"circle": 1, "spline": 2, "fourier": 3}
+FOLLOWER_KINDS = {"point": 1, "roller": 2, "flat": 3}
+COORDINATES = {"x": 1, "y": 2, "theta": 3}
+
+BodyIndex = Callable[[str], int]
+
+
+@dataclass
+class Body:
+    """A moving rigid body; its origin is its centre of mass.
+
+    Parameters
+    ----------
+    name : str
+        Unique name.
+    q0 : tuple of float
+        Rough estimate of (x, y, theta); assembly refines it.
+    mass, inertia : float or None
+        Mass and moment of inertia about the centre of mass (dynamics only).
+    """
+
+    name: str
+    q0: tuple[float, float, float]
+    mass: float | None = None
+    inertia: float | None = None
+
+
+@dataclass
+class Constraint:
+    """Common part of joints and drivers: a name and two bodies ('ground' allowed)."""
+
+    name: str
+    bodies: tuple[str, str]
+
+    type: ClassVar[str] = "constraint"
+    kind: ClassVar[int] = 0
+    labels: ClassVar[tuple[str, ...]] = ("",)
+    #: row (0-based) whose constant is taken from the q0 estimates when ``phase`` is None
+    phase_row: ClassVar[int | None] = None
+    is_driver: ClassVar[bool] = False
+
+    @property
+    def nrow(self) -> int:
+        """Number of equations."""
+        return len(self.labels)
+
+    def describe(self) -> str:
+        """How messages name this entry."""
+        return f"joint '{self.name}' ({self.type})"
+
+    def rows(self) -> list[str]:
+        """A label per equation: NAME.equation."""
+        return [f"{self.name}.{label}" for label in self.labels]
+
+    def raw(self) -> list[float]:
+        """Raw parameters of the flat table."""
+        raise NotImplementedError
+
+    def subkinds(self, body_index: BodyIndex, joint_index: Callable[[str], int]) -> tuple[int, int]:
+        """Sub-kinds a and b of the flat table."""
+        return 0, 0
+
+    def extra_names(self) -> list[str]:
+        """Names of the extra coordinates the constraint adds."""
+        return []
+
+
+@dataclass
+class Revolute(Constraint):
+    """Revolute joint: the two points coincide."""
+
+    points: tuple[tuple[float, float], tuple[float, float]] = ((0.0, 0.0), (0.0, 0.0))
+    type: ClassVar[str] = "revolute"
+    kind: ClassVar[int] = 1
+    labels: ClassVar[tuple[str, ...]] = ("x", "y")
+
+    def raw(self) -> list[float]:
+        return [*self.points[0], *self.points[1]]
+
+
+@dataclass
+class Translational(Constraint):
+    """Translational joint: point j stays on the line of body i; the axes stay parallel."""
+
+    points: tuple[tuple[float, float], tuple[float, float]] = ((0.0, 0.0), (0.0, 0.0))
+    axes: tuple[tuple[float, float], tuple[float, float]] = ((1.0, 0.0), (1.0, 0.0))
+    type: ClassVar[str] = "translational"
+    kind: ClassVar[int] = 2
+    labels: ClassVar[tuple[str, ...]] = ("normal", "angle")
+
+    def raw(self) -> list[float]:
+        return [*self.points[0], *self.points[1], *self.axes[0], *self.axes[1]]
+
+
+@dataclass
+class Cam(Constraint):
+    """Cam: a profile on body 1 touching a follower on body 2; adds the contact parameter
+    alpha as a coordinate."""
+
+    profile_kind: str = "circle"
+    profile: tuple[float, ...] = ()
+    follower_kind: str = "point"
+    follower: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0)
+    type: ClassVar[str] = "cam"
+    kind: ClassVar[int] = 3
+
+    @property
+    def labels(self) -> tuple[str, ...]:  # type: ignore[override]
+        return ("on_face", "tangent") if self.follower_kind == "flat" else ("x", "y")
+
+    def raw(self) -> list[float]:
+        return [*self.follower, *self.profile]
+
+    def subkinds(self, body_index: BodyIndex, joint_index: Callable[[str], int]) -> tuple[int, int]:
+        return PROFILE_KINDS[self.profile_kind], FOLLOWER_KINDS[self.follower_kind]
+
+    def extra_names(self) -> list[str]:
+        return [f"{self.name}.alpha"]
+
+
+@dataclass
+class PointOnCurve(Cam):
+    """A point of body 2 on a closed curve of body 1 (a pin in a curved slot)."""
+
+    type: ClassVar[str] = "point-on-curve"
+
+
+@dataclass
+class Distance(Constraint):
+    """Distance (revolute-revolute composite): |P_j - P_i| = distance."""
+
+    points: tuple[tuple[float, float], tuple[float, float]] = ((0.0, 0.0), (0.0, 0.0))
+    distance: float = 1.0
+    type: ClassVar[str] = "distance"
+    kind: ClassVar[int] = 4
+    labels: ClassVar[tuple[str, ...]] = ("length",)
+
+    def raw(self) -> list[float]:
+        return [*self.points[0], *self.points[1], self.distance]
+
+
+@dataclass
+class PointOnLine(Constraint):
+    """A point of body 2 on a line of body 1 (at a signed offset from it)."""
+
+    points: tuple[tuple[float, float], tuple[float, float]] = ((0.0, 0.0), (0.0, 0.0))
+    axis: tuple[float, float] = (1.0, 0.0)
+    offset: float = 0.0
+    type: ClassVar[str] = "point-on-line"
+    kind: ClassVar[int] = 5
+    labels: ClassVar[tuple[str, ...]] = ("normal",)
+
+    def raw(self) -> list[float]:
+        return [*self.points[0], *self.points[1], *self.axis, self.offset]
+
+
+@dataclass
+class PinInSlot(PointOnLine):
+    """Revolute-translational composite: a pin of body 2 in a straight slot of body 1."""
+
+    type: ClassVar[str] = "revolute-translational"
+
+
+@dataclass
+class Weld(Constraint):
+    """Weld: the points coincide and the relative angle theta_j - theta_i is fixed."""
+
+    points: tuple[tuple[float, float], tuple[float, float]] = ((0.0, 0.0), (0.0, 0.0))
+    angle: float = 0.0
+    type: ClassVar[str] = "weld"
+    kind: ClassVar[int] = 6
+    labels: ClassVar[tuple[str, ...]] = ("x", "y", "angle")
+
+    def raw(self) -> list[float]:
+        return [*self.points[0], *self.points[1], self.angle]
+
+
+@dataclass
+class Gear(Constraint):
+    """Gear pair on a common carrier: R_i (th_i - th_c) +/- R_j (th_j - th_c) = phase."""
+
+    radii: tuple[float, float] = (1.0, 1.0)
+    internal: bool = False
+    carrier: str = "ground"
+    phase: float | None = None
+    type: ClassVar[str] = "gear"
+    kind: ClassVar[int] = 7
+    labels: ClassVar[tuple[str, ...]] = ("mesh",)
+    phase_row: ClassVar[int | None] = 0
+
+    def raw(self) -> list[float]:
+        return [*self.radii, self.phase or 0.0]
+
+    def subkinds(self, body_index: BodyIndex, joint_index: Callable[[str], int]) -> tuple[int, int]:
+        return body_index(self.carrier), 2 if self.internal else 1
+
+
+@dataclass
+class RackPinion(Constraint):
+    """Rack and pinion: the pinion (body 1) rolls without slip along the rack line (body 2)."""
+
+    center: tuple[float, float] = (0.0, 0.0)
+    point: tuple[float, float] = (0.0, 0.0)
+    axis: tuple[float, float] = (1.0, 0.0)
+    radius: float = 1.0
+    phase: float | None = None
+    type: ClassVar[str] = "rack-pinion"
+    kind: ClassVar[int] = 8
+    labels: ClassVar[tuple[str, ...]] = ("no_slip",)
+    phase_row: ClassVar[int | None] = 0
+
+    def raw(self) -> list[float]:
+        return [*self.center, *self.point, *self.axis, self.radius, self.phase or 0.0]
+
+
+@dataclass
+class RollingDisc(RackPinion):
+    """A disc (body 1) rolling without slip on a line (body 2): contact and no slip."""
+
+    type: ClassVar[str] = "rolling-disc"
+    kind: ClassVar[int] = 9
+    labels: ClassVar[tuple[str, ...]] = ("no_slip", "contact")
+
+
+@dataclass
+class Absolute(Constraint):
+    """Absolute constraint: x, y or theta of a body is fixed."""
+
+    coordinate: str = "x"
+    value: float = 0.0
+    type: ClassVar[str] = "absolute"
+    kind: ClassVar[int] = 10
+
+    @property
+    def labels(self) -> tuple[str, ...]:  # type: ignore[override]
+        return (self.coordinate,)
+
+    def raw(self) -> list[float]:
+        return [self.value]
+
+    def subkinds(self, body_index: BodyIndex, joint_index: Callable[[str], int]) -> tuple[int, int]:
+        return COORDINATES[self.coordinate], 0
+
+
+@dataclass
+class Driver(Constraint):
+    """A driving constraint g(q) - f(t) = 0."""
+
+    f: TimeFunction = TimeFunction()
+    is_driver: ClassVar[bool] = True
+
+    def describe(self) -> str:
+        return f"driver '{self.name}'"
+
+    def raw(self) -> list[float]:
+        return self.f.encode()
+
+
+@dataclass
+class AbsoluteDriver(Driver):
+    """x, y or theta of a body = f(t)."""
+
+    coordinate: str = "theta"
+    type: ClassVar[str] = "absolute"
+    kind: ClassVar[int] = 101
+
+    @property
+    def labels(self) -> tuple[str, ...]:  # type: ignore[override]
+        return (f"{self.bodies[0]}.{self.coordinate}",)
+
+    def subkinds(self, body_index: BodyIndex, joint_index: Callable[[str], int]) -> tuple[int, int]:
+        return COORDINATES[self.coordinate], 0
+
+
+@dataclass
+class RelativeAngleDriver(Driver):
+    """theta_j - theta_i = f(t)."""
+
+    type: ClassVar[str] = "relative-angle"
+    kind: ClassVar[int] = 102
+    labels: ClassVar[tuple[str, ...]] = ("angle",)
+
+
+@dataclass
+class RelativeDistanceDriver(Driver):
+    """The slide along a translational joint = f(t)."""
+
+    joint: str = ""
+    type: ClassVar[str] = "relative-distance"
+    kind: ClassVar[int] = 103
+    labels: ClassVar[tuple[str, ...]] = ("slide",)
+
+    def subkinds(self, body_index: BodyIndex, joint_index: Callable[[str], int]) -> tuple[int, int]:
+        return joint_index(self.joint), 0
+
+
+def parse_profile(spec: Any, entry: str, key: str = "profile") -> tuple[str, tuple[float, ...]]:
+    """A closed profile curve: ``{circle = ...}``, ``{spline = ...}`` or ``{fourier = ...}``."""
+    spec = table(spec, key, entry)
+    if len(spec) != 1 or next(iter(spec)) not in PROFILE_KINDS:
+        raise ModelError(f"{key} must be one of {{circle = ...}}, {{spline = ...}}, "
+                         f"{{fourier = ...}}, got keys {sorted(spec)}", entry)
+    kind, body = next(iter(spec.items()))
+    body = table(body, f"{key}.{kind}", entry)
+    if kind == "circle":
+        only_keys(body, {"center", "radius"}, f"{entry} {key}.circle", ["center", "radius"])
+        c = vector(body["center"], 2, f"{key}.circle.center", entry)
+        r = positive(body["radius"], f"{key}.circle.radius", entry)
+        return kind, (*c, r)
+    if kind == "spline":
+        only_keys(body, {"points"}, f"{entry} {key}.spline", ["points"])
+        pts = as_list(body["points"])
+        if isinstance(pts, (str, bytes)) or not isinstance(pts, Sequence) or len(pts) < 4:
+            raise ModelError(f"{key}.spline.points must be a list of at least 4 [x, y] points "
+                             "around the closed curve", entry)
+        pp = pairs(pts, len(pts), f"{key}.spline.points", entry)
+        return kind, (float(len(pp)), *[v for p in pp for v in p])
+    only_keys(body, {"center", "a", "b"}, f"{entry} {key}.fourier", ["a"])
+    c = vector(body.get("center", [0.0, 0.0]), 2, f"{key}.fourier.center", entry)
+    a = as_list(body["a"])
+    if isinstance(a, (str, bytes)) or not isinstance(a, Sequence) or len(a) < 1:
+        raise ModelError(f"{key}.fourier.a must be a list [a0, a1, ...]", entry)
+    av = vector(a, len(a), f"{key}.fourier.a", entry)
+    k = len(av) - 1
+    b = as_list(body.get("b", [0.0] * k))
+    if isinstance(b, (str, bytes)) or not isinstance(b, Sequence):
+        raise ModelError(f"{key}.fourier.b must be a list [b1, ..., bK]", entry)
+    bv = vector(b, len(b), f"{key}.fourier.b", entry)
+    if len(bv) == k + 1:
+        if bv[0] != 0.0:
+            raise ModelError(f"{key}.fourier.b has a b0 term; sin(0) = 0, so give [b1, ...]",
+                             entry)
+        bv = bv[1:]
+    if len(bv) > k:
+        k = len(bv)
+        av = av + (0.0,) * (k + 1 - len(av))
+    bv = bv + (0.0,) * (k - len(bv))
+    if not av[0] > 0.0:
+        raise ModelError(f"{key}.fourier.a[0] (the mean radius) must be positive", entry)
+    coeffs = [v for i in range(1, k + 1) for v in (av[i], bv[i - 1])]
+    return "fourier", (*c, float(k), av[0], *coeffs)
+
+
+def parse_follower(spec: Any, entry: str) -> tuple[str, tuple[float, float, float, float]]:
+    """A follower: ``{point = [x, y]}``, ``{roller = ...}`` or ``{flat = ...}``."""
+    spec = table(spec, "follower", entry)
+    if len(spec) != 1 or next(iter(spec)) not in FOLLOWER_KINDS:
+        raise ModelError(f"follower must be one of {{point = [x, y]}}, {{roller = ...}}, "
+                         f"{{flat = ...}}, got keys {sorted(spec)}", entry)
+    kind, body = next(iter(spec.items()))
+    if kind == "point":
+        p = vector(body, 2, "follower.point", entry)
+        return kind, (p[0], p[1], 0.0, 0.0)
+    body = table(body, f"follower.{kind}", entry)
+    if kind == "roller":
+        only_keys(body, {"center", "radius"}, entry + " follower.roller", ["center", "radius"])
+        c = vector(body["center"], 2, "follower.roller.center", entry)
+        return kind, (c[0], c[1], positive(body["radius"], "follower.roller.radius", entry), 0.0)
+    only_keys(body, {"point", "normal"}, entry + " follower.flat", ["point", "normal"])
+    p = vector(body["point"], 2, "follower.flat.point", entry)
+    n = nonzero_vector(body["normal"], "follower.flat.normal", entry)
+    return kind, (p[0], p[1], n[0], n[1])
+
+
+def joint_keys() -> Mapping[str, tuple[set[str], set[str]]]:
+    """TOML keys of each joint type: (allowed, required)."""
+    return {
+        "revolute": ({"bodies", "points"}, {"bodies", "points"}),
+        "translational": ({"bodies", "points", "axes"}, {"bodies", "points", "axes"}),
+        "cam": ({"bodies", "profile", "follower"}, {"bodies", "profile", "follower"}),
+        "point-on-curve": ({"bodies", "curve", "point"}, {"bodies", "curve", "point"}),
+        "distance": ({"bodies", "points", "distance"}, {"bodies", "points", "distance"}),
+        "point-on-line": ({"bodies", "points", "axis", "offset"}, {"bodies", "points", "axis"}),
+        "revolute-translational": ({"bodies", "points", "axis", "offset"},
+                                   {"bodies", "points", "axis"}),
+        "weld": ({"bodies", "points", "angle"}, {"bodies", "points"}),
+        "gear": ({"bodies", "radii", "internal", "carrier", "phase"}, {"bodies", "radii"}),
+        "rack-pinion": ({"bodies", "center", "point", "axis", "radius", "phase"},
+                        {"bodies", "center", "point", "axis", "radius"}),
+        "rolling-disc": ({"bodies", "center", "point", "axis", "radius", "phase"},
+                         {"bodies", "center", "point", "axis", "radius"}),
+        "absolute": ({"body", "coordinate", "value"}, {"body", "coordinate"}),
+    }
