@@ -170,7 +170,68 @@ def constant_and_linear_drivers() -> Model:
     return m
 
 
+def distance_joints() -> Model:
+    m = _bodies(Model("distance"), "a", "spectator", "b")
+    m.add_distance(["a", "b"], [[0.3, -0.2], [-0.5, 0.7]], 2.5, name="link")
+    m.add_distance(["ground", "a"], [[1.0, -1.0], [0.4, 0.6]], 1.7, name="tie")
+    return m
+
+
+def line_joints() -> Model:
+    m = _bodies(Model("line"), "a", "b", "spectator")
+    m.add_point_on_line(["a", "b"], [[0.3, -0.2], [-0.5, 0.7]], [0.6, 0.8], name="on_line")
+    m.add_pin_in_slot(["ground", "a"], [[0.5, 1.5], [0.2, -0.3]], [1.0, -2.0], offset=0.15,
+                      name="slot")
+    m.add_pin_in_slot(["b", "ground"], [[-0.4, 0.2], [1.0, 1.0]], [0.0, 1.0], name="slot2")
+    return m
+
+
+def weld_joints() -> Model:
+    m = _bodies(Model("weld"), "spectator", "a", "b")
+    m.add_weld(["a", "b"], [[0.3, -0.2], [-0.5, 0.7]], angle=0.4, name="fix")
+    m.add_weld(["ground", "a"], [[1.0, 2.0], [0.4, -0.1]], name="fix_ground")
+    return m
+
+
+def curve_case(profile: str) -> Callable[[], Model]:
+    def build() -> Model:
+        m = _bodies(Model(f"curve-{profile}"), "a", "spectator", "b")
+        m.add_point_on_curve(["a", "b"], PROFILES[profile], [0.25, -0.35], name="slot")
+        return m
+    return build
+
+
+def gear_joints() -> Model:
+    m = _bodies(Model("gears"), "a", "b", "cam", "spectator")
+    m.add_gear(["a", "b"], [0.5, 1.25], name="external")           # carrier: ground
+    m.add_gear(["a", "b"], [0.4, 1.6], internal=True, carrier="cam", name="ring")
+    return m
+
+
+def rolling_joints() -> Model:
+    m = _bodies(Model("rolling"), "a", "b", "spectator")
+    m.add_rack_pinion(["a", "b"], [0.1, -0.2], [0.3, 0.4], [0.8, 0.6], 0.6, name="rack")
+    m.add_rolling_disc(["a", "ground"], [0.2, 0.1], [0.0, -3.0], [1.0, 0.2], 0.9, name="disc")
+    m.add_rolling_disc(["b", "a"], [-0.1, 0.3], [0.5, -0.5], [-0.3, 1.0], 0.4, name="disc2")
+    return m
+
+
+def absolute_constraints() -> Model:
+    m = _bodies(Model("absolute"), "a", "spectator")
+    for c in ("x", "y", "theta"):
+        m.add_absolute("a", c, value=0.3, name=f"fix_{c}")
+    return m
+
+
 CASES: dict[str, Case] = {
+    "distance": Case(distance_joints),
+    "point-on-line-and-slots": Case(line_joints),
+    "weld": Case(weld_joints),
+    **{f"point-on-curve-{p}": Case(curve_case(p), spline_cams=int(p == "spline"))
+       for p in PROFILES},
+    "gear-pairs": Case(gear_joints),
+    "rack-and-rolling-disc": Case(rolling_joints),
+    "absolute-constraints": Case(absolute_constraints),
     "revolute-body-body": Case(revolute_body_body),
     "revolute-body-ground": Case(revolute_body_ground),
     "translational-body-body": Case(translational_body_body),
