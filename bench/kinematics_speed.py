@@ -28,7 +28,8 @@ def core_us_per_step(model: mbd2d.Model, t_end: float, steps: int, repeats: int)
         out = _core.core_kinematics(p.nb, p.ctab, p.rpar, p.neq, p.q0, 0.0, t_end, steps,
                                     0.0, 0, 0.0)
         best = min(best, time.perf_counter() - t0)
-        assert out[7] == 0, out[8]
+        status, msg = out[-2], out[-1]
+        assert status == 0, msg
     iinfo = out[3]
     return {"us_per_step": 1e6 * best / steps, "steps": steps,
             "newton_corrections_per_step": int(iinfo[5]) / steps,

@@ -32,7 +32,7 @@ end subroutine core_eval
 
 subroutine core_kinematics(nb, nc, ctab, np, rpar, nq, neq, q0, t0, t1, nsteps, tol, &
                            maxit, tmin, qout, qdout, qddout, iinfo, rinfo, qsing, dep, &
-                           status, msg)
+                           redundant, tpass, status, msg)
   use iso_c_binding, only: c_double, c_int
   use mbd_api, only: api_kinematics
   implicit none
@@ -44,14 +44,32 @@ subroutine core_kinematics(nb, nc, ctab, np, rpar, nq, neq, q0, t0, t1, nsteps, 
   integer(c_int), intent(out) :: iinfo(10)
   real(c_double), intent(out) :: rinfo(10)
   real(c_double), intent(out) :: qsing(nq)
-  integer(c_int), intent(out) :: dep(neq)
+  integer(c_int), intent(out) :: dep(neq), redundant(neq)
+  real(c_double), intent(out) :: tpass(64)
   integer(c_int), intent(out) :: status
   character(len=512), intent(out) :: msg
   !f2py intent(hide) :: nc, np, nq
   !f2py threadsafe
   call api_kinematics(nb, ctab, rpar, q0, t0, t1, nsteps, tol, maxit, tmin, qout, qdout, &
-                      qddout, iinfo, rinfo, qsing, dep, status, msg)
+                      qddout, iinfo, rinfo, qsing, dep, redundant, tpass, status, msg)
 end subroutine core_kinematics
+
+subroutine core_analyze(nb, nc, ctab, np, rpar, nq, neq, q0, t, tol, q, rank, mobility, &
+                        redundant, dep, resid, worst, status, msg)
+  use iso_c_binding, only: c_double, c_int
+  use mbd_api, only: api_analyze
+  implicit none
+  integer(c_int), intent(in) :: nb, nc, np, nq, neq
+  integer(c_int), intent(in) :: ctab(8, nc)
+  real(c_double), intent(in) :: rpar(np), q0(nq), t, tol
+  real(c_double), intent(out) :: q(nq), resid
+  integer(c_int), intent(out) :: rank, mobility, worst, status
+  integer(c_int), intent(out) :: redundant(neq), dep(neq)
+  character(len=512), intent(out) :: msg
+  !f2py intent(hide) :: nc, np, nq
+  call api_analyze(nb, ctab, rpar, q0, t, tol, q, rank, mobility, redundant, dep, resid, &
+                   worst, status, msg)
+end subroutine core_analyze
 
 subroutine core_profile(kind, np, raw, na, alpha, pts, status, msg)
   use iso_c_binding, only: c_double, c_int

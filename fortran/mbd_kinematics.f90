@@ -1,34 +1,58 @@
 !> mbd_kinematics: assembly, Newton-Raphson on Phi(q, t) = 0, velocities and accelerations,
-!! the time loop, and the location of singular (dead-centre) configurations.
+!! the time loop, redundant constraints, and singular configurations.
 !!
 !! Per output time (Haug, ch. 3-4; Nikravesh, ch. 5):
-!!   predictor    q = q_k + h q_dot_k + h**2/2 q_ddot_k + h**3/6 q_dddot_k,
-!!                q_dddot_k from the last two accelerations
-!!   position     J(q) dq = -Phi(q, t),  q <- q + dq   until ||Phi||_inf <= tol   (dgetrf/dgetrs)
-!!   velocity     J q_dot = nu                              (the last factorization is reused)
-!!   acceleration J q_ddot = gamma(q, q_dot, t)             (same factorization)
-!! A step whose Newton solve fails, or whose det J changes sign (the solution would pass a
-!! singular configuration or jump to another assembly branch), is halved. When the step falls
-!! below tmin the run stops: the configuration is singular there, and the SVD of J names
-!! the dependent rows and the driver that can no longer be met.
+!!   predictor    q = q_k + h q_dot_k + h**2/2 q_ddot_k + h**3/6 q_dddot_k
+!!                (q_dddot_k from the last two accelerations)
+!!   position     J(q) dq = -Phi(q, t),  q <- q + dq   until ||Phi||_inf <= tol
+!!   velocity     J q_dot = nu                    (the last factorization is reused)
+!!   acceleration J q_ddot = gamma(q, q_dot, t)   (same factorization)
+!! Square, full-rank J: LU (dgetf2/dgetrf). Redundant constraints (more equations than the
+!! rank): least squares by QR with column pivoting (dgeqp3), with the residual checked, so
+!! consistent redundant constraints are satisfied exactly and contradicting ones are named.
+!!
+!! J is factored with its columns scaled to unit length at assembly (lengths and angles weigh
+!! alike). A step is rejected and halved when Newton fails, when det J changes sign (LU mode),
+!! when J is nearly singular (smallest/largest pivot < NEAR_SING), or when the solution leaves
+!! its branch: the Newton correction exceeds half the predicted motion, or the velocity jumps
+!! against its Taylor prediction (a switch of branch through a singular point). When the step falls
+!! below tmin the configuration is singular. If the motion continues through it (a bifurcation,
+!! as in a parallelogram at its collinear position), a step across it that lands on the
+!! predicted branch is taken and the passage recorded. Outputs near the passage, where J is too
+!! ill-conditioned for accurate accelerations (errors grow like cond**3 tol), are interpolated
+!! (quintic Hermite) between regular anchor states d either side, d doubled from h/64 until
+!! the pivot ratio there reaches ANCHOR_PIV. Otherwise (a dead centre) the run
+!! stops, and the SVD of the column-scaled J names the dependent rows and the driver that can
+!! no longer be met.
 module mbd_kinematics
   use mbd_kinds, only: wp, zero, one, half
-  use mbd_status, only: MBD_OK, MBD_BAD_SETTING, MBD_SINGULAR, MBD_NO_CONVERGENCE, &
-                        MBD_SINGULAR_CONFIG, MBD_ASSEMBLY_FAILED, MBD_LAPACK, MSG_LEN
+  use mbd_status, only: MBD_OK, MBD_BAD_SETTING, MBD_BAD_COUNT, MBD_SINGULAR, &
+                        MBD_NO_CONVERGENCE, MBD_SINGULAR_CONFIG, MBD_ASSEMBLY_FAILED, &
+                        MBD_LAPACK, MBD_INCONSISTENT, MSG_LEN
   use mbd_points, only: NLOC, MAXROW
   use mbd_model, only: model_t
   use mbd_constraints, only: con_is_driver, con_name
   use mbd_assemble, only: assemble_blocks, assemble_dense, init_extras
-  use mbd_linsolve, only: lu_factor, lu_solve, lu_det_sign, svd_null
-  use mbd_lapack, only: dgels
+  use mbd_linsolve, only: lu_factor, lu_solve, lu_det_sign, svd_null, row_rank, qr_factor, &
+                          qr_solve, qr_lwork
+  use mbd_lapack, only: dgels, dgecon, dtrcon
+  use mbd_interp, only: hermite5
   implicit none
   private
-  public :: kin_opts_t, kin_work_t, kin_report_t, DEP_TOL
-  public :: kin_work_init, kin_assemble, kin_vel_acc, kin_newton, kin_run, kin_singular_report
+  public :: kin_opts_t, kin_work_t, kin_report_t, DEP_TOL, SING_RATIO, MAXPASS
+  public :: kin_work_init, kin_assemble, kin_rank, kin_newton, kin_vel_acc, kin_run, &
+            kin_singular_report
 
   real(wp), parameter :: DEP_TOL = 1.0e-3_wp  !! |u_r| / max|u| above which a row is dependent
   !> sigma_min / sigma_max of the column-scaled J below which a configuration is singular
   real(wp), parameter :: SING_RATIO = 1.0e-3_wp
+  real(wp), parameter :: JUMP_RATIO = half     !! largest Newton correction / predicted motion
+  real(wp), parameter :: NEAR_SING = 1.0e-8_wp  !! 1/cond_1 of the scaled J: nearly singular
+  real(wp), parameter :: ANCHOR_PIV = 1.0e-3_wp !! 1/cond_1 wanted at outputs and anchors
+  !> LU pivot ratio below which the condition number is estimated (dgecon)
+  real(wp), parameter :: COND_CHECK = 0.1_wp
+  real(wp), parameter :: VJUMP_RATIO = 0.2_wp   !! largest velocity jump / velocity scale
+  integer, parameter :: MAXPASS = 64           !! singular passages recorded
 
   !> Settings of a kinematic analysis.
   type :: kin_opts_t
@@ -41,27 +65,37 @@ module mbd_kinematics
   !> Work arrays, allocated once per analysis.
   type :: kin_work_t
     real(wp), allocatable :: phi(:), nu(:), gam(:), jac(:, :), jb(:, :, :), qz(:)
-    integer, allocatable :: ipiv(:)
-    integer :: detsign = 0          !! sign of det J at the last factorization
+    real(wp), allocatable :: rhs(:), dq(:), tau(:), qrwork(:)
+    real(wp), allocatable :: cs(:)  !! column scale of J (1/|J_k| at assembly)
+    real(wp), allocatable :: cwork(:)   !! dgecon / dtrcon workspace (4 n)
+    integer, allocatable :: ipiv(:), jpvt(:), iwork(:)
+    logical :: lsq = .false.        !! least-squares mode (redundant constraints)
+    real(wp) :: pivratio = one      !! 1/cond_1 estimate of the scaled J (dgecon, dtrcon)
+    integer :: detsign = 0          !! sign of det J at the last LU factorization
     real(wp) :: tol = zero          !! absolute ||Phi|| tolerance in use
+    real(wp) :: resid = zero        !! least-squares residual of the last solve
     integer :: newton_its = 0       !! Newton corrections taken
-    integer :: lu_count = 0         !! LU factorizations
+    integer :: lu_count = 0         !! factorizations
   end type kin_work_t
 
-  !> What happened: counters, and the singular or failed configuration.
+  !> What happened: counters, redundancy, and the singular or failed configuration.
   type :: kin_report_t
     integer :: ndone = 0            !! output times computed
     integer :: driver = 0           !! driver that can no longer be met (constraint index)
     integer :: worst = 0            !! constraint with the largest residual at a failure
     integer :: deficiency = 0       !! rank deficiency of J at the singular configuration
     integer :: rejected = 0         !! rejected (halved) steps
+    integer :: rank = 0             !! rank of J at the assembled configuration
+    integer :: npass = 0            !! singular configurations passed through
     real(wp) :: t_fail = zero       !! time of the singular configuration or failure
     real(wp) :: smin = zero, smax = zero  !! extreme singular values of J there
     real(wp) :: resid = zero        !! ||Phi||_inf at a failure
     integer :: newton_its = 0       !! Newton corrections taken
-    integer :: lu_count = 0         !! LU factorizations
-    real(wp), allocatable :: qsing(:)     !! configuration there
-    integer, allocatable :: dep(:)        !! 1 for each row in the dependent set
+    integer :: lu_count = 0         !! factorizations
+    real(wp) :: tpass(MAXPASS) = zero     !! times of the passages
+    real(wp), allocatable :: qsing(:)     !! configuration at a singularity or failure
+    integer, allocatable :: dep(:)        !! 1 for each row in the dependent set there
+    integer, allocatable :: redundant(:)  !! 1 for each redundant row at assembly
   end type kin_report_t
 
 contains
@@ -70,23 +104,78 @@ contains
   subroutine kin_work_init(m, w)
     type(model_t), intent(in) :: m       !! model
     type(kin_work_t), intent(out) :: w   !! work arrays
+    integer :: nr
+    nr = max(m%neq, m%nq)
     allocate (w%phi(m%neq), w%nu(m%neq), w%gam(m%neq), w%jac(m%neq, m%nq), &
-              w%jb(MAXROW, NLOC, m%nc), w%qz(m%nq), w%ipiv(m%nq))
+              w%jb(MAXROW, NLOC, m%nc), w%qz(m%nq), w%ipiv(m%nq), w%rhs(nr), w%dq(m%nq), &
+              w%tau(m%nq), w%jpvt(m%nq), w%qrwork(qr_lwork(m%neq, m%nq)), w%cs(m%nq), &
+              w%cwork(4 * m%nq), w%iwork(m%nq))
     w%qz = zero
+    w%cs = one
   end subroutine kin_work_init
 
-  !> Newton-Raphson on Phi(q, t) = 0 from q. On success w%jac holds the LU factors of J(q)
-  !! at the returned q, w%nu holds nu(q, t) and w%detsign the sign of det J.
+  !> Factor J D (J in w%jac, D = diag(w%cs)) by LU or, in least-squares mode, QR.
+  subroutine factor(w, status)
+    type(kin_work_t), intent(inout) :: w   !! work arrays
+    integer, intent(out) :: status         !! MBD_OK or MBD_SINGULAR
+    character(len=MSG_LEN) :: msg
+    integer :: k, n, info
+    real(wp) :: anorm
+    w%lu_count = w%lu_count + 1
+    n = size(w%cs)
+    anorm = zero
+    do k = 1, n
+      w%jac(:, k) = w%jac(:, k) * w%cs(k)
+      anorm = max(anorm, sum(abs(w%jac(:, k))))
+    end do
+    w%pivratio = zero
+    if (w%lsq) then
+      call qr_factor(w%jac, w%jpvt, w%tau, w%qrwork, status, msg)
+      if (status == MBD_OK) call dtrcon('1', 'U', 'N', n, w%jac, size(w%jac, 1), w%pivratio, &
+                                        w%cwork, w%iwork, info)
+    else
+      call lu_factor(w%jac, w%ipiv, status, msg)
+      if (status == MBD_OK) then
+        w%detsign = lu_det_sign(w%jac, w%ipiv)
+        ! cheap pivot ratio first; the condition estimate only where it may matter
+        w%pivratio = minval([(abs(w%jac(k, k)), k=1, n)]) / maxval([(abs(w%jac(k, k)), k=1, n)])
+        if (w%pivratio < COND_CHECK) call dgecon('1', n, w%jac, n, anorm, w%pivratio, &
+                                                 w%cwork, w%iwork, info)
+      end if
+    end if
+  end subroutine factor
+
+  !> Solve J x = b with the factors (least squares in QR mode; w%resid is its residual).
+  subroutine solve(w, b, x)
+    type(kin_work_t), intent(inout) :: w   !! work arrays with the factors
+    real(wp), intent(in) :: b(:)           !! right-hand side (neq)
+    real(wp), intent(out) :: x(:)          !! solution (nq)
+    integer :: st
+    character(len=MSG_LEN) :: msg
+    if (w%lsq) then
+      w%rhs(1:size(b)) = b
+      call qr_solve(w%jac, w%jpvt, w%tau, w%rhs(1:size(b)), x, w%resid, w%qrwork)
+    else
+      x = b
+      call lu_solve(w%jac, w%ipiv, x, st, msg)
+      w%resid = zero
+    end if
+    x = x * w%cs
+  end subroutine solve
+
+  !> Newton-Raphson on Phi(q, t) = 0 from q. On success w holds the factors of J(q) at the
+  !! returned q and w%nu = nu(q, t). In least-squares mode a correction that no longer
+  !! reduces Phi while ||Phi|| > tol means the redundant constraints contradict:
+  !! MBD_INCONSISTENT.
   subroutine kin_newton(m, w, q, t, maxit, status)
-    type(model_t), intent(in) :: m          !! model (square: neq = nq)
+    type(model_t), intent(in) :: m          !! model
     type(kin_work_t), intent(inout) :: w    !! work arrays
     real(wp), intent(inout) :: q(:)         !! start, then solution
     real(wp), intent(in) :: t               !! time
     integer, intent(in) :: maxit            !! iteration limit
-    integer, intent(out) :: status          !! MBD_OK, MBD_NO_CONVERGENCE or MBD_SINGULAR
-    character(len=MSG_LEN) :: msg
+    integer, intent(out) :: status          !! MBD_OK, MBD_NO_CONVERGENCE, MBD_SINGULAR, ...
     real(wp) :: res, res0
-    integer :: it, st
+    integer :: it
     res0 = huge(one)
     do it = 0, maxit
       call assemble_dense(m, q, w%qz, t, w%phi, w%nu, w%gam, w%jb, w%jac)
@@ -94,46 +183,45 @@ contains
       if (.not. (res <= huge(one))) exit                 ! NaN or overflow
       if (it > 0 .and. res > 1.0e3_wp * res0 .and. res > w%tol) exit   ! diverging
       if (it == 0) res0 = res
-      call lu_factor(w%jac, w%ipiv, st, msg)
-      w%lu_count = w%lu_count + 1
-      if (st /= MBD_OK) then
-        status = MBD_SINGULAR; return
-      end if
-      if (res <= w%tol) then
-        w%detsign = lu_det_sign(w%jac, w%ipiv)
-        status = MBD_OK; return
-      end if
+      call factor(w, status)
+      if (status /= MBD_OK) return
+      if (res <= w%tol) return
       if (it == maxit) exit
-      w%phi = -w%phi
-      call lu_solve(w%jac, w%ipiv, w%phi, st, msg)
-      q = q + w%phi
+      call solve(w, -w%phi, w%dq)
+      if (w%lsq .and. maxval(abs(w%dq)) <= 1.0e-3_wp * w%tol .and. res > w%tol) then
+        status = MBD_INCONSISTENT; return
+      end if
+      q = q + w%dq
       w%newton_its = w%newton_its + 1
     end do
     status = MBD_NO_CONVERGENCE
   end subroutine kin_newton
 
-  !> Velocities and accelerations at a converged q: J q_dot = nu, J q_ddot = gamma.
-  !! Uses the factorization kin_newton left in w.
-  subroutine kin_vel_acc(m, w, q, t, qd, qdd)
+  !> Velocities and accelerations at a converged q: J q_dot = nu, J q_ddot = gamma, with the
+  !! factors kin_newton left in w. status MBD_INCONSISTENT when a least-squares residual
+  !! shows the redundant constraints disagree at velocity or acceleration level.
+  subroutine kin_vel_acc(m, w, q, t, qd, qdd, status)
     type(model_t), intent(in) :: m          !! model
-    type(kin_work_t), intent(inout) :: w    !! work arrays (LU of J(q), nu(q, t))
+    type(kin_work_t), intent(inout) :: w    !! work arrays (factors of J(q), nu(q, t))
     real(wp), intent(in) :: q(:)            !! converged coordinates
     real(wp), intent(in) :: t               !! time
     real(wp), intent(out) :: qd(:)          !! velocities
     real(wp), intent(out) :: qdd(:)         !! accelerations
-    integer :: st
-    character(len=MSG_LEN) :: msg
-    qd = w%nu
-    call lu_solve(w%jac, w%ipiv, qd, st, msg)
+    integer, intent(out) :: status          !! MBD_OK or MBD_INCONSISTENT
+    status = MBD_OK
+    call solve(w, w%nu, qd)
+    if (w%resid > 1.0e-8_wp * (one + maxval(abs(w%nu)))) status = MBD_INCONSISTENT
     call assemble_blocks(m, q, qd, t, w%phi, w%nu, w%gam, w%jb)
-    qdd = w%gam
-    call lu_solve(w%jac, w%ipiv, qdd, st, msg)
+    call solve(w, w%gam, qdd)
+    if (w%resid > 1.0e-8_wp * (one + maxval(abs(w%gam)))) status = MBD_INCONSISTENT
   end subroutine kin_vel_acc
 
-  !> Assemble: from rough estimates q (extras are estimated here) find Phi(q, t) = 0 by a
-  !! Levenberg-Marquardt iteration (min ||Phi||^2, steps from (J^T J + mu I) dq = -J^T Phi
-  !! solved as least squares with dgels), then polish with Newton. On success w holds the
-  !! LU factors of J(q) and nu, ready for kin_vel_acc.
+  !> Assemble: from rough estimates q (extras are estimated here) minimize ||Phi(q, t)||^2 by
+  !! Levenberg-Marquardt (steps from the least-squares problem [J; sqrt(mu) I] dq = [-Phi; 0],
+  !! dgels), to ||Phi||_inf <= tol. Works for any number of equations. On failure the
+  !! residual and the constraint with the largest residual are reported; if J is rank
+  !! deficient there, the rows that contradict each other (those with a residual: at the
+  !! minimum Phi is orthogonal to the range of J) are flagged in rep%dep, MBD_INCONSISTENT.
   subroutine kin_assemble(m, w, q, t, opts, rep, status, msg)
     type(model_t), intent(in) :: m           !! model
     type(kin_work_t), intent(inout) :: w     !! work arrays
@@ -141,11 +229,12 @@ contains
     real(wp), intent(in) :: t                !! time
     type(kin_opts_t), intent(in) :: opts     !! settings
     type(kin_report_t), intent(inout) :: rep !! failure details
-    integer, intent(out) :: status           !! MBD_OK, MBD_ASSEMBLY_FAILED or MBD_SINGULAR
+    integer, intent(out) :: status           !! MBD_OK, MBD_ASSEMBLY_FAILED, MBD_INCONSISTENT
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
     real(wp), allocatable :: aug(:, :), rhs(:), work(:), qt(:), phit(:)
-    real(wp) :: mu, f, ft, wq(1), dmax
-    integer :: it, n, neq, info, lwork, i, k, st
+    real(wp) :: mu, f, ft, wq(1), dmax, pmax
+    integer :: it, n, neq, info, lwork, i, k, rank, st
+    integer, allocatable :: order(:)
 
     status = MBD_OK; msg = ''
     n = m%nq; neq = m%neq
@@ -163,7 +252,6 @@ contains
     mu = 1.0e-3_wp * max(dmax, one)
     do it = 1, opts%assembly_maxit
       if (maxval(abs(w%phi)) <= w%tol) exit
-      ! least squares [J; sqrt(mu) I] dq = [-Phi; 0]
       aug = zero
       aug(1:neq, :) = w%jac
       do i = 1, n
@@ -186,27 +274,65 @@ contains
         if (mu > 1.0e20_wp * max(dmax, one)) exit
       end if
     end do
-    if (maxval(abs(w%phi)) > 1.0e3_wp * w%tol) then
+    pmax = maxval(abs(w%phi))
+    if (pmax <= 1.0e3_wp * w%tol) return
+    rep%resid = pmax
+    rep%worst = m%con_of_row(maxloc(abs(w%phi), 1))
+    rep%t_fail = t
+    rep%qsing = q
+    allocate (order(neq))
+    call row_rank(w%jac, rank, order, st, msg)
+    if (st == MBD_OK .and. rank < neq) then
+      status = MBD_INCONSISTENT
+      rep%rank = rank
+      rep%dep = merge(1, 0, abs(w%phi) > DEP_TOL * pmax)
+      rep%redundant = 0
+      rep%redundant(order(rank + 1:neq)) = 1
+      write (msg, '(a,es10.3,a)') 'assembly failed: redundant constraints contradict each '// &
+        'other (smallest residual ||Phi|| = ', pmax, ')'
+    else
       status = MBD_ASSEMBLY_FAILED
-      rep%resid = maxval(abs(w%phi))
-      rep%worst = m%con_of_row(maxloc(abs(w%phi), 1))
-      rep%t_fail = t
       write (msg, '(a,es10.3,a,i0,a)') 'assembly failed: no configuration satisfies the '// &
-        'constraints near the estimates; smallest residual ||Phi|| = ', rep%resid, &
+        'constraints near the estimates; smallest residual ||Phi|| = ', pmax, &
         ', largest in constraint ', rep%worst, ' ('//trim(con_name(m%kind(rep%worst)))//')'
-      return
-    end if
-    call kin_newton(m, w, q, t, opts%maxit, st)
-    if (st /= MBD_OK) then
-      status = MBD_SINGULAR
-      rep%t_fail = t
-      call kin_singular_report(m, w, q, t, rep, st, msg)
-      status = MBD_SINGULAR
-      msg = 'the assembled configuration is singular (J loses rank): ' // trim(msg)
     end if
   end subroutine kin_assemble
 
-  !> SVD of J at q: which rows became dependent and which driver can no longer be met.
+  !> Rank of J at q and the redundant rows (1 in redundant, the rows pivoted last by a
+  !! rank-revealing QR of the row-normalized J^T: later rows are the ones called redundant).
+  !! mobility: nq minus the rank of the kinematic (non-driver) rows.
+  subroutine kin_rank(m, w, q, t, rank, mobility, redundant, status, msg)
+    type(model_t), intent(in) :: m           !! model
+    type(kin_work_t), intent(inout) :: w     !! work arrays
+    real(wp), intent(in) :: q(:)             !! configuration
+    real(wp), intent(in) :: t                !! time
+    integer, intent(out) :: rank             !! rank of J
+    integer, intent(out) :: mobility         !! degrees of freedom of the joints alone
+    integer, intent(out) :: redundant(:)     !! 1 for a redundant row (neq)
+    integer, intent(out) :: status           !! MBD_OK or MBD_LAPACK
+    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    integer, allocatable :: order(:), krows(:)
+    integer :: r, nk, rk
+    allocate (order(m%neq))
+    call assemble_dense(m, q, w%qz, t, w%phi, w%nu, w%gam, w%jb, w%jac)
+    call row_rank(w%jac, rank, order, status, msg)
+    if (status /= MBD_OK) return
+    redundant = 0
+    redundant(order(rank + 1:m%neq)) = 1
+    krows = pack([(r, r=1, m%neq)], [(.not. con_is_driver(m%kind(m%con_of_row(r))), r=1, m%neq)])
+    nk = size(krows)
+    if (nk == 0) then
+      mobility = m%nq
+    else
+      deallocate (order)
+      allocate (order(nk))
+      call row_rank(w%jac(krows, :), rk, order, status, msg)
+      mobility = m%nq - rk
+    end if
+  end subroutine kin_rank
+
+  !> SVD of the column-scaled J at q: which rows became dependent and which driver can no
+  !! longer be met.
   subroutine kin_singular_report(m, w, q, t, rep, status, msg)
     type(model_t), intent(in) :: m           !! model
     type(kin_work_t), intent(inout) :: w     !! work arrays
@@ -273,15 +399,16 @@ contains
     integer, intent(out) :: status             !! MBD_OK or the failure
     character(len=MSG_LEN), intent(out) :: msg !! explanation
     type(kin_work_t) :: w
-    real(wp), allocatable :: q(:), qd(:), qdd(:), qn(:), q3(:), qddn(:)
-    real(wp) :: t, h, hcur, hh, tt, target, lscale
-    integer :: k, st, detprev
-    logical :: last
+    real(wp), allocatable :: q(:), qd(:), qdd(:), qn(:), qp(:), q3(:), qddn(:), qdn(:)
+    real(wp), allocatable :: qa(:), qda(:), qdda(:), qb(:), qdb(:), qddb(:)
+    real(wp) :: t, h, hcur, hh, tt, target, lscale, ts, ta, d
+    integer :: k, j, st, detprev, mobility
+    logical :: last, ok
 
     status = MBD_OK; msg = ''
     qout = zero; qdout = zero; qddout = zero
-    allocate (rep%qsing(m%nq), rep%dep(m%neq))
-    rep%qsing = zero; rep%dep = 0
+    allocate (rep%qsing(m%nq), rep%dep(m%neq), rep%redundant(m%neq))
+    rep%qsing = zero; rep%dep = 0; rep%redundant = 0
     if (nsteps < 0 .or. .not. (abs(t1 - t0) <= huge(one)) .or. .not. (opts%tol > zero)) then
       status = MBD_BAD_SETTING; msg = 'steps must be >= 0, times finite, tolerance > 0'; return
     end if
@@ -291,13 +418,40 @@ contains
     call kin_work_init(m, w)
     lscale = max(m%lscale, maxval(abs(q0(1:3 * m%nb)), mask=mod([(k, k=1, 3 * m%nb)], 3) /= 0))
     w%tol = opts%tol * lscale
-    allocate (q(m%nq), qd(m%nq), qdd(m%nq), qn(m%nq), q3(m%nq), qddn(m%nq))
+    allocate (q(m%nq), qd(m%nq), qdd(m%nq), qn(m%nq), qp(m%nq), q3(m%nq), qddn(m%nq), &
+              qdn(m%nq), qa(m%nq), qda(m%nq), qdda(m%nq), qb(m%nq), qdb(m%nq), qddb(m%nq))
     q = q0
     call kin_assemble(m, w, q, t0, opts, rep, status, msg)
     if (status /= MBD_OK) then
       call count_work(); return
     end if
-    call kin_vel_acc(m, w, q, t0, qd, qdd)
+    call kin_rank(m, w, q, t0, rep%rank, mobility, rep%redundant, status, msg)
+    if (status /= MBD_OK) then
+      call count_work(); return
+    end if
+    if (rep%rank < m%nq) then
+      status = MBD_BAD_COUNT
+      write (msg, '(a,i0,a,i0,a,i0,a)') 'the model is not kinematically determined: J has rank ', &
+        rep%rank, ' for ', m%nq, ' coordinates (', m%nq - rep%rank, ' degrees of freedom left)'
+      call count_work(); return
+    end if
+    ! column scale from J at the assembled configuration (w%jac holds it after kin_rank)
+    do k = 1, m%nq
+      d = norm2(w%jac(:, k))
+      if (d > zero) w%cs(k) = one / d
+    end do
+    w%lsq = m%neq > m%nq
+    call kin_newton(m, w, q, t0, opts%maxit, st)
+    if (st /= MBD_OK .or. w%pivratio < NEAR_SING) then
+      call kin_singular_report(m, w, q, t0, rep, k, msg)
+      status = MBD_SINGULAR
+      msg = 'the assembled configuration is singular (J loses rank): ' // trim(msg)
+      call count_work(); return
+    end if
+    call kin_vel_acc(m, w, q, t0, qd, qdd, st)
+    if (st /= MBD_OK) then
+      call inconsistent(t0); return
+    end if
     qout(:, 1) = q; qdout(:, 1) = qd; qddout(:, 1) = qdd
     rep%ndone = 1
     detprev = w%detsign
@@ -308,52 +462,200 @@ contains
     end if
     h = (t1 - t0) / nsteps
     hcur = h
-    do k = 1, nsteps
-      target = t0 + (t1 - t0) * (real(k, wp) / nsteps)
-      if (k == nsteps) target = t1
+    k = 1
+    do while (k <= nsteps)
+      target = out_time(k)
+      ! land exactly on the output time (no sliver step from rounding of t)
+      last = hcur >= (target - t) * (one - 1.0e-9_wp)
+      hh = merge(target - t, hcur, last)
+      tt = merge(target, t + hh, last)
+      qp = q + hh * (qd + (half * hh) * (qdd + (hh / 3.0_wp) * q3))
+      qn = qp
+      call kin_newton(m, w, qn, tt, opts%maxit, st)
+      ok = st == MBD_OK .and. on_branch(JUMP_RATIO) .and. w%pivratio >= NEAR_SING
+      if (ok .and. .not. w%lsq) ok = w%detsign == detprev
+      if (ok .and. w%pivratio < ANCHOR_PIV) call polish(tt)
+      if (ok) then
+        call kin_vel_acc(m, w, qn, tt, qdn, qddn, st)
+        if (st /= MBD_OK) then
+          call inconsistent(tt); return
+        end if
+        ok = smooth_velocity(hh)
+      end if
+      if (ok) then
+        call accept()
+        if (last) call store(k)
+        hcur = min(2 * hh, h)
+        cycle
+      end if
+      if (st == MBD_INCONSISTENT) then
+        call inconsistent(tt); return
+      end if
+      rep%rejected = rep%rejected + 1
+      q3 = zero
+      hcur = half * hh
+      if (hcur >= opts%tmin * max(one, abs(t))) cycle
+      ! the configuration at t is singular (to tmin): pass through it or stop
+      call kin_singular_report(m, w, q, t, rep, st, msg)
+      if (st /= MBD_OK) then
+        status = MBD_LAPACK; call count_work(); return
+      end if
+      if (rep%smin > SING_RATIO * rep%smax) then
+        ! J is regular here: not a dead centre but a failed step
+        status = MBD_NO_CONVERGENCE
+        rep%dep = 0; rep%driver = 0; rep%deficiency = 0
+        write (msg, '(a,es22.15,a,es9.2,a)') 'no solution could be followed past t = ', t, &
+          ' although J is regular there (sigma_min/sigma_max = ', rep%smin / rep%smax, &
+          '): a driver may jump or grow too fast for the step'
+        call count_work(); return
+      end if
+      ! a bifurcation lets the motion continue: regular anchors d either side of ts, far
+      ! enough out that J is well conditioned there (pivot ratio >= ANCHOR_PIV)
+      ts = t
+      d = h / 64
       do
-        ! land exactly on the output time (no sliver step from rounding of t)
-        last = hcur >= (target - t) * (one - 1.0e-9_wp)
-        hh = merge(target - t, hcur, last)
-        tt = merge(target, t + hh, last)
-        qn = q + hh * (qd + (half * hh) * (qdd + (hh / 3.0_wp) * q3))
-        call kin_newton(m, w, qn, tt, opts%maxit, st)
-        if (st == MBD_OK .and. w%detsign == detprev) then
-          q = qn
-          call kin_vel_acc(m, w, q, tt, qd, qddn)
-          q3 = (qddn - qdd) / hh
-          qdd = qddn; t = tt
-          if (last) exit
-          hcur = min(2 * hh, h)
-        else
-          rep%rejected = rep%rejected + 1
-          q3 = zero
-          hcur = half * hh
-          if (hcur < opts%tmin * max(one, abs(t))) then
-            call kin_singular_report(m, w, q, t, rep, st, msg)
-            status = MBD_SINGULAR_CONFIG
-            if (st /= MBD_OK) then
-              status = MBD_LAPACK
-            else if (rep%smin > SING_RATIO * rep%smax) then
-              ! J is regular here: not a dead centre but a failed step
-              status = MBD_NO_CONVERGENCE
-              rep%dep = 0; rep%driver = 0; rep%deficiency = 0
-              write (msg, '(a,es22.15,a,es9.2,a)') 'no solution could be followed past t = ', t, &
-                ' although J is regular there (sigma_min/sigma_max = ', rep%smin / rep%smax, &
-                '): a driver may jump or grow too fast for the step'
-            end if
-            call count_work(); return
-          end if
+        if (.not. anchor(ts + d)) then
+          status = MBD_SINGULAR_CONFIG; call count_work(); return   ! no motion beyond
+        end if
+        if (w%pivratio >= ANCHOR_PIV .or. d >= 64 * h) exit
+        d = 2 * d
+      end do
+      qb = qn; qdb = qdn; qddb = qddn
+      detprev = w%detsign
+      ta = ts - d
+      if (.not. anchor(ta)) then
+        status = MBD_SINGULAR_CONFIG; call count_work(); return
+      end if
+      qa = qn; qda = qdn; qdda = qddn
+      qn = qb; qdn = qdb; qddn = qddb
+      rep%npass = rep%npass + 1
+      if (rep%npass <= MAXPASS) rep%tpass(rep%npass) = ts
+      rep%dep = 0; rep%driver = 0; rep%deficiency = 0; msg = ''
+      ! outputs inside (ta, ts + d]: interpolate; earlier ones there are replaced
+      do j = 0, nsteps
+        if (out_time(j) > ta .and. out_time(j) <= ts + d) then
+          call hermite5(ta, qa, qda, qdda, ts + d, qn, qdn, qddn, out_time(j), qout(:, j + 1), &
+                        qdout(:, j + 1), qddout(:, j + 1))
+          rep%ndone = max(rep%ndone, j + 1)
+          if (j >= k) k = j + 1
         end if
       end do
-      qout(:, k + 1) = q; qdout(:, k + 1) = qd; qddout(:, k + 1) = qdd
-      rep%ndone = k + 1
+      tt = ts + d
+      q3 = zero
+      call accept()
+      q3 = zero
+      hcur = h
     end do
     call count_work()
+
   contains
+
+    !> Output time k (exact at both ends).
+    real(wp) function out_time(kk)
+      integer, intent(in) :: kk
+      out_time = t0 + (t1 - t0) * (real(kk, wp) / nsteps)
+      if (kk == nsteps) out_time = t1
+    end function out_time
+
+    !> The Newton correction is small against the predicted motion: same branch.
+    logical function on_branch(ratio)
+      real(wp), intent(in) :: ratio
+      on_branch = maxval(abs(qn - qp)) <= max(ratio * maxval(abs(qp - q)), 1.0e3_wp * w%tol)
+    end function on_branch
+
+    !> The new velocity continues the old one: at a switch to another branch through a
+    !! singular point the velocity jumps by O(|q_dot|), in smooth motion it differs from its
+    !! Taylor prediction by O(h**3).
+    logical function smooth_velocity(hs)
+      real(wp), intent(in) :: hs
+      real(wp) :: vpred(size(qd))
+      vpred = qd + hs * (qdd + (half * hs) * q3)
+      smooth_velocity = maxval(abs(qdn - vpred)) <= &
+        VJUMP_RATIO * (maxval(abs(qd)) + maxval(abs(vpred - qd))) + 1.0e3_wp * w%tol
+    end function smooth_velocity
+
+    !> One more Newton correction at tp (when J is poorly conditioned).
+    subroutine polish(tp)
+      real(wp), intent(in) :: tp
+      integer :: st2
+      call solve(w, -w%phi, w%dq)
+      qn = qn + w%dq
+      call assemble_dense(m, qn, w%qz, tp, w%phi, w%nu, w%gam, w%jb, w%jac)
+      call factor(w, st2)
+      if (st2 /= MBD_OK) w%pivratio = zero
+    end subroutine polish
+
+    !> A regular state (qn, qdn, qddn) at time ta2 on the predicted branch from (t, q).
+    !! First-order predictor: next to the singular point q_dot is still accurate (error
+    !! ~ cond eps) but q_ddot is not (~ cond**2 eps).
+    logical function anchor(ta2)
+      real(wp), intent(in) :: ta2
+      real(wp) :: hj
+      integer :: st2
+      hj = ta2 - t
+      qp = q + hj * qd
+      qn = qp
+      call kin_newton(m, w, qn, ta2, opts%maxit, st2)
+      anchor = st2 == MBD_OK .and. on_branch(0.25_wp)
+      if (.not. anchor) return
+      ! one more correction: errors grow like cond, cond**2, cond**3 in q, q_dot, q_ddot
+      call polish(ta2)
+      anchor = w%pivratio > zero
+      if (anchor) call kin_vel_acc(m, w, qn, ta2, qdn, qddn, st2)
+      anchor = anchor .and. st2 == MBD_OK
+    end function anchor
+
+    subroutine accept()
+      q3 = (qddn - qdd) / (tt - t)
+      q = qn; qd = qdn; qdd = qddn; t = tt
+    end subroutine accept
+
+    subroutine store(kk)
+      integer, intent(inout) :: kk
+      qout(:, kk + 1) = q; qdout(:, kk + 1) = qd; qddout(:, kk + 1) = qdd
+      if (w%pivratio < ANCHOR_PIV) call refine_output(kk)
+      rep%ndone = kk + 1
+      kk = kk + 1
+    end subroutine store
+
+    !> Output kk sits where J is poorly conditioned (near a singular point): its q_ddot (error
+    !! ~ cond**3 tol) is replaced by quintic Hermite interpolation between regular anchors at
+    !! t -+ d, d doubled from h/64 until J is well conditioned at both. The stepping state
+    !! is left as it is. If no regular anchor exists on one side (a dead centre), the direct
+    !! values stay.
+    subroutine refine_output(kk)
+      integer, intent(in) :: kk
+      real(wp) :: dd
+      dd = h / 64
+      do
+        if (.not. anchor(t - dd)) return
+        if (w%pivratio >= ANCHOR_PIV) then
+          qa = qn; qda = qdn; qdda = qddn
+          if (.not. anchor(t + dd)) return
+          if (w%pivratio >= ANCHOR_PIV) exit
+        end if
+        if (dd >= 64 * h) return
+        dd = 2 * dd
+      end do
+      call hermite5(t - dd, qa, qda, qdda, t + dd, qn, qdn, qddn, t, qout(:, kk + 1), &
+                    qdout(:, kk + 1), qddout(:, kk + 1))
+    end subroutine refine_output
+
+    subroutine inconsistent(tf)
+      real(wp), intent(in) :: tf
+      status = MBD_INCONSISTENT
+      rep%t_fail = tf; rep%qsing = qn
+      rep%resid = maxval(abs(w%phi))
+      rep%dep = merge(1, 0, abs(w%phi) > DEP_TOL * rep%resid)
+      write (msg, '(a,es22.15,a)') 'redundant constraints contradict each other at t = ', tf, &
+        ' (least-squares residual left)'
+      call count_work()
+    end subroutine inconsistent
+
     subroutine count_work()
       rep%newton_its = w%newton_its; rep%lu_count = w%lu_count
     end subroutine count_work
+
   end subroutine kin_run
 
 end module mbd_kinematics

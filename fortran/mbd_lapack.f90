@@ -3,7 +3,8 @@ module mbd_lapack
   use mbd_kinds, only: wp
   implicit none
   private
-  public :: dgetrf, dgetf2, dgetrs, dgesvd, dgels, dgtsv
+  public :: dgetrf, dgetf2, dgetrs, dgesvd, dgels, dgtsv, dgeqp3, dormqr, dtrtrs, dgecon, &
+            dtrcon
 
   interface
     !> LU factorization with partial pivoting.
@@ -50,6 +51,52 @@ module mbd_lapack
       real(wp), intent(out) :: work(*)
       integer, intent(out) :: info
     end subroutine dgels
+    !> QR factorization with column pivoting (rank revealing).
+    pure subroutine dgeqp3(m, n, a, lda, jpvt, tau, work, lwork, info)
+      import :: wp
+      integer, intent(in) :: m, n, lda, lwork
+      real(wp), intent(inout) :: a(lda, *)
+      integer, intent(inout) :: jpvt(*)
+      real(wp), intent(out) :: tau(*), work(*)
+      integer, intent(out) :: info
+    end subroutine dgeqp3
+    !> Apply Q or Q^T from a QR factorization.
+    pure subroutine dormqr(side, trans, m, n, k, a, lda, tau, c, ldc, work, lwork, info)
+      import :: wp
+      character(len=1), intent(in) :: side, trans
+      integer, intent(in) :: m, n, k, lda, ldc, lwork
+      real(wp), intent(in) :: a(lda, *), tau(*)
+      real(wp), intent(inout) :: c(ldc, *)
+      real(wp), intent(out) :: work(*)
+      integer, intent(out) :: info
+    end subroutine dormqr
+    !> Triangular solve.
+    pure subroutine dtrtrs(uplo, trans, diag, n, nrhs, a, lda, b, ldb, info)
+      import :: wp
+      character(len=1), intent(in) :: uplo, trans, diag
+      integer, intent(in) :: n, nrhs, lda, ldb
+      real(wp), intent(in) :: a(lda, *)
+      real(wp), intent(inout) :: b(ldb, *)
+      integer, intent(out) :: info
+    end subroutine dtrtrs
+    !> Reciprocal condition number estimate from LU factors.
+    pure subroutine dgecon(norm, n, a, lda, anorm, rcond, work, iwork, info)
+      import :: wp
+      character(len=1), intent(in) :: norm
+      integer, intent(in) :: n, lda
+      real(wp), intent(in) :: a(lda, *), anorm
+      real(wp), intent(out) :: rcond, work(*)
+      integer, intent(out) :: iwork(*), info
+    end subroutine dgecon
+    !> Reciprocal condition number estimate of a triangular matrix.
+    pure subroutine dtrcon(norm, uplo, diag, n, a, lda, rcond, work, iwork, info)
+      import :: wp
+      character(len=1), intent(in) :: norm, uplo, diag
+      integer, intent(in) :: n, lda
+      real(wp), intent(in) :: a(lda, *)
+      real(wp), intent(out) :: rcond, work(*)
+      integer, intent(out) :: iwork(*), info
+    end subroutine dtrcon
     !> Tridiagonal solve.
     pure subroutine dgtsv(n, nrhs, dl, d, du, b, ldb, info)
       import :: wp

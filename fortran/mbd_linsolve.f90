@@ -4,15 +4,23 @@
 !!   lu_solve    A x = b from the factors (dgetrs)
 !!   lu_det_sign sign of det A from the factors: prod(sign U_ii) * (-1)**(row swaps)
 !!   svd_null    singular values of A and the singular vectors of the smallest one (dgesvd)
+!!   row_rank    rank of A and an independent set of its rows: QR with column pivoting of the
+!!               row-normalized A^T (dgeqp3); the rows pivoted last are the redundant ones
+!!   qr_factor   A = Q R P^T for least squares (dgeqp3), A m x n with m >= n
+!!   qr_solve    x = argmin ||A x - b|| for full column rank: R x_p = (Q^T b)(1:n) (dormqr,
+!!               dtrtrs), x = P x_p; also returns the residual ||(Q^T b)(n+1:m)||
 module mbd_linsolve
   use mbd_kinds, only: wp, zero
   use mbd_status, only: MBD_OK, MBD_SINGULAR, MBD_LAPACK, MSG_LEN
-  use mbd_lapack, only: dgetrf, dgetf2, dgetrs, dgesvd
+  use mbd_lapack, only: dgetrf, dgetf2, dgetrs, dgesvd, dgeqp3, dormqr, dtrtrs
   implicit none
   private
-  public :: lapack_status, lu_factor, lu_solve, lu_det_sign, svd_null
+  public :: lapack_status, lu_factor, lu_solve, lu_det_sign, svd_null, row_rank
+  public :: qr_factor, qr_solve, qr_lwork, RANK_TOL
 
   integer, parameter :: SMALL_N = 48   !! below this the unblocked dgetf2 is faster
+  !> |R_kk| / |R_11| of the row-normalized matrix below which a row is dependent
+  real(wp), parameter :: RANK_TOL = 1.0e-8_wp
 
 contains
 
@@ -106,5 +114,95 @@ contains
     u = um(:, min(m, n))
     v = vt(min(m, n), :)
   end subroutine svd_null
+
+  !> Rank of A (m x n) and its rows ordered independent first: order(1:rank) is an
+  !! independent set, order(rank+1:m) the rows that depend on them. Rows are scaled to unit
+  !! length first, so the answer does not depend on units; of equal rows the later ones are
+  !! the redundant ones. Allocates: not for time loops.
+  subroutine row_rank(a, rank, order, status, msg)
+    real(wp), intent(in) :: a(:, :)             !! matrix (unchanged)
+    integer, intent(out) :: rank                !! numerical rank
+    integer, intent(out) :: order(:)            !! row order (m)
+    integer, intent(out) :: status              !! MBD_OK or MBD_LAPACK
+    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    real(wp), allocatable :: at(:, :), tau(:), work(:)
+    real(wp) :: wq(1), nrm, r11
+    integer :: m, n, i, info, lwork
+    m = size(a, 1); n = size(a, 2)
+    allocate (at(n, m), tau(min(m, n)))
+    do i = 1, m
+      nrm = norm2(a(i, :))
+      if (nrm > zero) then
+        ! a slight bias to earlier rows: of equal rows, the later ones are called redundant
+        at(:, i) = a(i, :) / nrm * (1.0_wp - 1.0e-3_wp * (i - 1) / m)
+      else
+        at(:, i) = zero
+      end if
+    end do
+    order = 0
+    call dgeqp3(n, m, at, n, order, tau, wq, -1, info)
+    lwork = max(1, int(wq(1)))
+    allocate (work(lwork))
+    call dgeqp3(n, m, at, n, order, tau, work, lwork, info)
+    call lapack_status('dgeqp3', info, status, msg)
+    if (status /= MBD_OK) return
+    rank = 0
+    r11 = abs(at(1, 1))
+    do i = 1, min(m, n)
+      if (abs(at(i, i)) > RANK_TOL * r11) rank = rank + 1
+    end do
+  end subroutine row_rank
+
+  !> Workspace length for qr_factor and qr_solve on an m x n matrix.
+  integer function qr_lwork(m, n) result(lwork)
+    integer, intent(in) :: m, n   !! matrix size
+    real(wp) :: a(1, 1), tau(1), wq(1), c(1, 1)
+    integer :: jp(1), info
+    call dgeqp3(m, n, a, max(1, m), jp, tau, wq, -1, info)
+    lwork = int(wq(1))
+    call dormqr('L', 'T', m, 1, n, a, max(1, m), tau, c, max(1, m), wq, -1, info)
+    lwork = max(lwork, int(wq(1)), 1)
+  end function qr_lwork
+
+  !> QR factorization with column pivoting, A = Q R P^T, in place.
+  subroutine qr_factor(a, jpvt, tau, work, status, msg)
+    real(wp), intent(inout) :: a(:, :)          !! m x n, m >= n; factors on return
+    integer, intent(out) :: jpvt(:)             !! column permutation
+    real(wp), intent(out) :: tau(:)             !! reflector scalars
+    real(wp), intent(inout) :: work(:)          !! workspace (qr_lwork)
+    integer, intent(out) :: status              !! MBD_OK or MBD_SINGULAR
+    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    integer :: m, n, info, i
+    m = size(a, 1); n = size(a, 2)
+    jpvt = 0
+    call dgeqp3(m, n, a, m, jpvt, tau, work, size(work), info)
+    call lapack_status('dgeqp3', info, status, msg)
+    if (status /= MBD_OK) return
+    do i = 1, n
+      if (.not. (abs(a(i, i)) > RANK_TOL * abs(a(1, 1)))) then
+        status = MBD_SINGULAR
+        write (msg, '(a,i0,a,i0,a)') 'Jacobian has rank ', i - 1, ' < ', n, ' coordinates'
+        return
+      end if
+    end do
+  end subroutine qr_factor
+
+  !> Least-squares solution from qr_factor: b(1:n) becomes x, resid = ||A x - b||.
+  subroutine qr_solve(a, jpvt, tau, b, x, resid, work)
+    real(wp), intent(in) :: a(:, :)             !! factors (m x n)
+    integer, intent(in) :: jpvt(:)              !! column permutation
+    real(wp), intent(in) :: tau(:)              !! reflector scalars
+    real(wp), intent(inout) :: b(:)             !! right-hand side (m), overwritten
+    real(wp), intent(out) :: x(:)               !! solution (n)
+    real(wp), intent(out) :: resid              !! residual norm
+    real(wp), intent(inout) :: work(:)          !! workspace
+    integer :: m, n, info
+    m = size(a, 1); n = size(a, 2)
+    call dormqr('L', 'T', m, 1, n, a, m, tau, b, m, work, size(work), info)
+    call dtrtrs('U', 'N', 'N', n, 1, a, m, b, m, info)
+    x(jpvt(1:n)) = b(1:n)
+    resid = zero
+    if (m > n) resid = norm2(b(n + 1:m))
+  end subroutine qr_solve
 
 end module mbd_linsolve

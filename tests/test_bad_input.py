@@ -204,9 +204,6 @@ CASES = {
     "not determined: driver missing": (
         BODIES + JOINTS,
         r"model 'bad'.*not kinematically determined: 8 equations for 9 coordinates"),
-    "not determined: one driver too many": (
-        VALID + driver("extra", 'type = "absolute"\nbody = "rod"\ncoordinate = "x"\nf = 1.0'),
-        r"model 'bad'.*10 equations for 9 coordinates"),
     # ---- types and keys
     "unknown joint type": (
         BODIES + joint("scissor", 'type = "scissor"\nbodies = ["crank", "rod"]'),

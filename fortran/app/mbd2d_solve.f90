@@ -10,14 +10,15 @@ program mbd2d_solve
   use mbd_mbdfile, only: mbd_spec_t, mbd_read
   use mbd_constraints, only: con_nrow
   use mbd_api, only: NINFO, api_sizes, api_kinematics
+  use mbd_kinematics, only: MAXPASS
   implicit none
   type(mbd_spec_t) :: spec
   character(len=1024) :: model_path, out_path
   character(len=MSG_LEN) :: msg
   integer :: status, bad, nq, neq, k, iinfo(NINFO)
   real(wp) :: rinfo(NINFO)
-  real(wp), allocatable :: q0(:), qout(:, :), qdout(:, :), qddout(:, :), qsing(:)
-  integer, allocatable :: dep(:)
+  real(wp), allocatable :: q0(:), qout(:, :), qdout(:, :), qddout(:, :), qsing(:), tpass(:)
+  integer, allocatable :: dep(:), redundant(:)
 
   if (command_argument_count() /= 2) then
     write (*, '(a)') 'usage: mbd2d-solve MODEL.mbd OUT.csv'
@@ -39,12 +40,12 @@ program mbd2d_solve
   if (status /= MBD_OK) call die(2, trim(where(bad)) // trim(msg))
 
   allocate (q0(nq), qout(nq, spec%steps + 1), qdout(nq, spec%steps + 1), &
-            qddout(nq, spec%steps + 1), qsing(nq), dep(neq))
+            qddout(nq, spec%steps + 1), qsing(nq), dep(neq), redundant(neq), tpass(MAXPASS))
   q0 = 0.0_wp
   q0(1:3 * spec%nb) = reshape(spec%q0, [3 * spec%nb])
   call api_kinematics(spec%nb, spec%ctab, spec%rpar, q0, spec%t0, spec%t_end, spec%steps, &
                       spec%tol, spec%maxit, spec%tmin, qout, qdout, qddout, iinfo, rinfo, &
-                      qsing, dep, status, msg)
+                      qsing, dep, redundant, tpass, status, msg)
   if (status < 0) call die(2, trim(where(iinfo(2))) // trim(msg))
   call write_csv(trim(out_path), iinfo(1))
   if (status == MBD_SINGULAR_CONFIG) then

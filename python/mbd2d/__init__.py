@@ -10,8 +10,11 @@ Examples
 """
 from __future__ import annotations
 
-from .errors import (AnalysisError, AssemblyError, ConvergenceError, CoreError, MbdError,
-                     ModelError, SingularConfigurationError, SingularJacobianError, ToggleError)
+from .analysis import DofReport
+from .errors import (AnalysisError, AssemblyError, ConvergenceError, CoreError,
+                     InconsistentConstraintsError, MbdError, MbdWarning, ModelError,
+                     RedundantConstraintWarning, SingularConfigurationError,
+                     SingularJacobianError, SingularPassageWarning, ToggleError)
 from .functions import Harmonic, TimeFunction
 from .model import Model
 from .results import BodyResult, KinematicsResult
@@ -20,6 +23,7 @@ from .toml_io import load, loads
 __version__ = "0.1.0"
 
 __all__ = ["load", "loads", "Model", "TimeFunction", "Harmonic", "KinematicsResult",
-           "BodyResult", "MbdError", "ModelError", "AnalysisError", "AssemblyError",
-           "ConvergenceError", "SingularJacobianError", "SingularConfigurationError",
-           "ToggleError", "CoreError", "__version__"]
+           "BodyResult", "DofReport", "MbdError", "ModelError", "AnalysisError",
+           "AssemblyError", "InconsistentConstraintsError", "ConvergenceError",
+           "SingularJacobianError", "SingularConfigurationError", "ToggleError", "CoreError",
+           "MbdWarning", "RedundantConstraintWarning", "SingularPassageWarning", "__version__"]

@@ -1,15 +1,18 @@
 """The analysis front door: settings checks, the one call into the core, and the mapping
-of the core's status to results or typed exceptions."""
+of the core's status to results, warnings or typed exceptions."""
 from __future__ import annotations
 
 import math
+import warnings
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from . import _core
-from .errors import (AssemblyError, ConvergenceError, CoreError, ModelError,
-                     SingularConfigurationError, SingularJacobianError)
+from .errors import (AssemblyError, ConvergenceError, CoreError, InconsistentConstraintsError,
+                     ModelError, RedundantConstraintWarning, SingularConfigurationError,
+                     SingularJacobianError, SingularPassageWarning)
 from .pack import Packed, decode, pack
 from .results import KinematicsResult
 from .validate import is_number, number, whole
@@ -18,9 +21,8 @@ if TYPE_CHECKING:  # pragma: no cover
     from .model import Model
 
 # status codes of mbd_status.f90
-OK, SINGULAR, NO_CONVERGENCE, SINGULAR_CONFIG, ASSEMBLY_FAILED, LAPACK = 0, 1, 2, 3, 4, 5
-
-
+OK, SINGULAR, NO_CONVERGENCE, SINGULAR_CONFIG, ASSEMBLY_FAILED, LAPACK, INCONSISTENT = range(7)
+BAD_COUNT = -4
 MAX_STEPS = 10**9      # output rows are held in memory; the core counts in 32-bit integers
 MIN_TOL = 1e-15        # below this a residual test cannot pass in double precision
 
@@ -47,21 +49,20 @@ def check_solver(tol: Any, maxit: Any) -> tuple[float, int]:
     return t, it
 
 
-def require_determined(p: Packed, model: "Model") -> None:
-    """Kinematics needs as many independent equations as coordinates."""
-    if p.neq == p.nq:
-        return
+def _count_detail(p: Packed) -> str:
     ncam = p.nq - 3 * p.nb
-    detail = (f"{p.neq} equations for {p.nq} coordinates ({p.nb} bodies x 3"
-              + (f" + {ncam} cam contact parameters" if ncam else "") + ")")
-    if p.neq < p.nq:
-        hint = (f"{p.nq - p.neq} degree(s) of freedom are not driven: add a driver for each "
-                "(or a joint you left out)")
-    else:
-        hint = (f"{p.neq - p.nq} equation(s) too many: remove a driver or a joint that repeats "
-                "another")
-    raise ModelError(f"the model is not kinematically determined: {detail}; {hint}",
-                     f"model {model.name!r}")
+    return (f"{p.neq} equations for {p.nq} coordinates ({p.nb} bodies x 3"
+            + (f" + {ncam} cam contact (or curve) parameters" if ncam else "") + ")")
+
+
+def require_determined(p: Packed, model: "Model") -> None:
+    """Kinematics needs at least as many equations as coordinates (the core then checks the
+    rank at the assembled configuration)."""
+    if p.neq >= p.nq:
+        return
+    raise ModelError(f"the model is not kinematically determined: {_count_detail(p)}; "
+                     f"{p.nq - p.neq} degree(s) of freedom are not driven: add a driver for each "
+                     "(or a joint you left out)", f"model {model.name!r}")
 
 
 def evaluate(model: "Model", q: Any, qd: Any, t: float) -> tuple[np.ndarray, ...]:
@@ -90,6 +91,120 @@ def _state(x: Any, n: int, what: str) -> np.ndarray:
     return np.ascontiguousarray(v)
 
 
+def _names(p: Packed, model: "Model", flags: np.ndarray) -> tuple[list[str], list[str]]:
+    """(constraint names, row labels) of the flagged rows."""
+    rows = [int(r) for r in np.flatnonzero(flags)]
+    cons = sorted({p.row_owner[r] for r in rows})
+    return [model.constraints[k].name for k in cons], [p.row_labels[r] for r in rows]
+
+
+@dataclass
+class DofReport:
+    """Degrees of freedom and redundancy at an assembled configuration.
+
+    Attributes
+    ----------
+    coordinates : int
+        Number of coordinates (3 per body plus curve parameters).
+    equations : int
+        Number of constraint equations (joints and drivers).
+    rank : int
+        Rank of the constraint Jacobian J (rank-revealing QR, LAPACK dgeqp3).
+    dof : int
+        coordinates - rank: the motion left free (0 for a driven mechanism).
+    mobility : int
+        Degrees of freedom of the joints alone (without drivers).
+    redundant_rows : list of str
+        Row labels of the redundant equations (NAME.equation).
+    redundant_constraints : list of str
+        The joints or drivers those rows belong to.
+    q : numpy.ndarray
+        The assembled configuration.
+    """
+
+    model_name: str
+    t: float
+    coordinates: int
+    equations: int
+    rank: int
+    dof: int
+    mobility: int
+    redundant_rows: list[str] = field(default_factory=list)
+    redundant_constraints: list[str] = field(default_factory=list)
+    q: np.ndarray = field(default_factory=lambda: np.zeros(0))
+
+    def __str__(self) -> str:
+        lines = [f"model '{self.model_name}' at t = {self.t:g}",
+                 f"  coordinates        {self.coordinates}",
+                 f"  equations          {self.equations}",
+                 f"  rank of J          {self.rank}",
+                 f"  degrees of freedom {self.dof}   (coordinates - rank)",
+                 f"  mobility           {self.mobility}   (joints alone, without drivers)",
+                 f"  redundant          {len(self.redundant_rows)} equation(s)"]
+        for r in self.redundant_rows:
+            lines.append(f"    {r}")
+        if self.redundant_rows:
+            lines.append("  redundant equations repeat what the others impose: kinematics solves "
+                         "them in least squares; reactions are statically indeterminate")
+        return "\n".join(lines)
+
+
+def analyze_dof(model: "Model", t: float = 0.0, tol: float | None = None) -> DofReport:
+    """Degrees of freedom and redundant constraints at the configuration assembled from q0.
+
+    Raises
+    ------
+    InconsistentConstraintsError
+        If redundant constraints contradict each other (names them and gives the residual).
+    AssemblyError
+        If no configuration satisfies the constraints near q0.
+    """
+    t = number(t, "t", "analysis")
+    tol_v, _ = check_solver(tol, None)
+    p = pack(model)
+    q, rank, mobility, red, dep, resid, worst, status, msg = _core.core_analyze(
+        p.nb, p.ctab, p.rpar, p.neq, p.q0, t, tol_v)
+    if status < 0:
+        raise ModelError(decode(msg), model.constraints[worst - 1].describe() if worst else
+                         f"model {model.name!r}")
+    if status == INCONSISTENT:
+        raise _inconsistent(model, p, float(resid), dep, red, int(rank), t, None)
+    if status == ASSEMBLY_FAILED:
+        raise _assembly_failed(model, float(resid), worst, t, None)
+    if status != OK:
+        raise CoreError(f"internal error in the core (status {status}): {decode(msg)}")
+    cons, rows = _names(p, model, red)
+    return DofReport(model.name, t, p.nq, p.neq, int(rank), p.nq - int(rank), int(mobility),
+                     rows, cons, q)
+
+
+def _inconsistent(model: "Model", p: Packed, resid: float, dep: np.ndarray, red: np.ndarray,
+                  rank: int, t: float, res: KinematicsResult | None
+                  ) -> InconsistentConstraintsError:
+    cons, rows = _names(p, model, dep)
+    red_cons, red_rows = _names(p, model, red)
+    lead = (f"{', '.join(red_rows)} ({len(red_rows)} redundant equation(s): {p.neq} equations, "
+            f"rank {rank}) contradict(s) the other constraints; " if red_rows and rank else "")
+    return InconsistentConstraintsError(
+        f"Redundant constraints contradict each other at t = {t:.6g} s: {lead}"
+        f"{', '.join(cons)} cannot all hold (smallest residual ||Phi|| = {resid:.3g}). "
+        "Check their points and dimensions, or remove the one that repeats another.",
+        t=t, results=res, status=INCONSISTENT, constraints=cons, redundant=red_cons,
+        residual=resid)
+
+
+def _assembly_failed(model: "Model", resid: float, worst: int, t: float,
+                     res: KinematicsResult | None) -> AssemblyError:
+    cons = model.constraints
+    name = cons[worst - 1].describe() if worst > 0 else "?"
+    return AssemblyError(
+        f"Assembly failed at t = {t:.6g} s: no configuration satisfies the constraints near "
+        f"the q0 estimates (smallest residual {resid:.3g}, largest in {name}). Check the "
+        "link lengths and joint points, and give q0 closer to the intended configuration.",
+        t=t, results=res, status=ASSEMBLY_FAILED, residual=resid,
+        constraint=cons[worst - 1].name if worst > 0 else None)
+
+
 def run_kinematics(model: "Model", t_end: float, steps: int, t0: float = 0.0,
                    tol: float | None = None, maxit: int | None = None,
                    tmin: float | None = None) -> KinematicsResult:
@@ -100,35 +215,59 @@ def run_kinematics(model: "Model", t_end: float, steps: int, t0: float = 0.0,
     require_determined(p, model)
     out = _core.core_kinematics(p.nb, p.ctab, p.rpar, p.neq, p.q0, t0, t_end, steps,
                                 tol_v, maxit_v, float(tmin or 0.0))
-    qout, qdout, qddout, iinfo, rinfo, qsing, dep, status, msg = out
+    qout, qdout, qddout, iinfo, rinfo, qsing, dep, red, tpass, status, msg = out
     n = int(iinfo[0])
     t = t0 + (t_end - t0) * (np.arange(steps + 1) / steps)
     t[-1] = t_end
+    npass = int(iinfo[9])
+    red_cons, red_rows = _names(p, model, red)
     res = KinematicsResult(t=t[:n], q=qout.T[:n].copy(), qd=qdout.T[:n].copy(),
                            qdd=qddout.T[:n].copy(), body_names=p.body_names,
                            coordinate_names=p.coordinate_names,
                            stats={"newton_corrections": int(iinfo[5]),
-                                  "lu_factorizations": int(iinfo[6]),
-                                  "rejected_steps": int(iinfo[7])},
+                                  "factorizations": int(iinfo[6]),
+                                  "rejected_steps": int(iinfo[7]),
+                                  "rank": int(iinfo[8]),
+                                  "redundant_rows": red_rows,
+                                  "singular_passages": [float(x) for x in tpass[:min(npass, 64)]],
+                                  "singular_passage_count": npass},
                            complete=status == OK, model=model)
+    if red_rows and status in (OK, SINGULAR_CONFIG, NO_CONVERGENCE):
+        warnings.warn(f"redundant constraints: {', '.join(red_rows)} repeat what the other "
+                      "constraints impose (rank of J is "
+                      f"{int(iinfo[8])} for {p.neq} equations); kinematics solves them in least "
+                      "squares, exactly while they agree", RedundantConstraintWarning,
+                      stacklevel=3)
+    if npass:
+        times = ", ".join(f"{x:.6g}" for x in tpass[:min(npass, 5)])
+        warnings.warn(f"passed through {npass} singular configuration(s) (bifurcation points, "
+                      f"J lost rank) at t = {times}{' ...' if npass > 5 else ''} s and stayed on "
+                      "the branch the run started on", SingularPassageWarning, stacklevel=3)
     if status == OK:
         return res
-    raise _failure(model, p, int(status), decode(msg), iinfo, rinfo, qsing, dep, res)
+    raise _failure(model, p, int(status), decode(msg), iinfo, rinfo, qsing, dep, red, res)
 
 
 def _failure(model: "Model", p: Packed, status: int, msg: str, iinfo: np.ndarray,
-             rinfo: np.ndarray, qsing: np.ndarray, dep: np.ndarray,
+             rinfo: np.ndarray, qsing: np.ndarray, dep: np.ndarray, red: np.ndarray,
              res: KinematicsResult) -> Exception:
     """The typed exception for a core status, with names in the message."""
     cons = model.constraints
+    if status == BAD_COUNT and int(iinfo[8]) > 0:
+        rank = int(iinfo[8])
+        return ModelError(f"the model is not kinematically determined at the assembled "
+                          f"configuration: J has rank {rank} for {p.nq} coordinates "
+                          f"({_count_detail(p)}), so {p.nq - rank} degree(s) of freedom are "
+                          "not driven; run model.analyze_dof() to see which equations are "
+                          "redundant, and add a driver for each free degree of freedom",
+                          f"model {model.name!r}")
     if status < 0:
         bad = int(iinfo[1])
         return ModelError(msg, cons[bad - 1].describe() if bad else f"model {model.name!r}")
     t = float(rinfo[0])
     last = f"t = {res.t[-1]:.6g} s" if len(res.t) else "no output rows"
     if status in (SINGULAR_CONFIG, SINGULAR):
-        dependent = sorted({p.row_owner[r] for r in np.flatnonzero(dep)})
-        dep_names = [cons[k].name for k in dependent]
+        dep_names, _ = _names(p, model, dep)
         drv = int(iinfo[2])
         driver = cons[drv - 1].name if drv > 0 else None
         ratio = rinfo[1] / rinfo[2] if rinfo[2] > 0 else 0.0
@@ -150,15 +289,10 @@ def _failure(model: "Model", p: Packed, status: int, msg: str, iinfo: np.ndarray
         return cls(text, t=t, results=res, status=status, driver=driver,
                    dependent=dep_names, q=np.array(qsing), sigma_min=float(rinfo[1]),
                    sigma_max=float(rinfo[2]))
+    if status == INCONSISTENT:
+        return _inconsistent(model, p, float(rinfo[3]), dep, red, int(iinfo[8]), t, res)
     if status == ASSEMBLY_FAILED:
-        worst = int(iinfo[3])
-        name = cons[worst - 1].describe() if worst > 0 else "?"
-        return AssemblyError(
-            f"Assembly failed at t = {t:.6g} s: no configuration satisfies the constraints near "
-            f"the q0 estimates (smallest residual {rinfo[3]:.3g}, largest in {name}). Check the "
-            "link lengths and joint points, and give q0 closer to the intended configuration.",
-            t=t, results=res, status=status, residual=float(rinfo[3]),
-            constraint=cons[worst - 1].name if worst > 0 else None)
+        return _assembly_failed(model, float(rinfo[3]), int(iinfo[3]), t, res)
     if status == NO_CONVERGENCE:
         return ConvergenceError(f"Newton-Raphson failed after t = {t:.6g} s: {msg}. Results up "
                                 f"to {last} are kept in the exception's .results.", t=t,

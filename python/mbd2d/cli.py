@@ -2,6 +2,7 @@
 
     mbd2d kinematics MODEL.toml --t-end T --steps N --out OUT.csv|OUT.npz
     mbd2d export MODEL.toml OUT.mbd --t-end T --steps N
+    mbd2d check MODEL.toml
 
 Exit codes: 0 ok, 2 bad input, 3 singular configuration (partial output written),
 4 other numerical failure (partial output written when there is any).
@@ -29,6 +30,9 @@ def _parser() -> argparse.ArgumentParser:
     k.add_argument("--t0", type=float, default=0.0, help="start time (default 0)")
     k.add_argument("--out", required=True, help="output file, .csv or .npz")
     k.add_argument("--tol", type=float, default=None, help="Newton tolerance (default 1e-12)")
+    c = sub.add_parser("check", help="degrees of freedom and redundant constraints")
+    c.add_argument("model", help="model file (.toml)")
+    c.add_argument("--t", type=float, default=0.0, help="time of the check (default 0)")
     e = sub.add_parser("export", help="write a model file for the standalone mbd2d-solve")
     e.add_argument("model", help="model file (.toml)")
     e.add_argument("out", help="output model file (.mbd)")
@@ -48,6 +52,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = _parser().parse_args(argv)
     try:
         model = load(args.model)
+        if args.command == "check":
+            print(model.analyze_dof(t=args.t))
+            return EXIT_OK
         if args.command == "export":
             model.export(args.out, t_end=args.t_end, steps=args.steps, t0=args.t0, tol=args.tol)
             print(f"wrote {args.out}")
@@ -62,6 +69,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         _say(f"mbd2d: error in the model or the command: {exc}")
         return EXIT_INPUT
     except AnalysisError as exc:
+        if args.command == "check":
+            _say(f"mbd2d: {exc}")
+            return EXIT_NUMERICAL
         if exc.results is not None and len(exc.results.t):
             exc.results.save(args.out)
         _say(f"mbd2d: {exc}")

@@ -60,6 +60,18 @@ class AssemblyError(AnalysisError):
     """No configuration satisfies the constraints near the given estimates ``q0``."""
 
 
+class InconsistentConstraintsError(AssemblyError):
+    """Redundant constraints contradict each other: no configuration satisfies them all.
+
+    Attributes
+    ----------
+    constraints : list of str
+        The constraints that disagree.
+    residual : float
+        The smallest residual ||Phi||_inf reached.
+    """
+
+
 class ConvergenceError(AnalysisError):
     """Newton-Raphson did not converge at a regular configuration."""
 
@@ -93,9 +105,25 @@ class SingularConfigurationError(AnalysisError):
 ToggleError = SingularConfigurationError
 
 
+class MbdWarning(UserWarning):
+    """Base class of mbd2d warnings."""
+
+
+class RedundantConstraintWarning(MbdWarning):
+    """Some constraint equations repeat what the others impose; they are solved in least
+    squares (exactly, when consistent), and reactions are statically indeterminate."""
+
+
+class SingularPassageWarning(MbdWarning):
+    """The run passed through singular configurations (bifurcation points) and stayed on the
+    branch it started on."""
+
+
 class CoreError(MbdError):
     """The Fortran core reported an internal error (a LAPACK argument error); a bug."""
 
 
-__all__ = ["MbdError", "ModelError", "AnalysisError", "AssemblyError", "ConvergenceError",
-           "SingularJacobianError", "SingularConfigurationError", "ToggleError", "CoreError"]
+__all__ = ["MbdError", "ModelError", "AnalysisError", "AssemblyError",
+           "InconsistentConstraintsError", "ConvergenceError", "SingularJacobianError",
+           "SingularConfigurationError", "ToggleError", "CoreError", "MbdWarning",
+           "RedundantConstraintWarning", "SingularPassageWarning"]

@@ -26,6 +26,7 @@ from .validate import (GROUND, as_list, check_name, choice, nonzero_vector, numb
                        pairs, positive, vector)
 
 if TYPE_CHECKING:  # pragma: no cover
+    from .analysis import DofReport
     from .results import KinematicsResult
 
 class Model:
@@ -443,6 +444,32 @@ class Model:
         """
         from .analysis import run_kinematics
         return run_kinematics(self, t_end=t_end, steps=steps, t0=t0, tol=tol, maxit=maxit)
+
+    def analyze_dof(self, t: float = 0.0, tol: float | None = None) -> "DofReport":
+        """Degrees of freedom and redundant constraints at the configuration assembled from
+        the q0 estimates at time t.
+
+        Returns
+        -------
+        DofReport
+            Coordinates, equations, rank of J, degrees of freedom, mobility of the joints
+            alone, and the redundant equations by name (``print(report)`` for a summary).
+
+        Raises
+        ------
+        InconsistentConstraintsError
+            If redundant constraints contradict each other.
+        AssemblyError
+            If no configuration satisfies the constraints near q0.
+
+        Examples
+        --------
+        >>> import mbd2d
+        >>> print(mbd2d.load("examples/door_two_hinges.toml").analyze_dof().redundant_rows)
+        ['upper.x', 'upper.y']
+        """
+        from .analysis import analyze_dof
+        return analyze_dof(self, t=t, tol=tol)
 
     def phi(self, q: Any, t: float = 0.0) -> np.ndarray:
         """Phi(q, t), computed by the core."""
