@@ -199,8 +199,9 @@ contains
 
   !> Velocities and accelerations at a converged q: J q_dot = nu, J q_ddot = gamma, with the
   !! factors kin_newton left in w. status MBD_INCONSISTENT when a least-squares residual
-  !! shows the redundant constraints disagree at velocity or acceleration level.
-  subroutine kin_vel_acc(m, w, q, t, qd, qdd, status)
+  !! shows the redundant constraints disagree at velocity (level 1) or acceleration (level 2)
+  !! level; w%phi then holds the residual J x - b of that level.
+  subroutine kin_vel_acc(m, w, q, t, qd, qdd, status, level)
     type(model_t), intent(in) :: m          !! model
     type(kin_work_t), intent(inout) :: w    !! work arrays (factors of J(q), nu(q, t))
     real(wp), intent(in) :: q(:)            !! converged coordinates
@@ -208,12 +209,24 @@ contains
     real(wp), intent(out) :: qd(:)          !! velocities
     real(wp), intent(out) :: qdd(:)         !! accelerations
     integer, intent(out) :: status          !! MBD_OK or MBD_INCONSISTENT
+    integer, intent(out), optional :: level !! 1 velocity, 2 acceleration (when inconsistent)
     status = MBD_OK
     call solve(w, w%nu, qd)
-    if (w%resid > 1.0e-8_wp * (one + maxval(abs(w%nu)))) status = MBD_INCONSISTENT
+    if (w%resid > 1.0e-8_wp * (one + maxval(abs(w%nu)))) then
+      status = MBD_INCONSISTENT
+      if (present(level)) level = 1
+      call assemble_dense(m, q, w%qz, t, w%phi, w%nu, w%gam, w%jb, w%jac)
+      w%phi = matmul(w%jac, qd) - w%nu
+      return
+    end if
     call assemble_blocks(m, q, qd, t, w%phi, w%nu, w%gam, w%jb)
     call solve(w, w%gam, qdd)
-    if (w%resid > 1.0e-8_wp * (one + maxval(abs(w%gam)))) status = MBD_INCONSISTENT
+    if (w%resid > 1.0e-8_wp * (one + maxval(abs(w%gam)))) then
+      status = MBD_INCONSISTENT
+      if (present(level)) level = 2
+      call assemble_dense(m, q, qd, t, w%phi, w%nu, w%gam, w%jb, w%jac)
+      w%phi = matmul(w%jac, qdd) - w%gam
+    end if
   end subroutine kin_vel_acc
 
   !> Assemble: from rough estimates q (extras are estimated here) minimize ||Phi(q, t)||^2 by
@@ -234,7 +247,7 @@ contains
     real(wp), allocatable :: aug(:, :), rhs(:), work(:), qt(:), phit(:)
     real(wp) :: mu, f, ft, wq(1), dmax, pmax
     integer :: it, n, neq, info, lwork, i, k, rank, st
-    integer, allocatable :: order(:)
+    integer, allocatable :: flags(:)
 
     status = MBD_OK; msg = ''
     n = m%nq; neq = m%neq
@@ -280,14 +293,13 @@ contains
     rep%worst = m%con_of_row(maxloc(abs(w%phi), 1))
     rep%t_fail = t
     rep%qsing = q
-    allocate (order(neq))
-    call row_rank(w%jac, rank, order, st, msg)
+    allocate (flags(neq))
+    call row_rank(w%jac, rank, flags, st, msg)
     if (st == MBD_OK .and. rank < neq) then
       status = MBD_INCONSISTENT
       rep%rank = rank
       rep%dep = merge(1, 0, abs(w%phi) > DEP_TOL * pmax)
-      rep%redundant = 0
-      rep%redundant(order(rank + 1:neq)) = 1
+      rep%redundant = flags
       write (msg, '(a,es10.3,a)') 'assembly failed: redundant constraints contradict each '// &
         'other (smallest residual ||Phi|| = ', pmax, ')'
     else
@@ -298,8 +310,8 @@ contains
     end if
   end subroutine kin_assemble
 
-  !> Rank of J at q and the redundant rows (1 in redundant, the rows pivoted last by a
-  !! rank-revealing QR of the row-normalized J^T: later rows are the ones called redundant).
+  !> Rank of J at q and the redundant rows (1 in redundant: rows that repeat what the rows
+  !! before them impose, see row_rank).
   !! mobility: nq minus the rank of the kinematic (non-driver) rows.
   subroutine kin_rank(m, w, q, t, rank, mobility, redundant, status, msg)
     type(model_t), intent(in) :: m           !! model
@@ -311,22 +323,18 @@ contains
     integer, intent(out) :: redundant(:)     !! 1 for a redundant row (neq)
     integer, intent(out) :: status           !! MBD_OK or MBD_LAPACK
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
-    integer, allocatable :: order(:), krows(:)
+    integer, allocatable :: flags(:), krows(:)
     integer :: r, nk, rk
-    allocate (order(m%neq))
     call assemble_dense(m, q, w%qz, t, w%phi, w%nu, w%gam, w%jb, w%jac)
-    call row_rank(w%jac, rank, order, status, msg)
+    call row_rank(w%jac, rank, redundant, status, msg)
     if (status /= MBD_OK) return
-    redundant = 0
-    redundant(order(rank + 1:m%neq)) = 1
     krows = pack([(r, r=1, m%neq)], [(.not. con_is_driver(m%kind(m%con_of_row(r))), r=1, m%neq)])
     nk = size(krows)
     if (nk == 0) then
       mobility = m%nq
     else
-      deallocate (order)
-      allocate (order(nk))
-      call row_rank(w%jac(krows, :), rk, order, status, msg)
+      allocate (flags(nk))
+      call row_rank(w%jac(krows, :), rk, flags, status, msg)
       mobility = m%nq - rk
     end if
   end subroutine kin_rank
@@ -402,7 +410,7 @@ contains
     real(wp), allocatable :: q(:), qd(:), qdd(:), qn(:), qp(:), q3(:), qddn(:), qdn(:)
     real(wp), allocatable :: qa(:), qda(:), qdda(:), qb(:), qdb(:), qddb(:)
     real(wp) :: t, h, hcur, hh, tt, target, lscale, ts, ta, d
-    integer :: k, j, st, detprev, mobility
+    integer :: k, j, st, detprev, mobility, lev
     logical :: last, ok
 
     status = MBD_OK; msg = ''
@@ -425,32 +433,43 @@ contains
     if (status /= MBD_OK) then
       call count_work(); return
     end if
-    call kin_rank(m, w, q, t0, rep%rank, mobility, rep%redundant, status, msg)
-    if (status /= MBD_OK) then
-      call count_work(); return
-    end if
-    if (rep%rank < m%nq) then
-      status = MBD_BAD_COUNT
-      write (msg, '(a,i0,a,i0,a,i0,a)') 'the model is not kinematically determined: J has rank ', &
-        rep%rank, ' for ', m%nq, ' coordinates (', m%nq - rep%rank, ' degrees of freedom left)'
-      call count_work(); return
-    end if
-    ! column scale from J at the assembled configuration (w%jac holds it after kin_rank)
+    ! column scale from J at the assembled configuration
+    call assemble_dense(m, q, w%qz, t0, w%phi, w%nu, w%gam, w%jb, w%jac)
     do k = 1, m%nq
       d = norm2(w%jac(:, k))
       if (d > zero) w%cs(k) = one / d
     end do
-    w%lsq = m%neq > m%nq
-    call kin_newton(m, w, q, t0, opts%maxit, st)
-    if (st /= MBD_OK .or. w%pivratio < NEAR_SING) then
-      call kin_singular_report(m, w, q, t0, rep, k, msg)
-      status = MBD_SINGULAR
-      msg = 'the assembled configuration is singular (J loses rank): ' // trim(msg)
-      call count_work(); return
+    ! square: a regular LU proves full rank; otherwise find the rank and the redundant rows
+    w%lsq = .false.
+    st = MBD_SINGULAR
+    if (m%neq == m%nq) call kin_newton(m, w, q, t0, opts%maxit, st)
+    if (st == MBD_OK .and. w%pivratio >= NEAR_SING) then
+      rep%rank = m%nq
+    else
+      call kin_rank(m, w, q, t0, rep%rank, mobility, rep%redundant, status, msg)
+      if (status /= MBD_OK) then
+        call count_work(); return
+      end if
+      if (rep%rank < m%nq .and. m%neq > m%nq) then
+        status = MBD_BAD_COUNT
+        write (msg, '(a,i0,a,i0,a,i0,a)') 'the model is not kinematically determined: J has '// &
+          'rank ', rep%rank, ' for ', m%nq, ' coordinates (', m%nq - rep%rank, &
+          ' degrees of freedom left)'
+        call count_work(); return
+      end if
+      w%lsq = m%neq > m%nq
+      if (w%lsq) call kin_newton(m, w, q, t0, opts%maxit, st)
+      if (st /= MBD_OK .or. w%pivratio < NEAR_SING) then
+        call kin_singular_report(m, w, q, t0, rep, k, msg)
+        status = MBD_SINGULAR
+        write (msg, '(a,i0,a,i0,a,a)') 'the assembled configuration is singular (J has rank ', &
+          rep%rank, ' for ', m%nq, ' coordinates): ', trim(msg)
+        call count_work(); return
+      end if
     end if
-    call kin_vel_acc(m, w, q, t0, qd, qdd, st)
+    call kin_vel_acc(m, w, q, t0, qd, qdd, st, lev)
     if (st /= MBD_OK) then
-      call inconsistent(t0); return
+      call inconsistent(t0, lev); return
     end if
     qout(:, 1) = q; qdout(:, 1) = qd; qddout(:, 1) = qdd
     rep%ndone = 1
@@ -476,9 +495,9 @@ contains
       if (ok .and. .not. w%lsq) ok = w%detsign == detprev
       if (ok .and. w%pivratio < ANCHOR_PIV) call polish(tt)
       if (ok) then
-        call kin_vel_acc(m, w, qn, tt, qdn, qddn, st)
+        call kin_vel_acc(m, w, qn, tt, qdn, qddn, st, lev)
         if (st /= MBD_OK) then
-          call inconsistent(tt); return
+          call inconsistent(tt, lev); return
         end if
         ok = smooth_velocity(hh)
       end if
@@ -489,7 +508,7 @@ contains
         cycle
       end if
       if (st == MBD_INCONSISTENT) then
-        call inconsistent(tt); return
+        call inconsistent(tt, 0); return
       end if
       rep%rejected = rep%rejected + 1
       q3 = zero
@@ -641,14 +660,20 @@ contains
                     qdout(:, kk + 1), qddout(:, kk + 1))
     end subroutine refine_output
 
-    subroutine inconsistent(tf)
+    !> Redundant constraints disagree at position (0), velocity (1) or acceleration (2)
+    !! level; w%phi holds the residual of that level.
+    subroutine inconsistent(tf, lv)
       real(wp), intent(in) :: tf
+      integer, intent(in) :: lv
+      character(len=*), parameter :: what(0:2) = [character(len=12) :: 'position', &
+                                                   'velocity', 'acceleration']
       status = MBD_INCONSISTENT
       rep%t_fail = tf; rep%qsing = qn
       rep%resid = maxval(abs(w%phi))
+      rep%deficiency = lv
       rep%dep = merge(1, 0, abs(w%phi) > DEP_TOL * rep%resid)
-      write (msg, '(a,es22.15,a)') 'redundant constraints contradict each other at t = ', tf, &
-        ' (least-squares residual left)'
+      write (msg, '(a,a,a,es22.15)') 'redundant constraints contradict each other at ', &
+        trim(what(lv)), ' level at t = ', tf
       call count_work()
     end subroutine inconsistent
 

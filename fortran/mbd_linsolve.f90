@@ -4,8 +4,9 @@
 !!   lu_solve    A x = b from the factors (dgetrs)
 !!   lu_det_sign sign of det A from the factors: prod(sign U_ii) * (-1)**(row swaps)
 !!   svd_null    singular values of A and the singular vectors of the smallest one (dgesvd)
-!!   row_rank    rank of A and an independent set of its rows: QR with column pivoting of the
-!!               row-normalized A^T (dgeqp3); the rows pivoted last are the redundant ones
+!!   row_rank    rank of A (QR with column pivoting of the row-normalized A^T, dgeqp3) and the
+!!               redundant rows in file order: a row is redundant when it lies in the span of
+!!               the rows before it (Gram-Schmidt, twice)
 !!   qr_factor   A = Q R P^T for least squares (dgeqp3), A m x n with m >= n
 !!   qr_solve    x = argmin ||A x - b|| for full column rank: R x_p = (Q^T b)(1:n) (dormqr,
 !!               dtrtrs), x = P x_p; also returns the residual ||(Q^T b)(n+1:m)||
@@ -115,30 +116,46 @@ contains
     v = vt(min(m, n), :)
   end subroutine svd_null
 
-  !> Rank of A (m x n) and its rows ordered independent first: order(1:rank) is an
-  !! independent set, order(rank+1:m) the rows that depend on them. Rows are scaled to unit
-  !! length first, so the answer does not depend on units; of equal rows the later ones are
-  !! the redundant ones. Allocates: not for time loops.
-  subroutine row_rank(a, rank, order, status, msg)
+  !> Rank of A (m x n) and its redundant rows: redundant(i) = 1 when row i is (to RANK_TOL)
+  !! a combination of rows 1..i-1, so of equal rows the later ones are called redundant.
+  !! The rank comes from a pivoted QR of the row-normalized A^T (dgeqp3); if the ordered
+  !! selection disagrees with it (an ill-conditioned case), the rows dgeqp3 pivots last are
+  !! flagged instead. Rows are scaled to unit length, so units do not matter.
+  !! Allocates: not for time loops.
+  subroutine row_rank(a, rank, redundant, status, msg)
     real(wp), intent(in) :: a(:, :)             !! matrix (unchanged)
     integer, intent(out) :: rank                !! numerical rank
-    integer, intent(out) :: order(:)            !! row order (m)
+    integer, intent(out) :: redundant(:)        !! 1 for a redundant row (m)
     integer, intent(out) :: status              !! MBD_OK or MBD_LAPACK
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
-    real(wp), allocatable :: at(:, :), tau(:), work(:)
+    real(wp), allocatable :: at(:, :), tau(:), work(:), basis(:, :), v(:)
     real(wp) :: wq(1), nrm, r11
-    integer :: m, n, i, info, lwork
+    integer, allocatable :: order(:)
+    integer :: m, n, i, info, lwork, r, pass
     m = size(a, 1); n = size(a, 2)
-    allocate (at(n, m), tau(min(m, n)))
+    allocate (at(n, m), tau(min(m, n)), order(m), basis(n, min(m, n)), v(n))
     do i = 1, m
       nrm = norm2(a(i, :))
-      if (nrm > zero) then
-        ! a slight bias to earlier rows: of equal rows, the later ones are called redundant
-        at(:, i) = a(i, :) / nrm * (1.0_wp - 1.0e-3_wp * (i - 1) / m)
+      at(:, i) = zero
+      if (nrm > zero) at(:, i) = a(i, :) / nrm
+    end do
+    ! ordered selection: Gram-Schmidt against the rows kept so far
+    redundant = 0
+    r = 0
+    do i = 1, m
+      v = at(:, i)
+      do pass = 1, 2
+        if (r > 0) v = v - matmul(basis(:, 1:r), matmul(v, basis(:, 1:r)))
+      end do
+      nrm = norm2(v)
+      if (nrm > sqrt(RANK_TOL) .and. r < n) then
+        r = r + 1
+        basis(:, r) = v / nrm
       else
-        at(:, i) = zero
+        redundant(i) = 1
       end if
     end do
+    ! the rank from a pivoted QR
     order = 0
     call dgeqp3(n, m, at, n, order, tau, wq, -1, info)
     lwork = max(1, int(wq(1)))
@@ -151,6 +168,10 @@ contains
     do i = 1, min(m, n)
       if (abs(at(i, i)) > RANK_TOL * r11) rank = rank + 1
     end do
+    if (r /= rank) then
+      redundant = 0
+      redundant(order(rank + 1:m)) = 1
+    end if
   end subroutine row_rank
 
   !> Workspace length for qr_factor and qr_solve on an m x n matrix.
@@ -160,8 +181,12 @@ contains
     integer :: jp(1), info
     call dgeqp3(m, n, a, max(1, m), jp, tau, wq, -1, info)
     lwork = int(wq(1))
-    call dormqr('L', 'T', m, 1, n, a, max(1, m), tau, c, max(1, m), wq, -1, info)
-    lwork = max(lwork, int(wq(1)), 1)
+    ! dormqr needs k = n <= m (the least-squares case); never pass LAPACK an illegal size
+    if (m >= n) then
+      call dormqr('L', 'T', m, 1, n, a, max(1, m), tau, c, max(1, m), wq, -1, info)
+      lwork = max(lwork, int(wq(1)))
+    end if
+    lwork = max(lwork, 1)
   end function qr_lwork
 
   !> QR factorization with column pivoting, A = Q R P^T, in place.

@@ -179,15 +179,17 @@ def analyze_dof(model: "Model", t: float = 0.0, tol: float | None = None) -> Dof
 
 
 def _inconsistent(model: "Model", p: Packed, resid: float, dep: np.ndarray, red: np.ndarray,
-                  rank: int, t: float, res: KinematicsResult | None
+                  rank: int, t: float, res: KinematicsResult | None, level: int = 0
                   ) -> InconsistentConstraintsError:
     cons, rows = _names(p, model, dep)
     red_cons, red_rows = _names(p, model, red)
     lead = (f"{', '.join(red_rows)} ({len(red_rows)} redundant equation(s): {p.neq} equations, "
             f"rank {rank}) contradict(s) the other constraints; " if red_rows and rank else "")
+    what = ("||Phi||", "||J q_dot - nu||", "||J q_ddot - gamma||")[level]
+    kind = ("", " at velocity level", " at acceleration level")[level]
     return InconsistentConstraintsError(
-        f"Redundant constraints contradict each other at t = {t:.6g} s: {lead}"
-        f"{', '.join(cons)} cannot all hold (smallest residual ||Phi|| = {resid:.3g}). "
+        f"Redundant constraints contradict each other{kind} at t = {t:.6g} s: {lead}"
+        f"{', '.join(cons)} cannot all hold (smallest residual {what} = {resid:.3g}). "
         "Check their points and dimensions, or remove the one that repeats another.",
         t=t, results=res, status=INCONSISTENT, constraints=cons, redundant=red_cons,
         residual=resid)
@@ -290,7 +292,8 @@ def _failure(model: "Model", p: Packed, status: int, msg: str, iinfo: np.ndarray
                    dependent=dep_names, q=np.array(qsing), sigma_min=float(rinfo[1]),
                    sigma_max=float(rinfo[2]))
     if status == INCONSISTENT:
-        return _inconsistent(model, p, float(rinfo[3]), dep, red, int(iinfo[8]), t, res)
+        return _inconsistent(model, p, float(rinfo[3]), dep, red, int(iinfo[8]), t, res,
+                             level=int(iinfo[4]))
     if status == ASSEMBLY_FAILED:
         return _assembly_failed(model, float(rinfo[3]), int(iinfo[3]), t, res)
     if status == NO_CONVERGENCE:
