@@ -1,0 +1,70 @@
+"""Passing through singular configurations where the motion continues: the IFToMM
+N-four-bar (benchmark A02) driven through its collinear positions, theta = pi/2 - t.
+
+Every crank must stay parallel to the first (the parallelogram branch) and the couplers
+translate: coupler k has x = k + 1/2 + cos(theta), y = sin(theta), angle 0.
+
+Tolerances follow from conditioning, not from fitting: near a singular configuration
+errors grow like cond(J) tol, cond^2 tol and cond^3 tol in q, q_dot, q_ddot. The engine
+computes outputs there by interpolation between anchors where cond(J) <= 1e3, so
+accelerations within about 0.1 s of a passage are good to ~1e-7, and everything else to the
+usual 1e-9.
+"""
+from __future__ import annotations
+
+import math
+import sys
+import warnings
+
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose
+
+import mbd2d
+from conftest import EXAMPLES
+
+sys.path.insert(0, str(EXAMPLES))
+import nfourbar  # noqa: E402
+
+
+def run(n: int, steps: int, t_end: float = 4 * math.pi) -> mbd2d.KinematicsResult:
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", mbd2d.SingularPassageWarning)
+        return nfourbar.build(n).kinematics(t_end=t_end, steps=steps)
+
+
+# 1000 steps put outputs exactly on the collinear times pi/2 + k pi; 997 and 37 do not
+@pytest.mark.parametrize("steps", [1000, 997, 37])
+@pytest.mark.parametrize("n", [1, 2, 5])
+def test_stays_on_the_parallelogram_branch(n: int, steps: int) -> None:
+    res = run(n, steps)
+    th = np.pi / 2 - res.t
+    near = np.abs(((res.t - np.pi / 2) + np.pi / 2) % np.pi - np.pi / 2) < 0.1
+    for k in range(n + 1):
+        c = res.body(f"crank{k}")
+        assert_allclose(c.theta, th, rtol=0, atol=1e-10)
+        assert_allclose(c.theta_dot, -1.0, rtol=0, atol=1e-9)
+        assert_allclose(c.theta_ddot[~near], 0.0, atol=1e-9)
+        assert_allclose(c.theta_ddot[near], 0.0, atol=1e-7)
+    for k in range(n):
+        c = res.body(f"coupler{k}")
+        assert_allclose(c.x, k + 0.5 + np.cos(th), rtol=0, atol=1e-10)
+        assert_allclose(c.y, np.sin(th), rtol=0, atol=1e-10)
+        assert_allclose(c.theta, 0.0, atol=1e-10)
+        assert_allclose(c.x_dot, np.sin(th), rtol=0, atol=1e-9)
+        assert_allclose(c.x_ddot[~near], -np.cos(th[~near]), rtol=0, atol=1e-9)
+        assert_allclose(c.x_ddot[near], -np.cos(th[near]), rtol=0, atol=1e-7)
+
+
+@pytest.mark.parametrize("n", [1, 5])
+def test_passages_are_reported(n: int) -> None:
+    with pytest.warns(mbd2d.SingularPassageWarning, match="passed through 4 singular"):
+        res = nfourbar.build(n).kinematics(t_end=4 * math.pi, steps=1000)
+    t_pass = np.array(res.stats["singular_passages"])
+    assert_allclose(t_pass, np.pi / 2 + np.pi * np.arange(4), atol=1e-6)
+
+
+def test_a_driven_crank_at_a_dead_centre_still_stops() -> None:
+    """Unlike the parallelogram, the seed four-bar has no motion beyond its toggle."""
+    with pytest.raises(mbd2d.SingularConfigurationError, match="dead centre"):
+        mbd2d.load(EXAMPLES / "fourbar_seed.toml").kinematics(t_end=1.0, steps=1000)
