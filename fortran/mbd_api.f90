@@ -8,17 +8,23 @@
 !!   rinfo(NINFO): 1 time of the singular configuration or failure, 2 sigma_min, 3 sigma_max,
 !!                 4 residual
 module mbd_api
-  use mbd_kinds, only: wp, zero
+  use mbd_kinds, only: wp, zero, one
   use mbd_status, only: MBD_OK, MBD_BAD_COUNT, MBD_INCONSISTENT, MSG_LEN
   use mbd_points, only: NLOC, MAXROW
-  use mbd_model, only: model_t, model_build
+  use mbd_model, only: model_t, model_build, model_add_dynamics
+  use mbd_dynamics, only: dyn_work_t, dyn_init, dyn_velocity, dyn_multipliers, dyn_reactions, &
+                          gen_forces, kinetic_energy
+  use mbd_integrators, only: dyn_opts_t, dyn_stats_t, integrate
+  use mbd_statics, only: statics_solve
   use mbd_assemble, only: assemble_dense
   use mbd_kinematics, only: kin_opts_t, kin_report_t, kin_work_t, kin_run, kin_work_init, &
                             kin_assemble, kin_rank, MAXPASS
+  use mbd_status, only: MBD_BAD_SETTING
   use mbd_profiles, only: profile_raw_length, profile_prepare, profile_eval
   implicit none
   private
   public :: NINFO, api_sizes, api_eval, api_kinematics, api_profile, api_analyze
+  public :: api_inverse, api_dynamics, api_statics, api_reactions
 
   integer, parameter :: NINFO = 10   !! length of the report arrays
 
@@ -190,5 +196,222 @@ contains
       call profile_eval(kind, prep, alpha(i), pts(:, i), c1, c2, c3)
     end do
   end subroutine api_profile
+
+  !> Build a model with masses and forces (bad: offending constraint > 0 or force > 0 with
+  !! kind flag; body errors come back as bad = -body).
+  subroutine build_dynamic(nb, ctab, rpar, bmass, grav, ftab, fpar, m, status, msg, bad, badf)
+    integer, intent(in) :: nb, ctab(:, :), ftab(:, :)
+    real(wp), intent(in) :: rpar(:), bmass(:, :), grav(2), fpar(:)
+    type(model_t), intent(out) :: m
+    integer, intent(out) :: status, bad, badf
+    character(len=MSG_LEN), intent(out) :: msg
+    badf = 0
+    call model_build(nb, ctab, rpar, m, status, msg, bad)
+    if (status /= MBD_OK) return
+    call model_add_dynamics(m, bmass, grav, ftab, fpar, status, msg, badf)
+  end subroutine build_dynamic
+
+  !> Energies and constraint residuals at a state: [kinetic, potential, ||Phi||, ||J q_dot - nu||].
+  subroutine state_measures(m, w, q, qd, t, e)
+    type(model_t), intent(in) :: m
+    type(dyn_work_t), intent(inout) :: w
+    real(wp), intent(in) :: q(:), qd(:), t
+    real(wp), intent(out) :: e(4)
+    real(wp) :: v
+    call assemble_dense(m, q, w%qz, t, w%phi, w%nu, w%gam, w%jb, w%jac)
+    e(3) = maxval(abs(w%phi))
+    e(4) = maxval(abs(matmul(w%jac, qd) - w%nu))
+    call gen_forces(m, q, qd, t, w%force, v)
+    e(1) = kinetic_energy(m, qd); e(2) = v
+  end subroutine state_measures
+
+  !> Inverse dynamics: a kinematic run, then at every output the multipliers
+  !! lambda (minimum norm over all rows) of J^T lambda = Q - M q_ddot, and the energies.
+  !! iinfo/rinfo as api_kinematics; iinfo(2) = -force index for a bad force.
+  subroutine api_inverse(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, t0, t1, nsteps, tol, &
+                         qout, qdout, qddout, lamout, eout, iinfo, rinfo, qsing, dep, redundant, &
+                         tpass, status, msg)
+    integer, intent(in) :: nb, ctab(:, :), ftab(:, :), nsteps
+    real(wp), intent(in) :: rpar(:), bmass(:, :), grav(2), fpar(:), q0(:), t0, t1, tol
+    real(wp), intent(out) :: qout(:, :), qdout(:, :), qddout(:, :)  !! (nq, nsteps + 1)
+    real(wp), intent(out) :: lamout(:, :)       !! (neq, nsteps + 1)
+    real(wp), intent(out) :: eout(:, :)         !! (4, nsteps + 1)
+    integer, intent(out) :: iinfo(NINFO)
+    real(wp), intent(out) :: rinfo(NINFO), qsing(:), tpass(:)
+    integer, intent(out) :: dep(:), redundant(:)
+    integer, intent(out) :: status              !! MBD_OK, < 0 input, > 0 numerical
+    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    type(model_t) :: m
+    type(dyn_work_t) :: w
+    integer :: bad, badf, k, st
+    real(wp) :: t
+    character(len=MSG_LEN) :: lmsg
+    lamout = zero; eout = zero
+    call build_dynamic(nb, ctab, rpar, bmass, grav, ftab, fpar, m, status, msg, bad, badf)
+    if (status /= MBD_OK) then
+      qout = zero; qdout = zero; qddout = zero; iinfo = 0; rinfo = zero
+      iinfo(2) = bad; if (badf /= 0) iinfo(2) = -1000000 - badf
+      qsing = zero; dep = 0; redundant = 0; tpass = zero
+      return
+    end if
+    call api_kinematics(nb, ctab, rpar, q0, t0, t1, nsteps, tol, 0, zero, qout, qdout, qddout, &
+                        iinfo, rinfo, qsing, dep, redundant, tpass, status, msg)
+    if (iinfo(1) < 1) return
+    call dyn_init(m, w, qout(:, 1), t0, 1.0e-12_wp, st, lmsg)
+    if (st /= MBD_OK) return
+    do k = 1, iinfo(1)
+      t = t0 + (t1 - t0) * (real(k - 1, wp) / max(nsteps, 1))
+      if (k == nsteps + 1) t = t1
+      call dyn_multipliers(m, w, qout(:, k), qdout(:, k), qddout(:, k), t, lamout(:, k), st, lmsg)
+      call state_measures(m, w, qout(:, k), qdout(:, k), t, eout(:, k))
+    end do
+  end subroutine api_inverse
+
+  !> Forward dynamics: assembly of q0, the velocity v0 projected onto J q_dot = nu (kinetic
+  !! energy metric), integration with the chosen method, outputs at nsteps + 1 times.
+  !! iinfo: 1 outputs, 2 bad entry, 3 steps, 4 rejected, 5 Newton iterations, 6 right-hand
+  !! sides, 7 iteration matrices, 8 partitions, 9 active (independent) constraint rows.
+  !! rinfo: 1 time of a failure, 2 smallest step, 3 largest step.
+  subroutine api_dynamics(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, v0, t0, t1, nsteps, &
+                          method, rtol, atol, h, rho_inf, balpha, bbeta, qout, qdout, qddout, &
+                          lamout, eout, iinfo, rinfo, redundant, status, msg)
+    integer, intent(in) :: nb, ctab(:, :), ftab(:, :), nsteps, method
+    real(wp), intent(in) :: rpar(:), bmass(:, :), grav(2), fpar(:), q0(:), v0(:), t0, t1
+    real(wp), intent(in) :: rtol, atol, h, rho_inf, balpha, bbeta  !! method settings
+    real(wp), intent(out) :: qout(:, :), qdout(:, :), qddout(:, :)  !! (nq, nsteps + 1)
+    real(wp), intent(out) :: lamout(:, :)       !! (neq, nsteps + 1)
+    real(wp), intent(out) :: eout(:, :)         !! (4, nsteps + 1) energies, drift
+    integer, intent(out) :: iinfo(NINFO)
+    real(wp), intent(out) :: rinfo(NINFO)
+    integer, intent(out) :: redundant(:)
+    integer, intent(out) :: status              !! MBD_OK, < 0 input, > 0 numerical
+    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    type(model_t) :: m
+    type(dyn_work_t) :: w
+    type(kin_work_t) :: kw
+    type(kin_opts_t) :: kopts
+    type(kin_report_t) :: rep
+    type(dyn_opts_t) :: opts
+    type(dyn_stats_t) :: dst
+    real(wp), allocatable :: q(:), qd(:)
+    real(wp) :: t, lscale
+    integer :: bad, badf, k, nout, st
+    character(len=MSG_LEN) :: lmsg
+    iinfo = 0; rinfo = zero; redundant = 0
+    qout = zero; qdout = zero; qddout = zero; lamout = zero; eout = zero
+    call build_dynamic(nb, ctab, rpar, bmass, grav, ftab, fpar, m, status, msg, bad, badf)
+    iinfo(2) = bad; if (badf /= 0) iinfo(2) = -1000000 - badf
+    if (status /= MBD_OK) return
+    if (size(q0) /= m%nq .or. size(v0) /= m%nq .or. size(qout, 1) /= m%nq .or. &
+        size(qout, 2) /= nsteps + 1 .or. size(lamout, 1) /= m%neq .or. &
+        size(redundant) /= m%neq) then
+      status = MBD_BAD_COUNT; msg = 'array sizes do not match the model'; return
+    end if
+    if (nsteps < 0 .or. .not. (t1 > t0)) then
+      status = MBD_BAD_SETTING; msg = 'steps must be >= 0 and t_end > t0'; return
+    end if
+    ! assembly at t0 (Levenberg-Marquardt; any number of equations)
+    call kin_work_init(m, kw)
+    lscale = max(m%lscale, maxval(abs(q0(1:3 * nb)), mask=mod([(k, k=1, 3 * nb)], 3) /= 0))
+    kw%tol = kopts%tol * lscale
+    allocate (q(m%nq), qd(m%nq), rep%qsing(m%nq), rep%dep(m%neq), rep%redundant(m%neq))
+    q = q0
+    call kin_assemble(m, kw, q, t0, kopts, rep, status, msg)
+    if (status /= MBD_OK) then
+      rinfo(1) = t0; return
+    end if
+    call dyn_init(m, w, q, t0, kw%tol, status, msg)
+    if (status /= MBD_OK) return
+    iinfo(9) = w%na
+    do k = 1, m%neq
+      if (.not. any(w%rows == k)) redundant(k) = 1
+    end do
+    call dyn_velocity(m, w, q, t0, v0, qd, status)
+    if (status /= MBD_OK) then
+      msg = 'the initial velocities cannot be made consistent: the mass matrix is singular '// &
+            'on the motions the constraints allow (a body without mass or inertia?)'
+      return
+    end if
+    opts%method = method
+    if (rtol > zero) opts%rtol = rtol
+    if (atol > zero) opts%atol = atol
+    opts%h = max(h, zero)
+    if (rho_inf >= zero) opts%rho_inf = min(rho_inf, one)
+    if (balpha >= zero) opts%balpha = balpha
+    if (bbeta >= zero) opts%bbeta = bbeta
+    call integrate(m, w, q, qd, t0, t1, nsteps, opts, qout, qdout, qddout, nout, dst, &
+                   status, msg)
+    iinfo(1) = nout; iinfo(3) = dst%steps; iinfo(4) = dst%rejected; iinfo(5) = dst%newton
+    iinfo(6) = dst%rhs; iinfo(7) = dst%jacobians; iinfo(8) = dst%partitions
+    rinfo(2) = dst%hmin; rinfo(3) = dst%hmax
+    if (status /= MBD_OK) rinfo(1) = t0 + (t1 - t0) * (real(max(nout - 1, 0), wp) / max(nsteps, 1))
+    do k = 1, nout
+      t = t0 + (t1 - t0) * (real(k - 1, wp) / max(nsteps, 1))
+      if (k == nsteps + 1) t = t1
+      call dyn_multipliers(m, w, qout(:, k), qdout(:, k), qddout(:, k), t, lamout(:, k), st, lmsg)
+      call state_measures(m, w, qout(:, k), qdout(:, k), t, eout(:, k))
+    end do
+  end subroutine api_dynamics
+
+  !> Static equilibrium near the assembled q0 at time t, its multipliers and stability
+  !! (1 stable, 0 unstable, -1 neutral, 2 no free motion).
+  subroutine api_statics(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, t, q, lam, stable, resid, &
+                         iinfo, status, msg)
+    integer, intent(in) :: nb, ctab(:, :), ftab(:, :)
+    real(wp), intent(in) :: rpar(:), bmass(:, :), grav(2), fpar(:), q0(:), t
+    real(wp), intent(out) :: q(:), lam(:), resid
+    integer, intent(out) :: stable, iinfo(NINFO)
+    integer, intent(out) :: status              !! MBD_OK, < 0 input, > 0 numerical
+    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    type(model_t) :: m
+    type(dyn_work_t) :: w
+    type(kin_work_t) :: kw
+    type(kin_opts_t) :: kopts
+    type(kin_report_t) :: rep
+    real(wp) :: lscale
+    integer :: bad, badf, k
+    q = zero; lam = zero; stable = 0; resid = zero; iinfo = 0
+    call build_dynamic(nb, ctab, rpar, bmass, grav, ftab, fpar, m, status, msg, bad, badf)
+    iinfo(2) = bad; if (badf /= 0) iinfo(2) = -1000000 - badf
+    if (status /= MBD_OK) return
+    if (size(q0) /= m%nq .or. size(q) /= m%nq .or. size(lam) /= m%neq) then
+      status = MBD_BAD_COUNT; msg = 'array sizes do not match the model'; return
+    end if
+    call kin_work_init(m, kw)
+    lscale = max(m%lscale, maxval(abs(q0(1:3 * nb)), mask=mod([(k, k=1, 3 * nb)], 3) /= 0))
+    kw%tol = kopts%tol * lscale
+    allocate (rep%qsing(m%nq), rep%dep(m%neq), rep%redundant(m%neq))
+    q = q0
+    call kin_assemble(m, kw, q, t, kopts, rep, status, msg)
+    if (status /= MBD_OK) return
+    call dyn_init(m, w, q, t, kw%tol, status, msg)
+    if (status /= MBD_OK) return
+    call statics_solve(m, w, q, t, lam, stable, resid, status, msg)
+  end subroutine api_statics
+
+  !> Reactions of every constraint at many states: reac(6, nc, nt) global
+  !! [Fx_i, Fy_i, Mz_i, Fx_j, Fy_j, Mz_j], rloc the same in the body frames.
+  subroutine api_reactions(nb, ctab, rpar, q, t, lam, reac, rloc, status, msg)
+    integer, intent(in) :: nb, ctab(:, :)
+    real(wp), intent(in) :: rpar(:), q(:, :), t(:), lam(:, :)
+    real(wp), intent(out) :: reac(:, :, :), rloc(:, :, :)
+    integer, intent(out) :: status              !! MBD_OK or < 0
+    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    type(model_t) :: m
+    type(dyn_work_t) :: w
+    integer :: bad, k
+    reac = zero; rloc = zero
+    call model_build(nb, ctab, rpar, m, status, msg, bad)
+    if (status /= MBD_OK) return
+    if (size(q, 1) /= m%nq .or. size(lam, 1) /= m%neq .or. size(reac, 2) /= m%nc .or. &
+        size(q, 2) /= size(t) .or. size(lam, 2) /= size(t) .or. size(reac, 3) /= size(t)) then
+      status = MBD_BAD_COUNT; msg = 'array sizes do not match the model'; return
+    end if
+    allocate (w%phi(m%neq), w%nu(m%neq), w%gam(m%neq), w%jb(3, NLOC, m%nc), w%qz(m%nq))
+    w%qz = zero
+    do k = 1, size(t)
+      call dyn_reactions(m, w, q(:, k), t(k), lam(:, k), reac(:, :, k), rloc(:, :, k))
+    end do
+  end subroutine api_reactions
 
 end module mbd_api

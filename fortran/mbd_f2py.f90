@@ -83,3 +83,77 @@ subroutine core_profile(kind, np, raw, na, alpha, pts, status, msg)
   !f2py intent(hide) :: np, na
   call api_profile(kind, raw, alpha, pts, status, msg)
 end subroutine core_profile
+
+subroutine core_inverse(nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp, fpar, nq, neq, q0, &
+                        t0, t1, nsteps, tol, qout, qdout, qddout, lamout, eout, iinfo, rinfo, &
+                        qsing, dep, redundant, tpass, status, msg)
+  use iso_c_binding, only: c_double, c_int
+  use mbd_api, only: api_inverse
+  implicit none
+  integer(c_int), intent(in) :: nb, nc, np, nf, nfp, nq, neq, nsteps
+  integer(c_int), intent(in) :: ctab(8, nc), ftab(6, nf)
+  real(c_double), intent(in) :: rpar(np), bmass(2, nb), grav(2), fpar(nfp), q0(nq), t0, t1, tol
+  real(c_double), intent(out) :: qout(nq, nsteps + 1), qdout(nq, nsteps + 1)
+  real(c_double), intent(out) :: qddout(nq, nsteps + 1), lamout(neq, nsteps + 1)
+  real(c_double), intent(out) :: eout(4, nsteps + 1)
+  integer(c_int), intent(out) :: iinfo(10), dep(neq), redundant(neq), status
+  real(c_double), intent(out) :: rinfo(10), qsing(nq), tpass(64)
+  character(len=512), intent(out) :: msg
+  !f2py intent(hide) :: nc, np, nf, nfp, nq
+  call api_inverse(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, t0, t1, nsteps, tol, qout, &
+                   qdout, qddout, lamout, eout, iinfo, rinfo, qsing, dep, redundant, tpass, &
+                   status, msg)
+end subroutine core_inverse
+
+subroutine core_dynamics(nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp, fpar, nq, neq, &
+                         q0, v0, t0, t1, nsteps, method, rtol, atol, h, rho_inf, balpha, bbeta, &
+                         qout, qdout, qddout, lamout, eout, iinfo, rinfo, redundant, status, msg)
+  use iso_c_binding, only: c_double, c_int
+  use mbd_api, only: api_dynamics
+  implicit none
+  integer(c_int), intent(in) :: nb, nc, np, nf, nfp, nq, neq, nsteps, method
+  integer(c_int), intent(in) :: ctab(8, nc), ftab(6, nf)
+  real(c_double), intent(in) :: rpar(np), bmass(2, nb), grav(2), fpar(nfp), q0(nq), v0(nq)
+  real(c_double), intent(in) :: t0, t1, rtol, atol, h, rho_inf, balpha, bbeta
+  real(c_double), intent(out) :: qout(nq, nsteps + 1), qdout(nq, nsteps + 1)
+  real(c_double), intent(out) :: qddout(nq, nsteps + 1), lamout(neq, nsteps + 1)
+  real(c_double), intent(out) :: eout(4, nsteps + 1)
+  integer(c_int), intent(out) :: iinfo(10), redundant(neq), status
+  real(c_double), intent(out) :: rinfo(10)
+  character(len=512), intent(out) :: msg
+  !f2py intent(hide) :: nc, np, nf, nfp, nq
+  call api_dynamics(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, v0, t0, t1, nsteps, method, &
+                    rtol, atol, h, rho_inf, balpha, bbeta, qout, qdout, qddout, lamout, eout, &
+                    iinfo, rinfo, redundant, status, msg)
+end subroutine core_dynamics
+
+subroutine core_statics(nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp, fpar, nq, neq, q0, &
+                        t, q, lam, stable, resid, iinfo, status, msg)
+  use iso_c_binding, only: c_double, c_int
+  use mbd_api, only: api_statics
+  implicit none
+  integer(c_int), intent(in) :: nb, nc, np, nf, nfp, nq, neq
+  integer(c_int), intent(in) :: ctab(8, nc), ftab(6, nf)
+  real(c_double), intent(in) :: rpar(np), bmass(2, nb), grav(2), fpar(nfp), q0(nq), t
+  real(c_double), intent(out) :: q(nq), lam(neq), resid
+  integer(c_int), intent(out) :: stable, iinfo(10), status
+  character(len=512), intent(out) :: msg
+  !f2py intent(hide) :: nc, np, nf, nfp, nq
+  call api_statics(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, t, q, lam, stable, resid, &
+                   iinfo, status, msg)
+end subroutine core_statics
+
+subroutine core_reactions(nb, nc, ctab, np, rpar, nq, neq, nt, q, t, lam, reac, rloc, status, &
+                          msg)
+  use iso_c_binding, only: c_double, c_int
+  use mbd_api, only: api_reactions
+  implicit none
+  integer(c_int), intent(in) :: nb, nc, np, nq, neq, nt
+  integer(c_int), intent(in) :: ctab(8, nc)
+  real(c_double), intent(in) :: rpar(np), q(nq, nt), t(nt), lam(neq, nt)
+  real(c_double), intent(out) :: reac(6, nc, nt), rloc(6, nc, nt)
+  integer(c_int), intent(out) :: status
+  character(len=512), intent(out) :: msg
+  !f2py intent(hide) :: nc, np, nq, neq, nt
+  call api_reactions(nb, ctab, rpar, q, t, lam, reac, rloc, status, msg)
+end subroutine core_reactions

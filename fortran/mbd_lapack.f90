@@ -3,8 +3,8 @@ module mbd_lapack
   use mbd_kinds, only: wp
   implicit none
   private
-  public :: dgetrf, dgetf2, dgetrs, dgesvd, dgels, dgtsv, dgeqp3, dormqr, dtrtrs, dgecon, &
-            dtrcon
+  public :: dgetrf, dgetf2, dgetrs, dgesvd, dgels, dgelsy, dgtsv, dgeqp3, dormqr, dtrtrs, dgecon, &
+            dtrcon, dsyev
 
   interface
     !> LU factorization with partial pivoting.
@@ -97,6 +97,25 @@ module mbd_lapack
       real(wp), intent(out) :: rcond, work(*)
       integer, intent(out) :: iwork(*), info
     end subroutine dtrcon
+    !> Minimum-norm least squares by complete orthogonal factorization.
+    pure subroutine dgelsy(m, n, nrhs, a, lda, b, ldb, jpvt, rcond, rank, work, lwork, info)
+      import :: wp
+      integer, intent(in) :: m, n, nrhs, lda, ldb, lwork
+      real(wp), intent(inout) :: a(lda, *), b(ldb, *)
+      integer, intent(inout) :: jpvt(*)
+      real(wp), intent(in) :: rcond
+      integer, intent(out) :: rank, info
+      real(wp), intent(out) :: work(*)
+    end subroutine dgelsy
+    !> Eigenvalues of a symmetric matrix.
+    pure subroutine dsyev(jobz, uplo, n, a, lda, w, work, lwork, info)
+      import :: wp
+      character(len=1), intent(in) :: jobz, uplo
+      integer, intent(in) :: n, lda, lwork
+      real(wp), intent(inout) :: a(lda, *)
+      real(wp), intent(out) :: w(*), work(*)
+      integer, intent(out) :: info
+    end subroutine dsyev
     !> Tridiagonal solve.
     pure subroutine dgtsv(n, nrhs, dl, d, du, b, ldb, info)
       import :: wp

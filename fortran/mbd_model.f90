@@ -12,6 +12,12 @@
 !!                    sub-kind b: cam follower kind; gear: 1 external, 2 internal
 !!   rpar(:)          raw real parameters (layouts in each joint module's banner)
 !! Extra coordinates (cam contact parameters) follow the body coordinates in constraint order.
+!! For dynamics (model_add_dynamics):
+!!   bmass(2, nb)     mass and moment of inertia about the centre of mass (>= 0)
+!!   grav(2)          gravity vector
+!!   ftab(NFT, nf)    one column per force element: 1 kind, 2 body i, 3 body j (0 = ground),
+!!                    4 offset of its raw parameters in fpar, 5 their number, 6 reserved
+!!   fpar(:)          raw force parameters (layouts in mbd_forces)
 module mbd_model
   use mbd_kinds, only: wp, one
   use mbd_status, only: MBD_OK, MBD_BAD_INPUT, MBD_BAD_BODY, MBD_BAD_PARAM, MSG_LEN
@@ -20,11 +26,14 @@ module mbd_model
                              con_prepare, con_name, CON_REVOLUTE, CON_TRANSLATIONAL, CON_CAM, &
                              CON_GEAR, CON_ABSOLUTE, CON_POINT_LINE, DRV_ABS, DRV_REL_DIST
   use mbd_joint_gear, only: CARRIER_SLOT
+  use mbd_forces, only: force_known, force_raw_length, force_prepare, FRC_TORQUE, FRC_POINT
+  use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   implicit none
   private
-  public :: NCT, model_t, model_build, model_slots
+  public :: NCT, NFT, model_t, model_build, model_slots, model_add_dynamics
 
   integer, parameter :: NCT = 8   !! rows of the constraint table
+  integer, parameter :: NFT = 6   !! rows of the force table
 
   !> A built model: constraint data in prepared form and the row and column maps.
   type :: model_t
@@ -42,6 +51,14 @@ module mbd_model
     integer, allocatable :: con_of_row(:) !! constraint owning each row
     real(wp), allocatable :: p(:)         !! prepared parameter pool
     real(wp) :: lscale = one              !! length scale of the model (tolerances)
+    ! dynamics (model_add_dynamics)
+    real(wp), allocatable :: mdiag(:)     !! diagonal mass matrix (nq; extras massless)
+    real(wp) :: grav(2) = 0.0_wp          !! gravity
+    integer :: nf = 0                     !! force elements
+    integer, allocatable :: fkind(:), fbi(:), fbj(:)  !! kind and bodies of each force
+    integer, allocatable :: floc(:, :)    !! (NLOC, nf) local slot -> global coordinate
+    integer, allocatable :: fpo(:), fpn(:)  !! prepared force parameters: offset and length
+    real(wp), allocatable :: fp(:)        !! prepared force parameter pool
   end type model_t
 
 contains
@@ -206,5 +223,83 @@ contains
       m%con_of_row(m%row0(k):m%row0(k) + m%nrow(k) - 1) = k
     end do
   end subroutine model_build
+
+  !> Add masses, gravity and force elements to a built model (for dynamics and statics).
+  !! bad returns the 1-based index of the offending force (0 when none, -k for body k).
+  subroutine model_add_dynamics(m, bmass, grav, ftab, fpar, status, msg, bad)
+    type(model_t), intent(inout) :: m           !! built model
+    real(wp), intent(in) :: bmass(:, :)         !! (2, nb) mass, inertia
+    real(wp), intent(in) :: grav(2)             !! gravity
+    integer, intent(in) :: ftab(:, :)           !! (NFT, nf) force table
+    real(wp), intent(in) :: fpar(:)             !! raw force parameters
+    integer, intent(out) :: status              !! MBD_OK or < 0
+    character(len=MSG_LEN), intent(out) :: msg  !! what is wrong
+    integer, intent(out) :: bad                 !! offending force (> 0) or body (< 0)
+    integer :: k, nf, kind, bi, bj, off, len, total
+    real(wp), allocatable :: prep(:), pool(:)
+    character(len=MSG_LEN) :: sub
+    status = MBD_OK; msg = ''; bad = 0
+    if (size(bmass, 1) /= 2 .or. size(bmass, 2) /= m%nb .or. size(ftab, 1) /= NFT) then
+      status = MBD_BAD_INPUT; msg = 'mass or force table has the wrong shape'; return
+    end if
+    allocate (m%mdiag(m%nq))
+    m%mdiag = 0.0_wp
+    do k = 1, m%nb
+      if (.not. all(ieee_is_finite(bmass(:, k))) .or. .not. all(bmass(:, k) >= 0.0_wp)) then
+        status = MBD_BAD_PARAM; bad = -k
+        msg = 'mass and inertia must be finite and >= 0'; return
+      end if
+      m%mdiag(3 * k - 2:3 * k - 1) = bmass(1, k)
+      m%mdiag(3 * k) = bmass(2, k)
+    end do
+    if (.not. all(ieee_is_finite(grav))) then
+      status = MBD_BAD_PARAM; msg = 'gravity must be finite'; return
+    end if
+    m%grav = grav
+    nf = size(ftab, 2)
+    m%nf = nf
+    allocate (m%fkind(nf), m%fbi(nf), m%fbj(nf), m%floc(NLOC, nf), m%fpo(nf), m%fpn(nf))
+    allocate (pool(0))
+    total = 0
+    do k = 1, nf
+      bad = k
+      kind = ftab(1, k); bi = ftab(2, k); bj = ftab(3, k); off = ftab(4, k); len = ftab(5, k)
+      if (.not. force_known(kind)) then
+        status = MBD_BAD_INPUT; write (msg, '(a,i0)') 'unknown force kind ', kind; return
+      end if
+      if (bi < 0 .or. bi > m%nb .or. bj < 0 .or. bj > m%nb) then
+        status = MBD_BAD_BODY; msg = 'force body index out of range'; return
+      end if
+      if (kind == FRC_TORQUE .or. kind == FRC_POINT) then
+        bj = 0
+        if (bi == 0) then
+          status = MBD_BAD_BODY; msg = 'a torque or point force needs a moving body'; return
+        end if
+      else if (bi == bj) then
+        status = MBD_BAD_BODY; msg = 'a spring needs two different bodies'; return
+      end if
+      if (off < 1 .or. len < 0 .or. off + len - 1 > size(fpar)) then
+        status = MBD_BAD_INPUT; msg = 'force parameter slice outside the parameter array'; return
+      end if
+      if (.not. all(ieee_is_finite(fpar(off:off + len - 1)))) then
+        status = MBD_BAD_PARAM; msg = 'a force parameter is not a finite number'; return
+      end if
+      if (force_raw_length(kind, fpar(off:off + len - 1)) /= len) then
+        status = MBD_BAD_PARAM; msg = 'force parameters are malformed'; return
+      end if
+      call force_prepare(kind, fpar(off:off + len - 1), prep, status, sub)
+      if (status /= MBD_OK) then
+        msg = sub; return
+      end if
+      m%fkind(k) = kind; m%fbi(k) = bi; m%fbj(k) = bj
+      m%fpo(k) = total + 1; m%fpn(k) = size(prep); total = total + size(prep)
+      pool = [pool, prep]
+      m%floc(:, k) = 0
+      if (bi > 0) m%floc(1:3, k) = [3 * bi - 2, 3 * bi - 1, 3 * bi]
+      if (bj > 0) m%floc(4:6, k) = [3 * bj - 2, 3 * bj - 1, 3 * bj]
+    end do
+    bad = 0
+    call move_alloc(pool, m%fp)
+  end subroutine model_add_dynamics
 
 end module mbd_model

@@ -12,18 +12,20 @@ from __future__ import annotations
 
 from .analysis import DofReport
 from .errors import (AnalysisError, AssemblyError, ConvergenceError, CoreError,
-                     InconsistentConstraintsError, MbdError, MbdWarning, ModelError,
+                     InconsistentConstraintsError, IntegrationError, MbdError, MbdWarning,
+                     ModelError,
                      RedundantConstraintWarning, SingularConfigurationError,
                      SingularJacobianError, SingularPassageWarning, ToggleError)
 from .functions import Harmonic, TimeFunction
 from .model import Model
-from .results import BodyResult, KinematicsResult
+from .results import BodyResult, DynamicsResult, KinematicsResult, Reaction, StaticsResult
 from .toml_io import load, loads
 
 __version__ = "0.1.0"
 
 __all__ = ["load", "loads", "Model", "TimeFunction", "Harmonic", "KinematicsResult",
-           "BodyResult", "DofReport", "MbdError", "ModelError", "AnalysisError",
+           "BodyResult", "DynamicsResult", "StaticsResult", "Reaction", "DofReport",
+           "MbdError", "ModelError", "AnalysisError", "IntegrationError",
            "AssemblyError", "InconsistentConstraintsError", "ConvergenceError",
            "SingularJacobianError", "SingularConfigurationError", "ToggleError", "CoreError",
            "MbdWarning", "RedundantConstraintWarning", "SingularPassageWarning", "__version__"]

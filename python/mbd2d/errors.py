@@ -105,6 +105,11 @@ class SingularConfigurationError(AnalysisError):
 ToggleError = SingularConfigurationError
 
 
+class IntegrationError(AnalysisError):
+    """A dynamics integrator failed: step-size underflow, blow-up, or a Newton iteration that
+    did not converge at a fixed step. Carries the results up to the failure."""
+
+
 class MbdWarning(UserWarning):
     """Base class of mbd2d warnings."""
 
@@ -125,5 +130,6 @@ class CoreError(MbdError):
 
 __all__ = ["MbdError", "ModelError", "AnalysisError", "AssemblyError",
            "InconsistentConstraintsError", "ConvergenceError", "SingularJacobianError",
+           "IntegrationError",
            "SingularConfigurationError", "ToggleError", "CoreError", "MbdWarning",
            "RedundantConstraintWarning", "SingularPassageWarning"]

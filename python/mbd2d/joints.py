@@ -37,6 +37,7 @@ class Body:
     q0: tuple[float, float, float]
     mass: float | None = None
     inertia: float | None = None
+    v0: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
 
 @dataclass

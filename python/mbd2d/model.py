@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, Any, Mapping, Sequence
 import numpy as np
 
 from .errors import ModelError
+from .forces import FORCE_KEYS, Force, PointForce, RotationalSpring, Spring, Torque
 from .functions import as_function
 from .joints import (COORDINATES, Absolute, AbsoluteDriver, Body, Cam, Constraint, Distance,
                      Driver, Gear, PinInSlot, PointOnCurve, PointOnLine, RackPinion,
@@ -27,7 +28,7 @@ from .validate import (GROUND, as_list, check_name, choice, nonzero_vector, numb
 
 if TYPE_CHECKING:  # pragma: no cover
     from .analysis import DofReport
-    from .results import KinematicsResult
+    from .results import DynamicsResult, KinematicsResult, StaticsResult
 
 class Model:
     """A planar multibody model.
@@ -55,6 +56,7 @@ class Model:
         self.bodies: list[Body] = []
         self.joints: list[Constraint] = []
         self.drivers: list[Driver] = []
+        self.forces: list[Force] = []
 
     # ------------------------------------------------------------------ lookups
     def body_index(self, name: str, entry: str, allow_ground: bool = True) -> int:
@@ -78,7 +80,8 @@ class Model:
         return [*self.joints, *self.drivers]
 
     def _names(self) -> set[str]:
-        return {b.name for b in self.bodies} | {c.name for c in self.constraints}
+        return ({b.name for b in self.bodies} | {c.name for c in self.constraints}
+                | {f.name for f in self.forces})
 
     def _new_name(self, name: str | None, stem: str, entry: str) -> str:
         if name is None:
@@ -109,7 +112,7 @@ class Model:
 
     # ------------------------------------------------------------------ builder
     def add_body(self, name: str, q0: Sequence[float], mass: float | None = None,
-                 inertia: float | None = None) -> Body:
+                 inertia: float | None = None, v0: Sequence[float] | None = None) -> Body:
         """Add a moving body.
 
         Parameters
@@ -119,7 +122,10 @@ class Model:
         q0 : sequence of 3 float
             Rough estimate of x, y, theta of the centre of mass.
         mass, inertia : float, optional
-            Needed only for dynamics.
+            Needed only for dynamics (mass > 0; inertia about the centre of mass, >= 0,
+            0 for a point mass).
+        v0 : sequence of 3 float, optional
+            Initial velocity estimate (dynamics); made consistent with the constraints.
 
         Returns
         -------
@@ -137,8 +143,11 @@ class Model:
                              "own name ('ground' is reserved)", entry)
         q = vector(q0, 3, "q0", entry)
         m = None if mass is None else positive(mass, "mass", entry)
-        j = None if inertia is None else positive(inertia, "inertia", entry)
-        b = Body(name, q, m, j)  # type: ignore[arg-type]
+        j = None if inertia is None else number(inertia, "inertia", entry)
+        if j is not None and j < 0.0:
+            raise ModelError(f"inertia must be >= 0, got {inertia!r}", entry)
+        v = (0.0, 0.0, 0.0) if v0 is None else vector(v0, 3, "v0", entry)
+        b = Body(name, q, m, j, v)  # type: ignore[arg-type]
         self.bodies.append(b)
         return b
 
@@ -324,6 +333,73 @@ class Model:
         only_keys(kw, allowed | {"name"}, entry, required=sorted(required))
         return builders[type](**kw)
 
+    # ------------------------------------------------------------------ forces
+    def _force_start(self, kind: str, name: str | None) -> tuple[str, str]:
+        entry = f"force {name!r} ({kind})" if isinstance(name, str) \
+            else f"force #{len(self.forces) + 1} ({kind})"
+        name = self._new_name(name, kind.replace("-", "_"), entry)
+        return name, f"force '{name}' ({kind})"
+
+    def add_spring(self, bodies: Sequence[str], points: Sequence[Sequence[float]],
+                   stiffness: float = 0.0, damping: float = 0.0, length0: float = 0.0,
+                   f: Any = 0.0, name: str | None = None) -> Spring:
+        """Translational spring-damper-actuator between two points: tension
+        stiffness (L - length0) + damping L_dot - f(t) (a positive f pushes apart)."""
+        name, entry = self._force_start("spring", name)
+        fs = Spring(name, self._two_bodies(bodies, entry), pairs(points, 2, "points", entry),
+                    _nonneg(stiffness, "stiffness", entry), _nonneg(damping, "damping", entry),
+                    _nonneg(length0, "length0", entry), as_function(f, entry))
+        self.forces.append(fs)
+        return fs
+
+    def add_torque(self, body: str, f: Any, name: str | None = None) -> Torque:
+        """A torque f(t) on a body (counterclockwise positive; reaction on ground)."""
+        name, entry = self._force_start("torque", name)
+        if not isinstance(body, str):
+            raise ModelError(f"body must be a name, got {body!r}", entry)
+        self.body_index(body, entry, allow_ground=False)
+        fs = Torque(name, (body, GROUND), as_function(f, entry))
+        self.forces.append(fs)
+        return fs
+
+    def add_point_force(self, body: str, point: Sequence[float], fx: Any = 0.0, fy: Any = 0.0,
+                        name: str | None = None) -> PointForce:
+        """A force (fx(t), fy(t)) in global components at a point of a body."""
+        name, entry = self._force_start("point", name)
+        if not isinstance(body, str):
+            raise ModelError(f"body must be a name, got {body!r}", entry)
+        self.body_index(body, entry, allow_ground=False)
+        fs = PointForce(name, (body, GROUND), vector(point, 2, "point", entry),  # type: ignore
+                        as_function(fx, entry, "fx"), as_function(fy, entry, "fy"))
+        self.forces.append(fs)
+        return fs
+
+    def add_rotational_spring(self, bodies: Sequence[str], stiffness: float = 0.0,
+                              damping: float = 0.0, angle0: float = 0.0, f: Any = 0.0,
+                              name: str | None = None) -> RotationalSpring:
+        """Rotational spring-damper between two bodies: on bodies[1] the torque
+        -stiffness (a - angle0) - damping a_dot + f(t), a = theta_j - theta_i."""
+        name, entry = self._force_start("rotational-spring", name)
+        fs = RotationalSpring(name, self._two_bodies(bodies, entry),
+                              _nonneg(stiffness, "stiffness", entry),
+                              _nonneg(damping, "damping", entry),
+                              number(angle0, "angle0", entry), as_function(f, entry))
+        self.forces.append(fs)
+        return fs
+
+    def add_force(self, type: str, **kw: Any) -> Force:
+        """Add a force element by its TOML type name, with the TOML keys as arguments."""
+        builders = {"spring": self.add_spring, "torque": self.add_torque,
+                    "point": self.add_point_force, "rotational-spring": self.add_rotational_spring}
+        name = kw.get("name")
+        entry = f"force {name!r} ({type})" if isinstance(name, str) \
+            else f"force #{len(self.forces) + 1} ({type})"
+        if not isinstance(type, str) or type not in builders:
+            raise ModelError(f"unknown force type {type!r}; known: {', '.join(builders)}", entry)
+        allowed, required = FORCE_KEYS[type]
+        only_keys(kw, allowed | {"name"}, entry, required=sorted(required))
+        return builders[type](**kw)
+
     def add_driver(self, type: str, f: Any, name: str | None = None, body: str | None = None,
                    coordinate: str | None = None, bodies: Sequence[str] | None = None,
                    joint: str | None = None) -> Driver:
@@ -425,6 +501,8 @@ class Model:
         Returns
         -------
         KinematicsResult
+            When every body has a mass and an inertia, a DynamicsResult with the inverse
+            dynamics too (see :meth:`inverse_dynamics`).
 
         Raises
         ------
@@ -443,6 +521,9 @@ class Model:
         11
         """
         from .analysis import run_kinematics
+        if self.has_masses() and maxit is None:
+            from .dynamics import run_inverse
+            return run_inverse(self, t_end=t_end, steps=steps, t0=t0, tol=tol)
         return run_kinematics(self, t_end=t_end, steps=steps, t0=t0, tol=tol, maxit=maxit)
 
     def analyze_dof(self, t: float = 0.0, tol: float | None = None) -> "DofReport":
@@ -471,6 +552,82 @@ class Model:
         from .analysis import analyze_dof
         return analyze_dof(self, t=t, tol=tol)
 
+    def has_masses(self) -> bool:
+        """Every body has a mass and an inertia (dynamics and inverse dynamics can run)."""
+        return bool(self.bodies) and all(b.mass is not None and b.inertia is not None
+                                         for b in self.bodies)
+
+    def inverse_dynamics(self, t_end: float, steps: int, t0: float = 0.0,
+                         tol: float | None = None) -> "DynamicsResult":
+        """Kinematics of the driven model plus, at every output time, the multipliers lambda
+        (J^T lambda = Q - M q_ddot), the joint reactions (``res.reaction(name)``), the driver
+        efforts (``res.effort(name)``) and the energies.
+
+        Raises
+        ------
+        ModelError
+            If a body has no mass or inertia, or the model is not kinematically determined.
+        SingularConfigurationError, AssemblyError, ConvergenceError
+            As :meth:`kinematics`.
+        """
+        from .dynamics import run_inverse
+        return run_inverse(self, t_end=t_end, steps=steps, t0=t0, tol=tol)
+
+    def dynamics(self, t_end: float, steps: int, method: str | None = None,
+                 rtol: float | None = None, atol: float | None = None, h: float | None = None,
+                 rho_inf: float | None = None, alpha: float | None = None,
+                 beta: float | None = None, t0: float = 0.0) -> "DynamicsResult":
+        """Forward dynamics of M q_ddot + J^T lambda = Q, Phi = 0 from the assembled q0 and
+        v0 (projected onto J q_dot = nu), outputs at steps + 1 uniform times.
+
+        Parameters
+        ----------
+        t_end, steps, t0 : float, int, float
+            Output times t0 + k (t_end - t0)/steps.
+        method : {'generalized-alpha', 'dopri5', 'baumgarte-rk4', 'partitioned'}
+            generalized-alpha (default): implicit index 3, error-controlled, or fixed step h;
+            dopri5: index 1, Dormand-Prince 5(4) with projection after each step;
+            baumgarte-rk4: index 1 with Baumgarte stabilization, fixed step h;
+            partitioned: coordinate partitioning (Wehage-Haug), Dormand-Prince on the
+            independent coordinates.
+        rtol, atol : float, optional
+            Error tolerances of the adaptive methods (defaults 1e-6, 1e-8).
+        h : float, optional
+            Fixed step (generalized-alpha, baumgarte-rk4).
+        rho_inf : float, optional
+            Generalized-alpha spectral radius at infinite frequency, in [0, 1] (default 0.8).
+        alpha, beta : float, optional
+            Baumgarte coefficients (default 10, 10).
+
+        Returns
+        -------
+        DynamicsResult
+
+        Raises
+        ------
+        ModelError
+            If a body has no mass or inertia, or a setting is invalid.
+        IntegrationError
+            When the method fails (blow-up, step-size underflow); carries the partial results.
+        """
+        from .dynamics import run_dynamics
+        return run_dynamics(self, t_end=t_end, steps=steps, method=method, rtol=rtol,
+                            atol=atol, h=h, rho_inf=rho_inf, alpha=alpha, beta=beta, t0=t0)
+
+    def statics(self, t: float = 0.0) -> "StaticsResult":
+        """Static equilibrium under gravity, springs and loads (drivers held at t), with the
+        multipliers, reactions (``res.reaction(name)``) and stability.
+
+        Raises
+        ------
+        ConvergenceError
+            If no equilibrium is found near the q0 estimates.
+        SingularJacobianError
+            If the equilibrium is not unique (a free motion without stiffness).
+        """
+        from .dynamics import run_statics
+        return run_statics(self, t=t)
+
     def phi(self, q: Any, t: float = 0.0) -> np.ndarray:
         """Phi(q, t), computed by the core."""
         from .analysis import evaluate
@@ -498,8 +655,16 @@ class Model:
         export(self, path, t_end=t_end, steps=steps, t0=t0, tol=tol, maxit=maxit)
 
     def __repr__(self) -> str:
+        forces = f", {len(self.forces)} forces" if self.forces else ""
         return (f"Model({self.name!r}: {len(self.bodies)} bodies, {len(self.joints)} joints, "
-                f"{len(self.drivers)} drivers)")
+                f"{len(self.drivers)} drivers{forces})")
+
+
+def _nonneg(x: Any, what: str, entry: str) -> float:
+    v = number(x, what, entry)
+    if v < 0.0:
+        raise ModelError(f"{what} must be >= 0, got {x!r}", entry)
+    return v
 
 
 __all__ = ["Model"]

@@ -112,6 +112,145 @@ class KinematicsResult:
                 f"coordinates{'' if self.complete else ', incomplete'})")
 
 
+@dataclass
+class Reaction:
+    """Reaction of a joint or driver on its two bodies over time (arrays over outputs).
+
+    fx, fy are the force on body i (global components) and mz the moment about its centre
+    of mass; fx_j, fy_j, mz_j the same on body j. The ``_local`` arrays are the forces in
+    each body's own frame. Forces on ground are zero (ground has no coordinates).
+    """
+
+    name: str
+    bodies: tuple[str, str]
+    fx: np.ndarray
+    fy: np.ndarray
+    mz: np.ndarray
+    fx_j: np.ndarray
+    fy_j: np.ndarray
+    mz_j: np.ndarray
+    fx_local: np.ndarray
+    fy_local: np.ndarray
+    fx_j_local: np.ndarray
+    fy_j_local: np.ndarray
+
+
+@dataclass(repr=False)
+class DynamicsResult(KinematicsResult):
+    """A kinematic or dynamic run with multipliers, energies and constraint drift.
+
+    Attributes
+    ----------
+    lam : numpy.ndarray
+        Lagrange multipliers (n, neq), rows labelled by ``row_labels``; with redundant
+        constraints the minimum-norm set.
+    kinetic, potential : numpy.ndarray
+        Kinetic energy q_dot^T M q_dot / 2 and potential energy (gravity and springs).
+    drift_position, drift_velocity : numpy.ndarray
+        ||Phi||_inf and ||J q_dot - nu||_inf at each output.
+    """
+
+    lam: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
+    kinetic: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    potential: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    drift_position: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    drift_velocity: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    row_labels: list[str] = field(default_factory=list)
+    packed: Any = None
+    _reac: Any = None
+
+    @property
+    def energy(self) -> np.ndarray:
+        """Kinetic plus potential energy."""
+        return self.kinetic + self.potential
+
+    def _reactions(self) -> tuple[np.ndarray, np.ndarray]:
+        if self._reac is None:
+            from .dynamics import reactions
+            self._reac = reactions(self.packed, self.q, self.t, self.lam)
+        return self._reac
+
+    def reaction(self, name: str) -> Reaction:
+        """Reaction of the joint or driver called name on its two bodies.
+
+        Raises
+        ------
+        KeyError
+            If there is no such joint or driver.
+        """
+        names = self.packed.constraint_names
+        if name not in names:
+            raise KeyError(f"no joint or driver {name!r}; known: {', '.join(names)}")
+        k = names.index(name)
+        g, loc = self._reactions()
+        c = self.model.constraints[k]
+        r, rl = g[:, k, :], loc[:, k, :]
+        return Reaction(name, c.bodies, r[:, 0], r[:, 1], r[:, 2], r[:, 3], r[:, 4], r[:, 5],
+                        rl[:, 0], rl[:, 1], rl[:, 3], rl[:, 4])
+
+    def effort(self, name: str) -> np.ndarray:
+        """What the driver called name supplies: the torque (angle drivers) or force
+        (x, y or slide drivers) in the driven direction, -lambda of its row."""
+        names = self.packed.constraint_names
+        if name not in names or not self.packed.driver_flags[names.index(name)]:
+            raise KeyError(f"no driver {name!r}")
+        row = self.packed.row_owner.index(names.index(name))
+        return -self.lam[:, row]
+
+    def multiplier(self, row: str) -> np.ndarray:
+        """The multiplier of a row by its label (see ``model.constraint_rows()``)."""
+        return self.lam[:, self.row_labels.index(row)]
+
+    def to_npz(self, path: str | Path) -> None:
+        """t, q, qd, qdd, the multipliers and energies, and the names."""
+        np.savez(path, t=self.t, q=self.q, qd=self.qd, qdd=self.qdd, lam=self.lam,
+                 kinetic=self.kinetic, potential=self.potential,
+                 drift_position=self.drift_position, drift_velocity=self.drift_velocity,
+                 coordinate_names=np.array(self.coordinate_names),
+                 body_names=np.array(self.body_names), row_labels=np.array(self.row_labels))
+
+    def __repr__(self) -> str:
+        return "Dynamics" + super().__repr__()
+
+
+@dataclass
+class StaticsResult:
+    """A static equilibrium: configuration, multipliers, reactions and stability."""
+
+    t: float
+    q: np.ndarray
+    lam: np.ndarray
+    stability: str
+    residual: float
+    body_names: list[str]
+    coordinate_names: list[str]
+    row_labels: list[str]
+    model: Any = None
+    packed: Any = None
+
+    def body(self, name: str) -> tuple[float, float, float]:
+        """(x, y, theta) of a body at the equilibrium."""
+        i = self.body_names.index(name)
+        return tuple(float(v) for v in self.q[3 * i:3 * i + 3])  # type: ignore[return-value]
+
+    def reaction(self, name: str) -> Reaction:
+        """The reaction of a joint or driver at the equilibrium (arrays of length 1)."""
+        from .dynamics import reactions
+        names = self.packed.constraint_names
+        if name not in names:
+            raise KeyError(f"no joint or driver {name!r}; known: {', '.join(names)}")
+        k = names.index(name)
+        g, loc = reactions(self.packed, self.q[None, :], np.array([self.t]), self.lam[None, :])
+        r, rl = g[:, k, :], loc[:, k, :]
+        c = self.model.constraints[k]
+        return Reaction(name, c.bodies, r[:, 0], r[:, 1], r[:, 2], r[:, 3], r[:, 4], r[:, 5],
+                        rl[:, 0], rl[:, 1], rl[:, 3], rl[:, 4])
+
+    def multiplier(self, row: str) -> float:
+        """The multiplier of a row by its label."""
+        return float(self.lam[self.row_labels.index(row)])
+
+
 def read_csv(path: str | Path) -> tuple[list[str], np.ndarray]:
     """Read a result CSV back: (header, rows)."""
     with open(path) as fh:

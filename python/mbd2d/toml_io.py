@@ -4,6 +4,8 @@
     [[body]]           name, q0, mass, inertia
     [[joint]]          name, type, bodies, points, axes, profile, follower
     [[driver]]         name, type, body, coordinate, bodies, joint, f
+    [[force]]          name, type, bodies, body, points, point, stiffness, damping, length0,
+                       angle0, f, fx, fy
 
 Every key goes through the builder methods of :class:`mbd2d.model.Model`, so a TOML model
 and a model built in code are checked the same way.
@@ -87,12 +89,14 @@ def from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Model:
     name = head.get("name", Path(source).stem if source.endswith(".toml") else "model")
     if not isinstance(name, str):
         raise ModelError(f"name must be a string, got {name!r}", "[model]")
+    if isinstance(head.get("gravity"), (str, bytes)):
+        raise ModelError("gravity must be a list of 2 numbers", "[model]")
     model = Model(name, head.get("gravity", (0.0, -9.81)))
     for i, b in enumerate(_entries(data, "body", source)):
         entry = f"[[body]] #{i + 1}" + (f" {b.get('name')!r}" if isinstance(b, Mapping) else "")
         b = table(b, "[[body]]", entry)
         only_keys(b, {"name", "q0", "mass", "inertia", "v0"}, entry, required=["name", "q0"])
-        model.add_body(b["name"], b["q0"], b.get("mass"), b.get("inertia"))
+        model.add_body(b["name"], b["q0"], b.get("mass"), b.get("inertia"), b.get("v0"))
     for i, j in enumerate(_entries(data, "joint", source)):
         entry = f"[[joint]] #{i + 1}" + (f" {j.get('name')!r}" if isinstance(j, Mapping) else "")
         j = dict(table(j, "[[joint]]", entry))
@@ -105,7 +109,11 @@ def from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Model:
         only_keys(d, {"name", "type", "body", "coordinate", "bodies", "joint", "f"}, entry,
                   required=["type", "f"])
         model.add_driver(**d)
-    if data.get("force"):
-        raise ModelError("[[force]] entries need dynamics, which this version does not have yet",
-                         source)
+    for i, fe in enumerate(_entries(data, "force", source)):
+        entry = f"[[force]] #{i + 1}" + (f" {fe.get('name')!r}" if isinstance(fe, Mapping) else "")
+        fe = dict(table(fe, "[[force]]", entry))
+        if "type" not in fe:
+            raise ModelError("missing key 'type' (spring, torque, point, rotational-spring)",
+                             entry)
+        model.add_force(**fe)
     return model

@@ -1,0 +1,314 @@
+!> mbd_dynamics: the constrained equations of motion and what the integrators need from them.
+!!
+!!   M q_ddot + J^T lambda = Q(q, q_dot, t),   Phi(q, t) = 0            (Haug ch. 6)
+!! Index 1 (accelerations and multipliers at a state):
+!!   [ M    s J^T ] [ q_ddot     ]   [ Q     ]
+!!   [ s J  0     ] [ lambda / s ] = [ gamma ]      s: a mass scale, for conditioning
+!! Only an independent set of constraint rows enters (redundant rows, found by the rank
+!! analysis at the start, carry no multiplier of their own); the reported lambda is the
+!! minimum-norm solution of J^T lambda = Q - M q_ddot over all rows.
+!! Also here: applied forces and energies, consistent initial velocities (the kinetic-energy
+!! projection [M J^T; J 0][q_dot; mu] = [M v0; nu]), the projection of positions onto Phi = 0
+!! (minimum-norm Newton steps), joint reactions and driver efforts.
+module mbd_dynamics
+  use mbd_kinds, only: wp, zero, one, half
+  use mbd_status, only: MBD_OK, MBD_SINGULAR, MBD_NO_CONVERGENCE, MBD_LAPACK, MSG_LEN
+  use mbd_points, only: NLOC, rot
+  use mbd_model, only: model_t, model_slots
+  use mbd_constraints, only: con_is_driver
+  use mbd_forces, only: force_eval
+  use mbd_assemble, only: assemble_blocks, assemble_dense, scatter_dense, gather_local
+  use mbd_linsolve, only: lu_factor, lu_solve, row_rank, lapack_status
+  use mbd_lapack, only: dgelsy
+  implicit none
+  private
+  public :: dyn_work_t, dyn_init, gen_forces, kinetic_energy, dyn_accel, dyn_velocity, &
+            dyn_project_pos, dyn_multipliers, dyn_reactions, dyn_tangent
+
+  !> Work arrays and the active (independent) constraint rows.
+  type :: dyn_work_t
+    integer :: n = 0, neq = 0, na = 0     !! coordinates, equations, active rows
+    integer, allocatable :: rows(:)       !! active rows
+    real(wp) :: s = one                   !! constraint scale in the augmented matrix
+    real(wp) :: tol = 1.0e-12_wp          !! position tolerance ||Phi||_inf
+    real(wp), allocatable :: phi(:), nu(:), gam(:), jac(:, :), jb(:, :, :), qz(:)
+    real(wp), allocatable :: aug(:, :), rhs(:), force(:), ja(:, :)
+    integer, allocatable :: apiv(:)
+    integer :: nsolve = 0                 !! augmented factorizations
+  end type dyn_work_t
+
+contains
+
+  !> Allocate, and choose the active rows by the rank of J at q (redundant rows out).
+  subroutine dyn_init(m, w, q, t, tol, status, msg)
+    type(model_t), intent(in) :: m              !! model with dynamics data
+    type(dyn_work_t), intent(out) :: w          !! work arrays
+    real(wp), intent(in) :: q(:)                !! configuration
+    real(wp), intent(in) :: t                   !! time
+    real(wp), intent(in) :: tol                 !! absolute position tolerance
+    integer, intent(out) :: status              !! MBD_OK or MBD_LAPACK
+    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    integer, allocatable :: red(:)
+    integer :: rank, r, na
+    w%n = m%nq; w%neq = m%neq; w%tol = tol
+    allocate (w%phi(m%neq), w%nu(m%neq), w%gam(m%neq), w%jac(m%neq, m%nq), &
+              w%jb(3, NLOC, m%nc), w%qz(m%nq), w%force(m%nq), red(m%neq))
+    w%qz = zero
+    call assemble_dense(m, q, w%qz, t, w%phi, w%nu, w%gam, w%jb, w%jac)
+    call row_rank(w%jac, rank, red, status, msg)
+    if (status /= MBD_OK) return
+    na = count(red == 0)
+    w%na = na
+    w%rows = pack([(r, r=1, m%neq)], red == 0)
+    allocate (w%aug(m%nq + na, m%nq + na), w%rhs(m%nq + na), w%apiv(m%nq + na), &
+              w%ja(na, m%nq))
+    w%s = one
+    if (any(m%mdiag > zero)) w%s = sum(m%mdiag, mask=m%mdiag > zero) / count(m%mdiag > zero)
+  end subroutine dyn_init
+
+  !> Applied generalized forces Q(q, q_dot, t) and the potential energy V (gravity, springs);
+  !! vload adds the potential of the loads frozen at t (statics).
+  pure subroutine gen_forces(m, q, qd, t, force, v, vload)
+    type(model_t), intent(in) :: m        !! model
+    real(wp), intent(in) :: q(:), qd(:)   !! state
+    real(wp), intent(in) :: t             !! time
+    real(wp), intent(out) :: force(:)     !! Q (nq)
+    real(wp), intent(out) :: v            !! potential energy
+    real(wp), intent(out), optional :: vload  !! potential of the loads at t
+    real(wp) :: ql(NLOC), qdl(NLOC), fl(NLOC), vk, vl, vls
+    integer :: k, s, si, sj
+    force = zero; v = zero; vls = zero
+    do k = 1, m%nb
+      force(3 * k - 2:3 * k - 1) = m%mdiag(3 * k - 2) * m%grav
+      v = v - m%mdiag(3 * k - 2) * dot_product(m%grav, q(3 * k - 2:3 * k - 1))
+    end do
+    do k = 1, m%nf
+      do s = 1, NLOC
+        ql(s) = zero; qdl(s) = zero
+        if (m%floc(s, k) > 0) then
+          ql(s) = q(m%floc(s, k)); qdl(s) = qd(m%floc(s, k))
+        end if
+      end do
+      si = merge(1, 0, m%fbi(k) > 0); sj = merge(2, 0, m%fbj(k) > 0)
+      call force_eval(m%fkind(k), m%fp(m%fpo(k):m%fpo(k) + m%fpn(k) - 1), si, sj, ql, qdl, t, &
+                      fl, vk, vl)
+      do s = 1, NLOC
+        if (m%floc(s, k) > 0) force(m%floc(s, k)) = force(m%floc(s, k)) + fl(s)
+      end do
+      v = v + vk; vls = vls + vl
+    end do
+    if (present(vload)) vload = vls
+  end subroutine gen_forces
+
+  !> T = q_dot^T M q_dot / 2.
+  pure real(wp) function kinetic_energy(m, qd)
+    type(model_t), intent(in) :: m      !! model
+    real(wp), intent(in) :: qd(:)       !! velocities
+    kinetic_energy = half * sum(m%mdiag * qd**2)
+  end function kinetic_energy
+
+  !> Factor [M s Ja^T; s Ja 0] with Ja = J(rows) from w%jac.
+  subroutine factor_aug(m, w, metric, status)
+    type(model_t), intent(in) :: m
+    type(dyn_work_t), intent(inout) :: w
+    real(wp), intent(in) :: metric(:)     ! diagonal of the upper-left block
+    integer, intent(out) :: status
+    character(len=MSG_LEN) :: msg
+    integer :: i, n
+    n = m%nq
+    w%ja = w%jac(w%rows, :)
+    w%aug = zero
+    do i = 1, n
+      w%aug(i, i) = metric(i)
+    end do
+    w%aug(1:n, n + 1:) = w%s * transpose(w%ja)
+    w%aug(n + 1:, 1:n) = w%s * w%ja
+    call lu_factor(w%aug, w%apiv, status, msg)
+    w%nsolve = w%nsolve + 1
+  end subroutine factor_aug
+
+  !> Accelerations and multipliers: [M J^T; J 0][q_ddot; lambda] = [Q; gamma] (active rows).
+  !! lam is filled on the active rows (zero elsewhere); dyn_multipliers gives the
+  !! minimum-norm multipliers over all rows.
+  subroutine dyn_accel(m, w, q, qd, t, qdd, lam, status)
+    type(model_t), intent(in) :: m           !! model
+    type(dyn_work_t), intent(inout) :: w     !! work arrays
+    real(wp), intent(in) :: q(:), qd(:)      !! state
+    real(wp), intent(in) :: t                !! time
+    real(wp), intent(out) :: qdd(:)          !! accelerations
+    real(wp), intent(out) :: lam(:)          !! multipliers (neq)
+    integer, intent(out) :: status           !! MBD_OK or MBD_SINGULAR
+    real(wp) :: v
+    character(len=MSG_LEN) :: msg
+    integer :: n
+    n = m%nq
+    call assemble_dense(m, q, qd, t, w%phi, w%nu, w%gam, w%jb, w%jac)
+    call gen_forces(m, q, qd, t, w%force, v)
+    call factor_aug(m, w, m%mdiag, status)
+    if (status /= MBD_OK) return
+    w%rhs(1:n) = w%force
+    w%rhs(n + 1:) = w%s * w%gam(w%rows)
+    call lu_solve(w%aug, w%apiv, w%rhs, status, msg)
+    qdd = w%rhs(1:n)
+    lam = zero
+    lam(w%rows) = w%s * w%rhs(n + 1:)
+  end subroutine dyn_accel
+
+  !> Velocities consistent with J q_dot = nu, nearest to v0 in kinetic energy:
+  !! [M J^T; J 0][q_dot; mu] = [M v0; nu]. Massless coordinates get the unit metric.
+  subroutine dyn_velocity(m, w, q, t, v0, qd, status)
+    type(model_t), intent(in) :: m           !! model
+    type(dyn_work_t), intent(inout) :: w     !! work arrays
+    real(wp), intent(in) :: q(:)             !! configuration
+    real(wp), intent(in) :: t                !! time
+    real(wp), intent(in) :: v0(:)            !! velocity estimate
+    real(wp), intent(out) :: qd(:)           !! consistent velocities
+    integer, intent(out) :: status           !! MBD_OK or MBD_SINGULAR
+    real(wp) :: metric(m%nq)
+    character(len=MSG_LEN) :: msg
+    integer :: n
+    n = m%nq
+    metric = merge(m%mdiag, w%s, m%mdiag > zero)
+    call assemble_dense(m, q, w%qz, t, w%phi, w%nu, w%gam, w%jb, w%jac)
+    call factor_aug(m, w, metric, status)
+    if (status /= MBD_OK) return
+    w%rhs(1:n) = metric * v0
+    w%rhs(n + 1:) = w%s * w%nu(w%rows)
+    call lu_solve(w%aug, w%apiv, w%rhs, status, msg)
+    qd = w%rhs(1:n)
+  end subroutine dyn_velocity
+
+  !> Project q onto Phi(q, t) = 0 by minimum-norm Newton steps:
+  !! [I J^T; J 0][dq; mu] = [0; -Phi] (active rows), to ||Phi||_inf <= w%tol.
+  subroutine dyn_project_pos(m, w, q, t, status)
+    type(model_t), intent(in) :: m           !! model
+    type(dyn_work_t), intent(inout) :: w     !! work arrays
+    real(wp), intent(inout) :: q(:)          !! configuration, projected
+    real(wp), intent(in) :: t                !! time
+    integer, intent(out) :: status           !! MBD_OK, MBD_NO_CONVERGENCE or MBD_SINGULAR
+    real(wp) :: metric(m%nq)
+    character(len=MSG_LEN) :: msg
+    integer :: it, n
+    n = m%nq
+    metric = one
+    do it = 1, 20
+      call assemble_dense(m, q, w%qz, t, w%phi, w%nu, w%gam, w%jb, w%jac)
+      status = MBD_OK
+      if (maxval(abs(w%phi)) <= w%tol) return
+      call factor_aug(m, w, metric, status)
+      if (status /= MBD_OK) return
+      w%rhs(1:n) = zero
+      w%rhs(n + 1:) = -w%s * w%phi(w%rows)
+      call lu_solve(w%aug, w%apiv, w%rhs, status, msg)
+      q = q + w%rhs(1:n)
+    end do
+    status = MBD_NO_CONVERGENCE
+  end subroutine dyn_project_pos
+
+  !> Minimum-norm multipliers over all rows: lambda = argmin ||l|| with J^T l = Q - M q_ddot
+  !! (LAPACK dgelsy). With independent rows this is the unique lambda; with redundant rows
+  !! the reactions are statically indeterminate and this is the smallest set.
+  subroutine dyn_multipliers(m, w, q, qd, qdd, t, lam, status, msg)
+    type(model_t), intent(in) :: m            !! model
+    type(dyn_work_t), intent(inout) :: w      !! work arrays
+    real(wp), intent(in) :: q(:), qd(:), qdd(:)  !! state and accelerations
+    real(wp), intent(in) :: t                 !! time
+    real(wp), intent(out) :: lam(:)           !! multipliers (neq)
+    integer, intent(out) :: status            !! MBD_OK or MBD_LAPACK
+    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    real(wp) :: jt(m%nq, m%neq), b(max(m%nq, m%neq)), v, wq(1)
+    real(wp), allocatable :: work(:)
+    integer :: jpvt(m%neq), rank, info, lwork
+    call assemble_dense(m, q, qd, t, w%phi, w%nu, w%gam, w%jb, w%jac)
+    call gen_forces(m, q, qd, t, w%force, v)
+    jt = transpose(w%jac)
+    b = zero
+    b(1:m%nq) = w%force - m%mdiag * qdd
+    jpvt = 0
+    call dgelsy(m%nq, m%neq, 1, jt, m%nq, b, size(b), jpvt, 1.0e-10_wp, rank, wq, -1, info)
+    lwork = max(1, int(wq(1)))
+    allocate (work(lwork))
+    call dgelsy(m%nq, m%neq, 1, jt, m%nq, b, size(b), jpvt, 1.0e-10_wp, rank, work, lwork, info)
+    call lapack_status('dgelsy', info, status, msg)
+    lam = b(1:m%neq)
+  end subroutine dyn_multipliers
+
+  !> Reactions of each constraint on its two bodies, from lambda: the generalized constraint
+  !! force -J_k^T lambda_k on body i and on body j: (Fx, Fy, Mz) global, Mz about the centre
+  !! of mass; and the same forces in each body's frame (A^T F, Mz).
+  !! reac(1:6, k) = [Fx_i, Fy_i, Mz_i, Fx_j, Fy_j, Mz_j] global; rloc likewise local.
+  subroutine dyn_reactions(m, w, q, t, lam, reac, rloc)
+    type(model_t), intent(in) :: m            !! model
+    type(dyn_work_t), intent(inout) :: w      !! work arrays
+    real(wp), intent(in) :: q(:)              !! configuration
+    real(wp), intent(in) :: t                 !! time
+    real(wp), intent(in) :: lam(:)            !! multipliers (neq)
+    real(wp), intent(out) :: reac(:, :)       !! (6, nc) global
+    real(wp), intent(out) :: rloc(:, :)       !! (6, nc) in the body frames
+    real(wp) :: g(NLOC), a(2, 2)
+    integer :: k, r0, nr
+    call assemble_blocks(m, q, w%qz, t, w%phi, w%nu, w%gam, w%jb)
+    do k = 1, m%nc
+      r0 = m%row0(k); nr = m%nrow(k)
+      g = -matmul(lam(r0:r0 + nr - 1), w%jb(1:nr, :, k))
+      reac(:, k) = g(1:6)
+      rloc(:, k) = g(1:6)
+      if (m%bi(k) > 0) then
+        a = rot(q(3 * m%bi(k)))
+        rloc(1:2, k) = matmul(transpose(a), g(1:2))
+      else
+        reac(1:3, k) = zero; rloc(1:3, k) = zero
+      end if
+      if (m%bj(k) > 0) then
+        a = rot(q(3 * m%bj(k)))
+        rloc(4:5, k) = matmul(transpose(a), g(4:5))
+      else
+        reac(4:6, k) = zero; rloc(4:6, k) = zero
+      end if
+    end do
+  end subroutine dyn_reactions
+
+  !> Tangent matrices of the residual M q_ddot - Q(q, q_dot, t) + J^T lambda by central
+  !! differences: kt = d/dq (including the geometric term d(J^T lambda)/dq), ct = d/dq_dot.
+  !! Allocation-free: uses columns of the caller's arrays.
+  subroutine dyn_tangent(m, w, q, qd, t, lam, kt, ct)
+    type(model_t), intent(in) :: m            !! model
+    type(dyn_work_t), intent(inout) :: w      !! work arrays
+    real(wp), intent(in) :: q(:), qd(:)       !! state
+    real(wp), intent(in) :: t                 !! time
+    real(wp), intent(in) :: lam(:)            !! multipliers (neq)
+    real(wp), intent(out) :: kt(:, :), ct(:, :)  !! (nq, nq) tangent stiffness and damping
+    real(wp) :: qp(m%nq), rp(m%nq), rm(m%nq), hk
+    integer :: k
+    qp = q
+    do k = 1, m%nq
+      hk = 1.0e-7_wp * max(one, abs(q(k)))
+      qp(k) = q(k) + hk
+      call residual(qp, qd, rp)
+      qp(k) = q(k) - hk
+      call residual(qp, qd, rm)
+      qp(k) = q(k)
+      kt(:, k) = (rp - rm) / (2 * hk)
+    end do
+    qp = qd
+    do k = 1, m%nq
+      hk = 1.0e-7_wp * max(one, abs(qd(k)))
+      qp(k) = qd(k) + hk
+      call residual(q, qp, rp)
+      qp(k) = qd(k) - hk
+      call residual(q, qp, rm)
+      qp(k) = qd(k)
+      ct(:, k) = (rp - rm) / (2 * hk)
+    end do
+  contains
+    subroutine residual(qa, qda, r)
+      real(wp), intent(in) :: qa(:), qda(:)
+      real(wp), intent(out) :: r(:)
+      real(wp) :: v
+      call assemble_dense(m, qa, qda, t, w%phi, w%nu, w%gam, w%jb, w%jac)
+      call gen_forces(m, qa, qda, t, w%force, v)
+      r = matmul(lam, w%jac) - w%force
+    end subroutine residual
+  end subroutine dyn_tangent
+
+end module mbd_dynamics

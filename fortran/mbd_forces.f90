@@ -1,0 +1,144 @@
+!> mbd_forces: applied forces as generalized forces Q(q, q_dot, t), and their potential energy.
+!!
+!! Each force element writes Q over the local slots of its bodies (as joints do for J):
+!!   spring     d = P_j - P_i, L = |d|, tension T = k (L - L0) + c L_dot - f(t)
+!!              Q = -T dL/dq (pulls the points together when T > 0),  V = k (L - L0)**2 / 2
+!!   torque     Q_theta_i = f(t)                       (reaction on ground)
+!!   point      Q = J_P^T F, F = (fx(t), fy(t)) global, at body point s'
+!!   rotational a = theta_j - theta_i, tau = -k (a - a0) - c a_dot + f(t) on body j,
+!!              -tau on body i;  Q = tau da/dq,  V = k (a - a0)**2 / 2
+!! Gravity adds m g to the x and y rows of every body, V = -m g . r.
+!! vload is the potential of the loads held at their value at t (torque: -f theta_i,
+!! point force: -F . P), for the equilibrium search in statics.
+!! Raw parameters:
+!!   spring     [s'_i(2), s'_j(2), k, c, L0, f...]      rotational [k, c, a0, f...]
+!!   torque     [f...]                                  point      [s'(2), fx..., fy...]
+!! (f: an encoded function of time, mbd_functions.)
+module mbd_forces
+  use mbd_kinds, only: wp, zero, half
+  use mbd_status, only: MBD_OK, MBD_BAD_PARAM, MSG_LEN
+  use mbd_points, only: NLOC, kvec, kscal, body_point, body_angle, vsub, vdot, ssqrt, ssub
+  use mbd_functions, only: fun_eval, fun_length, fun_check
+  implicit none
+  private
+  public :: FRC_SPRING, FRC_TORQUE, FRC_POINT, FRC_ROTSPRING
+  public :: force_known, force_raw_length, force_prepare, force_eval
+
+  integer, parameter :: FRC_SPRING = 1, FRC_TORQUE = 2, FRC_POINT = 3, FRC_ROTSPRING = 4
+
+contains
+
+  pure logical function force_known(kind)
+    integer, intent(in) :: kind   !! force kind
+    force_known = kind >= FRC_SPRING .and. kind <= FRC_ROTSPRING
+  end function force_known
+
+  !> Expected raw length given the data, or -1 when malformed.
+  pure integer function force_raw_length(kind, raw)
+    integer, intent(in) :: kind      !! force kind
+    real(wp), intent(in) :: raw(:)   !! raw parameters
+    integer :: n1, n2
+    force_raw_length = -1
+    select case (kind)
+    case (FRC_SPRING)
+      if (size(raw) < 8) return
+      n1 = fun_length(raw(8:))
+      if (n1 > 0) force_raw_length = 7 + n1
+    case (FRC_TORQUE)
+      force_raw_length = fun_length(raw)
+    case (FRC_POINT)
+      if (size(raw) < 3) return
+      n1 = fun_length(raw(3:))
+      if (n1 < 0) return
+      n2 = fun_length(raw(3 + n1:))
+      if (n2 > 0) force_raw_length = 2 + n1 + n2
+    case (FRC_ROTSPRING)
+      if (size(raw) < 4) return
+      n1 = fun_length(raw(4:))
+      if (n1 > 0) force_raw_length = 3 + n1
+    end select
+  end function force_raw_length
+
+  !> Check raw parameters (finite, k >= 0, c >= 0, L0 >= 0); prepared = raw.
+  subroutine force_prepare(kind, raw, prep, status, msg)
+    integer, intent(in) :: kind                    !! force kind
+    real(wp), intent(in) :: raw(:)                 !! raw parameters (exact length)
+    real(wp), allocatable, intent(out) :: prep(:)  !! prepared parameters
+    integer, intent(out) :: status                 !! MBD_OK or MBD_BAD_PARAM
+    character(len=MSG_LEN), intent(out) :: msg     !! what is wrong
+    integer :: nf
+    status = MBD_OK; msg = ''
+    select case (kind)
+    case (FRC_SPRING)
+      if (.not. (raw(5) >= zero .and. raw(6) >= zero .and. raw(7) >= zero)) then
+        status = MBD_BAD_PARAM
+        msg = 'spring stiffness, damping and free length must be >= 0'; return
+      end if
+      call fun_check(raw(8:), status, msg)
+    case (FRC_TORQUE)
+      call fun_check(raw, status, msg)
+    case (FRC_POINT)
+      nf = fun_length(raw(3:))
+      call fun_check(raw(3:2 + nf), status, msg)
+      if (status == MBD_OK) call fun_check(raw(3 + nf:), status, msg)
+    case (FRC_ROTSPRING)
+      if (.not. (raw(1) >= zero .and. raw(2) >= zero)) then
+        status = MBD_BAD_PARAM; msg = 'rotational spring stiffness and damping must be >= 0'
+        return
+      end if
+      call fun_check(raw(4:), status, msg)
+    case default
+      status = MBD_BAD_PARAM; msg = 'unknown force kind'
+    end select
+    if (status == MBD_OK) prep = raw
+  end subroutine force_prepare
+
+  !> Generalized force over the local slots and potential energy of one element.
+  pure subroutine force_eval(kind, p, si, sj, ql, qdl, t, ql_force, v, vload)
+    integer, intent(in) :: kind             !! force kind
+    real(wp), intent(in) :: p(:)            !! prepared parameters
+    integer, intent(in) :: si, sj           !! slot ids of the bodies (0 = ground)
+    real(wp), intent(in) :: ql(NLOC)        !! local coordinates
+    real(wp), intent(in) :: qdl(NLOC)       !! local velocities
+    real(wp), intent(in) :: t               !! time
+    real(wp), intent(out) :: ql_force(NLOC) !! generalized force on the local slots
+    real(wp), intent(out) :: v              !! potential energy
+    real(wp), intent(out) :: vload          !! potential of the loads frozen at t
+    type(kvec) :: d, pt
+    type(kscal) :: l, a
+    real(wp) :: f, f1, f2, fy, tension, tau
+    integer :: nf
+    ql_force = zero; v = zero; vload = zero
+    select case (kind)
+    case (FRC_SPRING)
+      d = vsub(body_point(ql, qdl, sj, p(3:4)), body_point(ql, qdl, si, p(1:2)))
+      call fun_eval(p(8:), t, f, f1, f2)
+      if (dot_product(d%v, d%v) > zero) then
+        l = ssqrt(vdot(d, d))
+        tension = p(5) * (l%v - p(7)) + p(6) * l%vd - f
+        ql_force = -tension * l%d
+        v = half * p(5) * (l%v - p(7))**2
+      else
+        v = half * p(5) * p(7)**2
+      end if
+    case (FRC_TORQUE)
+      call fun_eval(p, t, f, f1, f2)
+      if (si > 0) ql_force(3) = f
+      vload = -f * ql(3)
+    case (FRC_POINT)
+      pt = body_point(ql, qdl, si, p(1:2))
+      nf = fun_length(p(3:))
+      call fun_eval(p(3:), t, f, f1, f2)
+      call fun_eval(p(3 + nf:), t, fy, f1, f2)
+      ql_force = f * pt%d(1, :) + fy * pt%d(2, :)
+      vload = -(f * pt%v(1) + fy * pt%v(2))
+    case (FRC_ROTSPRING)
+      a = ssub(body_angle(ql, qdl, sj), body_angle(ql, qdl, si))
+      call fun_eval(p(4:), t, f, f1, f2)
+      tau = -p(1) * (a%v - p(3)) - p(2) * a%vd + f
+      ql_force = tau * a%d
+      v = half * p(1) * (a%v - p(3))**2
+    end select
+  end subroutine force_eval
+
+end module mbd_forces

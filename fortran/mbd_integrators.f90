@@ -1,0 +1,615 @@
+!> mbd_integrators: forward dynamics of M q_ddot + J^T lambda = Q, Phi = 0, the whole time
+!! loop in one call, outputs at uniform times by quintic Hermite dense output.
+!!
+!! Methods (opts%method):
+!!  1 generalized-alpha  index-3 implicit generalized-alpha (Arnold & Bruls 2007), Newton on
+!!                       (dq, dlambda) with the Bottasso scaling; fixed step h or error
+!!                       controlled (local error h^2 |beta - 1/6| |a_{n+1} - a_n|); rho_inf.
+!!                       Iteration matrix [M b' + C g' + K, b' J^T; b' J, 0],
+!!                       b' = (1 - am)/(beta h^2 (1 - af)), g' = gamma/(beta h), K and C by
+!!                       differences of the residual.
+!!  2 dopri5             index 1 ([M J^T; J 0][q_ddot; lambda] = [Q; gamma]) with Dormand-Prince
+!!                       5(4), adaptive (rtol, atol), then projection of q onto Phi = 0 and of
+!!                       q_dot onto J q_dot = nu after every step.
+!!  3 baumgarte-rk4      index 1 with Baumgarte stabilization,
+!!                       J q_ddot = gamma - 2 alpha (J q_dot - nu) - beta^2 Phi, classical RK4,
+!!                       fixed step.
+!!  4 partitioned        coordinate partitioning (Wehage-Haug): Dormand-Prince 5(4) on the
+!!                       independent coordinates v; the dependent u from Phi(u, v) = 0, u_dot
+!!                       from J_u u_dot = nu - J_v v_dot, at every stage; re-partitioned when
+!!                       J_u becomes ill conditioned (QR with column pivoting, dgeqp3).
+module mbd_integrators
+  use mbd_kinds, only: wp, zero, one, half, two
+  use mbd_status, only: MBD_OK, MBD_BAD_SETTING, MBD_SINGULAR, MBD_NO_CONVERGENCE, &
+                        MBD_INTEGRATOR_FAILED, MBD_LAPACK, MSG_LEN
+  use mbd_model, only: model_t
+  use mbd_assemble, only: assemble_dense
+  use mbd_linsolve, only: lu_factor, lu_solve, lapack_status
+  use mbd_lapack, only: dgeqp3, dgecon
+  use mbd_interp, only: hermite5
+  use mbd_dynamics, only: dyn_work_t, dyn_accel, dyn_velocity, dyn_project_pos, gen_forces, &
+                          kinetic_energy, dyn_tangent
+  use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+  implicit none
+  private
+  public :: dyn_opts_t, dyn_stats_t, METH_GENALPHA, METH_DOPRI5, METH_RK4, METH_PARTITIONED
+  public :: integrate
+
+  integer, parameter :: METH_GENALPHA = 1, METH_DOPRI5 = 2, METH_RK4 = 3, METH_PARTITIONED = 4
+
+  !> Integrator settings.
+  type :: dyn_opts_t
+    integer :: method = METH_GENALPHA
+    real(wp) :: rtol = 1.0e-6_wp      !! relative tolerance (adaptive methods)
+    real(wp) :: atol = 1.0e-8_wp      !! absolute tolerance
+    real(wp) :: h = zero              !! fixed step (0: adaptive; required for RK4)
+    real(wp) :: rho_inf = 0.8_wp      !! generalized-alpha spectral radius at infinity
+    real(wp) :: balpha = 10.0_wp      !! Baumgarte alpha
+    real(wp) :: bbeta = 10.0_wp       !! Baumgarte beta
+    integer :: max_steps = 10000000   !! internal step limit
+  end type dyn_opts_t
+
+  !> What the integrator did.
+  type :: dyn_stats_t
+    integer :: steps = 0, rejected = 0, newton = 0, rhs = 0, jacobians = 0, partitions = 0
+    real(wp) :: hmin = huge(one), hmax = zero
+  end type dyn_stats_t
+
+  !> Run context: settings, counters, the output grid, the form of the equations and the
+  !! partition, and the last full state evaluated.
+  type :: itg_t
+    type(dyn_opts_t) :: opts
+    type(dyn_stats_t) :: st
+    real(wp) :: t0 = zero, t1 = zero
+    integer :: nsteps = 0, nout = 0
+    logical :: baumgarte = .false.
+    integer :: ni = 0                       !! independent coordinates (partitioned)
+    integer, allocatable :: iv(:), iu(:)    !! independent and dependent coordinates
+    real(wp), allocatable :: qf(:), vf(:), af(:), lam(:)   !! last full state
+  end type itg_t
+
+  ! Dormand-Prince 5(4) tableau
+  real(wp), parameter :: C2 = 0.2_wp, C3 = 0.3_wp, C4 = 0.8_wp, C5 = 8.0_wp / 9.0_wp
+  real(wp), parameter :: A21 = 0.2_wp, A31 = 3.0_wp / 40, A32 = 9.0_wp / 40
+  real(wp), parameter :: A41 = 44.0_wp / 45, A42 = -56.0_wp / 15, A43 = 32.0_wp / 9
+  real(wp), parameter :: A51 = 19372.0_wp / 6561, A52 = -25360.0_wp / 2187
+  real(wp), parameter :: A53 = 64448.0_wp / 6561, A54 = -212.0_wp / 729
+  real(wp), parameter :: A61 = 9017.0_wp / 3168, A62 = -355.0_wp / 33, A63 = 46732.0_wp / 5247
+  real(wp), parameter :: A64 = 49.0_wp / 176, A65 = -5103.0_wp / 18656
+  real(wp), parameter :: A71 = 35.0_wp / 384, A73 = 500.0_wp / 1113, A74 = 125.0_wp / 192
+  real(wp), parameter :: A75 = -2187.0_wp / 6784, A76 = 11.0_wp / 84
+  real(wp), parameter :: E1 = 71.0_wp / 57600, E3 = -71.0_wp / 16695, E4 = 71.0_wp / 1920
+  real(wp), parameter :: E5 = -17253.0_wp / 339200, E6 = 22.0_wp / 525, E7 = -1.0_wp / 40
+
+contains
+
+  !> Integrate from the consistent state (q, qd) at t0 to t1, writing outputs at
+  !! t0 + k (t1 - t0)/nsteps, k = 0..nsteps, into the columns of qo, vo, ao.
+  !! nout returns the number of outputs written (all, unless a failure stopped the run).
+  subroutine integrate(m, w, q, qd, t0, t1, nsteps, opts, qo, vo, ao, nout, st, status, msg)
+    type(model_t), intent(in) :: m               !! model
+    type(dyn_work_t), intent(inout) :: w         !! dynamics work arrays (dyn_init done)
+    real(wp), intent(inout) :: q(:), qd(:)       !! consistent initial state, then final
+    real(wp), intent(in) :: t0, t1               !! time span
+    integer, intent(in) :: nsteps                !! output intervals
+    type(dyn_opts_t), intent(in) :: opts         !! settings
+    real(wp), intent(out) :: qo(:, :), vo(:, :), ao(:, :)  !! outputs (nq, nsteps + 1)
+    integer, intent(out) :: nout                 !! outputs written
+    type(dyn_stats_t), intent(out) :: st         !! counters
+    integer, intent(out) :: status               !! MBD_OK or a failure
+    character(len=MSG_LEN), intent(out) :: msg   !! explanation
+    type(itg_t) :: c
+    status = MBD_OK; msg = ''; nout = 0
+    qo = zero; vo = zero; ao = zero
+    if (opts%method == METH_RK4 .and. .not. (opts%h > zero)) then
+      status = MBD_BAD_SETTING; msg = 'baumgarte-rk4 needs a step h > 0'; return
+    end if
+    if (.not. (opts%rtol > zero .and. opts%atol > zero)) then
+      status = MBD_BAD_SETTING; msg = 'rtol and atol must be positive'; return
+    end if
+    c%opts = opts; c%t0 = t0; c%t1 = t1; c%nsteps = nsteps
+    allocate (c%qf(m%nq), c%vf(m%nq), c%af(m%nq), c%lam(m%neq))
+    c%qf = q; c%vf = qd
+    call dyn_accel(m, w, q, qd, t0, c%af, c%lam, status)
+    if (status /= MBD_OK) then
+      msg = 'the mass matrix and constraints give a singular system at the start'; return
+    end if
+    qo(:, 1) = q; vo(:, 1) = qd; ao(:, 1) = c%af
+    c%nout = 1
+    if (nsteps > 0) then
+      select case (opts%method)
+      case (METH_GENALPHA)
+        call run_genalpha(m, w, c, qo, vo, ao, status, msg)
+      case (METH_DOPRI5, METH_RK4)
+        call run_explicit(m, w, c, .false., qo, vo, ao, status, msg)
+      case (METH_PARTITIONED)
+        call run_explicit(m, w, c, .true., qo, vo, ao, status, msg)
+      case default
+        status = MBD_BAD_SETTING; msg = 'unknown integration method'
+      end select
+    end if
+    nout = c%nout; st = c%st
+    q = c%qf; qd = c%vf
+  end subroutine integrate
+
+  real(wp) function out_time(c, k)
+    type(itg_t), intent(in) :: c
+    integer, intent(in) :: k
+    out_time = c%t0 + (c%t1 - c%t0) * (real(k, wp) / c%nsteps)
+    if (k == c%nsteps) out_time = c%t1
+  end function out_time
+
+  !> Write the outputs in (ta, tb] by quintic Hermite interpolation of the two states.
+  subroutine emit(c, qo, vo, ao, ta, qa, va, aa, tb, qb, vb, ab)
+    type(itg_t), intent(inout) :: c
+    real(wp), intent(inout) :: qo(:, :), vo(:, :), ao(:, :)
+    real(wp), intent(in) :: ta, tb, qa(:), va(:), aa(:), qb(:), vb(:), ab(:)
+    do while (c%nout <= c%nsteps)
+      if (out_time(c, c%nout) > tb + 1.0e-12_wp * abs(c%t1 - c%t0)) exit
+      call hermite5(ta, qa, va, aa, tb, qb, vb, ab, out_time(c, c%nout), qo(:, c%nout + 1), &
+                    vo(:, c%nout + 1), ao(:, c%nout + 1))
+      c%nout = c%nout + 1
+    end do
+  end subroutine emit
+
+  !> Weighted RMS norm of an error estimate.
+  real(wp) function err_norm(c, e, ya, yb)
+    type(itg_t), intent(in) :: c
+    real(wp), intent(in) :: e(:), ya(:), yb(:)
+    err_norm = sqrt(sum((e / (c%opts%atol + c%opts%rtol * max(abs(ya), abs(yb))))**2) / size(e))
+  end function err_norm
+
+  !> A first step that makes h^2 |q_ddot| about atol + rtol |q| (at most the output spacing).
+  real(wp) function initial_step(c)
+    type(itg_t), intent(in) :: c
+    real(wp) :: sc
+    sc = maxval(abs(c%af) / (c%opts%atol + c%opts%rtol * abs(c%qf)))
+    initial_step = (c%t1 - c%t0) / c%nsteps
+    if (sc > zero) initial_step = min(initial_step, 0.1_wp * sqrt(one / sc))
+    initial_step = max(initial_step, 1.0e-10_wp * abs(c%t1 - c%t0))
+  end function initial_step
+
+  ! -------------------------------------------------------------------- generalized-alpha
+  subroutine run_genalpha(m, w, c, qo, vo, ao, status, msg)
+    type(model_t), intent(in) :: m
+    type(dyn_work_t), intent(inout) :: w
+    type(itg_t), intent(inout) :: c
+    real(wp), intent(inout) :: qo(:, :), vo(:, :), ao(:, :)
+    integer, intent(out) :: status
+    character(len=MSG_LEN), intent(out) :: msg
+    real(wp) :: am, af, gam, bet, bp, gp, h, t, err, tnew, facc, v
+    real(wp) :: q(m%nq), qd(m%nq), qdd(m%nq), acc(m%nq), lam(m%neq)
+    real(wp) :: qn(m%nq), vn(m%nq), an(m%nq), accn(m%nq), lamn(m%neq), dq(m%nq)
+    real(wp) :: res(m%nq + w%na), kt(m%nq, m%nq), ct(m%nq, m%nq)
+    real(wp) :: s(m%nq + w%na, m%nq + w%na)
+    integer :: piv(m%nq + w%na), it, n, k, stt
+    logical :: fixed, conv
+    character(len=MSG_LEN) :: lmsg
+    status = MBD_OK; msg = ''
+    n = m%nq
+    am = (2 * c%opts%rho_inf - 1) / (c%opts%rho_inf + 1)
+    af = c%opts%rho_inf / (c%opts%rho_inf + 1)
+    gam = half + af - am
+    bet = 0.25_wp * (gam + half)**2
+    fixed = c%opts%h > zero
+    q = c%qf; qd = c%vf; qdd = c%af; lam = c%lam
+    t = c%t0
+    if (fixed) then
+      h = (c%t1 - c%t0) / max(1, nint((c%t1 - c%t0) / c%opts%h))   ! land on t1
+    else
+      h = initial_step(c)
+    end if
+    acc = qdd              ! the auxiliary acceleration a_0 = q_ddot_0
+    err = zero
+    do while (t < c%t1 - 1.0e-14_wp * abs(c%t1 - c%t0))
+      if (c%st%steps + c%st%rejected >= c%opts%max_steps) then
+        status = MBD_INTEGRATOR_FAILED
+        write (msg, '(a,i0,a,es12.5)') 'more than ', c%opts%max_steps, ' steps before t = ', t
+        return
+      end if
+      h = min(h, c%t1 - t)
+      tnew = t + h
+      bp = (1 - am) / (bet * h * h * (1 - af))
+      gp = gam / (bet * h)
+      ! predictor with q_ddot_{n+1} = 0
+      an = zero
+      accn = (af * qdd - am * acc) / (1 - am)
+      qn = q + h * qd + h * h * (half - bet) * acc + h * h * bet * accn
+      vn = qd + h * (1 - gam) * acc + h * gam * accn
+      lamn = lam
+      conv = .false.
+      dq = zero
+      do it = 1, 30
+        call assemble_dense(m, qn, vn, tnew, w%phi, w%nu, w%gam, w%jb, w%jac)
+        call gen_forces(m, qn, vn, tnew, w%force, v)
+        res(1:n) = m%mdiag * an + matmul(lamn, w%jac) - w%force
+        res(n + 1:) = bp * w%phi(w%rows)
+        if (it > 1 .and. maxval(abs(w%phi)) <= w%tol .and. &
+            maxval(abs(dq)) <= 1.0e-3_wp * (c%opts%atol + c%opts%rtol * maxval(abs(qn)))) then
+          conv = .true.; exit
+        end if
+        if (.not. all(ieee_is_finite(res))) exit
+        if (it == 1 .or. it == 4) then
+          ! iteration matrix [M b' + C g' + K, b' J^T; b' J, 0], refreshed at iterations 1, 4
+          call dyn_tangent(m, w, qn, vn, tnew, lamn, kt, ct)
+          c%st%jacobians = c%st%jacobians + 1
+          s = zero
+          do k = 1, n
+            s(k, k) = m%mdiag(k) * bp
+          end do
+          s(1:n, 1:n) = s(1:n, 1:n) + gp * ct + kt
+          call assemble_dense(m, qn, vn, tnew, w%phi, w%nu, w%gam, w%jb, w%jac)
+          s(1:n, n + 1:) = bp * transpose(w%jac(w%rows, :))
+          s(n + 1:, 1:n) = bp * w%jac(w%rows, :)
+          call lu_factor(s, piv, stt, lmsg)
+          if (stt /= MBD_OK) exit
+        end if
+        res = -res
+        call lu_solve(s, piv, res, stt, lmsg)
+        dq = res(1:n)
+        qn = qn + dq
+        vn = vn + gp * dq
+        an = an + bp * dq
+        lamn(w%rows) = lamn(w%rows) + bp * res(n + 1:)
+        c%st%newton = c%st%newton + 1
+      end do
+      ! local error estimate (Newmark type): h^2 |beta - 1/6| |q_ddot_{n+1} - q_ddot_n|
+      if (conv .and. .not. fixed) err = err_norm(c, h * h * abs(bet - one / 6) * (an - qdd), q, qn)
+      if (.not. conv .or. (.not. fixed .and. err > one)) then
+        c%st%rejected = c%st%rejected + 1
+        if (fixed) then
+          status = MBD_INTEGRATOR_FAILED
+          write (msg, '(a,es12.5,a,es10.3)') 'generalized-alpha: Newton did not converge at t = ', &
+            tnew, ' with the fixed step h = ', h
+          return
+        end if
+        if (conv) then
+          h = h * max(0.2_wp, 0.9_wp * err**(-one / 3))
+        else
+          h = h / 4
+        end if
+        if (h < 1.0e-14_wp * max(one, abs(t))) then
+          status = MBD_INTEGRATOR_FAILED
+          write (msg, '(a,es12.5)') 'generalized-alpha: step size underflow at t = ', t
+          return
+        end if
+        cycle
+      end if
+      accn = accn + (1 - af) / (1 - am) * an
+      call emit(c, qo, vo, ao, t, q, qd, qdd, tnew, qn, vn, an)
+      c%st%steps = c%st%steps + 1
+      c%st%hmin = min(c%st%hmin, h); c%st%hmax = max(c%st%hmax, h)
+      t = tnew; q = qn; qd = vn; qdd = an; acc = accn; lam = lamn
+      if (.not. fixed) then
+        facc = min(2.0_wp, max(0.2_wp, 0.9_wp * max(err, 1.0e-10_wp)**(-one / 3)))
+        h = h * facc
+      end if
+    end do
+    c%qf = q; c%vf = qd; c%af = qdd; c%lam = lam
+  end subroutine run_genalpha
+
+  ! -------------------------------------------------------------------- explicit methods
+  subroutine run_explicit(m, w, c, partitioned, qo, vo, ao, status, msg)
+    type(model_t), intent(in) :: m
+    type(dyn_work_t), intent(inout) :: w
+    type(itg_t), intent(inout) :: c
+    logical, intent(in) :: partitioned
+    real(wp), intent(inout) :: qo(:, :), vo(:, :), ao(:, :)
+    integer, intent(out) :: status
+    character(len=MSG_LEN), intent(out) :: msg
+    real(wp), allocatable :: y(:), ynew(:), k(:, :), e(:)
+    real(wp) :: t, h, tnew, err, fac, qa(m%nq), va(m%nq), aa(m%nq)
+    integer :: stt
+    logical :: fixed, fsal
+    status = MBD_OK; msg = ''
+    c%baumgarte = c%opts%method == METH_RK4
+    if (partitioned) then
+      call partition(m, w, c, c%t0, stt)
+      if (stt /= MBD_OK) then
+        status = stt; msg = 'partitioned: cannot choose independent coordinates'; return
+      end if
+    end if
+    fixed = c%opts%method == METH_RK4
+    t = c%t0
+    if (fixed) then
+      h = (c%t1 - c%t0) / max(1, nint((c%t1 - c%t0) / c%opts%h))
+    else
+      h = initial_step(c)
+    end if
+    call pack_state(c, y, ynew, k, e)
+    fsal = .false.
+    qa = c%qf; va = c%vf; aa = c%af          ! the state at the start of the step
+    err = zero
+    do while (t < c%t1 - 1.0e-14_wp * abs(c%t1 - c%t0))
+      if (c%st%steps + c%st%rejected >= c%opts%max_steps) then
+        status = MBD_INTEGRATOR_FAILED
+        write (msg, '(a,i0,a,es12.5)') 'more than ', c%opts%max_steps, ' steps before t = ', t
+        return
+      end if
+      h = min(h, c%t1 - t)
+      tnew = t + h
+      if (fixed) then
+        call rk4_step(m, w, c, t, y, h, ynew, k, stt)
+        err = zero
+      else
+        call dopri5_step(m, w, c, t, y, h, ynew, k, e, fsal, stt)
+        if (stt == MBD_OK) err = err_norm(c, e, y, ynew)
+      end if
+      if (stt /= MBD_OK .or. .not. all(ieee_is_finite(ynew))) then
+        if (fixed) then
+          status = MBD_INTEGRATOR_FAILED
+          write (msg, '(a,es12.5,a)') 'the solution blew up or the equations became singular '// &
+            'at t = ', t, ' (try a smaller step)'
+          return
+        end if
+        err = 10.0_wp
+      end if
+      if (err > one) then
+        c%st%rejected = c%st%rejected + 1
+        fsal = .false.
+        h = h * max(0.2_wp, 0.9_wp * err**(-0.2_wp))
+        if (h < 1.0e-14_wp * max(one, abs(t))) then
+          status = MBD_INTEGRATOR_FAILED
+          write (msg, '(a,es12.5)') 'step size underflow at t = ', t
+          return
+        end if
+        cycle
+      end if
+      ! accepted: the full state at the end, projected (dopri5) or completed (partitioned)
+      call finish_step(m, w, c, partitioned, tnew, ynew, fsal, stt)
+      if (stt /= MBD_OK) then
+        status = MBD_INTEGRATOR_FAILED
+        write (msg, '(a,es12.5)') 'the constraints could not be satisfied after the step to t = ', &
+          tnew
+        return
+      end if
+      call emit(c, qo, vo, ao, t, qa, va, aa, tnew, c%qf, c%vf, c%af)
+      qa = c%qf; va = c%vf; aa = c%af
+      c%st%steps = c%st%steps + 1
+      c%st%hmin = min(c%st%hmin, h); c%st%hmax = max(c%st%hmax, h)
+      t = tnew
+      y = ynew
+      if (.not. fixed) then
+        fac = min(5.0_wp, max(0.2_wp, 0.9_wp * max(err, 1.0e-10_wp)**(-0.2_wp)))
+        h = h * fac
+      end if
+      if (partitioned) then
+        if (needs_partition(m, w, c)) then
+          call partition(m, w, c, t, stt)
+          if (stt /= MBD_OK) then
+            status = MBD_INTEGRATOR_FAILED
+            write (msg, '(a,es12.5)') 'partitioned: no well-conditioned partition at t = ', t
+            return
+          end if
+          call pack_state(c, y, ynew, k, e)
+          fsal = .false.
+        end if
+      end if
+    end do
+  end subroutine run_explicit
+
+  !> The integrated state y from the full state: (q, q_dot), or (v, v_dot) when partitioned.
+  subroutine pack_state(c, y, ynew, k, e)
+    type(itg_t), intent(in) :: c
+    real(wp), allocatable, intent(inout) :: y(:), ynew(:), k(:, :), e(:)
+    integer :: ny
+    if (c%ni > 0) then
+      y = [c%qf(c%iv), c%vf(c%iv)]
+    else
+      y = [c%qf, c%vf]
+    end if
+    ny = size(y)
+    if (allocated(ynew)) deallocate (ynew, k, e)
+    allocate (ynew(ny), k(ny, 7), e(ny))
+  end subroutine pack_state
+
+  !> After an accepted step: the full consistent state at tn in c (dopri5: projected).
+  subroutine finish_step(m, w, c, partitioned, tn, yn, fsal, stf)
+    type(model_t), intent(in) :: m
+    type(dyn_work_t), intent(inout) :: w
+    type(itg_t), intent(inout) :: c
+    logical, intent(in) :: partitioned
+    real(wp), intent(in) :: tn
+    real(wp), intent(inout) :: yn(:)
+    logical, intent(inout) :: fsal
+    integer, intent(out) :: stf
+    real(wp) :: f(size(yn)), v0(m%nq)
+    if (partitioned) then
+      call rhs(m, w, c, tn, yn, f, stf)          ! solves u, u_dot and the accelerations
+      return
+    end if
+    c%qf = yn(1:m%nq); c%vf = yn(m%nq + 1:)
+    stf = MBD_OK
+    if (c%opts%method == METH_DOPRI5) then
+      call dyn_project_pos(m, w, c%qf, tn, stf)
+      v0 = c%vf
+      if (stf == MBD_OK) call dyn_velocity(m, w, c%qf, tn, v0, c%vf, stf)
+      yn(1:m%nq) = c%qf; yn(m%nq + 1:) = c%vf
+      fsal = .false.
+    end if
+    if (stf == MBD_OK) call rhs(m, w, c, tn, yn, f, stf)
+  end subroutine finish_step
+
+  !> y' = f(t, y). Full: y = (q, q_dot). Partitioned: y = (v, v_dot) and the dependent
+  !! coordinates are solved here. Leaves the full state in c%qf, c%vf, c%af.
+  subroutine rhs(m, w, c, t, y, f, stf)
+    type(model_t), intent(in) :: m
+    type(dyn_work_t), intent(inout) :: w
+    type(itg_t), intent(inout) :: c
+    real(wp), intent(in) :: t, y(:)
+    real(wp), intent(out) :: f(:)
+    integer, intent(out) :: stf
+    integer :: nn
+    c%st%rhs = c%st%rhs + 1
+    nn = m%nq
+    if (c%ni > 0) then
+      c%qf(c%iv) = y(1:c%ni)
+      call solve_dependent(m, w, c, t, y(c%ni + 1:), stf)
+      if (stf /= MBD_OK) return
+    else
+      c%qf = y(1:nn); c%vf = y(nn + 1:)
+    end if
+    call accel(m, w, c, t, stf)
+    if (stf /= MBD_OK) return
+    if (c%ni > 0) then
+      f(1:c%ni) = c%vf(c%iv); f(c%ni + 1:) = c%af(c%iv)
+    else
+      f(1:nn) = c%vf; f(nn + 1:) = c%af
+    end if
+  end subroutine rhs
+
+  !> Accelerations at c's full state; Baumgarte-stabilized for RK4:
+  !! J q_ddot = gamma - 2 alpha (J q_dot - nu) - beta^2 Phi.
+  subroutine accel(m, w, c, t, stf)
+    type(model_t), intent(in) :: m
+    type(dyn_work_t), intent(inout) :: w
+    type(itg_t), intent(inout) :: c
+    real(wp), intent(in) :: t
+    integer, intent(out) :: stf
+    character(len=MSG_LEN) :: lmsg
+    integer :: nn
+    call dyn_accel(m, w, c%qf, c%vf, t, c%af, c%lam, stf)
+    if (stf /= MBD_OK .or. .not. c%baumgarte) return
+    nn = m%nq
+    w%rhs(1:nn) = w%force
+    w%rhs(nn + 1:) = w%s * (w%gam(w%rows) - two * c%opts%balpha * &
+                            (matmul(w%jac(w%rows, :), c%vf) - w%nu(w%rows)) - &
+                            c%opts%bbeta**2 * w%phi(w%rows))
+    call lu_solve(w%aug, w%apiv, w%rhs, stf, lmsg)
+    c%af = w%rhs(1:nn)
+  end subroutine accel
+
+  !> Dependent coordinates u from Phi(u, v) = 0 (Newton with J_u), then u_dot from
+  !! J_u u_dot = nu - J_v v_dot.
+  subroutine solve_dependent(m, w, c, t, vdot, stf)
+    type(model_t), intent(in) :: m
+    type(dyn_work_t), intent(inout) :: w
+    type(itg_t), intent(inout) :: c
+    real(wp), intent(in) :: t, vdot(:)
+    integer, intent(out) :: stf
+    real(wp) :: ju(w%na, w%na), b(w%na)
+    integer :: piv(w%na), it
+    character(len=MSG_LEN) :: lmsg
+    do it = 1, 25
+      call assemble_dense(m, c%qf, w%qz, t, w%phi, w%nu, w%gam, w%jb, w%jac)
+      ju = w%jac(w%rows, c%iu)
+      call lu_factor(ju, piv, stf, lmsg)
+      if (stf /= MBD_OK) return
+      if (maxval(abs(w%phi)) <= w%tol) exit
+      b = -w%phi(w%rows)
+      call lu_solve(ju, piv, b, stf, lmsg)
+      c%qf(c%iu) = c%qf(c%iu) + b
+      c%st%newton = c%st%newton + 1
+    end do
+    if (maxval(abs(w%phi)) > w%tol) then
+      stf = MBD_NO_CONVERGENCE; return
+    end if
+    c%vf(c%iv) = vdot
+    b = w%nu(w%rows) - matmul(w%jac(w%rows, c%iv), vdot)
+    call lu_solve(ju, piv, b, stf, lmsg)
+    c%vf(c%iu) = b
+  end subroutine solve_dependent
+
+  !> Choose the dependent coordinates: the first na columns of a QR with column pivoting of
+  !! J (the best-conditioned block J_u); the rest are independent.
+  subroutine partition(m, w, c, t, stf)
+    type(model_t), intent(in) :: m
+    type(dyn_work_t), intent(inout) :: w
+    type(itg_t), intent(inout) :: c
+    real(wp), intent(in) :: t
+    integer, intent(out) :: stf
+    real(wp) :: a(w%na, m%nq), tau(min(w%na, m%nq)), wq(1)
+    real(wp), allocatable :: work(:)
+    integer :: jp(m%nq), info
+    character(len=MSG_LEN) :: lmsg
+    call assemble_dense(m, c%qf, w%qz, t, w%phi, w%nu, w%gam, w%jb, w%jac)
+    a = w%jac(w%rows, :)
+    jp = 0
+    call dgeqp3(w%na, m%nq, a, w%na, jp, tau, wq, -1, info)
+    allocate (work(max(1, int(wq(1)))))
+    call dgeqp3(w%na, m%nq, a, w%na, jp, tau, work, size(work), info)
+    call lapack_status('dgeqp3', info, stf, lmsg)
+    if (stf /= MBD_OK) return
+    c%iu = jp(1:w%na)
+    c%iv = jp(w%na + 1:)
+    c%ni = m%nq - w%na
+    c%st%partitions = c%st%partitions + 1
+  end subroutine partition
+
+  !> J_u is ill conditioned at the current state (1/cond_1 < 1e-3): choose again.
+  logical function needs_partition(m, w, c)
+    type(model_t), intent(in) :: m
+    type(dyn_work_t), intent(inout) :: w
+    type(itg_t), intent(in) :: c
+    real(wp) :: ju(w%na, w%na), anorm, rc, cw(4 * w%na)
+    integer :: piv(w%na), iw(w%na), stf, info
+    character(len=MSG_LEN) :: lmsg
+    call assemble_dense(m, c%qf, w%qz, c%t0, w%phi, w%nu, w%gam, w%jb, w%jac)
+    ju = w%jac(w%rows, c%iu)
+    anorm = maxval(sum(abs(ju), dim=1))
+    call lu_factor(ju, piv, stf, lmsg)
+    needs_partition = stf /= MBD_OK
+    if (stf /= MBD_OK) return
+    call dgecon('1', w%na, ju, w%na, anorm, rc, cw, iw, info)
+    needs_partition = rc < 1.0e-3_wp
+  end function needs_partition
+
+  !> One classical Runge-Kutta step.
+  subroutine rk4_step(m, w, c, t, y, h, yn, k, stf)
+    type(model_t), intent(in) :: m
+    type(dyn_work_t), intent(inout) :: w
+    type(itg_t), intent(inout) :: c
+    real(wp), intent(in) :: t, y(:), h
+    real(wp), intent(out) :: yn(:)
+    real(wp), intent(inout) :: k(:, :)
+    integer, intent(out) :: stf
+    call rhs(m, w, c, t, y, k(:, 1), stf)
+    if (stf /= MBD_OK) return
+    call rhs(m, w, c, t + half * h, y + half * h * k(:, 1), k(:, 2), stf)
+    if (stf /= MBD_OK) return
+    call rhs(m, w, c, t + half * h, y + half * h * k(:, 2), k(:, 3), stf)
+    if (stf /= MBD_OK) return
+    call rhs(m, w, c, t + h, y + h * k(:, 3), k(:, 4), stf)
+    if (stf /= MBD_OK) return
+    yn = y + h / 6 * (k(:, 1) + 2 * k(:, 2) + 2 * k(:, 3) + k(:, 4))
+  end subroutine rk4_step
+
+  !> One Dormand-Prince 5(4) step; e is the embedded error estimate. k(:, 1) is reused from
+  !! the last stage of the previous step when fsal is true (first same as last).
+  subroutine dopri5_step(m, w, c, t, y, h, yn, k, e, fsal, stf)
+    type(model_t), intent(in) :: m
+    type(dyn_work_t), intent(inout) :: w
+    type(itg_t), intent(inout) :: c
+    real(wp), intent(in) :: t, y(:), h
+    real(wp), intent(out) :: yn(:), e(:)
+    real(wp), intent(inout) :: k(:, :)
+    logical, intent(inout) :: fsal
+    integer, intent(out) :: stf
+    stf = MBD_OK
+    if (.not. fsal) then
+      call rhs(m, w, c, t, y, k(:, 1), stf)
+      if (stf /= MBD_OK) return
+    end if
+    call rhs(m, w, c, t + C2 * h, y + h * A21 * k(:, 1), k(:, 2), stf)
+    if (stf /= MBD_OK) return
+    call rhs(m, w, c, t + C3 * h, y + h * (A31 * k(:, 1) + A32 * k(:, 2)), k(:, 3), stf)
+    if (stf /= MBD_OK) return
+    call rhs(m, w, c, t + C4 * h, y + h * (A41 * k(:, 1) + A42 * k(:, 2) + A43 * k(:, 3)), &
+             k(:, 4), stf)
+    if (stf /= MBD_OK) return
+    call rhs(m, w, c, t + C5 * h, y + h * (A51 * k(:, 1) + A52 * k(:, 2) + A53 * k(:, 3) + &
+             A54 * k(:, 4)), k(:, 5), stf)
+    if (stf /= MBD_OK) return
+    call rhs(m, w, c, t + h, y + h * (A61 * k(:, 1) + A62 * k(:, 2) + A63 * k(:, 3) + &
+             A64 * k(:, 4) + A65 * k(:, 5)), k(:, 6), stf)
+    if (stf /= MBD_OK) return
+    yn = y + h * (A71 * k(:, 1) + A73 * k(:, 3) + A74 * k(:, 4) + A75 * k(:, 5) + A76 * k(:, 6))
+    call rhs(m, w, c, t + h, yn, k(:, 7), stf)
+    if (stf /= MBD_OK) return
+    e = h * (E1 * k(:, 1) + E3 * k(:, 3) + E4 * k(:, 4) + E5 * k(:, 5) + E6 * k(:, 6) + &
+             E7 * k(:, 7))
+    k(:, 1) = k(:, 7)
+    fsal = .true.
+  end subroutine dopri5_step
+
+end module mbd_integrators
