@@ -9,7 +9,8 @@
 !!                 4 residual
 module mbd_api
   use mbd_kinds, only: wp, zero, one
-  use mbd_status, only: MBD_OK, MBD_BAD_COUNT, MBD_INCONSISTENT, MSG_LEN
+  use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+  use mbd_status, only: MBD_OK, MBD_BAD_COUNT, MBD_BAD_PARAM, MBD_INCONSISTENT, MSG_LEN
   use mbd_points, only: NLOC, MAXROW
   use mbd_model, only: model_t, model_build, model_add_dynamics
   use mbd_dynamics, only: dyn_work_t, dyn_init, dyn_velocity, dyn_multipliers, dyn_reactions, &
@@ -28,7 +29,36 @@ module mbd_api
 
   integer, parameter :: NINFO = 10   !! length of the report arrays
 
+  interface finite
+    module procedure finite_scalar, finite_vector, finite_matrix
+  end interface finite
+
 contains
+
+  !> All finite (no NaN or infinity).
+  pure logical function finite_scalar(x)
+    real(wp), intent(in) :: x
+    finite_scalar = ieee_is_finite(x)
+  end function finite_scalar
+
+  pure logical function finite_vector(x)
+    real(wp), intent(in) :: x(:)
+    finite_vector = all(ieee_is_finite(x))
+  end function finite_vector
+
+  pure logical function finite_matrix(x)
+    real(wp), intent(in) :: x(:, :)
+    finite_matrix = all(ieee_is_finite(x))
+  end function finite_matrix
+
+  !> Status and message for a non-finite input.
+  subroutine not_finite(what, status, msg)
+    character(len=*), intent(in) :: what
+    integer, intent(out) :: status
+    character(len=MSG_LEN), intent(out) :: msg
+    status = MBD_BAD_PARAM
+    msg = what // ' must be finite (no NaN or infinity)'
+  end subroutine not_finite
 
   !> Build the model; return its sizes.
   subroutine api_sizes(nb, ctab, rpar, nq, neq, status, msg, bad)
@@ -62,12 +92,19 @@ contains
     phi = zero; jac = zero; nu = zero; gam = zero
     call model_build(nb, ctab, rpar, m, status, msg, bad)
     if (status /= MBD_OK) return
+    if (.not. (finite(q) .and. finite(qd) .and. finite(t))) then
+      call not_finite('the state (q, q_dot, t)', status, msg); return
+    end if
     if (size(q) /= m%nq .or. size(qd) /= m%nq .or. size(phi) /= m%neq .or. &
         size(jac, 1) /= m%neq .or. size(jac, 2) /= m%nq) then
       status = MBD_BAD_COUNT; msg = 'array sizes do not match the model'; return
     end if
     allocate (jb(MAXROW, NLOC, m%nc))
     call assemble_dense(m, q, qd, t, phi, nu, gam, jb, jac)
+    if (.not. (finite(phi) .and. finite(jac) .and. finite(nu) .and. finite(gam))) then
+      status = MBD_BAD_PARAM
+      msg = 'the constraint equations overflow at this state (a parameter or state too large)'
+    end if
   end subroutine api_eval
 
   !> Kinematic analysis: the whole time loop in one call.
@@ -101,6 +138,13 @@ contains
     call model_build(nb, ctab, rpar, m, status, msg, bad)
     iinfo(2) = bad
     if (status /= MBD_OK) return
+    if (.not. (finite(q0) .and. finite(t0) .and. finite(t1) .and. finite(tol) .and. &
+               finite(tmin))) then
+      call not_finite('q0, the times and the tolerances', status, msg); return
+    end if
+    if (.not. (finite(t1 - t0))) then
+      call not_finite('the time span', status, msg); return
+    end if
     if (m%neq < m%nq) then
       status = MBD_BAD_COUNT
       write (msg, '(a,i0,a,i0,a,i0,a)') 'the model is not kinematically determined: ', m%neq, &
@@ -150,19 +194,21 @@ contains
     type(kin_opts_t) :: opts
     type(kin_report_t) :: rep
     type(kin_work_t) :: w
-    integer :: bad, k
+    integer :: bad
     q = zero; rank = 0; mobility = 0; redundant = 0; dep = 0; resid = zero; worst = 0
     call model_build(nb, ctab, rpar, m, status, msg, bad)
     worst = bad
     if (status /= MBD_OK) return
+    if (.not. (finite(q0) .and. finite(t) .and. finite(tol))) then
+      call not_finite('q0, t and tol', status, msg); return
+    end if
     if (size(q0) /= m%nq .or. size(q) /= m%nq .or. size(redundant) /= m%neq .or. &
         size(dep) /= m%neq) then
       status = MBD_BAD_COUNT; msg = 'array sizes do not match the model'; return
     end if
     if (tol > zero) opts%tol = tol
     call kin_work_init(m, w)
-    w%tol = opts%tol * max(m%lscale, maxval(abs(q0(1:3 * nb)), &
-                                            mask=mod([(k, k=1, 3 * nb)], 3) /= 0))
+    w%tol = opts%tol * m%lscale
     allocate (rep%qsing(m%nq), rep%dep(m%neq), rep%redundant(m%neq))
     rep%qsing = zero; rep%dep = 0; rep%redundant = 0
     q = q0
@@ -187,6 +233,9 @@ contains
     real(wp) :: c1(2), c2(2), c3(2)
     integer :: i
     pts = zero
+    if (.not. (finite(raw) .and. finite(alpha))) then
+      call not_finite('profile parameters and alpha', status, msg); return
+    end if
     if (profile_raw_length(kind, raw) /= size(raw)) then
       status = MBD_BAD_COUNT; msg = 'profile parameters are malformed'; return
     end if
@@ -302,6 +351,10 @@ contains
     call build_dynamic(nb, ctab, rpar, bmass, grav, ftab, fpar, m, status, msg, bad, badf)
     iinfo(2) = bad; if (badf /= 0) iinfo(2) = -1000000 - badf
     if (status /= MBD_OK) return
+    if (.not. (finite(q0) .and. finite(v0) .and. finite(t0) .and. finite(t1) .and. &
+               finite([rtol, atol, h, rho_inf, balpha, bbeta]))) then
+      call not_finite('q0, v0, the times and the settings', status, msg); return
+    end if
     if (size(q0) /= m%nq .or. size(v0) /= m%nq .or. size(qout, 1) /= m%nq .or. &
         size(qout, 2) /= nsteps + 1 .or. size(lamout, 1) /= m%neq .or. &
         size(redundant) /= m%neq) then
@@ -312,7 +365,7 @@ contains
     end if
     ! assembly at t0 (Levenberg-Marquardt; any number of equations)
     call kin_work_init(m, kw)
-    lscale = max(m%lscale, maxval(abs(q0(1:3 * nb)), mask=mod([(k, k=1, 3 * nb)], 3) /= 0))
+    lscale = m%lscale
     kw%tol = kopts%tol * lscale
     allocate (q(m%nq), qd(m%nq), rep%qsing(m%nq), rep%dep(m%neq), rep%redundant(m%neq))
     q = q0
@@ -369,16 +422,19 @@ contains
     type(kin_opts_t) :: kopts
     type(kin_report_t) :: rep
     real(wp) :: lscale
-    integer :: bad, badf, k
+    integer :: bad, badf
     q = zero; lam = zero; stable = 0; resid = zero; iinfo = 0
     call build_dynamic(nb, ctab, rpar, bmass, grav, ftab, fpar, m, status, msg, bad, badf)
     iinfo(2) = bad; if (badf /= 0) iinfo(2) = -1000000 - badf
     if (status /= MBD_OK) return
+    if (.not. (finite(q0) .and. finite(t))) then
+      call not_finite('q0 and t', status, msg); return
+    end if
     if (size(q0) /= m%nq .or. size(q) /= m%nq .or. size(lam) /= m%neq) then
       status = MBD_BAD_COUNT; msg = 'array sizes do not match the model'; return
     end if
     call kin_work_init(m, kw)
-    lscale = max(m%lscale, maxval(abs(q0(1:3 * nb)), mask=mod([(k, k=1, 3 * nb)], 3) /= 0))
+    lscale = m%lscale
     kw%tol = kopts%tol * lscale
     allocate (rep%qsing(m%nq), rep%dep(m%neq), rep%redundant(m%neq))
     q = q0
@@ -403,6 +459,9 @@ contains
     reac = zero; rloc = zero
     call model_build(nb, ctab, rpar, m, status, msg, bad)
     if (status /= MBD_OK) return
+    if (.not. (finite(q) .and. finite(t) .and. finite(lam))) then
+      call not_finite('q, t and lambda', status, msg); return
+    end if
     if (size(q, 1) /= m%nq .or. size(lam, 1) /= m%neq .or. size(reac, 2) /= m%nc .or. &
         size(q, 2) /= size(t) .or. size(lam, 2) /= size(t) .or. size(reac, 3) /= size(t)) then
       status = MBD_BAD_COUNT; msg = 'array sizes do not match the model'; return

@@ -10,6 +10,10 @@ module mbd_functions
   private
   public :: fun_eval, fun_check, fun_length
 
+  real(wp), parameter :: FMAX = 1.0e100_wp   !! largest coefficient
+  real(wp), parameter :: OMAX = 1.0e12_wp    !! largest angular frequency
+  real(wp), parameter :: PMAX = 1.0e6_wp     !! largest phase
+
 contains
 
   !> Length of the encoded function starting at p(1), or -1 when malformed.
@@ -48,7 +52,24 @@ contains
     end if
     if (.not. all(ieee_is_finite(p(1:n)))) then
       status = MBD_BAD_PARAM; msg = 'function of time has a non-finite coefficient'
+    else if (any(abs(p(1:n)) > FMAX)) then
+      status = MBD_BAD_PARAM
+      write (msg, '(a,es8.1)') 'function of time: every coefficient must be within +-', FMAX
+    else if (.not. harmonics_ok()) then
+      status = MBD_BAD_PARAM
+      write (msg, '(a,es8.1,a,es8.1,a)') 'function of time: a harmonic needs |omega| <= ', &
+        OMAX, ' and |phase| <= ', PMAX, ' (beyond that its values lose all precision)'
     end if
+  contains
+    logical function harmonics_ok()
+      integer :: np, nh, k, o
+      np = nint(p(1)); nh = nint(p(np + 2))
+      harmonics_ok = .true.
+      do k = 1, nh
+        o = np + 2 + 3 * (k - 1)
+        if (abs(p(o + 2)) > OMAX .or. abs(p(o + 3)) > PMAX) harmonics_ok = .false.
+      end do
+    end function harmonics_ok
   end subroutine fun_check
 
   !> f(t), f'(t), f''(t).

@@ -46,7 +46,7 @@ module mbd_integrators
     real(wp) :: rho_inf = 0.8_wp      !! generalized-alpha spectral radius at infinity
     real(wp) :: balpha = 10.0_wp      !! Baumgarte alpha
     real(wp) :: bbeta = 10.0_wp       !! Baumgarte beta
-    integer :: max_steps = 10000000   !! internal step limit
+    integer :: max_steps = 2000000    !! internal step limit
   end type dyn_opts_t
 
   !> What the integrator did.

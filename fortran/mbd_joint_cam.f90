@@ -68,12 +68,12 @@ contains
     end select
     call profile_prepare(prof, raw(5:), pp, status, msg)
     if (status /= MBD_OK) return
+    call profile_check(prof, pp, zero, status, msg)
+    if (status /= MBD_OK) return
     if (fol == FOL_ROLLER) then
       call profile_check(prof, pp, f(3), status, msg)
-    else
-      call profile_check(prof, pp, zero, status, msg)
+      if (status /= MBD_OK) return
     end if
-    if (status /= MBD_OK) return
     prep = [f, pp]
   end subroutine cam_prepare
 

@@ -37,6 +37,7 @@ module mbd_kinematics
                           qr_solve, qr_lwork
   use mbd_lapack, only: dgels, dgecon, dtrcon
   use mbd_interp, only: hermite5
+  use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   implicit none
   private
   public :: kin_opts_t, kin_work_t, kin_report_t, DEP_TOL, SING_RATIO, MAXPASS
@@ -53,6 +54,7 @@ module mbd_kinematics
   real(wp), parameter :: COND_CHECK = 0.1_wp
   real(wp), parameter :: VJUMP_RATIO = 0.2_wp   !! largest velocity jump / velocity scale
   integer, parameter :: MAXPASS = 64           !! singular passages recorded
+  integer, parameter :: MAX_SUBSTEPS = 100000  !! internal steps allowed per output interval
 
   !> Settings of a kinematic analysis.
   type :: kin_opts_t
@@ -410,7 +412,7 @@ contains
     real(wp), allocatable :: q(:), qd(:), qdd(:), qn(:), qp(:), q3(:), qddn(:), qdn(:)
     real(wp), allocatable :: qa(:), qda(:), qdda(:), qb(:), qdb(:), qddb(:)
     real(wp) :: t, h, hcur, hh, tt, target, lscale, ts, ta, d
-    integer :: k, j, st, detprev, mobility, lev
+    integer :: k, j, st, detprev, mobility, lev, nsub
     logical :: last, ok
 
     status = MBD_OK; msg = ''
@@ -424,7 +426,7 @@ contains
       status = MBD_BAD_SETTING; msg = 't_end must be greater than the start time'; return
     end if
     call kin_work_init(m, w)
-    lscale = max(m%lscale, maxval(abs(q0(1:3 * m%nb)), mask=mod([(k, k=1, 3 * m%nb)], 3) /= 0))
+    lscale = m%lscale
     w%tol = opts%tol * lscale
     allocate (q(m%nq), qd(m%nq), qdd(m%nq), qn(m%nq), qp(m%nq), q3(m%nq), qddn(m%nq), &
               qdn(m%nq), qa(m%nq), qda(m%nq), qdda(m%nq), qb(m%nq), qdb(m%nq), qddb(m%nq))
@@ -471,6 +473,11 @@ contains
     if (st /= MBD_OK) then
       call inconsistent(t0, lev); return
     end if
+    if (.not. (all(ieee_is_finite(qd)) .and. all(ieee_is_finite(qdd)))) then
+      status = MBD_NO_CONVERGENCE; rep%t_fail = t0
+      msg = 'velocities or accelerations overflow at the start: a driver is far too fast'
+      call count_work(); return
+    end if
     qout(:, 1) = q; qdout(:, 1) = qd; qddout(:, 1) = qdd
     rep%ndone = 1
     detprev = w%detsign
@@ -482,7 +489,17 @@ contains
     h = (t1 - t0) / nsteps
     hcur = h
     k = 1
+    nsub = 0
     do while (k <= nsteps)
+      nsub = nsub + 1
+      if (nsub > MAX_SUBSTEPS) then
+        status = MBD_NO_CONVERGENCE
+        rep%t_fail = t
+        write (msg, '(a,i0,a,es12.5,a)') 'the motion needs more than ', MAX_SUBSTEPS, &
+          ' internal steps between output times after t = ', t, &
+          ': give more output steps (or a slower driver)'
+        call count_work(); return
+      end if
       target = out_time(k)
       ! land exactly on the output time (no sliver step from rounding of t)
       last = hcur >= (target - t) * (one - 1.0e-9_wp)
@@ -499,7 +516,8 @@ contains
         if (st /= MBD_OK) then
           call inconsistent(tt, lev); return
         end if
-        ok = smooth_velocity(hh)
+        ok = smooth_velocity(hh) .and. all(ieee_is_finite(qdn)) .and. &
+             all(ieee_is_finite(qddn))
       end if
       if (ok) then
         call accept()
@@ -631,6 +649,7 @@ contains
 
     subroutine store(kk)
       integer, intent(inout) :: kk
+      nsub = 0
       qout(:, kk + 1) = q; qdout(:, kk + 1) = qd; qddout(:, kk + 1) = qdd
       if (w%pivratio < ANCHOR_PIV) call refine_output(kk)
       rep%ndone = kk + 1

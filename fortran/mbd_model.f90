@@ -34,6 +34,7 @@ module mbd_model
 
   integer, parameter :: NCT = 8   !! rows of the constraint table
   integer, parameter :: NFT = 6   !! rows of the force table
+  integer, parameter :: MAX_BODIES = 1000000   !! keeps 3 nb and the row counts in range
 
   !> A built model: constraint data in prepared form and the row and column maps.
   type :: model_t
@@ -73,6 +74,13 @@ contains
     if (m%bj(k) > 0) sj = 2
   end subroutine model_slots
 
+  !> 1 <= off and off + len - 1 <= n, tested without overflow.
+  pure logical function slice_ok(off, len, n)
+    integer, intent(in) :: off, len, n
+    slice_ok = off >= 1 .and. len >= 0 .and. len <= n
+    if (slice_ok) slice_ok = off <= n - len + 1
+  end function slice_ok
+
   !> Validate the flat tables and build the model.
   !! bad returns the 1-based index of the offending constraint (0 when none or global).
   subroutine model_build(nb, ctab, rpar, m, status, msg, bad)
@@ -96,6 +104,9 @@ contains
     nc = size(ctab, 2)
     if (nb < 1) then
       status = MBD_BAD_INPUT; msg = 'the model has no moving bodies'; return
+    end if
+    if (nb > MAX_BODIES .or. nc > 3 * MAX_BODIES) then
+      status = MBD_BAD_INPUT; msg = 'the model is too large for the dense solver'; return
     end if
     if (nc < 1) then
       status = MBD_BAD_INPUT; msg = 'the model has no joints or drivers'; return
@@ -141,6 +152,10 @@ contains
           status = MBD_BAD_INPUT
           msg = 'relative-distance driver must refer to a translational joint'; return
         end if
+        if (ctab(7, ref) /= 8 .or. .not. slice_ok(ctab(6, ref), 8, size(rpar))) then
+          status = MBD_BAD_INPUT
+          msg = 'the translational joint of a relative-distance driver is malformed'; return
+        end if
         bi = ctab(2, ref); bj = ctab(3, ref)
       case default
         if (bi == bj) then
@@ -166,8 +181,8 @@ contains
           status = MBD_BAD_PARAM; msg = 'cam profile or follower kind out of range'; return
         end if
       end if
-      ! parameters
-      if (off < 1 .or. len < 0 .or. off + len - 1 > size(rpar)) then
+      ! parameters (written so that no sum can overflow)
+      if (.not. slice_ok(off, len, size(rpar))) then
         status = MBD_BAD_INPUT; msg = 'parameter slice outside the parameter array'; return
       end if
       nexp = con_raw_length(kind, ctab(4, k), rpar(off:off + len - 1))
@@ -278,7 +293,7 @@ contains
       else if (bi == bj) then
         status = MBD_BAD_BODY; msg = 'a spring needs two different bodies'; return
       end if
-      if (off < 1 .or. len < 0 .or. off + len - 1 > size(fpar)) then
+      if (.not. slice_ok(off, len, size(fpar))) then
         status = MBD_BAD_INPUT; msg = 'force parameter slice outside the parameter array'; return
       end if
       if (.not. all(ieee_is_finite(fpar(off:off + len - 1)))) then

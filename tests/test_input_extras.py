@@ -44,16 +44,36 @@ def test_steps_beyond_the_core_integer_range() -> None:
         m.kinematics(t_end=1.0, steps=2**31)
 
 
+def seed_with_driver(f: str) -> mbd2d.Model:
+    return mbd2d.loads((EXAMPLES / "fourbar_seed.toml").read_text().replace(
+        "f = { poly = [1.0471975511965976, 1.0] }", f"f = {f}"))
+
+
 def test_runaway_driver_is_not_called_a_dead_centre() -> None:
-    """A driver that grows past anything the step can follow, at a regular configuration,
-    is a convergence failure, not a singular configuration."""
-    text = (EXAMPLES / "fourbar_seed.toml").read_text().replace(
-        "f = { poly = [1.0471975511965976, 1.0] }",
-        "f = { poly = [1.0471975511965976, 1e308, 1e308] }")
-    with pytest.raises(mbd2d.ConvergenceError, match="J is regular") as err:
-        mbd2d.loads(text).kinematics(t_end=1.0, steps=100)
+    """A driver far too fast for the output steps, at a regular configuration, is a
+    convergence failure (with advice), not a singular configuration."""
+    with pytest.raises(mbd2d.ConvergenceError, match="too fast") as err:
+        seed_with_driver("{ poly = [1.0471975511965976, 1e9] }").kinematics(t_end=1.0, steps=2)
     assert not isinstance(err.value, mbd2d.SingularConfigurationError)
     assert len(err.value.results.t) == 1   # the assembled state at t0
+
+
+def test_jumping_driver_is_not_called_a_dead_centre() -> None:
+    """A driver whose value jumps (a huge frequency sampled coarsely) fails at a regular J."""
+    with pytest.raises(mbd2d.ConvergenceError, match="J is regular"):
+        seed_with_driver("{ poly = [1.0471975511965976], harmonic = [{ amplitude = 0.3, "
+                         "omega = 1e11 }] }").kinematics(t_end=1.0, steps=100)
+
+
+@pytest.mark.parametrize("f, match", [
+    ("{ poly = [0, 1e308] }", "within"),
+    ("{ harmonic = [{ amplitude = 1, omega = 1, phase = 1e16 }] }", "phase"),
+    ("{ harmonic = [{ amplitude = 1, omega = 1e13 }] }", "omega"),
+    ("{ harmonic = [{ amplitude = 1, omega = 1e300 }] }", "within"),
+])
+def test_function_coefficients_out_of_range(f: str, match: str) -> None:
+    with pytest.raises(mbd2d.ModelError, match=match):
+        seed_with_driver(f).counts()
 
 
 def test_non_utf8_file(tmp_path) -> None:

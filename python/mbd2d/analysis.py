@@ -3,6 +3,7 @@ of the core's status to results, warnings or typed exceptions."""
 from __future__ import annotations
 
 import math
+import os
 import warnings
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
@@ -30,13 +31,31 @@ MIN_TOL = 1e-15        # below this a residual test cannot pass in double precis
 def check_span(t0: Any, t_end: Any, steps: Any) -> tuple[float, float, int]:
     """Validate an output time grid."""
     for name, v in (("t0", t0), ("t_end", t_end)):
-        if not is_number(v) or not math.isfinite(v):
+        try:
+            ok = is_number(v) and math.isfinite(float(v))
+        except OverflowError:
+            ok = False
+        if not ok:
             raise ModelError(f"{name} must be a finite number, got {v!r}", "analysis")
     t0, t_end = float(t0), float(t_end)
     steps = whole(steps, "steps", "analysis", 1, MAX_STEPS)
     if not t_end > t0:
         raise ModelError(f"t_end ({t_end}) must be greater than t0 ({t0})", "analysis")
+    if not math.isfinite(t_end - t0):
+        raise ModelError("the time span t_end - t0 is too large to represent", "analysis")
     return t0, t_end, steps
+
+
+def check_memory(rows: int, columns: int) -> None:
+    """Refuse output arrays that cannot fit in half the physical memory."""
+    need = 8.0 * rows * columns
+    try:
+        phys = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    except (ValueError, OSError, AttributeError):  # pragma: no cover
+        phys = 8.0 * 2**30
+    if need > 0.5 * phys:
+        raise ModelError(f"the results would need {need / 2**30:.1f} GiB ({rows} rows x "
+                         f"{columns} numbers); use fewer steps", "analysis")
 
 
 def check_solver(tol: Any, maxit: Any) -> tuple[float, int]:
@@ -79,9 +98,11 @@ def evaluate(model: "Model", q: Any, qd: Any, t: float) -> tuple[np.ndarray, ...
 
 
 def _state(x: Any, n: int, what: str) -> np.ndarray:
+    if np.iscomplexobj(x):
+        raise ModelError(f"{what} must be real numbers, got complex ones", "state")
     try:
         v = np.asarray(x, dtype=float)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise ModelError(f"{what} must be an array of {n} numbers", "state") from None
     if v.shape != (n,):
         raise ModelError(f"{what} must have {n} entries (the model's coordinates), "
@@ -215,6 +236,7 @@ def run_kinematics(model: "Model", t_end: float, steps: int, t0: float = 0.0,
     tol_v, maxit_v = check_solver(tol, maxit)
     p = pack(model)
     require_determined(p, model)
+    check_memory(steps + 1, 3 * p.nq)
     out = _core.core_kinematics(p.nb, p.ctab, p.rpar, p.neq, p.q0, t0, t_end, steps,
                                 tol_v, maxit_v, float(tmin or 0.0))
     qout, qdout, qddout, iinfo, rinfo, qsing, dep, red, tpass, status, msg = out

@@ -9,8 +9,8 @@ import numpy as np
 
 from . import _core
 from .analysis import (ASSEMBLY_FAILED, INCONSISTENT, NO_CONVERGENCE, OK, SINGULAR,
-                       SINGULAR_CONFIG, _assembly_failed, _failure, _names, check_solver,
-                       check_span, require_determined)
+                       SINGULAR_CONFIG, _assembly_failed, _failure, _names, check_memory,
+                       check_solver, check_span, require_determined)
 from .errors import (ConvergenceError, CoreError, IntegrationError, ModelError,
                      RedundantConstraintWarning, SingularJacobianError)
 from .pack import Packed, decode, pack
@@ -88,6 +88,7 @@ def run_inverse(model: "Model", t_end: float, steps: int, t0: float = 0.0,
     p = pack(model)
     require_determined(p, model)
     bmass, grav, ftab, fpar, _ = pack_dynamics(model, p)
+    check_memory(steps + 1, 3 * p.nq + p.neq + 4)
     out = _core.core_inverse(ctab=p.ctab, rpar=p.rpar, bmass=bmass, grav=grav, ftab=ftab,
                              fpar=fpar, neq=p.neq, q0=p.q0, t0=t0, t1=t_end, nsteps=steps,
                              tol=tol_v)
@@ -145,6 +146,7 @@ def run_dynamics(model: "Model", t_end: float, steps: int, method: str | None = 
     beta_v = opt(beta, "beta", 0.0, 1e9, -1.0)
     p = pack(model)
     bmass, grav, ftab, fpar, v0 = pack_dynamics(model, p)
+    check_memory(steps + 1, 3 * p.nq + p.neq + 4)
     out = _core.core_dynamics(ctab=p.ctab, rpar=p.rpar, bmass=bmass, grav=grav, ftab=ftab,
                               fpar=fpar, neq=p.neq, q0=p.q0, v0=v0, t0=t0, t1=t_end,
                               nsteps=steps, method=METHODS[method], rtol=rtol_v, atol=atol_v,

@@ -81,6 +81,8 @@ def as_function(spec: Any, entry: str, what: str = "f") -> TimeFunction:
         raise ModelError(f"{what} must be a number or a table like "
                          "{ poly = [c0, c1], harmonic = [{ amplitude = A, omega = w, phase = p }] }"
                          f", got {spec!r}", entry)
+    if any(not isinstance(k, str) for k in spec):
+        raise ModelError(f"{what} keys must be names (strings)", entry)
     unknown = set(spec) - {"poly", "harmonic"}
     if unknown:
         raise ModelError(f"{what} has unknown key(s) {sorted(unknown)}; "
@@ -104,7 +106,7 @@ def as_function(spec: Any, entry: str, what: str = "f") -> TimeFunction:
         bad = set(h) - {"amplitude", "omega", "phase"}
         if bad or "amplitude" not in h or "omega" not in h:
             raise ModelError(f"{what}.harmonic[{i}] needs 'amplitude' and 'omega' (and optional "
-                             f"'phase'), got keys {sorted(h)}", entry)
+                             f"'phase'), got keys {sorted(map(str, h))}", entry)
         harms.append(Harmonic(_finite(h["amplitude"], f"{what}.harmonic[{i}].amplitude", entry),
                               _finite(h["omega"], f"{what}.harmonic[{i}].omega", entry),
                               _finite(h.get("phase", 0.0), f"{what}.harmonic[{i}].phase", entry)))

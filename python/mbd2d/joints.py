@@ -314,7 +314,7 @@ def parse_profile(spec: Any, entry: str, key: str = "profile") -> tuple[str, tup
     spec = table(spec, key, entry)
     if len(spec) != 1 or next(iter(spec)) not in PROFILE_KINDS:
         raise ModelError(f"{key} must be one of {{circle = ...}}, {{spline = ...}}, "
-                         f"{{fourier = ...}}, got keys {sorted(spec)}", entry)
+                         f"{{fourier = ...}}, got keys {sorted(map(str, spec))}", entry)
     kind, body = next(iter(spec.items()))
     body = table(body, f"{key}.{kind}", entry)
     if kind == "circle":
@@ -361,7 +361,7 @@ def parse_follower(spec: Any, entry: str) -> tuple[str, tuple[float, float, floa
     spec = table(spec, "follower", entry)
     if len(spec) != 1 or next(iter(spec)) not in FOLLOWER_KINDS:
         raise ModelError(f"follower must be one of {{point = [x, y]}}, {{roller = ...}}, "
-                         f"{{flat = ...}}, got keys {sorted(spec)}", entry)
+                         f"{{flat = ...}}, got keys {sorted(map(str, spec))}", entry)
     kind, body = next(iter(spec.items()))
     if kind == "point":
         p = vector(body, 2, "follower.point", entry)

@@ -76,10 +76,18 @@ def _entries(data: Mapping[str, Any], key: str, source: str) -> list[Mapping[str
     return v
 
 
+def _named(entry: Any) -> str:
+    """' NAME' for an entry with a string name, else ''."""
+    name = entry.get("name") if isinstance(entry, Mapping) else None
+    return f" {name!r}" if isinstance(name, str) else ""
+
+
 def from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Model:
     """Build a model from parsed TOML (nested dicts and lists)."""
     if not isinstance(data, Mapping):
         raise ModelError("a model must be a table", source)
+    if any(not isinstance(k, str) for k in data):
+        raise ModelError("section names must be strings", source)
     unknown = set(data) - SECTIONS
     if unknown:
         raise ModelError(f"unknown section(s) {sorted(unknown)}; sections are "
@@ -93,25 +101,28 @@ def from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Model:
         raise ModelError("gravity must be a list of 2 numbers", "[model]")
     model = Model(name, head.get("gravity", (0.0, -9.81)))
     for i, b in enumerate(_entries(data, "body", source)):
-        entry = f"[[body]] #{i + 1}" + (f" {b.get('name')!r}" if isinstance(b, Mapping) else "")
+        entry = f"[[body]] #{i + 1}" + _named(b)
         b = table(b, "[[body]]", entry)
         only_keys(b, {"name", "q0", "mass", "inertia", "v0"}, entry, required=["name", "q0"])
         model.add_body(b["name"], b["q0"], b.get("mass"), b.get("inertia"), b.get("v0"))
     for i, j in enumerate(_entries(data, "joint", source)):
-        entry = f"[[joint]] #{i + 1}" + (f" {j.get('name')!r}" if isinstance(j, Mapping) else "")
+        entry = f"[[joint]] #{i + 1}" + _named(j)
         j = dict(table(j, "[[joint]]", entry))
+        only_keys(j, set(j) | {"type"}, entry)        # string keys only
         if "type" not in j:
             raise ModelError("missing key 'type' (revolute, translational, cam, ...)", entry)
         model.add_joint(**j)
     for i, d in enumerate(_entries(data, "driver", source)):
-        entry = f"[[driver]] #{i + 1}" + (f" {d.get('name')!r}" if isinstance(d, Mapping) else "")
+        entry = f"[[driver]] #{i + 1}" + _named(d)
         d = dict(table(d, "[[driver]]", entry))
+        only_keys(d, set(d), entry)
         only_keys(d, {"name", "type", "body", "coordinate", "bodies", "joint", "f"}, entry,
                   required=["type", "f"])
         model.add_driver(**d)
     for i, fe in enumerate(_entries(data, "force", source)):
-        entry = f"[[force]] #{i + 1}" + (f" {fe.get('name')!r}" if isinstance(fe, Mapping) else "")
+        entry = f"[[force]] #{i + 1}" + _named(fe)
         fe = dict(table(fe, "[[force]]", entry))
+        only_keys(fe, set(fe) | {"type"}, entry)
         if "type" not in fe:
             raise ModelError("missing key 'type' (spring, torque, point, rotational-spring)",
                              entry)

@@ -37,9 +37,14 @@ def number(x: Any, what: str, entry: str) -> float:
     """A finite real number."""
     if not is_number(x):
         raise ModelError(f"{what} must be a number, got {x!r}", entry)
-    if not math.isfinite(x):
+    try:
+        v = float(x)
+    except (OverflowError, ValueError):
+        raise ModelError(f"{what} must be finite, got a number too large for a float",
+                         entry) from None
+    if not math.isfinite(v):
         raise ModelError(f"{what} must be finite, got {x!r}", entry)
-    return float(x)
+    return v
 
 
 def positive(x: Any, what: str, entry: str) -> float:
@@ -99,7 +104,10 @@ def table(x: Any, what: str, entry: str) -> Mapping[str, Any]:
 
 def only_keys(d: Mapping[str, Any], allowed: set[str], entry: str,
               required: Sequence[str] = ()) -> None:
-    """Reject unknown keys and report missing ones."""
+    """Reject unknown or non-string keys and report missing ones."""
+    bad = [k for k in d if not isinstance(k, str)]
+    if bad:
+        raise ModelError(f"keys must be names (strings), got {bad[0]!r}", entry)
     unknown = set(d) - allowed
     if unknown:
         raise ModelError(f"unknown key(s) {sorted(unknown)}; allowed: {sorted(allowed)}", entry)
