@@ -3,6 +3,8 @@
     mbd2d kinematics MODEL.toml --t-end T --steps N --out OUT.csv|OUT.npz
     mbd2d export MODEL.toml OUT.mbd --t-end T --steps N
     mbd2d check MODEL.toml
+    mbd2d dynamics MODEL.toml --t-end T --steps N --out OUT.csv [--method M --rtol R --atol A --h H]
+    mbd2d statics MODEL.toml [--t T]
 
 Exit codes: 0 ok, 2 bad input, 3 singular configuration (partial output written),
 4 other numerical failure (partial output written when there is any).
@@ -12,10 +14,14 @@ from __future__ import annotations
 import argparse
 import sys
 import textwrap
-from typing import Sequence
+from typing import TYPE_CHECKING, Sequence
 
 from .errors import AnalysisError, MbdError, ModelError, SingularConfigurationError
 from .toml_io import load
+
+if TYPE_CHECKING:  # pragma: no cover
+    from .model import Model
+    from .results import StaticsResult
 
 EXIT_OK, EXIT_INPUT, EXIT_SINGULAR, EXIT_NUMERICAL = 0, 2, 3, 4
 
@@ -30,6 +36,25 @@ def _parser() -> argparse.ArgumentParser:
     k.add_argument("--t0", type=float, default=0.0, help="start time (default 0)")
     k.add_argument("--out", required=True, help="output file, .csv or .npz")
     k.add_argument("--tol", type=float, default=None, help="Newton tolerance (default 1e-12)")
+    d = sub.add_parser("dynamics", help="forward dynamics")
+    d.add_argument("model", help="model file (.toml) with masses")
+    d.add_argument("--t-end", type=float, required=True, help="final time")
+    d.add_argument("--steps", type=int, required=True, help="output intervals (rows = steps + 1)")
+    d.add_argument("--t0", type=float, default=0.0, help="start time (default 0)")
+    d.add_argument("--out", required=True, help="output file, .csv or .npz")
+    d.add_argument("--method", default=None,
+                   help="generalized-alpha (default), dopri5, baumgarte-rk4 or partitioned")
+    d.add_argument("--rtol", type=float, default=None, help="relative tolerance (adaptive)")
+    d.add_argument("--atol", type=float, default=None, help="absolute tolerance (adaptive)")
+    d.add_argument("--h", type=float, default=None, help="fixed step (generalized-alpha, "
+                   "baumgarte-rk4)")
+    d.add_argument("--rho-inf", type=float, default=None, help="generalized-alpha rho_inf")
+    d.add_argument("--alpha", type=float, default=None, help="Baumgarte alpha")
+    d.add_argument("--beta", type=float, default=None, help="Baumgarte beta")
+    s = sub.add_parser("statics", help="static equilibrium and reactions")
+    s.add_argument("model", help="model file (.toml) with masses")
+    s.add_argument("--t", type=float, default=0.0, help="time at which loads and drivers are "
+                   "taken (default 0)")
     c = sub.add_parser("check", help="degrees of freedom and redundant constraints")
     c.add_argument("model", help="model file (.toml)")
     c.add_argument("--t", type=float, default=0.0, help="time of the check (default 0)")
@@ -47,6 +72,23 @@ def _say(text: str) -> None:
     print(textwrap.fill(text, width=100), file=sys.stderr)
 
 
+def _statics_report(model: "Model", st: "StaticsResult") -> str:
+    """The equilibrium, its stability and the reactions, as text."""
+    lines = [f"equilibrium of '{model.name}' at t = {st.t:g}: {st.stability}"]
+    for name in st.body_names:
+        x, y, th = st.body(name)
+        lines.append(f"  {name:16s} x = {x: .9g}  y = {y: .9g}  theta = {th: .9g}")
+    lines.append("reactions (force on each body, global; moment about its centre of mass):")
+    for c in model.constraints:
+        r = st.reaction(c.name)
+        for b, fx, fy, mz in ((c.bodies[0], r.fx, r.fy, r.mz), (c.bodies[1], r.fx_j, r.fy_j,
+                                                                  r.mz_j)):
+            if b != "ground":
+                lines.append(f"  {c.name:12s} on {b:12s} Fx = {fx[0]: .6g}  Fy = {fy[0]: .6g}  "
+                             f"Mz = {mz[0]: .6g}")
+    return "\n".join(lines)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit code."""
     args = _parser().parse_args(argv)
@@ -55,13 +97,21 @@ def main(argv: Sequence[str] | None = None) -> int:
         if args.command == "check":
             print(model.analyze_dof(t=args.t))
             return EXIT_OK
+        if args.command == "statics":
+            print(_statics_report(model, model.statics(t=args.t)))
+            return EXIT_OK
         if args.command == "export":
             model.export(args.out, t_end=args.t_end, steps=args.steps, t0=args.t0, tol=args.tol)
             print(f"wrote {args.out}")
             return EXIT_OK
         if not str(args.out).endswith((".csv", ".npz")):
             raise ModelError(f"--out must end in .csv or .npz, got {args.out!r}", "command line")
-        res = model.kinematics(t_end=args.t_end, steps=args.steps, t0=args.t0, tol=args.tol)
+        if args.command == "dynamics":
+            res = model.dynamics(t_end=args.t_end, steps=args.steps, t0=args.t0,
+                                 method=args.method, rtol=args.rtol, atol=args.atol, h=args.h,
+                                 rho_inf=args.rho_inf, alpha=args.alpha, beta=args.beta)
+        else:
+            res = model.kinematics(t_end=args.t_end, steps=args.steps, t0=args.t0, tol=args.tol)
         res.save(args.out)
         print(f"wrote {len(res.t)} rows to {args.out}")
         return EXIT_OK
@@ -69,7 +119,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         _say(f"mbd2d: error in the model or the command: {exc}")
         return EXIT_INPUT
     except AnalysisError as exc:
-        if args.command == "check":
+        if args.command in ("check", "statics"):
             _say(f"mbd2d: {exc}")
             return EXIT_NUMERICAL
         if exc.results is not None and len(exc.results.t):
