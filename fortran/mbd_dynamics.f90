@@ -6,7 +6,10 @@
 !!   [ s J  0     ] [ lambda / s ] = [ gamma ]      s: a mass scale, for conditioning
 !! Only an independent set of constraint rows enters (redundant rows, found by the rank
 !! analysis at the start, carry no multiplier of their own); the reported lambda is the
-!! minimum-norm solution of J^T lambda = Q - M q_ddot over all rows.
+!! minimum-norm solution of J^T lambda = Q - M q_ddot over all rows. Near a singular
+!! configuration (J momentarily rank deficient, as a parallelogram at its collinear
+!! position) the LU is nearly singular although q_ddot is still well defined; there the
+!! system is solved by a rank-revealing minimum-norm least-squares solve (dgelsy) instead.
 !! Also here: applied forces and energies, consistent initial velocities (the kinetic-energy
 !! projection [M J^T; J 0][q_dot; mu] = [M v0; nu]), the projection of positions onto Phi = 0
 !! (minimum-norm Newton steps), joint reactions and driver efforts.
@@ -19,11 +22,14 @@ module mbd_dynamics
   use mbd_forces, only: force_eval
   use mbd_assemble, only: assemble_blocks, assemble_dense, scatter_dense, gather_local
   use mbd_linsolve, only: lu_factor, lu_solve, row_rank, lapack_status
-  use mbd_lapack, only: dgelsy
+  use mbd_lapack, only: dgelsy, dgecon
   implicit none
   private
   public :: dyn_work_t, dyn_init, gen_forces, kinetic_energy, dyn_accel, dyn_velocity, &
-            dyn_project_pos, dyn_multipliers, dyn_reactions, dyn_tangent
+            dyn_project_pos, dyn_multipliers, dyn_reactions, dyn_tangent, dyn_solve
+
+  !> 1/cond_1 of the augmented matrix below which it is solved by rank-revealing least squares
+  real(wp), parameter :: AUG_RCOND = 1.0e-9_wp
 
   !> Work arrays and the active (independent) constraint rows.
   type :: dyn_work_t
@@ -35,6 +41,8 @@ module mbd_dynamics
     real(wp), allocatable :: aug(:, :), rhs(:), force(:), ja(:, :)
     integer, allocatable :: apiv(:)
     integer :: nsolve = 0                 !! augmented factorizations
+    integer :: nrank = 0                  !! rank-revealing fallback solves
+    logical :: lsq = .false.              !! the last factorization was nearly singular
   end type dyn_work_t
 
 contains
@@ -107,13 +115,40 @@ contains
     kinetic_energy = half * sum(m%mdiag * qd**2)
   end function kinetic_energy
 
-  !> Factor [M s Ja^T; s Ja 0] with Ja = J(rows) from w%jac.
+  !> Factor [M s Ja^T; s Ja 0] with Ja = J(rows) from w%jac. Nearly singular (1/cond_1 below
+  !! AUG_RCOND, or an exact zero pivot): w%lsq is set and solve_aug uses dgelsy.
   subroutine factor_aug(m, w, metric, status)
     type(model_t), intent(in) :: m
     type(dyn_work_t), intent(inout) :: w
     real(wp), intent(in) :: metric(:)     ! diagonal of the upper-left block
     integer, intent(out) :: status
     character(len=MSG_LEN) :: msg
+    real(wp) :: anorm, rc, cw(4 * (m%nq + w%na)), pr
+    integer :: iw(m%nq + w%na), info, k, nt
+    call build_aug(m, w, metric)
+    nt = m%nq + w%na
+    anorm = maxval(sum(abs(w%aug), dim=1))
+    call lu_factor(w%aug, w%apiv, status, msg)
+    w%nsolve = w%nsolve + 1
+    w%lsq = status /= MBD_OK
+    if (.not. w%lsq) then
+      pr = minval([(abs(w%aug(k, k)), k=1, nt)]) / maxval([(abs(w%aug(k, k)), k=1, nt)])
+      if (pr < 1.0e-6_wp) then
+        call dgecon('1', nt, w%aug, nt, anorm, rc, cw, iw, info)
+        w%lsq = rc < AUG_RCOND
+      end if
+    end if
+    if (w%lsq) then
+      call build_aug(m, w, metric)        ! keep the matrix itself for dgelsy
+      status = MBD_OK
+    end if
+  end subroutine factor_aug
+
+  !> The augmented matrix itself.
+  subroutine build_aug(m, w, metric)
+    type(model_t), intent(in) :: m
+    type(dyn_work_t), intent(inout) :: w
+    real(wp), intent(in) :: metric(:)
     integer :: i, n
     n = m%nq
     w%ja = w%jac(w%rows, :)
@@ -123,9 +158,39 @@ contains
     end do
     w%aug(1:n, n + 1:) = w%s * transpose(w%ja)
     w%aug(n + 1:, 1:n) = w%s * w%ja
-    call lu_factor(w%aug, w%apiv, status, msg)
-    w%nsolve = w%nsolve + 1
-  end subroutine factor_aug
+  end subroutine build_aug
+
+  !> Another right-hand side with the last augmented matrix (Baumgarte's modified gamma).
+  subroutine dyn_solve(w, rhs, status)
+    type(dyn_work_t), intent(inout) :: w     !! work arrays with the last augmented matrix
+    real(wp), intent(inout) :: rhs(:)        !! right-hand side, then solution
+    integer, intent(out) :: status           !! MBD_OK or MBD_LAPACK
+    call solve_aug(w, rhs, status)
+  end subroutine dyn_solve
+
+  !> Solve with the factored augmented matrix, or by the minimum-norm least-squares solve
+  !! when it is nearly singular (the matrix then is unfactored; dgelsy works on a copy).
+  subroutine solve_aug(w, rhs, status)
+    type(dyn_work_t), intent(inout) :: w
+    real(wp), intent(inout) :: rhs(:)
+    integer, intent(out) :: status
+    character(len=MSG_LEN) :: msg
+    real(wp) :: a(size(w%aug, 1), size(w%aug, 2)), wq(1)
+    real(wp), allocatable :: work(:)
+    integer :: jp(size(w%aug, 2)), rank, info, nt
+    if (.not. w%lsq) then
+      call lu_solve(w%aug, w%apiv, rhs, status, msg)
+      return
+    end if
+    nt = size(rhs)
+    a = w%aug
+    jp = 0
+    call dgelsy(nt, nt, 1, a, nt, rhs, nt, jp, AUG_RCOND, rank, wq, -1, info)
+    allocate (work(max(1, int(wq(1)))))
+    call dgelsy(nt, nt, 1, a, nt, rhs, nt, jp, AUG_RCOND, rank, work, size(work), info)
+    call lapack_status('dgelsy', info, status, msg)
+    w%nrank = w%nrank + 1
+  end subroutine solve_aug
 
   !> Accelerations and multipliers: [M J^T; J 0][q_ddot; lambda] = [Q; gamma] (active rows).
   !! lam is filled on the active rows (zero elsewhere); dyn_multipliers gives the
@@ -139,7 +204,6 @@ contains
     real(wp), intent(out) :: lam(:)          !! multipliers (neq)
     integer, intent(out) :: status           !! MBD_OK or MBD_SINGULAR
     real(wp) :: v
-    character(len=MSG_LEN) :: msg
     integer :: n
     n = m%nq
     call assemble_dense(m, q, qd, t, w%phi, w%nu, w%gam, w%jb, w%jac)
@@ -148,7 +212,7 @@ contains
     if (status /= MBD_OK) return
     w%rhs(1:n) = w%force
     w%rhs(n + 1:) = w%s * w%gam(w%rows)
-    call lu_solve(w%aug, w%apiv, w%rhs, status, msg)
+    call solve_aug(w, w%rhs, status)
     qdd = w%rhs(1:n)
     lam = zero
     lam(w%rows) = w%s * w%rhs(n + 1:)
@@ -165,7 +229,6 @@ contains
     real(wp), intent(out) :: qd(:)           !! consistent velocities
     integer, intent(out) :: status           !! MBD_OK or MBD_SINGULAR
     real(wp) :: metric(m%nq)
-    character(len=MSG_LEN) :: msg
     integer :: n
     n = m%nq
     metric = merge(m%mdiag, w%s, m%mdiag > zero)
@@ -174,7 +237,7 @@ contains
     if (status /= MBD_OK) return
     w%rhs(1:n) = metric * v0
     w%rhs(n + 1:) = w%s * w%nu(w%rows)
-    call lu_solve(w%aug, w%apiv, w%rhs, status, msg)
+    call solve_aug(w, w%rhs, status)
     qd = w%rhs(1:n)
   end subroutine dyn_velocity
 
@@ -187,7 +250,6 @@ contains
     real(wp), intent(in) :: t                !! time
     integer, intent(out) :: status           !! MBD_OK, MBD_NO_CONVERGENCE or MBD_SINGULAR
     real(wp) :: metric(m%nq)
-    character(len=MSG_LEN) :: msg
     integer :: it, n
     n = m%nq
     metric = one
@@ -199,7 +261,7 @@ contains
       if (status /= MBD_OK) return
       w%rhs(1:n) = zero
       w%rhs(n + 1:) = -w%s * w%phi(w%rows)
-      call lu_solve(w%aug, w%apiv, w%rhs, status, msg)
+      call solve_aug(w, w%rhs, status)
       q = q + w%rhs(1:n)
     end do
     status = MBD_NO_CONVERGENCE

@@ -28,7 +28,7 @@ module mbd_integrators
   use mbd_lapack, only: dgeqp3, dgecon
   use mbd_interp, only: hermite5
   use mbd_dynamics, only: dyn_work_t, dyn_accel, dyn_velocity, dyn_project_pos, gen_forces, &
-                          kinetic_energy, dyn_tangent
+                          kinetic_energy, dyn_tangent, dyn_solve
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   implicit none
   private
@@ -66,6 +66,8 @@ module mbd_integrators
     integer :: ni = 0                       !! independent coordinates (partitioned)
     integer, allocatable :: iv(:), iu(:)    !! independent and dependent coordinates
     real(wp), allocatable :: qf(:), vf(:), af(:), lam(:)   !! last full state
+    real(wp) :: ts = zero                   !! start of the current step
+    real(wp), allocatable :: qs(:), vs(:), as(:)          !! full state there
   end type itg_t
 
   ! Dormand-Prince 5(4) tableau
@@ -319,6 +321,7 @@ contains
     call pack_state(c, y, ynew, k, e)
     fsal = .false.
     qa = c%qf; va = c%vf; aa = c%af          ! the state at the start of the step
+    c%qs = qa; c%vs = va; c%as = aa; c%ts = t
     err = zero
     do while (t < c%t1 - 1.0e-14_wp * abs(c%t1 - c%t0))
       if (c%st%steps + c%st%rejected >= c%opts%max_steps) then
@@ -334,6 +337,16 @@ contains
       else
         call dopri5_step(m, w, c, t, y, h, ynew, k, e, fsal, stt)
         if (stt == MBD_OK) err = err_norm(c, e, y, ynew)
+      end if
+      if (stt == MBD_OK .and. partitioned) then
+        ! the dependent coordinates are outside the error estimate: reject a step that
+        ! moved them off their Taylor prediction (a switch of branch at a singular point)
+        call rhs(m, w, c, tnew, ynew, e, stt)
+        if (stt == MBD_OK) then
+          if (maxval(abs(c%qf(c%iu) - predicted(c, tnew))) > &
+              half * maxval(abs(predicted(c, tnew) - c%qs(c%iu))) + 1.0e3_wp * w%tol) err = 10.0_wp
+        end if
+        fsal = .false.
       end if
       if (stt /= MBD_OK .or. .not. all(ieee_is_finite(ynew))) then
         if (fixed) then
@@ -365,6 +378,7 @@ contains
       end if
       call emit(c, qo, vo, ao, t, qa, va, aa, tnew, c%qf, c%vf, c%af)
       qa = c%qf; va = c%vf; aa = c%af
+      c%qs = qa; c%vs = va; c%as = aa; c%ts = tnew
       c%st%steps = c%st%steps + 1
       c%st%hmin = min(c%st%hmin, h); c%st%hmax = max(c%st%hmax, h)
       t = tnew
@@ -444,6 +458,7 @@ contains
     nn = m%nq
     if (c%ni > 0) then
       c%qf(c%iv) = y(1:c%ni)
+      if (allocated(c%qs)) c%qf(c%iu) = predicted(c, t)   ! Newton starts on the branch
       call solve_dependent(m, w, c, t, y(c%ni + 1:), stf)
       if (stf /= MBD_OK) return
     else
@@ -458,6 +473,15 @@ contains
     end if
   end subroutine rhs
 
+  !> Taylor prediction of the dependent coordinates at t from the step's start state.
+  pure function predicted(c, t) result(u)
+    type(itg_t), intent(in) :: c
+    real(wp), intent(in) :: t
+    real(wp) :: u(size(c%iu)), dt
+    dt = t - c%ts
+    u = c%qs(c%iu) + dt * (c%vs(c%iu) + half * dt * c%as(c%iu))
+  end function predicted
+
   !> Accelerations at c's full state; Baumgarte-stabilized for RK4:
   !! J q_ddot = gamma - 2 alpha (J q_dot - nu) - beta^2 Phi.
   subroutine accel(m, w, c, t, stf)
@@ -466,7 +490,6 @@ contains
     type(itg_t), intent(inout) :: c
     real(wp), intent(in) :: t
     integer, intent(out) :: stf
-    character(len=MSG_LEN) :: lmsg
     integer :: nn
     call dyn_accel(m, w, c%qf, c%vf, t, c%af, c%lam, stf)
     if (stf /= MBD_OK .or. .not. c%baumgarte) return
@@ -475,7 +498,7 @@ contains
     w%rhs(nn + 1:) = w%s * (w%gam(w%rows) - two * c%opts%balpha * &
                             (matmul(w%jac(w%rows, :), c%vf) - w%nu(w%rows)) - &
                             c%opts%bbeta**2 * w%phi(w%rows))
-    call lu_solve(w%aug, w%apiv, w%rhs, stf, lmsg)
+    call dyn_solve(w, w%rhs, stf)
     c%af = w%rhs(1:nn)
   end subroutine accel
 

@@ -43,7 +43,7 @@ def _parser() -> argparse.ArgumentParser:
     d.add_argument("--t0", type=float, default=0.0, help="start time (default 0)")
     d.add_argument("--out", required=True, help="output file, .csv or .npz")
     d.add_argument("--method", default=None,
-                   help="generalized-alpha (default), dopri5, baumgarte-rk4 or partitioned")
+                   help="dopri5 (default), generalized-alpha, baumgarte-rk4 or partitioned")
     d.add_argument("--rtol", type=float, default=None, help="relative tolerance (adaptive)")
     d.add_argument("--atol", type=float, default=None, help="absolute tolerance (adaptive)")
     d.add_argument("--h", type=float, default=None, help="fixed step (generalized-alpha, "

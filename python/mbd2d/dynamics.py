@@ -21,7 +21,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from .model import Model
 
 METHODS = {"generalized-alpha": 1, "dopri5": 2, "baumgarte-rk4": 3, "partitioned": 4}
-DEFAULT_METHOD = "generalized-alpha"
+DEFAULT_METHOD = "dopri5"
 INTEGRATOR_FAILED = 8
 BAD_FORCE = -1000000
 

@@ -122,8 +122,8 @@ class Model:
         q0 : sequence of 3 float
             Rough estimate of x, y, theta of the centre of mass.
         mass, inertia : float, optional
-            Needed only for dynamics (mass > 0; inertia about the centre of mass, >= 0,
-            0 for a point mass).
+            Needed only for dynamics (mass >= 0, 0 for a massless link; inertia about the
+            centre of mass, >= 0, 0 for a point mass).
         v0 : sequence of 3 float, optional
             Initial velocity estimate (dynamics); made consistent with the constraints.
 
@@ -142,7 +142,9 @@ class Model:
             raise ModelError(f"duplicate name {name!r}: every body, joint and driver needs its "
                              "own name ('ground' is reserved)", entry)
         q = vector(q0, 3, "q0", entry)
-        m = None if mass is None else positive(mass, "mass", entry)
+        m = None if mass is None else number(mass, "mass", entry)
+        if m is not None and m < 0.0:
+            raise ModelError(f"mass must be >= 0, got {mass!r}", entry)
         j = None if inertia is None else number(inertia, "inertia", entry)
         if j is not None and j < 0.0:
             raise ModelError(f"inertia must be >= 0, got {inertia!r}", entry)
@@ -584,9 +586,11 @@ class Model:
         ----------
         t_end, steps, t0 : float, int, float
             Output times t0 + k (t_end - t0)/steps.
-        method : {'generalized-alpha', 'dopri5', 'baumgarte-rk4', 'partitioned'}
-            generalized-alpha (default): implicit index 3, error-controlled, or fixed step h;
-            dopri5: index 1, Dormand-Prince 5(4) with projection after each step;
+        method : {'dopri5', 'generalized-alpha', 'baumgarte-rk4', 'partitioned'}
+            dopri5 (default): index 1, Dormand-Prince 5(4), error-controlled, with projection
+            onto the position and velocity constraints after each step;
+            generalized-alpha: implicit index 3, error-controlled or fixed step h; the choice
+            for stiff models;
             baumgarte-rk4: index 1 with Baumgarte stabilization, fixed step h;
             partitioned: coordinate partitioning (Wehage-Haug), Dormand-Prince on the
             independent coordinates.
