@@ -397,7 +397,7 @@ contains
     iinfo(1) = nout; iinfo(3) = dst%steps; iinfo(4) = dst%rejected; iinfo(5) = dst%newton
     iinfo(6) = dst%rhs; iinfo(7) = dst%jacobians; iinfo(8) = dst%partitions
     rinfo(2) = dst%hmin; rinfo(3) = dst%hmax
-    if (status /= MBD_OK) rinfo(1) = t0 + (t1 - t0) * (real(max(nout - 1, 0), wp) / max(nsteps, 1))
+    if (status /= MBD_OK) rinfo(1) = dst%t_fail
     do k = 1, nout
       t = t0 + (t1 - t0) * (real(k - 1, wp) / max(nsteps, 1))
       if (k == nsteps + 1) t = t1

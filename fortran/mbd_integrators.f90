@@ -53,6 +53,7 @@ module mbd_integrators
   type :: dyn_stats_t
     integer :: steps = 0, rejected = 0, newton = 0, rhs = 0, jacobians = 0, partitions = 0
     real(wp) :: hmin = huge(one), hmax = zero
+    real(wp) :: t_fail = zero         !! time reached when a method failed
   end type dyn_stats_t
 
   !> Run context: settings, counters, the output grid, the form of the equations and the
@@ -134,6 +135,27 @@ contains
     q = c%qf; qd = c%vf
   end subroutine integrate
 
+  !> More steps to take: fixed steps count to nfix, adaptive ones run to t1.
+  logical function more(c, t, fixed, nfix)
+    type(itg_t), intent(in) :: c
+    real(wp), intent(in) :: t
+    logical, intent(in) :: fixed
+    integer, intent(in) :: nfix
+    if (fixed) then
+      more = c%st%steps < nfix
+    else
+      more = t < c%t1 - 1.0e-14_wp * abs(c%t1 - c%t0)
+    end if
+  end function more
+
+  !> Time of fixed step k (exact at the end).
+  real(wp) function step_time(c, k, nfix)
+    type(itg_t), intent(in) :: c
+    integer, intent(in) :: k, nfix
+    step_time = c%t0 + (c%t1 - c%t0) * (real(k, wp) / nfix)
+    if (k == nfix) step_time = c%t1
+  end function step_time
+
   real(wp) function out_time(c, k)
     type(itg_t), intent(in) :: c
     integer, intent(in) :: k
@@ -184,7 +206,7 @@ contains
     real(wp) :: qn(m%nq), vn(m%nq), an(m%nq), accn(m%nq), lamn(m%neq), dq(m%nq)
     real(wp) :: res(m%nq + w%na), kt(m%nq, m%nq), ct(m%nq, m%nq)
     real(wp) :: s(m%nq + w%na, m%nq + w%na)
-    integer :: piv(m%nq + w%na), it, n, k, stt
+    integer :: piv(m%nq + w%na), it, n, k, stt, nfix
     logical :: fixed, conv
     character(len=MSG_LEN) :: lmsg
     status = MBD_OK; msg = ''
@@ -196,14 +218,16 @@ contains
     fixed = c%opts%h > zero
     q = c%qf; qd = c%vf; qdd = c%af; lam = c%lam
     t = c%t0
+    nfix = 0
     if (fixed) then
-      h = (c%t1 - c%t0) / max(1, nint((c%t1 - c%t0) / c%opts%h))   ! land on t1
+      nfix = max(1, nint((c%t1 - c%t0) / c%opts%h))
+      h = (c%t1 - c%t0) / nfix                                      ! land on t1
     else
       h = initial_step(c)
     end if
     acc = qdd              ! the auxiliary acceleration a_0 = q_ddot_0
     err = zero
-    do while (t < c%t1 - 1.0e-14_wp * abs(c%t1 - c%t0))
+    do while (more(c, t, fixed, nfix))
       if (c%st%steps + c%st%rejected >= c%opts%max_steps) then
         status = MBD_INTEGRATOR_FAILED
         write (msg, '(a,i0,a,es12.5)') 'more than ', c%opts%max_steps, ' steps before t = ', t
@@ -211,6 +235,11 @@ contains
       end if
       h = min(h, c%t1 - t)
       tnew = t + h
+      if (fixed) then
+        tnew = step_time(c, c%st%steps + 1, nfix)
+        h = tnew - t
+      end if
+      c%st%t_fail = t
       bp = (1 - am) / (bet * h * h * (1 - af))
       gp = gam / (bet * h)
       ! predictor with q_ddot_{n+1} = 0
@@ -261,7 +290,7 @@ contains
         c%st%rejected = c%st%rejected + 1
         if (fixed) then
           status = MBD_INTEGRATOR_FAILED
-          write (msg, '(a,es12.5,a,es10.3)') 'generalized-alpha: Newton did not converge at t = ', &
+          write (msg, '(a,es12.5,a,es10.3)') 'Newton did not converge at t = ', &
             tnew, ' with the fixed step h = ', h
           return
         end if
@@ -272,7 +301,7 @@ contains
         end if
         if (h < 1.0e-14_wp * max(one, abs(t))) then
           status = MBD_INTEGRATOR_FAILED
-          write (msg, '(a,es12.5)') 'generalized-alpha: step size underflow at t = ', t
+          write (msg, '(a,es12.5)') 'step size underflow at t = ', t
           return
         end if
         cycle
@@ -303,6 +332,7 @@ contains
     real(wp) :: t, h, tnew, err, fac, qa(m%nq), va(m%nq), aa(m%nq)
     integer :: stt
     logical :: fixed, fsal
+    integer :: nfix
     status = MBD_OK; msg = ''
     c%baumgarte = c%opts%method == METH_RK4
     if (partitioned) then
@@ -313,8 +343,10 @@ contains
     end if
     fixed = c%opts%method == METH_RK4
     t = c%t0
+    nfix = 0
     if (fixed) then
-      h = (c%t1 - c%t0) / max(1, nint((c%t1 - c%t0) / c%opts%h))
+      nfix = max(1, nint((c%t1 - c%t0) / c%opts%h))
+      h = (c%t1 - c%t0) / nfix
     else
       h = initial_step(c)
     end if
@@ -323,14 +355,19 @@ contains
     qa = c%qf; va = c%vf; aa = c%af          ! the state at the start of the step
     c%qs = qa; c%vs = va; c%as = aa; c%ts = t
     err = zero
-    do while (t < c%t1 - 1.0e-14_wp * abs(c%t1 - c%t0))
+    do while (more(c, t, fixed, nfix))
       if (c%st%steps + c%st%rejected >= c%opts%max_steps) then
         status = MBD_INTEGRATOR_FAILED
         write (msg, '(a,i0,a,es12.5)') 'more than ', c%opts%max_steps, ' steps before t = ', t
         return
       end if
+      c%st%t_fail = t
       h = min(h, c%t1 - t)
       tnew = t + h
+      if (fixed) then
+        tnew = step_time(c, c%st%steps + 1, nfix)
+        h = tnew - t
+      end if
       if (fixed) then
         call rk4_step(m, w, c, t, y, h, ynew, k, stt)
         err = zero
@@ -375,6 +412,17 @@ contains
         write (msg, '(a,es12.5)') 'the constraints could not be satisfied after the step to t = ', &
           tnew
         return
+      end if
+      if (c%baumgarte) then
+        ! an unstable run shows first as growing constraint violation
+        if (maxval(abs(w%phi)) > 1.0e-3_wp * m%lscale) then
+          status = MBD_INTEGRATOR_FAILED
+          write (msg, '(a,es10.3,a,es12.5,a)') 'the constraint violation reached ', &
+            maxval(abs(w%phi)), ' at t = ', tnew, ': unstable (a smaller step h, or '// &
+            'smaller Baumgarte alpha and beta)'
+          c%st%t_fail = tnew
+          return
+        end if
       end if
       call emit(c, qo, vo, ao, t, qa, va, aa, tnew, c%qf, c%vf, c%af)
       qa = c%qf; va = c%vf; aa = c%af
