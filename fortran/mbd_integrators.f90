@@ -201,7 +201,7 @@ contains
     real(wp), intent(inout) :: qo(:, :), vo(:, :), ao(:, :)
     integer, intent(out) :: status
     character(len=MSG_LEN), intent(out) :: msg
-    real(wp) :: am, af, gam, bet, bp, gp, h, t, err, tnew, facc, v
+    real(wp) :: am, af, gam, bet, bp, gp, h, t, err, tnew, facc, v, hprev
     real(wp) :: q(m%nq), qd(m%nq), qdd(m%nq), acc(m%nq), lam(m%neq)
     real(wp) :: qn(m%nq), vn(m%nq), an(m%nq), accn(m%nq), lamn(m%neq), dq(m%nq)
     real(wp) :: res(m%nq + w%na), kt(m%nq, m%nq), ct(m%nq, m%nq)
@@ -226,6 +226,7 @@ contains
       h = initial_step(c)
     end if
     acc = qdd              ! the auxiliary acceleration a_0 = q_ddot_0
+    hprev = zero
     err = zero
     do while (more(c, t, fixed, nfix))
       if (c%st%steps + c%st%rejected >= c%opts%max_steps) then
@@ -242,6 +243,10 @@ contains
       c%st%t_fail = t
       bp = (1 - am) / (bet * h * h * (1 - af))
       gp = gam / (bet * h)
+      ! the auxiliary acceleration is q_ddot shifted by (am - af) h: on a change of step size
+      ! a - q_ddot scales with it, a <- q_ddot + (h / h_prev) (a - q_ddot)
+      if (hprev > zero .and. abs(h - hprev) > zero) acc = qdd + (h / hprev) * (acc - qdd)
+      hprev = h
       ! predictor with q_ddot_{n+1} = 0
       an = zero
       accn = (af * qdd - am * acc) / (1 - am)
@@ -284,8 +289,11 @@ contains
         lamn(w%rows) = lamn(w%rows) + bp * res(n + 1:)
         c%st%newton = c%st%newton + 1
       end do
-      ! local error estimate (Newmark type): h^2 |beta - 1/6| |q_ddot_{n+1} - q_ddot_n|
-      if (conv .and. .not. fixed) err = err_norm(c, h * h * abs(bet - one / 6) * (an - qdd), q, qn)
+      ! local error estimate: the step's position error is (beta - 1/6) h^3 q''', and the
+      ! distance of q_{n+1} from its second-order Taylor prediction is h^3 q'''/6, so
+      ! e = (6 beta - 1) (q_{n+1} - q_n - h q_dot_n - h^2 q_ddot_n / 2)
+      if (conv .and. .not. fixed) err = err_norm(c, (6 * bet - 1) * &
+                                                 (qn - q - h * qd - half * h * h * qdd), q, qn)
       if (.not. conv .or. (.not. fixed .and. err > one)) then
         c%st%rejected = c%st%rejected + 1
         if (fixed) then
@@ -312,7 +320,7 @@ contains
       c%st%hmin = min(c%st%hmin, h); c%st%hmax = max(c%st%hmax, h)
       t = tnew; q = qn; qd = vn; qdd = an; acc = accn; lam = lamn
       if (.not. fixed) then
-        facc = min(2.0_wp, max(0.2_wp, 0.9_wp * max(err, 1.0e-10_wp)**(-one / 3)))
+        facc = min(1.5_wp, max(0.2_wp, 0.8_wp * max(err, 1.0e-10_wp)**(-one / 3)))
         h = h * facc
       end if
     end do

@@ -98,9 +98,9 @@ def evaluate(model: "Model", q: Any, qd: Any, t: float) -> tuple[np.ndarray, ...
 
 
 def _state(x: Any, n: int, what: str) -> np.ndarray:
-    if np.iscomplexobj(x):
-        raise ModelError(f"{what} must be real numbers, got complex ones", "state")
     try:
+        if np.iscomplexobj(x):
+            raise ModelError(f"{what} must be real numbers, got complex ones", "state")
         v = np.asarray(x, dtype=float)
     except (TypeError, ValueError, OverflowError):
         raise ModelError(f"{what} must be an array of {n} numbers", "state") from None

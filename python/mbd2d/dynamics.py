@@ -142,6 +142,12 @@ def run_dynamics(model: "Model", t_end: float, steps: int, method: str | None = 
         raise ModelError(f"{method} chooses its own steps from rtol and atol; h is for "
                          "generalized-alpha and baumgarte-rk4", "dynamics")
     rho_v = opt(rho_inf, "rho_inf", 0.0, 1.0, -1.0)
+    if method == "generalized-alpha" and h is None and rho_v >= 0.99:
+        # undamped, the algorithmic accelerations carry an oscillation the error
+        # estimate reads as error; the step then collapses
+        raise ModelError(f"error-controlled generalized-alpha needs numerical damping: "
+                         f"rho_inf={rho_v:g} is too close to 1; use rho_inf <= 0.9 or give "
+                         "a fixed step h", "dynamics")
     alpha_v = opt(alpha, "alpha", 0.0, 1e9, -1.0)
     beta_v = opt(beta, "beta", 0.0, 1e9, -1.0)
     p = pack(model)
