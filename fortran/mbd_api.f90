@@ -17,7 +17,7 @@ module mbd_api
                           gen_forces, kinetic_energy
   use mbd_integrators, only: dyn_opts_t, dyn_stats_t, integrate
   use mbd_statics, only: statics_solve
-  use mbd_assemble, only: assemble_dense
+  use mbd_assemble, only: assemble_dense, asm_work_t, asm_init
   use mbd_kinematics, only: kin_opts_t, kin_report_t, kin_work_t, kin_run, kin_work_init, &
                             kin_assemble, kin_rank, MAXPASS
   use mbd_status, only: MBD_BAD_SETTING
@@ -88,7 +88,7 @@ contains
     character(len=MSG_LEN), intent(out) :: msg  !! what is wrong
     integer, intent(out) :: bad                 !! offending constraint, or 0
     type(model_t) :: m
-    real(wp), allocatable :: jb(:, :, :)
+    type(asm_work_t) :: aw
     phi = zero; jac = zero; nu = zero; gam = zero
     call model_build(nb, ctab, rpar, m, status, msg, bad)
     if (status /= MBD_OK) return
@@ -99,8 +99,8 @@ contains
         size(jac, 1) /= m%neq .or. size(jac, 2) /= m%nq) then
       status = MBD_BAD_COUNT; msg = 'array sizes do not match the model'; return
     end if
-    allocate (jb(MAXROW, NLOC, m%nc))
-    call assemble_dense(m, q, qd, t, phi, nu, gam, jb, jac)
+    call asm_init(m, aw)
+    call assemble_dense(m, q, qd, t, phi, nu, gam, aw, jac)
     if (.not. (finite(phi) .and. finite(jac) .and. finite(nu) .and. finite(gam))) then
       status = MBD_BAD_PARAM
       msg = 'the constraint equations overflow at this state (a parameter or state too large)'
@@ -267,7 +267,7 @@ contains
     real(wp), intent(in) :: q(:), qd(:), t
     real(wp), intent(out) :: e(4)
     real(wp) :: v
-    call assemble_dense(m, q, w%qz, t, w%phi, w%nu, w%gam, w%jb, w%jac)
+    call assemble_dense(m, q, w%qz, t, w%phi, w%nu, w%gam, w%asm, w%jac)
     e(3) = maxval(abs(w%phi))
     e(4) = maxval(abs(matmul(w%jac, qd) - w%nu))
     call gen_forces(m, q, qd, t, w%force, v)
@@ -466,7 +466,8 @@ contains
         size(q, 2) /= size(t) .or. size(lam, 2) /= size(t) .or. size(reac, 3) /= size(t)) then
       status = MBD_BAD_COUNT; msg = 'array sizes do not match the model'; return
     end if
-    allocate (w%phi(m%neq), w%nu(m%neq), w%gam(m%neq), w%jb(3, NLOC, m%nc), w%qz(m%nq))
+    allocate (w%phi(m%neq), w%nu(m%neq), w%gam(m%neq), w%qz(m%nq))
+    call asm_init(m, w%asm)
     w%qz = zero
     do k = 1, size(t)
       call dyn_reactions(m, w, q(:, k), t(k), lam(:, k), reac(:, :, k), rloc(:, :, k))

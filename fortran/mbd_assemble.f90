@@ -5,15 +5,31 @@
 !! Each constraint writes its rows into slices of phi, nu, gam and its local Jacobian block
 !! into jb(:, :, k); scatter_dense then places the blocks in a dense J. No allocation here.
 module mbd_assemble
-  use mbd_kinds, only: wp, zero
-  use mbd_points, only: NLOC, MAXROW
+  use mbd_kinds, only: wp, zero, one
+  use mbd_points, only: NLOC, MAXROW, kloc
   use mbd_model, only: model_t, model_slots
   use mbd_constraints, only: con_eval, con_init_extra
   implicit none
   private
-  public :: assemble_blocks, scatter_dense, assemble_dense, init_extras, gather_local
+  public :: asm_work_t, asm_init, assemble_blocks, scatter_dense, assemble_dense, init_extras, &
+            gather_local
+
+  !> Work arrays of the assembly, allocated once per analysis.
+  type :: asm_work_t
+    real(wp), allocatable :: jb(:, :, :)   !! local Jacobian blocks (MAXROW, NLOC, nc)
+    real(wp), allocatable :: cb(:), sb(:)  !! cos and sin of each body's angle (0:nb; 0 ground)
+  end type asm_work_t
 
 contains
+
+  !> Allocate the assembly work arrays for model m.
+  pure subroutine asm_init(m, a)
+    type(model_t), intent(in) :: m         !! model
+    type(asm_work_t), intent(out) :: a     !! work arrays
+    allocate (a%jb(MAXROW, NLOC, m%nc), a%cb(0:m%nb), a%sb(0:m%nb))
+    a%jb = zero
+    a%cb = one; a%sb = zero
+  end subroutine asm_init
 
   !> Local coordinates (and velocities) of constraint k.
   pure subroutine gather_local(m, k, q, ql)
@@ -31,8 +47,9 @@ contains
     end do
   end subroutine gather_local
 
-  !> Phi, nu, gamma and the local Jacobian blocks at (q, q_dot, t).
-  pure subroutine assemble_blocks(m, q, qd, t, phi, nu, gam, jb)
+  !> Phi, nu, gamma and the local Jacobian blocks at (q, q_dot, t). The cosine and sine of
+  !! each body's angle are computed once here (same_q: they are still those of q).
+  pure subroutine assemble_blocks(m, q, qd, t, phi, nu, gam, a, same_q)
     type(model_t), intent(in) :: m            !! model
     real(wp), intent(in) :: q(:)              !! coordinates (nq)
     real(wp), intent(in) :: qd(:)             !! velocities (nq), for gamma
@@ -40,17 +57,36 @@ contains
     real(wp), intent(out) :: phi(:)           !! Phi (neq)
     real(wp), intent(out) :: nu(:)            !! nu (neq)
     real(wp), intent(out) :: gam(:)           !! gamma (neq)
-    real(wp), intent(out) :: jb(:, :, :)      !! local blocks (MAXROW, NLOC, nc)
-    real(wp) :: ql(NLOC), qdl(NLOC)
-    integer :: k, r0, r1, si, sj
+    type(asm_work_t), intent(inout) :: a      !! work: blocks (out) and body cos, sin
+    logical, intent(in), optional :: same_q   !! the last call had the same q
+    type(kloc) :: x
+    real(wp) :: ph(MAXROW), nv(MAXROW), ga(MAXROW)
+    integer :: k, r0, nr, si, sj, b, s, c
+    logical :: reuse
+    reuse = .false.
+    if (present(same_q)) reuse = same_q
+    if (.not. reuse) then
+      do b = 1, m%nb
+        a%cb(b) = cos(q(3 * b)); a%sb(b) = sin(q(3 * b))
+      end do
+    end if
     do k = 1, m%nc
-      call gather_local(m, k, q, ql)
-      call gather_local(m, k, qd, qdl)
-      call model_slots(m, k, si, sj)
-      r0 = m%row0(k); r1 = r0 + m%nrow(k) - 1
-      jb(:, :, k) = zero
+      do s = 1, NLOC
+        c = m%loc(s, k)
+        x%q(s) = zero; x%qd(s) = zero
+        if (c > 0) then
+          x%q(s) = q(c); x%qd(s) = qd(c)
+        end if
+      end do
+      x%c(1) = a%cb(m%bi(k)); x%c(2) = a%cb(m%bj(k))
+      x%s(1) = a%sb(m%bi(k)); x%s(2) = a%sb(m%bj(k))
+      si = merge(1, 0, m%bi(k) > 0); sj = merge(2, 0, m%bj(k) > 0)     ! model_slots
+      ! each constraint writes whole rows of its block (put_vec, put_scal): no zero fill
       call con_eval(m%kind(k), m%suba(k), m%subb(k), m%p(m%po(k):m%po(k) + m%pn(k) - 1), &
-                    si, sj, ql, qdl, t, phi(r0:r1), jb(1:m%nrow(k), :, k), nu(r0:r1), gam(r0:r1))
+                    si, sj, x, t, ph, a%jb(:, :, k), nv, ga)
+      r0 = m%row0(k) - 1; nr = m%nrow(k)
+      phi(r0 + 1:r0 + nr) = ph(1:nr); nu(r0 + 1:r0 + nr) = nv(1:nr)
+      gam(r0 + 1:r0 + nr) = ga(1:nr)
     end do
   end subroutine assemble_blocks
 
@@ -59,29 +95,30 @@ contains
     type(model_t), intent(in) :: m            !! model
     real(wp), intent(in) :: jb(:, :, :)       !! local blocks
     real(wp), intent(out) :: jac(:, :)        !! dense Jacobian
-    integer :: k, s, r, c
+    integer :: k, s, r, c, r0
     jac = zero
     do k = 1, m%nc
+      r0 = m%row0(k) - 1
       do s = 1, NLOC
         c = m%loc(s, k)
         if (c == 0) cycle
         do r = 1, m%nrow(k)
-          jac(m%row0(k) + r - 1, c) = jac(m%row0(k) + r - 1, c) + jb(r, s, k)
+          jac(r0 + r, c) = jac(r0 + r, c) + jb(r, s, k)
         end do
       end do
     end do
   end subroutine scatter_dense
 
   !> Phi, nu, gamma and the dense J in one call.
-  pure subroutine assemble_dense(m, q, qd, t, phi, nu, gam, jb, jac)
+  pure subroutine assemble_dense(m, q, qd, t, phi, nu, gam, a, jac)
     type(model_t), intent(in) :: m            !! model
     real(wp), intent(in) :: q(:), qd(:)       !! coordinates and velocities
     real(wp), intent(in) :: t                 !! time
     real(wp), intent(out) :: phi(:), nu(:), gam(:)  !! Phi, nu, gamma
-    real(wp), intent(out) :: jb(:, :, :)      !! work: local blocks
+    type(asm_work_t), intent(inout) :: a      !! work arrays
     real(wp), intent(out) :: jac(:, :)        !! dense Jacobian
-    call assemble_blocks(m, q, qd, t, phi, nu, gam, jb)
-    call scatter_dense(m, jb, jac)
+    call assemble_blocks(m, q, qd, t, phi, nu, gam, a)
+    call scatter_dense(m, a%jb, jac)
   end subroutine assemble_dense
 
   !> Starting values of the extra coordinates (cam contact parameters) from the bodies in q.

@@ -12,7 +12,7 @@ module mbd_constraints
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use mbd_kinds, only: wp
   use mbd_status, only: MBD_OK, MBD_BAD_INPUT, MBD_BAD_PARAM, MSG_LEN
-  use mbd_points, only: NLOC
+  use mbd_points, only: NLOC, MAXROW, kloc
   use mbd_functions, only: fun_length, fun_check
   use mbd_joint_revolute, only: revolute_prepare, revolute_eval
   use mbd_joint_translational, only: translational_prepare, translational_eval
@@ -151,49 +151,48 @@ contains
   end subroutine con_prepare
 
   !> Rows of Phi, the local J block, nu and gamma.
-  pure subroutine con_eval(kind, suba, subb, p, si, sj, ql, qdl, t, phi, jl, nu, gam)
+  pure subroutine con_eval(kind, suba, subb, p, si, sj, x, t, phi, jl, nu, gam)
     integer, intent(in) :: kind, suba, subb  !! kind and sub-kinds
     real(wp), intent(in) :: p(:)             !! prepared parameters
     integer, intent(in) :: si, sj            !! slot ids of the two bodies (0 = ground)
-    real(wp), intent(in) :: ql(NLOC)         !! local coordinates
-    real(wp), intent(in) :: qdl(NLOC)        !! local velocities
+    type(kloc), intent(in) :: x              !! local state
     real(wp), intent(in) :: t                !! time
-    real(wp), intent(inout) :: phi(:)        !! rows of Phi
-    real(wp), intent(inout) :: jl(:, :)      !! rows x NLOC block of J
-    real(wp), intent(inout) :: nu(:)         !! rows of nu
-    real(wp), intent(inout) :: gam(:)        !! rows of gamma
+    real(wp), intent(inout) :: phi(MAXROW)   !! rows of Phi (con_nrow of them written)
+    real(wp), intent(inout) :: jl(MAXROW, NLOC)  !! local block of J (the same rows)
+    real(wp), intent(inout) :: nu(MAXROW)    !! rows of nu
+    real(wp), intent(inout) :: gam(MAXROW)   !! rows of gamma
     select case (kind)
     case (CON_REVOLUTE)
-      call revolute_eval(p, si, sj, ql, qdl, phi, jl, gam)
+      call revolute_eval(p, si, sj, x, phi, jl, gam)
       nu(1:2) = 0.0_wp
     case (CON_TRANSLATIONAL)
-      call translational_eval(p, si, sj, ql, qdl, phi, jl, gam)
+      call translational_eval(p, si, sj, x, phi, jl, gam)
       nu(1:2) = 0.0_wp
     case (CON_CAM)
-      call cam_eval(suba, subb, p, si, sj, ql, qdl, phi, jl, gam)
+      call cam_eval(suba, subb, p, si, sj, x, phi, jl, gam)
       nu(1:2) = 0.0_wp
     case (CON_DISTANCE)
-      call distance_eval(p, si, sj, ql, qdl, phi, jl, gam)
+      call distance_eval(p, si, sj, x, phi, jl, gam)
       nu(1) = 0.0_wp
     case (CON_POINT_LINE)
-      call point_line_eval(p, si, sj, ql, qdl, phi, jl, gam)
+      call point_line_eval(p, si, sj, x, phi, jl, gam)
       nu(1) = 0.0_wp
     case (CON_WELD)
-      call weld_eval(p, si, sj, ql, qdl, phi, jl, gam)
+      call weld_eval(p, si, sj, x, phi, jl, gam)
       nu(1:3) = 0.0_wp
     case (CON_GEAR)
-      call gear_eval(subb, p, si, sj, ql, qdl, phi, jl, gam)
+      call gear_eval(subb, p, si, sj, x, phi, jl, gam)
       nu(1) = 0.0_wp
     case (CON_RACK)
-      call rolling_eval(.false., p, si, sj, ql, qdl, phi, jl, gam)
+      call rolling_eval(.false., p, si, sj, x, phi, jl, gam)
       nu(1) = 0.0_wp
     case (CON_ROLLING)
-      call rolling_eval(.true., p, si, sj, ql, qdl, phi, jl, gam)
+      call rolling_eval(.true., p, si, sj, x, phi, jl, gam)
       nu(1:2) = 0.0_wp
     case (CON_ABSOLUTE)
-      call driver_eval(DRV_ABS, suba, p, si, sj, ql, qdl, t, phi(1), jl(1, :), nu(1), gam(1))
+      call driver_eval(DRV_ABS, suba, p, si, sj, x, t, phi, jl, nu, gam)
     case default
-      call driver_eval(kind, suba, p, si, sj, ql, qdl, t, phi(1), jl(1, :), nu(1), gam(1))
+      call driver_eval(kind, suba, p, si, sj, x, t, phi, jl, nu, gam)
     end select
   end subroutine con_eval
 

@@ -8,7 +8,7 @@
 !! with the joint's prepared parameters in front: [joint prep(9), function].
 module mbd_drivers
   use mbd_kinds, only: wp
-  use mbd_points, only: NLOC, kscal, body_angle, ssub, put_scal
+  use mbd_points, only: NLOC, MAXROW, kloc, kscal, body_angle, ssub, put_scal
   use mbd_functions, only: fun_eval
   use mbd_joint_translational, only: slide_distance
   implicit none
@@ -22,34 +22,33 @@ module mbd_drivers
 contains
 
   !> Row of Phi, J (local block), nu and gamma of a driver.
-  pure subroutine driver_eval(kind, sub, p, si, sj, ql, qdl, t, phi, jl, nu, gam)
+  pure subroutine driver_eval(kind, sub, p, si, sj, x, t, phi, jl, nu, gam)
     integer, intent(in) :: kind, sub        !! driver kind; absolute: coordinate 1..3
     real(wp), intent(in) :: p(:)            !! prepared parameters
     integer, intent(in) :: si, sj           !! slot ids of the bodies
-    real(wp), intent(in) :: ql(NLOC)        !! local coordinates
-    real(wp), intent(in) :: qdl(NLOC)       !! local velocities
+    type(kloc), intent(in) :: x             !! local state
     real(wp), intent(in) :: t               !! time
-    real(wp), intent(inout) :: phi          !! row of Phi
-    real(wp), intent(inout) :: jl(:)        !! row of the local J block
-    real(wp), intent(inout) :: nu           !! row of nu
-    real(wp), intent(inout) :: gam          !! row of gamma
+    real(wp), intent(inout) :: phi(MAXROW)  !! rows of Phi (the first written)
+    real(wp), intent(inout) :: jl(MAXROW, NLOC)  !! local block of J (row 1 written)
+    real(wp), intent(inout) :: nu(MAXROW)   !! rows of nu
+    real(wp), intent(inout) :: gam(MAXROW)  !! rows of gamma
     type(kscal) :: g
     real(wp) :: f, f1, f2
     select case (kind)
     case (DRV_ABS)
-      g%v = ql(sub); g%d(sub) = 1.0_wp; g%vd = qdl(sub)
+      g%v = x%q(sub); g%d(sub) = 1.0_wp; g%vd = x%qd(sub)
       call fun_eval(p, t, f, f1, f2)
     case (DRV_REL_ANGLE)
-      g = ssub(body_angle(ql, qdl, sj), body_angle(ql, qdl, si))
+      g = ssub(body_angle(x, sj), body_angle(x, si))
       call fun_eval(p, t, f, f1, f2)
     case default  ! DRV_REL_DIST
-      g = slide_distance(p(1:TRANS_PREP_LEN), si, sj, ql, qdl)
+      g = slide_distance(p(1:TRANS_PREP_LEN), si, sj, x)
       call fun_eval(p(TRANS_PREP_LEN + 1:), t, f, f1, f2)
     end select
-    call put_scal(g, phi, jl, gam)
-    phi = phi - f
-    nu = f1
-    gam = gam + f2
+    call put_scal(g, phi(1), jl(1, :), gam(1))
+    phi(1) = phi(1) - f
+    nu(1) = f1
+    gam(1) = gam(1) + f2
   end subroutine driver_eval
 
 end module mbd_drivers

@@ -20,7 +20,8 @@ module mbd_dynamics
   use mbd_model, only: model_t, model_slots
   use mbd_constraints, only: con_is_driver
   use mbd_forces, only: force_eval
-  use mbd_assemble, only: assemble_blocks, assemble_dense, scatter_dense, gather_local
+  use mbd_assemble, only: asm_work_t, asm_init, assemble_blocks, assemble_dense, scatter_dense, &
+                          gather_local
   use mbd_linsolve, only: lu_factor, lu_solve, row_rank, lapack_status
   use mbd_lapack, only: dgelsy, dgecon
   implicit none
@@ -37,7 +38,8 @@ module mbd_dynamics
     integer, allocatable :: rows(:)       !! active rows
     real(wp) :: s = one                   !! constraint scale in the augmented matrix
     real(wp) :: tol = 1.0e-12_wp          !! position tolerance ||Phi||_inf
-    real(wp), allocatable :: phi(:), nu(:), gam(:), jac(:, :), jb(:, :, :), qz(:)
+    real(wp), allocatable :: phi(:), nu(:), gam(:), jac(:, :), qz(:)
+    type(asm_work_t) :: asm               !! assembly work arrays
     real(wp), allocatable :: aug(:, :), rhs(:), force(:), ja(:, :)
     integer, allocatable :: apiv(:)
     integer :: nsolve = 0                 !! augmented factorizations
@@ -60,9 +62,10 @@ contains
     integer :: rank, r, na
     w%n = m%nq; w%neq = m%neq; w%tol = tol
     allocate (w%phi(m%neq), w%nu(m%neq), w%gam(m%neq), w%jac(m%neq, m%nq), &
-              w%jb(3, NLOC, m%nc), w%qz(m%nq), w%force(m%nq), red(m%neq))
+              w%qz(m%nq), w%force(m%nq), red(m%neq))
+    call asm_init(m, w%asm)
     w%qz = zero
-    call assemble_dense(m, q, w%qz, t, w%phi, w%nu, w%gam, w%jb, w%jac)
+    call assemble_dense(m, q, w%qz, t, w%phi, w%nu, w%gam, w%asm, w%jac)
     call row_rank(w%jac, rank, red, status, msg)
     if (status /= MBD_OK) return
     na = count(red == 0)
@@ -206,7 +209,7 @@ contains
     real(wp) :: v
     integer :: n
     n = m%nq
-    call assemble_dense(m, q, qd, t, w%phi, w%nu, w%gam, w%jb, w%jac)
+    call assemble_dense(m, q, qd, t, w%phi, w%nu, w%gam, w%asm, w%jac)
     call gen_forces(m, q, qd, t, w%force, v)
     call factor_aug(m, w, m%mdiag, status)
     if (status /= MBD_OK) return
@@ -232,7 +235,7 @@ contains
     integer :: n
     n = m%nq
     metric = merge(m%mdiag, w%s, m%mdiag > zero)
-    call assemble_dense(m, q, w%qz, t, w%phi, w%nu, w%gam, w%jb, w%jac)
+    call assemble_dense(m, q, w%qz, t, w%phi, w%nu, w%gam, w%asm, w%jac)
     call factor_aug(m, w, metric, status)
     if (status /= MBD_OK) return
     w%rhs(1:n) = metric * v0
@@ -254,7 +257,7 @@ contains
     n = m%nq
     metric = one
     do it = 1, 20
-      call assemble_dense(m, q, w%qz, t, w%phi, w%nu, w%gam, w%jb, w%jac)
+      call assemble_dense(m, q, w%qz, t, w%phi, w%nu, w%gam, w%asm, w%jac)
       status = MBD_OK
       if (maxval(abs(w%phi)) <= w%tol) return
       call factor_aug(m, w, metric, status)
@@ -281,7 +284,7 @@ contains
     real(wp) :: jt(m%nq, m%neq), b(max(m%nq, m%neq)), v, wq(1)
     real(wp), allocatable :: work(:)
     integer :: jpvt(m%neq), rank, info, lwork
-    call assemble_dense(m, q, qd, t, w%phi, w%nu, w%gam, w%jb, w%jac)
+    call assemble_dense(m, q, qd, t, w%phi, w%nu, w%gam, w%asm, w%jac)
     call gen_forces(m, q, qd, t, w%force, v)
     jt = transpose(w%jac)
     b = zero
@@ -309,10 +312,10 @@ contains
     real(wp), intent(out) :: rloc(:, :)       !! (6, nc) in the body frames
     real(wp) :: g(NLOC), a(2, 2)
     integer :: k, r0, nr
-    call assemble_blocks(m, q, w%qz, t, w%phi, w%nu, w%gam, w%jb)
+    call assemble_blocks(m, q, w%qz, t, w%phi, w%nu, w%gam, w%asm)
     do k = 1, m%nc
       r0 = m%row0(k); nr = m%nrow(k)
-      g = -matmul(lam(r0:r0 + nr - 1), w%jb(1:nr, :, k))
+      g = -matmul(lam(r0:r0 + nr - 1), w%asm%jb(1:nr, :, k))
       reac(:, k) = g(1:6)
       rloc(:, k) = g(1:6)
       if (m%bi(k) > 0) then
@@ -367,7 +370,7 @@ contains
       real(wp), intent(in) :: qa(:), qda(:)
       real(wp), intent(out) :: r(:)
       real(wp) :: v
-      call assemble_dense(m, qa, qda, t, w%phi, w%nu, w%gam, w%jb, w%jac)
+      call assemble_dense(m, qa, qda, t, w%phi, w%nu, w%gam, w%asm, w%jac)
       call gen_forces(m, qa, qda, t, w%force, v)
       r = matmul(lam, w%jac) - w%force
     end subroutine residual

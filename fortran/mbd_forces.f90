@@ -17,7 +17,8 @@
 module mbd_forces
   use mbd_kinds, only: wp, zero, half
   use mbd_status, only: MBD_OK, MBD_BAD_PARAM, MSG_LEN
-  use mbd_points, only: NLOC, kvec, kscal, body_point, body_angle, vsub, vdot, ssqrt, ssub
+  use mbd_points, only: NLOC, kloc, local_state, kvec, kscal, body_point, body_angle, vsub, &
+                        vdot, ssqrt, ssub
   use mbd_functions, only: fun_eval, fun_length, fun_check
   implicit none
   private
@@ -106,12 +107,14 @@ contains
     real(wp), intent(out) :: vload          !! potential of the loads frozen at t
     type(kvec) :: d, pt
     type(kscal) :: l, a
+    type(kloc) :: x
     real(wp) :: f, f1, f2, fy, tension, tau
     integer :: nf
     ql_force = zero; v = zero; vload = zero
+    x = local_state(ql, qdl)
     select case (kind)
     case (FRC_SPRING)
-      d = vsub(body_point(ql, qdl, sj, p(3:4)), body_point(ql, qdl, si, p(1:2)))
+      d = vsub(body_point(x, sj, p(3:4)), body_point(x, si, p(1:2)))
       call fun_eval(p(8:), t, f, f1, f2)
       if (dot_product(d%v, d%v) > zero) then
         l = ssqrt(vdot(d, d))
@@ -126,14 +129,14 @@ contains
       if (si > 0) ql_force(3) = f
       vload = -f * ql(3)
     case (FRC_POINT)
-      pt = body_point(ql, qdl, si, p(1:2))
+      pt = body_point(x, si, p(1:2))
       nf = fun_length(p(3:))
       call fun_eval(p(3:), t, f, f1, f2)
       call fun_eval(p(3 + nf:), t, fy, f1, f2)
       ql_force = f * pt%d(1, :) + fy * pt%d(2, :)
       vload = -(f * pt%v(1) + fy * pt%v(2))
     case (FRC_ROTSPRING)
-      a = ssub(body_angle(ql, qdl, sj), body_angle(ql, qdl, si))
+      a = ssub(body_angle(x, sj), body_angle(x, si))
       call fun_eval(p(4:), t, f, f1, f2)
       tau = -p(1) * (a%v - p(3)) - p(2) * a%vd + f
       ql_force = tau * a%d

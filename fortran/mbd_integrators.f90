@@ -256,7 +256,7 @@ contains
       conv = .false.
       dq = zero
       do it = 1, 30
-        call assemble_dense(m, qn, vn, tnew, w%phi, w%nu, w%gam, w%jb, w%jac)
+        call assemble_dense(m, qn, vn, tnew, w%phi, w%nu, w%gam, w%asm, w%jac)
         call gen_forces(m, qn, vn, tnew, w%force, v)
         res(1:n) = m%mdiag * an + matmul(lamn, w%jac) - w%force
         res(n + 1:) = bp * w%phi(w%rows)
@@ -274,7 +274,7 @@ contains
             s(k, k) = m%mdiag(k) * bp
           end do
           s(1:n, 1:n) = s(1:n, 1:n) + gp * ct + kt
-          call assemble_dense(m, qn, vn, tnew, w%phi, w%nu, w%gam, w%jb, w%jac)
+          call assemble_dense(m, qn, vn, tnew, w%phi, w%nu, w%gam, w%asm, w%jac)
           s(1:n, n + 1:) = bp * transpose(w%jac(w%rows, :))
           s(n + 1:, 1:n) = bp * w%jac(w%rows, :)
           call lu_factor(s, piv, stt, lmsg)
@@ -570,7 +570,7 @@ contains
     integer :: piv(w%na), it
     character(len=MSG_LEN) :: lmsg
     do it = 1, 25
-      call assemble_dense(m, c%qf, w%qz, t, w%phi, w%nu, w%gam, w%jb, w%jac)
+      call assemble_dense(m, c%qf, w%qz, t, w%phi, w%nu, w%gam, w%asm, w%jac)
       ju = w%jac(w%rows, c%iu)
       call lu_factor(ju, piv, stf, lmsg)
       if (stf /= MBD_OK) return
@@ -601,7 +601,7 @@ contains
     real(wp), allocatable :: work(:)
     integer :: jp(m%nq), info
     character(len=MSG_LEN) :: lmsg
-    call assemble_dense(m, c%qf, w%qz, t, w%phi, w%nu, w%gam, w%jb, w%jac)
+    call assemble_dense(m, c%qf, w%qz, t, w%phi, w%nu, w%gam, w%asm, w%jac)
     a = w%jac(w%rows, :)
     jp = 0
     call dgeqp3(w%na, m%nq, a, w%na, jp, tau, wq, -1, info)
@@ -623,7 +623,7 @@ contains
     real(wp) :: ju(w%na, w%na), anorm, rc, cw(4 * w%na)
     integer :: piv(w%na), iw(w%na), stf, info
     character(len=MSG_LEN) :: lmsg
-    call assemble_dense(m, c%qf, w%qz, c%t0, w%phi, w%nu, w%gam, w%jb, w%jac)
+    call assemble_dense(m, c%qf, w%qz, c%t0, w%phi, w%nu, w%gam, w%asm, w%jac)
     ju = w%jac(w%rows, c%iu)
     anorm = maxval(sum(abs(ju), dim=1))
     call lu_factor(ju, piv, stf, lmsg)

@@ -13,8 +13,8 @@
 module mbd_joint_cam
   use mbd_kinds, only: wp, zero, two, pi
   use mbd_status, only: MBD_OK, MBD_BAD_PARAM, MSG_LEN
-  use mbd_points, only: NLOC, kvec, body_point, body_vector, curve_point, curve_vector, &
-                        vsub, vdot, put_vec, put_scal
+  use mbd_points, only: NLOC, MAXROW, kloc, local_state, kvec, body_point, body_vector, &
+                        curve_point, curve_vector, vsub, vdot, put_vec, put_scal
   use mbd_profiles, only: profile_raw_length, profile_prepare, profile_eval, profile_normal, &
                           profile_check
   implicit none
@@ -91,26 +91,25 @@ contains
   end subroutine contact_curve
 
   !> Rows of Phi, J (local block) and gamma.
-  pure subroutine cam_eval(prof, fol, p, si, sj, ql, qdl, phi, jl, gam)
+  pure subroutine cam_eval(prof, fol, p, si, sj, x, phi, jl, gam)
     integer, intent(in) :: prof, fol        !! profile and follower kinds
     real(wp), intent(in) :: p(:)            !! prepared parameters
     integer, intent(in) :: si, sj           !! slot ids of cam and follower bodies
-    real(wp), intent(in) :: ql(NLOC)        !! local coordinates (alpha in slot 7)
-    real(wp), intent(in) :: qdl(NLOC)       !! local velocities
-    real(wp), intent(inout) :: phi(:)       !! 2 rows of Phi
-    real(wp), intent(inout) :: jl(:, :)     !! 2 x NLOC block of J
-    real(wp), intent(inout) :: gam(:)       !! 2 rows of gamma
+    type(kloc), intent(in) :: x             !! local state
+    real(wp), intent(inout) :: phi(MAXROW)  !! rows of Phi (2 written)
+    real(wp), intent(inout) :: jl(MAXROW, NLOC)  !! local block of J (2 rows written)
+    real(wp), intent(inout) :: gam(MAXROW)  !! rows of gamma (2 written)
     real(wp) :: c0(2), c1(2), c2(2), c3(2)
     type(kvec) :: cp, m
-    call contact_curve(prof, fol, p, ql(ALPHA_SLOT), c0, c1, c2, c3)
-    cp = curve_point(ql, qdl, si, ALPHA_SLOT, c0, c1, c2)
+    call contact_curve(prof, fol, p, x%q(ALPHA_SLOT), c0, c1, c2, c3)
+    cp = curve_point(x, si, ALPHA_SLOT, c0, c1, c2)
     if (fol == FOL_FLAT) then
-      m = body_vector(ql, qdl, sj, p(3:4))
-      call put_scal(vdot(m, vsub(cp, body_point(ql, qdl, sj, p(1:2)))), phi(1), jl(1, :), gam(1))
-      call put_scal(vdot(m, curve_vector(ql, qdl, si, ALPHA_SLOT, c1, c2, c3)), &
+      m = body_vector(x, sj, p(3:4))
+      call put_scal(vdot(m, vsub(cp, body_point(x, sj, p(1:2)))), phi(1), jl(1, :), gam(1))
+      call put_scal(vdot(m, curve_vector(x, si, ALPHA_SLOT, c1, c2, c3)), &
                     phi(2), jl(2, :), gam(2))
     else
-      call put_vec(vsub(cp, body_point(ql, qdl, sj, p(1:2))), phi, jl, gam)
+      call put_vec(vsub(cp, body_point(x, sj, p(1:2))), phi, jl, gam)
     end if
   end subroutine cam_eval
 
@@ -124,15 +123,17 @@ contains
     real(wp), intent(in) :: ql(NLOC)        !! local coordinates
     real(wp) :: qz(NLOC), a, best, val, c0(2), c1(2), c2(2), c3(2), fpt(2), mv(2)
     type(kvec) :: cp, fk
+    type(kloc) :: x
     integer :: k
     qz = zero
-    fk = body_point(ql, qz, sj, p(1:2)); fpt = fk%v
-    fk = body_vector(ql, qz, sj, p(3:4)); mv = fk%v
+    x = local_state(ql, qz)
+    fk = body_point(x, sj, p(1:2)); fpt = fk%v
+    fk = body_vector(x, sj, p(3:4)); mv = fk%v
     alpha = zero; best = huge(1.0_wp)
     do k = 0, NSAMPLE - 1
       a = two * pi * k / NSAMPLE
       call contact_curve(prof, fol, p, a, c0, c1, c2, c3)
-      cp = curve_point(ql, qz, si, 0, c0, c1, c2)
+      cp = curve_point(x, si, 0, c0, c1, c2)
       if (fol == FOL_FLAT) then
         val = dot_product(mv, cp%v)
       else

@@ -6,7 +6,7 @@
 module mbd_joint_distance
   use mbd_kinds, only: wp, zero
   use mbd_status, only: MBD_OK, MBD_BAD_PARAM, MSG_LEN
-  use mbd_points, only: NLOC, kvec, body_point, vsub, vdot, sconst, ssub, put_scal
+  use mbd_points, only: NLOC, MAXROW, kloc, kvec, body_point, vsub, vdot, sconst, ssub, put_scal
   implicit none
   private
   public :: distance_prepare, distance_eval
@@ -27,13 +27,13 @@ contains
   end subroutine distance_prepare
 
   !> Row of Phi, J (local block) and gamma.
-  pure subroutine distance_eval(p, si, sj, ql, qdl, phi, jl, gam)
+  pure subroutine distance_eval(p, si, sj, x, phi, jl, gam)
     real(wp), intent(in) :: p(:)            !! prepared parameters
     integer, intent(in) :: si, sj           !! slot ids of the two bodies (0 = ground)
-    real(wp), intent(in) :: ql(NLOC), qdl(NLOC)  !! local coordinates and velocities
-    real(wp), intent(inout) :: phi(:), jl(:, :), gam(:)  !! 1 row
+    type(kloc), intent(in) :: x             !! local state
+    real(wp), intent(inout) :: phi(MAXROW), jl(MAXROW, NLOC), gam(MAXROW)  !! 1 row written
     type(kvec) :: d
-    d = vsub(body_point(ql, qdl, sj, p(3:4)), body_point(ql, qdl, si, p(1:2)))
+    d = vsub(body_point(x, sj, p(3:4)), body_point(x, si, p(1:2)))
     call put_scal(ssub(vdot(d, d), sconst(p(5)**2)), phi(1), jl(1, :), gam(1))
   end subroutine distance_eval
 

@@ -11,7 +11,8 @@
 module mbd_joint_gear
   use mbd_kinds, only: wp, zero
   use mbd_status, only: MBD_OK, MBD_BAD_PARAM, MSG_LEN
-  use mbd_points, only: NLOC, kscal, body_angle, slot_value, ssub, sadd, sscale, sconst, put_scal
+  use mbd_points, only: NLOC, MAXROW, kloc, kscal, body_angle, slot_value, ssub, sadd, sscale, &
+                        sconst, put_scal
   implicit none
   private
   public :: GEAR_EXTERNAL, GEAR_INTERNAL, CARRIER_SLOT, gear_prepare, gear_eval
@@ -44,17 +45,17 @@ contains
   end subroutine gear_prepare
 
   !> Row of Phi, J (local block) and gamma.
-  pure subroutine gear_eval(kind, p, si, sj, ql, qdl, phi, jl, gam)
+  pure subroutine gear_eval(kind, p, si, sj, x, phi, jl, gam)
     integer, intent(in) :: kind             !! GEAR_EXTERNAL or GEAR_INTERNAL
     real(wp), intent(in) :: p(:)            !! prepared parameters
     integer, intent(in) :: si, sj           !! slot ids of the gears
-    real(wp), intent(in) :: ql(NLOC), qdl(NLOC)  !! local coordinates (carrier angle in slot 7)
-    real(wp), intent(inout) :: phi(:), jl(:, :), gam(:)  !! 1 row
+    type(kloc), intent(in) :: x             !! local state
+    real(wp), intent(inout) :: phi(MAXROW), jl(MAXROW, NLOC), gam(MAXROW)  !! 1 row written
     type(kscal) :: ai, aj, c
     real(wp) :: sgn
-    c = slot_value(ql, qdl, CARRIER_SLOT)
-    ai = ssub(body_angle(ql, qdl, si), c)
-    aj = ssub(body_angle(ql, qdl, sj), c)
+    c = slot_value(x, CARRIER_SLOT)
+    ai = ssub(body_angle(x, si), c)
+    aj = ssub(body_angle(x, sj), c)
     sgn = 1.0_wp
     if (kind == GEAR_INTERNAL) sgn = -1.0_wp
     call put_scal(ssub(sadd(sscale(p(1), ai), sscale(sgn * p(2), aj)), sconst(p(3))), &

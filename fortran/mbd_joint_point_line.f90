@@ -8,7 +8,8 @@
 module mbd_joint_point_line
   use mbd_kinds, only: wp, zero
   use mbd_status, only: MBD_OK, MBD_BAD_PARAM, MSG_LEN
-  use mbd_points, only: NLOC, body_point, body_vector, vsub, vdot, ssub, sconst, put_scal, perp
+  use mbd_points, only: NLOC, MAXROW, kloc, body_point, body_vector, vsub, vdot, ssub, sconst, &
+                        put_scal, perp
   implicit none
   private
   public :: point_line_prepare, point_line_eval
@@ -31,13 +32,13 @@ contains
   end subroutine point_line_prepare
 
   !> Row of Phi, J (local block) and gamma.
-  pure subroutine point_line_eval(p, si, sj, ql, qdl, phi, jl, gam)
+  pure subroutine point_line_eval(p, si, sj, x, phi, jl, gam)
     real(wp), intent(in) :: p(:)            !! prepared parameters
     integer, intent(in) :: si, sj           !! slot ids (i carries the line)
-    real(wp), intent(in) :: ql(NLOC), qdl(NLOC)  !! local coordinates and velocities
-    real(wp), intent(inout) :: phi(:), jl(:, :), gam(:)  !! 1 row
-    call put_scal(ssub(vdot(body_vector(ql, qdl, si, p(5:6)), &
-                            vsub(body_point(ql, qdl, sj, p(3:4)), body_point(ql, qdl, si, p(1:2)))), &
+    type(kloc), intent(in) :: x             !! local state
+    real(wp), intent(inout) :: phi(MAXROW), jl(MAXROW, NLOC), gam(MAXROW)  !! 1 row written
+    call put_scal(ssub(vdot(body_vector(x, si, p(5:6)), &
+                            vsub(body_point(x, sj, p(3:4)), body_point(x, si, p(1:2)))), &
                        sconst(p(7))), phi(1), jl(1, :), gam(1))
   end subroutine point_line_eval
 

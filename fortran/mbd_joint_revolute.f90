@@ -5,9 +5,9 @@
 !! gamma = A_i s'_i thd_i**2 - A_j s'_j thd_j**2                    (Haug 3.3; the seed lesson)
 !! Raw parameters: [s'_i(2), s'_j(2)] (a ground point is global).
 module mbd_joint_revolute
-  use mbd_kinds, only: wp
+  use mbd_kinds, only: wp, zero, one
   use mbd_status, only: MBD_OK, MSG_LEN
-  use mbd_points, only: NLOC, kvec, body_point, vsub, put_vec
+  use mbd_points, only: NLOC, MAXROW, kloc, point_terms
   implicit none
   private
   public :: revolute_prepare, revolute_eval
@@ -24,17 +24,29 @@ contains
     prep = raw(1:4)
   end subroutine revolute_prepare
 
-  !> Rows of Phi, J (local block) and gamma.
-  pure subroutine revolute_eval(p, si, sj, ql, qdl, phi, jl, gam)
+  !> Rows of Phi, J (local block) and gamma, from the two points' terms.
+  pure subroutine revolute_eval(p, si, sj, x, phi, jl, gam)
     real(wp), intent(in) :: p(:)            !! prepared parameters
     integer, intent(in) :: si, sj           !! slot ids of the two bodies (0 = ground)
-    real(wp), intent(in) :: ql(NLOC)        !! local coordinates
-    real(wp), intent(in) :: qdl(NLOC)       !! local velocities
-    real(wp), intent(inout) :: phi(:)       !! 2 rows of Phi
-    real(wp), intent(inout) :: jl(:, :)     !! 2 x NLOC block of J
-    real(wp), intent(inout) :: gam(:)       !! 2 rows of gamma
-    call put_vec(vsub(body_point(ql, qdl, si, p(1:2)), body_point(ql, qdl, sj, p(3:4))), &
-                 phi, jl, gam)
+    type(kloc), intent(in) :: x             !! local state
+    real(wp), intent(inout) :: phi(MAXROW)  !! rows of Phi (2 written)
+    real(wp), intent(inout) :: jl(MAXROW, NLOC)  !! local block of J (2 rows written)
+    real(wp), intent(inout) :: gam(MAXROW)  !! rows of gamma (2 written)
+    real(wp) :: pi(2), bi(2), vi(2), ai(2), pj(2), bj(2), vj(2), aj(2)
+    integer :: c
+    call point_terms(x, si, p(1:2), pi, bi, vi, ai)
+    call point_terms(x, sj, p(3:4), pj, bj, vj, aj)
+    phi(1:2) = pi - pj                                 ! Phi = P_i - P_j
+    jl(1:2, :) = zero                                  ! J = [I, B_i s'_i, -I, -B_j s'_j]
+    if (si > 0) then
+      c = 3 * (si - 1)
+      jl(1, c + 1) = one; jl(2, c + 2) = one; jl(1:2, c + 3) = bi
+    end if
+    if (sj > 0) then
+      c = 3 * (sj - 1)
+      jl(1, c + 1) = -one; jl(2, c + 2) = -one; jl(1:2, c + 3) = -bj
+    end if
+    gam(1:2) = aj - ai                      ! gamma = A_i s'_i thd_i**2 - A_j s'_j thd_j**2
   end subroutine revolute_eval
 
 end module mbd_joint_revolute

@@ -14,8 +14,8 @@
 module mbd_joint_rolling
   use mbd_kinds, only: wp, zero, one
   use mbd_status, only: MBD_OK, MBD_BAD_PARAM, MSG_LEN
-  use mbd_points, only: NLOC, kvec, kscal, body_point, body_vector, body_angle, vsub, vdot, &
-                        vcross, ssub, sadd, sscale, sconst, put_scal
+  use mbd_points, only: NLOC, MAXROW, kloc, kvec, kscal, body_point, body_vector, body_angle, &
+                        vsub, vdot, vcross, ssub, sadd, sscale, sconst, put_scal
   implicit none
   private
   public :: rolling_prepare, rolling_eval
@@ -41,20 +41,20 @@ contains
   end subroutine rolling_prepare
 
   !> Rows of Phi, J (local block) and gamma: the no-slip row, then (contact) the contact row.
-  pure subroutine rolling_eval(contact, p, si, sj, ql, qdl, phi, jl, gam)
+  pure subroutine rolling_eval(contact, p, si, sj, x, phi, jl, gam)
     logical, intent(in) :: contact          !! add the contact row (rolling disc)
     real(wp), intent(in) :: p(:)            !! prepared parameters
     integer, intent(in) :: si, sj           !! slot ids: circle body, line body
-    real(wp), intent(in) :: ql(NLOC), qdl(NLOC)  !! local coordinates and velocities
-    real(wp), intent(inout) :: phi(:), jl(:, :), gam(:)  !! 1 or 2 rows
+    type(kloc), intent(in) :: x             !! local state
+    real(wp), intent(inout) :: phi(MAXROW), jl(MAXROW, NLOC), gam(MAXROW)  !! 1 or 2 rows written
     type(kvec) :: u, d
     type(kscal) :: e, rel
     real(wp) :: sgn
-    u = body_vector(ql, qdl, sj, p(5:6))
-    d = vsub(body_point(ql, qdl, si, p(1:2)), body_point(ql, qdl, sj, p(3:4)))
+    u = body_vector(x, sj, p(5:6))
+    d = vsub(body_point(x, si, p(1:2)), body_point(x, sj, p(3:4)))
     e = vcross(u, d)                       ! h . d with h = perp(U)
     sgn = merge(-one, one, e%v < zero)
-    rel = ssub(body_angle(ql, qdl, si), body_angle(ql, qdl, sj))
+    rel = ssub(body_angle(x, si), body_angle(x, sj))
     call put_scal(ssub(sadd(vdot(u, d), sscale(sgn * p(7), rel)), sconst(p(8))), &
                   phi(1), jl(1, :), gam(1))
     if (contact) call put_scal(ssub(sscale(sgn, e), sconst(p(7))), phi(2), jl(2, :), gam(2))

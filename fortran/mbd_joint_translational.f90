@@ -11,8 +11,8 @@
 module mbd_joint_translational
   use mbd_kinds, only: wp, zero
   use mbd_status, only: MBD_OK, MBD_BAD_PARAM, MSG_LEN
-  use mbd_points, only: NLOC, kscal, body_point, body_vector, body_angle, vsub, vdot, ssub, &
-                        sconst, put_scal, perp
+  use mbd_points, only: NLOC, MAXROW, kloc, kscal, body_point, body_vector, body_angle, vsub, &
+                        vdot, ssub, sconst, put_scal, perp
   implicit none
   private
   public :: translational_prepare, translational_eval, slide_distance
@@ -36,36 +36,35 @@ contains
   end subroutine translational_prepare
 
   !> The slide s = (P_j - P_i) . A_i u'_i along the axis (used by the distance driver).
-  pure function slide_distance(p, si, sj, ql, qdl) result(s)
+  pure function slide_distance(p, si, sj, x) result(s)
     real(wp), intent(in) :: p(:)            !! prepared parameters
     integer, intent(in) :: si, sj           !! slot ids of the two bodies
-    real(wp), intent(in) :: ql(NLOC), qdl(NLOC)  !! local coordinates and velocities
+    type(kloc), intent(in) :: x             !! local state
     type(kscal) :: s
-    s = relative_along(p, p(5:6), si, sj, ql, qdl)
+    s = relative_along(p, p(5:6), si, sj, x)
   end function slide_distance
 
   !> (P_j - P_i) . A_i u' for a direction u' fixed in body i.
-  pure function relative_along(p, u, si, sj, ql, qdl) result(s)
+  pure function relative_along(p, u, si, sj, x) result(s)
     real(wp), intent(in) :: p(:), u(2)
     integer, intent(in) :: si, sj
-    real(wp), intent(in) :: ql(NLOC), qdl(NLOC)
+    type(kloc), intent(in) :: x
     type(kscal) :: s
-    s = vdot(body_vector(ql, qdl, si, u), &
-             vsub(body_point(ql, qdl, sj, p(3:4)), body_point(ql, qdl, si, p(1:2))))
+    s = vdot(body_vector(x, si, u), &
+             vsub(body_point(x, sj, p(3:4)), body_point(x, si, p(1:2))))
   end function relative_along
 
   !> Rows of Phi, J (local block) and gamma.
-  pure subroutine translational_eval(p, si, sj, ql, qdl, phi, jl, gam)
+  pure subroutine translational_eval(p, si, sj, x, phi, jl, gam)
     real(wp), intent(in) :: p(:)            !! prepared parameters
     integer, intent(in) :: si, sj           !! slot ids of the two bodies (0 = ground)
-    real(wp), intent(in) :: ql(NLOC)        !! local coordinates
-    real(wp), intent(in) :: qdl(NLOC)       !! local velocities
-    real(wp), intent(inout) :: phi(:)       !! 2 rows of Phi
-    real(wp), intent(inout) :: jl(:, :)     !! 2 x NLOC block of J
-    real(wp), intent(inout) :: gam(:)       !! 2 rows of gamma
+    type(kloc), intent(in) :: x             !! local state
+    real(wp), intent(inout) :: phi(MAXROW)  !! rows of Phi (2 written)
+    real(wp), intent(inout) :: jl(MAXROW, NLOC)  !! local block of J (2 rows written)
+    real(wp), intent(inout) :: gam(MAXROW)  !! rows of gamma (2 written)
     type(kscal) :: s1, s2
-    s1 = relative_along(p, p(7:8), si, sj, ql, qdl)
-    s2 = ssub(ssub(body_angle(ql, qdl, sj), body_angle(ql, qdl, si)), sconst(p(9)))
+    s1 = relative_along(p, p(7:8), si, sj, x)
+    s2 = ssub(ssub(body_angle(x, sj), body_angle(x, si)), sconst(p(9)))
     call put_scal(s1, phi(1), jl(1, :), gam(1))
     call put_scal(s2, phi(2), jl(2, :), gam(2))
   end subroutine translational_eval

@@ -6,7 +6,7 @@
 module mbd_joint_weld
   use mbd_kinds, only: wp
   use mbd_status, only: MBD_OK, MSG_LEN
-  use mbd_points, only: NLOC, body_angle, ssub, sconst, put_scal
+  use mbd_points, only: NLOC, MAXROW, kloc, body_angle, ssub, sconst, put_scal
   use mbd_joint_revolute, only: revolute_eval
   implicit none
   private
@@ -25,13 +25,13 @@ contains
   end subroutine weld_prepare
 
   !> Rows of Phi, J (local block) and gamma.
-  pure subroutine weld_eval(p, si, sj, ql, qdl, phi, jl, gam)
+  pure subroutine weld_eval(p, si, sj, x, phi, jl, gam)
     real(wp), intent(in) :: p(:)            !! prepared parameters
     integer, intent(in) :: si, sj           !! slot ids
-    real(wp), intent(in) :: ql(NLOC), qdl(NLOC)  !! local coordinates and velocities
-    real(wp), intent(inout) :: phi(:), jl(:, :), gam(:)  !! 3 rows
-    call revolute_eval(p(1:4), si, sj, ql, qdl, phi(1:2), jl(1:2, :), gam(1:2))
-    call put_scal(ssub(ssub(body_angle(ql, qdl, sj), body_angle(ql, qdl, si)), sconst(p(5))), &
+    type(kloc), intent(in) :: x             !! local state
+    real(wp), intent(inout) :: phi(MAXROW), jl(MAXROW, NLOC), gam(MAXROW)  !! 3 rows written
+    call revolute_eval(p(1:4), si, sj, x, phi, jl, gam)
+    call put_scal(ssub(ssub(body_angle(x, sj), body_angle(x, si)), sconst(p(5))), &
                   phi(3), jl(3, :), gam(3))
   end subroutine weld_eval
 

@@ -32,7 +32,7 @@ module mbd_kinematics
   use mbd_points, only: NLOC, MAXROW
   use mbd_model, only: model_t
   use mbd_constraints, only: con_is_driver, con_name
-  use mbd_assemble, only: assemble_blocks, assemble_dense, init_extras
+  use mbd_assemble, only: asm_work_t, asm_init, assemble_blocks, assemble_dense, init_extras
   use mbd_linsolve, only: lu_factor, lu_solve, lu_det_sign, svd_null, row_rank, qr_factor, &
                           qr_solve, qr_lwork
   use mbd_lapack, only: dgels, dgecon, dtrcon
@@ -66,7 +66,8 @@ module mbd_kinematics
 
   !> Work arrays, allocated once per analysis.
   type :: kin_work_t
-    real(wp), allocatable :: phi(:), nu(:), gam(:), jac(:, :), jb(:, :, :), qz(:)
+    real(wp), allocatable :: phi(:), nu(:), gam(:), jac(:, :), qz(:)
+    type(asm_work_t) :: asm         !! assembly work arrays
     real(wp), allocatable :: rhs(:), dq(:), tau(:), qrwork(:)
     real(wp), allocatable :: cs(:)  !! column scale of J (1/|J_k| at assembly)
     real(wp), allocatable :: cwork(:)   !! dgecon / dtrcon workspace (4 n)
@@ -109,9 +110,10 @@ contains
     integer :: nr
     nr = max(m%neq, m%nq)
     allocate (w%phi(m%neq), w%nu(m%neq), w%gam(m%neq), w%jac(m%neq, m%nq), &
-              w%jb(MAXROW, NLOC, m%nc), w%qz(m%nq), w%ipiv(m%nq), w%rhs(nr), w%dq(m%nq), &
+              w%qz(m%nq), w%ipiv(m%nq), w%rhs(nr), w%dq(m%nq), &
               w%tau(m%nq), w%jpvt(m%nq), w%qrwork(qr_lwork(m%neq, m%nq)), w%cs(m%nq), &
               w%cwork(4 * m%nq), w%iwork(m%nq))
+    call asm_init(m, w%asm)
     w%qz = zero
     w%cs = one
   end subroutine kin_work_init
@@ -121,14 +123,18 @@ contains
     type(kin_work_t), intent(inout) :: w   !! work arrays
     integer, intent(out) :: status         !! MBD_OK or MBD_SINGULAR
     character(len=MSG_LEN) :: msg
-    integer :: k, n, info
-    real(wp) :: anorm
+    integer :: i, k, n, info
+    real(wp) :: anorm, colsum, umin, umax
     w%lu_count = w%lu_count + 1
     n = size(w%cs)
     anorm = zero
     do k = 1, n
-      w%jac(:, k) = w%jac(:, k) * w%cs(k)
-      anorm = max(anorm, sum(abs(w%jac(:, k))))
+      colsum = zero
+      do i = 1, size(w%jac, 1)
+        w%jac(i, k) = w%jac(i, k) * w%cs(k)
+        colsum = colsum + abs(w%jac(i, k))
+      end do
+      anorm = max(anorm, colsum)
     end do
     w%pivratio = zero
     if (w%lsq) then
@@ -140,7 +146,11 @@ contains
       if (status == MBD_OK) then
         w%detsign = lu_det_sign(w%jac, w%ipiv)
         ! cheap pivot ratio first; the condition estimate only where it may matter
-        w%pivratio = minval([(abs(w%jac(k, k)), k=1, n)]) / maxval([(abs(w%jac(k, k)), k=1, n)])
+        umin = huge(one); umax = zero
+        do k = 1, n
+          umin = min(umin, abs(w%jac(k, k))); umax = max(umax, abs(w%jac(k, k)))
+        end do
+        w%pivratio = umin / umax
         if (w%pivratio < COND_CHECK) call dgecon('1', n, w%jac, n, anorm, w%pivratio, &
                                                  w%cwork, w%iwork, info)
       end if
@@ -180,7 +190,7 @@ contains
     integer :: it
     res0 = huge(one)
     do it = 0, maxit
-      call assemble_dense(m, q, w%qz, t, w%phi, w%nu, w%gam, w%jb, w%jac)
+      call assemble_dense(m, q, w%qz, t, w%phi, w%nu, w%gam, w%asm, w%jac)
       res = maxval(abs(w%phi))
       if (.not. (res <= huge(one))) exit                 ! NaN or overflow
       if (it > 0 .and. res > 1.0e3_wp * res0 .and. res > w%tol) exit   ! diverging
@@ -217,16 +227,16 @@ contains
     if (w%resid > 1.0e-8_wp * (one + maxval(abs(w%nu)))) then
       status = MBD_INCONSISTENT
       if (present(level)) level = 1
-      call assemble_dense(m, q, w%qz, t, w%phi, w%nu, w%gam, w%jb, w%jac)
+      call assemble_dense(m, q, w%qz, t, w%phi, w%nu, w%gam, w%asm, w%jac)
       w%phi = matmul(w%jac, qd) - w%nu
       return
     end if
-    call assemble_blocks(m, q, qd, t, w%phi, w%nu, w%gam, w%jb)
+    call assemble_blocks(m, q, qd, t, w%phi, w%nu, w%gam, w%asm, same_q=.true.)
     call solve(w, w%gam, qdd)
     if (w%resid > 1.0e-8_wp * (one + maxval(abs(w%gam)))) then
       status = MBD_INCONSISTENT
       if (present(level)) level = 2
-      call assemble_dense(m, q, qd, t, w%phi, w%nu, w%gam, w%jb, w%jac)
+      call assemble_dense(m, q, qd, t, w%phi, w%nu, w%gam, w%asm, w%jac)
       w%phi = matmul(w%jac, qdd) - w%gam
     end if
   end subroutine kin_vel_acc
@@ -258,7 +268,7 @@ contains
     call dgels('N', neq + n, n, 1, aug, neq + n, rhs, neq + n, wq, -1, info)
     lwork = max(1, int(wq(1)))
     allocate (work(lwork))
-    call assemble_dense(m, q, w%qz, t, w%phi, w%nu, w%gam, w%jb, w%jac)
+    call assemble_dense(m, q, w%qz, t, w%phi, w%nu, w%gam, w%asm, w%jac)
     f = norm2(w%phi)
     dmax = zero
     do k = 1, n
@@ -278,13 +288,13 @@ contains
         mu = mu * 10.0_wp; cycle
       end if
       qt = q + rhs(1:n)
-      call assemble_dense(m, qt, w%qz, t, phit, w%nu, w%gam, w%jb, w%jac)
+      call assemble_dense(m, qt, w%qz, t, phit, w%nu, w%gam, w%asm, w%jac)
       ft = norm2(phit)
       if (ft < f) then
         q = qt; f = ft; w%phi = phit
         mu = max(mu / 10.0_wp, 1.0e-20_wp * max(dmax, one))
       else
-        call assemble_dense(m, q, w%qz, t, w%phi, w%nu, w%gam, w%jb, w%jac)
+        call assemble_dense(m, q, w%qz, t, w%phi, w%nu, w%gam, w%asm, w%jac)
         mu = mu * 10.0_wp
         if (mu > 1.0e20_wp * max(dmax, one)) exit
       end if
@@ -327,7 +337,7 @@ contains
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
     integer, allocatable :: flags(:), krows(:)
     integer :: r, nk, rk
-    call assemble_dense(m, q, w%qz, t, w%phi, w%nu, w%gam, w%jb, w%jac)
+    call assemble_dense(m, q, w%qz, t, w%phi, w%nu, w%gam, w%asm, w%jac)
     call row_rank(w%jac, rank, redundant, status, msg)
     if (status /= MBD_OK) return
     krows = pack([(r, r=1, m%neq)], [(.not. con_is_driver(m%kind(m%con_of_row(r))), r=1, m%neq)])
@@ -356,7 +366,7 @@ contains
     integer :: r, k
     character(len=MSG_LEN) :: rows
     allocate (sv(min(m%neq, m%nq)), u(m%neq), v(m%nq))
-    call assemble_dense(m, q, w%qz, t, w%phi, w%nu, w%gam, w%jb, w%jac)
+    call assemble_dense(m, q, w%qz, t, w%phi, w%nu, w%gam, w%asm, w%jac)
     ! columns to unit length, so lengths and angles weigh alike: J D, D = diag(1/|J_k|)
     do k = 1, m%nq
       umax = norm2(w%jac(:, k))
@@ -436,7 +446,7 @@ contains
       call count_work(); return
     end if
     ! column scale from J at the assembled configuration
-    call assemble_dense(m, q, w%qz, t0, w%phi, w%nu, w%gam, w%jb, w%jac)
+    call assemble_dense(m, q, w%qz, t0, w%phi, w%nu, w%gam, w%asm, w%jac)
     do k = 1, m%nq
       d = norm2(w%jac(:, k))
       if (d > zero) w%cs(k) = one / d
@@ -617,7 +627,7 @@ contains
       integer :: st2
       call solve(w, -w%phi, w%dq)
       qn = qn + w%dq
-      call assemble_dense(m, qn, w%qz, tp, w%phi, w%nu, w%gam, w%jb, w%jac)
+      call assemble_dense(m, qn, w%qz, tp, w%phi, w%nu, w%gam, w%asm, w%jac)
       call factor(w, st2)
       if (st2 /= MBD_OK) w%pivratio = zero
     end subroutine polish

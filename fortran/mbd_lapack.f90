@@ -5,6 +5,7 @@ module mbd_lapack
   private
   public :: dgetrf, dgetf2, dgetrs, dgesvd, dgels, dgelsy, dgtsv, dgeqp3, dormqr, dtrtrs, dgecon, &
             dtrcon, dsyev
+  public :: dgbtrf, dgbtrs, dgbcon, dlacn2
 
   interface
     !> LU factorization with partial pivoting.
@@ -123,5 +124,44 @@ module mbd_lapack
       real(wp), intent(inout) :: dl(*), d(*), du(*), b(ldb, *)
       integer, intent(out) :: info
     end subroutine dgtsv
+  end interface
+  interface
+    !> LU factorization of a band matrix with partial pivoting (ldab >= 2 kl + ku + 1).
+    pure subroutine dgbtrf(m, n, kl, ku, ab, ldab, ipiv, info)
+      import :: wp
+      integer, intent(in) :: m, n, kl, ku, ldab
+      real(wp), intent(inout) :: ab(ldab, *)
+      integer, intent(out) :: ipiv(*)
+      integer, intent(out) :: info
+    end subroutine dgbtrf
+    !> Solve with the band LU factors.
+    pure subroutine dgbtrs(trans, n, kl, ku, nrhs, ab, ldab, ipiv, b, ldb, info)
+      import :: wp
+      character(len=1), intent(in) :: trans
+      integer, intent(in) :: n, kl, ku, nrhs, ldab, ldb
+      real(wp), intent(in) :: ab(ldab, *)
+      integer, intent(in) :: ipiv(*)
+      real(wp), intent(inout) :: b(ldb, *)
+      integer, intent(out) :: info
+    end subroutine dgbtrs
+    !> Reciprocal condition number estimate from band LU factors.
+    pure subroutine dgbcon(norm, n, kl, ku, ab, ldab, ipiv, anorm, rcond, work, iwork, info)
+      import :: wp
+      character(len=1), intent(in) :: norm
+      integer, intent(in) :: n, kl, ku, ldab
+      real(wp), intent(in) :: ab(ldab, *), anorm
+      integer, intent(in) :: ipiv(*)
+      real(wp), intent(out) :: rcond, work(*)
+      integer, intent(out) :: iwork(*), info
+    end subroutine dgbcon
+    !> 1-norm estimate of a matrix known only through products (reverse communication):
+    !! start with kase = 0; while kase /= 0 on return, overwrite x by A x (kase = 1) or
+    !! A^T x (kase = 2) and call again; est is then ||A||_1 (Hager, Higham).
+    pure subroutine dlacn2(n, v, x, isgn, est, kase, isave)
+      import :: wp
+      integer, intent(in) :: n
+      real(wp), intent(inout) :: v(*), x(*), est
+      integer, intent(inout) :: isgn(*), kase, isave(3)
+    end subroutine dlacn2
   end interface
 end module mbd_lapack

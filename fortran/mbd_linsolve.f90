@@ -29,12 +29,14 @@ contains
   !! info < 0: argument -info was illegal (a bug here, reported as MBD_LAPACK);
   !! info > 0 from a factorization: U(info, info) is exactly zero (MBD_SINGULAR);
   !! info > 0 from dgesvd: the SVD did not converge (MBD_LAPACK).
+  !! msg is written only on a failure (it is left as it was on success: no 512-byte fill
+  !! per call in the time loop).
   subroutine lapack_status(routine, info, status, msg)
     character(len=*), intent(in) :: routine      !! LAPACK routine name
     integer, intent(in) :: info                  !! its info
     integer, intent(out) :: status               !! MBD_OK, MBD_SINGULAR or MBD_LAPACK
-    character(len=MSG_LEN), intent(out) :: msg   !! explanation
-    status = MBD_OK; msg = ''
+    character(len=MSG_LEN), intent(inout) :: msg !! explanation (on a failure)
+    status = MBD_OK
     if (info == 0) return
     if (info < 0) then
       status = MBD_LAPACK
@@ -53,7 +55,7 @@ contains
     real(wp), intent(inout) :: a(:, :)          !! square matrix; factors on return
     integer, intent(out) :: ipiv(:)             !! pivot indices
     integer, intent(out) :: status              !! MBD_OK or MBD_SINGULAR
-    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    character(len=MSG_LEN), intent(inout) :: msg  !! explanation (on a failure)
     integer :: n, info
     n = size(a, 1)
     if (n <= SMALL_N) then
@@ -71,7 +73,7 @@ contains
     integer, intent(in) :: ipiv(:)              !! pivots
     real(wp), intent(inout) :: b(:)             !! right-hand side, then solution
     integer, intent(out) :: status              !! MBD_OK
-    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    character(len=MSG_LEN), intent(inout) :: msg  !! explanation (on a failure)
     integer :: n, info
     n = size(a, 1)
     call dgetrs('N', n, 1, a, n, ipiv, b, n, info)
@@ -85,10 +87,12 @@ contains
     integer :: i
     sgn = 1
     do i = 1, size(a, 1)
+      if (.not. abs(a(i, i)) > zero) then
+        sgn = 0; return
+      end if
       if (a(i, i) < zero) sgn = -sgn
       if (ipiv(i) /= i) sgn = -sgn
     end do
-    if (.not. all(abs([(a(i, i), i=1, size(a, 1))]) > zero)) sgn = 0
   end function lu_det_sign
 
   !> Singular values of A (m x n) and the left/right singular vectors of the smallest.

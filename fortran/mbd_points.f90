@@ -13,13 +13,15 @@
 !!   d = [I, B s'],  vd = r_dot + B s' theta_dot,  ar = -A s' theta_dot**2.
 !! A constraint Phi = f(v, ...) then has J = df, gamma = -(ar of Phi) (+ time terms for drivers).
 !! A `kscal` is the same for a scalar. The operations below are the product rules.
+!! A `kloc` is what a constraint reads: its slots' coordinates and velocities and the cosine
+!! and sine of its two bodies' angles, computed once per body and assembly (mbd_assemble).
 module mbd_points
   use mbd_kinds, only: wp, zero, one, two, half
   implicit none
   private
-  public :: NLOC, MAXROW, kvec, kscal
-  public :: rot, drot, perp
-  public :: body_point, body_vector, curve_point, curve_vector, body_angle, slot_value, const_vec
+  public :: NLOC, MAXROW, kvec, kscal, kloc
+  public :: rot, drot, perp, local_state
+  public :: point_terms, body_point, body_vector, curve_point, curve_vector, body_angle, slot_value, const_vec
   public :: vsub, vadd, vscale, vdot, vcross, ssub, sadd, sscale, ssqrt, sconst
   public :: put_vec, put_scal
 
@@ -33,6 +35,14 @@ module mbd_points
     real(wp) :: vd(2) = zero        !! time derivative
     real(wp) :: ar(2) = zero        !! acceleration remainder: v_ddot = d q_ddot + ar
   end type kvec
+
+  !> The local state of a constraint.
+  type :: kloc
+    real(wp) :: q(NLOC) = zero      !! coordinates of the slots
+    real(wp) :: qd(NLOC) = zero     !! velocities of the slots
+    real(wp) :: c(2) = one          !! cos(theta) of the first and second body (ground: 1)
+    real(wp) :: s(2) = zero         !! sin(theta) of the first and second body (ground: 0)
+  end type kloc
 
   !> A scalar quantity and its derivatives.
   type :: kscal
@@ -69,6 +79,15 @@ contains
     w = [-u(2), u(1)]
   end function perp
 
+  !> The local state from slot coordinates and velocities (the angles sit in slots 3 and 6).
+  pure function local_state(ql, qdl) result(x)
+    real(wp), intent(in) :: ql(NLOC)   !! local coordinates
+    real(wp), intent(in) :: qdl(NLOC)  !! local velocities
+    type(kloc) :: x
+    x%q = ql; x%qd = qdl
+    x%c = [cos(ql(3)), cos(ql(6))]; x%s = [sin(ql(3)), sin(ql(6))]
+  end function local_state
+
   !> A constant vector (a point or a direction fixed in ground).
   pure function const_vec(u) result(a)
     real(wp), intent(in) :: u(2)  !! global components
@@ -77,23 +96,22 @@ contains
   end function const_vec
 
   !> Body vector A(theta) u(alpha) with u depending on the extra slot (aslot > 0) or not.
-  !! v = A u, d_theta = B u, d_alpha = A u1,
+  !! v = A u, d_theta = B u = perp(A u), d_alpha = A u1,
   !! ar = -A u thd**2 + 2 B u1 thd ald + A u2 ald**2.
-  pure function curve_vector(ql, qdl, slot, aslot, u, u1, u2) result(a)
-    real(wp), intent(in) :: ql(NLOC)   !! local coordinates
-    real(wp), intent(in) :: qdl(NLOC)  !! local velocities
+  pure function curve_vector(x, slot, aslot, u, u1, u2) result(a)
+    type(kloc), intent(in) :: x        !! local state
     integer, intent(in) :: slot        !! 0 ground, 1 first body, 2 second body
     integer, intent(in) :: aslot       !! 0, or the slot of the curve parameter
     real(wp), intent(in) :: u(2)       !! vector in the body frame
     real(wp), intent(in) :: u1(2)      !! du/dalpha
     real(wp), intent(in) :: u2(2)      !! d2u/dalpha2
     type(kvec) :: a
-    real(wp) :: am(2, 2), bm(2, 2), thd, ald, au(2), bu(2), au1(2), bu1(2)
+    real(wp) :: cs, sn, thd, ald, au(2), bu(2), au1(2), au2(2)
     integer :: c
     if (slot == 0) then
       a%v = u
       if (aslot > 0) then
-        ald = qdl(aslot)
+        ald = x%qd(aslot)
         a%d(:, aslot) = u1
         a%vd = u1 * ald
         a%ar = u2 * ald**2
@@ -101,25 +119,26 @@ contains
       return
     end if
     c = 3 * (slot - 1)
-    am = rot(ql(c + 3)); bm = drot(ql(c + 3)); thd = qdl(c + 3)
-    au = matmul(am, u); bu = matmul(bm, u)
+    cs = x%c(slot); sn = x%s(slot); thd = x%qd(c + 3)
+    au = [cs * u(1) - sn * u(2), sn * u(1) + cs * u(2)]       ! A u
+    bu = [-au(2), au(1)]                                       ! B u = perp(A u)
     a%v = au
     a%d(:, c + 3) = bu
     a%vd = bu * thd
     a%ar = -au * thd**2
     if (aslot > 0) then
-      ald = qdl(aslot)
-      au1 = matmul(am, u1); bu1 = matmul(bm, u1)
+      ald = x%qd(aslot)
+      au1 = [cs * u1(1) - sn * u1(2), sn * u1(1) + cs * u1(2)]
+      au2 = [cs * u2(1) - sn * u2(2), sn * u2(1) + cs * u2(2)]
       a%d(:, aslot) = au1
       a%vd = a%vd + au1 * ald
-      a%ar = a%ar + two * bu1 * thd * ald + matmul(am, u2) * ald**2
+      a%ar = a%ar + two * [-au1(2), au1(1)] * thd * ald + au2 * ald**2
     end if
   end function curve_vector
 
   !> Body point r + A(theta) s(alpha) on a curve fixed in the body.
-  pure function curve_point(ql, qdl, slot, aslot, s, s1, s2) result(a)
-    real(wp), intent(in) :: ql(NLOC)   !! local coordinates
-    real(wp), intent(in) :: qdl(NLOC)  !! local velocities
+  pure function curve_point(x, slot, aslot, s, s1, s2) result(a)
+    type(kloc), intent(in) :: x        !! local state
     integer, intent(in) :: slot        !! 0 ground, 1 first body, 2 second body
     integer, intent(in) :: aslot       !! slot of the curve parameter
     real(wp), intent(in) :: s(2)       !! point in the body frame
@@ -127,53 +146,89 @@ contains
     real(wp), intent(in) :: s2(2)      !! d2s/dalpha2
     type(kvec) :: a
     integer :: c
-    a = curve_vector(ql, qdl, slot, aslot, s, s1, s2)
+    a = curve_vector(x, slot, aslot, s, s1, s2)
     if (slot == 0) return
     c = 3 * (slot - 1)
-    a%v = a%v + ql(c + 1:c + 2)
+    a%v = a%v + x%q(c + 1:c + 2)
     a%d(1, c + 1) = one; a%d(2, c + 2) = one
-    a%vd = a%vd + qdl(c + 1:c + 2)
+    a%vd = a%vd + x%qd(c + 1:c + 2)
   end function curve_point
 
-  !> Body point P = r + A s':  d = [I, B s'], ar = -A s' thd**2.
-  pure function body_point(ql, qdl, slot, s) result(a)
-    real(wp), intent(in) :: ql(NLOC)   !! local coordinates
-    real(wp), intent(in) :: qdl(NLOC)  !! local velocities
+  !> A body point's terms without the product-rule algebra (the joints that only compare
+  !! points use these): P = r + A s', the theta column of its Jacobian [I, B s'], its
+  !! velocity P_dot = r_dot + B s' thd and its acceleration remainder ar = -A s' thd**2.
+  !! A ground point (slot 0) is the global point s: bs = vd = ar = 0.
+  pure subroutine point_terms(x, slot, s, p, bs, vd, ar)
+    type(kloc), intent(in) :: x        !! local state
+    integer, intent(in) :: slot        !! 0 ground, 1 or 2
+    real(wp), intent(in) :: s(2)       !! point in the body frame (global for ground)
+    real(wp), intent(out) :: p(2)      !! P
+    real(wp), intent(out) :: bs(2)     !! B s' = perp(A s')
+    real(wp), intent(out) :: vd(2)     !! P_dot
+    real(wp), intent(out) :: ar(2)     !! -A s' thd**2
+    real(wp) :: au(2), thd
+    integer :: c
+    if (slot == 0) then
+      p = s; bs = zero; vd = zero; ar = zero
+      return
+    end if
+    c = 3 * (slot - 1)
+    thd = x%qd(c + 3)
+    au = [x%c(slot) * s(1) - x%s(slot) * s(2), x%s(slot) * s(1) + x%c(slot) * s(2)]   ! A s'
+    p = x%q(c + 1:c + 2) + au
+    bs = [-au(2), au(1)]
+    vd = x%qd(c + 1:c + 2) + bs * thd
+    ar = -au * thd**2
+  end subroutine point_terms
+
+  !> Body point P = r + A s':  d = [I, B s'], vd = r_dot + B s' thd, ar = -A s' thd**2.
+  pure function body_point(x, slot, s) result(a)
+    type(kloc), intent(in) :: x        !! local state
     integer, intent(in) :: slot        !! 0 ground (s is global), 1 or 2
     real(wp), intent(in) :: s(2)       !! point in the body frame
     type(kvec) :: a
-    a = curve_point(ql, qdl, slot, 0, s, [zero, zero], [zero, zero])
+    real(wp) :: au(2), thd
+    integer :: c
+    if (slot == 0) then
+      a%v = s
+      return
+    end if
+    c = 3 * (slot - 1)
+    thd = x%qd(c + 3)
+    au = [x%c(slot) * s(1) - x%s(slot) * s(2), x%s(slot) * s(1) + x%c(slot) * s(2)]   ! A s'
+    a%v = x%q(c + 1:c + 2) + au
+    a%d(1, c + 1) = one; a%d(2, c + 2) = one
+    a%d(1, c + 3) = -au(2); a%d(2, c + 3) = au(1)                ! B s' = perp(A s')
+    a%vd = x%qd(c + 1:c + 2) + [-au(2), au(1)] * thd
+    a%ar = -au * thd**2
   end function body_point
 
   !> Body-fixed direction u = A u':  d_theta = B u', ar = -A u' thd**2.
-  pure function body_vector(ql, qdl, slot, u) result(a)
-    real(wp), intent(in) :: ql(NLOC)   !! local coordinates
-    real(wp), intent(in) :: qdl(NLOC)  !! local velocities
+  pure function body_vector(x, slot, u) result(a)
+    type(kloc), intent(in) :: x        !! local state
     integer, intent(in) :: slot        !! 0 ground, 1 or 2
     real(wp), intent(in) :: u(2)       !! vector in the body frame
     type(kvec) :: a
-    a = curve_vector(ql, qdl, slot, 0, u, [zero, zero], [zero, zero])
+    a = curve_vector(x, slot, 0, u, [zero, zero], [zero, zero])
   end function body_vector
 
   !> The absolute angle theta of a body (zero for ground).
-  pure function body_angle(ql, qdl, slot) result(a)
-    real(wp), intent(in) :: ql(NLOC)   !! local coordinates
-    real(wp), intent(in) :: qdl(NLOC)  !! local velocities
+  pure function body_angle(x, slot) result(a)
+    type(kloc), intent(in) :: x        !! local state
     integer, intent(in) :: slot        !! 0 ground, 1 or 2
     type(kscal) :: a
     integer :: c
     if (slot == 0) return
     c = 3 * (slot - 1)
-    a%v = ql(c + 3); a%d(c + 3) = one; a%vd = qdl(c + 3)
+    a%v = x%q(c + 3); a%d(c + 3) = one; a%vd = x%qd(c + 3)
   end function body_angle
 
   !> A local coordinate as a scalar quantity (0 when the slot maps to nothing).
-  pure function slot_value(ql, qdl, s) result(a)
-    real(wp), intent(in) :: ql(NLOC)   !! local coordinates
-    real(wp), intent(in) :: qdl(NLOC)  !! local velocities
+  pure function slot_value(x, s) result(a)
+    type(kloc), intent(in) :: x        !! local state
     integer, intent(in) :: s           !! slot
     type(kscal) :: a
-    a%v = ql(s); a%d(s) = one; a%vd = qdl(s)
+    a%v = x%q(s); a%d(s) = one; a%vd = x%qd(s)
   end function slot_value
 
   !> a - b.

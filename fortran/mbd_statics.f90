@@ -118,7 +118,7 @@ contains
       real(wp) :: ja(w%na, m%nq), sv(min(w%na, m%nq)), u(1, 1), vt(m%nq, m%nq), wq(1), v
       real(wp), allocatable :: work(:)
       integer :: info, rk
-      call assemble_dense(m, q, w%qz, t, w%phi, w%nu, w%gam, w%jb, w%jac)
+      call assemble_dense(m, q, w%qz, t, w%phi, w%nu, w%gam, w%asm, w%jac)
       call gen_forces(m, q, w%qz, t, w%force, v)
       ja = w%jac(w%rows, :)
       call dgesvd('N', 'A', w%na, m%nq, ja, w%na, sv, u, 1, vt, m%nq, wq, -1, info)
