@@ -19,7 +19,8 @@ module mbd_api
   use mbd_statics, only: statics_solve
   use mbd_assemble, only: assemble_dense, asm_work_t, asm_init
   use mbd_kinematics, only: kin_opts_t, kin_report_t, kin_work_t, kin_run, kin_work_init, &
-                            kin_assemble, kin_rank, MAXPASS
+                            kin_assemble, kin_rank, kin_out_count, MAXPASS, SOLVER_AUTO, &
+                            SOLVER_BANDED
   use mbd_status, only: MBD_BAD_SETTING
   use mbd_profiles, only: profile_raw_length, profile_prepare, profile_eval
   implicit none
@@ -108,9 +109,9 @@ contains
   end subroutine api_eval
 
   !> Kinematic analysis: the whole time loop in one call.
-  subroutine api_kinematics(nb, ctab, rpar, q0, t0, t1, nsteps, tol, maxit, tmin, &
-                            qout, qdout, qddout, iinfo, rinfo, qsing, dep, redundant, tpass, &
-                            status, msg)
+  subroutine api_kinematics(nb, ctab, rpar, q0, t0, t1, nsteps, tol, maxit, tmin, every, &
+                            solver, qout, qdout, qddout, iinfo, rinfo, qsing, dep, redundant, &
+                            tpass, status, msg)
     integer, intent(in) :: nb                   !! moving bodies
     integer, intent(in) :: ctab(:, :)           !! constraint table
     real(wp), intent(in) :: rpar(:)             !! raw parameters
@@ -120,7 +121,10 @@ contains
     real(wp), intent(in) :: tol                 !! Newton tolerance (<= 0: default)
     integer, intent(in) :: maxit                !! Newton iterations (<= 0: default)
     real(wp), intent(in) :: tmin                !! singular-time resolution (<= 0: default)
-    real(wp), intent(out) :: qout(:, :), qdout(:, :), qddout(:, :)  !! (nq, nsteps + 1)
+    integer, intent(in) :: every                !! store every k-th output (and the last)
+    integer, intent(in) :: solver               !! 0 auto, 1 dense, 2 banded LU
+    !> outputs (nq, kin_out_count(nsteps, every))
+    real(wp), intent(out) :: qout(:, :), qdout(:, :), qddout(:, :)
     integer, intent(out) :: iinfo(NINFO)        !! integer report
     real(wp), intent(out) :: rinfo(NINFO)       !! real report
     real(wp), intent(out) :: qsing(:)           !! configuration at a singularity (nq)
@@ -153,9 +157,14 @@ contains
     end if
     if (size(q0) /= m%nq .or. size(qsing) /= m%nq .or. size(dep) /= m%neq .or. &
         size(redundant) /= m%neq .or. size(tpass) /= MAXPASS .or. &
-        size(qout, 1) /= m%nq .or. size(qout, 2) /= nsteps + 1) then
+        size(qout, 1) /= m%nq .or. size(qout, 2) /= kin_out_count(nsteps, max(every, 1))) then
       status = MBD_BAD_COUNT; msg = 'array sizes do not match the model'; return
     end if
+    if (every < 1 .or. solver < SOLVER_AUTO .or. solver > SOLVER_BANDED) then
+      status = MBD_BAD_SETTING; msg = 'every must be >= 1 and solver 0 (auto), 1 (dense) '// &
+        'or 2 (banded)'; return
+    end if
+    opts%every = every; opts%solver = solver
     if (tol > zero) opts%tol = tol
     if (maxit > 0) opts%maxit = maxit
     if (tmin > zero) opts%tmin = tmin
@@ -164,6 +173,7 @@ contains
     iinfo(5) = rep%deficiency; iinfo(6) = rep%newton_its; iinfo(7) = rep%lu_count
     iinfo(8) = rep%rejected; iinfo(9) = rep%rank; iinfo(10) = rep%npass
     rinfo(1) = rep%t_fail; rinfo(2) = rep%smin; rinfo(3) = rep%smax; rinfo(4) = rep%resid
+    rinfo(5) = rep%solver; rinfo(6) = rep%kl; rinfo(7) = rep%ku
     if (allocated(rep%qsing)) qsing = rep%qsing
     if (allocated(rep%dep)) dep = rep%dep
     if (allocated(rep%redundant)) redundant = rep%redundant
@@ -303,8 +313,8 @@ contains
       qsing = zero; dep = 0; redundant = 0; tpass = zero
       return
     end if
-    call api_kinematics(nb, ctab, rpar, q0, t0, t1, nsteps, tol, 0, zero, qout, qdout, qddout, &
-                        iinfo, rinfo, qsing, dep, redundant, tpass, status, msg)
+    call api_kinematics(nb, ctab, rpar, q0, t0, t1, nsteps, tol, 0, zero, 1, SOLVER_AUTO, qout, &
+                        qdout, qddout, iinfo, rinfo, qsing, dep, redundant, tpass, status, msg)
     if (iinfo(1) < 1) return
     call dyn_init(m, w, qout(:, 1), t0, 1.0e-12_wp, st, lmsg)
     if (st /= MBD_OK) return

@@ -31,16 +31,15 @@ subroutine core_eval(nb, nc, ctab, np, rpar, nq, neq, q, qd, t, phi, jac, nu, ga
 end subroutine core_eval
 
 subroutine core_kinematics(nb, nc, ctab, np, rpar, nq, neq, q0, t0, t1, nsteps, tol, &
-                           maxit, tmin, qout, qdout, qddout, iinfo, rinfo, qsing, dep, &
-                           redundant, tpass, status, msg)
+                           maxit, tmin, every, solver, nout, qout, qdout, qddout, iinfo, rinfo, &
+                           qsing, dep, redundant, tpass, status, msg)
   use iso_c_binding, only: c_double, c_int
   use mbd_api, only: api_kinematics
   implicit none
-  integer(c_int), intent(in) :: nb, nc, np, nq, neq, nsteps, maxit
+  integer(c_int), intent(in) :: nb, nc, np, nq, neq, nsteps, maxit, every, solver, nout
   integer(c_int), intent(in) :: ctab(8, nc)
   real(c_double), intent(in) :: rpar(np), q0(nq), t0, t1, tol, tmin
-  real(c_double), intent(out) :: qout(nq, nsteps + 1), qdout(nq, nsteps + 1)
-  real(c_double), intent(out) :: qddout(nq, nsteps + 1)
+  real(c_double), intent(out) :: qout(nq, nout), qdout(nq, nout), qddout(nq, nout)
   integer(c_int), intent(out) :: iinfo(10)
   real(c_double), intent(out) :: rinfo(10)
   real(c_double), intent(out) :: qsing(nq)
@@ -50,8 +49,9 @@ subroutine core_kinematics(nb, nc, ctab, np, rpar, nq, neq, q0, t0, t1, nsteps, 
   character(len=512), intent(out) :: msg
   !f2py intent(hide) :: nc, np, nq
   !f2py threadsafe
-  call api_kinematics(nb, ctab, rpar, q0, t0, t1, nsteps, tol, maxit, tmin, qout, qdout, &
-                      qddout, iinfo, rinfo, qsing, dep, redundant, tpass, status, msg)
+  call api_kinematics(nb, ctab, rpar, q0, t0, t1, nsteps, tol, maxit, tmin, every, solver, &
+                      qout, qdout, qddout, iinfo, rinfo, qsing, dep, redundant, tpass, &
+                      status, msg)
 end subroutine core_kinematics
 
 subroutine core_analyze(nb, nc, ctab, np, rpar, nq, neq, q0, t, tol, q, rank, mobility, &

@@ -32,7 +32,10 @@ module mbd_kinematics
   use mbd_points, only: NLOC, MAXROW
   use mbd_model, only: model_t
   use mbd_constraints, only: con_is_driver, con_name
-  use mbd_assemble, only: asm_work_t, asm_init, assemble_blocks, assemble_dense, init_extras
+  use mbd_assemble, only: asm_work_t, asm_init, assemble_blocks, assemble_dense, scatter_dense, &
+                          init_extras
+  use mbd_band, only: band_t, band_plan, band_zero, band_norm1, band_factor, &
+                      band_rcond, band_solve
   use mbd_linsolve, only: lu_factor, lu_solve, lu_det_sign, svd_null, row_rank, qr_factor, &
                           qr_solve, qr_lwork
   use mbd_lapack, only: dgels, dgecon, dtrcon
@@ -41,8 +44,9 @@ module mbd_kinematics
   implicit none
   private
   public :: kin_opts_t, kin_work_t, kin_report_t, DEP_TOL, SING_RATIO, MAXPASS
+  public :: SOLVER_AUTO, SOLVER_DENSE, SOLVER_BANDED
   public :: kin_work_init, kin_assemble, kin_rank, kin_newton, kin_vel_acc, kin_run, &
-            kin_singular_report
+            kin_singular_report, kin_out_count
 
   real(wp), parameter :: DEP_TOL = 1.0e-3_wp  !! |u_r| / max|u| above which a row is dependent
   !> sigma_min / sigma_max of the column-scaled J below which a configuration is singular
@@ -55,6 +59,11 @@ module mbd_kinematics
   real(wp), parameter :: VJUMP_RATIO = 0.2_wp   !! largest velocity jump / velocity scale
   integer, parameter :: MAXPASS = 64           !! singular passages recorded
   integer, parameter :: MAX_SUBSTEPS = 100000  !! internal steps allowed per output interval
+  integer, parameter :: SOLVER_AUTO = 0, SOLVER_DENSE = 1, SOLVER_BANDED = 2  !! linear solvers
+  !> auto: banded LU when J is square, n >= BAND_MIN_N and the band (kl + ku + 1) is at most
+  !! n / BAND_RATIO wide
+  integer, parameter :: BAND_MIN_N = 60, BAND_RATIO = 4
+  integer, parameter :: BAND_ASSEMBLY_MAXIT = 50  !! Newton iterations of a banded assembly
 
   !> Settings of a kinematic analysis.
   type :: kin_opts_t
@@ -62,6 +71,8 @@ module mbd_kinematics
     integer :: maxit = 25           !! Newton iterations per step
     real(wp) :: tmin = 1.0e-10_wp   !! time resolution of a singular configuration
     integer :: assembly_maxit = 400 !! damped iterations for the initial assembly
+    integer :: solver = SOLVER_AUTO !! SOLVER_AUTO, SOLVER_DENSE or SOLVER_BANDED
+    integer :: every = 1            !! store every k-th output (and the last)
   end type kin_opts_t
 
   !> Work arrays, allocated once per analysis.
@@ -79,6 +90,9 @@ module mbd_kinematics
     real(wp) :: resid = zero        !! least-squares residual of the last solve
     integer :: newton_its = 0       !! Newton corrections taken
     integer :: lu_count = 0         !! factorizations
+    logical :: banded = .false.     !! J is factored in band storage (w%jac only on demand)
+    type(band_t) :: band            !! band plan, storage and factors
+    real(wp) :: anorm = zero        !! ||J D||_1 of the band matrix before factoring
   end type kin_work_t
 
   !> What happened: counters, redundancy, and the singular or failed configuration.
@@ -95,6 +109,8 @@ module mbd_kinematics
     real(wp) :: resid = zero        !! ||Phi||_inf at a failure
     integer :: newton_its = 0       !! Newton corrections taken
     integer :: lu_count = 0         !! factorizations
+    integer :: solver = SOLVER_DENSE  !! linear solver used
+    integer :: kl = 0, ku = 0       !! band widths (banded solver)
     real(wp) :: tpass(MAXPASS) = zero     !! times of the passages
     real(wp), allocatable :: qsing(:)     !! configuration at a singularity or failure
     integer, allocatable :: dep(:)        !! 1 for each row in the dependent set there
@@ -103,20 +119,98 @@ module mbd_kinematics
 
 contains
 
-  !> Allocate work arrays for model m.
-  subroutine kin_work_init(m, w)
-    type(model_t), intent(in) :: m       !! model
-    type(kin_work_t), intent(out) :: w   !! work arrays
+  !> Allocate work arrays for model m; with a band plan J is kept in band storage and the
+  !! dense J is allocated only when a diagnosis needs it (dense_j).
+  subroutine kin_work_init(m, w, band)
+    type(model_t), intent(in) :: m                 !! model
+    type(kin_work_t), intent(out) :: w             !! work arrays
+    type(band_t), intent(in), optional :: band     !! band plan of J (square J only)
     integer :: nr
     nr = max(m%neq, m%nq)
-    allocate (w%phi(m%neq), w%nu(m%neq), w%gam(m%neq), w%jac(m%neq, m%nq), &
+    allocate (w%phi(m%neq), w%nu(m%neq), w%gam(m%neq), &
               w%qz(m%nq), w%ipiv(m%nq), w%rhs(nr), w%dq(m%nq), &
-              w%tau(m%nq), w%jpvt(m%nq), w%qrwork(qr_lwork(m%neq, m%nq)), w%cs(m%nq), &
-              w%cwork(4 * m%nq), w%iwork(m%nq))
+              w%tau(m%nq), w%jpvt(m%nq), w%cs(m%nq), w%cwork(4 * m%nq), w%iwork(m%nq))
+    if (present(band)) then
+      w%banded = band%n == m%nq .and. m%neq == m%nq
+    end if
+    if (w%banded) then
+      w%band = band
+      allocate (w%qrwork(1))
+    else
+      allocate (w%jac(m%neq, m%nq), w%qrwork(qr_lwork(m%neq, m%nq)))
+    end if
     call asm_init(m, w%asm)
     w%qz = zero
     w%cs = one
   end subroutine kin_work_init
+
+  !> Band plan of J from its structure (the constraint blocks' rows and columns).
+  subroutine kin_band_plan(m, band, status, msg)
+    type(model_t), intent(in) :: m              !! model (square J)
+    type(band_t), intent(out) :: band           !! plan
+    integer, intent(out) :: status              !! MBD_OK or the failure of band_plan
+    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    integer, allocatable :: rows(:), cols(:)
+    integer :: k, s, r, nz
+    nz = 0
+    do k = 1, m%nc
+      nz = nz + m%nrow(k) * count(m%loc(:, k) > 0)
+    end do
+    allocate (rows(nz), cols(nz))
+    nz = 0
+    do k = 1, m%nc
+      do s = 1, NLOC
+        if (m%loc(s, k) == 0) cycle
+        do r = 1, m%nrow(k)
+          nz = nz + 1
+          rows(nz) = m%row0(k) + r - 1; cols(nz) = m%loc(s, k)
+        end do
+      end do
+    end do
+    call band_plan(m%nq, rows, cols, band, status, msg)
+  end subroutine kin_band_plan
+
+  !> Phi, nu, gamma at (q, q_dot, t) and J D in the solver's storage: dense J in w%jac
+  !! (scaled in factor), or J D scattered into the band (D = diag(w%cs)) with its 1-norm.
+  subroutine assemble_j(m, w, q, qd, t)
+    type(model_t), intent(in) :: m          !! model
+    type(kin_work_t), intent(inout) :: w    !! work arrays
+    real(wp), intent(in) :: q(:), qd(:)     !! coordinates and velocities
+    real(wp), intent(in) :: t               !! time
+    integer :: k, s, r, c, r0, d0, jc, ir
+    call assemble_blocks(m, q, qd, t, w%phi, w%nu, w%gam, w%asm)
+    if (.not. w%banded) then
+      call scatter_dense(m, w%asm%jb, w%jac)
+      return
+    end if
+    ! J(i, j) D(j) -> ab(kl + ku + 1 + prow(i) - pcol(j), pcol(j))  (the planned structure:
+    ! band_plan saw every (row, column) of the blocks, so no entry falls outside)
+    call band_zero(w%band)
+    d0 = w%band%kl + w%band%ku + 1
+    do k = 1, m%nc
+      r0 = m%row0(k) - 1
+      do s = 1, NLOC
+        c = m%loc(s, k)
+        if (c == 0) cycle
+        jc = w%band%pcol(c)
+        do r = 1, m%nrow(k)
+          ir = d0 + w%band%prow(r0 + r) - jc
+          w%band%ab(ir, jc) = w%band%ab(ir, jc) + w%asm%jb(r, s, k) * w%cs(c)
+        end do
+      end do
+    end do
+    w%anorm = band_norm1(w%band)
+  end subroutine assemble_j
+
+  !> Phi, nu, gamma and the dense, unscaled J in w%jac (allocated here in band mode).
+  subroutine dense_j(m, w, q, qd, t)
+    type(model_t), intent(in) :: m          !! model
+    type(kin_work_t), intent(inout) :: w    !! work arrays
+    real(wp), intent(in) :: q(:), qd(:)     !! coordinates and velocities
+    real(wp), intent(in) :: t               !! time
+    if (.not. allocated(w%jac)) allocate (w%jac(m%neq, m%nq))
+    call assemble_dense(m, q, qd, t, w%phi, w%nu, w%gam, w%asm, w%jac)
+  end subroutine dense_j
 
   !> Factor J D (J in w%jac, D = diag(w%cs)) by LU or, in least-squares mode, QR.
   subroutine factor(w, status)
@@ -126,6 +220,13 @@ contains
     integer :: i, k, n, info
     real(wp) :: anorm, colsum, umin, umax
     w%lu_count = w%lu_count + 1
+    if (w%banded) then
+      ! B = P_r J D P_c^T = P L U (dgbtrf); 1/cond_1 estimated only where it may matter
+      call band_factor(w%band, status, msg, w%detsign, w%pivratio)
+      if (status == MBD_OK .and. w%pivratio < COND_CHECK) &
+        call band_rcond(w%band, w%anorm, w%pivratio, info, msg)
+      return
+    end if
     n = size(w%cs)
     anorm = zero
     do k = 1, n
@@ -167,6 +268,10 @@ contains
     if (w%lsq) then
       w%rhs(1:size(b)) = b
       call qr_solve(w%jac, w%jpvt, w%tau, w%rhs(1:size(b)), x, w%resid, w%qrwork)
+    else if (w%banded) then
+      x = b
+      call band_solve(w%band, x, st, msg)
+      w%resid = zero
     else
       x = b
       call lu_solve(w%jac, w%ipiv, x, st, msg)
@@ -190,7 +295,7 @@ contains
     integer :: it
     res0 = huge(one)
     do it = 0, maxit
-      call assemble_dense(m, q, w%qz, t, w%phi, w%nu, w%gam, w%asm, w%jac)
+      call assemble_j(m, w, q, w%qz, t)
       res = maxval(abs(w%phi))
       if (.not. (res <= huge(one))) exit                 ! NaN or overflow
       if (it > 0 .and. res > 1.0e3_wp * res0 .and. res > w%tol) exit   ! diverging
@@ -227,7 +332,7 @@ contains
     if (w%resid > 1.0e-8_wp * (one + maxval(abs(w%nu)))) then
       status = MBD_INCONSISTENT
       if (present(level)) level = 1
-      call assemble_dense(m, q, w%qz, t, w%phi, w%nu, w%gam, w%asm, w%jac)
+      call dense_j(m, w, q, w%qz, t)
       w%phi = matmul(w%jac, qd) - w%nu
       return
     end if
@@ -236,7 +341,7 @@ contains
     if (w%resid > 1.0e-8_wp * (one + maxval(abs(w%gam)))) then
       status = MBD_INCONSISTENT
       if (present(level)) level = 2
-      call assemble_dense(m, q, qd, t, w%phi, w%nu, w%gam, w%asm, w%jac)
+      call dense_j(m, w, q, qd, t)
       w%phi = matmul(w%jac, qdd) - w%gam
     end if
   end subroutine kin_vel_acc
@@ -264,11 +369,19 @@ contains
     status = MBD_OK; msg = ''
     n = m%nq; neq = m%neq
     call init_extras(m, q)
-    allocate (aug(neq + n, n), rhs(neq + n), qt(n), phit(neq))
+    allocate (qt(n))
+    if (w%banded) then
+      ! large square models: plain Newton first (dense least squares as the fallback)
+      qt = q
+      call kin_newton(m, w, q, t, BAND_ASSEMBLY_MAXIT, st)
+      if (st == MBD_OK) return
+      q = qt
+    end if
+    allocate (aug(neq + n, n), rhs(neq + n), phit(neq))
     call dgels('N', neq + n, n, 1, aug, neq + n, rhs, neq + n, wq, -1, info)
     lwork = max(1, int(wq(1)))
     allocate (work(lwork))
-    call assemble_dense(m, q, w%qz, t, w%phi, w%nu, w%gam, w%asm, w%jac)
+    call dense_j(m, w, q, w%qz, t)
     f = norm2(w%phi)
     dmax = zero
     do k = 1, n
@@ -294,7 +407,7 @@ contains
         q = qt; f = ft; w%phi = phit
         mu = max(mu / 10.0_wp, 1.0e-20_wp * max(dmax, one))
       else
-        call assemble_dense(m, q, w%qz, t, w%phi, w%nu, w%gam, w%asm, w%jac)
+        call dense_j(m, w, q, w%qz, t)
         mu = mu * 10.0_wp
         if (mu > 1.0e20_wp * max(dmax, one)) exit
       end if
@@ -337,7 +450,7 @@ contains
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
     integer, allocatable :: flags(:), krows(:)
     integer :: r, nk, rk
-    call assemble_dense(m, q, w%qz, t, w%phi, w%nu, w%gam, w%asm, w%jac)
+    call dense_j(m, w, q, w%qz, t)
     call row_rank(w%jac, rank, redundant, status, msg)
     if (status /= MBD_OK) return
     krows = pack([(r, r=1, m%neq)], [(.not. con_is_driver(m%kind(m%con_of_row(r))), r=1, m%neq)])
@@ -366,7 +479,7 @@ contains
     integer :: r, k
     character(len=MSG_LEN) :: rows
     allocate (sv(min(m%neq, m%nq)), u(m%neq), v(m%nq))
-    call assemble_dense(m, q, w%qz, t, w%phi, w%nu, w%gam, w%asm, w%jac)
+    call dense_j(m, w, q, w%qz, t)
     ! columns to unit length, so lengths and angles weigh alike: J D, D = diag(1/|J_k|)
     do k = 1, m%nq
       umax = norm2(w%jac(:, k))
@@ -403,26 +516,28 @@ contains
   end subroutine kin_singular_report
 
   !> Kinematic analysis at nsteps + 1 uniform times from t0 to t1, the whole loop here.
-  !! q0: estimates of the body coordinates (extras are estimated). On a singular
-  !! configuration the outputs up to it are filled (rep%ndone) and status is
-  !! MBD_SINGULAR_CONFIG with rep describing the configuration.
+  !! q0: estimates of the body coordinates (extras are estimated). Outputs k = 0, e, 2e, ...
+  !! and nsteps (e = opts%every) are stored, in columns 1, 2, ... (kin_out_count of them).
+  !! On a singular configuration the outputs up to it are filled (rep%ndone columns) and
+  !! status is MBD_SINGULAR_CONFIG with rep describing the configuration.
   subroutine kin_run(m, q0, t0, t1, nsteps, opts, qout, qdout, qddout, rep, status, msg)
     type(model_t), intent(in) :: m             !! model
     real(wp), intent(in) :: q0(:)              !! estimates (nq)
     real(wp), intent(in) :: t0, t1             !! time span
     integer, intent(in) :: nsteps              !! output intervals
     type(kin_opts_t), intent(in) :: opts       !! settings
-    real(wp), intent(out) :: qout(:, :)        !! coordinates (nq, nsteps + 1)
+    real(wp), intent(out) :: qout(:, :)        !! coordinates (nq, kin_out_count)
     real(wp), intent(out) :: qdout(:, :)       !! velocities
     real(wp), intent(out) :: qddout(:, :)      !! accelerations
     type(kin_report_t), intent(out) :: rep     !! what happened
     integer, intent(out) :: status             !! MBD_OK or the failure
     character(len=MSG_LEN), intent(out) :: msg !! explanation
     type(kin_work_t) :: w
+    type(band_t) :: band
     real(wp), allocatable :: q(:), qd(:), qdd(:), qn(:), qp(:), q3(:), qddn(:), qdn(:)
     real(wp), allocatable :: qa(:), qda(:), qdda(:), qb(:), qdb(:), qddb(:)
     real(wp) :: t, h, hcur, hh, tt, target, lscale, ts, ta, d
-    integer :: k, j, st, detprev, mobility, lev, nsub
+    integer :: k, j, c, st, detprev, mobility, lev, nsub
     logical :: last, ok
 
     status = MBD_OK; msg = ''
@@ -435,7 +550,35 @@ contains
     if (nsteps > 0 .and. .not. (t1 > t0)) then
       status = MBD_BAD_SETTING; msg = 't_end must be greater than the start time'; return
     end if
-    call kin_work_init(m, w)
+    if (opts%every < 1 .or. size(qout, 2) /= kin_out_count(nsteps, opts%every)) then
+      status = MBD_BAD_SETTING; msg = 'every must be >= 1 (and the output arrays sized for it)'
+      return
+    end if
+    ! the linear solver: band LU for large square J with a narrow band (after RCM)
+    rep%solver = SOLVER_DENSE
+    if (opts%solver == SOLVER_BANDED .and. m%neq /= m%nq) then
+      status = MBD_BAD_SETTING
+      msg = 'the banded solver needs as many equations as coordinates (no redundant '// &
+            'constraints); use the dense solver'
+      return
+    end if
+    if (opts%solver /= SOLVER_DENSE .and. m%neq == m%nq .and. &
+        (opts%solver == SOLVER_BANDED .or. m%nq >= BAND_MIN_N)) then
+      call kin_band_plan(m, band, st, msg)
+      if (st == MBD_OK) then
+        if (opts%solver == SOLVER_BANDED .or. &
+            BAND_RATIO * (band%kl + band%ku + 1) <= m%nq) rep%solver = SOLVER_BANDED
+        rep%kl = band%kl; rep%ku = band%ku
+      else if (opts%solver == SOLVER_BANDED) then
+        status = MBD_SINGULAR; return
+      end if
+      msg = ''
+    end if
+    if (rep%solver == SOLVER_BANDED) then
+      call kin_work_init(m, w, band)
+    else
+      call kin_work_init(m, w)
+    end if
     lscale = m%lscale
     w%tol = opts%tol * lscale
     allocate (q(m%nq), qd(m%nq), qdd(m%nq), qn(m%nq), qp(m%nq), q3(m%nq), qddn(m%nq), &
@@ -445,12 +588,8 @@ contains
     if (status /= MBD_OK) then
       call count_work(); return
     end if
-    ! column scale from J at the assembled configuration
-    call assemble_dense(m, q, w%qz, t0, w%phi, w%nu, w%gam, w%asm, w%jac)
-    do k = 1, m%nq
-      d = norm2(w%jac(:, k))
-      if (d > zero) w%cs(k) = one / d
-    end do
+    ! column scale from J at the assembled configuration: D = diag(1/|J_k|)
+    call column_scale(m, w, q, t0)
     ! square: a regular LU proves full rank; otherwise find the rank and the redundant rows
     w%lsq = .false.
     st = MBD_SINGULAR
@@ -581,9 +720,12 @@ contains
       ! outputs inside (ta, ts + d]: interpolate; earlier ones there are replaced
       do j = 0, nsteps
         if (out_time(j) > ta .and. out_time(j) <= ts + d) then
-          call hermite5(ta, qa, qda, qdda, ts + d, qn, qdn, qddn, out_time(j), qout(:, j + 1), &
-                        qdout(:, j + 1), qddout(:, j + 1))
-          rep%ndone = max(rep%ndone, j + 1)
+          c = column(j)
+          if (c > 0) then
+            call hermite5(ta, qa, qda, qdda, ts + d, qn, qdn, qddn, out_time(j), qout(:, c), &
+                          qdout(:, c), qddout(:, c))
+            rep%ndone = max(rep%ndone, c)
+          end if
           if (j >= k) k = j + 1
         end if
       end do
@@ -596,6 +738,14 @@ contains
     call count_work()
 
   contains
+
+    !> Output column of output kk (0: not stored).
+    integer function column(kk)
+      integer, intent(in) :: kk
+      column = 0
+      if (mod(kk, opts%every) == 0) column = kk / opts%every + 1
+      if (kk == nsteps) column = size(qout, 2)
+    end function column
 
     !> Output time k (exact at both ends).
     real(wp) function out_time(kk)
@@ -627,7 +777,7 @@ contains
       integer :: st2
       call solve(w, -w%phi, w%dq)
       qn = qn + w%dq
-      call assemble_dense(m, qn, w%qz, tp, w%phi, w%nu, w%gam, w%asm, w%jac)
+      call assemble_j(m, w, qn, w%qz, tp)
       call factor(w, st2)
       if (st2 /= MBD_OK) w%pivratio = zero
     end subroutine polish
@@ -659,20 +809,24 @@ contains
 
     subroutine store(kk)
       integer, intent(inout) :: kk
+      integer :: cc
       nsub = 0
-      qout(:, kk + 1) = q; qdout(:, kk + 1) = qd; qddout(:, kk + 1) = qdd
-      if (w%pivratio < ANCHOR_PIV) call refine_output(kk)
-      rep%ndone = kk + 1
+      cc = column(kk)
+      if (cc > 0) then
+        qout(:, cc) = q; qdout(:, cc) = qd; qddout(:, cc) = qdd
+        if (w%pivratio < ANCHOR_PIV) call refine_output(cc)
+        rep%ndone = cc
+      end if
       kk = kk + 1
     end subroutine store
 
-    !> Output kk sits where J is poorly conditioned (near a singular point): its q_ddot (error
+    !> Output column cc sits where J is poorly conditioned (near a singular point): its q_ddot (error
     !! ~ cond**3 tol) is replaced by quintic Hermite interpolation between regular anchors at
     !! t -+ d, d doubled from h/64 until J is well conditioned at both. The stepping state
     !! is left as it is. If no regular anchor exists on one side (a dead centre), the direct
     !! values stay.
-    subroutine refine_output(kk)
-      integer, intent(in) :: kk
+    subroutine refine_output(cc)
+      integer, intent(in) :: cc
       real(wp) :: dd
       dd = h / 64
       do
@@ -685,8 +839,8 @@ contains
         if (dd >= 64 * h) return
         dd = 2 * dd
       end do
-      call hermite5(t - dd, qa, qda, qdda, t + dd, qn, qdn, qddn, t, qout(:, kk + 1), &
-                    qdout(:, kk + 1), qddout(:, kk + 1))
+      call hermite5(t - dd, qa, qda, qdda, t + dd, qn, qdn, qddn, t, qout(:, cc), &
+                    qdout(:, cc), qddout(:, cc))
     end subroutine refine_output
 
     !> Redundant constraints disagree at position (0), velocity (1) or acceleration (2)
@@ -711,5 +865,44 @@ contains
     end subroutine count_work
 
   end subroutine kin_run
+
+  !> Stored outputs of a run of nsteps intervals keeping every e-th (and the last).
+  pure integer function kin_out_count(nsteps, e) result(n)
+    integer, intent(in) :: nsteps   !! output intervals
+    integer, intent(in) :: e        !! every
+    n = nsteps / max(e, 1) + 1
+    if (mod(nsteps, max(e, 1)) /= 0) n = n + 1
+  end function kin_out_count
+
+  !> Column scale D = diag(1/|J_k|) from J at q (columns of J summed from the blocks).
+  subroutine column_scale(m, w, q, t)
+    type(model_t), intent(in) :: m          !! model
+    type(kin_work_t), intent(inout) :: w    !! work arrays; w%cs set
+    real(wp), intent(in) :: q(:)            !! configuration
+    real(wp), intent(in) :: t               !! time
+    integer :: k, s, c
+    if (.not. w%banded) then
+      call dense_j(m, w, q, w%qz, t)
+      do k = 1, m%nq
+        w%cs(k) = norm2(w%jac(:, k))
+      end do
+    else
+      ! J square with its rows split among the constraints: |J_k|^2 sums over blocks
+      call assemble_blocks(m, q, w%qz, t, w%phi, w%nu, w%gam, w%asm)
+      w%cs = zero
+      do k = 1, m%nc
+        do s = 1, NLOC
+          c = m%loc(s, k)
+          if (c > 0) w%cs(c) = w%cs(c) + sum(w%asm%jb(1:m%nrow(k), s, k)**2)
+        end do
+      end do
+      w%cs = sqrt(w%cs)
+    end if
+    where (w%cs > zero)
+      w%cs = one / w%cs
+    elsewhere
+      w%cs = one
+    end where
+  end subroutine column_scale
 
 end module mbd_kinematics

@@ -46,6 +46,16 @@ def test_kinematics_npz(tmp_path: Path) -> None:
     assert list(data["coordinate_names"])[:3] == ["crank.x", "crank.y", "crank.theta"]
 
 
+def test_kinematics_every_and_solver(tmp_path: Path) -> None:
+    out = tmp_path / "slider.npz"
+    r = cli("kinematics", str(EX / "slider_crank.toml"), "--t-end", "0.5", "--steps", "50",
+            "--every", "20", "--solver", "dense", "--out", str(out))
+    assert r.returncode == 0, r.stderr
+    data = np.load(out)
+    assert data["q"].shape == (4, 9)          # steps 0, 20, 40 and 50
+    np.testing.assert_allclose(data["t"], [0.0, 0.2, 0.4, 0.5], rtol=0, atol=1e-15)
+
+
 def test_toggle_paragraph_partial_output_and_exit_code(tmp_path: Path) -> None:
     out = tmp_path / "seed.csv"
     r = cli("kinematics", str(EX / "fourbar_seed.toml"), "--t-end", "1", "--steps", "1000",

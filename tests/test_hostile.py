@@ -1917,8 +1917,15 @@ def test_core_kinematics_hostile(data: st.DataObject) -> None:
     maxit = data.draw(st.sampled_from([0, 0, -1, 1, 3, 2**31 - 1, -(2**31)]), label="maxit")
     tmin = data.draw(st.sampled_from([0.0, 0.0, np.nan, np.inf, -1.0, 1e300, 5e-324])
                      | REAL_EDGE, label="tmin")
+    every = data.draw(st.sampled_from([1, 1, 1, 2, 3, 0, -1, 2**31 - 1]), label="every")
+    solver = data.draw(st.sampled_from([0, 0, 1, 2, 3, -1]), label="solver")
+    # the output columns the core expects, or a wrong count (kept small: f2py allocates it)
+    right = (nsteps // every + 1 + (nsteps % every > 0)
+             if isinstance(nsteps, int) and 0 <= nsteps <= 100 and every >= 1 else 3)
+    nout = data.draw(st.sampled_from([right, right, right, right + 1, right - 1, 0, -1]),
+                     label="nout")
     WORKER.call("check_core", "core_kinematics",
-                (nb, ctab, rpar, neq, q0, t0, t1, nsteps, tol, maxit, tmin))
+                (nb, ctab, rpar, neq, q0, t0, t1, nsteps, tol, maxit, tmin, every, solver, nout))
 
 
 @hostile_settings(250)

@@ -44,7 +44,7 @@ program mbd2d_solve
   q0 = 0.0_wp
   q0(1:3 * spec%nb) = reshape(spec%q0, [3 * spec%nb])
   call api_kinematics(spec%nb, spec%ctab, spec%rpar, q0, spec%t0, spec%t_end, spec%steps, &
-                      spec%tol, spec%maxit, spec%tmin, qout, qdout, qddout, iinfo, rinfo, &
+                      spec%tol, spec%maxit, spec%tmin, 1, 0, qout, qdout, qddout, iinfo, rinfo, &
                       qsing, dep, redundant, tpass, status, msg)
   if (status < 0) call die(2, trim(where(iinfo(2))) // trim(msg))
   call write_csv(trim(out_path), iinfo(1))

@@ -46,6 +46,35 @@ def check_span(t0: Any, t_end: Any, steps: Any) -> tuple[float, float, int]:
     return t0, t_end, steps
 
 
+def output_steps(steps: int, every: Any) -> np.ndarray:
+    """Step indices kept with output decimation: 0, every, 2 every, ... and always ``steps``.
+
+    Parameters
+    ----------
+    steps : int
+        Output intervals of the time grid.
+    every : int
+        Keep every k-th output (validated here: a whole number >= 1).
+
+    Returns
+    -------
+    numpy.ndarray
+        The kept indices into the grid of ``steps + 1`` times.
+    """
+    k = whole(every, "every", "analysis", 1, MAX_STEPS)
+    idx = np.arange(0, steps + 1, k)
+    if idx[-1] != steps:
+        idx = np.append(idx, steps)
+    return idx
+
+
+def time_grid(t0: float, t_end: float, steps: int, idx: np.ndarray) -> np.ndarray:
+    """Times of the grid indices idx (exact at both ends, as in the core)."""
+    t = t0 + (t_end - t0) * (idx / steps)
+    t[idx == steps] = t_end
+    return t
+
+
 def check_memory(rows: int, columns: int) -> None:
     """Refuse output arrays that cannot fit in half the physical memory."""
     need = 8.0 * rows * columns
@@ -228,21 +257,30 @@ def _assembly_failed(model: "Model", resid: float, worst: int, t: float,
         constraint=cons[worst - 1].name if worst > 0 else None)
 
 
+#: linear solvers of the kinematic loop (codes of mbd_kinematics.f90)
+SOLVERS = {"auto": 0, "dense": 1, "banded": 2}
+
+
 def run_kinematics(model: "Model", t_end: float, steps: int, t0: float = 0.0,
                    tol: float | None = None, maxit: int | None = None,
-                   tmin: float | None = None) -> KinematicsResult:
+                   tmin: float | None = None, every: int = 1,
+                   solver: str = "auto") -> KinematicsResult:
     """Run a kinematic analysis in one core call; see :meth:`Model.kinematics`."""
     t0, t_end, steps = check_span(t0, t_end, steps)
     tol_v, maxit_v = check_solver(tol, maxit)
+    idx = output_steps(steps, every)
+    if solver not in SOLVERS:
+        raise ModelError(f"unknown solver {solver!r}; use one of {', '.join(SOLVERS)}",
+                         "analysis")
     p = pack(model)
     require_determined(p, model)
-    check_memory(steps + 1, 3 * p.nq)
+    check_memory(len(idx), 3 * p.nq)
     out = _core.core_kinematics(p.nb, p.ctab, p.rpar, p.neq, p.q0, t0, t_end, steps,
-                                tol_v, maxit_v, float(tmin or 0.0))
+                                tol_v, maxit_v, float(tmin or 0.0), int(every),
+                                SOLVERS[solver], len(idx))
     qout, qdout, qddout, iinfo, rinfo, qsing, dep, red, tpass, status, msg = out
     n = int(iinfo[0])
-    t = t0 + (t_end - t0) * (np.arange(steps + 1) / steps)
-    t[-1] = t_end
+    t = time_grid(t0, t_end, steps, idx)
     npass = int(iinfo[9])
     red_cons, red_rows = _names(p, model, red)
     res = KinematicsResult(t=t[:n], q=qout.T[:n].copy(), qd=qdout.T[:n].copy(),
@@ -254,7 +292,9 @@ def run_kinematics(model: "Model", t_end: float, steps: int, t0: float = 0.0,
                                   "rank": int(iinfo[8]),
                                   "redundant_rows": red_rows,
                                   "singular_passages": [float(x) for x in tpass[:min(npass, 64)]],
-                                  "singular_passage_count": npass},
+                                  "singular_passage_count": npass,
+                                  "solver": "banded" if int(rinfo[4]) == 2 else "dense",
+                                  "band": (int(rinfo[5]), int(rinfo[6]))},
                            complete=status == OK, model=model)
     if red_rows and status in (OK, SINGULAR_CONFIG, NO_CONVERGENCE):
         warnings.warn(f"redundant constraints: {', '.join(red_rows)} repeat what the other "

@@ -1,6 +1,6 @@
 """The ``mbd2d`` command line.
 
-    mbd2d kinematics MODEL.toml --t-end T --steps N --out OUT.csv|OUT.npz
+    mbd2d kinematics MODEL.toml --t-end T --steps N --out OUT.csv|OUT.npz [--every K --solver S]
     mbd2d export MODEL.toml OUT.mbd --t-end T --steps N
     mbd2d check MODEL.toml
     mbd2d dynamics MODEL.toml --t-end T --steps N --out OUT.csv [--method M --rtol R --atol A --h H]
@@ -36,6 +36,9 @@ def _parser() -> argparse.ArgumentParser:
     k.add_argument("--t0", type=float, default=0.0, help="start time (default 0)")
     k.add_argument("--out", required=True, help="output file, .csv or .npz")
     k.add_argument("--tol", type=float, default=None, help="Newton tolerance (default 1e-12)")
+    k.add_argument("--every", type=int, default=1, help="write every k-th row (and the last)")
+    k.add_argument("--solver", default="auto", choices=["auto", "dense", "banded"],
+                   help="linear solver (default auto: banded LU for large chains)")
     d = sub.add_parser("dynamics", help="forward dynamics")
     d.add_argument("model", help="model file (.toml) with masses")
     d.add_argument("--t-end", type=float, required=True, help="final time")
@@ -111,7 +114,8 @@ def main(argv: Sequence[str] | None = None) -> int:
                                  method=args.method, rtol=args.rtol, atol=args.atol, h=args.h,
                                  rho_inf=args.rho_inf, alpha=args.alpha, beta=args.beta)
         else:
-            res = model.kinematics(t_end=args.t_end, steps=args.steps, t0=args.t0, tol=args.tol)
+            res = model.kinematics(t_end=args.t_end, steps=args.steps, t0=args.t0, tol=args.tol,
+                                   every=args.every, solver=args.solver)
         res.save(args.out)
         print(f"wrote {len(res.t)} rows to {args.out}")
         return EXIT_OK

@@ -63,9 +63,14 @@ class Model:
         """1-based index of a body, 0 for ground."""
         if name == GROUND and allow_ground:
             return 0
-        for i, b in enumerate(self.bodies):
-            if b.name == name:
-                return i + 1
+        cache: dict[str, int] = self.__dict__.setdefault("_body_cache", {})
+        i = cache.get(name, 0)
+        if not (0 < i <= len(self.bodies) and self.bodies[i - 1].name == name):
+            cache.clear()      # bodies were added or changed: rebuild (O(n) per change)
+            cache.update((b.name, k + 1) for k, b in reversed(list(enumerate(self.bodies))))
+            i = cache.get(name, 0)
+        if i:
+            return i
         known = ", ".join(b.name for b in self.bodies) or "(none yet)"
         hint = " (ground is not allowed here)" if name == GROUND else ""
         raise ModelError(f"unknown body {name!r}{hint}; bodies are: ground, {known}", entry)
@@ -80,8 +85,18 @@ class Model:
         return [*self.joints, *self.drivers]
 
     def _names(self) -> set[str]:
-        return ({b.name for b in self.bodies} | {c.name for c in self.constraints}
-                | {f.name for f in self.forces})
+        # entries are appended: only the new ones are added to the cached set (a shorter
+        # list rebuilds it), so building a large model stays linear
+        lists = (self.bodies, self.joints, self.drivers, self.forces)
+        key = tuple(len(x) for x in lists)
+        old, names = self.__dict__.get("_names_cache", ((0, 0, 0, 0), set()))
+        if any(k < o for k, o in zip(key, old)):
+            old, names = (0, 0, 0, 0), set()
+        if key != old:
+            for x, o in zip(lists, old):
+                names.update(e.name for e in x[o:])
+            self.__dict__["_names_cache"] = (key, names)
+        return names
 
     def _new_name(self, name: str | None, stem: str, entry: str) -> str:
         if name is None:
@@ -481,7 +496,8 @@ class Model:
 
     # ------------------------------------------------------------------ analyses
     def kinematics(self, t_end: float, steps: int, t0: float = 0.0, tol: float | None = None,
-                   maxit: int | None = None) -> "KinematicsResult":
+                   maxit: int | None = None, every: int = 1,
+                   solver: str = "auto") -> "KinematicsResult":
         """Kinematic analysis at steps + 1 uniform times from t0 to t_end.
 
         The whole time loop runs in the Fortran core. Assembly refines the q0 estimates at t0.
@@ -499,11 +515,20 @@ class Model:
             (default 1e-12).
         maxit : int, optional
             Newton iterations per step (default 25).
+        every : int, optional
+            Keep every k-th output row (and the last): memory stays flat on long runs. The
+            step size is still (t_end - t0) / steps.
+        solver : {"auto", "dense", "banded"}, optional
+            Linear solver of the Newton loop: dense LU, or band LU (dgbtrf) of J after a
+            reverse Cuthill-McKee ordering. "auto" picks the band for square J with at least
+            60 coordinates whose band is at most a quarter of them wide
+            (``res.stats["solver"]`` says which ran).
 
         Returns
         -------
         KinematicsResult
-            When every body has a mass and an inertia, a DynamicsResult with the inverse
+            When every body has a mass and an inertia (and ``every``, ``solver`` and
+            ``maxit`` are left at their defaults), a DynamicsResult with the inverse
             dynamics too (see :meth:`inverse_dynamics`).
 
         Raises
@@ -523,10 +548,11 @@ class Model:
         11
         """
         from .analysis import run_kinematics
-        if self.has_masses() and maxit is None:
+        if self.has_masses() and maxit is None and every == 1 and solver == "auto":
             from .dynamics import run_inverse
             return run_inverse(self, t_end=t_end, steps=steps, t0=t0, tol=tol)
-        return run_kinematics(self, t_end=t_end, steps=steps, t0=t0, tol=tol, maxit=maxit)
+        return run_kinematics(self, t_end=t_end, steps=steps, t0=t0, tol=tol, maxit=maxit,
+                              every=every, solver=solver)
 
     def analyze_dof(self, t: float = 0.0, tol: float | None = None) -> "DofReport":
         """Degrees of freedom and redundant constraints at the configuration assembled from

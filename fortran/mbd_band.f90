@@ -1,0 +1,642 @@
+!> mbd_band: a banded direct solver for the square constraint Jacobian J (n x n) of large
+!! mechanisms. The structure is planned once (band_plan: ordering, band widths, storage); the
+!! values are then assembled, factored and solved any number of times without allocation.
+!!
+!!   ordering   B = P_r J P_c^T,  B(prow(i), pcol(j)) = J(i, j)
+!!              columns: reverse Cuthill-McKee on the graph of J^T J (columns j, k adjacent
+!!              when a row touches both), each component started at a pseudo-peripheral
+!!              node (George & Liu), neighbours visited by increasing degree
+!!              rows: stably sorted by (lo, hi), (hi, lo) or (lo + hi, lo), where lo and hi
+!!              are the first and last new column a row touches; the candidate with the
+!!              smallest kl + ku (then the smallest kl) is kept. Sorting by lo minimizes kl
+!!              and sorting by hi minimizes ku (an earliest-due-date exchange argument)
+!!   widths     kl = max(prow(i) - pcol(j)),  ku = max(pcol(j) - prow(i))  over the nonzeros
+!!   storage    B(p, q) in ab(kl + ku + 1 + p - q, q),  ldab = 2 kl + ku + 1 (dgbtrf layout;
+!!              rows 1..kl are dgbtrf's room for the fill of the row swaps)
+!!   factor     B = P L U (dgbtrf);  det J = det(P_r) det(P_c) det(P) prod u_ii
+!!   solve      J x = b    <=>  B (P_c x) = P_r b          (dgbtrs 'N')
+!!              J^T y = c  <=>  B^T (P_r y) = P_c c        (dgbtrs 'T')
+!!   rcond      1 / (||B||_1 ||B^-1||_1), ||B^-1||_1 estimated by Hager-Higham (dlacn2) from
+!!              solves (dgbtrs), or dgbcon on request; permutations keep both norms, so it
+!!              is the rcond of J
+!! Cost: factor ~ 2 n kl (kl + ku) flops, a solve ~ 2 n (2 kl + ku), storage n (2 kl + ku + 1).
+!!
+!! Usage: band_plan once per structure; then per Jacobian band_zero, band_add for every
+!! nonzero (repeats add up), band_norm1 if rcond is wanted, band_factor, band_solve as often
+!! as needed (the factors are kept), band_rcond.
+!!
+!! References: E. Cuthill, J. McKee, Reducing the bandwidth of sparse symmetric matrices (1969);
+!! A. George, J. W. H. Liu, Computer Solution of Large Sparse Positive Definite Systems
+!! (1981), ch. 4 (RCM and the pseudo-peripheral node); LAPACK Users' Guide, band storage.
+module mbd_band
+  use mbd_kinds, only: wp, zero, one
+  use mbd_status, only: MBD_OK, MBD_BAD_INPUT, MBD_SINGULAR, MSG_LEN
+  use mbd_lapack, only: dgbtrf, dgbtrs, dgbcon, dlacn2
+  use mbd_linsolve, only: lapack_status
+  use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+  implicit none
+  private
+  public :: band_t, band_plan, band_zero, band_add, band_norm1, band_factor, band_rcond
+  public :: band_solve, band_natural, band_width_natural
+
+  !> A planned band matrix: the ordering, the band storage, the factors and all workspace.
+  type :: band_t
+    integer :: n = 0, kl = 0, ku = 0, ldab = 0
+    integer, allocatable :: prow(:)     !! prow(i): position of original row i in band order
+    integer, allocatable :: pcol(:)     !! pcol(j): position of original column j
+    real(wp), allocatable :: ab(:, :)   !! band storage (ldab, n), dgbtrf layout
+    integer, allocatable :: ipiv(:)     !! dgbtrf's row interchanges (n)
+    real(wp), allocatable :: work(:)    !! rcond workspace (3 n)
+    integer, allocatable :: iwork(:)    !! rcond workspace (n)
+    real(wp), allocatable :: rhs(:)     !! permuted right-hand side (n)
+    integer :: perm_sign = 1            !! sign of the two permutations (det P_r det P_c)
+    logical :: factored = .false.       !! ab holds the LU factors
+    integer :: n_outside = 0            !! band_add calls outside the band since band_zero
+    integer :: first_outside(2) = 0     !! (i, j) of the first of them
+  end type band_t
+
+contains
+
+  !> Plan the band structure of J from its structural nonzeros: the ordering, kl and ku,
+  !! and all storage. Allocates (once per structure, not in time loops).
+  subroutine band_plan(n, rows, cols, b, status, msg)
+    integer, intent(in) :: n                    !! size of the square J
+    integer, intent(in) :: rows(:)              !! row of each nonzero (1-based, repeats allowed)
+    integer, intent(in) :: cols(:)              !! column of each nonzero (same length)
+    type(band_t), intent(out) :: b              !! the plan; n = 0 on failure
+    integer, intent(out) :: status              !! MBD_OK, MBD_BAD_INPUT or MBD_SINGULAR
+    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    integer, allocatable :: rptr(:), rcol(:), cptr(:), crow(:), aptr(:), adj(:), order(:)
+    integer, allocatable :: prow(:), pcol(:)
+    integer :: k, kl, ku, ldab, ierr
+    status = MBD_OK; msg = ''
+    if (n < 1) then
+      status = MBD_BAD_INPUT
+      write (msg, '(a,i0)') 'band_plan: the matrix size must be at least 1, got ', n
+      return
+    end if
+    if (size(rows) /= size(cols)) then
+      status = MBD_BAD_INPUT
+      write (msg, '(a,i0,a,i0,a)') 'band_plan: ', size(rows), ' row indices but ', &
+        size(cols), ' column indices'
+      return
+    end if
+    do k = 1, size(rows)
+      if (rows(k) < 1 .or. rows(k) > n .or. cols(k) < 1 .or. cols(k) > n) then
+        status = MBD_BAD_INPUT
+        write (msg, '(a,i0,a,i0,a,i0,a,i0)') 'band_plan: nonzero ', k, ' at (', rows(k), &
+          ', ', cols(k), ') is outside 1..', n
+        return
+      end if
+    end do
+
+    ! structure by rows and by columns, repeats removed
+    call compress(n, rows, cols, rptr, rcol)
+    call compress(n, cols, rows, cptr, crow)
+    do k = 1, n
+      if (rptr(k + 1) == rptr(k)) then
+        status = MBD_SINGULAR
+        write (msg, '(a,i0,a)') 'Jacobian is structurally singular: row ', k, &
+          ' has no nonzero'
+        return
+      end if
+      if (cptr(k + 1) == cptr(k)) then
+        status = MBD_SINGULAR
+        write (msg, '(a,i0,a)') 'Jacobian is structurally singular: column ', k, &
+          ' has no nonzero'
+        return
+      end if
+    end do
+
+    ! columns: reverse Cuthill-McKee on the structure of J^T J
+    call column_graph(n, rptr, rcol, cptr, crow, aptr, adj)
+    allocate (order(n), pcol(n), prow(n))
+    call rcm(n, aptr, adj, order)
+    do k = 1, n
+      pcol(order(k)) = k
+    end do
+    ! rows: follow their columns
+    call order_rows(n, rptr, rcol, pcol, prow, kl, ku)
+
+    ldab = 2 * kl + ku + 1
+    allocate (b%ab(ldab, n), stat=ierr)
+    if (ierr /= 0) then
+      status = MBD_BAD_INPUT
+      write (msg, '(a,i0,a,i0,a,i0,a,i0,a)') 'band_plan: cannot allocate the band storage (', &
+        ldab, ' x ', n, '): the structure is not banded (kl = ', kl, ', ku = ', ku, ')'
+      return
+    end if
+    b%ab = zero
+    allocate (b%ipiv(n), b%work(3 * n), b%iwork(n), b%rhs(n))
+    b%ipiv = 0
+    b%n = n; b%kl = kl; b%ku = ku; b%ldab = ldab
+    b%perm_sign = perm_parity(prow) * perm_parity(pcol)
+    call move_alloc(prow, b%prow)
+    call move_alloc(pcol, b%pcol)
+  end subroutine band_plan
+
+  !> Clear the matrix before an assembly: rows kl+1..ldab of ab, the part dgbtrf reads
+  !! (it clears its fill rows 1..kl itself).
+  pure subroutine band_zero(b)
+    type(band_t), intent(inout) :: b   !! planned band matrix
+    if (.not. allocated(b%ab)) return
+    b%ab(b%kl + 1:b%ldab, :) = zero
+    b%factored = .false.
+    b%n_outside = 0
+    b%first_outside = 0
+  end subroutine band_zero
+
+  !> J(i, j) = J(i, j) + v, in the original numbering. (i, j) must be in the planned
+  !! structure; an entry outside the band is not stored but counted, and band_factor then
+  !! fails with MBD_BAD_INPUT naming it (an unplanned entry inside the band is stored).
+  pure subroutine band_add(b, i, j, v)
+    type(band_t), intent(inout) :: b   !! planned band matrix
+    integer, intent(in) :: i           !! original row
+    integer, intent(in) :: j           !! original column
+    real(wp), intent(in) :: v          !! value to add
+    integer :: d
+    if (i >= 1 .and. i <= b%n .and. j >= 1 .and. j <= b%n) then
+      d = b%prow(i) - b%pcol(j)
+      if (d <= b%kl .and. -d <= b%ku) then
+        b%ab(b%kl + b%ku + 1 + d, b%pcol(j)) = b%ab(b%kl + b%ku + 1 + d, b%pcol(j)) + v
+        return
+      end if
+    end if
+    if (b%n_outside == 0) then
+      b%first_outside(1) = i
+      b%first_outside(2) = j
+    end if
+    b%n_outside = b%n_outside + 1
+  end subroutine band_add
+
+  !> ||J||_1 = max_j sum_i |J(i, j)| of the assembled matrix, for band_rcond. Call it before
+  !! band_factor; on factors it returns -1 (and band_rcond refuses that).
+  pure real(wp) function band_norm1(b) result(anorm)
+    type(band_t), intent(in) :: b   !! assembled band matrix
+    integer :: q
+    anorm = zero
+    if (b%factored) then
+      anorm = -one
+      return
+    end if
+    do q = 1, b%n
+      anorm = max(anorm, sum(abs(b%ab(b%kl + 1:b%ldab, q))))
+    end do
+  end function band_norm1
+
+  !> LU factorization in place, B = P L U (dgbtrf). On success the factors stay in b for
+  !! band_solve and band_rcond until the next band_zero.
+  subroutine band_factor(b, status, msg, detsign, pivratio)
+    type(band_t), intent(inout) :: b             !! assembled band matrix; factors on return
+    integer, intent(out) :: status               !! MBD_OK, MBD_SINGULAR, MBD_BAD_INPUT or
+                                                 !! MBD_LAPACK
+    character(len=MSG_LEN), intent(out) :: msg   !! explanation
+    integer, intent(out), optional :: detsign    !! sign of det J (original order); 0 if singular
+    real(wp), intent(out), optional :: pivratio  !! min |u_ii| / max |u_ii|; 0 if singular
+    integer :: info, k, sgn, d
+    real(wp) :: u, umin, umax
+    status = MBD_OK; msg = ''
+    if (present(detsign)) detsign = 0
+    if (present(pivratio)) pivratio = zero
+    if (b%n < 1) then
+      status = MBD_BAD_INPUT
+      msg = 'band_factor: the band matrix has not been planned (band_plan)'
+      return
+    end if
+    if (b%factored) then
+      status = MBD_BAD_INPUT
+      msg = 'band_factor: already factored; band_zero and assemble again first'
+      return
+    end if
+    if (b%n_outside > 0) then
+      status = MBD_BAD_INPUT
+      write (msg, '(a,i0,a,i0,a,i0,a)') 'band_factor: ', b%n_outside, &
+        ' entries were added outside the planned structure, the first at (', &
+        b%first_outside(1), ', ', b%first_outside(2), ')'
+      return
+    end if
+    call dgbtrf(b%n, b%n, b%kl, b%ku, b%ab, b%ldab, b%ipiv, info)
+    if (info > 0) then
+      ! U(info, info) = 0 exactly; name the original column of that pivot
+      status = MBD_SINGULAR
+      write (msg, '(a,i0,a,i0,a)') 'Jacobian is singular: band pivot ', info, &
+        ' (column ', findloc(b%pcol, info, dim=1), ') is zero'
+      return
+    end if
+    call lapack_status('dgbtrf', info, status, msg)
+    if (status /= MBD_OK) return
+    b%factored = .true.
+    ! det B = (-1)**(row swaps) prod u_ii;  det J = det B det(P_r) det(P_c)
+    d = b%kl + b%ku + 1
+    sgn = b%perm_sign
+    umin = huge(one); umax = zero
+    do k = 1, b%n
+      u = b%ab(d, k)
+      if (u < zero) sgn = -sgn
+      if (b%ipiv(k) /= k) sgn = -sgn
+      umin = min(umin, abs(u)); umax = max(umax, abs(u))
+    end do
+    if (present(detsign)) detsign = sgn
+    if (present(pivratio)) pivratio = umin / umax
+  end subroutine band_factor
+
+  !> Reciprocal condition number of J in the 1-norm, estimated from the factors:
+  !! ||J^-1||_1 by Hager-Higham (dlacn2) with plain solves (dgbtrs), O(n (kl + ku)).
+  !! dgbcon (careful) guards each solve against overflow, but its growth bound underflows
+  !! after about a thousand columns, and it then takes O(n**2) (90 ms at n = 6000).
+  !! Without careful, a solve that overflows (cond(J) > ~1e300) gives rcond = 0.
+  subroutine band_rcond(b, anorm, rcond, status, msg, careful)
+    type(band_t), intent(inout) :: b            !! factored band matrix (its workspace is used)
+    real(wp), intent(in) :: anorm               !! ||J||_1 from band_norm1 before factoring
+    real(wp), intent(out) :: rcond              !! 1 / (||J||_1 ||J^-1||_1) estimate
+    integer, intent(out) :: status              !! MBD_OK, MBD_BAD_INPUT or MBD_LAPACK
+    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    logical, intent(in), optional :: careful    !! use dgbcon (default .false.)
+    integer :: info, kase, isave(3), n
+    real(wp) :: ainvnm
+    logical :: use_gbcon
+    status = MBD_OK; msg = ''
+    rcond = zero
+    if (.not. b%factored) then
+      status = MBD_BAD_INPUT
+      msg = 'band_rcond: the band matrix is not factored (band_factor)'
+      return
+    end if
+    if (.not. (ieee_is_finite(anorm) .and. anorm >= zero)) then
+      status = MBD_BAD_INPUT
+      msg = 'band_rcond: anorm must be the finite band_norm1 taken before band_factor'
+      return
+    end if
+    use_gbcon = .false.
+    if (present(careful)) use_gbcon = careful
+    if (use_gbcon) then
+      call dgbcon('1', b%n, b%kl, b%ku, b%ab, b%ldab, b%ipiv, anorm, rcond, b%work, &
+                  b%iwork, info)
+      call lapack_status('dgbcon', info, status, msg)
+      return
+    end if
+    if (anorm <= zero) return
+    ! ||B^-1||_1 = ||J^-1||_1: kase 1 asks for B^-1 x, kase 2 for B^-T x
+    n = b%n
+    ainvnm = zero
+    kase = 0
+    isave = 0
+    do
+      call dlacn2(n, b%work(1:n), b%work(n + 1:2 * n), b%iwork, ainvnm, kase, isave)
+      if (kase == 0) exit
+      call dgbtrs(merge('N', 'T', kase == 1), n, b%kl, b%ku, 1, b%ab, b%ldab, b%ipiv, &
+                  b%work(n + 1:2 * n), n, info)
+      call lapack_status('dgbtrs', info, status, msg)
+      if (status /= MBD_OK) return
+      if (.not. all(ieee_is_finite(b%work(n + 1:2 * n)))) return   ! overflow: rcond = 0
+    end do
+    if (ainvnm > zero .and. ieee_is_finite(ainvnm)) rcond = (one / ainvnm) / anorm
+  end subroutine band_rcond
+
+  !> Solve J x = b (or J^T x = b with transpose) with the factors; x is overwritten.
+  subroutine band_solve(b, x, status, msg, transpose)
+    type(band_t), intent(inout) :: b            !! factored band matrix (its rhs is used)
+    real(wp), intent(inout) :: x(:)             !! in: right-hand side, indexed like the rows
+                                                !! of J (its columns for transpose);
+                                                !! out: solution, indexed like the columns
+    integer, intent(out) :: status              !! MBD_OK, MBD_BAD_INPUT or MBD_LAPACK
+    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    logical, intent(in), optional :: transpose  !! solve J^T x = b (default .false.)
+    integer :: info, i
+    logical :: trans
+    status = MBD_OK; msg = ''
+    if (.not. b%factored) then
+      status = MBD_BAD_INPUT
+      msg = 'band_solve: the band matrix is not factored (band_factor)'
+      return
+    end if
+    if (size(x) /= b%n) then
+      status = MBD_BAD_INPUT
+      write (msg, '(a,i0,a,i0)') 'band_solve: right-hand side of length ', size(x), &
+        ', expected ', b%n
+      return
+    end if
+    trans = .false.
+    if (present(transpose)) trans = transpose
+    ! (loops, not vector subscripts: those make gfortran allocate temporaries)
+    if (trans) then
+      ! B^T (P_r x) = P_c b
+      do i = 1, b%n
+        b%rhs(b%pcol(i)) = x(i)
+      end do
+      call dgbtrs('T', b%n, b%kl, b%ku, 1, b%ab, b%ldab, b%ipiv, b%rhs, b%n, info)
+      do i = 1, b%n
+        x(i) = b%rhs(b%prow(i))
+      end do
+    else
+      ! B (P_c x) = P_r b
+      do i = 1, b%n
+        b%rhs(b%prow(i)) = x(i)
+      end do
+      call dgbtrs('N', b%n, b%kl, b%ku, 1, b%ab, b%ldab, b%ipiv, b%rhs, b%n, info)
+      do i = 1, b%n
+        x(i) = b%rhs(b%pcol(i))
+      end do
+    end if
+    call lapack_status('dgbtrs', info, status, msg)
+  end subroutine band_solve
+
+  !> kl and ku of the natural (identity) ordering of a structure, for comparison.
+  pure subroutine band_natural(rows, cols, kl, ku)
+    integer, intent(in) :: rows(:)   !! row of each nonzero
+    integer, intent(in) :: cols(:)   !! column of each nonzero
+    integer, intent(out) :: kl       !! max(i - j) over the nonzeros, at least 0
+    integer, intent(out) :: ku       !! max(j - i) over the nonzeros, at least 0
+    integer :: k
+    kl = 0; ku = 0
+    do k = 1, min(size(rows), size(cols))
+      kl = max(kl, rows(k) - cols(k))
+      ku = max(ku, cols(k) - rows(k))
+    end do
+  end subroutine band_natural
+
+  !> kl + ku of the natural (identity) ordering of a structure.
+  pure integer function band_width_natural(rows, cols) result(w)
+    integer, intent(in) :: rows(:)   !! row of each nonzero
+    integer, intent(in) :: cols(:)   !! column of each nonzero
+    integer :: kl, ku
+    call band_natural(rows, cols, kl, ku)
+    w = kl + ku
+  end function band_width_natural
+
+  ! ---------------------------------------------------------------------------------------
+  ! ordering
+
+  !> Compressed lists from (key, val) pairs: the distinct vals of key k are
+  !! idx(ptr(k):ptr(k+1)-1), in first-seen order. Indices are in 1..n.
+  pure subroutine compress(n, key, val, ptr, idx)
+    integer, intent(in) :: n                       !! number of keys
+    integer, intent(in) :: key(:), val(:)          !! pairs
+    integer, allocatable, intent(out) :: ptr(:)    !! n + 1 pointers
+    integer, allocatable, intent(out) :: idx(:)    !! values, repeats removed
+    integer, allocatable :: next(:), mark(:)
+    integer :: k, i, k0, w
+    allocate (ptr(n + 1), idx(size(key)), next(n), mark(n))
+    ptr = 0
+    do k = 1, size(key)
+      ptr(key(k) + 1) = ptr(key(k) + 1) + 1
+    end do
+    ptr(1) = 1
+    do i = 1, n
+      ptr(i + 1) = ptr(i + 1) + ptr(i)
+    end do
+    next = ptr(1:n)
+    do k = 1, size(key)
+      idx(next(key(k))) = val(k)
+      next(key(k)) = next(key(k)) + 1
+    end do
+    ! drop repeats in place (w <= k throughout)
+    mark = 0
+    w = 1
+    do i = 1, n
+      k0 = ptr(i)
+      ptr(i) = w
+      do k = k0, ptr(i + 1) - 1
+        if (mark(idx(k)) /= i) then
+          mark(idx(k)) = i
+          idx(w) = idx(k)
+          w = w + 1
+        end if
+      end do
+    end do
+    ptr(n + 1) = w
+  end subroutine compress
+
+  !> Adjacency of the column graph (the structure of J^T J without its diagonal).
+  pure subroutine column_graph(n, rptr, rcol, cptr, crow, aptr, adj)
+    integer, intent(in) :: n                      !! number of columns
+    integer, intent(in) :: rptr(:), rcol(:)       !! columns of each row
+    integer, intent(in) :: cptr(:), crow(:)       !! rows of each column
+    integer, allocatable, intent(out) :: aptr(:)  !! n + 1 pointers
+    integer, allocatable, intent(out) :: adj(:)   !! neighbours of each column
+    integer, allocatable :: mark(:)
+    integer :: c, k, m, d, pass, w
+    allocate (aptr(n + 1), mark(n), adj(0))
+    do pass = 1, 2
+      mark = 0
+      w = 1
+      do c = 1, n
+        aptr(c) = w
+        mark(c) = c
+        do k = cptr(c), cptr(c + 1) - 1
+          do m = rptr(crow(k)), rptr(crow(k) + 1) - 1
+            d = rcol(m)
+            if (mark(d) /= c) then
+              mark(d) = c
+              if (pass == 2) adj(w) = d
+              w = w + 1
+            end if
+          end do
+        end do
+      end do
+      aptr(n + 1) = w
+      if (pass == 1) then
+        deallocate (adj)
+        allocate (adj(w - 1))
+      end if
+    end do
+  end subroutine column_graph
+
+  !> Reverse Cuthill-McKee: order(k) is the node placed k-th.
+  pure subroutine rcm(n, aptr, adj, order)
+    integer, intent(in) :: n                 !! number of nodes
+    integer, intent(in) :: aptr(:), adj(:)   !! adjacency
+    integer, intent(out) :: order(:)         !! the ordering (n)
+    integer, allocatable :: deg(:), lvl(:), queue(:)
+    logical, allocatable :: done(:)
+    integer :: s, root, last, head, first, k, w, v, i, j
+    allocate (deg(n), lvl(n), queue(n), done(n))
+    deg = aptr(2:n + 1) - aptr(1:n)
+    lvl = 0
+    done = .false.
+    last = 0
+    do s = 1, n
+      if (done(s)) cycle
+      call peripheral(s, aptr, adj, deg, lvl, queue, root)
+      ! Cuthill-McKee: breadth first, unnumbered neighbours by increasing degree
+      last = last + 1
+      order(last) = root
+      done(root) = .true.
+      head = last
+      do while (head <= last)
+        v = order(head)
+        head = head + 1
+        first = last + 1
+        do k = aptr(v), aptr(v + 1) - 1
+          w = adj(k)
+          if (.not. done(w)) then
+            done(w) = .true.
+            last = last + 1
+            order(last) = w
+          end if
+        end do
+        do i = first + 1, last   ! stable insertion sort by degree
+          w = order(i)
+          j = i - 1
+          do while (j >= first)
+            if (deg(order(j)) <= deg(w)) exit
+            order(j + 1) = order(j)
+            j = j - 1
+          end do
+          order(j + 1) = w
+        end do
+      end do
+    end do
+    do i = 1, n / 2   ! reverse
+      w = order(i); order(i) = order(n + 1 - i); order(n + 1 - i) = w
+    end do
+  end subroutine rcm
+
+  !> A pseudo-peripheral node of the component of s (George & Liu): from the last level of
+  !! the rooted level structure take a node of least degree; repeat while the number of
+  !! levels (the eccentricity) grows.
+  pure subroutine peripheral(s, aptr, adj, deg, lvl, queue, root)
+    integer, intent(in) :: s                  !! a node of the component
+    integer, intent(in) :: aptr(:), adj(:)    !! adjacency
+    integer, intent(in) :: deg(:)             !! degrees
+    integer, intent(inout) :: lvl(:)          !! zero on entry and on return
+    integer, intent(inout) :: queue(:)        !! workspace
+    integer, intent(out) :: root              !! the pseudo-peripheral node
+    integer :: nlev, nlev_x, x, y
+    root = s
+    call levels(root, aptr, adj, deg, lvl, queue, nlev, x)
+    do
+      call levels(x, aptr, adj, deg, lvl, queue, nlev_x, y)
+      if (nlev_x <= nlev) exit
+      root = x; nlev = nlev_x; x = y
+    end do
+  end subroutine peripheral
+
+  !> Rooted level structure: its number of levels and a least-degree node of the last one.
+  pure subroutine levels(root, aptr, adj, deg, lvl, queue, nlev, x)
+    integer, intent(in) :: root               !! root node
+    integer, intent(in) :: aptr(:), adj(:)    !! adjacency
+    integer, intent(in) :: deg(:)             !! degrees
+    integer, intent(inout) :: lvl(:)          !! zero on entry and on return
+    integer, intent(inout) :: queue(:)        !! workspace
+    integer, intent(out) :: nlev              !! number of levels
+    integer, intent(out) :: x                 !! least-degree node of the last level
+    integer :: head, nq, v, w, k
+    lvl(root) = 1
+    queue(1) = root
+    nq = 1
+    head = 1
+    do while (head <= nq)
+      v = queue(head)
+      head = head + 1
+      do k = aptr(v), aptr(v + 1) - 1
+        w = adj(k)
+        if (lvl(w) == 0) then
+          lvl(w) = lvl(v) + 1
+          nq = nq + 1
+          queue(nq) = w
+        end if
+      end do
+    end do
+    nlev = lvl(queue(nq))
+    x = queue(nq)
+    do k = nq - 1, 1, -1
+      if (lvl(queue(k)) < nlev) exit
+      if (deg(queue(k)) < deg(x)) x = queue(k)
+    end do
+    lvl(queue(1:nq)) = 0
+  end subroutine levels
+
+  !> Row positions from the column positions: the best of three stable sorts by the first
+  !! (lo) and last (hi) new column of each row, by kl + ku and then kl.
+  pure subroutine order_rows(n, rptr, rcol, pcol, prow, kl, ku)
+    integer, intent(in) :: n                  !! number of rows
+    integer, intent(in) :: rptr(:), rcol(:)   !! columns of each row
+    integer, intent(in) :: pcol(:)            !! column positions
+    integer, intent(out) :: prow(:)           !! row positions
+    integer, intent(out) :: kl, ku            !! resulting band widths
+    integer, allocatable :: lo(:), hi(:), mid(:), idx(:), tmp(:), cnt(:)
+    integer :: r, k, cand, l, u
+    allocate (lo(n), hi(n), mid(n), idx(n), tmp(n), cnt(0:2 * n + 1))
+    do r = 1, n
+      lo(r) = n; hi(r) = 1
+      do k = rptr(r), rptr(r + 1) - 1
+        lo(r) = min(lo(r), pcol(rcol(k)))
+        hi(r) = max(hi(r), pcol(rcol(k)))
+      end do
+      mid(r) = lo(r) + hi(r)
+    end do
+    kl = n; ku = n   ! above any candidate's (kl, ku <= n - 1)
+    do cand = 1, 3
+      do r = 1, n
+        idx(r) = r
+      end do
+      select case (cand)
+      case (1)   ! (lo, hi)
+        call sort_stable(hi, idx, tmp, cnt)
+        call sort_stable(lo, idx, tmp, cnt)
+      case (2)   ! (hi, lo)
+        call sort_stable(lo, idx, tmp, cnt)
+        call sort_stable(hi, idx, tmp, cnt)
+      case default   ! (lo + hi, lo)
+        call sort_stable(lo, idx, tmp, cnt)
+        call sort_stable(mid, idx, tmp, cnt)
+      end select
+      l = 0; u = 0
+      do k = 1, n
+        l = max(l, k - lo(idx(k)))
+        u = max(u, hi(idx(k)) - k)
+      end do
+      if (l + u < kl + ku .or. (l + u == kl + ku .and. l < kl)) then
+        kl = l; ku = u
+        do k = 1, n
+          prow(idx(k)) = k
+        end do
+      end if
+    end do
+  end subroutine order_rows
+
+  !> Stable counting sort of idx by key(idx); keys in 0..size(cnt)-2.
+  pure subroutine sort_stable(key, idx, tmp, cnt)
+    integer, intent(in) :: key(:)          !! sort keys of the items
+    integer, intent(inout) :: idx(:)       !! items, sorted on return
+    integer, intent(inout) :: tmp(:)       !! workspace (size(idx))
+    integer, intent(inout) :: cnt(0:)      !! workspace (largest key + 2)
+    integer :: k, c
+    cnt = 0
+    do k = 1, size(idx)
+      cnt(key(idx(k)) + 1) = cnt(key(idx(k)) + 1) + 1
+    end do
+    do c = 1, ubound(cnt, 1)
+      cnt(c) = cnt(c) + cnt(c - 1)
+    end do
+    ! cnt(c) is now the number of keys below c
+    do k = 1, size(idx)
+      c = key(idx(k))
+      cnt(c) = cnt(c) + 1
+      tmp(cnt(c)) = idx(k)
+    end do
+    idx = tmp
+  end subroutine sort_stable
+
+  !> Sign of a permutation: (-1)**(n - number of cycles).
+  pure integer function perm_parity(p) result(sgn)
+    integer, intent(in) :: p(:)   !! a permutation of 1..size(p)
+    logical, allocatable :: seen(:)
+    integer :: i, j
+    allocate (seen(size(p)))
+    seen = .false.
+    sgn = 1
+    do i = 1, size(p)
+      if (seen(i)) cycle
+      j = p(i)
+      seen(i) = .true.
+      do while (j /= i)   ! each further element of the cycle is one transposition
+        seen(j) = .true.
+        sgn = -sgn
+        j = p(j)
+      end do
+    end do
+  end function perm_parity
+
+end module mbd_band
