@@ -20,12 +20,12 @@ module mbd_api
   use mbd_assemble, only: assemble_dense, asm_work_t, asm_init
   use mbd_kinematics, only: kin_opts_t, kin_report_t, kin_work_t, kin_run, kin_work_init, &
                             kin_assemble, kin_rank, kin_out_count, MAXPASS, SOLVER_AUTO, &
-                            SOLVER_BANDED
+                            SOLVER_BANDED, kin_newton, kin_vel_acc
   use mbd_status, only: MBD_BAD_SETTING
   use mbd_profiles, only: profile_raw_length, profile_prepare, profile_eval
   implicit none
   private
-  public :: NINFO, api_sizes, api_eval, api_kinematics, api_profile, api_analyze
+  public :: NINFO, api_sizes, api_eval, api_kinematics, api_profile, api_analyze, api_kin_step
   public :: api_inverse, api_dynamics, api_statics, api_reactions
 
   integer, parameter :: NINFO = 10   !! length of the report arrays
@@ -179,6 +179,63 @@ contains
     if (allocated(rep%redundant)) redundant = rep%redundant
     tpass = rep%tpass
   end subroutine api_kinematics
+
+  !> One kinematic step per call (for time loops driven from outside): from the state
+  !! (q, q_dot, q_ddot) at t_prev, the predictor q + h q_dot + h**2/2 q_ddot (h = t - t_prev),
+  !! Newton-Raphson on Phi(q, t) = 0, then J q_dot = nu and J q_ddot = gamma. With assemble,
+  !! q holds rough estimates at t and is assembled first (q_dot, q_ddot, t_prev unused).
+  !! No step control: a Newton failure or a singular J is returned as the status.
+  subroutine api_kin_step(nb, ctab, rpar, q, qd, qdd, t_prev, t, tol, maxit, assemble, &
+                          status, msg)
+    integer, intent(in) :: nb                   !! moving bodies
+    integer, intent(in) :: ctab(:, :)           !! constraint table
+    real(wp), intent(in) :: rpar(:)             !! raw parameters
+    real(wp), intent(inout) :: q(:)             !! coordinates at t_prev, then at t (nq)
+    real(wp), intent(inout) :: qd(:), qdd(:)    !! velocities and accelerations, likewise
+    real(wp), intent(in) :: t_prev, t           !! previous and new time
+    real(wp), intent(in) :: tol                 !! Newton tolerance (<= 0: default)
+    integer, intent(in) :: maxit                !! Newton iterations (<= 0: default)
+    integer, intent(in) :: assemble             !! 1: assemble q from estimates at t
+    integer, intent(out) :: status              !! MBD_OK, < 0 input, > 0 numerical
+    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    type(model_t) :: m
+    type(kin_opts_t) :: opts
+    type(kin_report_t) :: rep
+    type(kin_work_t) :: w
+    real(wp) :: h
+    integer :: bad, lev
+    call model_build(nb, ctab, rpar, m, status, msg, bad)
+    if (status /= MBD_OK) return
+    if (size(q) /= m%nq .or. size(qd) /= m%nq .or. size(qdd) /= m%nq .or. m%neq /= m%nq) then
+      status = MBD_BAD_COUNT
+      msg = 'array sizes do not match the model, or J is not square (stepping needs as '// &
+            'many equations as coordinates)'
+      return
+    end if
+    if (.not. (finite(q) .and. finite(qd) .and. finite(qdd) .and. finite(t) .and. &
+               finite(t_prev) .and. finite(tol))) then
+      call not_finite('the state, the times and tol', status, msg); return
+    end if
+    if (tol > zero) opts%tol = tol
+    if (maxit > 0) opts%maxit = maxit
+    call kin_work_init(m, w)
+    w%tol = opts%tol * m%lscale
+    if (assemble == 1) then
+      allocate (rep%qsing(m%nq), rep%dep(m%neq), rep%redundant(m%neq))
+      call kin_assemble(m, w, q, t, opts, rep, status, msg)
+      if (status /= MBD_OK) return
+    else
+      h = t - t_prev
+      q = q + h * (qd + (0.5_wp * h) * qdd)     ! q(t) ~ q + h q_dot + h**2/2 q_ddot
+    end if
+    call kin_newton(m, w, q, t, opts%maxit, status)
+    if (status /= MBD_OK) then
+      write (msg, '(a,es22.15)') 'Newton-Raphson failed (or J is singular) at t = ', t
+      return
+    end if
+    call kin_vel_acc(m, w, q, t, qd, qdd, status, lev)
+    if (status /= MBD_OK) msg = 'velocities or accelerations could not be solved'
+  end subroutine api_kin_step
 
   !> Degrees of freedom and redundancy at the configuration assembled from q0 at time t:
   !! the rank of J, the mobility of the joints alone, and the redundant rows. On a failed

@@ -54,6 +54,23 @@ subroutine core_kinematics(nb, nc, ctab, np, rpar, nq, neq, q0, t0, t1, nsteps, 
                       status, msg)
 end subroutine core_kinematics
 
+subroutine core_kin_step(nb, nc, ctab, np, rpar, nq, q, qd, qdd, t_prev, t, tol, maxit, &
+                         assemble, status, msg)
+  use iso_c_binding, only: c_double, c_int
+  use mbd_api, only: api_kin_step
+  implicit none
+  integer(c_int), intent(in) :: nb, nc, np, nq, maxit, assemble
+  integer(c_int), intent(in) :: ctab(8, nc)
+  real(c_double), intent(in) :: rpar(np), t_prev, t, tol
+  real(c_double), intent(inout) :: q(nq), qd(nq), qdd(nq)
+  integer(c_int), intent(out) :: status
+  character(len=512), intent(out) :: msg
+  !f2py intent(hide) :: nc, np, nq
+  !f2py intent(in,out) :: q, qd, qdd
+  !f2py threadsafe
+  call api_kin_step(nb, ctab, rpar, q, qd, qdd, t_prev, t, tol, maxit, assemble, status, msg)
+end subroutine core_kin_step
+
 subroutine core_analyze(nb, nc, ctab, np, rpar, nq, neq, q0, t, tol, q, rank, mobility, &
                         redundant, dep, resid, worst, status, msg)
   use iso_c_binding, only: c_double, c_int

@@ -18,13 +18,14 @@ from .errors import (AnalysisError, AssemblyError, ConvergenceError, CoreError,
                      SingularJacobianError, SingularPassageWarning, ToggleError)
 from .functions import Harmonic, TimeFunction
 from .model import Model
+from .stepping import KinematicStepper
 from .results import BodyResult, DynamicsResult, KinematicsResult, Reaction, StaticsResult
 from .toml_io import load, loads
 
 __version__ = "0.1.0"
 
 __all__ = ["load", "loads", "Model", "TimeFunction", "Harmonic", "KinematicsResult",
-           "BodyResult", "DynamicsResult", "StaticsResult", "Reaction", "DofReport",
+           "BodyResult", "DynamicsResult", "KinematicStepper", "StaticsResult", "Reaction", "DofReport",
            "MbdError", "ModelError", "AnalysisError", "IntegrationError",
            "AssemblyError", "InconsistentConstraintsError", "ConvergenceError",
            "SingularJacobianError", "SingularConfigurationError", "ToggleError", "CoreError",

@@ -1,0 +1,93 @@
+"""Kinematics one step per call, for time loops that live in Python (co-simulation, custom
+drivers, interactive tools). Each :meth:`KinematicStepper.step` is one call into the core."""
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from . import _core
+from .analysis import check_solver, require_determined
+from .errors import AssemblyError, ConvergenceError, ModelError
+from .pack import decode, pack
+from .validate import number
+
+if TYPE_CHECKING:  # pragma: no cover
+    from .model import Model
+
+
+class KinematicStepper:
+    """Position, velocity and acceleration analysis driven one output time at a time.
+
+    Each step predicts q from the last state (q + h q_dot + h^2/2 q_ddot), runs Newton-Raphson
+    on Phi(q, t) = 0 and solves J q_dot = nu, J q_ddot = gamma, all in one core call. There
+    is no step control: a singular configuration or a failed Newton iteration raises
+    :class:`~mbd2d.ConvergenceError`. :meth:`Model.kinematics` (the whole loop in the core)
+    is faster and locates dead centres; use it unless the loop must be in Python.
+
+    Parameters
+    ----------
+    model : Model
+        A kinematically determined model with as many equations as coordinates.
+    t0 : float
+        Start time; the q0 estimates are assembled there.
+    tol : float, optional
+        Newton tolerance relative to the model's length scale (default 1e-12).
+
+    Attributes
+    ----------
+    t : float
+        Time of the current state.
+    q, qd, qdd : numpy.ndarray
+        Coordinates, velocities and accelerations at ``t``.
+
+    Examples
+    --------
+    >>> import mbd2d
+    >>> s = mbd2d.KinematicStepper(mbd2d.load("examples/fourbar_grashof.toml"))
+    >>> q, qd, qdd = s.step(0.01)
+    >>> q.shape
+    (9,)
+    """
+
+    def __init__(self, model: "Model", t0: float = 0.0, tol: float | None = None) -> None:
+        self._p = pack(model)
+        require_determined(self._p, model)
+        if self._p.neq != self._p.nq:
+            raise ModelError("stepping needs as many equations as coordinates (no redundant "
+                             "constraints); use Model.kinematics", "stepping")
+        self._tol, _ = check_solver(tol, None)
+        self.t = number(t0, "t0", "stepping")
+        self.q = self._p.q0.copy()
+        self.qd = np.zeros_like(self.q)
+        self.qdd = np.zeros_like(self.q)
+        self._call(self.t, assemble=True)
+
+    def _call(self, t: float, assemble: bool) -> None:
+        p = self._p
+        q, qd, qdd, status, msg = _core.core_kin_step(p.nb, p.ctab, p.rpar, self.q, self.qd,
+                                                      self.qdd, self.t, t, self._tol, 0,
+                                                      int(assemble))
+        if status < 0:
+            raise ModelError(decode(msg), "stepping")
+        if status > 0:
+            cls = AssemblyError if assemble else ConvergenceError
+            raise cls(f"{decode(msg)}; the state stays at t = {self.t:.9g} s (Model.kinematics "
+                      "locates singular configurations)", t=t, status=int(status))
+        self.q, self.qd, self.qdd, self.t = q, qd, qdd, t
+
+    def step(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Advance to time t (one core call).
+
+        Parameters
+        ----------
+        t : float
+            The new time (any direction; small steps keep Newton on its branch).
+
+        Returns
+        -------
+        tuple of numpy.ndarray
+            q, q_dot, q_ddot at t.
+        """
+        self._call(float(t), assemble=False)
+        return self.q, self.qd, self.qdd
