@@ -11,13 +11,16 @@ module mbd_assemble
   use mbd_constraints, only: con_eval, con_init_extra
   implicit none
   private
-  public :: asm_work_t, asm_init, assemble_blocks, scatter_dense, assemble_dense, init_extras, &
-            gather_local
+  public :: asm_work_t, asm_init, assemble_blocks, scatter_dense, scatter_mapped, &
+            assemble_dense, init_extras, gather_local
 
   !> Work arrays of the assembly, allocated once per analysis.
   type :: asm_work_t
     real(wp), allocatable :: jb(:, :, :)   !! local Jacobian blocks (MAXROW, NLOC, nc)
     real(wp), allocatable :: cb(:), sb(:)  !! cos and sin of each body's angle (0:nb; 0 ground)
+    !> the nonzeros of the blocks: jb(src(i)) goes to J(dst(i)) and column col(i) (flat
+    !! column-major indices into jb and the dense neq x nq J)
+    integer, allocatable :: src(:), dst(:), col(:)
   end type asm_work_t
 
 contains
@@ -26,9 +29,27 @@ contains
   pure subroutine asm_init(m, a)
     type(model_t), intent(in) :: m         !! model
     type(asm_work_t), intent(out) :: a     !! work arrays
+    integer :: k, s, r, n
     allocate (a%jb(MAXROW, NLOC, m%nc), a%cb(0:m%nb), a%sb(0:m%nb))
     a%jb = zero
     a%cb = one; a%sb = zero
+    n = 0
+    do k = 1, m%nc
+      n = n + m%nrow(k) * count(m%loc(:, k) > 0)
+    end do
+    allocate (a%src(n), a%dst(n), a%col(n))
+    n = 0
+    do k = 1, m%nc
+      do s = 1, NLOC
+        if (m%loc(s, k) == 0) cycle
+        do r = 1, m%nrow(k)
+          n = n + 1
+          a%src(n) = r + MAXROW * (s - 1 + NLOC * (k - 1))
+          a%col(n) = m%loc(s, k)
+          a%dst(n) = m%row0(k) + r - 1 + m%neq * (m%loc(s, k) - 1)
+        end do
+      end do
+    end do
   end subroutine asm_init
 
   !> Local coordinates (and velocities) of constraint k.
@@ -108,6 +129,26 @@ contains
       end do
     end do
   end subroutine scatter_dense
+
+  !> Place the local blocks into a dense J D (neq x nq, D = diag(cs)) through the map of
+  !! asm_init.
+  pure subroutine scatter_mapped(a, cs, jac)
+    type(asm_work_t), intent(in) :: a         !! blocks and their map
+    real(wp), intent(in) :: cs(:)             !! column scale
+    real(wp), intent(out) :: jac(:, :)        !! dense J D
+    call scatter_flat(a%src, a%dst, a%col, a%jb, cs, jac, size(a%jb), size(jac))
+  end subroutine scatter_mapped
+
+  pure subroutine scatter_flat(src, dst, col, jb, cs, jac, nb, nj)
+    integer, intent(in) :: src(:), dst(:), col(:), nb, nj
+    real(wp), intent(in) :: jb(nb), cs(:)
+    real(wp), intent(out) :: jac(nj)
+    integer :: i
+    jac = zero
+    do i = 1, size(src)
+      jac(dst(i)) = jac(dst(i)) + jb(src(i)) * cs(col(i))
+    end do
+  end subroutine scatter_flat
 
   !> Phi, nu, gamma and the dense J in one call.
   pure subroutine assemble_dense(m, q, qd, t, phi, nu, gam, a, jac)

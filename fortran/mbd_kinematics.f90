@@ -32,7 +32,7 @@ module mbd_kinematics
   use mbd_points, only: NLOC, MAXROW
   use mbd_model, only: model_t
   use mbd_constraints, only: con_is_driver, con_name
-  use mbd_assemble, only: asm_work_t, asm_init, assemble_blocks, assemble_dense, scatter_dense, &
+  use mbd_assemble, only: asm_work_t, asm_init, assemble_blocks, assemble_dense, scatter_mapped, &
                           init_extras
   use mbd_band, only: band_t, band_plan, band_zero, band_norm1, band_factor, &
                       band_rcond, band_solve
@@ -180,7 +180,7 @@ contains
     integer :: k, s, r, c, r0, d0, jc, ir
     call assemble_blocks(m, q, qd, t, w%phi, w%nu, w%gam, w%asm)
     if (.not. w%banded) then
-      call scatter_dense(m, w%asm%jb, w%jac)
+      call scatter_mapped(w%asm, w%cs, w%jac)      ! J D, scaled here
       return
     end if
     ! J(i, j) D(j) -> ab(kl + ku + 1 + prow(i) - pcol(j), pcol(j))  (the planned structure:
@@ -212,7 +212,7 @@ contains
     call assemble_dense(m, q, qd, t, w%phi, w%nu, w%gam, w%asm, w%jac)
   end subroutine dense_j
 
-  !> Factor J D (J in w%jac, D = diag(w%cs)) by LU or, in least-squares mode, QR.
+  !> Factor J D (in w%jac or the band, from assemble_j) by LU or, in least-squares mode, QR.
   subroutine factor(w, status)
     type(kin_work_t), intent(inout) :: w   !! work arrays
     integer, intent(out) :: status         !! MBD_OK or MBD_SINGULAR
@@ -228,11 +228,10 @@ contains
       return
     end if
     n = size(w%cs)
-    anorm = zero
+    anorm = zero        ! ||J D||_1 (assemble_j scaled the columns)
     do k = 1, n
       colsum = zero
       do i = 1, size(w%jac, 1)
-        w%jac(i, k) = w%jac(i, k) * w%cs(k)
         colsum = colsum + abs(w%jac(i, k))
       end do
       anorm = max(anorm, colsum)

@@ -3,7 +3,7 @@ module mbd_lapack
   use mbd_kinds, only: wp
   implicit none
   private
-  public :: dgetrf, dgetf2, dgetrs, dgesvd, dgels, dgelsy, dgtsv, dgeqp3, dormqr, dtrtrs, dgecon, &
+  public :: dgetrf, dgetf2, dgetrs, dtrsv, dgesvd, dgels, dgelsy, dgtsv, dgeqp3, dormqr, dtrtrs, dgecon, &
             dtrcon, dsyev
   public :: dgbtrf, dgbtrs, dgbcon, dlacn2
 
@@ -126,6 +126,14 @@ module mbd_lapack
     end subroutine dgtsv
   end interface
   interface
+    !> Triangular solve A x = b (BLAS level 2), x overwrites b.
+    pure subroutine dtrsv(uplo, trans, diag, n, a, lda, x, incx)
+      import :: wp
+      character(len=1), intent(in) :: uplo, trans, diag
+      integer, intent(in) :: n, lda, incx
+      real(wp), intent(in) :: a(lda, *)
+      real(wp), intent(inout) :: x(*)
+    end subroutine dtrsv
     !> LU factorization of a band matrix with partial pivoting (ldab >= 2 kl + ku + 1).
     pure subroutine dgbtrf(m, n, kl, ku, ab, ldab, ipiv, info)
       import :: wp

@@ -1,7 +1,7 @@
 !> mbd_linsolve: the LAPACK calls, and the one place LAPACK's info becomes a status.
 !!
 !!   lu_factor   A = P L U               (dgetf2 up to SMALL_N, else dgetrf)
-!!   lu_solve    A x = b from the factors (dgetrs)
+!!   lu_solve    A x = b from the factors (dgetrs' steps: row interchanges, two dtrsv)
 !!   lu_det_sign sign of det A from the factors: prod(sign U_ii) * (-1)**(row swaps)
 !!   svd_null    singular values of A and the singular vectors of the smallest one (dgesvd)
 !!   row_rank    rank of A (QR with column pivoting of the row-normalized A^T, dgeqp3) and the
@@ -13,7 +13,7 @@
 module mbd_linsolve
   use mbd_kinds, only: wp, zero
   use mbd_status, only: MBD_OK, MBD_SINGULAR, MBD_LAPACK, MSG_LEN
-  use mbd_lapack, only: dgetrf, dgetf2, dgetrs, dgesvd, dgeqp3, dormqr, dtrtrs
+  use mbd_lapack, only: dgetrf, dgetf2, dtrsv, dgesvd, dgeqp3, dormqr, dtrtrs
   implicit none
   private
   public :: lapack_status, lu_factor, lu_solve, lu_det_sign, svd_null, row_rank
@@ -72,12 +72,28 @@ contains
     real(wp), intent(in) :: a(:, :)             !! LU factors
     integer, intent(in) :: ipiv(:)              !! pivots
     real(wp), intent(inout) :: b(:)             !! right-hand side, then solution
-    integer, intent(out) :: status              !! MBD_OK
+    integer, intent(out) :: status              !! MBD_OK, or MBD_SINGULAR on overflow
     character(len=MSG_LEN), intent(inout) :: msg  !! explanation (on a failure)
-    integer :: n, info
+    integer :: n, i
+    real(wp) :: s
+    ! dgetrs with one right-hand side, by its steps: b <- P^T b (the row interchanges in
+    ! order), L y = b, U x = y (dtrsv: level 2, cheaper than dgetrs' dtrsm for small n)
     n = size(a, 1)
-    call dgetrs('N', n, 1, a, n, ipiv, b, n, info)
-    call lapack_status('dgetrs', info, status, msg)
+    do i = 1, n
+      if (ipiv(i) /= i) then
+        s = b(i); b(i) = b(ipiv(i)); b(ipiv(i)) = s
+      end if
+    end do
+    call dtrsv('L', 'N', 'U', n, a, n, b, 1)
+    call dtrsv('U', 'N', 'N', n, a, n, b, 1)
+    status = MBD_OK
+    do i = 1, n
+      if (.not. abs(b(i)) <= huge(s)) then
+        status = MBD_SINGULAR
+        msg = 'the solution overflows: the matrix is singular to working precision'
+        return
+      end if
+    end do
   end subroutine lu_solve
 
   !> Sign of det A from its LU factors (zero if a pivot is zero).
