@@ -37,7 +37,16 @@ demo: install
 test: install
 	$(PY) -m pytest tests
 
-bench: install
+# bench-only packages; Exudyn (the peer comparison) is optional: without it the bench says
+# so and runs the rest
+BENCHDEPS := scipy
+$(VENV)/.bench-ok: $(VENV)/.deps-ok
+	$(PY) -m pip install -q --disable-pip-version-check $(BENCHDEPS)
+	$(PY) -m pip install -q --disable-pip-version-check exudyn || \
+		echo "exudyn could not be installed: the benchmarks run without the peer comparison"
+	touch $@
+
+bench: install $(VENV)/.bench-ok
 	$(PY) bench/run.py
 
 clean:

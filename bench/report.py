@@ -1,0 +1,420 @@
+"""Markdown from the benchmark results: bench/RESULTS.md, the README headline and the targets.
+
+Every function takes the ``results`` dict that bench/run.py assembles (one entry per section,
+a failed section being {"failed": True, "error", ...}) and returns text; nothing here runs a
+benchmark.
+"""
+from __future__ import annotations
+
+import math
+import os
+import statistics
+from pathlib import Path
+from typing import Any, Iterable, Sequence
+
+ROOT = Path(__file__).resolve().parents[1]
+FOURBAR = "four-bar (Grashof)"
+SLIDER = "slider-crank"
+
+Row = dict[str, Any]
+
+
+# ===================================================================== formatting
+def fmt(v: Any, spec: str = ".3g", none: str = "–") -> str:
+    """A number formatted with spec, or `none` for None / non-finite."""
+    if v is None or (isinstance(v, float) and not math.isfinite(v)):
+        return none
+    return format(v, spec)
+
+
+def table(header: Sequence[str], rows: Iterable[Sequence[Any]]) -> str:
+    """A Markdown table."""
+    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    lines += ["| " + " | ".join(str(c) for c in r) + " |" for r in rows]
+    return "\n".join(lines) + "\n"
+
+
+def image(charts: dict[str, str], name: str, out: Path, base: Path, alt: str) -> str:
+    """An image link from the directory `base` to the chart `name` in `out` ('' if none)."""
+    if name not in charts:
+        return f"*(chart {name} not drawn)*\n"
+    rel = os.path.relpath(out / charts[name], base).replace(os.sep, "/")
+    return f"![{alt}]({rel})\n"
+
+
+def get(d: Any, *keys: Any, default: Any = None) -> Any:
+    """d[k1][k2]... or default when a level is missing."""
+    for k in keys:
+        if isinstance(d, dict) and k in d:
+            d = d[k]
+        elif isinstance(d, (list, tuple)) and isinstance(k, int) and -len(d) <= k < len(d):
+            d = d[k]
+        else:
+            return default
+    return d
+
+
+def failed(section: Any) -> str | None:
+    """The error message of a failed (or missing) section, else None."""
+    if not isinstance(section, dict):
+        return "not run"
+    return section.get("error") if section.get("failed") else None
+
+
+# ===================================================================== targets
+def _target(name: str, figure: str, met: bool | None, detail: str = "") -> Row:
+    return {"target": name, "figure": figure, "met": met, "detail": detail}
+
+
+def kinematics_targets(results: dict) -> list[Row]:
+    """<= 1 us/step four-bar (Fortran loop) and >= 100x faster than NumPy."""
+    rows = get(results, "kinematics", "rows") or {}
+    fb = rows.get(FOURBAR, {})
+    us = get(fb, "fortran_loop", "us_per_step")
+    fine = get(fb, "fortran_loop_h1e-4", "us_per_step")
+    out = [_target("kinematics, four-bar, Fortran loop: <= 1 us/step",
+                   f"{fmt(us, '.2f')} us/step at h = 1 ms ({fmt(fine, '.2f')} at h = 0.1 ms)",
+                   None if us is None else us <= 1.0,
+                   "position + velocity + acceleration per step")]
+    ratios = {k: v.get("ratio_numpy_over_loop") for k, v in rows.items()}
+    if ratios and all(r is not None for r in ratios.values()):
+        fig = ", ".join(f"{k} {v:.0f}x" for k, v in ratios.items())
+        out.append(_target("kinematics: Fortran loop >= 100x faster than plain NumPy", fig,
+                           min(ratios.values()) >= 100.0, "same h = 1 ms, same algorithm"))
+    else:
+        out.append(_target("kinematics: Fortran loop >= 100x faster than plain NumPy",
+                           "not measured", None, failed(results.get("kinematics")) or ""))
+    return out
+
+
+def peer_targets(results: dict) -> list[Row]:
+    """>= 5x Exudyn on the free four-bar at equal accuracy, >= 50x on kinematic stepping."""
+    peers = results.get("peers") or {}
+    if failed(peers) or not peers.get("exudyn_available"):
+        why = failed(peers) or peers.get("exudyn_unavailable_reason") or "not run"
+        return [_target("free four-bar: >= 5x faster than Exudyn at equal accuracy",
+                        f"Exudyn unavailable: {why}", None),
+                _target("kinematic stepping: >= 50x faster than Exudyn",
+                        f"Exudyn unavailable: {why}", None)]
+    eq = [r["ratio"] for r in get(peers, "dynamics", "equal_accuracy", default=[]) or []
+          if r.get("ratio")]
+    same = [r["time_ratio_exudyn_over_mbd2d"]
+            for r in get(peers, "dynamics", "side_by_side", default=[]) or []
+            if r.get("time_ratio_exudyn_over_mbd2d")]
+    if eq:
+        fig = (f"min {min(eq):.1f}x, median {statistics.median(eq):.1f}x over {len(eq)} "
+               f"Exudyn step sizes")
+        if same:
+            fig += (f" (same method, generalized-alpha at equal h: {min(same):.1f}x – "
+                    f"{max(same):.1f}x)")
+        dyn = _target("free four-bar: >= 5x faster than Exudyn at equal accuracy", fig,
+                      min(eq) >= 5.0, "met when every Exudyn point is matched >= 5x faster")
+    else:
+        dyn = _target("free four-bar: >= 5x faster than Exudyn at equal accuracy",
+                      "not measured", None)
+    ratio = get(peers, "kinematics", "ratio")
+    kin = _target("kinematic stepping: >= 50x faster than Exudyn",
+                  f"{fmt(ratio, '.0f')}x (Exudyn's fastest variant: "
+                  f"{get(peers, 'kinematics', 'exudyn_best')})" if ratio else "not measured",
+                  None if ratio is None else ratio >= 50.0,
+                  "mbd2d computes q, qd, qdd; Exudyn's static solves q only")
+    return [dyn, kin]
+
+
+def scaling_targets(results: dict) -> list[Row]:
+    """About linear in N (banded path) and N = 1000 at <= 2 ms per step."""
+    sc = results.get("scaling") or {}
+    if failed(sc):
+        return [_target("scaling: about linear in N", "not measured", None, failed(sc))]
+    slope = sc.get("banded_slope")
+    path = "banded"
+    if slope is None:
+        slope, path = sc.get("dense_slope"), "dense (no banded path)"
+    t = sc.get("target") or {}
+    return [_target("kinematics scaling with N: about linear (log-log slope ~ 1)",
+                    f"slope {fmt(slope, '.2f')} ({path} path, N >= 10)",
+                    None if slope is None else slope <= 1.25,
+                    "met for a fitted slope <= 1.25"),
+            _target("kinematics, N-four-bar N = 1000: <= 2 ms per step",
+                    f"{fmt(t.get('ms_per_step'), '.3f')} ms/step ({t.get('path')} path)"
+                    if t.get("ms_per_step") is not None else "not measured",
+                    t.get("met") if t.get("ms_per_step") is not None else None)]
+
+
+def runtime_target(results: dict) -> list[Row]:
+    """`make bench` in under 10 minutes (the run itself, without the install)."""
+    total = get(results, "meta", "total_runtime_s")
+    return [_target("make bench: under 10 minutes on this 2-core machine",
+                    f"{fmt(total, '.0f')} s for bench/run.py (installs not counted)",
+                    None if total is None else total < 600.0)]
+
+
+def targets(results: dict) -> list[Row]:
+    """Every target with its measured figure and whether it is met (None: not measured)."""
+    return (kinematics_targets(results) + peer_targets(results) + scaling_targets(results)
+            + runtime_target(results))
+
+
+def met_text(met: bool | None) -> str:
+    return {True: "met", False: "**not met**", None: "not measured"}[met]
+
+
+# ===================================================================== sections
+def machine_section(env: dict) -> str:
+    """The machine and versions table."""
+    git = env.get("git") or {}
+    dirty = git.get("uncommitted_changes_outside_bench") or []
+    rows = [("CPU", f"{env.get('cpu_model')}, {env.get('cores')} cores, "
+                    f"{fmt(env.get('memory_gib'), '.0f')} GiB"),
+            ("OS", env.get("os")), ("Python", env.get("python")),
+            ("numpy", f"{env.get('numpy')} ({env.get('numpy_blas')})"),
+            ("scipy / matplotlib", f"{env.get('scipy')} / {env.get('matplotlib')}"),
+            ("gfortran", env.get("gfortran")),
+            ("BLAS / LAPACK of the mbd2d core", "<br>".join(env.get("blas_lapack") or [])
+             or "unknown"),
+            ("mbd2d", f"{env.get('mbd2d')}, commit `{str(git.get('commit'))[:12]}` "
+                      f"({git.get('subject')})"
+                      + (f"; uncommitted changes in {', '.join(dirty)}" if dirty else "")),
+            ("Exudyn", env.get("exudyn") or f"unavailable: {env.get('exudyn_unavailable_reason')}"),
+            ("load average (1 min) at start / end",
+             f"{fmt(get(env, 'load_average_start', 0), '.2f')} / "
+             f"{fmt(get(env, 'load_average_end', 0), '.2f')}"),
+            ("date (UTC)", env.get("date_utc"))]
+    return table(("", ""), rows)
+
+
+def wp_table(data: dict) -> str:
+    """Every row of one work-precision study."""
+    rows = []
+    for r in data.get("rows", []):
+        note = "" if r.get("ok") else r.get("message", "")[:80]
+        if "branch_kept" in r and r.get("ok"):
+            note = "branch kept" if r["branch_kept"] else "left the branch"
+        rows.append((r.get("variant", ""), r["method"], r["setting"], fmt(r.get("error"), ".2e"),
+                     fmt(r.get("cpu_s"), ".4f"), fmt(r.get("steps"), "d"), note))
+    return table(("model", "method", "setting", "error (rad)", "CPU s", "steps", "note"), rows)
+
+
+def work_precision_section(results: dict, charts: dict, out: Path, base: Path) -> str:
+    """Charts, settings and tables of the three studies."""
+    wp = results.get("work_precision") or {}
+    if failed(wp):
+        return f"Failed: {failed(wp)}\n"
+    parts = ["Error against CPU time (best-of-3 wall time of one `model.dynamics` call for "
+             "runs under 0.5 s, one run otherwise), one line per method and sweep: the "
+             "adaptive methods over rtol (atol = rtol/100), the fixed-step ones over h. "
+             "A sweep stops once one of its runs takes over its time budget (the remaining "
+             "settings are listed as skipped).\n"]
+    titles = {"fourbar": "Free four-bar, 10 s", "andrews": "Andrews' squeezer, to 0.03 s",
+              "nfourbar": "IFToMM N-four-bar, 10 s"}
+    for name, title in titles.items():
+        data = wp.get(name) or {}
+        parts.append(f"### {title}\n")
+        if failed(data):
+            parts.append(f"Failed: {failed(data)}\n")
+            continue
+        parts.append(f"{data.get('model', '')}.\n\nReference: "
+                     f"{get(data, 'reference', 'description')}; check "
+                     f"{fmt(get(data, 'reference', 'check'), '.1e')} rad.\n")
+        parts.append(image(charts, f"wp_{name}", out, base, f"work-precision {name}"))
+        parts.append("Sweeps: " + "; ".join(data.get("sweeps", [])) + ".\n")
+        parts.append(f"<details><summary>All {len(data.get('rows', []))} runs "
+                     f"({fmt(data.get('runtime_s'), '.0f')} s)</summary>\n\n{wp_table(data)}"
+                     "\n</details>\n")
+    return "\n".join(parts)
+
+
+def peers_section(results: dict) -> str:
+    """Exudyn side by side, at equal accuracy, and kinematic stepping."""
+    peers = results.get("peers") or {}
+    if failed(peers):
+        return f"Failed: {failed(peers)}\n"
+    parts = []
+    if not peers.get("exudyn_available"):
+        parts.append(f"**Exudyn is unavailable** ({peers.get('exudyn_unavailable_reason')}); "
+                     "only mbd2d's side was run.\n")
+    parts.append(f"Free four-bar, 10 s, generalized-alpha at fixed h in both codes "
+                 f"(rho_inf = {get(peers, 'dynamics', 'rho_inf')}); error: max abs angle "
+                 "error against mbd2d dopri5 at rtol 1e-12. Time: best-of-3 wall time of the "
+                 "solve call (Exudyn: `mbs.SolveDynamic`, model assembled before). The "
+                 "Exudyn points are also on the four-bar work-precision chart.\n")
+    rows = [(fmt(r["h"], ".0e"), fmt(r["exudyn_error"], ".2e"), fmt(r["exudyn_cpu_s"], ".4f"),
+             fmt(r["mbd2d_error"], ".2e"), fmt(r["mbd2d_cpu_s"], ".4f"),
+             fmt(r["time_ratio_exudyn_over_mbd2d"], ".1f"))
+            for r in get(peers, "dynamics", "side_by_side", default=[]) or []]
+    parts.append("#### Same method, equal h\n\n" + table(
+        ("h", "Exudyn error", "Exudyn s", "mbd2d error", "mbd2d s", "Exudyn / mbd2d"), rows))
+    eq = get(peers, "dynamics", "equal_accuracy", default=[]) or []
+    if eq:
+        rows = [(fmt(r["h"], ".0e"), fmt(r["exudyn_error"], ".2e"), fmt(r["exudyn_cpu_s"], ".4f"),
+                 r["mbd2d_method"] or "–", fmt(r["mbd2d_cpu_s"], ".4f"), fmt(r["ratio"], ".1f"))
+                for r in eq]
+        parts.append("#### At equal accuracy\n\nFor each Exudyn point, mbd2d's time at the same "
+                     "error: each mbd2d work-precision line of the four-bar study interpolated "
+                     "log-log at that error (no extrapolation), the fastest line taken.\n\n"
+                     + table(("Exudyn h", "error", "Exudyn s", "fastest mbd2d line",
+                              "mbd2d s", "Exudyn / mbd2d"), rows))
+    kin = peers.get("kinematics") or {}
+    rows = [(f"Exudyn: {name}", fmt(v.get("us_per_step"), ".2f"), fmt(v.get("max_error"), ".1e"),
+             v.get("message", "")[:80]) for name, v in (kin.get("exudyn_variants") or {}).items()]
+    m = kin.get("mbd2d") or {}
+    rows.append(("mbd2d: `model.kinematics` (q, qd, qdd)", fmt(m.get("us_per_step"), ".2f"),
+                 fmt(m.get("max_error"), ".1e"), ""))
+    parts.append(f"#### Kinematic stepping\n\nDriven four-bar (examples/fourbar_grashof.toml), "
+                 f"{kin.get('steps')} steps over {kin.get('t_end')} s; Exudyn has no kinematic "
+                 "solver, so a static solve per time with the crank angle prescribed. Error: "
+                 "max abs coordinate error against the closed form. Ratio (fastest Exudyn "
+                 f"variant / mbd2d): **{fmt(kin.get('ratio'), '.0f')}x**.\n\n"
+                 + table(("code", "us/step", "max error", "note"), rows))
+    return "\n".join(parts)
+
+
+def kinematics_section(results: dict) -> str:
+    """The three ways of running kinematics."""
+    kin = results.get("kinematics") or {}
+    if failed(kin):
+        return f"Failed: {failed(kin)}\n"
+    rows = []
+    for label, r in (kin.get("rows") or {}).items():
+        st = r.get("python_stepper") or {}
+        st_txt = fmt(st.get("us_per_step"), ".2f") if st.get("available") else \
+            f"not available ({st.get('message', '')})"
+        rows.append((label, fmt(get(r, "fortran_loop", "us_per_step"), ".3f"),
+                     fmt(get(r, "fortran_loop_h1e-4", "us_per_step"), ".3f"), st_txt,
+                     fmt(get(r, "numpy", "us_per_step"), ".1f"),
+                     fmt(r.get("ratio_numpy_over_loop"), ".0f"),
+                     fmt(r.get("ratio_numpy_over_stepper"), ".0f"),
+                     fmt(get(r, "agreement_numpy_vs_mbd2d", "q_rel"), ".0e")))
+    intro = ("Microseconds per output step (position + velocity + acceleration), best-of-5 "
+             "wall time over the run, at h = 1 ms (every step needs a Newton correction): "
+             "(a) the time loop in the Fortran core, one call per analysis; (b) one "
+             "`mbd2d.KinematicStepper.step(t)` call (one core call) per step from a Python "
+             "loop; (c) bench/numpy_kinematics.py, the same algorithm in plain NumPy. "
+             "The last column is the largest difference of the NumPy q from mbd2d's, "
+             "relative to the model size.\n\n")
+    return intro + table(("model", "(a) Fortran loop", "(a) at h = 0.1 ms",
+                          "(b) Python stepper", "(c) NumPy", "NumPy / (a)", "NumPy / (b)",
+                          "NumPy vs mbd2d q"), rows)
+
+
+def scaling_section(results: dict, charts: dict, out: Path, base: Path) -> str:
+    """Chart and table of time per step against N."""
+    sc = results.get("scaling") or {}
+    if failed(sc):
+        return f"Failed: {failed(sc)}\n"
+    parts = [f"{sc.get('model')}. {sc.get('method')}.\n"]
+    if not sc.get("banded_available"):
+        parts.append(f"Banded path: unavailable ({sc.get('banded_unavailable_reason')}).\n")
+    parts.append(image(charts, "scaling", out, base, "time per step against N"))
+    parts.append(f"Fitted log-log slope (N >= 10): banded {fmt(sc.get('banded_slope'), '.2f')}, "
+                 f"dense {fmt(sc.get('dense_slope'), '.2f')}.\n")
+    by_n: dict[int, dict[str, Row]] = {}
+    for path, rows in (sc.get("rows") or {}).items():
+        for r in rows:
+            by_n.setdefault(r["n"], {})[path] = r
+    rows = []
+    for n in sorted(by_n):
+        d, b = by_n[n].get("dense", {}), by_n[n].get("banded", {})
+        coords = d.get("coordinates") or b.get("coordinates") or 3 * (2 * n + 1)
+        rows.append((n, coords, fmt(d.get("us_per_step"), ".2f"), fmt(b.get("us_per_step"), ".2f"),
+                     fmt(b.get("factorizations_per_step") or d.get("factorizations_per_step"),
+                         ".2f"),
+                     d.get("message") or b.get("message") or ""))
+    parts.append(table(("N", "coordinates", "dense us/step", "banded us/step",
+                        "LU per step", "note"), rows))
+    return "\n".join(parts)
+
+
+def memory_section(results: dict, charts: dict, out: Path, base: Path) -> str:
+    """Table and chart of the memory cases."""
+    mem = results.get("memory") or {}
+    if failed(mem):
+        return f"Failed: {failed(mem)}\n"
+    rows = []
+    for r in mem.get("rows", []):
+        note = r.get("message", "") if r.get("run_mib") is None else ""
+        rows.append((r["analysis"], r["every"], f"{r['steps']:,}", fmt(r.get("rows"), ","),
+                     fmt(r.get("run_mib"), ".1f"), fmt(r.get("kept_data_mib"), ".1f"),
+                     fmt(r.get("seconds"), ".2f"), note or ("" if r.get("available", True)
+                                                           else "unavailable")))
+    return (f"{mem.get('method')}. Kinematics: {mem.get('kinematics_case')}; dynamics: "
+            f"{mem.get('dynamics_case')}. 'kept data' is t, q, qd, qdd of the rows returned.\n\n"
+            + table(("analysis", "every", "steps", "rows kept", "run peak MiB",
+                     "kept data MiB", "s", "note"), rows) + "\n"
+            + image(charts, "memory", out, base, "memory"))
+
+
+def notes_section(results: dict) -> str:
+    """Quick mode, failures and section run times."""
+    meta = results.get("meta") or {}
+    lines = []
+    if meta.get("quick"):
+        lines.append("- This run used `--quick` (reduced sweeps, fewer steps): a smoke test, "
+                     "not the reference figures.")
+    else:
+        lines.append("- Time budget: the N-four-bar work-precision sweep at N = 5 stops at "
+                     "loose settings (tight ones take minutes per run), and every sweep stops "
+                     "once one of its runs exceeds its budget; the Exudyn kinematic "
+                     "comparison uses 10,000 steps.")
+    for name, sec in results.items():
+        if isinstance(sec, dict) and sec.get("failed"):
+            lines.append(f"- Section **{name} failed**: {sec.get('error')}")
+    times = ", ".join(f"{k} {v['runtime_s']:.0f} s" for k, v in results.items()
+                      if isinstance(v, dict) and v.get("runtime_s") is not None)
+    lines.append(f"- Section run times: {times}; total {fmt(meta.get('total_runtime_s'), '.0f')} s.")
+    load = get(results, "environment", "load_average_start", 0)
+    if load is not None and load > 1.5:
+        lines.append(f"- The machine was busy at the start (load average {load:.1f} on 2 "
+                     "cores): the timings may be pessimistic.")
+    lines.append("- Timings are wall times (time.perf_counter) on a shared 2-core virtual "
+                 "machine; expect a few tens of percent run-to-run variation.")
+    return "\n".join(lines) + "\n"
+
+
+# ===================================================================== documents
+def results_markdown(results: dict, charts: dict[str, str], md_path: Path, out: Path) -> str:
+    """bench/RESULTS.md."""
+    base = md_path.resolve().parent
+    env = results.get("environment") or {}
+    tg = targets(results)
+    parts = ["# mbd2d benchmarks\n",
+             f"> Generated by `{get(results, 'meta', 'command')}` (`make bench` runs it) on "
+             f"{env.get('date_utc')}. Do not edit: regenerate with `make bench` or "
+             "`python bench/run.py` in the project's venv. Raw figures: "
+             f"[{os.path.relpath(out, base)}/]({os.path.relpath(out, base)}/) (JSON, with "
+             "the machine and versions in every file).\n",
+             "## Targets\n",
+             table(("target", "measured", "met"),
+                   [(t["target"], t["figure"], met_text(t["met"])) for t in tg]),
+             "## Machine\n", machine_section(env),
+             "## Work precision of the dynamics methods\n",
+             work_precision_section(results, charts, out, base),
+             "## Peers: Exudyn\n", peers_section(results),
+             "## Kinematics speed\n", kinematics_section(results),
+             "## Scaling with model size\n", scaling_section(results, charts, out, base),
+             "## Memory of long runs\n", memory_section(results, charts, out, base),
+             "## Notes\n", notes_section(results)]
+    return "\n".join(parts)
+
+
+def headline_markdown(results: dict, charts: dict[str, str], out: Path) -> str:
+    """A short README section: the four-bar work-precision chart and the key figures."""
+    tg = targets(results)
+    rows = [(t["target"], t["figure"], met_text(t["met"])) for t in tg
+            if not t["target"].startswith("make bench")]
+    mem = get(results, "memory", "rows", default=[]) or []
+    for r in mem:
+        if r.get("run_mib") is not None:
+            rows.append((f"memory, {r['analysis']} of {r['steps']:,} steps, every={r['every']}",
+                         f"{r['run_mib']:.1f} MiB", "–"))
+    env = results.get("environment") or {}
+    return "\n".join([
+        "## Performance\n",
+        f"Measured by `make bench` on {env.get('cpu_model')} ({env.get('cores')} cores), "
+        f"{env.get('os', '').split(' (')[0]}, mbd2d commit "
+        f"`{str(get(env, 'git', 'commit'))[:12]}`; all figures, charts and the method in "
+        "[bench/RESULTS.md](bench/RESULTS.md).\n",
+        image(charts, "wp_fourbar", out, ROOT, "work-precision of the free four-bar"),
+        "Error against CPU time of mbd2d's dynamics methods on a free four-bar (10 s), with "
+        "Exudyn's generalized-alpha for comparison.\n",
+        table(("target", "measured", "met"), rows)])

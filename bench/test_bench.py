@@ -1,0 +1,123 @@
+"""Tests of the benchmark bookkeeping (no timing assertions): interpolation at equal
+accuracy, slope fit, run planning, targets and the report on synthetic results.
+
+    python -m pytest bench/test_bench.py
+"""
+from __future__ import annotations
+
+import math
+import sys
+from pathlib import Path
+
+import pytest
+
+BENCH = Path(__file__).resolve().parent
+if str(BENCH) not in sys.path:
+    sys.path.insert(0, str(BENCH))
+
+import memory  # noqa: E402
+import peers_exudyn  # noqa: E402
+import report  # noqa: E402
+import scaling  # noqa: E402
+
+
+def wp_row(method: str, sweep: str, error: float, cpu_s: float) -> dict:
+    return {"method": method, "sweep": sweep, "error": error, "cpu_s": cpu_s, "ok": True}
+
+
+def test_time_at_error_interpolates_log_log() -> None:
+    pts = [(-6.0, -1.0), (-2.0, -3.0)]            # error 1e-6 at 0.1 s, 1e-2 at 1 ms
+    assert peers_exudyn.time_at_error(pts, -4.0) == pytest.approx(1e-2)
+    assert peers_exudyn.time_at_error(pts, -6.0) == pytest.approx(0.1)
+    assert peers_exudyn.time_at_error(pts, -1.0) is None      # no extrapolation
+    assert peers_exudyn.time_at_error(pts, -7.0) is None
+
+
+def test_equal_accuracy_takes_the_fastest_line() -> None:
+    wp = [wp_row("dopri5", "rtol", 1e-2, 1e-3), wp_row("dopri5", "rtol", 1e-6, 1e-2),
+          wp_row("baumgarte-rk4", "h", 1e-2, 1e-2), wp_row("baumgarte-rk4", "h", 1e-6, 1e-1),
+          {"method": "partitioned", "sweep": "rtol", "error": None, "cpu_s": 1.0, "ok": False}]
+    exu = [{"h": 1e-3, "error": 1e-4, "cpu_s": 0.5}, {"h": 1e-2, "error": 1.0, "cpu_s": 0.1},
+           {"h": 1e-1, "error": None, "cpu_s": None}]
+    out = peers_exudyn.equal_accuracy(exu, wp)
+    assert out[0]["mbd2d_method"] == "dopri5 (rtol)"
+    assert out[0]["mbd2d_cpu_s"] == pytest.approx(10 ** -2.5)
+    assert out[0]["ratio"] == pytest.approx(0.5 / 10 ** -2.5)
+    assert out[1]["ratio"] is None and out[2]["ratio"] is None
+
+
+def test_fit_slope_of_a_power_law() -> None:
+    rows = [{"n": n, "us_per_step": 3.0 * n ** 1.1} for n in (1, 10, 100, 1000)]
+    assert scaling.fit_slope(rows) == pytest.approx(1.1)
+    assert scaling.fit_slope(rows[:1]) is None
+    assert scaling.fit_slope([{"n": 10, "us_per_step": None}, {"n": 20}]) is None
+
+
+@pytest.mark.parametrize("per_step", [1e-9, 1e-6, 1e-3, 10.0])
+def test_plan_stays_in_bounds(per_step: float) -> None:
+    steps = scaling.plan(per_step, 1.0)
+    assert 10 <= steps <= scaling.MAX_STEPS
+    assert steps * scaling.H < math.pi / 2          # the cranks stay off the change point
+
+
+def synthetic_results(stepper: bool = True, exudyn: bool = True) -> dict:
+    """A results dict of the shape bench/run.py assembles."""
+    loop = {"us_per_step": 0.8}
+    kin_row = {"fortran_loop": loop, "fortran_loop_h1e-4": {"us_per_step": 0.5},
+               "numpy": {"us_per_step": 120.0}, "ratio_numpy_over_loop": 150.0,
+               "python_stepper": {"available": stepper, "us_per_step": 3.0} if stepper
+               else {"available": False, "message": "no KinematicStepper"}}
+    peers = {"exudyn_available": exudyn, "exudyn": "1.0" if exudyn else None,
+             "exudyn_unavailable_reason": None if exudyn else "import failed",
+             "dynamics": {"rho_inf": 0.9, "side_by_side": [
+                 {"h": 1e-3, "exudyn_error": 1e-4, "exudyn_cpu_s": 0.4, "mbd2d_error": 1e-4,
+                  "mbd2d_cpu_s": 0.2, "time_ratio_exudyn_over_mbd2d": 2.0}],
+                 "equal_accuracy": [{"h": 1e-3, "exudyn_error": 1e-4, "exudyn_cpu_s": 0.4,
+                                     "mbd2d_method": "dopri5 (rtol)", "mbd2d_cpu_s": 0.01,
+                                     "ratio": 40.0}] if exudyn else []},
+             "kinematics": {"steps": 100, "t_end": 1.0, "ratio": 20.0 if exudyn else None,
+                            "exudyn_best": "loop", "mbd2d": {"us_per_step": 2.0}}}
+    return {"environment": {"cpu_model": "cpu", "cores": 2, "os": "os (kernel)",
+                            "git": {"commit": "abc"}, "load_average_start": (0.1, 0, 0)},
+            "kinematics": {"rows": {report.FOURBAR: kin_row, report.SLIDER: dict(kin_row)}},
+            "peers": peers,
+            "scaling": {"banded_slope": 1.02, "dense_slope": 2.9, "banded_available": True,
+                        "rows": {"dense": [], "banded": []},
+                        "target": {"path": "banded", "ms_per_step": 1.5, "met": True}},
+            "memory": {"rows": [{"analysis": "kinematics", "every": 1000, "steps": 10,
+                                 "run_mib": 1.0, "available": True}]},
+            "work_precision": {"failed": True, "error": "RuntimeError: boom"},
+            "meta": {"total_runtime_s": 300.0, "quick": False, "command": "python bench/run.py"}}
+
+
+def test_targets_on_synthetic_results() -> None:
+    tg = {t["target"]: t for t in report.targets(synthetic_results())}
+    met = {name: t["met"] for name, t in tg.items()}
+    assert met["kinematics, four-bar, Fortran loop: <= 1 us/step"] is True
+    assert met["kinematics: Fortran loop >= 100x faster than plain NumPy"] is True
+    assert met["free four-bar: >= 5x faster than Exudyn at equal accuracy"] is True
+    assert met["kinematic stepping: >= 50x faster than Exudyn"] is False
+    assert met["kinematics, N-four-bar N = 1000: <= 2 ms per step"] is True
+    assert all(v is not None for v in met.values())
+
+
+def test_targets_without_exudyn_are_not_measured() -> None:
+    tg = report.peer_targets(synthetic_results(exudyn=False))
+    assert [t["met"] for t in tg] == [None, None]
+    assert all("unavailable" in t["figure"] for t in tg)
+
+
+def test_report_renders_failures_and_missing_stepper(tmp_path: Path) -> None:
+    res = synthetic_results(stepper=False)
+    md = report.results_markdown(res, {}, tmp_path / "RESULTS.md", tmp_path / "results")
+    assert "## Targets" in md and "Failed: RuntimeError: boom" in md
+    assert "not available (no KinematicStepper)" in md
+    assert "Section **work_precision failed**" in md
+    head = report.headline_markdown(res, {}, tmp_path)
+    assert head.startswith("## Performance") and "| target |" in head
+
+
+def test_memory_chart_with_an_unavailable_case(tmp_path: Path) -> None:
+    data = {"rows": [{"analysis": "kinematics", "every": 1, "steps": 10, "run_mib": 3.0},
+                     {"analysis": "dynamics", "every": 1000, "steps": 10, "available": False}]}
+    assert memory.chart(data, tmp_path / "m.png").stat().st_size > 0
