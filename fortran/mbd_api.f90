@@ -319,7 +319,8 @@ contains
   !> Forward dynamics: assembly of q0, the velocity v0 projected onto J q_dot = nu (kinetic
   !! energy metric), integration with the chosen method, outputs at nsteps + 1 times.
   !! iinfo: 1 outputs, 2 bad entry, 3 steps, 4 rejected, 5 Newton iterations, 6 right-hand
-  !! sides, 7 iteration matrices, 8 partitions, 9 active (independent) constraint rows.
+  !! sides, 7 iteration matrices (K, C evaluations), 8 partitions, 9 active (independent)
+  !! constraint rows, 10 LU factorizations of the generalized-alpha iteration matrix.
   !! rinfo: 1 time of a failure, 2 smallest step, 3 largest step.
   subroutine api_dynamics(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, v0, t0, t1, nsteps, &
                           method, rtol, atol, h, rho_inf, balpha, bbeta, qout, qdout, qddout, &
@@ -396,6 +397,7 @@ contains
                    status, msg)
     iinfo(1) = nout; iinfo(3) = dst%steps; iinfo(4) = dst%rejected; iinfo(5) = dst%newton
     iinfo(6) = dst%rhs; iinfo(7) = dst%jacobians; iinfo(8) = dst%partitions
+    iinfo(10) = dst%factorizations
     rinfo(2) = dst%hmin; rinfo(3) = dst%hmax
     if (status /= MBD_OK) rinfo(1) = dst%t_fail
     do k = 1, nout

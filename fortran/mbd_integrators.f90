@@ -7,7 +7,8 @@
 !!                       controlled (local error h^2 |beta - 1/6| |a_{n+1} - a_n|); rho_inf.
 !!                       Iteration matrix [M b' + C g' + K, b' J^T; b' J, 0],
 !!                       b' = (1 - am)/(beta h^2 (1 - af)), g' = gamma/(beta h), K and C by
-!!                       differences of the residual.
+!!                       differences of the residual, kept across steps (modified Newton);
+!!                       S factored once per step with the current J.
 !!  2 dopri5             index 1 ([M J^T; J 0][q_ddot; lambda] = [Q; gamma]) with Dormand-Prince
 !!                       5(4), adaptive (rtol, atol), then projection of q onto Phi = 0 and of
 !!                       q_dot onto J q_dot = nu after every step.
@@ -23,12 +24,12 @@ module mbd_integrators
   use mbd_status, only: MBD_OK, MBD_BAD_SETTING, MBD_SINGULAR, MBD_NO_CONVERGENCE, &
                         MBD_INTEGRATOR_FAILED, MBD_LAPACK, MSG_LEN
   use mbd_model, only: model_t
-  use mbd_assemble, only: assemble_dense
-  use mbd_linsolve, only: lu_factor, lu_solve, lapack_status
+  use mbd_assemble, only: assemble_dense, assemble_blocks, scatter_dense
+  use mbd_linsolve, only: lu_factor, lu_solve, lapack_status, lu_factor_small, lu_solve_small
   use mbd_lapack, only: dgeqp3, dgecon
   use mbd_interp, only: hermite5
   use mbd_dynamics, only: dyn_work_t, dyn_accel, dyn_velocity, dyn_project_pos, gen_forces, &
-                          kinetic_energy, dyn_tangent, dyn_solve
+                          kinetic_energy, dyn_tangent, dyn_solve, dyn_jt_lam
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   implicit none
   private
@@ -52,6 +53,7 @@ module mbd_integrators
   !> What the integrator did.
   type :: dyn_stats_t
     integer :: steps = 0, rejected = 0, newton = 0, rhs = 0, jacobians = 0, partitions = 0
+    integer :: factorizations = 0     !! LU factorizations of the iteration matrix
     real(wp) :: hmin = huge(one), hmax = zero
     real(wp) :: t_fail = zero         !! time reached when a method failed
   end type dyn_stats_t
@@ -194,6 +196,15 @@ contains
   end function initial_step
 
   ! -------------------------------------------------------------------- generalized-alpha
+  !> Index-3 generalized-alpha (Arnold & Bruls 2007), Newton on (q_{n+1}, lambda_{n+1}) with
+  !! the iteration matrix S = [M b' + C g' + K, b' J^T; b' J, 0]. The costly part, K and C
+  !! by differences, is kept across steps and evaluated again only when Newton contracts
+  !! slowly (|dq_k| > GA_RHO |dq_{k-1}|), takes GA_SLOW iterations, or fails (the step is
+  !! then retried with fresh K, C). S itself is formed with the current J and factored once
+  !! per step (a small dense LU, cheaper than the extra iterations an older J costs).
+  !! Converged: |Phi| <= w%tol, the last correction below 1e-3 (atol + rtol |q|), and the
+  !! residual of M q_ddot + J^T lambda = Q below GA_RTOL of its largest term, so that the
+  !! result is that of full Newton (a stale S only changes the iteration count).
   subroutine run_genalpha(m, w, c, qo, vo, ao, status, msg)
     type(model_t), intent(in) :: m
     type(dyn_work_t), intent(inout) :: w
@@ -201,21 +212,28 @@ contains
     real(wp), intent(inout) :: qo(:, :), vo(:, :), ao(:, :)
     integer, intent(out) :: status
     character(len=MSG_LEN), intent(out) :: msg
-    real(wp) :: am, af, gam, bet, bp, gp, h, t, err, tnew, facc, v, hprev
+    real(wp), parameter :: GA_RHO = 0.1_wp       ! contraction rate that asks for new K, C
+    real(wp), parameter :: GA_RTOL = 1.0e-11_wp  ! relative residual of the dynamic equations
+    integer, parameter :: GA_SLOW = 6            ! iterations that ask for new K, C
+    integer, parameter :: GA_MAXIT = 30          ! iterations before the step fails
+    real(wp) :: am, af, gam, bet, bp, gp, h, t, err, tnew, facc, v, hprev, dqn, dqp, dtol
+    real(wp) :: rtol_dyn, cf, kmax, cmax
     real(wp) :: q(m%nq), qd(m%nq), qdd(m%nq), acc(m%nq), lam(m%neq)
-    real(wp) :: qn(m%nq), vn(m%nq), an(m%nq), accn(m%nq), lamn(m%neq), dq(m%nq)
+    real(wp) :: qn(m%nq), vn(m%nq), an(m%nq), accn(m%nq), lamn(m%neq), dq(m%nq), ap(m%nq)
     real(wp) :: res(m%nq + w%na), kt(m%nq, m%nq), ct(m%nq, m%nq)
     real(wp) :: s(m%nq + w%na, m%nq + w%na)
-    integer :: piv(m%nq + w%na), it, n, k, stt, nfix
-    logical :: fixed, conv
-    character(len=MSG_LEN) :: lmsg
+    integer :: piv(m%nq + w%na), it, n, stt, nfix, na, attempt, nkc
+    logical :: fixed, conv, have_kc, new_kc
     status = MBD_OK; msg = ''
-    n = m%nq
-    am = (2 * c%opts%rho_inf - 1) / (c%opts%rho_inf + 1)
+    n = m%nq; na = w%na
+    am = (2 * c%opts%rho_inf - 1) / (c%opts%rho_inf + 1)        ! Arnold & Bruls (2007)
     af = c%opts%rho_inf / (c%opts%rho_inf + 1)
     gam = half + af - am
     bet = 0.25_wp * (gam + half)**2
+    cf = (1 - af) / (1 - am)             ! weight of q_ddot_{n+1} in a_{n+1}
     fixed = c%opts%h > zero
+    have_kc = .false.; new_kc = .false.
+    kt = zero; ct = zero; kmax = zero; cmax = zero
     q = c%qf; qd = c%vf; qdd = c%af; lam = c%lam
     t = c%t0
     nfix = 0
@@ -247,47 +265,68 @@ contains
       ! a - q_ddot scales with it, a <- q_ddot + (h / h_prev) (a - q_ddot)
       if (hprev > zero .and. abs(h - hprev) > zero) acc = qdd + (h / hprev) * (acc - qdd)
       hprev = h
-      ! predictor with q_ddot_{n+1} = 0
-      an = zero
-      accn = (af * qdd - am * acc) / (1 - am)
-      qn = q + h * qd + h * h * (half - bet) * acc + h * h * bet * accn
-      vn = qd + h * (1 - gam) * acc + h * gam * accn
-      lamn = lam
-      conv = .false.
-      dq = zero
-      do it = 1, 30
-        call assemble_dense(m, qn, vn, tnew, w%phi, w%nu, w%gam, w%asm, w%jac)
-        call gen_forces(m, qn, vn, tnew, w%force, v)
-        res(1:n) = m%mdiag * an + matmul(lamn, w%jac) - w%force
-        res(n + 1:) = bp * w%phi(w%rows)
-        if (it > 1 .and. maxval(abs(w%phi)) <= w%tol .and. &
-            maxval(abs(dq)) <= 1.0e-3_wp * (c%opts%atol + c%opts%rtol * maxval(abs(qn)))) then
-          conv = .true.; exit
-        end if
-        if (.not. all(ieee_is_finite(res))) exit
-        if (it == 1 .or. it == 4) then
-          ! iteration matrix [M b' + C g' + K, b' J^T; b' J, 0], refreshed at iterations 1, 4
-          call dyn_tangent(m, w, qn, vn, tnew, lamn, kt, ct)
-          c%st%jacobians = c%st%jacobians + 1
-          s = zero
-          do k = 1, n
-            s(k, k) = m%mdiag(k) * bp
-          end do
-          s(1:n, 1:n) = s(1:n, 1:n) + gp * ct + kt
-          call assemble_dense(m, qn, vn, tnew, w%phi, w%nu, w%gam, w%asm, w%jac)
-          s(1:n, n + 1:) = bp * transpose(w%jac(w%rows, :))
-          s(n + 1:, 1:n) = bp * w%jac(w%rows, :)
-          call lu_factor(s, piv, stt, lmsg)
-          if (stt /= MBD_OK) exit
-        end if
-        res = -res
-        call lu_solve(s, piv, res, stt, lmsg)
-        dq = res(1:n)
-        qn = qn + dq
-        vn = vn + gp * dq
-        an = an + bp * dq
-        lamn(w%rows) = lamn(w%rows) + bp * res(n + 1:)
-        c%st%newton = c%st%newton + 1
+      do attempt = 1, 2
+        ! predictor: q_ddot_{n+1} = q_ddot_n, lambda_{n+1} = lambda_n (not extrapolated:
+        ! the index-3 accelerations carry a step-to-step oscillation);
+        ! a_{n+1} = (af q_ddot_n + (1 - af) q_ddot_{n+1} - am a_n) / (1 - am);
+        ! q_{n+1} = q_n + h q_dot_n + h^2 ((1/2 - beta) a_n + beta a_{n+1}),
+        ! q_dot_{n+1} = q_dot_n + h ((1 - gamma) a_n + gamma a_{n+1})
+        an = qdd
+        lamn = lam
+        accn = (af * qdd - am * acc) / (1 - am)
+        ap = accn + cf * an
+        qn = q + h * qd + h * h * (half - bet) * acc + h * h * bet * ap
+        vn = qd + h * (1 - gam) * acc + h * gam * ap
+        conv = .false.
+        nkc = 0                         ! K, C evaluations in this attempt
+        dq = zero; dqp = huge(one)
+        do it = 1, GA_MAXIT
+          call assemble_blocks(m, qn, vn, tnew, w%phi, w%nu, w%gam, w%asm)
+          call gen_forces(m, qn, vn, tnew, w%force, v)
+          ! r = M q_ddot + J^T lambda - Q;  r_c = b' Phi
+          call dyn_jt_lam(m, w%asm%jb, lamn, res(1:n))
+          ! (not below the change that rounding q, q_dot to working precision makes)
+          rtol_dyn = max(GA_RTOL * max(maxval(abs(res(1:n))), maxval(abs(w%force)), &
+                                       maxval(abs(m%mdiag * an))), &
+                         100 * epsilon(one) * (kmax * maxval(abs(qn)) + cmax * maxval(abs(vn))))
+          res(1:n) = res(1:n) + m%mdiag * an - w%force
+          res(n + 1:) = bp * w%phi(w%rows)
+          dtol = 1.0e-3_wp * (c%opts%atol + c%opts%rtol * maxval(abs(qn)))
+          if (it > 1 .and. maxval(abs(w%phi)) <= w%tol .and. maxval(abs(dq)) <= dtol .and. &
+              maxval(abs(res(1:n))) <= rtol_dyn) then
+            conv = .true.; exit
+          end if
+          if (.not. all(ieee_is_finite(res))) exit
+          if (it == GA_SLOW .and. nkc < 2) new_kc = .true.
+          if (it == 1 .or. new_kc) then
+            if (.not. have_kc .or. new_kc) then
+              call dyn_tangent(m, w, qn, vn, tnew, lamn, kt, ct, fast=.true.)
+              c%st%jacobians = c%st%jacobians + 1
+              have_kc = .true.; new_kc = .false.; nkc = nkc + 1
+              kmax = maxval(abs(kt)); cmax = maxval(abs(ct))
+              call assemble_blocks(m, qn, vn, tnew, w%phi, w%nu, w%gam, w%asm)
+            end if
+            call form_s()
+            call lu_factor_small(s, piv, stt)
+            c%st%factorizations = c%st%factorizations + 1
+            if (stt /= MBD_OK) exit
+          end if
+          res = -res
+          call lu_solve_small(s, piv, res)
+          dq = res(1:n)
+          qn = qn + dq
+          vn = vn + gp * dq
+          an = an + bp * dq
+          lamn(w%rows) = lamn(w%rows) + bp * res(n + 1:)
+          c%st%newton = c%st%newton + 1
+          ! slow contraction (above the roundoff of q): new K, C next iteration
+          dqn = maxval(abs(dq))
+          if (dqn > GA_RHO * dqp .and. dqn > 100 * epsilon(one) * maxval(abs(qn)) .and. &
+              nkc < 2) new_kc = .true.
+          dqp = dqn
+        end do
+        if (conv .or. nkc > 0) exit
+        new_kc = .true.                 ! failed with old K, C: retry with fresh ones
       end do
       ! local error estimate: the step's position error is (beta - 1/6) h^3 q''', and the
       ! distance of q_{n+1} from its second-order Taylor prediction is h^3 q'''/6, so
@@ -325,6 +364,23 @@ contains
       end if
     end do
     c%qf = q; c%vf = qd; c%af = qdd; c%lam = lam
+  contains
+    !> S = [M b' + C g' + K, b' J^T; b' J, 0] at the last assembly (J from its blocks).
+    subroutine form_s()
+      integer :: j
+      call scatter_dense(m, w%asm%jb, w%jac)
+      do j = 1, n + na
+        s(:, j) = zero
+      end do
+      do j = 1, n
+        s(1:n, j) = kt(:, j) + gp * ct(:, j)
+        s(j, j) = s(j, j) + m%mdiag(j) * bp
+      end do
+      do j = 1, na
+        s(n + j, 1:n) = bp * w%jac(w%rows(j), :)
+        s(1:n, n + j) = bp * w%jac(w%rows(j), :)
+      end do
+    end subroutine form_s
   end subroutine run_genalpha
 
   ! -------------------------------------------------------------------- explicit methods

@@ -2,6 +2,8 @@
 !!
 !!   lu_factor   A = P L U               (dgetf2 up to SMALL_N, else dgetrf)
 !!   lu_solve    A x = b from the factors (dgetrs)
+!!   lu_factor_small, lu_solve_small   the same in plain loops, for the small iteration
+!!               matrices factored and solved in the generalized-alpha time loop
 !!   lu_det_sign sign of det A from the factors: prod(sign U_ii) * (-1)**(row swaps)
 !!   svd_null    singular values of A and the singular vectors of the smallest one (dgesvd)
 !!   row_rank    rank of A (QR with column pivoting of the row-normalized A^T, dgeqp3) and the
@@ -17,6 +19,7 @@ module mbd_linsolve
   implicit none
   private
   public :: lapack_status, lu_factor, lu_solve, lu_det_sign, svd_null, row_rank
+  public :: lu_factor_small, lu_solve_small
   public :: qr_factor, qr_solve, qr_lwork, RANK_TOL
 
   integer, parameter :: SMALL_N = 48   !! below this the unblocked dgetf2 is faster
@@ -79,6 +82,64 @@ contains
     call dgetrs('N', n, 1, a, n, ipiv, b, n, info)
     call lapack_status('dgetrs', info, status, msg)
   end subroutine lu_solve
+
+  !> LU with partial pivoting in place, A = P L U, for the small dense iteration matrices of
+  !! the time loop (plain loops, column oriented: no BLAS call overhead). Same pivoting rule as
+  !! dgetf2 (largest |a_ik| in the column). An exactly zero pivot gives MBD_SINGULAR.
+  pure subroutine lu_factor_small(a, ipiv, status)
+    real(wp), intent(inout) :: a(:, :)          !! square matrix; factors on return
+    integer, intent(out) :: ipiv(:)             !! pivot rows
+    integer, intent(out) :: status              !! MBD_OK or MBD_SINGULAR
+    integer :: n, j, k, p
+    real(wp) :: piv, tmp, f
+    n = size(a, 1)
+    status = MBD_OK
+    do k = 1, n
+      p = k; piv = abs(a(k, k))
+      do j = k + 1, n
+        if (abs(a(j, k)) > piv) then
+          p = j; piv = abs(a(j, k))
+        end if
+      end do
+      ipiv(k) = p
+      if (piv == zero) then
+        status = MBD_SINGULAR; return
+      end if
+      if (p /= k) then
+        do j = 1, n
+          tmp = a(k, j); a(k, j) = a(p, j); a(p, j) = tmp
+        end do
+      end if
+      f = 1 / a(k, k)
+      a(k + 1:n, k) = a(k + 1:n, k) * f                 ! l_ik = a_ik / u_kk
+      do j = k + 1, n                                   ! a_ij -= l_ik u_kj
+        if (a(k, j) /= zero) a(k + 1:n, j) = a(k + 1:n, j) - a(k, j) * a(k + 1:n, k)
+      end do
+    end do
+  end subroutine lu_factor_small
+
+  !> Solve A x = b with the factors of lu_factor_small: P L U x = b; b is overwritten by x.
+  pure subroutine lu_solve_small(a, ipiv, b)
+    real(wp), intent(in) :: a(:, :)             !! LU factors
+    integer, intent(in) :: ipiv(:)              !! pivot rows
+    real(wp), intent(inout) :: b(:)             !! right-hand side, then solution
+    integer :: n, k, p
+    real(wp) :: tmp
+    n = size(a, 1)
+    do k = 1, n                                 ! P b (the row interchanges in order)
+      p = ipiv(k)
+      if (p /= k) then
+        tmp = b(k); b(k) = b(p); b(p) = tmp
+      end if
+    end do
+    do k = 1, n                                 ! L y = P b (column oriented)
+      if (b(k) /= zero) b(k + 1:n) = b(k + 1:n) - b(k) * a(k + 1:n, k)
+    end do
+    do k = n, 1, -1                             ! U x = y
+      b(k) = b(k) / a(k, k)
+      if (b(k) /= zero) b(1:k - 1) = b(1:k - 1) - b(k) * a(1:k - 1, k)
+    end do
+  end subroutine lu_solve_small
 
   !> Sign of det A from its LU factors (zero if a pivot is zero).
   pure integer function lu_det_sign(a, ipiv) result(sgn)

@@ -164,7 +164,8 @@ def run_dynamics(model: "Model", t_end: float, steps: int, method: str | None = 
     _, red_rows = _names(p, model, red)
     stats = {"method": method, "steps": int(iinfo[2]), "rejected_steps": int(iinfo[3]),
              "newton_iterations": int(iinfo[4]), "rhs_evaluations": int(iinfo[5]),
-             "iteration_matrices": int(iinfo[6]), "partitions": int(iinfo[7]),
+             "iteration_matrices": int(iinfo[6]), "factorizations": int(iinfo[9]),
+             "partitions": int(iinfo[7]),
              "h_min": float(rinfo[1]) if iinfo[2] else None,
              "h_max": float(rinfo[2]) if iinfo[2] else None, "redundant_rows": red_rows}
     res = _result(model, p, t, n, qo, vo, ao, lam, e, stats, status == OK)
