@@ -22,7 +22,7 @@ module mbd_dynamics
   use mbd_forces, only: force_eval, FRC_SPRING, FRC_ROTSPRING
   use mbd_assemble, only: asm_work_t, asm_init, assemble_blocks, assemble_dense, scatter_dense, &
                           gather_local
-  use mbd_linsolve, only: lu_factor, lu_solve, row_rank, lapack_status
+  use mbd_linsolve, only: lu_factor, lu_solve, row_rank, lapack_status, ls_small
   use mbd_lapack, only: dgelsy, dgecon
   implicit none
   private
@@ -271,9 +271,10 @@ contains
     status = MBD_NO_CONVERGENCE
   end subroutine dyn_project_pos
 
-  !> Minimum-norm multipliers over all rows: lambda = argmin ||l|| with J^T l = Q - M q_ddot
-  !! (LAPACK dgelsy). With independent rows this is the unique lambda; with redundant rows
-  !! the reactions are statically indeterminate and this is the smallest set.
+  !> Minimum-norm multipliers over all rows: lambda = argmin ||l|| with J^T l = Q - M q_ddot.
+  !! With independent rows this is the unique lambda (Householder least squares, ls_small);
+  !! with redundant rows, or J^T numerically rank deficient, the reactions are statically
+  !! indeterminate and this is the smallest set (LAPACK dgelsy).
   subroutine dyn_multipliers(m, w, q, qd, qdd, t, lam, status, msg)
     type(model_t), intent(in) :: m            !! model
     type(dyn_work_t), intent(inout) :: w      !! work arrays
@@ -285,11 +286,23 @@ contains
     real(wp) :: jt(m%nq, m%neq), b(max(m%nq, m%neq)), v, wq(1)
     real(wp), allocatable :: work(:)
     integer :: jpvt(m%neq), rank, info, lwork
+    logical :: full
     call assemble_dense(m, q, qd, t, w%phi, w%nu, w%gam, w%asm, w%jac)
     call gen_forces(m, q, qd, t, w%force, v)
     jt = transpose(w%jac)
     b = zero
     b(1:m%nq) = w%force - m%mdiag * qdd
+    status = MBD_OK
+    if (w%na == m%neq .and. m%neq <= m%nq) then
+      ! independent rows: the unique solution, by a plain Householder QR (no allocation)
+      call ls_small(jt, b, full)
+      if (full) then
+        lam = b(1:m%neq); return
+      end if
+      jt = transpose(w%jac)
+      b = zero
+      b(1:m%nq) = w%force - m%mdiag * qdd
+    end if
     jpvt = 0
     call dgelsy(m%nq, m%neq, 1, jt, m%nq, b, size(b), jpvt, 1.0e-10_wp, rank, wq, -1, info)
     lwork = max(1, int(wq(1)))

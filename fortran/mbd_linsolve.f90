@@ -4,6 +4,7 @@
 !!   lu_solve    A x = b from the factors (dgetrs)
 !!   lu_factor_small, lu_solve_small   the same in plain loops, for the small iteration
 !!               matrices factored and solved in the generalized-alpha time loop
+!!   ls_small    min ||A x - b|| for a small A of full column rank (Householder QR, plain loops)
 !!   lu_det_sign sign of det A from the factors: prod(sign U_ii) * (-1)**(row swaps)
 !!   svd_null    singular values of A and the singular vectors of the smallest one (dgesvd)
 !!   row_rank    rank of A (QR with column pivoting of the row-normalized A^T, dgeqp3) and the
@@ -13,13 +14,13 @@
 !!   qr_solve    x = argmin ||A x - b|| for full column rank: R x_p = (Q^T b)(1:n) (dormqr,
 !!               dtrtrs), x = P x_p; also returns the residual ||(Q^T b)(n+1:m)||
 module mbd_linsolve
-  use mbd_kinds, only: wp, zero
+  use mbd_kinds, only: wp, zero, one
   use mbd_status, only: MBD_OK, MBD_SINGULAR, MBD_LAPACK, MSG_LEN
   use mbd_lapack, only: dgetrf, dgetf2, dgetrs, dgesvd, dgeqp3, dormqr, dtrtrs
   implicit none
   private
   public :: lapack_status, lu_factor, lu_solve, lu_det_sign, svd_null, row_rank
-  public :: lu_factor_small, lu_solve_small
+  public :: lu_factor_small, lu_solve_small, ls_small
   public :: qr_factor, qr_solve, qr_lwork, RANK_TOL
 
   integer, parameter :: SMALL_N = 48   !! below this the unblocked dgetf2 is faster
@@ -140,6 +141,43 @@ contains
       if (b(k) /= zero) b(1:k - 1) = b(1:k - 1) - b(k) * a(1:k - 1, k)
     end do
   end subroutine lu_solve_small
+
+  !> Least squares min ||A x - b|| for A (m x n), m >= n, of full column rank, by Householder
+  !! QR in plain loops (A = Q R, x = R^-1 (Q^T b)(1:n)); no allocation. ok is false (and a, b
+  !! are spoiled) when min |R_kk| < LS_RTOL max |R_kk|: use a rank-revealing solve then.
+  pure subroutine ls_small(a, b, ok)
+    real(wp), intent(inout) :: a(:, :)          !! A, overwritten by the factorization
+    real(wp), intent(inout) :: b(:)             !! b (m), then x in b(1:n)
+    logical, intent(out) :: ok                  !! A had full column rank
+    real(wp), parameter :: LS_RTOL = 1.0e-8_wp
+    integer :: mm, n, k, j
+    real(wp) :: alpha, nrm, vtv, f, rmax, rmin
+    mm = size(a, 1); n = size(a, 2)
+    ok = .false.
+    rmax = zero; rmin = huge(one)
+    do k = 1, n
+      ! Householder reflector H = I - 2 v v^T / v^T v zeroing a(k+1:m, k); v stored in a(k:m, k)
+      nrm = norm2(a(k:mm, k))
+      alpha = -sign(nrm, a(k, k))
+      rmax = max(rmax, nrm); rmin = min(rmin, nrm)
+      if (nrm == zero) return
+      a(k, k) = a(k, k) - alpha
+      vtv = dot_product(a(k:mm, k), a(k:mm, k))
+      do j = k + 1, n
+        f = 2 * dot_product(a(k:mm, k), a(k:mm, j)) / vtv
+        a(k:mm, j) = a(k:mm, j) - f * a(k:mm, k)
+      end do
+      f = 2 * dot_product(a(k:mm, k), b(k:mm)) / vtv
+      b(k:mm) = b(k:mm) - f * a(k:mm, k)
+      a(k, k) = alpha                           ! R_kk (v no longer needed below the diagonal)
+    end do
+    rmin = minval([(abs(a(k, k)), k=1, n)]); rmax = maxval([(abs(a(k, k)), k=1, n)])
+    if (rmin < LS_RTOL * rmax) return
+    do k = n, 1, -1                             ! R x = (Q^T b)(1:n)
+      b(k) = (b(k) - dot_product(a(k, k + 1:n), b(k + 1:n))) / a(k, k)
+    end do
+    ok = .true.
+  end subroutine ls_small
 
   !> Sign of det A from its LU factors (zero if a pivot is zero).
   pure integer function lu_det_sign(a, ipiv) result(sgn)
