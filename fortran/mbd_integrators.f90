@@ -34,7 +34,7 @@ module mbd_integrators
   implicit none
   private
   public :: dyn_opts_t, dyn_stats_t, METH_GENALPHA, METH_DOPRI5, METH_RK4, METH_PARTITIONED
-  public :: integrate
+  public :: integrate, output_rows, output_index
 
   integer, parameter :: METH_GENALPHA = 1, METH_DOPRI5 = 2, METH_RK4 = 3, METH_PARTITIONED = 4
 
@@ -64,7 +64,10 @@ module mbd_integrators
     type(dyn_opts_t) :: opts
     type(dyn_stats_t) :: st
     real(wp) :: t0 = zero, t1 = zero
-    integer :: nsteps = 0, nout = 0
+    integer :: nsteps = 0               !! output intervals
+    integer :: every = 1                !! store outputs k with mod(k, every) = 0, and k = nsteps
+    integer :: kout = 0                 !! next output index k (0 .. nsteps)
+    integer :: nout = 0                 !! rows stored
     logical :: baumgarte = .false.
     integer :: ni = 0                       !! independent coordinates (partitioned)
     integer, allocatable :: iv(:), iu(:)    !! independent and dependent coordinates
@@ -88,18 +91,21 @@ module mbd_integrators
 
 contains
 
-  !> Integrate from the consistent state (q, qd) at t0 to t1, writing outputs at
-  !! t0 + k (t1 - t0)/nsteps, k = 0..nsteps, into the columns of qo, vo, ao.
-  !! nout returns the number of outputs written (all, unless a failure stopped the run).
-  subroutine integrate(m, w, q, qd, t0, t1, nsteps, opts, qo, vo, ao, nout, st, status, msg)
+  !> Integrate from the consistent state (q, qd) at t0 to t1, with outputs at
+  !! t0 + k (t1 - t0)/nsteps, k = 0..nsteps, of which those with mod(k, every) = 0 and the
+  !! last (k = nsteps) are written into the columns of qo, vo, ao (output_rows of them).
+  !! nout returns the number of rows written (all, unless a failure stopped the run).
+  subroutine integrate(m, w, q, qd, t0, t1, nsteps, every, opts, qo, vo, ao, nout, st, status, &
+                       msg)
     type(model_t), intent(in) :: m               !! model
     type(dyn_work_t), intent(inout) :: w         !! dynamics work arrays (dyn_init done)
     real(wp), intent(inout) :: q(:), qd(:)       !! consistent initial state, then final
     real(wp), intent(in) :: t0, t1               !! time span
     integer, intent(in) :: nsteps                !! output intervals
+    integer, intent(in) :: every                 !! store every every-th output (and the last)
     type(dyn_opts_t), intent(in) :: opts         !! settings
-    real(wp), intent(out) :: qo(:, :), vo(:, :), ao(:, :)  !! outputs (nq, nsteps + 1)
-    integer, intent(out) :: nout                 !! outputs written
+    real(wp), intent(out) :: qo(:, :), vo(:, :), ao(:, :)  !! outputs (nq, rows)
+    integer, intent(out) :: nout                 !! rows written
     type(dyn_stats_t), intent(out) :: st         !! counters
     integer, intent(out) :: status               !! MBD_OK or a failure
     character(len=MSG_LEN), intent(out) :: msg   !! explanation
@@ -112,7 +118,10 @@ contains
     if (.not. (opts%rtol > zero .and. opts%atol > zero)) then
       status = MBD_BAD_SETTING; msg = 'rtol and atol must be positive'; return
     end if
-    c%opts = opts; c%t0 = t0; c%t1 = t1; c%nsteps = nsteps
+    if (every < 1 .or. size(qo, 2) /= output_rows(nsteps, every)) then
+      status = MBD_BAD_SETTING; msg = 'every must be >= 1 and the outputs sized for it'; return
+    end if
+    c%opts = opts; c%t0 = t0; c%t1 = t1; c%nsteps = nsteps; c%every = every
     allocate (c%qf(m%nq), c%vf(m%nq), c%af(m%nq), c%lam(m%neq))
     c%qf = q; c%vf = qd
     call dyn_accel(m, w, q, qd, t0, c%af, c%lam, status)
@@ -120,7 +129,7 @@ contains
       msg = 'the mass matrix and constraints give a singular system at the start'; return
     end if
     qo(:, 1) = q; vo(:, 1) = qd; ao(:, 1) = c%af
-    c%nout = 1
+    c%nout = 1; c%kout = 1
     if (nsteps > 0) then
       select case (opts%method)
       case (METH_GENALPHA)
@@ -165,18 +174,37 @@ contains
     if (k == c%nsteps) out_time = c%t1
   end function out_time
 
-  !> Write the outputs in (ta, tb] by quintic Hermite interpolation of the two states.
+  !> Write the stored outputs in (ta, tb] by quintic Hermite interpolation of the two
+  !! states; outputs between the stored ones (every > 1) are passed over, not computed.
   subroutine emit(c, qo, vo, ao, ta, qa, va, aa, tb, qb, vb, ab)
     type(itg_t), intent(inout) :: c
     real(wp), intent(inout) :: qo(:, :), vo(:, :), ao(:, :)
     real(wp), intent(in) :: ta, tb, qa(:), va(:), aa(:), qb(:), vb(:), ab(:)
-    do while (c%nout <= c%nsteps)
-      if (out_time(c, c%nout) > tb + 1.0e-12_wp * abs(c%t1 - c%t0)) exit
-      call hermite5(ta, qa, va, aa, tb, qb, vb, ab, out_time(c, c%nout), qo(:, c%nout + 1), &
-                    vo(:, c%nout + 1), ao(:, c%nout + 1))
-      c%nout = c%nout + 1
+    do while (c%kout <= c%nsteps)
+      if (out_time(c, c%kout) > tb + 1.0e-12_wp * abs(c%t1 - c%t0)) exit
+      if (mod(c%kout, c%every) == 0 .or. c%kout == c%nsteps) then
+        call hermite5(ta, qa, va, aa, tb, qb, vb, ab, out_time(c, c%kout), &
+                      qo(:, c%nout + 1), vo(:, c%nout + 1), ao(:, c%nout + 1))
+        c%nout = c%nout + 1
+      end if
+      c%kout = c%kout + 1
     end do
   end subroutine emit
+
+  !> Rows stored for nsteps output intervals, keeping k = 0, every, 2 every, ... and nsteps.
+  pure integer function output_rows(nsteps, every)
+    integer, intent(in) :: nsteps             !! output intervals
+    integer, intent(in) :: every              !! decimation (>= 1)
+    output_rows = nsteps / every + 1
+    if (mod(nsteps, every) /= 0) output_rows = output_rows + 1
+  end function output_rows
+
+  !> Output index k (0 .. nsteps) of stored row r (1 .. output_rows).
+  pure integer function output_index(nsteps, every, r)
+    integer, intent(in) :: nsteps, every      !! output intervals, decimation
+    integer, intent(in) :: r                  !! row
+    output_index = min((r - 1) * every, nsteps)
+  end function output_index
 
   !> Weighted RMS norm of an error estimate.
   real(wp) function err_norm(c, e, ya, yb)

@@ -8,14 +8,14 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from . import _core
-from .analysis import (ASSEMBLY_FAILED, INCONSISTENT, NO_CONVERGENCE, OK, SINGULAR,
+from .analysis import (ASSEMBLY_FAILED, INCONSISTENT, MAX_STEPS, NO_CONVERGENCE, OK, SINGULAR,
                        SINGULAR_CONFIG, _assembly_failed, _failure, _names, check_memory,
                        check_solver, check_span, require_determined)
 from .errors import (ConvergenceError, CoreError, IntegrationError, ModelError,
                      RedundantConstraintWarning, SingularJacobianError)
 from .pack import Packed, decode, pack
 from .results import DynamicsResult, StaticsResult
-from .validate import number
+from .validate import number, whole
 
 if TYPE_CHECKING:  # pragma: no cover
     from .model import Model
@@ -113,12 +113,36 @@ def run_inverse(model: "Model", t_end: float, steps: int, t0: float = 0.0,
     raise _failure(model, p, int(status), decode(msg), iinfo, rinfo, qsing, dep, red, res)
 
 
+def output_indices(steps: int, every: int) -> np.ndarray:
+    """Indices k of the stored outputs: 0, every, 2 every, ... and always steps.
+
+    Parameters
+    ----------
+    steps : int
+        Output intervals (the time grid t0 + k (t_end - t0) / steps, k = 0 .. steps).
+    every : int
+        Decimation, >= 1.
+
+    Returns
+    -------
+    np.ndarray
+        The stored k in increasing order (steps // every + 1 of them, plus steps when every
+        does not divide it).
+    """
+    idx = np.arange(0, steps + 1, every)
+    if idx[-1] != steps:
+        idx = np.append(idx, steps)
+    return idx
+
+
 def run_dynamics(model: "Model", t_end: float, steps: int, method: str | None = None,
                  rtol: float | None = None, atol: float | None = None, h: float | None = None,
                  rho_inf: float | None = None, alpha: float | None = None,
-                 beta: float | None = None, t0: float = 0.0) -> DynamicsResult:
+                 beta: float | None = None, t0: float = 0.0, every: int = 1) -> DynamicsResult:
     """Forward dynamics in one core call; see :meth:`Model.dynamics`."""
     t0, t_end, steps = check_span(t0, t_end, steps)
+    every = whole(every, "every", "dynamics", 1, MAX_STEPS)
+    idx = output_indices(steps, every)
     method = DEFAULT_METHOD if method is None else method
     if method not in METHODS:
         raise ModelError(f"unknown method {method!r}; use one of {', '.join(METHODS)}",
@@ -152,14 +176,15 @@ def run_dynamics(model: "Model", t_end: float, steps: int, method: str | None = 
     beta_v = opt(beta, "beta", 0.0, 1e9, -1.0)
     p = pack(model)
     bmass, grav, ftab, fpar, v0 = pack_dynamics(model, p)
-    check_memory(steps + 1, 3 * p.nq + p.neq + 4)
+    check_memory(len(idx), 3 * p.nq + p.neq + 4)
     out = _core.core_dynamics(ctab=p.ctab, rpar=p.rpar, bmass=bmass, grav=grav, ftab=ftab,
                               fpar=fpar, neq=p.neq, q0=p.q0, v0=v0, t0=t0, t1=t_end,
                               nsteps=steps, method=METHODS[method], rtol=rtol_v, atol=atol_v,
-                              h=h_v, rho_inf=rho_v, balpha=alpha_v, bbeta=beta_v)
+                              h=h_v, rho_inf=rho_v, balpha=alpha_v, bbeta=beta_v,
+                              every=every, nrow=len(idx))
     qo, vo, ao, lam, e, iinfo, rinfo, red, status, msg = out
     n = int(iinfo[0])
-    t = t0 + (t_end - t0) * (np.arange(steps + 1) / steps)
+    t = t0 + (t_end - t0) * (idx / steps)
     t[-1] = t_end
     _, red_rows = _names(p, model, red)
     stats = {"method": method, "steps": int(iinfo[2]), "rejected_steps": int(iinfo[3]),
