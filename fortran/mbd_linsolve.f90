@@ -91,7 +91,7 @@ contains
     real(wp), intent(inout) :: a(:, :)          !! square matrix; factors on return
     integer, intent(out) :: ipiv(:)             !! pivot rows
     integer, intent(out) :: status              !! MBD_OK or MBD_SINGULAR
-    integer :: n, j, k, p
+    integer :: n, i, j, k, p
     real(wp) :: piv, tmp, f
     n = size(a, 1)
     status = MBD_OK
@@ -112,9 +112,15 @@ contains
         end do
       end if
       f = 1 / a(k, k)
-      a(k + 1:n, k) = a(k + 1:n, k) * f                 ! l_ik = a_ik / u_kk
+      do i = k + 1, n                                   ! l_ik = a_ik / u_kk
+        a(i, k) = a(i, k) * f
+      end do
       do j = k + 1, n                                   ! a_ij -= l_ik u_kj
-        if (a(k, j) /= zero) a(k + 1:n, j) = a(k + 1:n, j) - a(k, j) * a(k + 1:n, k)
+        f = a(k, j)
+        if (f == zero) cycle
+        do i = k + 1, n
+          a(i, j) = a(i, j) - f * a(i, k)
+        end do
       end do
     end do
   end subroutine lu_factor_small
@@ -124,7 +130,7 @@ contains
     real(wp), intent(in) :: a(:, :)             !! LU factors
     integer, intent(in) :: ipiv(:)              !! pivot rows
     real(wp), intent(inout) :: b(:)             !! right-hand side, then solution
-    integer :: n, k, p
+    integer :: n, i, k, p
     real(wp) :: tmp
     n = size(a, 1)
     do k = 1, n                                 ! P b (the row interchanges in order)
@@ -134,11 +140,19 @@ contains
       end if
     end do
     do k = 1, n                                 ! L y = P b (column oriented)
-      if (b(k) /= zero) b(k + 1:n) = b(k + 1:n) - b(k) * a(k + 1:n, k)
+      tmp = b(k)
+      if (tmp == zero) cycle
+      do i = k + 1, n
+        b(i) = b(i) - tmp * a(i, k)
+      end do
     end do
     do k = n, 1, -1                             ! U x = y
       b(k) = b(k) / a(k, k)
-      if (b(k) /= zero) b(1:k - 1) = b(1:k - 1) - b(k) * a(1:k - 1, k)
+      tmp = b(k)
+      if (tmp == zero) cycle
+      do i = 1, k - 1
+        b(i) = b(i) - tmp * a(i, k)
+      end do
     end do
   end subroutine lu_solve_small
 
