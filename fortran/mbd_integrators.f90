@@ -245,13 +245,13 @@ contains
     integer, parameter :: GA_SLOW = 6            ! iterations that ask for new K, C
     integer, parameter :: GA_MAXIT = 30          ! iterations before the step fails
     real(wp) :: am, af, gam, bet, bp, gp, h, t, err, tnew, facc, v, hprev, dqn, dqp, dtol
-    real(wp) :: rtol_dyn, cf, kmax, cmax
+    real(wp) :: rtol_dyn, cf, kmax, cmax, fmax, qmax, vmax, rmax
     real(wp) :: q(m%nq), qd(m%nq), qdd(m%nq), acc(m%nq), lam(m%neq)
     real(wp) :: qn(m%nq), vn(m%nq), an(m%nq), accn(m%nq), lamn(m%neq), dq(m%nq), ap(m%nq)
     real(wp) :: res(m%nq + w%na), kt(m%nq, m%nq), ct(m%nq, m%nq)
     real(wp) :: s(m%nq + w%na, m%nq + w%na)
-    integer :: piv(m%nq + w%na), it, n, stt, nfix, na, attempt, nkc
-    logical :: fixed, conv, have_kc, new_kc
+    integer :: piv(m%nq + w%na), it, n, stt, nfix, na, attempt, nkc, k
+    logical :: fixed, conv, have_kc, new_kc, finite
     status = MBD_OK; msg = ''
     n = m%nq; na = w%na
     am = (2 * c%opts%rho_inf - 1) / (c%opts%rho_inf + 1)        ! Arnold & Bruls (2007)
@@ -313,18 +313,27 @@ contains
           call gen_forces(m, qn, vn, tnew, w%force, v)
           ! r = M q_ddot + J^T lambda - Q;  r_c = b' Phi
           call dyn_jt_lam(m, w%asm%jb, lamn, res(1:n))
-          ! (not below the change that rounding q, q_dot to working precision makes)
-          rtol_dyn = max(GA_RTOL * max(maxval(abs(res(1:n))), maxval(abs(w%force)), &
-                                       maxval(abs(m%mdiag * an))), &
-                         100 * epsilon(one) * (kmax * maxval(abs(qn)) + cmax * maxval(abs(vn))))
-          res(1:n) = res(1:n) + m%mdiag * an - w%force
-          res(n + 1:) = bp * w%phi(w%rows)
-          dtol = 1.0e-3_wp * (c%opts%atol + c%opts%rtol * maxval(abs(qn)))
-          if (it > 1 .and. maxval(abs(w%phi)) <= w%tol .and. maxval(abs(dq)) <= dtol .and. &
-              maxval(abs(res(1:n))) <= rtol_dyn) then
+          ! the residual tolerance is GA_RTOL of the largest term, but not below the change
+          ! that rounding q, q_dot to working precision makes (K |q| + C |q_dot|) eps
+          fmax = zero; qmax = zero; vmax = zero; rmax = zero; finite = .true.
+          do k = 1, n
+            fmax = max(fmax, abs(res(k)), abs(w%force(k)), abs(m%mdiag(k) * an(k)))
+            res(k) = res(k) + m%mdiag(k) * an(k) - w%force(k)
+            if (.not. abs(res(k)) <= huge(one)) finite = .false.      ! NaN or Inf
+            rmax = max(rmax, abs(res(k)))
+            qmax = max(qmax, abs(qn(k))); vmax = max(vmax, abs(vn(k)))
+          end do
+          rtol_dyn = max(GA_RTOL * fmax, 100 * epsilon(one) * (kmax * qmax + cmax * vmax))
+          do k = 1, na
+            res(n + k) = bp * w%phi(w%rows(k))
+            if (.not. abs(res(n + k)) <= huge(one)) finite = .false.
+          end do
+          dtol = 1.0e-3_wp * (c%opts%atol + c%opts%rtol * qmax)
+          if (it > 1 .and. finite .and. maxval(abs(w%phi)) <= w%tol .and. &
+              maxval(abs(dq)) <= dtol .and. rmax <= rtol_dyn) then
             conv = .true.; exit
           end if
-          if (.not. all(ieee_is_finite(res))) exit
+          if (.not. finite) exit
           if (it == GA_SLOW .and. nkc < 2) new_kc = .true.
           if (it == 1 .or. new_kc) then
             if (.not. have_kc .or. new_kc) then
@@ -345,7 +354,9 @@ contains
           qn = qn + dq
           vn = vn + gp * dq
           an = an + bp * dq
-          lamn(w%rows) = lamn(w%rows) + bp * res(n + 1:)
+          do k = 1, na
+            lamn(w%rows(k)) = lamn(w%rows(k)) + bp * res(n + k)
+          end do
           c%st%newton = c%st%newton + 1
           ! slow contraction (above the roundoff of q): new K, C next iteration
           dqn = maxval(abs(dq))
