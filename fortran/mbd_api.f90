@@ -15,7 +15,7 @@ module mbd_api
   use mbd_model, only: model_t, model_build, model_add_dynamics
   use mbd_dynamics, only: dyn_work_t, dyn_init, dyn_velocity, dyn_multipliers, dyn_reactions, &
                           gen_forces, kinetic_energy
-  use mbd_integrators, only: dyn_opts_t, dyn_stats_t, integrate
+  use mbd_integrators, only: dyn_opts_t, dyn_stats_t, integrate, output_rows, output_index
   use mbd_statics, only: statics_solve
   use mbd_assemble, only: assemble_dense, asm_work_t, asm_init
   use mbd_kinematics, only: kin_opts_t, kin_report_t, kin_work_t, kin_run, kin_work_init, &
@@ -384,19 +384,22 @@ contains
   end subroutine api_inverse
 
   !> Forward dynamics: assembly of q0, the velocity v0 projected onto J q_dot = nu (kinetic
-  !! energy metric), integration with the chosen method, outputs at nsteps + 1 times.
+  !! energy metric), integration with the chosen method, outputs at nsteps + 1 times of which
+  !! rows k = 0, every, 2 every, ... and nsteps are stored (output_rows(nsteps, every)).
   !! iinfo: 1 outputs, 2 bad entry, 3 steps, 4 rejected, 5 Newton iterations, 6 right-hand
-  !! sides, 7 iteration matrices, 8 partitions, 9 active (independent) constraint rows.
+  !! sides, 7 iteration matrices (K, C evaluations), 8 partitions, 9 active (independent)
+  !! constraint rows, 10 LU factorizations of the generalized-alpha iteration matrix.
   !! rinfo: 1 time of a failure, 2 smallest step, 3 largest step.
   subroutine api_dynamics(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, v0, t0, t1, nsteps, &
-                          method, rtol, atol, h, rho_inf, balpha, bbeta, qout, qdout, qddout, &
-                          lamout, eout, iinfo, rinfo, redundant, status, msg)
+                          method, rtol, atol, h, rho_inf, balpha, bbeta, every, qout, qdout, &
+                          qddout, lamout, eout, iinfo, rinfo, redundant, status, msg)
     integer, intent(in) :: nb, ctab(:, :), ftab(:, :), nsteps, method
+    integer, intent(in) :: every                !! store every every-th output (and the last)
     real(wp), intent(in) :: rpar(:), bmass(:, :), grav(2), fpar(:), q0(:), v0(:), t0, t1
     real(wp), intent(in) :: rtol, atol, h, rho_inf, balpha, bbeta  !! method settings
-    real(wp), intent(out) :: qout(:, :), qdout(:, :), qddout(:, :)  !! (nq, nsteps + 1)
-    real(wp), intent(out) :: lamout(:, :)       !! (neq, nsteps + 1)
-    real(wp), intent(out) :: eout(:, :)         !! (4, nsteps + 1) energies, drift
+    real(wp), intent(out) :: qout(:, :), qdout(:, :), qddout(:, :)  !! (nq, rows)
+    real(wp), intent(out) :: lamout(:, :)       !! (neq, rows)
+    real(wp), intent(out) :: eout(:, :)         !! (4, rows) energies, drift
     integer, intent(out) :: iinfo(NINFO)
     real(wp), intent(out) :: rinfo(NINFO)
     integer, intent(out) :: redundant(:)
@@ -411,7 +414,7 @@ contains
     type(dyn_stats_t) :: dst
     real(wp), allocatable :: q(:), qd(:)
     real(wp) :: t, lscale
-    integer :: bad, badf, k, nout, st
+    integer :: bad, badf, k, ko, nout, st
     character(len=MSG_LEN) :: lmsg
     iinfo = 0; rinfo = zero; redundant = 0
     qout = zero; qdout = zero; qddout = zero; lamout = zero; eout = zero
@@ -422,13 +425,13 @@ contains
                finite([rtol, atol, h, rho_inf, balpha, bbeta]))) then
       call not_finite('q0, v0, the times and the settings', status, msg); return
     end if
+    if (nsteps < 0 .or. .not. (t1 > t0) .or. every < 1) then
+      status = MBD_BAD_SETTING; msg = 'steps must be >= 0, every >= 1 and t_end > t0'; return
+    end if
     if (size(q0) /= m%nq .or. size(v0) /= m%nq .or. size(qout, 1) /= m%nq .or. &
-        size(qout, 2) /= nsteps + 1 .or. size(lamout, 1) /= m%neq .or. &
+        size(qout, 2) /= output_rows(nsteps, every) .or. size(lamout, 1) /= m%neq .or. &
         size(redundant) /= m%neq) then
       status = MBD_BAD_COUNT; msg = 'array sizes do not match the model'; return
-    end if
-    if (nsteps < 0 .or. .not. (t1 > t0)) then
-      status = MBD_BAD_SETTING; msg = 'steps must be >= 0 and t_end > t0'; return
     end if
     ! assembly at t0 (Levenberg-Marquardt; any number of equations)
     call kin_work_init(m, kw)
@@ -459,15 +462,17 @@ contains
     if (rho_inf >= zero) opts%rho_inf = min(rho_inf, one)
     if (balpha >= zero) opts%balpha = balpha
     if (bbeta >= zero) opts%bbeta = bbeta
-    call integrate(m, w, q, qd, t0, t1, nsteps, opts, qout, qdout, qddout, nout, dst, &
+    call integrate(m, w, q, qd, t0, t1, nsteps, every, opts, qout, qdout, qddout, nout, dst, &
                    status, msg)
     iinfo(1) = nout; iinfo(3) = dst%steps; iinfo(4) = dst%rejected; iinfo(5) = dst%newton
     iinfo(6) = dst%rhs; iinfo(7) = dst%jacobians; iinfo(8) = dst%partitions
+    iinfo(10) = dst%factorizations
     rinfo(2) = dst%hmin; rinfo(3) = dst%hmax
     if (status /= MBD_OK) rinfo(1) = dst%t_fail
     do k = 1, nout
-      t = t0 + (t1 - t0) * (real(k - 1, wp) / max(nsteps, 1))
-      if (k == nsteps + 1) t = t1
+      ko = output_index(nsteps, every, k)
+      t = t0 + (t1 - t0) * (real(ko, wp) / max(nsteps, 1))
+      if (ko == nsteps) t = t1
       call dyn_multipliers(m, w, qout(:, k), qdout(:, k), qddout(:, k), t, lamout(:, k), st, lmsg)
       call state_measures(m, w, qout(:, k), qdout(:, k), t, eout(:, k))
     end do

@@ -19,15 +19,16 @@ module mbd_dynamics
   use mbd_points, only: NLOC, rot
   use mbd_model, only: model_t, model_slots
   use mbd_constraints, only: con_is_driver
-  use mbd_forces, only: force_eval
+  use mbd_forces, only: force_eval, FRC_SPRING, FRC_ROTSPRING
   use mbd_assemble, only: asm_work_t, asm_init, assemble_blocks, assemble_dense, scatter_dense, &
                           gather_local
-  use mbd_linsolve, only: lu_factor, lu_solve, row_rank, lapack_status
+  use mbd_linsolve, only: lu_factor, lu_solve, row_rank, lapack_status, ls_small
   use mbd_lapack, only: dgelsy, dgecon
   implicit none
   private
   public :: dyn_work_t, dyn_init, gen_forces, kinetic_energy, dyn_accel, dyn_velocity, &
-            dyn_project_pos, dyn_multipliers, dyn_reactions, dyn_tangent, dyn_solve
+            dyn_project_pos, dyn_multipliers, dyn_reactions, dyn_tangent, dyn_solve, &
+            dyn_jt_lam, dyn_damped
 
   !> 1/cond_1 of the augmented matrix below which it is solved by rank-revealing least squares
   real(wp), parameter :: AUG_RCOND = 1.0e-9_wp
@@ -270,9 +271,10 @@ contains
     status = MBD_NO_CONVERGENCE
   end subroutine dyn_project_pos
 
-  !> Minimum-norm multipliers over all rows: lambda = argmin ||l|| with J^T l = Q - M q_ddot
-  !! (LAPACK dgelsy). With independent rows this is the unique lambda; with redundant rows
-  !! the reactions are statically indeterminate and this is the smallest set.
+  !> Minimum-norm multipliers over all rows: lambda = argmin ||l|| with J^T l = Q - M q_ddot.
+  !! With independent rows this is the unique lambda (Householder least squares, ls_small);
+  !! with redundant rows, or J^T numerically rank deficient, the reactions are statically
+  !! indeterminate and this is the smallest set (LAPACK dgelsy).
   subroutine dyn_multipliers(m, w, q, qd, qdd, t, lam, status, msg)
     type(model_t), intent(in) :: m            !! model
     type(dyn_work_t), intent(inout) :: w      !! work arrays
@@ -284,11 +286,23 @@ contains
     real(wp) :: jt(m%nq, m%neq), b(max(m%nq, m%neq)), v, wq(1)
     real(wp), allocatable :: work(:)
     integer :: jpvt(m%neq), rank, info, lwork
+    logical :: full
     call assemble_dense(m, q, qd, t, w%phi, w%nu, w%gam, w%asm, w%jac)
     call gen_forces(m, q, qd, t, w%force, v)
     jt = transpose(w%jac)
     b = zero
     b(1:m%nq) = w%force - m%mdiag * qdd
+    status = MBD_OK
+    if (w%na == m%neq .and. m%neq <= m%nq) then
+      ! independent rows: the unique solution, by a plain Householder QR (no allocation)
+      call ls_small(jt, b, full)
+      if (full) then
+        lam = b(1:m%neq); return
+      end if
+      jt = transpose(w%jac)
+      b = zero
+      b(1:m%nq) = w%force - m%mdiag * qdd
+    end if
     jpvt = 0
     call dgelsy(m%nq, m%neq, 1, jt, m%nq, b, size(b), jpvt, 1.0e-10_wp, rank, wq, -1, info)
     lwork = max(1, int(wq(1)))
@@ -333,18 +347,50 @@ contains
     end do
   end subroutine dyn_reactions
 
-  !> Tangent matrices of the residual M q_ddot - Q(q, q_dot, t) + J^T lambda by central
-  !! differences: kt = d/dq (including the geometric term d(J^T lambda)/dq), ct = d/dq_dot.
-  !! Allocation-free: uses columns of the caller's arrays.
-  subroutine dyn_tangent(m, w, q, qd, t, lam, kt, ct)
+  !> Tangent matrices of the residual r = J^T lambda - Q(q, q_dot, t) by differences:
+  !! kt = dr/dq = d(J^T lambda)/dq - dQ/dq (the geometric term included), ct = dr/dq_dot =
+  !! -dQ/dq_dot. Central differences (4 nq residuals), or with fast = .true. forward
+  !! differences (nq + 1 residuals) and ct only when a force is damped (otherwise ct = 0):
+  !! enough for an iteration matrix, which only steers Newton. Allocation-free.
+  subroutine dyn_tangent(m, w, q, qd, t, lam, kt, ct, fast)
     type(model_t), intent(in) :: m            !! model
     type(dyn_work_t), intent(inout) :: w      !! work arrays
     real(wp), intent(in) :: q(:), qd(:)       !! state
     real(wp), intent(in) :: t                 !! time
     real(wp), intent(in) :: lam(:)            !! multipliers (neq)
     real(wp), intent(out) :: kt(:, :), ct(:, :)  !! (nq, nq) tangent stiffness and damping
-    real(wp) :: qp(m%nq), rp(m%nq), rm(m%nq), hk
+    logical, intent(in), optional :: fast     !! forward differences, ct only if damped
+    real(wp), parameter :: SQEPS = 1.5e-8_wp  ! ~ sqrt(machine epsilon)
+    real(wp) :: qp(m%nq), r0(m%nq), rp(m%nq), rm(m%nq), hk
     integer :: k
+    logical :: fwd
+    fwd = .false.
+    if (present(fast)) fwd = fast
+    if (fwd) then
+      ! forward: K e_k = (r(q + h e_k) - r(q)) / h
+      call residual(q, qd, r0)
+      qp = q
+      do k = 1, m%nq
+        hk = SQEPS * max(one, abs(q(k)))
+        qp(k) = q(k) + hk
+        hk = qp(k) - q(k)                      ! the step actually taken
+        call residual(qp, qd, rp)
+        qp(k) = q(k)
+        kt(:, k) = (rp - r0) / hk
+      end do
+      ct = zero
+      if (.not. dyn_damped(m)) return
+      qp = qd
+      do k = 1, m%nq
+        hk = SQEPS * max(one, abs(qd(k)))
+        qp(k) = qd(k) + hk
+        hk = qp(k) - qd(k)
+        call residual(q, qp, rp)
+        qp(k) = qd(k)
+        ct(:, k) = (rp - r0) / hk
+      end do
+      return
+    end if
     qp = q
     do k = 1, m%nq
       hk = 1.0e-7_wp * max(one, abs(q(k)))
@@ -370,10 +416,54 @@ contains
       real(wp), intent(in) :: qa(:), qda(:)
       real(wp), intent(out) :: r(:)
       real(wp) :: v
-      call assemble_dense(m, qa, qda, t, w%phi, w%nu, w%gam, w%asm, w%jac)
+      integer :: j
+      call assemble_blocks(m, qa, qda, t, w%phi, w%nu, w%gam, w%asm)
       call gen_forces(m, qa, qda, t, w%force, v)
-      r = matmul(lam, w%jac) - w%force
+      call dyn_jt_lam(m, w%asm%jb, lam, r)
+      do j = 1, m%nq
+        r(j) = r(j) - w%force(j)
+      end do
     end subroutine residual
   end subroutine dyn_tangent
+
+  !> r = J^T lambda from the local Jacobian blocks (no dense J): each constraint adds
+  !! jb_k^T lambda_k to the coordinates of its slots.
+  pure subroutine dyn_jt_lam(m, jb, lam, r)
+    type(model_t), intent(in) :: m            !! model
+    real(wp), intent(in) :: jb(:, :, :)       !! local blocks (MAXROW, NLOC, nc)
+    real(wp), intent(in) :: lam(:)            !! multipliers (neq)
+    real(wp), intent(out) :: r(:)             !! J^T lambda (nq)
+    integer :: k, s, c, r0, i
+    real(wp) :: acc
+    r = zero
+    do k = 1, m%nc
+      r0 = m%row0(k) - 1
+      do s = 1, NLOC
+        c = m%loc(s, k)
+        if (c == 0) cycle
+        acc = zero
+        do i = 1, m%nrow(k)
+          acc = acc + jb(i, s, k) * lam(r0 + i)
+        end do
+        r(c) = r(c) + acc
+      end do
+    end do
+  end subroutine dyn_jt_lam
+
+  !> A force depends on q_dot: a damped spring or rotational spring.
+  pure logical function dyn_damped(m)
+    type(model_t), intent(in) :: m           !! model
+    integer :: k, o
+    dyn_damped = .false.
+    do k = 1, m%nf
+      o = m%fpo(k)
+      select case (m%fkind(k))
+      case (FRC_SPRING)
+        if (m%fp(o + 5) /= zero) dyn_damped = .true.
+      case (FRC_ROTSPRING)
+        if (m%fp(o + 1) /= zero) dyn_damped = .true.
+      end select
+    end do
+  end function dyn_damped
 
 end module mbd_dynamics

@@ -122,26 +122,29 @@ subroutine core_inverse(nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp, fpar
                    status, msg)
 end subroutine core_inverse
 
+! every >= 1: only the outputs k = 0, every, 2 every, ... and k = nsteps are stored; nrow is
+! their count, nsteps / every + 1, plus 1 when every does not divide nsteps.
 subroutine core_dynamics(nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp, fpar, nq, neq, &
                          q0, v0, t0, t1, nsteps, method, rtol, atol, h, rho_inf, balpha, bbeta, &
-                         qout, qdout, qddout, lamout, eout, iinfo, rinfo, redundant, status, msg)
+                         every, nrow, qout, qdout, qddout, lamout, eout, iinfo, rinfo, &
+                         redundant, status, msg)
   use iso_c_binding, only: c_double, c_int
   use mbd_api, only: api_dynamics
   implicit none
-  integer(c_int), intent(in) :: nb, nc, np, nf, nfp, nq, neq, nsteps, method
+  integer(c_int), intent(in) :: nb, nc, np, nf, nfp, nq, neq, nsteps, method, every, nrow
   integer(c_int), intent(in) :: ctab(8, nc), ftab(6, nf)
   real(c_double), intent(in) :: rpar(np), bmass(2, nb), grav(2), fpar(nfp), q0(nq), v0(nq)
   real(c_double), intent(in) :: t0, t1, rtol, atol, h, rho_inf, balpha, bbeta
-  real(c_double), intent(out) :: qout(nq, nsteps + 1), qdout(nq, nsteps + 1)
-  real(c_double), intent(out) :: qddout(nq, nsteps + 1), lamout(neq, nsteps + 1)
-  real(c_double), intent(out) :: eout(4, nsteps + 1)
+  real(c_double), intent(out) :: qout(nq, nrow), qdout(nq, nrow)
+  real(c_double), intent(out) :: qddout(nq, nrow), lamout(neq, nrow)
+  real(c_double), intent(out) :: eout(4, nrow)
   integer(c_int), intent(out) :: iinfo(10), redundant(neq), status
   real(c_double), intent(out) :: rinfo(10)
   character(len=512), intent(out) :: msg
   !f2py intent(hide) :: nc, np, nf, nfp, nq
   call api_dynamics(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, v0, t0, t1, nsteps, method, &
-                    rtol, atol, h, rho_inf, balpha, bbeta, qout, qdout, qddout, lamout, eout, &
-                    iinfo, rinfo, redundant, status, msg)
+                    rtol, atol, h, rho_inf, balpha, bbeta, every, qout, qdout, qddout, lamout, &
+                    eout, iinfo, rinfo, redundant, status, msg)
 end subroutine core_dynamics
 
 subroutine core_statics(nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp, fpar, nq, neq, q0, &

@@ -7,7 +7,8 @@
 !!                       controlled (local error h^2 |beta - 1/6| |a_{n+1} - a_n|); rho_inf.
 !!                       Iteration matrix [M b' + C g' + K, b' J^T; b' J, 0],
 !!                       b' = (1 - am)/(beta h^2 (1 - af)), g' = gamma/(beta h), K and C by
-!!                       differences of the residual.
+!!                       differences of the residual, kept across steps (modified Newton);
+!!                       S factored once per step with the current J.
 !!  2 dopri5             index 1 ([M J^T; J 0][q_ddot; lambda] = [Q; gamma]) with Dormand-Prince
 !!                       5(4), adaptive (rtol, atol), then projection of q onto Phi = 0 and of
 !!                       q_dot onto J q_dot = nu after every step.
@@ -23,17 +24,17 @@ module mbd_integrators
   use mbd_status, only: MBD_OK, MBD_BAD_SETTING, MBD_SINGULAR, MBD_NO_CONVERGENCE, &
                         MBD_INTEGRATOR_FAILED, MBD_LAPACK, MSG_LEN
   use mbd_model, only: model_t
-  use mbd_assemble, only: assemble_dense
-  use mbd_linsolve, only: lu_factor, lu_solve, lapack_status
+  use mbd_assemble, only: assemble_dense, assemble_blocks, scatter_dense
+  use mbd_linsolve, only: lu_factor, lu_solve, lapack_status, lu_factor_small, lu_solve_small
   use mbd_lapack, only: dgeqp3, dgecon
   use mbd_interp, only: hermite5
   use mbd_dynamics, only: dyn_work_t, dyn_accel, dyn_velocity, dyn_project_pos, gen_forces, &
-                          kinetic_energy, dyn_tangent, dyn_solve
+                          kinetic_energy, dyn_tangent, dyn_solve, dyn_jt_lam
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   implicit none
   private
   public :: dyn_opts_t, dyn_stats_t, METH_GENALPHA, METH_DOPRI5, METH_RK4, METH_PARTITIONED
-  public :: integrate
+  public :: integrate, output_rows, output_index
 
   integer, parameter :: METH_GENALPHA = 1, METH_DOPRI5 = 2, METH_RK4 = 3, METH_PARTITIONED = 4
 
@@ -52,6 +53,7 @@ module mbd_integrators
   !> What the integrator did.
   type :: dyn_stats_t
     integer :: steps = 0, rejected = 0, newton = 0, rhs = 0, jacobians = 0, partitions = 0
+    integer :: factorizations = 0     !! LU factorizations of the iteration matrix
     real(wp) :: hmin = huge(one), hmax = zero
     real(wp) :: t_fail = zero         !! time reached when a method failed
   end type dyn_stats_t
@@ -62,7 +64,10 @@ module mbd_integrators
     type(dyn_opts_t) :: opts
     type(dyn_stats_t) :: st
     real(wp) :: t0 = zero, t1 = zero
-    integer :: nsteps = 0, nout = 0
+    integer :: nsteps = 0               !! output intervals
+    integer :: every = 1                !! store outputs k with mod(k, every) = 0, and k = nsteps
+    integer :: kout = 0                 !! next output index k (0 .. nsteps)
+    integer :: nout = 0                 !! rows stored
     logical :: baumgarte = .false.
     integer :: ni = 0                       !! independent coordinates (partitioned)
     integer, allocatable :: iv(:), iu(:)    !! independent and dependent coordinates
@@ -86,18 +91,21 @@ module mbd_integrators
 
 contains
 
-  !> Integrate from the consistent state (q, qd) at t0 to t1, writing outputs at
-  !! t0 + k (t1 - t0)/nsteps, k = 0..nsteps, into the columns of qo, vo, ao.
-  !! nout returns the number of outputs written (all, unless a failure stopped the run).
-  subroutine integrate(m, w, q, qd, t0, t1, nsteps, opts, qo, vo, ao, nout, st, status, msg)
+  !> Integrate from the consistent state (q, qd) at t0 to t1, with outputs at
+  !! t0 + k (t1 - t0)/nsteps, k = 0..nsteps, of which those with mod(k, every) = 0 and the
+  !! last (k = nsteps) are written into the columns of qo, vo, ao (output_rows of them).
+  !! nout returns the number of rows written (all, unless a failure stopped the run).
+  subroutine integrate(m, w, q, qd, t0, t1, nsteps, every, opts, qo, vo, ao, nout, st, status, &
+                       msg)
     type(model_t), intent(in) :: m               !! model
     type(dyn_work_t), intent(inout) :: w         !! dynamics work arrays (dyn_init done)
     real(wp), intent(inout) :: q(:), qd(:)       !! consistent initial state, then final
     real(wp), intent(in) :: t0, t1               !! time span
     integer, intent(in) :: nsteps                !! output intervals
+    integer, intent(in) :: every                 !! store every every-th output (and the last)
     type(dyn_opts_t), intent(in) :: opts         !! settings
-    real(wp), intent(out) :: qo(:, :), vo(:, :), ao(:, :)  !! outputs (nq, nsteps + 1)
-    integer, intent(out) :: nout                 !! outputs written
+    real(wp), intent(out) :: qo(:, :), vo(:, :), ao(:, :)  !! outputs (nq, rows)
+    integer, intent(out) :: nout                 !! rows written
     type(dyn_stats_t), intent(out) :: st         !! counters
     integer, intent(out) :: status               !! MBD_OK or a failure
     character(len=MSG_LEN), intent(out) :: msg   !! explanation
@@ -110,7 +118,10 @@ contains
     if (.not. (opts%rtol > zero .and. opts%atol > zero)) then
       status = MBD_BAD_SETTING; msg = 'rtol and atol must be positive'; return
     end if
-    c%opts = opts; c%t0 = t0; c%t1 = t1; c%nsteps = nsteps
+    if (every < 1 .or. size(qo, 2) /= output_rows(nsteps, every)) then
+      status = MBD_BAD_SETTING; msg = 'every must be >= 1 and the outputs sized for it'; return
+    end if
+    c%opts = opts; c%t0 = t0; c%t1 = t1; c%nsteps = nsteps; c%every = every
     allocate (c%qf(m%nq), c%vf(m%nq), c%af(m%nq), c%lam(m%neq))
     c%qf = q; c%vf = qd
     call dyn_accel(m, w, q, qd, t0, c%af, c%lam, status)
@@ -118,7 +129,7 @@ contains
       msg = 'the mass matrix and constraints give a singular system at the start'; return
     end if
     qo(:, 1) = q; vo(:, 1) = qd; ao(:, 1) = c%af
-    c%nout = 1
+    c%nout = 1; c%kout = 1
     if (nsteps > 0) then
       select case (opts%method)
       case (METH_GENALPHA)
@@ -163,18 +174,37 @@ contains
     if (k == c%nsteps) out_time = c%t1
   end function out_time
 
-  !> Write the outputs in (ta, tb] by quintic Hermite interpolation of the two states.
+  !> Write the stored outputs in (ta, tb] by quintic Hermite interpolation of the two
+  !! states; outputs between the stored ones (every > 1) are passed over, not computed.
   subroutine emit(c, qo, vo, ao, ta, qa, va, aa, tb, qb, vb, ab)
     type(itg_t), intent(inout) :: c
     real(wp), intent(inout) :: qo(:, :), vo(:, :), ao(:, :)
     real(wp), intent(in) :: ta, tb, qa(:), va(:), aa(:), qb(:), vb(:), ab(:)
-    do while (c%nout <= c%nsteps)
-      if (out_time(c, c%nout) > tb + 1.0e-12_wp * abs(c%t1 - c%t0)) exit
-      call hermite5(ta, qa, va, aa, tb, qb, vb, ab, out_time(c, c%nout), qo(:, c%nout + 1), &
-                    vo(:, c%nout + 1), ao(:, c%nout + 1))
-      c%nout = c%nout + 1
+    do while (c%kout <= c%nsteps)
+      if (out_time(c, c%kout) > tb + 1.0e-12_wp * abs(c%t1 - c%t0)) exit
+      if (mod(c%kout, c%every) == 0 .or. c%kout == c%nsteps) then
+        call hermite5(ta, qa, va, aa, tb, qb, vb, ab, out_time(c, c%kout), &
+                      qo(:, c%nout + 1), vo(:, c%nout + 1), ao(:, c%nout + 1))
+        c%nout = c%nout + 1
+      end if
+      c%kout = c%kout + 1
     end do
   end subroutine emit
+
+  !> Rows stored for nsteps output intervals, keeping k = 0, every, 2 every, ... and nsteps.
+  pure integer function output_rows(nsteps, every)
+    integer, intent(in) :: nsteps             !! output intervals
+    integer, intent(in) :: every              !! decimation (>= 1)
+    output_rows = nsteps / every + 1
+    if (mod(nsteps, every) /= 0) output_rows = output_rows + 1
+  end function output_rows
+
+  !> Output index k (0 .. nsteps) of stored row r (1 .. output_rows).
+  pure integer function output_index(nsteps, every, r)
+    integer, intent(in) :: nsteps, every      !! output intervals, decimation
+    integer, intent(in) :: r                  !! row
+    output_index = min((r - 1) * every, nsteps)
+  end function output_index
 
   !> Weighted RMS norm of an error estimate.
   real(wp) function err_norm(c, e, ya, yb)
@@ -194,6 +224,15 @@ contains
   end function initial_step
 
   ! -------------------------------------------------------------------- generalized-alpha
+  !> Index-3 generalized-alpha (Arnold & Bruls 2007), Newton on (q_{n+1}, lambda_{n+1}) with
+  !! the iteration matrix S = [M b' + C g' + K, b' J^T; b' J, 0]. The costly part, K and C
+  !! by differences, is kept across steps and evaluated again only when Newton contracts
+  !! slowly (|dq_k| > GA_RHO |dq_{k-1}|), takes GA_SLOW iterations, or fails (the step is
+  !! then retried with fresh K, C). S itself is formed with the current J and factored once
+  !! per step (a small dense LU, cheaper than the extra iterations an older J costs).
+  !! Converged: |Phi| <= w%tol, the last correction below 1e-3 (atol + rtol |q|), and the
+  !! residual of M q_ddot + J^T lambda = Q below GA_RTOL of its largest term, so that the
+  !! result is that of full Newton (a stale S only changes the iteration count).
   subroutine run_genalpha(m, w, c, qo, vo, ao, status, msg)
     type(model_t), intent(in) :: m
     type(dyn_work_t), intent(inout) :: w
@@ -201,21 +240,28 @@ contains
     real(wp), intent(inout) :: qo(:, :), vo(:, :), ao(:, :)
     integer, intent(out) :: status
     character(len=MSG_LEN), intent(out) :: msg
-    real(wp) :: am, af, gam, bet, bp, gp, h, t, err, tnew, facc, v, hprev
+    real(wp), parameter :: GA_RHO = 0.1_wp       ! contraction rate that asks for new K, C
+    real(wp), parameter :: GA_RTOL = 1.0e-11_wp  ! relative residual of the dynamic equations
+    integer, parameter :: GA_SLOW = 6            ! iterations that ask for new K, C
+    integer, parameter :: GA_MAXIT = 30          ! iterations before the step fails
+    real(wp) :: am, af, gam, bet, bp, gp, h, t, err, tnew, facc, v, hprev, dqn, dqp, dtol
+    real(wp) :: rtol_dyn, cf, kmax, cmax, fmax, qmax, vmax, rmax
     real(wp) :: q(m%nq), qd(m%nq), qdd(m%nq), acc(m%nq), lam(m%neq)
-    real(wp) :: qn(m%nq), vn(m%nq), an(m%nq), accn(m%nq), lamn(m%neq), dq(m%nq)
+    real(wp) :: qn(m%nq), vn(m%nq), an(m%nq), accn(m%nq), lamn(m%neq), dq(m%nq), ap(m%nq)
     real(wp) :: res(m%nq + w%na), kt(m%nq, m%nq), ct(m%nq, m%nq)
     real(wp) :: s(m%nq + w%na, m%nq + w%na)
-    integer :: piv(m%nq + w%na), it, n, k, stt, nfix
-    logical :: fixed, conv
-    character(len=MSG_LEN) :: lmsg
+    integer :: piv(m%nq + w%na), it, n, stt, nfix, na, attempt, nkc, k
+    logical :: fixed, conv, have_kc, new_kc, finite
     status = MBD_OK; msg = ''
-    n = m%nq
-    am = (2 * c%opts%rho_inf - 1) / (c%opts%rho_inf + 1)
+    n = m%nq; na = w%na
+    am = (2 * c%opts%rho_inf - 1) / (c%opts%rho_inf + 1)        ! Arnold & Bruls (2007)
     af = c%opts%rho_inf / (c%opts%rho_inf + 1)
     gam = half + af - am
     bet = 0.25_wp * (gam + half)**2
+    cf = (1 - af) / (1 - am)             ! weight of q_ddot_{n+1} in a_{n+1}
     fixed = c%opts%h > zero
+    have_kc = .false.; new_kc = .false.
+    kt = zero; ct = zero; kmax = zero; cmax = zero
     q = c%qf; qd = c%vf; qdd = c%af; lam = c%lam
     t = c%t0
     nfix = 0
@@ -247,47 +293,79 @@ contains
       ! a - q_ddot scales with it, a <- q_ddot + (h / h_prev) (a - q_ddot)
       if (hprev > zero .and. abs(h - hprev) > zero) acc = qdd + (h / hprev) * (acc - qdd)
       hprev = h
-      ! predictor with q_ddot_{n+1} = 0
-      an = zero
-      accn = (af * qdd - am * acc) / (1 - am)
-      qn = q + h * qd + h * h * (half - bet) * acc + h * h * bet * accn
-      vn = qd + h * (1 - gam) * acc + h * gam * accn
-      lamn = lam
-      conv = .false.
-      dq = zero
-      do it = 1, 30
-        call assemble_dense(m, qn, vn, tnew, w%phi, w%nu, w%gam, w%asm, w%jac)
-        call gen_forces(m, qn, vn, tnew, w%force, v)
-        res(1:n) = m%mdiag * an + matmul(lamn, w%jac) - w%force
-        res(n + 1:) = bp * w%phi(w%rows)
-        if (it > 1 .and. maxval(abs(w%phi)) <= w%tol .and. &
-            maxval(abs(dq)) <= 1.0e-3_wp * (c%opts%atol + c%opts%rtol * maxval(abs(qn)))) then
-          conv = .true.; exit
-        end if
-        if (.not. all(ieee_is_finite(res))) exit
-        if (it == 1 .or. it == 4) then
-          ! iteration matrix [M b' + C g' + K, b' J^T; b' J, 0], refreshed at iterations 1, 4
-          call dyn_tangent(m, w, qn, vn, tnew, lamn, kt, ct)
-          c%st%jacobians = c%st%jacobians + 1
-          s = zero
+      do attempt = 1, 2
+        ! predictor: q_ddot_{n+1} = q_ddot_n, lambda_{n+1} = lambda_n (not extrapolated:
+        ! the index-3 accelerations carry a step-to-step oscillation);
+        ! a_{n+1} = (af q_ddot_n + (1 - af) q_ddot_{n+1} - am a_n) / (1 - am);
+        ! q_{n+1} = q_n + h q_dot_n + h^2 ((1/2 - beta) a_n + beta a_{n+1}),
+        ! q_dot_{n+1} = q_dot_n + h ((1 - gamma) a_n + gamma a_{n+1})
+        an = qdd
+        lamn = lam
+        accn = (af * qdd - am * acc) / (1 - am)
+        ap = accn + cf * an
+        qn = q + h * qd + h * h * (half - bet) * acc + h * h * bet * ap
+        vn = qd + h * (1 - gam) * acc + h * gam * ap
+        conv = .false.
+        nkc = 0                         ! K, C evaluations in this attempt
+        dq = zero; dqp = huge(one)
+        do it = 1, GA_MAXIT
+          call assemble_blocks(m, qn, vn, tnew, w%phi, w%nu, w%gam, w%asm)
+          call gen_forces(m, qn, vn, tnew, w%force, v)
+          ! r = M q_ddot + J^T lambda - Q;  r_c = b' Phi
+          call dyn_jt_lam(m, w%asm%jb, lamn, res(1:n))
+          ! the residual tolerance is GA_RTOL of the largest term, but not below the change
+          ! that rounding q, q_dot to working precision makes (K |q| + C |q_dot|) eps
+          fmax = zero; qmax = zero; vmax = zero; rmax = zero; finite = .true.
           do k = 1, n
-            s(k, k) = m%mdiag(k) * bp
+            fmax = max(fmax, abs(res(k)), abs(w%force(k)), abs(m%mdiag(k) * an(k)))
+            res(k) = res(k) + m%mdiag(k) * an(k) - w%force(k)
+            if (.not. abs(res(k)) <= huge(one)) finite = .false.      ! NaN or Inf
+            rmax = max(rmax, abs(res(k)))
+            qmax = max(qmax, abs(qn(k))); vmax = max(vmax, abs(vn(k)))
           end do
-          s(1:n, 1:n) = s(1:n, 1:n) + gp * ct + kt
-          call assemble_dense(m, qn, vn, tnew, w%phi, w%nu, w%gam, w%asm, w%jac)
-          s(1:n, n + 1:) = bp * transpose(w%jac(w%rows, :))
-          s(n + 1:, 1:n) = bp * w%jac(w%rows, :)
-          call lu_factor(s, piv, stt, lmsg)
-          if (stt /= MBD_OK) exit
-        end if
-        res = -res
-        call lu_solve(s, piv, res, stt, lmsg)
-        dq = res(1:n)
-        qn = qn + dq
-        vn = vn + gp * dq
-        an = an + bp * dq
-        lamn(w%rows) = lamn(w%rows) + bp * res(n + 1:)
-        c%st%newton = c%st%newton + 1
+          rtol_dyn = max(GA_RTOL * fmax, 100 * epsilon(one) * (kmax * qmax + cmax * vmax))
+          do k = 1, na
+            res(n + k) = bp * w%phi(w%rows(k))
+            if (.not. abs(res(n + k)) <= huge(one)) finite = .false.
+          end do
+          dtol = 1.0e-3_wp * (c%opts%atol + c%opts%rtol * qmax)
+          if (it > 1 .and. finite .and. maxval(abs(w%phi)) <= w%tol .and. &
+              maxval(abs(dq)) <= dtol .and. rmax <= rtol_dyn) then
+            conv = .true.; exit
+          end if
+          if (.not. finite) exit
+          if (it == GA_SLOW .and. nkc < 2) new_kc = .true.
+          if (it == 1 .or. new_kc) then
+            if (.not. have_kc .or. new_kc) then
+              call dyn_tangent(m, w, qn, vn, tnew, lamn, kt, ct, fast=.true.)
+              c%st%jacobians = c%st%jacobians + 1
+              have_kc = .true.; new_kc = .false.; nkc = nkc + 1
+              kmax = maxval(abs(kt)); cmax = maxval(abs(ct))
+              call assemble_blocks(m, qn, vn, tnew, w%phi, w%nu, w%gam, w%asm)
+            end if
+            call form_s()
+            call lu_factor_small(s, piv, stt)
+            c%st%factorizations = c%st%factorizations + 1
+            if (stt /= MBD_OK) exit
+          end if
+          res = -res
+          call lu_solve_small(s, piv, res)
+          dq = res(1:n)
+          qn = qn + dq
+          vn = vn + gp * dq
+          an = an + bp * dq
+          do k = 1, na
+            lamn(w%rows(k)) = lamn(w%rows(k)) + bp * res(n + k)
+          end do
+          c%st%newton = c%st%newton + 1
+          ! slow contraction (above the roundoff of q): new K, C next iteration
+          dqn = maxval(abs(dq))
+          if (dqn > GA_RHO * dqp .and. dqn > 100 * epsilon(one) * maxval(abs(qn)) .and. &
+              nkc < 2) new_kc = .true.
+          dqp = dqn
+        end do
+        if (conv .or. nkc > 0) exit
+        new_kc = .true.                 ! failed with old K, C: retry with fresh ones
       end do
       ! local error estimate: the step's position error is (beta - 1/6) h^3 q''', and the
       ! distance of q_{n+1} from its second-order Taylor prediction is h^3 q'''/6, so
@@ -325,6 +403,23 @@ contains
       end if
     end do
     c%qf = q; c%vf = qd; c%af = qdd; c%lam = lam
+  contains
+    !> S = [M b' + C g' + K, b' J^T; b' J, 0] at the last assembly (J from its blocks).
+    subroutine form_s()
+      integer :: j
+      call scatter_dense(m, w%asm%jb, w%jac)
+      do j = 1, n + na
+        s(:, j) = zero
+      end do
+      do j = 1, n
+        s(1:n, j) = kt(:, j) + gp * ct(:, j)
+        s(j, j) = s(j, j) + m%mdiag(j) * bp
+      end do
+      do j = 1, na
+        s(n + j, 1:n) = bp * w%jac(w%rows(j), :)
+        s(1:n, n + j) = bp * w%jac(w%rows(j), :)
+      end do
+    end subroutine form_s
   end subroutine run_genalpha
 
   ! -------------------------------------------------------------------- explicit methods

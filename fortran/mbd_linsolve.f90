@@ -2,6 +2,9 @@
 !!
 !!   lu_factor   A = P L U               (dgetf2 up to SMALL_N, else dgetrf)
 !!   lu_solve    A x = b from the factors (dgetrs' steps: row interchanges, two dtrsv)
+!!   lu_factor_small, lu_solve_small   the same in plain loops, for the small iteration
+!!               matrices factored and solved in the generalized-alpha time loop
+!!   ls_small    min ||A x - b|| for a small A of full column rank (Householder QR, plain loops)
 !!   lu_det_sign sign of det A from the factors: prod(sign U_ii) * (-1)**(row swaps)
 !!   svd_null    singular values of A and the singular vectors of the smallest one (dgesvd)
 !!   row_rank    rank of A (QR with column pivoting of the row-normalized A^T, dgeqp3) and the
@@ -11,12 +14,13 @@
 !!   qr_solve    x = argmin ||A x - b|| for full column rank: R x_p = (Q^T b)(1:n) (dormqr,
 !!               dtrtrs), x = P x_p; also returns the residual ||(Q^T b)(n+1:m)||
 module mbd_linsolve
-  use mbd_kinds, only: wp, zero
+  use mbd_kinds, only: wp, zero, one
   use mbd_status, only: MBD_OK, MBD_SINGULAR, MBD_LAPACK, MSG_LEN
   use mbd_lapack, only: dgetrf, dgetf2, dtrsv, dgesvd, dgeqp3, dormqr, dtrtrs
   implicit none
   private
   public :: lapack_status, lu_factor, lu_solve, lu_det_sign, svd_null, row_rank
+  public :: lu_factor_small, lu_solve_small, ls_small
   public :: qr_factor, qr_solve, qr_lwork, RANK_TOL
 
   integer, parameter :: SMALL_N = 48   !! below this the unblocked dgetf2 is faster
@@ -95,6 +99,115 @@ contains
       end if
     end do
   end subroutine lu_solve
+
+  !> LU with partial pivoting in place, A = P L U, for the small dense iteration matrices of
+  !! the time loop (plain loops, column oriented: no BLAS call overhead). Same pivoting rule as
+  !! dgetf2 (largest |a_ik| in the column). An exactly zero pivot gives MBD_SINGULAR.
+  pure subroutine lu_factor_small(a, ipiv, status)
+    real(wp), intent(inout) :: a(:, :)          !! square matrix; factors on return
+    integer, intent(out) :: ipiv(:)             !! pivot rows
+    integer, intent(out) :: status              !! MBD_OK or MBD_SINGULAR
+    integer :: n, i, j, k, p
+    real(wp) :: piv, tmp, f
+    n = size(a, 1)
+    status = MBD_OK
+    do k = 1, n
+      p = k; piv = abs(a(k, k))
+      do j = k + 1, n
+        if (abs(a(j, k)) > piv) then
+          p = j; piv = abs(a(j, k))
+        end if
+      end do
+      ipiv(k) = p
+      if (piv == zero) then
+        status = MBD_SINGULAR; return
+      end if
+      if (p /= k) then
+        do j = 1, n
+          tmp = a(k, j); a(k, j) = a(p, j); a(p, j) = tmp
+        end do
+      end if
+      f = 1 / a(k, k)
+      do i = k + 1, n                                   ! l_ik = a_ik / u_kk
+        a(i, k) = a(i, k) * f
+      end do
+      do j = k + 1, n                                   ! a_ij -= l_ik u_kj
+        f = a(k, j)
+        if (f == zero) cycle
+        do i = k + 1, n
+          a(i, j) = a(i, j) - f * a(i, k)
+        end do
+      end do
+    end do
+  end subroutine lu_factor_small
+
+  !> Solve A x = b with the factors of lu_factor_small: P L U x = b; b is overwritten by x.
+  pure subroutine lu_solve_small(a, ipiv, b)
+    real(wp), intent(in) :: a(:, :)             !! LU factors
+    integer, intent(in) :: ipiv(:)              !! pivot rows
+    real(wp), intent(inout) :: b(:)             !! right-hand side, then solution
+    integer :: n, i, k, p
+    real(wp) :: tmp
+    n = size(a, 1)
+    do k = 1, n                                 ! P b (the row interchanges in order)
+      p = ipiv(k)
+      if (p /= k) then
+        tmp = b(k); b(k) = b(p); b(p) = tmp
+      end if
+    end do
+    do k = 1, n                                 ! L y = P b (column oriented)
+      tmp = b(k)
+      if (tmp == zero) cycle
+      do i = k + 1, n
+        b(i) = b(i) - tmp * a(i, k)
+      end do
+    end do
+    do k = n, 1, -1                             ! U x = y
+      b(k) = b(k) / a(k, k)
+      tmp = b(k)
+      if (tmp == zero) cycle
+      do i = 1, k - 1
+        b(i) = b(i) - tmp * a(i, k)
+      end do
+    end do
+  end subroutine lu_solve_small
+
+  !> Least squares min ||A x - b|| for A (m x n), m >= n, of full column rank, by Householder
+  !! QR in plain loops (A = Q R, x = R^-1 (Q^T b)(1:n)); no allocation. ok is false (and a, b
+  !! are spoiled) when min |R_kk| < LS_RTOL max |R_kk|: use a rank-revealing solve then.
+  pure subroutine ls_small(a, b, ok)
+    real(wp), intent(inout) :: a(:, :)          !! A, overwritten by the factorization
+    real(wp), intent(inout) :: b(:)             !! b (m), then x in b(1:n)
+    logical, intent(out) :: ok                  !! A had full column rank
+    real(wp), parameter :: LS_RTOL = 1.0e-8_wp
+    integer :: mm, n, k, j
+    real(wp) :: alpha, nrm, vtv, f, rmax, rmin
+    mm = size(a, 1); n = size(a, 2)
+    ok = .false.
+    rmax = zero; rmin = huge(one)
+    do k = 1, n
+      ! Householder reflector H = I - 2 v v^T / v^T v zeroing a(k+1:m, k); v stored in a(k:m, k)
+      nrm = norm2(a(k:mm, k))
+      alpha = -sign(nrm, a(k, k))
+      rmax = max(rmax, nrm); rmin = min(rmin, nrm)
+      if (nrm == zero) return
+      a(k, k) = a(k, k) - alpha
+      vtv = dot_product(a(k:mm, k), a(k:mm, k))
+      do j = k + 1, n
+        f = 2 * dot_product(a(k:mm, k), a(k:mm, j)) / vtv
+        a(k:mm, j) = a(k:mm, j) - f * a(k:mm, k)
+      end do
+      f = 2 * dot_product(a(k:mm, k), b(k:mm)) / vtv
+      b(k:mm) = b(k:mm) - f * a(k:mm, k)
+      a(k, k) = alpha                           ! R_kk (v no longer needed below the diagonal)
+    end do
+    rmin = minval([(abs(a(k, k)), k=1, n)]); rmax = maxval([(abs(a(k, k)), k=1, n)])
+    if (rmin < LS_RTOL * rmax) return
+    do k = n, 1, -1                             ! R x = (Q^T b)(1:n)
+      b(k) = (b(k) - dot_product(a(k, k + 1:n), b(k + 1:n))) / a(k, k)
+    end do
+    ok = .true.
+  end subroutine ls_small
 
   !> Sign of det A from its LU factors (zero if a pivot is zero).
   pure integer function lu_det_sign(a, ipiv) result(sgn)

@@ -54,6 +54,7 @@ def _parser() -> argparse.ArgumentParser:
     d.add_argument("--rho-inf", type=float, default=None, help="generalized-alpha rho_inf")
     d.add_argument("--alpha", type=float, default=None, help="Baumgarte alpha")
     d.add_argument("--beta", type=float, default=None, help="Baumgarte beta")
+    d.add_argument("--every", type=int, default=1, help="write every k-th row (and the last)")
     s = sub.add_parser("statics", help="static equilibrium and reactions")
     s.add_argument("model", help="model file (.toml) with masses")
     s.add_argument("--t", type=float, default=0.0, help="time at which loads and drivers are "
@@ -112,7 +113,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         if args.command == "dynamics":
             res = model.dynamics(t_end=args.t_end, steps=args.steps, t0=args.t0,
                                  method=args.method, rtol=args.rtol, atol=args.atol, h=args.h,
-                                 rho_inf=args.rho_inf, alpha=args.alpha, beta=args.beta)
+                                 rho_inf=args.rho_inf, alpha=args.alpha, beta=args.beta,
+                                 every=args.every)
         else:
             res = model.kinematics(t_end=args.t_end, steps=args.steps, t0=args.t0, tol=args.tol,
                                    every=args.every, solver=args.solver)

@@ -10,7 +10,7 @@ import numpy as np
 from . import _core
 from .analysis import (ASSEMBLY_FAILED, INCONSISTENT, NO_CONVERGENCE, OK, SINGULAR,
                        SINGULAR_CONFIG, _assembly_failed, _failure, _names, check_memory,
-                       check_solver, check_span, require_determined)
+                       check_solver, check_span, output_steps, require_determined, time_grid)
 from .errors import (ConvergenceError, CoreError, IntegrationError, ModelError,
                      RedundantConstraintWarning, SingularJacobianError)
 from .pack import Packed, decode, pack
@@ -116,9 +116,11 @@ def run_inverse(model: "Model", t_end: float, steps: int, t0: float = 0.0,
 def run_dynamics(model: "Model", t_end: float, steps: int, method: str | None = None,
                  rtol: float | None = None, atol: float | None = None, h: float | None = None,
                  rho_inf: float | None = None, alpha: float | None = None,
-                 beta: float | None = None, t0: float = 0.0) -> DynamicsResult:
+                 beta: float | None = None, t0: float = 0.0, every: int = 1) -> DynamicsResult:
     """Forward dynamics in one core call; see :meth:`Model.dynamics`."""
     t0, t_end, steps = check_span(t0, t_end, steps)
+    idx = output_steps(steps, every)
+    every = int(every)
     method = DEFAULT_METHOD if method is None else method
     if method not in METHODS:
         raise ModelError(f"unknown method {method!r}; use one of {', '.join(METHODS)}",
@@ -152,19 +154,20 @@ def run_dynamics(model: "Model", t_end: float, steps: int, method: str | None = 
     beta_v = opt(beta, "beta", 0.0, 1e9, -1.0)
     p = pack(model)
     bmass, grav, ftab, fpar, v0 = pack_dynamics(model, p)
-    check_memory(steps + 1, 3 * p.nq + p.neq + 4)
+    check_memory(len(idx), 3 * p.nq + p.neq + 4)
     out = _core.core_dynamics(ctab=p.ctab, rpar=p.rpar, bmass=bmass, grav=grav, ftab=ftab,
                               fpar=fpar, neq=p.neq, q0=p.q0, v0=v0, t0=t0, t1=t_end,
                               nsteps=steps, method=METHODS[method], rtol=rtol_v, atol=atol_v,
-                              h=h_v, rho_inf=rho_v, balpha=alpha_v, bbeta=beta_v)
+                              h=h_v, rho_inf=rho_v, balpha=alpha_v, bbeta=beta_v,
+                              every=every, nrow=len(idx))
     qo, vo, ao, lam, e, iinfo, rinfo, red, status, msg = out
     n = int(iinfo[0])
-    t = t0 + (t_end - t0) * (np.arange(steps + 1) / steps)
-    t[-1] = t_end
+    t = time_grid(t0, t_end, steps, idx)
     _, red_rows = _names(p, model, red)
     stats = {"method": method, "steps": int(iinfo[2]), "rejected_steps": int(iinfo[3]),
              "newton_iterations": int(iinfo[4]), "rhs_evaluations": int(iinfo[5]),
-             "iteration_matrices": int(iinfo[6]), "partitions": int(iinfo[7]),
+             "iteration_matrices": int(iinfo[6]), "factorizations": int(iinfo[9]),
+             "partitions": int(iinfo[7]),
              "h_min": float(rinfo[1]) if iinfo[2] else None,
              "h_max": float(rinfo[2]) if iinfo[2] else None, "redundant_rows": red_rows}
     res = _result(model, p, t, n, qo, vo, ao, lam, e, stats, status == OK)

@@ -604,9 +604,11 @@ class Model:
     def dynamics(self, t_end: float, steps: int, method: str | None = None,
                  rtol: float | None = None, atol: float | None = None, h: float | None = None,
                  rho_inf: float | None = None, alpha: float | None = None,
-                 beta: float | None = None, t0: float = 0.0) -> "DynamicsResult":
+                 beta: float | None = None, t0: float = 0.0,
+                 every: int = 1) -> "DynamicsResult":
         """Forward dynamics of M q_ddot + J^T lambda = Q, Phi = 0 from the assembled q0 and
-        v0 (projected onto J q_dot = nu), outputs at steps + 1 uniform times.
+        v0 (projected onto J q_dot = nu), outputs at steps + 1 uniform times (every
+        every-th of them kept).
 
         Parameters
         ----------
@@ -628,6 +630,11 @@ class Model:
             Generalized-alpha spectral radius at infinite frequency, in [0, 1] (default 0.8).
         alpha, beta : float, optional
             Baumgarte coefficients (default 10, 10).
+        every : int, optional
+            Output decimation (default 1): of the output times k = 0 .. steps only those with
+            k % every == 0, and always the last (k = steps), are stored and returned, so
+            memory grows as steps / every. The integration (its time grid and, for fixed
+            steps, h) is the same as with every = 1, and so are the rows kept.
 
         Returns
         -------
@@ -636,13 +643,22 @@ class Model:
         Raises
         ------
         ModelError
-            If a body has no mass or inertia, or a setting is invalid.
+            If a body has no mass or inertia, or a setting is invalid (every not a whole
+            number >= 1).
         IntegrationError
             When the method fails (blow-up, step-size underflow); carries the partial results.
+
+        Examples
+        --------
+        >>> res = model.dynamics(10.0, 100_000, method="generalized-alpha", h=1e-4,
+        ...                      every=100)   # doctest: +SKIP
+        >>> res.t.shape                        # doctest: +SKIP
+        (1001,)
         """
         from .dynamics import run_dynamics
         return run_dynamics(self, t_end=t_end, steps=steps, method=method, rtol=rtol,
-                            atol=atol, h=h, rho_inf=rho_inf, alpha=alpha, beta=beta, t0=t0)
+                            atol=atol, h=h, rho_inf=rho_inf, alpha=alpha, beta=beta, t0=t0,
+                            every=every)
 
     def statics(self, t: float = 0.0) -> "StaticsResult":
         """Static equilibrium under gravity, springs and loads (drivers held at t), with the
