@@ -2,8 +2,8 @@
 !! the time loop, redundant constraints, and singular configurations.
 !!
 !! Per output time (Haug, ch. 3-4; Nikravesh, ch. 5):
-!!   predictor    q = q_k + h q_dot_k + h**2/2 q_ddot_k + h**3/6 q_dddot_k
-!!                (q_dddot_k from the last two accelerations)
+!!   predictor    q = q_k + h q_dot_k + (the acceleration's Newton polynomial through the last
+!!                three accelerations, integrated twice): error O(h**5)
 !!   position     J(q) dq = -Phi(q, t),  q <- q + dq   until ||Phi||_inf <= tol
 !!   velocity     J q_dot = nu                    (the last factorization is reused)
 !!   acceleration J q_ddot = gamma(q, q_dot, t)   (same factorization)
@@ -533,10 +533,10 @@ contains
     character(len=MSG_LEN), intent(out) :: msg !! explanation
     type(kin_work_t) :: w
     type(band_t) :: band
-    real(wp), allocatable :: q(:), qd(:), qdd(:), qn(:), qp(:), q3(:), qddn(:), qdn(:)
+    real(wp), allocatable :: q(:), qd(:), qdd(:), qn(:), qp(:), q3(:), q4(:), qddn(:), qdn(:)
     real(wp), allocatable :: qa(:), qda(:), qdda(:), qb(:), qdb(:), qddb(:)
-    real(wp) :: t, h, hcur, hh, tt, target, lscale, ts, ta, d
-    integer :: k, j, c, st, detprev, mobility, lev, nsub
+    real(wp) :: t, h, hcur, hh, tt, target, lscale, ts, ta, d, hprev
+    integer :: k, j, c, st, detprev, mobility, lev, nsub, nderiv
     logical :: last, ok
 
     status = MBD_OK; msg = ''
@@ -580,7 +580,7 @@ contains
     end if
     lscale = m%lscale
     w%tol = opts%tol * lscale
-    allocate (q(m%nq), qd(m%nq), qdd(m%nq), qn(m%nq), qp(m%nq), q3(m%nq), qddn(m%nq), &
+    allocate (q(m%nq), qd(m%nq), qdd(m%nq), qn(m%nq), qp(m%nq), q3(m%nq), q4(m%nq), qddn(m%nq), &
               qdn(m%nq), qa(m%nq), qda(m%nq), qdda(m%nq), qb(m%nq), qdb(m%nq), qddb(m%nq))
     q = q0
     call kin_assemble(m, w, q, t0, opts, rep, status, msg)
@@ -629,7 +629,7 @@ contains
     qout(:, 1) = q; qdout(:, 1) = qd; qddout(:, 1) = qdd
     rep%ndone = 1
     detprev = w%detsign
-    q3 = zero
+    call forget_derivatives()
     t = t0
     if (nsteps == 0) then
       call count_work(); return
@@ -653,7 +653,11 @@ contains
       last = hcur >= (target - t) * (one - 1.0e-9_wp)
       hh = merge(target - t, hcur, last)
       tt = merge(target, t + hh, last)
-      qp = q + hh * (qd + (half * hh) * (qdd + (hh / 3.0_wp) * q3))
+      ! q + h q_dot + h**2/2 q_ddot + h**3/6 (d1 + d2 h1) + h**4/12 d2: the acceleration
+      ! extrapolated by its Newton polynomial through the last three (d1, d2 its divided
+      ! differences, h1 the last step), integrated twice
+      qp = q + hh * (qd + (half * hh) * (qdd + (hh / 3.0_wp) * (q3 + hprev * q4) + &
+                                         (hh * hh / 6.0_wp) * q4))
       qn = qp
       call kin_newton(m, w, qn, tt, opts%maxit, st)
       ok = st == MBD_OK .and. on_branch(JUMP_RATIO) .and. w%pivratio >= NEAR_SING
@@ -677,7 +681,7 @@ contains
         call inconsistent(tt, 0); return
       end if
       rep%rejected = rep%rejected + 1
-      q3 = zero
+      call forget_derivatives()
       hcur = half * hh
       if (hcur >= opts%tmin * max(one, abs(t))) cycle
       ! the configuration at t is singular (to tmin): pass through it or stop
@@ -729,9 +733,9 @@ contains
         end if
       end do
       tt = ts + d
-      q3 = zero
+      call forget_derivatives()
       call accept()
-      q3 = zero
+      call forget_derivatives()
       hcur = h
     end do
     call count_work()
@@ -801,8 +805,20 @@ contains
       anchor = anchor .and. st2 == MBD_OK
     end function anchor
 
+    subroutine forget_derivatives()
+      q3 = zero; q4 = zero; hprev = zero; nderiv = 0
+    end subroutine forget_derivatives
+
     subroutine accept()
+      ! divided differences of the accelerations: d1 = a[k+1, k], d2 = a[k+1, k, k-1]
+      if (nderiv >= 1) then
+        q4 = ((qddn - qdd) / (tt - t) - q3) / (tt - t + hprev)
+      else
+        q4 = zero
+      end if
       q3 = (qddn - qdd) / (tt - t)
+      hprev = tt - t
+      nderiv = nderiv + 1
       q = qn; qd = qdn; qdd = qddn; t = tt
     end subroutine accept
 
