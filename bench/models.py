@@ -11,8 +11,13 @@
 from __future__ import annotations
 
 import math
+import sys
+from pathlib import Path
 
 import mbd2d
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
+import nfourbar  # noqa: E402
 
 G = 9.81
 
@@ -58,17 +63,4 @@ def free_nfourbar(n: int, omega0: float = -1.0) -> mbd2d.Model:
 
 def driven_nfourbar(n: int) -> mbd2d.Model:
     """The kinematic N-four-bar: crank 0 driven, theta = pi/2 - t (cranks upright at t = 0)."""
-    m = mbd2d.Model(f"{n}-four-bar")
-    for k in range(n + 1):
-        m.add_body(f"crank{k}", q0=[k, 0.5, math.pi / 2])
-    for k in range(n):
-        m.add_body(f"coupler{k}", q0=[k + 0.5, 1.0, 0.0])
-    for k in range(n + 1):
-        m.add_revolute(["ground", f"crank{k}"], [[k, 0.0], [-0.5, 0.0]], name=f"O{k}")
-    for k in range(n):
-        m.add_revolute([f"crank{k}", f"coupler{k}"], [[0.5, 0.0], [-0.5, 0.0]], name=f"L{k}")
-        m.add_revolute([f"crank{k + 1}", f"coupler{k}"], [[0.5, 0.0], [0.5, 0.0]],
-                       name=f"R{k}")
-    m.add_driver("absolute", body="crank0", coordinate="theta",
-                 f={"poly": [math.pi / 2, -1.0]}, name="motor")
-    return m
+    return nfourbar.build(n)

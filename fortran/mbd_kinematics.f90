@@ -144,30 +144,15 @@ contains
     w%cs = one
   end subroutine kin_work_init
 
-  !> Band plan of J from its structure (the constraint blocks' rows and columns).
+  !> Band plan of J from its structure (the nonzeros of the constraint blocks).
   subroutine kin_band_plan(m, band, status, msg)
     type(model_t), intent(in) :: m              !! model (square J)
     type(band_t), intent(out) :: band           !! plan
     integer, intent(out) :: status              !! MBD_OK or the failure of band_plan
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
-    integer, allocatable :: rows(:), cols(:)
-    integer :: k, s, r, nz
-    nz = 0
-    do k = 1, m%nc
-      nz = nz + m%nrow(k) * count(m%loc(:, k) > 0)
-    end do
-    allocate (rows(nz), cols(nz))
-    nz = 0
-    do k = 1, m%nc
-      do s = 1, NLOC
-        if (m%loc(s, k) == 0) cycle
-        do r = 1, m%nrow(k)
-          nz = nz + 1
-          rows(nz) = m%row0(k) + r - 1; cols(nz) = m%loc(s, k)
-        end do
-      end do
-    end do
-    call band_plan(m%nq, rows, cols, band, status, msg)
+    type(asm_work_t) :: a
+    call asm_init(m, a)       ! its map: J(dst) = J(row, col), dst = row + neq (col - 1)
+    call band_plan(m%nq, mod(a%dst - 1, m%neq) + 1, a%col, band, status, msg)
   end subroutine kin_band_plan
 
   !> Phi, nu, gamma at (q, q_dot, t) and J D in the solver's storage: dense J in w%jac

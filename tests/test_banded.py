@@ -6,6 +6,7 @@ dense path (the same analysis with another linear solver)."""
 from __future__ import annotations
 
 import math
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -15,23 +16,9 @@ import mbd2d
 from mbd2d.errors import ModelError, SingularConfigurationError
 
 EX = Path(__file__).resolve().parents[1] / "examples"
+sys.path.insert(0, str(EX))
+from nfourbar import build as nfourbar  # noqa: E402
 TOGGLE_T = 0.8859186477661    # closed form, tests/test_toggle.py
-
-
-def nfourbar(n: int) -> mbd2d.Model:
-    """N parallelograms in a row; crank 0 driven, theta = pi/2 - t."""
-    m = mbd2d.Model(f"{n}-four-bar")
-    for k in range(n + 1):
-        m.add_body(f"crank{k}", q0=[k, 0.5, math.pi / 2])
-    for k in range(n):
-        m.add_body(f"coupler{k}", q0=[k + 0.5, 1.0, 0.0])
-    for k in range(n + 1):
-        m.add_revolute(["ground", f"crank{k}"], [[k, 0.0], [-0.5, 0.0]])
-    for k in range(n):
-        m.add_revolute([f"crank{k}", f"coupler{k}"], [[0.5, 0.0], [-0.5, 0.0]])
-        m.add_revolute([f"crank{k + 1}", f"coupler{k}"], [[0.5, 0.0], [0.5, 0.0]])
-    m.add_driver("absolute", body="crank0", coordinate="theta", f={"poly": [math.pi / 2, -1.0]})
-    return m
 
 
 def closed_form(n: int, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
