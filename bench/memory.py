@@ -168,7 +168,7 @@ def memory(steps: int = STEPS, log: bool = True) -> dict:
             rows.append(row)
             if log:
                 print("  " + format_row(row), flush=True)
-    return {"method": "peak RSS of the run in a fresh process (VmHWM, reset after import "
+    return {"method": "Peak RSS of the run in a fresh process (VmHWM, reset after import "
                       "mbd2d and model load) minus the RSS after import and load",
             "kinematics_case": f"examples/fourbar_grashof.toml, {steps} steps over "
                                f"{T_END * steps / STEPS:g} s",

@@ -73,7 +73,8 @@ def kinematics_targets(results: dict) -> list[Row]:
     us = get(fb, "fortran_loop", "us_per_step")
     fine = get(fb, "fortran_loop_h1e-4", "us_per_step")
     out = [_target("kinematics, four-bar, Fortran loop: <= 1 us/step",
-                   f"{fmt(us, '.2f')} us/step at h = 1 ms ({fmt(fine, '.2f')} at h = 0.1 ms)",
+                   f"{fmt(us, '.2f')} us/step at h = 1 ms ({fmt(fine, '.2f')} at h = 0.1 ms)"
+                   if us is not None else "not measured",
                    None if us is None else us <= 1.0,
                    "position + velocity + acceleration per step")]
     ratios = {k: v.get("ratio_numpy_over_loop") for k, v in rows.items()}
@@ -89,13 +90,15 @@ def kinematics_targets(results: dict) -> list[Row]:
 
 def peer_targets(results: dict) -> list[Row]:
     """>= 5x Exudyn on the free four-bar at equal accuracy, >= 50x on kinematic stepping."""
-    peers = results.get("peers") or {}
-    if failed(peers) or not peers.get("exudyn_available"):
-        why = failed(peers) or peers.get("exudyn_unavailable_reason") or "not run"
+    peers = results.get("peers")
+    why = failed(peers)
+    if why is None and not peers.get("exudyn_available"):
+        why = f"Exudyn unavailable: {peers.get('exudyn_unavailable_reason')}"
+    if why is not None:
         return [_target("free four-bar: >= 5x faster than Exudyn at equal accuracy",
-                        f"Exudyn unavailable: {why}", None),
+                        f"not measured ({why})", None),
                 _target("kinematic stepping: >= 50x faster than Exudyn",
-                        f"Exudyn unavailable: {why}", None)]
+                        f"not measured ({why})", None)]
     eq = [r["ratio"] for r in get(peers, "dynamics", "equal_accuracy", default=[]) or []
           if r.get("ratio")]
     same = [r["time_ratio_exudyn_over_mbd2d"]
@@ -123,7 +126,7 @@ def peer_targets(results: dict) -> list[Row]:
 
 def scaling_targets(results: dict) -> list[Row]:
     """About linear in N (banded path) and N = 1000 at <= 2 ms per step."""
-    sc = results.get("scaling") or {}
+    sc = results.get("scaling")
     if failed(sc):
         return [_target("scaling: about linear in N", "not measured", None, failed(sc))]
     slope = sc.get("banded_slope")
@@ -197,7 +200,7 @@ def wp_table(data: dict) -> str:
 
 def work_precision_section(results: dict, charts: dict, out: Path, base: Path) -> str:
     """Charts, settings and tables of the three studies."""
-    wp = results.get("work_precision") or {}
+    wp = results.get("work_precision")
     if failed(wp):
         return f"Failed: {failed(wp)}\n"
     parts = ["Error against CPU time (best-of-3 wall time of one `model.dynamics` call for "
@@ -226,7 +229,7 @@ def work_precision_section(results: dict, charts: dict, out: Path, base: Path) -
 
 def peers_section(results: dict) -> str:
     """Exudyn side by side, at equal accuracy, and kinematic stepping."""
-    peers = results.get("peers") or {}
+    peers = results.get("peers")
     if failed(peers):
         return f"Failed: {failed(peers)}\n"
     parts = []
@@ -271,7 +274,7 @@ def peers_section(results: dict) -> str:
 
 def kinematics_section(results: dict) -> str:
     """The three ways of running kinematics."""
-    kin = results.get("kinematics") or {}
+    kin = results.get("kinematics")
     if failed(kin):
         return f"Failed: {failed(kin)}\n"
     rows = []
@@ -299,7 +302,7 @@ def kinematics_section(results: dict) -> str:
 
 def scaling_section(results: dict, charts: dict, out: Path, base: Path) -> str:
     """Chart and table of time per step against N."""
-    sc = results.get("scaling") or {}
+    sc = results.get("scaling")
     if failed(sc):
         return f"Failed: {failed(sc)}\n"
     parts = [f"{sc.get('model')}. {sc.get('method')}.\n"]
@@ -327,7 +330,7 @@ def scaling_section(results: dict, charts: dict, out: Path, base: Path) -> str:
 
 def memory_section(results: dict, charts: dict, out: Path, base: Path) -> str:
     """Table and chart of the memory cases."""
-    mem = results.get("memory") or {}
+    mem = results.get("memory")
     if failed(mem):
         return f"Failed: {failed(mem)}\n"
     rows = []
@@ -366,6 +369,11 @@ def notes_section(results: dict) -> str:
     if load is not None and load > 1.5:
         lines.append(f"- The machine was busy at the start (load average {load:.1f} on 2 "
                      "cores): the timings may be pessimistic.")
+    blas = " ".join(get(results, "environment", "blas_lapack", default=[]) or [])
+    if "libblas3" in blas or "liblapack3" in blas:
+        lines.append("- The mbd2d core links Debian's reference BLAS/LAPACK (libblas3, "
+                     "liblapack3), not an optimized BLAS: the dense path's figures for large N "
+                     "reflect that.")
     lines.append("- Timings are wall times (time.perf_counter) on a shared 2-core virtual "
                  "machine; expect a few tens of percent run-to-run variation.")
     return "\n".join(lines) + "\n"

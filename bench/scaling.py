@@ -196,7 +196,7 @@ def scaling(quick: bool = False, log: bool = True) -> dict:
     banded = has_parameter("solver")
     out: dict[str, Any] = {
         "model": "bench/models.driven_nfourbar(N): 3 (2N + 1) coordinates, crank 0 driven",
-        "method": f"marginal time per step (T(s) - T(1)) / (s - 1) of model.kinematics at "
+        "method": f"Marginal time per step (T(s) - T(1)) / (s - 1) of model.kinematics at "
                   f"h = {H} s, best of N calls; about {target_s} s of timed calls per row",
         "quick": quick, "banded_available": banded, "rows": {}}
     if log:

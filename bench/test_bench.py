@@ -104,7 +104,15 @@ def test_targets_on_synthetic_results() -> None:
 def test_targets_without_exudyn_are_not_measured() -> None:
     tg = report.peer_targets(synthetic_results(exudyn=False))
     assert [t["met"] for t in tg] == [None, None]
-    assert all("unavailable" in t["figure"] for t in tg)
+    assert all("Exudyn unavailable" in t["figure"] for t in tg)
+
+
+def test_missing_sections_are_not_measured(tmp_path: Path) -> None:
+    res = {"meta": {"total_runtime_s": 1.0, "command": "python bench/run.py"}}
+    tg = report.targets(res)
+    assert [t["met"] for t in tg][:-1] == [None] * (len(tg) - 1)
+    md = report.results_markdown(res, {}, tmp_path / "RESULTS.md", tmp_path / "results")
+    assert md.count("Failed: not run") == 5
 
 
 def test_report_renders_failures_and_missing_stepper(tmp_path: Path) -> None:
