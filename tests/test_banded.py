@@ -18,7 +18,7 @@ from mbd2d.errors import ModelError, SingularConfigurationError
 EX = Path(__file__).resolve().parents[1] / "examples"
 sys.path.insert(0, str(EX))
 from nfourbar import build as nfourbar  # noqa: E402
-TOGGLE_T = 0.8859186477661    # closed form, tests/test_toggle.py
+TOGGLE_T = math.acos((9 + 36 - 7.6**2) / 36) - math.pi / 3    # closed form (seed four-bar)
 
 
 def closed_form(n: int, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
