@@ -459,9 +459,9 @@ contains
       o = m%fpo(k)
       select case (m%fkind(k))
       case (FRC_SPRING)
-        if (m%fp(o + 5) /= zero) dyn_damped = .true.
+        if (abs(m%fp(o + 5)) > zero) dyn_damped = .true.
       case (FRC_ROTSPRING)
-        if (m%fp(o + 1) /= zero) dyn_damped = .true.
+        if (abs(m%fp(o + 1)) > zero) dyn_damped = .true.
       end select
     end do
   end function dyn_damped

@@ -119,7 +119,7 @@ contains
         end if
       end do
       ipiv(k) = p
-      if (piv == zero) then
+      if (.not. abs(piv) > zero) then
         status = MBD_SINGULAR; return
       end if
       if (p /= k) then
@@ -133,7 +133,7 @@ contains
       end do
       do j = k + 1, n                                   ! a_ij -= l_ik u_kj
         f = a(k, j)
-        if (f == zero) cycle
+        if (abs(f) <= zero) cycle
         do i = k + 1, n
           a(i, j) = a(i, j) - f * a(i, k)
         end do
@@ -157,7 +157,7 @@ contains
     end do
     do k = 1, n                                 ! L y = P b (column oriented)
       tmp = b(k)
-      if (tmp == zero) cycle
+      if (abs(tmp) <= zero) cycle
       do i = k + 1, n
         b(i) = b(i) - tmp * a(i, k)
       end do
@@ -165,7 +165,7 @@ contains
     do k = n, 1, -1                             ! U x = y
       b(k) = b(k) / a(k, k)
       tmp = b(k)
-      if (tmp == zero) cycle
+      if (abs(tmp) <= zero) cycle
       do i = 1, k - 1
         b(i) = b(i) - tmp * a(i, k)
       end do
@@ -190,7 +190,7 @@ contains
       nrm = norm2(a(k:mm, k))
       alpha = -sign(nrm, a(k, k))
       rmax = max(rmax, nrm); rmin = min(rmin, nrm)
-      if (nrm == zero) return
+      if (nrm <= zero) return
       a(k, k) = a(k, k) - alpha
       vtv = dot_product(a(k:mm, k), a(k:mm, k))
       do j = k + 1, n
