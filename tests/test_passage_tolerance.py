@@ -1,0 +1,55 @@
+"""A failure mode found by the benchmarks: dopri5 at tight tolerances across the N-four-bar's
+singular passage. Near the passage J loses rank, the projected index-1 solution carries
+errors of order cond(J) * eps, and dopri5's error estimate reads them as truncation error: its
+steps and its accuracy then depend erratically on the last digit of atol, and a step can
+underflow at a passage. The partitioned method (independent coordinate away from the singular
+direction) stays accurate for the same settings. Oracle: the reduced one-degree-of-freedom
+solution of the parallelogram branch."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import mbd2d
+from test_failure_modes import free_nfourbar, reduced_nfourbar
+
+T_END, STEPS = 10.0, 100
+ATOLS = (1.0e-14, 0.9e-14, 1.1e-14)     # the same tolerance up to its last digit
+
+
+@pytest.fixture(scope="module")
+def reference() -> np.ndarray:
+    return reduced_nfourbar(1, np.linspace(0.0, T_END, STEPS + 1), substeps=200)
+
+
+def crank_error(res: mbd2d.DynamicsResult, ref: np.ndarray) -> float:
+    th = np.array([res.body(f"crank{k}").theta for k in range(2)])
+    return float(np.abs(th - ref[: th.shape[1], 0]).max())
+
+
+def test_dopri5_at_rtol_1e12_underflows_at_a_singular_passage_for_some_atol(reference):
+    model = free_nfourbar(1)
+    failures = []
+    for atol in ATOLS:
+        try:
+            res = model.dynamics(t_end=T_END, steps=STEPS, method="dopri5", rtol=1e-12,
+                                 atol=atol)
+            assert crank_error(res, reference) < 1e-6
+        except mbd2d.IntegrationError as exc:
+            assert "step size underflow" in str(exc)
+            failures.append(exc.t)
+    assert failures, "expected at least one of these settings to fail (documented behaviour)"
+    for tf in failures:
+        # at a passage: the cranks horizontal on the reduced solution, sin(theta) ~ 0
+        th = reduced_nfourbar(1, np.array([0.0, tf]), substeps=4000)[-1, 0]
+        assert abs(math.sin(th)) < 0.05, f"underflow at t = {tf}, theta = {th}"
+
+
+def test_partitioned_stays_accurate_for_the_same_tolerances(reference):
+    model = free_nfourbar(1)
+    for atol in ATOLS:
+        res = model.dynamics(t_end=T_END, steps=STEPS, method="partitioned", rtol=1e-11,
+                             atol=10 * atol)
+        assert crank_error(res, reference) < 2e-7
