@@ -44,21 +44,7 @@ def free_fourbar(density: float = 1.0) -> mbd2d.Model:
 
 def free_nfourbar(n: int, omega0: float = -1.0) -> mbd2d.Model:
     """The IFToMM N-four-bar without its driver (A02)."""
-    m = mbd2d.Model(f"free-{n}-four-bar", gravity=(0.0, -G))
-    inertia = 1.0 / 12
-    for k in range(n + 1):
-        m.add_body(f"crank{k}", q0=[k, 0.5, math.pi / 2], mass=1.0, inertia=inertia,
-                   v0=[-0.5 * omega0, 0.0, omega0])
-    for k in range(n):
-        m.add_body(f"coupler{k}", q0=[k + 0.5, 1.0, 0.0], mass=1.0, inertia=inertia,
-                   v0=[-omega0, 0.0, 0.0])
-    for k in range(n + 1):
-        m.add_revolute(["ground", f"crank{k}"], [[k, 0.0], [-0.5, 0.0]], name=f"O{k}")
-    for k in range(n):
-        m.add_revolute([f"crank{k}", f"coupler{k}"], [[0.5, 0.0], [-0.5, 0.0]], name=f"L{k}")
-        m.add_revolute([f"crank{k + 1}", f"coupler{k}"], [[0.5, 0.0], [0.5, 0.0]],
-                       name=f"R{k}")
-    return m
+    return nfourbar.build(n, driven=False, omega0=omega0)
 
 
 def driven_nfourbar(n: int) -> mbd2d.Model:

@@ -14,13 +14,29 @@ import sys
 import mbd2d
 
 
-def build(n: int, driven: bool = True) -> mbd2d.Model:
-    """The N-four-bar as a model (cranks upright at t = 0)."""
-    m = mbd2d.Model(f"{n}-four-bar")
+def build(n: int, driven: bool = True, omega0: float | None = None) -> mbd2d.Model:
+    """The N-four-bar as a model (cranks upright at t = 0).
+
+    Parameters
+    ----------
+    n : int
+        Number of parallelogram loops.
+    driven : bool
+        Drive crank 0: theta = pi/2 - t.
+    omega0 : float, optional
+        For dynamics: 1 kg, 1 m uniform bars under gravity, every crank turning at omega0 and
+        the couplers translating (a consistent v0).
+    """
+    free = omega0 is not None
+    w = omega0 if free else 0.0
+    m = mbd2d.Model(f"{'free-' if free else ''}{n}-four-bar")    # default gravity -9.81
+    bar = {"mass": 1.0, "inertia": 1.0 / 12} if free else {}
     for k in range(n + 1):
-        m.add_body(f"crank{k}", q0=[k, 0.5, math.pi / 2])
+        m.add_body(f"crank{k}", q0=[k, 0.5, math.pi / 2],
+                   **bar, **({"v0": [-0.5 * w, 0.0, w]} if free else {}))
     for k in range(n):
-        m.add_body(f"coupler{k}", q0=[k + 0.5, 1.0, 0.0])
+        m.add_body(f"coupler{k}", q0=[k + 0.5, 1.0, 0.0],
+                   **bar, **({"v0": [-w, 0.0, 0.0]} if free else {}))
     for k in range(n + 1):
         m.add_revolute(["ground", f"crank{k}"], [[k, 0.0], [-0.5, 0.0]], name=f"O{k}")
     for k in range(n):

@@ -68,3 +68,23 @@ def test_a_driven_crank_at_a_dead_centre_still_stops() -> None:
     """Unlike the parallelogram, the seed four-bar has no motion beyond its toggle."""
     with pytest.raises(mbd2d.SingularConfigurationError, match="dead centre"):
         mbd2d.load(EXAMPLES / "fourbar_seed.toml").kinematics(t_end=1.0, steps=1000)
+
+
+def test_even_n_passes_without_a_rejected_step_and_without_a_record() -> None:
+    """At the passage N singular values of J vanish together; for even N det J touches zero
+    without changing sign (N = 2: det J < 0 at theta = +-0.01), so no step is rejected: the loop steps through on the parallelogram branch (closed form below) but
+    records no passage and gives no SingularPassageWarning. This documents the gap; the
+    accuracy near the passage still comes from the anchor interpolation of ill-conditioned
+    outputs."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", mbd2d.SingularPassageWarning)
+        res = nfourbar.build(2).kinematics(t_end=3.0, steps=2000)
+    assert res.stats["singular_passages"] == []
+    assert res.stats["rejected_steps"] == 0
+    th = math.pi / 2 - res.t
+    for k in range(3):
+        assert_allclose(res.body(f"crank{k}").theta, th, rtol=0, atol=1e-10)
+    for k in range(2):
+        c = res.body(f"coupler{k}")
+        assert_allclose(c.x, k + 0.5 + np.cos(th), rtol=0, atol=1e-10)
+        assert_allclose(c.x_ddot, -np.cos(th), rtol=0, atol=1e-7)

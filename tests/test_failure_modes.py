@@ -23,12 +23,16 @@ docs/failure_modes.py imports the builders from here to draw the charts.
 from __future__ import annotations
 
 import math
+import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 import mbd2d
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
+import nfourbar  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
 G = 9.81
@@ -81,21 +85,7 @@ def stiff_omega(k: float) -> float:
 def free_nfourbar(n: int, omega0: float = -1.0) -> mbd2d.Model:
     """The N-four-bar of examples/nfourbar.py without its driver: 1 kg, 1 m bars, cranks
     upright, every crank turning at omega0 and the couplers translating (consistent v0)."""
-    m = mbd2d.Model(f"free-{n}-four-bar", gravity=(0.0, -G))
-    inertia = 1.0 / 12
-    for k in range(n + 1):
-        m.add_body(f"crank{k}", q0=[k, 0.5, math.pi / 2], mass=1.0, inertia=inertia,
-                   v0=[-0.5 * omega0, 0.0, omega0])
-    for k in range(n):
-        m.add_body(f"coupler{k}", q0=[k + 0.5, 1.0, 0.0], mass=1.0, inertia=inertia,
-                   v0=[-omega0, 0.0, 0.0])
-    for k in range(n + 1):
-        m.add_revolute(["ground", f"crank{k}"], [[k, 0.0], [-0.5, 0.0]], name=f"O{k}")
-    for k in range(n):
-        m.add_revolute([f"crank{k}", f"coupler{k}"], [[0.5, 0.0], [-0.5, 0.0]], name=f"L{k}")
-        m.add_revolute([f"crank{k + 1}", f"coupler{k}"], [[0.5, 0.0], [0.5, 0.0]],
-                       name=f"R{k}")
-    return m
+    return nfourbar.build(n, driven=False, omega0=omega0)
 
 
 def reduced_nfourbar(n: int, t: np.ndarray, th0: float = math.pi / 2, omega0: float = -1.0,
