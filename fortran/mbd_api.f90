@@ -345,13 +345,16 @@ contains
   !! lambda (minimum norm over all rows) of J^T lambda = Q - M q_ddot, and the energies.
   !! iinfo/rinfo as api_kinematics; iinfo(2) = -force index for a bad force.
   subroutine api_inverse(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, t0, t1, nsteps, tol, &
-                         qout, qdout, qddout, lamout, eout, iinfo, rinfo, qsing, dep, redundant, &
-                         tpass, status, msg)
+                         every, solver, qout, qdout, qddout, lamout, eout, iinfo, rinfo, qsing, &
+                         dep, redundant, tpass, status, msg)
     integer, intent(in) :: nb, ctab(:, :), ftab(:, :), nsteps
     real(wp), intent(in) :: rpar(:), bmass(:, :), grav(2), fpar(:), q0(:), t0, t1, tol
-    real(wp), intent(out) :: qout(:, :), qdout(:, :), qddout(:, :)  !! (nq, nsteps + 1)
-    real(wp), intent(out) :: lamout(:, :)       !! (neq, nsteps + 1)
-    real(wp), intent(out) :: eout(:, :)         !! (4, nsteps + 1)
+    integer, intent(in) :: every                !! store every k-th output (and the last)
+    integer, intent(in) :: solver               !! 0 auto, 1 dense, 2 banded LU
+    !> outputs (nq, kin_out_count(nsteps, every)) and likewise
+    real(wp), intent(out) :: qout(:, :), qdout(:, :), qddout(:, :)
+    real(wp), intent(out) :: lamout(:, :)       !! (neq, ...)
+    real(wp), intent(out) :: eout(:, :)         !! (4, ...)
     integer, intent(out) :: iinfo(NINFO)
     real(wp), intent(out) :: rinfo(NINFO), qsing(:), tpass(:)
     integer, intent(out) :: dep(:), redundant(:)
@@ -370,14 +373,15 @@ contains
       qsing = zero; dep = 0; redundant = 0; tpass = zero
       return
     end if
-    call api_kinematics(nb, ctab, rpar, q0, t0, t1, nsteps, tol, 0, zero, 1, SOLVER_AUTO, qout, &
+    call api_kinematics(nb, ctab, rpar, q0, t0, t1, nsteps, tol, 0, zero, every, solver, qout, &
                         qdout, qddout, iinfo, rinfo, qsing, dep, redundant, tpass, status, msg)
     if (iinfo(1) < 1) return
     call dyn_init(m, w, qout(:, 1), t0, 1.0e-12_wp, st, lmsg)
     if (st /= MBD_OK) return
     do k = 1, iinfo(1)
-      t = t0 + (t1 - t0) * (real(k - 1, wp) / max(nsteps, 1))
-      if (k == nsteps + 1) t = t1
+      ! column k holds output min((k - 1) every, nsteps)
+      t = t0 + (t1 - t0) * (real(min((k - 1) * every, nsteps), wp) / max(nsteps, 1))
+      if (k == size(qout, 2)) t = t1
       call dyn_multipliers(m, w, qout(:, k), qdout(:, k), qddout(:, k), t, lamout(:, k), st, lmsg)
       call state_measures(m, w, qout(:, k), qdout(:, k), t, eout(:, k))
     end do

@@ -102,24 +102,24 @@ subroutine core_profile(kind, np, raw, na, alpha, pts, status, msg)
 end subroutine core_profile
 
 subroutine core_inverse(nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp, fpar, nq, neq, q0, &
-                        t0, t1, nsteps, tol, qout, qdout, qddout, lamout, eout, iinfo, rinfo, &
-                        qsing, dep, redundant, tpass, status, msg)
+                        t0, t1, nsteps, tol, every, solver, nout, qout, qdout, qddout, lamout, &
+                        eout, iinfo, rinfo, qsing, dep, redundant, tpass, status, msg)
   use iso_c_binding, only: c_double, c_int
   use mbd_api, only: api_inverse
   implicit none
-  integer(c_int), intent(in) :: nb, nc, np, nf, nfp, nq, neq, nsteps
+  integer(c_int), intent(in) :: nb, nc, np, nf, nfp, nq, neq, nsteps, every, solver, nout
   integer(c_int), intent(in) :: ctab(8, nc), ftab(6, nf)
   real(c_double), intent(in) :: rpar(np), bmass(2, nb), grav(2), fpar(nfp), q0(nq), t0, t1, tol
-  real(c_double), intent(out) :: qout(nq, nsteps + 1), qdout(nq, nsteps + 1)
-  real(c_double), intent(out) :: qddout(nq, nsteps + 1), lamout(neq, nsteps + 1)
-  real(c_double), intent(out) :: eout(4, nsteps + 1)
+  real(c_double), intent(out) :: qout(nq, nout), qdout(nq, nout)
+  real(c_double), intent(out) :: qddout(nq, nout), lamout(neq, nout)
+  real(c_double), intent(out) :: eout(4, nout)
   integer(c_int), intent(out) :: iinfo(10), dep(neq), redundant(neq), status
   real(c_double), intent(out) :: rinfo(10), qsing(nq), tpass(64)
   character(len=512), intent(out) :: msg
   !f2py intent(hide) :: nc, np, nf, nfp, nq
-  call api_inverse(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, t0, t1, nsteps, tol, qout, &
-                   qdout, qddout, lamout, eout, iinfo, rinfo, qsing, dep, redundant, tpass, &
-                   status, msg)
+  call api_inverse(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, t0, t1, nsteps, tol, every, &
+                   solver, qout, qdout, qddout, lamout, eout, iinfo, rinfo, qsing, dep, &
+                   redundant, tpass, status, msg)
 end subroutine core_inverse
 
 ! every >= 1: only the outputs k = 0, every, 2 every, ... and k = nsteps are stored; nrow is

@@ -45,6 +45,24 @@ def test_slider_crank_torque_closed_form() -> None:
     assert_allclose(guide.fx_j, 0.0, atol=1e-9)
 
 
+def test_decimated_inverse_dynamics_keeps_the_closed_form_torque() -> None:
+    """every=k: the same closed-form torque at the kept rows (0, k, 2k, ... and the last)."""
+    m = with_masses("slider_crank", {"crank": (0.0, 0.0), "rod": (0.0, 0.0),
+                                     "slider": (2.0, 0.0)})
+    res = m.kinematics(t_end=1.0, steps=400, every=30)
+    assert isinstance(res, mbd2d.DynamicsResult)
+    assert_allclose(res.t, np.append(np.arange(0, 401, 30), 400) / 400, rtol=0, atol=1e-15)
+    th = W * res.t
+    u = np.sin(th) - 0.5
+    rt = np.sqrt(9.0 - u**2)
+    xd = (-np.sin(th) - u * np.cos(th) / rt) * W
+    xdd = W**2 * (-np.cos(th) - (np.cos(th)**2 - u * np.sin(th)) / rt - (u * np.cos(th))**2 / rt**3)
+    torque = 2.0 * xdd * xd / W
+    assert_allclose(res.effort("motor"), torque, rtol=0, atol=1e-9 * np.abs(torque).max())
+    banded = m.inverse_dynamics(t_end=1.0, steps=400, every=30, solver="banded")
+    assert_allclose(banded.effort("motor"), torque, rtol=0, atol=1e-9 * np.abs(torque).max())
+
+
 def loop_closure(th1: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Coupler and rocker angles of the seed four-bar (crank 3, coupler 5, rocker 2.6,
     ground 6) on the branch the example assembles (B above the line A-O4)."""

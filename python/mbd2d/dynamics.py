@@ -10,7 +10,8 @@ import numpy as np
 from . import _core
 from .analysis import (ASSEMBLY_FAILED, INCONSISTENT, NO_CONVERGENCE, OK, SINGULAR,
                        SINGULAR_CONFIG, _assembly_failed, _failure, _names, check_memory,
-                       check_solver, check_span, output_steps, require_determined, time_grid)
+                       SOLVERS, check_solver, check_span, output_steps, require_determined,
+                       time_grid)
 from .errors import (ConvergenceError, CoreError, IntegrationError, ModelError,
                      RedundantConstraintWarning, SingularJacobianError)
 from .pack import Packed, decode, pack
@@ -78,24 +79,28 @@ def _result(model: "Model", p: Packed, t: np.ndarray, n: int, qo: np.ndarray, vo
 
 
 def run_inverse(model: "Model", t_end: float, steps: int, t0: float = 0.0,
-                tol: float | None = None) -> DynamicsResult:
+                tol: float | None = None, every: int = 1, solver: str = "auto") -> DynamicsResult:
     """Kinematics plus the multipliers, energies and (on demand) reactions at every output.
 
     See :meth:`Model.inverse_dynamics`.
     """
     t0, t_end, steps = check_span(t0, t_end, steps)
     tol_v, _ = check_solver(tol, None)
+    idx = output_steps(steps, every)
+    if solver not in SOLVERS:
+        raise ModelError(f"unknown solver {solver!r}; use one of {', '.join(SOLVERS)}",
+                         "analysis")
     p = pack(model)
     require_determined(p, model)
     bmass, grav, ftab, fpar, _ = pack_dynamics(model, p)
-    check_memory(steps + 1, 3 * p.nq + p.neq + 4)
+    check_memory(len(idx), 3 * p.nq + p.neq + 4)
     out = _core.core_inverse(ctab=p.ctab, rpar=p.rpar, bmass=bmass, grav=grav, ftab=ftab,
                              fpar=fpar, neq=p.neq, q0=p.q0, t0=t0, t1=t_end, nsteps=steps,
-                             tol=tol_v)
+                             tol=tol_v, every=int(every), solver=SOLVERS[solver],
+                             nout=len(idx))
     qo, vo, ao, lam, e, iinfo, rinfo, qsing, dep, red, tpass, status, msg = out
     n = int(iinfo[0])
-    t = t0 + (t_end - t0) * (np.arange(steps + 1) / steps)
-    t[-1] = t_end
+    t = time_grid(t0, t_end, steps, idx)
     _, red_rows = _names(p, model, red)
     stats = {"newton_corrections": int(iinfo[5]), "factorizations": int(iinfo[6]),
              "rejected_steps": int(iinfo[7]), "rank": int(iinfo[8]),

@@ -527,9 +527,8 @@ class Model:
         Returns
         -------
         KinematicsResult
-            When every body has a mass and an inertia (and ``every``, ``solver`` and
-            ``maxit`` are left at their defaults), a DynamicsResult with the inverse
-            dynamics too (see :meth:`inverse_dynamics`).
+            When every body has a mass and an inertia (and ``maxit`` is not given), a
+            DynamicsResult with the inverse dynamics too (see :meth:`inverse_dynamics`).
 
         Raises
         ------
@@ -548,9 +547,10 @@ class Model:
         11
         """
         from .analysis import run_kinematics
-        if self.has_masses() and maxit is None and every == 1 and solver == "auto":
+        if self.has_masses() and maxit is None:
             from .dynamics import run_inverse
-            return run_inverse(self, t_end=t_end, steps=steps, t0=t0, tol=tol)
+            return run_inverse(self, t_end=t_end, steps=steps, t0=t0, tol=tol, every=every,
+                               solver=solver)
         return run_kinematics(self, t_end=t_end, steps=steps, t0=t0, tol=tol, maxit=maxit,
                               every=every, solver=solver)
 
@@ -586,10 +586,12 @@ class Model:
                                          for b in self.bodies)
 
     def inverse_dynamics(self, t_end: float, steps: int, t0: float = 0.0,
-                         tol: float | None = None) -> "DynamicsResult":
+                         tol: float | None = None, every: int = 1,
+                         solver: str = "auto") -> "DynamicsResult":
         """Kinematics of the driven model plus, at every output time, the multipliers lambda
         (J^T lambda = Q - M q_ddot), the joint reactions (``res.reaction(name)``), the driver
-        efforts (``res.effort(name)``) and the energies.
+        efforts (``res.effort(name)``) and the energies. ``every`` and ``solver`` as in
+        :meth:`kinematics` (the multipliers are computed at the kept outputs only).
 
         Raises
         ------
@@ -599,7 +601,8 @@ class Model:
             As :meth:`kinematics`.
         """
         from .dynamics import run_inverse
-        return run_inverse(self, t_end=t_end, steps=steps, t0=t0, tol=tol)
+        return run_inverse(self, t_end=t_end, steps=steps, t0=t0, tol=tol, every=every,
+                           solver=solver)
 
     def dynamics(self, t_end: float, steps: int, method: str | None = None,
                  rtol: float | None = None, atol: float | None = None, h: float | None = None,
