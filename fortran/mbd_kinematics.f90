@@ -3,7 +3,7 @@
 !!
 !! Per output time (Haug, ch. 3-4; Nikravesh, ch. 5):
 !!   predictor    q = q_k + h q_dot_k + (the acceleration's Newton polynomial through the last
-!!                three accelerations, integrated twice): error O(h**5)
+!!                four accelerations, integrated twice): error O(h**6)
 !!   position     J(q) dq = -Phi(q, t),  q <- q + dq   until ||Phi||_inf <= tol
 !!   velocity     J q_dot = nu                    (the last factorization is reused)
 !!   acceleration J q_ddot = gamma(q, q_dot, t)   (same factorization)
@@ -64,6 +64,7 @@ module mbd_kinematics
   !! n / BAND_RATIO wide
   integer, parameter :: BAND_MIN_N = 60, BAND_RATIO = 4
   integer, parameter :: BAND_ASSEMBLY_MAXIT = 50  !! Newton iterations of a banded assembly
+  real(wp), parameter :: PRED_ACCEPT = 1.0e-2_wp  !! fraction of tol a start must meet
 
   !> Settings of a kinematic analysis.
   type :: kin_opts_t
@@ -286,7 +287,9 @@ contains
       if (it == 0) res0 = res
       call factor(w, status)
       if (status /= MBD_OK) return
-      if (res <= w%tol) return
+      ! a start that meets tol is taken only well inside it: the converged positions keep
+      ! the accuracy of a Newton correction (quadratic: far below tol), not just tol
+      if (res <= merge(PRED_ACCEPT * w%tol, w%tol, it == 0)) return
       if (it == maxit) exit
       call solve(w, -w%phi, w%dq)
       if (w%lsq .and. maxval(abs(w%dq)) <= 1.0e-3_wp * w%tol .and. res > w%tol) then
@@ -518,9 +521,10 @@ contains
     character(len=MSG_LEN), intent(out) :: msg !! explanation
     type(kin_work_t) :: w
     type(band_t) :: band
-    real(wp), allocatable :: q(:), qd(:), qdd(:), qn(:), qp(:), q3(:), q4(:), qddn(:), qdn(:)
+    real(wp), allocatable :: q(:), qd(:), qdd(:), qn(:), qp(:), q3(:), q4(:), q5(:), d1(:), &
+                             qddn(:), qdn(:)
     real(wp), allocatable :: qa(:), qda(:), qdda(:), qb(:), qdb(:), qddb(:)
-    real(wp) :: t, h, hcur, hh, tt, target, lscale, ts, ta, d, hprev
+    real(wp) :: t, h, hcur, hh, tt, target, lscale, ts, ta, d, hprev, hprev2
     integer :: k, j, c, st, detprev, mobility, lev, nsub, nderiv
     logical :: last, ok
 
@@ -565,7 +569,8 @@ contains
     end if
     lscale = m%lscale
     w%tol = opts%tol * lscale
-    allocate (q(m%nq), qd(m%nq), qdd(m%nq), qn(m%nq), qp(m%nq), q3(m%nq), q4(m%nq), qddn(m%nq), &
+    allocate (q(m%nq), qd(m%nq), qdd(m%nq), qn(m%nq), qp(m%nq), q3(m%nq), q4(m%nq), q5(m%nq), &
+              d1(m%nq), qddn(m%nq), &
               qdn(m%nq), qa(m%nq), qda(m%nq), qdda(m%nq), qb(m%nq), qdb(m%nq), qddb(m%nq))
     q = q0
     call kin_assemble(m, w, q, t0, opts, rep, status, msg)
@@ -638,11 +643,13 @@ contains
       last = hcur >= (target - t) * (one - 1.0e-9_wp)
       hh = merge(target - t, hcur, last)
       tt = merge(target, t + hh, last)
-      ! q + h q_dot + h**2/2 q_ddot + h**3/6 (d1 + d2 h1) + h**4/12 d2: the acceleration
-      ! extrapolated by its Newton polynomial through the last three (d1, d2 its divided
-      ! differences, h1 the last step), integrated twice
-      qp = q + hh * (qd + (half * hh) * (qdd + (hh / 3.0_wp) * (q3 + hprev * q4) + &
-                                         (hh * hh / 6.0_wp) * q4))
+      ! the acceleration extrapolated by its Newton polynomial through the last four,
+      ! a(s) = a + d1 s + d2 s (s + h1) + d3 s (s + h1) (s + h1 + h2)  (d1, d2, d3 its divided
+      ! differences, h1, h2 the last steps), integrated twice: q + h q_dot + h**2/2 a
+      ! + h**3/6 (d1 + h1 d2 + h1 (h1 + h2) d3) + h**4/12 (d2 + (2 h1 + h2) d3) + h**5/20 d3
+      qp = q + hh * (qd + (half * hh) * (qdd + (hh / 3.0_wp) * (q3 + hprev * q4 + &
+                     hprev * (hprev + hprev2) * q5) + (hh * hh / 6.0_wp) * (q4 + &
+                     (2 * hprev + hprev2) * q5) + (hh**3 / 10.0_wp) * q5))
       qn = qp
       call kin_newton(m, w, qn, tt, opts%maxit, st)
       ok = st == MBD_OK .and. on_branch(JUMP_RATIO) .and. w%pivratio >= NEAR_SING
@@ -791,18 +798,25 @@ contains
     end function anchor
 
     subroutine forget_derivatives()
-      q3 = zero; q4 = zero; hprev = zero; nderiv = 0
+      q3 = zero; q4 = zero; q5 = zero; hprev = zero; hprev2 = zero; nderiv = 0
     end subroutine forget_derivatives
 
     subroutine accept()
-      ! divided differences of the accelerations: d1 = a[k+1, k], d2 = a[k+1, k, k-1]
+      ! divided differences of the accelerations: d1 = a[k+1, k], d2 = a[k+1, k, k-1],
+      ! d3 = a[k+1, k, k-1, k-2] (each valid once enough accelerations are known)
+      d1 = (qddn - qdd) / (tt - t)
+      if (nderiv >= 2) then
+        q5 = ((d1 - q3) / (tt - t + hprev) - q4) / (tt - t + hprev + hprev2)
+      else
+        q5 = zero
+      end if
       if (nderiv >= 1) then
-        q4 = ((qddn - qdd) / (tt - t) - q3) / (tt - t + hprev)
+        q4 = (d1 - q3) / (tt - t + hprev)
       else
         q4 = zero
       end if
-      q3 = (qddn - qdd) / (tt - t)
-      hprev = tt - t
+      q3 = d1
+      hprev2 = hprev; hprev = tt - t
       nderiv = nderiv + 1
       q = qn; qd = qdn; qdd = qddn; t = tt
     end subroutine accept
