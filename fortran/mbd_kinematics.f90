@@ -525,6 +525,8 @@ contains
                              qddn(:), qdn(:)
     real(wp), allocatable :: qa(:), qda(:), qdda(:), qb(:), qdb(:), qddb(:)
     real(wp) :: t, h, hcur, hh, tt, target, lscale, ts, ta, d, hprev, hprev2
+    real(wp) :: pcur, phist(2), thist(2)   ! pivot ratios and times of the last accepted states
+    integer :: nhist
     integer :: k, j, c, st, detprev, mobility, lev, nsub, nderiv
     logical :: last, ok
 
@@ -664,8 +666,10 @@ contains
              all(ieee_is_finite(qddn))
       end if
       if (ok) then
+        pcur = w%pivratio
         call accept()
         if (last) call store(k)
+        call quiet_passage()
         hcur = min(2 * hh, h)
         cycle
       end if
@@ -799,7 +803,52 @@ contains
 
     subroutine forget_derivatives()
       q3 = zero; q4 = zero; q5 = zero; hprev = zero; hprev2 = zero; nderiv = 0
+      nhist = 0
     end subroutine forget_derivatives
+
+    !> A passage that leaves det J's sign unchanged (an even number of singular values
+    !! vanishing together, as in the N-four-bar with even N) rejects no step. It shows as a
+    !! local minimum of the pivot ratio below COND_CHECK at the last-but-one accepted state:
+    !! golden-section search for the minimum over the bracket of the accepted states either
+    !! side, each point a converged configuration (anchor); a minimum below NEAR_SING is a
+    !! singular configuration passed through, and is recorded.
+    subroutine quiet_passage()
+      real(wp), parameter :: GR = 0.6180339887498949_wp   ! (sqrt(5) - 1) / 2
+      real(wp) :: a, b, x1, x2, f1, f2
+      if (nhist == 2 .and. phist(2) < COND_CHECK .and. phist(2) <= phist(1) .and. &
+          phist(2) < pcur) then
+        a = thist(1); b = t
+        x1 = b - GR * (b - a); x2 = a + GR * (b - a)
+        f1 = pivot_at(x1); f2 = pivot_at(x2)
+        do while (b - a > opts%tmin * max(one, abs(t)))
+          if (f1 <= f2) then
+            b = x2; x2 = x1; f2 = f1
+            x1 = b - GR * (b - a); f1 = pivot_at(x1)
+          else
+            a = x1; x1 = x2; f1 = f2
+            x2 = a + GR * (b - a); f2 = pivot_at(x2)
+          end if
+        end do
+        if (min(f1, f2) < NEAR_SING) then
+          rep%npass = rep%npass + 1
+          if (rep%npass <= MAXPASS) rep%tpass(rep%npass) = half * (a + b)
+        end if
+        nhist = 0
+      end if
+      if (nhist == 2) then
+        phist(1) = phist(2); thist(1) = thist(2)
+      end if
+      nhist = min(nhist + 1, 2)
+      phist(nhist) = pcur; thist(nhist) = t
+    end subroutine quiet_passage
+
+    !> Pivot ratio of J at the configuration at time tx on the current branch (huge where
+    !! no configuration is found there: a failed solve is no evidence of a singular one).
+    real(wp) function pivot_at(tx)
+      real(wp), intent(in) :: tx
+      pivot_at = huge(one)
+      if (anchor(tx)) pivot_at = w%pivratio
+    end function pivot_at
 
     subroutine accept()
       ! divided differences of the accelerations: d1 = a[k+1, k], d2 = a[k+1, k, k-1],

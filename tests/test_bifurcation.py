@@ -56,7 +56,7 @@ def test_stays_on_the_parallelogram_branch(n: int, steps: int) -> None:
         assert_allclose(c.x_ddot[near], -np.cos(th[near]), rtol=0, atol=1e-7)
 
 
-@pytest.mark.parametrize("n", [1, 5])
+@pytest.mark.parametrize("n", [1, 2, 5])
 def test_passages_are_reported(n: int) -> None:
     with pytest.warns(mbd2d.SingularPassageWarning, match="passed through 4 singular"):
         res = nfourbar.build(n).kinematics(t_end=4 * math.pi, steps=1000)
@@ -70,17 +70,15 @@ def test_a_driven_crank_at_a_dead_centre_still_stops() -> None:
         mbd2d.load(EXAMPLES / "fourbar_seed.toml").kinematics(t_end=1.0, steps=1000)
 
 
-def test_even_n_passes_without_a_rejected_step_and_without_a_record() -> None:
+def test_even_n_passage_is_found_without_a_rejected_step() -> None:
     """At the passage N singular values of J vanish together; for even N det J touches zero
-    without changing sign (N = 2: det J < 0 at theta = +-0.01), so no step is rejected: the loop steps through on the parallelogram branch (closed form below) but
-    records no passage and gives no SingularPassageWarning. This documents the gap; the
-    accuracy near the passage still comes from the anchor interpolation of ill-conditioned
-    outputs."""
-    with warnings.catch_warnings():
-        warnings.simplefilter("error", mbd2d.SingularPassageWarning)
+    without changing sign (N = 2: det J < 0 at theta = +-0.01), so no step is rejected. The
+    passage shows as a local minimum of the pivot ratio between accepted steps, is located by
+    a golden-section search on it, and recorded; the motion stays on the branch."""
+    with pytest.warns(mbd2d.SingularPassageWarning, match="passed through 1 singular"):
         res = nfourbar.build(2).kinematics(t_end=3.0, steps=2000)
-    assert res.stats["singular_passages"] == []
     assert res.stats["rejected_steps"] == 0
+    assert_allclose(res.stats["singular_passages"], [np.pi / 2], atol=1e-6)
     th = math.pi / 2 - res.t
     for k in range(3):
         assert_allclose(res.body(f"crank{k}").theta, th, rtol=0, atol=1e-10)
@@ -88,3 +86,27 @@ def test_even_n_passes_without_a_rejected_step_and_without_a_record() -> None:
         c = res.body(f"coupler{k}")
         assert_allclose(c.x, k + 0.5 + np.cos(th), rtol=0, atol=1e-10)
         assert_allclose(c.x_ddot, -np.cos(th), rtol=0, atol=1e-7)
+
+
+def test_a_regular_minimum_of_the_conditioning_is_not_a_passage() -> None:
+    """The Grashof four-bar's J is best and worst conditioned somewhere in each turn, but never
+    singular: no passage is recorded."""
+    res = mbd2d.load(EXAMPLES / "fourbar_grashof.toml").kinematics(t_end=2.0, steps=2000,
+                                                                     maxit=25)
+    assert res.stats["singular_passages"] == []
+
+
+@pytest.mark.parametrize("gap", [1e-3, 1e-7])
+@pytest.mark.parametrize("steps", [3000, 31])
+def test_turning_back_just_short_of_a_dead_centre_is_not_a_passage(gap: float, steps: int) -> None:
+    """The seed four-bar's crank swung up to `gap` rad short of its toggle and back (theta =
+    pi/3 + A sin t): J comes close to singular but never is; no passage is recorded."""
+    th_toggle = math.acos((9 + 36 - 7.6**2) / 36)          # crank angle at the toggle
+    amp = th_toggle - math.pi / 3 - gap
+    text = (EXAMPLES / "fourbar_seed.toml").read_text().replace(
+        "f = { poly = [1.0471975511965976, 1.0] }",
+        f"f = {{ poly = [1.0471975511965976], harmonic = [{{ amplitude = {amp!r}, "
+        "omega = 1.0, phase = 0.0 }] }")
+    res = mbd2d.loads(text).kinematics(t_end=3.0, steps=steps, maxit=25)
+    assert res.complete
+    assert res.stats["singular_passages"] == []
