@@ -17,29 +17,17 @@ from pathlib import Path
 import mbd2d
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
+import free_fourbar as free_fourbar_example  # noqa: E402
 import nfourbar  # noqa: E402
 
 G = 9.81
 
-# (name, length, rough q0) of the free four-bar's moving bars; the joint points are the bar
-# ends (+-L/2 along the local x axis)
-FOURBAR_BARS = (("crank", 1.0, (0.5, 0.0, 0.0)),
-                ("coupler", 3.5, (2.25, 1.2, 0.78)),
-                ("rocker", 2.5, (3.25, 1.2, -1.77)))
-FOURBAR_GROUND = 3.0
+FOURBAR_BARS, FOURBAR_GROUND = free_fourbar_example.BARS, free_fourbar_example.GROUND
 
 
 def free_fourbar(density: float = 1.0) -> mbd2d.Model:
-    """The free four-bar under gravity (see the module docstring)."""
-    m = mbd2d.Model("free-four-bar", gravity=(0.0, -G))
-    for name, length, q0 in FOURBAR_BARS:
-        mass = density * length
-        m.add_body(name, q0=list(q0), mass=mass, inertia=mass * length ** 2 / 12)
-    m.add_revolute(["ground", "crank"], [[0.0, 0.0], [-0.5, 0.0]], name="O2")
-    m.add_revolute(["crank", "coupler"], [[0.5, 0.0], [-1.75, 0.0]], name="A")
-    m.add_revolute(["coupler", "rocker"], [[1.75, 0.0], [-1.25, 0.0]], name="B")
-    m.add_revolute(["rocker", "ground"], [[1.25, 0.0], [FOURBAR_GROUND, 0.0]], name="O4")
-    return m
+    """The free four-bar under gravity (examples/free_fourbar.py)."""
+    return free_fourbar_example.build(density)
 
 
 def free_nfourbar(n: int, omega0: float = -1.0) -> mbd2d.Model:

@@ -3,7 +3,8 @@
 !! Phi(q, t) = [Phi^K(q); Phi^D(q, t)],  J = Phi_q,  nu = -Phi_t,
 !! gamma = -(J q_dot)_q q_dot - 2 Phi_qt q_dot - Phi_tt.
 !! Each constraint writes its rows into slices of phi, nu, gam and its local Jacobian block
-!! into jb(:, :, k); scatter_dense then places the blocks in a dense J. No allocation here.
+!! into jb(:, :, k); scatter_dense then places the blocks in a dense J through a map built
+!! once (asm_init). No allocation here.
 module mbd_assemble
   use mbd_kinds, only: wp, zero, one
   use mbd_points, only: NLOC, MAXROW, kloc
@@ -11,8 +12,8 @@ module mbd_assemble
   use mbd_constraints, only: con_eval, con_init_extra
   implicit none
   private
-  public :: asm_work_t, asm_init, assemble_blocks, scatter_dense, scatter_mapped, &
-            assemble_dense, init_extras, gather_local
+  public :: asm_work_t, asm_init, assemble_blocks, scatter_dense, assemble_dense, init_extras, &
+            gather_local
 
   !> Work arrays of the assembly, allocated once per analysis.
   type :: asm_work_t
@@ -111,43 +112,32 @@ contains
     end do
   end subroutine assemble_blocks
 
-  !> Place the local blocks into a dense J (neq x nq).
-  pure subroutine scatter_dense(m, jb, jac)
-    type(model_t), intent(in) :: m            !! model
-    real(wp), intent(in) :: jb(:, :, :)       !! local blocks
-    real(wp), intent(out) :: jac(:, :)        !! dense Jacobian
-    integer :: k, s, r, c, r0
-    jac = zero
-    do k = 1, m%nc
-      r0 = m%row0(k) - 1
-      do s = 1, NLOC
-        c = m%loc(s, k)
-        if (c == 0) cycle
-        do r = 1, m%nrow(k)
-          jac(r0 + r, c) = jac(r0 + r, c) + jb(r, s, k)
-        end do
-      end do
-    end do
+  !> Place the local blocks into a dense J (neq x nq), or J D (D = diag(cs)) with a column
+  !! scale, through the map of asm_init.
+  pure subroutine scatter_dense(a, jac, cs)
+    type(asm_work_t), intent(in) :: a           !! blocks and their map
+    real(wp), intent(out) :: jac(:, :)          !! dense J (D)
+    real(wp), intent(in), optional :: cs(:)     !! column scale
+    call scatter_flat(a%src, a%dst, a%col, a%jb, jac, size(a%jb), size(jac), cs)
   end subroutine scatter_dense
 
-  !> Place the local blocks into a dense J D (neq x nq, D = diag(cs)) through the map of
-  !! asm_init.
-  pure subroutine scatter_mapped(a, cs, jac)
-    type(asm_work_t), intent(in) :: a         !! blocks and their map
-    real(wp), intent(in) :: cs(:)             !! column scale
-    real(wp), intent(out) :: jac(:, :)        !! dense J D
-    call scatter_flat(a%src, a%dst, a%col, a%jb, cs, jac, size(a%jb), size(jac))
-  end subroutine scatter_mapped
-
-  pure subroutine scatter_flat(src, dst, col, jb, cs, jac, nb, nj)
+  !> jac(dst(i)) += jb(src(i)) [* cs(col(i))] over flat (column-major) views.
+  pure subroutine scatter_flat(src, dst, col, jb, jac, nb, nj, cs)
     integer, intent(in) :: src(:), dst(:), col(:), nb, nj
-    real(wp), intent(in) :: jb(nb), cs(:)
+    real(wp), intent(in) :: jb(nb)
     real(wp), intent(out) :: jac(nj)
+    real(wp), intent(in), optional :: cs(:)
     integer :: i
     jac = zero
-    do i = 1, size(src)
-      jac(dst(i)) = jac(dst(i)) + jb(src(i)) * cs(col(i))
-    end do
+    if (present(cs)) then
+      do i = 1, size(src)
+        jac(dst(i)) = jac(dst(i)) + jb(src(i)) * cs(col(i))
+      end do
+    else
+      do i = 1, size(src)
+        jac(dst(i)) = jac(dst(i)) + jb(src(i))
+      end do
+    end if
   end subroutine scatter_flat
 
   !> Phi, nu, gamma and the dense J in one call.
@@ -159,7 +149,7 @@ contains
     type(asm_work_t), intent(inout) :: a      !! work arrays
     real(wp), intent(out) :: jac(:, :)        !! dense Jacobian
     call assemble_blocks(m, q, qd, t, phi, nu, gam, a)
-    call scatter_dense(m, a%jb, jac)
+    call scatter_dense(a, jac)
   end subroutine assemble_dense
 
   !> Starting values of the extra coordinates (cam contact parameters) from the bodies in q.

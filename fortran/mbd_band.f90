@@ -21,9 +21,10 @@
 !!              is the rcond of J
 !! Cost: factor ~ 2 n kl (kl + ku) flops, a solve ~ 2 n (2 kl + ku), storage n (2 kl + ku + 1).
 !!
-!! Usage: band_plan once per structure; then per Jacobian band_zero, band_add for every
-!! nonzero (repeats add up), band_norm1 if rcond is wanted, band_factor, band_solve as often
-!! as needed (the factors are kept), band_rcond.
+!! Usage: band_plan once per structure; then per Jacobian band_zero, add each nonzero of the
+!! planned structure into ab by the storage rule above (the caller's assembly loop does it),
+!! band_norm1 if rcond is wanted, band_factor, band_solve as often as needed (the factors are
+!! kept), band_rcond.
 !!
 !! References: E. Cuthill, J. McKee, Reducing the bandwidth of sparse symmetric matrices (1969);
 !! A. George, J. W. H. Liu, Computer Solution of Large Sparse Positive Definite Systems
@@ -36,8 +37,7 @@ module mbd_band
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   implicit none
   private
-  public :: band_t, band_plan, band_zero, band_add, band_norm1, band_factor, band_rcond
-  public :: band_solve, band_natural, band_width_natural
+  public :: band_t, band_plan, band_zero, band_norm1, band_factor, band_rcond, band_solve
 
   !> A planned band matrix: the ordering, the band storage, the factors and all workspace.
   type :: band_t
@@ -51,8 +51,6 @@ module mbd_band
     real(wp), allocatable :: rhs(:)     !! permuted right-hand side (n)
     integer :: perm_sign = 1            !! sign of the two permutations (det P_r det P_c)
     logical :: factored = .false.       !! ab holds the LU factors
-    integer :: n_outside = 0            !! band_add calls outside the band since band_zero
-    integer :: first_outside(2) = 0     !! (i, j) of the first of them
   end type band_t
 
 contains
@@ -142,32 +140,7 @@ contains
     if (.not. allocated(b%ab)) return
     b%ab(b%kl + 1:b%ldab, :) = zero
     b%factored = .false.
-    b%n_outside = 0
-    b%first_outside = 0
   end subroutine band_zero
-
-  !> J(i, j) = J(i, j) + v, in the original numbering. (i, j) must be in the planned
-  !! structure; an entry outside the band is not stored but counted, and band_factor then
-  !! fails with MBD_BAD_INPUT naming it (an unplanned entry inside the band is stored).
-  pure subroutine band_add(b, i, j, v)
-    type(band_t), intent(inout) :: b   !! planned band matrix
-    integer, intent(in) :: i           !! original row
-    integer, intent(in) :: j           !! original column
-    real(wp), intent(in) :: v          !! value to add
-    integer :: d
-    if (i >= 1 .and. i <= b%n .and. j >= 1 .and. j <= b%n) then
-      d = b%prow(i) - b%pcol(j)
-      if (d <= b%kl .and. -d <= b%ku) then
-        b%ab(b%kl + b%ku + 1 + d, b%pcol(j)) = b%ab(b%kl + b%ku + 1 + d, b%pcol(j)) + v
-        return
-      end if
-    end if
-    if (b%n_outside == 0) then
-      b%first_outside(1) = i
-      b%first_outside(2) = j
-    end if
-    b%n_outside = b%n_outside + 1
-  end subroutine band_add
 
   !> ||J||_1 = max_j sum_i |J(i, j)| of the assembled matrix, for band_rcond. Call it before
   !! band_factor; on factors it returns -1 (and band_rcond refuses that).
@@ -206,13 +179,6 @@ contains
     if (b%factored) then
       status = MBD_BAD_INPUT
       msg = 'band_factor: already factored; band_zero and assemble again first'
-      return
-    end if
-    if (b%n_outside > 0) then
-      status = MBD_BAD_INPUT
-      write (msg, '(a,i0,a,i0,a,i0,a)') 'band_factor: ', b%n_outside, &
-        ' entries were added outside the planned structure, the first at (', &
-        b%first_outside(1), ', ', b%first_outside(2), ')'
       return
     end if
     call dgbtrf(b%n, b%n, b%kl, b%ku, b%ab, b%ldab, b%ipiv, info)
@@ -340,29 +306,6 @@ contains
     end if
     call lapack_status('dgbtrs', info, status, msg)
   end subroutine band_solve
-
-  !> kl and ku of the natural (identity) ordering of a structure, for comparison.
-  pure subroutine band_natural(rows, cols, kl, ku)
-    integer, intent(in) :: rows(:)   !! row of each nonzero
-    integer, intent(in) :: cols(:)   !! column of each nonzero
-    integer, intent(out) :: kl       !! max(i - j) over the nonzeros, at least 0
-    integer, intent(out) :: ku       !! max(j - i) over the nonzeros, at least 0
-    integer :: k
-    kl = 0; ku = 0
-    do k = 1, min(size(rows), size(cols))
-      kl = max(kl, rows(k) - cols(k))
-      ku = max(ku, cols(k) - rows(k))
-    end do
-  end subroutine band_natural
-
-  !> kl + ku of the natural (identity) ordering of a structure.
-  pure integer function band_width_natural(rows, cols) result(w)
-    integer, intent(in) :: rows(:)   !! row of each nonzero
-    integer, intent(in) :: cols(:)   !! column of each nonzero
-    integer :: kl, ku
-    call band_natural(rows, cols, kl, ku)
-    w = kl + ku
-  end function band_width_natural
 
   ! ---------------------------------------------------------------------------------------
   ! ordering

@@ -20,8 +20,7 @@ module mbd_dynamics
   use mbd_model, only: model_t, model_slots
   use mbd_constraints, only: con_is_driver
   use mbd_forces, only: force_eval, FRC_SPRING, FRC_ROTSPRING
-  use mbd_assemble, only: asm_work_t, asm_init, assemble_blocks, assemble_dense, scatter_dense, &
-                          gather_local
+  use mbd_assemble, only: asm_work_t, asm_init, assemble_blocks, assemble_dense
   use mbd_linsolve, only: lu_factor, lu_solve, row_rank, lapack_status, ls_small
   use mbd_lapack, only: dgelsy, dgecon
   implicit none

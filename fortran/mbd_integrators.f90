@@ -407,7 +407,7 @@ contains
     !> S = [M b' + C g' + K, b' J^T; b' J, 0] at the last assembly (J from its blocks).
     subroutine form_s()
       integer :: j
-      call scatter_dense(m, w%asm%jb, w%jac)
+      call scatter_dense(w%asm, w%jac)
       do j = 1, n + na
         s(:, j) = zero
       end do

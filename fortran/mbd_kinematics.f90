@@ -32,7 +32,7 @@ module mbd_kinematics
   use mbd_points, only: NLOC, MAXROW
   use mbd_model, only: model_t
   use mbd_constraints, only: con_is_driver, con_name
-  use mbd_assemble, only: asm_work_t, asm_init, assemble_blocks, assemble_dense, scatter_mapped, &
+  use mbd_assemble, only: asm_work_t, asm_init, assemble_blocks, assemble_dense, scatter_dense, &
                           init_extras
   use mbd_band, only: band_t, band_plan, band_zero, band_norm1, band_factor, &
                       band_rcond, band_solve
@@ -166,7 +166,7 @@ contains
     integer :: k, s, r, c, r0, d0, jc, ir
     call assemble_blocks(m, q, qd, t, w%phi, w%nu, w%gam, w%asm)
     if (.not. w%banded) then
-      call scatter_mapped(w%asm, w%cs, w%jac)      ! J D, scaled here
+      call scatter_dense(w%asm, w%jac, w%cs)      ! J D, scaled here
       return
     end if
     ! J(i, j) D(j) -> ab(kl + ku + 1 + prow(i) - pcol(j), pcol(j))  (the planned structure:

@@ -32,6 +32,7 @@ import pytest
 import mbd2d
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
+import free_fourbar as free_fourbar_example  # noqa: E402
 import nfourbar  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -47,19 +48,8 @@ DP5_RADIUS = 4.0          # Dormand-Prince 5: its whole stability region lies in
 
 # ----------------------------------------------------------------------------- models
 def free_fourbar(density: float = 1.0) -> mbd2d.Model:
-    """The Grashof crank-rocker of examples/fourbar_grashof.toml without its motor: uniform
-    bars of `density` kg/m under gravity, released at rest with the crank horizontal."""
-    m = mbd2d.Model("free-four-bar", gravity=(0.0, -G))
-    for name, length, q0 in (("crank", 1.0, [0.5, 0.0, 0.0]),
-                             ("coupler", 3.5, [2.25, 1.2, 0.78]),
-                             ("rocker", 2.5, [3.25, 1.2, -1.77])):
-        mass = density * length
-        m.add_body(name, q0=q0, mass=mass, inertia=mass * length ** 2 / 12)
-    m.add_revolute(["ground", "crank"], [[0.0, 0.0], [-0.5, 0.0]], name="O2")
-    m.add_revolute(["crank", "coupler"], [[0.5, 0.0], [-1.75, 0.0]], name="A")
-    m.add_revolute(["coupler", "rocker"], [[1.75, 0.0], [-1.25, 0.0]], name="B")
-    m.add_revolute(["rocker", "ground"], [[1.25, 0.0], [3.0, 0.0]], name="O4")
-    return m
+    """The free four-bar of examples/free_fourbar.py."""
+    return free_fourbar_example.build(density)
 
 
 def cart_pendulum(k: float, phi0: float = math.radians(60.0)) -> mbd2d.Model:

@@ -15,27 +15,24 @@ model.jacobian; the initial accelerations from [M J^T; J 0][q_ddot; lambda] = [Q
 """
 from __future__ import annotations
 
+import sys
+
 import numpy as np
 import pytest
 
 import mbd2d
+from conftest import EXAMPLES
+
+sys.path.insert(0, str(EXAMPLES))
+import free_fourbar as free_fourbar_example  # noqa: E402
 
 G = 9.81
 RHO_INF = 0.9
 
 
 def free_fourbar() -> mbd2d.Model:
-    """The free four-bar of bench/models.py: uniform bars under gravity, from rest."""
-    m = mbd2d.Model("free-four-bar", gravity=(0.0, -G))
-    for name, length, q0 in (("crank", 1.0, (0.5, 0.0, 0.0)),
-                             ("coupler", 3.5, (2.25, 1.2, 0.78)),
-                             ("rocker", 2.5, (3.25, 1.2, -1.77))):
-        m.add_body(name, q0=list(q0), mass=length, inertia=length ** 3 / 12)
-    m.add_revolute(["ground", "crank"], [[0.0, 0.0], [-0.5, 0.0]], name="O2")
-    m.add_revolute(["crank", "coupler"], [[0.5, 0.0], [-1.75, 0.0]], name="A")
-    m.add_revolute(["coupler", "rocker"], [[1.75, 0.0], [-1.25, 0.0]], name="B")
-    m.add_revolute(["rocker", "ground"], [[1.25, 0.0], [3.0, 0.0]], name="O4")
-    return m
+    """The free four-bar of examples/free_fourbar.py."""
+    return free_fourbar_example.build()
 
 
 def mass_and_load(model: mbd2d.Model) -> tuple[np.ndarray, np.ndarray]:

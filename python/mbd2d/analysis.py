@@ -261,6 +261,14 @@ def _assembly_failed(model: "Model", resid: float, worst: int, t: float,
 SOLVERS = {"auto": 0, "dense": 1, "banded": 2}
 
 
+def solver_code(solver: Any) -> int:
+    """The core's code of a linear-solver name ("auto", "dense" or "banded")."""
+    if not isinstance(solver, str) or solver not in SOLVERS:
+        raise ModelError(f"unknown solver {solver!r}; use one of {', '.join(SOLVERS)}",
+                         "analysis")
+    return SOLVERS[solver]
+
+
 def run_kinematics(model: "Model", t_end: float, steps: int, t0: float = 0.0,
                    tol: float | None = None, maxit: int | None = None,
                    tmin: float | None = None, every: int = 1,
@@ -269,15 +277,13 @@ def run_kinematics(model: "Model", t_end: float, steps: int, t0: float = 0.0,
     t0, t_end, steps = check_span(t0, t_end, steps)
     tol_v, maxit_v = check_solver(tol, maxit)
     idx = output_steps(steps, every)
-    if solver not in SOLVERS:
-        raise ModelError(f"unknown solver {solver!r}; use one of {', '.join(SOLVERS)}",
-                         "analysis")
+    code = solver_code(solver)
     p = pack(model)
     require_determined(p, model)
     check_memory(len(idx), 3 * p.nq)
     out = _core.core_kinematics(p.nb, p.ctab, p.rpar, p.neq, p.q0, t0, t_end, steps,
                                 tol_v, maxit_v, float(tmin or 0.0), int(every),
-                                SOLVERS[solver], len(idx))
+                                code, len(idx))
     qout, qdout, qddout, iinfo, rinfo, qsing, dep, red, tpass, status, msg = out
     n = int(iinfo[0])
     t = time_grid(t0, t_end, steps, idx)

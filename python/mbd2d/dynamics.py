@@ -10,8 +10,8 @@ import numpy as np
 from . import _core
 from .analysis import (ASSEMBLY_FAILED, INCONSISTENT, NO_CONVERGENCE, OK, SINGULAR,
                        SINGULAR_CONFIG, _assembly_failed, _failure, _names, check_memory,
-                       SOLVERS, check_solver, check_span, output_steps, require_determined,
-                       time_grid)
+                       check_solver, check_span, output_steps, require_determined,
+                       solver_code, time_grid)
 from .errors import (ConvergenceError, CoreError, IntegrationError, ModelError,
                      RedundantConstraintWarning, SingularJacobianError)
 from .pack import Packed, decode, pack
@@ -87,16 +87,14 @@ def run_inverse(model: "Model", t_end: float, steps: int, t0: float = 0.0,
     t0, t_end, steps = check_span(t0, t_end, steps)
     tol_v, _ = check_solver(tol, None)
     idx = output_steps(steps, every)
-    if solver not in SOLVERS:
-        raise ModelError(f"unknown solver {solver!r}; use one of {', '.join(SOLVERS)}",
-                         "analysis")
+    code = solver_code(solver)
     p = pack(model)
     require_determined(p, model)
     bmass, grav, ftab, fpar, _ = pack_dynamics(model, p)
     check_memory(len(idx), 3 * p.nq + p.neq + 4)
     out = _core.core_inverse(ctab=p.ctab, rpar=p.rpar, bmass=bmass, grav=grav, ftab=ftab,
                              fpar=fpar, neq=p.neq, q0=p.q0, t0=t0, t1=t_end, nsteps=steps,
-                             tol=tol_v, every=int(every), solver=SOLVERS[solver],
+                             tol=tol_v, every=int(every), solver=code,
                              nout=len(idx))
     qo, vo, ao, lam, e, iinfo, rinfo, qsing, dep, red, tpass, status, msg = out
     n = int(iinfo[0])

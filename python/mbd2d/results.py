@@ -108,7 +108,7 @@ class KinematicsResult:
 
     def __repr__(self) -> str:
         span = f"t = {self.t[0]:g} .. {self.t[-1]:g}" if len(self.t) else "no rows"
-        return (f"KinematicsResult({len(self.t)} rows, {span}, {len(self.coordinate_names)} "
+        return (f"{type(self).__name__}({len(self.t)} rows, {span}, {len(self.coordinate_names)} "
                 f"coordinates{'' if self.complete else ', incomplete'})")
 
 
@@ -208,9 +208,6 @@ class DynamicsResult(KinematicsResult):
                  drift_position=self.drift_position, drift_velocity=self.drift_velocity,
                  coordinate_names=np.array(self.coordinate_names),
                  body_names=np.array(self.body_names), row_labels=np.array(self.row_labels))
-
-    def __repr__(self) -> str:
-        return "Dynamics" + super().__repr__()
 
 
 @dataclass
