@@ -10,10 +10,13 @@
 module mbd_api
   use mbd_kinds, only: wp, zero, one
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
-  use mbd_status, only: MBD_OK, MBD_BAD_COUNT, MBD_BAD_PARAM, MBD_INCONSISTENT, MSG_LEN
+  use mbd_status, only: MBD_OK, MBD_BAD_COUNT, MBD_BAD_PARAM, MBD_INCONSISTENT, MBD_NO_MEMORY, &
+                        MSG_LEN
+  use mbd_memory, only: REAL_BYTES, mem_fail
   use mbd_points, only: NLOC, MAXROW
   use mbd_model, only: model_t, model_build, model_add_dynamics
-  use mbd_dynamics, only: dyn_work_t, dyn_init, dyn_velocity, dyn_multipliers, dyn_reactions, &
+  use mbd_dynamics, only: dyn_work_t, dyn_init, dyn_memory_check, dyn_velocity, &
+                          dyn_multipliers, dyn_reactions, &
                           gen_forces, kinetic_energy
   use mbd_integrators, only: dyn_opts_t, dyn_stats_t, integrate, output_rows, output_index
   use mbd_statics, only: statics_solve
@@ -100,7 +103,8 @@ contains
         size(jac, 1) /= m%neq .or. size(jac, 2) /= m%nq) then
       status = MBD_BAD_COUNT; msg = 'array sizes do not match the model'; return
     end if
-    call asm_init(m, aw)
+    call asm_init(m, aw, status, msg)
+    if (status /= MBD_OK) return
     call assemble_dense(m, q, qd, t, phi, nu, gam, aw, jac)
     if (.not. (finite(phi) .and. finite(jac) .and. finite(nu) .and. finite(gam))) then
       status = MBD_BAD_PARAM
@@ -203,7 +207,7 @@ contains
     type(kin_report_t) :: rep
     type(kin_work_t) :: w
     real(wp) :: h
-    integer :: bad, lev
+    integer :: bad, lev, ierr
     call model_build(nb, ctab, rpar, m, status, msg, bad)
     if (status /= MBD_OK) return
     if (size(q) /= m%nq .or. size(qd) /= m%nq .or. size(qdd) /= m%nq .or. m%neq /= m%nq) then
@@ -218,10 +222,16 @@ contains
     end if
     if (tol > zero) opts%tol = tol
     if (maxit > 0) opts%maxit = maxit
-    call kin_work_init(m, w)
+    call kin_work_init(m, w, status, msg)
+    if (status /= MBD_OK) return
     w%tol = opts%tol * m%lscale
     if (assemble == 1) then
-      allocate (rep%qsing(m%nq), rep%dep(m%neq), rep%redundant(m%neq))
+      allocate (rep%qsing(m%nq), rep%dep(m%neq), rep%redundant(m%neq), stat=ierr)
+      if (ierr /= 0) then
+        call mem_fail(REAL_BYTES * (real(m%nq, wp) + m%neq), 'the assembly report', &
+                      'use a smaller model', status, msg)
+        return
+      end if
       call kin_assemble(m, w, q, t, opts, rep, status, msg)
       if (status /= MBD_OK) return
     else
@@ -261,7 +271,7 @@ contains
     type(kin_opts_t) :: opts
     type(kin_report_t) :: rep
     type(kin_work_t) :: w
-    integer :: bad
+    integer :: bad, ierr
     q = zero; rank = 0; mobility = 0; redundant = 0; dep = 0; resid = zero; worst = 0
     call model_build(nb, ctab, rpar, m, status, msg, bad)
     worst = bad
@@ -274,9 +284,15 @@ contains
       status = MBD_BAD_COUNT; msg = 'array sizes do not match the model'; return
     end if
     if (tol > zero) opts%tol = tol
-    call kin_work_init(m, w)
+    call kin_work_init(m, w, status, msg)
+    if (status /= MBD_OK) return
     w%tol = opts%tol * m%lscale
-    allocate (rep%qsing(m%nq), rep%dep(m%neq), rep%redundant(m%neq))
+    allocate (rep%qsing(m%nq), rep%dep(m%neq), rep%redundant(m%neq), stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail(REAL_BYTES * (real(m%nq, wp) + m%neq), 'the assembly report', &
+                    'use a smaller model', status, msg)
+      return
+    end if
     rep%qsing = zero; rep%dep = 0; rep%redundant = 0
     q = q0
     call kin_assemble(m, w, q, t, opts, rep, status, msg)
@@ -334,9 +350,14 @@ contains
     real(wp), intent(in) :: q(:), qd(:), t
     real(wp), intent(out) :: e(4)
     real(wp) :: v
+    integer :: j
     call assemble_dense(m, q, w%qz, t, w%phi, w%nu, w%gam, w%asm, w%jac)
     e(3) = maxval(abs(w%phi))
-    e(4) = maxval(abs(matmul(w%jac, qd) - w%nu))
+    w%phi = -w%nu                ! J q_dot - nu by columns (matmul would make a temporary)
+    do j = 1, size(qd)
+      w%phi = w%phi + w%jac(:, j) * qd(j)
+    end do
+    e(4) = maxval(abs(w%phi))
     call gen_forces(m, q, qd, t, w%force, v)
     e(1) = kinetic_energy(m, qd); e(2) = v
   end subroutine state_measures
@@ -373,16 +394,29 @@ contains
       qsing = zero; dep = 0; redundant = 0; tpass = zero
       return
     end if
+    ! the multipliers are dense: check the memory before the (possibly long) kinematic run
+    call dyn_memory_check(m, status, msg)
+    if (status /= MBD_OK) then
+      qout = zero; qdout = zero; qddout = zero; iinfo = 0; rinfo = zero
+      qsing = zero; dep = 0; redundant = 0; tpass = zero
+      return
+    end if
     call api_kinematics(nb, ctab, rpar, q0, t0, t1, nsteps, tol, 0, zero, every, solver, qout, &
                         qdout, qddout, iinfo, rinfo, qsing, dep, redundant, tpass, status, msg)
     if (iinfo(1) < 1) return
     call dyn_init(m, w, qout(:, 1), t0, 1.0e-12_wp, st, lmsg)
+    if (st == MBD_NO_MEMORY) then
+      status = st; msg = lmsg; return
+    end if
     if (st /= MBD_OK) return
     do k = 1, iinfo(1)
       ! column k holds output min((k - 1) every, nsteps)
       t = t0 + (t1 - t0) * (real(min((k - 1) * every, nsteps), wp) / max(nsteps, 1))
       if (k == size(qout, 2)) t = t1
       call dyn_multipliers(m, w, qout(:, k), qdout(:, k), qddout(:, k), t, lamout(:, k), st, lmsg)
+      if (st == MBD_NO_MEMORY) then
+        status = st; msg = lmsg; return
+      end if
       call state_measures(m, w, qout(:, k), qdout(:, k), t, eout(:, k))
     end do
   end subroutine api_inverse
@@ -418,7 +452,7 @@ contains
     type(dyn_stats_t) :: dst
     real(wp), allocatable :: q(:), qd(:)
     real(wp) :: t, lscale
-    integer :: bad, badf, k, ko, nout, st
+    integer :: bad, badf, k, ko, nout, st, ierr
     character(len=MSG_LEN) :: lmsg
     iinfo = 0; rinfo = zero; redundant = 0
     qout = zero; qdout = zero; qddout = zero; lamout = zero; eout = zero
@@ -437,11 +471,21 @@ contains
         size(redundant) /= m%neq) then
       status = MBD_BAD_COUNT; msg = 'array sizes do not match the model'; return
     end if
+    ! the dense dynamics must fit (checked before the assembly allocates its dense J)
+    call dyn_memory_check(m, status, msg)
+    if (status /= MBD_OK) return
     ! assembly at t0 (Levenberg-Marquardt; any number of equations)
-    call kin_work_init(m, kw)
+    call kin_work_init(m, kw, status, msg)
+    if (status /= MBD_OK) return
     lscale = m%lscale
     kw%tol = kopts%tol * lscale
-    allocate (q(m%nq), qd(m%nq), rep%qsing(m%nq), rep%dep(m%neq), rep%redundant(m%neq))
+    allocate (q(m%nq), qd(m%nq), rep%qsing(m%nq), stat=ierr)
+    if (ierr == 0) allocate (rep%dep(m%neq), rep%redundant(m%neq), stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail(REAL_BYTES * (3 * real(m%nq, wp) + m%neq), 'the state vectors', &
+                    'use a smaller model', status, msg)
+      return
+    end if
     q = q0
     call kin_assemble(m, kw, q, t0, kopts, rep, status, msg)
     if (status /= MBD_OK) then
@@ -478,6 +522,9 @@ contains
       t = t0 + (t1 - t0) * (real(ko, wp) / max(nsteps, 1))
       if (ko == nsteps) t = t1
       call dyn_multipliers(m, w, qout(:, k), qdout(:, k), qddout(:, k), t, lamout(:, k), st, lmsg)
+      if (st == MBD_NO_MEMORY .and. status == MBD_OK) then
+        status = st; msg = lmsg; return
+      end if
       call state_measures(m, w, qout(:, k), qdout(:, k), t, eout(:, k))
     end do
   end subroutine api_dynamics
@@ -498,7 +545,7 @@ contains
     type(kin_opts_t) :: kopts
     type(kin_report_t) :: rep
     real(wp) :: lscale
-    integer :: bad, badf
+    integer :: bad, badf, ierr
     q = zero; lam = zero; stable = 0; resid = zero; iinfo = 0
     call build_dynamic(nb, ctab, rpar, bmass, grav, ftab, fpar, m, status, msg, bad, badf)
     iinfo(2) = bad; if (badf /= 0) iinfo(2) = -1000000 - badf
@@ -509,10 +556,18 @@ contains
     if (size(q0) /= m%nq .or. size(q) /= m%nq .or. size(lam) /= m%neq) then
       status = MBD_BAD_COUNT; msg = 'array sizes do not match the model'; return
     end if
-    call kin_work_init(m, kw)
+    call dyn_memory_check(m, status, msg)
+    if (status /= MBD_OK) return
+    call kin_work_init(m, kw, status, msg)
+    if (status /= MBD_OK) return
     lscale = m%lscale
     kw%tol = kopts%tol * lscale
-    allocate (rep%qsing(m%nq), rep%dep(m%neq), rep%redundant(m%neq))
+    allocate (rep%qsing(m%nq), rep%dep(m%neq), rep%redundant(m%neq), stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail(REAL_BYTES * (real(m%nq, wp) + m%neq), 'the assembly report', &
+                    'use a smaller model', status, msg)
+      return
+    end if
     q = q0
     call kin_assemble(m, kw, q, t, kopts, rep, status, msg)
     if (status /= MBD_OK) return
@@ -531,7 +586,7 @@ contains
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
     type(model_t) :: m
     type(dyn_work_t) :: w
-    integer :: bad, k
+    integer :: bad, k, ierr
     reac = zero; rloc = zero
     call model_build(nb, ctab, rpar, m, status, msg, bad)
     if (status /= MBD_OK) return
@@ -542,8 +597,14 @@ contains
         size(q, 2) /= size(t) .or. size(lam, 2) /= size(t) .or. size(reac, 3) /= size(t)) then
       status = MBD_BAD_COUNT; msg = 'array sizes do not match the model'; return
     end if
-    allocate (w%phi(m%neq), w%nu(m%neq), w%gam(m%neq), w%qz(m%nq))
-    call asm_init(m, w%asm)
+    allocate (w%phi(m%neq), w%nu(m%neq), w%gam(m%neq), w%qz(m%nq), stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail(REAL_BYTES * (3 * real(m%neq, wp) + m%nq), 'the reaction work arrays', &
+                    'use a smaller model', status, msg)
+      return
+    end if
+    call asm_init(m, w%asm, status, msg)
+    if (status /= MBD_OK) return
     w%qz = zero
     do k = 1, size(t)
       call dyn_reactions(m, w, q(:, k), t(k), lam(:, k), reac(:, :, k), rloc(:, :, k))

@@ -22,7 +22,8 @@
 module mbd_integrators
   use mbd_kinds, only: wp, zero, one, half, two
   use mbd_status, only: MBD_OK, MBD_BAD_SETTING, MBD_SINGULAR, MBD_NO_CONVERGENCE, &
-                        MBD_INTEGRATOR_FAILED, MBD_LAPACK, MSG_LEN
+                        MBD_INTEGRATOR_FAILED, MBD_LAPACK, MBD_NO_MEMORY, MSG_LEN
+  use mbd_memory, only: REAL_BYTES, mem_fail
   use mbd_model, only: model_t
   use mbd_assemble, only: assemble_dense, assemble_blocks, scatter_dense
   use mbd_linsolve, only: lu_factor, lu_solve, lapack_status, lu_factor_small, lu_solve_small
@@ -122,7 +123,12 @@ contains
       status = MBD_BAD_SETTING; msg = 'every must be >= 1 and the outputs sized for it'; return
     end if
     c%opts = opts; c%t0 = t0; c%t1 = t1; c%nsteps = nsteps; c%every = every
-    allocate (c%qf(m%nq), c%vf(m%nq), c%af(m%nq), c%lam(m%neq))
+    allocate (c%qf(m%nq), c%vf(m%nq), c%af(m%nq), c%lam(m%neq), stat=status)
+    if (status /= 0) then
+      call mem_fail(REAL_BYTES * (3 * real(m%nq, wp) + m%neq), 'the integrator state', &
+                    'use a smaller model', status, msg)
+      return
+    end if
     c%qf = q; c%vf = qd
     call dyn_accel(m, w, q, qd, t0, c%af, c%lam, status)
     if (status /= MBD_OK) then
@@ -441,7 +447,9 @@ contains
     if (partitioned) then
       call partition(m, w, c, c%t0, stt)
       if (stt /= MBD_OK) then
-        status = stt; msg = 'partitioned: cannot choose independent coordinates'; return
+        status = stt; msg = 'partitioned: cannot choose independent coordinates'
+        if (stt == MBD_NO_MEMORY) msg = 'not enough memory for the partition (QR of J)'
+        return
       end if
     end if
     fixed = c%opts%method == METH_RK4
@@ -453,7 +461,12 @@ contains
     else
       h = initial_step(c)
     end if
-    call pack_state(c, y, ynew, k, e)
+    call pack_state(c, y, ynew, k, e, stt)
+    if (stt /= 0) then
+      call mem_fail(REAL_BYTES * 10 * size(c%qf), 'the integrator stages', &
+                    'use a smaller model', status, msg)
+      return
+    end if
     fsal = .false.
     qa = c%qf; va = c%vf; aa = c%af          ! the state at the start of the step
     c%qs = qa; c%vs = va; c%as = aa; c%ts = t
@@ -546,7 +559,12 @@ contains
             write (msg, '(a,es12.5)') 'partitioned: no well-conditioned partition at t = ', t
             return
           end if
-          call pack_state(c, y, ynew, k, e)
+          call pack_state(c, y, ynew, k, e, stt)
+          if (stt /= 0) then
+            call mem_fail(REAL_BYTES * 10 * size(c%qf), 'the integrator stages', &
+                          'use a smaller model', status, msg)
+            return
+          end if
           fsal = .false.
         end if
       end if
@@ -554,18 +572,22 @@ contains
   end subroutine run_explicit
 
   !> The integrated state y from the full state: (q, q_dot), or (v, v_dot) when partitioned.
-  subroutine pack_state(c, y, ynew, k, e)
+  subroutine pack_state(c, y, ynew, k, e, ierr)
     type(itg_t), intent(in) :: c
     real(wp), allocatable, intent(inout) :: y(:), ynew(:), k(:, :), e(:)
-    integer :: ny
+    integer, intent(out) :: ierr          ! allocation status (0 ok)
+    integer :: ny, nh
+    nh = size(c%qf)
+    if (c%ni > 0) nh = c%ni
+    ny = 2 * nh
+    if (allocated(y)) deallocate (y, ynew, k, e)
+    allocate (y(ny), ynew(ny), k(ny, 7), e(ny), stat=ierr)
+    if (ierr /= 0) return
     if (c%ni > 0) then
-      y = [c%qf(c%iv), c%vf(c%iv)]
+      y(1:nh) = c%qf(c%iv); y(nh + 1:) = c%vf(c%iv)
     else
-      y = [c%qf, c%vf]
+      y(1:nh) = c%qf; y(nh + 1:) = c%vf
     end if
-    ny = size(y)
-    if (allocated(ynew)) deallocate (ynew, k, e)
-    allocate (ynew(ny), k(ny, 7), e(ny))
   end subroutine pack_state
 
   !> After an accepted step: the full consistent state at tn in c (dopri5: projected).
@@ -700,7 +722,10 @@ contains
     a = w%jac(w%rows, :)
     jp = 0
     call dgeqp3(w%na, m%nq, a, w%na, jp, tau, wq, -1, info)
-    allocate (work(max(1, int(wq(1)))))
+    allocate (work(max(1, int(wq(1)))), stat=stf)
+    if (stf /= 0) then
+      stf = MBD_NO_MEMORY; return
+    end if
     call dgeqp3(w%na, m%nq, a, w%na, jp, tau, work, size(work), info)
     call lapack_status('dgeqp3', info, stf, lmsg)
     if (stf /= MBD_OK) return

@@ -21,6 +21,7 @@
 module mbd_model
   use mbd_kinds, only: wp, one
   use mbd_status, only: MBD_OK, MBD_BAD_INPUT, MBD_BAD_BODY, MBD_BAD_PARAM, MSG_LEN
+  use mbd_memory, only: REAL_BYTES, mem_fail
   use mbd_points, only: NLOC
   use mbd_constraints, only: con_known, con_nrow, con_nextra, con_raw_length, &
                              con_prepare, con_name, CON_REVOLUTE, CON_TRANSLATIONAL, CON_CAM, &
@@ -35,6 +36,7 @@ module mbd_model
   integer, parameter :: NCT = 8   !! rows of the constraint table
   integer, parameter :: NFT = 6   !! rows of the force table
   integer, parameter :: MAX_BODIES = 1000000   !! keeps 3 nb and the row counts in range
+  character(len=*), parameter :: HINT = 'use a smaller model'
 
   !> A built model: constraint data in prepared form and the row and column maps.
   type :: model_t
@@ -91,7 +93,7 @@ contains
     integer, intent(out) :: status              !! MBD_OK or < 0
     character(len=MSG_LEN), intent(out) :: msg  !! what is wrong
     integer, intent(out) :: bad                 !! offending constraint, or 0
-    integer :: nc, k, kind, bi, bj, off, len, nexp, row, extra, ref, total
+    integer :: nc, k, kind, bi, bj, off, len, nexp, row, extra, ref, total, ierr
     real(wp), allocatable :: prep(:), pool(:), refp(:)
     character(len=MSG_LEN) :: sub
     character(len=16) :: ks
@@ -112,9 +114,14 @@ contains
       status = MBD_BAD_INPUT; msg = 'the model has no joints or drivers'; return
     end if
     m%nb = nb; m%nc = nc
-    allocate (m%kind(nc), m%suba(nc), m%subb(nc), m%bi(nc), m%bj(nc), m%row0(nc), &
-              m%nrow(nc), m%loc(NLOC, nc), m%po(nc), m%pn(nc))
-    allocate (pool(0))
+    allocate (m%kind(nc), m%suba(nc), m%subb(nc), m%bi(nc), m%bj(nc), stat=ierr)
+    if (ierr == 0) allocate (m%row0(nc), m%nrow(nc), m%loc(NLOC, nc), stat=ierr)
+    if (ierr == 0) allocate (m%po(nc), m%pn(nc), pool(8 * nc), stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail(4 * (NLOC + 9 + 16) * real(nc, wp), 'the constraint tables', HINT, &
+                    status, msg)
+      return
+    end if
     row = 0; extra = 0; total = 0
     do k = 1, nc
       kind = ctab(1, k); bi = ctab(2, k); bj = ctab(3, k)
@@ -217,8 +224,14 @@ contains
       m%kind(k) = kind; m%suba(k) = ctab(4, k); m%subb(k) = ctab(5, k)
       m%bi(k) = bi; m%bj(k) = bj
       m%row0(k) = row + 1; m%nrow(k) = con_nrow(kind); row = row + m%nrow(k)
-      m%po(k) = total + 1; m%pn(k) = size(prep); total = total + size(prep)
-      pool = [pool, prep]
+      m%po(k) = total + 1; m%pn(k) = size(prep)
+      call append(pool, total, prep, ierr)
+      if (ierr /= 0) then
+        bad = 0
+        call mem_fail(2 * REAL_BYTES * (total + size(prep)), 'the constraint parameters', &
+                      HINT, status, msg)
+        return
+      end if
       ! local slots -> global coordinates
       m%loc(:, k) = 0
       if (bi > 0) m%loc(1:3, k) = [3 * bi - 2, 3 * bi - 1, 3 * bi]
@@ -232,8 +245,13 @@ contains
     bad = 0
     m%neq = row
     m%nq = 3 * nb + extra
-    call move_alloc(pool, m%p)
-    allocate (m%con_of_row(m%neq))
+    allocate (m%p(total), m%con_of_row(m%neq), stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail(REAL_BYTES * total + 4 * real(m%neq, wp), 'the constraint parameters', &
+                    HINT, status, msg)
+      return
+    end if
+    m%p = pool(1:total)
     do k = 1, nc
       m%con_of_row(m%row0(k):m%row0(k) + m%nrow(k) - 1) = k
     end do
@@ -250,14 +268,17 @@ contains
     integer, intent(out) :: status              !! MBD_OK or < 0
     character(len=MSG_LEN), intent(out) :: msg  !! what is wrong
     integer, intent(out) :: bad                 !! offending force (> 0) or body (< 0)
-    integer :: k, nf, kind, bi, bj, off, len, total
+    integer :: k, nf, kind, bi, bj, off, len, total, ierr
     real(wp), allocatable :: prep(:), pool(:)
     character(len=MSG_LEN) :: sub
     status = MBD_OK; msg = ''; bad = 0
     if (size(bmass, 1) /= 2 .or. size(bmass, 2) /= m%nb .or. size(ftab, 1) /= NFT) then
       status = MBD_BAD_INPUT; msg = 'mass or force table has the wrong shape'; return
     end if
-    allocate (m%mdiag(m%nq))
+    allocate (m%mdiag(m%nq), stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail(REAL_BYTES * m%nq, 'the mass matrix', HINT, status, msg); return
+    end if
     m%mdiag = 0.0_wp
     do k = 1, m%nb
       if (.not. all(ieee_is_finite(bmass(:, k))) .or. .not. all(bmass(:, k) >= 0.0_wp)) then
@@ -273,8 +294,12 @@ contains
     m%grav = grav
     nf = size(ftab, 2)
     m%nf = nf
-    allocate (m%fkind(nf), m%fbi(nf), m%fbj(nf), m%floc(NLOC, nf), m%fpo(nf), m%fpn(nf))
-    allocate (pool(0))
+    allocate (m%fkind(nf), m%fbi(nf), m%fbj(nf), m%floc(NLOC, nf), stat=ierr)
+    if (ierr == 0) allocate (m%fpo(nf), m%fpn(nf), pool(8 * nf), stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail(4 * (NLOC + 5 + 16) * real(nf, wp), 'the force tables', HINT, status, msg)
+      return
+    end if
     total = 0
     do k = 1, nf
       bad = k
@@ -307,14 +332,43 @@ contains
         msg = sub; return
       end if
       m%fkind(k) = kind; m%fbi(k) = bi; m%fbj(k) = bj
-      m%fpo(k) = total + 1; m%fpn(k) = size(prep); total = total + size(prep)
-      pool = [pool, prep]
+      m%fpo(k) = total + 1; m%fpn(k) = size(prep)
+      call append(pool, total, prep, ierr)
+      if (ierr /= 0) then
+        bad = 0
+        call mem_fail(2 * REAL_BYTES * (total + size(prep)), 'the force parameters', HINT, &
+                      status, msg)
+        return
+      end if
       m%floc(:, k) = 0
       if (bi > 0) m%floc(1:3, k) = [3 * bi - 2, 3 * bi - 1, 3 * bi]
       if (bj > 0) m%floc(4:6, k) = [3 * bj - 2, 3 * bj - 1, 3 * bj]
     end do
     bad = 0
-    call move_alloc(pool, m%fp)
+    allocate (m%fp(total), stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail(REAL_BYTES * total, 'the force parameters', HINT, status, msg); return
+    end if
+    m%fp = pool(1:total)
   end subroutine model_add_dynamics
+
+  !> pool(total + 1:total + size(x)) = x, the capacity doubled when it runs out (a pool built
+  !! by concatenation would cost O(nc**2) copies).
+  pure subroutine append(pool, total, x, ierr)
+    real(wp), allocatable, intent(inout) :: pool(:)  !! the pool (its size is the capacity)
+    integer, intent(inout) :: total                  !! entries in use
+    real(wp), intent(in) :: x(:)                     !! entries to add
+    integer, intent(out) :: ierr                     !! allocation status (0 ok)
+    real(wp), allocatable :: bigger(:)
+    ierr = 0
+    if (total + size(x) > size(pool)) then
+      allocate (bigger(max(2 * size(pool), total + size(x), 16)), stat=ierr)
+      if (ierr /= 0) return
+      bigger(1:total) = pool(1:total)
+      call move_alloc(bigger, pool)
+    end if
+    pool(total + 1:total + size(x)) = x
+    total = total + size(x)
+  end subroutine append
 
 end module mbd_model

@@ -11,7 +11,7 @@
 !! any start on the manifold; the signs of the eigenvalues of H there give the stability.
 module mbd_statics
   use mbd_kinds, only: wp, zero, one, half
-  use mbd_status, only: MBD_OK, MBD_NO_CONVERGENCE, MBD_SINGULAR, MSG_LEN
+  use mbd_status, only: MBD_OK, MBD_NO_CONVERGENCE, MBD_SINGULAR, MBD_NO_MEMORY, MSG_LEN
   use mbd_model, only: model_t
   use mbd_assemble, only: assemble_dense
   use mbd_lapack, only: dgesvd, dsyev
@@ -39,7 +39,9 @@ contains
     real(wp) :: kt(m%nq, m%nq), ct(m%nq, m%nq), qt(m%nq), v0, vt, alpha, gscale, emax
     integer :: it, ls, nfree, i, stp
     character(len=MSG_LEN) :: lmsg
+    logical :: nomem                          ! an allocation in null_space or eigen failed
     status = MBD_OK; msg = ''; stable = 2; resid = zero
+    nomem = .false.
     gscale = max(one, maxval(abs(m%mdiag)) * max(one, norm2(m%grav)))
     call dyn_project_pos(m, w, q, t, status)
     if (status /= MBD_OK) then
@@ -47,6 +49,7 @@ contains
     end if
     do it = 1, 200
       call null_space(nb, nfree)
+      if (nomem) exit
       if (nfree == 0) exit                   ! nothing can move: q is the equilibrium
       v0 = potential(q)
       g = matmul(transpose(nb), w%force)     ! reduced load N^T Q (= -reduced gradient of V)
@@ -56,6 +59,7 @@ contains
       call dyn_tangent(m, w, q, w%qz, t, lam, kt, ct)
       h = matmul(transpose(nb), matmul(half * (kt + transpose(kt)), nb))
       call eigen(h, ev, .true.)
+      if (nomem) exit
       ! saddle-free: |eigenvalues|, bounded below (a flat direction gets a gradient step
       ! of about the model's length scale)
       emax = max(1.0e-8_wp * maxval(abs(ev)), norm2(g) / m%lscale)
@@ -78,7 +82,13 @@ contains
       if (ls > 40) exit
       q = qt
     end do
-    call null_space(nb, nfree)
+    if (.not. nomem) call null_space(nb, nfree)
+    if (nomem) then
+      status = MBD_NO_MEMORY
+      msg = 'not enough memory for the statics (null space and reduced stiffness, dense): '// &
+            'use a model with fewer coordinates'
+      return
+    end if
     call dyn_multipliers(m, w, q, w%qz, w%qz, t, lam, stp, lmsg)
     if (nfree == 0) then
       stable = 2; resid = zero; return
@@ -94,6 +104,12 @@ contains
     call dyn_tangent(m, w, q, w%qz, t, lam, kt, ct)
     h = matmul(transpose(nb), matmul(half * (kt + transpose(kt)), nb))
     call eigen(h, ev, .false.)
+    if (nomem) then
+      status = MBD_NO_MEMORY
+      msg = 'not enough memory for the stability analysis (dense): use a model with fewer '// &
+            'coordinates'
+      return
+    end if
     emax = max(maxval(abs(ev)), tiny(one))
     if (minval(ev) > 1.0e-9_wp * emax) then
       stable = 1
@@ -122,7 +138,10 @@ contains
       call gen_forces(m, q, w%qz, t, w%force, v)
       ja = w%jac(w%rows, :)
       call dgesvd('N', 'A', w%na, m%nq, ja, w%na, sv, u, 1, vt, m%nq, wq, -1, info)
-      allocate (work(max(1, int(wq(1)))))
+      allocate (work(max(1, int(wq(1)))), stat=info)
+      if (info /= 0) then
+        nomem = .true.; nfr = 0; return
+      end if
       call dgesvd('N', 'A', w%na, m%nq, ja, w%na, sv, u, 1, vt, m%nq, work, size(work), info)
       rk = 0
       if (size(sv) > 0) rk = count(sv > 1.0e-10_wp * maxval(sv))
@@ -140,10 +159,16 @@ contains
       integer :: nn, info
       character(len=1) :: job
       nn = size(a, 1)
-      allocate (e(nn))
+      allocate (e(nn), stat=info)
+      if (info /= 0) then
+        nomem = .true.; return
+      end if
       job = merge('V', 'N', vectors)
       call dsyev(job, 'U', nn, a, nn, e, wq, -1, info)
-      allocate (work(max(1, int(wq(1)))))
+      allocate (work(max(1, int(wq(1)))), stat=info)
+      if (info /= 0) then
+        nomem = .true.; return
+      end if
       call dsyev(job, 'U', nn, a, nn, e, work, size(work), info)
     end subroutine eigen
   end subroutine statics_solve

@@ -12,8 +12,8 @@ from __future__ import annotations
 
 from .analysis import DofReport
 from .errors import (AnalysisError, AssemblyError, ConvergenceError, CoreError,
-                     InconsistentConstraintsError, IntegrationError, MbdError, MbdWarning,
-                     ModelError,
+                     InconsistentConstraintsError, InsufficientMemoryError, IntegrationError,
+                     MbdError, MbdWarning, ModelError,
                      RedundantConstraintWarning, SingularConfigurationError,
                      SingularJacobianError, SingularPassageWarning, ToggleError)
 from .functions import Harmonic, TimeFunction
@@ -28,5 +28,5 @@ __all__ = ["load", "loads", "Model", "TimeFunction", "Harmonic", "KinematicsResu
            "BodyResult", "DynamicsResult", "KinematicStepper", "StaticsResult", "Reaction", "DofReport",
            "MbdError", "ModelError", "AnalysisError", "IntegrationError",
            "AssemblyError", "InconsistentConstraintsError", "ConvergenceError",
-           "SingularJacobianError", "SingularConfigurationError", "ToggleError", "CoreError",
-           "MbdWarning", "RedundantConstraintWarning", "SingularPassageWarning", "__version__"]
+           "SingularJacobianError", "SingularConfigurationError", "ToggleError",
+           "InsufficientMemoryError", "CoreError", "MbdWarning", "RedundantConstraintWarning", "SingularPassageWarning", "__version__"]

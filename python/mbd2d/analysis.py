@@ -12,8 +12,8 @@ import numpy as np
 
 from . import _core
 from .errors import (AssemblyError, ConvergenceError, CoreError, InconsistentConstraintsError,
-                     ModelError, RedundantConstraintWarning, SingularConfigurationError,
-                     SingularJacobianError, SingularPassageWarning)
+                     InsufficientMemoryError, ModelError, RedundantConstraintWarning,
+                     SingularConfigurationError, SingularJacobianError, SingularPassageWarning)
 from .pack import Packed, decode, pack
 from .results import KinematicsResult
 from .validate import is_number, number, whole
@@ -24,6 +24,7 @@ if TYPE_CHECKING:  # pragma: no cover
 # status codes of mbd_status.f90
 OK, SINGULAR, NO_CONVERGENCE, SINGULAR_CONFIG, ASSEMBLY_FAILED, LAPACK, INCONSISTENT = range(7)
 BAD_COUNT = -4
+NO_MEMORY = 10         # an allocation failed or would not fit (mbd_memory.f90)
 MAX_STEPS = 10**9      # output rows are held in memory; the core counts in 32-bit integers
 MIN_TOL = 1e-15        # below this a residual test cannot pass in double precision
 
@@ -221,6 +222,8 @@ def analyze_dof(model: "Model", t: float = 0.0, tol: float | None = None) -> Dof
         raise _inconsistent(model, p, float(resid), dep, red, int(rank), t, None)
     if status == ASSEMBLY_FAILED:
         raise _assembly_failed(model, float(resid), worst, t, None)
+    if status == NO_MEMORY:
+        raise InsufficientMemoryError(decode(msg))
     if status != OK:
         raise CoreError(f"internal error in the core (status {status}): {decode(msg)}")
     cons, rows = _names(p, model, red)
@@ -368,4 +371,6 @@ def _failure(model: "Model", p: Packed, status: int, msg: str, iinfo: np.ndarray
         return ConvergenceError(f"Newton-Raphson failed after t = {t:.6g} s: {msg}. Results up "
                                 f"to {last} are kept in the exception's .results.", t=t,
                                 results=res, status=status)
+    if status == NO_MEMORY:
+        return InsufficientMemoryError(msg)
     return CoreError(f"internal error in the core (status {status}): {msg}")

@@ -8,12 +8,12 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from . import _core
-from .analysis import (ASSEMBLY_FAILED, INCONSISTENT, NO_CONVERGENCE, OK, SINGULAR,
+from .analysis import (ASSEMBLY_FAILED, INCONSISTENT, NO_CONVERGENCE, NO_MEMORY, OK, SINGULAR,
                        SINGULAR_CONFIG, _assembly_failed, _failure, _names, check_memory,
                        check_solver, check_span, output_steps, require_determined,
                        solver_code, time_grid)
-from .errors import (ConvergenceError, CoreError, IntegrationError, ModelError,
-                     RedundantConstraintWarning, SingularJacobianError)
+from .errors import (ConvergenceError, CoreError, InsufficientMemoryError, IntegrationError,
+                     ModelError, RedundantConstraintWarning, SingularJacobianError)
 from .pack import Packed, decode, pack
 from .results import DynamicsResult, StaticsResult
 from .validate import number
@@ -195,6 +195,8 @@ def run_dynamics(model: "Model", t_end: float, steps: int, method: str | None = 
         raise SingularJacobianError(f"{method}: {text}", t=tf, results=res, status=status)
     if status in (NO_CONVERGENCE, INCONSISTENT):
         raise ConvergenceError(f"{method}: {text}", t=tf, results=res, status=status)
+    if status == NO_MEMORY:
+        raise InsufficientMemoryError(text)
     raise CoreError(f"internal error in the core (status {status}): {text}")
 
 
@@ -218,6 +220,8 @@ def run_statics(model: "Model", t: float = 0.0) -> StaticsResult:
         raise SingularJacobianError(text, t=t, status=status)
     if status == NO_CONVERGENCE:
         raise ConvergenceError(text, t=t, status=status, residual=float(resid))
+    if status == NO_MEMORY:
+        raise InsufficientMemoryError(text)
     if status != OK:
         raise CoreError(f"internal error in the core (status {status}): {text}")
     return StaticsResult(t=t, q=q, lam=lam, stability=STABILITY.get(int(stable), "unknown"),
@@ -233,6 +237,8 @@ def reactions(p: Packed, q: np.ndarray, t: np.ndarray, lam: np.ndarray
     ll = np.asfortranarray(np.atleast_2d(lam).T)
     reac, rloc, status, msg = _core.core_reactions(p.nb, p.ctab, p.rpar, qq,
                                                    np.atleast_1d(t).astype(float), ll)
+    if status == NO_MEMORY:
+        raise InsufficientMemoryError(decode(msg))
     if status != OK:
         raise CoreError(decode(msg))
     return np.transpose(reac, (2, 1, 0)), np.transpose(rloc, (2, 1, 0))

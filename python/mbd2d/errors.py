@@ -124,6 +124,16 @@ class SingularPassageWarning(MbdWarning):
     branch it started on."""
 
 
+class InsufficientMemoryError(MbdError, MemoryError):
+    """The analysis needs more memory than the machine can give (the core's status 10).
+
+    The core refuses a request above half the physical memory (or above what is free) before
+    allocating it, and turns an allocation that fails anyway into this error; the message
+    gives the size asked and what to change (fewer steps, the banded solver, a smaller
+    model). The process and its earlier results are unharmed.
+    """
+
+
 class CoreError(MbdError):
     """The Fortran core reported an internal error (a LAPACK argument error); a bug."""
 
@@ -131,5 +141,6 @@ class CoreError(MbdError):
 __all__ = ["MbdError", "ModelError", "AnalysisError", "AssemblyError",
            "InconsistentConstraintsError", "ConvergenceError", "SingularJacobianError",
            "IntegrationError",
-           "SingularConfigurationError", "ToggleError", "CoreError", "MbdWarning",
+           "SingularConfigurationError", "ToggleError", "InsufficientMemoryError", "CoreError",
+           "MbdWarning",
            "RedundantConstraintWarning", "SingularPassageWarning"]

@@ -7,8 +7,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from . import _core
-from .analysis import check_solver, require_determined
-from .errors import AssemblyError, ConvergenceError, ModelError
+from .analysis import NO_MEMORY, check_solver, require_determined
+from .errors import AssemblyError, ConvergenceError, InsufficientMemoryError, ModelError
 from .pack import decode, pack
 from .validate import number
 
@@ -70,6 +70,8 @@ class KinematicStepper:
                                                       int(assemble))
         if status < 0:
             raise ModelError(decode(msg), "stepping")
+        if status == NO_MEMORY:
+            raise InsufficientMemoryError(decode(msg))
         if status > 0:
             cls = AssemblyError if assemble else ConvergenceError
             raise cls(f"{decode(msg)}; the state stays at t = {self.t:.9g} s (Model.kinematics "
