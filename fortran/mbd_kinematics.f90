@@ -65,6 +65,9 @@ module mbd_kinematics
   !! n / BAND_RATIO wide
   integer, parameter :: BAND_MIN_N = 60, BAND_RATIO = 4
   integer, parameter :: BAND_ASSEMBLY_MAXIT = 50  !! Newton iterations of a banded assembly
+  !> largest dense Levenberg-Marquardt assembly (J and [J; mu I]) allowed in band mode (bytes):
+  !! n up to about 1670; larger banded models assemble by damped Newton on the band
+  real(wp), parameter :: DENSE_FALLBACK = 64.0_wp * 1048576
   real(wp), parameter :: PRED_ACCEPT = 1.0e-2_wp  !! fraction of tol a start must meet
   !> what to change when the dense J does not fit
   character(len=*), parameter :: DENSE_HINT = 'the dense solver keeps J as a full matrix: ' // &
@@ -96,7 +99,8 @@ module mbd_kinematics
     real(wp) :: resid = zero        !! least-squares residual of the last solve
     integer :: newton_its = 0       !! Newton corrections taken
     integer :: lu_count = 0         !! factorizations
-    logical :: banded = .false.     !! J is factored in band storage (w%jac only on demand)
+    logical :: banded = .false.     !! J is factored in band storage (no dense J but for a
+                                    !! small model's Levenberg-Marquardt assembly)
     type(band_t) :: band            !! band plan, storage and factors
     real(wp) :: anorm = zero        !! ||J D||_1 of the band matrix before factoring
   end type kin_work_t
@@ -393,8 +397,10 @@ contains
   !! residual and the constraint with the largest residual are reported; if J is rank
   !! deficient there, the rows that contradict each other (those with a residual: at the
   !! minimum Phi is orthogonal to the range of J) are flagged in rep%dep, MBD_INCONSISTENT.
-  !! Band mode (no n x n array): Newton, then Newton damped by backtracking on ||Phi||_2
-  !! (band_assemble); its failure is MBD_ASSEMBLY_FAILED without the rank diagnosis.
+  !! Band mode: Newton from the estimates; if it fails, Levenberg-Marquardt on a dense J as
+  !! above while its arrays stay below DENSE_FALLBACK, otherwise Newton damped by backtracking
+  !! on ||Phi||_2 (band_assemble, no n x n array; its failure is MBD_ASSEMBLY_FAILED without
+  !! the rank diagnosis).
   subroutine kin_assemble(m, w, q, t, opts, rep, status, msg)
     type(model_t), intent(in) :: m           !! model
     type(kin_work_t), intent(inout) :: w     !! work arrays
@@ -417,18 +423,26 @@ contains
     if (ierr /= 0) then
       call mem_fail(REAL_BYTES * n, WHAT, DENSE_HINT, status, msg); return
     end if
+    call dgels('N', neq + n, n, 1, wq, neq + n, wq, neq + n, wq, -1, info)
+    lwork = max(1, int(wq(1)))
+    bytes = REAL_BYTES * ((real(neq, wp) + n) * (n + 1) + neq + lwork)
     if (w%banded) then
-      ! large square models: plain Newton first, then damped Newton (no dense fallback)
+      ! square models in band storage: plain Newton first
       qt = q
       call kin_newton(m, w, q, t, BAND_ASSEMBLY_MAXIT, st)
       if (st == MBD_OK) return
       q = qt
-      call band_assemble(m, w, q, t, opts%assembly_maxit, qt, rep, status, msg)
-      return
+      if (bytes + REAL_BYTES * real(neq, wp) * n > DENSE_FALLBACK) then
+        ! large: damped Newton on the band (no n x n array)
+        call band_assemble(m, w, q, t, opts%assembly_maxit, qt, rep, status, msg)
+        return
+      end if
+      ! small enough for the dense Levenberg-Marquardt below: its J, for this assembly only
+      if (.not. allocated(w%jac)) allocate (w%jac(neq, n), stat=ierr)
+      if (ierr /= 0) then
+        call mem_fail(REAL_BYTES * real(neq, wp) * n, WHAT, DENSE_HINT, status, msg); return
+      end if
     end if
-    call dgels('N', neq + n, n, 1, wq, neq + n, wq, neq + n, wq, -1, info)
-    lwork = max(1, int(wq(1)))
-    bytes = REAL_BYTES * ((real(neq, wp) + n) * (n + 1) + neq + lwork)
     call mem_check(bytes, WHAT, DENSE_HINT, status, msg)
     if (status /= MBD_OK) return
     allocate (aug(neq + n, n), rhs(neq + n), phit(neq), work(lwork), stat=ierr)

@@ -128,7 +128,8 @@ contains
       case ('steps')
         if (.not. one_int(big)) exit
         if (big < 1 .or. big > MAX_STEPS) then
-          call fail_int('steps must be a whole number from 1 to ', int(MAX_STEPS, int64), big)
+          call fail_int('steps must be a whole number from 1 to ', int(MAX_STEPS, int64), &
+                        ' (the number of output intervals)', big)
           exit
         end if
         spec%steps = int(big); spec%steps_line = lineno
@@ -136,7 +137,7 @@ contains
         if (.not. one_int(big)) exit
         if (big < 0 .or. big > MAX_ITER) then
           call fail_int('maxit must be a whole number from 0 (default) to ', &
-                        int(MAX_ITER, int64), big)
+                        int(MAX_ITER, int64), '', big)
           exit
         end if
         spec%maxit = int(big)
@@ -213,7 +214,8 @@ contains
               call fail('"' // trim(tok) // '" is not a whole number'); exit
             end if
             if (abs(big) > huge(1)) then
-              call fail_int('a constraint entry must lie within +-', int(huge(1), int64), big)
+              call fail('"' // trim(tok(1:40)) // '": a constraint entry must lie within '// &
+                        '+-2147483647')
               exit
             end if
             spec%ctab(k, i) = int(big)
@@ -298,7 +300,6 @@ contains
       character(len=*), intent(in) :: what
       integer, intent(in) :: lo
       integer(int64) :: c, room
-      character(len=32) :: rs
       count_ok = .false.; nn = 0
       if (.not. one_int(c)) return
       if (what == 'parameter') then
@@ -307,17 +308,16 @@ contains
         room = ndata - nread
       end if
       if (c < lo) then
-        call fail_int('the ' // what // ' count must be at least ', int(lo, int64), c)
+        call fail_int('the ' // what // ' count must be at least ', int(lo, int64), '', c)
         return
       end if
       if (c > room) then
-        write (rs, '(i0)') room
         if (what == 'parameter') then
-          call fail_int('the parameter count is larger than the numbers the rest of the ' // &
-                        'file can hold (' // trim(rs) // ')', -1_int64, c)
+          call fail_int('more parameters than the rest of the file can hold (at most ', room, &
+                        '): the count does not match the file (truncated or edited?)', c)
         else
-          call fail_int('the ' // what // ' count is larger than the lines left in the file (' &
-                        // trim(rs) // ')', -1_int64, c)
+          call fail_int('more ' // what // ' lines than the file has left (', room, &
+                        '): the count does not match the file (truncated or edited?)', c)
         end if
         return
       end if
@@ -398,16 +398,12 @@ contains
       real_ok = .true.
     end function real_ok
 
-    !> "what" and the value found, as a failure.
-    subroutine fail_int(what, limit, v)
-      character(len=*), intent(in) :: what
+    !> '"KEY VALUE": what LIMIT after' as a failure.
+    subroutine fail_int(what, limit, after, v)
+      character(len=*), intent(in) :: what, after
       integer(int64), intent(in) :: limit, v
       character(len=MSG_LEN) :: s
-      if (limit >= 0) then
-        write (s, '(a,i0,a,i0)') what, limit, ', got ', v
-      else
-        write (s, '(a,a,i0)') what, ', got ', v
-      end if
+      write (s, '(a,a,a,i0,a,a,i0,a)') '"', trim(key), ' ', v, '": ', what, limit, after
       call fail(trim(s))
     end subroutine fail_int
 

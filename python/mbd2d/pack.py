@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from . import _core
-from .errors import ModelError
+from .errors import InsufficientMemoryError, ModelError
 
 if TYPE_CHECKING:  # pragma: no cover
     from .model import Model
@@ -75,6 +75,8 @@ def pack(model: "Model") -> Packed:
     ctab = np.asfortranarray(np.array(cols, dtype=np.int32).T)
     rp = np.array(rpar if rpar else [0.0], dtype=np.float64)
     nq, neq, status, msg, bad = _core.core_sizes(len(model.bodies), ctab, rp)
+    if status == 10:                   # MBD_NO_MEMORY
+        raise InsufficientMemoryError(decode(msg))
     if status != 0:
         entry = cons[bad - 1].describe() if bad > 0 else "model"
         raise ModelError(decode(msg), entry)
