@@ -281,19 +281,33 @@ contains
     real(wp), intent(out) :: lam(:)          !! multipliers (neq)
     integer, intent(out) :: status           !! MBD_OK or MBD_SINGULAR
     real(wp) :: v
-    integer :: n
+    integer :: n, k
     n = m%nq
     call assemble_dense(m, q, qd, t, w%phi, w%nu, w%gam, w%asm, w%jac)
     call gen_forces(m, q, qd, t, w%force, v)
     call factor_aug(m, w, m%mdiag, status)
     if (status /= MBD_OK) return
     w%rhs(1:n) = w%force
-    w%rhs(n + 1:) = w%s * w%gam(w%rows)
+    call gather_rows(w, w%gam, w%s)
     call solve_aug(w, w%rhs, status)
     qdd = w%rhs(1:n)
     lam = zero
-    lam(w%rows) = w%s * w%rhs(n + 1:)
+    do k = 1, w%na                 ! (loops: vector subscripts make heap temporaries)
+      lam(w%rows(k)) = w%s * w%rhs(n + k)
+    end do
   end subroutine dyn_accel
+
+  !> w%rhs(nq + k) = f x(rows(k)) over the active rows (a loop: a vector subscript would
+  !! make a heap temporary at every call).
+  pure subroutine gather_rows(w, x, f)
+    type(dyn_work_t), intent(inout) :: w
+    real(wp), intent(in) :: x(:)
+    real(wp), intent(in) :: f
+    integer :: k
+    do k = 1, w%na
+      w%rhs(w%n + k) = f * x(w%rows(k))
+    end do
+  end subroutine gather_rows
 
   !> Velocities consistent with J q_dot = nu, nearest to v0 in kinetic energy:
   !! [M J^T; J 0][q_dot; mu] = [M v0; nu]. Massless coordinates get the unit metric.
@@ -312,7 +326,7 @@ contains
     call factor_aug(m, w, w%metric, status)
     if (status /= MBD_OK) return
     w%rhs(1:n) = w%metric * v0
-    w%rhs(n + 1:) = w%s * w%nu(w%rows)
+    call gather_rows(w, w%nu, w%s)
     call solve_aug(w, w%rhs, status)
     qd = w%rhs(1:n)
   end subroutine dyn_velocity
@@ -335,7 +349,7 @@ contains
       call factor_aug(m, w, w%metric, status)
       if (status /= MBD_OK) return
       w%rhs(1:n) = zero
-      w%rhs(n + 1:) = -w%s * w%phi(w%rows)
+      call gather_rows(w, w%phi, -w%s)
       call solve_aug(w, w%rhs, status)
       q = q + w%rhs(1:n)
     end do

@@ -12,7 +12,9 @@ allocation failures only the documented behaviour (``InsufficientMemoryError``, 
 from __future__ import annotations
 
 import json
+import os
 import re
+import shutil
 import subprocess
 import sys
 import textwrap
@@ -184,3 +186,50 @@ def test_banded_singular_report_agrees_with_the_dense_svd() -> None:
     d, b = got["dense"], got["banded"]
     assert abs(d[0] - b[0]) < 1e-9 and d[1] == b[1] == "motor" and d[2] == b[2]
     assert abs(b[3] / d[3] - 1) < 0.05, (d[3], b[3])
+
+
+MALLOC_COUNTER = r"""
+#define _GNU_SOURCE
+#include <dlfcn.h>
+#include <stdio.h>
+#include <stdlib.h>
+static long n_malloc = 0;
+static void *(*real_malloc)(size_t) = 0;
+void *malloc(size_t s) {
+  if (!real_malloc) real_malloc = (void *(*)(size_t)) dlsym(RTLD_NEXT, "malloc");
+  n_malloc++;
+  return real_malloc(s);
+}
+__attribute__((destructor)) static void report(void) {
+  fprintf(stderr, "MALLOC_COUNT %ld\n", n_malloc);
+}
+"""
+
+
+def test_the_kinematic_loop_allocates_nothing_per_step(tmp_path: Path) -> None:
+    """mbd2d-solve under a malloc counter (LD_PRELOAD): 10x the steps, the same number of
+    allocations, on the dense path (four-bar) and the band path (N-four-bar, 75 coordinates).
+    Before: one heap temporary per step or Newton iteration (an array expression passed as
+    an argument, an automatic array)."""
+    from test_standalone import find_solver
+    sys.path.insert(0, str(EX))
+    from nfourbar import build
+    cc = shutil.which("cc") or shutil.which("gcc")
+    assert cc, "the C compiler that built the package"
+    src = tmp_path / "count.c"
+    src.write_text(MALLOC_COUNTER)
+    lib = tmp_path / "count.so"
+    subprocess.run([cc, "-O2", "-shared", "-fPIC", str(src), "-o", str(lib), "-ldl"],
+                   check=True, capture_output=True)
+    solver = find_solver()
+    models = {"dense": mbd2d.load(EX / "fourbar_grashof.toml"), "banded": build(12)}
+    for path, model in models.items():
+        counts = []
+        for steps in (100, 1000):
+            f = tmp_path / f"{path}.mbd"
+            model.export(f, t_end=1.0, steps=steps)
+            r = subprocess.run([solver, str(f), str(tmp_path / "o.csv")], capture_output=True,
+                               text=True, timeout=60, env={**os.environ, "LD_PRELOAD": str(lib)})
+            assert r.returncode == 0, r.stderr
+            counts.append(int(r.stderr.split("MALLOC_COUNT")[-1]))
+        assert counts[0] == counts[1], (path, counts)
