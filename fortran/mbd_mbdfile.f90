@@ -85,6 +85,9 @@ contains
     if (.not. is_iostat_end(ios)) then
       call fail('cannot read the file (not a text file?)'); close (u); return
     end if
+    if (ndata == 0) then
+      call fail('the file is empty (or not a regular file)'); close (u); return
+    end if
     rewind (u)
     lineno = 0; nread = 0
     have_header = .false.; done = .false.; seen_b = .false.; seen_c = .false.
