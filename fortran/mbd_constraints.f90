@@ -20,7 +20,7 @@ module mbd_constraints
   use mbd_joint_distance, only: distance_prepare, distance_eval
   use mbd_joint_point_line, only: point_line_prepare, point_line_eval
   use mbd_joint_weld, only: weld_prepare, weld_eval
-  use mbd_joint_gear, only: gear_prepare, gear_eval
+  use mbd_joint_gear, only: gear_prepare, gear_eval, GEAR_RAW_LEN
   use mbd_joint_rolling, only: rolling_prepare, rolling_eval
   use mbd_drivers, only: driver_eval, DRV_ABS, DRV_REL_ANGLE, DRV_REL_DIST
   implicit none
@@ -100,7 +100,7 @@ contains
     case (CON_CAM); con_raw_length = cam_raw_length(suba, raw)
     case (CON_DISTANCE, CON_WELD); con_raw_length = 5
     case (CON_POINT_LINE); con_raw_length = 7
-    case (CON_GEAR); con_raw_length = 3
+    case (CON_GEAR); con_raw_length = GEAR_RAW_LEN
     case (CON_RACK, CON_ROLLING); con_raw_length = 8
     case (CON_ABSOLUTE); con_raw_length = 1
     case default; con_raw_length = fun_length(raw)

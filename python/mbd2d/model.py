@@ -12,6 +12,7 @@ or from TOML with :func:`mbd2d.load`, which calls the same methods.
 """
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING, Any, Mapping, Sequence
 
 import numpy as np
@@ -19,9 +20,9 @@ import numpy as np
 from .errors import ModelError
 from .forces import FORCE_KEYS, Force, PointForce, RotationalSpring, Spring, Torque
 from .functions import as_function
-from .joints import (COORDINATES, Absolute, AbsoluteDriver, Body, Cam, Constraint, Distance,
-                     Driver, Gear, PinInSlot, PointOnCurve, PointOnLine, RackPinion,
-                     RelativeAngleDriver, RelativeDistanceDriver, Revolute, RollingDisc,
+from .joints import (COORDINATES, PRESSURE_ANGLE, Absolute, AbsoluteDriver, Body, Cam,
+                     Constraint, Distance, Driver, Gear, PinInSlot, PointOnCurve, PointOnLine,
+                     RackPinion, RelativeAngleDriver, RelativeDistanceDriver, Revolute, RollingDisc,
                      Translational, Weld, joint_keys, parse_follower, parse_profile)
 from .validate import (GROUND, as_list, check_name, choice, nonzero_vector, number, only_keys,
                        pairs, positive, vector)
@@ -274,11 +275,18 @@ class Model:
 
     def add_gear(self, bodies: Sequence[str], radii: Sequence[float], internal: bool = False,
                  carrier: str = "ground", phase: float | None = None,
+                 pressure_angle: float = PRESSURE_ANGLE,
+                 centers: Sequence[Sequence[float]] | None = None,
                  name: str | None = None) -> Gear:
         """Gear pair whose centres are held by ``carrier`` (ground by default):
         R_i (theta_i - theta_c) + R_j (theta_j - theta_c) = phase (external), with a minus for
         an internal pair (bodies[1] is the ring). The phase defaults to its value at the q0
-        estimates."""
+        estimates. The reaction is the tooth force at the pitch point along the line of
+        action, ``pressure_angle`` (radians, default 20 degrees) from the common tangent; a
+        positive angle is the flank that separates the gears while the mesh turns gears[0]
+        clockwise (its multiplier positive), a negative one the other flank. ``centers``:
+        the gear centres in each gear's frame (default: the points of the revolutes that pin
+        the gears to the carrier, else the body origins)."""
         name, entry = self._start("gear", name)
         bb = self._two_bodies(bodies, entry)
         r = vector(radii, 2, "radii", entry)
@@ -295,7 +303,13 @@ class Model:
         if carrier in bb:
             raise ModelError(f"the carrier {carrier!r} cannot be one of the gears", entry)
         ph = None if phase is None else number(phase, "phase", entry)
-        return self._add(Gear(name, bb, (r[0], r[1]), internal, carrier, ph))  # type: ignore
+        pa = number(pressure_angle, "pressure_angle", entry)
+        if not abs(pa) < math.pi / 2:
+            raise ModelError(f"pressure_angle is in radians, between -pi/2 and pi/2 (20 "
+                             f"degrees = 0.349), got {pressure_angle!r}", entry)
+        cc = None if centers is None else pairs(centers, 2, "centers", entry)
+        return self._add(Gear(name, bb, (r[0], r[1]), internal, carrier, ph, pa,  # type: ignore
+                              cc))
 
     def add_rack_pinion(self, bodies: Sequence[str], center: Sequence[float],
                         point: Sequence[float], axis: Sequence[float], radius: float,

@@ -66,8 +66,10 @@ def pack(model: "Model") -> Packed:
     con_idx = {c.name: k + 1 for k, c in enumerate(cons)}
     cols: list[list[int]] = []
     rpar: list[float] = []
+    q0_by_name = {b.name: b.q0 for b in model.bodies}
+    q0_by_name["ground"] = (0.0, 0.0, 0.0)
     for c in cons:
-        params = c.raw()
+        params = c.raw_in(cons, q0_by_name)
         suba, subb = c.subkinds(body_idx.__getitem__, con_idx.__getitem__)
         cols.append([c.kind, body_idx[c.bodies[0]], body_idx[c.bodies[1]], suba, subb,
                      len(rpar) + 1, len(params), 0])
