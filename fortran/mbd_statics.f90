@@ -35,7 +35,7 @@ module mbd_statics
   integer, parameter :: MAXLS = 40           !! halvings of a line search
   real(wp), parameter :: ARMIJO = 1.0e-4_wp  !! sufficient decrease of V
   real(wp), parameter :: V_NOISE = 64 * eps  !! rounding error of V, relative to its terms
-  !> ||g|| / F above which no equilibrium was found
+  !> ||g|| / F above which no equilibrium was found (F: the largest load, Q or J^T lambda)
   real(wp), parameter :: RESID_FAIL = 1.0e-8_wp
   real(wp), parameter :: RANK_TOL = 1.0e-10_wp  !! singular values of J taken as zero
 
@@ -50,7 +50,7 @@ contains
     real(wp), intent(in) :: t                   !! time (drivers and loads are held here)
     real(wp), intent(out) :: lam(:)             !! multipliers (neq)
     integer, intent(out) :: stable              !! stability of the equilibrium
-    real(wp), intent(out) :: resid              !! final ||N^T Q||_inf
+    real(wp), intent(out) :: resid              !! final ||N^T Q||_inf / F (F: the loads)
     integer, intent(out) :: status              !! MBD_OK, MBD_NO_CONVERGENCE, MBD_LAPACK
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
     real(wp), allocatable :: nb(:, :), h(:, :), ev(:), g(:), dz(:), dqn(:), kt(:, :), &
@@ -123,11 +123,11 @@ contains
     if (nfree == 0) then
       stable = 2; resid = zero; return
     end if
-    resid = maxval(abs(g(1:nfree)))
-    if (.not. (resid <= RESID_FAIL * fscale)) then
+    resid = maxval(abs(g(1:nfree))) / fscale
+    if (.not. (resid <= RESID_FAIL)) then
       status = MBD_NO_CONVERGENCE
-      write (msg, '(a,es10.3,a,es10.3,a)') 'statics: no equilibrium found near the '// &
-        'estimates; unbalanced load ', resid, ' (loads of ', fscale, ')'
+      write (msg, '(a,es10.3,a)') 'statics: no equilibrium found near the estimates; the '// &
+        'unbalanced load is ', resid, ' times the loads'
       return
     end if
     call eigen(h(1:nfree, 1:nfree), ev(1:nfree), .false., stp)

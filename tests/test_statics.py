@@ -179,7 +179,7 @@ def test_equilibrium_to_round_off_from_every_start(y0: float) -> None:
         assert st.stability == "stable"
         assert abs(th - root) <= 1e-13, (th0, th - root)
         assert abs(bar_moment(th)) <= 1e-12                  # N m, independent residual
-        assert st.residual <= 1e-13 * BAR_M * G               # the core's ||N^T Q||
+        assert st.residual <= 1e-14          # the core's ||N^T Q|| relative to the loads
         h = BAR_L / 2
         assert_allclose([x, y], [h * math.cos(root), y0 + h * math.sin(root)], atol=1e-12,
                         rtol=0)
@@ -221,10 +221,11 @@ def slider_crank_load(th: float, torque: float = 2.0) -> float:
     return torque + 50.0 * (4.5 - x) * dx - G * c
 
 
-@pytest.mark.parametrize("y0", [0.0, 1000.0])
-def test_slider_crank_equilibrium_against_reduced_coordinates(y0: float) -> None:
+@pytest.mark.parametrize("y0, tol", [(0.0, 1e-13), (1000.0, 4e-13)])
+def test_slider_crank_equilibrium_against_reduced_coordinates(y0: float, tol: float) -> None:
     """Three bodies, five joint equations: every start reaches an equilibrium of the reduced
-    equation dV/dtheta = 0 (solved here by bisection) to 1e-13 rad."""
+    equation dV/dtheta = 0 (solved here by bisection) to 1e-13 rad. Lifted to y0 = 1000 m
+    the positions round to 1.1e-13 m, and the crank angle (1 m crank) follows them: 4e-13."""
     grid = np.linspace(-math.pi, math.pi, 721)
     vals = [slider_crank_load(float(a)) for a in grid]
     roots = [bisect(slider_crank_load, float(grid[i]), float(grid[i + 1]))
@@ -237,9 +238,9 @@ def test_slider_crank_equilibrium_against_reduced_coordinates(y0: float) -> None
         th = st.body("crank")[2]
         wrapped = math.remainder(th, 2 * math.pi)
         err = min(abs(wrapped - r) for r in stable)
-        assert err <= 1e-13, (th0, err)
+        assert err <= tol, (th0, err)
         assert st.stability == "stable"
         assert abs(slider_crank_load(wrapped)) <= 1e-11
         s, c = math.sin(th), math.cos(th)
         assert_allclose(st.body("slider")[0], c + math.sqrt(9.0 - (s - 0.5)**2), atol=1e-12)
-        assert st.residual <= 1e-13 * 50.0
+        assert st.residual <= 1e-14

@@ -212,7 +212,8 @@ class DynamicsResult(KinematicsResult):
 
 @dataclass
 class StaticsResult:
-    """A static equilibrium: configuration, multipliers, reactions and stability."""
+    """A static equilibrium: configuration, multipliers, reactions and stability;
+    ``residual`` is the unbalanced load ||N^T Q||_inf relative to the largest load."""
 
     t: float
     q: np.ndarray
