@@ -176,3 +176,21 @@ def test_inverse_dynamics_in_any_unit() -> None:
         fb, fr = res.reaction("B"), ref.reaction("B")
         assert_allclose(fb.fx_j * s, fr.fx_j, rtol=0, atol=1e-9 * np.abs(fr.fx_j).max())
         assert_allclose(fb.mz_j, fr.mz_j, rtol=0, atol=1e-9 * np.abs(fr.mz_j).max())
+
+
+@pytest.mark.parametrize("s", [1e-9, 1e6])
+def test_stepper_and_dof_report_in_any_unit(s: float) -> None:
+    """The step-by-step front door and the degrees-of-freedom report convert too."""
+    m = fourbar(s)
+    stepper = mbd2d.KinematicStepper(m)
+    for t in np.linspace(0.02, 0.2, 10):
+        q, qd, qdd = stepper.step(float(t))
+    names = m.coordinate_names
+    th2 = q[names.index("crank.theta")]
+    coupler, rocker = fourbar_angles(np.array([th2]))
+    assert abs(th2 - W * 0.2) < 1e-12
+    assert abs(wrap(q[names.index("rocker.theta")] - rocker[0])) < 1e-11
+    assert abs(q[names.index("coupler.x")] / s - (math.cos(th2) + 1.75 * math.cos(coupler[0]))) \
+        < 1e-11
+    rep = m.analyze_dof()
+    assert rep.dof == 0 and rep.rank == 9
