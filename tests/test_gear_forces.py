@@ -199,3 +199,34 @@ def test_planet_carrier_pivot_force() -> None:
     contact = 1.5 * e
     assert_allclose(r.mz_j, cross(contact, f), rtol=0, atol=1e-9)
     assert_allclose(res.body("planet").theta, -2.0 * psi, atol=1e-12)
+
+
+def test_explicit_centers_and_coincident_centres() -> None:
+    """`centers` given by hand (here the wheel's pivot off its body origin, and no pivot to
+    read it from: a point-on-line pair instead of a revolute) gives the same tooth force as the
+    pivots would; centres that coincide are a ModelError naming the gear."""
+    def pair(centers: list | None, pin: bool) -> mbd2d.Model:
+        m = mbd2d.Model("pair", gravity=(0.0, 0.0))
+        m.add_body("pinion", (0.0, 0.0, 0.0), mass=M1, inertia=I1)
+        m.add_body("wheel", (R1 + R2 + 0.3, 0.0, 0.0), mass=M2, inertia=I2)
+        m.add_revolute(["ground", "pinion"], [[0.0, 0.0], [0.0, 0.0]], name="O1")
+        if pin:
+            m.add_revolute(["ground", "wheel"], [[R1 + R2, 0.0], [-0.3, 0.0]], name="O2")
+        else:       # the same pin as two point-on-line equations
+            m.add_point_on_line(["ground", "wheel"], [[R1 + R2, 0.0], [-0.3, 0.0]], [1.0, 0.0],
+                                name="O2x")
+            m.add_point_on_line(["ground", "wheel"], [[R1 + R2, 0.0], [-0.3, 0.0]], [0.0, 1.0],
+                                name="O2y")
+        m.add_gear(["pinion", "wheel"], [R1, R2], centers=centers, name="mesh")
+        m.add_driver("absolute", body="pinion", coordinate="theta", f={"poly": [0.0, 0.0, 1.0]},
+                     name="motor")
+        return m
+    ref = pair(None, True).inverse_dynamics(1.0, 4).reaction("mesh")
+    res = pair([[0.0, 0.0], [-0.3, 0.0]], False).inverse_dynamics(1.0, 4).reaction("mesh")
+    fy = (I2 + M2 * 0.3**2) * R1 * 2.0 / R2**2        # the wheel turns about its pivot
+    assert_allclose(ref.fy_j, fy, atol=1e-10)
+    assert_allclose(res.fx_j, ref.fx_j, atol=1e-10)
+    assert_allclose(res.fy_j, ref.fy_j, atol=1e-10)
+    with pytest.raises(mbd2d.ModelError, match="centres coincide") as info:
+        pair([[0.0, 0.0], [-(R1 + R2 + 0.3), 0.0]], False).inverse_dynamics(1.0, 4)
+    assert "mesh" in info.value.entry
