@@ -82,10 +82,10 @@ contains
   !> a(:, k) = a(:, k) * u for every column (model units from the core's: u = cunit), or
   !! with divide, a(:, k) / u (multipliers: u = rowunit). Nothing to do when L = 1.
   subroutine units(m, a, u, divide)
-    type(model_t), intent(in) :: m
-    real(wp), intent(inout) :: a(:, :)
-    real(wp), intent(in) :: u(:)
-    logical, intent(in) :: divide
+    type(model_t), intent(in) :: m              !! model (its length unit lref)
+    real(wp), intent(inout) :: a(:, :)          !! columns to convert
+    real(wp), intent(in) :: u(:)                !! unit of each row (cunit or rowunit)
+    logical, intent(in) :: divide               !! divide by u instead of multiplying
     integer :: k
     if (.not. (m%lref > one .or. m%lref < one)) return
     do k = 1, size(a, 2)
@@ -99,9 +99,9 @@ contains
 
   !> The residual rep%resid in model units (that of the worst constraint's first row).
   pure real(wp) function resid_units(m, resid, worst)
-    type(model_t), intent(in) :: m
-    real(wp), intent(in) :: resid
-    integer, intent(in) :: worst
+    type(model_t), intent(in) :: m              !! model
+    real(wp), intent(in) :: resid               !! residual in the core's units
+    integer, intent(in) :: worst                !! constraint it belongs to (0: unknown)
     resid_units = resid * m%lref
     if (worst > 0 .and. worst <= m%nc) resid_units = resid * m%rowunit(m%row0(worst))
   end function resid_units

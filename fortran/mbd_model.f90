@@ -27,7 +27,7 @@
 !! con_exponents and force_exponents), gravity divided by L; angles, inertias, torques,
 !! times and energies are unchanged. Back in model units: q = q' cunit, and lambda =
 !! lambda' / rowunit (rowunit = L**power of each row's Phi). Powers of 2 make every
-!! conversion exact. L must lie in [LSCALE_MIN, LSCALE_MAX].
+!! conversion exact. The largest length must lie in [LSCALE_MIN, LSCALE_MAX].
 module mbd_model
   use mbd_kinds, only: wp, one
   use mbd_status, only: MBD_OK, MBD_BAD_INPUT, MBD_BAD_BODY, MBD_BAD_PARAM, MSG_LEN
@@ -292,8 +292,9 @@ contains
       rs = rw * m%lref**e
     end function scaled
 
-    !> L: the power of 2 nearest the largest geometry entry of the well-formed constraints
-    !! (1 when there is none); outside [LSCALE_MIN, LSCALE_MAX] a bad parameter.
+    !> L: the largest geometry entry of the well-formed constraints (and of the forces),
+    !! rounded down to a power of 2 (1 when there is none); a largest entry outside
+    !! [LSCALE_MIN, LSCALE_MAX] is a bad parameter (bad: the constraint that holds it).
     subroutine choose_lref(st)
       integer, intent(out) :: st
       real(wp) :: big
@@ -327,8 +328,8 @@ contains
       if (big < LSCALE_MIN .or. big > LSCALE_MAX) then
         st = MBD_BAD_PARAM; bad = kbig
         write (msg, '(a,es9.2,a,es8.1,a,es8.1,a)') 'the model''s length scale (its largest '// &
-          'joint point, size or position, here) is ', big, '; mbd2d works with length '// &
-          'scales from ', LSCALE_MIN, ' to ', LSCALE_MAX, ': change the unit of length'
+          'joint point, size or position) is ', big, '; mbd2d works with length scales '// &
+          'from ', LSCALE_MIN, ' to ', LSCALE_MAX, ': change the unit of length'
         return
       end if
       m%lref = 2.0_wp**(exponent(big) - 1)     ! L <= big < 2 L
@@ -383,11 +384,20 @@ contains
       end if
       m%mdiag(3 * k - 2:3 * k - 1) = bmass(1, k) * m%lref**2
       m%mdiag(3 * k) = bmass(2, k)
+      if (.not. ieee_is_finite(m%mdiag(3 * k - 2))) then
+        status = MBD_BAD_PARAM
+        write (msg, '(a,i0,a)') 'the mass of body ', k, ' is too large for the model''s '// &
+          'length scale'
+        return
+      end if
     end do
     if (.not. all(ieee_is_finite(grav))) then
       status = MBD_BAD_PARAM; msg = 'gravity must be finite'; return
     end if
     m%grav = grav / m%lref
+    if (.not. all(ieee_is_finite(m%grav))) then
+      status = MBD_BAD_PARAM; msg = 'gravity is too large for the model''s length scale'; return
+    end if
     nf = size(ftab, 2)
     m%nf = nf
     allocate (m%fkind(nf), m%fbi(nf), m%fbj(nf), m%floc(NLOC, nf), m%fpo(nf), m%fpn(nf))
@@ -424,6 +434,10 @@ contains
         status = MBD_BAD_INPUT; msg = 'not enough memory for the force tables'; return
       end if
       call force_exponents(kind, fpar(off:off + len - 1), ex)
+      if (.not. all(ieee_is_finite(fpar(off:off + len - 1) * m%lref**ex))) then
+        status = MBD_BAD_PARAM
+        msg = 'a force parameter is too large for the model''s length scale'; return
+      end if
       call force_prepare(kind, fpar(off:off + len - 1) * m%lref**ex, prep, status, sub)
       deallocate (ex)
       if (status /= MBD_OK) then

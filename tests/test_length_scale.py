@@ -194,3 +194,13 @@ def test_stepper_and_dof_report_in_any_unit(s: float) -> None:
         < 1e-11
     rep = m.analyze_dof()
     assert rep.dof == 0 and rep.rank == 9
+
+
+def test_mass_that_overflows_in_the_core_units_is_a_model_error() -> None:
+    """Masses are multiplied by L^2 in the core: 1e290 kg on a 1e10 m bar would overflow, and is
+    refused with a ModelError rather than ending in inf or NaN."""
+    s = 1e10
+    m = spring_pendulum(s, 0.3)
+    m.bodies[0].mass = 1e290
+    with pytest.raises(mbd2d.ModelError, match="too large for the model's length scale"):
+        m.dynamics(1.0, 10)
