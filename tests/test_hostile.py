@@ -605,16 +605,14 @@ ALL_KEYS = sorted({k for a, _ in joint_keys().values() for k in a}
 # checks (run in the worker)
 # ------------------------------------------------------------------------------------------
 ALLOWED_WARNINGS = (mbd2d.RedundantConstraintWarning, mbd2d.SingularPassageWarning)
-AUTO_NAME = re.compile(r"(revolute|translational|cam|point_on_curve|distance|point_on_line|"
-                       r"revolute_translational|weld|gear|rack_pinion|rolling_disc|absolute|"
-                       r"driver|spring|torque|point|rotational_spring)\d+")
+AUTO_NAME = re.compile(r"(joint|driver|force)\d+")
 FIXED_ENTRIES = {"[model]", "model", "analysis", "state", "<dict>", "<string>"}
 
 
 def assert_names_entry(err: BaseException, names: set[str], bounds: dict[str, int]) -> None:
     """A ModelError whose message starts with the entry it names, and that entry exists:
     a section entry "[[joint]] #k" with k within the input, "joint 'NAME' (type)" with a
-    NAME from the input (or a generated one such as 'revolute3'), "driver #k", "[model]",
+    NAME from the input (or a generated one such as 'joint3'), "driver #k", "[model]",
     "model 'NAME'", the file or string source, "analysis" or "state"."""
     assert isinstance(err, mbd2d.ModelError) and isinstance(err, ValueError), repr(err)
     msg, entry = str(err), err.entry
