@@ -12,6 +12,7 @@ from typing import Any, Protocol, Sequence
 import numpy as np
 
 from ..binding import core
+from ..binding.status import error_for
 from ..description.joints import PROFILE_KINDS, Cam, Revolute, Translational
 from ..validate import GROUND
 
@@ -77,8 +78,8 @@ def profile_points(cam: Cam, alphas: np.ndarray) -> np.ndarray:
     a = np.ascontiguousarray(alphas, dtype=np.float64)
     out = core.profile(PROFILE_KINDS[cam.profile_kind], raw, a)
     if out.status != 0:
-        raise ValueError(f"cam '{cam.name}': the core could not evaluate its profile: "
-                         f"{out.msg}")
+        raise error_for("profile", out.status, f"the core could not evaluate its profile: "
+                        f"{out.msg}", entry=cam.describe())
     return np.asarray(out.pts).T
 
 
