@@ -9,8 +9,8 @@ front door goes through it.
 * Real failures that used to reach the wrong class: statics and dynamics on contradicting
   redundant constraints (before: CoreError "internal error ... a bug" and ConvergenceError),
   KinematicStepper.step("x") (before: a bare ValueError), step(1e300) (before: q with +-inf,
-  q_dot NaN, no error), kinematics(steps=10**9) (before: a 7.45 GiB index array allocated before the memory
-  check: MemoryError from NumPy, or the memory used).
+  q_dot NaN, no error), kinematics(steps=10**9) (before: a 7.45 GiB index array allocated
+  before the memory check: MemoryError from NumPy, or the memory used).
 """
 from __future__ import annotations
 
@@ -302,3 +302,45 @@ def test_a_billion_steps_are_refused_before_anything_big_is_allocated(tmp_path):
                          "inverse_dynamics InsufficientMemoryError",
                          "dynamics InsufficientMemoryError"], out.stdout
     assert int(lines[3].split()[1]) < 10 * 2**20        # peak traced memory under 10 MB
+
+
+# ----------------------------------------------------------------------------- arguments
+def _fourbar() -> mbd2d.Model:
+    return mbd2d.load(EXAMPLES / "fourbar_grashof.toml")
+
+
+BAD_CALLS = {   # before: TypeError, AttributeError, IsADirectoryError, FileNotFoundError,
+    # ValueError from list.index or float(), or a model named "[1]"
+    "load(123)": lambda tmp: mbd2d.load(123),
+    "loads(bytes)": lambda tmp: mbd2d.loads(b"[model]"),
+    "loads(None)": lambda tmp: mbd2d.loads(None),
+    "Model(name=[1])": lambda tmp: mbd2d.Model(name=[1]),
+    "KinematicStepper('x')": lambda tmp: mbd2d.KinematicStepper("x"),
+    "export into a directory": lambda tmp: _fourbar().export(tmp, t_end=1.0, steps=10),
+    "save into a missing directory": lambda tmp: _fourbar().kinematics(1.0, 10).save(
+        tmp / "missing" / "out.csv"),
+    "to_npz into a missing directory": lambda tmp: _fourbar().kinematics(1.0, 10).to_npz(
+        tmp / "missing" / "out.npz"),
+    "point with s = 'ab'": lambda tmp: _fourbar().kinematics(1.0, 10).point("crank", "ab"),
+    "plot_mechanism(times=['a'])": lambda tmp: __import__(
+        "mbd2d.plots", fromlist=["plot_mechanism"]).plot_mechanism(
+            _fourbar().kinematics(1.0, 10), times=["a"]),
+}
+
+
+@pytest.mark.parametrize("what", sorted(BAD_CALLS))
+def test_public_calls_check_their_arguments(what, tmp_path):
+    with pytest.raises(ModelError) as err:
+        BAD_CALLS[what](tmp_path)
+    assert err.value.entry and str(err.value).strip()
+
+
+def test_unknown_names_in_results_are_key_errors():
+    model = massive_fourbar()
+    res = model.inverse_dynamics(t_end=0.1, steps=2)
+    st = model.statics()
+    for call in (lambda: res.multiplier("nope.x"), lambda: res.reaction("nope"),
+                 lambda: res.effort("O2"), lambda: st.multiplier("nope.x"),
+                 lambda: st.body("nope"), lambda: res.body("nope")):
+        with pytest.raises(KeyError, match="nope|no driver"):
+            call()

@@ -56,5 +56,5 @@ def run_inverse(model: ModelDescription, t_end: float, steps: int, t0: float = 0
                         results=res)
     if status < 0 and iinfo[1] <= BAD_FORCE:
         raise error_for("inverse", status, out.msg, entry=bad_entry(model, int(iinfo[1])))
-    raise kinematic_failure("inverse", model, p, status, out.msg, iinfo, out.rinfo, out.qsing, out.dep,
-                            out.red, res)
+    raise kinematic_failure("inverse", model, p, status, out.msg, iinfo, out.rinfo, out.qsing,
+                            out.dep, out.red, res)

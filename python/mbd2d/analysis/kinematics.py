@@ -70,5 +70,5 @@ def run_kinematics(model: ModelDescription, t_end: float, steps: int, t0: float 
                         f"the run gave non-finite values at t = {t[bad]:.6g} s; results up to "
                         f"there ({bad} rows) are kept in the exception's .results", t=t[bad],
                         results=res)
-    raise kinematic_failure("kinematics", model, p, status, out.msg, iinfo, rinfo, out.qsing, out.dep,
-                            out.red, res)
+    raise kinematic_failure("kinematics", model, p, status, out.msg, iinfo, rinfo, out.qsing,
+                            out.dep, out.red, res)

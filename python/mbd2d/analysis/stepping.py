@@ -48,6 +48,9 @@ class KinematicStepper:
     """
 
     def __init__(self, model: ModelDescription, t0: float = 0.0, tol: float | None = None) -> None:
+        if not isinstance(model, ModelDescription):
+            raise ModelError(f"KinematicStepper needs a Model, got {type(model).__name__}",
+                             "stepping")
         self._p = pack(model)
         require_determined(self._p, model)
         if self._p.neq != self._p.nq:

@@ -49,7 +49,9 @@ class ModelDescription:
     """
 
     def __init__(self, name: str = "model", gravity: Sequence[float] = (0.0, -9.81)) -> None:
-        self.name = str(name)
+        if not isinstance(name, str):
+            raise ModelError(f"name must be a string, got {name!r}", "[model]")
+        self.name = name
         self.gravity = vector(gravity, 2, "gravity", "[model]")
         self.bodies: list[Body] = []
         self.joints: list[Constraint] = []
