@@ -7,6 +7,7 @@ import numpy as np
 from ..description.builder import ModelDescription
 from ..errors import ModelError
 from . import core
+from .status import error_for
 from .tables import NCT, NFT, DynamicTables, Packed, decode
 
 
@@ -46,7 +47,7 @@ def pack(model: ModelDescription) -> Packed:
     nq, neq, bad = int(out.nq), int(out.neq), int(out.bad)
     if out.status != 0:
         entry = cons[bad - 1].describe() if bad > 0 else "model"
-        raise ModelError(out.msg, entry)
+        raise error_for("sizes", out.status, out.msg, entry=entry)
     q0 = np.zeros(nq)
     q0[:3 * len(model.bodies)] = np.array([b.q0 for b in model.bodies], dtype=float).ravel()
     rows = [0]

@@ -21,6 +21,23 @@ PRESSURE_ANGLE = math.radians(20.0)   #: default gear pressure angle (radians)
 
 BodyIndex = Callable[[str], int]
 
+#: The words that end row labels (``NAME.WORD``), each with one meaning for every joint and
+#: driver that uses it. A row's multiplier is the reaction along what the word names.
+ROW_WORDS = {
+    "x": "global x: two points coincide (revolute, weld, point or roller cam, point-on-curve), "
+         "or a body's x is fixed or driven",
+    "y": "global y, likewise",
+    "theta": "a body's absolute angle is fixed or driven",
+    "angle": "a relative angle theta_j - theta_i (translational, weld, relative-angle driver)",
+    "normal": "a point's distance from a line or face along its normal (translational, "
+              "point-on-line, revolute-translational, flat-faced cam, rolling disc)",
+    "tangent": "a flat follower's face lies along the cam profile's tangent",
+    "distance": "the distance between two points",
+    "mesh": "the pitch circles of a gear pair roll on each other",
+    "no_slip": "a pinion or disc rolls along its line without slip",
+    "slide": "the slide along a translational joint (relative-distance driver)",
+}
+
 
 @dataclass
 class Constraint:
@@ -46,7 +63,7 @@ class Constraint:
         return f"joint '{self.name}' ({self.type})"
 
     def rows(self) -> list[str]:
-        """A label per equation: NAME.equation."""
+        """A label per equation: NAME.WORD, the word from :data:`ROW_WORDS`."""
         return [f"{self.name}.{label}" for label in self.labels]
 
     def raw(self) -> list[float]:
@@ -109,7 +126,7 @@ class Cam(Constraint):
 
     @property
     def labels(self) -> tuple[str, ...]:  # type: ignore[override]
-        return ("on_face", "tangent") if self.follower_kind == "flat" else ("x", "y")
+        return ("normal", "tangent") if self.follower_kind == "flat" else ("x", "y")
 
     def raw(self) -> list[float]:
         return [*self.follower, *self.profile]
@@ -136,7 +153,7 @@ class Distance(Constraint):
     distance: float = 1.0
     type: ClassVar[str] = "distance"
     kind: ClassVar[int] = 4
-    labels: ClassVar[tuple[str, ...]] = ("length",)
+    labels: ClassVar[tuple[str, ...]] = ("distance",)
 
     def raw(self) -> list[float]:
         return [*self.points[0], *self.points[1], self.distance]
@@ -264,7 +281,7 @@ class RollingDisc(RackPinion):
 
     type: ClassVar[str] = "rolling-disc"
     kind: ClassVar[int] = 9
-    labels: ClassVar[tuple[str, ...]] = ("no_slip", "contact")
+    labels: ClassVar[tuple[str, ...]] = ("no_slip", "normal")
 
 
 @dataclass
