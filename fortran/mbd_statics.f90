@@ -1,17 +1,30 @@
 !> mbd_statics: static equilibrium under gravity, springs and applied loads.
 !!
-!! An equilibrium is a stationary point of the total potential V(q) (gravity, springs, and
-!! the loads frozen at time t) on the constraint manifold Phi(q, t) = 0:
-!!   J^T lambda = Q(q, 0, t),  Phi(q, t) = 0.
-!! The search is a saddle-free Newton method on the manifold: with N an orthonormal basis of
-!! the null space of J (SVD) and K = d(J^T lambda - Q)/dq (central differences), the reduced
-!! Hessian H = N^T K N has its eigenvalues replaced by their absolute values (bounded away
-!! from zero), the step N dz with H dz = N^T Q is projected back onto Phi = 0, and a
-!! backtracking line search keeps V decreasing. So it converges to a stable equilibrium from
-!! any start on the manifold; the signs of the eigenvalues of H there give the stability.
+!! An equilibrium solves the equilibrium equations on the constraint manifold
+!!   Q(q, 0, t) - J^T lambda = 0,   Phi(q, t) = 0,
+!! i.e. the reduced load g = N^T Q vanishes (N an orthonormal basis of the null space of J,
+!! by SVD; N^T J^T = 0, so lambda drops out). Convergence is decided on g and Phi, never on
+!! the potential V(q) (gravity, springs, the loads frozen at t): near an equilibrium V changes
+!! by less than its own rounding error (about eps |V|, which grows with any constant added
+!! to V), while g keeps resolving the equilibrium to round-off.
+!! Each step is a Newton step of the equilibrium equations (Haug ch. 6; Nocedal and Wright
+!! ch. 18, the null-space method): with K = d(J^T lambda - Q)/dq (central differences,
+!! lambda the least-squares multipliers) and H = N^T K_sym N the reduced stiffness,
+!!   dq = dq_n + N dz,  dq_n = -J^+ Phi (minimum-norm),  H dz = g - N^T K dq_n.
+!! Globalisation (saddle-free): far from an equilibrium H's eigenvalues are replaced by their
+!! absolute values (bounded away from zero), the step is projected onto Phi = 0 and a
+!! backtracking line search keeps V decreasing, so the search goes downhill to a stable
+!! equilibrium from any start. Once the decrease of V a full step predicts, g^T dz, is within
+!! 100 times V's rounding error (V can no longer judge a step), full Newton steps follow while
+!! they reduce the residual of the equilibrium equations, ||g|| / F + ||Phi|| / l (F the
+!! force scale, l the model's length scale), and stop where it no longer halves: round-off.
+!! The signs of the eigenvalues of H at the end give the stability.
+!! Memory: the dense work arrays (five n x n) are checked and allocated once per call, with
+!! MBD_NO_MEMORY when they cannot be had; the iterations allocate nothing.
 module mbd_statics
-  use mbd_kinds, only: wp, zero, one, half
-  use mbd_status, only: MBD_OK, MBD_NO_CONVERGENCE, MBD_SINGULAR, MBD_NO_MEMORY, MSG_LEN
+  use mbd_kinds, only: wp, zero, one, half, eps
+  use mbd_status, only: MBD_OK, MBD_NO_CONVERGENCE, MBD_LAPACK, MSG_LEN
+  use mbd_memory, only: REAL_BYTES, mem_check, mem_fail
   use mbd_model, only: model_t
   use mbd_assemble, only: assemble_dense
   use mbd_lapack, only: dgesvd, dsyev
@@ -20,6 +33,16 @@ module mbd_statics
   implicit none
   private
   public :: statics_solve
+
+  integer, parameter :: MAXIT = 200          !! steps in all
+  integer, parameter :: MAXLS = 40           !! halvings of a line search
+  real(wp), parameter :: ARMIJO = 1.0e-4_wp  !! sufficient decrease of V
+  real(wp), parameter :: V_NOISE = 64 * eps  !! rounding error of V, relative to its terms
+  !> ||g|| / F above which no equilibrium was found (F: the largest load, Q or J^T lambda)
+  real(wp), parameter :: RESID_FAIL = 1.0e-8_wp
+  real(wp), parameter :: RANK_TOL = 1.0e-10_wp  !! singular values of J taken as zero
+  character(len=*), parameter :: HINT = 'statics solves with dense matrices of the size of ' &
+    // 'J: use a model with fewer coordinates'
 
 contains
 
@@ -32,94 +55,228 @@ contains
     real(wp), intent(in) :: t                   !! time (drivers and loads are held here)
     real(wp), intent(out) :: lam(:)             !! multipliers (neq)
     integer, intent(out) :: stable              !! stability of the equilibrium
-    real(wp), intent(out) :: resid              !! final ||N^T Q||
-    integer, intent(out) :: status              !! MBD_OK, MBD_NO_CONVERGENCE, MBD_SINGULAR
+    real(wp), intent(out) :: resid              !! final ||N^T Q||_inf / F (F: the loads)
+    integer, intent(out) :: status  !! MBD_OK, MBD_NO_CONVERGENCE, MBD_LAPACK, MBD_NO_MEMORY
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
-    real(wp), allocatable :: nb(:, :), h(:, :), ev(:), g(:), dz(:)
-    real(wp) :: kt(m%nq, m%nq), ct(m%nq, m%nq), qt(m%nq), v0, vt, alpha, gscale, emax
-    integer :: it, ls, nfree, i, stp
-    character(len=MSG_LEN) :: lmsg
-    logical :: nomem                          ! an allocation in null_space or eigen failed
+    ! work arrays, allocated once: h holds H, then its eigenvectors; r, c, dqz and qt are
+    ! vectors of the steps; work is LAPACK's workspace (grown when a query asks for more)
+    real(wp), allocatable :: nb(:, :), h(:, :), ev(:), g(:), dz(:), dqn(:), kt(:, :), &
+                             ct(:, :), qt(:), ja(:, :), sv(:), u(:, :), vt(:, :), work(:), &
+                             r(:), c(:), dqz(:)
+    real(wp) :: v0, vt1, alpha, emax, fscale, vnoise, e0, e1, gn, pn, slope, bytes
+    integer :: it, ls, nfree, n, na, stp, ist, nu
+    logical :: local
+    character(len=MSG_LEN) :: lmsg, what
     status = MBD_OK; msg = ''; stable = 2; resid = zero
-    nomem = .false.
-    gscale = max(one, maxval(abs(m%mdiag)) * max(one, norm2(m%grav)))
+    n = m%nq; na = w%na; nu = min(na, n)
+    bytes = REAL_BYTES * (5 * real(n, wp)**2 + real(max(na, 1), wp) * (n + max(nu, 1)) &
+                          + 10 * real(n, wp) + max(nu, 1))
+    write (what, '(a,i0,a)') 'the statics work arrays (', n, ' coordinates, dense)'
+    call mem_check(bytes, trim(what), HINT, status, msg)
+    if (status /= MBD_OK) return
+    allocate (nb(n, n), h(n, n), kt(n, n), ct(n, n), vt(n, n), stat=ist)
+    if (ist == 0) allocate (ev(n), g(n), dz(n), dqn(n), qt(n), r(n), c(n), dqz(n), stat=ist)
+    if (ist == 0) allocate (ja(max(na, 1), n), sv(max(nu, 1)), u(max(na, 1), max(nu, 1)), &
+                            work(1), stat=ist)
+    if (ist /= 0) then
+      call mem_fail(bytes, trim(what), HINT, status, msg)
+      return
+    end if
     call dyn_project_pos(m, w, q, t, status)
     if (status /= MBD_OK) then
       msg = 'statics: the constraints cannot be satisfied near the estimates'; return
     end if
-    do it = 1, 200
-      call null_space(nb, nfree)
-      if (nomem) exit
-      if (nfree == 0) exit                   ! nothing can move: q is the equilibrium
-      v0 = potential(q)
-      g = matmul(transpose(nb), w%force)     ! reduced load N^T Q (= -reduced gradient of V)
-      resid = maxval(abs(g))
-      if (resid <= 1.0e-11_wp * gscale) exit
-      call dyn_multipliers(m, w, q, w%qz, w%qz, t, lam, stp, lmsg)
-      call dyn_tangent(m, w, q, w%qz, t, lam, kt, ct)
-      h = matmul(transpose(nb), matmul(half * (kt + transpose(kt)), nb))
-      call eigen(h, ev, .true.)
-      if (nomem) exit
-      ! saddle-free: |eigenvalues|, bounded below (a flat direction gets a gradient step
-      ! of about the model's length scale)
-      emax = max(1.0e-8_wp * maxval(abs(ev)), norm2(g) / m%lscale)
-      dz = matmul(transpose(h), g)
-      do i = 1, nfree
-        dz(i) = dz(i) / max(abs(ev(i)), emax)
-      end do
-      dz = matmul(h, dz)
-      alpha = one
-      do ls = 1, 40
-        qt = q + alpha * matmul(nb, dz)
-        call dyn_project_pos(m, w, qt, t, stp)
-        if (stp == MBD_OK) then
-          vt = potential(qt)
-          if (vt < v0 - 1.0e-4_wp * alpha * dot_product(g, dz) .or. &
-              vt <= v0 + 1.0e-14_wp * abs(v0) .and. ls > 30) exit
+    local = .false.
+    e0 = huge(one)
+    do it = 1, MAXIT
+      call reduce(q, status)                  ! N, g, lam, dq_n, H at q
+      if (status /= MBD_OK) return
+      if (nfree == 0) exit                    ! nothing can move: q is the equilibrium
+      gn = maxval(abs(g(1:nfree)))
+      if (.not. (gn > zero .or. maxval(abs(dqn)) > zero)) exit   ! exactly balanced
+      call newton_step(status)
+      if (status /= MBD_OK) return
+      call null_mul(dz, dqz)                   ! the step in q: N dz
+      if (.not. local) then
+        ! V can judge a step only while the decrease it predicts exceeds its rounding
+        slope = dot_product(g(1:nfree), dz(1:nfree))
+        if (slope <= 100 * vnoise) then
+          local = .true.
+        else
+          alpha = one
+          do ls = 1, MAXLS
+            qt = q + alpha * dqz
+            call dyn_project_pos(m, w, qt, t, stp)
+            if (stp == MBD_OK) then
+              vt1 = potential(qt)
+              if (vt1 < v0 - ARMIJO * alpha * slope) exit
+            end if
+            alpha = half * alpha
+          end do
+          if (ls > MAXLS) then
+            local = .true.                    ! no decrease V can resolve: polish by Newton
+          else
+            q = qt
+          end if
+          cycle
         end if
-        alpha = half * alpha
-      end do
-      if (ls > 40) exit
+      end if
+      ! local Newton on the equilibrium equations: full steps while the residual falls
+      e0 = merit(gn, pn)
+      qt = q + dqn + dqz
+      call reduce(qt, status)
+      if (status /= MBD_OK) return
+      if (nfree == 0) then
+        q = qt; exit
+      end if
+      e1 = merit(maxval(abs(g(1:nfree))), pn)
+      if (.not. (e1 < e0)) exit                ! no progress: round-off reached (q kept)
       q = qt
+      if (e1 > half * e0) exit                 ! progress stalls: round-off reached
     end do
-    if (.not. nomem) call null_space(nb, nfree)
-    if (nomem) then
-      status = MBD_NO_MEMORY
-      msg = 'not enough memory for the statics (null space and reduced stiffness, dense): '// &
-            'use a model with fewer coordinates'
-      return
-    end if
-    call dyn_multipliers(m, w, q, w%qz, w%qz, t, lam, stp, lmsg)
+    call reduce(q, status)
+    if (status /= MBD_OK) return
     if (nfree == 0) then
       stable = 2; resid = zero; return
     end if
-    g = matmul(transpose(nb), w%force)
-    resid = maxval(abs(g))
-    if (resid > 1.0e-8_wp * gscale) then
+    resid = maxval(abs(g(1:nfree))) / fscale
+    if (.not. (resid <= RESID_FAIL)) then
       status = MBD_NO_CONVERGENCE
-      write (msg, '(a,es10.3)') 'statics: no equilibrium found near the estimates; '// &
-        'unbalanced load ', resid
+      write (msg, '(a,es10.3,a)') 'statics: no equilibrium found near the estimates; the '// &
+        'unbalanced load is ', resid, ' times the loads'
       return
     end if
-    call dyn_tangent(m, w, q, w%qz, t, lam, kt, ct)
-    h = matmul(transpose(nb), matmul(half * (kt + transpose(kt)), nb))
-    call eigen(h, ev, .false.)
-    if (nomem) then
-      status = MBD_NO_MEMORY
-      msg = 'not enough memory for the stability analysis (dense): use a model with fewer '// &
-            'coordinates'
-      return
-    end if
-    emax = max(maxval(abs(ev)), tiny(one))
-    if (minval(ev) > 1.0e-9_wp * emax) then
+    call eigen(.false., status)
+    if (status /= MBD_OK) return
+    emax = max(maxval(abs(ev(1:nfree))), tiny(one))
+    if (minval(ev(1:nfree)) > 1.0e-9_wp * emax) then
       stable = 1
-    else if (minval(ev) < -1.0e-9_wp * emax) then
+    else if (minval(ev(1:nfree)) < -1.0e-9_wp * emax) then
       stable = 0
     else
       stable = -1
     end if
   contains
-    !> V at qa: gravity, springs and the loads frozen at t (also fills w%force at qa).
+    !> At qa: the null-space basis N (nb), the reduced load g = N^T Q, the least-squares
+    !! multipliers lam, the minimum-norm correction dq_n = -J^+ Phi (pn = ||Phi||_inf),
+    !! the force scale, V and its rounding error, and the reduced stiffness H (in h).
+    subroutine reduce(qa, st)
+      real(wp), intent(in) :: qa(:)
+      integer, intent(out) :: st
+      real(wp) :: wq(1)
+      integer :: info, rk, k, lw, i, j
+      st = MBD_OK
+      call dyn_multipliers(m, w, qa, w%qz, w%qz, t, lam, stp, lmsg)  ! also J and Q at qa
+      r = matmul(lam, w%jac)                           ! J^T lambda
+      fscale = max(maxval(abs(w%force)), maxval(abs(r)), tiny(one))
+      pn = zero
+      do i = 1, na                                     ! row gathers as loops (no temporary)
+        pn = max(pn, abs(w%phi(w%rows(i))))
+      end do
+      v0 = potential(qa)
+      vnoise = V_NOISE * (abs(v0) + scale_of_v(qa))
+      ! SVD of the active rows: J_a = U S V^T; N = the last columns of V
+      dqn = zero
+      rk = 0
+      if (na > 0) then
+        do i = 1, na
+          ja(i, :) = w%jac(w%rows(i), :)
+        end do
+        call dgesvd('S', 'A', na, n, ja, size(ja, 1), sv, u, size(u, 1), vt, n, wq, -1, info)
+        lw = max(1, int(wq(1)))
+        call grow_work(lw, st)
+        if (st /= MBD_OK) return
+        call dgesvd('S', 'A', na, n, ja, size(ja, 1), sv, u, size(u, 1), vt, n, work, &
+                    size(work), info)
+        if (info /= 0) then
+          st = MBD_LAPACK; write (msg, '(a,i0)') 'statics: the SVD of J failed, info ', info
+          return
+        end if
+        rk = count(sv(1:nu) > RANK_TOL * maxval(sv(1:nu)))
+        ! dq_n = -V_r S_r^-1 U_r^T Phi_a
+        do k = 1, rk
+          c(k) = zero
+          do i = 1, na
+            c(k) = c(k) - u(i, k) * w%phi(w%rows(i))
+          end do
+          c(k) = c(k) / sv(k)
+        end do
+        do k = 1, rk
+          dqn = dqn + c(k) * vt(k, :)
+        end do
+      else
+        vt = zero
+        do k = 1, n
+          vt(k, k) = one
+        end do
+      end if
+      nfree = n - rk
+      if (nfree == 0) return
+      nb(:, 1:nfree) = transpose(vt(rk + 1:n, :))
+      g(1:nfree) = matmul(w%force, nb(:, 1:nfree))     ! N^T Q (= -reduced gradient of V)
+      call dyn_tangent(m, w, qa, w%qz, t, lam, kt, ct)
+      do j = 1, n                                      ! K_sym = (K + K^T) / 2
+        do i = 1, j - 1
+          kt(i, j) = half * (kt(i, j) + kt(j, i)); kt(j, i) = kt(i, j)
+        end do
+      end do
+      ct(:, 1:nfree) = matmul(kt, nb(:, 1:nfree))      ! ct (the damping) is not needed: K N
+      h(1:nfree, 1:nfree) = matmul(transpose(nb(:, 1:nfree)), ct(:, 1:nfree))
+    end subroutine reduce
+
+    !> y = N dz (the first nfree columns of nb).
+    subroutine null_mul(x, y)
+      real(wp), intent(in) :: x(:)       !! (>= nfree) reduced step
+      real(wp), intent(out) :: y(:)      !! (n) the step in q
+      integer :: k
+      y = zero
+      do k = 1, nfree
+        y = y + x(k) * nb(:, k)
+      end do
+    end subroutine null_mul
+
+    !> work has at least lw entries (MBD_NO_MEMORY when it cannot grow).
+    subroutine grow_work(lw, st)
+      integer, intent(in) :: lw
+      integer, intent(out) :: st
+      integer :: ierr
+      st = MBD_OK
+      if (size(work) >= lw) return
+      deallocate (work)
+      allocate (work(lw), stat=ierr)
+      if (ierr /= 0) then
+        call mem_fail(REAL_BYTES * lw, 'the LAPACK workspace of the statics', HINT, st, msg)
+        allocate (work(1), stat=ierr)
+      end if
+    end subroutine grow_work
+
+    !> dz from H dz = g - N^T K dq_n, saddle-free: |eigenvalues| bounded below (a flat
+    !! direction gets a gradient step of about the model's length scale).
+    !! H is overwritten by its eigenvectors (reduce computes it again).
+    subroutine newton_step(st)
+      integer, intent(out) :: st      !! MBD_OK or MBD_NO_MEMORY
+      integer :: k
+      qt = matmul(dqn, kt)                               ! (K dq_n)^T, K symmetric
+      r(1:nfree) = matmul(qt, nb(:, 1:nfree))
+      r(1:nfree) = g(1:nfree) - r(1:nfree)
+      call eigen(.true., st)
+      if (st /= MBD_OK) return
+      emax = max(1.0e-8_wp * maxval(abs(ev(1:nfree))), norm2(g(1:nfree)) / m%lscale, &
+                 tiny(one))
+      dz(1:nfree) = matmul(transpose(h(1:nfree, 1:nfree)), r(1:nfree))
+      do k = 1, nfree
+        r(k) = dz(k) / max(abs(ev(k)), emax)
+      end do
+      dz(1:nfree) = matmul(h(1:nfree, 1:nfree), r(1:nfree))
+    end subroutine newton_step
+
+    !> Residual of the equilibrium equations, relative to the force and length scales.
+    real(wp) function merit(ga, pa)
+      real(wp), intent(in) :: ga, pa
+      merit = ga / fscale + pa / m%lscale
+    end function merit
+
+    !> V at qa: gravity, springs and the loads frozen at t (fills w%force at qa).
     real(wp) function potential(qa)
       real(wp), intent(in) :: qa(:)
       real(wp) :: v, vl
@@ -127,49 +284,31 @@ contains
       potential = v + vl
     end function potential
 
-    !> Orthonormal basis of the null space of J at q (columns of nb); also loads w%force.
-    subroutine null_space(basis, nfr)
-      real(wp), allocatable, intent(out) :: basis(:, :)
-      integer, intent(out) :: nfr
-      real(wp) :: ja(w%na, m%nq), sv(min(w%na, m%nq)), u(1, 1), vt(m%nq, m%nq), wq(1), v
-      real(wp), allocatable :: work(:)
-      integer :: info, rk
-      call assemble_dense(m, q, w%qz, t, w%phi, w%nu, w%gam, w%asm, w%jac)
-      call gen_forces(m, q, w%qz, t, w%force, v)
-      ja = w%jac(w%rows, :)
-      call dgesvd('N', 'A', w%na, m%nq, ja, w%na, sv, u, 1, vt, m%nq, wq, -1, info)
-      allocate (work(max(1, int(wq(1)))), stat=info)
-      if (info /= 0) then
-        nomem = .true.; nfr = 0; return
-      end if
-      call dgesvd('N', 'A', w%na, m%nq, ja, w%na, sv, u, 1, vt, m%nq, work, size(work), info)
-      rk = 0
-      if (size(sv) > 0) rk = count(sv > 1.0e-10_wp * maxval(sv))
-      nfr = m%nq - rk
-      basis = transpose(vt(rk + 1:m%nq, :))
-    end subroutine null_space
+    !> Size of the gravity terms of V, whose sum may cancel: sum m |g . r|.
+    real(wp) function scale_of_v(qa)
+      real(wp), intent(in) :: qa(:)
+      integer :: k
+      scale_of_v = zero
+      do k = 1, m%nb
+        scale_of_v = scale_of_v + &
+          m%mdiag(3 * k - 2) * abs(dot_product(m%grav, qa(3 * k - 2:3 * k - 1)))
+      end do
+    end function scale_of_v
 
-    !> Eigenvalues (and, when vectors, the vectors in a) of a symmetric matrix.
-    subroutine eigen(a, e, vectors)
-      real(wp), intent(inout) :: a(:, :)
-      real(wp), allocatable, intent(out) :: e(:)
+    !> Eigenvalues of H (h(1:nfree, 1:nfree)) in ev(1:nfree), and when vectors, the
+    !! eigenvectors in h. st: MBD_OK or MBD_NO_MEMORY (the workspace); a dsyev that does not
+    !! converge leaves what it has (the step or stability test uses it as it is).
+    subroutine eigen(vectors, st)
       logical, intent(in) :: vectors
+      integer, intent(out) :: st
       real(wp) :: wq(1)
-      real(wp), allocatable :: work(:)
-      integer :: nn, info
+      integer :: info
       character(len=1) :: job
-      nn = size(a, 1)
-      allocate (e(nn), stat=info)
-      if (info /= 0) then
-        nomem = .true.; return
-      end if
       job = merge('V', 'N', vectors)
-      call dsyev(job, 'U', nn, a, nn, e, wq, -1, info)
-      allocate (work(max(1, int(wq(1)))), stat=info)
-      if (info /= 0) then
-        nomem = .true.; return
-      end if
-      call dsyev(job, 'U', nn, a, nn, e, work, size(work), info)
+      call dsyev(job, 'U', nfree, h, n, ev, wq, -1, info)
+      call grow_work(max(1, int(wq(1))), st)
+      if (st /= MBD_OK) return
+      call dsyev(job, 'U', nfree, h, n, ev, work, size(work), info)
     end subroutine eigen
   end subroutine statics_solve
 

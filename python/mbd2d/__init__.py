@@ -14,9 +14,9 @@ from .analysis.stepping import KinematicStepper
 from .description.functions import Harmonic, TimeFunction
 from .errors import (AnalysisError, AssemblyError, ConvergenceError, CoreError,
                      InconsistentConstraintsError, InsufficientMemoryError, IntegrationError,
-                     MbdError, MbdWarning, ModelError,
-                     RedundantConstraintWarning, SingularConfigurationError,
-                     SingularJacobianError, SingularPassageWarning, ToggleError)
+                     MbdError, MbdWarning, ModelError, RedundantConstraintWarning,
+                     SingularConfigurationError, SingularJacobianError, SingularPassageWarning,
+                     ToggleError)
 from .model import Model, load, loads
 from .results import (BodyResult, DofReport, DynamicsResult, KinematicsResult, Reaction,
                       StaticsResult)
@@ -24,9 +24,9 @@ from .results import (BodyResult, DofReport, DynamicsResult, KinematicsResult, R
 __version__ = "0.1.0"
 
 __all__ = ["load", "loads", "Model", "TimeFunction", "Harmonic", "KinematicsResult",
-           "BodyResult", "DynamicsResult", "KinematicStepper", "StaticsResult", "Reaction", "DofReport",
-           "MbdError", "ModelError", "AnalysisError", "IntegrationError",
+           "BodyResult", "DynamicsResult", "KinematicStepper", "StaticsResult", "Reaction",
+           "DofReport", "MbdError", "ModelError", "AnalysisError", "IntegrationError",
            "AssemblyError", "InconsistentConstraintsError", "ConvergenceError",
-           "SingularJacobianError", "SingularConfigurationError", "ToggleError",
-           "InsufficientMemoryError", "CoreError", "MbdWarning", "RedundantConstraintWarning",
+           "SingularJacobianError", "SingularConfigurationError", "ToggleError", "CoreError",
+           "InsufficientMemoryError", "MbdWarning", "RedundantConstraintWarning",
            "SingularPassageWarning", "__version__"]

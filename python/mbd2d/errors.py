@@ -122,23 +122,32 @@ class SingularPassageWarning(MbdWarning):
     branch it started on."""
 
 
-class InsufficientMemoryError(MbdError, MemoryError):
-    """The analysis needs more memory than the machine can give (the core's status 10).
+class CoreError(MbdError):
+    """The Fortran core reported an internal error (a LAPACK argument error, or a status the
+    analysis cannot produce); a bug."""
 
-    The core refuses a request above half the physical memory (or above what is free) before
-    allocating it, and turns an allocation that fails anyway into this error; the message
-    gives the size asked and what to change (fewer steps, the banded solver, a smaller
-    model). The process and its earlier results are unharmed.
+
+class InsufficientMemoryError(MbdError, MemoryError):
+    """An analysis needs more memory than it can get (the core's status 10): refused before
+    the run from an estimate, refused by the core before allocating a request above half the
+    physical memory (or above what is free), or an allocation that failed. The message says
+    how much was asked and what to change: fewer steps, ``every=k`` to keep fewer output rows,
+    ``solver="banded"`` for large models. The process and its earlier results are unharmed.
+
+    Attributes
+    ----------
+    nbytes : float or None
+        The size asked for, in bytes, when known.
     """
 
-
-class CoreError(MbdError):
-    """The Fortran core reported an internal error (a LAPACK argument error); a bug."""
+    def __init__(self, message: str, nbytes: float | None = None) -> None:
+        super().__init__(message)
+        self.nbytes = nbytes
 
 
 __all__ = ["MbdError", "ModelError", "AnalysisError", "AssemblyError",
            "InconsistentConstraintsError", "ConvergenceError", "SingularJacobianError",
            "IntegrationError",
-           "SingularConfigurationError", "ToggleError", "InsufficientMemoryError", "CoreError",
+           "SingularConfigurationError", "ToggleError", "CoreError", "InsufficientMemoryError",
            "MbdWarning",
            "RedundantConstraintWarning", "SingularPassageWarning"]

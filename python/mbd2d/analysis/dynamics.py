@@ -8,16 +8,14 @@ from typing import Any
 
 from ..binding import core
 from ..binding.pack import pack, pack_dynamics
-from ..binding.status import (ASSEMBLY_FAILED, INCONSISTENT, INTEGRATOR_FAILED, NO_CONVERGENCE,
-                              NO_MEMORY, OK, SINGULAR, SINGULAR_CONFIG)
+from ..binding.status import ASSEMBLY_FAILED, INCONSISTENT, INTEGRATOR_FAILED, OK, error_for
 from ..description.builder import ModelDescription
-from ..errors import (ConvergenceError, CoreError, InsufficientMemoryError, IntegrationError,
-                      ModelError, RedundantConstraintWarning, SingularJacobianError)
+from ..errors import ModelError, RedundantConstraintWarning
 from ..results.dynamics import DynamicsResult
 from ..validate import number
-from .failures import assembly_failed, bad_entry, row_names
-from .outputs import dynamics_result
-from .settings import check_memory, check_span, output_steps, time_grid
+from .failures import assembly_failed, bad_entry, inconsistent_at, row_names
+from .outputs import dynamics_result, finite_part
+from .settings import check_memory, check_span, output_rows, output_steps, time_grid
 
 METHODS = {"generalized-alpha": 1, "dopri5": 2, "baumgarte-rk4": 3, "partitioned": 4}
 DEFAULT_METHOD = "dopri5"
@@ -29,7 +27,7 @@ def run_dynamics(model: ModelDescription, t_end: float, steps: int, method: str 
                  beta: float | None = None, t0: float = 0.0, every: Any = 1) -> DynamicsResult:
     """Forward dynamics in one core call; see :meth:`mbd2d.Model.dynamics`."""
     t0, t_end, steps = check_span(t0, t_end, steps)
-    idx = output_steps(steps, every)
+    nout = output_rows(steps, every)
     every = int(every)
     method = DEFAULT_METHOD if method is None else method
     if method not in METHODS:
@@ -64,9 +62,10 @@ def run_dynamics(model: ModelDescription, t_end: float, steps: int, method: str 
     beta_v = opt(beta, "beta", 0.0, 1e9, -1.0)
     p = pack(model)
     d = pack_dynamics(model, p)
-    check_memory(len(idx), 3 * p.nq + p.neq + 4)
+    check_memory(nout, 3 * p.nq + p.neq + 4, "dynamics")
+    idx = output_steps(steps, every)
     out = core.dynamics(p, d, t0, t_end, steps, METHODS[method], rtol_v, atol_v, h_v, rho_v,
-                        alpha_v, beta_v, every, len(idx))
+                        alpha_v, beta_v, every, nout)
     iinfo, rinfo, status = out.iinfo, out.rinfo, out.status
     n = int(iinfo[0])
     t = time_grid(t0, t_end, steps, idx)
@@ -77,28 +76,31 @@ def run_dynamics(model: ModelDescription, t_end: float, steps: int, method: str 
              "partitions": int(iinfo[7]),
              "h_min": float(rinfo[1]) if iinfo[2] else None,
              "h_max": float(rinfo[2]) if iinfo[2] else None, "redundant_rows": red_rows}
-    res = dynamics_result(model, p, t, n, out, stats, status == OK)
+    res, bad = finite_part(dynamics_result(model, p, t, n, out, stats, status == OK))
     if red_rows:
         warnings.warn(f"redundant constraints: {', '.join(red_rows)} are left out of the equations "
                       "of motion; the reported multipliers are the minimum-norm set (the "
                       "reactions are statically indeterminate)", RedundantConstraintWarning,
                       stacklevel=3)
-    if status == OK:
+    if status == OK and bad is None:
         return res
     text = out.msg
-    if status < 0:
-        raise ModelError(text, bad_entry(model, int(iinfo[1])))
-    tf = float(rinfo[0])
     last = f"t = {res.t[-1]:.6g} s" if len(res.t) else "no output rows"
+    kept = f"Results up to {last} are kept in the exception's .results."
+    if status == OK:
+        raise error_for("dynamics", INTEGRATOR_FAILED,
+                        f"{method}: the solution became non-finite at t = {t[bad]:.6g} s (a "
+                        f"blow-up: try a smaller rtol or h, or another method). {kept}",
+                        t=t[bad], results=res)
+    if status < 0:
+        raise error_for("dynamics", status, text, entry=bad_entry(model, int(iinfo[1])))
+    tf = float(rinfo[0])
     if status == ASSEMBLY_FAILED:
-        raise assembly_failed(model, 0.0, 0, t0, res)
+        raise assembly_failed("dynamics", model, 0.0, 0, t0, res)
+    if status == INCONSISTENT and not len(res.t):
+        raise inconsistent_at("dynamics", model, p, t0, res, f"{method}: {text}")
     if status == INTEGRATOR_FAILED:
-        raise IntegrationError(f"{method}: {text}. Results up to {last} are kept in the "
-                               "exception's .results.", t=tf, results=res, status=status)
-    if status in (SINGULAR, SINGULAR_CONFIG):
-        raise SingularJacobianError(f"{method}: {text}", t=tf, results=res, status=status)
-    if status in (NO_CONVERGENCE, INCONSISTENT):
-        raise ConvergenceError(f"{method}: {text}", t=tf, results=res, status=status)
-    if status == NO_MEMORY:
-        raise InsufficientMemoryError(text)
-    raise CoreError(f"internal error in the core (status {status}): {text}")
+        text = f"{method}: {text}. {kept}"
+    else:
+        text = f"{method}: {text}"
+    raise error_for("dynamics", status, text, t=tf, results=res)

@@ -7,14 +7,14 @@ from typing import Any
 
 from ..binding import core
 from ..binding.pack import pack, pack_dynamics
-from ..binding.status import OK
+from ..binding.status import NO_CONVERGENCE, OK, error_for
 from ..description.builder import ModelDescription
-from ..errors import ModelError, RedundantConstraintWarning
+from ..errors import RedundantConstraintWarning
 from ..results.dynamics import DynamicsResult
 from .failures import BAD_FORCE, bad_entry, kinematic_failure, row_names
-from .outputs import dynamics_result
-from .settings import (check_memory, check_solver, check_span, output_steps, require_determined,
-                       solver_code, time_grid)
+from .outputs import dynamics_result, finite_part
+from .settings import (check_memory, check_solver, check_span, output_rows, output_steps,
+                       require_determined, solver_code, time_grid)
 
 
 def run_inverse(model: ModelDescription, t_end: float, steps: int, t0: float = 0.0,
@@ -25,13 +25,14 @@ def run_inverse(model: ModelDescription, t_end: float, steps: int, t0: float = 0
     """
     t0, t_end, steps = check_span(t0, t_end, steps)
     tol_v, _ = check_solver(tol, None)
-    idx = output_steps(steps, every)
+    nout = output_rows(steps, every)
     code = solver_code(solver)
     p = pack(model)
     require_determined(p, model)
     d = pack_dynamics(model, p)
-    check_memory(len(idx), 3 * p.nq + p.neq + 4)
-    out = core.inverse(p, d, t0, t_end, steps, tol_v, int(every), code, len(idx))
+    check_memory(nout, 3 * p.nq + p.neq + 4, "inverse dynamics")
+    idx = output_steps(steps, every)
+    out = core.inverse(p, d, t0, t_end, steps, tol_v, int(every), code, nout)
     iinfo, status = out.iinfo, out.status
     n = int(iinfo[0])
     t = time_grid(t0, t_end, steps, idx)
@@ -40,14 +41,19 @@ def run_inverse(model: ModelDescription, t_end: float, steps: int, t0: float = 0
              "rejected_steps": int(iinfo[7]), "rank": int(iinfo[8]),
              "redundant_rows": red_rows,
              "singular_passages": [float(x) for x in out.tpass[:min(int(iinfo[9]), 64)]]}
-    res = dynamics_result(model, p, t, n, out, stats, status == OK)
+    res, bad = finite_part(dynamics_result(model, p, t, n, out, stats, status == OK))
     if red_rows:
         warnings.warn(f"redundant constraints: {', '.join(red_rows)}; the multipliers are the "
                       "minimum-norm set (the reactions are statically indeterminate)",
                       RedundantConstraintWarning, stacklevel=3)
-    if status == OK:
+    if status == OK and bad is None:
         return res
+    if status == OK:
+        raise error_for("inverse", NO_CONVERGENCE,
+                        f"the run gave non-finite values at t = {t[bad]:.6g} s; results up to "
+                        f"there ({bad} rows) are kept in the exception's .results", t=t[bad],
+                        results=res)
     if status < 0 and iinfo[1] <= BAD_FORCE:
-        raise ModelError(out.msg, bad_entry(model, int(iinfo[1])))
-    raise kinematic_failure(model, p, status, out.msg, iinfo, out.rinfo, out.qsing, out.dep,
-                            out.red, res)
+        raise error_for("inverse", status, out.msg, entry=bad_entry(model, int(iinfo[1])))
+    raise kinematic_failure("inverse", model, p, status, out.msg, iinfo, out.rinfo, out.qsing,
+                            out.dep, out.red, res)

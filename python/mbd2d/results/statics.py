@@ -11,7 +11,8 @@ from .reactions import Reaction, reaction_arrays, reaction_of
 
 @dataclass
 class StaticsResult:
-    """A static equilibrium: configuration, multipliers, reactions and stability."""
+    """A static equilibrium: configuration, multipliers, reactions and stability;
+    ``residual`` is the unbalanced load ||N^T Q||_inf relative to the largest load."""
 
     t: float
     q: np.ndarray
@@ -25,7 +26,9 @@ class StaticsResult:
     packed: Any = None
 
     def body(self, name: str) -> tuple[float, float, float]:
-        """(x, y, theta) of a body at the equilibrium."""
+        """(x, y, theta) of a body at the equilibrium (KeyError if there is none)."""
+        if name not in self.body_names:
+            raise KeyError(f"no body {name!r}; bodies: {', '.join(self.body_names)}")
         i = self.body_names.index(name)
         return tuple(float(v) for v in self.q[3 * i:3 * i + 3])  # type: ignore[return-value]
 
@@ -35,5 +38,7 @@ class StaticsResult:
             self.packed, self.q[None, :], np.array([self.t]), self.lam[None, :]))
 
     def multiplier(self, row: str) -> float:
-        """The multiplier of a row by its label."""
+        """The multiplier of a row by its label (KeyError if no row has it)."""
+        if row not in self.row_labels:
+            raise KeyError(f"no row {row!r}; rows: {', '.join(self.row_labels)}")
         return float(self.lam[self.row_labels.index(row)])
