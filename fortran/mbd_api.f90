@@ -396,7 +396,7 @@ contains
   !! rinfo: 1 time of a failure, 2 smallest step, 3 largest step.
   subroutine api_dynamics(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, v0, t0, t1, nsteps, &
                           method, rtol, atol, h, rho_inf, balpha, bbeta, every, qout, qdout, &
-                          qddout, lamout, eout, iinfo, rinfo, redundant, status, msg)
+                          qddout, lamout, eout, iinfo, rinfo, redundant, status, msg, max_steps)
     integer, intent(in) :: nb, ctab(:, :), ftab(:, :), nsteps, method
     integer, intent(in) :: every                !! store every every-th output (and the last)
     real(wp), intent(in) :: rpar(:), bmass(:, :), grav(2), fpar(:), q0(:), v0(:), t0, t1
@@ -409,6 +409,7 @@ contains
     integer, intent(out) :: redundant(:)
     integer, intent(out) :: status              !! MBD_OK, < 0 input, > 0 numerical
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    integer, intent(in) :: max_steps            !! step limit (accepted + rejected); 0: default
     type(model_t) :: m
     type(dyn_work_t) :: w
     type(kin_work_t) :: kw
@@ -429,8 +430,9 @@ contains
                finite([rtol, atol, h, rho_inf, balpha, bbeta]))) then
       call not_finite('q0, v0, the times and the settings', status, msg); return
     end if
-    if (nsteps < 0 .or. .not. (t1 > t0) .or. every < 1) then
-      status = MBD_BAD_SETTING; msg = 'steps must be >= 0, every >= 1 and t_end > t0'; return
+    if (nsteps < 0 .or. .not. (t1 > t0) .or. every < 1 .or. max_steps < 0) then
+      status = MBD_BAD_SETTING
+      msg = 'steps must be >= 0, every >= 1, max_steps >= 0 and t_end > t0'; return
     end if
     if (size(q0) /= m%nq .or. size(v0) /= m%nq .or. size(qout, 1) /= m%nq .or. &
         size(qout, 2) /= output_rows(nsteps, every) .or. size(lamout, 1) /= m%neq .or. &
@@ -466,6 +468,7 @@ contains
     if (rho_inf >= zero) opts%rho_inf = min(rho_inf, one)
     if (balpha >= zero) opts%balpha = balpha
     if (bbeta >= zero) opts%bbeta = bbeta
+    if (max_steps > 0) opts%max_steps = max_steps
     call integrate(m, w, q, qd, t0, t1, nsteps, every, opts, qout, qdout, qddout, nout, dst, &
                    status, msg)
     iinfo(1) = nout; iinfo(3) = dst%steps; iinfo(4) = dst%rejected; iinfo(5) = dst%newton

@@ -34,9 +34,12 @@ module mbd_integrators
   implicit none
   private
   public :: dyn_opts_t, dyn_stats_t, METH_GENALPHA, METH_DOPRI5, METH_RK4, METH_PARTITIONED
-  public :: integrate, output_rows, output_index
+  public :: integrate, output_rows, output_index, MAX_STEPS_DEFAULT
 
   integer, parameter :: METH_GENALPHA = 1, METH_DOPRI5 = 2, METH_RK4 = 3, METH_PARTITIONED = 4
+  !> Default step limit: it ends a run whose steps collapse without underflowing, after
+  !! 10 s to a few minutes at 1-20 us a step (small models); a long run raises it.
+  integer, parameter :: MAX_STEPS_DEFAULT = 10000000
 
   !> Integrator settings.
   type :: dyn_opts_t
@@ -47,7 +50,7 @@ module mbd_integrators
     real(wp) :: rho_inf = 0.8_wp      !! generalized-alpha spectral radius at infinity
     real(wp) :: balpha = 10.0_wp      !! Baumgarte alpha
     real(wp) :: bbeta = 10.0_wp       !! Baumgarte beta
-    integer :: max_steps = 2000000    !! internal step limit
+    integer :: max_steps = MAX_STEPS_DEFAULT  !! limit on accepted + rejected steps
   end type dyn_opts_t
 
   !> What the integrator did.
@@ -159,6 +162,36 @@ contains
     end if
   end function more
 
+  !> The run stops at the step limit (accepted plus rejected steps): say how to raise it.
+  !! nfix > 0: a fixed-step run that needs nfix steps (stopped before it starts).
+  subroutine step_limit(c, t, nfix, status, msg)
+    type(itg_t), intent(inout) :: c
+    real(wp), intent(in) :: t
+    integer, intent(in) :: nfix
+    integer, intent(out) :: status
+    character(len=MSG_LEN), intent(out) :: msg
+    status = MBD_INTEGRATOR_FAILED
+    c%st%t_fail = t
+    if (nfix > 0) then
+      write (msg, '(a,es10.3,a,i0,a,i0,a)') 'the fixed step h = ', c%opts%h, ' needs ', nfix, &
+        ' steps, more than the step limit max_steps = ', c%opts%max_steps, &
+        ': raise max_steps (command line: --max-steps), or take a larger h'
+    else
+      write (msg, '(a,i0,a,es12.5,a)') 'the step limit max_steps = ', c%opts%max_steps, &
+        ' (accepted and rejected steps) was reached at t = ', t, &
+        ': raise max_steps (command line: --max-steps), or loosen rtol and atol'
+    end if
+  end subroutine step_limit
+
+  !> Number of fixed steps of about h that span (t0, t1) (capped at huge(0), not overflowing).
+  integer function fixed_steps(c)
+    type(itg_t), intent(in) :: c
+    real(wp) :: r
+    r = anint((c%t1 - c%t0) / c%opts%h)
+    fixed_steps = huge(0)
+    if (r < real(huge(0), wp)) fixed_steps = max(1, int(r))
+  end function fixed_steps
+
   !> Time of fixed step k (exact at the end).
   real(wp) function step_time(c, k, nfix)
     type(itg_t), intent(in) :: c
@@ -266,7 +299,10 @@ contains
     t = c%t0
     nfix = 0
     if (fixed) then
-      nfix = max(1, nint((c%t1 - c%t0) / c%opts%h))
+      nfix = fixed_steps(c)
+      if (nfix > c%opts%max_steps) then
+        call step_limit(c, t, nfix, status, msg); return
+      end if
       h = (c%t1 - c%t0) / nfix                                      ! land on t1
     else
       h = initial_step(c)
@@ -276,9 +312,7 @@ contains
     err = zero
     do while (more(c, t, fixed, nfix))
       if (c%st%steps + c%st%rejected >= c%opts%max_steps) then
-        status = MBD_INTEGRATOR_FAILED
-        write (msg, '(a,i0,a,es12.5)') 'more than ', c%opts%max_steps, ' steps before t = ', t
-        return
+        call step_limit(c, t, 0, status, msg); return
       end if
       h = min(h, c%t1 - t)
       tnew = t + h
@@ -448,7 +482,10 @@ contains
     t = c%t0
     nfix = 0
     if (fixed) then
-      nfix = max(1, nint((c%t1 - c%t0) / c%opts%h))
+      nfix = fixed_steps(c)
+      if (nfix > c%opts%max_steps) then
+        call step_limit(c, t, nfix, status, msg); return
+      end if
       h = (c%t1 - c%t0) / nfix
     else
       h = initial_step(c)
@@ -460,9 +497,7 @@ contains
     err = zero
     do while (more(c, t, fixed, nfix))
       if (c%st%steps + c%st%rejected >= c%opts%max_steps) then
-        status = MBD_INTEGRATOR_FAILED
-        write (msg, '(a,i0,a,es12.5)') 'more than ', c%opts%max_steps, ' steps before t = ', t
-        return
+        call step_limit(c, t, 0, status, msg); return
       end if
       c%st%t_fail = t
       h = min(h, c%t1 - t)

@@ -16,7 +16,7 @@ from .errors import (ConvergenceError, CoreError, IntegrationError, ModelError,
                      RedundantConstraintWarning, SingularJacobianError)
 from .pack import Packed, decode, pack
 from .results import DynamicsResult, StaticsResult
-from .validate import number
+from .validate import number, whole
 
 if TYPE_CHECKING:  # pragma: no cover
     from .model import Model
@@ -25,6 +25,8 @@ METHODS = {"generalized-alpha": 1, "dopri5": 2, "baumgarte-rk4": 3, "partitioned
 DEFAULT_METHOD = "dopri5"
 INTEGRATOR_FAILED = 8
 BAD_FORCE = -1000000
+MAX_STEPS_DEFAULT = 10_000_000     # the core's default limit on accepted + rejected steps
+INT32_MAX = 2**31 - 1
 
 
 def pack_dynamics(model: "Model", p: Packed) -> tuple[np.ndarray, ...]:
@@ -119,11 +121,14 @@ def run_inverse(model: "Model", t_end: float, steps: int, t0: float = 0.0,
 def run_dynamics(model: "Model", t_end: float, steps: int, method: str | None = None,
                  rtol: float | None = None, atol: float | None = None, h: float | None = None,
                  rho_inf: float | None = None, alpha: float | None = None,
-                 beta: float | None = None, t0: float = 0.0, every: int = 1) -> DynamicsResult:
+                 beta: float | None = None, t0: float = 0.0, every: int = 1,
+                 max_steps: int | None = None) -> DynamicsResult:
     """Forward dynamics in one core call; see :meth:`Model.dynamics`."""
     t0, t_end, steps = check_span(t0, t_end, steps)
     idx = output_steps(steps, every)
     every = int(every)
+    nmax = MAX_STEPS_DEFAULT if max_steps is None else \
+        whole(max_steps, "max_steps", "dynamics", 1, INT32_MAX)
     method = DEFAULT_METHOD if method is None else method
     if method not in METHODS:
         raise ModelError(f"unknown method {method!r}; use one of {', '.join(METHODS)}",
@@ -162,7 +167,7 @@ def run_dynamics(model: "Model", t_end: float, steps: int, method: str | None = 
                               fpar=fpar, neq=p.neq, q0=p.q0, v0=v0, t0=t0, t1=t_end,
                               nsteps=steps, method=METHODS[method], rtol=rtol_v, atol=atol_v,
                               h=h_v, rho_inf=rho_v, balpha=alpha_v, bbeta=beta_v,
-                              every=every, nrow=len(idx))
+                              every=every, nrow=len(idx), max_steps=nmax)
     qo, vo, ao, lam, e, iinfo, rinfo, red, status, msg = out
     n = int(iinfo[0])
     t = time_grid(t0, t_end, steps, idx)
