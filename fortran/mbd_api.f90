@@ -469,8 +469,8 @@ contains
     if (balpha >= zero) opts%balpha = balpha
     if (bbeta >= zero) opts%bbeta = bbeta
     if (max_steps > 0) opts%max_steps = max_steps
-    call integrate(m, w, q, qd, t0, t1, nsteps, every, opts, qout, qdout, qddout, nout, dst, &
-                   status, msg)
+    call integrate(m, w, q, qd, t0, t1, nsteps, every, opts, qout, qdout, qddout, lamout, nout, &
+                   dst, status, msg)
     iinfo(1) = nout; iinfo(3) = dst%steps; iinfo(4) = dst%rejected; iinfo(5) = dst%newton
     iinfo(6) = dst%rhs; iinfo(7) = dst%jacobians; iinfo(8) = dst%partitions
     iinfo(10) = dst%factorizations
@@ -480,7 +480,6 @@ contains
       ko = output_index(nsteps, every, k)
       t = t0 + (t1 - t0) * (real(ko, wp) / max(nsteps, 1))
       if (ko == nsteps) t = t1
-      call dyn_multipliers(m, w, qout(:, k), qdout(:, k), qddout(:, k), t, lamout(:, k), st, lmsg)
       call state_measures(m, w, qout(:, k), qdout(:, k), t, eout(:, k))
     end do
   end subroutine api_dynamics

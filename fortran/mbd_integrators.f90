@@ -29,7 +29,7 @@ module mbd_integrators
   use mbd_lapack, only: dgeqp3, dgecon
   use mbd_interp, only: hermite5
   use mbd_dynamics, only: dyn_work_t, dyn_accel, dyn_velocity, dyn_project_pos, gen_forces, &
-                          kinetic_energy, dyn_tangent, dyn_solve, dyn_jt_lam
+                          kinetic_energy, dyn_tangent, dyn_solve, dyn_jt_lam, dyn_multipliers
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   implicit none
   private
@@ -96,10 +96,12 @@ contains
 
   !> Integrate from the consistent state (q, qd) at t0 to t1, with outputs at
   !! t0 + k (t1 - t0)/nsteps, k = 0..nsteps, of which those with mod(k, every) = 0 and the
-  !! last (k = nsteps) are written into the columns of qo, vo, ao (output_rows of them).
+  !! last (k = nsteps) are written into the columns of qo, vo, ao, lo (output_rows of them).
   !! nout returns the number of rows written (all, unless a failure stopped the run).
-  subroutine integrate(m, w, q, qd, t0, t1, nsteps, every, opts, qo, vo, ao, nout, st, status, &
-                       msg)
+  !! The multipliers lo at every output are those of the index-1 equations at the output
+  !! state (see finish_outputs).
+  subroutine integrate(m, w, q, qd, t0, t1, nsteps, every, opts, qo, vo, ao, lo, nout, st, &
+                       status, msg)
     type(model_t), intent(in) :: m               !! model
     type(dyn_work_t), intent(inout) :: w         !! dynamics work arrays (dyn_init done)
     real(wp), intent(inout) :: q(:), qd(:)       !! consistent initial state, then final
@@ -108,13 +110,14 @@ contains
     integer, intent(in) :: every                 !! store every every-th output (and the last)
     type(dyn_opts_t), intent(in) :: opts         !! settings
     real(wp), intent(out) :: qo(:, :), vo(:, :), ao(:, :)  !! outputs (nq, rows)
+    real(wp), intent(out) :: lo(:, :)            !! multipliers at the outputs (neq, rows)
     integer, intent(out) :: nout                 !! rows written
     type(dyn_stats_t), intent(out) :: st         !! counters
     integer, intent(out) :: status               !! MBD_OK or a failure
     character(len=MSG_LEN), intent(out) :: msg   !! explanation
     type(itg_t) :: c
     status = MBD_OK; msg = ''; nout = 0
-    qo = zero; vo = zero; ao = zero
+    qo = zero; vo = zero; ao = zero; lo = zero
     if (opts%method == METH_RK4 .and. .not. (opts%h > zero)) then
       status = MBD_BAD_SETTING; msg = 'baumgarte-rk4 needs a step h > 0'; return
     end if
@@ -147,7 +150,42 @@ contains
     end if
     nout = c%nout; st = c%st
     q = c%qf; qd = c%vf
+    call finish_outputs(m, w, c, qo, vo, ao, lo)
   end subroutine integrate
+
+  !> The accelerations and multipliers at the stored outputs, from the index-1 equations at
+  !! the output state (accel_at), for every method. For the explicit methods these are what
+  !! the integrator itself evaluates at a step; between steps they belong to the
+  !! interpolated state (q, q_dot), instead of an interpolant of the accelerations, whose
+  !! error is 100x larger. (Projecting the interpolated state onto Phi = 0 and
+  !! J q_dot = nu first made them less accurate: the kinetic-energy projection mixes the
+  !! velocity errors of all coordinates.) generalized-alpha keeps its own q_ddot, but its
+  !! lambda_{n+1} is a second difference of positions (q_ddot_{n+1} = (q_{n+1} - q*) /
+  !! (beta' h^2)), which carries the rounding of q amplified by 1 / (beta' h^2); its
+  !! reported multipliers are those of the state instead. lambda is the minimum-norm
+  !! solution of J^T lambda = Q - M q_ddot over all rows. If the solve fails at a state,
+  !! the row keeps its accelerations and lambda follows from them.
+  subroutine finish_outputs(m, w, c, qo, vo, ao, lo)
+    type(model_t), intent(in) :: m
+    type(dyn_work_t), intent(inout) :: w
+    type(itg_t), intent(in) :: c
+    real(wp), intent(in) :: qo(:, :), vo(:, :)
+    real(wp), intent(inout) :: ao(:, :), lo(:, :)
+    real(wp) :: t, a1(m%nq), lam(m%neq)
+    integer :: r, stt
+    character(len=MSG_LEN) :: lmsg
+    do r = 1, c%nout
+      t = c%t0
+      if (c%nsteps > 0) t = out_time(c, output_index(c%nsteps, c%every, r))
+      call accel_at(m, w, c%opts, qo(:, r), vo(:, r), t, a1, lam, stt)
+      if (stt == MBD_OK) then
+        if (c%opts%method /= METH_GENALPHA) ao(:, r) = a1
+      else
+        a1 = ao(:, r)
+      end if
+      call dyn_multipliers(m, w, qo(:, r), vo(:, r), a1, t, lo(:, r), stt, lmsg)
+    end do
+  end subroutine finish_outputs
 
   !> More steps to take: fixed steps count to nfix, adaptive ones run to t1.
   logical function more(c, t, fixed, nfix)
@@ -668,25 +706,37 @@ contains
     u = c%qs(c%iu) + dt * (c%vs(c%iu) + half * dt * c%as(c%iu))
   end function predicted
 
-  !> Accelerations at c's full state; Baumgarte-stabilized for RK4:
-  !! J q_ddot = gamma - 2 alpha (J q_dot - nu) - beta^2 Phi.
+  !> Accelerations at c's full state; Baumgarte-stabilized for RK4.
   subroutine accel(m, w, c, t, stf)
     type(model_t), intent(in) :: m
     type(dyn_work_t), intent(inout) :: w
     type(itg_t), intent(inout) :: c
     real(wp), intent(in) :: t
     integer, intent(out) :: stf
+    call accel_at(m, w, c%opts, c%qf, c%vf, t, c%af, c%lam, stf)
+  end subroutine accel
+
+  !> Accelerations and multipliers (active rows) of the index-1 equations at a state:
+  !! [M J^T; J 0][q_ddot; lambda] = [Q; gamma]; for baumgarte-rk4 the stabilized
+  !! J q_ddot = gamma - 2 alpha (J q_dot - nu) - beta^2 Phi (lam then is the plain one).
+  subroutine accel_at(m, w, opts, q, qd, t, qdd, lam, stf)
+    type(model_t), intent(in) :: m
+    type(dyn_work_t), intent(inout) :: w
+    type(dyn_opts_t), intent(in) :: opts
+    real(wp), intent(in) :: q(:), qd(:), t
+    real(wp), intent(out) :: qdd(:), lam(:)
+    integer, intent(out) :: stf
     integer :: nn
-    call dyn_accel(m, w, c%qf, c%vf, t, c%af, c%lam, stf)
-    if (stf /= MBD_OK .or. .not. c%baumgarte) return
+    call dyn_accel(m, w, q, qd, t, qdd, lam, stf)
+    if (stf /= MBD_OK .or. opts%method /= METH_RK4) return
     nn = m%nq
     w%rhs(1:nn) = w%force
-    w%rhs(nn + 1:) = w%s * (w%gam(w%rows) - two * c%opts%balpha * &
-                            (matmul(w%jac(w%rows, :), c%vf) - w%nu(w%rows)) - &
-                            c%opts%bbeta**2 * w%phi(w%rows))
+    w%rhs(nn + 1:) = w%s * (w%gam(w%rows) - two * opts%balpha * &
+                            (matmul(w%jac(w%rows, :), qd) - w%nu(w%rows)) - &
+                            opts%bbeta**2 * w%phi(w%rows))
     call dyn_solve(w, w%rhs, stf)
-    c%af = w%rhs(1:nn)
-  end subroutine accel
+    qdd = w%rhs(1:nn)
+  end subroutine accel_at
 
   !> Dependent coordinates u from Phi(u, v) = 0 (Newton with J_u), then u_dot from
   !! J_u u_dot = nu - J_v v_dot.
