@@ -18,7 +18,8 @@
 !!  4 partitioned        coordinate partitioning (Wehage-Haug): Dormand-Prince 5(4) on the
 !!                       independent coordinates v; the dependent u from Phi(u, v) = 0, u_dot
 !!                       from J_u u_dot = nu - J_v v_dot, at every stage; re-partitioned when
-!!                       J_u becomes ill conditioned (QR with column pivoting, dgeqp3).
+!!                       J_u becomes 4x worse conditioned than the choice of a QR with
+!!                       column pivoting (dgeqp3) at the current state.
 module mbd_integrators
   use mbd_kinds, only: wp, zero, one, half, two
   use mbd_status, only: MBD_OK, MBD_BAD_SETTING, MBD_SINGULAR, MBD_NO_CONVERGENCE, &
@@ -78,6 +79,10 @@ module mbd_integrators
     real(wp) :: ts = zero                   !! start of the current step
     real(wp), allocatable :: qs(:), vs(:), as(:)          !! full state there
   end type itg_t
+
+  !> partitioned: re-partition when J_u is this many times worse conditioned than the best
+  !! choice now (docs/dynamics.md: measured on a double pendulum and the N-four-bar)
+  real(wp), parameter :: REPARTITION = 0.25_wp
 
   ! Dormand-Prince 5(4) tableau
   real(wp), parameter :: C2 = 0.2_wp, C3 = 0.3_wp, C4 = 0.8_wp, C5 = 8.0_wp / 9.0_wp
@@ -612,7 +617,7 @@ contains
         h = h * fac
       end if
       if (partitioned) then
-        if (needs_partition(m, w, c)) then
+        if (needs_partition(m, w, c, t)) then
           call partition(m, w, c, t, stt)
           if (stt /= MBD_OK) then
             status = MBD_INTEGRATOR_FAILED
@@ -795,22 +800,44 @@ contains
     c%st%partitions = c%st%partitions + 1
   end subroutine partition
 
-  !> J_u is ill conditioned at the current state (1/cond_1 < 1e-3): choose again.
-  logical function needs_partition(m, w, c)
+  !> 1/cond_1 of J(rows, cols) at the last assembly (0 when singular).
+  real(wp) function rcond_cols(w, cols) result(rc)
+    type(dyn_work_t), intent(inout) :: w
+    integer, intent(in) :: cols(:)
+    real(wp) :: ju(w%na, w%na), anorm, cw(4 * w%na)
+    integer :: piv(w%na), iw(w%na), stf, info
+    character(len=MSG_LEN) :: lmsg
+    ju = w%jac(w%rows, cols)
+    anorm = maxval(sum(abs(ju), dim=1))
+    rc = zero
+    call lu_factor(ju, piv, stf, lmsg)
+    if (stf /= MBD_OK) return
+    call dgecon('1', w%na, ju, w%na, anorm, rc, cw, iw, info)
+  end function rcond_cols
+
+  !> Choose again when the current J_u has become REPARTITION times worse conditioned
+  !! (1/cond_1) than the choice a QR with column pivoting of J would make now. Near a
+  !! singular configuration, where every J_u is ill conditioned, nothing better exists and
+  !! the partition is kept.
+  logical function needs_partition(m, w, c, t)
     type(model_t), intent(in) :: m
     type(dyn_work_t), intent(inout) :: w
     type(itg_t), intent(in) :: c
-    real(wp) :: ju(w%na, w%na), anorm, rc, cw(4 * w%na)
-    integer :: piv(w%na), iw(w%na), stf, info
-    character(len=MSG_LEN) :: lmsg
-    call assemble_dense(m, c%qf, w%qz, c%t0, w%phi, w%nu, w%gam, w%asm, w%jac)
-    ju = w%jac(w%rows, c%iu)
-    anorm = maxval(sum(abs(ju), dim=1))
-    call lu_factor(ju, piv, stf, lmsg)
-    needs_partition = stf /= MBD_OK
-    if (stf /= MBD_OK) return
-    call dgecon('1', w%na, ju, w%na, anorm, rc, cw, iw, info)
-    needs_partition = rc < 1.0e-3_wp
+    real(wp), intent(in) :: t
+    real(wp) :: rc, a(w%na, m%nq), tau(w%na), wq(1)
+    real(wp), allocatable :: work(:)
+    integer :: jp(m%nq), info, stat
+    call assemble_dense(m, c%qf, w%qz, t, w%phi, w%nu, w%gam, w%asm, w%jac)
+    rc = rcond_cols(w, c%iu)
+    a = w%jac(w%rows, :)
+    jp = 0
+    call dgeqp3(w%na, m%nq, a, w%na, jp, tau, wq, -1, info)
+    allocate (work(max(1, int(wq(1)))), stat=stat)
+    needs_partition = rc <= zero
+    if (stat /= 0 .or. info /= 0) return
+    call dgeqp3(w%na, m%nq, a, w%na, jp, tau, work, size(work), info)
+    if (info /= 0) return
+    needs_partition = rc < REPARTITION * rcond_cols(w, jp(1:w%na))
   end function needs_partition
 
   !> One classical Runge-Kutta step.
