@@ -39,7 +39,7 @@ module mbd_integrators
 
   integer, parameter :: METH_GENALPHA = 1, METH_DOPRI5 = 2, METH_RK4 = 3, METH_PARTITIONED = 4
   !> Default step limit: it ends a run whose steps collapse without underflowing, after
-  !! 10 s to a few minutes at 1-20 us a step (small models); a long run raises it.
+  !! 10 s to 10 minutes at 1-80 us a step (small models); a long run raises it.
   integer, parameter :: MAX_STEPS_DEFAULT = 10000000
 
   !> Integrator settings.
