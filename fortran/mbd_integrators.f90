@@ -167,9 +167,11 @@ contains
   !! velocity errors of all coordinates.) generalized-alpha keeps its own q_ddot, but its
   !! lambda_{n+1} is a second difference of positions (q_ddot_{n+1} = (q_{n+1} - q*) /
   !! (beta' h^2)), which carries the rounding of q amplified by 1 / (beta' h^2); its
-  !! reported multipliers are those of the state instead. lambda is the minimum-norm
-  !! solution of J^T lambda = Q - M q_ddot over all rows. If the solve fails at a state,
-  !! the row keeps its accelerations and lambda follows from them.
+  !! reported multipliers are those of the state instead. With independent rows lambda is
+  !! the solve's; otherwise (redundant rows, a rank-revealing solve near a singular
+  !! position, Baumgarte's stabilized accelerations) the minimum-norm solution of
+  !! J^T lambda = Q - M q_ddot over all rows. If the solve fails at a state, the row keeps
+  !! its accelerations and lambda follows from them.
   subroutine finish_outputs(m, w, c, qo, vo, ao, lo)
     type(model_t), intent(in) :: m
     type(dyn_work_t), intent(inout) :: w
@@ -185,6 +187,10 @@ contains
       call accel_at(m, w, c%opts, qo(:, r), vo(:, r), t, a1, lam, stt)
       if (stt == MBD_OK) then
         if (c%opts%method /= METH_GENALPHA) ao(:, r) = a1
+        if (w%na == m%neq .and. .not. w%lsq .and. c%opts%method /= METH_RK4) then
+          lo(:, r) = lam                ! independent rows: the solve's lambda is the one
+          cycle
+        end if
       else
         a1 = ao(:, r)
       end if
