@@ -516,7 +516,7 @@ contains
     character(len=MSG_LEN), intent(out) :: msg
     real(wp), allocatable :: y(:), ynew(:), k(:, :), e(:)
     real(wp) :: t, h, tnew, err, fac, qa(m%nq), va(m%nq), aa(m%nq)
-    integer :: stt
+    integer :: stt, nprev
     logical :: fixed, fsal
     integer :: nfix
     status = MBD_OK; msg = ''
@@ -611,7 +611,9 @@ contains
           return
         end if
       end if
+      nprev = c%nout
       call emit(c, qo, vo, ao, t, qa, va, aa, tnew, c%qf, c%vf, c%af)
+      if (partitioned) call complete_outputs(m, w, c, qo, vo, nprev + 1)
       qa = c%qf; va = c%vf; aa = c%af
       c%qs = qa; c%vs = va; c%as = aa; c%ts = tnew
       c%st%steps = c%st%steps + 1
@@ -748,6 +750,30 @@ contains
     call dyn_solve(w, w%rhs, stf)
     qdd = w%rhs(1:nn)
   end subroutine accel_at
+
+  !> partitioned: the outputs r0 .. c%nout just interpolated keep their independent
+  !! (v, v_dot), and the dependent (u, u_dot) are solved from them as at a stage, so every
+  !! output is a consistent state whose error is that of v's interpolant. An output where
+  !! the solve fails keeps the interpolant.
+  subroutine complete_outputs(m, w, c, qo, vo, r0)
+    type(model_t), intent(in) :: m
+    type(dyn_work_t), intent(inout) :: w
+    type(itg_t), intent(inout) :: c
+    real(wp), intent(inout) :: qo(:, :), vo(:, :)
+    integer, intent(in) :: r0
+    real(wp) :: qf(m%nq), vf(m%nq)
+    integer :: r, stt, newton
+    qf = c%qf; vf = c%vf; newton = c%st%newton
+    do r = r0, c%nout
+      c%qf = qo(:, r); c%vf = vo(:, r)
+      call solve_dependent(m, w, c, out_time(c, output_index(c%nsteps, c%every, r)), &
+                           vo(c%iv, r), stt)
+      if (stt == MBD_OK) then
+        qo(:, r) = c%qf; vo(:, r) = c%vf
+      end if
+    end do
+    c%qf = qf; c%vf = vf; c%st%newton = newton
+  end subroutine complete_outputs
 
   !> Dependent coordinates u from Phi(u, v) = 0 (Newton with J_u), then u_dot from
   !! J_u u_dot = nu - J_v v_dot.

@@ -10,23 +10,23 @@ Examples
 """
 from __future__ import annotations
 
-from .analysis import DofReport
+from .analysis.stepping import KinematicStepper
+from .description.functions import Harmonic, TimeFunction
 from .errors import (AnalysisError, AssemblyError, ConvergenceError, CoreError,
-                     InconsistentConstraintsError, IntegrationError, MbdError, MbdWarning,
-                     ModelError,
-                     RedundantConstraintWarning, SingularConfigurationError,
-                     SingularJacobianError, SingularPassageWarning, ToggleError)
-from .functions import Harmonic, TimeFunction
-from .model import Model
-from .stepping import KinematicStepper
-from .results import BodyResult, DynamicsResult, KinematicsResult, Reaction, StaticsResult
-from .toml_io import load, loads
+                     InconsistentConstraintsError, InsufficientMemoryError, IntegrationError,
+                     MbdError, MbdWarning, ModelError, RedundantConstraintWarning,
+                     SingularConfigurationError, SingularJacobianError, SingularPassageWarning,
+                     ToggleError)
+from .model import Model, load, loads
+from .results import (BodyResult, DofReport, DynamicsResult, KinematicsResult, Reaction,
+                      StaticsResult)
 
 __version__ = "0.1.0"
 
 __all__ = ["load", "loads", "Model", "TimeFunction", "Harmonic", "KinematicsResult",
-           "BodyResult", "DynamicsResult", "KinematicStepper", "StaticsResult", "Reaction", "DofReport",
-           "MbdError", "ModelError", "AnalysisError", "IntegrationError",
+           "BodyResult", "DynamicsResult", "KinematicStepper", "StaticsResult", "Reaction",
+           "DofReport", "MbdError", "ModelError", "AnalysisError", "IntegrationError",
            "AssemblyError", "InconsistentConstraintsError", "ConvergenceError",
            "SingularJacobianError", "SingularConfigurationError", "ToggleError", "CoreError",
-           "MbdWarning", "RedundantConstraintWarning", "SingularPassageWarning", "__version__"]
+           "InsufficientMemoryError", "MbdWarning", "RedundantConstraintWarning",
+           "SingularPassageWarning", "__version__"]

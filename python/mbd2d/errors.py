@@ -6,10 +6,7 @@ Every failure the engine knows of maps to one class here. Input mistakes raise
 """
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
-
-if TYPE_CHECKING:  # pragma: no cover
-    from .results import KinematicsResult
+from typing import Any
 
 
 class MbdError(Exception):
@@ -40,13 +37,14 @@ class AnalysisError(MbdError):
     t : float or None
         Time of the failure.
     results : KinematicsResult or None
-        The rows computed before the failure (possibly only t0, or none).
+        The rows computed before the failure (possibly only t0, or none). (Typed ``Any``
+        here: errors are the lowest layer and know no result class.)
     status : int
         The core's status code.
     """
 
     def __init__(self, message: str, *, t: float | None = None,
-                 results: "KinematicsResult | None" = None, status: int = 0,
+                 results: Any = None, status: int = 0,
                  **details: Any) -> None:
         super().__init__(message)
         self.t = t
@@ -125,11 +123,29 @@ class SingularPassageWarning(MbdWarning):
 
 
 class CoreError(MbdError):
-    """The Fortran core reported an internal error (a LAPACK argument error); a bug."""
+    """The Fortran core reported an internal error (a LAPACK argument error, or a status the
+    analysis cannot produce); a bug."""
+
+
+class InsufficientMemoryError(MbdError, MemoryError):
+    """An analysis needs more memory than it can get (refused before the run from an estimate,
+    or an allocation that failed). The message says how much was asked and what to change:
+    fewer steps, ``every=k`` to keep fewer output rows, ``solver="banded"`` for large models.
+
+    Attributes
+    ----------
+    nbytes : float or None
+        The size asked for, in bytes, when known.
+    """
+
+    def __init__(self, message: str, nbytes: float | None = None) -> None:
+        super().__init__(message)
+        self.nbytes = nbytes
 
 
 __all__ = ["MbdError", "ModelError", "AnalysisError", "AssemblyError",
            "InconsistentConstraintsError", "ConvergenceError", "SingularJacobianError",
            "IntegrationError",
-           "SingularConfigurationError", "ToggleError", "CoreError", "MbdWarning",
+           "SingularConfigurationError", "ToggleError", "CoreError", "InsufficientMemoryError",
+           "MbdWarning",
            "RedundantConstraintWarning", "SingularPassageWarning"]

@@ -7,13 +7,12 @@ round-trips exactly and ``mbd2d-solve`` reproduces the Python results.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING
 
-from .analysis import check_solver, check_span, require_determined
-from .pack import NCT, pack
-
-if TYPE_CHECKING:  # pragma: no cover
-    from .model import Model
+from ..binding.pack import pack
+from ..binding.tables import NCT
+from ..description.builder import ModelDescription
+from ..results.files import write_text
+from .settings import check_solver, check_span, require_determined
 
 HEADER = """\
 # mbd2d model file, format 1 (written by `mbd2d export`; run with `mbd2d-solve FILE OUT.csv`)
@@ -48,7 +47,7 @@ def _r(x: float) -> str:
     return f"{x:.17e}"
 
 
-def export(model: "Model", path: str | Path, t_end: float, steps: int, t0: float = 0.0,
+def export(model: ModelDescription, path: str | Path, t_end: float, steps: int, t0: float = 0.0,
            tol: float | None = None, maxit: int | None = None) -> None:
     """Write a model file for ``mbd2d-solve``.
 
@@ -75,4 +74,4 @@ def export(model: "Model", path: str | Path, t_end: float, steps: int, t0: float
     for i in range(0, n, 4):
         lines.append(" ".join(_r(float(v)) for v in p.rpar[i:i + 4]))
     lines.append("end")
-    Path(path).write_text("\n".join(lines) + "\n")
+    write_text(path, "\n".join(lines) + "\n", "export")

@@ -1,0 +1,111 @@
+"""Forward dynamics front door: M q_ddot + J^T lambda = Q, Phi = 0 integrated in one core
+call."""
+from __future__ import annotations
+
+import math
+import warnings
+from typing import Any
+
+from ..binding import core
+from ..binding.pack import pack, pack_dynamics
+from ..binding.status import ASSEMBLY_FAILED, INCONSISTENT, INTEGRATOR_FAILED, OK, error_for
+from ..description.builder import ModelDescription
+from ..errors import ModelError, RedundantConstraintWarning
+from ..results.dynamics import DynamicsResult
+from ..validate import number, whole
+from .failures import assembly_failed, bad_entry, inconsistent_at, row_names
+from .outputs import dynamics_result, finite_part
+from .settings import check_memory, check_span, output_rows, output_steps, time_grid
+
+METHODS = {"generalized-alpha": 1, "dopri5": 2, "baumgarte-rk4": 3, "partitioned": 4}
+DEFAULT_METHOD = "dopri5"
+MAX_STEPS_DEFAULT = 10_000_000     # the core's default limit on accepted + rejected steps
+INT32_MAX = 2**31 - 1
+
+
+def run_dynamics(model: ModelDescription, t_end: float, steps: int, method: str | None = None,
+                 rtol: float | None = None, atol: float | None = None, h: float | None = None,
+                 rho_inf: float | None = None, alpha: float | None = None,
+                 beta: float | None = None, t0: float = 0.0, every: Any = 1,
+                 max_steps: Any = None) -> DynamicsResult:
+    """Forward dynamics in one core call; see :meth:`mbd2d.Model.dynamics`."""
+    t0, t_end, steps = check_span(t0, t_end, steps)
+    nout = output_rows(steps, every)
+    every = int(every)
+    nmax = MAX_STEPS_DEFAULT if max_steps is None else \
+        whole(max_steps, "max_steps", "dynamics", 1, INT32_MAX)
+    method = DEFAULT_METHOD if method is None else method
+    if method not in METHODS:
+        raise ModelError(f"unknown method {method!r}; use one of {', '.join(METHODS)}",
+                         "dynamics")
+
+    def opt(v: Any, name: str, lo: float, hi: float, default: float) -> float:
+        if v is None:
+            return default
+        x = number(v, name, "dynamics")
+        if not lo <= x <= hi:
+            raise ModelError(f"{name} must be in [{lo:g}, {hi:g}], got {v!r}", "dynamics")
+        return x
+
+    rtol_v = opt(rtol, "rtol", 1e-14, 1.0, 0.0)
+    atol_v = opt(atol, "atol", 1e-16, 1e6, 0.0)
+    h_v = opt(h, "h", 1e-12, math.inf, 0.0)
+    if method == "baumgarte-rk4" and h is None:
+        raise ModelError("baumgarte-rk4 is a fixed-step method: give h (for example h=1e-3)",
+                         "dynamics")
+    if h is not None and method in ("dopri5", "partitioned"):
+        raise ModelError(f"{method} chooses its own steps from rtol and atol; h is for "
+                         "generalized-alpha and baumgarte-rk4", "dynamics")
+    rho_v = opt(rho_inf, "rho_inf", 0.0, 1.0, -1.0)
+    if method == "generalized-alpha" and h is None and rho_v >= 0.99:
+        # undamped, the algorithmic accelerations carry an oscillation the error
+        # estimate reads as error; the step then collapses
+        raise ModelError(f"error-controlled generalized-alpha needs numerical damping: "
+                         f"rho_inf={rho_v:g} is too close to 1; use rho_inf <= 0.9 or give "
+                         "a fixed step h", "dynamics")
+    alpha_v = opt(alpha, "alpha", 0.0, 1e9, -1.0)
+    beta_v = opt(beta, "beta", 0.0, 1e9, -1.0)
+    p = pack(model)
+    d = pack_dynamics(model, p)
+    check_memory(nout, 3 * p.nq + p.neq + 4, "dynamics", dense=(p.nq + p.neq, p.nq + p.neq))
+    idx = output_steps(steps, every)
+    out = core.dynamics(p, d, t0, t_end, steps, METHODS[method], rtol_v, atol_v, h_v, rho_v,
+                        alpha_v, beta_v, every, nout, nmax)
+    iinfo, rinfo, status = out.iinfo, out.rinfo, out.status
+    n = int(iinfo[0])
+    t = time_grid(t0, t_end, steps, idx)
+    _, red_rows = row_names(p, model, out.red)
+    stats = {"method": method, "steps": int(iinfo[2]), "rejected_steps": int(iinfo[3]),
+             "newton_iterations": int(iinfo[4]), "rhs_evaluations": int(iinfo[5]),
+             "iteration_matrices": int(iinfo[6]), "factorizations": int(iinfo[9]),
+             "partitions": int(iinfo[7]),
+             "h_min": float(rinfo[1]) if iinfo[2] else None,
+             "h_max": float(rinfo[2]) if iinfo[2] else None, "redundant_rows": red_rows}
+    res, bad = finite_part(dynamics_result(model, p, t, n, out, stats, status == OK))
+    if red_rows:
+        warnings.warn(f"redundant constraints: {', '.join(red_rows)} are left out of the equations "
+                      "of motion; the reported multipliers are the minimum-norm set (the "
+                      "reactions are statically indeterminate)", RedundantConstraintWarning,
+                      stacklevel=3)
+    if status == OK and bad is None:
+        return res
+    text = out.msg
+    last = f"t = {res.t[-1]:.6g} s" if len(res.t) else "no output rows"
+    kept = f"Results up to {last} are kept in the exception's .results."
+    if status == OK:
+        raise error_for("dynamics", INTEGRATOR_FAILED,
+                        f"{method}: the solution became non-finite at t = {t[bad]:.6g} s (a "
+                        f"blow-up: try a smaller rtol or h, or another method). {kept}",
+                        t=t[bad], results=res)
+    if status < 0:
+        raise error_for("dynamics", status, text, entry=bad_entry(model, int(iinfo[1])))
+    tf = float(rinfo[0])
+    if status == ASSEMBLY_FAILED:
+        raise assembly_failed("dynamics", model, 0.0, 0, t0, res)
+    if status == INCONSISTENT and not len(res.t):
+        raise inconsistent_at("dynamics", model, p, t0, res, f"{method}: {text}")
+    if status == INTEGRATOR_FAILED:
+        text = f"{method}: {text}. {kept}"
+    else:
+        text = f"{method}: {text}"
+    raise error_for("dynamics", status, text, t=tf, results=res)

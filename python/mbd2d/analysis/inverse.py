@@ -1,0 +1,60 @@
+"""Inverse dynamics front door: kinematics of the driven model plus the multipliers, energies
+and (on demand) reactions at every output, in one core call."""
+from __future__ import annotations
+
+import warnings
+from typing import Any
+
+from ..binding import core
+from ..binding.pack import pack, pack_dynamics
+from ..binding.status import NO_CONVERGENCE, OK, error_for
+from ..description.builder import ModelDescription
+from ..errors import RedundantConstraintWarning
+from ..results.dynamics import DynamicsResult
+from .failures import BAD_FORCE, bad_entry, kinematic_failure, row_names
+from .outputs import dynamics_result, finite_part
+from .settings import (check_memory, check_solver, check_span, output_rows, output_steps,
+                       require_determined, solver_code, time_grid)
+
+
+def run_inverse(model: ModelDescription, t_end: float, steps: int, t0: float = 0.0,
+                tol: float | None = None, every: Any = 1, solver: str = "auto") -> DynamicsResult:
+    """Kinematics plus the multipliers, energies and (on demand) reactions at every output.
+
+    See :meth:`mbd2d.Model.inverse_dynamics`.
+    """
+    t0, t_end, steps = check_span(t0, t_end, steps)
+    tol_v, _ = check_solver(tol, None)
+    nout = output_rows(steps, every)
+    code = solver_code(solver)
+    p = pack(model)
+    require_determined(p, model)
+    d = pack_dynamics(model, p)
+    check_memory(nout, 3 * p.nq + p.neq + 4, "inverse dynamics",
+                 dense=(p.nq + p.neq, p.nq + p.neq))
+    idx = output_steps(steps, every)
+    out = core.inverse(p, d, t0, t_end, steps, tol_v, int(every), code, nout)
+    iinfo, status = out.iinfo, out.status
+    n = int(iinfo[0])
+    t = time_grid(t0, t_end, steps, idx)
+    _, red_rows = row_names(p, model, out.red)
+    stats = {"newton_corrections": int(iinfo[5]), "factorizations": int(iinfo[6]),
+             "rejected_steps": int(iinfo[7]), "rank": int(iinfo[8]),
+             "redundant_rows": red_rows,
+             "singular_passages": [float(x) for x in out.tpass[:min(int(iinfo[9]), 64)]]}
+    res, bad = finite_part(dynamics_result(model, p, t, n, out, stats, status == OK))
+    if red_rows:
+        warnings.warn(f"redundant constraints: {', '.join(red_rows)}; the multipliers are the "
+                      "minimum-norm set (the reactions are statically indeterminate)",
+                      RedundantConstraintWarning, stacklevel=3)
+    if status == OK and bad is None:
+        return res
+    if status == OK:
+        raise error_for("inverse", NO_CONVERGENCE,
+                        f"the run gave non-finite values at t = {t[bad]:.6g} s; results up to "
+                        f"there ({bad} rows) are kept in the exception's .results", t=t[bad],
+                        results=res)
+    if status < 0 and iinfo[1] <= BAD_FORCE:
+        raise error_for("inverse", status, out.msg, entry=bad_entry(model, int(iinfo[1])))
+    raise kinematic_failure("inverse", model, p, status, out.msg, iinfo, out.rinfo, out.qsing,
+                            out.dep, out.red, res)

@@ -1,0 +1,49 @@
+"""Statics front door: static equilibrium near the q0 estimates, in one core call."""
+from __future__ import annotations
+
+import numpy as np
+
+from ..binding import core
+from ..binding.pack import pack, pack_dynamics
+from ..binding.status import (ASSEMBLY_FAILED, INCONSISTENT, NO_CONVERGENCE, OK, SINGULAR,
+                              error_for)
+from ..description.builder import ModelDescription
+from ..results.statics import StaticsResult
+from ..validate import number
+from .failures import assembly_failed, bad_entry, inconsistent_at
+from .settings import check_memory
+
+STABILITY = {1: "stable", 0: "unstable", -1: "neutral", 2: "fully constrained"}
+
+
+def run_statics(model: ModelDescription, t: float = 0.0) -> StaticsResult:
+    """Static equilibrium near the q0 estimates; see :meth:`mbd2d.Model.statics`."""
+    t = number(t, "t", "statics")
+    p = pack(model)
+    d = pack_dynamics(model, p)
+    check_memory(0, 0, "statics", dense=(p.nq + p.neq, p.nq + p.neq))
+    out = core.statics(p, d, t)
+    status, text = out.status, out.msg
+    if status < 0:
+        raise error_for("statics", status, text, entry=bad_entry(model, int(out.iinfo[1])))
+    if status == ASSEMBLY_FAILED:
+        raise assembly_failed("statics", model, float(out.resid), 0, t, None)
+    if status == INCONSISTENT:
+        raise inconsistent_at("statics", model, p, t, None, text)
+    if status == NO_CONVERGENCE:
+        text = f"{text} (no equilibrium found near the q0 estimates; give q0 closer to one)"
+    elif status == SINGULAR:
+        text = (f"{text} (the equilibrium is not unique: a motion without stiffness, such as "
+                "a free rotation, is left; add a spring or a driver)")
+    if status != OK:
+        raise error_for("statics", status, text, t=t, residual=float(out.resid))
+    if not (np.isfinite(out.q).all() and np.isfinite(out.lam).all()
+            and np.isfinite(out.resid)):
+        raise error_for("statics", NO_CONVERGENCE, "the equilibrium iteration gave non-finite "
+                        "values; give q0 closer to an equilibrium", t=t,
+                        residual=float(out.resid))
+    return StaticsResult(t=t, q=out.q, lam=out.lam,
+                         stability=STABILITY.get(int(out.stable), "unknown"),
+                         residual=float(out.resid), body_names=p.body_names,
+                         coordinate_names=p.coordinate_names, row_labels=p.row_labels,
+                         model=model, packed=p)
