@@ -338,14 +338,14 @@ def test_generalized_alpha_without_damping_grows_a_sawtooth(model: str, t_end: f
 
 def test_generalized_alpha_without_damping_small_step_grows_without_an_error() -> None:
     """At h = 1e-3 the rho_inf = 1 run of the free four-bar reaches 10 s without an error,
-    but the scheme's accelerations end near 5e5 m/s^2 (physical: below 30) and J q_dot - nu
-    near 0.1."""
+    but the scheme's accelerations end near 2e5 rad/s^2 (physical: below 30) and J q_dot - nu
+    near 0.02."""
     m = free_fourbar()
     und = m.dynamics(10.0, 1000, method="generalized-alpha", h=1e-3, rho_inf=1.0)
     assert window(und, und.qdd, 0, 4) < 30.0                      # measured 29.3
-    assert window(und, und.qdd, 9, 10) > 1e5                      # measured 5.3e5
-    assert window(und, und.drift_velocity, 9, 10) > 1e-2          # measured 8.5e-2
-    assert energy_error(und)[-1] > 0.1                            # measured 1.33 J
+    assert window(und, und.qdd, 9, 10) > 1e5                      # measured 1.8e5
+    assert window(und, und.drift_velocity, 9, 10) > 1e-2          # measured 2.3e-2
+    assert energy_error(und)[-1] > 0.1                            # measured 0.33 J
     assert und.drift_position.max() < 1e-10
 
 
