@@ -476,7 +476,7 @@ contains
   !! rinfo: 1 time of a failure, 2 smallest step, 3 largest step.
   subroutine api_dynamics(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, v0, t0, t1, nsteps, &
                           method, rtol, atol, h, rho_inf, balpha, bbeta, every, qout, qdout, &
-                          qddout, lamout, eout, iinfo, rinfo, redundant, status, msg)
+                          qddout, lamout, eout, iinfo, rinfo, redundant, status, msg, max_steps)
     integer, intent(in) :: nb, ctab(:, :), ftab(:, :), nsteps, method
     integer, intent(in) :: every                !! store every every-th output (and the last)
     real(wp), intent(in) :: rpar(:), bmass(:, :), grav(2), fpar(:), q0(:), v0(:), t0, t1
@@ -489,6 +489,7 @@ contains
     integer, intent(out) :: redundant(:)
     integer, intent(out) :: status              !! MBD_OK, < 0 input, > 0 numerical
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    integer, intent(in) :: max_steps            !! step limit (accepted + rejected); 0: default
     type(model_t) :: m
     type(dyn_work_t) :: w
     type(kin_work_t) :: kw
@@ -498,8 +499,7 @@ contains
     type(dyn_stats_t) :: dst
     real(wp), allocatable :: q(:), qd(:)
     real(wp) :: t, lscale
-    integer :: bad, badf, k, ko, nout, st, ierr
-    character(len=MSG_LEN) :: lmsg
+    integer :: bad, badf, k, ko, nout, ierr
     iinfo = 0; rinfo = zero; redundant = 0
     qout = zero; qdout = zero; qddout = zero; lamout = zero; eout = zero
     call build_dynamic(nb, ctab, rpar, bmass, grav, ftab, fpar, m, status, msg, bad, badf)
@@ -509,8 +509,9 @@ contains
                finite([rtol, atol, h, rho_inf, balpha, bbeta]))) then
       call not_finite('q0, v0, the times and the settings', status, msg); return
     end if
-    if (nsteps < 0 .or. .not. (t1 > t0) .or. every < 1) then
-      status = MBD_BAD_SETTING; msg = 'steps must be >= 0, every >= 1 and t_end > t0'; return
+    if (nsteps < 0 .or. .not. (t1 > t0) .or. every < 1 .or. max_steps < 0) then
+      status = MBD_BAD_SETTING
+      msg = 'steps must be >= 0, every >= 1, max_steps >= 0 and t_end > t0'; return
     end if
     if (size(q0) /= m%nq .or. size(v0) /= m%nq .or. size(qout, 1) /= m%nq .or. &
         size(qout, 2) /= output_rows(nsteps, every) .or. size(lamout, 1) /= m%neq .or. &
@@ -556,8 +557,9 @@ contains
     if (rho_inf >= zero) opts%rho_inf = min(rho_inf, one)
     if (balpha >= zero) opts%balpha = balpha
     if (bbeta >= zero) opts%bbeta = bbeta
-    call integrate(m, w, q, qd, t0, t1, nsteps, every, opts, qout, qdout, qddout, nout, dst, &
-                   status, msg)
+    if (max_steps > 0) opts%max_steps = max_steps
+    call integrate(m, w, q, qd, t0, t1, nsteps, every, opts, qout, qdout, qddout, lamout, nout, &
+                   dst, status, msg)
     iinfo(1) = nout; iinfo(3) = dst%steps; iinfo(4) = dst%rejected; iinfo(5) = dst%newton
     iinfo(6) = dst%rhs; iinfo(7) = dst%jacobians; iinfo(8) = dst%partitions
     iinfo(10) = dst%factorizations
@@ -567,10 +569,6 @@ contains
       ko = output_index(nsteps, every, k)
       t = t0 + (t1 - t0) * (real(ko, wp) / max(nsteps, 1))
       if (ko == nsteps) t = t1
-      call dyn_multipliers(m, w, qout(:, k), qdout(:, k), qddout(:, k), t, lamout(:, k), st, lmsg)
-      if (st == MBD_NO_MEMORY .and. status == MBD_OK) then
-        status = st; msg = lmsg; return
-      end if
       call state_measures(m, w, qout(:, k), qdout(:, k), t, eout(:, k))
     end do
     call units(m, qout, m%cunit, .false.); call units(m, qdout, m%cunit, .false.)

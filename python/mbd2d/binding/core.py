@@ -98,14 +98,14 @@ def inverse(p: Packed, d: DynamicTables, t0: float, t1: float, steps: int, tol: 
 
 def dynamics(p: Packed, d: DynamicTables, t0: float, t1: float, steps: int, method: int,
              rtol: float, atol: float, h: float, rho_inf: float, alpha: float, beta: float,
-             every: int, nrow: int) -> SimpleNamespace:
+             every: int, nrow: int, max_steps: int) -> SimpleNamespace:
     """Forward dynamics: ``q``, ``qd``, ``qdd``, ``lam``, ``e``, ``iinfo``, ``rinfo``, ``red``,
-    ``status``, ``msg``."""
+    ``status``, ``msg``. max_steps: the limit on accepted plus rejected steps."""
     return _named("q qd qdd lam e iinfo rinfo red status msg", _core.core_dynamics,
                   ctab=p.ctab, rpar=p.rpar, bmass=d.bmass, grav=d.grav, ftab=d.ftab,
                   fpar=d.fpar, neq=p.neq, q0=p.q0, v0=d.v0, t0=t0, t1=t1, nsteps=steps,
                   method=method, rtol=rtol, atol=atol, h=h, rho_inf=rho_inf, balpha=alpha,
-                  bbeta=beta, every=every, nrow=nrow,
+                  bbeta=beta, every=every, nrow=nrow, max_steps=max_steps,
                   numbers=(3 * p.nq + p.neq + 4) * nrow + p.neq)
 
 
