@@ -20,11 +20,11 @@ module mbd_api
   use mbd_points, only: NLOC, MAXROW
   use mbd_model, only: model_t, model_build, model_add_dynamics, model_force_size
   use mbd_dynamics, only: dyn_work_t, dyn_init, dyn_memory_check, dyn_velocity, &
-                          dyn_multipliers, dyn_reactions, &
-                          gen_forces, kinetic_energy
+                          dyn_multipliers, dyn_reactions, dyn_assemble, dyn_choose, dyn_jv, &
+                          gen_forces, kinetic_energy, SOLVER_DENSE
   use mbd_integrators, only: dyn_opts_t, dyn_stats_t, integrate, output_rows, output_index
   use mbd_statics, only: statics_solve
-  use mbd_assemble, only: assemble_dense, asm_work_t, asm_init
+  use mbd_assemble, only: assemble_dense, assemble_blocks, asm_work_t, asm_init
   use mbd_kinematics, only: kin_opts_t, kin_report_t, kin_work_t, kin_run, kin_work_init, &
                             kin_assemble, kin_rank, kin_out_count, MAXPASS, SOLVER_AUTO, &
                             SOLVER_BANDED, kin_newton, kin_vel_acc
@@ -390,21 +390,19 @@ contains
     real(wp), intent(in) :: q(:), qd(:), t
     real(wp), intent(out) :: e(4)
     real(wp) :: v
-    integer :: j
-    call assemble_dense(m, q, w%qz, t, w%phi, w%nu, w%gam, w%asm, w%jac)
+    call assemble_blocks(m, q, w%qz, t, w%phi, w%nu, w%gam, w%asm)
     e(3) = maxval(abs(w%phi) * m%rowunit)
-    w%phi = -w%nu                ! J q_dot - nu by columns (matmul would make a temporary)
-    do j = 1, size(qd)
-      w%phi = w%phi + w%jac(:, j) * qd(j)
-    end do
-    e(4) = maxval(abs(w%phi) * m%rowunit)
+    call dyn_jv(m, w, qd)        ! J q_dot from the blocks (no dense J)
+    e(4) = maxval(abs(w%jv - w%nu) * m%rowunit)
     call gen_forces(m, q, qd, t, w%force, v)
     e(1) = kinetic_energy(m, qd); e(2) = v
   end subroutine state_measures
 
   !> Inverse dynamics: a kinematic run, then at every output the multipliers
   !! lambda (minimum norm over all rows) of J^T lambda = Q - M q_ddot, and the energies.
-  !! iinfo/rinfo as api_kinematics; iinfo(2) = -force index for a bad force.
+  !! iinfo/rinfo as api_kinematics; iinfo(2) = -force index for a bad force; rinfo(8) the
+  !! multipliers' path (1 dense, 2 band: saddle-point solves, dyn_multipliers), chosen by
+  !! solver as for dynamics (dyn_choose).
   subroutine api_inverse(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, t0, t1, nsteps, tol, &
                          every, solver, qout, qdout, qddout, lamout, eout, iinfo, rinfo, qsing, &
                          dep, redundant, tpass, status, msg)
@@ -423,7 +421,7 @@ contains
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
     type(model_t) :: m
     type(dyn_work_t) :: w
-    integer :: bad, badf, k, st
+    integer :: bad, badf, k, st, path, kl, ku
     real(wp) :: t
     character(len=MSG_LEN) :: lmsg
     lamout = zero; eout = zero
@@ -434,8 +432,10 @@ contains
       qsing = zero; dep = 0; redundant = 0; tpass = zero
       return
     end if
-    ! the multipliers are dense: check the memory before the (possibly long) kinematic run
-    call dyn_memory_check(m, status, msg)
+    ! the multipliers' path (dense or band, as dynamics; solver as for the kinematics);
+    ! a dense one must fit: check before the (possibly long) kinematic run
+    call dyn_choose(m, solver, path, kl, ku, status, msg)
+    if (status == MBD_OK .and. path == SOLVER_DENSE) call dyn_memory_check(m, status, msg)
     if (status /= MBD_OK) then
       qout = zero; qdout = zero; qddout = zero; iinfo = 0; rinfo = zero
       qsing = zero; dep = 0; redundant = 0; tpass = zero
@@ -443,11 +443,12 @@ contains
     end if
     call api_kinematics(nb, ctab, rpar, q0, t0, t1, nsteps, tol, 0, zero, every, solver, qout, &
                         qdout, qddout, iinfo, rinfo, qsing, dep, redundant, tpass, status, msg)
+    rinfo(8) = path
     if (iinfo(1) < 1) return
     ! the multipliers in the core's units (so the rank decisions do not depend on the unit)
     call units(m, qout, m%cunit, .true.); call units(m, qdout, m%cunit, .true.)
     call units(m, qddout, m%cunit, .true.)
-    call dyn_init(m, w, qout(:, 1), t0, 1.0e-12_wp, st, lmsg)
+    call dyn_init(m, w, qout(:, 1), t0, 1.0e-12_wp, st, lmsg, path)
     if (st == MBD_NO_MEMORY) then
       status = st; msg = lmsg
     else if (st == MBD_OK) then
@@ -473,10 +474,14 @@ contains
   !! iinfo: 1 outputs, 2 bad entry, 3 steps, 4 rejected, 5 Newton iterations, 6 right-hand
   !! sides, 7 iteration matrices (K, C evaluations), 8 partitions, 9 active (independent)
   !! constraint rows, 10 LU factorizations of the generalized-alpha iteration matrix.
-  !! rinfo: 1 time of a failure, 2 smallest step, 3 largest step.
+  !! rinfo: 1 time of a failure, 2 smallest step, 3 largest step, 5 linear solver (1 dense,
+  !! 2 banded), 6 and 7 the band widths kl and ku of the saddle-point matrix.
+  !! solver: 0 auto, 1 dense, 2 banded (dyn_choose); the band path assembles q0 by
+  !! Levenberg-Marquardt in band storage (dyn_assemble) and never allocates n x n.
   subroutine api_dynamics(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, v0, t0, t1, nsteps, &
                           method, rtol, atol, h, rho_inf, balpha, bbeta, every, qout, qdout, &
-                          qddout, lamout, eout, iinfo, rinfo, redundant, status, msg, max_steps)
+                          qddout, lamout, eout, iinfo, rinfo, redundant, status, msg, max_steps, &
+                          solver)
     integer, intent(in) :: nb, ctab(:, :), ftab(:, :), nsteps, method
     integer, intent(in) :: every                !! store every every-th output (and the last)
     real(wp), intent(in) :: rpar(:), bmass(:, :), grav(2), fpar(:), q0(:), v0(:), t0, t1
@@ -490,16 +495,15 @@ contains
     integer, intent(out) :: status              !! MBD_OK, < 0 input, > 0 numerical
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
     integer, intent(in) :: max_steps            !! step limit (accepted + rejected); 0: default
+    integer, intent(in) :: solver               !! 0 auto, 1 dense, 2 banded
     type(model_t) :: m
     type(dyn_work_t) :: w
-    type(kin_work_t) :: kw
     type(kin_opts_t) :: kopts
-    type(kin_report_t) :: rep
     type(dyn_opts_t) :: opts
     type(dyn_stats_t) :: dst
     real(wp), allocatable :: q(:), qd(:)
     real(wp) :: t, lscale
-    integer :: bad, badf, k, ko, nout, ierr
+    integer :: bad, badf, k, ko, nout, ierr, path, kl, ku
     iinfo = 0; rinfo = zero; redundant = 0
     qout = zero; qdout = zero; qddout = zero; lamout = zero; eout = zero
     call build_dynamic(nb, ctab, rpar, bmass, grav, ftab, fpar, m, status, msg, bad, badf)
@@ -518,28 +522,28 @@ contains
         size(redundant) /= m%neq) then
       status = MBD_BAD_COUNT; msg = 'array sizes do not match the model'; return
     end if
-    ! the dense dynamics must fit (checked before the assembly allocates its dense J)
-    call dyn_memory_check(m, status, msg)
+    call dyn_choose(m, solver, path, kl, ku, status, msg)
     if (status /= MBD_OK) return
-    ! assembly at t0 (Levenberg-Marquardt; any number of equations)
-    call kin_work_init(m, kw, status, msg)
+    rinfo(5) = path; rinfo(6) = kl; rinfo(7) = ku
+    ! the dense dynamics must fit (checked before the assembly allocates its dense J)
+    if (path == SOLVER_DENSE) call dyn_memory_check(m, status, msg)
     if (status /= MBD_OK) return
     lscale = m%lscale
-    kw%tol = kopts%tol * lscale
-    allocate (q(m%nq), qd(m%nq), rep%qsing(m%nq), stat=ierr)
-    if (ierr == 0) allocate (rep%dep(m%neq), rep%redundant(m%neq), stat=ierr)
+    allocate (q(m%nq), qd(m%nq), stat=ierr)
     if (ierr /= 0) then
-      call mem_fail(REAL_BYTES * (3 * real(m%nq, wp) + m%neq), 'the state vectors', &
+      call mem_fail(REAL_BYTES * 2 * real(m%nq, wp), 'the state vectors', &
                     'use a smaller model', status, msg)
       return
     end if
     q = q0 / m%cunit
-    call kin_assemble(m, kw, q, t0, kopts, rep, status, msg)
+    ! assembly at t0 (Levenberg-Marquardt; any number of equations)
+    call assemble_start(m, path, q, t0, kopts, status, msg)
     if (status /= MBD_OK) then
       rinfo(1) = t0; return
     end if
-    call dyn_init(m, w, q, t0, kw%tol, status, msg)
+    call dyn_init(m, w, q, t0, kopts%tol * lscale, status, msg, path)
     if (status /= MBD_OK) return
+    rinfo(6) = w%sd%kl; rinfo(7) = w%sd%ku
     iinfo(9) = w%na
     do k = 1, m%neq
       if (.not. any(w%rows == k)) redundant(k) = 1
@@ -575,23 +579,57 @@ contains
     call units(m, qddout, m%cunit, .false.); call units(m, lamout, m%rowunit, .true.)
   end subroutine api_dynamics
 
+  !> The assembly at the start of dynamics and statics: Levenberg-Marquardt from the q0
+  !! estimates to ||Phi||_inf <= tol (relative to the length scale), with a dense J
+  !! (kin_assemble, with its diagnosis of contradicting redundant constraints) or in band
+  !! storage (dyn_assemble).
+  subroutine assemble_start(m, path, q, t, kopts, status, msg)
+    type(model_t), intent(in) :: m              !! model
+    integer, intent(in) :: path                 !! SOLVER_DENSE or SOLVER_BANDED
+    real(wp), intent(inout) :: q(:)             !! estimates, then assembled (core units)
+    real(wp), intent(in) :: t                   !! time
+    type(kin_opts_t), intent(in) :: kopts       !! settings (tol, assembly_maxit)
+    integer, intent(out) :: status              !! MBD_OK or the assembly's failure
+    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    type(kin_work_t) :: kw
+    type(kin_report_t) :: rep
+    integer :: ierr, worst
+    real(wp) :: resid
+    msg = ''
+    if (path /= SOLVER_DENSE) then
+      call dyn_assemble(m, q, t, kopts%tol * m%lscale, kopts%assembly_maxit, status, msg, &
+                        worst, resid)
+      return
+    end if
+    call kin_work_init(m, kw, status, msg)
+    if (status /= MBD_OK) return
+    kw%tol = kopts%tol * m%lscale
+    allocate (rep%qsing(m%nq), rep%dep(m%neq), rep%redundant(m%neq), stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail(REAL_BYTES * (real(m%nq, wp) + m%neq), 'the assembly report', &
+                    'use a smaller model', status, msg)
+      return
+    end if
+    call kin_assemble(m, kw, q, t, kopts, rep, status, msg)
+  end subroutine assemble_start
+
   !> Static equilibrium near the assembled q0 at time t, its multipliers and stability
-  !! (1 stable, 0 unstable, -1 neutral, 2 no free motion).
+  !! (1 stable, 0 unstable, -1 neutral, 2 no free motion). solver: 0 auto, 1 dense,
+  !! 2 banded (dyn_choose); iinfo(5) the path taken (1 dense, 2 banded), iinfo(6), iinfo(7)
+  !! the band widths of the saddle-point matrix.
   subroutine api_statics(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, t, q, lam, stable, resid, &
-                         iinfo, status, msg)
+                         iinfo, status, msg, solver)
     integer, intent(in) :: nb, ctab(:, :), ftab(:, :)
     real(wp), intent(in) :: rpar(:), bmass(:, :), grav(2), fpar(:), q0(:), t
     real(wp), intent(out) :: q(:), lam(:), resid
     integer, intent(out) :: stable, iinfo(NINFO)
     integer, intent(out) :: status              !! MBD_OK, < 0 input, > 0 numerical
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    integer, intent(in) :: solver               !! 0 auto, 1 dense, 2 banded
     type(model_t) :: m
     type(dyn_work_t) :: w
-    type(kin_work_t) :: kw
     type(kin_opts_t) :: kopts
-    type(kin_report_t) :: rep
-    real(wp) :: lscale
-    integer :: bad, badf, ierr
+    integer :: bad, badf, path, kl, ku
     q = zero; lam = zero; stable = 0; resid = zero; iinfo = 0
     call build_dynamic(nb, ctab, rpar, bmass, grav, ftab, fpar, m, status, msg, bad, badf)
     iinfo(2) = bad; if (badf /= 0) iinfo(2) = -1000000 - badf
@@ -602,22 +640,18 @@ contains
     if (size(q0) /= m%nq .or. size(q) /= m%nq .or. size(lam) /= m%neq) then
       status = MBD_BAD_COUNT; msg = 'array sizes do not match the model'; return
     end if
-    call dyn_memory_check(m, status, msg)
+    call dyn_choose(m, solver, path, kl, ku, status, msg)
     if (status /= MBD_OK) return
-    call kin_work_init(m, kw, status, msg)
+    iinfo(5) = path; iinfo(6) = kl; iinfo(7) = ku
+    if (path == SOLVER_DENSE) call dyn_memory_check(m, status, msg)
     if (status /= MBD_OK) return
-    lscale = m%lscale
-    kw%tol = kopts%tol * lscale
-    allocate (rep%qsing(m%nq), rep%dep(m%neq), rep%redundant(m%neq), stat=ierr)
-    if (ierr /= 0) then
-      call mem_fail(REAL_BYTES * (real(m%nq, wp) + m%neq), 'the assembly report', &
-                    'use a smaller model', status, msg)
-      return
-    end if
     q = q0 / m%cunit
-    call kin_assemble(m, kw, q, t, kopts, rep, status, msg)
-    if (status == MBD_OK) call dyn_init(m, w, q, t, kw%tol, status, msg)
-    if (status == MBD_OK) call statics_solve(m, w, q, t, lam, stable, resid, status, msg)
+    call assemble_start(m, path, q, t, kopts, status, msg)
+    if (status == MBD_OK) call dyn_init(m, w, q, t, kopts%tol * m%lscale, status, msg, path)
+    if (status == MBD_OK) then
+      iinfo(6) = w%sd%kl; iinfo(7) = w%sd%ku
+      call statics_solve(m, w, q, t, lam, stable, resid, status, msg)
+    end if
     q = q * m%cunit; lam = lam / m%rowunit
   end subroutine api_statics
 

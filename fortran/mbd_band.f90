@@ -39,7 +39,7 @@ module mbd_band
   implicit none
   private
   public :: band_t, band_plan, band_move, band_zero, band_norm1, band_factor, band_rcond, &
-            band_solve
+            band_solve, band_plan_perm, band_graph, band_rcm, band_matvec
 
   !> A planned band matrix: the ordering, the band storage, the factors and all workspace.
   type :: band_t
@@ -53,6 +53,9 @@ module mbd_band
     real(wp), allocatable :: rhs(:)     !! permuted right-hand side (n)
     integer :: perm_sign = 1            !! sign of the two permutations (det P_r det P_c)
     logical :: factored = .false.       !! ab holds the LU factors
+    !> factor and solve in plain loops (band_lu, same pivoting and storage as dgbtf2 and
+    !! dgbtrs): for narrow bands, where the BLAS calls per column cost more than the work
+    logical :: plain = .false.
   end type band_t
 
 contains
@@ -68,7 +71,7 @@ contains
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
     integer, allocatable :: rptr(:), rcol(:), cptr(:), crow(:), aptr(:), adj(:), order(:)
     integer, allocatable :: prow(:), pcol(:)
-    integer :: k, kl, ku, ldab, ierr
+    integer :: k, kl, ku, ierr
     character(len=*), parameter :: HINT = 'use a smaller model'
     status = MBD_OK; msg = ''
     if (n < 1) then
@@ -133,6 +136,56 @@ contains
       return
     end if
 
+    call band_storage(n, kl, ku, prow, pcol, b, status, msg)
+  end subroutine band_plan
+
+  !> Plan a band matrix with a given ordering: B(prow(i), pcol(j)) = A(i, j) for the
+  !! structural nonzeros (rows(k), cols(k)) of A; kl and ku follow from them. For a
+  !! symmetric ordering of a structurally symmetric matrix (the saddle-point matrices of
+  !! mbd_saddle) pass the same permutation twice. Allocates (once per structure).
+  subroutine band_plan_perm(n, rows, cols, prow, pcol, b, status, msg)
+    integer, intent(in) :: n                    !! size of the square A
+    integer, intent(in) :: rows(:), cols(:)     !! structural nonzeros (1-based, repeats allowed)
+    integer, intent(in) :: prow(:), pcol(:)     !! positions of the rows and columns (n each)
+    type(band_t), intent(out) :: b              !! the plan; n = 0 on failure
+    integer, intent(out) :: status              !! MBD_OK, MBD_BAD_INPUT or MBD_NO_MEMORY
+    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    integer, allocatable :: pr(:), pc(:)
+    integer :: k, kl, ku, ierr
+    status = MBD_OK; msg = ''
+    if (n < 1 .or. size(rows) /= size(cols) .or. size(prow) /= n .or. size(pcol) /= n) then
+      status = MBD_BAD_INPUT
+      write (msg, '(a,i0)') 'band_plan_perm: inconsistent sizes for a matrix of size ', n
+      return
+    end if
+    kl = 0; ku = 0
+    do k = 1, size(rows)
+      if (rows(k) < 1 .or. rows(k) > n .or. cols(k) < 1 .or. cols(k) > n) then
+        status = MBD_BAD_INPUT
+        write (msg, '(a,i0,a,i0,a,i0,a,i0)') 'band_plan_perm: nonzero ', k, ' at (', &
+          rows(k), ', ', cols(k), ') is outside 1..', n
+        return
+      end if
+      kl = max(kl, prow(rows(k)) - pcol(cols(k)))
+      ku = max(ku, pcol(cols(k)) - prow(rows(k)))
+    end do
+    allocate (pr(n), pc(n), stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail(8 * real(n, wp), 'the band ordering', 'use a smaller model', status, msg)
+      return
+    end if
+    pr = prow; pc = pcol
+    call band_storage(n, kl, ku, pr, pc, b, status, msg)
+  end subroutine band_plan_perm
+
+  !> The storage and workspace of a planned band matrix (the permutations are moved in).
+  subroutine band_storage(n, kl, ku, prow, pcol, b, status, msg)
+    integer, intent(in) :: n, kl, ku
+    integer, allocatable, intent(inout) :: prow(:), pcol(:)
+    type(band_t), intent(inout) :: b
+    integer, intent(out) :: status
+    character(len=MSG_LEN), intent(inout) :: msg
+    integer :: ldab, ierr, k
     ldab = 2 * kl + ku + 1
     ! storage (ldab, n) for the factors and 3 n + n + n reals, n + n integers of workspace
     call mem_check(REAL_BYTES * (real(ldab, wp) + 5) * n, 'the band storage of J', &
@@ -154,7 +207,7 @@ contains
     b%perm_sign = ierr * k
     call move_alloc(prow, b%prow)
     call move_alloc(pcol, b%pcol)
-  end subroutine band_plan
+  end subroutine band_storage
 
   !> Move a plan (and its storage) from one band_t to another without copying: an intrinsic
   !! assignment would allocate, and could not report a failure.
@@ -162,7 +215,7 @@ contains
     type(band_t), intent(inout) :: from   !! plan; empty on return
     type(band_t), intent(inout) :: to     !! receives it
     to%n = from%n; to%kl = from%kl; to%ku = from%ku; to%ldab = from%ldab
-    to%perm_sign = from%perm_sign; to%factored = from%factored
+    to%perm_sign = from%perm_sign; to%factored = from%factored; to%plain = from%plain
     if (allocated(to%prow)) deallocate (to%prow)
     if (allocated(to%pcol)) deallocate (to%pcol)
     if (allocated(to%ab)) deallocate (to%ab)
@@ -232,7 +285,11 @@ contains
       msg = 'band_factor: already factored; band_zero and assemble again first'
       return
     end if
-    call dgbtrf(b%n, b%n, b%kl, b%ku, b%ab, b%ldab, b%ipiv, info)
+    if (b%plain) then
+      call band_lu(b%n, b%kl, b%ku, b%ab, b%ldab, b%ipiv, info)
+    else
+      call dgbtrf(b%n, b%n, b%kl, b%ku, b%ab, b%ldab, b%ipiv, info)
+    end if
     if (info > 0) then
       ! U(info, info) = 0 exactly; name the original column of that pivot
       status = MBD_SINGULAR
@@ -359,13 +416,181 @@ contains
       do i = 1, b%n
         b%rhs(b%prow(i)) = x(i)
       end do
-      call dgbtrs('N', b%n, b%kl, b%ku, 1, b%ab, b%ldab, b%ipiv, b%rhs, b%n, info)
+      if (b%plain) then
+        call band_lu_solve(b%n, b%kl, b%ku, b%ab, b%ldab, b%ipiv, b%rhs)
+        info = 0
+      else
+        call dgbtrs('N', b%n, b%kl, b%ku, 1, b%ab, b%ldab, b%ipiv, b%rhs, b%n, info)
+      end if
       do i = 1, b%n
         x(i) = b%rhs(b%pcol(i))
       end do
     end if
     call lapack_status('dgbtrs', info, status, msg)
   end subroutine band_solve
+
+
+  !> y = A x for an assembled (not factored) band matrix held in ab (a copy of b%ab taken
+  !! before band_factor, or b%ab itself before it). A(i, j) = B(prow(i), pcol(j)).
+  pure subroutine band_matvec(b, ab, x, y, xw)
+    type(band_t), intent(in) :: b        !! the plan (permutations and widths)
+    real(wp), intent(in) :: ab(:, :)     !! assembled band storage (ldab, n)
+    real(wp), intent(in) :: x(:)         !! vector, indexed like the columns of A (n)
+    real(wp), intent(out) :: y(:)        !! A x, indexed like the rows of A (n)
+    real(wp), intent(inout) :: xw(:)     !! workspace (n)
+    integer :: i, j, p, q, d
+    real(wp) :: acc
+    d = b%kl + b%ku + 1
+    do j = 1, b%n                        ! x by column positions
+      xw(b%pcol(j)) = x(j)
+    end do
+    do i = 1, b%n                        ! y_i = sum_q B(p, q) xw(q),  p = prow(i)
+      p = b%prow(i)
+      acc = zero
+      do q = max(1, p - b%kl), min(b%n, p + b%ku)
+        acc = acc + ab(d + p - q, q) * xw(q)
+      end do
+      y(i) = acc
+    end do
+  end subroutine band_matvec
+
+  !> Symmetric adjacency lists of the graph of A + A^T (no self loops) from the structural
+  !! nonzeros of A: the neighbours of node k are adj(aptr(k):aptr(k+1)-1).
+  pure subroutine band_graph(n, rows, cols, aptr, adj, ierr)
+    integer, intent(in) :: n                       !! number of nodes
+    integer, intent(in) :: rows(:), cols(:)        !! structural nonzeros (1..n)
+    integer, allocatable, intent(out) :: aptr(:)   !! n + 1 pointers
+    integer, allocatable, intent(out) :: adj(:)    !! neighbours
+    integer, intent(out) :: ierr                   !! allocation status (0 ok)
+    integer, allocatable :: key(:), val(:), ptr(:), idx(:)
+    integer :: k, m, w, i
+    m = 0
+    do k = 1, size(rows)
+      if (rows(k) /= cols(k)) m = m + 2
+    end do
+    allocate (key(m), val(m), stat=ierr)
+    if (ierr /= 0) return
+    m = 0
+    do k = 1, size(rows)
+      if (rows(k) == cols(k)) cycle
+      key(m + 1) = rows(k); val(m + 1) = cols(k)
+      key(m + 2) = cols(k); val(m + 2) = rows(k)
+      m = m + 2
+    end do
+    call compress(n, key, val, ptr, idx, ierr)
+    if (ierr /= 0) return
+    allocate (aptr(n + 1), adj(max(ptr(n + 1) - 1, 0)), stat=ierr)
+    if (ierr /= 0) return
+    w = 0
+    do i = 1, n
+      aptr(i) = w + 1
+      do k = ptr(i), ptr(i + 1) - 1
+        w = w + 1
+        adj(w) = idx(k)
+      end do
+    end do
+    aptr(n + 1) = w + 1
+  end subroutine band_graph
+
+  !> Reverse Cuthill-McKee ordering of a symmetric graph (band_graph): order(k) is the node
+  !! placed k-th (each component from a pseudo-peripheral node).
+  pure subroutine band_rcm(n, aptr, adj, order, ierr)
+    integer, intent(in) :: n                 !! number of nodes
+    integer, intent(in) :: aptr(:), adj(:)   !! adjacency
+    integer, intent(out) :: order(:)         !! the ordering (n)
+    integer, intent(out) :: ierr             !! allocation status (0 ok)
+    call rcm(n, aptr, adj, order, ierr)
+  end subroutine band_rcm
+
+  !> LU factorization with partial pivoting of a band matrix in plain loops: dgbtf2's
+  !! algorithm, storage and pivots (so dgbtrs and dgbcon read its factors), without its
+  !! BLAS calls per column. info > 0: U(info, info) is exactly zero.
+  pure subroutine band_lu(n, kl, ku, ab, ldab, ipiv, info)
+    integer, intent(in) :: n, kl, ku, ldab    !! size, widths, leading dimension (2kl+ku+1)
+    real(wp), intent(inout) :: ab(ldab, n)    !! band matrix, then its factors
+    integer, intent(out) :: ipiv(n)           !! row interchanges
+    integer, intent(out) :: info              !! 0, or the first zero pivot
+    integer :: kv, i, j, c, jp, km, ju, d
+    real(wp) :: piv, f, tmp
+    ! A(r, c) sits in ab(kv + 1 + r - c, c), kv = kl + ku (rows 1..kl: room for the fill)
+    kv = ku + kl
+    info = 0
+    do j = ku + 2, min(kv, n)                 ! clear the fill of the first columns
+      do i = kv - j + 2, kl
+        ab(i, j) = zero
+      end do
+    end do
+    ju = 1
+    do j = 1, n
+      if (j + kv <= n) then
+        do i = 1, kl
+          ab(i, j + kv) = zero
+        end do
+      end if
+      km = min(kl, n - j)
+      jp = 0; piv = abs(ab(kv + 1, j))        ! pivot: the first largest |a_ij|, i >= j
+      do i = 1, km
+        if (abs(ab(kv + 1 + i, j)) > piv) then
+          jp = i; piv = abs(ab(kv + 1 + i, j))
+        end if
+      end do
+      ipiv(j) = j + jp
+      if (.not. piv > zero) then
+        if (info == 0) info = j
+        cycle
+      end if
+      ju = max(ju, min(j + ku + jp, n))
+      if (jp /= 0) then                       ! swap rows j and j + jp in columns j..ju
+        do c = j, ju
+          d = kv + 1 + j - c
+          tmp = ab(d, c); ab(d, c) = ab(d + jp, c); ab(d + jp, c) = tmp
+        end do
+      end if
+      f = one / ab(kv + 1, j)                 ! l_ij = a_ij / u_jj
+      do i = 1, km
+        ab(kv + 1 + i, j) = ab(kv + 1 + i, j) * f
+      end do
+      do c = j + 1, ju                        ! a_ic -= l_ij u_jc
+        d = kv + 1 + j - c
+        f = ab(d, c)
+        if (abs(f) <= zero) cycle
+        do i = 1, km
+          ab(d + i, c) = ab(d + i, c) - ab(kv + 1 + i, j) * f
+        end do
+      end do
+    end do
+  end subroutine band_lu
+
+  !> Solve B x = r with the factors of band_lu (or dgbtrf) in plain loops: the row
+  !! interchanges and L (forward), then U (upper width kl + ku, backward); r becomes x.
+  pure subroutine band_lu_solve(n, kl, ku, ab, ldab, ipiv, r)
+    integer, intent(in) :: n, kl, ku, ldab    !! size, widths, leading dimension
+    real(wp), intent(in) :: ab(ldab, n)       !! factors
+    integer, intent(in) :: ipiv(n)            !! row interchanges
+    real(wp), intent(inout) :: r(n)           !! right-hand side, then solution
+    integer :: kv, i, j, p
+    real(wp) :: tmp, f
+    kv = ku + kl
+    do j = 1, n - 1
+      p = ipiv(j)
+      if (p /= j) then
+        tmp = r(j); r(j) = r(p); r(p) = tmp
+      end if
+      f = r(j)
+      if (abs(f) <= zero) cycle
+      do i = 1, min(kl, n - j)
+        r(j + i) = r(j + i) - ab(kv + 1 + i, j) * f
+      end do
+    end do
+    do j = n, 1, -1
+      r(j) = r(j) / ab(kv + 1, j)
+      f = r(j)
+      if (abs(f) <= zero) cycle
+      do i = max(1, j - kv), j - 1
+        r(i) = r(i) - ab(kv + 1 + i - j, j) * f
+      end do
+    end do
+  end subroutine band_lu_solve
 
   ! ---------------------------------------------------------------------------------------
   ! ordering

@@ -6,52 +6,74 @@
 !!   [ s J  0     ] [ lambda / s ] = [ gamma ]      s: a mass scale, for conditioning
 !! Only an independent set of constraint rows enters (redundant rows, found by the rank
 !! analysis at the start, carry no multiplier of their own); the reported lambda is the
-!! minimum-norm solution of J^T lambda = Q - M q_ddot over all rows. Near a singular
-!! configuration (J momentarily rank deficient, as a parallelogram at its collinear
+!! minimum-norm solution of J^T lambda = Q - M q_ddot over all rows (dense path) or the
+!! least-squares one over the active rows (band path, zero on redundant rows). Near a
+!! singular configuration (J momentarily rank deficient, as a parallelogram at its collinear
 !! position) the LU is nearly singular although q_ddot is still well defined; there the
-!! system is solved by a rank-revealing minimum-norm least-squares solve (dgelsy) instead.
+!! system is solved by a rank-revealing minimum-norm least-squares solve (dgelsy, dense) or
+!! a damped one (band); see mbd_saddle, which holds both paths of every saddle-point solve.
 !! Also here: applied forces and energies, consistent initial velocities (the kinetic-energy
 !! projection [M J^T; J 0][q_dot; mu] = [M v0; nu]), the projection of positions onto Phi = 0
-!! (minimum-norm Newton steps), joint reactions and driver efforts.
+!! (minimum-norm Newton steps), the assembly of a large model by Levenberg-Marquardt in
+!! band storage, joint reactions and driver efforts, and the tangent stiffness and damping
+!! K = d(J^T lambda - Q)/dq, C = -dQ/dq_dot by differences over column groups (a colouring).
+!!
+!! Linear algebra path (dyn_init's solver): dense (n x n matrices: J, the rank analysis by
+!! QR, LU of the saddle-point matrices) for small models, band (mbd_saddle, mbd_band: no
+!! n x n array; the rank analysis by a band Cholesky of J J^T) for large ones; auto picks
+!! the band for at least SADDLE_BAND_MIN_N coordinates whose saddle-point band is narrow.
 module mbd_dynamics
+  use, intrinsic :: iso_fortran_env, only: int64
   use mbd_kinds, only: wp, zero, one, half
-  use mbd_status, only: MBD_OK, MBD_SINGULAR, MBD_NO_CONVERGENCE, MBD_LAPACK, MSG_LEN
+  use mbd_status, only: MBD_OK, MBD_SINGULAR, MBD_NO_CONVERGENCE, MBD_LAPACK, MBD_NO_MEMORY, &
+                        MBD_ASSEMBLY_FAILED, MBD_BAD_SETTING, MSG_LEN
   use mbd_memory, only: REAL_BYTES, mem_check, mem_fail
   use mbd_points, only: NLOC, rot
   use mbd_model, only: model_t, model_slots
-  use mbd_constraints, only: con_is_driver
+  use mbd_constraints, only: con_is_driver, con_name
   use mbd_forces, only: force_eval, FRC_SPRING, FRC_ROTSPRING
-  use mbd_assemble, only: asm_work_t, asm_init, assemble_blocks, assemble_dense
-  use mbd_linsolve, only: lu_factor, lu_solve, row_rank, lapack_status, ls_small
-  use mbd_lapack, only: dgelsy, dgecon
+  use mbd_assemble, only: asm_work_t, asm_init, assemble_blocks, assemble_dense, blocks_jv, &
+                          blocks_jtv, init_extras
+  use mbd_linsolve, only: row_rank, lapack_status, ls_small, RANK_TOL
+  use mbd_lapack, only: dgelsy
+  use mbd_saddle, only: saddle_t, saddle_plan, saddle_factor, saddle_solve, saddle_row_rank, &
+                        SADDLE_BAND_MIN_N, SADDLE_BAND_RATIO
   implicit none
   private
   public :: dyn_work_t, dyn_init, dyn_memory_check, gen_forces, kinetic_energy, dyn_accel, &
             dyn_velocity, &
             dyn_project_pos, dyn_multipliers, dyn_reactions, dyn_tangent, dyn_solve, &
-            dyn_jt_lam, dyn_damped
+            dyn_jt_lam, dyn_damped, dyn_assemble, dyn_choose, dyn_jv, dyn_null_basis, &
+            SOLVER_AUTO, SOLVER_DENSE, SOLVER_BANDED
 
-  !> 1/cond_1 of the augmented matrix below which it is solved by rank-revealing least squares
-  real(wp), parameter :: AUG_RCOND = 1.0e-9_wp
+  integer, parameter :: SOLVER_AUTO = 0, SOLVER_DENSE = 1, SOLVER_BANDED = 2  !! as kinematics
   !> what to change when the dense dynamics does not fit
-  character(len=*), parameter :: DYN_HINT = 'dynamics, statics and inverse dynamics solve ' // &
-    'with dense matrices of the size of J: use a model with fewer coordinates'
+  character(len=*), parameter :: DYN_HINT = 'the dense solver keeps matrices of the size ' // &
+    'of J: use the banded solver (solver="banded") for a large chain-like model, or a ' // &
+    'model with fewer coordinates'
 
-  !> Work arrays and the active (independent) constraint rows.
+  !> Work arrays, the active (independent) constraint rows, the saddle-point solver and the
+  !! pattern of the tangent K with its column groups.
   type :: dyn_work_t
     integer :: n = 0, neq = 0, na = 0     !! coordinates, equations, active rows
+    integer :: solver = SOLVER_DENSE      !! path in use: SOLVER_DENSE or SOLVER_BANDED
     integer, allocatable :: rows(:)       !! active rows
     real(wp) :: s = one                   !! constraint scale in the augmented matrix
     real(wp) :: tol = 1.0e-12_wp          !! position tolerance ||Phi||_inf
-    real(wp), allocatable :: phi(:), nu(:), gam(:), jac(:, :), qz(:)
+    real(wp), allocatable :: phi(:), nu(:), gam(:), qz(:)
+    real(wp), allocatable :: jac(:, :)    !! dense J (dense path only)
     type(asm_work_t) :: asm               !! assembly work arrays
-    real(wp), allocatable :: aug(:, :), rhs(:), force(:), ja(:, :)
-    integer, allocatable :: apiv(:)
-    !> workspace, so that no solve allocates: dgecon (cw 4 (nq + na), iw), the metric (nq),
-    !! the multipliers' J^T (jt), right-hand side (bls) and pivots (jpvt), and the copy of the
-    !! augmented matrix a rank-revealing solve works on (acopy, lswork for dgelsy, jp)
-    real(wp), allocatable :: cw(:), metric(:), jt(:, :), bls(:), acopy(:, :), lswork(:)
-    integer, allocatable :: iw(:), jpvt(:), jp(:)
+    real(wp), allocatable :: rhs(:), force(:), jv(:)
+    type(saddle_t) :: sd                  !! the index-1 saddle-point matrix (both paths)
+    !> dense multipliers' workspace: J^T (jt), right-hand side (bls), pivots (jpvt); the
+    !! metric (nq)
+    real(wp), allocatable :: metric(:), jt(:, :), bls(:)
+    integer, allocatable :: jpvt(:)
+    !> pattern of K by columns (rows krow(kptr(c):kptr(c+1)-1) of column c) and the column
+    !! groups of the differences (columns gcol(gptr(g):gptr(g+1)-1) of group g)
+    integer, allocatable :: kptr(:), krow(:), gptr(:), gcol(:)
+    integer :: ncolor = 0
+    real(wp), allocatable :: tq(:), tr0(:), trp(:), trm(:), th(:)   !! tangent workspace (nq)
     integer :: nsolve = 0                 !! augmented factorizations
     integer :: nrank = 0                  !! rank-revealing fallback solves
     logical :: lsq = .false.              !! the last factorization was nearly singular
@@ -60,13 +82,13 @@ module mbd_dynamics
 contains
 
   !> Bytes of the dense dynamics of a model with nq coordinates and neq equations: J, its
-  !! transpose, [M J^T; J 0] and a copy, and the integrators' tangent and iteration matrices
-  !! (K, C: nq x nq; generalized-alpha: nq + neq square).
+  !! transpose, [M J^T; J 0] and a copy, and the integrators' iteration matrix
+  !! (generalized-alpha: nq + neq square).
   pure real(wp) function dyn_bytes(nq, neq) result(b)
     integer, intent(in) :: nq, neq   !! coordinates, equations
     real(wp) :: n, e
     n = real(nq, wp); e = real(neq, wp)
-    b = REAL_BYTES * (2 * n * e + 3 * (n + e)**2 + 2 * n**2 + 12 * (n + e))
+    b = REAL_BYTES * (2 * n * e + 3 * (n + e)**2 + 12 * (n + e))
   end function dyn_bytes
 
   !> MBD_NO_MEMORY (and what to change) when the dense dynamics of m (dyn_bytes) cannot fit.
@@ -80,9 +102,43 @@ contains
     call mem_check(dyn_bytes(m%nq, m%neq), trim(what), DYN_HINT, status, msg)
   end subroutine dyn_memory_check
 
-  !> Allocate, and choose the active rows by the rank of J at q (redundant rows out).
-  !! The whole dense footprint (dyn_bytes) is checked against the memory first.
-  subroutine dyn_init(m, w, q, t, tol, status, msg)
+  !> The path of a dynamics analysis: SOLVER_DENSE or SOLVER_BANDED. solver SOLVER_AUTO
+  !! picks the band for at least SADDLE_BAND_MIN_N coordinates when the band of the
+  !! saddle-point matrix (all rows; kl + ku + 1) is at most (nq + neq) / SADDLE_BAND_RATIO
+  !! wide. kl, ku: its widths (0 when not planned).
+  subroutine dyn_choose(m, solver, path, kl, ku, status, msg)
+    type(model_t), intent(in) :: m              !! model (with dynamics data)
+    integer, intent(in) :: solver               !! SOLVER_AUTO, SOLVER_DENSE, SOLVER_BANDED
+    integer, intent(out) :: path                !! SOLVER_DENSE or SOLVER_BANDED
+    integer, intent(out) :: kl, ku              !! band widths
+    integer, intent(out) :: status              !! MBD_OK, MBD_BAD_SETTING, MBD_NO_MEMORY
+    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    type(saddle_t) :: sd
+    integer :: r
+    status = MBD_OK; msg = ''
+    kl = 0; ku = 0
+    path = SOLVER_DENSE
+    if (solver < SOLVER_AUTO .or. solver > SOLVER_BANDED) then
+      status = MBD_BAD_SETTING
+      msg = 'solver must be 0 (auto), 1 (dense) or 2 (banded)'; return
+    end if
+    if (solver == SOLVER_DENSE) return
+    if (solver == SOLVER_AUTO .and. m%nq < SADDLE_BAND_MIN_N) return
+    call saddle_plan(m, [(r, r=1, m%neq)], SOLVER_BANDED, sd, status, msg)
+    if (status /= MBD_OK) then
+      if (solver == SOLVER_AUTO .and. status /= MBD_NO_MEMORY) status = MBD_OK
+      return
+    end if
+    kl = sd%kl; ku = sd%ku
+    if (solver == SOLVER_BANDED .or. &
+        SADDLE_BAND_RATIO * (kl + ku + 1) <= m%nq + m%neq) path = SOLVER_BANDED
+  end subroutine dyn_choose
+
+  !> Allocate, choose the active rows by the rank of J at q (redundant rows out), plan the
+  !! saddle-point solver on the path (SOLVER_DENSE or SOLVER_BANDED; dyn_choose) and the
+  !! pattern and column groups of the tangent. The dense path's footprint (dyn_bytes) is
+  !! checked against the memory first.
+  subroutine dyn_init(m, w, q, t, tol, status, msg, solver)
     type(model_t), intent(in) :: m              !! model with dynamics data
     type(dyn_work_t), intent(out) :: w          !! work arrays
     real(wp), intent(in) :: q(:)                !! configuration
@@ -90,19 +146,27 @@ contains
     real(wp), intent(in) :: tol                 !! absolute position tolerance
     integer, intent(out) :: status              !! MBD_OK, MBD_LAPACK or MBD_NO_MEMORY
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    integer, intent(in), optional :: solver     !! path: SOLVER_DENSE (default) or _BANDED
     integer, allocatable :: red(:)
-    integer :: rank, r, na, ierr, nt, info
-    real(wp) :: wq(1), rdum(1)
+    integer :: rank, r, na, ierr, nt
     character(len=MSG_LEN) :: what
     msg = ''
     w%n = m%nq; w%neq = m%neq; w%tol = tol
-    write (what, '(a,i0,a,i0,a)') 'the dense dynamics (', m%neq, ' equations, ', m%nq, &
+    w%solver = SOLVER_DENSE
+    if (present(solver)) w%solver = solver
+    write (what, '(a,i0,a,i0,a)') 'the dynamics work arrays (', m%neq, ' equations, ', m%nq, &
       ' coordinates)'
-    call dyn_memory_check(m, status, msg)
-    if (status /= MBD_OK) return
-    allocate (w%phi(m%neq), w%nu(m%neq), w%gam(m%neq), w%jac(m%neq, m%nq), stat=ierr)
+    if (w%solver == SOLVER_DENSE) then
+      call dyn_memory_check(m, status, msg)
+      if (status /= MBD_OK) return
+    end if
+    allocate (w%phi(m%neq), w%nu(m%neq), w%gam(m%neq), w%jv(m%neq), stat=ierr)
     if (ierr == 0) allocate (w%qz(m%nq), w%force(m%nq), red(m%neq), w%metric(m%nq), stat=ierr)
-    if (ierr == 0) allocate (w%jt(m%nq, m%neq), w%bls(max(m%nq, m%neq)), w%jpvt(m%neq), stat=ierr)
+    if (ierr == 0) allocate (w%tq(m%nq), w%tr0(m%nq), w%trp(m%nq), w%trm(m%nq), w%th(m%nq), &
+                             stat=ierr)
+    if (ierr == 0 .and. w%solver == SOLVER_DENSE) &
+      allocate (w%jac(m%neq, m%nq), w%jt(m%nq, m%neq), w%bls(max(m%nq, m%neq)), &
+                w%jpvt(m%neq), stat=ierr)
     if (ierr /= 0) then
       call mem_fail(REAL_BYTES * 2 * real(m%neq, wp) * m%nq, trim(what), DYN_HINT, status, msg)
       return
@@ -110,19 +174,21 @@ contains
     call asm_init(m, w%asm, status, msg)
     if (status /= MBD_OK) return
     w%qz = zero
-    call assemble_dense(m, q, w%qz, t, w%phi, w%nu, w%gam, w%asm, w%jac)
-    call row_rank(w%jac, rank, red, status, msg)
+    if (w%solver == SOLVER_DENSE) then
+      call assemble_dense(m, q, w%qz, t, w%phi, w%nu, w%gam, w%asm, w%jac)
+      call row_rank(w%jac, rank, red, status, msg)
+    else
+      ! (row_rank: |R_kk| / |R_11| < RANK_TOL of unit rows; here the squared distance)
+      call assemble_blocks(m, q, w%qz, t, w%phi, w%nu, w%gam, w%asm)
+      call saddle_row_rank(m, w%asm%jb, RANK_TOL**2, red, rank, status, msg)
+    end if
     if (status /= MBD_OK) return
     na = count(red == 0)
     w%na = na
     nt = m%nq + na
-    call dgelsy(nt, nt, 1, rdum, nt, rdum, nt, red, AUG_RCOND, rank, wq, -1, info)
-    allocate (w%rows(na), w%aug(nt, nt), w%rhs(nt), w%apiv(nt), w%ja(na, m%nq), stat=ierr)
-    if (ierr == 0) allocate (w%cw(4 * nt), w%iw(nt), w%jp(nt), w%acopy(nt, nt), stat=ierr)
-    if (ierr == 0) allocate (w%lswork(max(1, int(wq(1)))), stat=ierr)
+    allocate (w%rows(na), w%rhs(nt), stat=ierr)
     if (ierr /= 0) then
-      call mem_fail(REAL_BYTES * (real(nt, wp)**2 + real(na, wp) * m%nq), trim(what), DYN_HINT, &
-                    status, msg)
+      call mem_fail(REAL_BYTES * real(nt, wp), trim(what), DYN_HINT, status, msg)
       return
     end if
     na = 0
@@ -133,7 +199,132 @@ contains
     end do
     w%s = one
     if (any(m%mdiag > zero)) w%s = sum(m%mdiag, mask=m%mdiag > zero) / count(m%mdiag > zero)
+    call saddle_plan(m, w%rows, w%solver, w%sd, status, msg, index1=.true.)
+    if (status /= MBD_OK) return
+    call tangent_pattern(m, w, status, msg)
   end subroutine dyn_init
+
+  !> The pattern of K = d(J^T lambda - Q)/dq and C = -dQ/dq_dot: entry (i, c) when a
+  !! constraint or a force element holds both coordinates. The column groups: greedy
+  !! colouring in which two columns share a group only when no row has both in its pattern
+  !! (no element couples them to a common coordinate), so one residual evaluation with the
+  !! whole group perturbed gives each column's entries exactly as perturbing it alone would.
+  subroutine tangent_pattern(m, w, status, msg)
+    type(model_t), intent(in) :: m
+    type(dyn_work_t), intent(inout) :: w
+    integer, intent(out) :: status
+    character(len=MSG_LEN), intent(inout) :: msg
+    integer, allocatable :: cnt(:), color(:), mark(:), nxt(:)
+    integer :: n, k, s, i, c, e, nnz, p, pp, g, ierr, ne
+    status = MBD_OK
+    n = m%nq
+    ! count, with repeats, then dedupe per column
+    ne = 0
+    do k = 1, m%nc
+      ne = ne + count(m%loc(:, k) > 0)**2
+    end do
+    do k = 1, m%nf
+      ne = ne + count(m%floc(:, k) > 0)**2
+    end do
+    allocate (cnt(n + 1), w%krow(ne), mark(n), color(n), nxt(n), stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail(4 * (real(ne, wp) + 4 * n), 'the pattern of the tangent stiffness', &
+                    'use a smaller model', status, msg)
+      return
+    end if
+    cnt = 0
+    do e = 1, m%nc + m%nf
+      do s = 1, NLOC
+        c = slot(e, s)
+        if (c > 0) cnt(c + 1) = cnt(c + 1) + count([(slot(e, i) > 0, i=1, NLOC)])
+      end do
+    end do
+    cnt(1) = 1
+    do c = 1, n
+      cnt(c + 1) = cnt(c + 1) + cnt(c)
+    end do
+    nxt = cnt(1:n)
+    do e = 1, m%nc + m%nf
+      do s = 1, NLOC
+        c = slot(e, s)
+        if (c == 0) cycle
+        do i = 1, NLOC
+          if (slot(e, i) == 0) cycle
+          w%krow(nxt(c)) = slot(e, i)
+          nxt(c) = nxt(c) + 1
+        end do
+      end do
+    end do
+    ! dedupe in place, column by column
+    allocate (w%kptr(n + 1), stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail(4 * real(n, wp), 'the pattern of the tangent stiffness', &
+                    'use a smaller model', status, msg)
+      return
+    end if
+    mark = 0
+    nnz = 0
+    do c = 1, n
+      w%kptr(c) = nnz + 1
+      do p = cnt(c), cnt(c + 1) - 1
+        i = w%krow(p)
+        if (mark(i) == c) cycle
+        mark(i) = c
+        nnz = nnz + 1
+        w%krow(nnz) = i
+      end do
+    end do
+    w%kptr(n + 1) = nnz + 1
+    ! greedy distance-2 colouring (K is structurally symmetric: row i's columns are column
+    ! i's rows)
+    color = 0
+    mark = 0
+    w%ncolor = 0
+    do c = 1, n
+      do p = w%kptr(c), w%kptr(c + 1) - 1
+        i = w%krow(p)
+        do pp = w%kptr(i), w%kptr(i + 1) - 1
+          if (color(w%krow(pp)) > 0) mark(color(w%krow(pp))) = c
+        end do
+      end do
+      g = 1
+      do while (g <= w%ncolor)
+        if (mark(g) /= c) exit
+        g = g + 1
+      end do
+      color(c) = g
+      w%ncolor = max(w%ncolor, g)
+    end do
+    allocate (w%gptr(w%ncolor + 1), w%gcol(n), stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail(8 * real(n, wp), 'the column groups of the tangent stiffness', &
+                    'use a smaller model', status, msg)
+      return
+    end if
+    w%gptr = 0
+    do c = 1, n
+      w%gptr(color(c) + 1) = w%gptr(color(c) + 1) + 1
+    end do
+    w%gptr(1) = 1
+    do g = 1, w%ncolor
+      w%gptr(g + 1) = w%gptr(g + 1) + w%gptr(g)
+    end do
+    nxt(1:w%ncolor) = w%gptr(1:w%ncolor)
+    do c = 1, n
+      w%gcol(nxt(color(c))) = c
+      nxt(color(c)) = nxt(color(c)) + 1
+    end do
+  contains
+    !> Coordinate of slot s of element e (constraints 1..nc, then forces), 0 if none.
+    pure integer function slot(e, s)
+      integer, intent(in) :: e, s
+      if (e <= m%nc) then
+        slot = m%loc(s, e)
+      else
+        slot = m%floc(s, e - m%nc)
+      end if
+    end function slot
+  end subroutine tangent_pattern
 
   !> Applied generalized forces Q(q, q_dot, t) and the potential energy V (gravity, springs);
   !! vload adds the potential of the loads frozen at t (statics).
@@ -176,98 +367,46 @@ contains
     kinetic_energy = half * sum(m%mdiag * qd**2)
   end function kinetic_energy
 
-  !> Factor [M s Ja^T; s Ja 0] with Ja = J(rows) from w%jac. Nearly singular (1/cond_1 below
-  !! AUG_RCOND, or an exact zero pivot): w%lsq is set and solve_aug uses dgelsy.
-  subroutine factor_aug(m, w, metric, status)
-    type(model_t), intent(in) :: m
+  !> Factor [M s Ja^T; s Ja 0] (the diagonal metric, Ja = J(rows) from the blocks of the
+  !! last assembly). Nearly singular: w%lsq is set and the solves are least squares.
+  subroutine factor_aug(w, metric, status)
     type(dyn_work_t), intent(inout) :: w
     real(wp), intent(in) :: metric(:)     ! diagonal of the upper-left block
     integer, intent(out) :: status
-    character(len=MSG_LEN) :: msg
-    real(wp) :: anorm, rc, pr, umin, umax
-    integer :: info, k, nt
-    call build_aug(m, w, metric)
-    nt = m%nq + w%na
-    anorm = zero
-    do k = 1, nt
-      anorm = max(anorm, sum(abs(w%aug(:, k))))
-    end do
-    call lu_factor(w%aug, w%apiv, status, msg)
+    call saddle_factor(w%sd, metric, w%asm%jb, w%s, status, check=.true.)
     w%nsolve = w%nsolve + 1
-    w%lsq = status /= MBD_OK
-    if (.not. w%lsq) then
-      umin = huge(one); umax = zero
-      do k = 1, nt
-        umin = min(umin, abs(w%aug(k, k))); umax = max(umax, abs(w%aug(k, k)))
-      end do
-      pr = umin / umax
-      if (pr < 1.0e-6_wp) then
-        call dgecon('1', nt, w%aug, nt, anorm, rc, w%cw, w%iw, info)
-        w%lsq = rc < AUG_RCOND
-      end if
-    end if
-    if (w%lsq) then
-      call build_aug(m, w, metric)        ! keep the matrix itself for dgelsy
-      status = MBD_OK
-    end if
+    w%lsq = w%sd%lsq
   end subroutine factor_aug
-
-  !> The augmented matrix itself.
-  subroutine build_aug(m, w, metric)
-    type(model_t), intent(in) :: m
-    type(dyn_work_t), intent(inout) :: w
-    real(wp), intent(in) :: metric(:)
-    integer :: i, j, n
-    n = m%nq
-    do j = 1, n          ! (loops: a vector subscript or transpose() would make temporaries)
-      do i = 1, w%na
-        w%ja(i, j) = w%jac(w%rows(i), j)
-      end do
-    end do
-    w%aug = zero
-    do i = 1, n
-      w%aug(i, i) = metric(i)
-    end do
-    do j = 1, w%na
-      do i = 1, n
-        w%aug(i, n + j) = w%s * w%ja(j, i)
-      end do
-    end do
-    do j = 1, n
-      do i = 1, w%na
-        w%aug(n + i, j) = w%s * w%ja(i, j)
-      end do
-    end do
-  end subroutine build_aug
 
   !> Another right-hand side with the last augmented matrix (Baumgarte's modified gamma).
   subroutine dyn_solve(w, rhs, status)
     type(dyn_work_t), intent(inout) :: w     !! work arrays with the last augmented matrix
     real(wp), intent(inout) :: rhs(:)        !! right-hand side, then solution
     integer, intent(out) :: status           !! MBD_OK or MBD_LAPACK
-    call solve_aug(w, rhs, status)
+    call saddle_solve(w%sd, rhs, status)
+    if (w%sd%lsq) w%nrank = w%nrank + 1
   end subroutine dyn_solve
 
-  !> Solve with the factored augmented matrix, or by the minimum-norm least-squares solve
-  !! when it is nearly singular (the matrix then is unfactored; dgelsy works on a copy).
-  subroutine solve_aug(w, rhs, status)
+  !> Phi, nu, gamma and the constraint blocks at (q, q_dot, t); the dense J too on the
+  !! dense path.
+  subroutine assemble(m, w, q, qd, t)
+    type(model_t), intent(in) :: m
     type(dyn_work_t), intent(inout) :: w
-    real(wp), intent(inout) :: rhs(:)
-    integer, intent(out) :: status
-    character(len=MSG_LEN) :: msg
-    integer :: rank, info, nt
-    if (.not. w%lsq) then
-      call lu_solve(w%aug, w%apiv, rhs, status, msg)
-      return
+    real(wp), intent(in) :: q(:), qd(:), t
+    if (w%solver == SOLVER_DENSE) then
+      call assemble_dense(m, q, qd, t, w%phi, w%nu, w%gam, w%asm, w%jac)
+    else
+      call assemble_blocks(m, q, qd, t, w%phi, w%nu, w%gam, w%asm)
     end if
-    nt = size(rhs)
-    w%acopy = w%aug
-    w%jp = 0
-    call dgelsy(nt, nt, 1, w%acopy, nt, rhs, nt, w%jp, AUG_RCOND, rank, w%lswork, &
-                size(w%lswork), info)
-    call lapack_status('dgelsy', info, status, msg)
-    w%nrank = w%nrank + 1
-  end subroutine solve_aug
+  end subroutine assemble
+
+  !> w%jv = J x from the blocks of the last assembly (all rows).
+  subroutine dyn_jv(m, w, x)
+    type(model_t), intent(in) :: m           !! model
+    type(dyn_work_t), intent(inout) :: w     !! work arrays (blocks assembled)
+    real(wp), intent(in) :: x(:)             !! vector (nq)
+    call blocks_jv(m, w%asm, x, w%jv)
+  end subroutine dyn_jv
 
   !> Accelerations and multipliers: [M J^T; J 0][q_ddot; lambda] = [Q; gamma] (active rows).
   !! lam is filled on the active rows (zero elsewhere); dyn_multipliers gives the
@@ -283,13 +422,13 @@ contains
     real(wp) :: v
     integer :: n, k
     n = m%nq
-    call assemble_dense(m, q, qd, t, w%phi, w%nu, w%gam, w%asm, w%jac)
+    call assemble(m, w, q, qd, t)
     call gen_forces(m, q, qd, t, w%force, v)
-    call factor_aug(m, w, m%mdiag, status)
+    call factor_aug(w, m%mdiag, status)
     if (status /= MBD_OK) return
     w%rhs(1:n) = w%force
     call gather_rows(w, w%gam, w%s)
-    call solve_aug(w, w%rhs, status)
+    call dyn_solve(w, w%rhs, status)
     qdd = w%rhs(1:n)
     lam = zero
     do k = 1, w%na                 ! (loops: vector subscripts make heap temporaries)
@@ -322,12 +461,12 @@ contains
     integer :: n
     n = m%nq
     w%metric = merge(m%mdiag, w%s, m%mdiag > zero)
-    call assemble_dense(m, q, w%qz, t, w%phi, w%nu, w%gam, w%asm, w%jac)
-    call factor_aug(m, w, w%metric, status)
+    call assemble(m, w, q, w%qz, t)
+    call factor_aug(w, w%metric, status)
     if (status /= MBD_OK) return
     w%rhs(1:n) = w%metric * v0
     call gather_rows(w, w%nu, w%s)
-    call solve_aug(w, w%rhs, status)
+    call dyn_solve(w, w%rhs, status)
     qd = w%rhs(1:n)
   end subroutine dyn_velocity
 
@@ -343,14 +482,14 @@ contains
     n = m%nq
     w%metric = one
     do it = 1, 20
-      call assemble_dense(m, q, w%qz, t, w%phi, w%nu, w%gam, w%asm, w%jac)
+      call assemble(m, w, q, w%qz, t)
       status = MBD_OK
       if (maxval(abs(w%phi)) <= w%tol) return
-      call factor_aug(m, w, w%metric, status)
+      call factor_aug(w, w%metric, status)
       if (status /= MBD_OK) return
       w%rhs(1:n) = zero
       call gather_rows(w, w%phi, -w%s)
-      call solve_aug(w, w%rhs, status)
+      call dyn_solve(w, w%rhs, status)
       q = q + w%rhs(1:n)
     end do
     status = MBD_NO_CONVERGENCE
@@ -359,7 +498,9 @@ contains
   !> Minimum-norm multipliers over all rows: lambda = argmin ||l|| with J^T l = Q - M q_ddot.
   !! With independent rows this is the unique lambda (Householder least squares, ls_small);
   !! with redundant rows, or J^T numerically rank deficient, the reactions are statically
-  !! indeterminate and this is the smallest set (LAPACK dgelsy).
+  !! indeterminate and this is the smallest set (LAPACK dgelsy). Band path: the least-squares
+  !! lambda of the active rows, [s I, s Ja^T; s Ja, 0][x; lambda_a / s] = [Q - M q_ddot; 0]
+  !! (x the part of the load no multiplier balances), zero on the redundant rows.
   subroutine dyn_multipliers(m, w, q, qd, qdd, t, lam, status, msg)
     type(model_t), intent(in) :: m            !! model
     type(dyn_work_t), intent(inout) :: w      !! work arrays
@@ -370,10 +511,27 @@ contains
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
     real(wp) :: v, wq(1)
     real(wp), allocatable :: work(:)
-    integer :: rank, info, lwork, ierr
+    integer :: rank, info, lwork, ierr, k, n
     logical :: full
-    call assemble_dense(m, q, qd, t, w%phi, w%nu, w%gam, w%asm, w%jac)
+    msg = ''
+    call assemble(m, w, q, qd, t)
     call gen_forces(m, q, qd, t, w%force, v)
+    if (w%solver == SOLVER_BANDED) then
+      n = m%nq
+      lam = zero
+      w%metric = w%s
+      call factor_aug(w, w%metric, status)
+      if (status /= MBD_OK) then
+        msg = 'the multipliers: the band saddle-point matrix is singular'; return
+      end if
+      w%rhs(1:n) = w%force - m%mdiag * qdd
+      w%rhs(n + 1:) = zero
+      call dyn_solve(w, w%rhs, status)
+      do k = 1, w%na
+        lam(w%rows(k)) = w%s * w%rhs(n + k)
+      end do
+      return
+    end if
     w%jt = transpose(w%jac)
     w%bls = zero
     w%bls(1:m%nq) = w%force - m%mdiag * qdd
@@ -404,6 +562,135 @@ contains
     call lapack_status('dgelsy', info, status, msg)
     lam = w%bls(1:m%neq)
   end subroutine dyn_multipliers
+
+  !> An orthonormal basis nb (nq x ni, ni = nq - na) of the null space of J_a at q: the
+  !! projections x = P r = r - J_a^T (J_a J_a^T)^-1 J_a r of ni fixed pseudo-random vectors
+  !! r (each a solve [I J_a^T; J_a 0][x; mu] = [r; 0] with one factorization, on the path of
+  !! w), orthonormalized by Gram-Schmidt (twice). The span is that of P, so whatever uses
+  !! only P = nb nb^T (the partitioned method's choice of coordinates) does not depend on
+  !! the vectors r. status MBD_SINGULAR when the projections are not independent.
+  subroutine dyn_null_basis(m, w, q, t, nb, status)
+    type(model_t), intent(in) :: m           !! model
+    type(dyn_work_t), intent(inout) :: w     !! work arrays
+    real(wp), intent(in) :: q(:)             !! configuration
+    real(wp), intent(in) :: t                !! time
+    real(wp), intent(out) :: nb(:, :)        !! basis (nq, ni)
+    integer, intent(out) :: status           !! MBD_OK or MBD_SINGULAR
+    integer(int64) :: seed
+    integer :: n, k, i, j, pass
+    real(wp) :: d, nrm0, nrm
+    n = m%nq
+    call assemble(m, w, q, w%qz, t)
+    w%metric = one
+    call factor_aug(w, w%metric, status)
+    if (status /= MBD_OK) return
+    do k = 1, size(nb, 2)
+      seed = 12345_int64 + 7919_int64 * k          ! a fixed linear congruential sequence
+      do i = 1, n
+        seed = modulo(1103515245_int64 * seed + 12345_int64, 2147483648_int64)
+        w%rhs(i) = real(seed, wp) / 1073741824.0_wp - one
+      end do
+      w%rhs(n + 1:) = zero
+      call dyn_solve(w, w%rhs, status)
+      if (status /= MBD_OK) return
+      nb(:, k) = w%rhs(1:n)
+    end do
+    do k = 1, size(nb, 2)                            ! Gram-Schmidt, twice
+      nrm0 = norm2(nb(:, k))
+      do pass = 1, 2
+        do j = 1, k - 1
+          d = dot_product(nb(:, j), nb(:, k))
+          nb(:, k) = nb(:, k) - d * nb(:, j)
+        end do
+      end do
+      nrm = norm2(nb(:, k))
+      if (.not. nrm > 1.0e-8_wp * nrm0) then
+        status = MBD_SINGULAR; return
+      end if
+      nb(:, k) = nb(:, k) / nrm
+    end do
+  end subroutine dyn_null_basis
+
+  !> Assemble a model on the band path: from rough estimates q (extras estimated here)
+  !! minimize ||Phi(q, t)||^2 by Levenberg-Marquardt, as kin_assemble does with a dense J,
+  !! each step from the augmented system [mu I, J^T; J, -I][dq; y] = [0; -Phi] (the normal
+  !! equations (J^T J + mu I) dq = -J^T Phi of [J; sqrt(mu) I] dq = [-Phi; 0]) in band
+  !! storage over all rows, to ||Phi||_inf <= tol. MBD_ASSEMBLY_FAILED (worst: the
+  !! constraint with the largest residual, resid its size) when the residual stays above
+  !! 1000 tol.
+  subroutine dyn_assemble(m, q, t, tol, maxit, status, msg, worst, resid)
+    type(model_t), intent(in) :: m              !! model
+    real(wp), intent(inout) :: q(:)             !! estimates, then the assembled configuration
+    real(wp), intent(in) :: t                   !! time
+    real(wp), intent(in) :: tol                 !! ||Phi||_inf tolerance (absolute)
+    integer, intent(in) :: maxit                !! iterations
+    integer, intent(out) :: status              !! MBD_OK, MBD_ASSEMBLY_FAILED, MBD_NO_MEMORY
+    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    integer, intent(out) :: worst               !! constraint with the largest residual
+    real(wp), intent(out) :: resid              !! ||Phi||_inf at the end
+    type(saddle_t) :: sd
+    type(asm_work_t) :: aw
+    real(wp), allocatable :: phi(:), phit(:), nu(:), gam(:), qz(:), qt(:), rhs(:), dmu(:), cs(:)
+    real(wp) :: mu, f, ft, dmax
+    integer :: it, n, neq, ierr, r, k, s, c, st
+    status = MBD_OK; msg = ''
+    worst = 0; resid = zero
+    n = m%nq; neq = m%neq
+    call init_extras(m, q)
+    allocate (phi(neq), phit(neq), nu(neq), gam(neq), qz(n), qt(n), rhs(n + neq), dmu(n), &
+              cs(n), stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail(REAL_BYTES * (4 * real(neq, wp) + 5 * n), 'the assembly work arrays', &
+                    'use a smaller model', status, msg)
+      return
+    end if
+    call asm_init(m, aw, status, msg)
+    if (status /= MBD_OK) return
+    call saddle_plan(m, [(r, r=1, neq)], SOLVER_BANDED, sd, status, msg)
+    if (status /= MBD_OK) return
+    qz = zero
+    call assemble_blocks(m, q, qz, t, phi, nu, gam, aw)
+    f = norm2(phi)
+    ! the largest squared column norm of J (kin_assemble's scale of mu)
+    cs = zero
+    do k = 1, m%nc
+      do s = 1, NLOC
+        c = m%loc(s, k)
+        if (c > 0) cs(c) = cs(c) + sum(aw%jb(1:m%nrow(k), s, k)**2)
+      end do
+    end do
+    dmax = zero
+    if (n > 0) dmax = maxval(cs)
+    mu = 1.0e-3_wp * max(dmax, one)
+    do it = 1, maxit
+      if (maxval(abs(phi)) <= tol) exit
+      dmu = mu
+      call saddle_factor(sd, dmu, aw%jb, one, st, e=one)
+      rhs(1:n) = zero; rhs(n + 1:) = -phi
+      if (st == MBD_OK) call saddle_solve(sd, rhs, st)
+      if (st /= MBD_OK) then
+        mu = mu * 10.0_wp; cycle
+      end if
+      qt = q + rhs(1:n)
+      call assemble_blocks(m, qt, qz, t, phit, nu, gam, aw)
+      ft = norm2(phit)
+      if (ft < f) then
+        q = qt; f = ft; phi = phit
+        mu = max(mu / 10.0_wp, 1.0e-20_wp * max(dmax, one))
+      else
+        call assemble_blocks(m, q, qz, t, phi, nu, gam, aw)
+        mu = mu * 10.0_wp
+        if (mu > 1.0e20_wp * max(dmax, one)) exit
+      end if
+    end do
+    resid = maxval(abs(phi))
+    worst = m%con_of_row(maxloc(abs(phi), 1))
+    if (resid <= 1.0e3_wp * tol) return
+    status = MBD_ASSEMBLY_FAILED
+    write (msg, '(a,es10.3,a,i0,a)') 'assembly failed: no configuration satisfies the '// &
+      'constraints near the estimates (banded solver); smallest residual ||Phi|| = ', resid, &
+      ', largest in constraint ', worst, ' ('//trim(con_name(m%kind(worst)))//')'
+  end subroutine dyn_assemble
 
   !> Reactions of each constraint on its two bodies, from lambda: the generalized constraint
   !! force -J_k^T lambda_k on body i and on body j: (Fx, Fy, Mz) global, Mz about the centre
@@ -440,71 +727,90 @@ contains
     end do
   end subroutine dyn_reactions
 
-  !> Tangent matrices of the residual r = J^T lambda - Q(q, q_dot, t) by differences:
-  !! kt = dr/dq = d(J^T lambda)/dq - dQ/dq (the geometric term included), ct = dr/dq_dot =
-  !! -dQ/dq_dot. Central differences (4 nq residuals), or with fast = .true. forward
-  !! differences (nq + 1 residuals) and ct only when a force is damped (otherwise ct = 0):
-  !! enough for an iteration matrix, which only steers Newton. Allocation-free.
-  subroutine dyn_tangent(m, w, q, qd, t, lam, kt, ct, fast)
+  !> Tangent matrices of the residual r = J^T lambda - Q by differences, on the pattern of
+  !! tangent_pattern: kv(p) = K(krow(p), c) = dr_i/dq_c (the geometric term included), and
+  !! cv likewise for C = dr/dq_dot = -dQ/dq_dot. The columns of a group are perturbed
+  !! together (one residual per group and side instead of one per column), which gives each
+  !! entry exactly as perturbing its column alone. Central differences, or with fast =
+  !! .true. forward ones and cv only when a force is damped (otherwise cv = 0): enough for
+  !! an iteration matrix, which only steers Newton. Allocation-free.
+  subroutine dyn_tangent(m, w, q, qd, t, lam, kv, cv, fast)
     type(model_t), intent(in) :: m            !! model
-    type(dyn_work_t), intent(inout) :: w      !! work arrays
+    type(dyn_work_t), intent(inout) :: w      !! work arrays (pattern from dyn_init)
     real(wp), intent(in) :: q(:), qd(:)       !! state
     real(wp), intent(in) :: t                 !! time
     real(wp), intent(in) :: lam(:)            !! multipliers (neq)
-    real(wp), intent(out) :: kt(:, :), ct(:, :)  !! (nq, nq) tangent stiffness and damping
-    logical, intent(in), optional :: fast     !! forward differences, ct only if damped
-    real(wp), parameter :: SQEPS = 1.5e-8_wp  ! ~ sqrt(machine epsilon)
-    real(wp) :: qp(m%nq), r0(m%nq), rp(m%nq), rm(m%nq), hk
-    integer :: k
+    real(wp), intent(out) :: kv(:), cv(:)     !! K and C on the pattern
+    logical, intent(in), optional :: fast     !! forward differences, cv only if damped
     logical :: fwd
     fwd = .false.
     if (present(fast)) fwd = fast
     if (fwd) then
-      ! forward: K e_k = (r(q + h e_k) - r(q)) / h
-      call residual(q, qd, r0)
-      qp = q
-      do k = 1, m%nq
-        hk = SQEPS * max(one, abs(q(k)))
-        qp(k) = q(k) + hk
-        hk = qp(k) - q(k)                      ! the step actually taken
-        call residual(qp, qd, rp)
-        qp(k) = q(k)
-        kt(:, k) = (rp - r0) / hk
-      end do
-      ct = zero
-      if (.not. dyn_damped(m)) return
-      qp = qd
-      do k = 1, m%nq
-        hk = SQEPS * max(one, abs(qd(k)))
-        qp(k) = qd(k) + hk
-        hk = qp(k) - qd(k)
-        call residual(q, qp, rp)
-        qp(k) = qd(k)
-        ct(:, k) = (rp - r0) / hk
-      end do
+      call residual(q, qd, w%tr0)
+      call groups(.true., kv)
+      cv = zero
+      if (dyn_damped(m)) call groups(.false., cv)
       return
     end if
-    qp = q
-    do k = 1, m%nq
-      hk = 1.0e-7_wp * max(one, abs(q(k)))
-      qp(k) = q(k) + hk
-      call residual(qp, qd, rp)
-      qp(k) = q(k) - hk
-      call residual(qp, qd, rm)
-      qp(k) = q(k)
-      kt(:, k) = (rp - rm) / (2 * hk)
-    end do
-    qp = qd
-    do k = 1, m%nq
-      hk = 1.0e-7_wp * max(one, abs(qd(k)))
-      qp(k) = qd(k) + hk
-      call residual(q, qp, rp)
-      qp(k) = qd(k) - hk
-      call residual(q, qp, rm)
-      qp(k) = qd(k)
-      ct(:, k) = (rp - rm) / (2 * hk)
-    end do
+    call groups(.true., kv)
+    call groups(.false., cv)
   contains
+    !> One group at a time: perturb its columns of q (wrt_q) or q_dot, difference, scatter.
+    subroutine groups(wrt_q, val)
+      logical, intent(in) :: wrt_q
+      real(wp), intent(out) :: val(:)
+      real(wp), parameter :: SQEPS = 1.5e-8_wp  ! ~ sqrt(machine epsilon)
+      integer :: g, i, c, p
+      if (wrt_q) then
+        w%tq = q
+      else
+        w%tq = qd
+      end if
+      do g = 1, w%ncolor
+        do i = w%gptr(g), w%gptr(g + 1) - 1
+          c = w%gcol(i)
+          if (fwd) then
+            w%th(c) = SQEPS * max(one, abs(w%tq(c)))
+          else
+            w%th(c) = 1.0e-7_wp * max(one, abs(w%tq(c)))
+          end if
+          w%tq(c) = w%tq(c) + w%th(c)
+          if (fwd) w%th(c) = w%tq(c) - merge(q(c), qd(c), wrt_q)   ! the step taken
+        end do
+        call eval(wrt_q, w%trp)
+        if (.not. fwd) then
+          do i = w%gptr(g), w%gptr(g + 1) - 1
+            c = w%gcol(i)
+            w%tq(c) = merge(q(c), qd(c), wrt_q) - w%th(c)
+          end do
+          call eval(wrt_q, w%trm)
+        end if
+        do i = w%gptr(g), w%gptr(g + 1) - 1
+          c = w%gcol(i)
+          w%tq(c) = merge(q(c), qd(c), wrt_q)
+          if (fwd) then
+            do p = w%kptr(c), w%kptr(c + 1) - 1
+              val(p) = (w%trp(w%krow(p)) - w%tr0(w%krow(p))) / w%th(c)
+            end do
+          else
+            do p = w%kptr(c), w%kptr(c + 1) - 1
+              val(p) = (w%trp(w%krow(p)) - w%trm(w%krow(p))) / (2 * w%th(c))
+            end do
+          end if
+        end do
+      end do
+    end subroutine groups
+
+    subroutine eval(wrt_q, r)
+      logical, intent(in) :: wrt_q
+      real(wp), intent(out) :: r(:)
+      if (wrt_q) then
+        call residual(w%tq, qd, r)
+      else
+        call residual(q, w%tq, r)
+      end if
+    end subroutine eval
+
     subroutine residual(qa, qda, r)
       real(wp), intent(in) :: qa(:), qda(:)
       real(wp), intent(out) :: r(:)

@@ -26,12 +26,16 @@ module mbd_integrators
                         MBD_INTEGRATOR_FAILED, MBD_LAPACK, MBD_NO_MEMORY, MSG_LEN
   use mbd_memory, only: REAL_BYTES, mem_fail
   use mbd_model, only: model_t
-  use mbd_assemble, only: assemble_dense, assemble_blocks, scatter_dense
-  use mbd_linsolve, only: lu_factor, lu_solve, lapack_status, lu_factor_small, lu_solve_small
-  use mbd_lapack, only: dgeqp3, dgecon
+  use mbd_points, only: NLOC, MAXROW
+  use mbd_assemble, only: assemble_dense, assemble_blocks, blocks_jv
+  use mbd_linsolve, only: lu_factor, lu_solve, lapack_status
+  use mbd_lapack, only: dgesvd
   use mbd_interp, only: hermite5
+  use mbd_band, only: band_t, band_plan, band_zero, band_factor, band_solve
+  use mbd_saddle, only: saddle_t, saddle_plan, saddle_factor, saddle_solve
   use mbd_dynamics, only: dyn_work_t, dyn_accel, dyn_velocity, dyn_project_pos, gen_forces, &
-                          kinetic_energy, dyn_tangent, dyn_solve, dyn_jt_lam, dyn_multipliers
+                          kinetic_energy, dyn_tangent, dyn_solve, dyn_jt_lam, dyn_multipliers, &
+                          dyn_jv, dyn_null_basis, SOLVER_DENSE
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   implicit none
   private
@@ -76,6 +80,13 @@ module mbd_integrators
     logical :: baumgarte = .false.
     integer :: ni = 0                       !! independent coordinates (partitioned)
     integer, allocatable :: iv(:), iu(:)    !! independent and dependent coordinates
+    !> partitioned: null-space basis (nq, ni), the choice's workspace, J_u (dense, or in
+    !! band storage with the map of the blocks into it) and the dependent solves' vectors
+    real(wp), allocatable :: nb(:, :), gw(:, :), gn(:), nsq(:, :), sv(:), svw(:)
+    integer, allocatable :: sel(:), mark(:)
+    real(wp), allocatable :: ju(:, :), ub(:), px(:)
+    integer, allocatable :: upiv(:), usrc(:), upos(:)
+    type(band_t) :: bu
     real(wp), allocatable :: qf(:), vf(:), af(:), lam(:)   !! last full state
     real(wp) :: ts = zero                   !! start of the current step
     real(wp), allocatable :: qs(:), vs(:), as(:)          !! full state there
@@ -317,7 +328,9 @@ contains
   !! by differences, is kept across steps and evaluated again only when Newton contracts
   !! slowly (|dq_k| > GA_RHO |dq_{k-1}|), takes GA_SLOW iterations, or fails (the step is
   !! then retried with fresh K, C). S itself is formed with the current J and factored once
-  !! per step (a small dense LU, cheaper than the extra iterations an older J costs).
+  !! per step (cheaper than the extra iterations an older J costs), on the path of w
+  !! (mbd_saddle: a plain-loop dense LU, or the band LU of a large model). K and C are
+  !! differences over column groups (dyn_tangent), kept on their sparse pattern.
   !! Converged: |Phi| <= w%tol, the last correction below 1e-3 (atol + rtol |q|), and the
   !! residual of M q_ddot + J^T lambda = Q below GA_RTOL of its largest term, so that the
   !! result is that of full Newton (a stale S only changes the iteration count).
@@ -336,12 +349,24 @@ contains
     real(wp) :: rtol_dyn, cf, kmax, cmax, fmax, qmax, vmax, rmax
     real(wp) :: q(m%nq), qd(m%nq), qdd(m%nq), acc(m%nq), lam(m%neq)
     real(wp) :: qn(m%nq), vn(m%nq), an(m%nq), accn(m%nq), lamn(m%neq), dq(m%nq), ap(m%nq)
-    real(wp) :: res(m%nq + w%na), kt(m%nq, m%nq), ct(m%nq, m%nq)
-    real(wp) :: s(m%nq + w%na, m%nq + w%na)
-    integer :: piv(m%nq + w%na), it, n, stt, nfix, na, attempt, nkc, k
+    real(wp) :: res(m%nq + w%na), dg(m%nq)
+    real(wp), allocatable :: kv(:), cv(:), kc(:)   ! K, C and K + g' C on the pattern
+    type(saddle_t) :: sg                            ! the iteration matrix S
+    integer :: it, n, stt, nfix, na, attempt, nkc, k, nnz
     logical :: fixed, conv, have_kc, new_kc, finite
     status = MBD_OK; msg = ''
     n = m%nq; na = w%na
+    ! S = [M b' + K + g' C, b' J^T; b' J, 0] on the path of w (dense: plain-loop LU)
+    call saddle_plan(m, w%rows, w%solver, sg, status, msg, kptr=w%kptr, krow=w%krow, &
+                     small=.true.)
+    if (status /= MBD_OK) return
+    nnz = w%kptr(n + 1) - 1
+    allocate (kv(nnz), cv(nnz), kc(nnz), stat=stt)
+    if (stt /= 0) then
+      call mem_fail(REAL_BYTES * 3 * real(nnz, wp), 'the tangent stiffness and damping', &
+                    'use a smaller model', status, msg)
+      return
+    end if
     am = (2 * c%opts%rho_inf - 1) / (c%opts%rho_inf + 1)        ! Arnold & Bruls (2007)
     af = c%opts%rho_inf / (c%opts%rho_inf + 1)
     gam = half + af - am
@@ -349,7 +374,7 @@ contains
     cf = (1 - af) / (1 - am)             ! weight of q_ddot_{n+1} in a_{n+1}
     fixed = c%opts%h > zero
     have_kc = .false.; new_kc = .false.
-    kt = zero; ct = zero; kmax = zero; cmax = zero
+    kv = zero; cv = zero; kmax = zero; cmax = zero
     q = c%qf; qd = c%vf; qdd = c%af; lam = c%lam
     t = c%t0
     nfix = 0
@@ -426,19 +451,28 @@ contains
           if (it == GA_SLOW .and. nkc < 2) new_kc = .true.
           if (it == 1 .or. new_kc) then
             if (.not. have_kc .or. new_kc) then
-              call dyn_tangent(m, w, qn, vn, tnew, lamn, kt, ct, fast=.true.)
+              call dyn_tangent(m, w, qn, vn, tnew, lamn, kv, cv, fast=.true.)
               c%st%jacobians = c%st%jacobians + 1
               have_kc = .true.; new_kc = .false.; nkc = nkc + 1
-              kmax = maxval(abs(kt)); cmax = maxval(abs(ct))
+              kmax = zero; cmax = zero
+              if (nnz > 0) then
+                kmax = maxval(abs(kv)); cmax = maxval(abs(cv))
+              end if
               call assemble_blocks(m, qn, vn, tnew, w%phi, w%nu, w%gam, w%asm)
             end if
-            call form_s()
-            call lu_factor_small(s, piv, stt)
+            ! S with the current J: K + g' C on the pattern, + M b' on the diagonal, b' J
+            do k = 1, nnz
+              kc(k) = kv(k) + gp * cv(k)
+            end do
+            do k = 1, n
+              dg(k) = m%mdiag(k) * bp
+            end do
+            call saddle_factor(sg, dg, w%asm%jb, bp, stt, kv=kc)
             c%st%factorizations = c%st%factorizations + 1
             if (stt /= MBD_OK) exit
           end if
           res = -res
-          call lu_solve_small(s, piv, res)
+          call saddle_solve(sg, res, stt)
           dq = res(1:n)
           qn = qn + dq
           vn = vn + gp * dq
@@ -492,23 +526,6 @@ contains
       end if
     end do
     c%qf = q; c%vf = qd; c%af = qdd; c%lam = lam
-  contains
-    !> S = [M b' + C g' + K, b' J^T; b' J, 0] at the last assembly (J from its blocks).
-    subroutine form_s()
-      integer :: j
-      call scatter_dense(w%asm, w%jac)
-      do j = 1, n + na
-        s(:, j) = zero
-      end do
-      do j = 1, n
-        s(1:n, j) = kt(:, j) + gp * ct(:, j)
-        s(j, j) = s(j, j) + m%mdiag(j) * bp
-      end do
-      do j = 1, na
-        s(n + j, 1:n) = bp * w%jac(w%rows(j), :)
-        s(1:n, n + j) = bp * w%jac(w%rows(j), :)
-      end do
-    end subroutine form_s
   end subroutine run_genalpha
 
   ! -------------------------------------------------------------------- explicit methods
@@ -761,14 +778,17 @@ contains
     real(wp), intent(in) :: q(:), qd(:), t
     real(wp), intent(out) :: qdd(:), lam(:)
     integer, intent(out) :: stf
-    integer :: nn
+    integer :: nn, k, r
     call dyn_accel(m, w, q, qd, t, qdd, lam, stf)
     if (stf /= MBD_OK .or. opts%method /= METH_RK4) return
     nn = m%nq
+    call dyn_jv(m, w, qd)                     ! J q_dot from the blocks (no dense J)
     w%rhs(1:nn) = w%force
-    w%rhs(nn + 1:) = w%s * (w%gam(w%rows) - two * opts%balpha * &
-                            (matmul(w%jac(w%rows, :), qd) - w%nu(w%rows)) - &
-                            opts%bbeta**2 * w%phi(w%rows))
+    do k = 1, w%na
+      r = w%rows(k)
+      w%rhs(nn + k) = w%s * (w%gam(r) - two * opts%balpha * (w%jv(r) - w%nu(r)) - &
+                             opts%bbeta**2 * w%phi(r))
+    end do
     call dyn_solve(w, w%rhs, stf)
     qdd = w%rhs(1:nn)
   end subroutine accel_at
@@ -798,103 +818,280 @@ contains
   end subroutine complete_outputs
 
   !> Dependent coordinates u from Phi(u, v) = 0 (Newton with J_u), then u_dot from
-  !! J_u u_dot = nu - J_v v_dot.
+  !! J_u u_dot = nu - J_v v_dot. J_u is dense, or in band storage on the band path (its
+  !! plan made by partition).
   subroutine solve_dependent(m, w, c, t, vdot, stf)
     type(model_t), intent(in) :: m
     type(dyn_work_t), intent(inout) :: w
     type(itg_t), intent(inout) :: c
     real(wp), intent(in) :: t, vdot(:)
     integer, intent(out) :: stf
-    real(wp) :: ju(w%na, w%na), b(w%na)
-    integer :: piv(w%na), it
+    integer :: it, k
     character(len=MSG_LEN) :: lmsg
+    if (w%solver /= SOLVER_DENSE) then
+      call solve_dependent_band()
+      return
+    end if
     do it = 1, 25
       call assemble_dense(m, c%qf, w%qz, t, w%phi, w%nu, w%gam, w%asm, w%jac)
-      ju = w%jac(w%rows, c%iu)
-      call lu_factor(ju, piv, stf, lmsg)
+      do k = 1, w%na
+        c%ju(k, :) = w%jac(w%rows(k), c%iu)
+      end do
+      call lu_factor(c%ju, c%upiv, stf, lmsg)
       if (stf /= MBD_OK) return
       if (maxval(abs(w%phi)) <= w%tol) exit
-      b = -w%phi(w%rows)
-      call lu_solve(ju, piv, b, stf, lmsg)
-      c%qf(c%iu) = c%qf(c%iu) + b
+      do k = 1, w%na
+        c%ub(k) = -w%phi(w%rows(k))
+      end do
+      call lu_solve(c%ju, c%upiv, c%ub, stf, lmsg)
+      c%qf(c%iu) = c%qf(c%iu) + c%ub
       c%st%newton = c%st%newton + 1
     end do
     if (maxval(abs(w%phi)) > w%tol) then
       stf = MBD_NO_CONVERGENCE; return
     end if
     c%vf(c%iv) = vdot
-    b = w%nu(w%rows) - matmul(w%jac(w%rows, c%iv), vdot)
-    call lu_solve(ju, piv, b, stf, lmsg)
-    c%vf(c%iu) = b
+    do k = 1, w%na
+      c%ub(k) = w%nu(w%rows(k)) - dot_product(w%jac(w%rows(k), c%iv), vdot)
+    end do
+    call lu_solve(c%ju, c%upiv, c%ub, stf, lmsg)
+    c%vf(c%iu) = c%ub
+  contains
+    !> The same with J_u in band storage, J_v v_dot from the blocks (no dense J).
+    subroutine solve_dependent_band()
+      do it = 1, 25
+        call assemble_blocks(m, c%qf, w%qz, t, w%phi, w%nu, w%gam, w%asm)
+        call band_zero(c%bu)
+        call scatter_add(c%bu%ab, size(c%bu%ab), c%upos, c%usrc, w%asm%jb, size(w%asm%jb))
+        call band_factor(c%bu, stf, lmsg)
+        if (stf /= MBD_OK) return
+        if (maxval(abs(w%phi)) <= w%tol) exit
+        do k = 1, w%na
+          c%ub(k) = -w%phi(w%rows(k))
+        end do
+        call band_solve(c%bu, c%ub, stf, lmsg)
+        do k = 1, w%na
+          c%qf(c%iu(k)) = c%qf(c%iu(k)) + c%ub(k)
+        end do
+        c%st%newton = c%st%newton + 1
+      end do
+      if (maxval(abs(w%phi)) > w%tol) then
+        stf = MBD_NO_CONVERGENCE; return
+      end if
+      c%vf(c%iv) = vdot
+      c%px = zero                                ! J_v v_dot = J x, x = v_dot on v, 0 on u
+      do k = 1, c%ni
+        c%px(c%iv(k)) = vdot(k)
+      end do
+      call dyn_jv(m, w, c%px)
+      do k = 1, w%na
+        c%ub(k) = w%nu(w%rows(k)) - w%jv(w%rows(k))
+      end do
+      call band_solve(c%bu, c%ub, stf, lmsg)
+      do k = 1, w%na
+        c%vf(c%iu(k)) = c%ub(k)
+      end do
+    end subroutine solve_dependent_band
   end subroutine solve_dependent
 
-  !> Choose the dependent coordinates: the first na columns of a QR with column pivoting of
-  !! J (the best-conditioned block J_u); the rest are independent.
+  !> f(pos(i)) += jb(src(i)) over flat (column-major) views.
+  pure subroutine scatter_add(f, nf, pos, src, jb, nj)
+    integer, intent(in) :: nf, nj
+    real(wp), intent(inout) :: f(nf)
+    integer, intent(in) :: pos(:), src(:)
+    real(wp), intent(in) :: jb(nj)
+    integer :: i
+    do i = 1, size(pos)
+      f(pos(i)) = f(pos(i)) + jb(src(i))
+    end do
+  end subroutine scatter_add
+
+  !> Choose the independent coordinates v at the current state: the ni coordinates a
+  !! pivoted Gram-Schmidt picks from the rows of N, an orthonormal basis of the null space
+  !! of J (dyn_null_basis). The motion the constraints allow is N z; with v = N_v z the
+  !! dependent velocities are u_dot = N_u N_v^-1 v_dot (= -J_u^-1 J_v v_dot), so the best
+  !! v makes N_v well conditioned, and the pivoting takes, one at a time, the coordinate
+  !! along which the allowed motion not yet covered is largest. The rest are dependent;
+  !! both sets in increasing order. Band path: the band plan of J_u is made here.
   subroutine partition(m, w, c, t, stf)
     type(model_t), intent(in) :: m
     type(dyn_work_t), intent(inout) :: w
     type(itg_t), intent(inout) :: c
     real(wp), intent(in) :: t
     integer, intent(out) :: stf
-    real(wp) :: a(w%na, m%nq), tau(min(w%na, m%nq)), wq(1)
-    real(wp), allocatable :: work(:)
-    integer :: jp(m%nq), info
+    integer :: ni, n, k, j
     character(len=MSG_LEN) :: lmsg
-    call assemble_dense(m, c%qf, w%qz, t, w%phi, w%nu, w%gam, w%asm, w%jac)
-    a = w%jac(w%rows, :)
-    jp = 0
-    call dgeqp3(w%na, m%nq, a, w%na, jp, tau, wq, -1, info)
-    allocate (work(max(1, int(wq(1)))), stat=stf)
+    n = m%nq; ni = n - w%na
+    call partition_work(m, w, c, stf)
+    if (stf /= MBD_OK) return
+    call dyn_null_basis(m, w, c%qf, t, c%nb, stf)
+    if (stf /= MBD_OK) return
+    call select_coordinates(c, c%sel)
+    c%mark = 0
+    c%mark(c%sel) = 1
+    k = 0; j = 0
+    do n = 1, m%nq
+      if (c%mark(n) == 1) then
+        k = k + 1; c%iv(k) = n
+      else
+        j = j + 1; c%iu(j) = n
+      end if
+    end do
+    c%ni = ni
+    c%st%partitions = c%st%partitions + 1
+    if (w%solver /= SOLVER_DENSE) call plan_ju(m, w, c, stf, lmsg)
+  end subroutine partition
+
+  !> The partitioned method's work arrays (the first time).
+  subroutine partition_work(m, w, c, stf)
+    type(model_t), intent(in) :: m
+    type(dyn_work_t), intent(in) :: w
+    type(itg_t), intent(inout) :: c
+    integer, intent(out) :: stf
+    integer :: ni, na, lw
+    real(wp) :: wq(1), adum(1), sdum(1), udum(1), vdum(1)
+    stf = MBD_OK
+    if (allocated(c%nb)) return
+    na = w%na; ni = m%nq - na
+    call dgesvd('N', 'N', ni, ni, adum, max(ni, 1), sdum, udum, 1, vdum, 1, wq, -1, stf)
+    lw = max(1, int(wq(1)), 5 * ni)
+    allocate (c%nb(m%nq, ni), c%sel(ni), c%mark(m%nq), c%iv(ni), c%iu(na), c%ub(na), &
+              c%px(m%nq), c%gw(ni, m%nq), c%gn(m%nq), c%nsq(ni, ni), c%sv(ni), c%svw(lw), &
+              stat=stf)
+    if (stf == 0 .and. w%solver == SOLVER_DENSE) allocate (c%ju(na, na), c%upiv(na), stat=stf)
+    if (stf /= 0) stf = MBD_NO_MEMORY
+  end subroutine partition_work
+
+  !> Greedy pivoted Gram-Schmidt on the rows of c%nb: sel(k) is the coordinate whose row,
+  !! less its parts along the rows chosen before, is longest (ties within a relative 1e-6
+  !! go to the lowest index, so rounding does not decide between equal candidates).
+  subroutine select_coordinates(c, sel)
+    type(itg_t), intent(inout) :: c
+    integer, intent(out) :: sel(:)
+    integer :: ni, n, k, j, best
+    real(wp) :: gmax, u(size(c%nb, 2)), d
+    n = size(c%nb, 1); ni = size(c%nb, 2)
+    c%gw = transpose(c%nb)
+    do j = 1, n
+      c%gn(j) = sum(c%gw(:, j)**2)
+    end do
+    c%mark = 0
+    do k = 1, ni
+      gmax = -one
+      do j = 1, n
+        if (c%mark(j) == 0) gmax = max(gmax, c%gn(j))
+      end do
+      best = 0
+      do j = 1, n
+        if (c%mark(j) == 0 .and. c%gn(j) >= (one - 1.0e-6_wp) * gmax) then
+          best = j; exit
+        end if
+      end do
+      sel(k) = best
+      c%mark(best) = 1
+      u = c%gw(:, best) / sqrt(max(c%gn(best), tiny(one)))
+      do j = 1, n
+        if (c%mark(j) == 1) cycle
+        d = dot_product(u, c%gw(:, j))
+        c%gw(:, j) = c%gw(:, j) - d * u
+        c%gn(j) = sum(c%gw(:, j)**2)
+      end do
+    end do
+  end subroutine select_coordinates
+
+  !> The smallest singular value of N_v = nb(v, :), the rows of the coordinates v: how well
+  !! the independent coordinates v describe the allowed motion (0 when they cannot).
+  real(wp) function smin_rows(c, v) result(sm)
+    type(itg_t), intent(inout) :: c
+    integer, intent(in) :: v(:)
+    integer :: k, info, ni
+    real(wp) :: udum(1, 1), vdum(1, 1)
+    ni = size(v)
+    do k = 1, ni
+      c%nsq(k, :) = c%nb(v(k), :)
+    end do
+    call dgesvd('N', 'N', ni, ni, c%nsq, ni, c%sv, udum, 1, vdum, 1, c%svw, size(c%svw), info)
+    sm = zero
+    if (info == 0 .and. ni > 0) sm = c%sv(ni)
+  end function smin_rows
+
+  !> Band path: the band plan of J_u (active rows x dependent coordinates) and the map from
+  !! the constraint blocks into it.
+  subroutine plan_ju(m, w, c, stf, lmsg)
+    type(model_t), intent(in) :: m
+    type(dyn_work_t), intent(in) :: w
+    type(itg_t), intent(inout) :: c
+    integer, intent(out) :: stf
+    character(len=MSG_LEN), intent(out) :: lmsg
+    integer, allocatable :: arow(:), ucol(:), rr(:), cc(:)
+    integer :: k, s, r, a, u, ne, i, ldab
+    allocate (arow(m%neq), ucol(m%nq), stat=stf)
     if (stf /= 0) then
       stf = MBD_NO_MEMORY; return
     end if
-    call dgeqp3(w%na, m%nq, a, w%na, jp, tau, work, size(work), info)
-    call lapack_status('dgeqp3', info, stf, lmsg)
+    arow = 0; ucol = 0
+    do k = 1, w%na
+      arow(w%rows(k)) = k
+      ucol(c%iu(k)) = k
+    end do
+    ne = 0
+    do k = 1, m%nc
+      do s = 1, NLOC
+        if (m%loc(s, k) == 0) cycle
+        if (ucol(m%loc(s, k)) == 0) cycle
+        do r = 1, m%nrow(k)
+          if (arow(m%row0(k) + r - 1) > 0) ne = ne + 1
+        end do
+      end do
+    end do
+    if (allocated(c%usrc)) deallocate (c%usrc, c%upos)
+    allocate (rr(ne), cc(ne), c%usrc(ne), c%upos(ne), stat=stf)
+    if (stf /= 0) then
+      stf = MBD_NO_MEMORY; return
+    end if
+    ne = 0
+    do k = 1, m%nc
+      do s = 1, NLOC
+        if (m%loc(s, k) == 0) cycle
+        u = ucol(m%loc(s, k))
+        if (u == 0) cycle
+        do r = 1, m%nrow(k)
+          a = arow(m%row0(k) + r - 1)
+          if (a == 0) cycle
+          ne = ne + 1
+          rr(ne) = a; cc(ne) = u
+          c%usrc(ne) = r + MAXROW * (s - 1 + NLOC * (k - 1))
+        end do
+      end do
+    end do
+    call band_plan(w%na, rr, cc, c%bu, stf, lmsg)
     if (stf /= MBD_OK) return
-    c%iu = jp(1:w%na)
-    c%iv = jp(w%na + 1:)
-    c%ni = m%nq - w%na
-    c%st%partitions = c%st%partitions + 1
-  end subroutine partition
+    ldab = c%bu%ldab
+    do i = 1, ne
+      c%upos(i) = c%bu%kl + c%bu%ku + 1 + c%bu%prow(rr(i)) - c%bu%pcol(cc(i)) + &
+                  ldab * (c%bu%pcol(cc(i)) - 1)
+    end do
+  end subroutine plan_ju
 
-  !> 1/cond_1 of J(rows, cols) at the last assembly (0 when singular).
-  real(wp) function rcond_cols(w, cols) result(rc)
-    type(dyn_work_t), intent(inout) :: w
-    integer, intent(in) :: cols(:)
-    real(wp) :: ju(w%na, w%na), anorm, cw(4 * w%na)
-    integer :: piv(w%na), iw(w%na), stf, info
-    character(len=MSG_LEN) :: lmsg
-    ju = w%jac(w%rows, cols)
-    anorm = maxval(sum(abs(ju), dim=1))
-    rc = zero
-    call lu_factor(ju, piv, stf, lmsg)
-    if (stf /= MBD_OK) return
-    call dgecon('1', w%na, ju, w%na, anorm, rc, cw, iw, info)
-  end function rcond_cols
-
-  !> Choose again when the current J_u has become REPARTITION times worse conditioned
-  !! (1/cond_1) than the choice a QR with column pivoting of J would make now. Near a
-  !! singular configuration, where every J_u is ill conditioned, nothing better exists and
-  !! the partition is kept.
+  !> Choose again when the current independent coordinates describe the allowed motion
+  !! REPARTITION times worse (the smallest singular value of N_v) than the choice
+  !! partition would make now. Near a singular configuration, where every choice is poor,
+  !! nothing better exists and the partition is kept.
   logical function needs_partition(m, w, c, t)
     type(model_t), intent(in) :: m
     type(dyn_work_t), intent(inout) :: w
-    type(itg_t), intent(in) :: c
+    type(itg_t), intent(inout) :: c
     real(wp), intent(in) :: t
-    real(wp) :: rc, a(w%na, m%nq), tau(w%na), wq(1)
-    real(wp), allocatable :: work(:)
-    integer :: jp(m%nq), info, stat
-    call assemble_dense(m, c%qf, w%qz, t, w%phi, w%nu, w%gam, w%asm, w%jac)
-    rc = rcond_cols(w, c%iu)
-    a = w%jac(w%rows, :)
-    jp = 0
-    call dgeqp3(w%na, m%nq, a, w%na, jp, tau, wq, -1, info)
-    allocate (work(max(1, int(wq(1)))), stat=stat)
-    needs_partition = rc <= zero
-    if (stat /= 0 .or. info /= 0) return
-    call dgeqp3(w%na, m%nq, a, w%na, jp, tau, work, size(work), info)
-    if (info /= 0) return
-    needs_partition = rc < REPARTITION * rcond_cols(w, jp(1:w%na))
+    real(wp) :: now, best
+    integer :: stt
+    needs_partition = .false.
+    if (c%ni <= 0) return
+    call dyn_null_basis(m, w, c%qf, t, c%nb, stt)
+    if (stt /= MBD_OK) return
+    now = smin_rows(c, c%iv)
+    call select_coordinates(c, c%sel)
+    best = smin_rows(c, c%sel)
+    needs_partition = now < REPARTITION * best
   end function needs_partition
 
   !> One classical Runge-Kutta step.

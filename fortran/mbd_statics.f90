@@ -19,17 +19,24 @@
 !! they reduce the residual of the equilibrium equations, ||g|| / F + ||Phi|| / l (F the
 !! force scale, l the model's length scale), and stop where it no longer halves: round-off.
 !! The signs of the eigenvalues of H at the end give the stability.
-!! Memory: the dense work arrays (five n x n) are checked and allocated once per call, with
-!! MBD_NO_MEMORY when they cannot be had; the iterations allocate nothing.
+!! Band path (w%solver, large models; no n x n array): the active rows are independent
+!! (dyn_init's band rank analysis), so N has n - na columns, taken from projections of fixed
+!! vectors onto the null space (dyn_null_basis) instead of the SVD; dq_n and the multipliers
+!! from saddle-point solves [s I, s J^T; s J, 0]; K on its sparse pattern (differences over
+!! column groups), K N column by column. The work is O(n nfree^2 + n nfree bw), linear in n
+!! for a fixed number of free motions.
+!! Memory: the dense work arrays (five n x n; band path: three n x nfree) are checked and
+!! allocated once per call, with MBD_NO_MEMORY when they cannot be had; the iterations
+!! allocate nothing.
 module mbd_statics
   use mbd_kinds, only: wp, zero, one, half, eps
   use mbd_status, only: MBD_OK, MBD_NO_CONVERGENCE, MBD_LAPACK, MSG_LEN
   use mbd_memory, only: REAL_BYTES, mem_check, mem_fail
   use mbd_model, only: model_t
-  use mbd_assemble, only: assemble_dense
+  use mbd_assemble, only: blocks_jtv
   use mbd_lapack, only: dgesvd, dsyev
   use mbd_dynamics, only: dyn_work_t, gen_forces, dyn_tangent, dyn_project_pos, &
-                          dyn_multipliers
+                          dyn_multipliers, dyn_null_basis, dyn_solve, SOLVER_DENSE
   implicit none
   private
   public :: statics_solve
@@ -62,26 +69,41 @@ contains
     ! vectors of the steps; work is LAPACK's workspace (grown when a query asks for more)
     real(wp), allocatable :: nb(:, :), h(:, :), ev(:), g(:), dz(:), dqn(:), kt(:, :), &
                              ct(:, :), qt(:), ja(:, :), sv(:), u(:, :), vt(:, :), work(:), &
-                             r(:), c(:), dqz(:)
+                             r(:), c(:), dqz(:), kv(:), cv(:)
+    integer, allocatable :: ktr(:)
     real(wp) :: v0, vt1, alpha, emax, fscale, vnoise, e0, e1, gn, pn, slope, bytes
-    integer :: it, ls, nfree, n, na, stp, ist, nu
-    logical :: local
+    integer :: it, ls, nfree, n, na, stp, ist, nu, nnz, nn, nf0
+    logical :: local, band
     character(len=MSG_LEN) :: lmsg, what
     status = MBD_OK; msg = ''; stable = 2; resid = zero
     n = m%nq; na = w%na; nu = min(na, n)
-    bytes = REAL_BYTES * (5 * real(n, wp)**2 + real(max(na, 1), wp) * (n + max(nu, 1)) &
-                          + 10 * real(n, wp) + max(nu, 1))
-    write (what, '(a,i0,a)') 'the statics work arrays (', n, ' coordinates, dense)'
+    band = w%solver /= SOLVER_DENSE
+    nnz = w%kptr(n + 1) - 1
+    if (band) then
+      nf0 = max(n - na, 1); nn = nf0
+      bytes = REAL_BYTES * (3 * real(n, wp) * nf0 + real(nf0, wp)**2 + 10 * real(n, wp) + &
+                            2 * real(nnz, wp))
+      write (what, '(a,i0,a,i0,a)') 'the statics work arrays (', n, ' coordinates, ', &
+        n - na, ' free motions, band path)'
+    else
+      nf0 = n; nn = n
+      bytes = REAL_BYTES * (5 * real(n, wp)**2 + real(max(na, 1), wp) * (n + max(nu, 1)) &
+                            + 10 * real(n, wp) + max(nu, 1) + 2 * real(nnz, wp))
+      write (what, '(a,i0,a)') 'the statics work arrays (', n, ' coordinates, dense)'
+    end if
     call mem_check(bytes, trim(what), HINT, status, msg)
     if (status /= MBD_OK) return
-    allocate (nb(n, n), h(n, n), kt(n, n), ct(n, n), vt(n, n), stat=ist)
+    allocate (nb(n, nf0), h(nf0, nf0), ct(n, nf0), kv(nnz), cv(nnz), ktr(nnz), stat=ist)
+    if (ist == 0 .and. .not. band) allocate (kt(n, n), vt(n, n), stat=ist)
     if (ist == 0) allocate (ev(n), g(n), dz(n), dqn(n), qt(n), r(n), c(n), dqz(n), stat=ist)
-    if (ist == 0) allocate (ja(max(na, 1), n), sv(max(nu, 1)), u(max(na, 1), max(nu, 1)), &
-                            work(1), stat=ist)
+    if (ist == 0 .and. .not. band) &
+      allocate (ja(max(na, 1), n), sv(max(nu, 1)), u(max(na, 1), max(nu, 1)), stat=ist)
+    if (ist == 0) allocate (work(1), stat=ist)
     if (ist /= 0) then
       call mem_fail(bytes, trim(what), HINT, status, msg)
       return
     end if
+    call transpose_map()
     call dyn_project_pos(m, w, q, t, status)
     if (status /= MBD_OK) then
       msg = 'statics: the constraints cannot be satisfied near the estimates'; return
@@ -164,20 +186,53 @@ contains
       real(wp), intent(in) :: qa(:)
       integer, intent(out) :: st
       real(wp) :: wq(1)
-      integer :: info, rk, k, lw, i, j
+      integer :: info, rk, k, lw, i, j, p
       st = MBD_OK
       call dyn_multipliers(m, w, qa, w%qz, w%qz, t, lam, stp, lmsg)  ! also J and Q at qa
-      r = matmul(lam, w%jac)                           ! J^T lambda
+      call blocks_jtv(m, w%asm, lam, r)                ! J^T lambda
       fscale = max(maxval(abs(w%force)), maxval(abs(r)), tiny(one))
       pn = zero
       do i = 1, na                                     ! row gathers as loops (no temporary)
         pn = max(pn, abs(w%phi(w%rows(i))))
       end do
+      dqn = zero
+      rk = 0
+      if (band) then
+        ! dq_n = -J^+ Phi from the factors dyn_multipliers left: [s I, s J^T; s J, 0]
+        if (na > 0) then
+          w%rhs(1:n) = zero
+          do i = 1, na
+            w%rhs(n + i) = -w%s * w%phi(w%rows(i))
+          end do
+          call dyn_solve(w, w%rhs, st)
+          if (st /= MBD_OK) return
+          dqn = w%rhs(1:n)
+        end if
+        v0 = potential(qa)
+        vnoise = V_NOISE * (abs(v0) + scale_of_v(qa))
+        nfree = n - na
+        if (nfree == 0) return
+        call dyn_null_basis(m, w, qa, t, nb(:, 1:nfree), st)
+        if (st /= MBD_OK) then
+          st = MBD_LAPACK; msg = 'statics: no basis of the free motions (J is singular)'
+          return
+        end if
+        g(1:nfree) = matmul(w%force, nb(:, 1:nfree))   ! N^T Q (= -reduced gradient of V)
+        call dyn_tangent(m, w, qa, w%qz, t, lam, kv, cv)
+        do p = 1, nnz                                  ! K_sym = (K + K^T) / 2
+          if (ktr(p) > p) then
+            kv(p) = half * (kv(p) + kv(ktr(p))); kv(ktr(p)) = kv(p)
+          end if
+        end do
+        do j = 1, nfree                                ! K N, column by column
+          call kmul(nb(:, j), ct(:, j))
+        end do
+        h(1:nfree, 1:nfree) = matmul(transpose(nb(:, 1:nfree)), ct(:, 1:nfree))
+        return
+      end if
       v0 = potential(qa)
       vnoise = V_NOISE * (abs(v0) + scale_of_v(qa))
       ! SVD of the active rows: J_a = U S V^T; N = the last columns of V
-      dqn = zero
-      rk = 0
       if (na > 0) then
         do i = 1, na
           ja(i, :) = w%jac(w%rows(i), :)
@@ -214,15 +269,51 @@ contains
       if (nfree == 0) return
       nb(:, 1:nfree) = transpose(vt(rk + 1:n, :))
       g(1:nfree) = matmul(w%force, nb(:, 1:nfree))     ! N^T Q (= -reduced gradient of V)
-      call dyn_tangent(m, w, qa, w%qz, t, lam, kt, ct)
+      call dyn_tangent(m, w, qa, w%qz, t, lam, kv, cv)
+      kt = zero
+      do j = 1, n
+        do p = w%kptr(j), w%kptr(j + 1) - 1
+          kt(w%krow(p), j) = kv(p)
+        end do
+      end do
       do j = 1, n                                      ! K_sym = (K + K^T) / 2
         do i = 1, j - 1
           kt(i, j) = half * (kt(i, j) + kt(j, i)); kt(j, i) = kt(i, j)
         end do
       end do
-      ct(:, 1:nfree) = matmul(kt, nb(:, 1:nfree))      ! ct (the damping) is not needed: K N
+      ct(:, 1:nfree) = matmul(kt, nb(:, 1:nfree))      ! K N
       h(1:nfree, 1:nfree) = matmul(transpose(nb(:, 1:nfree)), ct(:, 1:nfree))
     end subroutine reduce
+
+    !> y = K x on the sparse pattern (band path; kv holds K_sym).
+    subroutine kmul(x, y)
+      real(wp), intent(in) :: x(:)
+      real(wp), intent(out) :: y(:)
+      integer :: j, p
+      y = zero
+      do j = 1, n
+        if (abs(x(j)) <= zero) cycle
+        do p = w%kptr(j), w%kptr(j + 1) - 1
+          y(w%krow(p)) = y(w%krow(p)) + kv(p) * x(j)
+        end do
+      end do
+    end subroutine kmul
+
+    !> ktr(p): the entry (c, i) of the pattern entry p = (i, c) (the pattern is symmetric).
+    subroutine transpose_map()
+      integer :: j, p, i, pp
+      do j = 1, n
+        do p = w%kptr(j), w%kptr(j + 1) - 1
+          i = w%krow(p)
+          ktr(p) = p
+          do pp = w%kptr(i), w%kptr(i + 1) - 1
+            if (w%krow(pp) == j) then
+              ktr(p) = pp; exit
+            end if
+          end do
+        end do
+      end do
+    end subroutine transpose_map
 
     !> y = N dz (the first nfree columns of nb).
     subroutine null_mul(x, y)
@@ -256,7 +347,11 @@ contains
     subroutine newton_step(st)
       integer, intent(out) :: st      !! MBD_OK or MBD_NO_MEMORY
       integer :: k
-      qt = matmul(dqn, kt)                               ! (K dq_n)^T, K symmetric
+      if (band) then
+        call kmul(dqn, qt)                               ! K dq_n
+      else
+        qt = matmul(dqn, kt)                             ! (K dq_n)^T, K symmetric
+      end if
       r(1:nfree) = matmul(qt, nb(:, 1:nfree))
       r(1:nfree) = g(1:nfree) - r(1:nfree)
       call eigen(.true., st)
@@ -305,10 +400,10 @@ contains
       integer :: info
       character(len=1) :: job
       job = merge('V', 'N', vectors)
-      call dsyev(job, 'U', nfree, h, n, ev, wq, -1, info)
+      call dsyev(job, 'U', nfree, h, size(h, 1), ev, wq, -1, info)
       call grow_work(max(1, int(wq(1))), st)
       if (st /= MBD_OK) return
-      call dsyev(job, 'U', nfree, h, n, ev, work, size(work), info)
+      call dsyev(job, 'U', nfree, h, size(h, 1), ev, work, size(work), info)
     end subroutine eigen
   end subroutine statics_solve
 

@@ -4,8 +4,8 @@
     mbd2d export MODEL.toml OUT.mbd --t-end T --steps N
     mbd2d check MODEL.toml
     mbd2d dynamics MODEL.toml --t-end T --steps N --out OUT.csv [--method M --rtol R --atol A --h H
-                   --max-steps S]
-    mbd2d statics MODEL.toml [--t T]
+                   --max-steps S --solver S]
+    mbd2d statics MODEL.toml [--t T --solver S]
 
 Exit codes: 0 ok, 2 bad input, 3 singular configuration (partial output written),
 4 other numerical failure (partial output written when there is any).
@@ -56,10 +56,14 @@ def _parser() -> argparse.ArgumentParser:
     d.add_argument("--every", type=int, default=1, help="write every k-th row (and the last)")
     d.add_argument("--max-steps", type=int, default=None, help="limit on the integrator's "
                    "steps, accepted and rejected (default 10000000)")
+    d.add_argument("--solver", default="auto", choices=["auto", "dense", "banded"],
+                   help="linear algebra (default auto: band LU for large chains)")
     s = sub.add_parser("statics", help="static equilibrium and reactions")
     s.add_argument("model", help="model file (.toml) with masses")
     s.add_argument("--t", type=float, default=0.0, help="time at which loads and drivers are "
                    "taken (default 0)")
+    s.add_argument("--solver", default="auto", choices=["auto", "dense", "banded"],
+                   help="linear algebra (default auto: band LU for large chains)")
     c = sub.add_parser("check", help="degrees of freedom and redundant constraints")
     c.add_argument("model", help="model file (.toml)")
     c.add_argument("--t", type=float, default=0.0, help="time of the check (default 0)")
@@ -103,7 +107,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             print(model.analyze_dof(t=args.t))
             return EXIT_OK
         if args.command == "statics":
-            print(_statics_report(model, model.statics(t=args.t)))
+            print(_statics_report(model, model.statics(t=args.t, solver=args.solver)))
             return EXIT_OK
         if args.command == "export":
             model.export(args.out, t_end=args.t_end, steps=args.steps, t0=args.t0, tol=args.tol)
@@ -115,7 +119,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             res = model.dynamics(t_end=args.t_end, steps=args.steps, t0=args.t0,
                                  method=args.method, rtol=args.rtol, atol=args.atol, h=args.h,
                                  rho_inf=args.rho_inf, alpha=args.alpha, beta=args.beta,
-                                 every=args.every, max_steps=args.max_steps)
+                                 every=args.every, max_steps=args.max_steps,
+                                 solver=args.solver)
         else:
             res = model.kinematics(t_end=args.t_end, steps=args.steps, t0=args.t0, tol=args.tol,
                                    every=args.every, solver=args.solver)

@@ -161,7 +161,8 @@ class Model(ModelDescription):
                  rtol: float | None = None, atol: float | None = None, h: float | None = None,
                  rho_inf: float | None = None, alpha: float | None = None,
                  beta: float | None = None, t0: float = 0.0,
-                 every: int = 1, max_steps: int | None = None) -> DynamicsResult:
+                 every: int = 1, max_steps: int | None = None,
+                 solver: str = "auto") -> DynamicsResult:
         """Forward dynamics of M q_ddot + J^T lambda = Q, Phi = 0 from the assembled q0 and
         v0 (projected onto J q_dot = nu), outputs at steps + 1 uniform times (every
         every-th of them kept).
@@ -197,6 +198,14 @@ class Model(ModelDescription):
             ends a run whose steps collapse; a long run at a tight tolerance (or a fixed h
             that needs more steps) raises it. When it is reached the run stops with an
             IntegrationError that says so, the results up to then kept.
+        solver : {"auto", "dense", "banded"}, optional
+            Linear algebra of every saddle-point solve ([M J^T; J 0], generalized-alpha's
+            iteration matrix, the projections, the consistent start, the multipliers):
+            dense LU, or band LU after an ordering that interleaves each body's coordinates
+            with the rows of its constraints (no n x n matrix: cost and memory linear in the
+            number of bodies of a chain-like model). "auto" picks the band for at least 60
+            coordinates whose band is narrow (``res.stats["solver"]`` and
+            ``res.stats["band"]`` say which ran).
 
         Returns
         -------
@@ -220,11 +229,12 @@ class Model(ModelDescription):
         """
         return run_dynamics(self, t_end=t_end, steps=steps, method=method, rtol=rtol,
                             atol=atol, h=h, rho_inf=rho_inf, alpha=alpha, beta=beta, t0=t0,
-                            every=every, max_steps=max_steps)
+                            every=every, max_steps=max_steps, solver=solver)
 
-    def statics(self, t: float = 0.0) -> StaticsResult:
+    def statics(self, t: float = 0.0, solver: str = "auto") -> StaticsResult:
         """Static equilibrium under gravity, springs and loads (drivers held at t), with the
-        multipliers, reactions (``res.reaction(name)``) and stability.
+        multipliers, reactions (``res.reaction(name)``) and stability. ``solver`` as in
+        :meth:`dynamics` (``res.stats["solver"]`` says which ran).
 
         Raises
         ------
@@ -233,7 +243,7 @@ class Model(ModelDescription):
         SingularJacobianError
             If the equilibrium is not unique (a free motion without stiffness).
         """
-        return run_statics(self, t=t)
+        return run_statics(self, t=t, solver=solver)
 
     # ------------------------------------------------------------------ at one state
     def phi(self, q: Any, t: float = 0.0) -> np.ndarray:

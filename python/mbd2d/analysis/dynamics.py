@@ -15,7 +15,8 @@ from ..results.dynamics import DynamicsResult
 from ..validate import number, whole
 from .failures import assembly_failed, bad_entry, inconsistent_at, row_names
 from .outputs import dynamics_result, finite_part
-from .settings import check_memory, check_span, output_rows, output_steps, time_grid
+from .settings import (check_memory, check_span, output_rows, output_steps, solver_code,
+                       time_grid)
 
 METHODS = {"generalized-alpha": 1, "dopri5": 2, "baumgarte-rk4": 3, "partitioned": 4}
 DEFAULT_METHOD = "dopri5"
@@ -27,9 +28,10 @@ def run_dynamics(model: ModelDescription, t_end: float, steps: int, method: str 
                  rtol: float | None = None, atol: float | None = None, h: float | None = None,
                  rho_inf: float | None = None, alpha: float | None = None,
                  beta: float | None = None, t0: float = 0.0, every: Any = 1,
-                 max_steps: Any = None) -> DynamicsResult:
+                 max_steps: Any = None, solver: str = "auto") -> DynamicsResult:
     """Forward dynamics in one core call; see :meth:`mbd2d.Model.dynamics`."""
     t0, t_end, steps = check_span(t0, t_end, steps)
+    code = solver_code(solver)
     nout = output_rows(steps, every)
     every = int(every)
     nmax = MAX_STEPS_DEFAULT if max_steps is None else \
@@ -70,7 +72,7 @@ def run_dynamics(model: ModelDescription, t_end: float, steps: int, method: str 
     check_memory(nout, 3 * p.nq + p.neq + 4, "dynamics")
     idx = output_steps(steps, every)
     out = core.dynamics(p, d, t0, t_end, steps, METHODS[method], rtol_v, atol_v, h_v, rho_v,
-                        alpha_v, beta_v, every, nout, nmax)
+                        alpha_v, beta_v, every, nout, nmax, code)
     iinfo, rinfo, status = out.iinfo, out.rinfo, out.status
     n = int(iinfo[0])
     t = time_grid(t0, t_end, steps, idx)
@@ -80,7 +82,9 @@ def run_dynamics(model: ModelDescription, t_end: float, steps: int, method: str 
              "iteration_matrices": int(iinfo[6]), "factorizations": int(iinfo[9]),
              "partitions": int(iinfo[7]),
              "h_min": float(rinfo[1]) if iinfo[2] else None,
-             "h_max": float(rinfo[2]) if iinfo[2] else None, "redundant_rows": red_rows}
+             "h_max": float(rinfo[2]) if iinfo[2] else None, "redundant_rows": red_rows,
+             "solver": "banded" if int(rinfo[4]) == 2 else "dense",
+             "band": (int(rinfo[5]), int(rinfo[6]))}
     res, bad = finite_part(dynamics_result(model, p, t, n, out, stats, status == OK))
     if red_rows:
         warnings.warn(f"redundant constraints: {', '.join(red_rows)} are left out of the equations "

@@ -40,7 +40,10 @@ def run_inverse(model: ModelDescription, t_end: float, steps: int, t0: float = 0
     stats = {"newton_corrections": int(iinfo[5]), "factorizations": int(iinfo[6]),
              "rejected_steps": int(iinfo[7]), "rank": int(iinfo[8]),
              "redundant_rows": red_rows,
-             "singular_passages": [float(x) for x in out.tpass[:min(int(iinfo[9]), 64)]]}
+             "singular_passages": [float(x) for x in out.tpass[:min(int(iinfo[9]), 64)]],
+             "solver": "banded" if int(out.rinfo[4]) == 2 else "dense",
+             "band": (int(out.rinfo[5]), int(out.rinfo[6])),
+             "multiplier_solver": "banded" if int(out.rinfo[7]) == 2 else "dense"}
     res, bad = finite_part(dynamics_result(model, p, t, n, out, stats, status == OK))
     if red_rows:
         warnings.warn(f"redundant constraints: {', '.join(red_rows)}; the multipliers are the "

@@ -11,16 +11,18 @@ from ..description.builder import ModelDescription
 from ..results.statics import StaticsResult
 from ..validate import number
 from .failures import assembly_failed, bad_entry, inconsistent_at
+from .settings import solver_code
 
 STABILITY = {1: "stable", 0: "unstable", -1: "neutral", 2: "fully constrained"}
 
 
-def run_statics(model: ModelDescription, t: float = 0.0) -> StaticsResult:
+def run_statics(model: ModelDescription, t: float = 0.0, solver: str = "auto") -> StaticsResult:
     """Static equilibrium near the q0 estimates; see :meth:`mbd2d.Model.statics`."""
     t = number(t, "t", "statics")
+    code = solver_code(solver)
     p = pack(model)
     d = pack_dynamics(model, p)
-    out = core.statics(p, d, t)
+    out = core.statics(p, d, t, code)
     status, text = out.status, out.msg
     if status < 0:
         raise error_for("statics", status, text, entry=bad_entry(model, int(out.iinfo[1])))
@@ -44,4 +46,6 @@ def run_statics(model: ModelDescription, t: float = 0.0) -> StaticsResult:
                          stability=STABILITY.get(int(out.stable), "unknown"),
                          residual=float(out.resid), body_names=p.body_names,
                          coordinate_names=p.coordinate_names, row_labels=p.row_labels,
-                         model=model, packed=p)
+                         model=model, packed=p,
+                         stats={"solver": "banded" if int(out.iinfo[4]) == 2 else "dense",
+                                "band": (int(out.iinfo[5]), int(out.iinfo[6]))})

@@ -98,23 +98,24 @@ def inverse(p: Packed, d: DynamicTables, t0: float, t1: float, steps: int, tol: 
 
 def dynamics(p: Packed, d: DynamicTables, t0: float, t1: float, steps: int, method: int,
              rtol: float, atol: float, h: float, rho_inf: float, alpha: float, beta: float,
-             every: int, nrow: int, max_steps: int) -> SimpleNamespace:
+             every: int, nrow: int, max_steps: int, solver: int = 0) -> SimpleNamespace:
     """Forward dynamics: ``q``, ``qd``, ``qdd``, ``lam``, ``e``, ``iinfo``, ``rinfo``, ``red``,
-    ``status``, ``msg``. max_steps: the limit on accepted plus rejected steps."""
+    ``status``, ``msg``. max_steps: the limit on accepted plus rejected steps; solver: 0 auto,
+    1 dense, 2 banded."""
     return _named("q qd qdd lam e iinfo rinfo red status msg", _core.core_dynamics,
                   ctab=p.ctab, rpar=p.rpar, bmass=d.bmass, grav=d.grav, ftab=d.ftab,
                   fpar=d.fpar, neq=p.neq, q0=p.q0, v0=d.v0, t0=t0, t1=t1, nsteps=steps,
                   method=method, rtol=rtol, atol=atol, h=h, rho_inf=rho_inf, balpha=alpha,
-                  bbeta=beta, every=every, nrow=nrow, max_steps=max_steps,
+                  bbeta=beta, every=every, nrow=nrow, max_steps=max_steps, solver=solver,
                   numbers=(3 * p.nq + p.neq + 4) * nrow + p.neq)
 
 
-def statics(p: Packed, d: DynamicTables, t: float) -> SimpleNamespace:
+def statics(p: Packed, d: DynamicTables, t: float, solver: int = 0) -> SimpleNamespace:
     """Static equilibrium: ``q``, ``lam``, ``stable``, ``resid``, ``iinfo``, ``status``,
-    ``msg``."""
+    ``msg``; solver: 0 auto, 1 dense, 2 banded."""
     return _named("q lam stable resid iinfo status msg", _core.core_statics, ctab=p.ctab,
                   rpar=p.rpar, bmass=d.bmass, grav=d.grav, ftab=d.ftab, fpar=d.fpar,
-                  neq=p.neq, q0=p.q0, t=t, numbers=p.nq + p.neq)
+                  neq=p.neq, q0=p.q0, t=t, solver=solver, numbers=p.nq + p.neq)
 
 
 def reactions(p: Packed, q: np.ndarray, t: np.ndarray, lam: np.ndarray) -> SimpleNamespace:

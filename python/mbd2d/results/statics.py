@@ -1,7 +1,7 @@
 """Static results: an equilibrium with its multipliers, reactions and stability."""
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -24,6 +24,8 @@ class StaticsResult:
     row_labels: list[str]
     model: Any = None
     packed: Any = None
+    #: the linear-algebra path: {"solver": "dense" | "banded", "band": (kl, ku)}
+    stats: dict = field(default_factory=dict)
 
     def body(self, name: str) -> tuple[float, float, float]:
         """(x, y, theta) of a body at the equilibrium (KeyError if there is none)."""

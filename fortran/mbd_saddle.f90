@@ -1,0 +1,703 @@
+!> mbd_saddle: the saddle-point systems of the dynamics, behind one interface with two paths,
+!! dense LU for small models and band LU for large ones.
+!!
+!!   [ A        s J_a^T ] [ x ]   [ b ]
+!!   [ s J_a    -e I    ] [ y ] = [ c ]           (n coordinates, na active rows)
+!!
+!! A is diagonal, d (the index-1 systems: M q_ddot + J^T lambda = Q with d = M; the velocity
+!! and position projections with d = M or 1), or, with a tangent pattern (full), d + K on
+!! the pattern of K = d(J^T lambda - Q)/dq (the generalized-alpha iteration matrix
+!! M b' + K + g' C). J_a are the active rows of J, placed from the constraint blocks (jb of
+!! mbd_assemble) through a map built once, s scales them (a mass scale, or b'). e >= 0 on
+!! the constraint diagonal is 0 for a saddle point, 1 for Levenberg-Marquardt's augmented
+!! form [mu I, J^T; J, -I] (its step minimizes ||J dx + Phi||^2 + mu ||dx||^2).
+!!
+!! Dense path: the matrix (n + na)^2; index-1 systems by LU (dgetf2/dgetrf) and, when nearly
+!! singular (1/cond_1 < AUG_RCOND, as at the collinear position of a parallelogram), by the
+!! rank-revealing minimum-norm least-squares solve dgelsy; the generalized-alpha matrix by
+!! the plain-loop LU (lu_factor_small).
+!! Band path (mbd_band): the rows and columns of the saddle matrix ordered by one symmetric
+!! permutation, the narrower of two (the smaller kl + ku):
+!!   interleaved  the coordinate groups (a body's x, y, theta; each extra coordinate) in
+!!                reverse Cuthill-McKee order of the graph in which two groups are adjacent
+!!                when a constraint (or, full, a force) couples them, and after each group
+!!                the active rows of the constraints that touch it and are not yet placed:
+!!                every row sits next to its bodies, as in a chain body-row-body-row;
+!!   rcm          reverse Cuthill-McKee on the graph of the whole saddle matrix.
+!! LU with partial pivoting of the band (band_lu in plain loops while the band is narrow,
+!! dgbtrf beyond; zero diagonal entries of the constraint block are pivoted away within the
+!! band). A nearly singular index-1 matrix is solved with the constraint block regularized,
+!! -eps I with eps = AUG_RCOND ||A||_1 (a damped least-squares solve: directions of J_a
+!! with sigma^2 below about eps are damped, as dgelsy drops them), refined twice against the
+!! unregularized matrix. Nothing of size n^2 is allocated on the band path.
+!! Cost per factorization: dense ~ (2/3)(n + na)^3, band ~ 2 (n + na) kl (kl + ku).
+!!
+!! Usage: saddle_plan once per structure (allocates); then saddle_factor with the current
+!! d, jb, s (and K) and saddle_solve for any number of right-hand sides; no allocation.
+module mbd_saddle
+  use mbd_kinds, only: wp, zero, one
+  use mbd_status, only: MBD_OK, MBD_BAD_INPUT, MBD_SINGULAR, MBD_NO_MEMORY, MSG_LEN
+  use mbd_memory, only: REAL_BYTES, mem_check, mem_fail
+  use mbd_points, only: NLOC, MAXROW
+  use mbd_model, only: model_t
+  use mbd_band, only: band_t, band_plan_perm, band_graph, band_rcm, band_zero, band_norm1, &
+                      band_factor, band_rcond, band_solve, band_matvec
+  use mbd_linsolve, only: lu_factor, lu_solve, lu_factor_small, lu_solve_small, lapack_status
+  use mbd_lapack, only: dgecon, dgelsy
+  implicit none
+  private
+  public :: saddle_t, saddle_plan, saddle_factor, saddle_solve, saddle_bytes, AUG_RCOND
+  public :: saddle_row_rank
+  public :: SADDLE_BAND_MIN_N, SADDLE_BAND_RATIO
+
+  !> 1/cond_1 of an index-1 matrix below which it is solved as nearly singular
+  real(wp), parameter :: AUG_RCOND = 1.0e-9_wp
+  !> auto choice: the band path for at least SADDLE_BAND_MIN_N coordinates when the band
+  !! (kl + ku + 1) is at most (n + na) / SADDLE_BAND_RATIO wide (as kinematics)
+  integer, parameter :: SADDLE_BAND_MIN_N = 60, SADDLE_BAND_RATIO = 4
+  !> bands up to this kl + ku are factored in plain loops (band_lu), wider ones by dgbtrf
+  integer, parameter :: PLAIN_MAX = 64
+  character(len=*), parameter :: HINT = 'use a model with fewer coordinates'
+
+  !> A planned saddle-point matrix: the map from the constraint blocks, the storage and
+  !! factors of one path, and the workspace of its solves.
+  type :: saddle_t
+    integer :: n = 0, na = 0, nt = 0     !! coordinates, active rows, n + na
+    logical :: banded = .false.          !! band path
+    logical :: full = .false.            !! A has the tangent pattern (not only its diagonal)
+    logical :: lsq = .false.             !! the last index-1 factorization was nearly singular
+    logical :: plain = .false.           !! factored without the near-singularity check
+    integer :: nfactor = 0               !! factorizations
+    integer :: nrank = 0                 !! nearly singular solves
+    integer :: kl = 0, ku = 0            !! band widths (band path)
+    !> the constraint blocks' nonzeros of active rows: jb(esrc(i)) goes to the flat storage
+    !! positions epos(i) (s J_a) and etpos(i) (s J_a^T); the diagonal (nt) and the tangent
+    !! pattern entries (full) likewise
+    integer, allocatable :: esrc(:), epos(:), etpos(:), dpos(:), kpos(:)
+    ! dense path
+    real(wp), allocatable :: a(:, :)     !! (nt, nt) matrix, then its factors
+    integer, allocatable :: ipiv(:)
+    real(wp), allocatable :: acopy(:, :), lswork(:), cw(:)
+    integer, allocatable :: iw(:), jp(:)
+    ! band path
+    type(band_t) :: b                    !! plan, storage, factors
+    real(wp), allocatable :: bcopy(:, :) !! the unregularized matrix of a nearly singular one
+    real(wp), allocatable :: r(:), x(:), xw(:)  !! refinement workspace (nt)
+  end type saddle_t
+
+contains
+
+  !> Bytes of a saddle-point matrix of nt = n + na: dense nt^2 (with the copy for the
+  !! rank-revealing solve when check), band nt (2 kl + ku + 1) plus its copy and vectors.
+  pure real(wp) function saddle_bytes(nt, banded, kl, ku, check) result(bytes)
+    integer, intent(in) :: nt          !! n + na
+    logical, intent(in) :: banded      !! band path
+    integer, intent(in) :: kl, ku      !! band widths (band path)
+    logical, intent(in) :: check       !! index-1 (nearly singular solves possible)
+    real(wp) :: t
+    t = real(nt, wp)
+    if (banded) then
+      bytes = REAL_BYTES * t * (merge(2, 1, check) * (2 * kl + ku + 1) + 12)
+    else
+      bytes = REAL_BYTES * (t * t * merge(2, 1, check) + 8 * t)
+    end if
+  end function saddle_bytes
+
+  !> Plan the saddle-point matrix of model m with the active rows `rows` (equation numbers):
+  !! the ordering and storage of the chosen path and the maps from the constraint blocks.
+  !! kptr, krow: the pattern of the tangent K by columns (rows krow(kptr(c):kptr(c+1)-1) of
+  !! column c), for a full matrix. solver: 1 dense, 2 banded. small: the dense path factors
+  !! in plain loops (a small iteration matrix, no near-singularity check). index1: allocate
+  !! the workspace of nearly singular solves (saddle_factor's check). Allocates.
+  subroutine saddle_plan(m, rows, solver, sd, status, msg, kptr, krow, small, index1)
+    type(model_t), intent(in) :: m                 !! model
+    integer, intent(in) :: rows(:)                 !! active rows (na), increasing
+    integer, intent(in) :: solver                  !! 1 dense, 2 banded
+    type(saddle_t), intent(out) :: sd              !! the plan
+    integer, intent(out) :: status                 !! MBD_OK, MBD_BAD_INPUT or MBD_NO_MEMORY
+    character(len=MSG_LEN), intent(out) :: msg     !! explanation
+    integer, intent(in), optional :: kptr(:), krow(:)  !! tangent pattern (full)
+    logical, intent(in), optional :: small         !! dense: plain-loop LU for iterations
+    logical, intent(in), optional :: index1        !! workspace of nearly singular solves
+    integer, allocatable :: arow(:), sr(:), sc(:), perm(:)
+    integer :: n, na, nt, ne, nk, k, s, r, c, a, i, ierr, ldab
+    real(wp) :: bytes
+    logical :: chk
+    status = MBD_OK; msg = ''
+    chk = .false.; if (present(index1)) chk = index1
+    n = m%nq; na = size(rows); nt = n + na
+    sd%n = n; sd%na = na; sd%nt = nt
+    sd%full = present(kptr) .and. present(krow)
+    sd%banded = solver == 2
+    if (present(small)) sd%plain = small .and. .not. sd%banded
+    allocate (arow(m%neq), stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail(4 * real(m%neq, wp), 'the saddle-point map', HINT, status, msg); return
+    end if
+    arow = 0
+    do a = 1, na
+      arow(rows(a)) = a
+    end do
+    ! the nonzeros of the active rows' blocks
+    ne = 0
+    do k = 1, m%nc
+      do r = 1, m%nrow(k)
+        if (arow(m%row0(k) + r - 1) == 0) cycle
+        ne = ne + count(m%loc(:, k) > 0)
+      end do
+    end do
+    nk = 0
+    if (sd%full) nk = kptr(n + 1) - 1
+    allocate (sd%esrc(ne), sd%epos(ne), sd%etpos(ne), sd%dpos(nt), sd%kpos(nk), &
+              sr(nt + 2 * ne + nk), sc(nt + 2 * ne + nk), perm(nt), stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail(4 * (3 * real(ne, wp) + 3 * nt + 5 * ne + 3 * nk), 'the saddle-point map', &
+                    HINT, status, msg)
+      return
+    end if
+    ! the structure: the diagonal, s J_a and s J_a^T, the tangent pattern
+    do i = 1, nt
+      sr(i) = i; sc(i) = i
+    end do
+    ne = 0
+    do k = 1, m%nc
+      do s = 1, NLOC
+        c = m%loc(s, k)
+        if (c == 0) cycle
+        do r = 1, m%nrow(k)
+          a = arow(m%row0(k) + r - 1)
+          if (a == 0) cycle
+          ne = ne + 1
+          sd%esrc(ne) = r + MAXROW * (s - 1 + NLOC * (k - 1))
+          sr(nt + 2 * ne - 1) = n + a; sc(nt + 2 * ne - 1) = c
+          sr(nt + 2 * ne) = c; sc(nt + 2 * ne) = n + a
+        end do
+      end do
+    end do
+    if (sd%full) then
+      do c = 1, n
+        do i = kptr(c), kptr(c + 1) - 1
+          sr(nt + 2 * ne + i) = krow(i); sc(nt + 2 * ne + i) = c
+        end do
+      end do
+    end if
+    if (sd%banded) then
+      call order(m, arow, n, na, sr, sc, perm, status, msg)
+      if (status /= MBD_OK) return
+      call band_plan_perm(nt, sr, sc, perm, perm, sd%b, status, msg)
+      if (status /= MBD_OK) return
+      sd%kl = sd%b%kl; sd%ku = sd%b%ku
+      sd%b%plain = sd%kl + sd%ku <= PLAIN_MAX
+      ldab = sd%b%ldab
+      bytes = saddle_bytes(nt, .true., sd%kl, sd%ku, chk)
+      call mem_check(bytes, 'the band saddle-point matrix', HINT, status, msg)
+      if (status /= MBD_OK) return
+      allocate (sd%r(nt), sd%x(nt), sd%xw(nt), stat=ierr)
+      if (ierr == 0 .and. chk) allocate (sd%bcopy(ldab, nt), stat=ierr)
+      if (ierr /= 0) then
+        call mem_fail(bytes, 'the band saddle-point workspace', HINT, status, msg); return
+      end if
+    else
+      ldab = nt
+      perm = [(i, i=1, nt)]
+      bytes = saddle_bytes(nt, .false., 0, 0, chk)
+      call mem_check(bytes, 'the dense saddle-point matrix', HINT, status, msg)
+      if (status /= MBD_OK) return
+      allocate (sd%a(nt, nt), sd%ipiv(nt), stat=ierr)
+      if (ierr == 0 .and. chk) call dense_work(sd, ierr)
+      if (ierr /= 0) then
+        call mem_fail(bytes, 'the dense saddle-point matrix', HINT, status, msg); return
+      end if
+      sd%a = zero
+    end if
+    ! flat positions in the storage
+    do i = 1, nt
+      sd%dpos(i) = flat(i, i)
+    end do
+    do i = 1, ne
+      sd%epos(i) = flat(sr(nt + 2 * i - 1), sc(nt + 2 * i - 1))
+      sd%etpos(i) = flat(sr(nt + 2 * i), sc(nt + 2 * i))
+    end do
+    do i = 1, nk
+      sd%kpos(i) = flat(sr(nt + 2 * ne + i), sc(nt + 2 * ne + i))
+    end do
+  contains
+    !> Column-major position of entry (i, j) in the storage of the path.
+    integer function flat(i, j)
+      integer, intent(in) :: i, j
+      if (sd%banded) then
+        flat = sd%b%kl + sd%b%ku + 1 + perm(i) - perm(j) + ldab * (perm(j) - 1)
+      else
+        flat = i + ldab * (j - 1)
+      end if
+    end function flat
+  end subroutine saddle_plan
+
+  !> The symmetric ordering of the band path: the narrower of the interleaved and the plain
+  !! reverse Cuthill-McKee orderings (module banner). perm(i): position of saddle index i.
+  subroutine order(m, arow, n, na, sr, sc, perm, status, msg)
+    type(model_t), intent(in) :: m
+    integer, intent(in) :: arow(:), n, na, sr(:), sc(:)
+    integer, intent(out) :: perm(:)
+    integer, intent(out) :: status
+    character(len=MSG_LEN), intent(inout) :: msg
+    integer, allocatable :: aptr(:), adj(:), ord(:), p2(:)
+    integer :: nt, ierr, w1, w2, i
+    nt = n + na
+    status = MBD_OK
+    allocate (ord(nt), p2(nt), stat=ierr)
+    if (ierr == 0) call interleaved(m, arow, n, na, sr, sc, perm, ierr)
+    if (ierr == 0) call band_graph(nt, sr, sc, aptr, adj, ierr)
+    if (ierr == 0) call band_rcm(nt, aptr, adj, ord, ierr)
+    if (ierr /= 0) then
+      call mem_fail(4 * 12 * real(size(sr), wp), 'the band ordering of the saddle-point matrix', &
+                    HINT, status, msg)
+      return
+    end if
+    do i = 1, nt
+      p2(ord(i)) = i
+    end do
+    w1 = width(perm); w2 = width(p2)
+    if (w2 < w1) perm = p2
+  contains
+    integer function width(p)
+      integer, intent(in) :: p(:)
+      integer :: k
+      width = 0
+      do k = 1, size(sr)
+        width = max(width, abs(p(sr(k)) - p(sc(k))))
+      end do
+    end function width
+  end subroutine order
+
+  !> The interleaved ordering (module banner): coordinate groups in reverse Cuthill-McKee
+  !! order of their coupling graph, each followed by the active rows of the constraints that
+  !! touch it and are not yet placed.
+  subroutine interleaved(m, arow, n, na, sr, sc, perm, ierr)
+    type(model_t), intent(in) :: m
+    integer, intent(in) :: arow(:), n, na, sr(:), sc(:)
+    integer, intent(out) :: perm(:)
+    integer, intent(out) :: ierr
+    integer, allocatable :: grp(:), gr(:), gc(:), aptr(:), adj(:), gord(:), cptr(:), ccon(:), &
+                            cnt(:)
+    logical, allocatable :: placed(:)
+    integer :: ng, k, s, c, g, i, nn, pos, r, a, ks, ne
+    ierr = 0
+    ! coordinate groups: body b holds 3b-2..3b; each extra coordinate is a group of its own
+    ng = m%nb + (n - 3 * m%nb)
+    allocate (grp(n), stat=ierr)
+    if (ierr /= 0) return
+    do c = 1, n
+      if (c <= 3 * m%nb) then
+        grp(c) = (c + 2) / 3
+      else
+        grp(c) = m%nb + c - 3 * m%nb
+      end if
+    end do
+    ! group coupling from the coordinate-coordinate entries the structure implies: two
+    ! coordinates of one constraint row, and the tangent pattern
+    ne = 0
+    do k = 1, size(sr)
+      if (sr(k) <= n .and. sc(k) <= n .and. sr(k) /= sc(k)) ne = ne + 1
+    end do
+    do k = 1, m%nc
+      nn = count(m%loc(:, k) > 0)
+      ne = ne + nn * nn
+    end do
+    allocate (gr(ne), gc(ne), gord(ng), placed(m%nc), cptr(ng + 1), cnt(ng), stat=ierr)
+    if (ierr /= 0) return
+    ne = 0
+    do k = 1, size(sr)
+      if (sr(k) <= n .and. sc(k) <= n .and. sr(k) /= sc(k)) then
+        ne = ne + 1
+        gr(ne) = grp(sr(k)); gc(ne) = grp(sc(k))
+      end if
+    end do
+    do k = 1, m%nc
+      if (.not. any([(arow(m%row0(k) + r - 1) > 0, r=1, m%nrow(k))])) cycle
+      do s = 1, NLOC
+        if (m%loc(s, k) == 0) cycle
+        do i = 1, NLOC
+          if (m%loc(i, k) == 0) cycle
+          ne = ne + 1
+          gr(ne) = grp(m%loc(s, k)); gc(ne) = grp(m%loc(i, k))
+        end do
+      end do
+    end do
+    call band_graph(ng, gr(1:ne), gc(1:ne), aptr, adj, ierr)
+    if (ierr == 0) call band_rcm(ng, aptr, adj, gord, ierr)
+    if (ierr /= 0) return
+    ! the constraints touching each group (counting sort)
+    cnt = 0
+    do k = 1, m%nc
+      do s = 1, NLOC
+        if (m%loc(s, k) > 0) cnt(grp(m%loc(s, k))) = cnt(grp(m%loc(s, k))) + 1
+      end do
+    end do
+    cptr(1) = 1
+    do g = 1, ng
+      cptr(g + 1) = cptr(g) + cnt(g)
+    end do
+    allocate (ccon(cptr(ng + 1) - 1), stat=ierr)
+    if (ierr /= 0) return
+    cnt = 0
+    do k = 1, m%nc
+      do s = 1, NLOC
+        if (m%loc(s, k) == 0) cycle
+        g = grp(m%loc(s, k))
+        ccon(cptr(g) + cnt(g)) = k
+        cnt(g) = cnt(g) + 1
+      end do
+    end do
+    ! emit
+    perm = 0
+    placed = .false.
+    pos = 0
+    do i = 1, ng
+      g = gord(i)
+      if (g <= m%nb) then                       ! a body: x, y, theta
+        do c = 3 * g - 2, 3 * g
+          pos = pos + 1; perm(c) = pos
+        end do
+      else                                      ! an extra coordinate
+        pos = pos + 1; perm(3 * m%nb + g - m%nb) = pos
+      end if
+      do ks = cptr(g), cptr(g + 1) - 1
+        k = ccon(ks)
+        if (placed(k)) cycle
+        placed(k) = .true.
+        do r = 1, m%nrow(k)
+          a = arow(m%row0(k) + r - 1)
+          if (a == 0) cycle
+          pos = pos + 1; perm(n + a) = pos
+        end do
+      end do
+    end do
+    do i = 1, n + na                ! anything left (not expected): at the end
+      if (perm(i) == 0) then
+        pos = pos + 1; perm(i) = pos
+      end if
+    end do
+  end subroutine interleaved
+
+  !> Fill the matrix from d (n), the blocks jb and s (and K values kv on the pattern, e on
+  !! the constraint diagonal) and factor it. check: index-1 (a nearly singular matrix is
+  !! detected and solved as such, sd%lsq; the plan needs index1); otherwise a plain
+  !! factorization (status MBD_SINGULAR on an exactly zero pivot).
+  subroutine saddle_factor(sd, d, jb, s, status, kv, e, check)
+    type(saddle_t), intent(inout) :: sd        !! planned matrix; factors on return
+    real(wp), intent(in) :: d(:)               !! diagonal of A (n)
+    real(wp), intent(in) :: jb(:, :, :)        !! constraint blocks (MAXROW, NLOC, nc)
+    real(wp), intent(in) :: s                  !! scale of J_a
+    integer, intent(out) :: status             !! MBD_OK, MBD_SINGULAR or MBD_LAPACK
+    real(wp), intent(in), optional :: kv(:)    !! K on its pattern (full)
+    real(wp), intent(in), optional :: e        !! constraint diagonal -e (default 0)
+    logical, intent(in), optional :: check     !! index-1: nearly singular solves
+    real(wp) :: ee, anorm, rc, pr
+    logical :: chk
+    character(len=MSG_LEN) :: msg
+    integer :: info, k
+    ee = zero; if (present(e)) ee = e
+    chk = .false.; if (present(check)) chk = check
+    sd%nfactor = sd%nfactor + 1
+    sd%lsq = .false.
+    if (sd%banded) then
+      call fill(ee)
+      if (.not. chk) then
+        call band_factor(sd%b, status, msg)
+        return
+      end if
+      anorm = band_norm1(sd%b)
+      call band_factor(sd%b, status, msg, pivratio=pr)
+      if (status == MBD_OK .and. pr < 1.0e-6_wp) then
+        call band_rcond(sd%b, anorm, rc, info, msg)
+        sd%lsq = info == MBD_OK .and. rc < AUG_RCOND
+      else
+        sd%lsq = status /= MBD_OK
+      end if
+      if (.not. allocated(sd%bcopy)) sd%lsq = .false.
+      if (sd%lsq) then
+        ! keep the matrix, then factor it with the constraint block regularized
+        call fill(ee)
+        sd%bcopy = sd%b%ab
+        call fill(ee + AUG_RCOND * anorm)
+        call band_factor(sd%b, status, msg)
+      end if
+      return
+    end if
+    call fill(ee)
+    if (sd%plain) then
+      call lu_factor_small(sd%a, sd%ipiv, status)
+      return
+    end if
+    if (.not. (chk .and. allocated(sd%acopy))) then
+      call lu_factor(sd%a, sd%ipiv, status, msg)
+      return
+    end if
+    anorm = zero
+    do k = 1, sd%nt
+      anorm = max(anorm, sum(abs(sd%a(:, k))))
+    end do
+    call lu_factor(sd%a, sd%ipiv, status, msg)
+    sd%lsq = status /= MBD_OK
+    if (.not. sd%lsq) then
+      pr = pivot_ratio(sd%a)
+      if (pr < 1.0e-6_wp) then
+        call dgecon('1', sd%nt, sd%a, sd%nt, anorm, rc, sd%cw, sd%iw, info)
+        sd%lsq = rc < AUG_RCOND
+      end if
+    end if
+    if (sd%lsq) call fill(ee)                  ! the matrix itself, for dgelsy
+    status = MBD_OK
+  contains
+    !> The matrix into the storage of the path: zero, then the pieces (put).
+    subroutine fill(ediag)
+      real(wp), intent(in) :: ediag
+      if (sd%banded) then
+        call band_zero(sd%b)
+        call put(sd%b%ab, size(sd%b%ab), sd%n, sd%nt, sd%dpos, sd%kpos, sd%esrc, sd%epos, &
+                 sd%etpos, d, jb, size(jb), s, ediag, kv)
+      else
+        sd%a = zero
+        call put(sd%a, size(sd%a), sd%n, sd%nt, sd%dpos, sd%kpos, sd%esrc, sd%epos, &
+                 sd%etpos, d, jb, size(jb), s, ediag, kv)
+      end if
+    end subroutine fill
+  end subroutine saddle_factor
+
+  !> Place the pieces into flat storage: K on its pattern, += d on the diagonal of A, -e on
+  !! the constraint diagonal, s J_a and s J_a^T (the order of the dense matrices before, so
+  !! the dense path's sums are the same).
+  pure subroutine put(f, nf, n, nt, dpos, kpos, esrc, epos, etpos, d, jb, nj, s, e, kv)
+    integer, intent(in) :: nf, n, nt, nj
+    real(wp), intent(inout) :: f(nf)
+    integer, intent(in) :: dpos(:), kpos(:), esrc(:), epos(:), etpos(:)
+    real(wp), intent(in) :: d(:), jb(nj), s, e
+    real(wp), intent(in), optional :: kv(:)
+    integer :: i
+    real(wp) :: v
+    if (present(kv)) then
+      do i = 1, size(kpos)
+        f(kpos(i)) = kv(i)
+      end do
+    end if
+    do i = 1, n
+      f(dpos(i)) = f(dpos(i)) + d(i)
+    end do
+    if (abs(e) > zero) then
+      do i = n + 1, nt
+        f(dpos(i)) = -e
+      end do
+    end if
+    do i = 1, size(esrc)
+      v = s * jb(esrc(i))
+      f(epos(i)) = f(epos(i)) + v
+      f(etpos(i)) = f(etpos(i)) + v
+    end do
+  end subroutine put
+
+  !> min |u_ii| / max |u_ii| of dense LU factors.
+  pure real(wp) function pivot_ratio(a) result(pr)
+    real(wp), intent(in) :: a(:, :)
+    real(wp) :: umin, umax
+    integer :: k
+    umin = huge(one); umax = zero
+    do k = 1, size(a, 1)
+      umin = min(umin, abs(a(k, k))); umax = max(umax, abs(a(k, k)))
+    end do
+    pr = umin / umax
+  end function pivot_ratio
+
+  !> The workspace of the dense nearly singular solves.
+  subroutine dense_work(sd, ierr)
+    type(saddle_t), intent(inout) :: sd
+    integer, intent(out) :: ierr              ! allocation status (0 ok)
+    real(wp) :: wq(1), rdum(1)
+    integer :: nt, rank, info
+    integer :: idum(1)
+    nt = sd%nt
+    call dgelsy(nt, nt, 1, rdum, nt, rdum, nt, idum, AUG_RCOND, rank, wq, -1, info)
+    allocate (sd%acopy(nt, nt), sd%cw(4 * nt), sd%iw(nt), sd%jp(nt), &
+              sd%lswork(max(1, int(wq(1)))), stat=ierr)
+  end subroutine dense_work
+
+  !> Solve with the factored matrix: [x; y] overwrites the right-hand side [b; c].
+  subroutine saddle_solve(sd, rhs, status)
+    type(saddle_t), intent(inout) :: sd      !! factored matrix
+    real(wp), intent(inout) :: rhs(:)        !! right-hand side (nt), then solution
+    integer, intent(out) :: status           !! MBD_OK, MBD_SINGULAR or MBD_LAPACK
+    character(len=MSG_LEN) :: msg
+    integer :: rank, info, it
+    if (size(rhs) /= sd%nt) then
+      status = MBD_BAD_INPUT; return
+    end if
+    if (sd%banded) then
+      if (.not. sd%lsq) then
+        call band_solve(sd%b, rhs, status, msg)
+        return
+      end if
+      ! regularized solve, refined against the matrix itself: x += A_eps^-1 (b - A x)
+      sd%r = rhs
+      call band_solve(sd%b, rhs, status, msg)
+      do it = 1, 2
+        if (status /= MBD_OK) return
+        call band_matvec(sd%b, sd%bcopy, rhs, sd%x, sd%xw)
+        sd%x = sd%r - sd%x
+        call band_solve(sd%b, sd%x, status, msg)
+        rhs = rhs + sd%x
+      end do
+      sd%nrank = sd%nrank + 1
+      return
+    end if
+    if (sd%plain) then
+      call lu_solve_small(sd%a, sd%ipiv, rhs)
+      status = MBD_OK
+      return
+    end if
+    if (.not. sd%lsq) then
+      call lu_solve(sd%a, sd%ipiv, rhs, status, msg)
+      return
+    end if
+    sd%acopy = sd%a
+    sd%jp = 0
+    call dgelsy(sd%nt, sd%nt, 1, sd%acopy, sd%nt, rhs, sd%nt, sd%jp, AUG_RCOND, rank, &
+                sd%lswork, size(sd%lswork), info)
+    call lapack_status('dgelsy', info, status, msg)
+    sd%nrank = sd%nrank + 1
+  end subroutine saddle_solve
+
+  !> Redundant rows of J without a dense matrix: a Cholesky factorization of the Gram matrix
+  !! G = D J J^T D of the rows scaled to unit length (D), in band storage after a reverse
+  !! Cuthill-McKee ordering of the rows (two rows adjacent when they share a coordinate), in
+  !! which a row whose pivot (the squared distance of its unit row from the span of the
+  !! rows before it) is at most tol2 is redundant and left out, the ordered Gram-Schmidt
+  !! selection of row_rank (mbd_linsolve) in the band order. Cost O(neq kd^2), kd the band
+  !! width of the rows. redundant(r) = 1 for a redundant row; rank = neq - their number.
+  subroutine saddle_row_rank(m, jb, tol2, redundant, rank, status, msg)
+    type(model_t), intent(in) :: m                !! model
+    real(wp), intent(in) :: jb(:, :, :)           !! constraint blocks at the configuration
+    real(wp), intent(in) :: tol2                  !! pivot tolerance (squared distance)
+    integer, intent(out) :: redundant(:)          !! (neq) 1 for a redundant row
+    integer, intent(out) :: rank                  !! number of independent rows
+    integer, intent(out) :: status                !! MBD_OK or MBD_NO_MEMORY
+    character(len=MSG_LEN), intent(out) :: msg    !! explanation
+    integer, allocatable :: cptr(:), crow(:), cslot(:), ccon(:), pr(:), pc(:), aptr(:), &
+                            adj(:), ord(:), pos(:), rowof(:), nxt(:)
+    real(wp), allocatable :: g(:, :), rnorm(:)
+    integer :: neq, n, k, s, r, c, i, j, a, b, kd, ne, ierr, l, w, np
+    real(wp) :: v, dj
+    status = MBD_OK; msg = ''
+    neq = m%neq; n = m%nq
+    redundant = 0; rank = 0
+    if (neq == 0) return
+    ! the rows touching each coordinate (with the block entry), by counting
+    ne = 0
+    do k = 1, m%nc
+      ne = ne + m%nrow(k) * count(m%loc(:, k) > 0)
+    end do
+    allocate (cptr(n + 1), crow(ne), cslot(ne), ccon(ne), rnorm(neq), pos(neq), rowof(neq), &
+              ord(neq), stat=ierr)
+    if (ierr /= 0) goto 90
+    cptr = 0
+    do k = 1, m%nc
+      do s = 1, NLOC
+        c = m%loc(s, k)
+        if (c > 0) cptr(c + 1) = cptr(c + 1) + m%nrow(k)
+      end do
+    end do
+    cptr(1) = 1
+    do c = 1, n
+      cptr(c + 1) = cptr(c + 1) + cptr(c)
+    end do
+    rnorm = zero
+    allocate (nxt(n), stat=ierr)
+    if (ierr /= 0) goto 90
+    nxt = cptr(1:n)
+    do k = 1, m%nc
+      do s = 1, NLOC
+        c = m%loc(s, k)
+        if (c == 0) cycle
+        do r = 1, m%nrow(k)
+          crow(nxt(c)) = m%row0(k) + r - 1; cslot(nxt(c)) = s; ccon(nxt(c)) = k
+          nxt(c) = nxt(c) + 1
+          rnorm(m%row0(k) + r - 1) = rnorm(m%row0(k) + r - 1) + jb(r, s, k)**2
+        end do
+      end do
+    end do
+    rnorm = sqrt(rnorm)
+    ! row graph: rows sharing a coordinate
+    np = 0
+    do c = 1, n
+      np = np + (cptr(c + 1) - cptr(c))**2
+    end do
+    allocate (pr(np), pc(np), stat=ierr)
+    if (ierr /= 0) goto 90
+    np = 0
+    do c = 1, n
+      do i = cptr(c), cptr(c + 1) - 1
+        do j = cptr(c), cptr(c + 1) - 1
+          np = np + 1
+          pr(np) = crow(i); pc(np) = crow(j)
+        end do
+      end do
+    end do
+    call band_graph(neq, pr, pc, aptr, adj, ierr)
+    if (ierr == 0) call band_rcm(neq, aptr, adj, ord, ierr)
+    if (ierr /= 0) goto 90
+    do i = 1, neq
+      pos(ord(i)) = i
+      rowof(i) = ord(i)
+    end do
+    kd = 0
+    do i = 1, np
+      kd = max(kd, abs(pos(pr(i)) - pos(pc(i))))
+    end do
+    ! G in lower band storage: G(p, q) (p >= q, band positions) in g(1 + p - q, q)
+    call mem_check(REAL_BYTES * real(kd + 1, wp) * neq, 'the rank analysis of J (band)', HINT, &
+                   status, msg)
+    if (status /= MBD_OK) return
+    allocate (g(kd + 1, neq), stat=ierr)
+    if (ierr /= 0) goto 90
+    g = zero
+    do c = 1, n
+      do i = cptr(c), cptr(c + 1) - 1
+        a = crow(i)
+        if (.not. rnorm(a) > zero) cycle
+        do j = cptr(c), cptr(c + 1) - 1
+          b = crow(j)
+          if (pos(a) < pos(b) .or. .not. rnorm(b) > zero) cycle
+          v = jb(a - m%row0(ccon(i)) + 1, cslot(i), ccon(i)) * &
+              jb(b - m%row0(ccon(j)) + 1, cslot(j), ccon(j)) / (rnorm(a) * rnorm(b))
+          g(1 + pos(a) - pos(b), pos(b)) = g(1 + pos(a) - pos(b), pos(b)) + v
+        end do
+      end do
+    end do
+    ! right-looking Cholesky; a pivot <= tol2 marks its row redundant (left out)
+    do j = 1, neq
+      dj = g(1, j)
+      l = min(kd, neq - j)
+      if (.not. dj > tol2) then
+        redundant(rowof(j)) = 1
+        g(:, j) = zero
+        cycle
+      end if
+      dj = sqrt(dj)
+      g(1, j) = dj
+      do i = 2, l + 1
+        g(i, j) = g(i, j) / dj
+      end do
+      do w = 1, l                              ! G(j+w, j+i) -= L(j+w, j) L(j+i, j), i <= w
+        v = g(w + 1, j)
+        if (abs(v) <= zero) cycle
+        do i = 1, w
+          g(w - i + 1, j + i) = g(w - i + 1, j + i) - v * g(i + 1, j)
+        end do
+      end do
+    end do
+    rank = neq - count(redundant == 1)
+    return
+90  call mem_fail(REAL_BYTES * 8 * real(ne, wp), 'the rank analysis of J (band)', HINT, &
+                  status, msg)
+  end subroutine saddle_row_rank
+
+end module mbd_saddle
