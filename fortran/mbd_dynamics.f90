@@ -63,7 +63,7 @@ module mbd_dynamics
     real(wp), allocatable :: phi(:), nu(:), gam(:), qz(:)
     real(wp), allocatable :: jac(:, :)    !! dense J (dense path only)
     type(asm_work_t) :: asm               !! assembly work arrays
-    real(wp), allocatable :: rhs(:), force(:), jv(:)
+    real(wp), allocatable :: rhs(:), force(:), jv(:), rsave(:), rres(:)
     type(saddle_t) :: sd                  !! the index-1 saddle-point matrix (both paths)
     !> dense multipliers' workspace: J^T (jt), right-hand side (bls), pivots (jpvt); the
     !! metric (nq)
@@ -186,7 +186,7 @@ contains
     na = count(red == 0)
     w%na = na
     nt = m%nq + na
-    allocate (w%rows(na), w%rhs(nt), stat=ierr)
+    allocate (w%rows(na), w%rhs(nt), w%rsave(nt), w%rres(nt), stat=ierr)
     if (ierr /= 0) then
       call mem_fail(REAL_BYTES * real(nt, wp), trim(what), DYN_HINT, status, msg)
       return
@@ -471,7 +471,8 @@ contains
   end subroutine dyn_velocity
 
   !> Project q onto Phi(q, t) = 0 by minimum-norm Newton steps:
-  !! [I J^T; J 0][dq; mu] = [0; -Phi] (active rows), to ||Phi||_inf <= w%tol.
+  !! s [I J^T; J 0][dq; mu] = [0; -s Phi] (active rows; the factor s, the constraint scale,
+  !! keeps the matrix as well scaled as the index-1 ones), to ||Phi||_inf <= w%tol.
   subroutine dyn_project_pos(m, w, q, t, status)
     type(model_t), intent(in) :: m           !! model
     type(dyn_work_t), intent(inout) :: w     !! work arrays
@@ -480,7 +481,7 @@ contains
     integer, intent(out) :: status           !! MBD_OK, MBD_NO_CONVERGENCE or MBD_SINGULAR
     integer :: it, n
     n = m%nq
-    w%metric = one
+    w%metric = w%s
     do it = 1, 20
       call assemble(m, w, q, w%qz, t)
       status = MBD_OK
@@ -564,9 +565,12 @@ contains
   end subroutine dyn_multipliers
 
   !> An orthonormal basis nb (nq x ni, ni = nq - na) of the null space of J_a at q: the
-  !! projections x = P r = r - J_a^T (J_a J_a^T)^-1 J_a r of ni fixed pseudo-random vectors
-  !! r (each a solve [I J_a^T; J_a 0][x; mu] = [r; 0] with one factorization, on the path of
-  !! w), orthonormalized by Gram-Schmidt (twice). The span is that of P, so whatever uses
+  !! projections x = r - D^2 J_a^T (J_a D^2 J_a^T)^-1 J_a r of ni fixed pseudo-random
+  !! vectors r, each a solve [s D^-2, s J_a^T; s J_a, 0][x; mu] = [s D^-2 r; 0] (D = the
+  !! inverse column norms of J_a, so that J_a D is well scaled: in the units of a long
+  !! chain's length scale a body angle's column is small) with one factorization on the path
+  !! of w, refined twice with the residual from the blocks, then orthonormalized by
+  !! Gram-Schmidt (twice). The span is that of P, so whatever uses
   !! only P = nb nb^T (the partitioned method's choice of coordinates) does not depend on
   !! the vectors r. status MBD_SINGULAR when the projections are not independent.
   subroutine dyn_null_basis(m, w, q, t, nb, status)
@@ -581,18 +585,41 @@ contains
     real(wp) :: d, nrm0, nrm
     n = m%nq
     call assemble(m, w, q, w%qz, t)
-    w%metric = one
+    ! metric s D^-2 with D = 1 / |column of J_a|: J_a D has unit columns (a body angle's
+    ! column holds lengths, small in units of a long chain's length scale)
+    w%metric = zero
+    do k = 1, m%nc
+      do i = 1, NLOC
+        j = m%loc(i, k)
+        if (j == 0) cycle
+        do pass = 1, m%nrow(k)
+          if (arow_active(m%row0(k) + pass - 1)) w%metric(j) = w%metric(j) + &
+            w%asm%jb(pass, i, k)**2
+        end do
+      end do
+    end do
+    do i = 1, n
+      if (.not. w%metric(i) > zero) w%metric(i) = one
+      w%metric(i) = w%s * w%metric(i)
+    end do
     call factor_aug(w, w%metric, status)
     if (status /= MBD_OK) return
     do k = 1, size(nb, 2)
       seed = 12345_int64 + 7919_int64 * k          ! a fixed linear congruential sequence
       do i = 1, n
         seed = modulo(1103515245_int64 * seed + 12345_int64, 2147483648_int64)
-        w%rhs(i) = real(seed, wp) / 1073741824.0_wp - one
+        w%rhs(i) = w%metric(i) * (real(seed, wp) / 1073741824.0_wp - one)
       end do
       w%rhs(n + 1:) = zero
+      w%rsave = w%rhs
       call dyn_solve(w, w%rhs, status)
       if (status /= MBD_OK) return
+      do pass = 1, 2                                ! iterative refinement
+        call residual(w%rhs, w%rres)
+        call dyn_solve(w, w%rres, status)
+        if (status /= MBD_OK) return
+        w%rhs = w%rhs + w%rres
+      end do
       nb(:, k) = w%rhs(1:n)
     end do
     do k = 1, size(nb, 2)                            ! Gram-Schmidt, twice
@@ -609,6 +636,43 @@ contains
       end if
       nb(:, k) = nb(:, k) / nrm
     end do
+  contains
+    !> Row r is active (a binary search in the increasing w%rows).
+    logical function arow_active(r)
+      integer, intent(in) :: r
+      integer :: lo, hi, mid
+      arow_active = .false.
+      lo = 1; hi = w%na
+      do while (lo <= hi)
+        mid = (lo + hi) / 2
+        if (w%rows(mid) == r) then
+          arow_active = .true.; return
+        else if (w%rows(mid) < r) then
+          lo = mid + 1
+        else
+          hi = mid - 1
+        end if
+      end do
+    end function arow_active
+
+    !> res = rsave - A z for A = [s D^-2, s J_a^T; s J_a, 0] from the blocks (z = [x; y]).
+    subroutine residual(z, res)
+      real(wp), intent(in) :: z(:)
+      real(wp), intent(out) :: res(:)
+      integer :: i
+      w%jv = zero
+      do i = 1, w%na
+        w%jv(w%rows(i)) = z(n + i)
+      end do
+      call blocks_jtv(m, w%asm, w%jv, w%tr0)         ! J_a^T y
+      call blocks_jv(m, w%asm, z(1:n), w%jv)         ! J x
+      do i = 1, n
+        res(i) = w%rsave(i) - w%metric(i) * z(i) - w%s * w%tr0(i)
+      end do
+      do i = 1, w%na
+        res(n + i) = -w%s * w%jv(w%rows(i))
+      end do
+    end subroutine residual
   end subroutine dyn_null_basis
 
   !> Assemble a model on the band path: from rough estimates q (extras estimated here)

@@ -29,7 +29,7 @@ module mbd_integrators
   use mbd_points, only: NLOC, MAXROW
   use mbd_assemble, only: assemble_dense, assemble_blocks, blocks_jv
   use mbd_linsolve, only: lu_factor, lu_solve, lapack_status
-  use mbd_lapack, only: dgesvd
+  use mbd_lapack, only: dgesvd, dgeqp3, dgecon
   use mbd_interp, only: hermite5
   use mbd_band, only: band_t, band_plan, band_zero, band_factor, band_solve
   use mbd_saddle, only: saddle_t, saddle_plan, saddle_factor, saddle_solve
@@ -84,8 +84,8 @@ module mbd_integrators
     !! band storage with the map of the blocks into it) and the dependent solves' vectors
     real(wp), allocatable :: nb(:, :), gw(:, :), gn(:), nsq(:, :), sv(:), svw(:)
     integer, allocatable :: sel(:), mark(:)
-    real(wp), allocatable :: ju(:, :), ub(:), px(:)
-    integer, allocatable :: upiv(:), usrc(:), upos(:)
+    real(wp), allocatable :: ju(:, :), ub(:), px(:), qa(:, :), tau(:), qwork(:), cw(:)
+    integer, allocatable :: upiv(:), usrc(:), upos(:), jp(:), iw(:)
     type(band_t) :: bu
     real(wp), allocatable :: qf(:), vf(:), af(:), lam(:)   !! last full state
     real(wp) :: ts = zero                   !! start of the current step
@@ -906,41 +906,92 @@ contains
     end do
   end subroutine scatter_add
 
-  !> Choose the independent coordinates v at the current state: the ni coordinates a
-  !! pivoted Gram-Schmidt picks from the rows of N, an orthonormal basis of the null space
-  !! of J (dyn_null_basis). The motion the constraints allow is N z; with v = N_v z the
-  !! dependent velocities are u_dot = N_u N_v^-1 v_dot (= -J_u^-1 J_v v_dot), so the best
-  !! v makes N_v well conditioned, and the pivoting takes, one at a time, the coordinate
-  !! along which the allowed motion not yet covered is largest. The rest are dependent;
-  !! both sets in increasing order. Band path: the band plan of J_u is made here.
+  !> Choose the dependent coordinates u and the independent v.
+  !! Dense path: u = the first na columns of a QR with column pivoting of J (the
+  !! best-conditioned block J_u), v the rest.
+  !! Band path (a QR of J would cost O(n^3)): v = the ni coordinates a pivoted Gram-Schmidt
+  !! picks from the rows of N, an orthonormal basis of the null space of J
+  !! (dyn_null_basis, linear in n). The motion the constraints allow is N z; with v = N_v z
+  !! the dependent velocities are u_dot = N_u N_v^-1 v_dot (= -J_u^-1 J_v v_dot), so a good
+  !! v makes N_v well conditioned (|det J_u| = |det N_v| vol(J) for orthonormal N: the same
+  !! aim as the QR's), and the pivoting takes, one at a time, the coordinate along which the
+  !! allowed motion not yet covered is largest; both sets in increasing order, and the band
+  !! plan of J_u is made here.
   subroutine partition(m, w, c, t, stf)
     type(model_t), intent(in) :: m
     type(dyn_work_t), intent(inout) :: w
     type(itg_t), intent(inout) :: c
     real(wp), intent(in) :: t
     integer, intent(out) :: stf
-    integer :: ni, n, k, j
+    integer :: ni, k, j, i
     character(len=MSG_LEN) :: lmsg
-    n = m%nq; ni = n - w%na
+    ni = m%nq - w%na
     call partition_work(m, w, c, stf)
     if (stf /= MBD_OK) return
+    if (w%solver == SOLVER_DENSE) then
+      call qr_choice(m, w, c, t, c%jp, stf)
+      if (stf /= MBD_OK) return
+      c%iu = c%jp(1:w%na)
+      c%iv = c%jp(w%na + 1:)
+      c%ni = ni
+      c%st%partitions = c%st%partitions + 1
+      return
+    end if
     call dyn_null_basis(m, w, c%qf, t, c%nb, stf)
     if (stf /= MBD_OK) return
-    call select_coordinates(c, c%sel)
+    call select_coordinates(c, m%nb, c%sel)
     c%mark = 0
     c%mark(c%sel) = 1
     k = 0; j = 0
-    do n = 1, m%nq
-      if (c%mark(n) == 1) then
-        k = k + 1; c%iv(k) = n
+    do i = 1, m%nq
+      if (c%mark(i) == 1) then
+        k = k + 1; c%iv(k) = i
       else
-        j = j + 1; c%iu(j) = n
+        j = j + 1; c%iu(j) = i
       end if
     end do
     c%ni = ni
     c%st%partitions = c%st%partitions + 1
-    if (w%solver /= SOLVER_DENSE) call plan_ju(m, w, c, stf, lmsg)
+    call plan_ju(m, w, c, stf, lmsg)
   end subroutine partition
+
+  !> Dense path: the column order jp of a QR with column pivoting of J (rows active) at the
+  !! current state.
+  subroutine qr_choice(m, w, c, t, jp, stf)
+    type(model_t), intent(in) :: m
+    type(dyn_work_t), intent(inout) :: w
+    type(itg_t), intent(inout) :: c
+    real(wp), intent(in) :: t
+    integer, intent(out) :: jp(:)
+    integer, intent(out) :: stf
+    integer :: info, k
+    character(len=MSG_LEN) :: lmsg
+    call assemble_dense(m, c%qf, w%qz, t, w%phi, w%nu, w%gam, w%asm, w%jac)
+    do k = 1, w%na
+      c%qa(k, :) = w%jac(w%rows(k), :)
+    end do
+    jp = 0
+    call dgeqp3(w%na, m%nq, c%qa, w%na, jp, c%tau, c%qwork, size(c%qwork), info)
+    call lapack_status('dgeqp3', info, stf, lmsg)
+  end subroutine qr_choice
+
+  !> Dense path: 1/cond_1 of J(rows, cols) at the last assembly (0 when singular).
+  real(wp) function rcond_cols(w, c, cols) result(rc)
+    type(dyn_work_t), intent(inout) :: w
+    type(itg_t), intent(inout) :: c
+    integer, intent(in) :: cols(:)
+    real(wp) :: anorm
+    integer :: stf, info, k
+    character(len=MSG_LEN) :: lmsg
+    do k = 1, w%na
+      c%ju(k, :) = w%jac(w%rows(k), cols)
+    end do
+    anorm = maxval(sum(abs(c%ju), dim=1))
+    rc = zero
+    call lu_factor(c%ju, c%upiv, stf, lmsg)
+    if (stf /= MBD_OK) return
+    call dgecon('1', w%na, c%ju, w%na, anorm, rc, c%cw, c%iw, info)
+  end function rcond_cols
 
   !> The partitioned method's work arrays (the first time).
   subroutine partition_work(m, w, c, stf)
@@ -955,18 +1006,27 @@ contains
     na = w%na; ni = m%nq - na
     call dgesvd('N', 'N', ni, ni, adum, max(ni, 1), sdum, udum, 1, vdum, 1, wq, -1, stf)
     lw = max(1, int(wq(1)), 5 * ni)
-    allocate (c%nb(m%nq, ni), c%sel(ni), c%mark(m%nq), c%iv(ni), c%iu(na), c%ub(na), &
-              c%px(m%nq), c%gw(ni, m%nq), c%gn(m%nq), c%nsq(ni, ni), c%sv(ni), c%svw(lw), &
-              stat=stf)
-    if (stf == 0 .and. w%solver == SOLVER_DENSE) allocate (c%ju(na, na), c%upiv(na), stat=stf)
+    allocate (c%iv(ni), c%iu(na), c%ub(na), c%px(m%nq), stat=stf)
+    if (stf == 0 .and. w%solver == SOLVER_DENSE) then
+      ! J_u, the QR's copy of J and its workspace, dgecon's
+      call dgeqp3(na, m%nq, adum, max(na, 1), c%upiv, sdum, wq, -1, stf)
+      lw = max(1, int(wq(1)))
+      allocate (c%ju(na, na), c%upiv(na), c%jp(m%nq), c%qa(na, m%nq), c%tau(min(na, m%nq)), &
+                c%qwork(lw), c%cw(4 * na), c%iw(na), stat=stf)
+    else if (stf == 0) then
+      allocate (c%nb(m%nq, ni), c%sel(ni), c%mark(m%nq), c%gw(ni, m%nq), c%gn(m%nq), &
+                c%nsq(ni, ni), c%sv(ni), c%svw(lw), stat=stf)
+    end if
     if (stf /= 0) stf = MBD_NO_MEMORY
   end subroutine partition_work
 
   !> Greedy pivoted Gram-Schmidt on the rows of c%nb: sel(k) is the coordinate whose row,
-  !! less its parts along the rows chosen before, is longest (ties within a relative 1e-6
-  !! go to the lowest index, so rounding does not decide between equal candidates).
-  subroutine select_coordinates(c, sel)
+  !! less its parts along the rows chosen before, is longest. Ties within a relative 1e-6
+  !! (rounding does not decide between equal candidates) go to a body's angle, the natural
+  !! coordinate of a link that turns (its x and y oscillate), the first of them.
+  subroutine select_coordinates(c, nbody, sel)
     type(itg_t), intent(inout) :: c
+    integer, intent(in) :: nbody             ! moving bodies (angles are 3, 6, .. 3 nbody)
     integer, intent(out) :: sel(:)
     integer :: ni, n, k, j, best
     real(wp) :: gmax, u(size(c%nb, 2)), d
@@ -982,9 +1042,12 @@ contains
         if (c%mark(j) == 0) gmax = max(gmax, c%gn(j))
       end do
       best = 0
-      do j = 1, n
+      do j = 1, n                      ! the first tied body angle, else the first tied one
         if (c%mark(j) == 0 .and. c%gn(j) >= (one - 1.0e-6_wp) * gmax) then
-          best = j; exit
+          if (best == 0) best = j
+          if (j <= 3 * nbody .and. mod(j, 3) == 0) then
+            best = j; exit
+          end if
         end if
       end do
       sel(k) = best
@@ -1073,10 +1136,12 @@ contains
     end do
   end subroutine plan_ju
 
-  !> Choose again when the current independent coordinates describe the allowed motion
-  !! REPARTITION times worse (the smallest singular value of N_v) than the choice
-  !! partition would make now. Near a singular configuration, where every choice is poor,
-  !! nothing better exists and the partition is kept.
+  !> Choose again when the current partition has become REPARTITION times worse than the
+  !! choice partition would make now. Dense path: J_u's 1/cond_1 against that of the QR's
+  !! choice. Band path: the smallest singular value of N_v (how well v describes the
+  !! allowed motion) against that of the pivoted choice. Near a singular configuration,
+  !! where every choice is poor (on the band path the projection that gives N is then itself
+  !! nearly singular), nothing better exists and the partition is kept.
   logical function needs_partition(m, w, c, t)
     type(model_t), intent(in) :: m
     type(dyn_work_t), intent(inout) :: w
@@ -1086,10 +1151,18 @@ contains
     integer :: stt
     needs_partition = .false.
     if (c%ni <= 0) return
+    if (w%solver == SOLVER_DENSE) then
+      call qr_choice(m, w, c, t, c%jp, stt)
+      now = rcond_cols(w, c, c%iu)
+      needs_partition = now <= zero
+      if (stt /= MBD_OK) return
+      needs_partition = now < REPARTITION * rcond_cols(w, c, c%jp(1:w%na))
+      return
+    end if
     call dyn_null_basis(m, w, c%qf, t, c%nb, stt)
-    if (stt /= MBD_OK) return
+    if (stt /= MBD_OK .or. w%lsq) return
     now = smin_rows(c, c%iv)
-    call select_coordinates(c, c%sel)
+    call select_coordinates(c, m%nb, c%sel)
     best = smin_rows(c, c%sel)
     needs_partition = now < REPARTITION * best
   end function needs_partition
