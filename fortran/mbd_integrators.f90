@@ -1002,7 +1002,7 @@ contains
     integer :: ni, na, lw
     real(wp) :: wq(1), adum(1), sdum(1), udum(1), vdum(1)
     stf = MBD_OK
-    if (allocated(c%nb)) return
+    if (allocated(c%iv)) return
     na = w%na; ni = m%nq - na
     call dgesvd('N', 'N', ni, ni, adum, max(ni, 1), sdum, udum, 1, vdum, 1, wq, -1, stf)
     lw = max(1, int(wq(1)), 5 * ni)

@@ -152,24 +152,57 @@ def test_every_allocation_of_the_band_path_fails_cleanly() -> None:
             assert "MiB" in text and "allocating" in text, text
 
 
-def test_dense_analyses_of_a_huge_model_refuse_before_allocating() -> None:
-    """Dynamics, statics and inverse dynamics are dense today: at N = 10000 they need
-    hundreds of GB and refuse at once, naming the size (under a 2 GiB address-space limit,
-    so that a missed check fails the test instead of filling the machine)."""
+def test_huge_model_dynamics_statics_and_inverse_run_banded_in_little_memory() -> None:
+    """N = 10000 (60,003 coordinates): dynamics, statics and inverse dynamics once needed
+    hundreds of GB of dense matrices and refused; now (solver="auto") they take the band
+    path, no n x n array: generalized-alpha and dopri5 for a few steps, the equilibrium and
+    the multipliers, all under a 1 GiB address-space limit (a missed n x n allocation fails
+    the test instead of filling the machine), peak RSS of the whole process under 400 MiB
+    (measured 215 MiB). Oracle for the motion: the parallelogram branch (every crank at the
+    same angle, the couplers level). solver="dense" keeps n x n matrices and refuses at
+    once, naming the size and the band path."""
     out = run_child("""
         model = build(10000, driven=False, omega0=1.0)     # 1 kg bars, free
         driven = build(10000, omega0=1.0)                   # the same, driven
-        old = limit(2048)
-        print(json.dumps({
-            "dynamics": outcome(lambda: model.dynamics(t_end=0.01, steps=2)),
-            "statics": outcome(lambda: model.statics()),
-            "inverse_dynamics": outcome(lambda: driven.inverse_dynamics(t_end=0.01, steps=2))}))
+        old = limit(1024)
+        res = {}
+        def dyn(method, **kw):
+            r = model.dynamics(t_end=0.002, steps=2, method=method, **kw)
+            th = r.q[:, 2::3][:, :10001]                   # the crank angles
+            yc = r.q[:, 3 * 10001 + 1::3]                   # the couplers' heights
+            res[method] = [r.stats["solver"], float(np.abs(th - th[:, :1]).max()),
+                           float(np.abs(yc - yc[:, :1]).max())]
+        def st():
+            s = model.statics()
+            res["statics"] = [s.stats["solver"], s.stability, s.residual]
+        def inv():
+            r = driven.inverse_dynamics(t_end=0.002, steps=2)
+            res["inverse"] = [r.stats["multiplier_solver"], float(np.abs(r.lam).max()), 0.0]
+        res["outcomes"] = [outcome(lambda: dyn("generalized-alpha", h=1e-3)),
+                           outcome(lambda: dyn("dopri5")), outcome(st), outcome(inv)]
+        # solver="dense" keeps n x n matrices: refused at once, naming the size
+        res["dense"] = [outcome(lambda: model.dynamics(t_end=0.01, steps=2, solver="dense")),
+                        outcome(lambda: model.statics(solver="dense")),
+                        outcome(lambda: driven.inverse_dynamics(t_end=0.01, steps=2,
+                                                                solver="dense"))]
+        unlimit(old)
+        res["rss_mib"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+        print(json.dumps(res))
     """)
-    for analysis, (kind, text) in out.items():
-        assert kind == "InsufficientMemoryError", (analysis, kind, text)
+    assert [k for k, _ in out["outcomes"]] == ["ok"] * 4, out["outcomes"]
+    for method in ("generalized-alpha", "dopri5"):
+        solver, spread, level = out[method]
+        assert solver == "banded"
+        assert spread < 1e-9 and level < 1e-9, out[method]     # cranks parallel, couplers level
+    assert out["statics"][0] == "banded" and out["statics"][1] == "unstable"   # upright
+    assert out["statics"][2] < 1e-12                                          # measured 1e-18
+    assert out["inverse"][0] == "banded" and np.isfinite(out["inverse"][1])
+    assert out["rss_mib"] < 400, out["rss_mib"]
+    for kind, text in out["dense"]:
+        assert kind == "InsufficientMemoryError", (kind, text)
         assert re.search(r"the dense dynamics \(6000[23] equations, 60003 coordinates\) would "
-                         r"need [0-9.]+ GiB", text), (analysis, text)
-        assert "fewer coordinates" in text, (analysis, text)
+                         r"need [0-9.]+ GiB", text), text
+        assert "fewer coordinates" in text and 'solver="banded"' in text, text
 
 
 def test_banded_singular_report_agrees_with_the_dense_svd() -> None:
