@@ -475,7 +475,8 @@ contains
   !! sides, 7 iteration matrices (K, C evaluations), 8 partitions, 9 active (independent)
   !! constraint rows, 10 LU factorizations of the generalized-alpha iteration matrix.
   !! rinfo: 1 time of a failure, 2 smallest step, 3 largest step, 5 linear solver (1 dense,
-  !! 2 banded), 6 and 7 the band widths kl and ku of the saddle-point matrix.
+  !! 2 banded), 6 and 7 the band widths kl and ku of the saddle-point matrix (of
+  !! generalized-alpha's iteration matrix for that method).
   !! solver: 0 auto, 1 dense, 2 banded (dyn_choose); the band path assembles q0 by
   !! Levenberg-Marquardt in band storage (dyn_assemble) and never allocates n x n.
   subroutine api_dynamics(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, v0, t0, t1, nsteps, &
@@ -545,8 +546,9 @@ contains
     if (status /= MBD_OK) return
     rinfo(6) = w%sd%kl; rinfo(7) = w%sd%ku
     iinfo(9) = w%na
-    do k = 1, m%neq
-      if (.not. any(w%rows == k)) redundant(k) = 1
+    redundant = 1                            ! (a loop over the active rows: O(neq))
+    do k = 1, w%na
+      redundant(w%rows(k)) = 0
     end do
     call dyn_velocity(m, w, q, t0, v0 / m%cunit, qd, status)
     if (status /= MBD_OK) then
@@ -568,6 +570,9 @@ contains
     iinfo(6) = dst%rhs; iinfo(7) = dst%jacobians; iinfo(8) = dst%partitions
     iinfo(10) = dst%factorizations
     rinfo(2) = dst%hmin; rinfo(3) = dst%hmax
+    if (dst%kl > 0) then                      ! generalized-alpha: its iteration matrix's
+      rinfo(6) = dst%kl; rinfo(7) = dst%ku
+    end if
     if (status /= MBD_OK) rinfo(1) = dst%t_fail
     do k = 1, nout
       ko = output_index(nsteps, every, k)

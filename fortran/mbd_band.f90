@@ -56,6 +56,7 @@ module mbd_band
     !> factor and solve in plain loops (band_lu, same pivoting and storage as dgbtf2 and
     !! dgbtrs): for narrow bands, where the BLAS calls per column cost more than the work
     logical :: plain = .false.
+    integer :: kvu = 0                  !! upper width of U used by the last band_lu (<= kl+ku)
   end type band_t
 
 contains
@@ -216,6 +217,7 @@ contains
     type(band_t), intent(inout) :: to     !! receives it
     to%n = from%n; to%kl = from%kl; to%ku = from%ku; to%ldab = from%ldab
     to%perm_sign = from%perm_sign; to%factored = from%factored; to%plain = from%plain
+    to%kvu = from%kvu
     if (allocated(to%prow)) deallocate (to%prow)
     if (allocated(to%pcol)) deallocate (to%pcol)
     if (allocated(to%ab)) deallocate (to%ab)
@@ -286,7 +288,7 @@ contains
       return
     end if
     if (b%plain) then
-      call band_lu(b%n, b%kl, b%ku, b%ab, b%ldab, b%ipiv, info)
+      call band_lu(b%n, b%kl, b%ku, b%ab, b%ldab, b%ipiv, info, b%kvu)
     else
       call dgbtrf(b%n, b%n, b%kl, b%ku, b%ab, b%ldab, b%ipiv, info)
     end if
@@ -417,7 +419,7 @@ contains
         b%rhs(b%prow(i)) = x(i)
       end do
       if (b%plain) then
-        call band_lu_solve(b%n, b%kl, b%ku, b%ab, b%ldab, b%ipiv, b%rhs)
+        call band_lu_solve(b%n, b%kl, b%ku, b%ab, b%ldab, b%ipiv, b%rhs, b%kvu)
         info = 0
       else
         call dgbtrs('N', b%n, b%kl, b%ku, 1, b%ab, b%ldab, b%ipiv, b%rhs, b%n, info)
@@ -504,17 +506,21 @@ contains
 
   !> LU factorization with partial pivoting of a band matrix in plain loops: dgbtf2's
   !! algorithm, storage and pivots (so dgbtrs and dgbcon read its factors), without its
-  !! BLAS calls per column. info > 0: U(info, info) is exactly zero.
-  pure subroutine band_lu(n, kl, ku, ab, ldab, ipiv, info)
+  !! BLAS calls per column. info > 0: U(info, info) is exactly zero. kvu: the upper width
+  !! of U the row interchanges actually filled (ku without any, at most kl + ku), so that
+  !! band_lu_solve reads no more of U than it holds.
+  pure subroutine band_lu(n, kl, ku, ab, ldab, ipiv, info, kvu)
     integer, intent(in) :: n, kl, ku, ldab    !! size, widths, leading dimension (2kl+ku+1)
     real(wp), intent(inout) :: ab(ldab, n)    !! band matrix, then its factors
     integer, intent(out) :: ipiv(n)           !! row interchanges
     integer, intent(out) :: info              !! 0, or the first zero pivot
+    integer, intent(out) :: kvu               !! upper width of U used
     integer :: kv, i, j, c, jp, km, ju, d
     real(wp) :: piv, f, tmp
     ! A(r, c) sits in ab(kv + 1 + r - c, c), kv = kl + ku (rows 1..kl: room for the fill)
     kv = ku + kl
     info = 0
+    kvu = ku
     do j = ku + 2, min(kv, n)                 ! clear the fill of the first columns
       do i = kv - j + 2, kl
         ab(i, j) = zero
@@ -540,6 +546,7 @@ contains
         cycle
       end if
       ju = max(ju, min(j + ku + jp, n))
+      kvu = max(kvu, ju - j)
       if (jp /= 0) then                       ! swap rows j and j + jp in columns j..ju
         do c = j, ju
           d = kv + 1 + j - c
@@ -563,11 +570,12 @@ contains
 
   !> Solve B x = r with the factors of band_lu (or dgbtrf) in plain loops: the row
   !! interchanges and L (forward), then U (upper width kl + ku, backward); r becomes x.
-  pure subroutine band_lu_solve(n, kl, ku, ab, ldab, ipiv, r)
+  pure subroutine band_lu_solve(n, kl, ku, ab, ldab, ipiv, r, kvu)
     integer, intent(in) :: n, kl, ku, ldab    !! size, widths, leading dimension
     real(wp), intent(in) :: ab(ldab, n)       !! factors
     integer, intent(in) :: ipiv(n)            !! row interchanges
     real(wp), intent(inout) :: r(n)           !! right-hand side, then solution
+    integer, intent(in) :: kvu                !! upper width of U (band_lu's)
     integer :: kv, i, j, p
     real(wp) :: tmp, f
     kv = ku + kl
@@ -586,7 +594,7 @@ contains
       r(j) = r(j) / ab(kv + 1, j)
       f = r(j)
       if (abs(f) <= zero) cycle
-      do i = max(1, j - kv), j - 1
+      do i = max(1, j - kvu), j - 1
         r(i) = r(i) - ab(kv + 1 + i - j, j) * f
       end do
     end do

@@ -63,6 +63,7 @@ module mbd_integrators
   type :: dyn_stats_t
     integer :: steps = 0, rejected = 0, newton = 0, rhs = 0, jacobians = 0, partitions = 0
     integer :: factorizations = 0     !! LU factorizations of the iteration matrix
+    integer :: kl = 0, ku = 0         !! band widths of the iteration matrix (band path)
     real(wp) :: hmin = huge(one), hmax = zero
     real(wp) :: t_fail = zero         !! time reached when a method failed
   end type dyn_stats_t
@@ -360,6 +361,7 @@ contains
     call saddle_plan(m, w%rows, w%solver, sg, status, msg, kptr=w%kptr, krow=w%krow, &
                      small=.true.)
     if (status /= MBD_OK) return
+    c%st%kl = sg%kl; c%st%ku = sg%ku
     nnz = w%kptr(n + 1) - 1
     allocate (kv(nnz), cv(nnz), kc(nnz), stat=stt)
     if (stt /= 0) then
@@ -1129,6 +1131,7 @@ contains
     end do
     call band_plan(w%na, rr, cc, c%bu, stf, lmsg)
     if (stf /= MBD_OK) return
+    c%bu%plain = c%bu%kl + c%bu%ku <= 64       ! narrow: plain loops (mbd_band's band_lu)
     ldab = c%bu%ldab
     do i = 1, ne
       c%upos(i) = c%bu%kl + c%bu%ku + 1 + c%bu%prow(rr(i)) - c%bu%pcol(cc(i)) + &
