@@ -23,10 +23,13 @@ module mbd_api
                             SOLVER_BANDED, kin_newton, kin_vel_acc
   use mbd_status, only: MBD_BAD_SETTING
   use mbd_profiles, only: profile_raw_length, profile_prepare, profile_eval
+  use mbd_sensitivity, only: sens_t, sens_setup, sens_eval_d
+  use mbd_assemble, only: scatter_dense
   implicit none
   private
   public :: NINFO, api_sizes, api_eval, api_kinematics, api_profile, api_analyze, api_kin_step
   public :: api_inverse, api_dynamics, api_statics, api_reactions
+  public :: api_eval_d
 
   integer, parameter :: NINFO = 10   !! length of the report arrays
 
@@ -111,7 +114,7 @@ contains
   !> Kinematic analysis: the whole time loop in one call.
   subroutine api_kinematics(nb, ctab, rpar, q0, t0, t1, nsteps, tol, maxit, tmin, every, &
                             solver, qout, qdout, qddout, iinfo, rinfo, qsing, dep, redundant, &
-                            tpass, status, msg)
+                            tpass, status, msg, ptab, sq, sqd, sqdd)
     integer, intent(in) :: nb                   !! moving bodies
     integer, intent(in) :: ctab(:, :)           !! constraint table
     real(wp), intent(in) :: rpar(:)             !! raw parameters
@@ -133,15 +136,33 @@ contains
     real(wp), intent(out) :: tpass(:)           !! times of singular passages (MAXPASS)
     integer, intent(out) :: status              !! MBD_OK, < 0 input, > 0 numerical
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    !> design parameters (mbd_sensitivity; (2, np)) and, with them, dq/dp, dq_dot/dp,
+    !! dq_ddot/dp at the outputs, each (nq, np, kin_out_count(nsteps, every))
+    integer, intent(in), optional :: ptab(:, :)
+    real(wp), intent(out), optional :: sq(:, :, :), sqd(:, :, :), sqdd(:, :, :)
     type(model_t) :: m
     type(kin_opts_t) :: opts
     type(kin_report_t) :: rep
+    type(sens_t) :: sens
     integer :: bad
     iinfo = 0; rinfo = zero; qsing = zero; dep = 0; redundant = 0; tpass = zero
     qout = zero; qdout = zero; qddout = zero
+    if (present(ptab)) then
+      sq = zero; sqd = zero; sqdd = zero
+    end if
     call model_build(nb, ctab, rpar, m, status, msg, bad)
     iinfo(2) = bad
     if (status /= MBD_OK) return
+    if (present(ptab)) then
+      if (any(shape(sq) /= [m%nq, size(ptab, 2), size(qout, 2)]) .or. &
+          any(shape(sqd) /= shape(sq)) .or. any(shape(sqdd) /= shape(sq))) then
+        status = MBD_BAD_COUNT; msg = 'sensitivity arrays do not match the model'; return
+      end if
+      call sens_setup(m, ctab, rpar, ptab, sens, status, msg, bad)
+      if (status /= MBD_OK) then
+        iinfo(2) = -2000000 - bad; return
+      end if
+    end if
     if (.not. (finite(q0) .and. finite(t0) .and. finite(t1) .and. finite(tol) .and. &
                finite(tmin))) then
       call not_finite('q0, the times and the tolerances', status, msg); return
@@ -168,7 +189,12 @@ contains
     if (tol > zero) opts%tol = tol
     if (maxit > 0) opts%maxit = maxit
     if (tmin > zero) opts%tmin = tmin
-    call kin_run(m, q0, t0, t1, nsteps, opts, qout, qdout, qddout, rep, status, msg)
+    if (present(ptab)) then
+      call kin_run(m, q0, t0, t1, nsteps, opts, qout, qdout, qddout, rep, status, msg, sens, &
+                   sq, sqd, sqdd)
+    else
+      call kin_run(m, q0, t0, t1, nsteps, opts, qout, qdout, qddout, rep, status, msg)
+    end if
     iinfo(1) = rep%ndone; iinfo(3) = rep%driver; iinfo(4) = rep%worst
     iinfo(5) = rep%deficiency; iinfo(6) = rep%newton_its; iinfo(7) = rep%lu_count
     iinfo(8) = rep%rejected; iinfo(9) = rep%rank; iinfo(10) = rep%npass
@@ -549,5 +575,48 @@ contains
       call dyn_reactions(m, w, q(:, k), t(k), lam(:, k), reac(:, :, k), rloc(:, :, k))
     end do
   end subroutine api_reactions
+
+  !> Changes of Phi, J, nu and gamma along a direction (dq, dq_dot) and one design parameter
+  !! (ptab(:, 1); an empty table: none) at (q, q_dot, t), each evaluated analytically on dual
+  !! numbers (mbd_dual): Phi_q dq + Phi_p, J_q dq + J_p, nu_p, gamma_q dq + gamma_q_dot dq_dot
+  !! + gamma_p. For checks by finite differences.
+  subroutine api_eval_d(nb, ctab, rpar, q, qd, t, dq, dqd, ptab, tphi, tjac, tnu, tgam, status, &
+                        msg, bad)
+    integer, intent(in) :: nb                   !! moving bodies
+    integer, intent(in) :: ctab(:, :)           !! constraint table
+    real(wp), intent(in) :: rpar(:)             !! raw parameters
+    real(wp), intent(in) :: q(:), qd(:)         !! state (nq)
+    real(wp), intent(in) :: t                   !! time
+    real(wp), intent(in) :: dq(:), dqd(:)       !! direction (nq)
+    integer, intent(in) :: ptab(:, :)           !! (2, 0 or 1) the parameter
+    real(wp), intent(out) :: tphi(:)            !! change of Phi (neq)
+    real(wp), intent(out) :: tjac(:, :)         !! change of J (neq x nq)
+    real(wp), intent(out) :: tnu(:), tgam(:)    !! changes of nu, gamma (neq)
+    integer, intent(out) :: status              !! MBD_OK or < 0
+    character(len=MSG_LEN), intent(out) :: msg  !! what is wrong
+    integer, intent(out) :: bad                 !! offending constraint, or 0
+    type(model_t) :: m
+    type(asm_work_t) :: aw
+    type(sens_t) :: sens
+    integer :: k
+    tphi = zero; tjac = zero; tnu = zero; tgam = zero
+    call model_build(nb, ctab, rpar, m, status, msg, bad)
+    if (status /= MBD_OK) return
+    if (.not. (finite(q) .and. finite(qd) .and. finite(t) .and. finite(dq) .and. &
+               finite(dqd))) then
+      call not_finite('the state and the direction', status, msg); return
+    end if
+    if (size(q) /= m%nq .or. size(qd) /= m%nq .or. size(dq) /= m%nq .or. &
+        size(dqd) /= m%nq .or. size(tphi) /= m%neq .or. size(tjac, 1) /= m%neq .or. &
+        size(tjac, 2) /= m%nq .or. size(ptab, 2) > 1) then
+      status = MBD_BAD_COUNT; msg = 'array sizes do not match the model'; return
+    end if
+    call sens_setup(m, ctab, rpar, ptab, sens, status, msg, bad)
+    if (status /= MBD_OK) return
+    k = size(ptab, 2)
+    call asm_init(m, aw)
+    call sens_eval_d(m, sens, k, q, qd, dq, dqd, t, tphi, tnu, tgam, aw%jb)
+    call scatter_dense(aw, tjac)
+  end subroutine api_eval_d
 
 end module mbd_api

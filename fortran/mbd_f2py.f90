@@ -177,3 +177,49 @@ subroutine core_reactions(nb, nc, ctab, np, rpar, nq, neq, nt, q, t, lam, reac, 
   !f2py intent(hide) :: nc, np, nq, neq, nt
   call api_reactions(nb, ctab, rpar, q, t, lam, reac, rloc, status, msg)
 end subroutine core_reactions
+
+! ------------------------------------------------------------------ design sensitivities
+! A design parameter is a column (table, index) of ptab: table 1 rpar, 2 bmass (flattened
+! (2, nb)), 3 grav, 4 fpar (mbd_sensitivity).
+
+subroutine core_eval_d(nb, nc, ctab, np, rpar, nq, neq, q, qd, t, dq, dqd, npar, ptab, tphi, &
+                       tjac, tnu, tgam, status, msg, bad)
+  use iso_c_binding, only: c_double, c_int
+  use mbd_api, only: api_eval_d
+  implicit none
+  integer(c_int), intent(in) :: nb, nc, np, nq, neq, npar
+  integer(c_int), intent(in) :: ctab(8, nc), ptab(2, npar)
+  real(c_double), intent(in) :: rpar(np), q(nq), qd(nq), t, dq(nq), dqd(nq)
+  real(c_double), intent(out) :: tphi(neq), tjac(neq, nq), tnu(neq), tgam(neq)
+  integer(c_int), intent(out) :: status, bad
+  character(len=512), intent(out) :: msg
+  !f2py intent(hide) :: nc, np, nq, npar
+  call api_eval_d(nb, ctab, rpar, q, qd, t, dq, dqd, ptab, tphi, tjac, tnu, tgam, status, msg, &
+                  bad)
+end subroutine core_eval_d
+
+subroutine core_kinematics_sens(nb, nc, ctab, np, rpar, nq, neq, q0, t0, t1, nsteps, tol, &
+                                maxit, tmin, every, solver, nout, npar, ptab, qout, qdout, &
+                                qddout, sq, sqd, sqdd, iinfo, rinfo, qsing, dep, redundant, &
+                                tpass, status, msg)
+  use iso_c_binding, only: c_double, c_int
+  use mbd_api, only: api_kinematics
+  implicit none
+  integer(c_int), intent(in) :: nb, nc, np, nq, neq, nsteps, maxit, every, solver, nout, npar
+  integer(c_int), intent(in) :: ctab(8, nc), ptab(2, npar)
+  real(c_double), intent(in) :: rpar(np), q0(nq), t0, t1, tol, tmin
+  real(c_double), intent(out) :: qout(nq, nout), qdout(nq, nout), qddout(nq, nout)
+  real(c_double), intent(out) :: sq(nq, npar, nout), sqd(nq, npar, nout), sqdd(nq, npar, nout)
+  integer(c_int), intent(out) :: iinfo(10)
+  real(c_double), intent(out) :: rinfo(10)
+  real(c_double), intent(out) :: qsing(nq)
+  integer(c_int), intent(out) :: dep(neq), redundant(neq)
+  real(c_double), intent(out) :: tpass(64)
+  integer(c_int), intent(out) :: status
+  character(len=512), intent(out) :: msg
+  !f2py intent(hide) :: nc, np, nq, npar
+  !f2py threadsafe
+  call api_kinematics(nb, ctab, rpar, q0, t0, t1, nsteps, tol, maxit, tmin, every, solver, &
+                      qout, qdout, qddout, iinfo, rinfo, qsing, dep, redundant, tpass, &
+                      status, msg, ptab, sq, sqd, sqdd)
+end subroutine core_kinematics_sens

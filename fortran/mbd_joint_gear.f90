@@ -13,9 +13,10 @@ module mbd_joint_gear
   use mbd_status, only: MBD_OK, MBD_BAD_PARAM, MSG_LEN
   use mbd_points, only: NLOC, MAXROW, kloc, kscal, body_angle, slot_value, ssub, sadd, sscale, &
                         sconst, put_scal
+  use mbd_dual, only: dloc, dscal, body_angle, slot_value, ssub, sadd, sscale, sconst, put_scal
   implicit none
   private
-  public :: GEAR_EXTERNAL, GEAR_INTERNAL, CARRIER_SLOT, gear_prepare, gear_eval
+  public :: GEAR_EXTERNAL, GEAR_INTERNAL, CARRIER_SLOT, gear_prepare, gear_eval, gear_eval_d
 
   integer, parameter :: GEAR_EXTERNAL = 1, GEAR_INTERNAL = 2
   integer, parameter :: CARRIER_SLOT = 7
@@ -61,5 +62,23 @@ contains
     call put_scal(ssub(sadd(sscale(p(1), ai), sscale(sgn * p(2), aj)), sconst(p(3))), &
                   phi(1), jl(1, :), gam(1))
   end subroutine gear_eval
+
+  !> Change of the row along a direction and a parameter change tp (mbd_dual).
+  pure subroutine gear_eval_d(kind, p, tp, si, sj, x, tphi, tjl, tgam)
+    integer, intent(in) :: kind             !! GEAR_EXTERNAL or GEAR_INTERNAL
+    real(wp), intent(in) :: p(:), tp(:)     !! prepared parameters and their change
+    integer, intent(in) :: si, sj           !! slot ids of the gears
+    type(dloc), intent(in) :: x             !! local state and direction
+    real(wp), intent(inout) :: tphi(MAXROW), tjl(MAXROW, NLOC), tgam(MAXROW)  !! 1 row
+    type(dscal) :: ai, aj, c
+    real(wp) :: sgn
+    c = slot_value(x, CARRIER_SLOT)
+    ai = ssub(body_angle(x, si), c)
+    aj = ssub(body_angle(x, sj), c)
+    sgn = 1.0_wp
+    if (kind == GEAR_INTERNAL) sgn = -1.0_wp
+    call put_scal(ssub(sadd(sscale(p(1), tp(1), ai), sscale(sgn * p(2), sgn * tp(2), aj)), &
+                       sconst(p(3), tp(3))), tphi(1), tjl(1, :), tgam(1))
+  end subroutine gear_eval_d
 
 end module mbd_joint_gear

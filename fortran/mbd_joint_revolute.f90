@@ -8,9 +8,10 @@ module mbd_joint_revolute
   use mbd_kinds, only: wp, zero, one
   use mbd_status, only: MBD_OK, MSG_LEN
   use mbd_points, only: NLOC, MAXROW, kloc, point_terms
+  use mbd_dual, only: dloc, body_point, vsub, put_vec
   implicit none
   private
-  public :: revolute_prepare, revolute_eval
+  public :: revolute_prepare, revolute_eval, revolute_eval_d
 
 contains
 
@@ -48,5 +49,16 @@ contains
     end if
     gam(1:2) = aj - ai                      ! gamma = A_i s'_i thd_i**2 - A_j s'_j thd_j**2
   end subroutine revolute_eval
+
+  !> Changes of the rows of Phi, J and gamma along a direction (x) and a change tp of the
+  !! parameters (mbd_dual): the same Phi = P_i - P_j on dual points.
+  pure subroutine revolute_eval_d(p, tp, si, sj, x, tphi, tjl, tgam)
+    real(wp), intent(in) :: p(:), tp(:)     !! prepared parameters and their change
+    integer, intent(in) :: si, sj           !! slot ids of the two bodies (0 = ground)
+    type(dloc), intent(in) :: x             !! local state and direction
+    real(wp), intent(inout) :: tphi(MAXROW), tjl(MAXROW, NLOC), tgam(MAXROW)  !! 2 rows
+    call put_vec(vsub(body_point(x, si, p(1:2), tp(1:2)), body_point(x, sj, p(3:4), tp(3:4))), &
+                 tphi, tjl, tgam)
+  end subroutine revolute_eval_d
 
 end module mbd_joint_revolute

@@ -1,0 +1,537 @@
+!> mbd_sensitivity: design parameters and the derivatives the sensitivity equations need.
+!!
+!! A parameter is an entry of one of the flat tables the front end hands over, named in a
+!! table ptab(2, np) by (table, index):  1 rpar (a constraint's raw parameter), 2 bmass
+!! (flattened (2, nb): mass of body b at 2 b - 1, inertia at 2 b), 3 grav (1 x, 2 y), 4 fpar
+!! (a force's raw parameter). sens_setup turns each into the change of the prepared
+!! parameter pools (the chain rule through each joint's prepare: axis normalisation, spline
+!! coefficients, ...), of the mass matrix and of gravity.
+!!
+!! Differentiating Phi(q, t; p) = 0, J q_dot = nu and J q_ddot = gamma along a motion gives,
+!! with s = dq/dp (Haug, Computer-Aided Kinematics and Dynamics, sec. 6.5):
+!!   J s       = -Phi_p
+!!   J s_dot   = nu_p - J_p q_dot - Hv s                           Hv = (J q_dot)_q
+!!   J s_ddot  = gamma_p - J_p q_ddot - Ha s - 2 Hv s_dot           Ha = (J q_ddot - gamma)_q
+!! (gamma_q_dot = -2 Hv for constraints quadratic in q_dot). Hv and Ha come from the local
+!! Hessian of each constraint, hs(:, :, j) = dJ_loc/dq_slot_j, evaluated by dual numbers
+!! (mbd_dual) along each slot of the constraint; Phi_p, J_p, nu_p, gamma_p along each
+!! parameter's change of the prepared pool. All are local blocks in the layout of J's
+!! blocks (MAXROW x NLOC per constraint); products with them go through the slot map.
+module mbd_sensitivity
+  use mbd_kinds, only: wp, zero, one
+  use mbd_status, only: MBD_OK, MBD_BAD_PARAM, MBD_BAD_INPUT, MBD_NO_MEMORY, MSG_LEN
+  use mbd_points, only: NLOC, MAXROW, kloc, local_state
+  use mbd_dual, only: dual_state
+  use mbd_model, only: model_t, NCT, NFT
+  use mbd_constraints, only: con_eval_d, con_prepare_d, con_is_count, con_name, &
+                             CON_TRANSLATIONAL, DRV_REL_DIST
+  use mbd_forces, only: force_eval_d, force_is_count
+  implicit none
+  private
+  public :: sens_t, PT_RPAR, PT_MASS, PT_GRAV, PT_FPAR
+  public :: sens_setup, sens_hessian, sens_params, sens_kin_rhs, block_apply, block_apply_t, &
+            sens_klam, sens_jpt_lam, sens_force_d, sens_force_jac, sens_eval_d
+
+  integer, parameter :: PT_RPAR = 1, PT_MASS = 2, PT_GRAV = 3, PT_FPAR = 4  !! table ids
+
+  !> The parameters and the work arrays of the sensitivity equations.
+  type :: sens_t
+    integer :: np = 0                        !! parameters
+    integer, allocatable :: ptab(:, :)       !! (2, np) table and index of each
+    real(wp), allocatable :: tp(:, :)        !! (size(m%p), np) change of the prepared pool
+    logical, allocatable :: caff(:, :)       !! (nc, np) the constraint's parameters change
+    real(wp), allocatable :: tfp(:, :)       !! (size(m%fp), np) change of the force pool
+    logical, allocatable :: faff(:, :)       !! (nf, np) the force's parameters change
+    real(wp), allocatable :: tmass(:, :)     !! (nq, np) change of the mass matrix diagonal
+    real(wp), allocatable :: tgrav(:, :)     !! (2, np) change of gravity
+    ! local blocks at the current state (sens_hessian)
+    real(wp), allocatable :: hs(:, :, :, :)  !! (MAXROW, NLOC, NLOC, nc) dJ_loc / dq_slot
+    real(wp), allocatable :: hv(:, :, :)     !! (MAXROW, NLOC, nc) (J q_dot)_q
+    real(wp), allocatable :: ha(:, :, :)     !! (MAXROW, NLOC, nc) (J q_ddot - gamma)_q
+    ! parameter parts at the current state (sens_params), (neq, np)
+    real(wp), allocatable :: phip(:, :)      !! Phi_p
+    real(wp), allocatable :: vp(:, :)        !! nu_p - J_p q_dot
+    real(wp), allocatable :: ap(:, :)        !! gamma_p - J_p q_ddot
+    real(wp), allocatable :: work(:)         !! (neq)
+    real(wp), allocatable :: rhs(:)          !! (neq) right-hand side for the caller's solves
+    real(wp), allocatable :: zp(:)           !! zeros, the longest prepared slice
+  end type sens_t
+
+contains
+
+  !> Check the parameter table and build the changes of the prepared pools.
+  !! bad returns the offending parameter (column of ptab), 0 when none.
+  subroutine sens_setup(m, ctab, rpar, ptab, s, status, msg, bad, ftab, fpar)
+    type(model_t), intent(in) :: m              !! built model
+    integer, intent(in) :: ctab(:, :)           !! constraint table (NCT, nc)
+    real(wp), intent(in) :: rpar(:)             !! raw constraint parameters
+    integer, intent(in) :: ptab(:, :)           !! (2, np) parameter table
+    type(sens_t), intent(out) :: s              !! parameters and work arrays
+    integer, intent(out) :: status              !! MBD_OK or < 0
+    character(len=MSG_LEN), intent(out) :: msg  !! what is wrong
+    integer, intent(out) :: bad                 !! offending parameter
+    integer, intent(in), optional :: ftab(:, :) !! force table (NFT, nf), for dynamics
+    real(wp), intent(in), optional :: fpar(:)   !! raw force parameters
+    real(wp), allocatable :: tprep(:)
+    integer :: k, i, c, d, j, off, len, st, nfp
+    logical :: dyn
+    status = MBD_OK; msg = ''; bad = 0
+    if (size(ptab, 1) /= 2) then
+      status = MBD_BAD_INPUT; msg = 'the parameter table must have 2 rows'; return
+    end if
+    dyn = allocated(m%mdiag) .and. present(ftab) .and. present(fpar)
+    s%np = size(ptab, 2)
+    nfp = 0
+    if (dyn) nfp = size(m%fp)
+    allocate (s%ptab(2, s%np), s%tp(size(m%p), s%np), s%caff(m%nc, s%np), &
+              s%tfp(nfp, s%np), s%faff(m%nf, s%np), s%tmass(m%nq, s%np), s%tgrav(2, s%np), &
+              s%hs(MAXROW, NLOC, NLOC, m%nc), s%hv(MAXROW, NLOC, m%nc), &
+              s%ha(MAXROW, NLOC, m%nc), s%phip(m%neq, s%np), s%vp(m%neq, s%np), &
+              s%ap(m%neq, s%np), s%work(m%neq), s%rhs(m%neq), s%zp(maxval(m%pn)), stat=st)
+    if (st /= 0) then
+      status = MBD_NO_MEMORY; msg = 'out of memory for the sensitivity arrays'; return
+    end if
+    s%ptab = ptab
+    s%tp = zero; s%caff = .false.; s%tfp = zero; s%faff = .false.; s%tmass = zero
+    s%tgrav = zero; s%hs = zero; s%hv = zero; s%ha = zero; s%zp = zero
+    do k = 1, s%np
+      bad = k
+      i = ptab(2, k)
+      select case (ptab(1, k))
+      case (PT_RPAR)
+        if (i < 1 .or. i > size(rpar)) then
+          call fail('constraint parameter index out of range'); return
+        end if
+        c = owner(ctab(6, :), ctab(7, :), i)
+        if (c == 0) then
+          call fail('the constraint parameter belongs to no constraint'); return
+        end if
+        off = ctab(6, c); len = ctab(7, c); j = i - off + 1
+        if (con_is_count(ctab(1, c), ctab(4, c), rpar(off:off + len - 1), j)) then
+          call fail('is a count, not a continuous parameter'); return
+        end if
+        call con_prepare_d(ctab(1, c), ctab(4, c), ctab(5, c), rpar(off:off + len - 1), j, &
+                           tprep, status, msg)
+        if (status /= MBD_OK) return
+        call put_prep(c, tprep, k)
+        if (ctab(1, c) == CON_TRANSLATIONAL) then
+          ! relative-distance drivers on this joint carry its prepared parameters in front
+          do d = 1, m%nc
+            if (ctab(1, d) == DRV_REL_DIST .and. ctab(4, d) == c) then
+              s%tp(m%po(d):m%po(d) + size(tprep) - 1, k) = tprep
+              s%caff(d, k) = .true.
+            end if
+          end do
+        end if
+      case (PT_MASS)
+        if (.not. allocated(m%mdiag)) then
+          call fail('masses need a model with dynamics data'); return
+        end if
+        if (i < 1 .or. i > 2 * m%nb) then
+          call fail('mass table index out of range'); return
+        end if
+        c = (i + 1) / 2
+        if (mod(i, 2) == 1) then
+          s%tmass(3 * c - 2:3 * c - 1, k) = one
+        else
+          s%tmass(3 * c, k) = one
+        end if
+      case (PT_GRAV)
+        if (i < 1 .or. i > 2) then
+          call fail('gravity index must be 1 or 2'); return
+        end if
+        s%tgrav(i, k) = one
+      case (PT_FPAR)
+        if (.not. dyn) then
+          call fail('force parameters need a model with dynamics data'); return
+        end if
+        if (i < 1 .or. i > size(fpar)) then
+          call fail('force parameter index out of range'); return
+        end if
+        c = owner(ftab(4, :), ftab(5, :), i)
+        if (c == 0) then
+          call fail('the force parameter belongs to no force'); return
+        end if
+        j = i - ftab(4, c) + 1
+        if (force_is_count(ftab(1, c), fpar(ftab(4, c):ftab(4, c) + ftab(5, c) - 1), j)) then
+          call fail('is a count, not a continuous parameter'); return
+        end if
+        s%tfp(m%fpo(c) + j - 1, k) = one          ! forces: prepared = raw
+        s%faff(c, k) = .true.
+      case default
+        call fail('unknown parameter table (1 constraints, 2 masses, 3 gravity, 4 forces)')
+        return
+      end select
+    end do
+    bad = 0
+  contains
+    !> The element whose slice [off, off + len) holds index ii (0 when none).
+    pure integer function owner(offs, lens, ii)
+      integer, intent(in) :: offs(:), lens(:), ii
+      integer :: e
+      owner = 0
+      do e = 1, size(offs)
+        if (ii >= offs(e) .and. ii < offs(e) + lens(e)) then
+          owner = e; return
+        end if
+      end do
+    end function owner
+
+    subroutine put_prep(cc, tpr, kk)
+      integer, intent(in) :: cc, kk
+      real(wp), intent(in) :: tpr(:)
+      if (size(tpr) /= m%pn(cc)) then
+        status = MBD_BAD_PARAM
+        msg = trim(con_name(m%kind(cc))) // ': prepared parameter change has the wrong length'
+        return
+      end if
+      s%tp(m%po(cc):m%po(cc) + m%pn(cc) - 1, kk) = tpr
+      s%caff(cc, kk) = .true.
+    end subroutine put_prep
+
+    subroutine fail(what)
+      character(len=*), intent(in) :: what
+      status = MBD_BAD_PARAM
+      write (msg, '(a,i0,a,i0,a,i0,a,a)') 'parameter ', k, ' (table ', ptab(1, k), ', entry ', &
+        ptab(2, k), '): ', what
+    end subroutine fail
+  end subroutine sens_setup
+
+  !> The local state of constraint k at (q, q_dot) and its slots' accelerations.
+  pure subroutine gather(m, k, q, qd, qdd, x, qddl)
+    type(model_t), intent(in) :: m
+    integer, intent(in) :: k
+    real(wp), intent(in) :: q(:), qd(:), qdd(:)
+    type(kloc), intent(out) :: x
+    real(wp), intent(out) :: qddl(NLOC)
+    real(wp) :: ql(NLOC), qdl(NLOC)
+    integer :: j, c
+    do j = 1, NLOC
+      c = m%loc(j, k)
+      ql(j) = zero; qdl(j) = zero; qddl(j) = zero
+      if (c > 0) then
+        ql(j) = q(c); qdl(j) = qd(c); qddl(j) = qdd(c)
+      end if
+    end do
+    x = local_state(ql, qdl)
+  end subroutine gather
+
+  !> Local Hessian blocks at (q, q_dot, q_ddot, t): for each constraint and each of its
+  !! slots j, the dual evaluation along dq = e_j gives hs(:, :, j) = dJ_loc/dq_j and
+  !! d ar/dq_j = -dgamma/dq_j; then hv(:, j) = hs(:, :, j) q_dot_loc and
+  !! ha(:, j) = hs(:, :, j) q_ddot_loc + d ar/dq_j.
+  pure subroutine sens_hessian(m, s, q, qd, qdd, t)
+    type(model_t), intent(in) :: m             !! model
+    type(sens_t), intent(inout) :: s           !! blocks (out)
+    real(wp), intent(in) :: q(:), qd(:), qdd(:)  !! state and accelerations
+    real(wp), intent(in) :: t                  !! time
+    type(kloc) :: x
+    real(wp) :: qddl(NLOC), e(NLOC), tphi(MAXROW), tnu(MAXROW), tgam(MAXROW)
+    integer :: k, j, nr, si, sj, r
+    real(wp), parameter :: z(NLOC) = zero
+    do k = 1, m%nc
+      call gather(m, k, q, qd, qdd, x, qddl)
+      si = merge(1, 0, m%bi(k) > 0); sj = merge(2, 0, m%bj(k) > 0)
+      nr = m%nrow(k)
+      s%hs(:, :, :, k) = zero; s%hv(:, :, k) = zero; s%ha(:, :, k) = zero
+      do j = 1, NLOC
+        if (m%loc(j, k) == 0) cycle
+        e = zero; e(j) = one
+        call con_eval_d(m%kind(k), m%suba(k), m%subb(k), m%p(m%po(k):m%po(k) + m%pn(k) - 1), &
+                        s%zp(1:m%pn(k)), si, sj, dual_state(x, e, z), t, tphi, &
+                        s%hs(:, :, j, k), tnu, tgam)
+        do r = 1, nr
+          s%hv(r, j, k) = dot_product(s%hs(r, :, j, k), x%qd)
+          s%ha(r, j, k) = dot_product(s%hs(r, :, j, k), qddl) - tgam(r)
+        end do
+      end do
+    end do
+  end subroutine sens_hessian
+
+  !> Parameter parts at (q, q_dot, q_ddot, t): Phi_p, nu_p - J_p q_dot and
+  !! gamma_p - J_p q_ddot, each a column per parameter (zero rows for unaffected
+  !! constraints), from the dual evaluation along the parameter's change (dq = 0).
+  pure subroutine sens_params(m, s, q, qd, qdd, t)
+    type(model_t), intent(in) :: m             !! model
+    type(sens_t), intent(inout) :: s           !! parameter parts (out)
+    real(wp), intent(in) :: q(:), qd(:), qdd(:)  !! state and accelerations
+    real(wp), intent(in) :: t                  !! time
+    type(kloc) :: x
+    real(wp) :: qddl(NLOC), tphi(MAXROW), tjl(MAXROW, NLOC), tnu(MAXROW), tgam(MAXROW)
+    integer :: k, c, nr, si, sj, r, r0
+    real(wp), parameter :: z(NLOC) = zero
+    s%phip = zero; s%vp = zero; s%ap = zero
+    do c = 1, m%nc
+      if (.not. any(s%caff(c, :))) cycle
+      call gather(m, c, q, qd, qdd, x, qddl)
+      si = merge(1, 0, m%bi(c) > 0); sj = merge(2, 0, m%bj(c) > 0)
+      nr = m%nrow(c); r0 = m%row0(c) - 1
+      do k = 1, s%np
+        if (.not. s%caff(c, k)) cycle
+        call con_eval_d(m%kind(c), m%suba(c), m%subb(c), m%p(m%po(c):m%po(c) + m%pn(c) - 1), &
+                        s%tp(m%po(c):m%po(c) + m%pn(c) - 1, k), si, sj, dual_state(x, z, z), &
+                        t, tphi, tjl, tnu, tgam)
+        do r = 1, nr
+          s%phip(r0 + r, k) = tphi(r)
+          s%vp(r0 + r, k) = tnu(r) - dot_product(tjl(r, :), x%qd)
+          s%ap(r0 + r, k) = tgam(r) - dot_product(tjl(r, :), qddl)
+        end do
+      end do
+    end do
+  end subroutine sens_params
+
+  !> Changes of Phi, nu, gamma (neq) and of the local J blocks (MAXROW, NLOC, nc) along a
+  !! direction (dq, dq_dot) and parameter k (k = 0: none): every constraint evaluated on
+  !! dual numbers.
+  pure subroutine sens_eval_d(m, s, k, q, qd, dq, dqd, t, tphi, tnu, tgam, tjb)
+    type(model_t), intent(in) :: m             !! model
+    type(sens_t), intent(in) :: s              !! parameters
+    integer, intent(in) :: k                   !! parameter, or 0
+    real(wp), intent(in) :: q(:), qd(:)        !! state
+    real(wp), intent(in) :: dq(:), dqd(:)      !! direction
+    real(wp), intent(in) :: t                  !! time
+    real(wp), intent(out) :: tphi(:), tnu(:), tgam(:)  !! (neq)
+    real(wp), intent(out) :: tjb(:, :, :)      !! (MAXROW, NLOC, nc)
+    type(kloc) :: x
+    real(wp) :: qddl(NLOC), tql(NLOC), tqdl(NLOC), ph(MAXROW), nv(MAXROW), ga(MAXROW)
+    integer :: c, si, sj, r0, nr
+    tjb = zero
+    do c = 1, m%nc
+      call gather(m, c, q, qd, qd, x, qddl)
+      call gather_dir(c, tql, tqdl)
+      si = merge(1, 0, m%bi(c) > 0); sj = merge(2, 0, m%bj(c) > 0)
+      ph = zero; nv = zero; ga = zero
+      if (k > 0) then
+        call con_eval_d(m%kind(c), m%suba(c), m%subb(c), m%p(m%po(c):m%po(c) + m%pn(c) - 1), &
+                        s%tp(m%po(c):m%po(c) + m%pn(c) - 1, k), si, sj, &
+                        dual_state(x, tql, tqdl), t, ph, tjb(:, :, c), nv, ga)
+      else
+        call con_eval_d(m%kind(c), m%suba(c), m%subb(c), m%p(m%po(c):m%po(c) + m%pn(c) - 1), &
+                        s%zp(1:m%pn(c)), si, sj, dual_state(x, tql, tqdl), t, ph, &
+                        tjb(:, :, c), nv, ga)
+      end if
+      r0 = m%row0(c) - 1; nr = m%nrow(c)
+      tphi(r0 + 1:r0 + nr) = ph(1:nr); tnu(r0 + 1:r0 + nr) = nv(1:nr)
+      tgam(r0 + 1:r0 + nr) = ga(1:nr)
+    end do
+  contains
+    pure subroutine gather_dir(cc, a, b)
+      integer, intent(in) :: cc
+      real(wp), intent(out) :: a(NLOC), b(NLOC)
+      integer :: jj
+      do jj = 1, NLOC
+        a(jj) = zero; b(jj) = zero
+        if (m%loc(jj, cc) > 0) then
+          a(jj) = dq(m%loc(jj, cc)); b(jj) = dqd(m%loc(jj, cc))
+        end if
+      end do
+    end subroutine gather_dir
+  end subroutine sens_eval_d
+
+  !> y = B x for local blocks B (MAXROW, NLOC, nc) in J's layout (y: neq, x: nq).
+  pure subroutine block_apply(m, b, x, y)
+    type(model_t), intent(in) :: m           !! model
+    real(wp), intent(in) :: b(:, :, :)       !! local blocks
+    real(wp), intent(in) :: x(:)             !! (nq)
+    real(wp), intent(out) :: y(:)            !! (neq)
+    integer :: k, j, c, r, r0
+    y = zero
+    do k = 1, m%nc
+      r0 = m%row0(k) - 1
+      do j = 1, NLOC
+        c = m%loc(j, k)
+        if (c == 0) cycle
+        do r = 1, m%nrow(k)
+          y(r0 + r) = y(r0 + r) + b(r, j, k) * x(c)
+        end do
+      end do
+    end do
+  end subroutine block_apply
+
+  !> y = B^T l for local blocks B in J's layout (y: nq, l: neq).
+  pure subroutine block_apply_t(m, b, l, y)
+    type(model_t), intent(in) :: m           !! model
+    real(wp), intent(in) :: b(:, :, :)       !! local blocks
+    real(wp), intent(in) :: l(:)             !! (neq)
+    real(wp), intent(out) :: y(:)            !! (nq)
+    integer :: k, j, c, r, r0
+    y = zero
+    do k = 1, m%nc
+      r0 = m%row0(k) - 1
+      do j = 1, NLOC
+        c = m%loc(j, k)
+        if (c == 0) cycle
+        do r = 1, m%nrow(k)
+          y(c) = y(c) + b(r, j, k) * l(r0 + r)
+        end do
+      end do
+    end do
+  end subroutine block_apply_t
+
+  !> Right-hand sides of the three sensitivity equations of parameter k, given the solutions
+  !! of the levels before (level 1: -Phi_p; 2: nu_p - J_p q_dot - Hv s;
+  !! 3: gamma_p - J_p q_ddot - Ha s - 2 Hv s_dot). sens_hessian and sens_params first.
+  pure subroutine sens_kin_rhs(m, s, level, k, sq, sqd, rhs)
+    type(model_t), intent(in) :: m           !! model
+    type(sens_t), intent(inout) :: s         !! blocks, parameter parts, work
+    integer, intent(in) :: level             !! 1 position, 2 velocity, 3 acceleration
+    integer, intent(in) :: k                 !! parameter
+    real(wp), intent(in) :: sq(:), sqd(:)    !! s and s_dot of parameter k (as known)
+    real(wp), intent(out) :: rhs(:)          !! (neq)
+    select case (level)
+    case (1)
+      rhs = -s%phip(:, k)
+    case (2)
+      call block_apply(m, s%hv, sq, rhs)
+      rhs = s%vp(:, k) - rhs
+    case default
+      call block_apply(m, s%ha, sq, rhs)
+      call block_apply(m, s%hv, sqd, s%work)
+      rhs = s%ap(:, k) - rhs - 2 * s%work
+    end select
+  end subroutine sens_kin_rhs
+
+  !> y = (J^T lambda)_q x = sum over rows of lambda_r (Phi_r)_qq x, from the local Hessian
+  !! blocks (sens_hessian at the same q).
+  pure subroutine sens_klam(m, s, lam, x, y)
+    type(model_t), intent(in) :: m           !! model
+    type(sens_t), intent(in) :: s            !! Hessian blocks
+    real(wp), intent(in) :: lam(:)           !! multipliers (neq)
+    real(wp), intent(in) :: x(:)             !! direction (nq)
+    real(wp), intent(out) :: y(:)            !! (nq)
+    integer :: k, i, j, r, r0, ci, cj
+    real(wp) :: acc
+    y = zero
+    do k = 1, m%nc
+      r0 = m%row0(k) - 1
+      do j = 1, NLOC
+        cj = m%loc(j, k)
+        if (cj == 0) cycle
+        do i = 1, NLOC
+          ci = m%loc(i, k)
+          if (ci == 0) cycle
+          acc = zero
+          do r = 1, m%nrow(k)
+            acc = acc + lam(r0 + r) * s%hs(r, i, j, k)
+          end do
+          y(ci) = y(ci) + acc * x(cj)
+        end do
+      end do
+    end do
+  end subroutine sens_klam
+
+  !> y = J_p^T lambda for parameter k at (q, t), and jpb, the change of the local J blocks
+  !! (MAXROW, NLOC, nc) along the parameter (zero for unaffected constraints).
+  pure subroutine sens_jpt_lam(m, s, k, q, t, lam, y, jpb)
+    type(model_t), intent(in) :: m           !! model
+    type(sens_t), intent(in) :: s            !! parameters
+    integer, intent(in) :: k                 !! parameter
+    real(wp), intent(in) :: q(:), t          !! configuration, time
+    real(wp), intent(in) :: lam(:)           !! multipliers (neq)
+    real(wp), intent(out) :: y(:)            !! (nq)
+    real(wp), intent(out) :: jpb(:, :, :)    !! (MAXROW, NLOC, nc)
+    type(kloc) :: x
+    real(wp) :: qddl(NLOC), tphi(MAXROW), tnu(MAXROW), tgam(MAXROW)
+    real(wp), parameter :: z(NLOC) = zero
+    integer :: c, si, sj
+    jpb = zero
+    do c = 1, m%nc
+      if (.not. s%caff(c, k)) cycle
+      call gather(m, c, q, q * zero, q * zero, x, qddl)
+      si = merge(1, 0, m%bi(c) > 0); sj = merge(2, 0, m%bj(c) > 0)
+      call con_eval_d(m%kind(c), m%suba(c), m%subb(c), m%p(m%po(c):m%po(c) + m%pn(c) - 1), &
+                      s%tp(m%po(c):m%po(c) + m%pn(c) - 1, k), si, sj, dual_state(x, z, z), t, &
+                      tphi, jpb(:, :, c), tnu, tgam)
+    end do
+    call block_apply_t(m, jpb, lam, y)
+  end subroutine sens_jpt_lam
+
+  !> Change of the applied generalized force Q along (dq, dq_dot) and parameter k
+  !! (k = 0: no parameter change): forces by dual evaluation, gravity m g by the changes of
+  !! the masses and of g.
+  pure subroutine sens_force_d(m, s, k, q, qd, dq, dqd, t, y)
+    type(model_t), intent(in) :: m           !! model with dynamics data
+    type(sens_t), intent(in) :: s            !! parameters
+    integer, intent(in) :: k                 !! parameter, or 0
+    real(wp), intent(in) :: q(:), qd(:)      !! state
+    real(wp), intent(in) :: dq(:), dqd(:)    !! direction
+    real(wp), intent(in) :: t                !! time
+    real(wp), intent(out) :: y(:)            !! (nq)
+    real(wp) :: ql(NLOC), qdl(NLOC), tql(NLOC), tqdl(NLOC), fl(NLOC), tpz(size(m%fp))
+    integer :: f, j, c, si, sj, b
+    y = zero
+    if (k > 0) then
+      do b = 1, m%nb
+        y(3 * b - 2:3 * b - 1) = s%tmass(3 * b - 2, k) * m%grav + m%mdiag(3 * b - 2) * s%tgrav(:, k)
+      end do
+    end if
+    tpz = zero
+    do f = 1, m%nf
+      do j = 1, NLOC
+        c = m%floc(j, f)
+        ql(j) = zero; qdl(j) = zero; tql(j) = zero; tqdl(j) = zero
+        if (c > 0) then
+          ql(j) = q(c); qdl(j) = qd(c); tql(j) = dq(c); tqdl(j) = dqd(c)
+        end if
+      end do
+      si = merge(1, 0, m%fbi(f) > 0); sj = merge(2, 0, m%fbj(f) > 0)
+      if (k > 0) then
+        call force_eval_d(m%fkind(f), m%fp(m%fpo(f):m%fpo(f) + m%fpn(f) - 1), &
+                          s%tfp(m%fpo(f):m%fpo(f) + m%fpn(f) - 1, k), si, sj, ql, qdl, &
+                          tql, tqdl, t, fl)
+      else
+        call force_eval_d(m%fkind(f), m%fp(m%fpo(f):m%fpo(f) + m%fpn(f) - 1), &
+                          tpz(m%fpo(f):m%fpo(f) + m%fpn(f) - 1), si, sj, ql, qdl, &
+                          tql, tqdl, t, fl)
+      end if
+      do j = 1, NLOC
+        c = m%floc(j, f)
+        if (c > 0) y(c) = y(c) + fl(j)
+      end do
+    end do
+  end subroutine sens_force_d
+
+  !> Dense Jacobians of the applied forces, kq = dQ/dq and (optionally) kv = dQ/dq_dot,
+  !! from the dual evaluation of each force along its slots (nq x nq each).
+  pure subroutine sens_force_jac(m, q, qd, t, kq, kv)
+    type(model_t), intent(in) :: m           !! model with dynamics data
+    real(wp), intent(in) :: q(:), qd(:)      !! state
+    real(wp), intent(in) :: t                !! time
+    real(wp), intent(out) :: kq(:, :)        !! dQ/dq
+    real(wp), intent(out), optional :: kv(:, :)  !! dQ/dq_dot
+    real(wp) :: ql(NLOC), qdl(NLOC), e(NLOC), fl(NLOC), tpz(size(m%fp))
+    real(wp), parameter :: z(NLOC) = zero
+    integer :: f, i, j, c, si, sj
+    kq = zero
+    if (present(kv)) kv = zero
+    tpz = zero
+    do f = 1, m%nf
+      do j = 1, NLOC
+        c = m%floc(j, f)
+        ql(j) = zero; qdl(j) = zero
+        if (c > 0) then
+          ql(j) = q(c); qdl(j) = qd(c)
+        end if
+      end do
+      si = merge(1, 0, m%fbi(f) > 0); sj = merge(2, 0, m%fbj(f) > 0)
+      do j = 1, NLOC
+        c = m%floc(j, f)
+        if (c == 0) cycle
+        e = zero; e(j) = one
+        call force_eval_d(m%fkind(f), m%fp(m%fpo(f):m%fpo(f) + m%fpn(f) - 1), &
+                          tpz(m%fpo(f):m%fpo(f) + m%fpn(f) - 1), si, sj, ql, qdl, e, z, t, fl)
+        do i = 1, NLOC
+          if (m%floc(i, f) > 0) kq(m%floc(i, f), c) = kq(m%floc(i, f), c) + fl(i)
+        end do
+        if (present(kv)) then
+          call force_eval_d(m%fkind(f), m%fp(m%fpo(f):m%fpo(f) + m%fpn(f) - 1), &
+                            tpz(m%fpo(f):m%fpo(f) + m%fpn(f) - 1), si, sj, ql, qdl, z, e, t, fl)
+          do i = 1, NLOC
+            if (m%floc(i, f) > 0) kv(m%floc(i, f), c) = kv(m%floc(i, f), c) + fl(i)
+          end do
+        end if
+      end do
+    end do
+  end subroutine sens_force_jac
+
+end module mbd_sensitivity
