@@ -34,7 +34,7 @@ module mbd_constraints
             CON_GEAR, CON_RACK, CON_ROLLING, CON_ABSOLUTE, DRV_ABS, DRV_REL_ANGLE, DRV_REL_DIST
   public :: con_known, con_nrow, con_nextra, con_is_driver, con_raw_length, con_prepare
   public :: con_eval, con_init_extra, con_name
-  public :: con_is_count, con_prepare_d, con_eval_d
+  public :: con_is_count, con_prepare_d, con_eval_d, con_linear, con_affine_r
 
   integer, parameter :: CON_REVOLUTE = 1, CON_TRANSLATIONAL = 2, CON_CAM = 3, CON_DISTANCE = 4
   integer, parameter :: CON_POINT_LINE = 5, CON_WELD = 6, CON_GEAR = 7, CON_RACK = 8
@@ -210,6 +210,25 @@ contains
     real(wp), intent(inout) :: ql(NLOC)      !! local coordinates
     if (kind == CON_CAM) ql(ALPHA_SLOT) = cam_init_alpha(suba, subb, p, si, sj, ql)
   end subroutine con_init_extra
+
+  !> Phi is linear in q (J constant, gamma free of q): absolute constraints and drivers,
+  !! relative-angle drivers, gears. Their second derivatives in q vanish.
+  pure logical function con_linear(kind)
+    integer, intent(in) :: kind   !! kind code
+    select case (kind)
+    case (CON_ABSOLUTE, CON_GEAR, DRV_ABS, DRV_REL_ANGLE)
+      con_linear = .true.
+    case default
+      con_linear = .false.
+    end select
+  end function con_linear
+
+  !> Phi is affine in the body positions r_i, r_j (revolute, weld: points compared,
+  !! r_i + A_i s'_i - r_j - A_j s'_j): no second derivative involves a position slot.
+  pure logical function con_affine_r(kind)
+    integer, intent(in) :: kind   !! kind code
+    con_affine_r = kind == CON_REVOLUTE .or. kind == CON_WELD .or. con_linear(kind)
+  end function con_affine_r
 
   !> True when raw entry j of a constraint is a count (a function's or a profile's), which
   !! no derivative can be taken with respect to.

@@ -18,13 +18,13 @@
 !! that field; the rates enter vd and ar through theta_dot and alpha_dot.
 module mbd_dual
   use mbd_kinds, only: wp, zero, one, two, half
-  use mbd_points, only: NLOC, MAXROW, kvec, kscal, kloc, perp, &
+  use mbd_points, only: NLOC, MAXROW, kvec, kscal, kloc, &
                         curve_vector, curve_point, body_point, body_vector, body_angle, &
                         slot_value, const_vec, vsub, vadd, vscale, vdot, vcross, ssub, sadd, &
                         sscale, ssqrt, sconst, put_vec, put_scal
   implicit none
   private
-  public :: dloc, dvec, dscal, dual_state
+  public :: dloc, dvec, dscal, dual_state, point_terms_d
   public :: curve_vector, curve_point, body_point, body_vector, body_angle, slot_value, &
             const_vec, vsub, vadd, vscale, vdot, vcross, ssub, sadd, sscale, ssqrt, sconst, &
             put_vec, put_scal
@@ -150,21 +150,22 @@ contains
     thd = x%x%qd(c + 3); dth = x%tq(c + 3); dthd = x%tqd(c + 3)
     cs = x%x%c(slot); sn = x%x%s(slot)
     ! the turn: d/dtheta (A w) = perp(A w), for every field of the value
-    a%t%v = a%t%v + dth * perp(a%a%v)
+    a%t%v = a%t%v + dth * [-a%a%v(2), a%a%v(1)]
     do k = 1, NLOC
-      a%t%d(:, k) = a%t%d(:, k) + dth * perp(a%a%d(:, k))
+      a%t%d(1, k) = a%t%d(1, k) - dth * a%a%d(2, k)
+      a%t%d(2, k) = a%t%d(2, k) + dth * a%a%d(1, k)
     end do
-    a%t%vd = a%t%vd + dth * perp(a%a%vd)
-    a%t%ar = a%t%ar + dth * perp(a%a%ar)
+    a%t%vd = a%t%vd + dth * [-a%a%vd(2), a%a%vd(1)]
+    a%t%ar = a%t%ar + dth * [-a%a%ar(2), a%a%ar(1)]
     ! the rates
     au = [cs * u(1) - sn * u(2), sn * u(1) + cs * u(2)]
-    bu = perp(au)
+    bu = [-au(2), au(1)]
     a%t%vd = a%t%vd + bu * dthd
     a%t%ar = a%t%ar - two * au * thd * dthd
     if (aslot > 0) then
       au1 = [cs * u1(1) - sn * u1(2), sn * u1(1) + cs * u1(2)]
       au2 = [cs * u2(1) - sn * u2(2), sn * u2(1) + cs * u2(2)]
-      bu1 = perp(au1)
+      bu1 = [-au1(2), au1(1)]
       a%t%vd = a%t%vd + au1 * dald
       a%t%ar = a%t%ar + two * bu1 * (dthd * ald + thd * dald) + two * au2 * ald * dald
     end if
@@ -190,24 +191,96 @@ contains
     a%t%vd = a%t%vd + x%tqd(c + 1:c + 2)
   end function curve_point_d
 
-  !> Body point P = r + A s' whose s' changes by ts.
+  !> Body point P = r + A s' whose s' changes by ts (written out: the most used leaf).
+  !! With a = A s', b = perp(a) = B s', e = A ts:
+  !!   t_v = dr + b dth + e,   t_d(:, theta) = -a dth + perp(e),
+  !!   t_vd = dr_dot + (-a dth + perp(e)) thd + b dthd,  t_ar = -(b dth + e) thd**2 - 2 a thd dthd.
   pure function body_point_d(x, slot, s, ts) result(a)
     type(dloc), intent(in) :: x          !! local state and direction
     integer, intent(in) :: slot          !! 0 ground (s global), 1 or 2
     real(wp), intent(in) :: s(2), ts(2)  !! point in the body frame and its change
     type(dvec) :: a
-    real(wp), parameter :: z(2) = zero
-    a = curve_point_d(x, slot, 0, s, z, z, z, ts, z, z)
+    real(wp) :: cs, sn, thd, dth, dthd, au(2), bu(2), e(2), pe(2), tdt(2)
+    integer :: c
+    if (slot == 0) then
+      a%a%v = s; a%t%v = ts
+      return
+    end if
+    c = 3 * (slot - 1)
+    cs = x%x%c(slot); sn = x%x%s(slot)
+    thd = x%x%qd(c + 3); dth = x%tq(c + 3); dthd = x%tqd(c + 3)
+    au = [cs * s(1) - sn * s(2), sn * s(1) + cs * s(2)]
+    bu = [-au(2), au(1)]
+    e = [cs * ts(1) - sn * ts(2), sn * ts(1) + cs * ts(2)]
+    pe = [-e(2), e(1)]
+    a%a%v = x%x%q(c + 1:c + 2) + au
+    a%a%d(1, c + 1) = one; a%a%d(2, c + 2) = one
+    a%a%d(:, c + 3) = bu
+    a%a%vd = x%x%qd(c + 1:c + 2) + bu * thd
+    a%a%ar = -au * thd**2
+    tdt = pe - au * dth
+    a%t%v = x%tq(c + 1:c + 2) + bu * dth + e
+    a%t%d(:, c + 3) = tdt
+    a%t%vd = x%tqd(c + 1:c + 2) + tdt * thd + bu * dthd
+    a%t%ar = -(bu * dth + e) * thd**2 - two * au * thd * dthd
   end function body_point_d
 
-  !> Body-fixed direction A u' whose u' changes by tu.
+  !> The fields of body_point_d without the product-rule types (the joints that only compare
+  !! points use these, as point_terms in mbd_points): the value P, its theta column bs of J,
+  !! its velocity and acceleration remainder, and their changes tp, tbs, tvd, tar.
+  pure subroutine point_terms_d(x, slot, s, ts, p, bs, ar, tp, tbs, tar)
+    type(dloc), intent(in) :: x          !! local state and direction
+    integer, intent(in) :: slot          !! 0 ground (s global), 1 or 2
+    real(wp), intent(in) :: s(2), ts(2)  !! point in the body frame and its change
+    real(wp), intent(out) :: p(2), bs(2), ar(2)      !! P, B s', -A s' thd**2
+    real(wp), intent(out) :: tp(2), tbs(2), tar(2)   !! their changes
+    real(wp) :: cs, sn, thd, dth, dthd, au(2), e(2)
+    integer :: c
+    if (slot == 0) then
+      p = s; tp = ts; bs = zero; ar = zero; tbs = zero; tar = zero
+      return
+    end if
+    c = 3 * (slot - 1)
+    cs = x%x%c(slot); sn = x%x%s(slot)
+    thd = x%x%qd(c + 3); dth = x%tq(c + 3); dthd = x%tqd(c + 3)
+    au = [cs * s(1) - sn * s(2), sn * s(1) + cs * s(2)]
+    bs = [-au(2), au(1)]
+    e = [cs * ts(1) - sn * ts(2), sn * ts(1) + cs * ts(2)]
+    p = x%x%q(c + 1:c + 2) + au
+    ar = -au * thd**2
+    tp = x%tq(c + 1:c + 2) + bs * dth + e
+    tbs = [-e(2), e(1)] - au * dth
+    tar = -(bs * dth + e) * thd**2 - two * au * thd * dthd
+  end subroutine point_terms_d
+
+  !> Body-fixed direction A u' whose u' changes by tu (body_point_d without r).
   pure function body_vector_d(x, slot, u, tu) result(a)
     type(dloc), intent(in) :: x          !! local state and direction
     integer, intent(in) :: slot          !! 0 ground, 1 or 2
     real(wp), intent(in) :: u(2), tu(2)  !! vector in the body frame and its change
     type(dvec) :: a
-    real(wp), parameter :: z(2) = zero
-    a = curve_vector_d(x, slot, 0, u, z, z, z, tu, z, z)
+    real(wp) :: cs, sn, thd, dth, dthd, au(2), bu(2), e(2), pe(2), tdt(2)
+    integer :: c
+    if (slot == 0) then
+      a%a%v = u; a%t%v = tu
+      return
+    end if
+    c = 3 * (slot - 1)
+    cs = x%x%c(slot); sn = x%x%s(slot)
+    thd = x%x%qd(c + 3); dth = x%tq(c + 3); dthd = x%tqd(c + 3)
+    au = [cs * u(1) - sn * u(2), sn * u(1) + cs * u(2)]
+    bu = [-au(2), au(1)]
+    e = [cs * tu(1) - sn * tu(2), sn * tu(1) + cs * tu(2)]
+    pe = [-e(2), e(1)]
+    a%a%v = au
+    a%a%d(:, c + 3) = bu
+    a%a%vd = bu * thd
+    a%a%ar = -au * thd**2
+    tdt = pe - au * dth
+    a%t%v = bu * dth + e
+    a%t%d(:, c + 3) = tdt
+    a%t%vd = tdt * thd + bu * dthd
+    a%t%ar = -(bu * dth + e) * thd**2 - two * au * thd * dthd
   end function body_vector_d
 
   !> A constant vector u (changing by tu).

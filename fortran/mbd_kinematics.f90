@@ -37,10 +37,10 @@ module mbd_kinematics
   use mbd_band, only: band_t, band_plan, band_zero, band_norm1, band_factor, &
                       band_rcond, band_solve
   use mbd_linsolve, only: lu_factor, lu_solve, lu_det_sign, svd_null, row_rank, qr_factor, &
-                          qr_solve, qr_lwork
+                          qr_solve, qr_lwork, lu_solve_rows
   use mbd_lapack, only: dgels, dgecon, dtrcon
   use mbd_interp, only: hermite5
-  use mbd_sensitivity, only: sens_t, sens_hessian, sens_params, sens_kin_rhs
+  use mbd_sensitivity, only: sens_t, sens_trig, sens_hessian, sens_params, sens_kin_rhs
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   implicit none
   private
@@ -265,6 +265,28 @@ contains
     end if
     x = x * w%cs
   end subroutine solve
+
+  !> Solve J X = B for several right-hand sides with the factors (as solve), B given as rows
+  !! bt = B^T (n rounded up to a multiple of 4, neq; padding rows zero) and overwritten; the
+  !! dense LU by plain loops over all of them at once.
+  subroutine solve_cols(w, bt, x)
+    type(kin_work_t), intent(inout) :: w   !! work arrays with the factors
+    real(wp), intent(inout) :: bt(:, :)    !! right-hand sides as rows (4 k, neq), spoiled
+    real(wp), intent(out) :: x(:, :)       !! solutions (nq, n)
+    real(wp) :: b(size(bt, 2))
+    integer :: k
+    if (w%lsq .or. w%banded) then
+      do k = 1, size(x, 2)
+        b = bt(k, :)
+        call solve(w, b, x(:, k))
+      end do
+      return
+    end if
+    call lu_solve_rows(w%jac, w%ipiv, bt)
+    do k = 1, size(x, 2)
+      x(:, k) = bt(k, :) * w%cs
+    end do
+  end subroutine solve_cols
 
   !> Newton-Raphson on Phi(q, t) = 0 from q. On success w holds the factors of J(q) at the
   !! returned q and w%nu = nu(q, t). In least-squares mode a correction that no longer
@@ -970,17 +992,15 @@ contains
     real(wp), intent(in) :: q(:), qd(:), qdd(:)  !! state and accelerations
     real(wp), intent(in) :: t                !! time
     real(wp), intent(out) :: sq(:, :), sqd(:, :), sqdd(:, :)  !! (nq, np)
-    integer :: k
+    call sens_trig(m, s, q)
     call sens_hessian(m, s, q, qd, qdd, t)
     call sens_params(m, s, q, qd, qdd, t)
-    do k = 1, s%np
-      call sens_kin_rhs(m, s, 1, k, sq(:, k), sqd(:, k), s%rhs)
-      call solve(w, s%rhs, sq(:, k))
-      call sens_kin_rhs(m, s, 2, k, sq(:, k), sqd(:, k), s%rhs)
-      call solve(w, s%rhs, sqd(:, k))
-      call sens_kin_rhs(m, s, 3, k, sq(:, k), sqd(:, k), s%rhs)
-      call solve(w, s%rhs, sqdd(:, k))
-    end do
+    call sens_kin_rhs(s, 1, sq, sqd, s%rhs)
+    call solve_cols(w, s%rhs, sq)
+    call sens_kin_rhs(s, 2, sq, sqd, s%rhs)
+    call solve_cols(w, s%rhs, sqd)
+    call sens_kin_rhs(s, 3, sq, sqd, s%rhs)
+    call solve_cols(w, s%rhs, sqdd)
   end subroutine kin_sens
 
   !> Stored outputs of a run of nsteps intervals keeping every e-th (and the last).

@@ -20,7 +20,7 @@ module mbd_linsolve
   implicit none
   private
   public :: lapack_status, lu_factor, lu_solve, lu_det_sign, svd_null, row_rank
-  public :: lu_factor_small, lu_solve_small, ls_small
+  public :: lu_factor_small, lu_solve_small, ls_small, lu_solve_rows
   public :: qr_factor, qr_solve, qr_lwork, RANK_TOL
 
   integer, parameter :: SMALL_N = 48   !! below this the unblocked dgetf2 is faster
@@ -171,6 +171,44 @@ contains
       end do
     end do
   end subroutine lu_solve_small
+
+  !> Solve A X = B for several right-hand sides with LU factors (dgetf2/dgetrf or
+  !! lu_factor_small), the right-hand sides stored as rows: bt = B^T (4 k, n), so each step
+  !! of the substitutions is a vector operation over 4 of them at a time (fixed length: the
+  !! compiler unrolls it). bt is overwritten by X^T; its row count is a multiple of 4 (pad
+  !! with zero rows).
+  pure subroutine lu_solve_rows(a, ipiv, bt)
+    real(wp), intent(in) :: a(:, :)             !! LU factors
+    integer, intent(in) :: ipiv(:)              !! pivot rows
+    real(wp), intent(inout) :: bt(:, :)         !! B^T (4 k, n), then X^T
+    integer :: n, i, k, p, c
+    real(wp) :: tmp(4), f
+    n = size(a, 1)
+    do c = 1, size(bt, 1) - 3, 4
+      do k = 1, n                               ! P B (the row interchanges in order)
+        p = ipiv(k)
+        if (p /= k) then
+          tmp = bt(c:c + 3, k); bt(c:c + 3, k) = bt(c:c + 3, p); bt(c:c + 3, p) = tmp
+        end if
+      end do
+      do k = 1, n                               ! L Y = P B (zero multipliers skipped)
+        do i = k + 1, n
+          f = a(i, k)
+          if (abs(f) <= zero) cycle
+          bt(c:c + 3, i) = bt(c:c + 3, i) - f * bt(c:c + 3, k)
+        end do
+      end do
+      do k = n, 1, -1                           ! U X = Y
+        f = one / a(k, k)
+        bt(c:c + 3, k) = bt(c:c + 3, k) * f
+        do i = 1, k - 1
+          f = a(i, k)
+          if (abs(f) <= zero) cycle
+          bt(c:c + 3, i) = bt(c:c + 3, i) - f * bt(c:c + 3, k)
+        end do
+      end do
+    end do
+  end subroutine lu_solve_rows
 
   !> Least squares min ||A x - b|| for A (m x n), m >= n, of full column rank, by Householder
   !! QR in plain loops (A = Q R, x = R^-1 (Q^T b)(1:n)); no allocation. ok is false (and a, b

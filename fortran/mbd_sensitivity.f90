@@ -21,15 +21,17 @@ module mbd_sensitivity
   use mbd_kinds, only: wp, zero, one
   use mbd_status, only: MBD_OK, MBD_BAD_PARAM, MBD_BAD_INPUT, MBD_NO_MEMORY, MSG_LEN
   use mbd_points, only: NLOC, MAXROW, kloc, local_state
-  use mbd_dual, only: dual_state
+  use mbd_dual, only: dloc
   use mbd_model, only: model_t, NCT, NFT
-  use mbd_constraints, only: con_eval_d, con_prepare_d, con_is_count, con_name, &
+  use mbd_constraints, only: con_eval_d, con_prepare_d, con_is_count, con_name, con_linear, &
+                             con_affine_r, &
                              CON_TRANSLATIONAL, DRV_REL_DIST
   use mbd_forces, only: force_eval_d, force_is_count
   implicit none
   private
   public :: sens_t, PT_RPAR, PT_MASS, PT_GRAV, PT_FPAR
-  public :: sens_setup, sens_hessian, sens_params, sens_kin_rhs, block_apply, block_apply_t, &
+  public :: sens_setup, sens_trig, sens_hessian, sens_params, sens_kin_rhs, block_apply, block_apply_t, &
+            block_apply_cols, &
             sens_klam, sens_jpt_lam, sens_force_d, sens_force_jac, sens_eval_d
 
   integer, parameter :: PT_RPAR = 1, PT_MASS = 2, PT_GRAV = 3, PT_FPAR = 4  !! table ids
@@ -48,12 +50,20 @@ module mbd_sensitivity
     real(wp), allocatable :: hs(:, :, :, :)  !! (MAXROW, NLOC, NLOC, nc) dJ_loc / dq_slot
     real(wp), allocatable :: hv(:, :, :)     !! (MAXROW, NLOC, nc) (J q_dot)_q
     real(wp), allocatable :: ha(:, :, :)     !! (MAXROW, NLOC, nc) (J q_ddot - gamma)_q
-    ! parameter parts at the current state (sens_params), (neq, np)
+    ! parameter parts at the current state (sens_params), (np, neq): a row per parameter
     real(wp), allocatable :: phip(:, :)      !! Phi_p
     real(wp), allocatable :: vp(:, :)        !! nu_p - J_p q_dot
     real(wp), allocatable :: ap(:, :)        !! gamma_p - J_p q_ddot
     real(wp), allocatable :: work(:)         !! (neq)
-    real(wp), allocatable :: rhs(:)          !! (neq) right-hand side for the caller's solves
+    !> (npad, neq) right-hand sides as rows, npad = np rounded up to a multiple of 4 (the
+    !! padding rows stay zero: lu_solve_rows works on 4 at a time)
+    real(wp), allocatable :: rhs(:, :)
+    logical :: curved = .true.               !! some constraint is not linear in q
+    real(wp), allocatable :: cb(:), sb(:)    !! (0:nb) cos and sin of the body angles (sens_trig)
+    ! the nonzeros of Hv and Ha (sens_hessian): row, column, values
+    integer :: nnz = 0
+    integer, allocatable :: nzr(:), nzc(:)
+    real(wp), allocatable :: nzv(:), nza(:)
     real(wp), allocatable :: zp(:)           !! zeros, the longest prepared slice
   end type sens_t
 
@@ -86,14 +96,17 @@ contains
     allocate (s%ptab(2, s%np), s%tp(size(m%p), s%np), s%caff(m%nc, s%np), &
               s%tfp(nfp, s%np), s%faff(m%nf, s%np), s%tmass(m%nq, s%np), s%tgrav(2, s%np), &
               s%hs(MAXROW, NLOC, NLOC, m%nc), s%hv(MAXROW, NLOC, m%nc), &
-              s%ha(MAXROW, NLOC, m%nc), s%phip(m%neq, s%np), s%vp(m%neq, s%np), &
-              s%ap(m%neq, s%np), s%work(m%neq), s%rhs(m%neq), s%zp(maxval(m%pn)), stat=st)
+              s%ha(MAXROW, NLOC, m%nc), s%phip(s%np, m%neq), s%vp(s%np, m%neq), &
+              s%ap(s%np, m%neq), s%work(m%neq), s%rhs(4 * ((s%np + 3) / 4), m%neq), s%zp(maxval(m%pn)), &
+              s%cb(0:m%nb), s%sb(0:m%nb), s%nzr(NLOC * m%neq), s%nzc(NLOC * m%neq), &
+              s%nzv(NLOC * m%neq), s%nza(NLOC * m%neq), stat=st)
     if (st /= 0) then
       status = MBD_NO_MEMORY; msg = 'out of memory for the sensitivity arrays'; return
     end if
     s%ptab = ptab
     s%tp = zero; s%caff = .false.; s%tfp = zero; s%faff = .false.; s%tmass = zero
     s%tgrav = zero; s%hs = zero; s%hv = zero; s%ha = zero; s%zp = zero
+    s%cb = one; s%sb = zero; s%rhs = zero
     do k = 1, s%np
       bad = k
       i = ptab(2, k)
@@ -197,52 +210,75 @@ contains
     end subroutine fail
   end subroutine sens_setup
 
-  !> The local state of constraint k at (q, q_dot) and its slots' accelerations.
-  pure subroutine gather(m, k, q, qd, qdd, x, qddl)
+  !> cos and sin of every body angle at q, for the evaluations that follow at the same q.
+  pure subroutine sens_trig(m, s, q)
+    type(model_t), intent(in) :: m           !! model
+    type(sens_t), intent(inout) :: s         !! cache (out)
+    real(wp), intent(in) :: q(:)             !! configuration
+    integer :: b
+    do b = 1, m%nb
+      s%cb(b) = cos(q(3 * b)); s%sb(b) = sin(q(3 * b))
+    end do
+  end subroutine sens_trig
+
+  !> The local state of constraint k at (q, q_dot) and its slots' accelerations (cos and sin
+  !! from sens_trig).
+  pure subroutine gather(m, s, k, q, qd, qdd, xd, qddl)
     type(model_t), intent(in) :: m
+    type(sens_t), intent(in) :: s
     integer, intent(in) :: k
     real(wp), intent(in) :: q(:), qd(:), qdd(:)
-    type(kloc), intent(out) :: x
+    type(dloc), intent(out) :: xd          ! the state, with a zero direction
     real(wp), intent(out) :: qddl(NLOC)
-    real(wp) :: ql(NLOC), qdl(NLOC)
     integer :: j, c
     do j = 1, NLOC
       c = m%loc(j, k)
-      ql(j) = zero; qdl(j) = zero; qddl(j) = zero
+      xd%x%q(j) = zero; xd%x%qd(j) = zero; qddl(j) = zero
       if (c > 0) then
-        ql(j) = q(c); qdl(j) = qd(c); qddl(j) = qdd(c)
+        xd%x%q(j) = q(c); xd%x%qd(j) = qd(c); qddl(j) = qdd(c)
       end if
     end do
-    x = local_state(ql, qdl)
+    xd%x%c(1) = s%cb(m%bi(k)); xd%x%c(2) = s%cb(m%bj(k))
+    xd%x%s(1) = s%sb(m%bi(k)); xd%x%s(2) = s%sb(m%bj(k))
+    xd%tq = zero; xd%tqd = zero
   end subroutine gather
 
   !> Local Hessian blocks at (q, q_dot, q_ddot, t): for each constraint and each of its
   !! slots j, the dual evaluation along dq = e_j gives hs(:, :, j) = dJ_loc/dq_j and
   !! d ar/dq_j = -dgamma/dq_j; then hv(:, j) = hs(:, :, j) q_dot_loc and
-  !! ha(:, j) = hs(:, :, j) q_ddot_loc + d ar/dq_j.
+  !! ha(:, j) = hs(:, :, j) q_ddot_loc + d ar/dq_j (and their nonzeros in a list).
+  !! sens_trig first.
   pure subroutine sens_hessian(m, s, q, qd, qdd, t)
     type(model_t), intent(in) :: m             !! model
     type(sens_t), intent(inout) :: s           !! blocks (out)
     real(wp), intent(in) :: q(:), qd(:), qdd(:)  !! state and accelerations
     real(wp), intent(in) :: t                  !! time
-    type(kloc) :: x
-    real(wp) :: qddl(NLOC), e(NLOC), tphi(MAXROW), tnu(MAXROW), tgam(MAXROW)
+    type(dloc) :: x
+    real(wp) :: qddl(NLOC), tphi(MAXROW), tnu(MAXROW), tgam(MAXROW)
     integer :: k, j, nr, si, sj, r
-    real(wp), parameter :: z(NLOC) = zero
+    s%curved = .false.
+    s%nnz = 0
     do k = 1, m%nc
-      call gather(m, k, q, qd, qdd, x, qddl)
+      if (con_linear(m%kind(k))) cycle          ! blocks stay zero (sens_setup)
+      s%curved = .true.
+      call gather(m, s, k, q, qd, qdd, x, qddl)
       si = merge(1, 0, m%bi(k) > 0); sj = merge(2, 0, m%bj(k) > 0)
       nr = m%nrow(k)
-      s%hs(:, :, :, k) = zero; s%hv(:, :, k) = zero; s%ha(:, :, k) = zero
       do j = 1, NLOC
         if (m%loc(j, k) == 0) cycle
-        e = zero; e(j) = one
+        if (con_affine_r(m%kind(k)) .and. j /= 3 .and. j /= 6) cycle   ! zero blocks
+        x%tq(j) = one
         call con_eval_d(m%kind(k), m%suba(k), m%subb(k), m%p(m%po(k):m%po(k) + m%pn(k) - 1), &
-                        s%zp(1:m%pn(k)), si, sj, dual_state(x, e, z), t, tphi, &
-                        s%hs(:, :, j, k), tnu, tgam)
+                        s%zp(1:m%pn(k)), si, sj, x, t, tphi, s%hs(:, :, j, k), tnu, tgam)
+        x%tq(j) = zero
         do r = 1, nr
-          s%hv(r, j, k) = dot_product(s%hs(r, :, j, k), x%qd)
+          s%hv(r, j, k) = dot_product(s%hs(r, :, j, k), x%x%qd)
           s%ha(r, j, k) = dot_product(s%hs(r, :, j, k), qddl) - tgam(r)
+          if (s%hv(r, j, k) /= zero .or. s%ha(r, j, k) /= zero) then
+            s%nnz = s%nnz + 1
+            s%nzr(s%nnz) = m%row0(k) + r - 1; s%nzc(s%nnz) = m%loc(j, k)
+            s%nzv(s%nnz) = s%hv(r, j, k); s%nza(s%nnz) = s%ha(r, j, k)
+          end if
         end do
       end do
     end do
@@ -256,25 +292,24 @@ contains
     type(sens_t), intent(inout) :: s           !! parameter parts (out)
     real(wp), intent(in) :: q(:), qd(:), qdd(:)  !! state and accelerations
     real(wp), intent(in) :: t                  !! time
-    type(kloc) :: x
+    type(dloc) :: x
     real(wp) :: qddl(NLOC), tphi(MAXROW), tjl(MAXROW, NLOC), tnu(MAXROW), tgam(MAXROW)
     integer :: k, c, nr, si, sj, r, r0
-    real(wp), parameter :: z(NLOC) = zero
     s%phip = zero; s%vp = zero; s%ap = zero
     do c = 1, m%nc
       if (.not. any(s%caff(c, :))) cycle
-      call gather(m, c, q, qd, qdd, x, qddl)
+      call gather(m, s, c, q, qd, qdd, x, qddl)
       si = merge(1, 0, m%bi(c) > 0); sj = merge(2, 0, m%bj(c) > 0)
       nr = m%nrow(c); r0 = m%row0(c) - 1
       do k = 1, s%np
         if (.not. s%caff(c, k)) cycle
         call con_eval_d(m%kind(c), m%suba(c), m%subb(c), m%p(m%po(c):m%po(c) + m%pn(c) - 1), &
-                        s%tp(m%po(c):m%po(c) + m%pn(c) - 1, k), si, sj, dual_state(x, z, z), &
+                        s%tp(m%po(c):m%po(c) + m%pn(c) - 1, k), si, sj, x, &
                         t, tphi, tjl, tnu, tgam)
         do r = 1, nr
-          s%phip(r0 + r, k) = tphi(r)
-          s%vp(r0 + r, k) = tnu(r) - dot_product(tjl(r, :), x%qd)
-          s%ap(r0 + r, k) = tgam(r) - dot_product(tjl(r, :), qddl)
+          s%phip(k, r0 + r) = tphi(r)
+          s%vp(k, r0 + r) = tnu(r) - dot_product(tjl(r, :), x%x%qd)
+          s%ap(k, r0 + r) = tgam(r) - dot_product(tjl(r, :), qddl)
         end do
       end do
     end do
@@ -292,22 +327,22 @@ contains
     real(wp), intent(in) :: t                  !! time
     real(wp), intent(out) :: tphi(:), tnu(:), tgam(:)  !! (neq)
     real(wp), intent(out) :: tjb(:, :, :)      !! (MAXROW, NLOC, nc)
-    type(kloc) :: x
-    real(wp) :: qddl(NLOC), tql(NLOC), tqdl(NLOC), ph(MAXROW), nv(MAXROW), ga(MAXROW)
+    type(dloc) :: x
+    real(wp) :: qddl(NLOC), ph(MAXROW), nv(MAXROW), ga(MAXROW)
     integer :: c, si, sj, r0, nr
     tjb = zero
     do c = 1, m%nc
-      call gather(m, c, q, qd, qd, x, qddl)
-      call gather_dir(c, tql, tqdl)
+      call gather(m, s, c, q, qd, qd, x, qddl)
+      call gather_dir(c, x%tq, x%tqd)
       si = merge(1, 0, m%bi(c) > 0); sj = merge(2, 0, m%bj(c) > 0)
       ph = zero; nv = zero; ga = zero
       if (k > 0) then
         call con_eval_d(m%kind(c), m%suba(c), m%subb(c), m%p(m%po(c):m%po(c) + m%pn(c) - 1), &
                         s%tp(m%po(c):m%po(c) + m%pn(c) - 1, k), si, sj, &
-                        dual_state(x, tql, tqdl), t, ph, tjb(:, :, c), nv, ga)
+                        x, t, ph, tjb(:, :, c), nv, ga)
       else
         call con_eval_d(m%kind(c), m%suba(c), m%subb(c), m%p(m%po(c):m%po(c) + m%pn(c) - 1), &
-                        s%zp(1:m%pn(c)), si, sj, dual_state(x, tql, tqdl), t, ph, &
+                        s%zp(1:m%pn(c)), si, sj, x, t, ph, &
                         tjb(:, :, c), nv, ga)
       end if
       r0 = m%row0(c) - 1; nr = m%nrow(c)
@@ -368,26 +403,58 @@ contains
     end do
   end subroutine block_apply_t
 
-  !> Right-hand sides of the three sensitivity equations of parameter k, given the solutions
-  !! of the levels before (level 1: -Phi_p; 2: nu_p - J_p q_dot - Hv s;
-  !! 3: gamma_p - J_p q_ddot - Ha s - 2 Hv s_dot). sens_hessian and sens_params first.
-  pure subroutine sens_kin_rhs(m, s, level, k, sq, sqd, rhs)
+  !> Y = B X for local blocks B in J's layout, X (nq, n), Y (neq, n): block_apply on n
+  !! columns at once.
+  pure subroutine block_apply_cols(m, b, x, y)
     type(model_t), intent(in) :: m           !! model
-    type(sens_t), intent(inout) :: s         !! blocks, parameter parts, work
+    real(wp), intent(in) :: b(:, :, :)       !! local blocks
+    real(wp), intent(in) :: x(:, :)          !! (nq, n)
+    real(wp), intent(inout) :: y(:, :)       !! (neq, n), added to
+    integer :: k, j, c, r, r0, i
+    do k = 1, m%nc
+      r0 = m%row0(k) - 1
+      do j = 1, NLOC
+        c = m%loc(j, k)
+        if (c == 0) cycle
+        do r = 1, m%nrow(k)
+          if (b(r, j, k) == zero) cycle
+          do i = 1, size(x, 2)
+            y(r0 + r, i) = y(r0 + r, i) + b(r, j, k) * x(c, i)
+          end do
+        end do
+      end do
+    end do
+  end subroutine block_apply_cols
+
+  !> Right-hand sides of the sensitivity equations of all parameters at one level, a row per
+  !! parameter (np, neq), given the solutions of the levels before: level 1 -Phi_p;
+  !! 2 nu_p - J_p q_dot - Hv s; 3 gamma_p - J_p q_ddot - Ha s - 2 Hv s_dot.
+  !! sens_hessian and sens_params first.
+  pure subroutine sens_kin_rhs(s, level, sq, sqd, rhs)
+    type(sens_t), intent(in) :: s            !! blocks and parameter parts
     integer, intent(in) :: level             !! 1 position, 2 velocity, 3 acceleration
-    integer, intent(in) :: k                 !! parameter
-    real(wp), intent(in) :: sq(:), sqd(:)    !! s and s_dot of parameter k (as known)
-    real(wp), intent(out) :: rhs(:)          !! (neq)
+    real(wp), intent(in) :: sq(:, :), sqd(:, :)  !! s and s_dot (nq, np), as far as known
+    real(wp), intent(inout) :: rhs(:, :)     !! (np or more, neq): rows 1 .. np written
+    integer :: i, n, r, c
     select case (level)
     case (1)
-      rhs = -s%phip(:, k)
+      rhs(1:s%np, :) = -s%phip
     case (2)
-      call block_apply(m, s%hv, sq, rhs)
-      rhs = s%vp(:, k) - rhs
+      rhs(1:s%np, :) = s%vp
+      do n = 1, s%nnz
+        r = s%nzr(n); c = s%nzc(n)
+        do i = 1, s%np
+          rhs(i, r) = rhs(i, r) - s%nzv(n) * sq(c, i)
+        end do
+      end do
     case default
-      call block_apply(m, s%ha, sq, rhs)
-      call block_apply(m, s%hv, sqd, s%work)
-      rhs = s%ap(:, k) - rhs - 2 * s%work
+      rhs(1:s%np, :) = s%ap
+      do n = 1, s%nnz
+        r = s%nzr(n); c = s%nzc(n)
+        do i = 1, s%np
+          rhs(i, r) = rhs(i, r) - s%nza(n) * sq(c, i) - 2 * s%nzv(n) * sqd(c, i)
+        end do
+      end do
     end select
   end subroutine sens_kin_rhs
 
@@ -430,17 +497,16 @@ contains
     real(wp), intent(in) :: lam(:)           !! multipliers (neq)
     real(wp), intent(out) :: y(:)            !! (nq)
     real(wp), intent(out) :: jpb(:, :, :)    !! (MAXROW, NLOC, nc)
-    type(kloc) :: x
+    type(dloc) :: x
     real(wp) :: qddl(NLOC), tphi(MAXROW), tnu(MAXROW), tgam(MAXROW)
-    real(wp), parameter :: z(NLOC) = zero
     integer :: c, si, sj
     jpb = zero
     do c = 1, m%nc
       if (.not. s%caff(c, k)) cycle
-      call gather(m, c, q, q * zero, q * zero, x, qddl)
+      call gather(m, s, c, q, q * zero, q * zero, x, qddl)
       si = merge(1, 0, m%bi(c) > 0); sj = merge(2, 0, m%bj(c) > 0)
       call con_eval_d(m%kind(c), m%suba(c), m%subb(c), m%p(m%po(c):m%po(c) + m%pn(c) - 1), &
-                      s%tp(m%po(c):m%po(c) + m%pn(c) - 1, k), si, sj, dual_state(x, z, z), t, &
+                      s%tp(m%po(c):m%po(c) + m%pn(c) - 1, k), si, sj, x, t, &
                       tphi, jpb(:, :, c), tnu, tgam)
     end do
     call block_apply_t(m, jpb, lam, y)
