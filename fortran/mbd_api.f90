@@ -23,7 +23,7 @@ module mbd_api
                             SOLVER_BANDED, kin_newton, kin_vel_acc
   use mbd_status, only: MBD_BAD_SETTING
   use mbd_profiles, only: profile_raw_length, profile_prepare, profile_eval
-  use mbd_sensitivity, only: sens_t, sens_setup, sens_eval_d
+  use mbd_sensitivity, only: sens_t, sens_setup, sens_eval_d, sens_trig
   use mbd_assemble, only: scatter_dense
   implicit none
   private
@@ -615,6 +615,7 @@ contains
     if (status /= MBD_OK) return
     k = size(ptab, 2)
     call asm_init(m, aw)
+    call sens_trig(m, sens, q)
     call sens_eval_d(m, sens, k, q, qd, dq, dqd, t, tphi, tnu, tgam, aw%jb)
     call scatter_dense(aw, tjac)
   end subroutine api_eval_d

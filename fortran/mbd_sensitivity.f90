@@ -317,7 +317,7 @@ contains
 
   !> Changes of Phi, nu, gamma (neq) and of the local J blocks (MAXROW, NLOC, nc) along a
   !! direction (dq, dq_dot) and parameter k (k = 0: none): every constraint evaluated on
-  !! dual numbers.
+  !! dual numbers. sens_trig first.
   pure subroutine sens_eval_d(m, s, k, q, qd, dq, dqd, t, tphi, tnu, tgam, tjb)
     type(model_t), intent(in) :: m             !! model
     type(sens_t), intent(in) :: s              !! parameters
