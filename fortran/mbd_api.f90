@@ -25,11 +25,12 @@ module mbd_api
   use mbd_profiles, only: profile_raw_length, profile_prepare, profile_eval
   use mbd_sensitivity, only: sens_t, sens_setup, sens_eval_d, sens_trig
   use mbd_assemble, only: scatter_dense
+  use mbd_sens_dynamics, only: sens_multipliers, sens_reactions, sens_statics
   implicit none
   private
   public :: NINFO, api_sizes, api_eval, api_kinematics, api_profile, api_analyze, api_kin_step
   public :: api_inverse, api_dynamics, api_statics, api_reactions
-  public :: api_eval_d
+  public :: api_eval_d, api_reactions_dp
 
   integer, parameter :: NINFO = 10   !! length of the report arrays
 
@@ -372,7 +373,7 @@ contains
   !! iinfo/rinfo as api_kinematics; iinfo(2) = -force index for a bad force.
   subroutine api_inverse(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, t0, t1, nsteps, tol, &
                          every, solver, qout, qdout, qddout, lamout, eout, iinfo, rinfo, qsing, &
-                         dep, redundant, tpass, status, msg)
+                         dep, redundant, tpass, status, msg, ptab, sq, sqd, sqdd, slam)
     integer, intent(in) :: nb, ctab(:, :), ftab(:, :), nsteps
     real(wp), intent(in) :: rpar(:), bmass(:, :), grav(2), fpar(:), q0(:), t0, t1, tol
     integer, intent(in) :: every                !! store every k-th output (and the last)
@@ -386,12 +387,20 @@ contains
     integer, intent(out) :: dep(:), redundant(:)
     integer, intent(out) :: status              !! MBD_OK, < 0 input, > 0 numerical
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    !> design parameters (2, np) and, with them, dq/dp, dq_dot/dp, dq_ddot/dp (nq, np, rows)
+    !! and dlambda/dp (neq, np, rows) at the outputs
+    integer, intent(in), optional :: ptab(:, :)
+    real(wp), intent(out), optional :: sq(:, :, :), sqd(:, :, :), sqdd(:, :, :), slam(:, :, :)
     type(model_t) :: m
     type(dyn_work_t) :: w
+    type(sens_t) :: sens
     integer :: bad, badf, k, st
     real(wp) :: t
     character(len=MSG_LEN) :: lmsg
     lamout = zero; eout = zero
+    if (present(ptab)) then
+      sq = zero; sqd = zero; sqdd = zero; slam = zero
+    end if
     call build_dynamic(nb, ctab, rpar, bmass, grav, ftab, fpar, m, status, msg, bad, badf)
     if (status /= MBD_OK) then
       qout = zero; qdout = zero; qddout = zero; iinfo = 0; rinfo = zero
@@ -399,8 +408,22 @@ contains
       qsing = zero; dep = 0; redundant = 0; tpass = zero
       return
     end if
-    call api_kinematics(nb, ctab, rpar, q0, t0, t1, nsteps, tol, 0, zero, every, solver, qout, &
-                        qdout, qddout, iinfo, rinfo, qsing, dep, redundant, tpass, status, msg)
+    if (present(ptab)) then
+      if (size(slam, 1) /= m%neq .or. any(shape(slam) /= [m%neq, shape(sq(1, :, :))])) then
+        status = MBD_BAD_COUNT; msg = 'sensitivity arrays do not match the model'; return
+      end if
+      call sens_setup(m, ctab, rpar, ptab, sens, status, msg, bad, ftab, fpar)
+      if (status /= MBD_OK) then
+        iinfo = 0; iinfo(2) = -2000000 - bad; return
+      end if
+      call api_kinematics(nb, ctab, rpar, q0, t0, t1, nsteps, tol, 0, zero, every, solver, &
+                          qout, qdout, qddout, iinfo, rinfo, qsing, dep, redundant, tpass, &
+                          status, msg, ptab, sq, sqd, sqdd)
+    else
+      call api_kinematics(nb, ctab, rpar, q0, t0, t1, nsteps, tol, 0, zero, every, solver, &
+                          qout, qdout, qddout, iinfo, rinfo, qsing, dep, redundant, tpass, &
+                          status, msg)
+    end if
     if (iinfo(1) < 1) return
     call dyn_init(m, w, qout(:, 1), t0, 1.0e-12_wp, st, lmsg)
     if (st /= MBD_OK) return
@@ -410,6 +433,10 @@ contains
       if (k == size(qout, 2)) t = t1
       call dyn_multipliers(m, w, qout(:, k), qdout(:, k), qddout(:, k), t, lamout(:, k), st, lmsg)
       call state_measures(m, w, qout(:, k), qdout(:, k), t, eout(:, k))
+      if (present(ptab)) call sens_multipliers(m, sens, qout(:, k), qdout(:, k), &
+                                               qddout(:, k), t, lamout(:, k), sq(:, :, k), &
+                                               sqd(:, :, k), sqdd(:, :, k), slam(:, :, k), st, &
+                                               lmsg)
     end do
   end subroutine api_inverse
 
@@ -511,13 +538,18 @@ contains
   !> Static equilibrium near the assembled q0 at time t, its multipliers and stability
   !! (1 stable, 0 unstable, -1 neutral, 2 no free motion).
   subroutine api_statics(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, t, q, lam, stable, resid, &
-                         iinfo, status, msg)
+                         iinfo, status, msg, ptab, sq, slam)
     integer, intent(in) :: nb, ctab(:, :), ftab(:, :)
     real(wp), intent(in) :: rpar(:), bmass(:, :), grav(2), fpar(:), q0(:), t
     real(wp), intent(out) :: q(:), lam(:), resid
     integer, intent(out) :: stable, iinfo(NINFO)
     integer, intent(out) :: status              !! MBD_OK, < 0 input, > 0 numerical
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    !> design parameters (2, np) and, with them, dq/dp (nq, np) and dlambda/dp (neq, np) at
+    !! the equilibrium
+    integer, intent(in), optional :: ptab(:, :)
+    real(wp), intent(out), optional :: sq(:, :), slam(:, :)
+    type(sens_t) :: sens
     type(model_t) :: m
     type(dyn_work_t) :: w
     type(kin_work_t) :: kw
@@ -544,7 +576,20 @@ contains
     if (status /= MBD_OK) return
     call dyn_init(m, w, q, t, kw%tol, status, msg)
     if (status /= MBD_OK) return
+    if (present(ptab)) then
+      sq = zero; slam = zero
+      if (any(shape(sq) /= [m%nq, size(ptab, 2)]) .or. &
+          any(shape(slam) /= [m%neq, size(ptab, 2)])) then
+        status = MBD_BAD_COUNT; msg = 'sensitivity arrays do not match the model'; return
+      end if
+      call sens_setup(m, ctab, rpar, ptab, sens, status, msg, bad, ftab, fpar)
+      if (status /= MBD_OK) then
+        iinfo(2) = -2000000 - bad; return
+      end if
+    end if
     call statics_solve(m, w, q, t, lam, stable, resid, status, msg)
+    if (status /= MBD_OK .or. .not. present(ptab)) return
+    call sens_statics(m, sens, w%rows, q, t, lam, sq, slam, status, msg)
   end subroutine api_statics
 
   !> Reactions of every constraint at many states: reac(6, nc, nt) global
@@ -619,5 +664,40 @@ contains
     call sens_eval_d(m, sens, k, q, qd, dq, dqd, t, tphi, tnu, tgam, aw%jb)
     call scatter_dense(aw, tjac)
   end subroutine api_eval_d
+
+  !> Changes of the reactions (as api_reactions) along design parameters at many states:
+  !! dreac, drloc (6, nc, np, nt), from dq/dp (nq, np, nt) and dlambda/dp (neq, np, nt).
+  subroutine api_reactions_dp(nb, ctab, rpar, ptab, q, t, lam, sq, slam, dreac, drloc, status, &
+                              msg)
+    integer, intent(in) :: nb, ctab(:, :)
+    real(wp), intent(in) :: rpar(:)
+    integer, intent(in) :: ptab(:, :)
+    real(wp), intent(in) :: q(:, :), t(:), lam(:, :), sq(:, :, :), slam(:, :, :)
+    real(wp), intent(out) :: dreac(:, :, :, :), drloc(:, :, :, :)
+    integer, intent(out) :: status              !! MBD_OK or < 0
+    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    type(model_t) :: m
+    type(sens_t) :: sens
+    integer :: bad, k
+    dreac = zero; drloc = zero
+    call model_build(nb, ctab, rpar, m, status, msg, bad)
+    if (status /= MBD_OK) return
+    if (.not. (finite(q) .and. finite(t) .and. finite(lam))) then
+      call not_finite('q, t and lambda', status, msg); return
+    end if
+    if (size(q, 1) /= m%nq .or. size(lam, 1) /= m%neq .or. size(q, 2) /= size(t) .or. &
+        size(lam, 2) /= size(t) .or. any(shape(sq) /= [m%nq, size(ptab, 2), size(t)]) .or. &
+        any(shape(slam) /= [m%neq, size(ptab, 2), size(t)]) .or. &
+        any(shape(dreac) /= [6, m%nc, size(ptab, 2), size(t)]) .or. &
+        any(shape(drloc) /= shape(dreac))) then
+      status = MBD_BAD_COUNT; msg = 'array sizes do not match the model'; return
+    end if
+    call sens_setup(m, ctab, rpar, ptab, sens, status, msg, bad)
+    if (status /= MBD_OK) return
+    do k = 1, size(t)
+      call sens_reactions(m, sens, q(:, k), t(k), lam(:, k), sq(:, :, k), slam(:, :, k), &
+                          dreac(:, :, :, k), drloc(:, :, :, k))
+    end do
+  end subroutine api_reactions_dp
 
 end module mbd_api

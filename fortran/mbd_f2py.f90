@@ -223,3 +223,60 @@ subroutine core_kinematics_sens(nb, nc, ctab, np, rpar, nq, neq, q0, t0, t1, nst
                       qout, qdout, qddout, iinfo, rinfo, qsing, dep, redundant, tpass, &
                       status, msg, ptab, sq, sqd, sqdd)
 end subroutine core_kinematics_sens
+
+subroutine core_inverse_sens(nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp, fpar, nq, neq, &
+                             q0, t0, t1, nsteps, tol, every, solver, nout, npar, ptab, qout, &
+                             qdout, qddout, lamout, eout, sq, sqd, sqdd, slam, iinfo, rinfo, &
+                             qsing, dep, redundant, tpass, status, msg)
+  use iso_c_binding, only: c_double, c_int
+  use mbd_api, only: api_inverse
+  implicit none
+  integer(c_int), intent(in) :: nb, nc, np, nf, nfp, nq, neq, nsteps, every, solver, nout, npar
+  integer(c_int), intent(in) :: ctab(8, nc), ftab(6, nf), ptab(2, npar)
+  real(c_double), intent(in) :: rpar(np), bmass(2, nb), grav(2), fpar(nfp), q0(nq), t0, t1, tol
+  real(c_double), intent(out) :: qout(nq, nout), qdout(nq, nout)
+  real(c_double), intent(out) :: qddout(nq, nout), lamout(neq, nout)
+  real(c_double), intent(out) :: eout(4, nout)
+  real(c_double), intent(out) :: sq(nq, npar, nout), sqd(nq, npar, nout), sqdd(nq, npar, nout)
+  real(c_double), intent(out) :: slam(neq, npar, nout)
+  integer(c_int), intent(out) :: iinfo(10), dep(neq), redundant(neq), status
+  real(c_double), intent(out) :: rinfo(10), qsing(nq), tpass(64)
+  character(len=512), intent(out) :: msg
+  !f2py intent(hide) :: nc, np, nf, nfp, nq, npar
+  call api_inverse(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, t0, t1, nsteps, tol, every, &
+                   solver, qout, qdout, qddout, lamout, eout, iinfo, rinfo, qsing, dep, &
+                   redundant, tpass, status, msg, ptab, sq, sqd, sqdd, slam)
+end subroutine core_inverse_sens
+
+subroutine core_statics_sens(nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp, fpar, nq, neq, &
+                             q0, t, npar, ptab, q, lam, sq, slam, stable, resid, iinfo, status, &
+                             msg)
+  use iso_c_binding, only: c_double, c_int
+  use mbd_api, only: api_statics
+  implicit none
+  integer(c_int), intent(in) :: nb, nc, np, nf, nfp, nq, neq, npar
+  integer(c_int), intent(in) :: ctab(8, nc), ftab(6, nf), ptab(2, npar)
+  real(c_double), intent(in) :: rpar(np), bmass(2, nb), grav(2), fpar(nfp), q0(nq), t
+  real(c_double), intent(out) :: q(nq), lam(neq), sq(nq, npar), slam(neq, npar), resid
+  integer(c_int), intent(out) :: stable, iinfo(10), status
+  character(len=512), intent(out) :: msg
+  !f2py intent(hide) :: nc, np, nf, nfp, nq, npar
+  call api_statics(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, t, q, lam, stable, resid, &
+                   iinfo, status, msg, ptab, sq, slam)
+end subroutine core_statics_sens
+
+subroutine core_reactions_dp(nb, nc, ctab, np, rpar, nq, neq, nt, npar, ptab, q, t, lam, sq, &
+                             slam, dreac, drloc, status, msg)
+  use iso_c_binding, only: c_double, c_int
+  use mbd_api, only: api_reactions_dp
+  implicit none
+  integer(c_int), intent(in) :: nb, nc, np, nq, neq, nt, npar
+  integer(c_int), intent(in) :: ctab(8, nc), ptab(2, npar)
+  real(c_double), intent(in) :: rpar(np), q(nq, nt), t(nt), lam(neq, nt)
+  real(c_double), intent(in) :: sq(nq, npar, nt), slam(neq, npar, nt)
+  real(c_double), intent(out) :: dreac(6, nc, npar, nt), drloc(6, nc, npar, nt)
+  integer(c_int), intent(out) :: status
+  character(len=512), intent(out) :: msg
+  !f2py intent(hide) :: nc, np, nq, neq, nt, npar
+  call api_reactions_dp(nb, ctab, rpar, ptab, q, t, lam, sq, slam, dreac, drloc, status, msg)
+end subroutine core_reactions_dp

@@ -5,7 +5,9 @@
 !! (flattened (2, nb): mass of body b at 2 b - 1, inertia at 2 b), 3 grav (1 x, 2 y), 4 fpar
 !! (a force's raw parameter). sens_setup turns each into the change of the prepared
 !! parameter pools (the chain rule through each joint's prepare: axis normalisation, spline
-!! coefficients, ...), of the mass matrix and of gravity.
+!! coefficients, ...), of the mass matrix and of gravity. Masses, gravity and forces do not
+!! enter the kinematics: without dynamics data their columns are zero (and force indices are
+!! checked only with the force table).
 !!
 !! Differentiating Phi(q, t; p) = 0, J q_dot = nu and J q_ddot = gamma along a motion gives,
 !! with s = dq/dp (Haug, Computer-Aided Kinematics and Dynamics, sec. 6.5):
@@ -137,9 +139,6 @@ contains
           end do
         end if
       case (PT_MASS)
-        if (.not. allocated(m%mdiag)) then
-          call fail('masses need a model with dynamics data'); return
-        end if
         if (i < 1 .or. i > 2 * m%nb) then
           call fail('mass table index out of range'); return
         end if
@@ -155,9 +154,7 @@ contains
         end if
         s%tgrav(i, k) = one
       case (PT_FPAR)
-        if (.not. dyn) then
-          call fail('force parameters need a model with dynamics data'); return
-        end if
+        if (.not. dyn) cycle            ! no forces in a kinematic model: no change
         if (i < 1 .or. i > size(fpar)) then
           call fail('force parameter index out of range'); return
         end if
