@@ -10,7 +10,8 @@
 module mbd_api
   use mbd_kinds, only: wp, zero, one
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
-  use mbd_status, only: MBD_OK, MBD_BAD_COUNT, MBD_BAD_PARAM, MBD_INCONSISTENT, MSG_LEN
+  use mbd_status, only: MBD_OK, MBD_BAD_COUNT, MBD_BAD_PARAM, MBD_INCONSISTENT, MBD_NO_MEMORY, &
+                        MSG_LEN
   use mbd_points, only: NLOC, MAXROW
   use mbd_model, only: model_t, model_build, model_add_dynamics
   use mbd_dynamics, only: dyn_work_t, dyn_init, dyn_velocity, dyn_multipliers, dyn_reactions, &
@@ -25,12 +26,13 @@ module mbd_api
   use mbd_profiles, only: profile_raw_length, profile_prepare, profile_eval
   use mbd_sensitivity, only: sens_t, sens_setup, sens_eval_d, sens_trig
   use mbd_assemble, only: scatter_dense
-  use mbd_sens_dynamics, only: sens_multipliers, sens_reactions, sens_statics
+  use mbd_sens_dynamics, only: sens_multipliers, sens_reactions, sens_statics, sens_dopri5, &
+                               sens_initial
   implicit none
   private
   public :: NINFO, api_sizes, api_eval, api_kinematics, api_profile, api_analyze, api_kin_step
   public :: api_inverse, api_dynamics, api_statics, api_reactions
-  public :: api_eval_d, api_reactions_dp
+  public :: api_eval_d, api_reactions_dp, api_dynamics_sens
 
   integer, parameter :: NINFO = 10   !! length of the report arrays
 
@@ -699,5 +701,104 @@ contains
                           dreac(:, :, :, k), drloc(:, :, :, k))
     end do
   end subroutine api_reactions_dp
+
+  !> Forward dynamics by dopri5 with design sensitivities (mbd_sens_dynamics): as
+  !! api_dynamics (method dopri5; iinfo 1 outputs, 2 bad entry, 3 steps, 4 rejected, 6
+  !! right-hand sides, 9 active rows; rinfo 1 failure time, 2 and 3 smallest and largest step)
+  !! plus sq, sqd, sqdd (nq, np, rows), the sensitivities of q, q_dot and q_ddot.
+  subroutine api_dynamics_sens(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, v0, t0, t1, &
+                               nsteps, rtol, atol, every, max_steps, ptab, qout, qdout, qddout, &
+                               lamout, eout, sq, sqd, sqdd, iinfo, rinfo, redundant, status, msg)
+    integer, intent(in) :: nb, ctab(:, :), ftab(:, :), nsteps, every, max_steps
+    real(wp), intent(in) :: rpar(:), bmass(:, :), grav(2), fpar(:), q0(:), v0(:), t0, t1
+    real(wp), intent(in) :: rtol, atol          !! tolerances (<= 0: defaults 1e-6, 1e-8)
+    integer, intent(in) :: ptab(:, :)           !! design parameters (2, np)
+    real(wp), intent(out) :: qout(:, :), qdout(:, :), qddout(:, :)  !! (nq, rows)
+    real(wp), intent(out) :: lamout(:, :)       !! (neq, rows)
+    real(wp), intent(out) :: eout(:, :)         !! (4, rows) energies, drift
+    real(wp), intent(out) :: sq(:, :, :), sqd(:, :, :), sqdd(:, :, :)  !! (nq, np, rows)
+    integer, intent(out) :: iinfo(NINFO)
+    real(wp), intent(out) :: rinfo(NINFO)
+    integer, intent(out) :: redundant(:)
+    integer, intent(out) :: status              !! MBD_OK, < 0 input, > 0 numerical
+    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    type(model_t) :: m
+    type(dyn_work_t) :: w
+    type(kin_work_t) :: kw
+    type(kin_opts_t) :: kopts
+    type(kin_report_t) :: rep
+    type(sens_t) :: sens
+    real(wp), allocatable :: q(:), qd(:), s0(:, :), sd0(:, :)
+    real(wp) :: t, r_tol, a_tol, hmm(2), tfail
+    integer :: bad, badf, k, ko, nout, st, stats(3)
+    character(len=MSG_LEN) :: lmsg
+    iinfo = 0; rinfo = zero; redundant = 0
+    qout = zero; qdout = zero; qddout = zero; lamout = zero; eout = zero
+    sq = zero; sqd = zero; sqdd = zero
+    call build_dynamic(nb, ctab, rpar, bmass, grav, ftab, fpar, m, status, msg, bad, badf)
+    iinfo(2) = bad; if (badf /= 0) iinfo(2) = -1000000 - badf
+    if (status /= MBD_OK) return
+    if (.not. (finite(q0) .and. finite(v0) .and. finite(t0) .and. finite(t1) .and. &
+               finite([rtol, atol]))) then
+      call not_finite('q0, v0, the times and the settings', status, msg); return
+    end if
+    if (nsteps < 0 .or. .not. (t1 > t0) .or. every < 1 .or. max_steps < 1) then
+      status = MBD_BAD_SETTING
+      msg = 'steps must be >= 0, every >= 1, max_steps >= 1 and t_end > t0'; return
+    end if
+    if (size(q0) /= m%nq .or. size(v0) /= m%nq .or. size(qout, 1) /= m%nq .or. &
+        size(qout, 2) /= output_rows(nsteps, every) .or. size(lamout, 1) /= m%neq .or. &
+        size(redundant) /= m%neq .or. &
+        any(shape(sq) /= [m%nq, size(ptab, 2), size(qout, 2)]) .or. &
+        any(shape(sqd) /= shape(sq)) .or. any(shape(sqdd) /= shape(sq))) then
+      status = MBD_BAD_COUNT; msg = 'array sizes do not match the model'; return
+    end if
+    call sens_setup(m, ctab, rpar, ptab, sens, status, msg, bad, ftab, fpar)
+    if (status /= MBD_OK) then
+      iinfo(2) = -2000000 - bad; return
+    end if
+    call kin_work_init(m, kw)
+    kw%tol = kopts%tol * m%lscale
+    allocate (q(m%nq), qd(m%nq), rep%qsing(m%nq), rep%dep(m%neq), rep%redundant(m%neq), &
+              s0(m%nq, sens%np), sd0(m%nq, sens%np), stat=st)
+    if (st /= 0) then
+      status = MBD_NO_MEMORY; msg = 'out of memory'; return
+    end if
+    q = q0
+    call kin_assemble(m, kw, q, t0, kopts, rep, status, msg)
+    if (status /= MBD_OK) then
+      rinfo(1) = t0; return
+    end if
+    call dyn_init(m, w, q, t0, kw%tol, status, msg)
+    if (status /= MBD_OK) return
+    iinfo(9) = w%na
+    do k = 1, m%neq
+      if (.not. any(w%rows == k)) redundant(k) = 1
+    end do
+    call dyn_velocity(m, w, q, t0, v0, qd, status)
+    if (status /= MBD_OK) then
+      msg = 'the initial velocities cannot be made consistent: the mass matrix is singular '// &
+            'on the motions the constraints allow (a body without mass or inertia?)'
+      return
+    end if
+    call sens_initial(m, w, sens, q, qd, t0, s0, sd0, status, msg)
+    if (status /= MBD_OK) return
+    r_tol = 1.0e-6_wp; a_tol = 1.0e-8_wp
+    if (rtol > zero) r_tol = rtol
+    if (atol > zero) a_tol = atol
+    call sens_dopri5(m, w, sens, q, qd, s0, sd0, t0, t1, nsteps, every, r_tol, a_tol, &
+                     max_steps, qout, qdout, qddout, sq, sqd, sqdd, nout, stats, hmm, tfail, &
+                     status, msg)
+    iinfo(1) = nout; iinfo(3) = stats(1); iinfo(4) = stats(2); iinfo(6) = stats(3)
+    rinfo(2) = hmm(1); rinfo(3) = hmm(2)
+    if (status /= MBD_OK) rinfo(1) = tfail
+    do k = 1, nout
+      ko = output_index(nsteps, every, k)
+      t = t0 + (t1 - t0) * (real(ko, wp) / max(nsteps, 1))
+      if (ko == nsteps) t = t1
+      call dyn_multipliers(m, w, qout(:, k), qdout(:, k), qddout(:, k), t, lamout(:, k), st, lmsg)
+      call state_measures(m, w, qout(:, k), qdout(:, k), t, eout(:, k))
+    end do
+  end subroutine api_dynamics_sens
 
 end module mbd_api
