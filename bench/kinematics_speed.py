@@ -26,7 +26,7 @@ from typing import Any
 
 import mbd2d
 from mbd2d import _core
-from mbd2d.pack import pack
+from mbd2d.binding.pack import pack
 
 BENCH = Path(__file__).resolve().parent
 EX = BENCH.parent / "examples"

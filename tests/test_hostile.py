@@ -49,8 +49,9 @@ from hypothesis import strategies as st
 
 import mbd2d
 from mbd2d import _core
-from mbd2d.pack import pack
-from mbd2d.toml_io import from_dict
+from mbd2d.binding.pack import pack
+from mbd2d.description.joints import joint_keys
+from mbd2d.model import from_dict
 
 ROOT = Path(__file__).resolve().parent.parent
 EXAMPLES = ROOT / "examples"
@@ -592,9 +593,9 @@ BASE: dict[str, dict[str, Any]] = {k: tomllib.loads(v) for k, v in BASE_TEXT.ite
 BASE_NAMES = sorted(BASE)
 
 SECTIONS = ("body", "joint", "driver", "force")
-JOINT_TYPES = sorted(mbd2d.joints.joint_keys())
+JOINT_TYPES = sorted(joint_keys())
 DRIVER_TYPES = ["absolute", "relative-angle", "relative-distance"]
-ALL_KEYS = sorted({k for a, _ in mbd2d.joints.joint_keys().values() for k in a}
+ALL_KEYS = sorted({k for a, _ in joint_keys().values() for k in a}
                   | {"name", "type", "q0", "mass", "inertia", "v0", "body", "coordinate",
                      "bodies", "joint", "f", "gravity", "poly", "harmonic", "amplitude",
                      "omega", "phase", "circle", "spline", "fourier", "center", "radius",
@@ -1660,7 +1661,7 @@ def builder_call(draw: Any) -> tuple[str, dict[str, Any]]:
     elif method == "add_joint":
         jtype = draw(_maybe(st.sampled_from(JOINT_TYPES)))
         kw["type"] = jtype
-        allowed = sorted(mbd2d.joints.joint_keys().get(jtype, ({"bodies"}, set()))[0]
+        allowed = sorted(joint_keys().get(jtype, ({"bodies"}, set()))[0]
                          if isinstance(jtype, str) else {"bodies"})
         keys = draw(st.lists(st.sampled_from(allowed + ["colour", "axes", "q0", "mass"]),
                              unique=True, min_size=0, max_size=len(allowed) + 1))

@@ -10,17 +10,16 @@ Examples
 """
 from __future__ import annotations
 
-from .analysis import DofReport
+from .analysis.stepping import KinematicStepper
+from .description.functions import Harmonic, TimeFunction
 from .errors import (AnalysisError, AssemblyError, ConvergenceError, CoreError,
                      InconsistentConstraintsError, IntegrationError, MbdError, MbdWarning,
                      ModelError,
                      RedundantConstraintWarning, SingularConfigurationError,
                      SingularJacobianError, SingularPassageWarning, ToggleError)
-from .functions import Harmonic, TimeFunction
-from .model import Model
-from .stepping import KinematicStepper
-from .results import BodyResult, DynamicsResult, KinematicsResult, Reaction, StaticsResult
-from .toml_io import load, loads
+from .model import Model, load, loads
+from .results import (BodyResult, DofReport, DynamicsResult, KinematicsResult, Reaction,
+                      StaticsResult)
 
 __version__ = "0.1.0"
 

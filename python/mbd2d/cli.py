@@ -14,14 +14,11 @@ from __future__ import annotations
 import argparse
 import sys
 import textwrap
-from typing import TYPE_CHECKING, Sequence
+from typing import Sequence
 
 from .errors import AnalysisError, MbdError, ModelError, SingularConfigurationError
-from .toml_io import load
-
-if TYPE_CHECKING:  # pragma: no cover
-    from .model import Model
-    from .results import StaticsResult
+from .model import Model, load
+from .results import StaticsResult
 
 EXIT_OK, EXIT_INPUT, EXIT_SINGULAR, EXIT_NUMERICAL = 0, 2, 3, 4
 
@@ -76,7 +73,7 @@ def _say(text: str) -> None:
     print(textwrap.fill(text, width=100), file=sys.stderr)
 
 
-def _statics_report(model: "Model", st: "StaticsResult") -> str:
+def _statics_report(model: Model, st: StaticsResult) -> str:
     """The equilibrium, its stability and the reactions, as text."""
     lines = [f"equilibrium of '{model.name}' at t = {st.t:g}: {st.stability}"]
     for name in st.body_names:

@@ -6,10 +6,7 @@ Every failure the engine knows of maps to one class here. Input mistakes raise
 """
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
-
-if TYPE_CHECKING:  # pragma: no cover
-    from .results import KinematicsResult
+from typing import Any
 
 
 class MbdError(Exception):
@@ -40,13 +37,14 @@ class AnalysisError(MbdError):
     t : float or None
         Time of the failure.
     results : KinematicsResult or None
-        The rows computed before the failure (possibly only t0, or none).
+        The rows computed before the failure (possibly only t0, or none). (Typed ``Any``
+        here: errors are the lowest layer and know no result class.)
     status : int
         The core's status code.
     """
 
     def __init__(self, message: str, *, t: float | None = None,
-                 results: "KinematicsResult | None" = None, status: int = 0,
+                 results: Any = None, status: int = 0,
                  **details: Any) -> None:
         super().__init__(message)
         self.t = t

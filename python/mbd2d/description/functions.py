@@ -7,8 +7,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any, Mapping, Sequence
 
-from .errors import ModelError
-from .validate import as_list, is_number, number
+from ..errors import ModelError
+from ..validate import as_list, is_number, number
 
 
 @dataclass(frozen=True)

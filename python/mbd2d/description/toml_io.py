@@ -7,33 +7,39 @@
     [[force]]          name, type, bodies, body, points, point, stiffness, damping, length0,
                        angle0, f, fx, fy
 
-Every key goes through the builder methods of :class:`mbd2d.model.Model`, so a TOML model
-and a model built in code are checked the same way.
+Every key goes through the builder methods of
+:class:`~mbd2d.description.builder.ModelDescription`, so a TOML model and a model built in code
+are checked the same way. The functions here build any subclass of it (``cls``);
+:func:`mbd2d.load` and :func:`mbd2d.loads` build the analysable :class:`mbd2d.Model`.
 """
 from __future__ import annotations
 
 import tomllib
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any, Mapping, TypeVar
 
-from .errors import ModelError
-from .model import Model
-from .validate import only_keys, table
+from ..errors import ModelError
+from ..validate import only_keys, table
+from .builder import ModelDescription
+
+M = TypeVar("M", bound=ModelDescription)
 
 SECTIONS = {"model", "body", "joint", "driver", "force"}
 
 
-def load(path: str | Path) -> Model:
+def load(path: str | Path, cls: type[M] = ModelDescription) -> M:  # type: ignore[assignment]
     """Read a model from a TOML file.
 
     Parameters
     ----------
     path : str or Path
         The .toml file.
+    cls : type
+        The class to build (a subclass of ModelDescription).
 
     Returns
     -------
-    Model
+    cls instance
 
     Raises
     ------
@@ -43,9 +49,8 @@ def load(path: str | Path) -> Model:
 
     Examples
     --------
-    >>> import mbd2d
-    >>> mbd2d.load("examples/fourbar_seed.toml")
-    Model('seed-four-bar': 3 bodies, 4 joints, 1 drivers)
+    >>> load("examples/fourbar_seed.toml")
+    ModelDescription('seed-four-bar': 3 bodies, 4 joints, 1 drivers)
     """
     p = Path(path)
     try:
@@ -55,16 +60,17 @@ def load(path: str | Path) -> Model:
     except UnicodeDecodeError as exc:
         raise ModelError(f"the model file is not UTF-8 text (byte {exc.start}); save it as "
                          "UTF-8", str(p)) from None
-    return loads(text, source=str(p))
+    return loads(text, source=str(p), cls=cls)
 
 
-def loads(text: str, source: str = "<string>") -> Model:
+def loads(text: str, source: str = "<string>",
+          cls: type[M] = ModelDescription) -> M:  # type: ignore[assignment]
     """Read a model from TOML text; see :func:`load`."""
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ModelError(f"not valid TOML: {exc}", source) from None
-    return from_dict(data, source)
+    return from_dict(data, source, cls=cls)
 
 
 def _entries(data: Mapping[str, Any], key: str, source: str) -> list[Mapping[str, Any]]:
@@ -82,8 +88,9 @@ def _named(entry: Any) -> str:
     return f" {name!r}" if isinstance(name, str) else ""
 
 
-def from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Model:
-    """Build a model from parsed TOML (nested dicts and lists)."""
+def from_dict(data: Mapping[str, Any], source: str = "<dict>",
+              cls: type[M] = ModelDescription) -> M:  # type: ignore[assignment]
+    """Build a model of class ``cls`` from parsed TOML (nested dicts and lists)."""
     if not isinstance(data, Mapping):
         raise ModelError("a model must be a table", source)
     if any(not isinstance(k, str) for k in data):
@@ -99,7 +106,7 @@ def from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Model:
         raise ModelError(f"name must be a string, got {name!r}", "[model]")
     if isinstance(head.get("gravity"), (str, bytes)):
         raise ModelError("gravity must be a list of 2 numbers", "[model]")
-    model = Model(name, head.get("gravity", (0.0, -9.81)))
+    model = cls(name, head.get("gravity", (0.0, -9.81)))
     for i, b in enumerate(_entries(data, "body", source)):
         entry = f"[[body]] #{i + 1}" + _named(b)
         b = table(b, "[[body]]", entry)

@@ -1,50 +1,16 @@
-"""Packing a model into the flat tables the Fortran core reads (see mbd_model.f90)."""
+"""Packing a model description into the flat tables the Fortran core reads (see
+``fortran/mbd_model.f90``)."""
 from __future__ import annotations
-
-from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
 
 import numpy as np
 
-from . import _core
-from .errors import ModelError
-
-if TYPE_CHECKING:  # pragma: no cover
-    from .model import Model
-
-NCT = 8  # rows of the constraint table
+from ..description.builder import ModelDescription
+from ..errors import ModelError
+from . import core
+from .tables import NCT, NFT, DynamicTables, Packed, decode
 
 
-@dataclass
-class Packed:
-    """A model as flat tables, with the names that go with them."""
-
-    nb: int
-    ctab: np.ndarray            # int32 (NCT, nc), Fortran order
-    rpar: np.ndarray            # float64
-    q0: np.ndarray              # float64 (nq,), extras zero (the core estimates them)
-    nq: int
-    neq: int
-    body_names: list[str]
-    constraint_names: list[str]
-    driver_flags: list[bool]
-    coordinate_names: list[str]
-    row_owner: list[int] = field(default_factory=list)   # constraint index of each row
-    row_labels: list[str] = field(default_factory=list)
-
-    @property
-    def nc(self) -> int:
-        return self.ctab.shape[1]
-
-
-def decode(raw: bytes | str) -> str:
-    """A Fortran message as text."""
-    if isinstance(raw, bytes):
-        raw = raw.decode("utf-8", "replace")
-    return raw.strip()
-
-
-def pack(model: "Model") -> Packed:
+def pack(model: ModelDescription) -> Packed:
     """Flat tables of a model, checked by the core.
 
     Constants left open (the phase of a gear, rack or rolling disc) are set so that their
@@ -74,10 +40,11 @@ def pack(model: "Model") -> Packed:
         rpar.extend(params)
     ctab = np.asfortranarray(np.array(cols, dtype=np.int32).T)
     rp = np.array(rpar if rpar else [0.0], dtype=np.float64)
-    nq, neq, status, msg, bad = _core.core_sizes(len(model.bodies), ctab, rp)
-    if status != 0:
+    out = core.sizes(len(model.bodies), ctab, rp)
+    nq, neq, bad = int(out.nq), int(out.neq), int(out.bad)
+    if out.status != 0:
         entry = cons[bad - 1].describe() if bad > 0 else "model"
-        raise ModelError(decode(msg), entry)
+        raise ModelError(out.msg, entry)
     q0 = np.zeros(nq)
     q0[:3 * len(model.bodies)] = np.array([b.q0 for b in model.bodies], dtype=float).ravel()
     rows = [0]
@@ -86,14 +53,46 @@ def pack(model: "Model") -> Packed:
     open_phase = [k for k, c in enumerate(cons)
                   if c.phase_row is not None and getattr(c, "phase", 0.0) is None]
     if open_phase:
-        phi = _core.core_eval(len(model.bodies), ctab, rp, neq, q0, np.zeros(nq), 0.0)[0]
+        phi = core.evaluate(len(model.bodies), ctab, rp, neq, q0, np.zeros(nq), 0.0).phi
         for k in open_phase:
             # the phase is the last raw parameter; Phi = g(q0) - 0 gives it
             rp[ctab[5, k] - 1 + ctab[6, k] - 1] = phi[rows[k] + cons[k].phase_row]
-    names = [f"{b.name}.{s}" for b in model.bodies for s in ("x", "y", "theta")]
-    names += [n for c in cons for n in c.extra_names()]
+    names = model.coordinate_names
     owner = [k for k, c in enumerate(cons) for _ in range(c.nrow)]
     labels = [r for c in cons for r in c.rows()]
-    return Packed(len(model.bodies), ctab, rp, q0, int(nq), int(neq),
+    return Packed(len(model.bodies), ctab, rp, q0, nq, neq,
                   [b.name for b in model.bodies], [c.name for c in cons],
                   [c.is_driver for c in cons], names, owner, labels)
+
+
+def pack_dynamics(model: ModelDescription, p: Packed) -> DynamicTables:
+    """Masses (2, nb), gravity, the force table (NFT, nf), force parameters and v0 (nq).
+
+    Raises
+    ------
+    ModelError
+        If a body has no mass or inertia.
+    """
+    bmass = np.zeros((2, len(model.bodies)), order="F")
+    for i, b in enumerate(model.bodies):
+        if b.mass is None or b.inertia is None:
+            raise ModelError("dynamics needs 'mass' and 'inertia' for every body (inertia about "
+                             "the centre of mass; 0 for a point mass)", f"body '{b.name}'")
+        bmass[:, i] = (b.mass, b.inertia)
+    body_idx = {b.name: i + 1 for i, b in enumerate(model.bodies)}
+    body_idx["ground"] = 0
+    cols: list[list[int]] = []
+    fpar: list[float] = []
+    for f in model.forces:
+        raw = f.raw()
+        cols.append([f.kind, body_idx[f.bodies[0]], body_idx[f.bodies[1]], len(fpar) + 1,
+                     len(raw), 0])
+        fpar.extend(raw)
+    ftab = np.asfortranarray(np.array(cols, dtype=np.int32).reshape(-1, NFT).T)
+    fp = np.array(fpar if fpar else [0.0])
+    v0 = np.zeros(p.nq)
+    v0[:3 * p.nb] = np.array([b.v0 for b in model.bodies], dtype=float).ravel()
+    return DynamicTables(bmass, np.asarray(model.gravity, dtype=float), ftab, fp, v0)
+
+
+__all__ = ["NCT", "Packed", "DynamicTables", "decode", "pack", "pack_dynamics"]

@@ -7,13 +7,11 @@ round-trips exactly and ``mbd2d-solve`` reproduces the Python results.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING
 
-from .analysis import check_solver, check_span, require_determined
-from .pack import NCT, pack
-
-if TYPE_CHECKING:  # pragma: no cover
-    from .model import Model
+from ..binding.pack import pack
+from ..binding.tables import NCT
+from ..description.builder import ModelDescription
+from .settings import check_solver, check_span, require_determined
 
 HEADER = """\
 # mbd2d model file, format 1 (written by `mbd2d export`; run with `mbd2d-solve FILE OUT.csv`)
@@ -48,7 +46,7 @@ def _r(x: float) -> str:
     return f"{x:.17e}"
 
 
-def export(model: "Model", path: str | Path, t_end: float, steps: int, t0: float = 0.0,
+def export(model: ModelDescription, path: str | Path, t_end: float, steps: int, t0: float = 0.0,
            tol: float | None = None, maxit: int | None = None) -> None:
     """Write a model file for ``mbd2d-solve``.
 

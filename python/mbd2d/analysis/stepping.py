@@ -2,18 +2,14 @@
 drivers, interactive tools). Each :meth:`KinematicStepper.step` is one call into the core."""
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 import numpy as np
 
-from . import _core
-from .analysis import check_solver, require_determined
-from .errors import AssemblyError, ConvergenceError, ModelError
-from .pack import decode, pack
-from .validate import number
-
-if TYPE_CHECKING:  # pragma: no cover
-    from .model import Model
+from ..binding import core
+from ..binding.pack import pack
+from ..description.builder import ModelDescription
+from ..errors import AssemblyError, ConvergenceError, ModelError
+from ..validate import number
+from .settings import check_solver, require_determined
 
 
 class KinematicStepper:
@@ -50,7 +46,7 @@ class KinematicStepper:
     (9,)
     """
 
-    def __init__(self, model: "Model", t0: float = 0.0, tol: float | None = None) -> None:
+    def __init__(self, model: ModelDescription, t0: float = 0.0, tol: float | None = None) -> None:
         self._p = pack(model)
         require_determined(self._p, model)
         if self._p.neq != self._p.nq:
@@ -65,16 +61,15 @@ class KinematicStepper:
 
     def _call(self, t: float, assemble: bool) -> None:
         p = self._p
-        q, qd, qdd, status, msg = _core.core_kin_step(p.nb, p.ctab, p.rpar, self.q, self.qd,
-                                                      self.qdd, self.t, t, self._tol, 0,
-                                                      int(assemble))
+        out = core.kin_step(p, self.q, self.qd, self.qdd, self.t, t, self._tol, 0, assemble)
+        status = out.status
         if status < 0:
-            raise ModelError(decode(msg), "stepping")
+            raise ModelError(out.msg, "stepping")
         if status > 0:
             cls = AssemblyError if assemble else ConvergenceError
-            raise cls(f"{decode(msg)}; the state stays at t = {self.t:.9g} s (Model.kinematics "
-                      "locates singular configurations)", t=t, status=int(status))
-        self.q, self.qd, self.qdd, self.t = q, qd, qdd, t
+            raise cls(f"{out.msg}; the state stays at t = {self.t:.9g} s (Model.kinematics "
+                      "locates singular configurations)", t=t, status=status)
+        self.q, self.qd, self.qdd, self.t = out.q, out.qd, out.qdd, t
 
     def step(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Advance to time t (one core call).

@@ -1,43 +1,23 @@
-"""Model entries: bodies, joints and drivers, each able to pack itself into the flat table.
+"""Joints: the constraint base class and every joint kind, each able to pack itself into the
+flat table.
 
 Every constraint class knows its kind code (``fortran/mbd_constraints.f90``), how many rows it
-adds, what each row stands for, and its raw parameters. The numerics live in Fortran.
+adds, what each row stands for, and its raw parameters. The numerics live in Fortran. Drivers
+(:mod:`mbd2d.description.drivers`) are constraints too.
 """
 from __future__ import annotations
 
 from dataclasses import dataclass
 from typing import Any, Callable, ClassVar, Mapping, Sequence
 
-from .errors import ModelError
-from .functions import TimeFunction
-from .validate import as_list, nonzero_vector, only_keys, pairs, positive, table, vector
+from ..errors import ModelError
+from ..validate import as_list, nonzero_vector, only_keys, pairs, positive, table, vector
 
 PROFILE_KINDS = {"circle": 1, "spline": 2, "fourier": 3}
 FOLLOWER_KINDS = {"point": 1, "roller": 2, "flat": 3}
 COORDINATES = {"x": 1, "y": 2, "theta": 3}
 
 BodyIndex = Callable[[str], int]
-
-
-@dataclass
-class Body:
-    """A moving rigid body; its origin is its centre of mass.
-
-    Parameters
-    ----------
-    name : str
-        Unique name.
-    q0 : tuple of float
-        Rough estimate of (x, y, theta); assembly refines it.
-    mass, inertia : float or None
-        Mass and moment of inertia about the centre of mass (dynamics only).
-    """
-
-    name: str
-    q0: tuple[float, float, float]
-    mass: float | None = None
-    inertia: float | None = None
-    v0: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
 
 @dataclass
@@ -255,58 +235,6 @@ class Absolute(Constraint):
 
     def subkinds(self, body_index: BodyIndex, joint_index: Callable[[str], int]) -> tuple[int, int]:
         return COORDINATES[self.coordinate], 0
-
-
-@dataclass
-class Driver(Constraint):
-    """A driving constraint g(q) - f(t) = 0."""
-
-    f: TimeFunction = TimeFunction()
-    is_driver: ClassVar[bool] = True
-
-    def describe(self) -> str:
-        return f"driver '{self.name}'"
-
-    def raw(self) -> list[float]:
-        return self.f.encode()
-
-
-@dataclass
-class AbsoluteDriver(Driver):
-    """x, y or theta of a body = f(t)."""
-
-    coordinate: str = "theta"
-    type: ClassVar[str] = "absolute"
-    kind: ClassVar[int] = 101
-
-    @property
-    def labels(self) -> tuple[str, ...]:  # type: ignore[override]
-        return (f"{self.bodies[0]}.{self.coordinate}",)
-
-    def subkinds(self, body_index: BodyIndex, joint_index: Callable[[str], int]) -> tuple[int, int]:
-        return COORDINATES[self.coordinate], 0
-
-
-@dataclass
-class RelativeAngleDriver(Driver):
-    """theta_j - theta_i = f(t)."""
-
-    type: ClassVar[str] = "relative-angle"
-    kind: ClassVar[int] = 102
-    labels: ClassVar[tuple[str, ...]] = ("angle",)
-
-
-@dataclass
-class RelativeDistanceDriver(Driver):
-    """The slide along a translational joint = f(t)."""
-
-    joint: str = ""
-    type: ClassVar[str] = "relative-distance"
-    kind: ClassVar[int] = 103
-    labels: ClassVar[tuple[str, ...]] = ("slide",)
-
-    def subkinds(self, body_index: BodyIndex, joint_index: Callable[[str], int]) -> tuple[int, int]:
-        return joint_index(self.joint), 0
 
 
 def parse_profile(spec: Any, entry: str, key: str = "profile") -> tuple[str, tuple[float, ...]]:

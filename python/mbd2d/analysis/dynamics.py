@@ -1,0 +1,102 @@
+"""Forward dynamics front door: M q_ddot + J^T lambda = Q, Phi = 0 integrated in one core
+call."""
+from __future__ import annotations
+
+import math
+import warnings
+from typing import Any
+
+from ..binding import core
+from ..binding.pack import pack, pack_dynamics
+from ..binding.status import (ASSEMBLY_FAILED, INCONSISTENT, INTEGRATOR_FAILED, NO_CONVERGENCE,
+                              OK, SINGULAR, SINGULAR_CONFIG)
+from ..description.builder import ModelDescription
+from ..errors import (ConvergenceError, CoreError, IntegrationError, ModelError,
+                      RedundantConstraintWarning, SingularJacobianError)
+from ..results.dynamics import DynamicsResult
+from ..validate import number
+from .failures import assembly_failed, bad_entry, row_names
+from .outputs import dynamics_result
+from .settings import check_memory, check_span, output_steps, time_grid
+
+METHODS = {"generalized-alpha": 1, "dopri5": 2, "baumgarte-rk4": 3, "partitioned": 4}
+DEFAULT_METHOD = "dopri5"
+
+
+def run_dynamics(model: ModelDescription, t_end: float, steps: int, method: str | None = None,
+                 rtol: float | None = None, atol: float | None = None, h: float | None = None,
+                 rho_inf: float | None = None, alpha: float | None = None,
+                 beta: float | None = None, t0: float = 0.0, every: Any = 1) -> DynamicsResult:
+    """Forward dynamics in one core call; see :meth:`mbd2d.Model.dynamics`."""
+    t0, t_end, steps = check_span(t0, t_end, steps)
+    idx = output_steps(steps, every)
+    every = int(every)
+    method = DEFAULT_METHOD if method is None else method
+    if method not in METHODS:
+        raise ModelError(f"unknown method {method!r}; use one of {', '.join(METHODS)}",
+                         "dynamics")
+
+    def opt(v: Any, name: str, lo: float, hi: float, default: float) -> float:
+        if v is None:
+            return default
+        x = number(v, name, "dynamics")
+        if not lo <= x <= hi:
+            raise ModelError(f"{name} must be in [{lo:g}, {hi:g}], got {v!r}", "dynamics")
+        return x
+
+    rtol_v = opt(rtol, "rtol", 1e-14, 1.0, 0.0)
+    atol_v = opt(atol, "atol", 1e-16, 1e6, 0.0)
+    h_v = opt(h, "h", 1e-12, math.inf, 0.0)
+    if method == "baumgarte-rk4" and h is None:
+        raise ModelError("baumgarte-rk4 is a fixed-step method: give h (for example h=1e-3)",
+                         "dynamics")
+    if h is not None and method in ("dopri5", "partitioned"):
+        raise ModelError(f"{method} chooses its own steps from rtol and atol; h is for "
+                         "generalized-alpha and baumgarte-rk4", "dynamics")
+    rho_v = opt(rho_inf, "rho_inf", 0.0, 1.0, -1.0)
+    if method == "generalized-alpha" and h is None and rho_v >= 0.99:
+        # undamped, the algorithmic accelerations carry an oscillation the error
+        # estimate reads as error; the step then collapses
+        raise ModelError(f"error-controlled generalized-alpha needs numerical damping: "
+                         f"rho_inf={rho_v:g} is too close to 1; use rho_inf <= 0.9 or give "
+                         "a fixed step h", "dynamics")
+    alpha_v = opt(alpha, "alpha", 0.0, 1e9, -1.0)
+    beta_v = opt(beta, "beta", 0.0, 1e9, -1.0)
+    p = pack(model)
+    d = pack_dynamics(model, p)
+    check_memory(len(idx), 3 * p.nq + p.neq + 4)
+    out = core.dynamics(p, d, t0, t_end, steps, METHODS[method], rtol_v, atol_v, h_v, rho_v,
+                        alpha_v, beta_v, every, len(idx))
+    iinfo, rinfo, status = out.iinfo, out.rinfo, out.status
+    n = int(iinfo[0])
+    t = time_grid(t0, t_end, steps, idx)
+    _, red_rows = row_names(p, model, out.red)
+    stats = {"method": method, "steps": int(iinfo[2]), "rejected_steps": int(iinfo[3]),
+             "newton_iterations": int(iinfo[4]), "rhs_evaluations": int(iinfo[5]),
+             "iteration_matrices": int(iinfo[6]), "factorizations": int(iinfo[9]),
+             "partitions": int(iinfo[7]),
+             "h_min": float(rinfo[1]) if iinfo[2] else None,
+             "h_max": float(rinfo[2]) if iinfo[2] else None, "redundant_rows": red_rows}
+    res = dynamics_result(model, p, t, n, out, stats, status == OK)
+    if red_rows:
+        warnings.warn(f"redundant constraints: {', '.join(red_rows)} are left out of the equations "
+                      "of motion; the reported multipliers are the minimum-norm set (the "
+                      "reactions are statically indeterminate)", RedundantConstraintWarning,
+                      stacklevel=3)
+    if status == OK:
+        return res
+    text = out.msg
+    if status < 0:
+        raise ModelError(text, bad_entry(model, int(iinfo[1])))
+    tf = float(rinfo[0])
+    last = f"t = {res.t[-1]:.6g} s" if len(res.t) else "no output rows"
+    if status == ASSEMBLY_FAILED:
+        raise assembly_failed(model, 0.0, 0, t0, res)
+    if status == INTEGRATOR_FAILED:
+        raise IntegrationError(f"{method}: {text}. Results up to {last} are kept in the "
+                               "exception's .results.", t=tf, results=res, status=status)
+    if status in (SINGULAR, SINGULAR_CONFIG):
+        raise SingularJacobianError(f"{method}: {text}", t=tf, results=res, status=status)
+    if status in (NO_CONVERGENCE, INCONSISTENT):
+        raise ConvergenceError(f"{method}: {text}", t=tf, results=res, status=status)
+    raise CoreError(f"internal error in the core (status {status}): {text}")

@@ -1,0 +1,53 @@
+"""Inverse dynamics front door: kinematics of the driven model plus the multipliers, energies
+and (on demand) reactions at every output, in one core call."""
+from __future__ import annotations
+
+import warnings
+from typing import Any
+
+from ..binding import core
+from ..binding.pack import pack, pack_dynamics
+from ..binding.status import OK
+from ..description.builder import ModelDescription
+from ..errors import ModelError, RedundantConstraintWarning
+from ..results.dynamics import DynamicsResult
+from .failures import BAD_FORCE, bad_entry, kinematic_failure, row_names
+from .outputs import dynamics_result
+from .settings import (check_memory, check_solver, check_span, output_steps, require_determined,
+                       solver_code, time_grid)
+
+
+def run_inverse(model: ModelDescription, t_end: float, steps: int, t0: float = 0.0,
+                tol: float | None = None, every: Any = 1, solver: str = "auto") -> DynamicsResult:
+    """Kinematics plus the multipliers, energies and (on demand) reactions at every output.
+
+    See :meth:`mbd2d.Model.inverse_dynamics`.
+    """
+    t0, t_end, steps = check_span(t0, t_end, steps)
+    tol_v, _ = check_solver(tol, None)
+    idx = output_steps(steps, every)
+    code = solver_code(solver)
+    p = pack(model)
+    require_determined(p, model)
+    d = pack_dynamics(model, p)
+    check_memory(len(idx), 3 * p.nq + p.neq + 4)
+    out = core.inverse(p, d, t0, t_end, steps, tol_v, int(every), code, len(idx))
+    iinfo, status = out.iinfo, out.status
+    n = int(iinfo[0])
+    t = time_grid(t0, t_end, steps, idx)
+    _, red_rows = row_names(p, model, out.red)
+    stats = {"newton_corrections": int(iinfo[5]), "factorizations": int(iinfo[6]),
+             "rejected_steps": int(iinfo[7]), "rank": int(iinfo[8]),
+             "redundant_rows": red_rows,
+             "singular_passages": [float(x) for x in out.tpass[:min(int(iinfo[9]), 64)]]}
+    res = dynamics_result(model, p, t, n, out, stats, status == OK)
+    if red_rows:
+        warnings.warn(f"redundant constraints: {', '.join(red_rows)}; the multipliers are the "
+                      "minimum-norm set (the reactions are statically indeterminate)",
+                      RedundantConstraintWarning, stacklevel=3)
+    if status == OK:
+        return res
+    if status < 0 and iinfo[1] <= BAD_FORCE:
+        raise ModelError(out.msg, bad_entry(model, int(iinfo[1])))
+    raise kinematic_failure(model, p, status, out.msg, iinfo, out.rinfo, out.qsing, out.dep,
+                            out.red, res)

@@ -1,0 +1,65 @@
+"""Kinematics front door: settings checks, the one call into the core, and the result,
+warnings or typed exception."""
+from __future__ import annotations
+
+import warnings
+from typing import Any
+
+from ..binding import core
+from ..binding.pack import pack
+from ..binding.status import NO_CONVERGENCE, OK, SINGULAR_CONFIG
+from ..description.builder import ModelDescription
+from ..errors import RedundantConstraintWarning, SingularPassageWarning
+from ..results.kinematics import KinematicsResult
+from .failures import kinematic_failure, row_names
+from .settings import (check_memory, check_solver, check_span, output_steps, require_determined,
+                       solver_code, time_grid)
+
+
+def run_kinematics(model: ModelDescription, t_end: float, steps: int, t0: float = 0.0,
+                   tol: float | None = None, maxit: int | None = None,
+                   tmin: float | None = None, every: Any = 1,
+                   solver: str = "auto") -> KinematicsResult:
+    """Run a kinematic analysis in one core call; see :meth:`mbd2d.Model.kinematics`."""
+    t0, t_end, steps = check_span(t0, t_end, steps)
+    tol_v, maxit_v = check_solver(tol, maxit)
+    idx = output_steps(steps, every)
+    code = solver_code(solver)
+    p = pack(model)
+    require_determined(p, model)
+    check_memory(len(idx), 3 * p.nq)
+    out = core.kinematics(p, t0, t_end, steps, tol_v, maxit_v, float(tmin or 0.0), int(every),
+                          code, len(idx))
+    iinfo, rinfo, tpass, status = out.iinfo, out.rinfo, out.tpass, out.status
+    n = int(iinfo[0])
+    t = time_grid(t0, t_end, steps, idx)
+    npass = int(iinfo[9])
+    red_cons, red_rows = row_names(p, model, out.red)
+    res = KinematicsResult(t=t[:n], q=out.q.T[:n].copy(), qd=out.qd.T[:n].copy(),
+                           qdd=out.qdd.T[:n].copy(), body_names=p.body_names,
+                           coordinate_names=p.coordinate_names,
+                           stats={"newton_corrections": int(iinfo[5]),
+                                  "factorizations": int(iinfo[6]),
+                                  "rejected_steps": int(iinfo[7]),
+                                  "rank": int(iinfo[8]),
+                                  "redundant_rows": red_rows,
+                                  "singular_passages": [float(x) for x in tpass[:min(npass, 64)]],
+                                  "singular_passage_count": npass,
+                                  "solver": "banded" if int(rinfo[4]) == 2 else "dense",
+                                  "band": (int(rinfo[5]), int(rinfo[6]))},
+                           complete=status == OK, model=model)
+    if red_rows and status in (OK, SINGULAR_CONFIG, NO_CONVERGENCE):
+        warnings.warn(f"redundant constraints: {', '.join(red_rows)} repeat what the other "
+                      "constraints impose (rank of J is "
+                      f"{int(iinfo[8])} for {p.neq} equations); kinematics solves them in least "
+                      "squares, exactly while they agree", RedundantConstraintWarning,
+                      stacklevel=3)
+    if npass:
+        times = ", ".join(f"{x:.6g}" for x in tpass[:min(npass, 5)])
+        warnings.warn(f"passed through {npass} singular configuration(s) (bifurcation points, "
+                      f"J lost rank) at t = {times}{' ...' if npass > 5 else ''} s and stayed on "
+                      "the branch the run started on", SingularPassageWarning, stacklevel=3)
+    if status == OK:
+        return res
+    raise kinematic_failure(model, p, status, out.msg, iinfo, rinfo, out.qsing, out.dep,
+                            out.red, res)

@@ -1,0 +1,107 @@
+"""The calls into the compiled core (``mbd2d._core``, built by f2py from
+``fortran/mbd_f2py.f90``): the only module that touches it.
+
+Each function passes the flat tables and settings as the f2py wrapper wants them and returns
+the core's outputs by name (``out.status``, ``out.msg`` as text, ...). The outputs are the
+core's own arrays (Fortran order, one column per output time); turning them into results
+and status codes into exceptions is the caller's job.
+"""
+from __future__ import annotations
+
+from types import SimpleNamespace
+from typing import Any
+
+import numpy as np
+
+from .. import _core
+from .tables import DynamicTables, Packed, decode
+
+
+def _named(names: str, out: tuple[Any, ...]) -> SimpleNamespace:
+    """The core's output tuple by name; ``msg`` decoded to text."""
+    fields = dict(zip(names.split(), out, strict=True))
+    if "msg" in fields:
+        fields["msg"] = decode(fields["msg"])
+    fields["status"] = int(fields["status"])
+    return SimpleNamespace(**fields)
+
+
+def sizes(nb: int, ctab: np.ndarray, rpar: np.ndarray) -> SimpleNamespace:
+    """Check the tables; ``nq``, ``neq``, ``status``, ``msg``, ``bad`` (1-based constraint)."""
+    return _named("nq neq status msg bad", _core.core_sizes(nb, ctab, rpar))
+
+
+def evaluate(nb: int, ctab: np.ndarray, rpar: np.ndarray, neq: int, q: np.ndarray,
+             qd: np.ndarray, t: float) -> SimpleNamespace:
+    """Phi, J, nu and gamma at a state: ``phi``, ``jac``, ``nu``, ``gam``, ``status``, ``msg``,
+    ``bad``."""
+    return _named("phi jac nu gam status msg bad",
+                  _core.core_eval(nb, ctab, rpar, neq, q, qd, float(t)))
+
+
+def kinematics(p: Packed, t0: float, t1: float, steps: int, tol: float, maxit: int,
+               tmin: float, every: int, solver: int, nout: int) -> SimpleNamespace:
+    """The whole kinematic run: ``q``, ``qd``, ``qdd`` (nq, nout), ``iinfo``, ``rinfo``,
+    ``qsing``, ``dep``, ``red``, ``tpass``, ``status``, ``msg``."""
+    return _named("q qd qdd iinfo rinfo qsing dep red tpass status msg",
+                  _core.core_kinematics(p.nb, p.ctab, p.rpar, p.neq, p.q0, t0, t1, steps, tol,
+                                        maxit, tmin, every, solver, nout))
+
+
+def kin_step(p: Packed, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, t_prev: float,
+             t: float, tol: float, maxit: int, assemble: bool) -> SimpleNamespace:
+    """One kinematic step (or the assembly at t): ``q``, ``qd``, ``qdd``, ``status``,
+    ``msg``."""
+    return _named("q qd qdd status msg",
+                  _core.core_kin_step(p.nb, p.ctab, p.rpar, q, qd, qdd, t_prev, t, tol, maxit,
+                                      int(assemble)))
+
+
+def analyze(p: Packed, t: float, tol: float) -> SimpleNamespace:
+    """Rank and redundancy at the assembled configuration: ``q``, ``rank``, ``mobility``,
+    ``red``, ``dep``, ``resid``, ``worst``, ``status``, ``msg``."""
+    return _named("q rank mobility red dep resid worst status msg",
+                  _core.core_analyze(p.nb, p.ctab, p.rpar, p.neq, p.q0, t, tol))
+
+
+def profile(kind: int, raw: np.ndarray, alphas: np.ndarray) -> SimpleNamespace:
+    """Points c(alpha) of a closed profile curve: ``pts`` (2, n), ``status``, ``msg``."""
+    return _named("pts status msg", _core.core_profile(kind, raw, alphas))
+
+
+def inverse(p: Packed, d: DynamicTables, t0: float, t1: float, steps: int, tol: float,
+            every: int, solver: int, nout: int) -> SimpleNamespace:
+    """Kinematics plus multipliers and energies: ``q``, ``qd``, ``qdd``, ``lam``, ``e``,
+    ``iinfo``, ``rinfo``, ``qsing``, ``dep``, ``red``, ``tpass``, ``status``, ``msg``."""
+    return _named("q qd qdd lam e iinfo rinfo qsing dep red tpass status msg",
+                  _core.core_inverse(ctab=p.ctab, rpar=p.rpar, bmass=d.bmass, grav=d.grav,
+                                     ftab=d.ftab, fpar=d.fpar, neq=p.neq, q0=p.q0, t0=t0,
+                                     t1=t1, nsteps=steps, tol=tol, every=every, solver=solver,
+                                     nout=nout))
+
+
+def dynamics(p: Packed, d: DynamicTables, t0: float, t1: float, steps: int, method: int,
+             rtol: float, atol: float, h: float, rho_inf: float, alpha: float, beta: float,
+             every: int, nrow: int) -> SimpleNamespace:
+    """Forward dynamics: ``q``, ``qd``, ``qdd``, ``lam``, ``e``, ``iinfo``, ``rinfo``, ``red``,
+    ``status``, ``msg``."""
+    return _named("q qd qdd lam e iinfo rinfo red status msg",
+                  _core.core_dynamics(ctab=p.ctab, rpar=p.rpar, bmass=d.bmass, grav=d.grav,
+                                      ftab=d.ftab, fpar=d.fpar, neq=p.neq, q0=p.q0, v0=d.v0,
+                                      t0=t0, t1=t1, nsteps=steps, method=method, rtol=rtol,
+                                      atol=atol, h=h, rho_inf=rho_inf, balpha=alpha,
+                                      bbeta=beta, every=every, nrow=nrow))
+
+
+def statics(p: Packed, d: DynamicTables, t: float) -> SimpleNamespace:
+    """Static equilibrium: ``q``, ``lam``, ``stable``, ``resid``, ``iinfo``, ``status``,
+    ``msg``."""
+    return _named("q lam stable resid iinfo status msg",
+                  _core.core_statics(ctab=p.ctab, rpar=p.rpar, bmass=d.bmass, grav=d.grav,
+                                     ftab=d.ftab, fpar=d.fpar, neq=p.neq, q0=p.q0, t=t))
+
+
+def reactions(p: Packed, q: np.ndarray, t: np.ndarray, lam: np.ndarray) -> SimpleNamespace:
+    """Joint reactions at states q (nq, nt), times t (nt) and multipliers lam (neq, nt):
+    ``reac`` and ``rloc`` (6, nc, nt), ``status``, ``msg``."""
+    return _named("reac rloc status msg", _core.core_reactions(p.nb, p.ctab, p.rpar, q, t, lam))

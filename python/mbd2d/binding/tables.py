@@ -1,0 +1,50 @@
+"""The flat tables the Fortran core reads (see ``fortran/mbd_model.f90``), with the names that
+go with them."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+NCT = 8  # rows of the constraint table
+NFT = 6  # rows of the force table
+
+
+@dataclass
+class Packed:
+    """A model as flat tables, with the names that go with them."""
+
+    nb: int
+    ctab: np.ndarray            # int32 (NCT, nc), Fortran order
+    rpar: np.ndarray            # float64
+    q0: np.ndarray              # float64 (nq,), extras zero (the core estimates them)
+    nq: int
+    neq: int
+    body_names: list[str]
+    constraint_names: list[str]
+    driver_flags: list[bool]
+    coordinate_names: list[str]
+    row_owner: list[int] = field(default_factory=list)   # constraint index of each row
+    row_labels: list[str] = field(default_factory=list)
+
+    @property
+    def nc(self) -> int:
+        return self.ctab.shape[1]
+
+
+@dataclass
+class DynamicTables:
+    """What dynamics adds to :class:`Packed`: masses, gravity, forces and initial velocities."""
+
+    bmass: np.ndarray           # float64 (2, nb): mass, inertia
+    grav: np.ndarray            # float64 (2,)
+    ftab: np.ndarray            # int32 (NFT, nf), Fortran order
+    fpar: np.ndarray            # float64
+    v0: np.ndarray              # float64 (nq,)
+
+
+def decode(raw: bytes | str) -> str:
+    """A Fortran message as text."""
+    if isinstance(raw, bytes):
+        raw = raw.decode("utf-8", "replace")
+    return raw.strip()

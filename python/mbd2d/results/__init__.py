@@ -1,0 +1,18 @@
+"""Layer 5, the results: arrays by time with per-body views, multipliers, energies, reactions
+and efforts, the degree-of-freedom report, and result files (CSV, NPZ).
+
+Results hold data and answer questions about it; pictures of a result are drawn by
+:mod:`mbd2d.plots` (a lower layer), reactions are computed from the multipliers through
+:mod:`mbd2d.binding`. Nothing here runs an analysis.
+"""
+from __future__ import annotations
+
+from .dof import DofReport
+from .dynamics import DynamicsResult
+from .files import read_csv
+from .kinematics import SUFFIXES, BodyResult, KinematicsResult
+from .reactions import Reaction
+from .statics import StaticsResult
+
+__all__ = ["BodyResult", "KinematicsResult", "DynamicsResult", "StaticsResult", "Reaction",
+           "DofReport", "SUFFIXES", "read_csv"]

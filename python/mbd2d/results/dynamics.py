@@ -1,0 +1,78 @@
+"""Dynamic results: a kinematic or dynamic run with multipliers, energies, drift, reactions
+and driver efforts."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .kinematics import KinematicsResult
+from .reactions import Reaction, reaction_arrays, reaction_of
+
+
+@dataclass(repr=False)
+class DynamicsResult(KinematicsResult):
+    """A kinematic or dynamic run with multipliers, energies and constraint drift.
+
+    Attributes
+    ----------
+    lam : numpy.ndarray
+        Lagrange multipliers (n, neq), rows labelled by ``row_labels``; with redundant
+        constraints the minimum-norm set.
+    kinetic, potential : numpy.ndarray
+        Kinetic energy q_dot^T M q_dot / 2 and potential energy (gravity and springs).
+    drift_position, drift_velocity : numpy.ndarray
+        ||Phi||_inf and ||J q_dot - nu||_inf at each output.
+    """
+
+    lam: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
+    kinetic: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    potential: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    drift_position: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    drift_velocity: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    row_labels: list[str] = field(default_factory=list)
+    packed: Any = None
+    _reac: Any = None
+
+    @property
+    def energy(self) -> np.ndarray:
+        """Kinetic plus potential energy."""
+        return self.kinetic + self.potential
+
+    def _reactions(self) -> tuple[np.ndarray, np.ndarray]:
+        if self._reac is None:
+            self._reac = reaction_arrays(self.packed, self.q, self.t, self.lam)
+        return self._reac
+
+    def reaction(self, name: str) -> Reaction:
+        """Reaction of the joint or driver called name on its two bodies.
+
+        Raises
+        ------
+        KeyError
+            If there is no such joint or driver.
+        """
+        return reaction_of(self.packed, self.model, name, self._reactions)
+
+    def effort(self, name: str) -> np.ndarray:
+        """What the driver called name supplies: the torque (angle drivers) or force
+        (x, y or slide drivers) in the driven direction, -lambda of its row."""
+        names = self.packed.constraint_names
+        if name not in names or not self.packed.driver_flags[names.index(name)]:
+            raise KeyError(f"no driver {name!r}")
+        row = self.packed.row_owner.index(names.index(name))
+        return -self.lam[:, row]
+
+    def multiplier(self, row: str) -> np.ndarray:
+        """The multiplier of a row by its label (see ``model.constraint_rows()``)."""
+        return self.lam[:, self.row_labels.index(row)]
+
+    def to_npz(self, path: str | Path) -> None:
+        """t, q, qd, qdd, the multipliers and energies, and the names."""
+        np.savez(path, t=self.t, q=self.q, qd=self.qd, qdd=self.qdd, lam=self.lam,
+                 kinetic=self.kinetic, potential=self.potential,
+                 drift_position=self.drift_position, drift_velocity=self.drift_velocity,
+                 coordinate_names=np.array(self.coordinate_names),
+                 body_names=np.array(self.body_names), row_labels=np.array(self.row_labels))
