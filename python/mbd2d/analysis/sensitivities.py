@@ -1,0 +1,58 @@
+"""Design sensitivities in the analysis front doors: the requested parameters checked by name,
+their table for the core, and the core's arrays put into the result."""
+from __future__ import annotations
+
+from typing import Any, Sequence
+
+import numpy as np
+
+from ..binding.params import parameter_table
+from ..binding.tables import DynamicTables, Packed
+from ..description.parameters import Parameter, find
+from ..errors import ModelError
+
+#: iinfo(2) of the core below this names a bad design parameter (-2000000 - its column)
+BAD_PARAMETER = -2000000
+
+
+def requested(model: Any, names: Sequence[str] | None) -> list[Parameter] | None:
+    """The design parameters called names (None: no sensitivities).
+
+    Raises
+    ------
+    ModelError
+        For an unknown name (with the closest names) or a repeated one.
+    """
+    if names is None:
+        return None
+    params = find(model, names, "sensitivities")
+    if not params:
+        raise ModelError("sensitivities=[] names no parameter; give parameter names "
+                         "(model.parameters() lists them) or leave it out", "sensitivities")
+    return params
+
+
+def table(p: Packed, params: list[Parameter], d: DynamicTables | None = None) -> np.ndarray:
+    """The core's parameter table."""
+    return parameter_table(p, params, d)
+
+
+def check_status(status: int, iinfo: Any, msg: str, params: list[Parameter]) -> None:
+    """Raise the ModelError for a design parameter the core refused."""
+    bad = int(iinfo[1])
+    if status < 0 and bad <= BAD_PARAMETER:
+        k = BAD_PARAMETER - bad
+        name = params[k - 1].name if 0 < k <= len(params) else "sensitivities"
+        raise ModelError(msg, name)
+
+
+def attach(res: Any, out: Any, params: list[Parameter], n: int, ptab: np.ndarray) -> None:
+    """Put the first n rows of the core's sensitivity arrays (nq, np, rows) into res as
+    (rows, nq, np)."""
+    res.parameter_names = [prm.name for prm in params]
+    res.dq_dp = np.transpose(out.sq, (2, 0, 1))[:n].copy()
+    res.dqd_dp = np.transpose(out.sqd, (2, 0, 1))[:n].copy()
+    res.dqdd_dp = np.transpose(out.sqdd, (2, 0, 1))[:n].copy()
+    if hasattr(out, "slam"):
+        res.dlam_dp = np.transpose(out.slam, (2, 0, 1))[:n].copy()
+    res.ptab = ptab
