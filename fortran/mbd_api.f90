@@ -436,9 +436,9 @@ contains
       call dyn_multipliers(m, w, qout(:, k), qdout(:, k), qddout(:, k), t, lamout(:, k), st, lmsg)
       call state_measures(m, w, qout(:, k), qdout(:, k), t, eout(:, k))
       if (present(ptab)) call sens_multipliers(m, sens, qout(:, k), qdout(:, k), &
-                                               qddout(:, k), t, lamout(:, k), sq(:, :, k), &
-                                               sqd(:, :, k), sqdd(:, :, k), slam(:, :, k), st, &
-                                               lmsg)
+                                               qddout(:, k), t, w%jac, lamout(:, k), &
+                                               sq(:, :, k), sqd(:, :, k), sqdd(:, :, k), &
+                                               slam(:, :, k), st, lmsg)
     end do
   end subroutine api_inverse
 

@@ -223,11 +223,15 @@ contains
     end select
   end function con_linear
 
-  !> Phi is affine in the body positions r_i, r_j (revolute, weld: points compared,
-  !! r_i + A_i s'_i - r_j - A_j s'_j): no second derivative involves a position slot.
-  pure logical function con_affine_r(kind)
+  !> Phi is affine in the body positions r_i, r_j, so no second derivative involves a
+  !! position slot: points compared (revolute, weld: r_i + A_i s'_i - r_j - A_j s'_j), or a
+  !! line fixed in ground (translational, point on line with body i ground: h . (P_j - P_i)
+  !! with a constant h).
+  pure logical function con_affine_r(kind, bi)
     integer, intent(in) :: kind   !! kind code
-    con_affine_r = kind == CON_REVOLUTE .or. kind == CON_WELD .or. con_linear(kind)
+    integer, intent(in) :: bi     !! first body (0 ground)
+    con_affine_r = kind == CON_REVOLUTE .or. kind == CON_WELD .or. con_linear(kind) .or. &
+                   ((kind == CON_TRANSLATIONAL .or. kind == CON_POINT_LINE) .and. bi == 0)
   end function con_affine_r
 
   !> True when raw entry j of a constraint is a count (a function's or a profile's), which

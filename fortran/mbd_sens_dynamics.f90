@@ -27,8 +27,9 @@ module mbd_sens_dynamics
   use mbd_model, only: model_t
   use mbd_assemble, only: asm_work_t, asm_init, assemble_blocks, assemble_dense
   use mbd_sensitivity, only: sens_t, sens_trig, sens_hessian, sens_params, sens_klam, &
+                             sens_klam_list, &
                              sens_jpt_lam, sens_force_d, sens_force_jac
-  use mbd_linsolve, only: lu_factor, lu_solve, lapack_status
+  use mbd_linsolve, only: lu_factor, lu_solve, lapack_status, ls_small_cols
   use mbd_lapack, only: dgelsy
   use mbd_status, only: MBD_INTEGRATOR_FAILED, MBD_BAD_SETTING
   use mbd_dynamics, only: dyn_work_t, dyn_accel, dyn_solve, dyn_project_pos, dyn_velocity
@@ -44,20 +45,20 @@ module mbd_sens_dynamics
 contains
 
   !> dlambda/dp (neq, np) at one output of an inverse dynamics run, from the kinematic
-  !! sensitivities sq, sqd, sqdd (nq, np) there.
-  subroutine sens_multipliers(m, s, q, qd, qdd, t, lam, sq, sqd, sqdd, slam, status, msg)
+  !! sensitivities sq, sqd, sqdd (nq, np) there; jac is J at q.
+  subroutine sens_multipliers(m, s, q, qd, qdd, t, jac, lam, sq, sqd, sqdd, slam, status, msg)
     type(model_t), intent(in) :: m              !! model with dynamics data
     type(sens_t), intent(inout) :: s            !! parameters and blocks
     real(wp), intent(in) :: q(:), qd(:), qdd(:) !! state and accelerations
     real(wp), intent(in) :: t                   !! time
+    real(wp), intent(in) :: jac(:, :)           !! J at q (neq, nq)
     real(wp), intent(in) :: lam(:)              !! multipliers (neq)
     real(wp), intent(in) :: sq(:, :), sqd(:, :), sqdd(:, :)  !! (nq, np)
     real(wp), intent(out) :: slam(:, :)         !! (neq, np)
     integer, intent(out) :: status              !! MBD_OK or MBD_LAPACK / MBD_NO_MEMORY
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
-    type(asm_work_t) :: a
-    real(wp), allocatable :: jt(:, :), b(:, :), y(:), jpb(:, :, :), work(:), phi(:), nu(:), &
-                             gam(:), jac(:, :)
+    real(wp), allocatable :: jt(:, :), b(:, :), y(:), jpb(:, :, :), work(:), bb(:, :)
+    logical :: full
     real(wp) :: wq(1)
     integer, allocatable :: jpvt(:)
     integer :: k, nq, neq, np, rank, info, st
@@ -66,23 +67,32 @@ contains
     slam = zero
     if (np == 0) return
     allocate (jt(nq, neq), b(max(nq, neq), np), y(nq), jpb(MAXROW, NLOC, m%nc), jpvt(neq), &
-              phi(neq), nu(neq), gam(neq), jac(neq, nq), stat=st)
+              bb(max(nq, neq), np), stat=st)
     if (st /= 0) then
       status = MBD_NO_MEMORY; msg = 'out of memory for the multiplier sensitivities'; return
     end if
-    call asm_init(m, a)
-    call assemble_dense(m, q, qd, t, phi, nu, gam, a, jac)
     call sens_trig(m, s, q)
     call sens_hessian(m, s, q, qd, qdd, t)
+    call sens_klam_list(m, s, lam)
     b = zero
     do k = 1, np
       call sens_force_d(m, s, k, q, qd, sq(:, k), sqd(:, k), t, y)   ! Q_q s + Q_qd s_dot + Q_p
       b(1:nq, k) = y - s%tmass(:, k) * qdd - m%mdiag * sqdd(:, k)
-      call sens_klam(m, s, lam, sq(:, k), y)
+      call sens_klam(s, sq(:, k), y)
       b(1:nq, k) = b(1:nq, k) - y
       call sens_jpt_lam(m, s, k, q, t, lam, y, jpb)
       b(1:nq, k) = b(1:nq, k) - y
     end do
+    ! J^T dlambda = b: Householder least squares (independent rows, the unique solution),
+    ! or the minimum-norm one by dgelsy when J^T is rank deficient (redundant rows)
+    if (neq <= nq) then
+      jt = transpose(jac)
+      bb = b
+      call ls_small_cols(jt, bb, full)
+      if (full) then
+        slam = bb(1:neq, :); return
+      end if
+    end if
     jt = transpose(jac)
     jpvt = 0
     call dgelsy(nq, neq, np, jt, nq, b, size(b, 1), jpvt, 1.0e-10_wp, rank, wq, -1, info)
@@ -184,9 +194,10 @@ contains
     call sens_params(m, s, q, z, z, t)
     ! K = K_lam - Q_q, column by column
     call sens_force_jac(m, q, z, t, kq)
+    call sens_klam_list(m, s, lam)
     do i = 1, n
       e = zero; e(i) = one
-      call sens_klam(m, s, lam, e, y)
+      call sens_klam(s, e, y)
       kk(:, i) = y - kq(:, i)
     end do
     aug = zero
@@ -364,12 +375,13 @@ contains
       call sens_trig(m, s, qq)
       call sens_hessian(m, s, qq, vv, aa, tt)
       call sens_params(m, s, qq, vv, aa, tt)
+      call sens_klam_list(m, s, lam)
       do kk = 1, np
         o = n * kk
         sk = yy(o + 1:o + n); sdk = yy(nz + o + 1:nz + o + n)
         call sens_force_d(m, s, kk, qq, vv, sk, sdk, tt, y1)
         r(1:n) = y1 - s%tmass(:, kk) * aa
-        call sens_klam(m, s, lam, sk, y1)
+        call sens_klam(s, sk, y1)
         r(1:n) = r(1:n) - y1
         call sens_jpt_lam(m, s, kk, qq, tt, lam, y1, jpb)
         r(1:n) = r(1:n) - y1

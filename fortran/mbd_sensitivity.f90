@@ -34,7 +34,7 @@ module mbd_sensitivity
   public :: sens_t, PT_RPAR, PT_MASS, PT_GRAV, PT_FPAR
   public :: sens_setup, sens_trig, sens_hessian, sens_params, sens_kin_rhs, block_apply, block_apply_t, &
             block_apply_cols, &
-            sens_klam, sens_jpt_lam, sens_force_d, sens_force_jac, sens_eval_d
+            sens_klam, sens_klam_list, sens_jpt_lam, sens_force_d, sens_force_jac, sens_eval_d
 
   integer, parameter :: PT_RPAR = 1, PT_MASS = 2, PT_GRAV = 3, PT_FPAR = 4  !! table ids
 
@@ -66,6 +66,10 @@ module mbd_sensitivity
     integer :: nnz = 0
     integer, allocatable :: nzr(:), nzc(:)
     real(wp), allocatable :: nzv(:), nza(:)
+    ! the nonzeros of K_lambda (sens_klam_list): row, column, value
+    integer :: kln = 0
+    integer, allocatable :: klr(:), klc(:)
+    real(wp), allocatable :: klv(:)
     real(wp), allocatable :: zp(:)           !! zeros, the longest prepared slice
   end type sens_t
 
@@ -101,7 +105,8 @@ contains
               s%ha(MAXROW, NLOC, m%nc), s%phip(s%np, m%neq), s%vp(s%np, m%neq), &
               s%ap(s%np, m%neq), s%work(m%neq), s%rhs(4 * ((s%np + 3) / 4), m%neq), s%zp(maxval(m%pn)), &
               s%cb(0:m%nb), s%sb(0:m%nb), s%nzr(NLOC * m%neq), s%nzc(NLOC * m%neq), &
-              s%nzv(NLOC * m%neq), s%nza(NLOC * m%neq), stat=st)
+              s%nzv(NLOC * m%neq), s%nza(NLOC * m%neq), s%klr(NLOC * NLOC * m%nc), &
+              s%klc(NLOC * NLOC * m%nc), s%klv(NLOC * NLOC * m%nc), stat=st)
     if (st /= 0) then
       status = MBD_NO_MEMORY; msg = 'out of memory for the sensitivity arrays'; return
     end if
@@ -263,7 +268,7 @@ contains
       nr = m%nrow(k)
       do j = 1, NLOC
         if (m%loc(j, k) == 0) cycle
-        if (con_affine_r(m%kind(k)) .and. j /= 3 .and. j /= 6) cycle   ! zero blocks
+        if (con_affine_r(m%kind(k), m%bi(k)) .and. j /= 3 .and. j /= 6) cycle   ! zero blocks
         x%tq(j) = one
         call con_eval_d(m%kind(k), m%suba(k), m%subb(k), m%p(m%po(k):m%po(k) + m%pn(k) - 1), &
                         s%zp(1:m%pn(k)), si, sj, x, t, tphi, s%hs(:, :, j, k), tnu, tgam)
@@ -455,18 +460,17 @@ contains
     end select
   end subroutine sens_kin_rhs
 
-  !> y = (J^T lambda)_q x = sum over rows of lambda_r (Phi_r)_qq x, from the local Hessian
-  !! blocks (sens_hessian at the same q).
-  pure subroutine sens_klam(m, s, lam, x, y)
+  !> K_lambda = (J^T lambda)_q = sum over rows of lambda_r (Phi_r)_qq as a list of its
+  !! nonzeros (row, column, value), from the local Hessian blocks (sens_hessian at the same q).
+  pure subroutine sens_klam_list(m, s, lam)
     type(model_t), intent(in) :: m           !! model
-    type(sens_t), intent(in) :: s            !! Hessian blocks
+    type(sens_t), intent(inout) :: s         !! Hessian blocks; the list (out)
     real(wp), intent(in) :: lam(:)           !! multipliers (neq)
-    real(wp), intent(in) :: x(:)             !! direction (nq)
-    real(wp), intent(out) :: y(:)            !! (nq)
     integer :: k, i, j, r, r0, ci, cj
     real(wp) :: acc
-    y = zero
+    s%kln = 0
     do k = 1, m%nc
+      if (con_linear(m%kind(k))) cycle
       r0 = m%row0(k) - 1
       do j = 1, NLOC
         cj = m%loc(j, k)
@@ -478,9 +482,23 @@ contains
           do r = 1, m%nrow(k)
             acc = acc + lam(r0 + r) * s%hs(r, i, j, k)
           end do
-          y(ci) = y(ci) + acc * x(cj)
+          if (acc == zero) cycle
+          s%kln = s%kln + 1
+          s%klr(s%kln) = ci; s%klc(s%kln) = cj; s%klv(s%kln) = acc
         end do
       end do
+    end do
+  end subroutine sens_klam_list
+
+  !> y = K_lambda x from the list of sens_klam_list.
+  pure subroutine sens_klam(s, x, y)
+    type(sens_t), intent(in) :: s            !! the list
+    real(wp), intent(in) :: x(:)             !! direction (nq)
+    real(wp), intent(out) :: y(:)            !! (nq)
+    integer :: n
+    y = zero
+    do n = 1, s%kln
+      y(s%klr(n)) = y(s%klr(n)) + s%klv(n) * x(s%klc(n))
     end do
   end subroutine sens_klam
 
@@ -496,7 +514,7 @@ contains
     real(wp), intent(out) :: jpb(:, :, :)    !! (MAXROW, NLOC, nc)
     type(dloc) :: x
     real(wp) :: qddl(NLOC), tphi(MAXROW), tnu(MAXROW), tgam(MAXROW)
-    integer :: c, si, sj
+    integer :: c, si, sj, j, r
     jpb = zero
     do c = 1, m%nc
       if (.not. s%caff(c, k)) cycle
@@ -506,7 +524,16 @@ contains
                       s%tp(m%po(c):m%po(c) + m%pn(c) - 1, k), si, sj, x, t, &
                       tphi, jpb(:, :, c), tnu, tgam)
     end do
-    call block_apply_t(m, jpb, lam, y)
+    y = zero
+    do c = 1, m%nc
+      if (.not. s%caff(c, k)) cycle
+      do j = 1, NLOC
+        if (m%loc(j, c) == 0) cycle
+        do r = 1, m%nrow(c)
+          y(m%loc(j, c)) = y(m%loc(j, c)) + jpb(r, j, c) * lam(m%row0(c) + r - 1)
+        end do
+      end do
+    end do
   end subroutine sens_jpt_lam
 
   !> Change of the applied generalized force Q along (dq, dq_dot) and parameter k

@@ -50,9 +50,14 @@ def attach(res: Any, out: Any, params: list[Parameter], n: int, ptab: np.ndarray
     """Put the first n rows of the core's sensitivity arrays (nq, np, rows) into res as
     (rows, nq, np)."""
     res.parameter_names = [prm.name for prm in params]
-    res.dq_dp = np.transpose(out.sq, (2, 0, 1))[:n].copy()
-    res.dqd_dp = np.transpose(out.sqd, (2, 0, 1))[:n].copy()
-    res.dqdd_dp = np.transpose(out.sqdd, (2, 0, 1))[:n].copy()
+    res.dq_dp, res.dqd_dp, res.dqdd_dp = rows(out.sq, n), rows(out.sqd, n), rows(out.sqdd, n)
     if hasattr(out, "slam"):
-        res.dlam_dp = np.transpose(out.slam, (2, 0, 1))[:n].copy()
+        res.dlam_dp = rows(out.slam, n)
     res.ptab = ptab
+
+
+def rows(a: np.ndarray, n: int) -> np.ndarray:
+    """The core's (nq, np, rows) array as (rows, nq, np), its first n rows: a view of the
+    core's own array when all rows are kept (no copy), else a copy."""
+    v = np.transpose(a, (2, 0, 1))
+    return v if n == v.shape[0] else v[:n].copy()
