@@ -7,13 +7,17 @@
 !!                 9 rank of J at assembly, 10 singular configurations passed through
 !!   rinfo(NINFO): 1 time of the singular configuration or failure, 2 sigma_min, 3 sigma_max,
 !!                 4 residual
+!! The analyses run on the nondimensional model (mbd_model: lengths in units of the model's
+!! length scale, a power of 2, so the conversions are exact); their inputs and outputs are
+!! converted here, so callers see model units throughout. Evaluations (api_eval) and reactions
+!! (api_reactions) need no tolerance and use the model as given.
 module mbd_api
   use mbd_kinds, only: wp, zero, one
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use mbd_status, only: MBD_OK, MBD_BAD_COUNT, MBD_BAD_PARAM, MBD_INCONSISTENT, MBD_NO_MEMORY, &
                         MSG_LEN
   use mbd_points, only: NLOC, MAXROW
-  use mbd_model, only: model_t, model_build, model_add_dynamics
+  use mbd_model, only: model_t, model_build, model_add_dynamics, model_force_size
   use mbd_dynamics, only: dyn_work_t, dyn_init, dyn_velocity, dyn_multipliers, dyn_reactions, &
                           gen_forces, kinetic_energy
   use mbd_integrators, only: dyn_opts_t, dyn_stats_t, integrate, output_rows, output_index
@@ -77,9 +81,80 @@ contains
     character(len=MSG_LEN), intent(out) :: msg  !! what is wrong
     integer, intent(out) :: bad                 !! offending constraint, or 0
     type(model_t) :: m
-    call model_build(nb, ctab, rpar, m, status, msg, bad)
+    call model_build(nb, ctab, rpar, m, status, msg, bad, nondim=.true.)
     nq = m%nq; neq = m%neq
   end subroutine api_sizes
+
+  !> a(:, k) = a(:, k) * u for every column (model units from the core's: u = cunit), or
+  !! with divide, a(:, k) / u (multipliers: u = rowunit). Nothing to do when L = 1.
+  subroutine units(m, a, u, divide)
+    type(model_t), intent(in) :: m              !! model (its length unit lref)
+    real(wp), intent(inout) :: a(:, :)          !! columns to convert
+    real(wp), intent(in) :: u(:)                !! unit of each row (cunit or rowunit)
+    logical, intent(in) :: divide               !! divide by u instead of multiplying
+    integer :: k
+    if (.not. (m%lref > one .or. m%lref < one)) return
+    do k = 1, size(a, 2)
+      if (divide) then
+        a(:, k) = a(:, k) / u
+      else
+        a(:, k) = a(:, k) * u
+      end if
+    end do
+  end subroutine units
+
+  !> Sensitivities (rows, np[, outputs]) in model units: with p' = p L**e the core's
+  !! derivatives d(.)'/dp' become d(.)/dp = u d(.)'/dp' dp'/dp (dp'/dp = sens%pscale; u the
+  !! unit of each row, multiplied, or with divide divided); with back, the inverse.
+  subroutine sens_units(m, sens, a, u, divide, back)
+    type(model_t), intent(in) :: m              !! model (its length unit lref)
+    type(sens_t), intent(in) :: sens            !! parameters (pscale)
+    real(wp), intent(inout) :: a(:, :, :)       !! (rows, np, outputs)
+    real(wp), intent(in) :: u(:)                !! unit of each row
+    logical, intent(in) :: divide               !! divide by u
+    logical, intent(in), optional :: back       !! the inverse conversion
+    integer :: k, j
+    logical :: inv
+    if (.not. (m%lref > one .or. m%lref < one)) return
+    inv = .false.
+    if (present(back)) inv = back
+    do j = 1, size(a, 3)
+      do k = 1, size(a, 2)
+        if (divide .neqv. inv) then
+          a(:, k, j) = a(:, k, j) / u
+        else
+          a(:, k, j) = a(:, k, j) * u
+        end if
+        if (inv) then
+          a(:, k, j) = a(:, k, j) / sens%pscale(k)
+        else
+          a(:, k, j) = a(:, k, j) * sens%pscale(k)
+        end if
+      end do
+    end do
+  end subroutine sens_units
+
+  !> sens_units for one output (rows, np).
+  subroutine sens_units2(m, sens, a, u, divide)
+    type(model_t), intent(in) :: m              !! model
+    type(sens_t), intent(in) :: sens            !! parameters (pscale)
+    real(wp), intent(inout) :: a(:, :)          !! (rows, np)
+    real(wp), intent(in) :: u(:)                !! unit of each row
+    logical, intent(in) :: divide               !! divide by u
+    real(wp) :: b(size(a, 1), size(a, 2), 1)
+    b(:, :, 1) = a
+    call sens_units(m, sens, b, u, divide)
+    a = b(:, :, 1)
+  end subroutine sens_units2
+
+  !> The residual rep%resid in model units (that of the worst constraint's first row).
+  pure real(wp) function resid_units(m, resid, worst)
+    type(model_t), intent(in) :: m              !! model
+    real(wp), intent(in) :: resid               !! residual in the core's units
+    integer, intent(in) :: worst                !! constraint it belongs to (0: unknown)
+    resid_units = resid * m%lref
+    if (worst > 0 .and. worst <= m%nc) resid_units = resid * m%rowunit(m%row0(worst))
+  end function resid_units
 
   !> Phi, J, nu and gamma at (q, q_dot, t).
   subroutine api_eval(nb, ctab, rpar, q, qd, t, phi, jac, nu, gam, status, msg, bad)
@@ -153,7 +228,7 @@ contains
     if (present(ptab)) then
       sq = zero; sqd = zero; sqdd = zero
     end if
-    call model_build(nb, ctab, rpar, m, status, msg, bad)
+    call model_build(nb, ctab, rpar, m, status, msg, bad, nondim=.true.)
     iinfo(2) = bad
     if (status /= MBD_OK) return
     if (present(ptab)) then
@@ -193,17 +268,22 @@ contains
     if (maxit > 0) opts%maxit = maxit
     if (tmin > zero) opts%tmin = tmin
     if (present(ptab)) then
-      call kin_run(m, q0, t0, t1, nsteps, opts, qout, qdout, qddout, rep, status, msg, sens, &
-                   sq, sqd, sqdd)
+      call kin_run(m, q0 / m%cunit, t0, t1, nsteps, opts, qout, qdout, qddout, rep, status, &
+                   msg, sens, sq, sqd, sqdd)
+      call sens_units(m, sens, sq, m%cunit, .false.); call sens_units(m, sens, sqd, m%cunit, .false.)
+      call sens_units(m, sens, sqdd, m%cunit, .false.)
     else
-      call kin_run(m, q0, t0, t1, nsteps, opts, qout, qdout, qddout, rep, status, msg)
+      call kin_run(m, q0 / m%cunit, t0, t1, nsteps, opts, qout, qdout, qddout, rep, status, msg)
     end if
+    call units(m, qout, m%cunit, .false.); call units(m, qdout, m%cunit, .false.)
+    call units(m, qddout, m%cunit, .false.)
     iinfo(1) = rep%ndone; iinfo(3) = rep%driver; iinfo(4) = rep%worst
     iinfo(5) = rep%deficiency; iinfo(6) = rep%newton_its; iinfo(7) = rep%lu_count
     iinfo(8) = rep%rejected; iinfo(9) = rep%rank; iinfo(10) = rep%npass
-    rinfo(1) = rep%t_fail; rinfo(2) = rep%smin; rinfo(3) = rep%smax; rinfo(4) = rep%resid
+    rinfo(1) = rep%t_fail; rinfo(2) = rep%smin; rinfo(3) = rep%smax
+    rinfo(4) = resid_units(m, rep%resid, rep%worst)
     rinfo(5) = rep%solver; rinfo(6) = rep%kl; rinfo(7) = rep%ku
-    if (allocated(rep%qsing)) qsing = rep%qsing
+    if (allocated(rep%qsing)) qsing = rep%qsing * m%cunit
     if (allocated(rep%dep)) dep = rep%dep
     if (allocated(rep%redundant)) redundant = rep%redundant
     tpass = rep%tpass
@@ -233,7 +313,7 @@ contains
     type(kin_work_t) :: w
     real(wp) :: h
     integer :: bad, lev
-    call model_build(nb, ctab, rpar, m, status, msg, bad)
+    call model_build(nb, ctab, rpar, m, status, msg, bad, nondim=.true.)
     if (status /= MBD_OK) return
     if (size(q) /= m%nq .or. size(qd) /= m%nq .or. size(qdd) /= m%nq .or. m%neq /= m%nq) then
       status = MBD_BAD_COUNT
@@ -249,21 +329,27 @@ contains
     if (maxit > 0) opts%maxit = maxit
     call kin_work_init(m, w)
     w%tol = opts%tol * m%lscale
-    if (assemble == 1) then
-      allocate (rep%qsing(m%nq), rep%dep(m%neq), rep%redundant(m%neq))
-      call kin_assemble(m, w, q, t, opts, rep, status, msg)
-      if (status /= MBD_OK) return
-    else
-      h = t - t_prev
-      q = q + h * (qd + (0.5_wp * h) * qdd)     ! q(t) ~ q + h q_dot + h**2/2 q_ddot
-    end if
-    call kin_newton(m, w, q, t, opts%maxit, status)
-    if (status /= MBD_OK) then
-      write (msg, '(a,es22.15)') 'Newton-Raphson failed (or J is singular) at t = ', t
-      return
-    end if
-    call kin_vel_acc(m, w, q, t, qd, qdd, status, lev)
-    if (status /= MBD_OK) msg = 'velocities or accelerations could not be solved'
+    q = q / m%cunit; qd = qd / m%cunit; qdd = qdd / m%cunit
+    call step()
+    q = q * m%cunit; qd = qd * m%cunit; qdd = qdd * m%cunit
+  contains
+    subroutine step()
+      if (assemble == 1) then
+        allocate (rep%qsing(m%nq), rep%dep(m%neq), rep%redundant(m%neq))
+        call kin_assemble(m, w, q, t, opts, rep, status, msg)
+        if (status /= MBD_OK) return
+      else
+        h = t - t_prev
+        q = q + h * (qd + (0.5_wp * h) * qdd)     ! q(t) ~ q + h q_dot + h**2/2 q_ddot
+      end if
+      call kin_newton(m, w, q, t, opts%maxit, status)
+      if (status /= MBD_OK) then
+        write (msg, '(a,es22.15)') 'Newton-Raphson failed (or J is singular) at t = ', t
+        return
+      end if
+      call kin_vel_acc(m, w, q, t, qd, qdd, status, lev)
+      if (status /= MBD_OK) msg = 'velocities or accelerations could not be solved'
+    end subroutine step
   end subroutine api_kin_step
 
   !> Degrees of freedom and redundancy at the configuration assembled from q0 at time t:
@@ -292,7 +378,7 @@ contains
     type(kin_work_t) :: w
     integer :: bad
     q = zero; rank = 0; mobility = 0; redundant = 0; dep = 0; resid = zero; worst = 0
-    call model_build(nb, ctab, rpar, m, status, msg, bad)
+    call model_build(nb, ctab, rpar, m, status, msg, bad, nondim=.true.)
     worst = bad
     if (status /= MBD_OK) return
     if (.not. (finite(q0) .and. finite(t) .and. finite(tol))) then
@@ -307,14 +393,14 @@ contains
     w%tol = opts%tol * m%lscale
     allocate (rep%qsing(m%nq), rep%dep(m%neq), rep%redundant(m%neq))
     rep%qsing = zero; rep%dep = 0; rep%redundant = 0
-    q = q0
+    q = q0 / m%cunit
     call kin_assemble(m, w, q, t, opts, rep, status, msg)
-    resid = maxval(abs(w%phi)); worst = rep%worst; dep = rep%dep
+    resid = maxval(abs(w%phi) * m%rowunit); worst = rep%worst; dep = rep%dep
     if (status == MBD_INCONSISTENT) then
       rank = rep%rank; redundant = rep%redundant
     end if
-    if (status /= MBD_OK) return
-    call kin_rank(m, w, q, t, rank, mobility, redundant, status, msg)
+    if (status == MBD_OK) call kin_rank(m, w, q, t, rank, mobility, redundant, status, msg)
+    q = q * m%cunit
   end subroutine api_analyze
 
   !> Points c(alpha) of a cam profile in its body frame (for drawing), from raw parameters.
@@ -351,12 +437,14 @@ contains
     integer, intent(out) :: status, bad, badf
     character(len=MSG_LEN), intent(out) :: msg
     badf = 0
-    call model_build(nb, ctab, rpar, m, status, msg, bad)
+    call model_build(nb, ctab, rpar, m, status, msg, bad, nondim=.true., &
+                     lforce=model_force_size(ftab, fpar))
     if (status /= MBD_OK) return
     call model_add_dynamics(m, bmass, grav, ftab, fpar, status, msg, badf)
   end subroutine build_dynamic
 
-  !> Energies and constraint residuals at a state: [kinetic, potential, ||Phi||, ||J q_dot - nu||].
+  !> Energies and constraint residuals at a state: [kinetic, potential, ||Phi||, ||J q_dot - nu||]
+  !! (the state in the core's units, the residuals in model units).
   subroutine state_measures(m, w, q, qd, t, e)
     type(model_t), intent(in) :: m
     type(dyn_work_t), intent(inout) :: w
@@ -364,8 +452,8 @@ contains
     real(wp), intent(out) :: e(4)
     real(wp) :: v
     call assemble_dense(m, q, w%qz, t, w%phi, w%nu, w%gam, w%asm, w%jac)
-    e(3) = maxval(abs(w%phi))
-    e(4) = maxval(abs(matmul(w%jac, qd) - w%nu))
+    e(3) = maxval(abs(w%phi) * m%rowunit)
+    e(4) = maxval(abs(matmul(w%jac, qd) - w%nu) * m%rowunit)
     call gen_forces(m, q, qd, t, w%force, v)
     e(1) = kinetic_energy(m, qd); e(2) = v
   end subroutine state_measures
@@ -427,19 +515,36 @@ contains
                           status, msg)
     end if
     if (iinfo(1) < 1) return
+    ! the multipliers in the core's units (so the rank decisions do not depend on the unit)
+    call units(m, qout, m%cunit, .true.); call units(m, qdout, m%cunit, .true.)
+    call units(m, qddout, m%cunit, .true.)
     call dyn_init(m, w, qout(:, 1), t0, 1.0e-12_wp, st, lmsg)
-    if (st /= MBD_OK) return
-    do k = 1, iinfo(1)
-      ! column k holds output min((k - 1) every, nsteps)
-      t = t0 + (t1 - t0) * (real(min((k - 1) * every, nsteps), wp) / max(nsteps, 1))
-      if (k == size(qout, 2)) t = t1
-      call dyn_multipliers(m, w, qout(:, k), qdout(:, k), qddout(:, k), t, lamout(:, k), st, lmsg)
-      call state_measures(m, w, qout(:, k), qdout(:, k), t, eout(:, k))
-      if (present(ptab)) call sens_multipliers(m, sens, qout(:, k), qdout(:, k), &
-                                               qddout(:, k), t, w%jac, lamout(:, k), &
-                                               sq(:, :, k), sqd(:, :, k), sqdd(:, :, k), &
-                                               slam(:, :, k), st, lmsg)
-    end do
+    if (present(ptab)) then
+      call sens_units(m, sens, sq, m%cunit, .false., back=.true.)
+      call sens_units(m, sens, sqd, m%cunit, .false., back=.true.)
+      call sens_units(m, sens, sqdd, m%cunit, .false., back=.true.)
+    end if
+    if (st == MBD_OK) then
+      do k = 1, iinfo(1)
+        ! column k holds output min((k - 1) every, nsteps)
+        t = t0 + (t1 - t0) * (real(min((k - 1) * every, nsteps), wp) / max(nsteps, 1))
+        if (k == size(qout, 2)) t = t1
+        call dyn_multipliers(m, w, qout(:, k), qdout(:, k), qddout(:, k), t, lamout(:, k), &
+                             st, lmsg)
+        call state_measures(m, w, qout(:, k), qdout(:, k), t, eout(:, k))
+        if (present(ptab)) call sens_multipliers(m, sens, qout(:, k), qdout(:, k), &
+                                                 qddout(:, k), t, w%jac, lamout(:, k), &
+                                                 sq(:, :, k), sqd(:, :, k), sqdd(:, :, k), &
+                                                 slam(:, :, k), st, lmsg)
+      end do
+    end if
+    call units(m, qout, m%cunit, .false.); call units(m, qdout, m%cunit, .false.)
+    call units(m, qddout, m%cunit, .false.); call units(m, lamout, m%rowunit, .true.)
+    if (present(ptab)) then
+      call sens_units(m, sens, sq, m%cunit, .false.); call sens_units(m, sens, sqd, m%cunit, .false.)
+      call sens_units(m, sens, sqdd, m%cunit, .false.)
+      call sens_units(m, sens, slam, m%rowunit, .true.)
+    end if
   end subroutine api_inverse
 
   !> Forward dynamics: assembly of q0, the velocity v0 projected onto J q_dot = nu (kinetic
@@ -497,7 +602,7 @@ contains
     lscale = m%lscale
     kw%tol = kopts%tol * lscale
     allocate (q(m%nq), qd(m%nq), rep%qsing(m%nq), rep%dep(m%neq), rep%redundant(m%neq))
-    q = q0
+    q = q0 / m%cunit
     call kin_assemble(m, kw, q, t0, kopts, rep, status, msg)
     if (status /= MBD_OK) then
       rinfo(1) = t0; return
@@ -508,7 +613,7 @@ contains
     do k = 1, m%neq
       if (.not. any(w%rows == k)) redundant(k) = 1
     end do
-    call dyn_velocity(m, w, q, t0, v0, qd, status)
+    call dyn_velocity(m, w, q, t0, v0 / m%cunit, qd, status)
     if (status /= MBD_OK) then
       msg = 'the initial velocities cannot be made consistent: the mass matrix is singular '// &
             'on the motions the constraints allow (a body without mass or inertia?)'
@@ -535,6 +640,8 @@ contains
       call dyn_multipliers(m, w, qout(:, k), qdout(:, k), qddout(:, k), t, lamout(:, k), st, lmsg)
       call state_measures(m, w, qout(:, k), qdout(:, k), t, eout(:, k))
     end do
+    call units(m, qout, m%cunit, .false.); call units(m, qdout, m%cunit, .false.)
+    call units(m, qddout, m%cunit, .false.); call units(m, lamout, m%rowunit, .true.)
   end subroutine api_dynamics
 
   !> Static equilibrium near the assembled q0 at time t, its multipliers and stability
@@ -573,12 +680,10 @@ contains
     lscale = m%lscale
     kw%tol = kopts%tol * lscale
     allocate (rep%qsing(m%nq), rep%dep(m%neq), rep%redundant(m%neq))
-    q = q0
+    q = q0 / m%cunit
     call kin_assemble(m, kw, q, t, kopts, rep, status, msg)
-    if (status /= MBD_OK) return
-    call dyn_init(m, w, q, t, kw%tol, status, msg)
-    if (status /= MBD_OK) return
-    if (present(ptab)) then
+    if (status == MBD_OK) call dyn_init(m, w, q, t, kw%tol, status, msg)
+    if (status == MBD_OK .and. present(ptab)) then
       sq = zero; slam = zero
       if (any(shape(sq) /= [m%nq, size(ptab, 2)]) .or. &
           any(shape(slam) /= [m%neq, size(ptab, 2)])) then
@@ -589,9 +694,13 @@ contains
         iinfo(2) = -2000000 - bad; return
       end if
     end if
-    call statics_solve(m, w, q, t, lam, stable, resid, status, msg)
-    if (status /= MBD_OK .or. .not. present(ptab)) return
-    call sens_statics(m, sens, w%rows, q, t, lam, sq, slam, status, msg)
+    if (status == MBD_OK) call statics_solve(m, w, q, t, lam, stable, resid, status, msg)
+    if (status == MBD_OK .and. present(ptab)) then
+      call sens_statics(m, sens, w%rows, q, t, lam, sq, slam, status, msg)
+      call sens_units2(m, sens, sq, m%cunit, .false.)
+      call sens_units2(m, sens, slam, m%rowunit, .true.)
+    end if
+    q = q * m%cunit; lam = lam / m%rowunit
   end subroutine api_statics
 
   !> Reactions of every constraint at many states: reac(6, nc, nt) global
@@ -764,7 +873,7 @@ contains
     if (st /= 0) then
       status = MBD_NO_MEMORY; msg = 'out of memory'; return
     end if
-    q = q0
+    q = q0 / m%cunit
     call kin_assemble(m, kw, q, t0, kopts, rep, status, msg)
     if (status /= MBD_OK) then
       rinfo(1) = t0; return
@@ -775,7 +884,7 @@ contains
     do k = 1, m%neq
       if (.not. any(w%rows == k)) redundant(k) = 1
     end do
-    call dyn_velocity(m, w, q, t0, v0, qd, status)
+    call dyn_velocity(m, w, q, t0, v0 / m%cunit, qd, status)
     if (status /= MBD_OK) then
       msg = 'the initial velocities cannot be made consistent: the mass matrix is singular '// &
             'on the motions the constraints allow (a body without mass or inertia?)'
@@ -799,6 +908,10 @@ contains
       call dyn_multipliers(m, w, qout(:, k), qdout(:, k), qddout(:, k), t, lamout(:, k), st, lmsg)
       call state_measures(m, w, qout(:, k), qdout(:, k), t, eout(:, k))
     end do
+    call units(m, qout, m%cunit, .false.); call units(m, qdout, m%cunit, .false.)
+    call units(m, qddout, m%cunit, .false.); call units(m, lamout, m%rowunit, .true.)
+    call sens_units(m, sens, sq, m%cunit, .false.); call sens_units(m, sens, sqd, m%cunit, .false.)
+    call sens_units(m, sens, sqdd, m%cunit, .false.)
   end subroutine api_dynamics_sens
 
 end module mbd_api

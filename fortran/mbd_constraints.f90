@@ -14,7 +14,8 @@ module mbd_constraints
   use mbd_status, only: MBD_OK, MBD_BAD_INPUT, MBD_BAD_PARAM, MBD_NO_MEMORY, MSG_LEN
   use mbd_points, only: NLOC, MAXROW, kloc
   use mbd_dual, only: dloc
-  use mbd_functions, only: fun_length, fun_check, fun_is_count
+  use mbd_functions, only: fun_length, fun_check, fun_exponents, fun_is_count
+  use mbd_profiles, only: profile_exponents
   use mbd_joint_revolute, only: revolute_prepare, revolute_eval, revolute_eval_d
   use mbd_joint_translational, only: translational_prepare, translational_eval, &
                                      translational_prepare_d, translational_eval_d
@@ -24,7 +25,7 @@ module mbd_constraints
   use mbd_joint_point_line, only: point_line_prepare, point_line_eval, point_line_prepare_d, &
                                   point_line_eval_d
   use mbd_joint_weld, only: weld_prepare, weld_eval, weld_eval_d
-  use mbd_joint_gear, only: gear_prepare, gear_eval, gear_eval_d
+  use mbd_joint_gear, only: gear_prepare, gear_eval, GEAR_RAW_LEN, gear_prepare_d, gear_eval_d
   use mbd_joint_rolling, only: rolling_prepare, rolling_eval, rolling_prepare_d, rolling_eval_d
   use mbd_drivers, only: driver_eval, driver_eval_d, DRV_ABS, DRV_REL_ANGLE, DRV_REL_DIST, &
                          TRANS_PREP_LEN
@@ -33,7 +34,7 @@ module mbd_constraints
   public :: CON_REVOLUTE, CON_TRANSLATIONAL, CON_CAM, CON_DISTANCE, CON_POINT_LINE, CON_WELD, &
             CON_GEAR, CON_RACK, CON_ROLLING, CON_ABSOLUTE, DRV_ABS, DRV_REL_ANGLE, DRV_REL_DIST
   public :: con_known, con_nrow, con_nextra, con_is_driver, con_raw_length, con_prepare
-  public :: con_eval, con_init_extra, con_name
+  public :: con_eval, con_init_extra, con_name, con_exponents, con_row_power
   public :: con_is_count, con_prepare_d, con_eval_d, con_linear, con_affine_r
 
   integer, parameter :: CON_REVOLUTE = 1, CON_TRANSLATIONAL = 2, CON_CAM = 3, CON_DISTANCE = 4
@@ -106,12 +107,70 @@ contains
     case (CON_CAM); con_raw_length = cam_raw_length(suba, raw)
     case (CON_DISTANCE, CON_WELD); con_raw_length = 5
     case (CON_POINT_LINE); con_raw_length = 7
-    case (CON_GEAR); con_raw_length = 3
+    case (CON_GEAR); con_raw_length = GEAR_RAW_LEN
     case (CON_RACK, CON_ROLLING); con_raw_length = 8
     case (CON_ABSOLUTE); con_raw_length = 1
     case default; con_raw_length = fun_length(raw)
     end select
   end function con_raw_length
+
+  !> Length exponents of the raw parameters (a nondimensional model, mbd_model, divides each
+  !! length by L: p L**ex with ex = -1 for a length, 0 for an angle, a direction or a count),
+  !! and which of them are the model's geometry (points, sizes, positions: they set L).
+  !! Driver functions scale with what they drive; extra coordinates (cam alpha) are angles.
+  pure subroutine con_exponents(kind, suba, subb, raw, ex, geom)
+    integer, intent(in) :: kind, suba, subb  !! kind and sub-kinds
+    real(wp), intent(in) :: raw(:)           !! raw parameters (well formed, exact length)
+    integer, intent(out) :: ex(:)            !! exponents (size(raw))
+    logical, intent(out) :: geom(:)          !! geometry entries (size(raw))
+    ex = 0
+    select case (kind)
+    case (CON_REVOLUTE, CON_DISTANCE)
+      ex = -1
+    case (CON_TRANSLATIONAL)
+      ex(1:4) = -1
+    case (CON_CAM)
+      ex(1:2) = -1
+      if (subb == 2) ex(3) = -1                      ! roller radius
+      call profile_exponents(suba, raw(5:), ex(5:))
+    case (CON_POINT_LINE)
+      ex(1:4) = -1; ex(7) = -1
+    case (CON_WELD)
+      ex(1:4) = -1
+    case (CON_GEAR)
+      ex = -1; ex(4) = 0                             ! [R_i, R_j, phase, angle, centres]
+    case (CON_RACK, CON_ROLLING)
+      ex = -1; ex(5:6) = 0                           ! [c, p, u (a direction), R, phase]
+    case (CON_ABSOLUTE)
+      if (suba <= 2) ex = -1
+    case (DRV_ABS)
+      if (suba <= 2) call fun_exponents(raw, -1, ex)
+    case (DRV_REL_DIST)
+      call fun_exponents(raw, -1, ex)
+    end select
+    geom = ex == -1 .and. .not. con_is_driver(kind)
+    if (kind == CON_GEAR) geom(3) = .false.          ! phases are not sizes
+    if (kind == CON_RACK .or. kind == CON_ROLLING) geom(8) = .false.
+  end subroutine con_exponents
+
+  !> Length power of row r (1-based) of a constraint: Phi scales as L**power.
+  pure integer function con_row_power(kind, suba, r)
+    integer, intent(in) :: kind, suba, r   !! kind, first sub-kind, row
+    select case (kind)
+    case (CON_TRANSLATIONAL)
+      con_row_power = merge(1, 0, r == 1)
+    case (CON_DISTANCE)
+      con_row_power = 2                              ! d . d - L**2
+    case (CON_WELD)
+      con_row_power = merge(1, 0, r <= 2)
+    case (CON_ABSOLUTE, DRV_ABS)
+      con_row_power = merge(1, 0, suba <= 2)
+    case (DRV_REL_ANGLE)
+      con_row_power = 0
+    case default
+      con_row_power = 1
+    end select
+  end function con_row_power
 
   !> Check raw parameters and build the prepared ones. ref: the prepared parameters of
   !! the translational joint a relative-distance driver refers to.
@@ -212,11 +271,11 @@ contains
   end subroutine con_init_extra
 
   !> Phi is linear in q (J constant, gamma free of q): absolute constraints and drivers,
-  !! relative-angle drivers, gears. Their second derivatives in q vanish.
+  !! relative-angle drivers. Their second derivatives in q vanish.
   pure logical function con_linear(kind)
     integer, intent(in) :: kind   !! kind code
     select case (kind)
-    case (CON_ABSOLUTE, CON_GEAR, DRV_ABS, DRV_REL_ANGLE)
+    case (CON_ABSOLUTE, DRV_ABS, DRV_REL_ANGLE)
       con_linear = .true.
     case default
       con_linear = .false.
@@ -267,6 +326,7 @@ contains
       call cam_prepare_d(suba, subb, raw, j, tprep, status, msg)
       return
     case (CON_TRANSLATIONAL); n = 9
+    case (CON_GEAR); n = 12
     case (CON_POINT_LINE); n = 7
     case (CON_RACK, CON_ROLLING); n = 8
     case (CON_ABSOLUTE); n = 3
@@ -281,6 +341,8 @@ contains
     select case (kind)
     case (CON_TRANSLATIONAL)
       call translational_prepare_d(raw, j, tprep)
+    case (CON_GEAR)
+      call gear_prepare_d(subb, raw, j, tprep)
     case (CON_POINT_LINE)
       call point_line_prepare_d(raw, j, tprep)
     case (CON_RACK, CON_ROLLING)

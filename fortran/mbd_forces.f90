@@ -19,13 +19,14 @@ module mbd_forces
   use mbd_status, only: MBD_OK, MBD_BAD_PARAM, MSG_LEN
   use mbd_points, only: NLOC, kloc, local_state, kvec, kscal, body_point, body_angle, vsub, &
                         vdot, ssqrt, ssub
-  use mbd_functions, only: fun_eval, fun_length, fun_check, fun_eval_d, fun_is_count
+  use mbd_functions, only: fun_eval, fun_length, fun_check, fun_exponents, fun_eval_d, &
+                           fun_is_count
   use mbd_dual, only: dloc, dvec, dscal, dual_state, body_point, body_angle, vsub, vdot, ssqrt, &
                       ssub
   implicit none
   private
   public :: FRC_SPRING, FRC_TORQUE, FRC_POINT, FRC_ROTSPRING
-  public :: force_known, force_raw_length, force_prepare, force_eval
+  public :: force_known, force_raw_length, force_prepare, force_eval, force_exponents
   public :: force_is_count, force_eval_d
 
   integer, parameter :: FRC_SPRING = 1, FRC_TORQUE = 2, FRC_POINT = 3, FRC_ROTSPRING = 4
@@ -96,6 +97,28 @@ contains
     end select
     if (status == MBD_OK) prep = raw
   end subroutine force_prepare
+
+  !> Length exponents e of the raw parameters of a nondimensional model (mbd_model): a
+  !! parameter p becomes p L**e. With lengths over L, masses m L**2 and forces F L (the
+  !! generalized forces conjugate to x / L), stiffness and damping of a spring take L**2, its
+  !! points and free length L**-1, its actuator force L; torques and rotational springs stay.
+  pure subroutine force_exponents(kind, raw, ex)
+    integer, intent(in) :: kind      !! force kind
+    real(wp), intent(in) :: raw(:)   !! raw parameters (well formed, exact length)
+    integer, intent(out) :: ex(:)    !! exponents (size(raw))
+    integer :: nf
+    ex = 0
+    select case (kind)
+    case (FRC_SPRING)
+      ex(1:4) = -1; ex(5:6) = 2; ex(7) = -1
+      call fun_exponents(raw(8:), 1, ex(8:))
+    case (FRC_POINT)
+      ex(1:2) = -1
+      nf = fun_length(raw(3:))
+      call fun_exponents(raw(3:), 1, ex(3:))
+      call fun_exponents(raw(3 + nf:), 1, ex(3 + nf:))
+    end select
+  end subroutine force_exponents
 
   !> Generalized force over the local slots and potential energy of one element.
   pure subroutine force_eval(kind, p, si, sj, ql, qdl, t, ql_force, v, vload)

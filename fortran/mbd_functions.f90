@@ -8,7 +8,7 @@ module mbd_functions
   use mbd_status, only: MBD_OK, MBD_BAD_PARAM, MSG_LEN
   implicit none
   private
-  public :: fun_eval, fun_check, fun_length, fun_eval_d, fun_is_count
+  public :: fun_eval, fun_check, fun_length, fun_exponents, fun_eval_d, fun_is_count
 
   real(wp), parameter :: FMAX = 1.0e100_wp   !! largest coefficient
   real(wp), parameter :: OMAX = 1.0e12_wp    !! largest angular frequency
@@ -71,6 +71,23 @@ contains
       end do
     end function harmonics_ok
   end subroutine fun_check
+
+  !> Length exponents of an encoded function (see mbd_model, nondimensional models): e on
+  !! the coefficients c_k and the amplitudes A_h (f is scaled as a whole), 0 on the counts,
+  !! the frequencies and the phases. Entries past the function are left as they are.
+  pure subroutine fun_exponents(p, e, ex)
+    real(wp), intent(in) :: p(:)       !! encoded function (well formed)
+    integer, intent(in) :: e           !! exponent of f
+    integer, intent(inout) :: ex(:)    !! exponents (size(p))
+    integer :: np, nh, k, o
+    np = nint(p(1))
+    ex(1) = 0; ex(2:np + 1) = e; ex(np + 2) = 0
+    nh = nint(p(np + 2))
+    do k = 1, nh
+      o = np + 2 + 3 * (k - 1)
+      ex(o + 1) = e; ex(o + 2:o + 3) = 0
+    end do
+  end subroutine fun_exponents
 
   !> f(t), f'(t), f''(t).
   pure subroutine fun_eval(p, t, f, f1, f2)

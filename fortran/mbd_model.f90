@@ -18,23 +18,38 @@
 !!   ftab(NFT, nf)    one column per force element: 1 kind, 2 body i, 3 body j (0 = ground),
 !!                    4 offset of its raw parameters in fpar, 5 their number, 6 reserved
 !!   fpar(:)          raw force parameters (layouts in mbd_forces)
+!! Nondimensional models (model_build with nondim): the analyses work in units of the model's
+!! length scale L (lref: the largest joint point, size or position, or with forces spring
+!! point or length, rounded down to a power of 2; 1 when there is none), so every tolerance
+!! and rank test is the same for a mechanism in micrometres or in
+!! thousands of kilometres. Lengths are divided by L, masses multiplied by L**2, forces by L
+!! (the generalized forces conjugate to x / L; each parameter p becomes p L**e, e from
+!! con_exponents and force_exponents), gravity divided by L; angles, inertias, torques,
+!! times and energies are unchanged. Back in model units: q = q' cunit, and lambda =
+!! lambda' / rowunit (rowunit = L**power of each row's Phi). Powers of 2 make every
+!! conversion exact. The largest length must lie in [LSCALE_MIN, LSCALE_MAX].
 module mbd_model
   use mbd_kinds, only: wp, one
   use mbd_status, only: MBD_OK, MBD_BAD_INPUT, MBD_BAD_BODY, MBD_BAD_PARAM, MSG_LEN
   use mbd_points, only: NLOC
   use mbd_constraints, only: con_known, con_nrow, con_nextra, con_raw_length, &
-                             con_prepare, con_name, CON_REVOLUTE, CON_TRANSLATIONAL, CON_CAM, &
+                             con_prepare, con_name, con_exponents, con_row_power, &
+                             CON_REVOLUTE, CON_TRANSLATIONAL, CON_CAM, &
                              CON_GEAR, CON_ABSOLUTE, CON_POINT_LINE, DRV_ABS, DRV_REL_DIST
   use mbd_joint_gear, only: CARRIER_SLOT
-  use mbd_forces, only: force_known, force_raw_length, force_prepare, FRC_TORQUE, FRC_POINT
+  use mbd_forces, only: force_known, force_raw_length, force_prepare, force_exponents, &
+                        FRC_TORQUE, FRC_POINT
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   implicit none
   private
   public :: NCT, NFT, model_t, model_build, model_slots, model_add_dynamics
+  public :: LSCALE_MIN, LSCALE_MAX, model_force_size
 
   integer, parameter :: NCT = 8   !! rows of the constraint table
   integer, parameter :: NFT = 6   !! rows of the force table
   integer, parameter :: MAX_BODIES = 1000000   !! keeps 3 nb and the row counts in range
+  !> the range of length scales a nondimensional model accepts (model units)
+  real(wp), parameter :: LSCALE_MIN = 1.0e-12_wp, LSCALE_MAX = 1.0e12_wp
 
   !> A built model: constraint data in prepared form and the row and column maps.
   type :: model_t
@@ -52,6 +67,9 @@ module mbd_model
     integer, allocatable :: con_of_row(:) !! constraint owning each row
     real(wp), allocatable :: p(:)         !! prepared parameter pool
     real(wp) :: lscale = one              !! length scale of the model (tolerances)
+    real(wp) :: lref = one                !! unit of the core's lengths in model units (L)
+    real(wp), allocatable :: cunit(:)     !! (nq) unit of each coordinate: L for x, y; 1
+    real(wp), allocatable :: rowunit(:)   !! (neq) unit of each row of Phi: L**power
     ! dynamics (model_add_dynamics)
     real(wp), allocatable :: mdiag(:)     !! diagonal mass matrix (nq; extras massless)
     real(wp) :: grav(2) = 0.0_wp          !! gravity
@@ -83,7 +101,7 @@ contains
 
   !> Validate the flat tables and build the model.
   !! bad returns the 1-based index of the offending constraint (0 when none or global).
-  subroutine model_build(nb, ctab, rpar, m, status, msg, bad)
+  subroutine model_build(nb, ctab, rpar, m, status, msg, bad, nondim, lforce)
     integer, intent(in) :: nb                   !! number of moving bodies
     integer, intent(in) :: ctab(:, :)           !! constraint table (NCT x nc)
     real(wp), intent(in) :: rpar(:)             !! raw parameters
@@ -91,8 +109,13 @@ contains
     integer, intent(out) :: status              !! MBD_OK or < 0
     character(len=MSG_LEN), intent(out) :: msg  !! what is wrong
     integer, intent(out) :: bad                 !! offending constraint, or 0
-    integer :: nc, k, kind, bi, bj, off, len, nexp, row, extra, ref, total
-    real(wp), allocatable :: prep(:), pool(:), refp(:)
+    logical, intent(in), optional :: nondim     !! in units of the length scale (see banner)
+    !> largest point or length of the force elements (model_force_size), also geometry
+    real(wp), intent(in), optional :: lforce
+    integer :: nc, k, kind, bi, bj, off, len, nexp, row, extra, ref, total, r, ist
+    real(wp), allocatable :: prep(:), pool(:), refp(:), raw(:), rref(:)
+    integer, allocatable :: ex(:)
+    logical, allocatable :: geom(:)
     character(len=MSG_LEN) :: sub
     character(len=16) :: ks
 
@@ -113,7 +136,14 @@ contains
     end if
     m%nb = nb; m%nc = nc
     allocate (m%kind(nc), m%suba(nc), m%subb(nc), m%bi(nc), m%bj(nc), m%row0(nc), &
-              m%nrow(nc), m%loc(NLOC, nc), m%po(nc), m%pn(nc))
+              m%nrow(nc), m%loc(NLOC, nc), m%po(nc), m%pn(nc), stat=ist)
+    if (ist /= 0) then
+      status = MBD_BAD_INPUT; msg = 'not enough memory for the model tables'; return
+    end if
+    if (present(nondim)) then
+      if (nondim) call choose_lref(status)
+      if (status /= MBD_OK) return
+    end if
     allocate (pool(0))
     row = 0; extra = 0; total = 0
     do k = 1, nc
@@ -193,26 +223,25 @@ contains
         msg = trim(con_name(kind)) // ' ' // trim(msg)
         return
       end if
+      raw = scaled(kind, ctab(4, k), ctab(5, k), rpar(off:off + len - 1))
       if (kind == DRV_REL_DIST) then
         ! prepare the referenced joint again to read its prepared parameters
-        call con_prepare(CON_TRANSLATIONAL, 0, 0, rpar(ctab(6, ref):ctab(6, ref) + 7), &
-                         [real(wp) ::], refp, status, sub)
+        rref = scaled(CON_TRANSLATIONAL, 0, 0, rpar(ctab(6, ref):ctab(6, ref) + 7))
+        call con_prepare(CON_TRANSLATIONAL, 0, 0, rref, [real(wp) ::], refp, status, sub)
         if (status == MBD_OK) then
-          call con_prepare(kind, ctab(4, k), ctab(5, k), rpar(off:off + len - 1), refp, prep, &
-                           status, sub)
+          call con_prepare(kind, ctab(4, k), ctab(5, k), raw, refp, prep, status, sub)
         end if
       else
-        call con_prepare(kind, ctab(4, k), ctab(5, k), rpar(off:off + len - 1), &
-                         [real(wp) ::], prep, status, sub)
+        call con_prepare(kind, ctab(4, k), ctab(5, k), raw, [real(wp) ::], prep, status, sub)
       end if
       if (status /= MBD_OK) then
         msg = trim(con_name(kind)) // ': ' // trim(sub); return
       end if
       ! length scale from joint points (cam: the follower point)
       if (kind == CON_REVOLUTE .or. kind == CON_TRANSLATIONAL .or. kind == CON_POINT_LINE) then
-        m%lscale = max(m%lscale, maxval(abs(rpar(off:off + 3))))
+        m%lscale = max(m%lscale, maxval(abs(raw(1:4))))
       else if (kind == CON_CAM) then
-        m%lscale = max(m%lscale, maxval(abs(rpar(off:off + 1))))
+        m%lscale = max(m%lscale, maxval(abs(raw(1:2))))
       end if
       m%kind(k) = kind; m%suba(k) = ctab(4, k); m%subb(k) = ctab(5, k)
       m%bi(k) = bi; m%bj(k) = bj
@@ -233,11 +262,99 @@ contains
     m%neq = row
     m%nq = 3 * nb + extra
     call move_alloc(pool, m%p)
-    allocate (m%con_of_row(m%neq))
+    allocate (m%con_of_row(m%neq), m%rowunit(m%neq), m%cunit(m%nq), stat=ist)
+    if (ist /= 0) then
+      status = MBD_BAD_INPUT; msg = 'not enough memory for the model tables'; return
+    end if
     do k = 1, nc
       m%con_of_row(m%row0(k):m%row0(k) + m%nrow(k) - 1) = k
+      do r = 1, m%nrow(k)
+        m%rowunit(m%row0(k) + r - 1) = m%lref**con_row_power(m%kind(k), m%suba(k), r)
+      end do
     end do
+    m%cunit = one
+    do k = 1, nb
+      m%cunit(3 * k - 2:3 * k - 1) = m%lref
+    end do
+
+  contains
+
+    !> Raw parameters in the model's units (p L**e; unchanged when L = 1).
+    function scaled(kd, sa, sb, rw) result(rs)
+      integer, intent(in) :: kd, sa, sb
+      real(wp), intent(in) :: rw(:)
+      real(wp) :: rs(size(rw))
+      integer :: e(size(rw))
+      logical :: g(size(rw))
+      rs = rw
+      if (.not. (m%lref > one .or. m%lref < one)) return
+      call con_exponents(kd, sa, sb, rw, e, g)
+      rs = rw * m%lref**e
+    end function scaled
+
+    !> L: the largest geometry entry of the well-formed constraints (and of the forces),
+    !! rounded down to a power of 2 (1 when there is none); a largest entry outside
+    !! [LSCALE_MIN, LSCALE_MAX] is a bad parameter (bad: the constraint that holds it).
+    subroutine choose_lref(st)
+      integer, intent(out) :: st
+      real(wp) :: big
+      integer :: kk, o, n, kd, kbig
+      st = MBD_OK; kbig = 0
+      big = 0.0_wp
+      do kk = 1, nc
+        kd = ctab(1, kk); o = ctab(6, kk); n = ctab(7, kk)
+        if (.not. con_known(kd) .or. .not. slice_ok(o, n, size(rpar))) cycle
+        if (con_raw_length(kd, ctab(4, kk), rpar(o:o + n - 1)) /= n) cycle
+        if (.not. all(ieee_is_finite(rpar(o:o + n - 1)))) cycle
+        if (kd == CON_CAM .and. (ctab(4, kk) < 1 .or. ctab(4, kk) > 3)) cycle
+        if (allocated(ex)) deallocate (ex, geom)
+        allocate (ex(n), geom(n), stat=ist)
+        if (ist /= 0) then
+          st = MBD_BAD_INPUT; msg = 'not enough memory for the model tables'; return
+        end if
+        call con_exponents(kd, ctab(4, kk), ctab(5, kk), rpar(o:o + n - 1), ex, geom)
+        if (any(geom)) then
+          if (maxval(abs(rpar(o:o + n - 1)), mask=geom) > big) then
+            big = maxval(abs(rpar(o:o + n - 1)), mask=geom); kbig = kk
+          end if
+        end if
+      end do
+      if (present(lforce)) then
+        if (lforce > big) then
+          big = lforce; kbig = 0
+        end if
+      end if
+      if (.not. (big > 0.0_wp)) return
+      if (big < LSCALE_MIN .or. big > LSCALE_MAX) then
+        st = MBD_BAD_PARAM; bad = kbig
+        write (msg, '(a,es9.2,a,es8.1,a,es8.1,a)') 'the model''s length scale (its largest '// &
+          'joint point, size or position) is ', big, '; mbd2d works with length scales '// &
+          'from ', LSCALE_MIN, ' to ', LSCALE_MAX, ': change the unit of length'
+        return
+      end if
+      m%lref = 2.0_wp**(exponent(big) - 1)     ! L <= big < 2 L
+    end subroutine choose_lref
   end subroutine model_build
+
+  !> The largest point or length of the well-formed force elements (spring points and free
+  !! lengths, points of point forces): geometry that sets a dynamic model's length scale.
+  pure real(wp) function model_force_size(ftab, fpar) result(big)
+    integer, intent(in) :: ftab(:, :)           !! (NFT, nf) force table
+    real(wp), intent(in) :: fpar(:)             !! raw force parameters
+    integer :: k, kind, off, len
+    integer :: ex(size(fpar))
+    big = 0.0_wp
+    if (size(ftab, 1) /= NFT) return
+    do k = 1, size(ftab, 2)
+      kind = ftab(1, k); off = ftab(4, k); len = ftab(5, k)
+      if (.not. force_known(kind) .or. .not. slice_ok(off, len, size(fpar))) cycle
+      if (force_raw_length(kind, fpar(off:off + len - 1)) /= len) cycle
+      if (.not. all(ieee_is_finite(fpar(off:off + len - 1)))) cycle
+      call force_exponents(kind, fpar(off:off + len - 1), ex(1:len))
+      if (any(ex(1:len) == -1)) &
+        big = max(big, maxval(abs(fpar(off:off + len - 1)), mask=ex(1:len) == -1))
+    end do
+  end function model_force_size
 
   !> Add masses, gravity and force elements to a built model (for dynamics and statics).
   !! bad returns the 1-based index of the offending force (0 when none, -k for body k).
@@ -250,8 +367,9 @@ contains
     integer, intent(out) :: status              !! MBD_OK or < 0
     character(len=MSG_LEN), intent(out) :: msg  !! what is wrong
     integer, intent(out) :: bad                 !! offending force (> 0) or body (< 0)
-    integer :: k, nf, kind, bi, bj, off, len, total
+    integer :: k, nf, kind, bi, bj, off, len, total, ist
     real(wp), allocatable :: prep(:), pool(:)
+    integer, allocatable :: ex(:)
     character(len=MSG_LEN) :: sub
     status = MBD_OK; msg = ''; bad = 0
     if (size(bmass, 1) /= 2 .or. size(bmass, 2) /= m%nb .or. size(ftab, 1) /= NFT) then
@@ -264,13 +382,22 @@ contains
         status = MBD_BAD_PARAM; bad = -k
         msg = 'mass and inertia must be finite and >= 0'; return
       end if
-      m%mdiag(3 * k - 2:3 * k - 1) = bmass(1, k)
+      m%mdiag(3 * k - 2:3 * k - 1) = bmass(1, k) * m%lref**2
       m%mdiag(3 * k) = bmass(2, k)
+      if (.not. ieee_is_finite(m%mdiag(3 * k - 2))) then
+        status = MBD_BAD_PARAM
+        write (msg, '(a,i0,a)') 'the mass of body ', k, ' is too large for the model''s '// &
+          'length scale'
+        return
+      end if
     end do
     if (.not. all(ieee_is_finite(grav))) then
       status = MBD_BAD_PARAM; msg = 'gravity must be finite'; return
     end if
-    m%grav = grav
+    m%grav = grav / m%lref
+    if (.not. all(ieee_is_finite(m%grav))) then
+      status = MBD_BAD_PARAM; msg = 'gravity is too large for the model''s length scale'; return
+    end if
     nf = size(ftab, 2)
     m%nf = nf
     allocate (m%fkind(nf), m%fbi(nf), m%fbj(nf), m%floc(NLOC, nf), m%fpo(nf), m%fpn(nf))
@@ -302,7 +429,17 @@ contains
       if (force_raw_length(kind, fpar(off:off + len - 1)) /= len) then
         status = MBD_BAD_PARAM; msg = 'force parameters are malformed'; return
       end if
-      call force_prepare(kind, fpar(off:off + len - 1), prep, status, sub)
+      allocate (ex(len), stat=ist)
+      if (ist /= 0) then
+        status = MBD_BAD_INPUT; msg = 'not enough memory for the force tables'; return
+      end if
+      call force_exponents(kind, fpar(off:off + len - 1), ex)
+      if (.not. all(ieee_is_finite(fpar(off:off + len - 1) * m%lref**ex))) then
+        status = MBD_BAD_PARAM
+        msg = 'a force parameter is too large for the model''s length scale'; return
+      end if
+      call force_prepare(kind, fpar(off:off + len - 1) * m%lref**ex, prep, status, sub)
+      deallocate (ex)
       if (status /= MBD_OK) then
         msg = sub; return
       end if

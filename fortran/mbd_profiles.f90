@@ -19,6 +19,7 @@ module mbd_profiles
   private
   public :: PROF_CIRCLE, PROF_SPLINE, PROF_FOURIER
   public :: profile_raw_length, profile_prepare, profile_eval, profile_normal, profile_check
+  public :: profile_exponents
   public :: profile_c4, profile_normal3, profile_eval_d, profile_normal_d, profile_prepare_d, &
             profile_is_count
 
@@ -48,6 +49,21 @@ contains
       if (size(p) >= 4 + 2 * n) profile_raw_length = 4 + 2 * n
     end select
   end function profile_raw_length
+
+  !> Length exponents of the raw parameters (-1: a length; 0: a count). alpha is an angle in
+  !! every kind, so a profile scales with its parameters.
+  pure subroutine profile_exponents(kind, p, ex)
+    integer, intent(in) :: kind     !! profile kind
+    real(wp), intent(in) :: p(:)    !! raw parameters (well formed, exact length)
+    integer, intent(out) :: ex(:)   !! exponents (size(p))
+    ex = -1
+    select case (kind)
+    case (PROF_SPLINE)
+      ex(1) = 0
+    case (PROF_FOURIER)
+      if (size(p) >= 3) ex(3) = 0
+    end select
+  end subroutine profile_exponents
 
   !> Turn raw parameters into the prepared form profile_eval reads.
   !! Circle and Fourier are used as given; a spline gets its periodic cubic coefficients:

@@ -26,9 +26,9 @@ module mbd_sensitivity
   use mbd_dual, only: dloc
   use mbd_model, only: model_t, NCT, NFT
   use mbd_constraints, only: con_eval_d, con_prepare_d, con_is_count, con_name, con_linear, &
-                             con_affine_r, &
+                             con_affine_r, con_exponents, &
                              CON_TRANSLATIONAL, DRV_REL_DIST
-  use mbd_forces, only: force_eval_d, force_is_count
+  use mbd_forces, only: force_eval_d, force_is_count, force_exponents
   implicit none
   private
   public :: sens_t, PT_RPAR, PT_MASS, PT_GRAV, PT_FPAR
@@ -42,6 +42,9 @@ module mbd_sensitivity
   type :: sens_t
     integer :: np = 0                        !! parameters
     integer, allocatable :: ptab(:, :)       !! (2, np) table and index of each
+    !> (np) dp'/dp: a nondimensional model (mbd_model) works with p' = p L**e; the
+    !! sensitivities the core computes are with respect to p'
+    real(wp), allocatable :: pscale(:)
     real(wp), allocatable :: tp(:, :)        !! (size(m%p), np) change of the prepared pool
     logical, allocatable :: caff(:, :)       !! (nc, np) the constraint's parameters change
     real(wp), allocatable :: tfp(:, :)       !! (size(m%fp), np) change of the force pool
@@ -88,8 +91,9 @@ contains
     integer, intent(out) :: bad                 !! offending parameter
     integer, intent(in), optional :: ftab(:, :) !! force table (NFT, nf), for dynamics
     real(wp), intent(in), optional :: fpar(:)   !! raw force parameters
-    real(wp), allocatable :: tprep(:)
+    real(wp), allocatable :: tprep(:), raw(:)
     integer :: k, i, c, d, j, off, len, st, nfp
+    integer, allocatable :: fe(:)
     logical :: dyn
     status = MBD_OK; msg = ''; bad = 0
     if (size(ptab, 1) /= 2) then
@@ -99,7 +103,7 @@ contains
     s%np = size(ptab, 2)
     nfp = 0
     if (dyn) nfp = size(m%fp)
-    allocate (s%ptab(2, s%np), s%tp(size(m%p), s%np), s%caff(m%nc, s%np), &
+    allocate (s%ptab(2, s%np), s%pscale(s%np), s%tp(size(m%p), s%np), s%caff(m%nc, s%np), &
               s%tfp(nfp, s%np), s%faff(m%nf, s%np), s%tmass(m%nq, s%np), s%tgrav(2, s%np), &
               s%hs(MAXROW, NLOC, NLOC, m%nc), s%hv(MAXROW, NLOC, m%nc), &
               s%ha(MAXROW, NLOC, m%nc), s%phip(s%np, m%neq), s%vp(s%np, m%neq), &
@@ -113,7 +117,7 @@ contains
     s%ptab = ptab
     s%tp = zero; s%caff = .false.; s%tfp = zero; s%faff = .false.; s%tmass = zero
     s%tgrav = zero; s%hs = zero; s%hv = zero; s%ha = zero; s%zp = zero
-    s%cb = one; s%sb = zero; s%rhs = zero
+    s%cb = one; s%sb = zero; s%rhs = zero; s%pscale = one
     do k = 1, s%np
       bad = k
       i = ptab(2, k)
@@ -130,8 +134,9 @@ contains
         if (con_is_count(ctab(1, c), ctab(4, c), rpar(off:off + len - 1), j)) then
           call fail('is a count, not a continuous parameter'); return
         end if
-        call con_prepare_d(ctab(1, c), ctab(4, c), ctab(5, c), rpar(off:off + len - 1), j, &
-                           tprep, status, msg)
+        raw = scaled_raw(ctab(1, c), ctab(4, c), ctab(5, c), rpar(off:off + len - 1), j, &
+                         s%pscale(k))
+        call con_prepare_d(ctab(1, c), ctab(4, c), ctab(5, c), raw, j, tprep, status, msg)
         if (status /= MBD_OK) return
         call put_prep(c, tprep, k)
         if (ctab(1, c) == CON_TRANSLATIONAL) then
@@ -150,6 +155,7 @@ contains
         c = (i + 1) / 2
         if (mod(i, 2) == 1) then
           s%tmass(3 * c - 2:3 * c - 1, k) = one
+          s%pscale(k) = m%lref**2                  ! masses x L**2
         else
           s%tmass(3 * c, k) = one
         end if
@@ -158,6 +164,7 @@ contains
           call fail('gravity index must be 1 or 2'); return
         end if
         s%tgrav(i, k) = one
+        s%pscale(k) = one / m%lref                 ! gravity / L
       case (PT_FPAR)
         if (.not. dyn) cycle            ! no forces in a kinematic model: no change
         if (i < 1 .or. i > size(fpar)) then
@@ -173,6 +180,13 @@ contains
         end if
         s%tfp(m%fpo(c) + j - 1, k) = one          ! forces: prepared = raw
         s%faff(c, k) = .true.
+        allocate (fe(ftab(5, c)), stat=st)
+        if (st /= 0) then
+          status = MBD_NO_MEMORY; msg = 'out of memory'; return
+        end if
+        call force_exponents(ftab(1, c), fpar(ftab(4, c):ftab(4, c) + ftab(5, c) - 1), fe)
+        s%pscale(k) = m%lref**fe(j)
+        deallocate (fe)
       case default
         call fail('unknown parameter table (1 constraints, 2 masses, 3 gravity, 4 forces)')
         return
@@ -180,6 +194,22 @@ contains
     end do
     bad = 0
   contains
+    !> A constraint's raw parameters as the nondimensional model has them (p L**e), and the
+    !! factor dp'/dp = L**e of entry jj.
+    function scaled_raw(kd, sa, sb, rw, jj, f) result(rs)
+      integer, intent(in) :: kd, sa, sb, jj
+      real(wp), intent(in) :: rw(:)
+      real(wp), intent(out) :: f
+      real(wp) :: rs(size(rw))
+      integer :: e(size(rw))
+      logical :: g(size(rw))
+      rs = rw; f = one
+      if (.not. (m%lref > one .or. m%lref < one)) return
+      call con_exponents(kd, sa, sb, rw, e, g)
+      rs = rw * m%lref**e
+      f = m%lref**e(jj)
+    end function scaled_raw
+
     !> The element whose slice [off, off + len) holds index ii (0 when none).
     pure integer function owner(offs, lens, ii)
       integer, intent(in) :: offs(:), lens(:), ii

@@ -1,17 +1,27 @@
 !> mbd_statics: static equilibrium under gravity, springs and applied loads.
 !!
-!! An equilibrium is a stationary point of the total potential V(q) (gravity, springs, and
-!! the loads frozen at time t) on the constraint manifold Phi(q, t) = 0:
-!!   J^T lambda = Q(q, 0, t),  Phi(q, t) = 0.
-!! The search is a saddle-free Newton method on the manifold: with N an orthonormal basis of
-!! the null space of J (SVD) and K = d(J^T lambda - Q)/dq (central differences), the reduced
-!! Hessian H = N^T K N has its eigenvalues replaced by their absolute values (bounded away
-!! from zero), the step N dz with H dz = N^T Q is projected back onto Phi = 0, and a
-!! backtracking line search keeps V decreasing. So it converges to a stable equilibrium from
-!! any start on the manifold; the signs of the eigenvalues of H there give the stability.
+!! An equilibrium solves the equilibrium equations on the constraint manifold
+!!   Q(q, 0, t) - J^T lambda = 0,   Phi(q, t) = 0,
+!! i.e. the reduced load g = N^T Q vanishes (N an orthonormal basis of the null space of J,
+!! by SVD; N^T J^T = 0, so lambda drops out). Convergence is decided on g and Phi, never on
+!! the potential V(q) (gravity, springs, the loads frozen at t): near an equilibrium V changes
+!! by less than its own rounding error (about eps |V|, which grows with any constant added
+!! to V), while g keeps resolving the equilibrium to round-off.
+!! Each step is a Newton step of the equilibrium equations (Haug ch. 6; Nocedal and Wright
+!! ch. 18, the null-space method): with K = d(J^T lambda - Q)/dq (central differences,
+!! lambda the least-squares multipliers) and H = N^T K_sym N the reduced stiffness,
+!!   dq = dq_n + N dz,  dq_n = -J^+ Phi (minimum-norm),  H dz = g - N^T K dq_n.
+!! Globalisation (saddle-free): far from an equilibrium H's eigenvalues are replaced by their
+!! absolute values (bounded away from zero), the step is projected onto Phi = 0 and a
+!! backtracking line search keeps V decreasing, so the search goes downhill to a stable
+!! equilibrium from any start. Once the decrease of V a full step predicts, g^T dz, is within
+!! 100 times V's rounding error (V can no longer judge a step), full Newton steps follow while
+!! they reduce the residual of the equilibrium equations, ||g|| / F + ||Phi|| / l (F the
+!! force scale, l the model's length scale), and stop where it no longer halves: round-off.
+!! The signs of the eigenvalues of H at the end give the stability.
 module mbd_statics
-  use mbd_kinds, only: wp, zero, one, half
-  use mbd_status, only: MBD_OK, MBD_NO_CONVERGENCE, MBD_SINGULAR, MSG_LEN
+  use mbd_kinds, only: wp, zero, one, half, eps
+  use mbd_status, only: MBD_OK, MBD_NO_CONVERGENCE, MBD_LAPACK, MSG_LEN
   use mbd_model, only: model_t
   use mbd_assemble, only: assemble_dense
   use mbd_lapack, only: dgesvd, dsyev
@@ -20,6 +30,14 @@ module mbd_statics
   implicit none
   private
   public :: statics_solve
+
+  integer, parameter :: MAXIT = 200          !! steps in all
+  integer, parameter :: MAXLS = 40           !! halvings of a line search
+  real(wp), parameter :: ARMIJO = 1.0e-4_wp  !! sufficient decrease of V
+  real(wp), parameter :: V_NOISE = 64 * eps  !! rounding error of V, relative to its terms
+  !> ||g|| / F above which no equilibrium was found (F: the largest load, Q or J^T lambda)
+  real(wp), parameter :: RESID_FAIL = 1.0e-8_wp
+  real(wp), parameter :: RANK_TOL = 1.0e-10_wp  !! singular values of J taken as zero
 
 contains
 
@@ -32,78 +50,177 @@ contains
     real(wp), intent(in) :: t                   !! time (drivers and loads are held here)
     real(wp), intent(out) :: lam(:)             !! multipliers (neq)
     integer, intent(out) :: stable              !! stability of the equilibrium
-    real(wp), intent(out) :: resid              !! final ||N^T Q||
-    integer, intent(out) :: status              !! MBD_OK, MBD_NO_CONVERGENCE, MBD_SINGULAR
+    real(wp), intent(out) :: resid              !! final ||N^T Q||_inf / F (F: the loads)
+    integer, intent(out) :: status              !! MBD_OK, MBD_NO_CONVERGENCE, MBD_LAPACK
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
-    real(wp), allocatable :: nb(:, :), h(:, :), ev(:), g(:), dz(:)
-    real(wp) :: kt(m%nq, m%nq), ct(m%nq, m%nq), qt(m%nq), v0, vt, alpha, gscale, emax
-    integer :: it, ls, nfree, i, stp
+    real(wp), allocatable :: nb(:, :), h(:, :), ev(:), g(:), dz(:), dqn(:), kt(:, :), &
+                             ct(:, :), qt(:), ja(:, :), sv(:), u(:, :), vt(:, :), work(:)
+    real(wp) :: v0, vt1, alpha, emax, fscale, vnoise, e0, e1, gn, pn, slope
+    integer :: it, ls, nfree, n, na, stp, ist, nu
+    logical :: local
     character(len=MSG_LEN) :: lmsg
     status = MBD_OK; msg = ''; stable = 2; resid = zero
-    gscale = max(one, maxval(abs(m%mdiag)) * max(one, norm2(m%grav)))
+    n = m%nq; na = w%na; nu = min(na, n)
+    allocate (nb(n, n), h(n, n), ev(n), g(n), dz(n), dqn(n), kt(n, n), ct(n, n), qt(n), &
+              ja(max(na, 1), n), sv(max(nu, 1)), u(max(na, 1), max(nu, 1)), vt(n, n), &
+              work(1), stat=ist)
+    if (ist /= 0) then
+      status = MBD_NO_CONVERGENCE; msg = 'statics: not enough memory for the work arrays'
+      return
+    end if
     call dyn_project_pos(m, w, q, t, status)
     if (status /= MBD_OK) then
       msg = 'statics: the constraints cannot be satisfied near the estimates'; return
     end if
-    do it = 1, 200
-      call null_space(nb, nfree)
-      if (nfree == 0) exit                   ! nothing can move: q is the equilibrium
-      v0 = potential(q)
-      g = matmul(transpose(nb), w%force)     ! reduced load N^T Q (= -reduced gradient of V)
-      resid = maxval(abs(g))
-      if (resid <= 1.0e-11_wp * gscale) exit
-      call dyn_multipliers(m, w, q, w%qz, w%qz, t, lam, stp, lmsg)
-      call dyn_tangent(m, w, q, w%qz, t, lam, kt, ct)
-      h = matmul(transpose(nb), matmul(half * (kt + transpose(kt)), nb))
-      call eigen(h, ev, .true.)
-      ! saddle-free: |eigenvalues|, bounded below (a flat direction gets a gradient step
-      ! of about the model's length scale)
-      emax = max(1.0e-8_wp * maxval(abs(ev)), norm2(g) / m%lscale)
-      dz = matmul(transpose(h), g)
-      do i = 1, nfree
-        dz(i) = dz(i) / max(abs(ev(i)), emax)
-      end do
-      dz = matmul(h, dz)
-      alpha = one
-      do ls = 1, 40
-        qt = q + alpha * matmul(nb, dz)
-        call dyn_project_pos(m, w, qt, t, stp)
-        if (stp == MBD_OK) then
-          vt = potential(qt)
-          if (vt < v0 - 1.0e-4_wp * alpha * dot_product(g, dz) .or. &
-              vt <= v0 + 1.0e-14_wp * abs(v0) .and. ls > 30) exit
+    local = .false.
+    e0 = huge(one)
+    do it = 1, MAXIT
+      call reduce(q, status)                  ! N, g, lam, dq_n, H at q
+      if (status /= MBD_OK) return
+      if (nfree == 0) exit                    ! nothing can move: q is the equilibrium
+      gn = maxval(abs(g(1:nfree)))
+      if (.not. (gn > zero .or. maxval(abs(dqn)) > zero)) exit   ! exactly balanced
+      call newton_step()
+      if (.not. local) then
+        ! V can judge a step only while the decrease it predicts exceeds its rounding
+        slope = dot_product(g(1:nfree), dz(1:nfree))
+        if (slope <= 100 * vnoise) then
+          local = .true.
+        else
+          alpha = one
+          do ls = 1, MAXLS
+            qt = q + alpha * matmul(nb(:, 1:nfree), dz(1:nfree))
+            call dyn_project_pos(m, w, qt, t, stp)
+            if (stp == MBD_OK) then
+              vt1 = potential(qt)
+              if (vt1 < v0 - ARMIJO * alpha * slope) exit
+            end if
+            alpha = half * alpha
+          end do
+          if (ls > MAXLS) then
+            local = .true.                    ! no decrease V can resolve: polish by Newton
+          else
+            q = qt
+          end if
+          cycle
         end if
-        alpha = half * alpha
-      end do
-      if (ls > 40) exit
+      end if
+      ! local Newton on the equilibrium equations: full steps while the residual falls
+      e0 = merit(gn, pn)
+      qt = q + dqn + matmul(nb(:, 1:nfree), dz(1:nfree))
+      call reduce(qt, status)
+      if (status /= MBD_OK) return
+      if (nfree == 0) then
+        q = qt; exit
+      end if
+      e1 = merit(maxval(abs(g(1:nfree))), pn)
+      if (.not. (e1 < e0)) exit                ! no progress: round-off reached (q kept)
       q = qt
+      if (e1 > half * e0) exit                 ! progress stalls: round-off reached
     end do
-    call null_space(nb, nfree)
-    call dyn_multipliers(m, w, q, w%qz, w%qz, t, lam, stp, lmsg)
+    call reduce(q, status)
+    if (status /= MBD_OK) return
     if (nfree == 0) then
       stable = 2; resid = zero; return
     end if
-    g = matmul(transpose(nb), w%force)
-    resid = maxval(abs(g))
-    if (resid > 1.0e-8_wp * gscale) then
+    resid = maxval(abs(g(1:nfree))) / fscale
+    if (.not. (resid <= RESID_FAIL)) then
       status = MBD_NO_CONVERGENCE
-      write (msg, '(a,es10.3)') 'statics: no equilibrium found near the estimates; '// &
-        'unbalanced load ', resid
+      write (msg, '(a,es10.3,a)') 'statics: no equilibrium found near the estimates; the '// &
+        'unbalanced load is ', resid, ' times the loads'
       return
     end if
-    call dyn_tangent(m, w, q, w%qz, t, lam, kt, ct)
-    h = matmul(transpose(nb), matmul(half * (kt + transpose(kt)), nb))
-    call eigen(h, ev, .false.)
-    emax = max(maxval(abs(ev)), tiny(one))
-    if (minval(ev) > 1.0e-9_wp * emax) then
+    call eigen(h(1:nfree, 1:nfree), ev(1:nfree), .false., stp)
+    emax = max(maxval(abs(ev(1:nfree))), tiny(one))
+    if (minval(ev(1:nfree)) > 1.0e-9_wp * emax) then
       stable = 1
-    else if (minval(ev) < -1.0e-9_wp * emax) then
+    else if (minval(ev(1:nfree)) < -1.0e-9_wp * emax) then
       stable = 0
     else
       stable = -1
     end if
   contains
-    !> V at qa: gravity, springs and the loads frozen at t (also fills w%force at qa).
+    !> At qa: the null-space basis N (nb), the reduced load g = N^T Q, the least-squares
+    !! multipliers lam, the minimum-norm correction dq_n = -J^+ Phi (pn = ||Phi||_inf),
+    !! the force scale, V and its rounding error, and the reduced stiffness H (in h).
+    subroutine reduce(qa, st)
+      real(wp), intent(in) :: qa(:)
+      integer, intent(out) :: st
+      real(wp) :: wq(1), c(max(nu, 1))
+      integer :: info, rk, k, lw
+      st = MBD_OK
+      call dyn_multipliers(m, w, qa, w%qz, w%qz, t, lam, stp, lmsg)  ! also J and Q at qa
+      fscale = max(maxval(abs(w%force)), maxval(abs(matmul(lam, w%jac))), tiny(one))
+      pn = zero
+      if (na > 0) pn = maxval(abs(w%phi(w%rows)))
+      v0 = potential(qa)
+      vnoise = V_NOISE * (abs(v0) + scale_of_v(qa))
+      ! SVD of the active rows: J_a = U S V^T; N = the last columns of V
+      dqn = zero
+      rk = 0
+      if (na > 0) then
+        ja(1:na, :) = w%jac(w%rows, :)
+        call dgesvd('S', 'A', na, n, ja, size(ja, 1), sv, u, size(u, 1), vt, n, wq, -1, info)
+        lw = max(1, int(wq(1)))
+        if (size(work) < lw) then
+          deallocate (work)
+          allocate (work(lw), stat=info)
+          if (info /= 0) then
+            st = MBD_NO_CONVERGENCE; msg = 'statics: not enough memory for the SVD'; return
+          end if
+        end if
+        call dgesvd('S', 'A', na, n, ja, size(ja, 1), sv, u, size(u, 1), vt, n, work, &
+                    size(work), info)
+        if (info /= 0) then
+          st = MBD_LAPACK; write (msg, '(a,i0)') 'statics: the SVD of J failed, info ', info
+          return
+        end if
+        rk = count(sv(1:nu) > RANK_TOL * maxval(sv(1:nu)))
+        ! dq_n = -V_r S_r^-1 U_r^T Phi_a
+        do k = 1, rk
+          c(k) = -dot_product(u(1:na, k), w%phi(w%rows)) / sv(k)
+        end do
+        do k = 1, rk
+          dqn = dqn + c(k) * vt(k, :)
+        end do
+      else
+        vt = zero
+        do k = 1, n
+          vt(k, k) = one
+        end do
+      end if
+      nfree = n - rk
+      if (nfree == 0) return
+      nb(:, 1:nfree) = transpose(vt(rk + 1:n, :))
+      g(1:nfree) = matmul(w%force, nb(:, 1:nfree))     ! N^T Q (= -reduced gradient of V)
+      call dyn_tangent(m, w, qa, w%qz, t, lam, kt, ct)
+      kt = half * (kt + transpose(kt))
+      h(1:nfree, 1:nfree) = matmul(transpose(nb(:, 1:nfree)), matmul(kt, nb(:, 1:nfree)))
+    end subroutine reduce
+
+    !> dz from H dz = g - N^T K dq_n, saddle-free: |eigenvalues| bounded below (a flat
+    !! direction gets a gradient step of about the model's length scale).
+    subroutine newton_step()
+      real(wp) :: r(nfree), hv(nfree, nfree), e(nfree)
+      integer :: k, st2
+      r = g(1:nfree) - matmul(matmul(dqn, kt), nb(:, 1:nfree))
+      hv = h(1:nfree, 1:nfree)
+      call eigen(hv, e, .true., st2)
+      emax = max(1.0e-8_wp * maxval(abs(e)), norm2(g(1:nfree)) / m%lscale, tiny(one))
+      dz(1:nfree) = matmul(transpose(hv), r)
+      do k = 1, nfree
+        dz(k) = dz(k) / max(abs(e(k)), emax)
+      end do
+      dz(1:nfree) = matmul(hv, dz(1:nfree))
+    end subroutine newton_step
+
+    !> Residual of the equilibrium equations, relative to the force and length scales.
+    real(wp) function merit(ga, pa)
+      real(wp), intent(in) :: ga, pa
+      merit = ga / fscale + pa / m%lscale
+    end function merit
+
+    !> V at qa: gravity, springs and the loads frozen at t (fills w%force at qa).
     real(wp) function potential(qa)
       real(wp), intent(in) :: qa(:)
       real(wp) :: v, vl
@@ -111,40 +228,34 @@ contains
       potential = v + vl
     end function potential
 
-    !> Orthonormal basis of the null space of J at q (columns of nb); also loads w%force.
-    subroutine null_space(basis, nfr)
-      real(wp), allocatable, intent(out) :: basis(:, :)
-      integer, intent(out) :: nfr
-      real(wp) :: ja(w%na, m%nq), sv(min(w%na, m%nq)), u(1, 1), vt(m%nq, m%nq), wq(1), v
-      real(wp), allocatable :: work(:)
-      integer :: info, rk
-      call assemble_dense(m, q, w%qz, t, w%phi, w%nu, w%gam, w%asm, w%jac)
-      call gen_forces(m, q, w%qz, t, w%force, v)
-      ja = w%jac(w%rows, :)
-      call dgesvd('N', 'A', w%na, m%nq, ja, w%na, sv, u, 1, vt, m%nq, wq, -1, info)
-      allocate (work(max(1, int(wq(1)))))
-      call dgesvd('N', 'A', w%na, m%nq, ja, w%na, sv, u, 1, vt, m%nq, work, size(work), info)
-      rk = 0
-      if (size(sv) > 0) rk = count(sv > 1.0e-10_wp * maxval(sv))
-      nfr = m%nq - rk
-      basis = transpose(vt(rk + 1:m%nq, :))
-    end subroutine null_space
+    !> Size of the gravity terms of V, whose sum may cancel: sum m |g . r|.
+    real(wp) function scale_of_v(qa)
+      real(wp), intent(in) :: qa(:)
+      integer :: k
+      scale_of_v = zero
+      do k = 1, m%nb
+        scale_of_v = scale_of_v + &
+          m%mdiag(3 * k - 2) * abs(dot_product(m%grav, qa(3 * k - 2:3 * k - 1)))
+      end do
+    end function scale_of_v
 
     !> Eigenvalues (and, when vectors, the vectors in a) of a symmetric matrix.
-    subroutine eigen(a, e, vectors)
+    subroutine eigen(a, e, vectors, st)
       real(wp), intent(inout) :: a(:, :)
-      real(wp), allocatable, intent(out) :: e(:)
+      real(wp), intent(out) :: e(:)
       logical, intent(in) :: vectors
+      integer, intent(out) :: st
       real(wp) :: wq(1)
-      real(wp), allocatable :: work(:)
+      real(wp), allocatable :: wk(:)
       integer :: nn, info
       character(len=1) :: job
       nn = size(a, 1)
-      allocate (e(nn))
       job = merge('V', 'N', vectors)
       call dsyev(job, 'U', nn, a, nn, e, wq, -1, info)
-      allocate (work(max(1, int(wq(1)))))
-      call dsyev(job, 'U', nn, a, nn, e, work, size(work), info)
+      allocate (wk(max(1, int(wq(1)))), stat=st)
+      if (st /= 0) return
+      call dsyev(job, 'U', nn, a, nn, e, wk, size(wk), info)
+      st = info
     end subroutine eigen
   end subroutine statics_solve
 

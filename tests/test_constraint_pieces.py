@@ -11,7 +11,7 @@ from conftest import EXAMPLES
 def test_rows_are_labelled_by_constraint_and_equation() -> None:
     m = mbd2d.load(EXAMPLES / "slider_crank.toml")
     assert m.constraint_rows() == ["O.x", "O.y", "A.x", "A.y", "B.x", "B.y", "guide.normal",
-                                   "guide.angle", "motor.crank.theta"]
+                                   "guide.angle", "motor.theta"]
     assert m.coordinate_names[:3] == ["crank.x", "crank.y", "crank.theta"]
 
 

@@ -72,12 +72,23 @@ def _count(test: str) -> None:
     COUNTS[test] = COUNTS.get(test, 0) + 1
 
 
+def fuzz_examples(n: int) -> int:
+    """The example count of a property test: n in the suite, or MBD2D_FUZZ_EXAMPLES when that
+    is larger (a long fuzzing run: ``MBD2D_FUZZ_EXAMPLES=20000 pytest tests/test_hostile.py
+    tests/test_fuzz_analyses.py``)."""
+    try:
+        more = int(os.environ.get("MBD2D_FUZZ_EXAMPLES", "0"))
+    except ValueError:
+        more = 0
+    return max(n, more)
+
+
 def hostile_settings(n: int, shrink: bool = False) -> settings:
     """Deterministic settings: derandomized, no database, no deadline (timing is the worker's
     job). Without shrink (tests whose cases may hang), the first failing case is reported as
     drawn, so a hang costs one timeout rather than hundreds."""
     phases = [Phase.explicit, Phase.generate] + ([Phase.shrink] if shrink else [])
-    return settings(max_examples=n, deadline=None, derandomize=True, database=None,
+    return settings(max_examples=fuzz_examples(n), deadline=None, derandomize=True, database=None,
                     phases=phases, print_blob=False, report_multiple_bugs=shrink,
                     suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large,
                                            HealthCheck.filter_too_much,
@@ -92,18 +103,21 @@ import importlib.util, os, sys
 chan = os.fdopen(os.dup(1), "wb")
 os.dup2(2, 1)              # stray output (Fortran unit 6 too) goes to stderr, not the channel
 sys.stdout = sys.stderr
-spec = importlib.util.spec_from_file_location("test_hostile", sys.argv[1])
+sys.path.insert(0, os.path.dirname(sys.argv[1]))   # the test file's neighbours import
+spec = importlib.util.spec_from_file_location(sys.argv[2], sys.argv[1])
 mod = importlib.util.module_from_spec(spec)
-sys.modules["test_hostile"] = mod      # values pickled by the test resolve to this module
+sys.modules[sys.argv[2]] = mod         # values pickled by the test resolve to this module
 spec.loader.exec_module(mod)
 mod._worker_loop(sys.stdin.buffer, chan)
 """
 
 
-def _worker_loop(inp: Any, out: Any) -> None:
-    """Worker side: read (function name, args), run it, answer ("ok", value) or ("raised",
-    traceback text). Never dies on an exception; only a crash or a hang stops it."""
+def _worker_loop(inp: Any, out: Any, namespace: dict[str, Any] | None = None) -> None:
+    """Worker side: read (function name, args), run it (a function of ``namespace``, this
+    module's by default), answer ("ok", value) or ("raised", traceback text). Never dies on
+    an exception; only a crash or a hang stops it."""
     import traceback
+    calls = globals() if namespace is None else namespace
     warnings.simplefilter("error")     # as pytest's filterwarnings = error
     while True:
         head = inp.read(8)
@@ -112,7 +126,7 @@ def _worker_loop(inp: Any, out: Any) -> None:
         (n,) = struct.unpack("<Q", head)
         name, args = pickle.loads(inp.read(n))
         try:
-            reply: tuple[str, Any] = ("ok", globals()[name](*args))
+            reply: tuple[str, Any] = ("ok", calls[name](*args))
         except BaseException as exc:  # noqa: BLE001 - relayed to the test as a failure
             reply = ("raised", "".join(traceback.format_exception(exc)))
         try:
@@ -143,9 +157,11 @@ class _Fatal(Exception):
 
 
 class Worker:
-    """The pytest side of the worker: call, detect crashes and hangs, restart."""
+    """The pytest side of the worker: call, detect crashes and hangs, restart. The worker
+    imports ``path`` (this file by default), whose functions it runs."""
 
-    def __init__(self) -> None:
+    def __init__(self, path: Path | None = None) -> None:
+        self.path = Path(__file__) if path is None else Path(path)
         self.proc: subprocess.Popen[bytes] | None = None
         self.err: Any = None
         self.fatal: dict[bytes, str] = {}
@@ -160,7 +176,7 @@ class Worker:
         # the interpreter's own flags (-S, -I, -X ...) as multiprocessing passes them on
         flags = subprocess._args_from_interpreter_flags()  # type: ignore[attr-defined]
         self.proc = subprocess.Popen([sys.executable, *flags, "-c", _WORKER_MAIN,
-                                      str(Path(__file__))],
+                                      str(self.path), self.path.stem],
                                      stdin=subprocess.PIPE, stdout=subprocess.PIPE,
                                      stderr=self.err, cwd=str(ROOT), env=env, bufsize=0)
 
@@ -203,9 +219,9 @@ class Worker:
             return "(stderr unavailable)"
         return text[-3000:].strip() or "(empty)"
 
-    def call(self, name: str, *args: Any) -> Any:
-        """Run check function `name` in the worker; fail the test on crash, hang or a raised
-        exception (with its traceback). A case that crashed or hung is not run again when
+    def call(self, name: str, *args: Any, limit: float = HANG_SECONDS) -> Any:
+        """Run check function `name` in the worker; fail the test on crash, hang (no answer
+        within ``limit`` seconds) or a raised exception (with its traceback). A case that crashed or hung is not run again when
         hypothesis replays it to report it (the engine is deterministic): the same failure
         is raised at once."""
         __tracebackhide__ = True
@@ -216,7 +232,7 @@ class Worker:
             self.start()
             self._call("ping", START_SECONDS)        # import time is not the case's time
         try:
-            return self._call(name, HANG_SECONDS, *args)
+            return self._call(name, limit, *args)
         except _Fatal as exc:
             self.fatal[key] = str(exc)
             raise AssertionError(str(exc)) from None
@@ -605,16 +621,15 @@ ALL_KEYS = sorted({k for a, _ in joint_keys().values() for k in a}
 # checks (run in the worker)
 # ------------------------------------------------------------------------------------------
 ALLOWED_WARNINGS = (mbd2d.RedundantConstraintWarning, mbd2d.SingularPassageWarning)
-AUTO_NAME = re.compile(r"(revolute|translational|cam|point_on_curve|distance|point_on_line|"
-                       r"revolute_translational|weld|gear|rack_pinion|rolling_disc|absolute|"
-                       r"driver|spring|torque|point|rotational_spring)\d+")
-FIXED_ENTRIES = {"[model]", "model", "analysis", "state", "<dict>", "<string>"}
+AUTO_NAME = re.compile(r"(joint|driver|force)\d+")
+FIXED_ENTRIES = {"[model]", "model", "analysis", "state", "<dict>", "<string>", "stepping",
+                 "dynamics", "statics"}
 
 
 def assert_names_entry(err: BaseException, names: set[str], bounds: dict[str, int]) -> None:
     """A ModelError whose message starts with the entry it names, and that entry exists:
     a section entry "[[joint]] #k" with k within the input, "joint 'NAME' (type)" with a
-    NAME from the input (or a generated one such as 'revolute3'), "driver #k", "[model]",
+    NAME from the input (or a generated one such as 'joint3'), "driver #k", "[model]",
     "model 'NAME'", the file or string source, "analysis" or "state"."""
     assert isinstance(err, mbd2d.ModelError) and isinstance(err, ValueError), repr(err)
     msg, entry = str(err), err.entry
@@ -656,8 +671,15 @@ def _analysis_error(err: mbd2d.AnalysisError, what: str) -> None:
     assert str(err).strip(), f"{type(err).__name__} with an empty message in {what}"
     res = err.results
     if res is not None:
-        _no_nan(f"the partial results of {type(err).__name__} from {what} ({str(err)[:200]})",
+        _finite(f"the partial results of {type(err).__name__} from {what} ({str(err)[:200]})",
                 res.t, res.q, res.qd, res.qdd)
+
+
+def _memory_error(err: mbd2d.InsufficientMemoryError, what: str) -> None:
+    """A refusal for memory says how much and what to change."""
+    text = str(err)
+    assert isinstance(err, MemoryError) and "every=" in text and "banded" in text, \
+        f"InsufficientMemoryError from {what} without the size or the advice: {text!r}"
 
 
 def exercise(model: mbd2d.Model, names: set[str], bounds: dict[str, int]) -> tuple[str, ...]:
@@ -689,6 +711,9 @@ def exercise(model: mbd2d.Model, names: set[str], bounds: dict[str, int]) -> tup
         except mbd2d.AnalysisError as exc:
             _analysis_error(exc, "kinematics")
             out.append(f"kinematics:{type(exc).__name__}")
+        except mbd2d.InsufficientMemoryError as exc:
+            _memory_error(exc, "kinematics")
+            out.append("kinematics:InsufficientMemoryError")
         else:
             assert res.q.shape == (3, nq), res.q.shape
             _finite("kinematics results", res.t, res.q, res.qd, res.qdd)
@@ -708,7 +733,7 @@ def exercise(model: mbd2d.Model, names: set[str], bounds: dict[str, int]) -> tup
         q = np.zeros(nq)
         q[:3 * nb] = np.array([b.q0 for b in model.bodies]).ravel()
         try:
-            _no_nan("Phi, J, nu, gamma at the q0 estimates", model.phi(q), model.jacobian(q),
+            _finite("Phi, J, nu, gamma at the q0 estimates", model.phi(q), model.jacobian(q),
                     model.nu(q), model.gamma(q, np.zeros(nq)))
         except mbd2d.ModelError as exc:
             assert_names_entry(exc, names, bounds)
@@ -882,13 +907,16 @@ def check_analysis_call(base: str, method: str, kw: dict[str, Any]) -> tuple[str
         except mbd2d.AnalysisError as exc:
             _analysis_error(exc, method)
             result = type(exc).__name__
+        except mbd2d.InsufficientMemoryError as exc:
+            _memory_error(exc, method)
+            result = "InsufficientMemoryError"
         else:
             if method == "kinematics":
                 _finite("kinematics results", value.t, value.q, value.qd, value.qdd)
             elif method == "analyze_dof":
                 _finite("the DOF report's configuration", value.q)
             else:
-                _no_nan(f"model.{method}", value)
+                _finite(f"model.{method}", value)
             result = "ok"
     bad = [f"{w.category.__name__}: {w.message}" for w in caught
            if not issubclass(w.category, ALLOWED_WARNINGS)]
@@ -1611,6 +1639,8 @@ PARAMS: dict[str, st.SearchStrategy] = {
     "internal": _maybe(st.booleans()),
     "carrier": _maybe(BODY_REF),
     "phase": _maybe(st.none() | SMALL_FLOATS),
+    "pressure_angle": _maybe(SMALL_FLOATS),
+    "centers": _maybe(st.lists(VEC2, min_size=2, max_size=2)),
     "center": _maybe(VEC2),
     "point": _maybe(VEC2),
     "radius": _maybe(st.floats(-1, 3)),
@@ -1638,7 +1668,8 @@ METHOD_PARAMS = {   # method: (required, optional) arguments besides name
     "add_point_on_line": (["bodies", "points", "axis"], ["offset"]),
     "add_pin_in_slot": (["bodies", "points", "axis"], ["offset"]),
     "add_weld": (["bodies", "points"], ["angle"]),
-    "add_gear": (["bodies", "radii"], ["internal", "carrier", "phase"]),
+    "add_gear": (["bodies", "radii"], ["internal", "carrier", "phase", "pressure_angle",
+                                       "centers"]),
     "add_rack_pinion": (["bodies", "center", "point", "axis", "radius"], ["phase"]),
     "add_rolling_disc": (["bodies", "center", "point", "axis", "radius"], ["phase"]),
     "add_absolute": (["body", "coordinate"], ["value"]),
@@ -1725,7 +1756,7 @@ TIME_ARG = st.one_of(st.sampled_from([0.0, 0.1, 1.0, -1.0, 1e-300, 5e-324, 1e8, 
                                       Fraction(1, 10), np.array([0.1])]),
                      st.floats(-10, 10))
 STEPS_ARG = st.sampled_from([-1, 0, 1, 2, 3, True, 2.0, "2", None, np.int64(2), np.int32(3),
-                             10**9 + 1, 2**31, 2**63, -(2**63), 1.5, np.nan, [2]])
+                             10**9, 10**9 + 1, 2**31, 2**63, -(2**63), 1.5, np.nan, [2]])
 TOL_ARG = st.sampled_from([None, 0, 0.0, -1.0, np.nan, np.inf, 1e-300, 1e-16, 1e-15, 1e-9,
                            0.5, 0.999, 1.0, 2.0, "1e-9", True, [1e-9], 10**400])
 MAXIT_ARG = st.sampled_from([None, 0, -1, 1, 2, 50, 10**6, 10**6 + 1, 2**31, 2**63, 1.5,
@@ -1773,9 +1804,11 @@ def analysis_call(draw: Any) -> tuple[str, str, dict[str, Any]]:
 @hostile_settings(250)
 @given(call=analysis_call())
 def test_analysis_settings_and_states(call: tuple[str, str, dict[str, Any]]) -> None:
-    """kinematics, analyze_dof, phi, jacobian, nu and gamma with hostile times, steps,
-    tolerances, iteration limits and states: a ModelError naming "analysis", "state" or the
-    model, an AnalysisError, or finite results; no hang, no stray warning."""
+    """kinematics, analyze_dof, phi, jacobian, nu and gamma with hostile times, steps
+    (10**9 among them: refused for memory before anything is allocated), tolerances,
+    iteration limits and states: a ModelError naming "analysis", "state" or the model, an
+    AnalysisError, an InsufficientMemoryError, or finite results; no hang, no stray
+    warning."""
     _count("test_analysis_settings_and_states")
     WORKER.call("check_analysis_call", *call)
 

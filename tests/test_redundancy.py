@@ -21,7 +21,7 @@ def load(name: str) -> mbd2d.Model:
 @pytest.mark.parametrize("name, coords, eqs, rank, mobility, rows", [
     ("door_two_hinges", 3, 5, 3, 1, ["upper.x", "upper.y"]),
     ("parallelogram_extra_link", 12, 13, 12, 1, None),
-    ("fourbar_redundant", 9, 10, 9, 1, ["tie.length"]),
+    ("fourbar_redundant", 9, 10, 9, 1, ["tie.distance"]),
     ("fourbar_grashof", 9, 9, 9, 1, []),
 ])
 def test_dof_report(name: str, coords: int, eqs: int, rank: int, mobility: int,
@@ -62,7 +62,7 @@ def test_door_runs_with_a_warning_and_matches_the_closed_form() -> None:
 
 def test_redundant_four_bar_equals_the_plain_one() -> None:
     plain = load("fourbar_grashof").kinematics(t_end=1.0, steps=200)
-    with pytest.warns(mbd2d.RedundantConstraintWarning, match="tie.length"):
+    with pytest.warns(mbd2d.RedundantConstraintWarning, match="tie.distance"):
         red = load("fourbar_redundant").kinematics(t_end=1.0, steps=200)
     assert_allclose(red.q, plain.q, atol=1e-10)
     assert_allclose(red.qd, plain.qd, atol=1e-9)
@@ -97,7 +97,7 @@ def test_one_driver_too_many_that_contradicts() -> None:
         '\n[[driver]]\nname = "extra"\ntype = "absolute"\nbody = "rod"\ncoordinate = "x"\n'
         'f = 1.0\n')
     with pytest.raises(mbd2d.InconsistentConstraintsError,
-                       match=r"extra\.rod\.x \(1 redundant equation\(s\): 10 equations, rank 9\)"):
+                       match=r"extra\.x \(1 redundant equation\(s\): 10 equations, rank 9\)"):
         mbd2d.loads(text).kinematics(t_end=1.0, steps=10)
 
 
@@ -111,7 +111,7 @@ def twin_driver(extra_poly: str) -> mbd2d.Model:
 def test_redundant_drivers_that_part_ways_during_the_run() -> None:
     """Two drivers that agree in position, velocity and acceleration at t = 0
     (2 pi t and 2 pi t + t^3) and then part ways: stopped after t = 0, both named."""
-    with pytest.raises(mbd2d.InconsistentConstraintsError, match=r"twin\.crank\.theta") as err:
+    with pytest.raises(mbd2d.InconsistentConstraintsError, match=r"twin\.theta") as err:
         twin_driver("0.0, 1.0").kinematics(t_end=1.0, steps=100)
     assert err.value.t > 0.0
     assert {"motor", "twin"} <= set(err.value.constraints)

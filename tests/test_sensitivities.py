@@ -427,7 +427,7 @@ def test_builder_models_get_the_same_names():
     m.add_revolute(["ground", "bar"], [[0.0, 0.0], [-0.5, 0.0]])
     m.add_driver("absolute", body="bar", coordinate="theta", f={"poly": [0.0, 1.0]})
     names = set(m.parameters())
-    assert {"joint.revolute1.points.1.0", "driver.driver2.f.poly.1", "body.bar.mass",
+    assert {"joint.joint1.points.1.0", "driver.driver1.f.poly.1", "body.bar.mass",
             "body.bar.inertia", "model.gravity.0"} <= names
 
 
@@ -480,3 +480,33 @@ def test_dead_centre_keeps_the_sensitivities_up_to_it():
     assert np.all(np.isfinite(res.dq_dp))
     growth = np.abs(res.dq_dp[:, 8, 0])
     assert growth[-1] > 10 * growth[0]
+
+
+def test_sensitivities_do_not_depend_on_the_length_unit():
+    """The same four-bar in metres and in millimetres (the core works in units of the model's
+    length scale): d(x, y)/d(length) is unit-free, d(theta)/d(length) scales as 1/unit, and
+    d/d(mass) of an effort scales like the effort."""
+    def build(s: float) -> mbd2d.Model:
+        m = mbd2d.Model("four-bar", gravity=(0.0, -9.81 * s))
+        for name, q0 in (("crank", [0.5, 0.0, 0.0]), ("coupler", [2.25, 1.2, 0.78]),
+                         ("rocker", [3.25, 1.2, -1.77])):
+            m.add_body(name, q0=[q0[0] * s, q0[1] * s, q0[2]], mass=2.0, inertia=0.1 * s * s)
+        for name, bodies, pts in (("O2", ["ground", "crank"], [[0, 0], [-0.5, 0]]),
+                                  ("A", ["crank", "coupler"], [[0.5, 0], [-1.75, 0]]),
+                                  ("B", ["coupler", "rocker"], [[1.75, 0], [-1.25, 0]]),
+                                  ("O4", ["rocker", "ground"], [[1.25, 0], [3.0, 0]])):
+            m.add_revolute(bodies, [[p[0] * s, p[1] * s] for p in pts], name=name)
+        m.add_driver("absolute", body="crank", coordinate="theta", f={"poly": [0.0, TWO_PI]},
+                     name="motor")
+        return m
+
+    names = ["joint.B.points.0.0", "body.coupler.mass"]
+    a = build(1.0).inverse_dynamics(1.0, 20, sensitivities=names)
+    b = build(1000.0).inverse_dynamics(1.0, 20, sensitivities=names)
+    xy = [c for c in range(9) if c % 3 != 2]
+    th = [2, 5, 8]
+    assert_allclose(b.dq_dp[:, xy, 0], a.dq_dp[:, xy, 0], rtol=1e-9, atol=1e-12)
+    assert_allclose(b.dq_dp[:, th, 0] * 1000.0, a.dq_dp[:, th, 0], rtol=1e-9, atol=1e-12)
+    # torque ~ m g L and m L^2 w^2: scales by 1000**2 with lengths, gravity and inertia
+    assert_allclose(b.effort_dp("motor")[:, 1], 1e6 * a.effort_dp("motor")[:, 1], rtol=1e-9)
+    assert_allclose(b.effort_dp("motor")[:, 0], 1e3 * a.effort_dp("motor")[:, 0], rtol=1e-9)

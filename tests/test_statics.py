@@ -122,3 +122,125 @@ def test_statics_cli(tmp_path) -> None:
     assert r.returncode == 0, r.stderr
     assert "stable" in r.stdout and "pivot" in r.stdout
     assert np.isclose(float(r.stdout.split("theta =")[1].split()[0]), -0.443125528, atol=1e-8)
+
+
+# ---------------------------------------------------------------------------------------------
+# Convergence on the equilibrium equations (issue 9, item 1): the angle to 1e-13 from every
+# start, at any height of the pivot (a constant added to V), against a root found here.
+
+def bisect(f, a: float, b: float) -> float:
+    """A root of f in [a, b] (f(a) f(b) < 0) by bisection until the interval stops shrinking:
+    an independent solver whose answer is limited only by the rounding of f."""
+    fa = f(a)
+    assert fa * f(b) < 0.0
+    while True:
+        c = 0.5 * (a + b)
+        if not a < c < b:
+            return c
+        fc = f(c)
+        if fc == 0.0:
+            return c
+        if (fc < 0.0) == (fa < 0.0):
+            a, fa = c, fc
+        else:
+            b = c
+
+
+BAR_M, BAR_L, BAR_K, BAR_A0, G = 2.0, 1.0, 40.0, 1.0, 9.81
+
+
+def bar_on_spring(theta0: float, y0: float) -> mbd2d.Model:
+    """A bar (2 kg, 1 m) pivoted at one end at (0, y0) with a rotational spring to ground
+    (40 N m/rad, free at 1 rad), started at theta0."""
+    m = mbd2d.Model("bar", gravity=(0.0, -G))
+    h = BAR_L / 2
+    m.add_body("bar", (h * math.cos(theta0), y0 + h * math.sin(theta0), theta0), mass=BAR_M,
+               inertia=BAR_M * BAR_L**2 / 12)
+    m.add_revolute(["ground", "bar"], [[0.0, y0], [-h, 0.0]], name="pivot")
+    m.add_rotational_spring(["ground", "bar"], stiffness=BAR_K, angle0=BAR_A0)
+    return m
+
+
+def bar_moment(th: float) -> float:
+    """Moment about the pivot of the spring and the weight: k (theta - a0) + m g (L/2) cos."""
+    return BAR_K * (th - BAR_A0) + BAR_M * G * (BAR_L / 2) * math.cos(th)
+
+
+@pytest.mark.parametrize("y0", [0.0, 1000.0])
+def test_equilibrium_to_round_off_from_every_start(y0: float) -> None:
+    """31 starts in [0, 1.5] rad all reach the one equilibrium to 1e-13 rad, with the
+    reduced load at round-off; raising the pivot by 1000 m (V + m g 1000) changes nothing.
+    Before the fix (a step accepted only when V fell): 6 starts 2e-10 to 6e-9 rad off, and at
+    y0 = 1000 six ConvergenceErrors."""
+    root = bisect(bar_moment, 0.0, 1.5)
+    for th0 in np.linspace(0.0, 1.5, 31):
+        st = bar_on_spring(float(th0), y0).statics()
+        x, y, th = st.body("bar")
+        assert st.stability == "stable"
+        assert abs(th - root) <= 1e-13, (th0, th - root)
+        assert abs(bar_moment(th)) <= 1e-12                  # N m, independent residual
+        assert st.residual <= 1e-14          # the core's ||N^T Q|| relative to the loads
+        h = BAR_L / 2
+        assert_allclose([x, y], [h * math.cos(root), y0 + h * math.sin(root)], atol=1e-12,
+                        rtol=0)
+        # the pivot carries the weight
+        r = st.reaction("pivot")
+        assert_allclose([r.fx_j[0], r.fy_j[0]], [0.0, BAR_M * G], atol=1e-9)
+
+
+def gravity_slider_crank(theta0: float, y0: float, torque: float = 2.0) -> mbd2d.Model:
+    """The offset slider-crank (crank 1, rod 3, guide 0.5 above the pivot) lifted by y0, under
+    gravity (1 kg bodies, centres at mid-length), a crank torque and a slider spring
+    (k = 50, free length 1.5) to an anchor at (6, y0 + 0.5); started near crank angle theta0."""
+    m = mbd2d.Model("slider-crank", gravity=(0.0, -G))
+    c, s = math.cos(theta0), math.sin(theta0)
+    xb = c + math.sqrt(9.0 - (s - 0.5)**2)
+    phi = math.atan2(0.5 - s, xb - c)
+    m.add_body("crank", (0.5 * c, y0 + 0.5 * s, theta0), mass=1.0, inertia=0.1)
+    m.add_body("rod", (0.5 * (c + xb), y0 + 0.5 * (s + 0.5), phi), mass=1.0, inertia=0.1)
+    m.add_body("slider", (xb, y0 + 0.5, 0.0), mass=1.0, inertia=0.1)
+    m.add_revolute(["ground", "crank"], [[0.0, y0], [-0.5, 0.0]], name="O")
+    m.add_revolute(["crank", "rod"], [[0.5, 0.0], [-1.5, 0.0]], name="A")
+    m.add_revolute(["rod", "slider"], [[1.5, 0.0], [0.0, 0.0]], name="B")
+    m.add_translational(["ground", "slider"], [[0.0, y0 + 0.5], [0.0, 0.0]],
+                        [[1.0, 0.0], [1.0, 0.0]], name="guide")
+    m.add_torque("crank", torque)
+    m.add_spring(["slider", "ground"], [[0.0, 0.0], [6.0, y0 + 0.5]], stiffness=50.0,
+                 length0=1.5)
+    return m
+
+
+def slider_crank_load(th: float, torque: float = 2.0) -> float:
+    """-dV/dtheta in the crank angle alone (reduced coordinate): with
+    x = cos th + sqrt(9 - (sin th - 0.5)^2), V = k (4.5 - x)^2 / 2 - T th + g (sin th + const)
+    (crank centre at height sin(th)/2, rod centre at (sin th + 0.5)/2)."""
+    s, c = math.sin(th), math.cos(th)
+    r = math.sqrt(9.0 - (s - 0.5)**2)
+    x = c + r
+    dx = -s - (s - 0.5) * c / r
+    return torque + 50.0 * (4.5 - x) * dx - G * c
+
+
+@pytest.mark.parametrize("y0, tol", [(0.0, 1e-13), (1000.0, 4e-13)])
+def test_slider_crank_equilibrium_against_reduced_coordinates(y0: float, tol: float) -> None:
+    """Three bodies, five joint equations: every start reaches an equilibrium of the reduced
+    equation dV/dtheta = 0 (solved here by bisection) to 1e-13 rad. Lifted to y0 = 1000 m
+    the positions round to 1.1e-13 m, and the crank angle (1 m crank) follows them: 4e-13."""
+    grid = np.linspace(-math.pi, math.pi, 721)
+    vals = [slider_crank_load(float(a)) for a in grid]
+    roots = [bisect(slider_crank_load, float(grid[i]), float(grid[i + 1]))
+             for i in range(len(grid) - 1) if vals[i] * vals[i + 1] < 0]
+    # stable ones: -dV/dtheta falls through zero
+    stable = [r for r in roots if slider_crank_load(r - 1e-6) > 0 > slider_crank_load(r + 1e-6)]
+    assert stable
+    for th0 in np.linspace(-1.0, 1.0, 9):
+        st = gravity_slider_crank(float(th0), y0).statics()
+        th = st.body("crank")[2]
+        wrapped = math.remainder(th, 2 * math.pi)
+        err = min(abs(wrapped - r) for r in stable)
+        assert err <= tol, (th0, err)
+        assert st.stability == "stable"
+        assert abs(slider_crank_load(wrapped)) <= 1e-11
+        s, c = math.sin(th), math.cos(th)
+        assert_allclose(st.body("slider")[0], c + math.sqrt(9.0 - (s - 0.5)**2), atol=1e-12)
+        assert st.residual <= 1e-14

@@ -13,10 +13,10 @@ from __future__ import annotations
 from .analysis.stepping import KinematicStepper
 from .description.functions import Harmonic, TimeFunction
 from .errors import (AnalysisError, AssemblyError, ConvergenceError, CoreError,
-                     InconsistentConstraintsError, IntegrationError, MbdError, MbdWarning,
-                     ModelError,
-                     RedundantConstraintWarning, SingularConfigurationError,
-                     SingularJacobianError, SingularPassageWarning, ToggleError)
+                     InconsistentConstraintsError, InsufficientMemoryError, IntegrationError,
+                     MbdError, MbdWarning, ModelError, RedundantConstraintWarning,
+                     SingularConfigurationError, SingularJacobianError, SingularPassageWarning,
+                     ToggleError)
 from .model import Model, load, loads
 from .results import (BodyResult, DofReport, DynamicsResult, KinematicsResult, Reaction,
                       StaticsResult)
@@ -24,8 +24,9 @@ from .results import (BodyResult, DofReport, DynamicsResult, KinematicsResult, R
 __version__ = "0.1.0"
 
 __all__ = ["load", "loads", "Model", "TimeFunction", "Harmonic", "KinematicsResult",
-           "BodyResult", "DynamicsResult", "KinematicStepper", "StaticsResult", "Reaction", "DofReport",
-           "MbdError", "ModelError", "AnalysisError", "IntegrationError",
+           "BodyResult", "DynamicsResult", "KinematicStepper", "StaticsResult", "Reaction",
+           "DofReport", "MbdError", "ModelError", "AnalysisError", "IntegrationError",
            "AssemblyError", "InconsistentConstraintsError", "ConvergenceError",
            "SingularJacobianError", "SingularConfigurationError", "ToggleError", "CoreError",
-           "MbdWarning", "RedundantConstraintWarning", "SingularPassageWarning", "__version__"]
+           "InsufficientMemoryError", "MbdWarning", "RedundantConstraintWarning",
+           "SingularPassageWarning", "__version__"]

@@ -123,11 +123,29 @@ class SingularPassageWarning(MbdWarning):
 
 
 class CoreError(MbdError):
-    """The Fortran core reported an internal error (a LAPACK argument error); a bug."""
+    """The Fortran core reported an internal error (a LAPACK argument error, or a status the
+    analysis cannot produce); a bug."""
+
+
+class InsufficientMemoryError(MbdError, MemoryError):
+    """An analysis needs more memory than it can get (refused before the run from an estimate,
+    or an allocation that failed). The message says how much was asked and what to change:
+    fewer steps, ``every=k`` to keep fewer output rows, ``solver="banded"`` for large models.
+
+    Attributes
+    ----------
+    nbytes : float or None
+        The size asked for, in bytes, when known.
+    """
+
+    def __init__(self, message: str, nbytes: float | None = None) -> None:
+        super().__init__(message)
+        self.nbytes = nbytes
 
 
 __all__ = ["MbdError", "ModelError", "AnalysisError", "AssemblyError",
            "InconsistentConstraintsError", "ConvergenceError", "SingularJacobianError",
            "IntegrationError",
-           "SingularConfigurationError", "ToggleError", "CoreError", "MbdWarning",
+           "SingularConfigurationError", "ToggleError", "CoreError", "InsufficientMemoryError",
+           "MbdWarning",
            "RedundantConstraintWarning", "SingularPassageWarning"]

@@ -209,7 +209,8 @@ class Model(ModelDescription):
             partitioned: coordinate partitioning (Wehage-Haug), Dormand-Prince on the
             independent coordinates.
         rtol, atol : float, optional
-            Error tolerances of the adaptive methods (defaults 1e-6, 1e-8).
+            Error tolerances of the adaptive methods (defaults 1e-6, 1e-8); atol applies to
+            lengths in units of the model's length scale (see README, "Any unit of length").
         h : float, optional
             Fixed step (generalized-alpha, baumgarte-rk4).
         rho_inf : float, optional

@@ -3,9 +3,8 @@ from __future__ import annotations
 
 from ..binding import core
 from ..binding.pack import pack
-from ..binding.status import ASSEMBLY_FAILED, INCONSISTENT, OK
+from ..binding.status import ASSEMBLY_FAILED, INCONSISTENT, OK, error_for
 from ..description.builder import ModelDescription
-from ..errors import CoreError, ModelError
 from ..results.dof import DofReport
 from ..validate import number
 from .failures import assembly_failed, inconsistent, row_names
@@ -28,14 +27,15 @@ def analyze_dof(model: ModelDescription, t: float = 0.0, tol: float | None = Non
     out = core.analyze(p, t, tol_v)
     status, worst = out.status, int(out.worst)
     if status < 0:
-        raise ModelError(out.msg, model.constraints[worst - 1].describe() if worst else
-                         f"model {model.name!r}")
+        raise error_for("dof", status, out.msg, entry=model.constraints[worst - 1].describe()
+                        if worst else f"model {model.name!r}")
     if status == INCONSISTENT:
-        raise inconsistent(model, p, float(out.resid), out.dep, out.red, int(out.rank), t, None)
+        raise inconsistent("dof", model, p, float(out.resid), out.dep, out.red, int(out.rank),
+                           t, None)
     if status == ASSEMBLY_FAILED:
-        raise assembly_failed(model, float(out.resid), worst, t, None)
+        raise assembly_failed("dof", model, float(out.resid), worst, t, None)
     if status != OK:
-        raise CoreError(f"internal error in the core (status {status}): {out.msg}")
+        raise error_for("dof", status, out.msg, t=t)
     cons, rows = row_names(p, model, out.red)
     return DofReport(model.name, t, p.nq, p.neq, int(out.rank), p.nq - int(out.rank),
                      int(out.mobility), rows, cons, out.q)

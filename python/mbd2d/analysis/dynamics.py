@@ -8,17 +8,15 @@ from typing import Any
 
 from ..binding import core
 from ..binding.pack import pack, pack_dynamics
-from ..binding.status import (ASSEMBLY_FAILED, INCONSISTENT, INTEGRATOR_FAILED, NO_CONVERGENCE,
-                              OK, SINGULAR, SINGULAR_CONFIG)
+from ..binding.status import ASSEMBLY_FAILED, INCONSISTENT, INTEGRATOR_FAILED, OK, error_for
 from ..description.builder import ModelDescription
-from ..errors import (ConvergenceError, CoreError, IntegrationError, ModelError,
-                      RedundantConstraintWarning, SingularJacobianError)
+from ..errors import ModelError, RedundantConstraintWarning
 from ..results.dynamics import DynamicsResult
 from ..validate import number
-from .failures import assembly_failed, bad_entry, row_names
-from .outputs import dynamics_result
+from .failures import assembly_failed, bad_entry, inconsistent_at, row_names
+from .outputs import dynamics_result, finite_part
 from .sensitivities import attach, check_status, requested, table
-from .settings import check_memory, check_span, output_steps, time_grid
+from .settings import check_memory, check_span, output_rows, output_steps, time_grid
 
 METHODS = {"generalized-alpha": 1, "dopri5": 2, "baumgarte-rk4": 3, "partitioned": 4}
 DEFAULT_METHOD = "dopri5"
@@ -32,7 +30,7 @@ def run_dynamics(model: ModelDescription, t_end: float, steps: int, method: str 
                  sensitivities: Any = None) -> DynamicsResult:
     """Forward dynamics in one core call; see :meth:`mbd2d.Model.dynamics`."""
     t0, t_end, steps = check_span(t0, t_end, steps)
-    idx = output_steps(steps, every)
+    nout = output_rows(steps, every)
     every = int(every)
     method = DEFAULT_METHOD if method is None else method
     if method not in METHODS:
@@ -73,15 +71,17 @@ def run_dynamics(model: ModelDescription, t_end: float, steps: int, method: str 
     p = pack(model)
     d = pack_dynamics(model, p)
     npar = len(params) if params else 0
-    check_memory(len(idx), 3 * p.nq * (1 + npar) + p.neq + 4)
+    check_memory(nout, 3 * p.nq * (1 + npar) + p.neq + 4, "dynamics",
+                 dense=(p.nq + p.neq, p.nq + p.neq))
+    idx = output_steps(steps, every)
     if params:
         ptab = table(p, params, d)
-        out = core.dynamics_sens(p, d, t0, t_end, steps, rtol_v, atol_v, every,
-                                 MAX_STEPS, len(idx), ptab)
+        out = core.dynamics_sens(p, d, t0, t_end, steps, rtol_v, atol_v, every, MAX_STEPS,
+                                 nout, ptab)
         check_status(out.status, out.iinfo, out.msg, params)
     else:
         out = core.dynamics(p, d, t0, t_end, steps, METHODS[method], rtol_v, atol_v, h_v,
-                            rho_v, alpha_v, beta_v, every, len(idx))
+                            rho_v, alpha_v, beta_v, every, nout)
     iinfo, rinfo, status = out.iinfo, out.rinfo, out.status
     n = int(iinfo[0])
     t = time_grid(t0, t_end, steps, idx)
@@ -95,25 +95,31 @@ def run_dynamics(model: ModelDescription, t_end: float, steps: int, method: str 
     res = dynamics_result(model, p, t, n, out, stats, status == OK)
     if params:
         attach(res, out, params, n, ptab)
+    res, bad = finite_part(res)
     if red_rows:
         warnings.warn(f"redundant constraints: {', '.join(red_rows)} are left out of the equations "
                       "of motion; the reported multipliers are the minimum-norm set (the "
                       "reactions are statically indeterminate)", RedundantConstraintWarning,
                       stacklevel=3)
-    if status == OK:
+    if status == OK and bad is None:
         return res
     text = out.msg
-    if status < 0:
-        raise ModelError(text, bad_entry(model, int(iinfo[1])))
-    tf = float(rinfo[0])
     last = f"t = {res.t[-1]:.6g} s" if len(res.t) else "no output rows"
+    kept = f"Results up to {last} are kept in the exception's .results."
+    if status == OK:
+        raise error_for("dynamics", INTEGRATOR_FAILED,
+                        f"{method}: the solution became non-finite at t = {t[bad]:.6g} s (a "
+                        f"blow-up: try a smaller rtol or h, or another method). {kept}",
+                        t=t[bad], results=res)
+    if status < 0:
+        raise error_for("dynamics", status, text, entry=bad_entry(model, int(iinfo[1])))
+    tf = float(rinfo[0])
     if status == ASSEMBLY_FAILED:
-        raise assembly_failed(model, 0.0, 0, t0, res)
+        raise assembly_failed("dynamics", model, 0.0, 0, t0, res)
+    if status == INCONSISTENT and not len(res.t):
+        raise inconsistent_at("dynamics", model, p, t0, res, f"{method}: {text}")
     if status == INTEGRATOR_FAILED:
-        raise IntegrationError(f"{method}: {text}. Results up to {last} are kept in the "
-                               "exception's .results.", t=tf, results=res, status=status)
-    if status in (SINGULAR, SINGULAR_CONFIG):
-        raise SingularJacobianError(f"{method}: {text}", t=tf, results=res, status=status)
-    if status in (NO_CONVERGENCE, INCONSISTENT):
-        raise ConvergenceError(f"{method}: {text}", t=tf, results=res, status=status)
-    raise CoreError(f"internal error in the core (status {status}): {text}")
+        text = f"{method}: {text}. {kept}"
+    else:
+        text = f"{method}: {text}"
+    raise error_for("dynamics", status, text, t=tf, results=res)

@@ -7,7 +7,7 @@ import numpy as np
 
 from ..binding import core
 from ..binding.pack import pack
-from ..binding.status import OK
+from ..binding.status import OK, error_for
 from ..description.builder import ModelDescription
 from ..errors import ModelError
 from ..validate import number
@@ -22,8 +22,13 @@ def evaluate(model: ModelDescription, q: Any, qd: Any, t: float) -> tuple[np.nda
     out = core.evaluate(p.nb, p.ctab, p.rpar, p.neq, qv, qdv, float(t))
     if out.status != OK:
         bad = int(out.bad)
-        raise ModelError(out.msg, model.constraints[bad - 1].describe() if bad else "model")
-    return out.phi, out.jac, out.nu, out.gam
+        raise error_for("eval", out.status, out.msg,
+                        entry=model.constraints[bad - 1].describe() if bad else "model")
+    values = (out.phi, out.jac, out.nu, out.gam)
+    if not all(np.isfinite(v).all() for v in values):
+        raise ModelError("Phi, J, nu or gamma overflow at this state (non-finite values): "
+                         "q and qd are too large for the model's dimensions", "state")
+    return values
 
 
 def _state(x: Any, n: int, what: str) -> np.ndarray:

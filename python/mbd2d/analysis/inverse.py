@@ -7,15 +7,15 @@ from typing import Any
 
 from ..binding import core
 from ..binding.pack import pack, pack_dynamics
-from ..binding.status import OK
+from ..binding.status import NO_CONVERGENCE, OK, error_for
 from ..description.builder import ModelDescription
-from ..errors import ModelError, RedundantConstraintWarning
+from ..errors import RedundantConstraintWarning
 from ..results.dynamics import DynamicsResult
 from .failures import BAD_FORCE, bad_entry, kinematic_failure, row_names
-from .outputs import dynamics_result
+from .outputs import dynamics_result, finite_part
 from .sensitivities import attach, check_status, requested, table
-from .settings import (check_memory, check_solver, check_span, output_steps, require_determined,
-                       solver_code, time_grid)
+from .settings import (check_memory, check_solver, check_span, output_rows, output_steps,
+                       require_determined, solver_code, time_grid)
 
 
 def run_inverse(model: ModelDescription, t_end: float, steps: int, t0: float = 0.0,
@@ -27,20 +27,22 @@ def run_inverse(model: ModelDescription, t_end: float, steps: int, t0: float = 0
     """
     t0, t_end, steps = check_span(t0, t_end, steps)
     tol_v, _ = check_solver(tol, None)
-    idx = output_steps(steps, every)
+    nout = output_rows(steps, every)
     code = solver_code(solver)
     params = requested(model, sensitivities)
     p = pack(model)
     require_determined(p, model)
     d = pack_dynamics(model, p)
     npar = len(params) if params else 0
-    check_memory(len(idx), (3 * p.nq + p.neq) * (1 + npar) + 4)
+    check_memory(nout, (3 * p.nq + p.neq) * (1 + npar) + 4, "inverse dynamics",
+                 dense=(p.nq + p.neq, p.nq + p.neq))
+    idx = output_steps(steps, every)
     if params:
         ptab = table(p, params, d)
-        out = core.inverse_sens(p, d, t0, t_end, steps, tol_v, int(every), code, len(idx), ptab)
+        out = core.inverse_sens(p, d, t0, t_end, steps, tol_v, int(every), code, nout, ptab)
         check_status(out.status, out.iinfo, out.msg, params)
     else:
-        out = core.inverse(p, d, t0, t_end, steps, tol_v, int(every), code, len(idx))
+        out = core.inverse(p, d, t0, t_end, steps, tol_v, int(every), code, nout)
     iinfo, status = out.iinfo, out.status
     n = int(iinfo[0])
     t = time_grid(t0, t_end, steps, idx)
@@ -52,13 +54,19 @@ def run_inverse(model: ModelDescription, t_end: float, steps: int, t0: float = 0
     res = dynamics_result(model, p, t, n, out, stats, status == OK)
     if params:
         attach(res, out, params, n, ptab)
+    res, bad = finite_part(res)
     if red_rows:
         warnings.warn(f"redundant constraints: {', '.join(red_rows)}; the multipliers are the "
                       "minimum-norm set (the reactions are statically indeterminate)",
                       RedundantConstraintWarning, stacklevel=3)
-    if status == OK:
+    if status == OK and bad is None:
         return res
+    if status == OK:
+        raise error_for("inverse", NO_CONVERGENCE,
+                        f"the run gave non-finite values at t = {t[bad]:.6g} s; results up to "
+                        f"there ({bad} rows) are kept in the exception's .results", t=t[bad],
+                        results=res)
     if status < 0 and iinfo[1] <= BAD_FORCE:
-        raise ModelError(out.msg, bad_entry(model, int(iinfo[1])))
-    raise kinematic_failure(model, p, status, out.msg, iinfo, out.rinfo, out.qsing, out.dep,
-                            out.red, res)
+        raise error_for("inverse", status, out.msg, entry=bad_entry(model, int(iinfo[1])))
+    raise kinematic_failure("inverse", model, p, status, out.msg, iinfo, out.rinfo, out.qsing,
+                            out.dep, out.red, res)

@@ -7,14 +7,15 @@ from typing import Any
 
 from ..binding import core
 from ..binding.pack import pack
-from ..binding.status import NO_CONVERGENCE, OK, SINGULAR_CONFIG
+from ..binding.status import NO_CONVERGENCE, OK, SINGULAR_CONFIG, error_for
 from ..description.builder import ModelDescription
 from ..errors import RedundantConstraintWarning, SingularPassageWarning
 from ..results.kinematics import KinematicsResult
 from .failures import kinematic_failure, row_names
+from .outputs import finite_part
 from .sensitivities import attach, check_status, requested, table
-from .settings import (check_memory, check_solver, check_span, output_steps, require_determined,
-                       solver_code, time_grid)
+from .settings import (check_memory, check_solver, check_span, output_rows, output_steps,
+                       require_determined, solver_code, time_grid)
 
 
 def run_kinematics(model: ModelDescription, t_end: float, steps: int, t0: float = 0.0,
@@ -24,21 +25,23 @@ def run_kinematics(model: ModelDescription, t_end: float, steps: int, t0: float 
     """Run a kinematic analysis in one core call; see :meth:`mbd2d.Model.kinematics`."""
     t0, t_end, steps = check_span(t0, t_end, steps)
     tol_v, maxit_v = check_solver(tol, maxit)
-    idx = output_steps(steps, every)
+    nout = output_rows(steps, every)
     code = solver_code(solver)
     params = requested(model, sensitivities)
     p = pack(model)
     require_determined(p, model)
     npar = len(params) if params else 0
-    check_memory(len(idx), 3 * p.nq * (1 + npar))
+    check_memory(nout, 3 * p.nq * (1 + npar), "kinematics",
+                 dense=(p.neq, p.nq) if solver == "dense" else None)
+    idx = output_steps(steps, every)
     if params:
         ptab = table(p, params)
         out = core.kinematics_sens(p, t0, t_end, steps, tol_v, maxit_v, float(tmin or 0.0),
-                                   int(every), code, len(idx), ptab)
+                                   int(every), code, nout, ptab)
         check_status(out.status, out.iinfo, out.msg, params)
     else:
         out = core.kinematics(p, t0, t_end, steps, tol_v, maxit_v, float(tmin or 0.0),
-                              int(every), code, len(idx))
+                              int(every), code, nout)
     iinfo, rinfo, tpass, status = out.iinfo, out.rinfo, out.tpass, out.status
     n = int(iinfo[0])
     t = time_grid(t0, t_end, steps, idx)
@@ -59,6 +62,7 @@ def run_kinematics(model: ModelDescription, t_end: float, steps: int, t0: float 
                            complete=status == OK, model=model)
     if params:
         attach(res, out, params, n, ptab)
+    res, bad = finite_part(res)
     if red_rows and status in (OK, SINGULAR_CONFIG, NO_CONVERGENCE):
         warnings.warn(f"redundant constraints: {', '.join(red_rows)} repeat what the other "
                       "constraints impose (rank of J is "
@@ -70,7 +74,12 @@ def run_kinematics(model: ModelDescription, t_end: float, steps: int, t0: float 
         warnings.warn(f"passed through {npass} singular configuration(s) (bifurcation points, "
                       f"J lost rank) at t = {times}{' ...' if npass > 5 else ''} s and stayed on "
                       "the branch the run started on", SingularPassageWarning, stacklevel=3)
-    if status == OK:
+    if status == OK and bad is None:
         return res
-    raise kinematic_failure(model, p, status, out.msg, iinfo, rinfo, out.qsing, out.dep,
-                            out.red, res)
+    if status == OK:
+        raise error_for("kinematics", NO_CONVERGENCE,
+                        f"the run gave non-finite values at t = {t[bad]:.6g} s; results up to "
+                        f"there ({bad} rows) are kept in the exception's .results", t=t[bad],
+                        results=res)
+    raise kinematic_failure("kinematics", model, p, status, out.msg, iinfo, rinfo, out.qsing,
+                            out.dep, out.red, res)

@@ -11,6 +11,7 @@ from pathlib import Path
 from ..binding.pack import pack
 from ..binding.tables import NCT
 from ..description.builder import ModelDescription
+from ..results.files import write_text
 from .settings import check_solver, check_span, require_determined
 
 HEADER = """\
@@ -73,4 +74,4 @@ def export(model: ModelDescription, path: str | Path, t_end: float, steps: int, 
     for i in range(0, n, 4):
         lines.append(" ".join(_r(float(v)) for v in p.rpar[i:i + 4]))
     lines.append("end")
-    Path(path).write_text("\n".join(lines) + "\n")
+    write_text(path, "\n".join(lines) + "\n", "export")

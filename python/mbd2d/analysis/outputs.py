@@ -1,13 +1,22 @@
-"""Results built from the core's output arrays (one column per output time)."""
+"""Results built from the core's output arrays (one column per output time), and the check
+that no result leaves a front door with a non-finite number in it."""
 from __future__ import annotations
 
-from typing import Any
+import dataclasses
+from typing import Any, TypeVar
 
 import numpy as np
 
 from ..binding.tables import Packed
 from ..description.builder import ModelDescription
 from ..results.dynamics import DynamicsResult
+from ..results.kinematics import KinematicsResult
+
+R = TypeVar("R", bound=KinematicsResult)
+
+#: arrays of a result with one row per output time
+ROW_FIELDS = ("t", "q", "qd", "qdd", "lam", "kinetic", "potential", "drift_position",
+              "drift_velocity", "dq_dp", "dqd_dp", "dqdd_dp", "dlam_dp")
 
 
 def dynamics_result(model: ModelDescription, p: Packed, t: np.ndarray, n: int, out: Any,
@@ -21,3 +30,29 @@ def dynamics_result(model: ModelDescription, p: Packed, t: np.ndarray, n: int, o
                           model=model, lam=out.lam.T[:n].copy(), kinetic=e[0, :n].copy(),
                           potential=e[1, :n].copy(), drift_position=e[2, :n].copy(),
                           drift_velocity=e[3, :n].copy(), row_labels=p.row_labels, packed=p)
+
+
+def first_nonfinite_row(*arrays: np.ndarray) -> int | None:
+    """Index of the first row (axis 0) where any of the arrays holds a non-finite value, or
+    None when all are finite."""
+    bad = None
+    for a in arrays:
+        a = np.asarray(a)
+        if a.size == 0:
+            continue
+        rows = ~np.isfinite(a.reshape(a.shape[0], -1)).all(axis=1)
+        if rows.any():
+            k = int(np.argmax(rows))
+            bad = k if bad is None else min(bad, k)
+    return bad
+
+
+def finite_part(res: R) -> tuple[R, int | None]:
+    """The result cut before its first row with a non-finite number (marked incomplete),
+    and that row's index; the result itself and None when every number is finite."""
+    names = [f for f in ROW_FIELDS if getattr(res, f, None) is not None]
+    k = first_nonfinite_row(*(getattr(res, f) for f in names))
+    if k is None:
+        return res, None
+    cut = {f: getattr(res, f)[:k].copy() for f in names}
+    return dataclasses.replace(res, complete=False, **cut), k

@@ -8,9 +8,10 @@ from typing import Any
 
 import numpy as np
 
+from ..binding.status import MEMORY_ADVICE
 from ..binding.tables import Packed
 from ..description.builder import ModelDescription
-from ..errors import ModelError
+from ..errors import InsufficientMemoryError, ModelError
 from ..validate import is_number, number, whole
 
 MAX_STEPS = 10**9      # output rows are held in memory; the core counts in 32-bit integers
@@ -38,8 +39,18 @@ def check_span(t0: Any, t_end: Any, steps: Any) -> tuple[float, float, int]:
     return t0, t_end, steps
 
 
+def output_rows(steps: int, every: Any) -> int:
+    """Number of output rows kept with decimation ``every`` (validated here: a whole number
+    >= 1): steps 0, every, 2 every, ... and always ``steps``. Nothing is allocated."""
+    k = whole(every, "every", "analysis", 1, MAX_STEPS)
+    return steps // k + 1 + (1 if steps % k else 0)
+
+
 def output_steps(steps: int, every: Any) -> np.ndarray:
     """Step indices kept with output decimation: 0, every, 2 every, ... and always ``steps``.
+
+    Call :func:`check_memory` with :func:`output_rows` first: this array has one entry per
+    kept row.
 
     Parameters
     ----------
@@ -67,16 +78,34 @@ def time_grid(t0: float, t_end: float, steps: int, idx: np.ndarray) -> np.ndarra
     return t
 
 
-def check_memory(rows: int, columns: int) -> None:
-    """Refuse output arrays that cannot fit in half the physical memory."""
-    need = 8.0 * rows * columns
+def physical_memory() -> float:
+    """Bytes of physical memory (8 GiB when the system does not say)."""
     try:
-        phys = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+        return float(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
     except (ValueError, OSError, AttributeError):  # pragma: no cover
-        phys = 8.0 * 2**30
-    if need > 0.5 * phys:
-        raise ModelError(f"the results would need {need / 2**30:.1f} GiB ({rows} rows x "
-                         f"{columns} numbers); use fewer steps", "analysis")
+        return 8.0 * 2**30
+
+
+def check_memory(rows: int, columns: int, analysis: str = "analysis",
+                 dense: tuple[int, int] | None = None) -> None:
+    """Refuse a run whose memory cannot fit in half the physical memory, before anything is
+    allocated: the output arrays (rows x columns numbers, held twice: the core's and the
+    result's) and, when ``dense`` = (m, n) is given, a dense m x n matrix of the core's.
+
+    Raises
+    ------
+    InsufficientMemoryError
+        With the size asked and what to change.
+    """
+    outputs = 2.0 * 8.0 * rows * columns
+    need = outputs + (8.0 * dense[0] * dense[1] if dense else 0.0)
+    if need > 0.5 * physical_memory():
+        parts = f"{rows} output rows x {columns} numbers, twice"
+        if dense:
+            parts += f", and a dense {dense[0]} x {dense[1]} matrix"
+        raise InsufficientMemoryError(
+            f"{analysis}: the run would need {need / 2**30:.3g} GiB ({parts}), more than half "
+            f"of this machine's {physical_memory() / 2**30:.3g} GiB; {MEMORY_ADVICE}", need)
 
 
 def check_solver(tol: Any, maxit: Any) -> tuple[float, int]:

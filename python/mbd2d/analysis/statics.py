@@ -3,15 +3,18 @@ from __future__ import annotations
 
 from typing import Any
 
+import numpy as np
+
 from ..binding import core
 from ..binding.pack import pack, pack_dynamics
-from ..binding.status import ASSEMBLY_FAILED, NO_CONVERGENCE, OK, SINGULAR
+from ..binding.status import (ASSEMBLY_FAILED, INCONSISTENT, NO_CONVERGENCE, OK, SINGULAR,
+                              error_for)
 from ..description.builder import ModelDescription
-from ..errors import ConvergenceError, CoreError, ModelError, SingularJacobianError
 from ..results.statics import StaticsResult
 from ..validate import number
-from .failures import assembly_failed, bad_entry
+from .failures import assembly_failed, bad_entry, inconsistent_at
 from .sensitivities import check_status, requested, table
+from .settings import check_memory
 
 STABILITY = {1: "stable", 0: "unstable", -1: "neutral", 2: "fully constrained"}
 
@@ -23,6 +26,7 @@ def run_statics(model: ModelDescription, t: float = 0.0,
     params = requested(model, sensitivities)
     p = pack(model)
     d = pack_dynamics(model, p)
+    check_memory(0, 0, "statics", dense=(p.nq + p.neq, p.nq + p.neq))
     if params:
         ptab = table(p, params, d)
         out = core.statics_sens(p, d, t, ptab)
@@ -31,21 +35,33 @@ def run_statics(model: ModelDescription, t: float = 0.0,
         out = core.statics(p, d, t)
     status, text = out.status, out.msg
     if status < 0:
-        raise ModelError(text, bad_entry(model, int(out.iinfo[1])))
+        raise error_for("statics", status, text, entry=bad_entry(model, int(out.iinfo[1])))
     if status == ASSEMBLY_FAILED:
-        raise assembly_failed(model, float(out.resid), 0, t, None)
-    if status == SINGULAR:
-        raise SingularJacobianError(text, t=t, status=status)
+        raise assembly_failed("statics", model, float(out.resid), 0, t, None)
+    if status == INCONSISTENT:
+        raise inconsistent_at("statics", model, p, t, None, text)
     if status == NO_CONVERGENCE:
-        raise ConvergenceError(text, t=t, status=status, residual=float(out.resid))
+        text = f"{text} (no equilibrium found near the q0 estimates; give q0 closer to one)"
+    elif status == SINGULAR:
+        text = (f"{text} (the equilibrium is not unique: a motion without stiffness, such as "
+                "a free rotation, is left; add a spring or a driver)")
     if status != OK:
-        raise CoreError(f"internal error in the core (status {status}): {text}")
+        raise error_for("statics", status, text, t=t, residual=float(out.resid))
+    if not (np.isfinite(out.q).all() and np.isfinite(out.lam).all()
+            and np.isfinite(out.resid)):
+        raise error_for("statics", NO_CONVERGENCE, "the equilibrium iteration gave non-finite "
+                        "values; give q0 closer to an equilibrium", t=t,
+                        residual=float(out.resid))
     res = StaticsResult(t=t, q=out.q, lam=out.lam,
                         stability=STABILITY.get(int(out.stable), "unknown"),
                         residual=float(out.resid), body_names=p.body_names,
                         coordinate_names=p.coordinate_names, row_labels=p.row_labels,
                         model=model, packed=p)
     if params:
+        if not (np.isfinite(out.sq).all() and np.isfinite(out.slam).all()):
+            raise error_for("statics", NO_CONVERGENCE, "the sensitivities of the equilibrium "
+                            "are not finite (the equilibrium is not isolated)", t=t,
+                            residual=float(out.resid))
         res.parameter_names = [prm.name for prm in params]
         res.dq_dp, res.dlam_dp, res.ptab = out.sq.copy(), out.slam.copy(), ptab
     return res

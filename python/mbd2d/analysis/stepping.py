@@ -6,8 +6,9 @@ import numpy as np
 
 from ..binding import core
 from ..binding.pack import pack
+from ..binding.status import NO_CONVERGENCE, error_for
 from ..description.builder import ModelDescription
-from ..errors import AssemblyError, ConvergenceError, ModelError
+from ..errors import ModelError
 from ..validate import number
 from .settings import check_solver, require_determined
 
@@ -47,6 +48,9 @@ class KinematicStepper:
     """
 
     def __init__(self, model: ModelDescription, t0: float = 0.0, tol: float | None = None) -> None:
+        if not isinstance(model, ModelDescription):
+            raise ModelError(f"KinematicStepper needs a Model, got {type(model).__name__}",
+                             "stepping")
         self._p = pack(model)
         require_determined(self._p, model)
         if self._p.neq != self._p.nq:
@@ -60,15 +64,25 @@ class KinematicStepper:
         self._call(self.t, assemble=True)
 
     def _call(self, t: float, assemble: bool) -> None:
+        """One core call from the current state to t; the state changes only on success
+        (the core works on copies)."""
         p = self._p
-        out = core.kin_step(p, self.q, self.qd, self.qdd, self.t, t, self._tol, 0, assemble)
+        analysis = "stepper-start" if assemble else "stepper"
+        out = core.kin_step(p, self.q.copy(), self.qd.copy(), self.qdd.copy(), self.t, t,
+                            self._tol, 0, assemble)
         status = out.status
+        stays = (f"the state stays at t = {self.t:.9g} s (Model.kinematics locates singular "
+                 "configurations)")
         if status < 0:
-            raise ModelError(out.msg, "stepping")
+            raise error_for(analysis, status, out.msg, entry="stepping")
         if status > 0:
-            cls = AssemblyError if assemble else ConvergenceError
-            raise cls(f"{out.msg}; the state stays at t = {self.t:.9g} s (Model.kinematics "
-                      "locates singular configurations)", t=t, status=status)
+            raise error_for(analysis, status, f"{out.msg}; {stays}", t=t)
+        if not (np.isfinite(out.q).all() and np.isfinite(out.qd).all()
+                and np.isfinite(out.qdd).all()):
+            raise error_for(analysis, NO_CONVERGENCE,
+                            f"the step to t = {t:.9g} s gave non-finite coordinates, velocities "
+                            f"or accelerations (a step far too long for Newton-Raphson); {stays}",
+                            t=t)
         self.q, self.qd, self.qdd, self.t = out.q, out.qd, out.qdd, t
 
     def step(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -82,7 +96,15 @@ class KinematicStepper:
         Returns
         -------
         tuple of numpy.ndarray
-            q, q_dot, q_ddot at t.
+            q, q_dot, q_ddot at t (finite).
+
+        Raises
+        ------
+        ModelError
+            If t is not a finite number.
+        ConvergenceError
+            If Newton-Raphson fails, J is singular, or the step gives non-finite values;
+            the state stays where it was.
         """
-        self._call(float(t), assemble=False)
+        self._call(number(t, "t", "stepping"), assemble=False)
         return self.q, self.qd, self.qdd

@@ -9,16 +9,28 @@ and status codes into exceptions is the caller's job.
 from __future__ import annotations
 
 from types import SimpleNamespace
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
 from .. import _core
+from ..errors import InsufficientMemoryError
+from .status import MEMORY_ADVICE
 from .tables import DynamicTables, Packed, decode
 
 
-def _named(names: str, out: tuple[Any, ...]) -> SimpleNamespace:
-    """The core's output tuple by name; ``msg`` decoded to text."""
+def _named(names: str, fn: Callable[..., tuple[Any, ...]], *args: Any,
+           **kwargs: Any) -> SimpleNamespace:
+    """Call the core and name its output tuple; ``msg`` decoded to text. The output arrays
+    f2py allocates for the call failing to fit in memory is an InsufficientMemoryError."""
+    try:
+        out = fn(*args, **kwargs)
+    except InsufficientMemoryError:
+        raise
+    except MemoryError:
+        what = getattr(fn, "__name__", "the core")
+        raise InsufficientMemoryError(f"the core's arrays for {what} could not be allocated; "
+                                      f"{MEMORY_ADVICE}") from None
     fields = dict(zip(names.split(), out, strict=True))
     if "msg" in fields:
         fields["msg"] = decode(fields["msg"])
@@ -28,45 +40,44 @@ def _named(names: str, out: tuple[Any, ...]) -> SimpleNamespace:
 
 def sizes(nb: int, ctab: np.ndarray, rpar: np.ndarray) -> SimpleNamespace:
     """Check the tables; ``nq``, ``neq``, ``status``, ``msg``, ``bad`` (1-based constraint)."""
-    return _named("nq neq status msg bad", _core.core_sizes(nb, ctab, rpar))
+    return _named("nq neq status msg bad", _core.core_sizes, nb, ctab, rpar)
 
 
 def evaluate(nb: int, ctab: np.ndarray, rpar: np.ndarray, neq: int, q: np.ndarray,
              qd: np.ndarray, t: float) -> SimpleNamespace:
     """Phi, J, nu and gamma at a state: ``phi``, ``jac``, ``nu``, ``gam``, ``status``, ``msg``,
     ``bad``."""
-    return _named("phi jac nu gam status msg bad",
-                  _core.core_eval(nb, ctab, rpar, neq, q, qd, float(t)))
+    return _named("phi jac nu gam status msg bad", _core.core_eval, nb, ctab, rpar, neq, q, qd,
+                  float(t))
 
 
 def kinematics(p: Packed, t0: float, t1: float, steps: int, tol: float, maxit: int,
                tmin: float, every: int, solver: int, nout: int) -> SimpleNamespace:
     """The whole kinematic run: ``q``, ``qd``, ``qdd`` (nq, nout), ``iinfo``, ``rinfo``,
     ``qsing``, ``dep``, ``red``, ``tpass``, ``status``, ``msg``."""
-    return _named("q qd qdd iinfo rinfo qsing dep red tpass status msg",
-                  _core.core_kinematics(p.nb, p.ctab, p.rpar, p.neq, p.q0, t0, t1, steps, tol,
-                                        maxit, tmin, every, solver, nout))
+    return _named("q qd qdd iinfo rinfo qsing dep red tpass status msg", _core.core_kinematics,
+                  p.nb, p.ctab, p.rpar, p.neq, p.q0, t0, t1, steps, tol, maxit, tmin, every,
+                  solver, nout)
 
 
 def kin_step(p: Packed, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, t_prev: float,
              t: float, tol: float, maxit: int, assemble: bool) -> SimpleNamespace:
     """One kinematic step (or the assembly at t): ``q``, ``qd``, ``qdd``, ``status``,
-    ``msg``."""
-    return _named("q qd qdd status msg",
-                  _core.core_kin_step(p.nb, p.ctab, p.rpar, q, qd, qdd, t_prev, t, tol, maxit,
-                                      int(assemble)))
+    ``msg``. q, qd and qdd may be overwritten (f2py passes them in and out)."""
+    return _named("q qd qdd status msg", _core.core_kin_step, p.nb, p.ctab, p.rpar, q, qd, qdd,
+                  t_prev, t, tol, maxit, int(assemble))
 
 
 def analyze(p: Packed, t: float, tol: float) -> SimpleNamespace:
     """Rank and redundancy at the assembled configuration: ``q``, ``rank``, ``mobility``,
     ``red``, ``dep``, ``resid``, ``worst``, ``status``, ``msg``."""
-    return _named("q rank mobility red dep resid worst status msg",
-                  _core.core_analyze(p.nb, p.ctab, p.rpar, p.neq, p.q0, t, tol))
+    return _named("q rank mobility red dep resid worst status msg", _core.core_analyze, p.nb,
+                  p.ctab, p.rpar, p.neq, p.q0, t, tol)
 
 
 def profile(kind: int, raw: np.ndarray, alphas: np.ndarray) -> SimpleNamespace:
     """Points c(alpha) of a closed profile curve: ``pts`` (2, n), ``status``, ``msg``."""
-    return _named("pts status msg", _core.core_profile(kind, raw, alphas))
+    return _named("pts status msg", _core.core_profile, kind, raw, alphas)
 
 
 def inverse(p: Packed, d: DynamicTables, t0: float, t1: float, steps: int, tol: float,
@@ -74,10 +85,9 @@ def inverse(p: Packed, d: DynamicTables, t0: float, t1: float, steps: int, tol: 
     """Kinematics plus multipliers and energies: ``q``, ``qd``, ``qdd``, ``lam``, ``e``,
     ``iinfo``, ``rinfo``, ``qsing``, ``dep``, ``red``, ``tpass``, ``status``, ``msg``."""
     return _named("q qd qdd lam e iinfo rinfo qsing dep red tpass status msg",
-                  _core.core_inverse(ctab=p.ctab, rpar=p.rpar, bmass=d.bmass, grav=d.grav,
-                                     ftab=d.ftab, fpar=d.fpar, neq=p.neq, q0=p.q0, t0=t0,
-                                     t1=t1, nsteps=steps, tol=tol, every=every, solver=solver,
-                                     nout=nout))
+                  _core.core_inverse, ctab=p.ctab, rpar=p.rpar, bmass=d.bmass, grav=d.grav,
+                  ftab=d.ftab, fpar=d.fpar, neq=p.neq, q0=p.q0, t0=t0, t1=t1, nsteps=steps,
+                  tol=tol, every=every, solver=solver, nout=nout)
 
 
 def dynamics(p: Packed, d: DynamicTables, t0: float, t1: float, steps: int, method: int,
@@ -85,26 +95,26 @@ def dynamics(p: Packed, d: DynamicTables, t0: float, t1: float, steps: int, meth
              every: int, nrow: int) -> SimpleNamespace:
     """Forward dynamics: ``q``, ``qd``, ``qdd``, ``lam``, ``e``, ``iinfo``, ``rinfo``, ``red``,
     ``status``, ``msg``."""
-    return _named("q qd qdd lam e iinfo rinfo red status msg",
-                  _core.core_dynamics(ctab=p.ctab, rpar=p.rpar, bmass=d.bmass, grav=d.grav,
-                                      ftab=d.ftab, fpar=d.fpar, neq=p.neq, q0=p.q0, v0=d.v0,
-                                      t0=t0, t1=t1, nsteps=steps, method=method, rtol=rtol,
-                                      atol=atol, h=h, rho_inf=rho_inf, balpha=alpha,
-                                      bbeta=beta, every=every, nrow=nrow))
+    return _named("q qd qdd lam e iinfo rinfo red status msg", _core.core_dynamics,
+                  ctab=p.ctab, rpar=p.rpar, bmass=d.bmass, grav=d.grav, ftab=d.ftab,
+                  fpar=d.fpar, neq=p.neq, q0=p.q0, v0=d.v0, t0=t0, t1=t1, nsteps=steps,
+                  method=method, rtol=rtol, atol=atol, h=h, rho_inf=rho_inf, balpha=alpha,
+                  bbeta=beta, every=every, nrow=nrow)
 
 
 def statics(p: Packed, d: DynamicTables, t: float) -> SimpleNamespace:
     """Static equilibrium: ``q``, ``lam``, ``stable``, ``resid``, ``iinfo``, ``status``,
     ``msg``."""
-    return _named("q lam stable resid iinfo status msg",
-                  _core.core_statics(ctab=p.ctab, rpar=p.rpar, bmass=d.bmass, grav=d.grav,
-                                     ftab=d.ftab, fpar=d.fpar, neq=p.neq, q0=p.q0, t=t))
+    return _named("q lam stable resid iinfo status msg", _core.core_statics, ctab=p.ctab,
+                  rpar=p.rpar, bmass=d.bmass, grav=d.grav, ftab=d.ftab, fpar=d.fpar,
+                  neq=p.neq, q0=p.q0, t=t)
 
 
 def reactions(p: Packed, q: np.ndarray, t: np.ndarray, lam: np.ndarray) -> SimpleNamespace:
     """Joint reactions at states q (nq, nt), times t (nt) and multipliers lam (neq, nt):
     ``reac`` and ``rloc`` (6, nc, nt), ``status``, ``msg``."""
-    return _named("reac rloc status msg", _core.core_reactions(p.nb, p.ctab, p.rpar, q, t, lam))
+    return _named("reac rloc status msg", _core.core_reactions, p.nb, p.ctab, p.rpar, q, t,
+                  lam)
 
 
 # ------------------------------------------------------------------ design sensitivities
@@ -115,8 +125,8 @@ def eval_d(p: Packed, rpar: np.ndarray, q: np.ndarray, qd: np.ndarray, t: float,
            dq: np.ndarray, dqd: np.ndarray, ptab: np.ndarray) -> SimpleNamespace:
     """Changes of Phi, J, nu and gamma along a direction (dq, dqd) and at most one design
     parameter: ``tphi``, ``tjac``, ``tnu``, ``tgam``, ``status``, ``msg``, ``bad``."""
-    return _named("tphi tjac tnu tgam status msg bad",
-                  _core.core_eval_d(p.nb, p.ctab, rpar, p.neq, q, qd, float(t), dq, dqd, ptab))
+    return _named("tphi tjac tnu tgam status msg bad", _core.core_eval_d, p.nb, p.ctab, rpar,
+                  p.neq, q, qd, float(t), dq, dqd, ptab)
 
 
 def kinematics_sens(p: Packed, t0: float, t1: float, steps: int, tol: float, maxit: int,
@@ -125,8 +135,8 @@ def kinematics_sens(p: Packed, t0: float, t1: float, steps: int, tol: float, max
     """A kinematic run with sensitivities: as :func:`kinematics` plus ``sq``, ``sqd``,
     ``sqdd`` (nq, np, nout)."""
     return _named("q qd qdd sq sqd sqdd iinfo rinfo qsing dep red tpass status msg",
-                  _core.core_kinematics_sens(p.nb, p.ctab, p.rpar, p.neq, p.q0, t0, t1, steps,
-                                             tol, maxit, tmin, every, solver, nout, ptab))
+                  _core.core_kinematics_sens, p.nb, p.ctab, p.rpar, p.neq, p.q0, t0, t1, steps,
+                  tol, maxit, tmin, every, solver, nout, ptab)
 
 
 def inverse_sens(p: Packed, d: DynamicTables, t0: float, t1: float, steps: int, tol: float,
@@ -134,10 +144,9 @@ def inverse_sens(p: Packed, d: DynamicTables, t0: float, t1: float, steps: int, 
     """Inverse dynamics with sensitivities: as :func:`inverse` plus ``sq``, ``sqd``, ``sqdd``
     (nq, np, nout) and ``slam`` (neq, np, nout)."""
     return _named("q qd qdd lam e sq sqd sqdd slam iinfo rinfo qsing dep red tpass status msg",
-                  _core.core_inverse_sens(ctab=p.ctab, rpar=p.rpar, bmass=d.bmass,
-                                          grav=d.grav, ftab=d.ftab, fpar=d.fpar, neq=p.neq,
-                                          q0=p.q0, t0=t0, t1=t1, nsteps=steps, tol=tol,
-                                          every=every, solver=solver, nout=nout, ptab=ptab))
+                  _core.core_inverse_sens, ctab=p.ctab, rpar=p.rpar, bmass=d.bmass,
+                  grav=d.grav, ftab=d.ftab, fpar=d.fpar, neq=p.neq, q0=p.q0, t0=t0, t1=t1,
+                  nsteps=steps, tol=tol, every=every, solver=solver, nout=nout, ptab=ptab)
 
 
 def dynamics_sens(p: Packed, d: DynamicTables, t0: float, t1: float, steps: int, rtol: float,
@@ -146,25 +155,23 @@ def dynamics_sens(p: Packed, d: DynamicTables, t0: float, t1: float, steps: int,
     """Forward dynamics by dopri5 with sensitivities: ``q``, ``qd``, ``qdd``, ``lam``, ``e``,
     ``sq``, ``sqd``, ``sqdd``, ``iinfo``, ``rinfo``, ``red``, ``status``, ``msg``."""
     return _named("q qd qdd lam e sq sqd sqdd iinfo rinfo red status msg",
-                  _core.core_dynamics_sens(ctab=p.ctab, rpar=p.rpar, bmass=d.bmass,
-                                           grav=d.grav, ftab=d.ftab, fpar=d.fpar, neq=p.neq,
-                                           q0=p.q0, v0=d.v0, t0=t0, t1=t1, nsteps=steps,
-                                           rtol=rtol, atol=atol, every=every,
-                                           max_steps=max_steps, nrow=nrow, ptab=ptab))
+                  _core.core_dynamics_sens, ctab=p.ctab, rpar=p.rpar, bmass=d.bmass,
+                  grav=d.grav, ftab=d.ftab, fpar=d.fpar, neq=p.neq, q0=p.q0, v0=d.v0, t0=t0,
+                  t1=t1, nsteps=steps, rtol=rtol, atol=atol, every=every, max_steps=max_steps,
+                  nrow=nrow, ptab=ptab)
 
 
 def statics_sens(p: Packed, d: DynamicTables, t: float, ptab: np.ndarray) -> SimpleNamespace:
     """Static equilibrium with sensitivities: ``q``, ``lam``, ``sq`` (nq, np), ``slam``
     (neq, np), ``stable``, ``resid``, ``iinfo``, ``status``, ``msg``."""
-    return _named("q lam sq slam stable resid iinfo status msg",
-                  _core.core_statics_sens(ctab=p.ctab, rpar=p.rpar, bmass=d.bmass,
-                                          grav=d.grav, ftab=d.ftab, fpar=d.fpar, neq=p.neq,
-                                          q0=p.q0, t=t, ptab=ptab))
+    return _named("q lam sq slam stable resid iinfo status msg", _core.core_statics_sens,
+                  ctab=p.ctab, rpar=p.rpar, bmass=d.bmass, grav=d.grav, ftab=d.ftab,
+                  fpar=d.fpar, neq=p.neq, q0=p.q0, t=t, ptab=ptab)
 
 
 def reactions_dp(p: Packed, ptab: np.ndarray, q: np.ndarray, t: np.ndarray, lam: np.ndarray,
                  sq: np.ndarray, slam: np.ndarray) -> SimpleNamespace:
     """Changes of the reactions along the parameters: ``dreac``, ``drloc``
     (6, nc, np, nt), ``status``, ``msg``."""
-    return _named("dreac drloc status msg",
-                  _core.core_reactions_dp(p.nb, p.ctab, p.rpar, ptab, q, t, lam, sq, slam))
+    return _named("dreac drloc status msg", _core.core_reactions_dp, p.nb, p.ctab, p.rpar,
+                  ptab, q, t, lam, sq, slam)

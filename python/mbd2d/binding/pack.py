@@ -7,6 +7,7 @@ import numpy as np
 from ..description.builder import ModelDescription
 from ..errors import ModelError
 from . import core
+from .status import error_for
 from .tables import NCT, NFT, DynamicTables, Packed, decode
 
 
@@ -32,8 +33,10 @@ def pack(model: ModelDescription) -> Packed:
     con_idx = {c.name: k + 1 for k, c in enumerate(cons)}
     cols: list[list[int]] = []
     rpar: list[float] = []
+    q0_by_name = {b.name: b.q0 for b in model.bodies}
+    q0_by_name["ground"] = (0.0, 0.0, 0.0)
     for c in cons:
-        params = c.raw()
+        params = c.raw_in(cons, q0_by_name)
         suba, subb = c.subkinds(body_idx.__getitem__, con_idx.__getitem__)
         cols.append([c.kind, body_idx[c.bodies[0]], body_idx[c.bodies[1]], suba, subb,
                      len(rpar) + 1, len(params), 0])
@@ -44,7 +47,7 @@ def pack(model: ModelDescription) -> Packed:
     nq, neq, bad = int(out.nq), int(out.neq), int(out.bad)
     if out.status != 0:
         entry = cons[bad - 1].describe() if bad > 0 else "model"
-        raise ModelError(out.msg, entry)
+        raise error_for("sizes", out.status, out.msg, entry=entry)
     q0 = np.zeros(nq)
     q0[:3 * len(model.bodies)] = np.array([b.q0 for b in model.bodies], dtype=float).ravel()
     rows = [0]

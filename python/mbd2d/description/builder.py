@@ -14,6 +14,7 @@ model only; :class:`mbd2d.Model` adds the analyses on top of it.
 """
 from __future__ import annotations
 
+import math
 from typing import Any, Mapping, Sequence
 
 from ..errors import ModelError
@@ -23,9 +24,9 @@ from .bodies import Body
 from .drivers import AbsoluteDriver, Driver, RelativeAngleDriver, RelativeDistanceDriver
 from .forces import FORCE_KEYS, Force, PointForce, RotationalSpring, Spring, Torque
 from .functions import as_function
-from .joints import (COORDINATES, Absolute, Cam, Constraint, Distance, Gear, PinInSlot,
-                     PointOnCurve, PointOnLine, RackPinion, Revolute, RollingDisc, Translational,
-                     Weld, joint_keys, parse_follower, parse_profile)
+from .joints import (COORDINATES, PRESSURE_ANGLE, Absolute, Cam, Constraint, Distance, Gear,
+                     PinInSlot, PointOnCurve, PointOnLine, RackPinion, Revolute, RollingDisc,
+                     Translational, Weld, joint_keys, parse_follower, parse_profile)
 from .parameters import parameter_list
 from .parameters import with_params as _with_params
 
@@ -47,11 +48,13 @@ class ModelDescription:
     >>> _ = m.add_revolute(["ground", "bar"], [[0, 0], [-0.5, 0]])
     >>> _ = m.add_driver("absolute", body="bar", coordinate="theta", f={"poly": [0.0, 1.0]})
     >>> m.constraint_rows()
-    ['revolute1.x', 'revolute1.y', 'driver2.bar.theta']
+    ['joint1.x', 'joint1.y', 'driver1.theta']
     """
 
     def __init__(self, name: str = "model", gravity: Sequence[float] = (0.0, -9.81)) -> None:
-        self.name = str(name)
+        if not isinstance(name, str):
+            raise ModelError(f"name must be a string, got {name!r}", "[model]")
+        self.name = name
         self.gravity = vector(gravity, 2, "gravity", "[model]")
         self.bodies: list[Body] = []
         self.joints: list[Constraint] = []
@@ -98,13 +101,18 @@ class ModelDescription:
             self.__dict__["_names_cache"] = (key, names)
         return names
 
-    def _new_name(self, name: str | None, stem: str, entry: str) -> str:
+    def _new_name(self, name: str | None, section: str, entry: str) -> str:
+        """The name of a new joint, driver or force (``section``): the one given, checked,
+        or the automatic ``joint<k>``, ``driver<k>``, ``force<k>`` where k counts the
+        entries of that section, this one included (the k-th ``[[joint]]`` of a file)."""
         if name is None:
-            k = len(self.constraints) + 1
-            name = f"{stem}{k}"
-            while name in self._names():
-                k += 1
-                name = f"{stem}{k}"
+            k = len({"joint": self.joints, "driver": self.drivers, "force": self.forces}[section])
+            name = f"{section}{k + 1}"
+            if name == GROUND or name in self._names():
+                raise ModelError(f"this {section} has no name, and its automatic name {name!r} "
+                                 f"(the {section}s are numbered {section}1, {section}2, ... "
+                                 "in the order they are added) is already used by another "
+                                 f"entry; give this {section} a name", entry)
             return name
         check_name(name, entry)
         if name == GROUND or name in self._names():
@@ -175,7 +183,7 @@ class ModelDescription:
     def _start(self, kind: str, name: str | None) -> tuple[str, str]:
         """Settle the name of a new joint; return (name, entry for messages)."""
         entry = self._entry(kind, name)
-        name = self._new_name(name, kind.replace("-", "_"), entry)
+        name = self._new_name(name, "joint", entry)
         return name, f"joint '{name}' ({kind})"
 
     def add_revolute(self, bodies: Sequence[str], points: Sequence[Sequence[float]],
@@ -274,11 +282,18 @@ class ModelDescription:
 
     def add_gear(self, bodies: Sequence[str], radii: Sequence[float], internal: bool = False,
                  carrier: str = "ground", phase: float | None = None,
+                 pressure_angle: float = PRESSURE_ANGLE,
+                 centers: Sequence[Sequence[float]] | None = None,
                  name: str | None = None) -> Gear:
         """Gear pair whose centres are held by ``carrier`` (ground by default):
         R_i (theta_i - theta_c) + R_j (theta_j - theta_c) = phase (external), with a minus for
         an internal pair (bodies[1] is the ring). The phase defaults to its value at the q0
-        estimates."""
+        estimates. The reaction is the tooth force at the pitch point along the line of
+        action, ``pressure_angle`` (radians, default 20 degrees) from the common tangent; a
+        positive angle is the flank that separates the gears while the mesh turns bodies[0]
+        clockwise (its multiplier positive), a negative one the other flank. ``centers``:
+        the gear centres in each gear's frame (default: the points of the revolutes that pin
+        the gears to the carrier, else the body origins)."""
         name, entry = self._start("gear", name)
         bb = self._two_bodies(bodies, entry)
         r = vector(radii, 2, "radii", entry)
@@ -295,7 +310,13 @@ class ModelDescription:
         if carrier in bb:
             raise ModelError(f"the carrier {carrier!r} cannot be one of the gears", entry)
         ph = None if phase is None else number(phase, "phase", entry)
-        return self._add(Gear(name, bb, (r[0], r[1]), internal, carrier, ph))  # type: ignore
+        pa = number(pressure_angle, "pressure_angle", entry)
+        if not abs(pa) < math.pi / 2:
+            raise ModelError(f"pressure_angle is in radians, between -pi/2 and pi/2 (20 "
+                             f"degrees = 0.349), got {pressure_angle!r}", entry)
+        cc = None if centers is None else pairs(centers, 2, "centers", entry)
+        return self._add(Gear(name, bb, (r[0], r[1]), internal, carrier, ph, pa,  # type: ignore
+                              cc))
 
     def add_rack_pinion(self, bodies: Sequence[str], center: Sequence[float],
                         point: Sequence[float], axis: Sequence[float], radius: float,
@@ -354,7 +375,7 @@ class ModelDescription:
     def _force_start(self, kind: str, name: str | None) -> tuple[str, str]:
         entry = f"force {name!r} ({kind})" if isinstance(name, str) \
             else f"force #{len(self.forces) + 1} ({kind})"
-        name = self._new_name(name, kind.replace("-", "_"), entry)
+        name = self._new_name(name, "force", entry)
         return name, f"force '{name}' ({kind})"
 
     def add_spring(self, bodies: Sequence[str], points: Sequence[Sequence[float]],
@@ -485,8 +506,9 @@ class ModelDescription:
         return names + [n for c in self.constraints for n in c.extra_names()]
 
     def constraint_rows(self) -> list[str]:
-        """A label for each row of Phi: ``NAME.equation`` (for example ``O2.x``,
-        ``guide.angle``, ``motor.crank.theta``)."""
+        """A label for each row of Phi: ``NAME.EQUATION``, the joint's or driver's name and
+        the equation's word from :data:`~mbd2d.description.joints.ROW_WORDS` (for example
+        ``O2.x``, ``guide.angle``, ``motor.theta``)."""
         return [r for c in self.constraints for r in c.rows()]
 
     # ------------------------------------------------------------------ design parameters

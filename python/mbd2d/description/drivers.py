@@ -32,7 +32,7 @@ class AbsoluteDriver(Driver):
 
     @property
     def labels(self) -> tuple[str, ...]:  # type: ignore[override]
-        return (f"{self.bodies[0]}.{self.coordinate}",)
+        return (self.coordinate,)
 
     def subkinds(self, body_index: BodyIndex, joint_index: Callable[[str], int]) -> tuple[int, int]:
         return COORDINATES[self.coordinate], 0

@@ -7,6 +7,7 @@ adds, what each row stands for, and its raw parameters. The numerics live in For
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any, Callable, ClassVar, Mapping, Sequence
 
@@ -16,8 +17,26 @@ from ..validate import as_list, nonzero_vector, only_keys, pairs, positive, tabl
 PROFILE_KINDS = {"circle": 1, "spline": 2, "fourier": 3}
 FOLLOWER_KINDS = {"point": 1, "roller": 2, "flat": 3}
 COORDINATES = {"x": 1, "y": 2, "theta": 3}
+PRESSURE_ANGLE = math.radians(20.0)   #: default gear pressure angle (radians)
 
 BodyIndex = Callable[[str], int]
+
+#: The words that end row labels (``NAME.WORD``), each with one meaning for every joint and
+#: driver that uses it. A row's multiplier is the reaction along what the word names.
+ROW_WORDS = {
+    "x": "global x: two points coincide (revolute, weld, point or roller cam, point-on-curve), "
+         "or a body's x is fixed or driven",
+    "y": "global y, likewise",
+    "theta": "a body's absolute angle is fixed or driven",
+    "angle": "a relative angle theta_j - theta_i (translational, weld, relative-angle driver)",
+    "normal": "a point's distance from a line or face along its normal (translational, "
+              "point-on-line, revolute-translational, flat-faced cam, rolling disc)",
+    "tangent": "a flat follower's face lies along the cam profile's tangent",
+    "distance": "the distance between two points",
+    "mesh": "the pitch circles of a gear pair roll on each other",
+    "no_slip": "a pinion or disc rolls along its line without slip",
+    "slide": "the slide along a translational joint (relative-distance driver)",
+}
 
 
 @dataclass
@@ -44,12 +63,18 @@ class Constraint:
         return f"joint '{self.name}' ({self.type})"
 
     def rows(self) -> list[str]:
-        """A label per equation: NAME.equation."""
+        """A label per equation: NAME.WORD, the word from :data:`ROW_WORDS`."""
         return [f"{self.name}.{label}" for label in self.labels]
 
     def raw(self) -> list[float]:
         """Raw parameters of the flat table."""
         raise NotImplementedError
+
+    def raw_in(self, constraints: Sequence["Constraint"],
+               q0: Mapping[str, Sequence[float]]) -> list[float]:
+        """Raw parameters given the rest of the model (its constraints and the q0 estimates
+        by body name, ground included); most constraints need neither."""
+        return self.raw()
 
     def subkinds(self, body_index: BodyIndex, joint_index: Callable[[str], int]) -> tuple[int, int]:
         """Sub-kinds a and b of the flat table."""
@@ -101,7 +126,7 @@ class Cam(Constraint):
 
     @property
     def labels(self) -> tuple[str, ...]:  # type: ignore[override]
-        return ("on_face", "tangent") if self.follower_kind == "flat" else ("x", "y")
+        return ("normal", "tangent") if self.follower_kind == "flat" else ("x", "y")
 
     def raw(self) -> list[float]:
         return [*self.follower, *self.profile]
@@ -128,7 +153,7 @@ class Distance(Constraint):
     distance: float = 1.0
     type: ClassVar[str] = "distance"
     kind: ClassVar[int] = 4
-    labels: ClassVar[tuple[str, ...]] = ("length",)
+    labels: ClassVar[tuple[str, ...]] = ("distance",)
 
     def raw(self) -> list[float]:
         return [*self.points[0], *self.points[1], self.distance]
@@ -172,19 +197,61 @@ class Weld(Constraint):
 
 @dataclass
 class Gear(Constraint):
-    """Gear pair on a common carrier: R_i (th_i - th_c) +/- R_j (th_j - th_c) = phase."""
+    """Gear pair on a common carrier: R_i (th_i - th_c) +/- R_j (th_j - th_c) = phase, with the
+    tooth force at the pitch point, along the line of action (``pressure_angle``, radians), as
+    its reaction (fortran/mbd_joint_gear.f90).
+
+    The gear centres are ``centers`` (in each gear's frame) or, by default, the points of the
+    revolute joints that pin the gears to the carrier (the body origin when there is none);
+    where they sit in the carrier comes from those revolutes too, else from the q0 estimates.
+    """
 
     radii: tuple[float, float] = (1.0, 1.0)
     internal: bool = False
     carrier: str = "ground"
     phase: float | None = None
+    pressure_angle: float = PRESSURE_ANGLE
+    centers: tuple[tuple[float, float], tuple[float, float]] | None = None
     type: ClassVar[str] = "gear"
     kind: ClassVar[int] = 7
     labels: ClassVar[tuple[str, ...]] = ("mesh",)
-    phase_row: ClassVar[int | None] = 0
 
     def raw(self) -> list[float]:
-        return [*self.radii, self.phase or 0.0]
+        # the centres at the body origins, on the x axis of the carrier
+        d = self.radii[1] - self.radii[0] if self.internal else sum(self.radii)
+        return [*self.radii, self.phase or 0.0, self.pressure_angle, 0.0, 0.0, 0.0, 0.0,
+                0.0, 0.0, d, 0.0]
+
+    def raw_in(self, constraints: Sequence[Constraint],
+               q0: Mapping[str, Sequence[float]]) -> list[float]:
+        ci, ai = self._centre(0, constraints, q0)
+        cj, aj = self._centre(1, constraints, q0)
+        sgn = -1.0 if self.internal else 1.0
+        tc = q0[self.carrier][2]
+        phase = self.phase
+        if phase is None:       # the teeth mesh as drawn
+            phase = (self.radii[0] * (q0[self.bodies[0]][2] - tc)
+                     + sgn * self.radii[1] * (q0[self.bodies[1]][2] - tc))
+        return [*self.radii, phase, self.pressure_angle, *ci, *cj, *ai, *aj]
+
+    def _centre(self, k: int, constraints: Sequence[Constraint],
+                q0: Mapping[str, Sequence[float]]) -> tuple[tuple[float, float], ...]:
+        """Centre of gear k in its own frame and in the carrier frame."""
+        gear, carrier = self.bodies[k], self.carrier
+        given = None if self.centers is None else self.centers[k]
+        for c in constraints:
+            if isinstance(c, Revolute) and set(c.bodies) == {gear, carrier}:
+                g = c.bodies.index(gear)
+                if given is None or tuple(given) == tuple(c.points[g]):
+                    return c.points[g], c.points[1 - g]
+        own = (0.0, 0.0) if given is None else given
+        # as drawn: C = r_g + A_g c', then A_c^T (C - r_c)
+        xg, yg, tg = q0[gear]
+        xc, yc, tc = q0[carrier]
+        cx = xg + math.cos(tg) * own[0] - math.sin(tg) * own[1] - xc
+        cy = yg + math.sin(tg) * own[0] + math.cos(tg) * own[1] - yc
+        return own, (math.cos(tc) * cx + math.sin(tc) * cy,
+                     -math.sin(tc) * cx + math.cos(tc) * cy)
 
     def subkinds(self, body_index: BodyIndex, joint_index: Callable[[str], int]) -> tuple[int, int]:
         return body_index(self.carrier), 2 if self.internal else 1
@@ -214,7 +281,7 @@ class RollingDisc(RackPinion):
 
     type: ClassVar[str] = "rolling-disc"
     kind: ClassVar[int] = 9
-    labels: ClassVar[tuple[str, ...]] = ("no_slip", "contact")
+    labels: ClassVar[tuple[str, ...]] = ("no_slip", "normal")
 
 
 @dataclass
@@ -317,7 +384,8 @@ def joint_keys() -> Mapping[str, tuple[set[str], set[str]]]:
         "revolute-translational": ({"bodies", "points", "axis", "offset"},
                                    {"bodies", "points", "axis"}),
         "weld": ({"bodies", "points", "angle"}, {"bodies", "points"}),
-        "gear": ({"bodies", "radii", "internal", "carrier", "phase"}, {"bodies", "radii"}),
+        "gear": ({"bodies", "radii", "internal", "carrier", "phase", "pressure_angle",
+                  "centers"}, {"bodies", "radii"}),
         "rack-pinion": ({"bodies", "center", "point", "axis", "radius", "phase"},
                         {"bodies", "center", "point", "axis", "radius"}),
         "rolling-disc": ({"bodies", "center", "point", "axis", "radius", "phase"},

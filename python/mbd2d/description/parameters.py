@@ -155,6 +155,9 @@ def _constraint(c: Any) -> Iterator[tuple[str, str, tuple, int]]:
     elif t == "gear":
         yield from _vec("radii", 0)
         yield "phase", "phase", (), 2
+        yield "pressure_angle", "pressure_angle", (), 3
+        if c.centers is not None:
+            yield from _pairs("centers", 4)
     elif t in ("rack-pinion", "rolling-disc"):
         yield from _vec("center", 0)
         yield from _vec("point", 2)

@@ -14,6 +14,7 @@ are checked the same way. The functions here build any subclass of it (``cls``);
 """
 from __future__ import annotations
 
+import os
 import tomllib
 from pathlib import Path
 from typing import Any, Mapping, TypeVar
@@ -52,6 +53,9 @@ def load(path: str | Path, cls: type[M] = ModelDescription) -> M:  # type: ignor
     >>> load("examples/fourbar_seed.toml")
     ModelDescription('seed-four-bar': 3 bodies, 4 joints, 1 drivers)
     """
+    if not isinstance(path, (str, os.PathLike)):
+        raise ModelError(f"the model file must be a path (str or pathlib.Path), got {path!r}",
+                         "load")
     p = Path(path)
     try:
         text = p.read_text(encoding="utf-8")
@@ -66,6 +70,9 @@ def load(path: str | Path, cls: type[M] = ModelDescription) -> M:  # type: ignor
 def loads(text: str, source: str = "<string>",
           cls: type[M] = ModelDescription) -> M:  # type: ignore[assignment]
     """Read a model from TOML text; see :func:`load`."""
+    if not isinstance(text, str):
+        raise ModelError(f"the model text must be a str (decode bytes first), got "
+                         f"{type(text).__name__}", source if isinstance(source, str) else "loads")
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:

@@ -12,7 +12,9 @@ from typing import Any, Protocol, Sequence
 import numpy as np
 
 from ..binding import core
+from ..binding.status import error_for
 from ..description.joints import PROFILE_KINDS, Cam, Revolute, Translational
+from ..errors import ModelError
 from ..validate import GROUND
 
 TracePoint = tuple[str, tuple[float, float]]
@@ -77,8 +79,8 @@ def profile_points(cam: Cam, alphas: np.ndarray) -> np.ndarray:
     a = np.ascontiguousarray(alphas, dtype=np.float64)
     out = core.profile(PROFILE_KINDS[cam.profile_kind], raw, a)
     if out.status != 0:
-        raise ValueError(f"cam '{cam.name}': the core could not evaluate its profile: "
-                         f"{out.msg}")
+        raise error_for("profile", out.status, f"the core could not evaluate its profile: "
+                        f"{out.msg}", entry=cam.describe())
     return np.asarray(out.pts).T
 
 
@@ -134,10 +136,10 @@ def check_trace(result: Motion, trace: Any) -> list[TracePoint]:
             if len(s) != 2:
                 raise ValueError
         except (TypeError, ValueError):
-            raise ValueError(f"trace entries must be (body_name, (sx, sy)), got {item!r}") \
+            raise ModelError(f"entries must be (body_name, (sx, sy)), got {item!r}", "trace") \
                 from None
         if body not in result.body_names:
-            raise ValueError(f"trace: no body {body!r}; bodies: {', '.join(result.body_names)}")
+            raise ModelError(f"no body {body!r}; bodies: {', '.join(result.body_names)}", "trace")
         out.append((str(body), (sx, sy)))
     return out
 
@@ -149,15 +151,18 @@ def snapshot_rows(result: Motion, times: Any) -> np.ndarray:
         k = min(n, 6)
         rows = np.unique(np.round(np.linspace(0, n - 1, k)).astype(int))
     else:
-        tt = np.atleast_1d(np.asarray(times, dtype=float))
-        if tt.size == 0 or not np.all(np.isfinite(tt)):
-            raise ValueError("times must be a non-empty list of finite times")
+        try:
+            tt = np.atleast_1d(np.asarray(times, dtype=float))
+        except (TypeError, ValueError):
+            tt = np.zeros(0)
+        if tt.ndim != 1 or tt.size == 0 or not np.all(np.isfinite(tt)):
+            raise ModelError("must be a non-empty list of finite times", "times")
         lo, hi = result.t[0], result.t[-1]
         span = max(hi - lo, 1.0)
         bad = tt[(tt < lo - 1e-9 * span) | (tt > hi + 1e-9 * span)]
         if bad.size:
-            raise ValueError(f"times {bad.tolist()} are outside the result's span "
-                             f"t = {lo:g} .. {hi:g} s")
+            raise ModelError(f"{bad.tolist()} are outside the result's span "
+                             f"t = {lo:g} .. {hi:g} s", "times")
         rows = np.unique(np.abs(result.t[None, :] - tt[:, None]).argmin(axis=1))
     if not result.complete and rows[-1] != n - 1:
         rows = np.append(rows, n - 1)

@@ -6,6 +6,7 @@ from typing import TYPE_CHECKING, Any, Sequence
 import numpy as np
 
 from ..description.joints import Cam, Revolute, Translational
+from ..errors import ModelError
 from ..validate import GROUND
 from .canvas import (GROUND_COLOUR, PALETTE, STOP_COLOUR, import_matplotlib, new_figure,
                      shade)
@@ -53,16 +54,16 @@ def plot_mechanism(result: Motion, times: Sequence[float] | None = None,
 
     Raises
     ------
-    ValueError
-        If the result has no rows or no model, a time is outside the run, or a trace entry
-        names no body.
+    ModelError
+        (a ValueError) If the result has no rows or no model, a time is outside the run, or a
+        trace entry names no body.
     """
     model = getattr(result, "model", None)
     if model is None:
-        raise ValueError("the result carries no model (result.model is None); plot_mechanism "
-                         "needs the joints to draw the bodies")
+        raise ModelError("the result carries no model (result.model is None); plot_mechanism "
+                         "needs the joints to draw the bodies", "plot_mechanism")
     if len(result.t) == 0:
-        raise ValueError("the result has no rows to draw")
+        raise ModelError("the result has no rows to draw", "plot_mechanism")
     tr = check_trace(result, trace)
     if ax is None:
         ax = new_figure((8.0, 6.5)).add_subplot()

@@ -8,6 +8,7 @@ from typing import Any
 
 import numpy as np
 
+from .files import writing
 from .kinematics import KinematicsResult
 from .reactions import Reaction, reaction_arrays, reaction_of
 from .sensitivities import parameter_index, reaction_dp_arrays, reaction_dp_of
@@ -114,13 +115,22 @@ class DynamicsResult(KinematicsResult):
                             parameter_index(self.parameter_names, name)]
 
     def multiplier(self, row: str) -> np.ndarray:
-        """The multiplier of a row by its label (see ``model.constraint_rows()``)."""
+        """The multiplier of a row by its label (see ``model.constraint_rows()``).
+
+        Raises
+        ------
+        KeyError
+            If no row has that label.
+        """
+        if row not in self.row_labels:
+            raise KeyError(f"no row {row!r}; rows: {', '.join(self.row_labels)}")
         return self.lam[:, self.row_labels.index(row)]
 
     def to_npz(self, path: str | Path) -> None:
         """t, q, qd, qdd, the multipliers and energies, and the names."""
-        np.savez(path, t=self.t, q=self.q, qd=self.qd, qdd=self.qdd, lam=self.lam,
-                 kinetic=self.kinetic, potential=self.potential,
-                 drift_position=self.drift_position, drift_velocity=self.drift_velocity,
-                 coordinate_names=np.array(self.coordinate_names),
-                 body_names=np.array(self.body_names), row_labels=np.array(self.row_labels))
+        with writing(path, "to_npz") as p:
+            np.savez(p, t=self.t, q=self.q, qd=self.qd, qdd=self.qdd, lam=self.lam,
+                     kinetic=self.kinetic, potential=self.potential,
+                     drift_position=self.drift_position, drift_velocity=self.drift_velocity,
+                     coordinate_names=np.array(self.coordinate_names),
+                     body_names=np.array(self.body_names), row_labels=np.array(self.row_labels))

@@ -8,6 +8,8 @@ from typing import Any
 
 import numpy as np
 
+from ..validate import vector
+from .files import writing
 from .sensitivities import LEVELS, body_columns, parameter_index
 
 SUFFIXES = ("x", "y", "theta", "x_dot", "y_dot", "theta_dot", "x_ddot", "y_ddot", "theta_ddot")
@@ -109,8 +111,8 @@ class KinematicsResult:
 
     def point(self, name: str, s: Any) -> np.ndarray:
         """Global path r + A(theta) s' of a point s' fixed in a body, shape (n, 2)."""
+        sx, sy = vector(s, 2, "s", "point")
         b = self.body(name)
-        sx, sy = float(s[0]), float(s[1])
         c, sn = np.cos(b.theta), np.sin(b.theta)
         return np.column_stack([b.x + c * sx - sn * sy, b.y + sn * sx + c * sy])
 
@@ -127,13 +129,16 @@ class KinematicsResult:
     def to_csv(self, path: str | Path) -> None:
         """Write the CSV (17 significant digits)."""
         header, rows = self.table()
-        np.savetxt(path, rows, delimiter=",", header=",".join(header), comments="", fmt="%.17g")
+        with writing(path, "to_csv") as p:
+            np.savetxt(p, rows, delimiter=",", header=",".join(header), comments="",
+                       fmt="%.17g")
 
     def to_npz(self, path: str | Path) -> None:
         """Write t, q, qd, qdd and the names to a NumPy .npz archive."""
-        np.savez(path, t=self.t, q=self.q, qd=self.qd, qdd=self.qdd,
-                 coordinate_names=np.array(self.coordinate_names),
-                 body_names=np.array(self.body_names))
+        with writing(path, "to_npz") as p:
+            np.savez(p, t=self.t, q=self.q, qd=self.qd, qdd=self.qdd,
+                     coordinate_names=np.array(self.coordinate_names),
+                     body_names=np.array(self.body_names))
 
     def save(self, path: str | Path) -> None:
         """Write .csv or .npz by the file suffix."""

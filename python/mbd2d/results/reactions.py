@@ -7,8 +7,8 @@ from typing import Any, Callable
 import numpy as np
 
 from ..binding import core
+from ..binding.status import error_for
 from ..binding.tables import Packed
-from ..errors import CoreError
 
 
 @dataclass
@@ -41,7 +41,7 @@ def reaction_arrays(p: Packed, q: np.ndarray, t: np.ndarray, lam: np.ndarray
     ll = np.asfortranarray(np.atleast_2d(lam).T)
     out = core.reactions(p, qq, np.atleast_1d(t).astype(float), ll)
     if out.status != 0:
-        raise CoreError(out.msg)
+        raise error_for("reactions", out.status, out.msg, entry="reactions")
     return np.transpose(out.reac, (2, 1, 0)), np.transpose(out.rloc, (2, 1, 0))
 
 

@@ -12,7 +12,8 @@ from .sensitivities import body_columns, parameter_index, reaction_dp_arrays, re
 
 @dataclass
 class StaticsResult:
-    """A static equilibrium: configuration, multipliers, reactions and stability; with
+    """A static equilibrium: configuration, multipliers, reactions and stability;
+    ``residual`` is the unbalanced load ||N^T Q||_inf relative to the largest load. With
     ``sensitivities=[...]`` also ``dq_dp`` (nq, n_params) and ``dlam_dp`` (neq, n_params),
     the derivatives of the equilibrium and its multipliers."""
 
@@ -32,7 +33,9 @@ class StaticsResult:
     ptab: Any = None
 
     def body(self, name: str) -> tuple[float, float, float]:
-        """(x, y, theta) of a body at the equilibrium."""
+        """(x, y, theta) of a body at the equilibrium (KeyError if there is none)."""
+        if name not in self.body_names:
+            raise KeyError(f"no body {name!r}; bodies: {', '.join(self.body_names)}")
         i = self.body_names.index(name)
         return tuple(float(v) for v in self.q[3 * i:3 * i + 3])  # type: ignore[return-value]
 
@@ -58,5 +61,7 @@ class StaticsResult:
         return reaction_dp_of(self.packed, self.model, name, g, loc)
 
     def multiplier(self, row: str) -> float:
-        """The multiplier of a row by its label."""
+        """The multiplier of a row by its label (KeyError if no row has it)."""
+        if row not in self.row_labels:
+            raise KeyError(f"no row {row!r}; rows: {', '.join(self.row_labels)}")
         return float(self.lam[self.row_labels.index(row)])
