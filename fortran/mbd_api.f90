@@ -270,7 +270,8 @@ contains
     if (present(ptab)) then
       call kin_run(m, q0 / m%cunit, t0, t1, nsteps, opts, qout, qdout, qddout, rep, status, &
                    msg, sens, sq, sqd, sqdd)
-      call sens_units(m, sens, sq, m%cunit, .false.); call sens_units(m, sens, sqd, m%cunit, .false.)
+      call sens_units(m, sens, sq, m%cunit, .false.)
+      call sens_units(m, sens, sqd, m%cunit, .false.)
       call sens_units(m, sens, sqdd, m%cunit, .false.)
     else
       call kin_run(m, q0 / m%cunit, t0, t1, nsteps, opts, qout, qdout, qddout, rep, status, msg)
@@ -541,7 +542,8 @@ contains
     call units(m, qout, m%cunit, .false.); call units(m, qdout, m%cunit, .false.)
     call units(m, qddout, m%cunit, .false.); call units(m, lamout, m%rowunit, .true.)
     if (present(ptab)) then
-      call sens_units(m, sens, sq, m%cunit, .false.); call sens_units(m, sens, sqd, m%cunit, .false.)
+      call sens_units(m, sens, sq, m%cunit, .false.)
+      call sens_units(m, sens, sqd, m%cunit, .false.)
       call sens_units(m, sens, sqdd, m%cunit, .false.)
       call sens_units(m, sens, slam, m%rowunit, .true.)
     end if
@@ -910,7 +912,8 @@ contains
     end do
     call units(m, qout, m%cunit, .false.); call units(m, qdout, m%cunit, .false.)
     call units(m, qddout, m%cunit, .false.); call units(m, lamout, m%rowunit, .true.)
-    call sens_units(m, sens, sq, m%cunit, .false.); call sens_units(m, sens, sqd, m%cunit, .false.)
+    call sens_units(m, sens, sq, m%cunit, .false.)
+    call sens_units(m, sens, sqd, m%cunit, .false.)
     call sens_units(m, sens, sqdd, m%cunit, .false.)
   end subroutine api_dynamics_sens
 

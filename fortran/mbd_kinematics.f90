@@ -28,7 +28,7 @@ module mbd_kinematics
   use mbd_kinds, only: wp, zero, one, half
   use mbd_status, only: MBD_OK, MBD_BAD_SETTING, MBD_BAD_COUNT, MBD_SINGULAR, &
                         MBD_NO_CONVERGENCE, MBD_SINGULAR_CONFIG, MBD_ASSEMBLY_FAILED, &
-                        MBD_LAPACK, MBD_INCONSISTENT, MSG_LEN
+                        MBD_LAPACK, MBD_INCONSISTENT, MBD_NO_MEMORY, MSG_LEN
   use mbd_points, only: NLOC, MAXROW
   use mbd_model, only: model_t
   use mbd_constraints, only: con_is_driver, con_name
@@ -563,7 +563,10 @@ contains
     qout = zero; qdout = zero; qddout = zero
     if (present(sens)) then
       sq = zero; sqd = zero; sqdd = zero
-      allocate (post(size(qout, 2)))
+      allocate (post(size(qout, 2)), stat=st)
+      if (st /= 0) then
+        status = MBD_NO_MEMORY; msg = 'out of memory for the sensitivity bookkeeping'; return
+      end if
       post = .false.
     end if
     allocate (rep%qsing(m%nq), rep%dep(m%neq), rep%redundant(m%neq))

@@ -313,8 +313,8 @@ contains
       if (st == MBD_OK) call rhs(tnew, yn, k(:, 1), st)
       if (st /= MBD_OK) then
         status = MBD_INTEGRATOR_FAILED
-        write (msg, '(a,es12.5)') 'the constraints could not be satisfied after the step to t = ', &
-          tnew
+        write (msg, '(a,es12.5)') 'the constraints could not be satisfied after the step '// &
+          'to t = ', tnew
         return
       end if
       fsal = .true.

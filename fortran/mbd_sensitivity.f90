@@ -32,8 +32,8 @@ module mbd_sensitivity
   implicit none
   private
   public :: sens_t, PT_RPAR, PT_MASS, PT_GRAV, PT_FPAR
-  public :: sens_setup, sens_trig, sens_hessian, sens_params, sens_kin_rhs, block_apply, block_apply_t, &
-            block_apply_cols, &
+  public :: sens_setup, sens_trig, sens_hessian, sens_params, sens_kin_rhs, block_apply, &
+            block_apply_t, block_apply_cols, &
             sens_klam, sens_klam_list, sens_jpt_lam, sens_force_d, sens_force_jac, sens_eval_d
 
   integer, parameter :: PT_RPAR = 1, PT_MASS = 2, PT_GRAV = 3, PT_FPAR = 4  !! table ids
@@ -107,7 +107,8 @@ contains
               s%tfp(nfp, s%np), s%faff(m%nf, s%np), s%tmass(m%nq, s%np), s%tgrav(2, s%np), &
               s%hs(MAXROW, NLOC, NLOC, m%nc), s%hv(MAXROW, NLOC, m%nc), &
               s%ha(MAXROW, NLOC, m%nc), s%phip(s%np, m%neq), s%vp(s%np, m%neq), &
-              s%ap(s%np, m%neq), s%work(m%neq), s%rhs(4 * ((s%np + 3) / 4), m%neq), s%zp(maxval(m%pn)), &
+              s%ap(s%np, m%neq), s%work(m%neq), s%rhs(4 * ((s%np + 3) / 4), m%neq), &
+              s%zp(maxval(m%pn)), &
               s%cb(0:m%nb), s%sb(0:m%nb), s%nzr(NLOC * m%neq), s%nzc(NLOC * m%neq), &
               s%nzv(NLOC * m%neq), s%nza(NLOC * m%neq), s%klr(NLOC * NLOC * m%nc), &
               s%klc(NLOC * NLOC * m%nc), s%klv(NLOC * NLOC * m%nc), stat=st)
@@ -582,7 +583,8 @@ contains
     y = zero
     if (k > 0) then
       do b = 1, m%nb
-        y(3 * b - 2:3 * b - 1) = s%tmass(3 * b - 2, k) * m%grav + m%mdiag(3 * b - 2) * s%tgrav(:, k)
+        y(3 * b - 2:3 * b - 1) = s%tmass(3 * b - 2, k) * m%grav + &
+                                 m%mdiag(3 * b - 2) * s%tgrav(:, k)
       end do
     end if
     tpz = zero
