@@ -19,7 +19,8 @@ help:
 system:
 	@./tools/system-deps.sh
 
-$(VENV)/.deps-ok:
+# re-run when the Makefile changes (PYDEPS gained a package)
+$(VENV)/.deps-ok: Makefile
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install -q --disable-pip-version-check $(PYDEPS)
 	touch $@

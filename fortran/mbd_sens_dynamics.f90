@@ -119,8 +119,11 @@ contains
     type(asm_work_t) :: a
     real(wp) :: phi(m%neq), nu(m%neq), gam(m%neq), y(m%nq), g(NLOC), dg(NLOC), sl(NLOC), &
                 jpb(MAXROW, NLOC, m%nc), dj(MAXROW, NLOC), th, dth
-    integer :: k, c, r0, nr, j, b, off
-    call asm_init(m, a)
+    integer :: k, c, r0, nr, j, b, off, st
+    character(len=MSG_LEN) :: lmsg
+    dreac = zero; drloc = zero
+    call asm_init(m, a, st, lmsg)
+    if (st /= MBD_OK) return
     call assemble_blocks(m, q, q * zero, t, phi, nu, gam, a)
     call sens_trig(m, s, q)
     call sens_hessian(m, s, q, q * zero, q * zero, t)
@@ -136,7 +139,7 @@ contains
         end do
         dj = jpb(:, :, c)
         do j = 1, NLOC
-          if (sl(j) /= zero) dj = dj + s%hs(:, :, j, c) * sl(j)
+          dj = dj + s%hs(:, :, j, c) * sl(j)
         end do
         g = -matmul(lam(r0:r0 + nr - 1), a%jb(1:nr, :, c))
         dg = -matmul(slam(r0:r0 + nr - 1, k), a%jb(1:nr, :, c)) - &
@@ -187,7 +190,8 @@ contains
       status = MBD_NO_MEMORY; msg = 'out of memory for the statics sensitivities'; return
     end if
     z = zero
-    call asm_init(m, a)
+    call asm_init(m, a, status, msg)
+    if (status /= MBD_OK) return
     call assemble_dense(m, q, z, t, phi, nu, gam, a, jac)
     call sens_trig(m, s, q)
     call sens_hessian(m, s, q, z, z, t)
@@ -459,7 +463,8 @@ contains
     n = m%nq; nz = n * (1 + s%np)
     vv = yy(nz + 1:nz + n)
     z = zero
-    call asm_init(m, a)
+    call asm_init(m, a, stp, lmsg)
+    if (stp /= MBD_OK) return
     call assemble_dense(m, yy(1:n), vv, tt, phi, nu, gam, a, jac)
     call sens_trig(m, s, yy(1:n))
     call sens_hessian(m, s, yy(1:n), vv, z, tt)

@@ -307,7 +307,7 @@ contains
         do r = 1, nr
           s%hv(r, j, k) = dot_product(s%hs(r, :, j, k), x%x%qd)
           s%ha(r, j, k) = dot_product(s%hs(r, :, j, k), qddl) - tgam(r)
-          if (s%hv(r, j, k) /= zero .or. s%ha(r, j, k) /= zero) then
+          if (abs(s%hv(r, j, k)) > zero .or. abs(s%ha(r, j, k)) > zero) then
             s%nnz = s%nnz + 1
             s%nzr(s%nnz) = m%row0(k) + r - 1; s%nzc(s%nnz) = m%loc(j, k)
             s%nzv(s%nnz) = s%hv(r, j, k); s%nza(s%nnz) = s%ha(r, j, k)
@@ -450,7 +450,7 @@ contains
         c = m%loc(j, k)
         if (c == 0) cycle
         do r = 1, m%nrow(k)
-          if (b(r, j, k) == zero) cycle
+          if (abs(b(r, j, k)) <= zero) cycle
           do i = 1, size(x, 2)
             y(r0 + r, i) = y(r0 + r, i) + b(r, j, k) * x(c, i)
           end do
@@ -513,7 +513,7 @@ contains
           do r = 1, m%nrow(k)
             acc = acc + lam(r0 + r) * s%hs(r, i, j, k)
           end do
-          if (acc == zero) cycle
+          if (abs(acc) <= zero) cycle
           s%kln = s%kln + 1
           s%klr(s%kln) = ci; s%klc(s%kln) = cj; s%klv(s%kln) = acc
         end do

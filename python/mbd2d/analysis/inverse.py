@@ -34,8 +34,7 @@ def run_inverse(model: ModelDescription, t_end: float, steps: int, t0: float = 0
     require_determined(p, model)
     d = pack_dynamics(model, p)
     npar = len(params) if params else 0
-    check_memory(nout, (3 * p.nq + p.neq) * (1 + npar) + 4, "inverse dynamics",
-                 dense=(p.nq + p.neq, p.nq + p.neq))
+    check_memory(nout, (3 * p.nq + p.neq) * (1 + npar) + 4, "inverse dynamics")
     idx = output_steps(steps, every)
     if params:
         ptab = table(p, params, d)

@@ -31,8 +31,7 @@ def run_kinematics(model: ModelDescription, t_end: float, steps: int, t0: float 
     p = pack(model)
     require_determined(p, model)
     npar = len(params) if params else 0
-    check_memory(nout, 3 * p.nq * (1 + npar), "kinematics",
-                 dense=(p.neq, p.nq) if solver == "dense" else None)
+    check_memory(nout, 3 * p.nq * (1 + npar), "kinematics")
     idx = output_steps(steps, every)
     if params:
         ptab = table(p, params)

@@ -14,7 +14,6 @@ from ..results.statics import StaticsResult
 from ..validate import number
 from .failures import assembly_failed, bad_entry, inconsistent_at
 from .sensitivities import check_status, requested, table
-from .settings import check_memory
 
 STABILITY = {1: "stable", 0: "unstable", -1: "neutral", 2: "fully constrained"}
 
@@ -26,7 +25,6 @@ def run_statics(model: ModelDescription, t: float = 0.0,
     params = requested(model, sensitivities)
     p = pack(model)
     d = pack_dynamics(model, p)
-    check_memory(0, 0, "statics", dense=(p.nq + p.neq, p.nq + p.neq))
     if params:
         ptab = table(p, params, d)
         out = core.statics_sens(p, d, t, ptab)
