@@ -115,24 +115,22 @@ contains
     real(wp), intent(in) :: u(:)                !! unit of each row
     logical, intent(in) :: divide               !! divide by u
     logical, intent(in), optional :: back       !! the inverse conversion
+    real(wp) :: f(size(a, 1), size(a, 2))
     integer :: k, j
     logical :: inv
     if (.not. (m%lref > one .or. m%lref < one)) return
     inv = .false.
     if (present(back)) inv = back
+    do k = 1, size(a, 2)          ! one factor per row and parameter (exact: powers of 2)
+      if (divide .neqv. inv) then
+        f(:, k) = sens%pscale(k) / u
+      else
+        f(:, k) = sens%pscale(k) * u
+      end if
+      if (inv) f(:, k) = (one / sens%pscale(k)**2) * f(:, k)
+    end do
     do j = 1, size(a, 3)
-      do k = 1, size(a, 2)
-        if (divide .neqv. inv) then
-          a(:, k, j) = a(:, k, j) / u
-        else
-          a(:, k, j) = a(:, k, j) * u
-        end if
-        if (inv) then
-          a(:, k, j) = a(:, k, j) / sens%pscale(k)
-        else
-          a(:, k, j) = a(:, k, j) * sens%pscale(k)
-        end if
-      end do
+      a(:, :, j) = a(:, :, j) * f
     end do
   end subroutine sens_units
 
@@ -229,7 +227,7 @@ contains
     iinfo = 0; rinfo = zero; qsing = zero; dep = 0; redundant = 0; tpass = zero
     qout = zero; qdout = zero; qddout = zero
     if (present(ptab)) then
-      sq = zero; sqd = zero; sqdd = zero
+      sq = zero; sqd = zero; sqdd = zero      ! (kin_run writes them; for the early returns)
     end if
     call model_build(nb, ctab, rpar, m, status, msg, bad, nondim=.true.)
     iinfo(2) = bad

@@ -41,7 +41,7 @@ module mbd_kinematics
                           qr_solve, qr_lwork, lu_solve_rows
   use mbd_lapack, only: dgels, dgecon, dtrcon
   use mbd_interp, only: hermite5
-  use mbd_sensitivity, only: sens_t, sens_trig, sens_hessian, sens_params, sens_kin_rhs
+  use mbd_sensitivity, only: sens_t, sens_hessian, sens_params, sens_kin_rhs
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   implicit none
   private
@@ -808,7 +808,6 @@ contains
     status = MBD_OK; msg = ''
     qout = zero; qdout = zero; qddout = zero
     if (present(sens)) then
-      sq = zero; sqd = zero; sqdd = zero
       allocate (post(size(qout, 2)), stat=ierr)
       if (ierr /= 0) then
         call mem_fail(4.0_wp * size(qout, 2), 'the sensitivity bookkeeping', &
@@ -1275,7 +1274,7 @@ contains
     real(wp), intent(in) :: q(:), qd(:), qdd(:)  !! state and accelerations
     real(wp), intent(in) :: t                !! time
     real(wp), intent(out) :: sq(:, :), sqd(:, :), sqdd(:, :)  !! (nq, np)
-    call sens_trig(m, s, q)
+    s%cb = w%asm%cb; s%sb = w%asm%sb          ! the angles' cos and sin of the assembly at q
     call sens_hessian(m, s, q, qd, qdd, t)
     call sens_params(m, s, q, qd, qdd, t)
     call sens_kin_rhs(s, 1, sq, sqd, s%rhs)

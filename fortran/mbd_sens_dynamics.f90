@@ -124,9 +124,9 @@ contains
     dreac = zero; drloc = zero
     call asm_init(m, a, st, lmsg)
     if (st /= MBD_OK) return
-    call assemble_blocks(m, q, q * zero, t, phi, nu, gam, a)
+    call assemble_blocks(m, q, s%zq, t, phi, nu, gam, a)
     call sens_trig(m, s, q)
-    call sens_hessian(m, s, q, q * zero, q * zero, t)
+    call sens_hessian(m, s, q, s%zq, s%zq, t)
     dreac = zero; drloc = zero
     do k = 1, s%np
       call sens_jpt_lam(m, s, k, q, t, lam, y, jpb)

@@ -74,6 +74,7 @@ module mbd_sensitivity
     integer, allocatable :: klr(:), klc(:)
     real(wp), allocatable :: klv(:)
     real(wp), allocatable :: zp(:)           !! zeros, the longest prepared slice
+    real(wp), allocatable :: zq(:)           !! zeros (nq)
   end type sens_t
 
 contains
@@ -108,7 +109,7 @@ contains
               s%hs(MAXROW, NLOC, NLOC, m%nc), s%hv(MAXROW, NLOC, m%nc), &
               s%ha(MAXROW, NLOC, m%nc), s%phip(s%np, m%neq), s%vp(s%np, m%neq), &
               s%ap(s%np, m%neq), s%work(m%neq), s%rhs(4 * ((s%np + 3) / 4), m%neq), &
-              s%zp(maxval(m%pn)), &
+              s%zp(maxval(m%pn)), s%zq(m%nq), &
               s%cb(0:m%nb), s%sb(0:m%nb), s%nzr(NLOC * m%neq), s%nzc(NLOC * m%neq), &
               s%nzv(NLOC * m%neq), s%nza(NLOC * m%neq), s%klr(NLOC * NLOC * m%nc), &
               s%klc(NLOC * NLOC * m%nc), s%klv(NLOC * NLOC * m%nc), stat=st)
@@ -118,7 +119,7 @@ contains
     s%ptab = ptab
     s%tp = zero; s%caff = .false.; s%tfp = zero; s%faff = .false.; s%tmass = zero
     s%tgrav = zero; s%hs = zero; s%hv = zero; s%ha = zero; s%zp = zero
-    s%cb = one; s%sb = zero; s%rhs = zero; s%pscale = one
+    s%cb = one; s%sb = zero; s%rhs = zero; s%pscale = one; s%zq = zero
     do k = 1, s%np
       bad = k
       i = ptab(2, k)
@@ -549,7 +550,7 @@ contains
     jpb = zero
     do c = 1, m%nc
       if (.not. s%caff(c, k)) cycle
-      call gather(m, s, c, q, q * zero, q * zero, x, qddl)
+      call gather(m, s, c, q, s%zq, s%zq, x, qddl)
       si = merge(1, 0, m%bi(c) > 0); sj = merge(2, 0, m%bj(c) > 0)
       call con_eval_d(m%kind(c), m%suba(c), m%subb(c), m%p(m%po(c):m%po(c) + m%pn(c) - 1), &
                       s%tp(m%po(c):m%po(c) + m%pn(c) - 1, k), si, sj, x, t, &
