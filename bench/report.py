@@ -347,6 +347,45 @@ def memory_section(results: dict, charts: dict, out: Path, base: Path) -> str:
             + image(charts, "memory", out, base, "memory"))
 
 
+def synthesis_section(results: dict) -> str:
+    """The literature cases: published errors, mbd2d and pylinkage, with times."""
+    syn = results.get("synthesis")
+    if failed(syn):
+        return f"Failed: {failed(syn)}\n"
+    parts = ["Four-bar path generation, the three standard cases of the synthesis literature "
+             "(bench/synthesis.py has the targets, bounds and the published design vectors). "
+             "Error: sum of squared distances between the coupler point and the targets. The "
+             "published errors are recomputed from the published design vectors with the "
+             "literature's closed form. mbd2d: `mbd2d.synthesize` (Latin-hypercube starts "
+             "screened for defects, least squares with the exact Jacobian from the "
+             "sensitivities), both assembly branches; every design defect-free (no dead "
+             "centre or branch change over the input range, targets in order, Grashof type). "
+             "pylinkage: its differential-evolution optimizer over its own dyad solver, same "
+             "bounds, Grashof and order as penalties. Times are CPU seconds of this process "
+             "(pylinkage single-threaded; mbd2d with one worker).\n"]
+    if syn.get("pylinkage_unavailable_reason"):
+        parts.append(f"**pylinkage unavailable**: {syn['pylinkage_unavailable_reason']}.\n")
+    rows = []
+    for name, c in (syn.get("cases") or {}).items():
+        pub = c.get("published") or {}
+        best_pub = min(pub.items(), key=lambda kv: kv[1]) if pub else (None, None)
+        mb, pl, po = c.get("mbd2d") or {}, c.get("pylinkage") or {}, c.get("polish") or {}
+        rows.append((name, f"{fmt(best_pub[1], '.3g')} ({best_pub[0]})",
+                     fmt(mb.get("error"), ".3g"), fmt(mb.get("cpu_s"), ".1f"),
+                     fmt(pl.get("error"), ".3g"), fmt(pl.get("cpu_s"), ".1f"),
+                     fmt(po.get("error"), ".3g")))
+    parts.append(table(("case", "best published (recomputed)", "mbd2d error", "mbd2d CPU s",
+                        "pylinkage error", "pylinkage CPU s",
+                        "mbd2d from the best published design"), rows))
+    for name, c in (syn.get("cases") or {}).items():
+        pub = c.get("published") or {}
+        parts.append(f"<details><summary>{name}: every published design</summary>\n\n"
+                     + table(("source", "error (recomputed)"),
+                             [(a, fmt(e, ".4g")) for a, e in pub.items()])
+                     + "\n</details>\n")
+    return "\n".join(parts)
+
+
 def notes_section(results: dict) -> str:
     """Quick mode, failures and section run times."""
     meta = results.get("meta") or {}
@@ -401,6 +440,8 @@ def results_markdown(results: dict, charts: dict[str, str], md_path: Path, out: 
              "## Kinematics speed\n", kinematics_section(results),
              "## Scaling with model size\n", scaling_section(results, charts, out, base),
              "## Memory of long runs\n", memory_section(results, charts, out, base),
+             "## Linkage synthesis: literature cases and pylinkage\n",
+             synthesis_section(results),
              "## Notes\n", notes_section(results)]
     return "\n".join(parts)
 

@@ -9,7 +9,9 @@ Sections (each in its own try/except: a failure is recorded and the rest runs):
    (bench/peers_exudyn.py), with the ratios at equal accuracy;
 4. kinematics speed: Fortran loop, Python stepper, plain NumPy (bench/kinematics_speed.py);
 5. scaling of kinematics with N (bench/scaling.py);
-6. memory of 10^6 output steps (bench/memory.py).
+6. memory of 10^6 output steps (bench/memory.py);
+7. linkage synthesis: the three standard four-bar path-generation cases of the literature,
+   mbd2d against the published errors and pylinkage (bench/synthesis.py).
 
 Writes bench/results/*.json and *.png, bench/RESULTS.md and bench/README_headline.md
 (bench/report.py). The whole run is sized to finish in well under 10 minutes on a 2-core
@@ -41,9 +43,11 @@ import memory  # noqa: E402
 import peers_exudyn  # noqa: E402
 import report  # noqa: E402
 import scaling  # noqa: E402
+import synthesis  # noqa: E402
 import work_precision  # noqa: E402
 
-SECTIONS = ("environment", "work_precision", "peers", "kinematics", "scaling", "memory")
+SECTIONS = ("environment", "work_precision", "peers", "kinematics", "scaling", "memory",
+            "synthesis")
 
 
 # ===================================================================== JSON
@@ -136,6 +140,11 @@ def section_memory(quick: bool) -> dict:
     return memory.memory(steps=100_000 if quick else memory.STEPS)
 
 
+def section_synthesis(quick: bool) -> dict:
+    """Four-bar path generation: published errors, mbd2d, pylinkage."""
+    return synthesis.study(quick=quick)
+
+
 def failure(e: BaseException) -> dict:
     """The record of a failed section."""
     return {"failed": True, "error": f"{type(e).__name__}: {e}",
@@ -218,9 +227,13 @@ def main(argv: Sequence[str] | None = None) -> dict:
     fns: dict[str, Callable[[bool], dict]] = {
         "environment": environment.collect, "work_precision": section_work_precision,
         "peers": section_peers, "kinematics": section_kinematics,
-        "scaling": section_scaling, "memory": section_memory}
+        "scaling": section_scaling, "memory": section_memory,
+        "synthesis": section_synthesis}
     results = {name: run_section(name, fns[name], a.quick) for name in SECTIONS
                if name in wanted}
+    for name in SECTIONS:       # --only: the other sections' last figures stay in the report
+        if name not in results and name != "environment" and (out / f"{name}.json").exists():
+            results[name] = json.loads((out / f"{name}.json").read_text(encoding="utf-8"))
     derive(results)
     env = results.get("environment")
     if env is not None:
@@ -231,7 +244,7 @@ def main(argv: Sequence[str] | None = None) -> dict:
     print("\n=== charts and report", flush=True)
     charts = draw_charts(results, out)
     for name, data in results.items():
-        if name not in ("environment", "meta"):
+        if name not in ("environment", "meta") and name in wanted:
             write_json(out / f"{name}.json", data, env)
     write_json(out / "environment.json", {"environment": env or {}, "meta": results["meta"]},
                None)

@@ -36,11 +36,13 @@ LAYERS: dict[str, int] = {
     "mbd2d.analysis": 6,
     # 7. the public Model (description + analyses) and its readers
     "mbd2d.model": 7,
-    # 8. command line
-    "mbd2d.cli": 8,
-    "mbd2d.__main__": 8,
-    # 9. the package's public face
-    "mbd2d": 9,
+    # 8. design studies on whole models: synthesis (builds and returns Models)
+    "mbd2d.synthesis": 8,
+    # 9. command line
+    "mbd2d.cli": 9,
+    "mbd2d.__main__": 9,
+    # 10. the package's public face
+    "mbd2d": 10,
 }
 
 #: Only this module may import the compiled core.
@@ -199,7 +201,7 @@ def test_the_checks_catch_what_they_should():
     assert _cycle({"a": {"b"}, "b": set(), "c": {"a", "b"}}) is None
     assert layer_of("mbd2d.results.kinematics") > layer_of("mbd2d.plots.mechanism")
     assert layer_of("mbd2d.description.joints") == 2
-    assert layer_of("mbd2d") == 9
+    assert layer_of("mbd2d") == 10
 
 
 def test_meson_installs_every_module():

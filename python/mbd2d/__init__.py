@@ -20,6 +20,7 @@ from .errors import (AnalysisError, AssemblyError, ConvergenceError, CoreError,
 from .model import Model, load, loads
 from .results import (BodyResult, DofReport, DynamicsResult, KinematicsResult, Reaction,
                       StaticsResult)
+from .synthesis import SynthesisResult, synthesize
 
 __version__ = "0.1.0"
 
@@ -29,4 +30,4 @@ __all__ = ["load", "loads", "Model", "TimeFunction", "Harmonic", "KinematicsResu
            "AssemblyError", "InconsistentConstraintsError", "ConvergenceError",
            "SingularJacobianError", "SingularConfigurationError", "ToggleError", "CoreError",
            "InsufficientMemoryError", "MbdWarning", "RedundantConstraintWarning",
-           "SingularPassageWarning", "__version__"]
+           "SingularPassageWarning", "synthesize", "SynthesisResult", "__version__"]
