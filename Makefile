@@ -38,13 +38,15 @@ demo: install
 test: install
 	$(PY) -m pytest tests
 
-# bench-only packages; Exudyn (the peer comparison) is optional: without it the bench says
-# so and runs the rest
+# bench-only packages; Exudyn and pylinkage (the peer comparisons) are optional: without
+# them the bench says so and runs the rest
 BENCHDEPS := scipy
-$(VENV)/.bench-ok: $(VENV)/.deps-ok
+$(VENV)/.bench-ok: $(VENV)/.deps-ok Makefile
 	$(PY) -m pip install -q --disable-pip-version-check $(BENCHDEPS)
 	$(PY) -m pip install -q --disable-pip-version-check exudyn || \
 		echo "exudyn could not be installed: the benchmarks run without the peer comparison"
+	$(PY) -m pip install -q --disable-pip-version-check pylinkage || \
+		echo "pylinkage could not be installed: the synthesis bench runs without it"
 	touch $@
 
 bench: install $(VENV)/.bench-ok

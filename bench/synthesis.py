@@ -380,7 +380,7 @@ def study(quick: bool = False, starts: int | None = None) -> dict:
     out: dict[str, Any] = {"pylinkage": info if ok else None,
                            "pylinkage_unavailable_reason": None if ok else info,
                            "cases": {}}
-    k = starts or (4 if quick else 16)
+    k = starts or (3 if quick else 8)
     for name, case in CASES.items():
         print(f" {name} ...", flush=True)
         row: dict[str, Any] = {"key": case["key"], "targets": case["targets"],
@@ -398,8 +398,8 @@ def study(quick: bool = False, starts: int | None = None) -> dict:
               f"{row['mbd2d']['cpu_s']:.1f} s CPU", flush=True)
         if ok:
             try:
-                row["pylinkage"] = run_pylinkage(case, maxiter=30 if quick else 300,
-                                                 popsize=10 if quick else 20)
+                row["pylinkage"] = run_pylinkage(case, maxiter=30 if quick else 200,
+                                                 popsize=10 if quick else 15)
                 print(f"  pylinkage: error {row['pylinkage']['error']}, "
                       f"{row['pylinkage']['cpu_s']:.1f} s CPU", flush=True)
             except Exception as exc:  # noqa: BLE001 - recorded, the bench goes on

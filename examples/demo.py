@@ -71,11 +71,25 @@ def run_full(path: Path, out: Path, trace: list[tuple[str, tuple[float, float]]]
     return ("" if res.complete else "the run did not complete"), res, files
 
 
+def synthesis_example(out: Path) -> int:
+    """examples/synthesis_straight_line.py (its exit code)."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("synthesis_straight_line",
+                                                  HERE / "synthesis_straight_line.py")
+    assert spec is not None and spec.loader is not None
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return int(mod.main(["--out", str(out)]))
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the examples; return the exit code."""
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--out", type=Path, default=HERE / "output",
                     help="directory for the PNG files (default: examples/output/)")
+    ap.add_argument("--no-synthesis", action="store_true",
+                    help="skip the linkage-synthesis example (it takes tens of seconds)")
     args = ap.parse_args(argv)
     out: Path = args.out
     out.mkdir(parents=True, exist_ok=True)
@@ -103,6 +117,17 @@ def main(argv: list[str] | None = None) -> int:
               + ", ".join(str(Path(f).name) for f in files) + f" in {out}")
         if problem:
             problems.append(f"{name}: {problem}")
+
+    if not args.no_synthesis:
+        print("\nsynthesis_straight_line (linkage synthesis, issue 14):")
+        try:
+            if synthesis_example(out) != 0:
+                problems.append("synthesis_straight_line: the design is not straighter than "
+                                "the start")
+        except Exception as exc:  # report every example, then fail
+            traceback.print_exc()
+            problems.append(f"synthesis_straight_line: {type(exc).__name__}: {exc}")
+        runs.append(("synthesis_straight_line", run_full))
 
     print()
     print(f"summary: {len(runs) - len(problems)}/{len(runs)} examples as expected, "

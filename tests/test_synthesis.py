@@ -365,3 +365,96 @@ def test_executor_paths_give_the_same_design():
     assert threaded.error == pytest.approx(serial.error, rel=1e-10)
     assert dask_like.error == pytest.approx(serial.error, rel=1e-10)
     assert run_all(abs, [-1, 2, -3], workers=2) == [1, 2, 3]
+
+
+# ===================================================================== CLI and example
+TASK = """
+model = "start.toml"
+free = ["joint.O4.points.0.0", "joint.A.points.0.0", "joint.B.points.0.0",
+        "joint.B.points.1.0", "path.point.0", "path.point.1"]
+starts = 1
+
+[task]
+type = "path"
+body = "coupler"
+point = [1.6, 1.7]
+targets = [[3, 3], [2.759, 3.363], [2.372, 3.663], [1.890, 3.862], [1.355, 3.943]]
+times = [0.5235987755982988, 0.7853981633974483, 1.0471975511965976, 1.3089969389957472,
+         1.5707963267948966]
+span = [0.0, 1.5707963267948966]
+
+[[constraint]]
+type = "grashof"
+kind = "grashof"
+"""
+
+
+def test_cli_synthesize_writes_an_ordinary_model_file(tmp_path, capsys):
+    from mbd2d.cli import main
+
+    toml_io.dump(fourbar([[0, 0], [3.0, 0]], crank=2.0, coupler=3.3, rocker=2.5),
+                 tmp_path / "start.toml")
+    (tmp_path / "task.toml").write_text(TASK)
+    out = tmp_path / "best.toml"
+    assert main(["synthesize", str(tmp_path / "task.toml"), "--out", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert "best design: error" in text and "wrote" in text
+    best = mbd2d.load(out)
+    kin = best.kinematics(t_end=CASE2_TIMES[-1], steps=4, t0=CASE2_TIMES[0])
+    header = out.read_text().splitlines()
+    px = float(next(h for h in header if "path.point.0" in h).split("=")[1])
+    py = float(next(h for h in header if "path.point.1" in h).split("=")[1])
+    err = float(((kin.point("coupler", (px, py)) - CASE2)**2).sum())
+    reported = float(header[0].split("error")[1])
+    assert err == pytest.approx(reported, rel=1e-6)
+    assert err < literature_error(CASE2_PUBLISHED["Cabrera GA"], CASE2, CASE2_TIMES)
+
+
+@pytest.mark.parametrize("text, match", [
+    ("free = []\n[task]\ntype = 'path'", "missing key 'model'"),
+    ("model = 'start.toml'\nfree = ['x']\n[task]\ntype = 'spline'", "unknown task kind"),
+    ("model = 'start.toml'\nfree = ['x']\nfoo = 1\n[task]\ntype = 'path'", "unknown key"),
+    ("model = 'nope.toml'\nfree = ['x']\n[task]\ntype = 'path'", "cannot read"),
+    ("model = 'start.toml'\nfree = ['x']\n[task]\ntype = 'path'\nbody = 'c'\npoint = [0, 0]\n"
+     "targets = [[0, 0]]\ncolour = 1", "unknown key"),
+    ("model = 'start.toml'\nfree = ['x']\n[task]\ntype = 'path'\nbody = 'c'\npoint = [0, 0]\n"
+     "targets = [[0, 0]]\n[[constraint]]\ntype = 'grashof'\nkind = 'no'", "Grashof kind"),
+    ("not toml [", "not a valid TOML"),
+])
+def test_cli_bad_task_files_exit_2(tmp_path, text, match, capsys):
+    from mbd2d.cli import main
+
+    toml_io.dump(fourbar([[0, 0], [3.0, 0]], crank=2.0, coupler=3.3, rocker=2.5),
+                 tmp_path / "start.toml")
+    (tmp_path / "task.toml").write_text(text)
+    assert main(["synthesize", str(tmp_path / "task.toml"), "--out",
+                 str(tmp_path / "b.toml")]) == 2
+    assert match in " ".join(capsys.readouterr().err.split())
+
+
+def test_straight_line_example_runs(tmp_path):
+    """examples/synthesis_straight_line.py (one short start): the design is straighter than
+    Hoeken's start and its picture is written."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    ex = Path(__file__).resolve().parent.parent / "examples" / "synthesis_straight_line.py"
+    proc = subprocess.run([sys.executable, str(ex), "--out", str(tmp_path), "--starts", "1",
+                           "--max-nfev", "100"],
+                          capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    assert (tmp_path / "synthesis_straight_line.png").stat().st_size > 0
+
+
+def test_sixbar_example_fits_its_function():
+    """examples/synthesis_sixbar.py: a Watt II six-bar (function generation) reaches an
+    error below 1e-12 rad^2, the same in an ordinary kinematic run of the design."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    ex = Path(__file__).resolve().parent.parent / "examples" / "synthesis_sixbar.py"
+    proc = subprocess.run([sys.executable, str(ex)], capture_output=True, text=True,
+                          timeout=600)
+    assert proc.returncode == 0, proc.stdout + proc.stderr

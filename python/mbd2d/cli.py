@@ -6,6 +6,7 @@
     mbd2d dynamics MODEL.toml --t-end T --steps N --out OUT.csv [--method M --rtol R --atol A --h H
                    --max-steps S]
     mbd2d statics MODEL.toml [--t T]
+    mbd2d synthesize TASK.toml --out BEST.toml [--starts K --seed S --workers N]
 
 Exit codes: 0 ok, 2 bad input, 3 singular configuration (partial output written),
 4 other numerical failure (partial output written when there is any).
@@ -20,7 +21,9 @@ from typing import Sequence
 from .errors import (AnalysisError, InsufficientMemoryError, MbdError, ModelError,
                      SingularConfigurationError)
 from .model import Model, load
+from .description import toml_io
 from .results import StaticsResult
+from .synthesis import SynthesisResult, load_task, synthesize
 
 EXIT_OK, EXIT_INPUT, EXIT_SINGULAR, EXIT_NUMERICAL = 0, 2, 3, 4
 
@@ -70,7 +73,46 @@ def _parser() -> argparse.ArgumentParser:
     e.add_argument("--steps", type=int, required=True, help="output intervals")
     e.add_argument("--t0", type=float, default=0.0, help="start time (default 0)")
     e.add_argument("--tol", type=float, default=None, help="Newton tolerance (default 1e-12)")
+    y = sub.add_parser("synthesize", help="fit a mechanism to a task (linkage synthesis)")
+    y.add_argument("task", help="task file (.toml): model, free parameters, bounds, targets")
+    y.add_argument("--out", required=True, help="best model, written as a model file (.toml)")
+    y.add_argument("--starts", type=int, default=None, help="local solves (default: the task "
+                   "file's, else 8)")
+    y.add_argument("--seed", type=int, default=None, help="Latin-hypercube seed")
+    y.add_argument("--workers", type=int, default=1, help="local processes (default 1)")
     return ap
+
+
+def _synthesis_report(res: SynthesisResult) -> str:
+    """The best design, its error per target and the defects met, as text."""
+    lines = [f"best design: error {res.error:.6g} (sum of squared target errors), objective "
+             f"{res.objective:.6g}, {len(res.history)} local solve(s), {res.seconds:.2f} s"]
+    lines += [f"  {n:28s} = {v:.12g}" for n, v in res.values.items()]
+    lines.append("error per target: " + ", ".join(f"{e:.3g}" for e in res.residuals))
+    lines.append("target times: " + ", ".join(f"{t:.6g}" for t in res.times))
+    for name, v in res.terms.items():
+        lines.append(f"  {name}: {v:.6g}")
+    if res.rejected:
+        lines.append(f"rejected candidates: {len(res.rejected)} ("
+                     + ", ".join(f"{k} x{n}" for k, n in res.defect_reasons.items()) + ")")
+    return "\n".join(lines)
+
+
+def _synthesize(args: argparse.Namespace) -> int:
+    tf = load_task(args.task)
+    opts = dict(tf.options)
+    if args.starts is not None:
+        opts["starts"] = args.starts
+    if args.seed is not None:
+        opts["seed"] = args.seed
+    res = synthesize(tf.model, tf.free, tf.task, bounds=tf.bounds, constraints=tf.constraints,
+                     workers=args.workers, **opts)
+    print(_synthesis_report(res))
+    header = (f"mbd2d synthesize {args.task}: error {res.error:.9g}\n"
+              + "\n".join(f"{n} = {v:.15g}" for n, v in res.values.items()))
+    toml_io.dump(res.model, args.out, header=header)
+    print(f"wrote {args.out}")
+    return EXIT_OK
 
 
 def _say(text: str) -> None:
@@ -98,6 +140,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit code."""
     args = _parser().parse_args(argv)
     try:
+        if args.command == "synthesize":
+            return _synthesize(args)
         model = load(args.model)
         if args.command == "check":
             print(model.analyze_dof(t=args.t))
@@ -129,7 +173,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         _say(f"mbd2d: {exc}")
         return EXIT_INPUT
     except AnalysisError as exc:
-        if args.command in ("check", "statics"):
+        if args.command in ("check", "statics", "synthesize"):
             _say(f"mbd2d: {exc}")
             return EXIT_NUMERICAL
         if exc.results is not None and len(exc.results.t):

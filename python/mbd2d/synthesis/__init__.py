@@ -15,10 +15,12 @@ from __future__ import annotations
 from .fourbar import FOURBAR_PARAMETERS, fourbar, fourbar_parameters, loop_configuration
 from .problem import Evaluation, Problem
 from .search import StartRecord, SynthesisResult, latin_hypercube, run_all, synthesize
+from .taskfile import TaskFile, load_task
 from .tasks import FunctionTask, MotionTask, PathTask, Task, make_task
 from .terms import Grashof, LinkRatio, PeakEffort, TransmissionAngle, make_term
 
 __all__ = ["synthesize", "SynthesisResult", "StartRecord", "Problem", "Evaluation", "Task",
            "PathTask", "MotionTask", "FunctionTask", "make_task", "Grashof", "LinkRatio",
            "TransmissionAngle", "PeakEffort", "make_term", "fourbar", "fourbar_parameters",
-           "loop_configuration", "FOURBAR_PARAMETERS", "run_all", "latin_hypercube"]
+           "loop_configuration", "FOURBAR_PARAMETERS", "run_all", "latin_hypercube",
+           "load_task", "TaskFile"]

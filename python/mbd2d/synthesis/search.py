@@ -273,6 +273,11 @@ def synthesize(model: Any, free: Sequence[str], task: Task,
     ...                        bounds={"joint.B.points.0.0": (2, 4)}, starts=1)  # doctest: +SKIP
     """
     t_start = time.perf_counter()
+    try:
+        import scipy.optimize  # noqa: F401  (the local solver)
+    except ImportError:
+        raise ModelError("mbd2d.synthesize needs scipy (pip install 'mbd2d[synthesis]')",
+                         "synthesize") from None
     k = whole(starts, "starts", "synthesize", 1, 100000)
     problem = Problem(model, free, task, bounds, constraints, resolution, t_ref)
     rejected: list[tuple[np.ndarray, list[str]]] = []

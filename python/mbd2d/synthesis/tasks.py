@@ -402,7 +402,7 @@ class TaskSpec:
 KINDS = {"path": PathTask, "motion": MotionTask, "function": FunctionTask}
 
 
-def make_task(kind: str, **keys: Any) -> Task:
+def make_task(kind: str, /, **keys: Any) -> Task:
     """A task by its kind name ('path', 'motion', 'function') and keys.
 
     Raises

@@ -253,7 +253,7 @@ TERMS = {"grashof": Grashof, "link-ratio": LinkRatio, "transmission-angle": Tran
          "peak-effort": PeakEffort}
 
 
-def make_term(kind: str, **keys: Any) -> Term:
+def make_term(term_type: str, /, **keys: Any) -> Term:
     """A constraint by its task-file name and keys.
 
     Raises
@@ -261,14 +261,18 @@ def make_term(kind: str, **keys: Any) -> Term:
     ModelError
         For an unknown kind or key.
     """
-    if kind not in TERMS:
-        raise ModelError(f"unknown constraint {kind!r}; known: {', '.join(TERMS)}",
+    if term_type not in TERMS:
+        raise ModelError(f"unknown constraint {term_type!r}; known: {', '.join(TERMS)}",
                          "constraints")
-    cls = TERMS[kind]
+    cls = TERMS[term_type]
     bad = set(keys) - set(cls.__dataclass_fields__)
     if bad:
-        raise ModelError(f"unknown key(s) {sorted(bad)} of constraint {kind!r}", "constraints")
-    return cls(**keys)
+        raise ModelError(f"unknown key(s) {sorted(bad)} of constraint {term_type!r}",
+                         "constraints")
+    try:
+        return cls(**keys)
+    except TypeError as exc:
+        raise ModelError(f"constraint {term_type!r}: {exc}", "constraints") from None
 
 
 __all__ = ["Term", "Grashof", "LinkRatio", "TransmissionAngle", "PeakEffort", "make_term",
