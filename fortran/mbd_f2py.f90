@@ -177,3 +177,31 @@ subroutine core_reactions(nb, nc, ctab, np, rpar, nq, neq, nt, q, t, lam, reac, 
   !f2py intent(hide) :: nc, np, nq, neq, nt
   call api_reactions(nb, ctab, rpar, q, t, lam, reac, rloc, status, msg)
 end subroutine core_reactions
+
+subroutine core_conditioning(nb, nc, ctab, np, rpar, nq, nt, q, t, cond, status, msg)
+  use iso_c_binding, only: c_double, c_int
+  use mbd_measures, only: api_conditioning
+  implicit none
+  integer(c_int), intent(in) :: nb, nc, np, nq, nt
+  integer(c_int), intent(in) :: ctab(8, nc)
+  real(c_double), intent(in) :: rpar(np), q(nq, nt), t(nt)
+  real(c_double), intent(out) :: cond(nt)
+  integer(c_int), intent(out) :: status
+  character(len=512), intent(out) :: msg
+  !f2py intent(hide) :: nc, np, nq, nt
+  call api_conditioning(nb, ctab, rpar, q, t, cond, status, msg)
+end subroutine core_conditioning
+
+subroutine core_influence(nb, nc, ctab, np, rpar, nq, nt, q, t, row, u, ok, status, msg)
+  use iso_c_binding, only: c_double, c_int
+  use mbd_measures, only: api_influence
+  implicit none
+  integer(c_int), intent(in) :: nb, nc, np, nq, nt, row
+  integer(c_int), intent(in) :: ctab(8, nc)
+  real(c_double), intent(in) :: rpar(np), q(nq, nt), t(nt)
+  real(c_double), intent(out) :: u(nq, nt)
+  integer(c_int), intent(out) :: ok(nt), status
+  character(len=512), intent(out) :: msg
+  !f2py intent(hide) :: nc, np, nq, nt
+  call api_influence(nb, ctab, rpar, q, t, row, u, ok, status, msg)
+end subroutine core_influence

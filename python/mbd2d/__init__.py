@@ -18,13 +18,13 @@ from .errors import (AnalysisError, AssemblyError, ConvergenceError, CoreError,
                      SingularConfigurationError, SingularJacobianError, SingularPassageWarning,
                      ToggleError)
 from .model import Model, load, loads
-from .results import (BodyResult, DofReport, DynamicsResult, KinematicsResult, Reaction,
-                      StaticsResult)
+from .results import (BodyResult, DofReport, DynamicsResult, KinematicsResult, PointResult,
+                      Reaction, StaticsResult)
 
 __version__ = "0.1.0"
 
 __all__ = ["load", "loads", "Model", "TimeFunction", "Harmonic", "KinematicsResult",
-           "BodyResult", "DynamicsResult", "KinematicStepper", "StaticsResult", "Reaction",
+           "BodyResult", "PointResult", "DynamicsResult", "KinematicStepper", "StaticsResult", "Reaction",
            "DofReport", "MbdError", "ModelError", "AnalysisError", "IntegrationError",
            "AssemblyError", "InconsistentConstraintsError", "ConvergenceError",
            "SingularJacobianError", "SingularConfigurationError", "ToggleError", "CoreError",

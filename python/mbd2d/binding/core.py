@@ -115,3 +115,17 @@ def reactions(p: Packed, q: np.ndarray, t: np.ndarray, lam: np.ndarray) -> Simpl
     ``reac`` and ``rloc`` (6, nc, nt), ``status``, ``msg``."""
     return _named("reac rloc status msg", _core.core_reactions, p.nb, p.ctab, p.rpar, q, t,
                   lam)
+
+
+def conditioning(p: Packed, q: np.ndarray, t: np.ndarray) -> SimpleNamespace:
+    """sigma_min / sigma_max of the column-scaled J (the core's units) at states q (nq, nt)
+    and times t (nt): ``cond`` (nt), ``status``, ``msg``."""
+    return _named("cond status msg", _core.core_conditioning, p.nb, p.ctab, p.rpar, q, t)
+
+
+def influence(p: Packed, q: np.ndarray, t: np.ndarray, row: int) -> SimpleNamespace:
+    """Influence coefficients dq/ds of the quantity driven by row ``row`` (1-based) at states
+    q (nq, nt) and times t (nt): ``u`` (nq, nt), ``ok`` (nt; 0 where J is singular),
+    ``status``, ``msg``."""
+    return _named("u ok status msg", _core.core_influence, p.nb, p.ctab, p.rpar, q, t,
+                  int(row))

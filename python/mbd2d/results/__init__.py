@@ -11,8 +11,9 @@ from .dof import DofReport
 from .dynamics import DynamicsResult
 from .files import read_csv
 from .kinematics import SUFFIXES, BodyResult, KinematicsResult
+from .points import PointResult
 from .reactions import Reaction
 from .statics import StaticsResult
 
 __all__ = ["BodyResult", "KinematicsResult", "DynamicsResult", "StaticsResult", "Reaction",
-           "DofReport", "SUFFIXES", "read_csv"]
+           "DofReport", "PointResult", "SUFFIXES", "read_csv"]

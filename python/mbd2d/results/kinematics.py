@@ -9,7 +9,9 @@ from typing import Any
 import numpy as np
 
 from ..validate import vector
+from . import measures
 from .files import writing
+from .points import PointResult
 
 SUFFIXES = ("x", "y", "theta", "x_dot", "y_dot", "theta_dot", "x_ddot", "y_ddot", "theta_ddot")
 
@@ -75,12 +77,149 @@ class KinematicsResult:
         return BodyResult(name, q[:, 0], q[:, 1], q[:, 2], qd[:, 0], qd[:, 1], qd[:, 2],
                           qdd[:, 0], qdd[:, 1], qdd[:, 2])
 
-    def point(self, name: str, s: Any) -> np.ndarray:
-        """Global path r + A(theta) s' of a point s' fixed in a body, shape (n, 2)."""
+    def point(self, name: str, s: Any) -> PointResult:
+        """Position, velocity and acceleration of a point fixed in a body.
+
+        Parameters
+        ----------
+        name : str
+            The body.
+        s : sequence of two floats
+            The point in the body's frame.
+
+        Returns
+        -------
+        PointResult
+            ``.r``, ``.v``, ``.a`` (n, 2) global position, velocity, acceleration (also
+            ``.x``, ``.y``, ``.x_dot``, ..., ``.speed``); indexing it indexes ``.r``.
+
+        Raises
+        ------
+        ModelError
+            If s is not two finite numbers.
+        KeyError
+            If there is no such body.
+
+        Examples
+        --------
+        >>> import mbd2d
+        >>> res = mbd2d.load("examples/fourbar_grashof.toml").kinematics(t_end=1.0, steps=4)
+        >>> p = res.point("coupler", [0.0, 1.0])
+        >>> p.r.shape, p.v.shape, p.a.shape
+        ((5, 2), (5, 2), (5, 2))
+        """
         sx, sy = vector(s, 2, "s", "point")
         b = self.body(name)
-        c, sn = np.cos(b.theta), np.sin(b.theta)
-        return np.column_stack([b.x + c * sx - sn * sy, b.y + sn * sx + c * sy])
+        q = np.column_stack([b.x, b.y, b.theta])
+        qd = np.column_stack([b.x_dot, b.y_dot, b.theta_dot])
+        qdd = np.column_stack([b.x_ddot, b.y_ddot, b.theta_ddot])
+        return PointResult.of(name, (sx, sy), q, qd, qdd)
+
+    # ------------------------------------------------------------------ mechanism measures
+    def transmission_angle(self, joint: str, output: str | None = None) -> np.ndarray:
+        """Transmission angle at a revolute joint between a coupler and an output link.
+
+        mu is the angle between the coupler (from ``joint`` to the coupler's other revolute
+        joint) and the output link (from ``joint`` to its other pivot), in [0, pi]; pi/2 is
+        ideal, and designers keep it within about pi/2 +- 50 deg. For an output that slides
+        (a translational joint), mu = pi/2 - the acute angle between the coupler and the
+        slide, in [0, pi/2]. A four-bar a (crank), b (coupler), c (rocker), d (ground) has
+        cos mu = (b^2 + c^2 - a^2 - d^2 + 2 a d cos theta2) / (2 b c).
+
+        Parameters
+        ----------
+        joint : str
+            The revolute joint between the coupler and the output link (e.g. "B").
+        output : str, optional
+            Which of its bodies is the output link (default: its second body).
+
+        Returns
+        -------
+        numpy.ndarray
+            mu in radians at every output time.
+
+        Raises
+        ------
+        ModelError
+            If the joint or the bodies around it do not form a coupler and an output link.
+
+        Examples
+        --------
+        >>> import mbd2d
+        >>> res = mbd2d.load("examples/fourbar_grashof.toml").kinematics(t_end=1.0, steps=4)
+        >>> res.transmission_angle("B").shape
+        (5,)
+        """
+        return measures.transmission_angle(self, joint, output)
+
+    def velocity_ratio(self, input: str, output: str, via: str | None = None) -> np.ndarray:
+        """d(output)/d(input) along the motion: the kinematic influence coefficients.
+
+        Each quantity is a coordinate name (``"rocker.theta"``, ``"slider.x"``, see
+        ``coordinate_names``) or a driver name (the quantity it prescribes). Both are
+        differentiated by the quantity s of one driver, the others held (J u = e_s, solved
+        by the core at every output): ``via``, else whichever of input and output is a
+        driver, else the model's only driver. The ratio is a property of the configuration,
+        defined even where the driver stands still.
+
+        Returns
+        -------
+        numpy.ndarray
+            dY/dX at every output; +-inf where the input stands still (its dead centre or
+            limit position); inf where J is singular for the driver.
+
+        Raises
+        ------
+        ModelError
+            If a name is neither a driver nor a coordinate, or a quantity does not move with
+            the driver at all.
+        """
+        dx, dy, ok = measures.rates(self, input, output, via)
+        return measures.ratio(dy, dx, ok, np.inf)
+
+    def mechanical_advantage(self, input: str, output: str,
+                             via: str | None = None) -> np.ndarray:
+        """The mechanical advantage from input to output: the load at the output that a unit
+        effort at the input balances, by virtual work the inverse of the velocity ratio,
+        d(input)/d(output) (e.g. output force per input torque for a crank and a slider).
+        Quantities and ``via`` as in :meth:`velocity_ratio`.
+
+        Returns
+        -------
+        numpy.ndarray
+            At every output time; signed (negative when the output moves against the
+            input); +-inf where the output stands still (a limit position, the toggle a
+            press uses); 0 where J is singular for the driver.
+
+        Raises
+        ------
+        ModelError
+            As :meth:`velocity_ratio`.
+
+        Examples
+        --------
+        >>> import mbd2d
+        >>> res = mbd2d.load("examples/slider_crank.toml").kinematics(t_end=0.5, steps=4)
+        >>> ma = res.mechanical_advantage("motor", "slider.x")   # N per N m
+        >>> ma.shape
+        (5,)
+        """
+        dx, dy, ok = measures.rates(self, input, output, via)
+        return measures.ratio(dx, dy, ok, 0.0)
+
+    def dead_centre_distance(self) -> np.ndarray:
+        """Distance to a dead centre at every output: sigma_min / sigma_max of the
+        constraint Jacobian J, computed by the core with lengths in units of the model's
+        length scale and the columns of J scaled to unit length (the measure the kinematics
+        uses to call a configuration singular). It is 0 at a dead centre (toggle) or
+        bifurcation and near a toggle falls like sqrt(t* - t).
+
+        Returns
+        -------
+        numpy.ndarray
+            Values in [0, 1] at every output time.
+        """
+        return measures.dead_centre_distance(self)
 
     def table(self) -> tuple[list[str], np.ndarray]:
         """Header and rows of the CSV: t, then NAME.x ... NAME.theta_ddot per body."""
