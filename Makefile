@@ -6,7 +6,7 @@ PYTHON ?= python3
 PY := $(VENV)/bin/python
 export PATH := $(abspath $(VENV))/bin:$(PATH)
 
-PYDEPS := numpy meson meson-python ninja pytest hypothesis matplotlib
+PYDEPS := numpy meson meson-python ninja pytest hypothesis matplotlib scipy
 SOURCES := $(wildcard fortran/*.f90 fortran/app/*.f90 python/mbd2d/*.py python/mbd2d/*/*.py) meson.build pyproject.toml
 
 .PHONY: demo test bench system install clean help
@@ -19,7 +19,8 @@ help:
 system:
 	@./tools/system-deps.sh
 
-$(VENV)/.deps-ok:
+# re-run when the Makefile changes (PYDEPS gained a package)
+$(VENV)/.deps-ok: Makefile
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install -q --disable-pip-version-check $(PYDEPS)
 	touch $@

@@ -14,10 +14,13 @@
 module mbd_api
   use mbd_kinds, only: wp, zero, one
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
-  use mbd_status, only: MBD_OK, MBD_BAD_COUNT, MBD_BAD_PARAM, MBD_INCONSISTENT, MSG_LEN
+  use mbd_status, only: MBD_OK, MBD_BAD_COUNT, MBD_BAD_PARAM, MBD_INCONSISTENT, MBD_NO_MEMORY, &
+                        MSG_LEN
+  use mbd_memory, only: REAL_BYTES, mem_fail
   use mbd_points, only: NLOC, MAXROW
   use mbd_model, only: model_t, model_build, model_add_dynamics, model_force_size
-  use mbd_dynamics, only: dyn_work_t, dyn_init, dyn_velocity, dyn_multipliers, dyn_reactions, &
+  use mbd_dynamics, only: dyn_work_t, dyn_init, dyn_memory_check, dyn_velocity, &
+                          dyn_multipliers, dyn_reactions, &
                           gen_forces, kinetic_energy
   use mbd_integrators, only: dyn_opts_t, dyn_stats_t, integrate, output_rows, output_index
   use mbd_statics, only: statics_solve
@@ -131,7 +134,8 @@ contains
         size(jac, 1) /= m%neq .or. size(jac, 2) /= m%nq) then
       status = MBD_BAD_COUNT; msg = 'array sizes do not match the model'; return
     end if
-    call asm_init(m, aw)
+    call asm_init(m, aw, status, msg)
+    if (status /= MBD_OK) return
     call assemble_dense(m, q, qd, t, phi, nu, gam, aw, jac)
     if (.not. (finite(phi) .and. finite(jac) .and. finite(nu) .and. finite(gam))) then
       status = MBD_BAD_PARAM
@@ -237,7 +241,7 @@ contains
     type(kin_report_t) :: rep
     type(kin_work_t) :: w
     real(wp) :: h
-    integer :: bad, lev
+    integer :: bad, lev, ierr
     call model_build(nb, ctab, rpar, m, status, msg, bad, nondim=.true.)
     if (status /= MBD_OK) return
     if (size(q) /= m%nq .or. size(qd) /= m%nq .or. size(qdd) /= m%nq .or. m%neq /= m%nq) then
@@ -252,17 +256,20 @@ contains
     end if
     if (tol > zero) opts%tol = tol
     if (maxit > 0) opts%maxit = maxit
-    call kin_work_init(m, w)
+    call kin_work_init(m, w, status, msg)
+    if (status /= MBD_OK) return
     w%tol = opts%tol * m%lscale
     q = q / m%cunit; qd = qd / m%cunit; qdd = qdd / m%cunit
-    call step()
-    q = q * m%cunit; qd = qd * m%cunit; qdd = qdd * m%cunit
-  contains
-    subroutine step()
+    step: block                                ! in the core's units; any exit converts back
       if (assemble == 1) then
-        allocate (rep%qsing(m%nq), rep%dep(m%neq), rep%redundant(m%neq))
+        allocate (rep%qsing(m%nq), rep%dep(m%neq), rep%redundant(m%neq), stat=ierr)
+        if (ierr /= 0) then
+          call mem_fail(REAL_BYTES * (real(m%nq, wp) + m%neq), 'the assembly report', &
+                        'use a smaller model', status, msg)
+          exit step
+        end if
         call kin_assemble(m, w, q, t, opts, rep, status, msg)
-        if (status /= MBD_OK) return
+        if (status /= MBD_OK) exit step
       else
         h = t - t_prev
         q = q + h * (qd + (0.5_wp * h) * qdd)     ! q(t) ~ q + h q_dot + h**2/2 q_ddot
@@ -270,11 +277,12 @@ contains
       call kin_newton(m, w, q, t, opts%maxit, status)
       if (status /= MBD_OK) then
         write (msg, '(a,es22.15)') 'Newton-Raphson failed (or J is singular) at t = ', t
-        return
+        exit step
       end if
       call kin_vel_acc(m, w, q, t, qd, qdd, status, lev)
       if (status /= MBD_OK) msg = 'velocities or accelerations could not be solved'
-    end subroutine step
+    end block step
+    q = q * m%cunit; qd = qd * m%cunit; qdd = qdd * m%cunit
   end subroutine api_kin_step
 
   !> Degrees of freedom and redundancy at the configuration assembled from q0 at time t:
@@ -301,7 +309,7 @@ contains
     type(kin_opts_t) :: opts
     type(kin_report_t) :: rep
     type(kin_work_t) :: w
-    integer :: bad
+    integer :: bad, ierr
     q = zero; rank = 0; mobility = 0; redundant = 0; dep = 0; resid = zero; worst = 0
     call model_build(nb, ctab, rpar, m, status, msg, bad, nondim=.true.)
     worst = bad
@@ -314,9 +322,15 @@ contains
       status = MBD_BAD_COUNT; msg = 'array sizes do not match the model'; return
     end if
     if (tol > zero) opts%tol = tol
-    call kin_work_init(m, w)
+    call kin_work_init(m, w, status, msg)
+    if (status /= MBD_OK) return
     w%tol = opts%tol * m%lscale
-    allocate (rep%qsing(m%nq), rep%dep(m%neq), rep%redundant(m%neq))
+    allocate (rep%qsing(m%nq), rep%dep(m%neq), rep%redundant(m%neq), stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail(REAL_BYTES * (real(m%nq, wp) + m%neq), 'the assembly report', &
+                    'use a smaller model', status, msg)
+      return
+    end if
     rep%qsing = zero; rep%dep = 0; rep%redundant = 0
     q = q0 / m%cunit
     call kin_assemble(m, w, q, t, opts, rep, status, msg)
@@ -376,9 +390,14 @@ contains
     real(wp), intent(in) :: q(:), qd(:), t
     real(wp), intent(out) :: e(4)
     real(wp) :: v
+    integer :: j
     call assemble_dense(m, q, w%qz, t, w%phi, w%nu, w%gam, w%asm, w%jac)
     e(3) = maxval(abs(w%phi) * m%rowunit)
-    e(4) = maxval(abs(matmul(w%jac, qd) - w%nu) * m%rowunit)
+    w%phi = -w%nu                ! J q_dot - nu by columns (matmul would make a temporary)
+    do j = 1, size(qd)
+      w%phi = w%phi + w%jac(:, j) * qd(j)
+    end do
+    e(4) = maxval(abs(w%phi) * m%rowunit)
     call gen_forces(m, q, qd, t, w%force, v)
     e(1) = kinetic_energy(m, qd); e(2) = v
   end subroutine state_measures
@@ -415,6 +434,13 @@ contains
       qsing = zero; dep = 0; redundant = 0; tpass = zero
       return
     end if
+    ! the multipliers are dense: check the memory before the (possibly long) kinematic run
+    call dyn_memory_check(m, status, msg)
+    if (status /= MBD_OK) then
+      qout = zero; qdout = zero; qddout = zero; iinfo = 0; rinfo = zero
+      qsing = zero; dep = 0; redundant = 0; tpass = zero
+      return
+    end if
     call api_kinematics(nb, ctab, rpar, q0, t0, t1, nsteps, tol, 0, zero, every, solver, qout, &
                         qdout, qddout, iinfo, rinfo, qsing, dep, redundant, tpass, status, msg)
     if (iinfo(1) < 1) return
@@ -422,13 +448,18 @@ contains
     call units(m, qout, m%cunit, .true.); call units(m, qdout, m%cunit, .true.)
     call units(m, qddout, m%cunit, .true.)
     call dyn_init(m, w, qout(:, 1), t0, 1.0e-12_wp, st, lmsg)
-    if (st == MBD_OK) then
+    if (st == MBD_NO_MEMORY) then
+      status = st; msg = lmsg
+    else if (st == MBD_OK) then
       do k = 1, iinfo(1)
         ! column k holds output min((k - 1) every, nsteps)
         t = t0 + (t1 - t0) * (real(min((k - 1) * every, nsteps), wp) / max(nsteps, 1))
         if (k == size(qout, 2)) t = t1
         call dyn_multipliers(m, w, qout(:, k), qdout(:, k), qddout(:, k), t, lamout(:, k), &
                              st, lmsg)
+        if (st == MBD_NO_MEMORY) then
+          status = st; msg = lmsg; exit
+        end if
         call state_measures(m, w, qout(:, k), qdout(:, k), t, eout(:, k))
       end do
     end if
@@ -445,7 +476,7 @@ contains
   !! rinfo: 1 time of a failure, 2 smallest step, 3 largest step.
   subroutine api_dynamics(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, v0, t0, t1, nsteps, &
                           method, rtol, atol, h, rho_inf, balpha, bbeta, every, qout, qdout, &
-                          qddout, lamout, eout, iinfo, rinfo, redundant, status, msg)
+                          qddout, lamout, eout, iinfo, rinfo, redundant, status, msg, max_steps)
     integer, intent(in) :: nb, ctab(:, :), ftab(:, :), nsteps, method
     integer, intent(in) :: every                !! store every every-th output (and the last)
     real(wp), intent(in) :: rpar(:), bmass(:, :), grav(2), fpar(:), q0(:), v0(:), t0, t1
@@ -458,6 +489,7 @@ contains
     integer, intent(out) :: redundant(:)
     integer, intent(out) :: status              !! MBD_OK, < 0 input, > 0 numerical
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    integer, intent(in) :: max_steps            !! step limit (accepted + rejected); 0: default
     type(model_t) :: m
     type(dyn_work_t) :: w
     type(kin_work_t) :: kw
@@ -467,8 +499,7 @@ contains
     type(dyn_stats_t) :: dst
     real(wp), allocatable :: q(:), qd(:)
     real(wp) :: t, lscale
-    integer :: bad, badf, k, ko, nout, st
-    character(len=MSG_LEN) :: lmsg
+    integer :: bad, badf, k, ko, nout, ierr
     iinfo = 0; rinfo = zero; redundant = 0
     qout = zero; qdout = zero; qddout = zero; lamout = zero; eout = zero
     call build_dynamic(nb, ctab, rpar, bmass, grav, ftab, fpar, m, status, msg, bad, badf)
@@ -478,19 +509,30 @@ contains
                finite([rtol, atol, h, rho_inf, balpha, bbeta]))) then
       call not_finite('q0, v0, the times and the settings', status, msg); return
     end if
-    if (nsteps < 0 .or. .not. (t1 > t0) .or. every < 1) then
-      status = MBD_BAD_SETTING; msg = 'steps must be >= 0, every >= 1 and t_end > t0'; return
+    if (nsteps < 0 .or. .not. (t1 > t0) .or. every < 1 .or. max_steps < 0) then
+      status = MBD_BAD_SETTING
+      msg = 'steps must be >= 0, every >= 1, max_steps >= 0 and t_end > t0'; return
     end if
     if (size(q0) /= m%nq .or. size(v0) /= m%nq .or. size(qout, 1) /= m%nq .or. &
         size(qout, 2) /= output_rows(nsteps, every) .or. size(lamout, 1) /= m%neq .or. &
         size(redundant) /= m%neq) then
       status = MBD_BAD_COUNT; msg = 'array sizes do not match the model'; return
     end if
+    ! the dense dynamics must fit (checked before the assembly allocates its dense J)
+    call dyn_memory_check(m, status, msg)
+    if (status /= MBD_OK) return
     ! assembly at t0 (Levenberg-Marquardt; any number of equations)
-    call kin_work_init(m, kw)
+    call kin_work_init(m, kw, status, msg)
+    if (status /= MBD_OK) return
     lscale = m%lscale
     kw%tol = kopts%tol * lscale
-    allocate (q(m%nq), qd(m%nq), rep%qsing(m%nq), rep%dep(m%neq), rep%redundant(m%neq))
+    allocate (q(m%nq), qd(m%nq), rep%qsing(m%nq), stat=ierr)
+    if (ierr == 0) allocate (rep%dep(m%neq), rep%redundant(m%neq), stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail(REAL_BYTES * (3 * real(m%nq, wp) + m%neq), 'the state vectors', &
+                    'use a smaller model', status, msg)
+      return
+    end if
     q = q0 / m%cunit
     call kin_assemble(m, kw, q, t0, kopts, rep, status, msg)
     if (status /= MBD_OK) then
@@ -515,8 +557,9 @@ contains
     if (rho_inf >= zero) opts%rho_inf = min(rho_inf, one)
     if (balpha >= zero) opts%balpha = balpha
     if (bbeta >= zero) opts%bbeta = bbeta
-    call integrate(m, w, q, qd, t0, t1, nsteps, every, opts, qout, qdout, qddout, nout, dst, &
-                   status, msg)
+    if (max_steps > 0) opts%max_steps = max_steps
+    call integrate(m, w, q, qd, t0, t1, nsteps, every, opts, qout, qdout, qddout, lamout, nout, &
+                   dst, status, msg)
     iinfo(1) = nout; iinfo(3) = dst%steps; iinfo(4) = dst%rejected; iinfo(5) = dst%newton
     iinfo(6) = dst%rhs; iinfo(7) = dst%jacobians; iinfo(8) = dst%partitions
     iinfo(10) = dst%factorizations
@@ -526,7 +569,6 @@ contains
       ko = output_index(nsteps, every, k)
       t = t0 + (t1 - t0) * (real(ko, wp) / max(nsteps, 1))
       if (ko == nsteps) t = t1
-      call dyn_multipliers(m, w, qout(:, k), qdout(:, k), qddout(:, k), t, lamout(:, k), st, lmsg)
       call state_measures(m, w, qout(:, k), qdout(:, k), t, eout(:, k))
     end do
     call units(m, qout, m%cunit, .false.); call units(m, qdout, m%cunit, .false.)
@@ -549,7 +591,7 @@ contains
     type(kin_opts_t) :: kopts
     type(kin_report_t) :: rep
     real(wp) :: lscale
-    integer :: bad, badf
+    integer :: bad, badf, ierr
     q = zero; lam = zero; stable = 0; resid = zero; iinfo = 0
     call build_dynamic(nb, ctab, rpar, bmass, grav, ftab, fpar, m, status, msg, bad, badf)
     iinfo(2) = bad; if (badf /= 0) iinfo(2) = -1000000 - badf
@@ -560,10 +602,18 @@ contains
     if (size(q0) /= m%nq .or. size(q) /= m%nq .or. size(lam) /= m%neq) then
       status = MBD_BAD_COUNT; msg = 'array sizes do not match the model'; return
     end if
-    call kin_work_init(m, kw)
+    call dyn_memory_check(m, status, msg)
+    if (status /= MBD_OK) return
+    call kin_work_init(m, kw, status, msg)
+    if (status /= MBD_OK) return
     lscale = m%lscale
     kw%tol = kopts%tol * lscale
-    allocate (rep%qsing(m%nq), rep%dep(m%neq), rep%redundant(m%neq))
+    allocate (rep%qsing(m%nq), rep%dep(m%neq), rep%redundant(m%neq), stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail(REAL_BYTES * (real(m%nq, wp) + m%neq), 'the assembly report', &
+                    'use a smaller model', status, msg)
+      return
+    end if
     q = q0 / m%cunit
     call kin_assemble(m, kw, q, t, kopts, rep, status, msg)
     if (status == MBD_OK) call dyn_init(m, w, q, t, kw%tol, status, msg)
@@ -581,7 +631,7 @@ contains
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
     type(model_t) :: m
     type(dyn_work_t) :: w
-    integer :: bad, k
+    integer :: bad, k, ierr
     reac = zero; rloc = zero
     call model_build(nb, ctab, rpar, m, status, msg, bad)
     if (status /= MBD_OK) return
@@ -592,8 +642,14 @@ contains
         size(q, 2) /= size(t) .or. size(lam, 2) /= size(t) .or. size(reac, 3) /= size(t)) then
       status = MBD_BAD_COUNT; msg = 'array sizes do not match the model'; return
     end if
-    allocate (w%phi(m%neq), w%nu(m%neq), w%gam(m%neq), w%qz(m%nq))
-    call asm_init(m, w%asm)
+    allocate (w%phi(m%neq), w%nu(m%neq), w%gam(m%neq), w%qz(m%nq), stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail(REAL_BYTES * (3 * real(m%neq, wp) + m%nq), 'the reaction work arrays', &
+                    'use a smaller model', status, msg)
+      return
+    end if
+    call asm_init(m, w%asm, status, msg)
+    if (status /= MBD_OK) return
     w%qz = zero
     do k = 1, size(t)
       call dyn_reactions(m, w, q(:, k), t(k), lam(:, k), reac(:, :, k), rloc(:, :, k))

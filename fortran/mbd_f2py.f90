@@ -124,14 +124,17 @@ end subroutine core_inverse
 
 ! every >= 1: only the outputs k = 0, every, 2 every, ... and k = nsteps are stored; nrow is
 ! their count, nsteps / every + 1, plus 1 when every does not divide nsteps.
+! max_steps: the limit on accepted plus rejected steps (0, the default: the core's default).
 subroutine core_dynamics(nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp, fpar, nq, neq, &
                          q0, v0, t0, t1, nsteps, method, rtol, atol, h, rho_inf, balpha, bbeta, &
                          every, nrow, qout, qdout, qddout, lamout, eout, iinfo, rinfo, &
-                         redundant, status, msg)
+                         redundant, status, msg, max_steps)
   use iso_c_binding, only: c_double, c_int
   use mbd_api, only: api_dynamics
   implicit none
   integer(c_int), intent(in) :: nb, nc, np, nf, nfp, nq, neq, nsteps, method, every, nrow
+  integer(c_int), intent(in) :: max_steps
+  !f2py integer(c_int) optional, intent(in) :: max_steps = 0
   integer(c_int), intent(in) :: ctab(8, nc), ftab(6, nf)
   real(c_double), intent(in) :: rpar(np), bmass(2, nb), grav(2), fpar(nfp), q0(nq), v0(nq)
   real(c_double), intent(in) :: t0, t1, rtol, atol, h, rho_inf, balpha, bbeta
@@ -144,7 +147,7 @@ subroutine core_dynamics(nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp, fpa
   !f2py intent(hide) :: nc, np, nf, nfp, nq
   call api_dynamics(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, v0, t0, t1, nsteps, method, &
                     rtol, atol, h, rho_inf, balpha, bbeta, every, qout, qdout, qddout, lamout, &
-                    eout, iinfo, rinfo, redundant, status, msg)
+                    eout, iinfo, rinfo, redundant, status, msg, max_steps)
 end subroutine core_dynamics
 
 subroutine core_statics(nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp, fpar, nq, neq, q0, &

@@ -18,25 +18,30 @@
 !!  4 partitioned        coordinate partitioning (Wehage-Haug): Dormand-Prince 5(4) on the
 !!                       independent coordinates v; the dependent u from Phi(u, v) = 0, u_dot
 !!                       from J_u u_dot = nu - J_v v_dot, at every stage; re-partitioned when
-!!                       J_u becomes ill conditioned (QR with column pivoting, dgeqp3).
+!!                       J_u becomes 4x worse conditioned than the choice of a QR with
+!!                       column pivoting (dgeqp3) at the current state.
 module mbd_integrators
   use mbd_kinds, only: wp, zero, one, half, two
   use mbd_status, only: MBD_OK, MBD_BAD_SETTING, MBD_SINGULAR, MBD_NO_CONVERGENCE, &
-                        MBD_INTEGRATOR_FAILED, MBD_LAPACK, MSG_LEN
+                        MBD_INTEGRATOR_FAILED, MBD_LAPACK, MBD_NO_MEMORY, MSG_LEN
+  use mbd_memory, only: REAL_BYTES, mem_fail
   use mbd_model, only: model_t
   use mbd_assemble, only: assemble_dense, assemble_blocks, scatter_dense
   use mbd_linsolve, only: lu_factor, lu_solve, lapack_status, lu_factor_small, lu_solve_small
   use mbd_lapack, only: dgeqp3, dgecon
   use mbd_interp, only: hermite5
   use mbd_dynamics, only: dyn_work_t, dyn_accel, dyn_velocity, dyn_project_pos, gen_forces, &
-                          kinetic_energy, dyn_tangent, dyn_solve, dyn_jt_lam
+                          kinetic_energy, dyn_tangent, dyn_solve, dyn_jt_lam, dyn_multipliers
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   implicit none
   private
   public :: dyn_opts_t, dyn_stats_t, METH_GENALPHA, METH_DOPRI5, METH_RK4, METH_PARTITIONED
-  public :: integrate, output_rows, output_index
+  public :: integrate, output_rows, output_index, MAX_STEPS_DEFAULT
 
   integer, parameter :: METH_GENALPHA = 1, METH_DOPRI5 = 2, METH_RK4 = 3, METH_PARTITIONED = 4
+  !> Default step limit: it ends a run whose steps collapse without underflowing, after
+  !! 10 s to 10 minutes at 1-80 us a step (small models); a long run raises it.
+  integer, parameter :: MAX_STEPS_DEFAULT = 10000000
 
   !> Integrator settings.
   type :: dyn_opts_t
@@ -47,7 +52,7 @@ module mbd_integrators
     real(wp) :: rho_inf = 0.8_wp      !! generalized-alpha spectral radius at infinity
     real(wp) :: balpha = 10.0_wp      !! Baumgarte alpha
     real(wp) :: bbeta = 10.0_wp       !! Baumgarte beta
-    integer :: max_steps = 2000000    !! internal step limit
+    integer :: max_steps = MAX_STEPS_DEFAULT  !! limit on accepted + rejected steps
   end type dyn_opts_t
 
   !> What the integrator did.
@@ -76,6 +81,10 @@ module mbd_integrators
     real(wp), allocatable :: qs(:), vs(:), as(:)          !! full state there
   end type itg_t
 
+  !> partitioned: re-partition when J_u is this many times worse conditioned than the best
+  !! choice now (docs/dynamics.md: measured on a double pendulum and the N-four-bar)
+  real(wp), parameter :: REPARTITION = 0.25_wp
+
   ! Dormand-Prince 5(4) tableau
   real(wp), parameter :: C2 = 0.2_wp, C3 = 0.3_wp, C4 = 0.8_wp, C5 = 8.0_wp / 9.0_wp
   real(wp), parameter :: A21 = 0.2_wp, A31 = 3.0_wp / 40, A32 = 9.0_wp / 40
@@ -93,10 +102,12 @@ contains
 
   !> Integrate from the consistent state (q, qd) at t0 to t1, with outputs at
   !! t0 + k (t1 - t0)/nsteps, k = 0..nsteps, of which those with mod(k, every) = 0 and the
-  !! last (k = nsteps) are written into the columns of qo, vo, ao (output_rows of them).
+  !! last (k = nsteps) are written into the columns of qo, vo, ao, lo (output_rows of them).
   !! nout returns the number of rows written (all, unless a failure stopped the run).
-  subroutine integrate(m, w, q, qd, t0, t1, nsteps, every, opts, qo, vo, ao, nout, st, status, &
-                       msg)
+  !! The multipliers lo at every output are those of the index-1 equations at the output
+  !! state (see finish_outputs).
+  subroutine integrate(m, w, q, qd, t0, t1, nsteps, every, opts, qo, vo, ao, lo, nout, st, &
+                       status, msg)
     type(model_t), intent(in) :: m               !! model
     type(dyn_work_t), intent(inout) :: w         !! dynamics work arrays (dyn_init done)
     real(wp), intent(inout) :: q(:), qd(:)       !! consistent initial state, then final
@@ -105,13 +116,14 @@ contains
     integer, intent(in) :: every                 !! store every every-th output (and the last)
     type(dyn_opts_t), intent(in) :: opts         !! settings
     real(wp), intent(out) :: qo(:, :), vo(:, :), ao(:, :)  !! outputs (nq, rows)
+    real(wp), intent(out) :: lo(:, :)            !! multipliers at the outputs (neq, rows)
     integer, intent(out) :: nout                 !! rows written
     type(dyn_stats_t), intent(out) :: st         !! counters
     integer, intent(out) :: status               !! MBD_OK or a failure
     character(len=MSG_LEN), intent(out) :: msg   !! explanation
     type(itg_t) :: c
     status = MBD_OK; msg = ''; nout = 0
-    qo = zero; vo = zero; ao = zero
+    qo = zero; vo = zero; ao = zero; lo = zero
     if (opts%method == METH_RK4 .and. .not. (opts%h > zero)) then
       status = MBD_BAD_SETTING; msg = 'baumgarte-rk4 needs a step h > 0'; return
     end if
@@ -122,7 +134,12 @@ contains
       status = MBD_BAD_SETTING; msg = 'every must be >= 1 and the outputs sized for it'; return
     end if
     c%opts = opts; c%t0 = t0; c%t1 = t1; c%nsteps = nsteps; c%every = every
-    allocate (c%qf(m%nq), c%vf(m%nq), c%af(m%nq), c%lam(m%neq))
+    allocate (c%qf(m%nq), c%vf(m%nq), c%af(m%nq), c%lam(m%neq), stat=status)
+    if (status /= 0) then
+      call mem_fail(REAL_BYTES * (3 * real(m%nq, wp) + m%neq), 'the integrator state', &
+                    'use a smaller model', status, msg)
+      return
+    end if
     c%qf = q; c%vf = qd
     call dyn_accel(m, w, q, qd, t0, c%af, c%lam, status)
     if (status /= MBD_OK) then
@@ -144,7 +161,48 @@ contains
     end if
     nout = c%nout; st = c%st
     q = c%qf; qd = c%vf
+    call finish_outputs(m, w, c, qo, vo, ao, lo)
   end subroutine integrate
+
+  !> The accelerations and multipliers at the stored outputs, from the index-1 equations at
+  !! the output state (accel_at), for every method. For the explicit methods these are what
+  !! the integrator itself evaluates at a step; between steps they belong to the
+  !! interpolated state (q, q_dot), instead of an interpolant of the accelerations, whose
+  !! error is 100x larger. (Projecting the interpolated state onto Phi = 0 and
+  !! J q_dot = nu first made them less accurate: the kinetic-energy projection mixes the
+  !! velocity errors of all coordinates.) generalized-alpha keeps its own q_ddot, but its
+  !! lambda_{n+1} is a second difference of positions (q_ddot_{n+1} = (q_{n+1} - q*) /
+  !! (beta' h^2)), which carries the rounding of q amplified by 1 / (beta' h^2); its
+  !! reported multipliers are those of the state instead. With independent rows lambda is
+  !! the solve's; otherwise (redundant rows, a rank-revealing solve near a singular
+  !! position, Baumgarte's stabilized accelerations) the minimum-norm solution of
+  !! J^T lambda = Q - M q_ddot over all rows. If the solve fails at a state, the row keeps
+  !! its accelerations and lambda follows from them.
+  subroutine finish_outputs(m, w, c, qo, vo, ao, lo)
+    type(model_t), intent(in) :: m
+    type(dyn_work_t), intent(inout) :: w
+    type(itg_t), intent(in) :: c
+    real(wp), intent(in) :: qo(:, :), vo(:, :)
+    real(wp), intent(inout) :: ao(:, :), lo(:, :)
+    real(wp) :: t, a1(m%nq), lam(m%neq)
+    integer :: r, stt
+    character(len=MSG_LEN) :: lmsg
+    do r = 1, c%nout
+      t = c%t0
+      if (c%nsteps > 0) t = out_time(c, output_index(c%nsteps, c%every, r))
+      call accel_at(m, w, c%opts, qo(:, r), vo(:, r), t, a1, lam, stt)
+      if (stt == MBD_OK) then
+        if (c%opts%method /= METH_GENALPHA) ao(:, r) = a1
+        if (w%na == m%neq .and. .not. w%lsq .and. c%opts%method /= METH_RK4) then
+          lo(:, r) = lam                ! independent rows: the solve's lambda is the one
+          cycle
+        end if
+      else
+        a1 = ao(:, r)
+      end if
+      call dyn_multipliers(m, w, qo(:, r), vo(:, r), a1, t, lo(:, r), stt, lmsg)
+    end do
+  end subroutine finish_outputs
 
   !> More steps to take: fixed steps count to nfix, adaptive ones run to t1.
   logical function more(c, t, fixed, nfix)
@@ -158,6 +216,36 @@ contains
       more = t < c%t1 - 1.0e-14_wp * abs(c%t1 - c%t0)
     end if
   end function more
+
+  !> The run stops at the step limit (accepted plus rejected steps): say how to raise it.
+  !! nfix > 0: a fixed-step run that needs nfix steps (stopped before it starts).
+  subroutine step_limit(c, t, nfix, status, msg)
+    type(itg_t), intent(inout) :: c
+    real(wp), intent(in) :: t
+    integer, intent(in) :: nfix
+    integer, intent(out) :: status
+    character(len=MSG_LEN), intent(out) :: msg
+    status = MBD_INTEGRATOR_FAILED
+    c%st%t_fail = t
+    if (nfix > 0) then
+      write (msg, '(a,es10.3,a,i0,a,i0,a)') 'the fixed step h = ', c%opts%h, ' needs ', nfix, &
+        ' steps, more than the step limit max_steps = ', c%opts%max_steps, &
+        ': raise max_steps (command line: --max-steps), or take a larger h'
+    else
+      write (msg, '(a,i0,a,es12.5,a)') 'the step limit max_steps = ', c%opts%max_steps, &
+        ' (accepted and rejected steps) was reached at t = ', t, &
+        ': raise max_steps (command line: --max-steps), or loosen rtol and atol'
+    end if
+  end subroutine step_limit
+
+  !> Number of fixed steps of about h that span (t0, t1) (capped at huge(0), not overflowing).
+  integer function fixed_steps(c)
+    type(itg_t), intent(in) :: c
+    real(wp) :: r
+    r = anint((c%t1 - c%t0) / c%opts%h)
+    fixed_steps = huge(0)
+    if (r < real(huge(0), wp)) fixed_steps = max(1, int(r))
+  end function fixed_steps
 
   !> Time of fixed step k (exact at the end).
   real(wp) function step_time(c, k, nfix)
@@ -266,7 +354,10 @@ contains
     t = c%t0
     nfix = 0
     if (fixed) then
-      nfix = max(1, nint((c%t1 - c%t0) / c%opts%h))
+      nfix = fixed_steps(c)
+      if (nfix > c%opts%max_steps) then
+        call step_limit(c, t, nfix, status, msg); return
+      end if
       h = (c%t1 - c%t0) / nfix                                      ! land on t1
     else
       h = initial_step(c)
@@ -276,9 +367,7 @@ contains
     err = zero
     do while (more(c, t, fixed, nfix))
       if (c%st%steps + c%st%rejected >= c%opts%max_steps) then
-        status = MBD_INTEGRATOR_FAILED
-        write (msg, '(a,i0,a,es12.5)') 'more than ', c%opts%max_steps, ' steps before t = ', t
-        return
+        call step_limit(c, t, 0, status, msg); return
       end if
       h = min(h, c%t1 - t)
       tnew = t + h
@@ -433,7 +522,7 @@ contains
     character(len=MSG_LEN), intent(out) :: msg
     real(wp), allocatable :: y(:), ynew(:), k(:, :), e(:)
     real(wp) :: t, h, tnew, err, fac, qa(m%nq), va(m%nq), aa(m%nq)
-    integer :: stt
+    integer :: stt, nprev
     logical :: fixed, fsal
     integer :: nfix
     status = MBD_OK; msg = ''
@@ -441,28 +530,36 @@ contains
     if (partitioned) then
       call partition(m, w, c, c%t0, stt)
       if (stt /= MBD_OK) then
-        status = stt; msg = 'partitioned: cannot choose independent coordinates'; return
+        status = stt; msg = 'partitioned: cannot choose independent coordinates'
+        if (stt == MBD_NO_MEMORY) msg = 'not enough memory for the partition (QR of J)'
+        return
       end if
     end if
     fixed = c%opts%method == METH_RK4
     t = c%t0
     nfix = 0
     if (fixed) then
-      nfix = max(1, nint((c%t1 - c%t0) / c%opts%h))
+      nfix = fixed_steps(c)
+      if (nfix > c%opts%max_steps) then
+        call step_limit(c, t, nfix, status, msg); return
+      end if
       h = (c%t1 - c%t0) / nfix
     else
       h = initial_step(c)
     end if
-    call pack_state(c, y, ynew, k, e)
+    call pack_state(c, y, ynew, k, e, stt)
+    if (stt /= 0) then
+      call mem_fail(REAL_BYTES * 10 * size(c%qf), 'the integrator stages', &
+                    'use a smaller model', status, msg)
+      return
+    end if
     fsal = .false.
     qa = c%qf; va = c%vf; aa = c%af          ! the state at the start of the step
     c%qs = qa; c%vs = va; c%as = aa; c%ts = t
     err = zero
     do while (more(c, t, fixed, nfix))
       if (c%st%steps + c%st%rejected >= c%opts%max_steps) then
-        status = MBD_INTEGRATOR_FAILED
-        write (msg, '(a,i0,a,es12.5)') 'more than ', c%opts%max_steps, ' steps before t = ', t
-        return
+        call step_limit(c, t, 0, status, msg); return
       end if
       c%st%t_fail = t
       h = min(h, c%t1 - t)
@@ -527,7 +624,9 @@ contains
           return
         end if
       end if
+      nprev = c%nout
       call emit(c, qo, vo, ao, t, qa, va, aa, tnew, c%qf, c%vf, c%af)
+      if (partitioned) call complete_outputs(m, w, c, qo, vo, nprev + 1)
       qa = c%qf; va = c%vf; aa = c%af
       c%qs = qa; c%vs = va; c%as = aa; c%ts = tnew
       c%st%steps = c%st%steps + 1
@@ -539,14 +638,19 @@ contains
         h = h * fac
       end if
       if (partitioned) then
-        if (needs_partition(m, w, c)) then
+        if (needs_partition(m, w, c, t)) then
           call partition(m, w, c, t, stt)
           if (stt /= MBD_OK) then
             status = MBD_INTEGRATOR_FAILED
             write (msg, '(a,es12.5)') 'partitioned: no well-conditioned partition at t = ', t
             return
           end if
-          call pack_state(c, y, ynew, k, e)
+          call pack_state(c, y, ynew, k, e, stt)
+          if (stt /= 0) then
+            call mem_fail(REAL_BYTES * 10 * size(c%qf), 'the integrator stages', &
+                          'use a smaller model', status, msg)
+            return
+          end if
           fsal = .false.
         end if
       end if
@@ -554,18 +658,22 @@ contains
   end subroutine run_explicit
 
   !> The integrated state y from the full state: (q, q_dot), or (v, v_dot) when partitioned.
-  subroutine pack_state(c, y, ynew, k, e)
+  subroutine pack_state(c, y, ynew, k, e, ierr)
     type(itg_t), intent(in) :: c
     real(wp), allocatable, intent(inout) :: y(:), ynew(:), k(:, :), e(:)
-    integer :: ny
+    integer, intent(out) :: ierr          ! allocation status (0 ok)
+    integer :: ny, nh
+    nh = size(c%qf)
+    if (c%ni > 0) nh = c%ni
+    ny = 2 * nh
+    if (allocated(y)) deallocate (y, ynew, k, e)
+    allocate (y(ny), ynew(ny), k(ny, 7), e(ny), stat=ierr)
+    if (ierr /= 0) return
     if (c%ni > 0) then
-      y = [c%qf(c%iv), c%vf(c%iv)]
+      y(1:nh) = c%qf(c%iv); y(nh + 1:) = c%vf(c%iv)
     else
-      y = [c%qf, c%vf]
+      y(1:nh) = c%qf; y(nh + 1:) = c%vf
     end if
-    ny = size(y)
-    if (allocated(ynew)) deallocate (ynew, k, e)
-    allocate (ynew(ny), k(ny, 7), e(ny))
   end subroutine pack_state
 
   !> After an accepted step: the full consistent state at tn in c (dopri5: projected).
@@ -633,25 +741,61 @@ contains
     u = c%qs(c%iu) + dt * (c%vs(c%iu) + half * dt * c%as(c%iu))
   end function predicted
 
-  !> Accelerations at c's full state; Baumgarte-stabilized for RK4:
-  !! J q_ddot = gamma - 2 alpha (J q_dot - nu) - beta^2 Phi.
+  !> Accelerations at c's full state; Baumgarte-stabilized for RK4.
   subroutine accel(m, w, c, t, stf)
     type(model_t), intent(in) :: m
     type(dyn_work_t), intent(inout) :: w
     type(itg_t), intent(inout) :: c
     real(wp), intent(in) :: t
     integer, intent(out) :: stf
+    call accel_at(m, w, c%opts, c%qf, c%vf, t, c%af, c%lam, stf)
+  end subroutine accel
+
+  !> Accelerations and multipliers (active rows) of the index-1 equations at a state:
+  !! [M J^T; J 0][q_ddot; lambda] = [Q; gamma]; for baumgarte-rk4 the stabilized
+  !! J q_ddot = gamma - 2 alpha (J q_dot - nu) - beta^2 Phi (lam then is the plain one).
+  subroutine accel_at(m, w, opts, q, qd, t, qdd, lam, stf)
+    type(model_t), intent(in) :: m
+    type(dyn_work_t), intent(inout) :: w
+    type(dyn_opts_t), intent(in) :: opts
+    real(wp), intent(in) :: q(:), qd(:), t
+    real(wp), intent(out) :: qdd(:), lam(:)
+    integer, intent(out) :: stf
     integer :: nn
-    call dyn_accel(m, w, c%qf, c%vf, t, c%af, c%lam, stf)
-    if (stf /= MBD_OK .or. .not. c%baumgarte) return
+    call dyn_accel(m, w, q, qd, t, qdd, lam, stf)
+    if (stf /= MBD_OK .or. opts%method /= METH_RK4) return
     nn = m%nq
     w%rhs(1:nn) = w%force
-    w%rhs(nn + 1:) = w%s * (w%gam(w%rows) - two * c%opts%balpha * &
-                            (matmul(w%jac(w%rows, :), c%vf) - w%nu(w%rows)) - &
-                            c%opts%bbeta**2 * w%phi(w%rows))
+    w%rhs(nn + 1:) = w%s * (w%gam(w%rows) - two * opts%balpha * &
+                            (matmul(w%jac(w%rows, :), qd) - w%nu(w%rows)) - &
+                            opts%bbeta**2 * w%phi(w%rows))
     call dyn_solve(w, w%rhs, stf)
-    c%af = w%rhs(1:nn)
-  end subroutine accel
+    qdd = w%rhs(1:nn)
+  end subroutine accel_at
+
+  !> partitioned: the outputs r0 .. c%nout just interpolated keep their independent
+  !! (v, v_dot), and the dependent (u, u_dot) are solved from them as at a stage, so every
+  !! output is a consistent state whose error is that of v's interpolant. An output where
+  !! the solve fails keeps the interpolant.
+  subroutine complete_outputs(m, w, c, qo, vo, r0)
+    type(model_t), intent(in) :: m
+    type(dyn_work_t), intent(inout) :: w
+    type(itg_t), intent(inout) :: c
+    real(wp), intent(inout) :: qo(:, :), vo(:, :)
+    integer, intent(in) :: r0
+    real(wp) :: qf(m%nq), vf(m%nq)
+    integer :: r, stt, newton
+    qf = c%qf; vf = c%vf; newton = c%st%newton
+    do r = r0, c%nout
+      c%qf = qo(:, r); c%vf = vo(:, r)
+      call solve_dependent(m, w, c, out_time(c, output_index(c%nsteps, c%every, r)), &
+                           vo(c%iv, r), stt)
+      if (stt == MBD_OK) then
+        qo(:, r) = c%qf; vo(:, r) = c%vf
+      end if
+    end do
+    c%qf = qf; c%vf = vf; c%st%newton = newton
+  end subroutine complete_outputs
 
   !> Dependent coordinates u from Phi(u, v) = 0 (Newton with J_u), then u_dot from
   !! J_u u_dot = nu - J_v v_dot.
@@ -700,7 +844,10 @@ contains
     a = w%jac(w%rows, :)
     jp = 0
     call dgeqp3(w%na, m%nq, a, w%na, jp, tau, wq, -1, info)
-    allocate (work(max(1, int(wq(1)))))
+    allocate (work(max(1, int(wq(1)))), stat=stf)
+    if (stf /= 0) then
+      stf = MBD_NO_MEMORY; return
+    end if
     call dgeqp3(w%na, m%nq, a, w%na, jp, tau, work, size(work), info)
     call lapack_status('dgeqp3', info, stf, lmsg)
     if (stf /= MBD_OK) return
@@ -710,22 +857,44 @@ contains
     c%st%partitions = c%st%partitions + 1
   end subroutine partition
 
-  !> J_u is ill conditioned at the current state (1/cond_1 < 1e-3): choose again.
-  logical function needs_partition(m, w, c)
+  !> 1/cond_1 of J(rows, cols) at the last assembly (0 when singular).
+  real(wp) function rcond_cols(w, cols) result(rc)
+    type(dyn_work_t), intent(inout) :: w
+    integer, intent(in) :: cols(:)
+    real(wp) :: ju(w%na, w%na), anorm, cw(4 * w%na)
+    integer :: piv(w%na), iw(w%na), stf, info
+    character(len=MSG_LEN) :: lmsg
+    ju = w%jac(w%rows, cols)
+    anorm = maxval(sum(abs(ju), dim=1))
+    rc = zero
+    call lu_factor(ju, piv, stf, lmsg)
+    if (stf /= MBD_OK) return
+    call dgecon('1', w%na, ju, w%na, anorm, rc, cw, iw, info)
+  end function rcond_cols
+
+  !> Choose again when the current J_u has become REPARTITION times worse conditioned
+  !! (1/cond_1) than the choice a QR with column pivoting of J would make now. Near a
+  !! singular configuration, where every J_u is ill conditioned, nothing better exists and
+  !! the partition is kept.
+  logical function needs_partition(m, w, c, t)
     type(model_t), intent(in) :: m
     type(dyn_work_t), intent(inout) :: w
     type(itg_t), intent(in) :: c
-    real(wp) :: ju(w%na, w%na), anorm, rc, cw(4 * w%na)
-    integer :: piv(w%na), iw(w%na), stf, info
-    character(len=MSG_LEN) :: lmsg
-    call assemble_dense(m, c%qf, w%qz, c%t0, w%phi, w%nu, w%gam, w%asm, w%jac)
-    ju = w%jac(w%rows, c%iu)
-    anorm = maxval(sum(abs(ju), dim=1))
-    call lu_factor(ju, piv, stf, lmsg)
-    needs_partition = stf /= MBD_OK
-    if (stf /= MBD_OK) return
-    call dgecon('1', w%na, ju, w%na, anorm, rc, cw, iw, info)
-    needs_partition = rc < 1.0e-3_wp
+    real(wp), intent(in) :: t
+    real(wp) :: rc, a(w%na, m%nq), tau(w%na), wq(1)
+    real(wp), allocatable :: work(:)
+    integer :: jp(m%nq), info, stat
+    call assemble_dense(m, c%qf, w%qz, t, w%phi, w%nu, w%gam, w%asm, w%jac)
+    rc = rcond_cols(w, c%iu)
+    a = w%jac(w%rows, :)
+    jp = 0
+    call dgeqp3(w%na, m%nq, a, w%na, jp, tau, wq, -1, info)
+    allocate (work(max(1, int(wq(1)))), stat=stat)
+    needs_partition = rc <= zero
+    if (stat /= 0 .or. info /= 0) return
+    call dgeqp3(w%na, m%nq, a, w%na, jp, tau, work, size(work), info)
+    if (info /= 0) return
+    needs_partition = rc < REPARTITION * rcond_cols(w, jp(1:w%na))
   end function needs_partition
 
   !> One classical Runge-Kutta step.

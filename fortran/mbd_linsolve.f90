@@ -16,6 +16,7 @@
 module mbd_linsolve
   use mbd_kinds, only: wp, zero, one
   use mbd_status, only: MBD_OK, MBD_SINGULAR, MBD_LAPACK, MSG_LEN
+  use mbd_memory, only: REAL_BYTES, mem_check, mem_fail
   use mbd_lapack, only: dgetrf, dgetf2, dtrsv, dgesvd, dgeqp3, dormqr, dtrtrs
   implicit none
   private
@@ -234,14 +235,25 @@ contains
     integer, intent(out) :: status              !! MBD_OK or MBD_LAPACK
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
     real(wp), allocatable :: w(:, :), um(:, :), vt(:, :), work(:)
-    real(wp) :: wq(1)
-    integer :: m, n, info, lwork
+    real(wp) :: wq(1), bytes
+    integer :: m, n, info, lwork, ierr
+    character(len=*), parameter :: WHAT = 'the singular value decomposition of J (a dense ' // &
+      'diagnosis of the singular configuration)', HINT = 'use a smaller model'
     m = size(a, 1); n = size(a, 2)
-    allocate (w(m, n), um(m, m), vt(n, n))
+    bytes = REAL_BYTES * (2 * real(m, wp) * n + real(m, wp) * m + real(n, wp) * n)
+    call mem_check(bytes, WHAT, HINT, status, msg)
+    if (status /= MBD_OK) return
+    allocate (w(m, n), um(m, m), vt(n, n), stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail(bytes, WHAT, HINT, status, msg); return
+    end if
     w = a
     call dgesvd('A', 'A', m, n, w, m, sv, um, m, vt, n, wq, -1, info)
     lwork = max(1, int(wq(1)))
-    allocate (work(lwork))
+    allocate (work(lwork), stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail(REAL_BYTES * lwork, WHAT, HINT, status, msg); return
+    end if
     call dgesvd('A', 'A', m, n, w, m, sv, um, m, vt, n, work, lwork, info)
     call lapack_status('dgesvd', info, status, msg)
     if (status /= MBD_OK) return
@@ -262,11 +274,20 @@ contains
     integer, intent(out) :: status              !! MBD_OK or MBD_LAPACK
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
     real(wp), allocatable :: at(:, :), tau(:), work(:), basis(:, :), v(:)
-    real(wp) :: wq(1), nrm, r11
+    real(wp) :: wq(1), nrm, r11, bytes
     integer, allocatable :: order(:)
-    integer :: m, n, i, info, lwork, r, pass
+    integer :: m, n, i, info, lwork, r, pass, ierr
+    character(len=*), parameter :: WHAT = 'the rank analysis of J (dense)', &
+      HINT = 'use a smaller model'
     m = size(a, 1); n = size(a, 2)
-    allocate (at(n, m), tau(min(m, n)), order(m), basis(n, min(m, n)), v(n))
+    rank = 0; redundant = 0
+    bytes = REAL_BYTES * (real(n, wp) * m + real(n, wp) * min(m, n) + 2 * (m + n))
+    call mem_check(bytes, WHAT, HINT, status, msg)
+    if (status /= MBD_OK) return
+    allocate (at(n, m), tau(min(m, n)), order(m), basis(n, min(m, n)), v(n), stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail(bytes, WHAT, HINT, status, msg); return
+    end if
     do i = 1, m
       nrm = norm2(a(i, :))
       at(:, i) = zero
@@ -292,7 +313,10 @@ contains
     order = 0
     call dgeqp3(n, m, at, n, order, tau, wq, -1, info)
     lwork = max(1, int(wq(1)))
-    allocate (work(lwork))
+    allocate (work(lwork), stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail(REAL_BYTES * lwork, WHAT, HINT, status, msg); return
+    end if
     call dgeqp3(n, m, at, n, order, tau, work, lwork, info)
     call lapack_status('dgeqp3', info, status, msg)
     if (status /= MBD_OK) return

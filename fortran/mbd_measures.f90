@@ -16,9 +16,10 @@
 !! Work arrays are allocated once per call (with stat=), none in the loop over states.
 module mbd_measures
   use mbd_kinds, only: wp, zero, one
-  use mbd_status, only: MBD_OK, MBD_BAD_COUNT, MBD_BAD_PARAM, MBD_NO_MEMORY, MSG_LEN
+  use mbd_status, only: MBD_OK, MBD_BAD_COUNT, MBD_BAD_PARAM, MSG_LEN
   use mbd_model, only: model_t, model_build
   use mbd_assemble, only: asm_work_t, asm_init, assemble_dense
+  use mbd_memory, only: mem_fail, REAL_BYTES
   use mbd_linsolve, only: lapack_status, lu_factor, lu_solve, qr_factor, qr_solve, qr_lwork
   use mbd_lapack, only: dgesvd
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
@@ -51,15 +52,16 @@ contains
     allocate (phi(m%neq), nu(m%neq), gam(m%neq), jac(m%neq, m%nq), qz(m%nq), qc(m%nq), &
               sv(max(ns, 1)), stat=ist)
     if (ist /= 0) then
-      call no_memory(status, msg); return
+      call no_memory(m, status, msg); return
     end if
-    call asm_init(m, aw)
+    call asm_init(m, aw, status, msg)
+    if (status /= MBD_OK) return
     qz = zero
     call dgesvd('N', 'N', m%neq, m%nq, jac, m%neq, sv, du, 1, dvt, 1, wq, -1, info)
     lwork = max(1, int(wq(1)))
     allocate (work(lwork), stat=ist)
     if (ist /= 0) then
-      call no_memory(status, msg); return
+      call no_memory(m, status, msg); return
     end if
     do k = 1, size(t)
       qc = q(:, k) / m%cunit
@@ -115,9 +117,10 @@ contains
     allocate (phi(m%neq), nu(m%neq), gam(m%neq), jac(m%neq, m%nq), qz(m%nq), b(m%neq), &
               ipiv(m%nq), jpvt(m%nq), tau(m%nq), work(qr_lwork(m%neq, m%nq)), stat=ist)
     if (ist /= 0) then
-      call no_memory(status, msg); return
+      call no_memory(m, status, msg); return
     end if
-    call asm_init(m, aw)
+    call asm_init(m, aw, status, msg)
+    if (status /= MBD_OK) return
     qz = zero
     do k = 1, size(t)
       call assemble_dense(m, q(:, k), qz, t(k), phi, nu, gam, aw, jac)
@@ -157,11 +160,16 @@ contains
     good = .true.
   end function check_states
 
-  subroutine no_memory(status, msg)
-    integer, intent(out) :: status
-    character(len=MSG_LEN), intent(out) :: msg
-    status = MBD_NO_MEMORY
-    msg = 'not enough memory for the work arrays of the measures'
+  !> MBD_NO_MEMORY after a failed allocation of the work arrays (about a dense J and a few
+  !! vectors).
+  subroutine no_memory(m, status, msg)
+    type(model_t), intent(in) :: m              !! model
+    integer, intent(out) :: status              !! MBD_NO_MEMORY
+    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    msg = ''
+    call mem_fail(REAL_BYTES * (real(m%neq, wp) * m%nq + 8.0_wp * (m%neq + m%nq)), &
+                  'the work arrays of the mechanism measures (a dense J)', &
+                  'the model is too large for a dense J', status, msg)
   end subroutine no_memory
 
 end module mbd_measures

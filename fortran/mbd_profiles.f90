@@ -15,6 +15,7 @@ module mbd_profiles
   use mbd_kinds, only: wp, zero, one, two, half, pi
   use mbd_lapack, only: dgtsv
   use mbd_status, only: MBD_OK, MBD_BAD_PARAM, MBD_LAPACK, MSG_LEN
+  use mbd_memory, only: REAL_BYTES, mem_fail
   implicit none
   private
   public :: PROF_CIRCLE, PROF_SPLINE, PROF_FOURIER
@@ -86,7 +87,12 @@ contains
       prep = raw
     case (PROF_SPLINE)
       n = nint(raw(1))
-      allocate (x(n + 1), y(n + 1), s(n + 1), h(n))
+      allocate (x(n + 1), y(n + 1), s(n + 1), h(n), mx(n + 1), my(n + 1), stat=i)
+      if (i /= 0) then
+        call mem_fail(REAL_BYTES * 6 * (n + 1), 'the spline profile', 'use fewer spline points', &
+                      status, msg)
+        return
+      end if
       x(1:n) = raw(2:2 * n:2); y(1:n) = raw(3:2 * n + 1:2)
       ! shoelace area: reverse a clockwise loop so the outward normal is perp_-(c')
       area = half * (sum(x(1:n - 1) * y(2:n) - x(2:n) * y(1:n - 1)) + x(n) * y(1) - x(1) * y(n))
@@ -107,7 +113,6 @@ contains
         s(i + 1) = s(i) + h(i)
       end do
       s(n + 1) = two * pi
-      allocate (mx(n + 1), my(n + 1))
       call periodic_spline(n, h, x, y, mx, my, status, msg)
       if (status /= MBD_OK) return
       prep = [real(n, wp), s, x, mx, y, my]

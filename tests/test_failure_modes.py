@@ -294,8 +294,11 @@ def test_stiff_spring_limits_explicit_steps_not_generalized_alpha() -> None:
 def test_generalized_alpha_without_damping_grows_a_sawtooth(model: str, t_end: float,
                                                             t_fail: tuple) -> None:
     """Index-3 generalized-alpha at rho_inf = 1 leaves the recursion of the accelerations
-    with a root at -1: a step-to-step sawtooth in q_ddot and the multipliers that nothing
-    damps. It grows until Newton fails (fixed h = 1e-2); at rho_inf = 0.8 it is damped."""
+    with a root at -1: a step-to-step sawtooth in the scheme's q_ddot (and its lambda) that
+    nothing damps. It grows until Newton fails (fixed h = 1e-2); at rho_inf = 0.8 it is
+    damped. The reported multipliers are those of the index-1 equations at each output
+    state, so they do not carry the sawtooth; the velocity drift and the energy show the
+    state going wrong."""
     m = free_fourbar() if model == "free-four-bar" else \
         mbd2d.load(ROOT / "examples" / "pendulum_spring.toml")
     damped = m.dynamics(t_end, int(round(t_end / 1e-2)), method="generalized-alpha", h=1e-2,
@@ -305,38 +308,44 @@ def test_generalized_alpha_without_damping_grows_a_sawtooth(model: str, t_end: f
                    rho_inf=1.0)
     und = info.value.results
     assert t_fail[0] < info.value.t < t_fail[1]
-    lam_ok = np.abs(damped.lam).max()
+    qdd_ok = np.abs(damped.qdd).max()
     dv_ok = damped.drift_velocity.max()
     # early on the two agree (same step, same accuracy) ...
-    assert window(und, und.lam, 0, 2) < 1.05 * window(damped, damped.lam, 0, 2)
+    assert window(und, und.qdd, 0, 2) < 1.05 * window(damped, damped.qdd, 0, 2)
     assert window(und, und.drift_velocity, 0, 2) < 1.5 * window(damped, damped.drift_velocity,
                                                                 0, 2)
-    # ... in the last second before the failure the multipliers are 50x their damped size
-    # and the velocity constraints are violated 100x more
+    # ... in the last second before the failure the accelerations are 300x their damped
+    # size (measured 550x, 650x) and the velocity constraints are violated 100x more
     t_end_und = float(und.t[-1])
-    assert window(und, und.lam, t_end_und - 1, t_end_und) > 50 * lam_ok
+    assert window(und, und.qdd, t_end_und - 1, t_end_und) > 300 * qdd_ok
     assert window(und, und.drift_velocity, t_end_und - 1, t_end_und) > 100 * dv_ok
     # the position constraints stay satisfied (index 3 enforces them)
     assert und.drift_position.max() < 1e-10
-    # the growth is a sawtooth: the largest multiplier alternates in sign step by step
-    row = int(np.argmax(np.abs(und.lam[-1])))
-    tail = und.lam[-20:, row] - np.mean(und.lam[-20:, row])
+    # the growth is a sawtooth: the largest acceleration alternates in sign step by step
+    row = int(np.argmax(np.abs(und.qdd[-1])))
+    tail = und.qdd[-8:, row]
     assert np.all(tail[1:] * tail[:-1] < 0.0)
+    # the multipliers of the states stay of their physical size (measured 253 N of 190 N,
+    # 19 N of 15 N): the reactions of a wrong state, not the sawtooth
+    assert window(und, und.lam, t_end_und - 1, t_end_und) < 2 * np.abs(damped.lam).max()
     # the damped run is stable: energy within 0.2 % and no growth
     assert energy_error(damped).max() < 2e-3 * np.abs(damped.energy).max() + 1e-3
     assert window(damped, damped.lam, t_end - 2, t_end) < 1.1 * window(damped, damped.lam,
+                                                                       0, t_end - 2)
+    assert window(damped, damped.qdd, t_end - 2, t_end) < 1.1 * window(damped, damped.qdd,
                                                                        0, t_end - 2)
 
 
 def test_generalized_alpha_without_damping_small_step_grows_without_an_error() -> None:
     """At h = 1e-3 the rho_inf = 1 run of the free four-bar reaches 10 s without an error,
-    but the multipliers end near 1e6 N (physical: below 200 N) and J q_dot - nu near 0.1."""
+    but the scheme's accelerations end near 2e5 rad/s^2 (physical: below 30) and J q_dot - nu
+    near 0.02."""
     m = free_fourbar()
     und = m.dynamics(10.0, 1000, method="generalized-alpha", h=1e-3, rho_inf=1.0)
-    assert window(und, und.lam, 0, 4) < 200.0                     # measured 190 N
-    assert window(und, und.lam, 9, 10) > 1e5                      # measured 9.6e5 N
-    assert window(und, und.drift_velocity, 9, 10) > 1e-2          # measured 8.5e-2
-    assert energy_error(und)[-1] > 0.1                            # measured 1.33 J
+    assert window(und, und.qdd, 0, 4) < 30.0                      # measured 29.3
+    assert window(und, und.qdd, 9, 10) > 1e5                      # measured 1.8e5
+    assert window(und, und.drift_velocity, 9, 10) > 1e-2          # measured 2.3e-2
+    assert energy_error(und)[-1] > 0.1                            # measured 0.33 J
     assert und.drift_position.max() < 1e-10
 
 

@@ -3,7 +3,8 @@
     mbd2d kinematics MODEL.toml --t-end T --steps N --out OUT.csv|OUT.npz [--every K --solver S]
     mbd2d export MODEL.toml OUT.mbd --t-end T --steps N
     mbd2d check MODEL.toml
-    mbd2d dynamics MODEL.toml --t-end T --steps N --out OUT.csv [--method M --rtol R --atol A --h H]
+    mbd2d dynamics MODEL.toml --t-end T --steps N --out OUT.csv [--method M --rtol R --atol A --h H
+                   --max-steps S]
     mbd2d statics MODEL.toml [--t T]
 
 Exit codes: 0 ok, 2 bad input, 3 singular configuration (partial output written),
@@ -16,7 +17,8 @@ import sys
 import textwrap
 from typing import Sequence
 
-from .errors import AnalysisError, MbdError, ModelError, SingularConfigurationError
+from .errors import (AnalysisError, InsufficientMemoryError, MbdError, ModelError,
+                     SingularConfigurationError)
 from .model import Model, load
 from .results import StaticsResult
 
@@ -52,6 +54,8 @@ def _parser() -> argparse.ArgumentParser:
     d.add_argument("--alpha", type=float, default=None, help="Baumgarte alpha")
     d.add_argument("--beta", type=float, default=None, help="Baumgarte beta")
     d.add_argument("--every", type=int, default=1, help="write every k-th row (and the last)")
+    d.add_argument("--max-steps", type=int, default=None, help="limit on the integrator's "
+                   "steps, accepted and rejected (default 10000000)")
     s = sub.add_parser("statics", help="static equilibrium and reactions")
     s.add_argument("model", help="model file (.toml) with masses")
     s.add_argument("--t", type=float, default=0.0, help="time at which loads and drivers are "
@@ -111,7 +115,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             res = model.dynamics(t_end=args.t_end, steps=args.steps, t0=args.t0,
                                  method=args.method, rtol=args.rtol, atol=args.atol, h=args.h,
                                  rho_inf=args.rho_inf, alpha=args.alpha, beta=args.beta,
-                                 every=args.every)
+                                 every=args.every, max_steps=args.max_steps)
         else:
             res = model.kinematics(t_end=args.t_end, steps=args.steps, t0=args.t0, tol=args.tol,
                                    every=args.every, solver=args.solver)
@@ -120,6 +124,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         return EXIT_OK
     except ModelError as exc:
         _say(f"mbd2d: error in the model or the command: {exc}")
+        return EXIT_INPUT
+    except InsufficientMemoryError as exc:      # too large for this machine: change the input
+        _say(f"mbd2d: {exc}")
         return EXIT_INPUT
     except AnalysisError as exc:
         if args.command in ("check", "statics"):

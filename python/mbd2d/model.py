@@ -161,7 +161,7 @@ class Model(ModelDescription):
                  rtol: float | None = None, atol: float | None = None, h: float | None = None,
                  rho_inf: float | None = None, alpha: float | None = None,
                  beta: float | None = None, t0: float = 0.0,
-                 every: int = 1) -> DynamicsResult:
+                 every: int = 1, max_steps: int | None = None) -> DynamicsResult:
         """Forward dynamics of M q_ddot + J^T lambda = Q, Phi = 0 from the assembled q0 and
         v0 (projected onto J q_dot = nu), outputs at steps + 1 uniform times (every
         every-th of them kept).
@@ -192,6 +192,11 @@ class Model(ModelDescription):
             k % every == 0, and always the last (k = steps), are stored and returned, so
             memory grows as steps / every. The integration (its time grid and, for fixed
             steps, h) is the same as with every = 1, and so are the rows kept.
+        max_steps : int, optional
+            Limit on the integrator's steps, accepted and rejected (default 10_000_000). It
+            ends a run whose steps collapse; a long run at a tight tolerance (or a fixed h
+            that needs more steps) raises it. When it is reached the run stops with an
+            IntegrationError that says so, the results up to then kept.
 
         Returns
         -------
@@ -200,10 +205,11 @@ class Model(ModelDescription):
         Raises
         ------
         ModelError
-            If a body has no mass or inertia, or a setting is invalid (every not a whole
-            number >= 1).
+            If a body has no mass or inertia, or a setting is invalid (every or max_steps not
+            a whole number >= 1).
         IntegrationError
-            When the method fails (blow-up, step-size underflow); carries the partial results.
+            When the method fails (blow-up, step-size underflow, the step limit max_steps);
+            carries the partial results.
 
         Examples
         --------
@@ -214,7 +220,7 @@ class Model(ModelDescription):
         """
         return run_dynamics(self, t_end=t_end, steps=steps, method=method, rtol=rtol,
                             atol=atol, h=h, rho_inf=rho_inf, alpha=alpha, beta=beta, t0=t0,
-                            every=every)
+                            every=every, max_steps=max_steps)
 
     def statics(self, t: float = 0.0) -> StaticsResult:
         """Static equilibrium under gravity, springs and loads (drivers held at t), with the

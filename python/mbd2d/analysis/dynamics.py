@@ -12,23 +12,28 @@ from ..binding.status import ASSEMBLY_FAILED, INCONSISTENT, INTEGRATOR_FAILED, O
 from ..description.builder import ModelDescription
 from ..errors import ModelError, RedundantConstraintWarning
 from ..results.dynamics import DynamicsResult
-from ..validate import number
+from ..validate import number, whole
 from .failures import assembly_failed, bad_entry, inconsistent_at, row_names
 from .outputs import dynamics_result, finite_part
 from .settings import check_memory, check_span, output_rows, output_steps, time_grid
 
 METHODS = {"generalized-alpha": 1, "dopri5": 2, "baumgarte-rk4": 3, "partitioned": 4}
 DEFAULT_METHOD = "dopri5"
+MAX_STEPS_DEFAULT = 10_000_000     # the core's default limit on accepted + rejected steps
+INT32_MAX = 2**31 - 1
 
 
 def run_dynamics(model: ModelDescription, t_end: float, steps: int, method: str | None = None,
                  rtol: float | None = None, atol: float | None = None, h: float | None = None,
                  rho_inf: float | None = None, alpha: float | None = None,
-                 beta: float | None = None, t0: float = 0.0, every: Any = 1) -> DynamicsResult:
+                 beta: float | None = None, t0: float = 0.0, every: Any = 1,
+                 max_steps: Any = None) -> DynamicsResult:
     """Forward dynamics in one core call; see :meth:`mbd2d.Model.dynamics`."""
     t0, t_end, steps = check_span(t0, t_end, steps)
     nout = output_rows(steps, every)
     every = int(every)
+    nmax = MAX_STEPS_DEFAULT if max_steps is None else \
+        whole(max_steps, "max_steps", "dynamics", 1, INT32_MAX)
     method = DEFAULT_METHOD if method is None else method
     if method not in METHODS:
         raise ModelError(f"unknown method {method!r}; use one of {', '.join(METHODS)}",
@@ -62,10 +67,10 @@ def run_dynamics(model: ModelDescription, t_end: float, steps: int, method: str 
     beta_v = opt(beta, "beta", 0.0, 1e9, -1.0)
     p = pack(model)
     d = pack_dynamics(model, p)
-    check_memory(nout, 3 * p.nq + p.neq + 4, "dynamics", dense=(p.nq + p.neq, p.nq + p.neq))
+    check_memory(nout, 3 * p.nq + p.neq + 4, "dynamics")
     idx = output_steps(steps, every)
     out = core.dynamics(p, d, t0, t_end, steps, METHODS[method], rtol_v, atol_v, h_v, rho_v,
-                        alpha_v, beta_v, every, nout)
+                        alpha_v, beta_v, every, nout, nmax)
     iinfo, rinfo, status = out.iinfo, out.rinfo, out.status
     n = int(iinfo[0])
     t = time_grid(t0, t_end, steps, idx)

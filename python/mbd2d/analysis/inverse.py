@@ -30,8 +30,7 @@ def run_inverse(model: ModelDescription, t_end: float, steps: int, t0: float = 0
     p = pack(model)
     require_determined(p, model)
     d = pack_dynamics(model, p)
-    check_memory(nout, 3 * p.nq + p.neq + 4, "inverse dynamics",
-                 dense=(p.nq + p.neq, p.nq + p.neq))
+    check_memory(nout, 3 * p.nq + p.neq + 4, "inverse dynamics")
     idx = output_steps(steps, every)
     out = core.inverse(p, d, t0, t_end, steps, tol_v, int(every), code, nout)
     iinfo, status = out.iinfo, out.status

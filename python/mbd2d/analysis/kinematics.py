@@ -28,8 +28,7 @@ def run_kinematics(model: ModelDescription, t_end: float, steps: int, t0: float 
     code = solver_code(solver)
     p = pack(model)
     require_determined(p, model)
-    check_memory(nout, 3 * p.nq, "kinematics",
-                 dense=(p.neq, p.nq) if solver == "dense" else None)
+    check_memory(nout, 3 * p.nq, "kinematics")
     idx = output_steps(steps, every)
     out = core.kinematics(p, t0, t_end, steps, tol_v, maxit_v, float(tmin or 0.0), int(every),
                           code, nout)

@@ -11,7 +11,6 @@ from ..description.builder import ModelDescription
 from ..results.statics import StaticsResult
 from ..validate import number
 from .failures import assembly_failed, bad_entry, inconsistent_at
-from .settings import check_memory
 
 STABILITY = {1: "stable", 0: "unstable", -1: "neutral", 2: "fully constrained"}
 
@@ -21,7 +20,6 @@ def run_statics(model: ModelDescription, t: float = 0.0) -> StaticsResult:
     t = number(t, "t", "statics")
     p = pack(model)
     d = pack_dynamics(model, p)
-    check_memory(0, 0, "statics", dense=(p.nq + p.neq, p.nq + p.neq))
     out = core.statics(p, d, t)
     status, text = out.status, out.msg
     if status < 0:

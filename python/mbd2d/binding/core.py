@@ -19,18 +19,21 @@ from .status import MEMORY_ADVICE
 from .tables import DynamicTables, Packed, decode
 
 
-def _named(names: str, fn: Callable[..., tuple[Any, ...]], *args: Any,
+def _named(names: str, fn: Callable[..., tuple[Any, ...]], *args: Any, numbers: float = 0,
            **kwargs: Any) -> SimpleNamespace:
-    """Call the core and name its output tuple; ``msg`` decoded to text. The output arrays
-    f2py allocates for the call failing to fit in memory is an InsufficientMemoryError."""
+    """Call the core and name its output tuple; ``msg`` decoded to text. The arrays f2py
+    allocates for the call (its outputs, about ``numbers`` float64 values) failing to fit in
+    memory is an InsufficientMemoryError naming their size."""
     try:
         out = fn(*args, **kwargs)
     except InsufficientMemoryError:
         raise
     except MemoryError:
         what = getattr(fn, "__name__", "the core")
-        raise InsufficientMemoryError(f"the core's arrays for {what} could not be allocated; "
-                                      f"{MEMORY_ADVICE}") from None
+        nbytes = 8.0 * numbers
+        raise InsufficientMemoryError(f"allocating the core's arrays for {what} (about "
+                                      f"{nbytes / 2**20:.1f} MiB) failed; {MEMORY_ADVICE}",
+                                      nbytes) from None
     fields = dict(zip(names.split(), out, strict=True))
     if "msg" in fields:
         fields["msg"] = decode(fields["msg"])
@@ -40,7 +43,8 @@ def _named(names: str, fn: Callable[..., tuple[Any, ...]], *args: Any,
 
 def sizes(nb: int, ctab: np.ndarray, rpar: np.ndarray) -> SimpleNamespace:
     """Check the tables; ``nq``, ``neq``, ``status``, ``msg``, ``bad`` (1-based constraint)."""
-    return _named("nq neq status msg bad", _core.core_sizes, nb, ctab, rpar)
+    return _named("nq neq status msg bad", _core.core_sizes, nb, ctab, rpar,
+                  numbers=np.size(rpar) + np.size(ctab) / 2)   # the inputs, if copied
 
 
 def evaluate(nb: int, ctab: np.ndarray, rpar: np.ndarray, neq: int, q: np.ndarray,
@@ -48,7 +52,7 @@ def evaluate(nb: int, ctab: np.ndarray, rpar: np.ndarray, neq: int, q: np.ndarra
     """Phi, J, nu and gamma at a state: ``phi``, ``jac``, ``nu``, ``gam``, ``status``, ``msg``,
     ``bad``."""
     return _named("phi jac nu gam status msg bad", _core.core_eval, nb, ctab, rpar, neq, q, qd,
-                  float(t))
+                  float(t), numbers=neq * (len(q) + 3))
 
 
 def kinematics(p: Packed, t0: float, t1: float, steps: int, tol: float, maxit: int,
@@ -57,7 +61,7 @@ def kinematics(p: Packed, t0: float, t1: float, steps: int, tol: float, maxit: i
     ``qsing``, ``dep``, ``red``, ``tpass``, ``status``, ``msg``."""
     return _named("q qd qdd iinfo rinfo qsing dep red tpass status msg", _core.core_kinematics,
                   p.nb, p.ctab, p.rpar, p.neq, p.q0, t0, t1, steps, tol, maxit, tmin, every,
-                  solver, nout)
+                  solver, nout, numbers=3 * p.nq * nout + p.nq + 2 * p.neq)
 
 
 def kin_step(p: Packed, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, t_prev: float,
@@ -72,12 +76,13 @@ def analyze(p: Packed, t: float, tol: float) -> SimpleNamespace:
     """Rank and redundancy at the assembled configuration: ``q``, ``rank``, ``mobility``,
     ``red``, ``dep``, ``resid``, ``worst``, ``status``, ``msg``."""
     return _named("q rank mobility red dep resid worst status msg", _core.core_analyze, p.nb,
-                  p.ctab, p.rpar, p.neq, p.q0, t, tol)
+                  p.ctab, p.rpar, p.neq, p.q0, t, tol, numbers=p.nq + 2 * p.neq)
 
 
 def profile(kind: int, raw: np.ndarray, alphas: np.ndarray) -> SimpleNamespace:
     """Points c(alpha) of a closed profile curve: ``pts`` (2, n), ``status``, ``msg``."""
-    return _named("pts status msg", _core.core_profile, kind, raw, alphas)
+    return _named("pts status msg", _core.core_profile, kind, raw, alphas,
+                  numbers=2 * len(alphas))
 
 
 def inverse(p: Packed, d: DynamicTables, t0: float, t1: float, steps: int, tol: float,
@@ -87,19 +92,21 @@ def inverse(p: Packed, d: DynamicTables, t0: float, t1: float, steps: int, tol: 
     return _named("q qd qdd lam e iinfo rinfo qsing dep red tpass status msg",
                   _core.core_inverse, ctab=p.ctab, rpar=p.rpar, bmass=d.bmass, grav=d.grav,
                   ftab=d.ftab, fpar=d.fpar, neq=p.neq, q0=p.q0, t0=t0, t1=t1, nsteps=steps,
-                  tol=tol, every=every, solver=solver, nout=nout)
+                  tol=tol, every=every, solver=solver, nout=nout,
+                  numbers=(3 * p.nq + p.neq + 4) * nout + p.nq + 2 * p.neq)
 
 
 def dynamics(p: Packed, d: DynamicTables, t0: float, t1: float, steps: int, method: int,
              rtol: float, atol: float, h: float, rho_inf: float, alpha: float, beta: float,
-             every: int, nrow: int) -> SimpleNamespace:
+             every: int, nrow: int, max_steps: int) -> SimpleNamespace:
     """Forward dynamics: ``q``, ``qd``, ``qdd``, ``lam``, ``e``, ``iinfo``, ``rinfo``, ``red``,
-    ``status``, ``msg``."""
+    ``status``, ``msg``. max_steps: the limit on accepted plus rejected steps."""
     return _named("q qd qdd lam e iinfo rinfo red status msg", _core.core_dynamics,
                   ctab=p.ctab, rpar=p.rpar, bmass=d.bmass, grav=d.grav, ftab=d.ftab,
                   fpar=d.fpar, neq=p.neq, q0=p.q0, v0=d.v0, t0=t0, t1=t1, nsteps=steps,
                   method=method, rtol=rtol, atol=atol, h=h, rho_inf=rho_inf, balpha=alpha,
-                  bbeta=beta, every=every, nrow=nrow)
+                  bbeta=beta, every=every, nrow=nrow, max_steps=max_steps,
+                  numbers=(3 * p.nq + p.neq + 4) * nrow + p.neq)
 
 
 def statics(p: Packed, d: DynamicTables, t: float) -> SimpleNamespace:
@@ -107,20 +114,21 @@ def statics(p: Packed, d: DynamicTables, t: float) -> SimpleNamespace:
     ``msg``."""
     return _named("q lam stable resid iinfo status msg", _core.core_statics, ctab=p.ctab,
                   rpar=p.rpar, bmass=d.bmass, grav=d.grav, ftab=d.ftab, fpar=d.fpar,
-                  neq=p.neq, q0=p.q0, t=t)
+                  neq=p.neq, q0=p.q0, t=t, numbers=p.nq + p.neq)
 
 
 def reactions(p: Packed, q: np.ndarray, t: np.ndarray, lam: np.ndarray) -> SimpleNamespace:
     """Joint reactions at states q (nq, nt), times t (nt) and multipliers lam (neq, nt):
     ``reac`` and ``rloc`` (6, nc, nt), ``status``, ``msg``."""
     return _named("reac rloc status msg", _core.core_reactions, p.nb, p.ctab, p.rpar, q, t,
-                  lam)
+                  lam, numbers=12 * p.ctab.shape[1] * len(np.atleast_1d(t)))
 
 
 def conditioning(p: Packed, q: np.ndarray, t: np.ndarray) -> SimpleNamespace:
     """sigma_min / sigma_max of the column-scaled J (the core's units) at states q (nq, nt)
     and times t (nt): ``cond`` (nt), ``status``, ``msg``."""
-    return _named("cond status msg", _core.core_conditioning, p.nb, p.ctab, p.rpar, q, t)
+    return _named("cond status msg", _core.core_conditioning, p.nb, p.ctab, p.rpar, q, t,
+                  numbers=np.size(t))
 
 
 def influence(p: Packed, q: np.ndarray, t: np.ndarray, row: int) -> SimpleNamespace:
@@ -128,4 +136,4 @@ def influence(p: Packed, q: np.ndarray, t: np.ndarray, row: int) -> SimpleNamesp
     q (nq, nt) and times t (nt): ``u`` (nq, nt), ``ok`` (nt; 0 where J is singular),
     ``status``, ``msg``."""
     return _named("u ok status msg", _core.core_influence, p.nb, p.ctab, p.rpar, q, t,
-                  int(row))
+                  int(row), numbers=np.size(q) + np.size(t))
