@@ -208,3 +208,16 @@ subroutine core_influence(nb, nc, ctab, np, rpar, nq, nt, q, t, row, u, ok, stat
   !f2py intent(hide) :: nc, np, nq, nt
   call api_influence(nb, ctab, rpar, q, t, row, u, ok, status, msg)
 end subroutine core_influence
+
+subroutine core_fun_values(np, p, nt, t, f, f1, f2, status, msg)
+  use iso_c_binding, only: c_double, c_int
+  use mbd_measures, only: api_fun_values
+  implicit none
+  integer(c_int), intent(in) :: np, nt
+  real(c_double), intent(in) :: p(np), t(nt)
+  real(c_double), intent(out) :: f(nt), f1(nt), f2(nt)
+  integer(c_int), intent(out) :: status
+  character(len=512), intent(out) :: msg
+  !f2py intent(hide) :: np, nt
+  call api_fun_values(p, t, f, f1, f2, status, msg)
+end subroutine core_fun_values

@@ -12,6 +12,8 @@
 !!                 mechanical advantage between two quantities X and Y moved by that driver is
 !!                 u_X / u_Y. Square J: LU; more rows than coordinates (redundant, consistent
 !!                 constraints): least squares by pivoted QR, exact while they agree.
+!!   fun_values    f(t), f'(t), f''(t) of an encoded function of time at many times (the
+!!                 applied loads drawn as arrows).
 !!
 !! Work arrays are allocated once per call (with stat=), none in the loop over states.
 module mbd_measures
@@ -22,10 +24,11 @@ module mbd_measures
   use mbd_memory, only: mem_fail, REAL_BYTES
   use mbd_linsolve, only: lapack_status, lu_factor, lu_solve, qr_factor, qr_solve, qr_lwork
   use mbd_lapack, only: dgesvd
+  use mbd_functions, only: fun_check, fun_eval, fun_length
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   implicit none
   private
-  public :: api_conditioning, api_influence
+  public :: api_conditioning, api_influence, api_fun_values
 
 contains
 
@@ -140,6 +143,30 @@ contains
       end if
     end do
   end subroutine api_influence
+
+  !> f(t), f'(t), f''(t) of the encoded function p at the times t.
+  subroutine api_fun_values(p, t, f, f1, f2, status, msg)
+    real(wp), intent(in) :: p(:)                !! encoded function (mbd_functions)
+    real(wp), intent(in) :: t(:)                !! times
+    real(wp), intent(out) :: f(:), f1(:), f2(:) !! values and two derivatives (size(t))
+    integer, intent(out) :: status              !! MBD_OK or < 0
+    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    integer :: k
+    f = zero; f1 = zero; f2 = zero
+    status = MBD_OK; msg = ''
+    if (size(f) /= size(t) .or. size(f1) /= size(t) .or. size(f2) /= size(t) .or. &
+        fun_length(p) /= size(p)) then
+      status = MBD_BAD_COUNT; msg = 'array sizes do not match the function'; return
+    end if
+    call fun_check(p, status, msg)
+    if (status /= MBD_OK) return
+    if (.not. all(ieee_is_finite(t))) then
+      status = MBD_BAD_PARAM; msg = 'the times must be finite'; return
+    end if
+    do k = 1, size(t)
+      call fun_eval(p, t(k), f(k), f1(k), f2(k))
+    end do
+  end subroutine api_fun_values
 
   !> States and times finite and sized for the model.
   logical function check_states(m, q, t, nt, status, msg) result(good)

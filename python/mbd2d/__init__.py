@@ -18,6 +18,7 @@ from .errors import (AnalysisError, AssemblyError, ConvergenceError, CoreError,
                      SingularConfigurationError, SingularJacobianError, SingularPassageWarning,
                      ToggleError)
 from .model import Model, load, loads
+from .plots import animate, plot_mechanism, plot_paths, plot_timeseries
 from .results import (BodyResult, DofReport, DynamicsResult, KinematicsResult, PointResult,
                       Reaction, StaticsResult)
 
@@ -29,4 +30,5 @@ __all__ = ["load", "loads", "Model", "TimeFunction", "Harmonic", "KinematicsResu
            "AssemblyError", "InconsistentConstraintsError", "ConvergenceError",
            "SingularJacobianError", "SingularConfigurationError", "ToggleError", "CoreError",
            "InsufficientMemoryError", "MbdWarning", "RedundantConstraintWarning",
-           "SingularPassageWarning", "__version__"]
+           "SingularPassageWarning", "plot_mechanism", "plot_paths", "plot_timeseries",
+           "animate", "__version__"]

@@ -1,11 +1,18 @@
 """The ``mbd2d`` command line.
 
     mbd2d kinematics MODEL.toml --t-end T --steps N --out OUT.csv|OUT.npz [--every K --solver S]
-    mbd2d export MODEL.toml OUT.mbd --t-end T --steps N
-    mbd2d check MODEL.toml
     mbd2d dynamics MODEL.toml --t-end T --steps N --out OUT.csv [--method M --rtol R --atol A --h H
                    --max-steps S]
     mbd2d statics MODEL.toml [--t T]
+    mbd2d check MODEL.toml
+    mbd2d export MODEL.toml OUT.mbd --t-end T --steps N
+    mbd2d plot MODEL.toml --t-end T --steps N --out FIG.png
+               [--what mechanism|paths|time-series|forces|energy] [--analysis A] [--trace B:X,Y]
+    mbd2d animate MODEL.toml --t-end T --steps N --out MOTION.gif|MOTION.mp4 [--fps F --speed S]
+
+``plot`` and ``animate`` run the analysis ``--analysis`` (default ``auto``: kinematics of a
+driven model, with the inverse dynamics when every body has a mass; dynamics otherwise) and
+draw it; a run that stops at a dead centre is drawn up to there (exit code 3).
 
 Exit codes: 0 ok, 2 bad input, 3 singular configuration (partial output written),
 4 other numerical failure (partial output written when there is any).
@@ -15,47 +22,68 @@ from __future__ import annotations
 import argparse
 import sys
 import textwrap
-from typing import Sequence
+from typing import Any, Sequence
 
+from . import plots
 from .errors import (AnalysisError, InsufficientMemoryError, MbdError, ModelError,
                      SingularConfigurationError)
 from .model import Model, load
 from .results import StaticsResult
 
 EXIT_OK, EXIT_INPUT, EXIT_SINGULAR, EXIT_NUMERICAL = 0, 2, 3, 4
+ANALYSES = ("auto", "kinematics", "inverse-dynamics", "dynamics")
+PICTURES = ("mechanism", "paths", "time-series", "forces", "energy")
+
+
+def _span(p: argparse.ArgumentParser) -> None:
+    p.add_argument("model", help="model file (.toml)")
+    p.add_argument("--t-end", type=float, required=True, help="final time")
+    p.add_argument("--steps", type=int, required=True, help="output intervals (rows = steps + 1)")
+    p.add_argument("--t0", type=float, default=0.0, help="start time (default 0)")
+
+
+def _dynamics_settings(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--method", default=None,
+                   help="dopri5 (default), generalized-alpha, baumgarte-rk4 or partitioned")
+    p.add_argument("--rtol", type=float, default=None, help="relative tolerance (adaptive)")
+    p.add_argument("--atol", type=float, default=None, help="absolute tolerance (adaptive)")
+    p.add_argument("--h", type=float, default=None, help="fixed step (generalized-alpha, "
+                   "baumgarte-rk4)")
+    p.add_argument("--rho-inf", type=float, default=None, help="generalized-alpha rho_inf")
+    p.add_argument("--alpha", type=float, default=None, help="Baumgarte alpha")
+    p.add_argument("--beta", type=float, default=None, help="Baumgarte beta")
+    p.add_argument("--max-steps", type=int, default=None, help="limit on the integrator's "
+                   "steps, accepted and rejected (default 10000000)")
+
+
+def _picture_settings(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--analysis", default="auto", choices=ANALYSES,
+                   help="auto (default): kinematics of a driven model (with the inverse "
+                   "dynamics when it has masses), else dynamics")
+    p.add_argument("--trace", action="append", default=None, metavar="BODY:X,Y",
+                   help="draw the path of the point (X, Y) of BODY (repeatable)")
+    p.add_argument("--forces", action="store_true",
+                   help="draw the joints' reaction forces as arrows (needs masses)")
+    p.add_argument("--length-unit", default="m", help="unit of length on the axes (default m)")
+    p.add_argument("--dpi", type=int, default=None, help="dots per inch")
+    _dynamics_settings(p)
 
 
 def _parser() -> argparse.ArgumentParser:
     ap = argparse.ArgumentParser(prog="mbd2d", description="Planar multibody analysis.")
     sub = ap.add_subparsers(dest="command", required=True)
     k = sub.add_parser("kinematics", help="kinematic analysis of a driven model")
-    k.add_argument("model", help="model file (.toml)")
-    k.add_argument("--t-end", type=float, required=True, help="final time")
-    k.add_argument("--steps", type=int, required=True, help="output intervals (rows = steps + 1)")
-    k.add_argument("--t0", type=float, default=0.0, help="start time (default 0)")
+    _span(k)
     k.add_argument("--out", required=True, help="output file, .csv or .npz")
     k.add_argument("--tol", type=float, default=None, help="Newton tolerance (default 1e-12)")
     k.add_argument("--every", type=int, default=1, help="write every k-th row (and the last)")
     k.add_argument("--solver", default="auto", choices=["auto", "dense", "banded"],
                    help="linear solver (default auto: banded LU for large chains)")
     d = sub.add_parser("dynamics", help="forward dynamics")
-    d.add_argument("model", help="model file (.toml) with masses")
-    d.add_argument("--t-end", type=float, required=True, help="final time")
-    d.add_argument("--steps", type=int, required=True, help="output intervals (rows = steps + 1)")
-    d.add_argument("--t0", type=float, default=0.0, help="start time (default 0)")
+    _span(d)
     d.add_argument("--out", required=True, help="output file, .csv or .npz")
-    d.add_argument("--method", default=None,
-                   help="dopri5 (default), generalized-alpha, baumgarte-rk4 or partitioned")
-    d.add_argument("--rtol", type=float, default=None, help="relative tolerance (adaptive)")
-    d.add_argument("--atol", type=float, default=None, help="absolute tolerance (adaptive)")
-    d.add_argument("--h", type=float, default=None, help="fixed step (generalized-alpha, "
-                   "baumgarte-rk4)")
-    d.add_argument("--rho-inf", type=float, default=None, help="generalized-alpha rho_inf")
-    d.add_argument("--alpha", type=float, default=None, help="Baumgarte alpha")
-    d.add_argument("--beta", type=float, default=None, help="Baumgarte beta")
+    _dynamics_settings(d)
     d.add_argument("--every", type=int, default=1, help="write every k-th row (and the last)")
-    d.add_argument("--max-steps", type=int, default=None, help="limit on the integrator's "
-                   "steps, accepted and rejected (default 10000000)")
     s = sub.add_parser("statics", help="static equilibrium and reactions")
     s.add_argument("model", help="model file (.toml) with masses")
     s.add_argument("--t", type=float, default=0.0, help="time at which loads and drivers are "
@@ -70,6 +98,22 @@ def _parser() -> argparse.ArgumentParser:
     e.add_argument("--steps", type=int, required=True, help="output intervals")
     e.add_argument("--t0", type=float, default=0.0, help="start time (default 0)")
     e.add_argument("--tol", type=float, default=None, help="Newton tolerance (default 1e-12)")
+    p = sub.add_parser("plot", help="run an analysis and draw it (PNG, SVG or PDF)")
+    _span(p)
+    p.add_argument("--out", required=True, help="picture file (.png, .svg or .pdf)")
+    p.add_argument("--what", default="mechanism", choices=PICTURES,
+                   help="mechanism (default): snapshots; paths: point paths; time-series: "
+                   "positions, velocities, accelerations; forces: driver efforts and joint "
+                   "reactions; energy: energies and constraint drift")
+    _picture_settings(p)
+    a = sub.add_parser("animate", help="run an analysis and animate it (GIF or MP4)")
+    _span(a)
+    a.add_argument("--out", required=True, help="animation file (.gif, or .mp4 with ffmpeg)")
+    a.add_argument("--fps", type=float, default=30.0, help="frames per second (default 30)")
+    a.add_argument("--speed", type=float, default=1.0,
+                   help="seconds of the run per second of animation (default 1: real time)")
+    a.add_argument("--max-frames", type=int, default=300, help="at most this many frames")
+    _picture_settings(a)
     return ap
 
 
@@ -94,6 +138,84 @@ def _statics_report(model: Model, st: StaticsResult) -> str:
     return "\n".join(lines)
 
 
+def _trace(items: list[str] | None) -> list[tuple[str, tuple[float, float]]] | None:
+    """--trace BODY:X,Y entries."""
+    if not items:
+        return None
+    out = []
+    for item in items:
+        body, sep, xy = item.rpartition(":")
+        try:
+            x, y = (float(v) for v in xy.split(","))
+        except ValueError:
+            sep = ""
+        if not sep or not body:
+            raise ModelError(f"--trace takes BODY:X,Y (for example coupler:0,1), got {item!r}",
+                             "command line")
+        out.append((body, (x, y)))
+    return out
+
+
+def _dynamics_kwargs(args: argparse.Namespace) -> dict[str, Any]:
+    return {"method": args.method, "rtol": args.rtol, "atol": args.atol, "h": args.h,
+            "rho_inf": args.rho_inf, "alpha": args.alpha, "beta": args.beta,
+            "max_steps": args.max_steps}
+
+
+def _run(model: Model, args: argparse.Namespace, analysis: str) -> Any:
+    """The result of the analysis a command asks for."""
+    span = {"t_end": args.t_end, "steps": args.steps, "t0": args.t0}
+    if analysis == "auto":
+        neq, nq = model.counts()
+        analysis = "kinematics" if neq >= nq else "dynamics"
+    if analysis == "dynamics":
+        return model.dynamics(**span, every=getattr(args, "every", 1), **_dynamics_kwargs(args))
+    if analysis == "inverse-dynamics":
+        return model.inverse_dynamics(**span)
+    return model.kinematics(**span, tol=getattr(args, "tol", None),
+                            every=getattr(args, "every", 1),
+                            solver=getattr(args, "solver", "auto"))
+
+
+def _picture(res: Any, args: argparse.Namespace) -> str:
+    """Draw a result as the plot or animate command asks; returns the file written."""
+    trace = _trace(args.trace)
+    extra = {} if args.dpi is None else {"dpi": args.dpi}
+    if args.command == "animate":
+        return plots.animate(res, args.out, fps=args.fps, speed=args.speed, trace=trace,
+                             forces=args.forces, max_frames=args.max_frames,
+                             length_unit=args.length_unit, **extra)
+    if args.what == "mechanism":
+        fig = plots.plot_mechanism(res, trace=trace, forces=args.forces,
+                                   length_unit=args.length_unit)
+    elif args.what == "paths":
+        fig = plots.plot_paths(res, trace, length_unit=args.length_unit)
+    else:
+        kind = {"time-series": "motion"}.get(args.what, args.what)
+        fig = plots.plot_timeseries(res, kind=kind, length_unit=args.length_unit)
+    return plots.save_figure(fig, args.out, **extra)
+
+
+def _check_out(args: argparse.Namespace) -> None:
+    if args.command in ("kinematics", "dynamics"):
+        ok = (".csv", ".npz")
+    elif args.command == "plot":
+        ok = (".png", ".svg", ".pdf")
+    else:
+        ok = (".gif", ".mp4")
+    if not str(args.out).lower().endswith(ok):
+        raise ModelError(f"--out must end in {' or '.join(ok)}, got {args.out!r}",
+                         "command line")
+
+
+def _write(res: Any, args: argparse.Namespace) -> str:
+    """Write a (possibly partial) result where the command puts it."""
+    if args.command in ("plot", "animate"):
+        return _picture(res, args)
+    res.save(args.out)
+    return args.out
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit code."""
     args = _parser().parse_args(argv)
@@ -109,18 +231,12 @@ def main(argv: Sequence[str] | None = None) -> int:
             model.export(args.out, t_end=args.t_end, steps=args.steps, t0=args.t0, tol=args.tol)
             print(f"wrote {args.out}")
             return EXIT_OK
-        if not str(args.out).endswith((".csv", ".npz")):
-            raise ModelError(f"--out must end in .csv or .npz, got {args.out!r}", "command line")
-        if args.command == "dynamics":
-            res = model.dynamics(t_end=args.t_end, steps=args.steps, t0=args.t0,
-                                 method=args.method, rtol=args.rtol, atol=args.atol, h=args.h,
-                                 rho_inf=args.rho_inf, alpha=args.alpha, beta=args.beta,
-                                 every=args.every, max_steps=args.max_steps)
-        else:
-            res = model.kinematics(t_end=args.t_end, steps=args.steps, t0=args.t0, tol=args.tol,
-                                   every=args.every, solver=args.solver)
-        res.save(args.out)
-        print(f"wrote {len(res.t)} rows to {args.out}")
+        _check_out(args)
+        _trace(getattr(args, "trace", None))       # a malformed --trace fails before the run
+        res = _run(model, args, getattr(args, "analysis", args.command))
+        _write(res, args)
+        what = "rows" if args.command in ("kinematics", "dynamics") else "rows, drawn,"
+        print(f"wrote {len(res.t)} {what} to {args.out}")
         return EXIT_OK
     except ModelError as exc:
         _say(f"mbd2d: error in the model or the command: {exc}")
@@ -132,10 +248,13 @@ def main(argv: Sequence[str] | None = None) -> int:
         if args.command in ("check", "statics"):
             _say(f"mbd2d: {exc}")
             return EXIT_NUMERICAL
-        if exc.results is not None and len(exc.results.t):
-            exc.results.save(args.out)
         _say(f"mbd2d: {exc}")
         if exc.results is not None and len(exc.results.t):
+            try:
+                _write(exc.results, args)
+            except MbdError as err:
+                _say(f"mbd2d: the partial results could not be written: {err}")
+                return EXIT_INPUT
             print(f"wrote {len(exc.results.t)} rows (up to t = {exc.results.t[-1]:.6g}) to "
                   f"{args.out}", file=sys.stderr)
         return EXIT_SINGULAR if isinstance(exc, SingularConfigurationError) else EXIT_NUMERICAL

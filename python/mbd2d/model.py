@@ -15,6 +15,7 @@ from typing import Any, Mapping
 
 import numpy as np
 
+from . import plots
 from .analysis.dof import analyze_dof
 from .analysis.dynamics import run_dynamics
 from .analysis.evaluate import evaluate
@@ -25,6 +26,7 @@ from .analysis.statics import run_statics
 from .binding.pack import pack
 from .description import toml_io
 from .description.builder import ModelDescription
+from .errors import MbdError
 from .results import DofReport, DynamicsResult, KinematicsResult, StaticsResult
 
 
@@ -251,6 +253,39 @@ class Model(ModelDescription):
     def gamma(self, q: Any, qd: Any, t: float = 0.0) -> np.ndarray:
         """gamma(q, q_dot, t), the right-hand side of J q_ddot = gamma, computed by the core."""
         return evaluate(self, q, qd, t)[3]
+
+    # ------------------------------------------------------------------ pictures
+    def configuration(self, t: float = 0.0) -> plots.Configuration:
+        """The model assembled at time t from its q0 estimates, as a one-row motion for the
+        pictures; the q0 estimates themselves when assembly fails (``.note`` says so)."""
+        try:
+            return plots.Configuration(self, self.analyze_dof(t=t).q, t)
+        except MbdError as exc:
+            q0 = pack(self).q0
+            return plots.Configuration(self, q0, t, note=f"q0 estimates (assembly failed: "
+                                       f"{type(exc).__name__})")
+
+    def plot(self, t: float = 0.0, **kwargs: Any) -> Any:
+        """The model assembled at time t: :func:`mbd2d.plot_mechanism` (returns the Axes).
+
+        Examples
+        --------
+        >>> import mbd2d
+        >>> ax = mbd2d.load("examples/slider_crank.toml").plot()
+        """
+        conf = self.configuration(t)
+        kwargs.setdefault("title", f"{self.name}" + (f": {conf.note}" if conf.note else
+                                                     f" at t = {t:g} s"))
+        return plots.plot_mechanism(conf, **kwargs)
+
+    def _repr_png_(self) -> bytes | None:
+        """The assembled model's picture, for Jupyter (None when it cannot be drawn)."""
+        try:
+            conf = self.configuration()
+            title = f"{self.name}" + (f": {conf.note}" if conf.note else "")
+            return plots.png_bytes(conf, title=title)
+        except (ImportError, MbdError, ValueError):
+            return None
 
     # ------------------------------------------------------------------ files
     def export(self, path: str, t_end: float, steps: int, t0: float = 0.0,

@@ -111,6 +111,7 @@ def kinematic_failure(analysis: str, model: ModelDescription, p: Packed, status:
                  f"{', '.join(dep_names)} became dependent"
                  if driver else f"the constraints {', '.join(dep_names)} became dependent")
         if status == SINGULAR_CONFIG:
+            res.stats["dead_centre"] = t     # marked on the time axes of the pictures
             text = (f"Singular configuration (dead centre) at t = {t:.10f} s: {where} "
                     f"(J lost rank; sigma_min/sigma_max = {ratio:.1e}). The mechanism cannot "
                     "move further as driven: end the run before this time, or change the "

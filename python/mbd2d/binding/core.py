@@ -137,3 +137,9 @@ def influence(p: Packed, q: np.ndarray, t: np.ndarray, row: int) -> SimpleNamesp
     ``status``, ``msg``."""
     return _named("u ok status msg", _core.core_influence, p.nb, p.ctab, p.rpar, q, t,
                   int(row), numbers=np.size(q) + np.size(t))
+
+
+def fun_values(p: np.ndarray, t: np.ndarray) -> SimpleNamespace:
+    """f(t), f'(t), f''(t) of an encoded function of time (``TimeFunction.encode()``) at the
+    times t: ``f``, ``f1``, ``f2``, ``status``, ``msg``."""
+    return _named("f f1 f2 status msg", _core.core_fun_values, p, t, numbers=3 * np.size(t))

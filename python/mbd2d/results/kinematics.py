@@ -8,10 +8,21 @@ from typing import Any
 
 import numpy as np
 
+from .. import plots
+from ..errors import MbdError
 from ..validate import vector
 from . import measures
 from .files import writing
 from .points import PointResult
+
+def repr_png(obj: Any) -> bytes | None:
+    """PNG of a result's mechanism picture for notebooks; None (plain text shown instead)
+    when matplotlib is missing or the picture cannot be drawn."""
+    try:
+        return plots.png_bytes(obj)
+    except (ImportError, MbdError, ValueError):
+        return None
+
 
 SUFFIXES = ("x", "y", "theta", "x_dot", "y_dot", "theta_dot", "x_ddot", "y_ddot", "theta_ddot")
 
@@ -220,6 +231,41 @@ class KinematicsResult:
             Values in [0, 1] at every output time.
         """
         return measures.dead_centre_distance(self)
+
+    # ------------------------------------------------------------------ pictures
+    def plot(self, times: Any = None, trace: Any = None, forces: bool = False,
+             **kwargs: Any) -> Any:
+        """The mechanism at a few times with traced paths: :func:`mbd2d.plot_mechanism`
+        (returns the matplotlib Axes)."""
+        return plots.plot_mechanism(self, times=times, trace=trace, forces=forces, **kwargs)
+
+    def plot_paths(self, points: Any = None, **kwargs: Any) -> Any:
+        """Paths of body points over the run: :func:`mbd2d.plot_paths` (returns the
+        Axes)."""
+        return plots.plot_paths(self, points, **kwargs)
+
+    def plot_timeseries(self, bodies: Any = None, kind: str = "motion", **kwargs: Any) -> Any:
+        """Quantities against time: :func:`mbd2d.plot_timeseries` (returns the Figure)."""
+        return plots.plot_timeseries(self, bodies=bodies, kind=kind, **kwargs)
+
+    def animate(self, path: Any = None, fps: float = 30, trace: Any = None,
+                forces: bool = False, **kwargs: Any) -> Any:
+        """Animate the run: a GIF (Pillow) or MP4 (ffmpeg) at ``path``, or without a path an
+        inline HTML animation for Jupyter; see :func:`mbd2d.plots.animate` for ``speed``,
+        ``max_frames``, ``size``, ``dpi`` and the rest.
+
+        Examples
+        --------
+        >>> import mbd2d
+        >>> res = mbd2d.load("examples/fourbar_grashof.toml").kinematics(t_end=1.0, steps=60)
+        >>> res.animate("/tmp/crank_rocker.gif", fps=15, trace=[("coupler", [0.0, 1.0])])
+        '/tmp/crank_rocker.gif'
+        """
+        return plots.animate(self, path, fps=fps, trace=trace, forces=forces, **kwargs)
+
+    def _repr_png_(self) -> bytes | None:
+        """The mechanism picture, for Jupyter (None when it cannot be drawn)."""
+        return repr_png(self)
 
     def table(self) -> tuple[list[str], np.ndarray]:
         """Header and rows of the CSV: t, then NAME.x ... NAME.theta_ddot per body."""

@@ -6,6 +6,8 @@ from typing import Any
 
 import numpy as np
 
+from .. import plots
+from .kinematics import repr_png
 from .reactions import Reaction, reaction_arrays, reaction_of
 
 
@@ -36,6 +38,21 @@ class StaticsResult:
         """The reaction of a joint or driver at the equilibrium (arrays of length 1)."""
         return reaction_of(self.packed, self.model, name, lambda: reaction_arrays(
             self.packed, self.q[None, :], np.array([self.t]), self.lam[None, :]))
+
+    def configuration(self) -> Any:
+        """The equilibrium as a one-row motion for the pictures."""
+        return plots.Configuration(self.model, self.q, self.t)
+
+    def plot(self, **kwargs: Any) -> Any:
+        """The mechanism at the equilibrium: :func:`mbd2d.plot_mechanism` (returns the
+        Axes)."""
+        kwargs.setdefault("title", f"{getattr(self.model, 'name', 'model')}: equilibrium "
+                          f"({self.stability})")
+        return plots.plot_mechanism(self.configuration(), **kwargs)
+
+    def _repr_png_(self) -> bytes | None:
+        """The equilibrium's picture, for Jupyter."""
+        return repr_png(self.configuration())
 
     def multiplier(self, row: str) -> float:
         """The multiplier of a row by its label (KeyError if no row has it)."""
