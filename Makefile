@@ -6,7 +6,7 @@ PYTHON ?= python3
 PY := $(VENV)/bin/python
 export PATH := $(abspath $(VENV))/bin:$(PATH)
 
-PYDEPS := numpy meson meson-python ninja pytest hypothesis matplotlib scipy
+PYDEPS := numpy meson meson-python ninja pytest hypothesis matplotlib pillow scipy
 SOURCES := $(wildcard fortran/*.f90 fortran/app/*.f90 python/mbd2d/*.py python/mbd2d/*/*.py) meson.build pyproject.toml
 
 .PHONY: demo test bench system install clean help

@@ -5,7 +5,8 @@ Usage::
     python examples/demo.py [--out DIR]
 
 Writes ``NAME_mechanism.png`` and ``NAME_timeseries.png`` for each example to DIR (default
-``examples/output/`` next to this script). The seed four-bar is non-Grashof: driven past its
+``examples/output/`` next to this script), and animations ``fourbar_grashof.gif`` (with its
+coupler curve) and ``slider_crank.gif``. The seed four-bar is non-Grashof: driven past its
 toggle it raises :class:`mbd2d.SingularConfigurationError`, which is the expected outcome;
 its partial results are drawn with the toggle configuration marked.
 
@@ -63,11 +64,13 @@ def run_seed(path: Path, out: Path) -> tuple[str, Any, list[str]]:
             "completed", res, save_figures(res, out / path.stem))
 
 
-def run_full(path: Path, out: Path, trace: list[tuple[str, tuple[float, float]]] | None = None
-             ) -> tuple[str, Any, list[str]]:
-    """A full crank turn; expect a complete result."""
+def run_full(path: Path, out: Path, trace: list[tuple[str, tuple[float, float]]] | None = None,
+             gif: bool = False) -> tuple[str, Any, list[str]]:
+    """A full crank turn; expect a complete result (and animate it when gif)."""
     res = mbd2d.load(path).kinematics(t_end=1.0, steps=360)
     files = save_figures(res, out / path.stem, trace=trace)
+    if gif:
+        files.append(res.animate(out / f"{path.stem}.gif", fps=30, speed=0.5, trace=trace))
     return ("" if res.complete else "the run did not complete"), res, files
 
 
@@ -75,15 +78,16 @@ def main(argv: list[str] | None = None) -> int:
     """Run the examples; return the exit code."""
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--out", type=Path, default=HERE / "output",
-                    help="directory for the PNG files (default: examples/output/)")
+                    help="directory for the pictures (default: examples/output/)")
     args = ap.parse_args(argv)
     out: Path = args.out
     out.mkdir(parents=True, exist_ok=True)
 
     runs: list[tuple[str, Callable[[Path, Path], tuple[str, Any, list[str]]]]] = [
         ("fourbar_seed", run_seed),
-        ("fourbar_grashof", lambda p, o: run_full(p, o, trace=[("coupler", (0.0, 1.0))])),
-        ("slider_crank", run_full),
+        ("fourbar_grashof", lambda p, o: run_full(p, o, trace=[("coupler", (0.0, 1.0))],
+                                                  gif=True)),
+        ("slider_crank", lambda p, o: run_full(p, o, gif=True)),
         ("cam_follower", run_full),
     ]
     problems: list[str] = []
@@ -105,8 +109,10 @@ def main(argv: list[str] | None = None) -> int:
             problems.append(f"{name}: {problem}")
 
     print()
+    pngs = sum(f.endswith(".png") for f in written)
+    gifs = sum(f.endswith(".gif") for f in written)
     print(f"summary: {len(runs) - len(problems)}/{len(runs)} examples as expected, "
-          f"{len(written)} PNG files in {out}")
+          f"{pngs} PNG files and {gifs} GIF animations in {out}")
     for p in problems:
         print(f"  unexpected: {p}")
     return 1 if problems else 0

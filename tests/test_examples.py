@@ -127,5 +127,7 @@ def test_demo_script(tmp_path: Path) -> None:
         for kind in ["mechanism", "timeseries"]:
             p = out / f"{name}_{kind}.png"
             assert p.is_file() and p.stat().st_size > 0
+    gifs = sorted(p.name for p in out.glob("*.gif"))
+    assert gifs == ["fourbar_grashof.gif", "slider_crank.gif"]
     assert "Singular configuration" in proc.stdout
-    assert "summary: 4/4" in proc.stdout
+    assert "summary: 4/4" in proc.stdout and "2 GIF animations" in proc.stdout

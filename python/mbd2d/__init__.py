@@ -25,7 +25,8 @@ from .results import (BodyResult, DofReport, DynamicsResult, KinematicsResult, P
 __version__ = "0.1.0"
 
 __all__ = ["load", "loads", "Model", "TimeFunction", "Harmonic", "KinematicsResult",
-           "BodyResult", "PointResult", "DynamicsResult", "KinematicStepper", "StaticsResult", "Reaction",
+           "BodyResult", "PointResult", "DynamicsResult", "KinematicStepper", "StaticsResult",
+           "Reaction",
            "DofReport", "MbdError", "ModelError", "AnalysisError", "IntegrationError",
            "AssemblyError", "InconsistentConstraintsError", "ConvergenceError",
            "SingularJacobianError", "SingularConfigurationError", "ToggleError", "CoreError",

@@ -9,7 +9,7 @@ classes. :class:`Configuration` is a Motion of one configuration (a model before
 from __future__ import annotations
 
 from types import SimpleNamespace
-from typing import Any, Protocol, Sequence
+from typing import Any, Protocol
 
 import numpy as np
 

@@ -11,8 +11,8 @@ from ..description.joints import Cam, Translational
 from ..errors import ModelError
 from ..validate import GROUND
 from .canvas import GROUND_COLOUR, PALETTE
-from .elements import (BodyLink, CamDrawer, Element, Look, ReactionDrawer, Updater, _pin, convex_hull,
-                       drawer_for)
+from .elements import (BodyLink, CamDrawer, Element, Look, ReactionDrawer, Updater,
+                       convex_hull, drawer_for)
 from .geometry import Motion, Poses, TracePoint, check_trace
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -228,4 +228,4 @@ class Scene:
             ax.set_title(title)
 
 
-__all__ = ["Scene", "Look", "TraceDrawer", "_pin"]
+__all__ = ["Scene", "Look", "TraceDrawer"]
