@@ -30,10 +30,15 @@ module mbd_api
                             SOLVER_BANDED, kin_newton, kin_vel_acc
   use mbd_status, only: MBD_BAD_SETTING
   use mbd_profiles, only: profile_raw_length, profile_prepare, profile_eval
+  use mbd_sensitivity, only: sens_t, sens_setup, sens_eval_d, sens_trig
+  use mbd_assemble, only: scatter_dense
+  use mbd_sens_dynamics, only: sens_multipliers, sens_reactions, sens_statics, sens_dopri5, &
+                               sens_initial
   implicit none
   private
   public :: NINFO, api_sizes, api_eval, api_kinematics, api_profile, api_analyze, api_kin_step
   public :: api_inverse, api_dynamics, api_statics, api_reactions
+  public :: api_eval_d, api_reactions_dp, api_dynamics_sens
 
   integer, parameter :: NINFO = 10   !! length of the report arrays
 
@@ -100,6 +105,48 @@ contains
     end do
   end subroutine units
 
+  !> Sensitivities (rows, np[, outputs]) in model units: with p' = p L**e the core's
+  !! derivatives d(.)'/dp' become d(.)/dp = u d(.)'/dp' dp'/dp (dp'/dp = sens%pscale; u the
+  !! unit of each row, multiplied, or with divide divided); with back, the inverse.
+  subroutine sens_units(m, sens, a, u, divide, back)
+    type(model_t), intent(in) :: m              !! model (its length unit lref)
+    type(sens_t), intent(in) :: sens            !! parameters (pscale)
+    real(wp), intent(inout) :: a(:, :, :)       !! (rows, np, outputs)
+    real(wp), intent(in) :: u(:)                !! unit of each row
+    logical, intent(in) :: divide               !! divide by u
+    logical, intent(in), optional :: back       !! the inverse conversion
+    real(wp) :: f(size(a, 1), size(a, 2))
+    integer :: k, j
+    logical :: inv
+    if (.not. (m%lref > one .or. m%lref < one)) return
+    inv = .false.
+    if (present(back)) inv = back
+    do k = 1, size(a, 2)          ! one factor per row and parameter (exact: powers of 2)
+      if (divide .neqv. inv) then
+        f(:, k) = sens%pscale(k) / u
+      else
+        f(:, k) = sens%pscale(k) * u
+      end if
+      if (inv) f(:, k) = (one / sens%pscale(k)**2) * f(:, k)
+    end do
+    do j = 1, size(a, 3)
+      a(:, :, j) = a(:, :, j) * f
+    end do
+  end subroutine sens_units
+
+  !> sens_units for one output (rows, np).
+  subroutine sens_units2(m, sens, a, u, divide)
+    type(model_t), intent(in) :: m              !! model
+    type(sens_t), intent(in) :: sens            !! parameters (pscale)
+    real(wp), intent(inout) :: a(:, :)          !! (rows, np)
+    real(wp), intent(in) :: u(:)                !! unit of each row
+    logical, intent(in) :: divide               !! divide by u
+    real(wp) :: b(size(a, 1), size(a, 2), 1)
+    b(:, :, 1) = a
+    call sens_units(m, sens, b, u, divide)
+    a = b(:, :, 1)
+  end subroutine sens_units2
+
   !> The residual rep%resid in model units (that of the worst constraint's first row).
   pure real(wp) function resid_units(m, resid, worst)
     type(model_t), intent(in) :: m              !! model
@@ -146,7 +193,7 @@ contains
   !> Kinematic analysis: the whole time loop in one call.
   subroutine api_kinematics(nb, ctab, rpar, q0, t0, t1, nsteps, tol, maxit, tmin, every, &
                             solver, qout, qdout, qddout, iinfo, rinfo, qsing, dep, redundant, &
-                            tpass, status, msg)
+                            tpass, status, msg, ptab, sq, sqd, sqdd)
     integer, intent(in) :: nb                   !! moving bodies
     integer, intent(in) :: ctab(:, :)           !! constraint table
     real(wp), intent(in) :: rpar(:)             !! raw parameters
@@ -168,15 +215,33 @@ contains
     real(wp), intent(out) :: tpass(:)           !! times of singular passages (MAXPASS)
     integer, intent(out) :: status              !! MBD_OK, < 0 input, > 0 numerical
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    !> design parameters (mbd_sensitivity; (2, np)) and, with them, dq/dp, dq_dot/dp,
+    !! dq_ddot/dp at the outputs, each (nq, np, kin_out_count(nsteps, every))
+    integer, intent(in), optional :: ptab(:, :)
+    real(wp), intent(out), optional :: sq(:, :, :), sqd(:, :, :), sqdd(:, :, :)
     type(model_t) :: m
     type(kin_opts_t) :: opts
     type(kin_report_t) :: rep
+    type(sens_t) :: sens
     integer :: bad
     iinfo = 0; rinfo = zero; qsing = zero; dep = 0; redundant = 0; tpass = zero
     qout = zero; qdout = zero; qddout = zero
+    if (present(ptab)) then
+      sq = zero; sqd = zero; sqdd = zero      ! (kin_run writes them; for the early returns)
+    end if
     call model_build(nb, ctab, rpar, m, status, msg, bad, nondim=.true.)
     iinfo(2) = bad
     if (status /= MBD_OK) return
+    if (present(ptab)) then
+      if (any(shape(sq) /= [m%nq, size(ptab, 2), size(qout, 2)]) .or. &
+          any(shape(sqd) /= shape(sq)) .or. any(shape(sqdd) /= shape(sq))) then
+        status = MBD_BAD_COUNT; msg = 'sensitivity arrays do not match the model'; return
+      end if
+      call sens_setup(m, ctab, rpar, ptab, sens, status, msg, bad)
+      if (status /= MBD_OK) then
+        iinfo(2) = -2000000 - bad; return
+      end if
+    end if
     if (.not. (finite(q0) .and. finite(t0) .and. finite(t1) .and. finite(tol) .and. &
                finite(tmin))) then
       call not_finite('q0, the times and the tolerances', status, msg); return
@@ -203,7 +268,15 @@ contains
     if (tol > zero) opts%tol = tol
     if (maxit > 0) opts%maxit = maxit
     if (tmin > zero) opts%tmin = tmin
-    call kin_run(m, q0 / m%cunit, t0, t1, nsteps, opts, qout, qdout, qddout, rep, status, msg)
+    if (present(ptab)) then
+      call kin_run(m, q0 / m%cunit, t0, t1, nsteps, opts, qout, qdout, qddout, rep, status, &
+                   msg, sens, sq, sqd, sqdd)
+      call sens_units(m, sens, sq, m%cunit, .false.)
+      call sens_units(m, sens, sqd, m%cunit, .false.)
+      call sens_units(m, sens, sqdd, m%cunit, .false.)
+    else
+      call kin_run(m, q0 / m%cunit, t0, t1, nsteps, opts, qout, qdout, qddout, rep, status, msg)
+    end if
     call units(m, qout, m%cunit, .false.); call units(m, qdout, m%cunit, .false.)
     call units(m, qddout, m%cunit, .false.)
     iinfo(1) = rep%ndone; iinfo(3) = rep%driver; iinfo(4) = rep%worst
@@ -407,7 +480,7 @@ contains
   !! iinfo/rinfo as api_kinematics; iinfo(2) = -force index for a bad force.
   subroutine api_inverse(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, t0, t1, nsteps, tol, &
                          every, solver, qout, qdout, qddout, lamout, eout, iinfo, rinfo, qsing, &
-                         dep, redundant, tpass, status, msg)
+                         dep, redundant, tpass, status, msg, ptab, sq, sqd, sqdd, slam)
     integer, intent(in) :: nb, ctab(:, :), ftab(:, :), nsteps
     real(wp), intent(in) :: rpar(:), bmass(:, :), grav(2), fpar(:), q0(:), t0, t1, tol
     integer, intent(in) :: every                !! store every k-th output (and the last)
@@ -421,12 +494,20 @@ contains
     integer, intent(out) :: dep(:), redundant(:)
     integer, intent(out) :: status              !! MBD_OK, < 0 input, > 0 numerical
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    !> design parameters (2, np) and, with them, dq/dp, dq_dot/dp, dq_ddot/dp (nq, np, rows)
+    !! and dlambda/dp (neq, np, rows) at the outputs
+    integer, intent(in), optional :: ptab(:, :)
+    real(wp), intent(out), optional :: sq(:, :, :), sqd(:, :, :), sqdd(:, :, :), slam(:, :, :)
     type(model_t) :: m
     type(dyn_work_t) :: w
+    type(sens_t) :: sens
     integer :: bad, badf, k, st
     real(wp) :: t
     character(len=MSG_LEN) :: lmsg
     lamout = zero; eout = zero
+    if (present(ptab)) then
+      sq = zero; sqd = zero; sqdd = zero; slam = zero
+    end if
     call build_dynamic(nb, ctab, rpar, bmass, grav, ftab, fpar, m, status, msg, bad, badf)
     if (status /= MBD_OK) then
       qout = zero; qdout = zero; qddout = zero; iinfo = 0; rinfo = zero
@@ -441,13 +522,32 @@ contains
       qsing = zero; dep = 0; redundant = 0; tpass = zero
       return
     end if
-    call api_kinematics(nb, ctab, rpar, q0, t0, t1, nsteps, tol, 0, zero, every, solver, qout, &
-                        qdout, qddout, iinfo, rinfo, qsing, dep, redundant, tpass, status, msg)
+    if (present(ptab)) then
+      if (size(slam, 1) /= m%neq .or. any(shape(slam) /= [m%neq, shape(sq(1, :, :))])) then
+        status = MBD_BAD_COUNT; msg = 'sensitivity arrays do not match the model'; return
+      end if
+      call sens_setup(m, ctab, rpar, ptab, sens, status, msg, bad, ftab, fpar)
+      if (status /= MBD_OK) then
+        iinfo = 0; iinfo(2) = -2000000 - bad; return
+      end if
+      call api_kinematics(nb, ctab, rpar, q0, t0, t1, nsteps, tol, 0, zero, every, solver, &
+                          qout, qdout, qddout, iinfo, rinfo, qsing, dep, redundant, tpass, &
+                          status, msg, ptab, sq, sqd, sqdd)
+    else
+      call api_kinematics(nb, ctab, rpar, q0, t0, t1, nsteps, tol, 0, zero, every, solver, &
+                          qout, qdout, qddout, iinfo, rinfo, qsing, dep, redundant, tpass, &
+                          status, msg)
+    end if
     if (iinfo(1) < 1) return
     ! the multipliers in the core's units (so the rank decisions do not depend on the unit)
     call units(m, qout, m%cunit, .true.); call units(m, qdout, m%cunit, .true.)
     call units(m, qddout, m%cunit, .true.)
     call dyn_init(m, w, qout(:, 1), t0, 1.0e-12_wp, st, lmsg)
+    if (present(ptab)) then
+      call sens_units(m, sens, sq, m%cunit, .false., back=.true.)
+      call sens_units(m, sens, sqd, m%cunit, .false., back=.true.)
+      call sens_units(m, sens, sqdd, m%cunit, .false., back=.true.)
+    end if
     if (st == MBD_NO_MEMORY) then
       status = st; msg = lmsg
     else if (st == MBD_OK) then
@@ -461,10 +561,20 @@ contains
           status = st; msg = lmsg; exit
         end if
         call state_measures(m, w, qout(:, k), qdout(:, k), t, eout(:, k))
+        if (present(ptab)) call sens_multipliers(m, sens, qout(:, k), qdout(:, k), &
+                                                 qddout(:, k), t, w%jac, lamout(:, k), &
+                                                 sq(:, :, k), sqd(:, :, k), sqdd(:, :, k), &
+                                                 slam(:, :, k), st, lmsg)
       end do
     end if
     call units(m, qout, m%cunit, .false.); call units(m, qdout, m%cunit, .false.)
     call units(m, qddout, m%cunit, .false.); call units(m, lamout, m%rowunit, .true.)
+    if (present(ptab)) then
+      call sens_units(m, sens, sq, m%cunit, .false.)
+      call sens_units(m, sens, sqd, m%cunit, .false.)
+      call sens_units(m, sens, sqdd, m%cunit, .false.)
+      call sens_units(m, sens, slam, m%rowunit, .true.)
+    end if
   end subroutine api_inverse
 
   !> Forward dynamics: assembly of q0, the velocity v0 projected onto J q_dot = nu (kinetic
@@ -578,13 +688,18 @@ contains
   !> Static equilibrium near the assembled q0 at time t, its multipliers and stability
   !! (1 stable, 0 unstable, -1 neutral, 2 no free motion).
   subroutine api_statics(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, t, q, lam, stable, resid, &
-                         iinfo, status, msg)
+                         iinfo, status, msg, ptab, sq, slam)
     integer, intent(in) :: nb, ctab(:, :), ftab(:, :)
     real(wp), intent(in) :: rpar(:), bmass(:, :), grav(2), fpar(:), q0(:), t
     real(wp), intent(out) :: q(:), lam(:), resid
     integer, intent(out) :: stable, iinfo(NINFO)
     integer, intent(out) :: status              !! MBD_OK, < 0 input, > 0 numerical
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    !> design parameters (2, np) and, with them, dq/dp (nq, np) and dlambda/dp (neq, np) at
+    !! the equilibrium
+    integer, intent(in), optional :: ptab(:, :)
+    real(wp), intent(out), optional :: sq(:, :), slam(:, :)
+    type(sens_t) :: sens
     type(model_t) :: m
     type(dyn_work_t) :: w
     type(kin_work_t) :: kw
@@ -617,7 +732,23 @@ contains
     q = q0 / m%cunit
     call kin_assemble(m, kw, q, t, kopts, rep, status, msg)
     if (status == MBD_OK) call dyn_init(m, w, q, t, kw%tol, status, msg)
+    if (status == MBD_OK .and. present(ptab)) then
+      sq = zero; slam = zero
+      if (any(shape(sq) /= [m%nq, size(ptab, 2)]) .or. &
+          any(shape(slam) /= [m%neq, size(ptab, 2)])) then
+        status = MBD_BAD_COUNT; msg = 'sensitivity arrays do not match the model'; return
+      end if
+      call sens_setup(m, ctab, rpar, ptab, sens, status, msg, bad, ftab, fpar)
+      if (status /= MBD_OK) then
+        iinfo(2) = -2000000 - bad; return
+      end if
+    end if
     if (status == MBD_OK) call statics_solve(m, w, q, t, lam, stable, resid, status, msg)
+    if (status == MBD_OK .and. present(ptab)) then
+      call sens_statics(m, sens, w%rows, q, t, lam, sq, slam, status, msg)
+      call sens_units2(m, sens, sq, m%cunit, .false.)
+      call sens_units2(m, sens, slam, m%rowunit, .true.)
+    end if
     q = q * m%cunit; lam = lam / m%rowunit
   end subroutine api_statics
 
@@ -655,5 +786,194 @@ contains
       call dyn_reactions(m, w, q(:, k), t(k), lam(:, k), reac(:, :, k), rloc(:, :, k))
     end do
   end subroutine api_reactions
+
+  !> Changes of Phi, J, nu and gamma along a direction (dq, dq_dot) and one design parameter
+  !! (ptab(:, 1); an empty table: none) at (q, q_dot, t), each evaluated analytically on dual
+  !! numbers (mbd_dual): Phi_q dq + Phi_p, J_q dq + J_p, nu_p, gamma_q dq + gamma_q_dot dq_dot
+  !! + gamma_p. For checks by finite differences.
+  subroutine api_eval_d(nb, ctab, rpar, q, qd, t, dq, dqd, ptab, tphi, tjac, tnu, tgam, status, &
+                        msg, bad)
+    integer, intent(in) :: nb                   !! moving bodies
+    integer, intent(in) :: ctab(:, :)           !! constraint table
+    real(wp), intent(in) :: rpar(:)             !! raw parameters
+    real(wp), intent(in) :: q(:), qd(:)         !! state (nq)
+    real(wp), intent(in) :: t                   !! time
+    real(wp), intent(in) :: dq(:), dqd(:)       !! direction (nq)
+    integer, intent(in) :: ptab(:, :)           !! (2, 0 or 1) the parameter
+    real(wp), intent(out) :: tphi(:)            !! change of Phi (neq)
+    real(wp), intent(out) :: tjac(:, :)         !! change of J (neq x nq)
+    real(wp), intent(out) :: tnu(:), tgam(:)    !! changes of nu, gamma (neq)
+    integer, intent(out) :: status              !! MBD_OK or < 0
+    character(len=MSG_LEN), intent(out) :: msg  !! what is wrong
+    integer, intent(out) :: bad                 !! offending constraint, or 0
+    type(model_t) :: m
+    type(asm_work_t) :: aw
+    type(sens_t) :: sens
+    integer :: k
+    tphi = zero; tjac = zero; tnu = zero; tgam = zero
+    call model_build(nb, ctab, rpar, m, status, msg, bad)
+    if (status /= MBD_OK) return
+    if (.not. (finite(q) .and. finite(qd) .and. finite(t) .and. finite(dq) .and. &
+               finite(dqd))) then
+      call not_finite('the state and the direction', status, msg); return
+    end if
+    if (size(q) /= m%nq .or. size(qd) /= m%nq .or. size(dq) /= m%nq .or. &
+        size(dqd) /= m%nq .or. size(tphi) /= m%neq .or. size(tjac, 1) /= m%neq .or. &
+        size(tjac, 2) /= m%nq .or. size(ptab, 2) > 1) then
+      status = MBD_BAD_COUNT; msg = 'array sizes do not match the model'; return
+    end if
+    call sens_setup(m, ctab, rpar, ptab, sens, status, msg, bad)
+    if (status /= MBD_OK) return
+    k = size(ptab, 2)
+    call asm_init(m, aw, status, msg)
+    if (status /= MBD_OK) return
+    call sens_trig(m, sens, q)
+    call sens_eval_d(m, sens, k, q, qd, dq, dqd, t, tphi, tnu, tgam, aw%jb)
+    call scatter_dense(aw, tjac)
+  end subroutine api_eval_d
+
+  !> Changes of the reactions (as api_reactions) along design parameters at many states:
+  !! dreac, drloc (6, nc, np, nt), from dq/dp (nq, np, nt) and dlambda/dp (neq, np, nt).
+  subroutine api_reactions_dp(nb, ctab, rpar, ptab, q, t, lam, sq, slam, dreac, drloc, status, &
+                              msg)
+    integer, intent(in) :: nb, ctab(:, :)
+    real(wp), intent(in) :: rpar(:)
+    integer, intent(in) :: ptab(:, :)
+    real(wp), intent(in) :: q(:, :), t(:), lam(:, :), sq(:, :, :), slam(:, :, :)
+    real(wp), intent(out) :: dreac(:, :, :, :), drloc(:, :, :, :)
+    integer, intent(out) :: status              !! MBD_OK or < 0
+    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    type(model_t) :: m
+    type(sens_t) :: sens
+    integer :: bad, k
+    dreac = zero; drloc = zero
+    call model_build(nb, ctab, rpar, m, status, msg, bad)
+    if (status /= MBD_OK) return
+    if (.not. (finite(q) .and. finite(t) .and. finite(lam))) then
+      call not_finite('q, t and lambda', status, msg); return
+    end if
+    if (size(q, 1) /= m%nq .or. size(lam, 1) /= m%neq .or. size(q, 2) /= size(t) .or. &
+        size(lam, 2) /= size(t) .or. any(shape(sq) /= [m%nq, size(ptab, 2), size(t)]) .or. &
+        any(shape(slam) /= [m%neq, size(ptab, 2), size(t)]) .or. &
+        any(shape(dreac) /= [6, m%nc, size(ptab, 2), size(t)]) .or. &
+        any(shape(drloc) /= shape(dreac))) then
+      status = MBD_BAD_COUNT; msg = 'array sizes do not match the model'; return
+    end if
+    call sens_setup(m, ctab, rpar, ptab, sens, status, msg, bad)
+    if (status /= MBD_OK) return
+    do k = 1, size(t)
+      call sens_reactions(m, sens, q(:, k), t(k), lam(:, k), sq(:, :, k), slam(:, :, k), &
+                          dreac(:, :, :, k), drloc(:, :, :, k))
+    end do
+  end subroutine api_reactions_dp
+
+  !> Forward dynamics by dopri5 with design sensitivities (mbd_sens_dynamics): as
+  !! api_dynamics (method dopri5; iinfo 1 outputs, 2 bad entry, 3 steps, 4 rejected, 6
+  !! right-hand sides, 9 active rows; rinfo 1 failure time, 2 and 3 smallest and largest step)
+  !! plus sq, sqd, sqdd (nq, np, rows), the sensitivities of q, q_dot and q_ddot.
+  subroutine api_dynamics_sens(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, v0, t0, t1, &
+                               nsteps, rtol, atol, every, max_steps, ptab, qout, qdout, qddout, &
+                               lamout, eout, sq, sqd, sqdd, iinfo, rinfo, redundant, status, msg)
+    integer, intent(in) :: nb, ctab(:, :), ftab(:, :), nsteps, every, max_steps
+    real(wp), intent(in) :: rpar(:), bmass(:, :), grav(2), fpar(:), q0(:), v0(:), t0, t1
+    real(wp), intent(in) :: rtol, atol          !! tolerances (<= 0: defaults 1e-6, 1e-8)
+    integer, intent(in) :: ptab(:, :)           !! design parameters (2, np)
+    real(wp), intent(out) :: qout(:, :), qdout(:, :), qddout(:, :)  !! (nq, rows)
+    real(wp), intent(out) :: lamout(:, :)       !! (neq, rows)
+    real(wp), intent(out) :: eout(:, :)         !! (4, rows) energies, drift
+    real(wp), intent(out) :: sq(:, :, :), sqd(:, :, :), sqdd(:, :, :)  !! (nq, np, rows)
+    integer, intent(out) :: iinfo(NINFO)
+    real(wp), intent(out) :: rinfo(NINFO)
+    integer, intent(out) :: redundant(:)
+    integer, intent(out) :: status              !! MBD_OK, < 0 input, > 0 numerical
+    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    type(model_t) :: m
+    type(dyn_work_t) :: w
+    type(kin_work_t) :: kw
+    type(kin_opts_t) :: kopts
+    type(kin_report_t) :: rep
+    type(sens_t) :: sens
+    real(wp), allocatable :: q(:), qd(:), s0(:, :), sd0(:, :)
+    real(wp) :: t, r_tol, a_tol, hmm(2), tfail
+    integer :: bad, badf, k, ko, nout, st, stats(3)
+    character(len=MSG_LEN) :: lmsg
+    iinfo = 0; rinfo = zero; redundant = 0
+    qout = zero; qdout = zero; qddout = zero; lamout = zero; eout = zero
+    sq = zero; sqd = zero; sqdd = zero
+    call build_dynamic(nb, ctab, rpar, bmass, grav, ftab, fpar, m, status, msg, bad, badf)
+    iinfo(2) = bad; if (badf /= 0) iinfo(2) = -1000000 - badf
+    if (status /= MBD_OK) return
+    if (.not. (finite(q0) .and. finite(v0) .and. finite(t0) .and. finite(t1) .and. &
+               finite([rtol, atol]))) then
+      call not_finite('q0, v0, the times and the settings', status, msg); return
+    end if
+    if (nsteps < 0 .or. .not. (t1 > t0) .or. every < 1 .or. max_steps < 1) then
+      status = MBD_BAD_SETTING
+      msg = 'steps must be >= 0, every >= 1, max_steps >= 1 and t_end > t0'; return
+    end if
+    if (size(q0) /= m%nq .or. size(v0) /= m%nq .or. size(qout, 1) /= m%nq .or. &
+        size(qout, 2) /= output_rows(nsteps, every) .or. size(lamout, 1) /= m%neq .or. &
+        size(redundant) /= m%neq .or. &
+        any(shape(sq) /= [m%nq, size(ptab, 2), size(qout, 2)]) .or. &
+        any(shape(sqd) /= shape(sq)) .or. any(shape(sqdd) /= shape(sq))) then
+      status = MBD_BAD_COUNT; msg = 'array sizes do not match the model'; return
+    end if
+    call sens_setup(m, ctab, rpar, ptab, sens, status, msg, bad, ftab, fpar)
+    if (status /= MBD_OK) then
+      iinfo(2) = -2000000 - bad; return
+    end if
+    call dyn_memory_check(m, status, msg)
+    if (status /= MBD_OK) return
+    call kin_work_init(m, kw, status, msg)
+    if (status /= MBD_OK) return
+    kw%tol = kopts%tol * m%lscale
+    allocate (q(m%nq), qd(m%nq), rep%qsing(m%nq), rep%dep(m%neq), rep%redundant(m%neq), &
+              s0(m%nq, sens%np), sd0(m%nq, sens%np), stat=st)
+    if (st /= 0) then
+      call mem_fail(REAL_BYTES * (3 * real(m%nq, wp) * (1 + sens%np) + m%neq), &
+                    'the state and its sensitivities', 'use fewer parameters', status, msg)
+      return
+    end if
+    q = q0 / m%cunit
+    call kin_assemble(m, kw, q, t0, kopts, rep, status, msg)
+    if (status /= MBD_OK) then
+      rinfo(1) = t0; return
+    end if
+    call dyn_init(m, w, q, t0, kw%tol, status, msg)
+    if (status /= MBD_OK) return
+    iinfo(9) = w%na
+    do k = 1, m%neq
+      if (.not. any(w%rows == k)) redundant(k) = 1
+    end do
+    call dyn_velocity(m, w, q, t0, v0 / m%cunit, qd, status)
+    if (status /= MBD_OK) then
+      msg = 'the initial velocities cannot be made consistent: the mass matrix is singular '// &
+            'on the motions the constraints allow (a body without mass or inertia?)'
+      return
+    end if
+    call sens_initial(m, w, sens, q, qd, t0, s0, sd0, status, msg)
+    if (status /= MBD_OK) return
+    r_tol = 1.0e-6_wp; a_tol = 1.0e-8_wp
+    if (rtol > zero) r_tol = rtol
+    if (atol > zero) a_tol = atol
+    call sens_dopri5(m, w, sens, q, qd, s0, sd0, t0, t1, nsteps, every, r_tol, a_tol, &
+                     max_steps, qout, qdout, qddout, sq, sqd, sqdd, nout, stats, hmm, tfail, &
+                     status, msg)
+    iinfo(1) = nout; iinfo(3) = stats(1); iinfo(4) = stats(2); iinfo(6) = stats(3)
+    rinfo(2) = hmm(1); rinfo(3) = hmm(2)
+    if (status /= MBD_OK) rinfo(1) = tfail
+    do k = 1, nout
+      ko = output_index(nsteps, every, k)
+      t = t0 + (t1 - t0) * (real(ko, wp) / max(nsteps, 1))
+      if (ko == nsteps) t = t1
+      call dyn_multipliers(m, w, qout(:, k), qdout(:, k), qddout(:, k), t, lamout(:, k), st, lmsg)
+      call state_measures(m, w, qout(:, k), qdout(:, k), t, eout(:, k))
+    end do
+    call units(m, qout, m%cunit, .false.); call units(m, qdout, m%cunit, .false.)
+    call units(m, qddout, m%cunit, .false.); call units(m, lamout, m%rowunit, .true.)
+    call sens_units(m, sens, sq, m%cunit, .false.)
+    call sens_units(m, sens, sqd, m%cunit, .false.)
+    call sens_units(m, sens, sqdd, m%cunit, .false.)
+  end subroutine api_dynamics_sens
 
 end module mbd_api

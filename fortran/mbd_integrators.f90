@@ -37,6 +37,9 @@ module mbd_integrators
   private
   public :: dyn_opts_t, dyn_stats_t, METH_GENALPHA, METH_DOPRI5, METH_RK4, METH_PARTITIONED
   public :: integrate, output_rows, output_index, MAX_STEPS_DEFAULT
+  ! the Dormand-Prince 5(4) tableau, also used by the sensitivity integrator (mbd_sens_dynamics)
+  public :: C2, C3, C4, C5, A21, A31, A32, A41, A42, A43, A51, A52, A53, A54, A61, A62, A63, &
+            A64, A65, A71, A73, A74, A75, A76, E1, E3, E4, E5, E6, E7
 
   integer, parameter :: METH_GENALPHA = 1, METH_DOPRI5 = 2, METH_RK4 = 3, METH_PARTITIONED = 4
   !> Default step limit: it ends a run whose steps collapse without underflowing, after

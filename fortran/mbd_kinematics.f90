@@ -38,9 +38,10 @@ module mbd_kinematics
   use mbd_band, only: band_t, band_plan, band_move, band_zero, band_norm1, band_factor, &
                       band_rcond, band_solve
   use mbd_linsolve, only: lu_factor, lu_solve, lu_det_sign, svd_null, row_rank, qr_factor, &
-                          qr_solve, qr_lwork
+                          qr_solve, qr_lwork, lu_solve_rows
   use mbd_lapack, only: dgels, dgecon, dtrcon
   use mbd_interp, only: hermite5
+  use mbd_sensitivity, only: sens_t, sens_hessian, sens_params, sens_kin_rhs
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   implicit none
   private
@@ -313,6 +314,28 @@ contains
     end if
     x = x * w%cs
   end subroutine solve
+
+  !> Solve J X = B for several right-hand sides with the factors (as solve), B given as rows
+  !! bt = B^T (n rounded up to a multiple of 4, neq; padding rows zero) and overwritten; the
+  !! dense LU by plain loops over all of them at once.
+  subroutine solve_cols(w, bt, x)
+    type(kin_work_t), intent(inout) :: w   !! work arrays with the factors
+    real(wp), intent(inout) :: bt(:, :)    !! right-hand sides as rows (4 k, neq), spoiled
+    real(wp), intent(out) :: x(:, :)       !! solutions (nq, n)
+    real(wp) :: b(size(bt, 2))
+    integer :: k
+    if (w%lsq .or. w%banded) then
+      do k = 1, size(x, 2)
+        b = bt(k, :)
+        call solve(w, b, x(:, k))
+      end do
+      return
+    end if
+    call lu_solve_rows(w%jac, w%ipiv, bt)
+    do k = 1, size(x, 2)
+      x(:, k) = bt(k, :) * w%cs
+    end do
+  end subroutine solve_cols
 
   !> The Newton correction w%dq from J dq = -Phi with the factors (Phi negated in place and
   !! back: an expression argument -w%phi would be a heap temporary at every iteration).
@@ -753,7 +776,8 @@ contains
   !! and nsteps (e = opts%every) are stored, in columns 1, 2, ... (kin_out_count of them).
   !! On a singular configuration the outputs up to it are filled (rep%ndone columns) and
   !! status is MBD_SINGULAR_CONFIG with rep describing the configuration.
-  subroutine kin_run(m, q0, t0, t1, nsteps, opts, qout, qdout, qddout, rep, status, msg)
+  subroutine kin_run(m, q0, t0, t1, nsteps, opts, qout, qdout, qddout, rep, status, msg, &
+                     sens, sq, sqd, sqdd)
     type(model_t), intent(in) :: m             !! model
     real(wp), intent(in) :: q0(:)              !! estimates (nq)
     real(wp), intent(in) :: t0, t1             !! time span
@@ -765,8 +789,13 @@ contains
     type(kin_report_t), intent(out) :: rep     !! what happened
     integer, intent(out) :: status             !! MBD_OK or the failure
     character(len=MSG_LEN), intent(out) :: msg !! explanation
+    !> design parameters (mbd_sensitivity): with them, sq, sqd, sqdd (nq, np, outputs) get
+    !! dq/dp, dq_dot/dp and dq_ddot/dp at every stored output
+    type(sens_t), intent(inout), optional :: sens
+    real(wp), intent(out), optional :: sq(:, :, :), sqd(:, :, :), sqdd(:, :, :)
     type(kin_work_t) :: w
     type(band_t) :: band
+    logical, allocatable :: post(:)   ! outputs whose sensitivities are computed at the end
     real(wp), allocatable :: q(:), qd(:), qdd(:), qn(:), qp(:), q3(:), q4(:), q5(:), d1(:), &
                              qddn(:), qdn(:)
     real(wp), allocatable :: qa(:), qda(:), qdda(:), qb(:), qdb(:), qddb(:)
@@ -778,6 +807,15 @@ contains
 
     status = MBD_OK; msg = ''
     qout = zero; qdout = zero; qddout = zero
+    if (present(sens)) then
+      allocate (post(size(qout, 2)), stat=ierr)
+      if (ierr /= 0) then
+        call mem_fail(4.0_wp * size(qout, 2), 'the sensitivity bookkeeping', &
+                      'use fewer outputs (every)', status, msg)
+        return
+      end if
+      post = .false.
+    end if
     allocate (rep%qsing(m%nq), rep%dep(m%neq), rep%redundant(m%neq), stat=ierr)
     if (ierr /= 0) then
       call mem_fail(REAL_BYTES * (real(m%nq, wp) + m%neq), 'the kinematic report', &
@@ -891,6 +929,8 @@ contains
       call count_work(); return
     end if
     qout(:, 1) = q; qdout(:, 1) = qd; qddout(:, 1) = qdd
+    if (present(sens)) call kin_sens(m, w, sens, q, qd, qdd, t0, sq(:, :, 1), sqd(:, :, 1), &
+                                     sqdd(:, :, 1))
     rep%ndone = 1
     detprev = w%detsign
     call forget_derivatives()
@@ -997,6 +1037,7 @@ contains
             call hermite5(ta, qa, qda, qdda, ts + d, qn, qdn, qddn, out_time(j), qout(:, c), &
                           qdout(:, c), qddout(:, c))
             rep%ndone = max(rep%ndone, c)
+            if (present(sens)) post(c) = .true.
           end if
           if (j >= k) k = j + 1
         end if
@@ -1155,6 +1196,8 @@ contains
       cc = column(kk)
       if (cc > 0) then
         qout(:, cc) = q; qdout(:, cc) = qd; qddout(:, cc) = qdd
+        if (present(sens)) call kin_sens(m, w, sens, q, qd, qdd, t, sq(:, :, cc), &
+                                         sqd(:, :, cc), sqdd(:, :, cc))
         if (w%pivratio < ANCHOR_PIV) call refine_output(cc)
         rep%ndone = cc
       end if
@@ -1182,6 +1225,7 @@ contains
       end do
       call hermite5(t - dd, qa, qda, qdda, t + dd, qn, qdn, qddn, t, qout(:, cc), &
                     qdout(:, cc), qddout(:, cc))
+      if (present(sens)) post(cc) = .true.
     end subroutine refine_output
 
     !> Redundant constraints disagree at position (0), velocity (1) or acceleration (2)
@@ -1202,10 +1246,44 @@ contains
     end subroutine inconsistent
 
     subroutine count_work()
+      integer :: cc, st3
       rep%newton_its = w%newton_its; rep%lu_count = w%lu_count
+      if (.not. allocated(post)) return
+      ! interpolated outputs: sensitivities from a factorization at the output itself
+      do cc = 1, min(rep%ndone, size(post))
+        if (.not. post(cc)) cycle
+        tt = t0 + (t1 - t0) * (real(min((cc - 1) * opts%every, nsteps), wp) / max(nsteps, 1))
+        if (cc == size(qout, 2)) tt = t1
+        call assemble_j(m, w, qout(:, cc), w%qz, tt)
+        call factor(w, st3)
+        if (st3 == MBD_OK) call kin_sens(m, w, sens, qout(:, cc), qdout(:, cc), qddout(:, cc), &
+                                         tt, sq(:, :, cc), sqd(:, :, cc), sqdd(:, :, cc))
+      end do
+      post = .false.
     end subroutine count_work
 
   end subroutine kin_run
+
+  !> Sensitivities at a converged state (q, q_dot, q_ddot) whose J factors are in w:
+  !! J s = -Phi_p, J s_dot = nu_p - J_p q_dot - Hv s, J s_ddot = gamma_p - J_p q_ddot - Ha s
+  !! - 2 Hv s_dot (mbd_sensitivity), three solves with the same factors per parameter.
+  subroutine kin_sens(m, w, s, q, qd, qdd, t, sq, sqd, sqdd)
+    type(model_t), intent(in) :: m           !! model
+    type(kin_work_t), intent(inout) :: w     !! work arrays with the factors of J(q)
+    type(sens_t), intent(inout) :: s         !! parameters and blocks
+    real(wp), intent(in) :: q(:), qd(:), qdd(:)  !! state and accelerations
+    real(wp), intent(in) :: t                !! time
+    real(wp), intent(out) :: sq(:, :), sqd(:, :), sqdd(:, :)  !! (nq, np)
+    s%cb = w%asm%cb; s%sb = w%asm%sb          ! the angles' cos and sin of the assembly at q
+    call sens_hessian(m, s, q, qd, qdd, t)
+    call sens_params(m, s, q, qd, qdd, t)
+    call sens_kin_rhs(s, 1, sq, sqd, s%rhs)
+    call solve_cols(w, s%rhs, sq)
+    call sens_kin_rhs(s, 2, sq, sqd, s%rhs)
+    call solve_cols(w, s%rhs, sqd)
+    call sens_kin_rhs(s, 3, sq, sqd, s%rhs)
+    call solve_cols(w, s%rhs, sqdd)
+  end subroutine kin_sens
 
   !> Stored outputs of a run of nsteps intervals keeping every e-th (and the last).
   pure integer function kin_out_count(nsteps, e) result(n)

@@ -15,6 +15,7 @@ from ..results.dynamics import DynamicsResult
 from ..validate import number, whole
 from .failures import assembly_failed, bad_entry, inconsistent_at, row_names
 from .outputs import dynamics_result, finite_part
+from .sensitivities import attach, check_status, requested, table
 from .settings import check_memory, check_span, output_rows, output_steps, time_grid
 
 METHODS = {"generalized-alpha": 1, "dopri5": 2, "baumgarte-rk4": 3, "partitioned": 4}
@@ -27,7 +28,7 @@ def run_dynamics(model: ModelDescription, t_end: float, steps: int, method: str 
                  rtol: float | None = None, atol: float | None = None, h: float | None = None,
                  rho_inf: float | None = None, alpha: float | None = None,
                  beta: float | None = None, t0: float = 0.0, every: Any = 1,
-                 max_steps: Any = None) -> DynamicsResult:
+                 max_steps: Any = None, sensitivities: Any = None) -> DynamicsResult:
     """Forward dynamics in one core call; see :meth:`mbd2d.Model.dynamics`."""
     t0, t_end, steps = check_span(t0, t_end, steps)
     nout = output_rows(steps, every)
@@ -65,12 +66,24 @@ def run_dynamics(model: ModelDescription, t_end: float, steps: int, method: str 
                          "a fixed step h", "dynamics")
     alpha_v = opt(alpha, "alpha", 0.0, 1e9, -1.0)
     beta_v = opt(beta, "beta", 0.0, 1e9, -1.0)
+    params = requested(model, sensitivities)
+    if params and method != "dopri5":
+        raise ModelError(f"sensitivities are integrated with dopri5 (the variational "
+                         f"equations with the state); method {method!r} has none",
+                         "dynamics")
     p = pack(model)
     d = pack_dynamics(model, p)
-    check_memory(nout, 3 * p.nq + p.neq + 4, "dynamics")
+    npar = len(params) if params else 0
+    check_memory(nout, 3 * p.nq * (1 + npar) + p.neq + 4, "dynamics")
     idx = output_steps(steps, every)
-    out = core.dynamics(p, d, t0, t_end, steps, METHODS[method], rtol_v, atol_v, h_v, rho_v,
-                        alpha_v, beta_v, every, nout, nmax)
+    if params:
+        ptab = table(p, params, d)
+        out = core.dynamics_sens(p, d, t0, t_end, steps, rtol_v, atol_v, every, nmax, nout,
+                                 ptab)
+        check_status(out.status, out.iinfo, out.msg, params)
+    else:
+        out = core.dynamics(p, d, t0, t_end, steps, METHODS[method], rtol_v, atol_v, h_v,
+                            rho_v, alpha_v, beta_v, every, nout, nmax)
     iinfo, rinfo, status = out.iinfo, out.rinfo, out.status
     n = int(iinfo[0])
     t = time_grid(t0, t_end, steps, idx)
@@ -81,7 +94,10 @@ def run_dynamics(model: ModelDescription, t_end: float, steps: int, method: str 
              "partitions": int(iinfo[7]),
              "h_min": float(rinfo[1]) if iinfo[2] else None,
              "h_max": float(rinfo[2]) if iinfo[2] else None, "redundant_rows": red_rows}
-    res, bad = finite_part(dynamics_result(model, p, t, n, out, stats, status == OK))
+    res = dynamics_result(model, p, t, n, out, stats, status == OK)
+    if params:
+        attach(res, out, params, n, ptab)
+    res, bad = finite_part(res)
     if red_rows:
         warnings.warn(f"redundant constraints: {', '.join(red_rows)} are left out of the equations "
                       "of motion; the reported multipliers are the minimum-norm set (the "

@@ -13,12 +13,14 @@ from ..errors import RedundantConstraintWarning
 from ..results.dynamics import DynamicsResult
 from .failures import BAD_FORCE, bad_entry, kinematic_failure, row_names
 from .outputs import dynamics_result, finite_part
+from .sensitivities import attach, check_status, requested, table
 from .settings import (check_memory, check_solver, check_span, output_rows, output_steps,
                        require_determined, solver_code, time_grid)
 
 
 def run_inverse(model: ModelDescription, t_end: float, steps: int, t0: float = 0.0,
-                tol: float | None = None, every: Any = 1, solver: str = "auto") -> DynamicsResult:
+                tol: float | None = None, every: Any = 1, solver: str = "auto",
+                sensitivities: Any = None) -> DynamicsResult:
     """Kinematics plus the multipliers, energies and (on demand) reactions at every output.
 
     See :meth:`mbd2d.Model.inverse_dynamics`.
@@ -27,12 +29,19 @@ def run_inverse(model: ModelDescription, t_end: float, steps: int, t0: float = 0
     tol_v, _ = check_solver(tol, None)
     nout = output_rows(steps, every)
     code = solver_code(solver)
+    params = requested(model, sensitivities)
     p = pack(model)
     require_determined(p, model)
     d = pack_dynamics(model, p)
-    check_memory(nout, 3 * p.nq + p.neq + 4, "inverse dynamics")
+    npar = len(params) if params else 0
+    check_memory(nout, (3 * p.nq + p.neq) * (1 + npar) + 4, "inverse dynamics")
     idx = output_steps(steps, every)
-    out = core.inverse(p, d, t0, t_end, steps, tol_v, int(every), code, nout)
+    if params:
+        ptab = table(p, params, d)
+        out = core.inverse_sens(p, d, t0, t_end, steps, tol_v, int(every), code, nout, ptab)
+        check_status(out.status, out.iinfo, out.msg, params)
+    else:
+        out = core.inverse(p, d, t0, t_end, steps, tol_v, int(every), code, nout)
     iinfo, status = out.iinfo, out.status
     n = int(iinfo[0])
     t = time_grid(t0, t_end, steps, idx)
@@ -41,7 +50,10 @@ def run_inverse(model: ModelDescription, t_end: float, steps: int, t0: float = 0
              "rejected_steps": int(iinfo[7]), "rank": int(iinfo[8]),
              "redundant_rows": red_rows,
              "singular_passages": [float(x) for x in out.tpass[:min(int(iinfo[9]), 64)]]}
-    res, bad = finite_part(dynamics_result(model, p, t, n, out, stats, status == OK))
+    res = dynamics_result(model, p, t, n, out, stats, status == OK)
+    if params:
+        attach(res, out, params, n, ptab)
+    res, bad = finite_part(res)
     if red_rows:
         warnings.warn(f"redundant constraints: {', '.join(red_rows)}; the multipliers are the "
                       "minimum-norm set (the reactions are statically indeterminate)",

@@ -16,7 +16,7 @@ R = TypeVar("R", bound=KinematicsResult)
 
 #: arrays of a result with one row per output time
 ROW_FIELDS = ("t", "q", "qd", "qdd", "lam", "kinetic", "potential", "drift_position",
-              "drift_velocity")
+              "drift_velocity", "dq_dp", "dqd_dp", "dqdd_dp", "dlam_dp")
 
 
 def dynamics_result(model: ModelDescription, p: Packed, t: np.ndarray, n: int, out: Any,
@@ -50,7 +50,7 @@ def first_nonfinite_row(*arrays: np.ndarray) -> int | None:
 def finite_part(res: R) -> tuple[R, int | None]:
     """The result cut before its first row with a non-finite number (marked incomplete),
     and that row's index; the result itself and None when every number is finite."""
-    names = [f for f in ROW_FIELDS if hasattr(res, f)]
+    names = [f for f in ROW_FIELDS if getattr(res, f, None) is not None]
     k = first_nonfinite_row(*(getattr(res, f) for f in names))
     if k is None:
         return res, None

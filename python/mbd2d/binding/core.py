@@ -143,3 +143,65 @@ def fun_values(p: np.ndarray, t: np.ndarray) -> SimpleNamespace:
     """f(t), f'(t), f''(t) of an encoded function of time (``TimeFunction.encode()``) at the
     times t: ``f``, ``f1``, ``f2``, ``status``, ``msg``."""
     return _named("f f1 f2 status msg", _core.core_fun_values, p, t, numbers=3 * np.size(t))
+# ------------------------------------------------------------------ design sensitivities
+# ptab: int32 (2, np), Fortran order: per design parameter its table (1 rpar, 2 bmass
+# flattened (2, nb), 3 grav, 4 fpar) and 1-based index (see fortran/mbd_sensitivity.f90).
+
+def eval_d(p: Packed, rpar: np.ndarray, q: np.ndarray, qd: np.ndarray, t: float,
+           dq: np.ndarray, dqd: np.ndarray, ptab: np.ndarray) -> SimpleNamespace:
+    """Changes of Phi, J, nu and gamma along a direction (dq, dqd) and at most one design
+    parameter: ``tphi``, ``tjac``, ``tnu``, ``tgam``, ``status``, ``msg``, ``bad``."""
+    return _named("tphi tjac tnu tgam status msg bad", _core.core_eval_d, p.nb, p.ctab, rpar,
+                  p.neq, q, qd, float(t), dq, dqd, ptab)
+
+
+def kinematics_sens(p: Packed, t0: float, t1: float, steps: int, tol: float, maxit: int,
+                    tmin: float, every: int, solver: int, nout: int,
+                    ptab: np.ndarray) -> SimpleNamespace:
+    """A kinematic run with sensitivities: as :func:`kinematics` plus ``sq``, ``sqd``,
+    ``sqdd`` (nq, np, nout)."""
+    return _named("q qd qdd sq sqd sqdd iinfo rinfo qsing dep red tpass status msg",
+                  _core.core_kinematics_sens, p.nb, p.ctab, p.rpar, p.neq, p.q0, t0, t1, steps,
+                  tol, maxit, tmin, every, solver, nout, ptab,
+                  numbers=3 * p.nq * nout * (1 + ptab.shape[1]))
+
+
+def inverse_sens(p: Packed, d: DynamicTables, t0: float, t1: float, steps: int, tol: float,
+                 every: int, solver: int, nout: int, ptab: np.ndarray) -> SimpleNamespace:
+    """Inverse dynamics with sensitivities: as :func:`inverse` plus ``sq``, ``sqd``, ``sqdd``
+    (nq, np, nout) and ``slam`` (neq, np, nout)."""
+    return _named("q qd qdd lam e sq sqd sqdd slam iinfo rinfo qsing dep red tpass status msg",
+                  _core.core_inverse_sens, ctab=p.ctab, rpar=p.rpar, bmass=d.bmass,
+                  grav=d.grav, ftab=d.ftab, fpar=d.fpar, neq=p.neq, q0=p.q0, t0=t0, t1=t1,
+                  nsteps=steps, tol=tol, every=every, solver=solver, nout=nout, ptab=ptab,
+                  numbers=(3 * p.nq + p.neq) * nout * (1 + ptab.shape[1]))
+
+
+def dynamics_sens(p: Packed, d: DynamicTables, t0: float, t1: float, steps: int, rtol: float,
+                  atol: float, every: int, max_steps: int, nrow: int,
+                  ptab: np.ndarray) -> SimpleNamespace:
+    """Forward dynamics by dopri5 with sensitivities: ``q``, ``qd``, ``qdd``, ``lam``, ``e``,
+    ``sq``, ``sqd``, ``sqdd``, ``iinfo``, ``rinfo``, ``red``, ``status``, ``msg``."""
+    return _named("q qd qdd lam e sq sqd sqdd iinfo rinfo red status msg",
+                  _core.core_dynamics_sens, ctab=p.ctab, rpar=p.rpar, bmass=d.bmass,
+                  grav=d.grav, ftab=d.ftab, fpar=d.fpar, neq=p.neq, q0=p.q0, v0=d.v0, t0=t0,
+                  t1=t1, nsteps=steps, rtol=rtol, atol=atol, every=every, max_steps=max_steps,
+                  nrow=nrow, ptab=ptab,
+                  numbers=(3 * p.nq + p.neq) * nrow * (1 + ptab.shape[1]))
+
+
+def statics_sens(p: Packed, d: DynamicTables, t: float, ptab: np.ndarray) -> SimpleNamespace:
+    """Static equilibrium with sensitivities: ``q``, ``lam``, ``sq`` (nq, np), ``slam``
+    (neq, np), ``stable``, ``resid``, ``iinfo``, ``status``, ``msg``."""
+    return _named("q lam sq slam stable resid iinfo status msg", _core.core_statics_sens,
+                  ctab=p.ctab, rpar=p.rpar, bmass=d.bmass, grav=d.grav, ftab=d.ftab,
+                  fpar=d.fpar, neq=p.neq, q0=p.q0, t=t, ptab=ptab)
+
+
+def reactions_dp(p: Packed, ptab: np.ndarray, q: np.ndarray, t: np.ndarray, lam: np.ndarray,
+                 sq: np.ndarray, slam: np.ndarray) -> SimpleNamespace:
+    """Changes of the reactions along the parameters: ``dreac``, ``drloc``
+    (6, nc, np, nt), ``status``, ``msg``."""
+    return _named("dreac drloc status msg", _core.core_reactions_dp, p.nb, p.ctab, p.rpar,
+                  ptab, q, t, lam, sq, slam,
+                  numbers=12 * p.ctab.shape[1] * ptab.shape[1] * len(np.atleast_1d(t)))
