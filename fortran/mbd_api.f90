@@ -28,7 +28,7 @@ module mbd_api
   use mbd_kinematics, only: kin_opts_t, kin_report_t, kin_work_t, kin_run, kin_work_init, &
                             kin_assemble, kin_rank, kin_out_count, MAXPASS, SOLVER_AUTO, &
                             SOLVER_BANDED, kin_newton, kin_vel_acc
-  use mbd_status, only: MBD_BAD_SETTING
+  use mbd_status, only: MBD_BAD_SETTING, MBD_USER_ABORT
   use mbd_profiles, only: profile_raw_length, profile_prepare, profile_eval
   use mbd_sensitivity, only: sens_t, sens_setup, sens_eval_d, sens_trig
   use mbd_assemble, only: scatter_dense
@@ -193,7 +193,7 @@ contains
   !> Kinematic analysis: the whole time loop in one call.
   subroutine api_kinematics(nb, ctab, rpar, q0, t0, t1, nsteps, tol, maxit, tmin, every, &
                             solver, qout, qdout, qddout, iinfo, rinfo, qsing, dep, redundant, &
-                            tpass, status, msg, ptab, sq, sqd, sqdd)
+                            tpass, status, msg, ptab, sq, sqd, sqdd, ctl)
     integer, intent(in) :: nb                   !! moving bodies
     integer, intent(in) :: ctab(:, :)           !! constraint table
     real(wp), intent(in) :: rpar(:)             !! raw parameters
@@ -219,6 +219,9 @@ contains
     !! dq_ddot/dp at the outputs, each (nq, np, kin_out_count(nsteps, every))
     integer, intent(in), optional :: ptab(:, :)
     real(wp), intent(out), optional :: sq(:, :, :), sqd(:, :, :), sqdd(:, :, :)
+    !> progress, shared with a caller in another thread (2): ctl(1) the outputs stored so
+    !! far, ctl(2) /= 0 asks the run to stop (MBD_USER_ABORT, the outputs so far kept)
+    integer, intent(inout), optional, volatile :: ctl(:)
     type(model_t) :: m
     type(kin_opts_t) :: opts
     type(kin_report_t) :: rep
@@ -270,12 +273,13 @@ contains
     if (tmin > zero) opts%tmin = tmin
     if (present(ptab)) then
       call kin_run(m, q0 / m%cunit, t0, t1, nsteps, opts, qout, qdout, qddout, rep, status, &
-                   msg, sens, sq, sqd, sqdd)
+                   msg, sens, sq, sqd, sqdd, ctl=ctl)
       call sens_units(m, sens, sq, m%cunit, .false.)
       call sens_units(m, sens, sqd, m%cunit, .false.)
       call sens_units(m, sens, sqdd, m%cunit, .false.)
     else
-      call kin_run(m, q0 / m%cunit, t0, t1, nsteps, opts, qout, qdout, qddout, rep, status, msg)
+      call kin_run(m, q0 / m%cunit, t0, t1, nsteps, opts, qout, qdout, qddout, rep, status, &
+                   msg, ctl=ctl)
     end if
     call units(m, qout, m%cunit, .false.); call units(m, qdout, m%cunit, .false.)
     call units(m, qddout, m%cunit, .false.)
@@ -480,7 +484,7 @@ contains
   !! iinfo/rinfo as api_kinematics; iinfo(2) = -force index for a bad force.
   subroutine api_inverse(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, t0, t1, nsteps, tol, &
                          every, solver, qout, qdout, qddout, lamout, eout, iinfo, rinfo, qsing, &
-                         dep, redundant, tpass, status, msg, ptab, sq, sqd, sqdd, slam)
+                         dep, redundant, tpass, status, msg, ptab, sq, sqd, sqdd, slam, ctl)
     integer, intent(in) :: nb, ctab(:, :), ftab(:, :), nsteps
     real(wp), intent(in) :: rpar(:), bmass(:, :), grav(2), fpar(:), q0(:), t0, t1, tol
     integer, intent(in) :: every                !! store every k-th output (and the last)
@@ -498,6 +502,9 @@ contains
     !! and dlambda/dp (neq, np, rows) at the outputs
     integer, intent(in), optional :: ptab(:, :)
     real(wp), intent(out), optional :: sq(:, :, :), sqd(:, :, :), sqdd(:, :, :), slam(:, :, :)
+    !> progress as in api_kinematics: the kinematic pass counts the outputs, the multipliers'
+    !! pass counts on from there (2 x outputs in all)
+    integer, intent(inout), optional, volatile :: ctl(:)
     type(model_t) :: m
     type(dyn_work_t) :: w
     type(sens_t) :: sens
@@ -536,7 +543,7 @@ contains
     else
       call api_kinematics(nb, ctab, rpar, q0, t0, t1, nsteps, tol, 0, zero, every, solver, &
                           qout, qdout, qddout, iinfo, rinfo, qsing, dep, redundant, tpass, &
-                          status, msg)
+                          status, msg, ctl=ctl)
     end if
     if (iinfo(1) < 1) return
     ! the multipliers in the core's units (so the rank decisions do not depend on the unit)
@@ -561,6 +568,15 @@ contains
           status = st; msg = lmsg; exit
         end if
         call state_measures(m, w, qout(:, k), qdout(:, k), t, eout(:, k))
+        if (present(ctl)) then
+          ctl(1) = size(qout, 2) + k
+          if (ctl(2) /= 0 .and. k < iinfo(1)) then
+            status = MBD_USER_ABORT; iinfo(1) = k; rinfo(1) = t
+            write (msg, '(a,es12.5,a)') 'stopped on request at t = ', t, &
+              ' (the outputs so far are kept)'
+            exit
+          end if
+        end if
         if (present(ptab)) call sens_multipliers(m, sens, qout(:, k), qdout(:, k), &
                                                  qddout(:, k), t, w%jac, lamout(:, k), &
                                                  sq(:, :, k), sqd(:, :, k), sqdd(:, :, k), &
@@ -586,7 +602,8 @@ contains
   !! rinfo: 1 time of a failure, 2 smallest step, 3 largest step.
   subroutine api_dynamics(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, v0, t0, t1, nsteps, &
                           method, rtol, atol, h, rho_inf, balpha, bbeta, every, qout, qdout, &
-                          qddout, lamout, eout, iinfo, rinfo, redundant, status, msg, max_steps)
+                          qddout, lamout, eout, iinfo, rinfo, redundant, status, msg, max_steps, &
+                          ctl)
     integer, intent(in) :: nb, ctab(:, :), ftab(:, :), nsteps, method
     integer, intent(in) :: every                !! store every every-th output (and the last)
     real(wp), intent(in) :: rpar(:), bmass(:, :), grav(2), fpar(:), q0(:), v0(:), t0, t1
@@ -600,6 +617,8 @@ contains
     integer, intent(out) :: status              !! MBD_OK, < 0 input, > 0 numerical
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
     integer, intent(in) :: max_steps            !! step limit (accepted + rejected); 0: default
+    !> progress as in api_kinematics (the rows stored so far; a request to stop)
+    integer, intent(inout), optional, volatile :: ctl(:)
     type(model_t) :: m
     type(dyn_work_t) :: w
     type(kin_work_t) :: kw
@@ -669,7 +688,7 @@ contains
     if (bbeta >= zero) opts%bbeta = bbeta
     if (max_steps > 0) opts%max_steps = max_steps
     call integrate(m, w, q, qd, t0, t1, nsteps, every, opts, qout, qdout, qddout, lamout, nout, &
-                   dst, status, msg)
+                   dst, status, msg, ctl)
     iinfo(1) = nout; iinfo(3) = dst%steps; iinfo(4) = dst%rejected; iinfo(5) = dst%newton
     iinfo(6) = dst%rhs; iinfo(7) = dst%jacobians; iinfo(8) = dst%partitions
     iinfo(10) = dst%factorizations

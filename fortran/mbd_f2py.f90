@@ -31,13 +31,16 @@ subroutine core_eval(nb, nc, ctab, np, rpar, nq, neq, q, qd, t, phi, jac, nu, ga
 end subroutine core_eval
 
 subroutine core_kinematics(nb, nc, ctab, np, rpar, nq, neq, q0, t0, t1, nsteps, tol, &
-                           maxit, tmin, every, solver, nout, qout, qdout, qddout, iinfo, rinfo, &
-                           qsing, dep, redundant, tpass, status, msg)
+                           maxit, tmin, every, solver, nout, ctl, qout, qdout, qddout, iinfo, &
+                           rinfo, qsing, dep, redundant, tpass, status, msg)
   use iso_c_binding, only: c_double, c_int
   use mbd_api, only: api_kinematics
   implicit none
   integer(c_int), intent(in) :: nb, nc, np, nq, neq, nsteps, maxit, every, solver, nout
   integer(c_int), intent(in) :: ctab(8, nc)
+  !> progress: ctl(1) outputs stored so far, ctl(2) /= 0 stops the run (read and written
+  !! while the call runs, from another thread)
+  integer(c_int), intent(inout) :: ctl(2)
   real(c_double), intent(in) :: rpar(np), q0(nq), t0, t1, tol, tmin
   real(c_double), intent(out) :: qout(nq, nout), qdout(nq, nout), qddout(nq, nout)
   integer(c_int), intent(out) :: iinfo(10)
@@ -51,7 +54,7 @@ subroutine core_kinematics(nb, nc, ctab, np, rpar, nq, neq, q0, t0, t1, nsteps, 
   !f2py threadsafe
   call api_kinematics(nb, ctab, rpar, q0, t0, t1, nsteps, tol, maxit, tmin, every, solver, &
                       qout, qdout, qddout, iinfo, rinfo, qsing, dep, redundant, tpass, &
-                      status, msg)
+                      status, msg, ctl=ctl)
 end subroutine core_kinematics
 
 subroutine core_kin_step(nb, nc, ctab, np, rpar, nq, q, qd, qdd, t_prev, t, tol, maxit, &
@@ -102,13 +105,17 @@ subroutine core_profile(kind, np, raw, na, alpha, pts, status, msg)
 end subroutine core_profile
 
 subroutine core_inverse(nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp, fpar, nq, neq, q0, &
-                        t0, t1, nsteps, tol, every, solver, nout, qout, qdout, qddout, lamout, &
-                        eout, iinfo, rinfo, qsing, dep, redundant, tpass, status, msg)
+                        t0, t1, nsteps, tol, every, solver, nout, ctl, qout, qdout, qddout, &
+                        lamout, eout, iinfo, rinfo, qsing, dep, redundant, tpass, status, &
+                        msg)
   use iso_c_binding, only: c_double, c_int
   use mbd_api, only: api_inverse
   implicit none
   integer(c_int), intent(in) :: nb, nc, np, nf, nfp, nq, neq, nsteps, every, solver, nout
   integer(c_int), intent(in) :: ctab(8, nc), ftab(6, nf)
+  !> progress: ctl(1) outputs stored so far, ctl(2) /= 0 stops the run (read and written
+  !! while the call runs, from another thread)
+  integer(c_int), intent(inout) :: ctl(2)
   real(c_double), intent(in) :: rpar(np), bmass(2, nb), grav(2), fpar(nfp), q0(nq), t0, t1, tol
   real(c_double), intent(out) :: qout(nq, nout), qdout(nq, nout)
   real(c_double), intent(out) :: qddout(nq, nout), lamout(neq, nout)
@@ -117,9 +124,10 @@ subroutine core_inverse(nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp, fpar
   real(c_double), intent(out) :: rinfo(10), qsing(nq), tpass(64)
   character(len=512), intent(out) :: msg
   !f2py intent(hide) :: nc, np, nf, nfp, nq
+  !f2py threadsafe
   call api_inverse(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, t0, t1, nsteps, tol, every, &
                    solver, qout, qdout, qddout, lamout, eout, iinfo, rinfo, qsing, dep, &
-                   redundant, tpass, status, msg)
+                   redundant, tpass, status, msg, ctl=ctl)
 end subroutine core_inverse
 
 ! every >= 1: only the outputs k = 0, every, 2 every, ... and k = nsteps are stored; nrow is
@@ -127,8 +135,8 @@ end subroutine core_inverse
 ! max_steps: the limit on accepted plus rejected steps (0, the default: the core's default).
 subroutine core_dynamics(nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp, fpar, nq, neq, &
                          q0, v0, t0, t1, nsteps, method, rtol, atol, h, rho_inf, balpha, bbeta, &
-                         every, nrow, qout, qdout, qddout, lamout, eout, iinfo, rinfo, &
-                         redundant, status, msg, max_steps)
+                         every, nrow, ctl, qout, qdout, qddout, lamout, eout, iinfo, &
+                         rinfo, redundant, status, msg, max_steps)
   use iso_c_binding, only: c_double, c_int
   use mbd_api, only: api_dynamics
   implicit none
@@ -136,6 +144,9 @@ subroutine core_dynamics(nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp, fpa
   integer(c_int), intent(in) :: max_steps
   !f2py integer(c_int) optional, intent(in) :: max_steps = 0
   integer(c_int), intent(in) :: ctab(8, nc), ftab(6, nf)
+  !> progress: ctl(1) outputs stored so far, ctl(2) /= 0 stops the run (read and written
+  !! while the call runs, from another thread)
+  integer(c_int), intent(inout) :: ctl(2)
   real(c_double), intent(in) :: rpar(np), bmass(2, nb), grav(2), fpar(nfp), q0(nq), v0(nq)
   real(c_double), intent(in) :: t0, t1, rtol, atol, h, rho_inf, balpha, bbeta
   real(c_double), intent(out) :: qout(nq, nrow), qdout(nq, nrow)
@@ -145,9 +156,10 @@ subroutine core_dynamics(nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp, fpa
   real(c_double), intent(out) :: rinfo(10)
   character(len=512), intent(out) :: msg
   !f2py intent(hide) :: nc, np, nf, nfp, nq
+  !f2py threadsafe
   call api_dynamics(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, v0, t0, t1, nsteps, method, &
                     rtol, atol, h, rho_inf, balpha, bbeta, every, qout, qdout, qddout, lamout, &
-                    eout, iinfo, rinfo, redundant, status, msg, max_steps)
+                    eout, iinfo, rinfo, redundant, status, msg, max_steps, ctl)
 end subroutine core_dynamics
 
 subroutine core_statics(nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp, fpar, nq, neq, q0, &

@@ -23,7 +23,8 @@
 module mbd_integrators
   use mbd_kinds, only: wp, zero, one, half, two
   use mbd_status, only: MBD_OK, MBD_BAD_SETTING, MBD_SINGULAR, MBD_NO_CONVERGENCE, &
-                        MBD_INTEGRATOR_FAILED, MBD_LAPACK, MBD_NO_MEMORY, MSG_LEN
+                        MBD_INTEGRATOR_FAILED, MBD_LAPACK, MBD_NO_MEMORY, MBD_USER_ABORT, &
+                        MSG_LEN
   use mbd_memory, only: REAL_BYTES, mem_fail
   use mbd_model, only: model_t
   use mbd_assemble, only: assemble_dense, assemble_blocks, scatter_dense
@@ -110,7 +111,7 @@ contains
   !! The multipliers lo at every output are those of the index-1 equations at the output
   !! state (see finish_outputs).
   subroutine integrate(m, w, q, qd, t0, t1, nsteps, every, opts, qo, vo, ao, lo, nout, st, &
-                       status, msg)
+                       status, msg, ctl)
     type(model_t), intent(in) :: m               !! model
     type(dyn_work_t), intent(inout) :: w         !! dynamics work arrays (dyn_init done)
     real(wp), intent(inout) :: q(:), qd(:)       !! consistent initial state, then final
@@ -124,6 +125,9 @@ contains
     type(dyn_stats_t), intent(out) :: st         !! counters
     integer, intent(out) :: status               !! MBD_OK or a failure
     character(len=MSG_LEN), intent(out) :: msg   !! explanation
+    !> progress, shared with a caller in another thread: ctl(1) gets the rows stored so far,
+    !! ctl(2) /= 0 asks the run to stop (MBD_USER_ABORT, the rows so far kept)
+    integer, intent(inout), optional, volatile :: ctl(:)
     type(itg_t) :: c
     status = MBD_OK; msg = ''; nout = 0
     qo = zero; vo = zero; ao = zero; lo = zero
@@ -153,11 +157,11 @@ contains
     if (nsteps > 0) then
       select case (opts%method)
       case (METH_GENALPHA)
-        call run_genalpha(m, w, c, qo, vo, ao, status, msg)
+        call run_genalpha(m, w, c, qo, vo, ao, status, msg, ctl)
       case (METH_DOPRI5, METH_RK4)
-        call run_explicit(m, w, c, .false., qo, vo, ao, status, msg)
+        call run_explicit(m, w, c, .false., qo, vo, ao, status, msg, ctl)
       case (METH_PARTITIONED)
-        call run_explicit(m, w, c, .true., qo, vo, ao, status, msg)
+        call run_explicit(m, w, c, .true., qo, vo, ao, status, msg, ctl)
       case default
         status = MBD_BAD_SETTING; msg = 'unknown integration method'
       end select
@@ -282,6 +286,24 @@ contains
     end do
   end subroutine emit
 
+  !> Publish the rows stored so far in ctl(1); .true. (with MBD_USER_ABORT) when the caller
+  !! asked the run to stop (ctl(2) /= 0). Without ctl, nothing.
+  logical function stopped(c, t, status, msg, ctl)
+    type(itg_t), intent(inout) :: c
+    real(wp), intent(in) :: t
+    integer, intent(inout) :: status
+    character(len=MSG_LEN), intent(inout) :: msg
+    integer, intent(inout), optional, volatile :: ctl(:)
+    stopped = .false.
+    if (.not. present(ctl)) return
+    ctl(1) = c%nout
+    if (ctl(2) == 0) return
+    stopped = .true.
+    status = MBD_USER_ABORT
+    c%st%t_fail = t
+    write (msg, '(a,es12.5,a)') 'stopped on request at t = ', t, ' (the rows so far are kept)'
+  end function stopped
+
   !> Rows stored for nsteps output intervals, keeping k = 0, every, 2 every, ... and nsteps.
   pure integer function output_rows(nsteps, every)
     integer, intent(in) :: nsteps             !! output intervals
@@ -324,10 +346,11 @@ contains
   !! Converged: |Phi| <= w%tol, the last correction below 1e-3 (atol + rtol |q|), and the
   !! residual of M q_ddot + J^T lambda = Q below GA_RTOL of its largest term, so that the
   !! result is that of full Newton (a stale S only changes the iteration count).
-  subroutine run_genalpha(m, w, c, qo, vo, ao, status, msg)
+  subroutine run_genalpha(m, w, c, qo, vo, ao, status, msg, ctl)
     type(model_t), intent(in) :: m
     type(dyn_work_t), intent(inout) :: w
     type(itg_t), intent(inout) :: c
+    integer, intent(inout), optional, volatile :: ctl(:)   !! progress (see integrate)
     real(wp), intent(inout) :: qo(:, :), vo(:, :), ao(:, :)
     integer, intent(out) :: status
     character(len=MSG_LEN), intent(out) :: msg
@@ -488,6 +511,10 @@ contains
       call emit(c, qo, vo, ao, t, q, qd, qdd, tnew, qn, vn, an)
       c%st%steps = c%st%steps + 1
       c%st%hmin = min(c%st%hmin, h); c%st%hmax = max(c%st%hmax, h)
+      if (stopped(c, tnew, status, msg, ctl)) then
+        c%qf = qn; c%vf = vn; c%af = an; c%lam = lamn
+        return
+      end if
       t = tnew; q = qn; qd = vn; qdd = an; acc = accn; lam = lamn
       if (.not. fixed) then
         facc = min(1.5_wp, max(0.2_wp, 0.8_wp * max(err, 1.0e-10_wp)**(-one / 3)))
@@ -515,7 +542,7 @@ contains
   end subroutine run_genalpha
 
   ! -------------------------------------------------------------------- explicit methods
-  subroutine run_explicit(m, w, c, partitioned, qo, vo, ao, status, msg)
+  subroutine run_explicit(m, w, c, partitioned, qo, vo, ao, status, msg, ctl)
     type(model_t), intent(in) :: m
     type(dyn_work_t), intent(inout) :: w
     type(itg_t), intent(inout) :: c
@@ -523,6 +550,7 @@ contains
     real(wp), intent(inout) :: qo(:, :), vo(:, :), ao(:, :)
     integer, intent(out) :: status
     character(len=MSG_LEN), intent(out) :: msg
+    integer, intent(inout), optional, volatile :: ctl(:)   !! progress (see integrate)
     real(wp), allocatable :: y(:), ynew(:), k(:, :), e(:)
     real(wp) :: t, h, tnew, err, fac, qa(m%nq), va(m%nq), aa(m%nq)
     integer :: stt, nprev
@@ -634,6 +662,7 @@ contains
       c%qs = qa; c%vs = va; c%as = aa; c%ts = tnew
       c%st%steps = c%st%steps + 1
       c%st%hmin = min(c%st%hmin, h); c%st%hmax = max(c%st%hmax, h)
+      if (stopped(c, tnew, status, msg, ctl)) return
       t = tnew
       y = ynew
       if (.not. fixed) then

@@ -28,7 +28,8 @@ module mbd_kinematics
   use mbd_kinds, only: wp, zero, one, half
   use mbd_status, only: MBD_OK, MBD_BAD_SETTING, MBD_BAD_COUNT, MBD_SINGULAR, &
                         MBD_NO_CONVERGENCE, MBD_SINGULAR_CONFIG, MBD_ASSEMBLY_FAILED, &
-                        MBD_LAPACK, MBD_INCONSISTENT, MBD_NO_MEMORY, MSG_LEN
+                        MBD_LAPACK, MBD_INCONSISTENT, MBD_NO_MEMORY, MBD_USER_ABORT, &
+                        MSG_LEN
   use mbd_memory, only: REAL_BYTES, mem_check, mem_fail
   use mbd_points, only: NLOC, MAXROW
   use mbd_model, only: model_t
@@ -777,7 +778,7 @@ contains
   !! On a singular configuration the outputs up to it are filled (rep%ndone columns) and
   !! status is MBD_SINGULAR_CONFIG with rep describing the configuration.
   subroutine kin_run(m, q0, t0, t1, nsteps, opts, qout, qdout, qddout, rep, status, msg, &
-                     sens, sq, sqd, sqdd)
+                     sens, sq, sqd, sqdd, ctl)
     type(model_t), intent(in) :: m             !! model
     real(wp), intent(in) :: q0(:)              !! estimates (nq)
     real(wp), intent(in) :: t0, t1             !! time span
@@ -793,6 +794,9 @@ contains
     !! dq/dp, dq_dot/dp and dq_ddot/dp at every stored output
     type(sens_t), intent(inout), optional :: sens
     real(wp), intent(out), optional :: sq(:, :, :), sqd(:, :, :), sqdd(:, :, :)
+    !> progress, shared with a caller in another thread: ctl(1) gets the outputs stored so
+    !! far, ctl(2) /= 0 asks the run to stop (MBD_USER_ABORT, the outputs so far kept)
+    integer, intent(inout), optional, volatile :: ctl(:)
     type(kin_work_t) :: w
     type(band_t) :: band
     logical, allocatable :: post(:)   ! outputs whose sensitivities are computed at the end
@@ -981,6 +985,15 @@ contains
         pcur = w%pivratio
         call accept()
         if (last) call store(k)
+        if (present(ctl)) then
+          ctl(1) = rep%ndone
+          if (ctl(2) /= 0) then
+            status = MBD_USER_ABORT; rep%t_fail = tt
+            write (msg, '(a,es12.5,a)') 'stopped on request at t = ', tt, &
+              ' (the outputs so far are kept)'
+            call count_work(); return
+          end if
+        end if
         call quiet_passage()
         hcur = min(2 * hh, h)
         cycle

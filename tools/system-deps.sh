@@ -8,6 +8,7 @@ command -v pkg-config >/dev/null 2>&1 || need+=(pkg-config)
 if ! pkg-config --exists lapack 2>/dev/null; then need+=(liblapack-dev libblas-dev); fi
 if ! python3 -c 'import venv, ensurepip' >/dev/null 2>&1; then need+=(python3-venv); fi
 if [ ${#need[@]} -eq 0 ]; then
+  echo "   all present"
   exit 0
 fi
 echo "installing system packages: ${need[*]}"

@@ -80,7 +80,7 @@ class Model(ModelDescription):
     # ------------------------------------------------------------------ analyses
     def kinematics(self, t_end: float, steps: int, t0: float = 0.0, tol: float | None = None,
                    maxit: int | None = None, every: int = 1, solver: str = "auto",
-                   sensitivities: Any = None) -> KinematicsResult:
+                   sensitivities: Any = None, progress: bool | None = None) -> KinematicsResult:
         """Kinematic analysis at steps + 1 uniform times from t0 to t_end.
 
         The whole time loop runs in the Fortran core. Assembly refines the q0 estimates at t0.
@@ -112,6 +112,11 @@ class Model(ModelDescription):
             n_coordinates, n_params), and ``res.sensitivity(body, name)``. They come from
             the differentiated constraint equations, J dq/dp = -Phi_p and so on, solved
             with each step's factorization (exact to round-off; see docs/sensitivities.md).
+        progress : bool, optional
+            A progress bar (tqdm) while the core runs: None (default) shows it when the run
+            lasts more than about 2 s on a terminal or in a notebook, True always, False
+            never. The results are the same bit for bit (one core call either way); Ctrl-C
+            stops the run at its next output.
 
         Returns
         -------
@@ -137,9 +142,10 @@ class Model(ModelDescription):
         """
         if self.has_masses() and maxit is None:
             return run_inverse(self, t_end=t_end, steps=steps, t0=t0, tol=tol, every=every,
-                               solver=solver, sensitivities=sensitivities)
+                               solver=solver, sensitivities=sensitivities, progress=progress)
         return run_kinematics(self, t_end=t_end, steps=steps, t0=t0, tol=tol, maxit=maxit,
-                              every=every, solver=solver, sensitivities=sensitivities)
+                              every=every, solver=solver, sensitivities=sensitivities,
+                              progress=progress)
 
     def analyze_dof(self, t: float = 0.0, tol: float | None = None) -> DofReport:
         """Degrees of freedom and redundant constraints at the configuration assembled from
@@ -168,7 +174,8 @@ class Model(ModelDescription):
 
     def inverse_dynamics(self, t_end: float, steps: int, t0: float = 0.0,
                          tol: float | None = None, every: int = 1, solver: str = "auto",
-                         sensitivities: Any = None) -> DynamicsResult:
+                         sensitivities: Any = None,
+                         progress: bool | None = None) -> DynamicsResult:
         """Kinematics of the driven model plus, at every output time, the multipliers lambda
         (J^T lambda = Q - M q_ddot), the joint reactions (``res.reaction(name)``), the driver
         efforts (``res.effort(name)``) and the energies. ``every`` and ``solver`` as in
@@ -177,7 +184,8 @@ class Model(ModelDescription):
         With ``sensitivities=[names]`` (geometry, masses, inertias, gravity, force and
         driver parameters) the result also has the kinematic sensitivities of
         :meth:`kinematics`, ``dlam_dp`` (rows, neq, n_params), ``res.effort_dp(driver)``
-        (rows, n_params) and ``res.reaction_dp(name)``.
+        (rows, n_params) and ``res.reaction_dp(name)``. ``progress`` as in :meth:`kinematics`
+        (the bar counts the kinematic pass, then the multipliers').
 
         Raises
         ------
@@ -187,13 +195,14 @@ class Model(ModelDescription):
             As :meth:`kinematics`.
         """
         return run_inverse(self, t_end=t_end, steps=steps, t0=t0, tol=tol, every=every,
-                           solver=solver, sensitivities=sensitivities)
+                           solver=solver, sensitivities=sensitivities, progress=progress)
 
     def dynamics(self, t_end: float, steps: int, method: str | None = None,
                  rtol: float | None = None, atol: float | None = None, h: float | None = None,
                  rho_inf: float | None = None, alpha: float | None = None,
                  beta: float | None = None, t0: float = 0.0, every: int = 1,
-                 max_steps: int | None = None, sensitivities: Any = None) -> DynamicsResult:
+                 max_steps: int | None = None, sensitivities: Any = None,
+                 progress: bool | None = None) -> DynamicsResult:
         """Forward dynamics of M q_ddot + J^T lambda = Q, Phi = 0 from the assembled q0 and
         v0 (projected onto J q_dot = nu), outputs at steps + 1 uniform times (every
         every-th of them kept).
@@ -235,6 +244,8 @@ class Model(ModelDescription):
             control, giving ``dq_dp``, ``dqd_dp``, ``dqdd_dp`` (rows, n_coordinates,
             n_params). The start's sensitivities are those of the assembled q0 (the minimum-
             norm change) and of the projected v0.
+        progress : bool, optional
+            A progress bar while the core integrates, as in :meth:`kinematics`.
 
         Returns
         -------
@@ -258,7 +269,8 @@ class Model(ModelDescription):
         """
         return run_dynamics(self, t_end=t_end, steps=steps, method=method, rtol=rtol,
                             atol=atol, h=h, rho_inf=rho_inf, alpha=alpha, beta=beta, t0=t0,
-                            every=every, max_steps=max_steps, sensitivities=sensitivities)
+                            every=every, max_steps=max_steps, sensitivities=sensitivities,
+                            progress=progress)
 
     def statics(self, t: float = 0.0, sensitivities: Any = None) -> StaticsResult:
         """Static equilibrium under gravity, springs and loads (drivers held at t), with the

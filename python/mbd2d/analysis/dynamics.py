@@ -15,6 +15,7 @@ from ..results.dynamics import DynamicsResult
 from ..validate import number, whole
 from .failures import assembly_failed, bad_entry, inconsistent_at, row_names
 from .outputs import dynamics_result, finite_part
+from .progress import run_core
 from .sensitivities import attach, check_status, requested, table
 from .settings import check_memory, check_span, output_rows, output_steps, time_grid
 
@@ -28,7 +29,8 @@ def run_dynamics(model: ModelDescription, t_end: float, steps: int, method: str 
                  rtol: float | None = None, atol: float | None = None, h: float | None = None,
                  rho_inf: float | None = None, alpha: float | None = None,
                  beta: float | None = None, t0: float = 0.0, every: Any = 1,
-                 max_steps: Any = None, sensitivities: Any = None) -> DynamicsResult:
+                 max_steps: Any = None, sensitivities: Any = None,
+                 progress: bool | None = None) -> DynamicsResult:
     """Forward dynamics in one core call; see :meth:`mbd2d.Model.dynamics`."""
     t0, t_end, steps = check_span(t0, t_end, steps)
     nout = output_rows(steps, every)
@@ -82,8 +84,12 @@ def run_dynamics(model: ModelDescription, t_end: float, steps: int, method: str 
                                  ptab)
         check_status(out.status, out.iinfo, out.msg, params)
     else:
-        out = core.dynamics(p, d, t0, t_end, steps, METHODS[method], rtol_v, atol_v, h_v,
-                            rho_v, alpha_v, beta_v, every, nout, nmax)
+        fixed = (t_end - t0) / h_v if h_v > 0 else 0.0
+        out = run_core(lambda ctl: core.dynamics(p, d, t0, t_end, steps, METHODS[method],
+                                                 rtol_v, atol_v, h_v, rho_v, alpha_v, beta_v,
+                                                 every, nout, nmax, ctl),
+                       nout, f"dynamics ({method})", progress,
+                       max(float(steps), fixed) * float(p.nq + p.neq)**2)
     iinfo, rinfo, status = out.iinfo, out.rinfo, out.status
     n = int(iinfo[0])
     t = time_grid(t0, t_end, steps, idx)

@@ -13,6 +13,7 @@ from ..errors import RedundantConstraintWarning
 from ..results.dynamics import DynamicsResult
 from .failures import BAD_FORCE, bad_entry, kinematic_failure, row_names
 from .outputs import dynamics_result, finite_part
+from .progress import run_core
 from .sensitivities import attach, check_status, requested, table
 from .settings import (check_memory, check_solver, check_span, output_rows, output_steps,
                        require_determined, solver_code, time_grid)
@@ -20,7 +21,7 @@ from .settings import (check_memory, check_solver, check_span, output_rows, outp
 
 def run_inverse(model: ModelDescription, t_end: float, steps: int, t0: float = 0.0,
                 tol: float | None = None, every: Any = 1, solver: str = "auto",
-                sensitivities: Any = None) -> DynamicsResult:
+                sensitivities: Any = None, progress: bool | None = None) -> DynamicsResult:
     """Kinematics plus the multipliers, energies and (on demand) reactions at every output.
 
     See :meth:`mbd2d.Model.inverse_dynamics`.
@@ -41,7 +42,10 @@ def run_inverse(model: ModelDescription, t_end: float, steps: int, t0: float = 0
         out = core.inverse_sens(p, d, t0, t_end, steps, tol_v, int(every), code, nout, ptab)
         check_status(out.status, out.iinfo, out.msg, params)
     else:
-        out = core.inverse(p, d, t0, t_end, steps, tol_v, int(every), code, nout)
+        out = run_core(lambda ctl: core.inverse(p, d, t0, t_end, steps, tol_v, int(every),
+                                                code, nout, ctl),
+                       2 * nout, "inverse dynamics", progress,
+                       float(steps) * (p.nq + p.neq) + nout * float(p.nq + p.neq)**2)
     iinfo, status = out.iinfo, out.status
     n = int(iinfo[0])
     t = time_grid(t0, t_end, steps, idx)

@@ -13,6 +13,7 @@ from ..errors import RedundantConstraintWarning, SingularPassageWarning
 from ..results.kinematics import KinematicsResult
 from .failures import kinematic_failure, row_names
 from .outputs import finite_part
+from .progress import run_core
 from .sensitivities import attach, check_status, requested, table
 from .settings import (check_memory, check_solver, check_span, output_rows, output_steps,
                        require_determined, solver_code, time_grid)
@@ -21,7 +22,7 @@ from .settings import (check_memory, check_solver, check_span, output_rows, outp
 def run_kinematics(model: ModelDescription, t_end: float, steps: int, t0: float = 0.0,
                    tol: float | None = None, maxit: int | None = None,
                    tmin: float | None = None, every: Any = 1, solver: str = "auto",
-                   sensitivities: Any = None) -> KinematicsResult:
+                   sensitivities: Any = None, progress: bool | None = None) -> KinematicsResult:
     """Run a kinematic analysis in one core call; see :meth:`mbd2d.Model.kinematics`."""
     t0, t_end, steps = check_span(t0, t_end, steps)
     tol_v, maxit_v = check_solver(tol, maxit)
@@ -39,8 +40,10 @@ def run_kinematics(model: ModelDescription, t_end: float, steps: int, t0: float 
                                    int(every), code, nout, ptab)
         check_status(out.status, out.iinfo, out.msg, params)
     else:
-        out = core.kinematics(p, t0, t_end, steps, tol_v, maxit_v, float(tmin or 0.0),
-                              int(every), code, nout)
+        out = run_core(lambda ctl: core.kinematics(p, t0, t_end, steps, tol_v, maxit_v,
+                                                   float(tmin or 0.0), int(every), code, nout,
+                                                   ctl),
+                       nout, "kinematics", progress, float(steps) * (p.nq + p.neq))
     iinfo, rinfo, tpass, status = out.iinfo, out.rinfo, out.tpass, out.status
     n = int(iinfo[0])
     t = time_grid(t0, t_end, steps, idx)

@@ -55,13 +55,21 @@ def evaluate(nb: int, ctab: np.ndarray, rpar: np.ndarray, neq: int, q: np.ndarra
                   float(t), numbers=neq * (len(q) + 3))
 
 
+def new_ctl() -> np.ndarray:
+    """The progress array a time loop shares while it runs (read and written from another
+    thread): [0] outputs done so far, [1] set to 1 to ask the run to stop."""
+    return np.zeros(2, dtype=np.int32)
+
+
 def kinematics(p: Packed, t0: float, t1: float, steps: int, tol: float, maxit: int,
-               tmin: float, every: int, solver: int, nout: int) -> SimpleNamespace:
+               tmin: float, every: int, solver: int, nout: int,
+               ctl: np.ndarray | None = None) -> SimpleNamespace:
     """The whole kinematic run: ``q``, ``qd``, ``qdd`` (nq, nout), ``iinfo``, ``rinfo``,
-    ``qsing``, ``dep``, ``red``, ``tpass``, ``status``, ``msg``."""
+    ``qsing``, ``dep``, ``red``, ``tpass``, ``status``, ``msg``. ``ctl``: see
+    :func:`new_ctl` (the core releases the GIL while it runs)."""
     return _named("q qd qdd iinfo rinfo qsing dep red tpass status msg", _core.core_kinematics,
                   p.nb, p.ctab, p.rpar, p.neq, p.q0, t0, t1, steps, tol, maxit, tmin, every,
-                  solver, nout, numbers=3 * p.nq * nout + p.nq + 2 * p.neq)
+                  solver, nout, new_ctl() if ctl is None else ctl, numbers=3 * p.nq * nout + p.nq + 2 * p.neq)
 
 
 def kin_step(p: Packed, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, t_prev: float,
@@ -86,26 +94,32 @@ def profile(kind: int, raw: np.ndarray, alphas: np.ndarray) -> SimpleNamespace:
 
 
 def inverse(p: Packed, d: DynamicTables, t0: float, t1: float, steps: int, tol: float,
-            every: int, solver: int, nout: int) -> SimpleNamespace:
+            every: int, solver: int, nout: int,
+            ctl: np.ndarray | None = None) -> SimpleNamespace:
     """Kinematics plus multipliers and energies: ``q``, ``qd``, ``qdd``, ``lam``, ``e``,
-    ``iinfo``, ``rinfo``, ``qsing``, ``dep``, ``red``, ``tpass``, ``status``, ``msg``."""
+    ``iinfo``, ``rinfo``, ``qsing``, ``dep``, ``red``, ``tpass``, ``status``, ``msg``.
+    ``ctl``: see :func:`new_ctl`; ctl[0] runs to 2 nout (kinematics, then multipliers)."""
     return _named("q qd qdd lam e iinfo rinfo qsing dep red tpass status msg",
                   _core.core_inverse, ctab=p.ctab, rpar=p.rpar, bmass=d.bmass, grav=d.grav,
                   ftab=d.ftab, fpar=d.fpar, neq=p.neq, q0=p.q0, t0=t0, t1=t1, nsteps=steps,
                   tol=tol, every=every, solver=solver, nout=nout,
+                  ctl=new_ctl() if ctl is None else ctl,
                   numbers=(3 * p.nq + p.neq + 4) * nout + p.nq + 2 * p.neq)
 
 
 def dynamics(p: Packed, d: DynamicTables, t0: float, t1: float, steps: int, method: int,
              rtol: float, atol: float, h: float, rho_inf: float, alpha: float, beta: float,
-             every: int, nrow: int, max_steps: int) -> SimpleNamespace:
+             every: int, nrow: int, max_steps: int,
+             ctl: np.ndarray | None = None) -> SimpleNamespace:
     """Forward dynamics: ``q``, ``qd``, ``qdd``, ``lam``, ``e``, ``iinfo``, ``rinfo``, ``red``,
-    ``status``, ``msg``. max_steps: the limit on accepted plus rejected steps."""
+    ``status``, ``msg``. max_steps: the limit on accepted plus rejected steps. ``ctl``: see
+    :func:`new_ctl`."""
     return _named("q qd qdd lam e iinfo rinfo red status msg", _core.core_dynamics,
                   ctab=p.ctab, rpar=p.rpar, bmass=d.bmass, grav=d.grav, ftab=d.ftab,
                   fpar=d.fpar, neq=p.neq, q0=p.q0, v0=d.v0, t0=t0, t1=t1, nsteps=steps,
                   method=method, rtol=rtol, atol=atol, h=h, rho_inf=rho_inf, balpha=alpha,
                   bbeta=beta, every=every, nrow=nrow, max_steps=max_steps,
+                  ctl=new_ctl() if ctl is None else ctl,
                   numbers=(3 * p.nq + p.neq + 4) * nrow + p.neq)
 
 
