@@ -116,7 +116,7 @@ class Model(ModelDescription):
             A progress bar (tqdm) while the core runs: None (default) shows it when the run
             lasts more than about 2 s on a terminal or in a notebook, True always, False
             never. The results are the same bit for bit (one core call either way); Ctrl-C
-            stops the run at its next output.
+            stops the run at its next step.
 
         Returns
         -------

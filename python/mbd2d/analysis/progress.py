@@ -4,8 +4,8 @@ The core runs the whole analysis in one call, as always, on a worker thread (the
 releases the GIL). While it runs, the core writes the number of outputs done into a small
 shared array (one integer store per output) and reads a stop flag from it; this thread reads
 the count a few times a second and moves a tqdm bar. The results are those of the same
-single call without a bar, bit for bit. Ctrl-C sets the stop flag: the core stops at its next
-output and the KeyboardInterrupt is raised here.
+single call without a bar, bit for bit. Ctrl-C sets the stop flag: the core stops after its
+next step and the KeyboardInterrupt is raised here.
 
 ``progress=None`` (the default) shows the bar only for a run that lasts longer than
 :data:`DELAY` seconds, on a terminal or in a notebook; ``True`` shows it from the start;
@@ -72,7 +72,7 @@ def run_core(call: Callable[[np.ndarray], Any], total: int, label: str, progress
     Raises
     ------
     KeyboardInterrupt
-        On Ctrl-C, after the core has stopped at its next output.
+        On Ctrl-C, after the core has stopped at its next step.
     """
     ctl = new_ctl()
     if progress is False or (progress is None and (work < SMALL_WORK or not _interactive())):
@@ -88,17 +88,18 @@ def run_core(call: Callable[[np.ndarray], Any], total: int, label: str, progress
     worker = threading.Thread(target=target, name="mbd2d-core", daemon=True)
     start = time.monotonic()
     worker.start()
-    bar = None
+    bar = _bar(total, label) if progress is True else None
     try:
-        while worker.is_alive():
+        alive = True
+        while alive:
             worker.join(POLL)
-            if bar is None and worker.is_alive() and \
-                    (progress is True or time.monotonic() - start >= DELAY):
+            alive = worker.is_alive()
+            if bar is None and alive and time.monotonic() - start >= DELAY:
                 bar = _bar(total, label)
             if bar is not None:
                 bar.update(max(0, min(int(ctl[0]), total) - bar.n))
     except KeyboardInterrupt:
-        ctl[1] = 1                        # the core stops at its next output
+        ctl[1] = 1                        # the core stops at its next step
         worker.join()
         raise
     finally:
