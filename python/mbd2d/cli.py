@@ -1,14 +1,20 @@
 """The ``mbd2d`` command line.
 
     mbd2d kinematics MODEL.toml --t-end T --steps N --out OUT.csv|OUT.npz [--every K --solver S]
+    mbd2d inverse-dynamics MODEL.toml --t-end T --steps N --out OUT.csv [--every K --solver S]
     mbd2d dynamics MODEL.toml --t-end T --steps N --out OUT.csv [--method M --rtol R --atol A --h H
                    --max-steps S]
-    mbd2d statics MODEL.toml [--t T]
+    mbd2d statics MODEL.toml [--t T] [--out OUT.csv]
     mbd2d check MODEL.toml
-    mbd2d export MODEL.toml OUT.mbd --t-end T --steps N
+    mbd2d export MODEL.toml OUT.mbd [--analysis A] --t-end T --steps N [settings of A]
     mbd2d plot MODEL.toml --t-end T --steps N --out FIG.png
                [--what mechanism|paths|time-series|forces|energy] [--analysis A] [--trace B:X,Y]
     mbd2d animate MODEL.toml --t-end T --steps N --out MOTION.gif|MOTION.mp4 [--fps F --speed S]
+
+The result commands take optional columns: ``--energy`` (kinetic, potential, total energy,
+drift), ``--multipliers``, ``--reactions`` and ``--efforts`` (need multipliers: inverse
+dynamics, dynamics, statics, or kinematics of a model with masses; inverse-dynamics writes
+the efforts unless ``--no-efforts``). ``export`` writes them into the file for mbd2d-solve.
 
 ``plot`` and ``animate`` run the analysis ``--analysis`` (default ``auto``: kinematics of a
 driven model, with the inverse dynamics when every body has a mass; dynamics otherwise) and
@@ -29,6 +35,7 @@ from .errors import (AnalysisError, InsufficientMemoryError, MbdError, ModelErro
                      SingularConfigurationError)
 from .model import Model, load
 from .results import StaticsResult
+from .results.files import OUTPUTS
 
 EXIT_OK, EXIT_INPUT, EXIT_SINGULAR, EXIT_NUMERICAL = 0, 2, 3, 4
 ANALYSES = ("auto", "kinematics", "inverse-dynamics", "dynamics")
@@ -56,6 +63,24 @@ def _dynamics_settings(p: argparse.ArgumentParser) -> None:
                    "steps, accepted and rejected (default 10000000)")
 
 
+def _columns(p: argparse.ArgumentParser, energy: bool = True, efforts: bool = False) -> None:
+    """The optional output columns."""
+    if energy:
+        p.add_argument("--energy", action="store_true",
+                       help="columns kinetic, potential, energy, drift_position, drift_velocity")
+    p.add_argument("--multipliers", action="store_true",
+                   help="a column lambda.LABEL per row of Phi")
+    p.add_argument("--reactions", action="store_true", help="columns NAME.fx, NAME.fy, "
+                   "NAME.mz (on the first body) and NAME.fx_j, NAME.fy_j, NAME.mz_j per joint "
+                   "and driver")
+    p.add_argument("--efforts", action=argparse.BooleanOptionalAction, default=efforts,
+                   help="a column NAME.effort per driver" + (" (default)" if efforts else ""))
+
+
+def _outputs(args: argparse.Namespace) -> dict[str, bool]:
+    return {k: bool(getattr(args, k, False)) for k in OUTPUTS if getattr(args, k, False)}
+
+
 def _picture_settings(p: argparse.ArgumentParser) -> None:
     p.add_argument("--analysis", default="auto", choices=ANALYSES,
                    help="auto (default): kinematics of a driven model (with the inverse "
@@ -79,25 +104,47 @@ def _parser() -> argparse.ArgumentParser:
     k.add_argument("--every", type=int, default=1, help="write every k-th row (and the last)")
     k.add_argument("--solver", default="auto", choices=["auto", "dense", "banded"],
                    help="linear solver (default auto: banded LU for large chains)")
+    _columns(k)
+    i = sub.add_parser("inverse-dynamics", help="kinematics of a driven model with masses, "
+                       "with driver efforts, multipliers and reactions")
+    _span(i)
+    i.add_argument("--out", required=True, help="output file, .csv or .npz")
+    i.add_argument("--tol", type=float, default=None, help="Newton tolerance (default 1e-12)")
+    i.add_argument("--every", type=int, default=1, help="write every k-th row (and the last)")
+    i.add_argument("--solver", default="auto", choices=["auto", "dense", "banded"],
+                   help="linear solver (default auto: banded LU for large chains)")
+    _columns(i, efforts=True)
     d = sub.add_parser("dynamics", help="forward dynamics")
     _span(d)
     d.add_argument("--out", required=True, help="output file, .csv or .npz")
     _dynamics_settings(d)
     d.add_argument("--every", type=int, default=1, help="write every k-th row (and the last)")
+    _columns(d)
     s = sub.add_parser("statics", help="static equilibrium and reactions")
     s.add_argument("model", help="model file (.toml) with masses")
     s.add_argument("--t", type=float, default=0.0, help="time at which loads and drivers are "
                    "taken (default 0)")
+    s.add_argument("--out", default=None, help="also write the equilibrium as CSV")
+    _columns(s, energy=False)
     c = sub.add_parser("check", help="degrees of freedom and redundant constraints")
     c.add_argument("model", help="model file (.toml)")
     c.add_argument("--t", type=float, default=0.0, help="time of the check (default 0)")
-    e = sub.add_parser("export", help="write a model file for the standalone mbd2d-solve")
+    e = sub.add_parser("export", help="write a model file with its analysis for the standalone "
+                       "mbd2d-solve")
     e.add_argument("model", help="model file (.toml)")
     e.add_argument("out", help="output model file (.mbd)")
-    e.add_argument("--t-end", type=float, required=True, help="final time")
-    e.add_argument("--steps", type=int, required=True, help="output intervals")
+    e.add_argument("--analysis", default="kinematics", choices=ANALYSES[1:] + ("statics",),
+                   help="the analysis mbd2d-solve runs (default kinematics)")
+    e.add_argument("--t-end", type=float, default=None, help="final time (not for statics)")
+    e.add_argument("--steps", type=int, default=None, help="output intervals")
     e.add_argument("--t0", type=float, default=0.0, help="start time (default 0)")
+    e.add_argument("--every", type=int, default=1, help="keep every k-th row (and the last)")
     e.add_argument("--tol", type=float, default=None, help="Newton tolerance (default 1e-12)")
+    e.add_argument("--solver", default="auto", choices=["auto", "dense", "banded"],
+                   help="linear solver of kinematic runs (default auto)")
+    e.add_argument("--t", type=float, default=0.0, help="statics: time of loads and drivers")
+    _dynamics_settings(e)
+    _columns(e)
     p = sub.add_parser("plot", help="run an analysis and draw it (PNG, SVG or PDF)")
     _span(p)
     p.add_argument("--out", required=True, help="picture file (.png, .svg or .pdf)")
@@ -171,7 +218,9 @@ def _run(model: Model, args: argparse.Namespace, analysis: str) -> Any:
     if analysis == "dynamics":
         return model.dynamics(**span, every=getattr(args, "every", 1), **_dynamics_kwargs(args))
     if analysis == "inverse-dynamics":
-        return model.inverse_dynamics(**span)
+        return model.inverse_dynamics(**span, tol=getattr(args, "tol", None),
+                                      every=getattr(args, "every", 1),
+                                      solver=getattr(args, "solver", "auto"))
     return model.kinematics(**span, tol=getattr(args, "tol", None),
                             every=getattr(args, "every", 1),
                             solver=getattr(args, "solver", "auto"))
@@ -197,7 +246,7 @@ def _picture(res: Any, args: argparse.Namespace) -> str:
 
 
 def _check_out(args: argparse.Namespace) -> None:
-    if args.command in ("kinematics", "dynamics"):
+    if args.command in ("kinematics", "dynamics", "inverse-dynamics"):
         ok = (".csv", ".npz")
     elif args.command == "plot":
         ok = (".png", ".svg", ".pdf")
@@ -212,7 +261,7 @@ def _write(res: Any, args: argparse.Namespace) -> str:
     """Write a (possibly partial) result where the command puts it."""
     if args.command in ("plot", "animate"):
         return _picture(res, args)
-    res.save(args.out)
+    res.save(args.out, **_outputs(args))
     return args.out
 
 
@@ -225,17 +274,27 @@ def main(argv: Sequence[str] | None = None) -> int:
             print(model.analyze_dof(t=args.t))
             return EXIT_OK
         if args.command == "statics":
-            print(_statics_report(model, model.statics(t=args.t)))
+            st = model.statics(t=args.t)
+            print(_statics_report(model, st))
+            if args.out is not None:
+                if not str(args.out).endswith(".csv"):
+                    raise ModelError(f"--out must end in .csv, got {args.out!r}", "command line")
+                st.to_csv(args.out, **_outputs(args))
+                print(f"wrote the equilibrium to {args.out}")
             return EXIT_OK
         if args.command == "export":
-            model.export(args.out, t_end=args.t_end, steps=args.steps, t0=args.t0, tol=args.tol)
-            print(f"wrote {args.out}")
+            extra = _dynamics_kwargs(args) if args.analysis == "dynamics" else {}
+            model.export(args.out, t_end=args.t_end, steps=args.steps, t0=args.t0, tol=args.tol,
+                         analysis=args.analysis, every=args.every, solver=args.solver, t=args.t,
+                         outputs=list(_outputs(args)), **extra)
+            print(f"wrote {args.out} ({args.analysis}; run it with mbd2d-solve "
+                  f"{args.out} OUT.csv)")
             return EXIT_OK
         _check_out(args)
         _trace(getattr(args, "trace", None))       # a malformed --trace fails before the run
         res = _run(model, args, getattr(args, "analysis", args.command))
         _write(res, args)
-        what = "rows" if args.command in ("kinematics", "dynamics") else "rows, drawn,"
+        what = "rows, drawn," if args.command in ("plot", "animate") else "rows"
         print(f"wrote {len(res.t)} {what} to {args.out}")
         return EXIT_OK
     except ModelError as exc:

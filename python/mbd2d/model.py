@@ -11,7 +11,7 @@ Examples
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any, Mapping, Sequence
 
 import numpy as np
 
@@ -338,10 +338,51 @@ class Model(ModelDescription):
             return None
 
     # ------------------------------------------------------------------ files
-    def export(self, path: str, t_end: float, steps: int, t0: float = 0.0,
-               tol: float | None = None, maxit: int | None = None) -> None:
-        """Write a plain-text model file for the standalone ``mbd2d-solve``."""
-        export_mbd(self, path, t_end=t_end, steps=steps, t0=t0, tol=tol, maxit=maxit)
+    def export(self, path: str | Path, t_end: float | None = None, steps: int | None = None,
+               t0: float = 0.0, tol: float | None = None, maxit: int | None = None,
+               analysis: str = "kinematics", every: int = 1, solver: str = "auto",
+               method: str | None = None, rtol: float | None = None,
+               atol: float | None = None, h: float | None = None,
+               rho_inf: float | None = None, alpha: float | None = None,
+               beta: float | None = None, max_steps: int | None = None, t: float = 0.0,
+               outputs: Sequence[str] | None = None) -> None:
+        """Write a plain-text model file that the standalone ``mbd2d-solve`` runs without
+        Python (format: docs/mbd-format.md), with the analysis and its settings.
+
+        Parameters
+        ----------
+        path : str or pathlib.Path
+            The file to write (.mbd).
+        t_end, steps, t0, every : float, int, float, int
+            The output times, as for the analyses (not for statics).
+        analysis : {"kinematics", "inverse-dynamics", "dynamics", "statics"}
+            The analysis ``mbd2d-solve`` runs.
+        tol, maxit, solver
+            As :meth:`kinematics` (``tol`` and ``solver`` also for inverse dynamics).
+        method, rtol, atol, h, rho_inf, alpha, beta, max_steps
+            As :meth:`dynamics`.
+        t : float
+            Statics: the time of loads and drivers.
+        outputs : list of str, optional
+            Optional CSV columns: "energy", "multipliers", "reactions", "efforts" (not for
+            kinematics; no energy for statics), as ``res.to_csv(path, energy=True, ...)``.
+
+        Raises
+        ------
+        ModelError
+            If the model or a setting is invalid (checked as for a Python run).
+
+        Examples
+        --------
+        >>> import mbd2d
+        >>> m = mbd2d.load("examples/fourbar_masses.toml")
+        >>> m.export("/tmp/fourbar.mbd", t_end=1.0, steps=100, analysis="dynamics",
+        ...          method="generalized-alpha", h=1e-3, outputs=["energy", "reactions"])
+        """
+        export_mbd(self, path, t_end=t_end, steps=steps, t0=t0, tol=tol, maxit=maxit,
+                   analysis=analysis, every=every, solver=solver, method=method, rtol=rtol,
+                   atol=atol, h=h, rho_inf=rho_inf, alpha=alpha, beta=beta,
+                   max_steps=max_steps, t=t, outputs=outputs)
 
 
 def load(path: str | Path) -> Model:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 import warnings
+from dataclasses import dataclass
 from typing import Any
 
 from ..binding import core
@@ -25,20 +26,36 @@ MAX_STEPS_DEFAULT = 10_000_000     # the core's default limit on accepted + reje
 INT32_MAX = 2**31 - 1
 
 
-def run_dynamics(model: ModelDescription, t_end: float, steps: int, method: str | None = None,
-                 rtol: float | None = None, atol: float | None = None, h: float | None = None,
-                 rho_inf: float | None = None, alpha: float | None = None,
-                 beta: float | None = None, t0: float = 0.0, every: Any = 1,
-                 max_steps: Any = None, sensitivities: Any = None,
-                 progress: bool | None = None) -> DynamicsResult:
-    """Forward dynamics in one core call; see :meth:`mbd2d.Model.dynamics`."""
-    t0, t_end, steps = check_span(t0, t_end, steps)
-    nout = output_rows(steps, every)
-    every = int(every)
+@dataclass(frozen=True)
+class DynamicsSettings:
+    """Checked settings of a dynamics run, as the core takes them (0 or -1: its default)."""
+
+    method: str
+    code: int
+    rtol: float
+    atol: float
+    h: float
+    rho_inf: float
+    alpha: float
+    beta: float
+    max_steps: int
+
+
+def dynamics_settings(method: str | None = None, rtol: Any = None, atol: Any = None,
+                      h: Any = None, rho_inf: Any = None, alpha: Any = None, beta: Any = None,
+                      max_steps: Any = None) -> DynamicsSettings:
+    """Check the settings of :meth:`mbd2d.Model.dynamics` and give them as the core takes
+    them (the same numbers for a Python run and an exported file).
+
+    Raises
+    ------
+    ModelError
+        For an unknown method, a setting out of range, or one the method does not use.
+    """
     nmax = MAX_STEPS_DEFAULT if max_steps is None else \
         whole(max_steps, "max_steps", "dynamics", 1, INT32_MAX)
     method = DEFAULT_METHOD if method is None else method
-    if method not in METHODS:
+    if not isinstance(method, str) or method not in METHODS:
         raise ModelError(f"unknown method {method!r}; use one of {', '.join(METHODS)}",
                          "dynamics")
 
@@ -68,6 +85,24 @@ def run_dynamics(model: ModelDescription, t_end: float, steps: int, method: str 
                          "a fixed step h", "dynamics")
     alpha_v = opt(alpha, "alpha", 0.0, 1e9, -1.0)
     beta_v = opt(beta, "beta", 0.0, 1e9, -1.0)
+    return DynamicsSettings(method, METHODS[method], rtol_v, atol_v, h_v, rho_v, alpha_v,
+                            beta_v, nmax)
+
+
+def run_dynamics(model: ModelDescription, t_end: float, steps: int, method: str | None = None,
+                 rtol: float | None = None, atol: float | None = None, h: float | None = None,
+                 rho_inf: float | None = None, alpha: float | None = None,
+                 beta: float | None = None, t0: float = 0.0, every: Any = 1,
+                 max_steps: Any = None, sensitivities: Any = None,
+                 progress: bool | None = None) -> DynamicsResult:
+    """Forward dynamics in one core call; see :meth:`mbd2d.Model.dynamics`."""
+    t0, t_end, steps = check_span(t0, t_end, steps)
+    nout = output_rows(steps, every)
+    every = int(every)
+    st = dynamics_settings(method, rtol, atol, h, rho_inf, alpha, beta, max_steps)
+    method, nmax = st.method, st.max_steps
+    rtol_v, atol_v, h_v, rho_v, alpha_v, beta_v = (st.rtol, st.atol, st.h, st.rho_inf,
+                                                   st.alpha, st.beta)
     params = requested(model, sensitivities)
     if params and method != "dopri5":
         raise ModelError(f"sensitivities are integrated with dopri5 (the variational "

@@ -8,10 +8,16 @@ from typing import Any
 
 import numpy as np
 
-from .files import writing
+from .files import check_outputs, writing
 from .kinematics import KinematicsResult
 from .reactions import Reaction, reaction_arrays, reaction_of
 from .sensitivities import parameter_index, reaction_dp_arrays, reaction_dp_of
+
+
+#: columns of ``energy=True`` in a table
+ENERGY_COLUMNS = ("kinetic", "potential", "energy", "drift_position", "drift_velocity")
+#: the reaction columns of a constraint, NAME.WORD (the Reaction attributes)
+REACTION_WORDS = ("fx", "fy", "mz", "fx_j", "fy_j", "mz_j")
 
 
 @dataclass(repr=False)
@@ -126,11 +132,63 @@ class DynamicsResult(KinematicsResult):
             raise KeyError(f"no row {row!r}; rows: {', '.join(self.row_labels)}")
         return self.lam[:, self.row_labels.index(row)]
 
-    def to_npz(self, path: str | Path) -> None:
-        """t, q, qd, qdd, the multipliers and energies, and the names."""
+    def table(self, energy: bool = False, multipliers: bool = False, reactions: bool = False,
+              efforts: bool = False, **unknown: bool) -> tuple[list[str], np.ndarray]:
+        """Header and rows of the CSV: the motion columns of
+        :meth:`KinematicsResult.table`, then the optional columns asked for, in this order:
+
+        * ``energy``: kinetic, potential, energy, drift_position, drift_velocity;
+        * ``multipliers``: ``lambda.LABEL`` for every row of Phi (``row_labels``);
+        * ``reactions``: ``NAME.fx``, ``NAME.fy``, ``NAME.mz`` (force and moment of the
+          joint or driver on its first body, global, moment about its centre of mass) and
+          ``NAME.fx_j``, ``NAME.fy_j``, ``NAME.mz_j`` (on its second body), every
+          constraint in file order;
+        * ``efforts``: ``NAME.effort``, what each driver supplies.
+
+        ``mbd2d-solve`` writes the same columns for an exported file (``outputs``).
+        """
+        check_outputs(unknown, (), "table")
+        header, rows = self._motion_table()
+        blocks = [rows]
+        if energy:
+            header += list(ENERGY_COLUMNS)
+            blocks.append(np.column_stack([self.kinetic, self.potential, self.energy,
+                                           self.drift_position, self.drift_velocity]))
+        if multipliers:
+            header += [f"lambda.{r}" for r in self.row_labels]
+            blocks.append(self.lam)
+        if reactions:
+            g, _ = self._reactions()
+            for k, name in enumerate(self.packed.constraint_names):
+                header += [f"{name}.{w}" for w in REACTION_WORDS]
+                blocks.append(g[:, k, :])
+        if efforts:
+            names = self.packed.constraint_names
+            for k, name in enumerate(names):
+                if self.packed.driver_flags[k]:
+                    header.append(f"{name}.effort")
+                    blocks.append(self.effort(name)[:, None])
+        return header, np.hstack(blocks)
+
+    def to_npz(self, path: str | Path, reactions: bool = False, efforts: bool = False,
+               **always: bool) -> None:
+        """t, q, qd, qdd, the multipliers and energies, and the names; with
+        ``reactions=True`` also ``reactions`` (n, nc, 6: as the table's reaction columns)
+        and with ``efforts=True`` ``efforts`` (n, n_drivers)."""
+        check_outputs(always, ("energy", "multipliers"), "to_npz")
+        extra: dict[str, np.ndarray] = {}
+        if reactions:
+            extra["reactions"] = self._reactions()[0]
+        if efforts:
+            drivers = [n for n, d in zip(self.packed.constraint_names, self.packed.driver_flags)
+                       if d]
+            extra["efforts"] = np.column_stack([self.effort(n) for n in drivers]) if drivers \
+                else np.zeros((len(self.t), 0))
+            extra["driver_names"] = np.array(drivers)
         with writing(path, "to_npz") as p:
             np.savez(p, t=self.t, q=self.q, qd=self.qd, qdd=self.qdd, lam=self.lam,
                      kinetic=self.kinetic, potential=self.potential,
                      drift_position=self.drift_position, drift_velocity=self.drift_velocity,
                      coordinate_names=np.array(self.coordinate_names),
-                     body_names=np.array(self.body_names), row_labels=np.array(self.row_labels))
+                     body_names=np.array(self.body_names), row_labels=np.array(self.row_labels),
+                     **extra)

@@ -12,7 +12,7 @@ from .. import plots
 from ..errors import MbdError
 from ..validate import vector
 from . import measures
-from .files import writing
+from .files import check_outputs, write_csv, writing
 from .points import PointResult
 from .sensitivities import LEVELS, body_columns, parameter_index
 
@@ -302,8 +302,16 @@ class KinematicsResult:
         """The mechanism picture, for Jupyter (None when it cannot be drawn)."""
         return repr_png(self)
 
-    def table(self) -> tuple[list[str], np.ndarray]:
-        """Header and rows of the CSV: t, then NAME.x ... NAME.theta_ddot per body."""
+    def table(self, **outputs: bool) -> tuple[list[str], np.ndarray]:
+        """Header and rows of the CSV: t, then NAME.x ... NAME.theta_ddot per body.
+
+        A kinematic result has no optional columns (``energy``, ``multipliers``,
+        ``reactions``, ``efforts`` need a DynamicsResult): asking for one is a ModelError.
+        """
+        check_outputs(outputs, (), "table")
+        return self._motion_table()
+
+    def _motion_table(self) -> tuple[list[str], np.ndarray]:
         header = ["t"] + [f"{b}.{s}" for b in self.body_names for s in SUFFIXES]
         nb = len(self.body_names)
         blocks = [self.t[:, None]]
@@ -312,26 +320,26 @@ class KinematicsResult:
             blocks += [self.q[:, c], self.qd[:, c], self.qdd[:, c]]
         return header, np.hstack(blocks)
 
-    def to_csv(self, path: str | Path) -> None:
-        """Write the CSV (17 significant digits)."""
-        header, rows = self.table()
-        with writing(path, "to_csv") as p:
-            np.savetxt(p, rows, delimiter=",", header=",".join(header), comments="",
-                       fmt="%.17g")
+    def to_csv(self, path: str | Path, **outputs: bool) -> None:
+        """Write the CSV (the columns of :meth:`table`; every number with 17 significant
+        digits, ``%.16e``, as ``mbd2d-solve`` writes them)."""
+        header, rows = self.table(**outputs)
+        write_csv(path, header, rows, "to_csv")
 
-    def to_npz(self, path: str | Path) -> None:
+    def to_npz(self, path: str | Path, **outputs: bool) -> None:
         """Write t, q, qd, qdd and the names to a NumPy .npz archive."""
+        check_outputs(outputs, (), "to_npz")
         with writing(path, "to_npz") as p:
             np.savez(p, t=self.t, q=self.q, qd=self.qd, qdd=self.qdd,
                      coordinate_names=np.array(self.coordinate_names),
                      body_names=np.array(self.body_names))
 
-    def save(self, path: str | Path) -> None:
-        """Write .csv or .npz by the file suffix."""
+    def save(self, path: str | Path, **outputs: bool) -> None:
+        """Write .csv or .npz by the file suffix (optional columns as :meth:`table`)."""
         if str(path).endswith(".npz"):
-            self.to_npz(path)
+            self.to_npz(path, **outputs)
         else:
-            self.to_csv(path)
+            self.to_csv(path, **outputs)
 
     def __repr__(self) -> str:
         span = f"t = {self.t[0]:g} .. {self.t[-1]:g}" if len(self.t) else "no rows"
