@@ -155,3 +155,8 @@ def test_errors_in_the_worker_reach_the_caller(recorder):
     with pytest.raises(mbd2d.SingularConfigurationError) as info:
         mbd2d.load(EX / "fourbar_seed.toml").kinematics(1.0, 1000, progress=True)
     assert len(info.value.results.t) == 886
+
+
+def test_progress_must_be_a_bool_or_none():
+    with pytest.raises(mbd2d.ModelError, match="progress must be"):
+        mbd2d.load(EX / "fourbar_grashof.toml").kinematics(1.0, 10, progress="yes")

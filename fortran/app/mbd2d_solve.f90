@@ -309,7 +309,8 @@ contains
     end if
     if (spec%out_eff) then
       do c = 1, spec%nc
-        if (con_is_driver(spec%ctab(1, c))) call put(u, ios, ',' // trim(spec%con_names(c)) // '.effort')
+        if (con_is_driver(spec%ctab(1, c))) &
+          call put(u, ios, ',' // trim(spec%con_names(c)) // '.effort')
       end do
     end if
     if (ios == 0) write (u, '(a)', iostat=ios) ''

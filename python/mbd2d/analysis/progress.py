@@ -21,6 +21,7 @@ from typing import Any, Callable
 import numpy as np
 
 from ..binding.core import new_ctl
+from ..errors import ModelError
 
 #: a run longer than this (seconds) shows its bar (progress=None)
 DELAY = 2.0
@@ -74,6 +75,8 @@ def run_core(call: Callable[[np.ndarray], Any], total: int, label: str, progress
     KeyboardInterrupt
         On Ctrl-C, after the core has stopped at its next step.
     """
+    if progress is not None and not isinstance(progress, bool):
+        raise ModelError(f"progress must be True, False or None, got {progress!r}", "progress")
     ctl = new_ctl()
     if progress is False or (progress is None and (work < SMALL_WORK or not _interactive())):
         return call(ctl)

@@ -69,7 +69,8 @@ def kinematics(p: Packed, t0: float, t1: float, steps: int, tol: float, maxit: i
     :func:`new_ctl` (the core releases the GIL while it runs)."""
     return _named("q qd qdd iinfo rinfo qsing dep red tpass status msg", _core.core_kinematics,
                   p.nb, p.ctab, p.rpar, p.neq, p.q0, t0, t1, steps, tol, maxit, tmin, every,
-                  solver, nout, new_ctl() if ctl is None else ctl, numbers=3 * p.nq * nout + p.nq + 2 * p.neq)
+                  solver, nout, new_ctl() if ctl is None else ctl,
+                  numbers=3 * p.nq * nout + p.nq + 2 * p.neq)
 
 
 def kin_step(p: Packed, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, t_prev: float,
