@@ -15,7 +15,7 @@ module mbd_assemble
   implicit none
   private
   public :: asm_work_t, asm_init, assemble_blocks, scatter_dense, assemble_dense, init_extras, &
-            gather_local, blocks_jv, blocks_jtv
+            gather_local, blocks_jv, blocks_jtv, scatter_values
 
   !> Work arrays of the assembly, allocated once per analysis.
   type :: asm_work_t
@@ -155,6 +155,36 @@ contains
       end do
     end if
   end subroutine scatter_flat
+
+  !> The blocks' entries (times the column scale cs) written straight into a solver's value
+  !! vector through a map: val(pos(i)) = jb(src(i)) cs(col(i)) where pos(i) > 0. off: the
+  !! sum of |jb(src(i))| where pos(i) = 0 (entries the solver's pattern leaves out, which
+  !! must be zero; NaN propagates).
+  pure subroutine scatter_values(a, pos, cs, val, off)
+    type(asm_work_t), intent(in) :: a           !! blocks and their map
+    integer, intent(in) :: pos(:)               !! position of each entry in val (0: none)
+    real(wp), intent(in) :: cs(:)               !! column scale
+    real(wp), intent(inout) :: val(:)           !! values
+    real(wp), intent(out) :: off                !! largest entry left out
+    call scatter_pos(a%src, a%col, pos, a%jb, size(a%jb), cs, val, off)
+  end subroutine scatter_values
+
+  !> scatter_values over a flat (column-major) view of the blocks.
+  pure subroutine scatter_pos(src, col, pos, jb, nb, cs, val, off)
+    integer, intent(in) :: src(:), col(:), pos(:), nb
+    real(wp), intent(in) :: jb(nb), cs(:)
+    real(wp), intent(inout) :: val(:)
+    real(wp), intent(out) :: off
+    integer :: i
+    off = zero
+    do i = 1, size(src)
+      if (pos(i) > 0) then
+        val(pos(i)) = jb(src(i)) * cs(col(i))
+      else
+        off = off + abs(jb(src(i)))
+      end if
+    end do
+  end subroutine scatter_pos
 
   !> Phi, nu, gamma and the dense J in one call.
   pure subroutine assemble_dense(m, q, qd, t, phi, nu, gam, a, jac)

@@ -34,11 +34,12 @@ module mbd_kinematics
   use mbd_model, only: model_t
   use mbd_constraints, only: con_is_driver, con_name
   use mbd_assemble, only: asm_work_t, asm_init, assemble_blocks, assemble_dense, scatter_dense, &
-                          init_extras, blocks_jv, blocks_jtv
+                          init_extras, blocks_jv, blocks_jtv, scatter_values
   use mbd_band, only: band_t, band_plan, band_move, band_zero, band_norm1, band_factor, &
                       band_rcond, band_solve
   use mbd_linsolve, only: lu_factor, lu_solve, lu_det_sign, svd_null, row_rank, qr_factor, &
                           qr_solve, qr_lwork, lu_solve_rows
+  use mbd_splu, only: splu_t, splu_init, splu_plan, splu_factor, splu_solve, splu_pos, LMAX
   use mbd_lapack, only: dgels, dgecon, dtrcon
   use mbd_interp, only: hermite5
   use mbd_sensitivity, only: sens_t, sens_hessian, sens_params, sens_kin_rhs
@@ -66,6 +67,10 @@ module mbd_kinematics
   !! n / BAND_RATIO wide
   integer, parameter :: BAND_MIN_N = 60, BAND_RATIO = 4
   integer, parameter :: BAND_ASSEMBLY_MAXIT = 50  !! Newton iterations of a banded assembly
+  !> dense mode, square J up to this order: sparse LU with a replayed pivot order (mbd_splu)
+  integer, parameter :: SPARSE_MAX_N = 60
+  !> divided differences of the accelerations in the predictor (its error O(h**(order + 3)))
+  integer, parameter :: PRED_ORDER = 5
   !> largest dense Levenberg-Marquardt assembly (J and [J; mu I]) allowed in band mode (bytes):
   !! n up to about 1670; larger banded models assemble by damped Newton on the band
   real(wp), parameter :: DENSE_FALLBACK = 64.0_wp * 1048576
@@ -104,6 +109,14 @@ module mbd_kinematics
                                     !! small model's Levenberg-Marquardt assembly)
     type(band_t) :: band            !! band plan, storage and factors
     real(wp) :: anorm = zero        !! ||J D||_1 of the band matrix before factoring
+    !> small square J in dense mode: J D assembled straight into the sparse LU's values and
+    !! factored in its planned pivot order; LAPACK's dense LU where that order is no longer
+    !! stable (replanned) or J D is poorly conditioned (pivot ratio below COND_CHECK)
+    logical :: sparse = .false.
+    logical :: spfact = .false.     !! the factors in use are the sparse ones
+    type(splu_t) :: sp              !! sparse LU plan, values and factors
+    integer, allocatable :: spos(:) !! position in sp%val of each block entry (0: none)
+    real(wp) :: offpat = zero       !! sum |entries| outside the sparse pattern (must be 0)
   end type kin_work_t
 
   !> What happened: counters, redundancy, and the singular or failed configuration.
@@ -172,7 +185,35 @@ contains
     if (status /= MBD_OK) return
     w%qz = zero
     w%cs = one
+    if (.not. w%banded .and. m%neq == m%nq .and. m%nq <= SPARSE_MAX_N) then
+      call sparse_init(m, w, status, msg)
+    end if
   end subroutine kin_work_init
+
+  !> The sparse LU of J (structure from the blocks' map); an entry written twice keeps the
+  !! dense LU (status MBD_OK, w%sparse false).
+  subroutine sparse_init(m, w, status, msg)
+    type(model_t), intent(in) :: m                 !! model (square J)
+    type(kin_work_t), intent(inout) :: w           !! work arrays (assembly map set)
+    integer, intent(out) :: status                 !! MBD_OK or MBD_NO_MEMORY
+    character(len=MSG_LEN), intent(inout) :: msg   !! explanation (on a failure)
+    integer, allocatable :: rows(:), cols(:)
+    integer :: ne, ierr
+    ne = size(w%asm%src)
+    allocate (rows(ne), cols(ne), w%spos(ne), stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail(12 * real(ne, wp), 'the sparse LU of J', DENSE_HINT, status, msg)
+      return
+    end if
+    rows = mod(w%asm%dst - 1, m%neq) + 1
+    cols = w%asm%col
+    w%spos = 0
+    call splu_init(m%nq, rows, cols, w%sp, status, msg)
+    w%sparse = status == MBD_OK
+    if (status == MBD_SINGULAR) then
+      status = MBD_OK; msg = ''
+    end if
+  end subroutine sparse_init
 
   !> Band plan of J from its structure (the nonzeros of the constraint blocks).
   subroutine kin_band_plan(m, band, status, msg)
@@ -215,6 +256,10 @@ contains
     real(wp), intent(in) :: t               !! time
     integer :: k, s, r, c, r0, d0, jc, ir
     call assemble_blocks(m, q, qd, t, w%phi, w%nu, w%gam, w%asm)
+    if (w%sparse) then
+      call scatter_values(w%asm, w%spos, w%cs, w%sp%val, w%offpat)   ! J D, sparse storage
+      return
+    end if
     if (.not. w%banded) then
       call scatter_dense(w%asm, w%jac, w%cs)      ! J D, scaled here
       return
@@ -256,6 +301,12 @@ contains
     integer :: i, k, n, info
     real(wp) :: anorm, colsum, umin, umax
     w%lu_count = w%lu_count + 1
+    w%spfact = .false.
+    if (w%sparse .and. .not. w%lsq) then
+      call sparse_factor(w, status)
+      if (w%spfact .or. status == MBD_NO_MEMORY) return
+      call scatter_dense(w%asm, w%jac, w%cs)      ! the dense LU below, of the same J D
+    end if
     if (w%banded) then
       ! B = P_r J D P_c^T = P L U (dgbtrf); 1/cond_1 estimated only where it may matter
       call band_factor(w%band, status, msg, w%detsign, w%pivratio)
@@ -293,6 +344,36 @@ contains
     end if
   end subroutine factor
 
+  !> Factor J D (assembled into w%sp%val) in the planned pivot order; plan again (on the
+  !! dense J D) when there is no plan, an entry outside the pattern is non-zero, a pivot is
+  !! zero or a multiplier exceeds LMAX. w%spfact: the sparse factors are good (pivot ratio
+  !! >= COND_CHECK); otherwise the caller factors densely (status MBD_OK) or MBD_NO_MEMORY.
+  subroutine sparse_factor(w, status)
+    type(kin_work_t), intent(inout) :: w   !! work arrays
+    integer, intent(out) :: status         !! MBD_OK or MBD_NO_MEMORY
+    character(len=MSG_LEN) :: msg
+    real(wp) :: lmax
+    integer :: st, e, r
+    status = MBD_OK
+    st = MBD_SINGULAR
+    lmax = zero
+    if (w%sp%planned .and. w%offpat <= zero) &
+      call splu_factor(w%sp, st, lmax, w%detsign, w%pivratio)
+    if (st /= MBD_OK .or. .not. lmax <= LMAX) then
+      call scatter_dense(w%asm, w%jac, w%cs)
+      call splu_plan(w%sp, w%jac, st, msg)
+      if (st == MBD_NO_MEMORY) status = st
+      if (st /= MBD_OK) return
+      do e = 1, size(w%spos)
+        r = mod(w%asm%dst(e) - 1, size(w%jac, 1)) + 1
+        w%spos(e) = splu_pos(w%sp, r, w%asm%col(e))
+      end do
+      call splu_factor(w%sp, st, lmax, w%detsign, w%pivratio)
+      if (st /= MBD_OK) return
+    end if
+    w%spfact = w%pivratio >= COND_CHECK
+  end subroutine sparse_factor
+
   !> Solve J x = b with the factors (least squares in QR mode; w%resid is its residual).
   subroutine solve(w, b, x)
     type(kin_work_t), intent(inout) :: w   !! work arrays with the factors
@@ -300,6 +381,11 @@ contains
     real(wp), intent(out) :: x(:)          !! solution (nq)
     integer :: st
     character(len=MSG_LEN) :: msg
+    if (w%spfact) then
+      call splu_solve(w%sp, b, x, w%cs)       ! x = D (J D)^-1 b
+      w%resid = zero
+      return
+    end if
     if (w%lsq) then
       w%rhs(1:size(b)) = b
       call qr_solve(w%jac, w%jpvt, w%tau, w%rhs(1:size(b)), x, w%resid, w%qrwork)
@@ -324,7 +410,7 @@ contains
     real(wp), intent(out) :: x(:, :)       !! solutions (nq, n)
     real(wp) :: b(size(bt, 2))
     integer :: k
-    if (w%lsq .or. w%banded) then
+    if (w%lsq .or. w%banded .or. w%spfact) then
       do k = 1, size(x, 2)
         b = bt(k, :)
         call solve(w, b, x(:, k))
@@ -397,7 +483,7 @@ contains
     integer, intent(out), optional :: level !! 1 velocity, 2 acceleration (when inconsistent)
     status = MBD_OK
     call solve(w, w%nu, qd)
-    if (w%resid > 1.0e-8_wp * (one + maxval(abs(w%nu)))) then
+    if (w%lsq .and. w%resid > 1.0e-8_wp * (one + maxval(abs(w%nu)))) then
       status = MBD_INCONSISTENT
       if (present(level)) level = 1
       call dense_j(m, w, q, w%qz, t)
@@ -406,7 +492,7 @@ contains
     end if
     call assemble_blocks(m, q, qd, t, w%phi, w%nu, w%gam, w%asm, same_q=.true.)
     call solve(w, w%gam, qdd)
-    if (w%resid > 1.0e-8_wp * (one + maxval(abs(w%gam)))) then
+    if (w%lsq .and. w%resid > 1.0e-8_wp * (one + maxval(abs(w%gam)))) then
       status = MBD_INCONSISTENT
       if (present(level)) level = 2
       call dense_j(m, w, q, qd, t)
@@ -796,10 +882,12 @@ contains
     type(kin_work_t) :: w
     type(band_t) :: band
     logical, allocatable :: post(:)   ! outputs whose sensitivities are computed at the end
-    real(wp), allocatable :: q(:), qd(:), qdd(:), qn(:), qp(:), q3(:), q4(:), q5(:), d1(:), &
-                             qddn(:), qdn(:)
+    real(wp), allocatable :: q(:), qd(:), qdd(:), qn(:), qp(:), qddn(:), qdn(:)
+    !> divided differences d_j = a[t_k, ..., t_(k-j)] of the accelerations (nq, PRED_ORDER)
+    real(wp), allocatable :: dd(:, :)
+    real(wp) :: tau(0:PRED_ORDER)  ! tau_j = t_k - t_(k-j) (tau_0 = 0)
     real(wp), allocatable :: qa(:), qda(:), qdda(:), qb(:), qdb(:), qddb(:)
-    real(wp) :: t, h, hcur, hh, tt, target, lscale, ts, ta, d, hprev, hprev2
+    real(wp) :: t, h, hcur, hh, tt, target, lscale, ts, ta, d
     real(wp) :: pcur, phist(2), thist(2)   ! pivot ratios and times of the last accepted states
     integer :: nhist
     integer :: k, j, c, st, detprev, mobility, lev, nsub, nderiv, ierr
@@ -861,8 +949,8 @@ contains
     if (status /= MBD_OK) return
     lscale = m%lscale
     w%tol = opts%tol * lscale
-    allocate (q(m%nq), qd(m%nq), qdd(m%nq), qn(m%nq), qp(m%nq), q3(m%nq), stat=ierr)
-    if (ierr == 0) allocate (q4(m%nq), q5(m%nq), d1(m%nq), qddn(m%nq), qdn(m%nq), stat=ierr)
+    allocate (q(m%nq), qd(m%nq), qdd(m%nq), qn(m%nq), qp(m%nq), stat=ierr)
+    if (ierr == 0) allocate (dd(m%nq, PRED_ORDER), qddn(m%nq), qdn(m%nq), stat=ierr)
     if (ierr == 0) allocate (qa(m%nq), qda(m%nq), qdda(m%nq), qb(m%nq), stat=ierr)
     if (ierr == 0) allocate (qdb(m%nq), qddb(m%nq), stat=ierr)
     if (ierr /= 0) then
@@ -957,14 +1045,7 @@ contains
       last = hcur >= (target - t) * (one - 1.0e-9_wp)
       hh = merge(target - t, hcur, last)
       tt = merge(target, t + hh, last)
-      ! the acceleration extrapolated by its Newton polynomial through the last four,
-      ! a(s) = a + d1 s + d2 s (s + h1) + d3 s (s + h1) (s + h1 + h2)  (d1, d2, d3 its divided
-      ! differences, h1, h2 the last steps), integrated twice: q + h q_dot + h**2/2 a
-      ! + h**3/6 (d1 + h1 d2 + h1 (h1 + h2) d3) + h**4/12 (d2 + (2 h1 + h2) d3) + h**5/20 d3
-      qp = q + hh * (qd + (half * hh) * (qdd + (hh / 3.0_wp) * (q3 + hprev * q4 + &
-                     hprev * (hprev + hprev2) * q5) + (hh * hh / 6.0_wp) * (q4 + &
-                     (2 * hprev + hprev2) * q5) + (hh**3 / 10.0_wp) * q5))
-      qn = qp
+      call predict(hh)
       call kin_newton(m, w, qn, tt, opts%maxit, st)
       ok = st == MBD_OK .and. on_branch(JUMP_RATIO) .and. w%pivratio >= NEAR_SING
       if (ok .and. .not. w%lsq) ok = w%detsign == detprev
@@ -974,8 +1055,7 @@ contains
         if (st /= MBD_OK) then
           call inconsistent(tt, lev); return
         end if
-        ok = smooth_velocity(hh) .and. all(ieee_is_finite(qdn)) .and. &
-             all(ieee_is_finite(qddn))
+        ok = smooth_velocity(hh)
       end if
       if (ok) then
         pcur = w%pivratio
@@ -1070,8 +1150,45 @@ contains
     !> The Newton correction is small against the predicted motion: same branch.
     logical function on_branch(ratio)
       real(wp), intent(in) :: ratio
-      on_branch = maxval(abs(qn - qp)) <= max(ratio * maxval(abs(qp - q)), 1.0e3_wp * w%tol)
+      real(wp) :: corr, motion
+      integer :: i
+      corr = zero; motion = zero
+      do i = 1, size(q)
+        corr = max(corr, abs(qn(i) - qp(i))); motion = max(motion, abs(qp(i) - q(i)))
+      end do
+      on_branch = corr <= max(ratio * motion, 1.0e3_wp * w%tol)
     end function on_branch
+
+    !> The predictor qp at t + hs: the acceleration extrapolated by its Newton polynomial
+    !! through the last PRED_ORDER + 1 accelerations, a(s) = a + sum_j d_j w_j(s) with
+    !! w_j(s) = s (s + tau_1) ... (s + tau_(j-1)), integrated twice:
+    !! qp = q + hs q_dot + hs**2/2 a + sum_j W_j d_j, W_j = int_0^hs (hs - s) w_j(s) ds
+    !! = sum_n c_jn hs**(n+2) / ((n + 1)(n + 2)) (c_jn: the coefficients of w_j). Error
+    !! O(hs**(PRED_ORDER + 3)) once the divided differences are known.
+    subroutine predict(hs)
+      real(wp), intent(in) :: hs
+      real(wp) :: c(0:PRED_ORDER), wt(PRED_ORDER), hp(0:PRED_ORDER), x
+      integer :: i, jj, n
+      c = zero; c(0) = one                      ! w_0 = 1
+      do n = 0, PRED_ORDER                      ! hs**(n+2) / ((n + 1)(n + 2))
+        hp(n) = hs**(n + 2) / ((n + 1) * (n + 2))
+      end do
+      do jj = 1, PRED_ORDER                     ! w_j = w_(j-1) (s + tau_(j-1))
+        do n = jj, 1, -1
+          c(n) = c(n - 1) + tau(jj - 1) * c(n)
+        end do
+        c(0) = tau(jj - 1) * c(0)
+        wt(jj) = dot_product(c(0:jj), hp(0:jj))
+      end do
+      do i = 1, size(q)
+        x = hs * qd(i) + hp(0) * qdd(i)
+        do jj = 1, PRED_ORDER
+          x = x + wt(jj) * dd(i, jj)
+        end do
+        qp(i) = q(i) + x
+      end do
+      qn = qp
+    end subroutine predict
 
     !> The new velocity continues the old one: at a switch to another branch through a
     !! singular point the velocity jumps by O(|q_dot|), in smooth motion it differs from its
@@ -1080,13 +1197,18 @@ contains
       real(wp), intent(in) :: hs
       real(wp) :: vp, jump, dv
       integer :: i
-      ! v_pred = q_dot + h (q_ddot + h/2 q3), element by element (no array temporary)
-      jump = zero; dv = zero
+      ! v_pred = q_dot + h (q_ddot + h/2 d_1), element by element (no array temporary); the
+      ! new velocities and accelerations must be finite (a NaN fails every comparison)
+      real(wp) :: vmax, fin
+      jump = zero; dv = zero; vmax = zero; fin = zero
       do i = 1, size(qd)
-        vp = qd(i) + hs * (qdd(i) + (half * hs) * q3(i))
+        vp = qd(i) + hs * (qdd(i) + (half * hs) * dd(i, 1))
         jump = max(jump, abs(qdn(i) - vp)); dv = max(dv, abs(vp - qd(i)))
+        vmax = max(vmax, abs(qd(i)))
+        fin = fin + (qdn(i) - qdn(i)) + (qddn(i) - qddn(i))    ! 0, or NaN if not finite
       end do
-      smooth_velocity = jump <= VJUMP_RATIO * (maxval(abs(qd)) + dv) + 1.0e3_wp * w%tol
+      smooth_velocity = jump <= VJUMP_RATIO * (vmax + dv) + 1.0e3_wp * w%tol .and. &
+                        fin == zero
     end function smooth_velocity
 
     !> One more Newton correction at tp (when J is poorly conditioned).
@@ -1121,7 +1243,7 @@ contains
     end function anchor
 
     subroutine forget_derivatives()
-      q3 = zero; q4 = zero; q5 = zero; hprev = zero; hprev2 = zero; nderiv = 0
+      dd = zero; tau = zero; nderiv = 0
       nhist = 0
     end subroutine forget_derivatives
 
@@ -1169,33 +1291,41 @@ contains
       if (anchor(tx)) pivot_at = w%pivratio
     end function pivot_at
 
+    !> Take the step to (tt, qn, qdn, qddn): the divided differences of the accelerations with
+    !! the new one, d_j <- (d_(j-1)new - d_(j-1)old) / (t_(k+1) - t_(k+1-j)) (d_0 = q_ddot),
+    !! each once j + 1 accelerations are known; tau_j <- hs + tau_(j-1).
     subroutine accept()
-      ! divided differences of the accelerations: d1 = a[k+1, k], d2 = a[k+1, k, k-1],
-      ! d3 = a[k+1, k, k-1, k-2] (each valid once enough accelerations are known)
-      d1 = (qddn - qdd) / (tt - t)
-      if (nderiv >= 2) then
-        q5 = ((d1 - q3) / (tt - t + hprev) - q4) / (tt - t + hprev + hprev2)
-      else
-        q5 = zero
-      end if
-      if (nderiv >= 1) then
-        q4 = (d1 - q3) / (tt - t + hprev)
-      else
-        q4 = zero
-      end if
-      q3 = d1
-      hprev2 = hprev; hprev = tt - t
+      real(wp) :: rden(PRED_ORDER), hs, dn, dnew, dold
+      integer :: i, jj, jmax
+      hs = tt - t
+      jmax = min(PRED_ORDER, nderiv + 1)
+      do jj = 1, jmax
+        rden(jj) = one / (hs + tau(jj - 1))
+      end do
+      do i = 1, size(q)
+        dnew = qddn(i); dold = qdd(i)
+        do jj = 1, jmax
+          dn = (dnew - dold) * rden(jj)
+          dold = dd(i, jj); dd(i, jj) = dn; dnew = dn
+        end do
+        q(i) = qn(i); qd(i) = qdn(i); qdd(i) = qddn(i)
+      end do
+      do jj = PRED_ORDER, 1, -1
+        tau(jj) = hs + tau(jj - 1)
+      end do
       nderiv = nderiv + 1
-      q = qn; qd = qdn; qdd = qddn; t = tt
+      t = tt
     end subroutine accept
 
     subroutine store(kk)
       integer, intent(inout) :: kk
-      integer :: cc
+      integer :: cc, i
       nsub = 0
       cc = column(kk)
       if (cc > 0) then
-        qout(:, cc) = q; qdout(:, cc) = qd; qddout(:, cc) = qdd
+        do i = 1, size(q)
+          qout(i, cc) = q(i); qdout(i, cc) = qd(i); qddout(i, cc) = qdd(i)
+        end do
         if (present(sens)) call kin_sens(m, w, sens, q, qd, qdd, t, sq(:, :, cc), &
                                          sqd(:, :, cc), sqdd(:, :, cc))
         if (w%pivratio < ANCHOR_PIV) call refine_output(cc)
