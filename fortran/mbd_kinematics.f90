@@ -115,7 +115,10 @@ module mbd_kinematics
     logical :: sparse = .false.
     logical :: spfact = .false.     !! the factors in use are the sparse ones
     type(splu_t) :: sp              !! sparse LU plan, values and factors
-    integer, allocatable :: spos(:) !! position in sp%val of each block entry (0: none)
+    !> the blocks' entries for the sparse values: flat index into the blocks, column, place
+    !! in sp%val; the first snon are in the pattern, the others must be zero
+    integer, allocatable :: ssrc(:), scol(:), spos(:)
+    integer :: snon = 0
     real(wp) :: offpat = zero       !! sum |entries| outside the sparse pattern (must be 0)
   end type kin_work_t
 
@@ -200,14 +203,14 @@ contains
     integer, allocatable :: rows(:), cols(:)
     integer :: ne, ierr
     ne = size(w%asm%src)
-    allocate (rows(ne), cols(ne), w%spos(ne), stat=ierr)
+    allocate (rows(ne), cols(ne), w%ssrc(ne), w%scol(ne), w%spos(ne), stat=ierr)
     if (ierr /= 0) then
       call mem_fail(12 * real(ne, wp), 'the sparse LU of J', DENSE_HINT, status, msg)
       return
     end if
     rows = mod(w%asm%dst - 1, m%neq) + 1
     cols = w%asm%col
-    w%spos = 0
+    w%spos = 0; w%ssrc = w%asm%src; w%scol = w%asm%col; w%snon = 0
     call splu_init(m%nq, rows, cols, w%sp, status, msg)
     w%sparse = status == MBD_OK
     if (status == MBD_SINGULAR) then
@@ -257,7 +260,7 @@ contains
     integer :: k, s, r, c, r0, d0, jc, ir
     call assemble_blocks(m, q, qd, t, w%phi, w%nu, w%gam, w%asm)
     if (w%sparse) then
-      call scatter_values(w%asm, w%spos, w%cs, w%sp%val, w%offpat)   ! J D, sparse storage
+      call scatter_values(w%asm, w%ssrc, w%scol, w%spos, w%snon, w%cs, w%sp%val, w%offpat)
       return
     end if
     if (.not. w%banded) then
@@ -353,7 +356,7 @@ contains
     integer, intent(out) :: status         !! MBD_OK or MBD_NO_MEMORY
     character(len=MSG_LEN) :: msg
     real(wp) :: lmax
-    integer :: st, e, r
+    integer :: st, e, r, p, pass, ne
     status = MBD_OK
     st = MBD_SINGULAR
     lmax = zero
@@ -364,10 +367,19 @@ contains
       call splu_plan(w%sp, w%jac, st, msg)
       if (st == MBD_NO_MEMORY) status = st
       if (st /= MBD_OK) return
-      do e = 1, size(w%spos)
-        r = mod(w%asm%dst(e) - 1, size(w%jac, 1)) + 1
-        w%spos(e) = splu_pos(w%sp, r, w%asm%col(e))
+      ! the map: the entries the pattern holds first
+      w%snon = 0
+      do pass = 1, 2
+        do e = 1, size(w%spos)
+          r = mod(w%asm%dst(e) - 1, size(w%jac, 1)) + 1
+          p = splu_pos(w%sp, r, w%asm%col(e))
+          if ((p > 0) .neqv. (pass == 1)) cycle
+          w%snon = w%snon + 1
+          w%ssrc(w%snon) = w%asm%src(e); w%scol(w%snon) = w%asm%col(e); w%spos(w%snon) = p
+        end do
+        if (pass == 1) ne = w%snon
       end do
+      w%snon = ne
       call splu_factor(w%sp, st, lmax, w%detsign, w%pivratio)
       if (st /= MBD_OK) return
     end if
@@ -483,8 +495,10 @@ contains
     integer, intent(out), optional :: level !! 1 velocity, 2 acceleration (when inconsistent)
     status = MBD_OK
     call solve(w, w%nu, qd)
-    if (w%lsq .and. w%resid > 1.0e-8_wp * (one + maxval(abs(w%nu)))) then
-      status = MBD_INCONSISTENT
+    if (w%lsq) then
+      if (w%resid > 1.0e-8_wp * (one + maxval(abs(w%nu)))) status = MBD_INCONSISTENT
+    end if
+    if (status == MBD_INCONSISTENT) then
       if (present(level)) level = 1
       call dense_j(m, w, q, w%qz, t)
       w%phi = matmul(w%jac, qd) - w%nu
@@ -492,8 +506,10 @@ contains
     end if
     call assemble_blocks(m, q, qd, t, w%phi, w%nu, w%gam, w%asm, same_q=.true.)
     call solve(w, w%gam, qdd)
-    if (w%lsq .and. w%resid > 1.0e-8_wp * (one + maxval(abs(w%gam)))) then
-      status = MBD_INCONSISTENT
+    if (w%lsq) then
+      if (w%resid > 1.0e-8_wp * (one + maxval(abs(w%gam)))) status = MBD_INCONSISTENT
+    end if
+    if (status == MBD_INCONSISTENT) then
       if (present(level)) level = 2
       call dense_j(m, w, q, qd, t)
       w%phi = matmul(w%jac, qdd) - w%gam
@@ -869,9 +885,39 @@ contains
     real(wp), intent(in) :: t0, t1             !! time span
     integer, intent(in) :: nsteps              !! output intervals
     type(kin_opts_t), intent(in) :: opts       !! settings
-    real(wp), intent(out) :: qout(:, :)        !! coordinates (nq, kin_out_count)
-    real(wp), intent(out) :: qdout(:, :)       !! velocities
-    real(wp), intent(out) :: qddout(:, :)      !! accelerations
+    real(wp), contiguous, intent(out) :: qout(:, :)    !! coordinates (nq, kin_out_count)
+    real(wp), contiguous, intent(out) :: qdout(:, :)   !! velocities
+    real(wp), contiguous, intent(out) :: qddout(:, :)  !! accelerations
+    type(kin_report_t), intent(out) :: rep     !! what happened
+    integer, intent(out) :: status             !! MBD_OK or the failure
+    character(len=MSG_LEN), intent(out) :: msg !! explanation
+    !> design parameters (mbd_sensitivity): with them, sq, sqd, sqdd (nq, np, outputs) get
+    !! dq/dp, dq_dot/dp and dq_ddot/dp at every stored output
+    type(sens_t), intent(inout), optional :: sens
+    real(wp), intent(out), optional :: sq(:, :, :), sqd(:, :, :), sqdd(:, :, :)
+    integer :: c0, n
+    call kin_loop(m, q0, t0, t1, nsteps, opts, qout, qdout, qddout, rep, status, msg, &
+                  sens, sq, sqd, sqdd)
+    ! the outputs not computed are zero (set here, not before the loop: no pass over them)
+    c0 = max(rep%ndone, 0); n = size(qout, 1)
+    if (c0 < size(qout, 2)) then
+      call zero_fill(n * (size(qout, 2) - c0), qout(:, c0 + 1:))
+      call zero_fill(n * (size(qout, 2) - c0), qdout(:, c0 + 1:))
+      call zero_fill(n * (size(qout, 2) - c0), qddout(:, c0 + 1:))
+    end if
+  end subroutine kin_run
+
+  !> kin_run's work (the outputs beyond rep%ndone are left as they are).
+  subroutine kin_loop(m, q0, t0, t1, nsteps, opts, qout, qdout, qddout, rep, status, msg, &
+                     sens, sq, sqd, sqdd)
+    type(model_t), intent(in) :: m             !! model
+    real(wp), intent(in) :: q0(:)              !! estimates (nq)
+    real(wp), intent(in) :: t0, t1             !! time span
+    integer, intent(in) :: nsteps              !! output intervals
+    type(kin_opts_t), intent(in) :: opts       !! settings
+    real(wp), contiguous, intent(out) :: qout(:, :)    !! coordinates (nq, kin_out_count)
+    real(wp), contiguous, intent(out) :: qdout(:, :)   !! velocities
+    real(wp), contiguous, intent(out) :: qddout(:, :)  !! accelerations
     type(kin_report_t), intent(out) :: rep     !! what happened
     integer, intent(out) :: status             !! MBD_OK or the failure
     character(len=MSG_LEN), intent(out) :: msg !! explanation
@@ -883,9 +929,11 @@ contains
     type(band_t) :: band
     logical, allocatable :: post(:)   ! outputs whose sensitivities are computed at the end
     real(wp), allocatable :: q(:), qd(:), qdd(:), qn(:), qp(:), qddn(:), qdn(:)
-    !> divided differences d_j = a[t_k, ..., t_(k-j)] of the accelerations (nq, PRED_ORDER)
+    !> divided differences d_j = a[t_k, ..., t_(k-j)] of the accelerations (PRED_ORDER, nq)
     real(wp), allocatable :: dd(:, :)
     real(wp) :: tau(0:PRED_ORDER)  ! tau_j = t_k - t_(k-j) (tau_0 = 0)
+    ! the predictor's weights and the step and tau they were computed for
+    real(wp) :: wt(PRED_ORDER), wt_h, wt_tau(0:PRED_ORDER)
     real(wp), allocatable :: qa(:), qda(:), qdda(:), qb(:), qdb(:), qddb(:)
     real(wp) :: t, h, hcur, hh, tt, target, lscale, ts, ta, d
     real(wp) :: pcur, phist(2), thist(2)   ! pivot ratios and times of the last accepted states
@@ -894,7 +942,6 @@ contains
     logical :: last, ok
 
     status = MBD_OK; msg = ''
-    qout = zero; qdout = zero; qddout = zero
     if (present(sens)) then
       allocate (post(size(qout, 2)), stat=ierr)
       if (ierr /= 0) then
@@ -950,7 +997,7 @@ contains
     lscale = m%lscale
     w%tol = opts%tol * lscale
     allocate (q(m%nq), qd(m%nq), qdd(m%nq), qn(m%nq), qp(m%nq), stat=ierr)
-    if (ierr == 0) allocate (dd(m%nq, PRED_ORDER), qddn(m%nq), qdn(m%nq), stat=ierr)
+    if (ierr == 0) allocate (dd(PRED_ORDER, m%nq), qddn(m%nq), qdn(m%nq), stat=ierr)
     if (ierr == 0) allocate (qa(m%nq), qda(m%nq), qdda(m%nq), qb(m%nq), stat=ierr)
     if (ierr == 0) allocate (qdb(m%nq), qddb(m%nq), stat=ierr)
     if (ierr /= 0) then
@@ -1151,11 +1198,7 @@ contains
     logical function on_branch(ratio)
       real(wp), intent(in) :: ratio
       real(wp) :: corr, motion
-      integer :: i
-      corr = zero; motion = zero
-      do i = 1, size(q)
-        corr = max(corr, abs(qn(i) - qp(i))); motion = max(motion, abs(qp(i) - q(i)))
-      end do
+      call max_diffs(size(q), qn, qp, q, corr, motion)
       on_branch = corr <= max(ratio * motion, 1.0e3_wp * w%tol)
     end function on_branch
 
@@ -1167,27 +1210,35 @@ contains
     !! O(hs**(PRED_ORDER + 3)) once the divided differences are known.
     subroutine predict(hs)
       real(wp), intent(in) :: hs
-      real(wp) :: c(0:PRED_ORDER), wt(PRED_ORDER), hp(0:PRED_ORDER), x
-      integer :: i, jj, n
-      c = zero; c(0) = one                      ! w_0 = 1
+      !> 1 / ((n + 1)(n + 2)), n = 0, 1, ...
+      real(wp), parameter :: RDEN(0:7) = one / [2, 6, 12, 20, 30, 42, 56, 72]
+      real(wp) :: c(0:PRED_ORDER), hp(0:PRED_ORDER), x, hpow
+      integer :: jj, n
+      ! the weights depend on hs and the last steps only: kept while those stay (to 1e-10;
+      ! any predictor is a start for Newton, whose tolerance decides)
+      if (abs(hs - wt_h) <= 1.0e-10_wp * hs .and. &
+          all(abs(tau - wt_tau) <= 1.0e-10_wp * hs)) then
+        call pred_sum(size(q), hs, half * hs * hs, wt, q, qd, qdd, dd, qp, qn)
+        return
+      end if
+      wt_h = hs; wt_tau = tau
+      hpow = hs * hs
       do n = 0, PRED_ORDER                      ! hs**(n+2) / ((n + 1)(n + 2))
-        hp(n) = hs**(n + 2) / ((n + 1) * (n + 2))
+        hp(n) = hpow * RDEN(n); hpow = hpow * hs
       end do
+      c = zero; c(0) = one                      ! w_0 = 1
       do jj = 1, PRED_ORDER                     ! w_j = w_(j-1) (s + tau_(j-1))
         do n = jj, 1, -1
           c(n) = c(n - 1) + tau(jj - 1) * c(n)
         end do
         c(0) = tau(jj - 1) * c(0)
-        wt(jj) = dot_product(c(0:jj), hp(0:jj))
-      end do
-      do i = 1, size(q)
-        x = hs * qd(i) + hp(0) * qdd(i)
-        do jj = 1, PRED_ORDER
-          x = x + wt(jj) * dd(i, jj)
+        x = zero
+        do n = 0, jj
+          x = x + c(n) * hp(n)
         end do
-        qp(i) = q(i) + x
+        wt(jj) = x
       end do
-      qn = qp
+      call pred_sum(size(q), hs, hp(0), wt, q, qd, qdd, dd, qp, qn)
     end subroutine predict
 
     !> The new velocity continues the old one: at a switch to another branch through a
@@ -1195,18 +1246,8 @@ contains
     !! Taylor prediction by O(h**3).
     logical function smooth_velocity(hs)
       real(wp), intent(in) :: hs
-      real(wp) :: vp, jump, dv
-      integer :: i
-      ! v_pred = q_dot + h (q_ddot + h/2 d_1), element by element (no array temporary); the
-      ! new velocities and accelerations must be finite (a NaN fails every comparison)
-      real(wp) :: vmax, fin
-      jump = zero; dv = zero; vmax = zero; fin = zero
-      do i = 1, size(qd)
-        vp = qd(i) + hs * (qdd(i) + (half * hs) * dd(i, 1))
-        jump = max(jump, abs(qdn(i) - vp)); dv = max(dv, abs(vp - qd(i)))
-        vmax = max(vmax, abs(qd(i)))
-        fin = fin + (qdn(i) - qdn(i)) + (qddn(i) - qddn(i))    ! 0, or NaN if not finite
-      end do
+      real(wp) :: jump, dv, vmax, fin
+      call velocity_jump(size(q), hs, qd, qdd, dd, qdn, qddn, jump, dv, vmax, fin)
       smooth_velocity = jump <= VJUMP_RATIO * (vmax + dv) + 1.0e3_wp * w%tol .and. &
                         fin == zero
     end function smooth_velocity
@@ -1243,7 +1284,7 @@ contains
     end function anchor
 
     subroutine forget_derivatives()
-      dd = zero; tau = zero; nderiv = 0
+      dd = zero; tau = zero; nderiv = 0; wt_h = -one
       nhist = 0
     end subroutine forget_derivatives
 
@@ -1295,21 +1336,14 @@ contains
     !! the new one, d_j <- (d_(j-1)new - d_(j-1)old) / (t_(k+1) - t_(k+1-j)) (d_0 = q_ddot),
     !! each once j + 1 accelerations are known; tau_j <- hs + tau_(j-1).
     subroutine accept()
-      real(wp) :: rden(PRED_ORDER), hs, dn, dnew, dold
-      integer :: i, jj, jmax
+      real(wp) :: rden(PRED_ORDER), hs
+      integer :: jj
       hs = tt - t
-      jmax = min(PRED_ORDER, nderiv + 1)
-      do jj = 1, jmax
-        rden(jj) = one / (hs + tau(jj - 1))
+      do jj = 1, PRED_ORDER           ! d_j stays zero until j + 1 accelerations are known
+        rden(jj) = zero
+        if (jj <= nderiv + 1) rden(jj) = one / (hs + tau(jj - 1))
       end do
-      do i = 1, size(q)
-        dnew = qddn(i); dold = qdd(i)
-        do jj = 1, jmax
-          dn = (dnew - dold) * rden(jj)
-          dold = dd(i, jj); dd(i, jj) = dn; dnew = dn
-        end do
-        q(i) = qn(i); qd(i) = qdn(i); qdd(i) = qddn(i)
-      end do
+      call accept_state(size(q), rden, qn, qdn, qddn, q, qd, qdd, dd)
       do jj = PRED_ORDER, 1, -1
         tau(jj) = hs + tau(jj - 1)
       end do
@@ -1319,13 +1353,11 @@ contains
 
     subroutine store(kk)
       integer, intent(inout) :: kk
-      integer :: cc, i
+      integer :: cc
       nsub = 0
       cc = column(kk)
       if (cc > 0) then
-        do i = 1, size(q)
-          qout(i, cc) = q(i); qdout(i, cc) = qd(i); qddout(i, cc) = qdd(i)
-        end do
+        call copy3(size(q), q, qd, qdd, qout(:, cc), qdout(:, cc), qddout(:, cc))
         if (present(sens)) call kin_sens(m, w, sens, q, qd, qdd, t, sq(:, :, cc), &
                                          sqd(:, :, cc), sqdd(:, :, cc))
         if (w%pivratio < ANCHOR_PIV) call refine_output(cc)
@@ -1392,7 +1424,7 @@ contains
       post = .false.
     end subroutine count_work
 
-  end subroutine kin_run
+  end subroutine kin_loop
 
   !> Sensitivities at a converged state (q, q_dot, q_ddot) whose J factors are in w:
   !! J s = -Phi_p, J s_dot = nu_p - J_p q_dot - Hv s, J s_ddot = gamma_p - J_p q_ddot - Ha s
@@ -1414,6 +1446,89 @@ contains
     call sens_kin_rhs(s, 3, sq, sqd, s%rhs)
     call solve_cols(w, s%rhs, sqdd)
   end subroutine kin_sens
+
+  !> The predictor's sum qp = q + hs q_dot + hp0 q_ddot + sum_j wt_j d_j; qn = qp (explicit
+  !! shapes: the loops of the time step see plain arrays).
+  pure subroutine pred_sum(n, hs, hp0, wt, q, qd, qdd, dd, qp, qn)
+    integer, intent(in) :: n
+    real(wp), intent(in) :: hs, hp0, wt(PRED_ORDER), q(n), qd(n), qdd(n), dd(PRED_ORDER, n)
+    real(wp), intent(out) :: qp(n), qn(n)
+    real(wp) :: x
+    integer :: i, j
+    do i = 1, n
+      x = hs * qd(i) + hp0 * qdd(i)
+      do j = 1, PRED_ORDER
+        x = x + wt(j) * dd(j, i)
+      end do
+      qp(i) = q(i) + x; qn(i) = qp(i)
+    end do
+  end subroutine pred_sum
+
+  !> The accepted state (qn, qdn, qddn) becomes (q, qd, qdd); the divided differences take the
+  !! new acceleration: d_j <- (d_(j-1)new - d_(j-1)old) rden_j (d_0 = q_ddot).
+  pure subroutine accept_state(n, rden, qn, qdn, qddn, q, qd, qdd, dd)
+    integer, intent(in) :: n
+    real(wp), intent(in) :: rden(PRED_ORDER), qn(n), qdn(n), qddn(n)
+    real(wp), intent(inout) :: q(n), qd(n), qdd(n), dd(PRED_ORDER, n)
+    real(wp) :: dn, dnew, dold
+    integer :: i, j
+    do i = 1, n
+      dnew = qddn(i); dold = qdd(i)
+      do j = 1, PRED_ORDER
+        dn = (dnew - dold) * rden(j)
+        dold = dd(j, i); dd(j, i) = dn; dnew = dn
+      end do
+      q(i) = qn(i); qd(i) = qdn(i); qdd(i) = qddn(i)
+    end do
+  end subroutine accept_state
+
+  !> corr = max |qn - qp| (the Newton correction), motion = max |qp - q| (the predicted one).
+  pure subroutine max_diffs(n, qn, qp, q, corr, motion)
+    integer, intent(in) :: n
+    real(wp), intent(in) :: qn(n), qp(n), q(n)
+    real(wp), intent(out) :: corr, motion
+    integer :: i
+    corr = zero; motion = zero
+    do i = 1, n
+      corr = max(corr, abs(qn(i) - qp(i))); motion = max(motion, abs(qp(i) - q(i)))
+    end do
+  end subroutine max_diffs
+
+  !> The velocity against its prediction v_p = q_dot + h (q_ddot + h/2 d_1): jump =
+  !! max |qdn - v_p|, dv = max |v_p - q_dot|, vmax = max |q_dot|; fin is 0 when qdn and qddn
+  !! are finite, NaN otherwise.
+  pure subroutine velocity_jump(n, hs, qd, qdd, dd, qdn, qddn, jump, dv, vmax, fin)
+    integer, intent(in) :: n
+    real(wp), intent(in) :: hs, qd(n), qdd(n), dd(PRED_ORDER, n), qdn(n), qddn(n)
+    real(wp), intent(out) :: jump, dv, vmax, fin
+    real(wp) :: vp
+    integer :: i
+    jump = zero; dv = zero; vmax = zero; fin = zero
+    do i = 1, n
+      vp = qd(i) + hs * (qdd(i) + (half * hs) * dd(1, i))
+      jump = max(jump, abs(qdn(i) - vp)); dv = max(dv, abs(vp - qd(i)))
+      vmax = max(vmax, abs(qd(i)))
+      fin = fin + (qdn(i) - qdn(i)) + (qddn(i) - qddn(i))    ! 0, or NaN if not finite
+    end do
+  end subroutine velocity_jump
+
+  !> x = 0 (an array of any shape, by sequence association).
+  pure subroutine zero_fill(n, x)
+    integer, intent(in) :: n
+    real(wp), intent(out) :: x(n)
+    x = zero
+  end subroutine zero_fill
+
+  !> x = a, y = b, z = c.
+  pure subroutine copy3(n, a, b, c, x, y, z)
+    integer, intent(in) :: n
+    real(wp), intent(in) :: a(n), b(n), c(n)
+    real(wp), intent(out) :: x(n), y(n), z(n)
+    integer :: i
+    do i = 1, n
+      x(i) = a(i); y(i) = b(i); z(i) = c(i)
+    end do
+  end subroutine copy3
 
   !> Stored outputs of a run of nsteps intervals keeping every e-th (and the last).
   pure integer function kin_out_count(nsteps, e) result(n)

@@ -14,7 +14,9 @@
 !!           and reports max |l_ik| (the caller plans again when it exceeds LMAX: bounded
 !!           multipliers keep the growth, hence the backward error, bounded), the sign of
 !!           det A and min |u_kk| / max |u_kk|.
-!!   solve   A x = b: y = P b, L z = y, U w = z, x = Q w (column-oriented, no BLAS calls).
+!!           U's rows are then divided by their pivots, U = diag(u_kk) U1 (U1 unit upper).
+!!   solve   A x = b: y = P b, L z = y, U1 w = diag(1/u_kk) z, x = Q w: one flat loop over the
+!!           entries of L (by columns), one over U1 (by columns, last first); no BLAS calls.
 !! No allocation after splu_init; the values live in val(:), indexed by at(i, j) for A(i, j).
 module mbd_splu
   use mbd_kinds, only: wp, zero, one
@@ -44,7 +46,11 @@ module mbd_splu
     integer, allocatable :: prow(:), pcol(:)  !! (n) step k pivots on A(prow(k), pcol(k))
     integer, allocatable :: diag(:)       !! (n) position of u_kk
     integer, allocatable :: lptr(:), lpos(:), lrow(:)  !! L by columns: entries, step rows
+    integer, allocatable :: lcol(:)       !! step column of each L entry
     integer, allocatable :: uptr(:), upos(:), urow(:)  !! U above the diagonal by columns
+    integer :: nu = 0                     !! entries of U above the diagonal
+    !> U1 entries by columns, last column first: position, step row, step column
+    integer, allocatable :: bpos(:), brow(:), bcol(:)
     integer, allocatable :: optr(:), otgt(:), ol(:), ou(:)  !! updates of step k: tgt -= l u
     integer, allocatable :: fill(:)       !! positions of the fill entries
     real(wp), allocatable :: a(:, :)      !! (n, n) work of the plan
@@ -69,7 +75,8 @@ contains
     allocate (sp%struct(n, n), sp%seen(n, n), sp%at(n, n), sp%val(nn), sp%rinv(n), &
               sp%y(n), sp%prow(n), sp%pcol(n), sp%diag(n), sp%lptr(n + 1), sp%lpos(nn), &
               sp%lrow(nn), sp%uptr(n + 1), sp%upos(nn), sp%urow(nn), sp%optr(n + 1), &
-              sp%fill(nn), sp%a(n, n), sp%s(n, n), stat=ierr)
+              sp%fill(nn), sp%a(n, n), sp%s(n, n), sp%lcol(nn), sp%bpos(nn), sp%brow(nn), &
+              sp%bcol(nn), stat=ierr)
     if (ierr /= 0) then
       call mem_fail(REAL_BYTES * 4 * real(nn, wp), 'the sparse LU of J', &
                     'use a smaller model', status, msg)
@@ -176,11 +183,19 @@ contains
           sp%diag(c) = p
         else
           sp%lpos(sp%lptr(c + 1)) = p; sp%lrow(sp%lptr(c + 1)) = r
+          sp%lcol(sp%lptr(c + 1)) = c
           sp%lptr(c + 1) = sp%lptr(c + 1) + 1
         end if
       end do
     end do
     sp%nnz = p
+    sp%nu = 0
+    do c = n, 1, -1
+      do p = sp%uptr(c), sp%uptr(c + 1) - 1
+        sp%nu = sp%nu + 1
+        sp%bpos(sp%nu) = sp%upos(p); sp%brow(sp%nu) = sp%urow(p); sp%bcol(sp%nu) = c
+      end do
+    end do
     ! the updates of step k: a(r, c) -= l(r, k) u(k, c) for r, c > k in the pattern
     if (allocated(sp%otgt)) deallocate (sp%otgt, sp%ol, sp%ou)
     allocate (otgt(max(nops, 1)), ol(max(nops, 1)), ou(max(nops, 1)), stat=ierr)
@@ -224,69 +239,92 @@ contains
     real(wp), intent(out) :: lmax         !! largest multiplier
     integer, intent(out) :: detsign       !! sign of det A
     real(wp), intent(out) :: ratio        !! min |u_kk| / max |u_kk|
+    integer :: nl
+    nl = sp%lptr(sp%n + 1) - 1
+    call factor_kernel(sp%n, nl, sp%nops, sp%nfill, sp%nu, sp%diag, sp%lptr, sp%lpos, &
+                       sp%optr, sp%otgt, sp%ol, sp%ou, sp%fill, sp%upos, sp%urow, sp%val, &
+                       sp%rinv, status, lmax, detsign, ratio)
+    if (sp%sgn < 0) detsign = -detsign
+  end subroutine splu_factor
+
+  !> splu_factor on plain arrays (explicit shapes: no descriptors in the loops).
+  pure subroutine factor_kernel(n, nl, nops, nfill, nu, diag, lptr, lpos, optr, otgt, ol, ou, &
+                                fill, upos, urow, val, rinv, status, lmax, detsign, ratio)
+    integer, intent(in) :: n, nl, nops, nfill, nu
+    integer, intent(in) :: diag(n), lptr(n + 1), lpos(nl), optr(n + 1), otgt(nops), ol(nops)
+    integer, intent(in) :: ou(nops), fill(nfill), upos(nu), urow(nu)
+    real(wp), intent(inout) :: val(*)
+    real(wp), intent(out) :: rinv(n)
+    integer, intent(out) :: status, detsign
+    real(wp), intent(out) :: lmax, ratio
     integer :: k, p, o
     real(wp) :: d, r, l, umin, umax
     status = MBD_OK
-    lmax = zero; detsign = sp%sgn; umin = huge(one); umax = zero; ratio = zero
-    do p = 1, sp%nfill
-      sp%val(sp%fill(p)) = zero
+    lmax = zero; detsign = 1; umin = huge(one); umax = zero; ratio = zero
+    do p = 1, nfill
+      val(fill(p)) = zero
     end do
-    do k = 1, sp%n
-      d = sp%val(sp%diag(k))
+    do k = 1, n
+      d = val(diag(k))
       if (.not. abs(d) > zero) then
         status = MBD_SINGULAR; return
       end if
       if (d < zero) detsign = -detsign
       umin = min(umin, abs(d)); umax = max(umax, abs(d))
       r = one / d
-      sp%rinv(k) = r
-      do p = sp%lptr(k), sp%lptr(k + 1) - 1          ! l_ik = a_ik / u_kk
-        l = sp%val(sp%lpos(p)) * r
-        sp%val(sp%lpos(p)) = l
+      rinv(k) = r
+      do p = lptr(k), lptr(k + 1) - 1                ! l_ik = a_ik / u_kk
+        l = val(lpos(p)) * r
+        val(lpos(p)) = l
         lmax = max(lmax, abs(l))
       end do
-      do o = sp%optr(k), sp%optr(k + 1) - 1          ! a_ij -= l_ik u_kj
-        sp%val(sp%otgt(o)) = sp%val(sp%otgt(o)) - sp%val(sp%ol(o)) * sp%val(sp%ou(o))
+      do o = optr(k), optr(k + 1) - 1                ! a_ij -= l_ik u_kj
+        val(otgt(o)) = val(otgt(o)) - val(ol(o)) * val(ou(o))
       end do
+    end do
+    do p = 1, nu                                     ! U1 = diag(1/u_kk) U
+      val(upos(p)) = val(upos(p)) * rinv(urow(p))
     end do
     ratio = umin / umax
-  end subroutine splu_factor
+  end subroutine factor_kernel
 
-  !> x = A^-1 b with the factors; x(j) is multiplied by cs(j) when cs is given (the solution
-  !! of a column-scaled A D: x = D (A D)^-1 b).
+  !> x = A^-1 b with the factors; x(j) is multiplied by cs(j) (the solution of a
+  !! column-scaled A D: x = D (A D)^-1 b; cs = 1 for A itself).
   pure subroutine splu_solve(sp, b, x, cs)
-    type(splu_t), intent(inout) :: sp          !! factors (and the work vector)
-    real(wp), intent(in) :: b(:)               !! right-hand side (A's rows)
-    real(wp), intent(out) :: x(:)              !! solution (A's columns)
-    real(wp), intent(in), optional :: cs(:)    !! column scale
-    integer :: k, p
-    real(wp) :: yk
-    do k = 1, sp%n                                   ! y = P b
-      sp%y(k) = b(sp%prow(k))
-    end do
-    do k = 1, sp%n                                   ! L z = y (unit diagonal)
-      yk = sp%y(k)
-      do p = sp%lptr(k), sp%lptr(k + 1) - 1
-        sp%y(sp%lrow(p)) = sp%y(sp%lrow(p)) - sp%val(sp%lpos(p)) * yk
-      end do
-    end do
-    do k = sp%n, 1, -1                               ! U w = z
-      yk = sp%y(k) * sp%rinv(k)
-      sp%y(k) = yk
-      do p = sp%uptr(k), sp%uptr(k + 1) - 1
-        sp%y(sp%urow(p)) = sp%y(sp%urow(p)) - sp%val(sp%upos(p)) * yk
-      end do
-    end do
-    if (present(cs)) then                            ! x = Q w (D Q w)
-      do k = 1, sp%n
-        x(sp%pcol(k)) = sp%y(k) * cs(sp%pcol(k))
-      end do
-    else
-      do k = 1, sp%n
-        x(sp%pcol(k)) = sp%y(k)
-      end do
-    end if
+    type(splu_t), intent(inout) :: sp                !! factors (and the work vector)
+    real(wp), intent(in) :: b(:)                     !! right-hand side (A's rows)
+    real(wp), intent(inout) :: x(:)                  !! solution (A's columns)
+    real(wp), intent(in) :: cs(:)                    !! column scale
+    call solve_kernel(sp%n, sp%lptr(sp%n + 1) - 1, sp%nu, sp%prow, sp%pcol, sp%lpos, &
+                      sp%lrow, sp%lcol, sp%bpos, sp%brow, sp%bcol, sp%rinv, sp%val, sp%y, b, &
+                      x, cs)
   end subroutine splu_solve
+
+  !> splu_solve on plain arrays.
+  pure subroutine solve_kernel(n, nl, nu, prow, pcol, lpos, lrow, lcol, bpos, brow, bcol, &
+                               rinv, val, y, b, x, cs)
+    integer, intent(in) :: n, nl, nu
+    integer, intent(in) :: prow(n), pcol(n), lpos(nl), lrow(nl), lcol(nl)
+    integer, intent(in) :: bpos(nu), brow(nu), bcol(nu)
+    real(wp), intent(in) :: rinv(n), val(*), b(n), cs(n)
+    real(wp), intent(out) :: y(n), x(n)
+    integer :: k, p
+    do k = 1, n                                      ! y = P b
+      y(k) = b(prow(k))
+    end do
+    do p = 1, nl                                     ! L z = y (unit diagonal)
+      y(lrow(p)) = y(lrow(p)) - val(lpos(p)) * y(lcol(p))
+    end do
+    do k = 1, n                                      ! diag(1/u_kk) z
+      y(k) = y(k) * rinv(k)
+    end do
+    do p = 1, nu                                     ! U1 w = diag(1/u_kk) z
+      y(brow(p)) = y(brow(p)) - val(bpos(p)) * y(bcol(p))
+    end do
+    do k = 1, n                                      ! x = D Q w
+      x(pcol(k)) = y(k) * cs(pcol(k))
+    end do
+  end subroutine solve_kernel
 
   !> Position in sp%val that A(i, j) is written to, 0 when the plan does not hold it (the
   !! entry must then be zero: a fill position is zeroed before each factorization).
