@@ -29,14 +29,20 @@ EX = BENCH.parent / "examples"
 H_VALUES = (1e-3, 1e-4)
 STEPS = (1000, 3000)          # n1, n2
 LOOP_FN = "__mbd_kinematics_MOD_kin_run"
-#: the parts of a step: symbol-name patterns whose inclusive counts are summed (first match
-#: wins; what no pattern claims is "loop")
+#: the parts of a step: each function's own instructions (exclusive, callgrind's "self")
+#: go to the first part with a pattern matching its name; what no pattern claims is "loop"
+#: (the time loop: predictor, step acceptance, checks, output). Library functions are
+#: matched by name as well (sincos is the assembly's, the LAPACK routines the LU's or the
+#: solves').
 PARTS = {
-    "assembly": (r"assemble_blocks", r"assemble_j\b", r"scatter_dense", r"scatter_flat",
-                 r"con_eval", r"_MOD_sp_assemble"),
-    "LU": (r"_MOD_factor\b", r"sp_factor", r"lu_factor", r"dgetf2", r"dgetrf", r"dgecon"),
-    "solves": (r"_MOD_solve\b", r"_MOD_solve_newton", r"sp_solve", r"lu_solve", r"dtrsv",
-               r"dgetrs"),
+    "assembly": (r"assemble", r"scatter_", r"asm_turn", r"con_eval", r"_eval\b",
+                 r"point_terms", r"put_", r"sincos", r"\bsin\b", r"\bcos\b", r"mbd_joint_",
+                 r"mbd_points_", r"mbd_drivers_", r"mbd_functions_"),
+    "LU": (r"_MOD_factor\b", r"sparse_factor", r"splu_factor", r"factor_kernel", r"lu_factor",
+           r"lu_det_sign", r"dgetf2", r"dgetrf", r"dgecon", r"dlaswp", r"idamax", r"dger_",
+           r"dscal", r"dlacn2", r"dlatrs"),
+    "solves": (r"_MOD_solve", r"splu_solve", r"solve2?_kernel", r"lu_solve", r"dtrsv",
+               r"dtrsm", r"dgetrs"),
 }
 
 WORKER = r"""
@@ -74,12 +80,12 @@ def _totals(path: Path) -> int:
     return 0
 
 
-def _inclusive(path: Path) -> dict[str, int]:
-    """Inclusive instructions per function of one dump (callgrind_annotate)."""
+def _exclusive(path: Path) -> dict[str, int]:
+    """Own (exclusive) instructions per function of one dump (callgrind_annotate)."""
     exe = shutil.which("callgrind_annotate")
     if exe is None:
         return {}
-    out = subprocess.run([exe, "--inclusive=yes", "--threshold=100", str(path)],
+    out = subprocess.run([exe, "--inclusive=no", "--threshold=100", str(path)],
                          capture_output=True, text=True, timeout=120).stdout
     fns: dict[str, int] = {}
     for line in out.splitlines():
@@ -91,43 +97,20 @@ def _inclusive(path: Path) -> dict[str, int]:
 
 
 def _parts(d1: dict[str, int], d2: dict[str, int], steps: int, total: float) -> dict[str, float]:
-    """Instructions per step of each part, from the inclusive counts of the two dumps.
+    """Instructions per step of each part, from the exclusive counts of the two dumps.
 
-    A function counts towards the first part whose pattern it matches, and only when no
-    function it is called from already counted (the outermost match: callgrind's inclusive
-    counts of nested matches would otherwise count twice; the patterns name routines that do
-    not call one another across parts).
+    Each function's own instructions count once, towards the first part whose pattern its
+    name matches (PARTS); the rest of the step is "loop".
     """
     per = {k: (d2.get(k, 0) - d1.get(k, 0)) / steps for k in set(d1) | set(d2)}
     out = {name: 0.0 for name in PARTS}
-    for name, pats in PARTS.items():
-        hits = [f for f in per if any(re.search(p, f) for p in pats)]
-        # outermost only: keep the largest of nested ones (assemble_j includes scatter)
-        hits.sort(key=lambda f: -per[f])
-        kept: list[str] = []
-        for f in hits:
-            if not kept or not _nested(f, kept):
-                kept.append(f)
-        out[name] = sum(per[f] for f in kept)
+    for f, v in per.items():
+        for name, pats in PARTS.items():
+            if any(re.search(p, f) for p in pats):
+                out[name] += v
+                break
     out["loop"] = total - sum(out.values())
     return out
-
-
-#: functions called from one another (inner: outer): counted only through the outer one
-NESTED = {"scatter_dense": ("assemble_j", "sp_assemble"), "scatter_flat": ("assemble_j",),
-          "assemble_blocks": ("assemble_j", "sp_assemble"), "con_eval": ("assemble_blocks",),
-          "dgetf2": ("lu_factor",), "lu_factor": ("_MOD_factor",), "dgecon": ("_MOD_factor",),
-          "sp_factor": ("_MOD_factor",), "lu_solve": ("_MOD_solve",),
-          "dtrsv": ("lu_solve",), "sp_solve": ("_MOD_solve",),
-          "_MOD_solve\b": ("solve_newton",)}
-
-
-def _nested(f: str, kept: list[str]) -> bool:
-    """f is called only from a function already kept (by the NESTED table)."""
-    for inner, outers in NESTED.items():
-        if re.search(inner, f) and any(re.search(o, k) for o in outers for k in kept):
-            return True
-    return False
 
 
 def measure(stem: str = "fourbar_grashof", h: float = 1e-3, steps: tuple[int, int] = STEPS,
@@ -176,7 +159,7 @@ def measure(stem: str = "fourbar_grashof", h: float = 1e-3, steps: tuple[int, in
             res["newton_corrections_per_step"] = (int(c2) - int(c1)) / (n2 - n1)
             res["lu_per_step"] = (int(l2) - int(l1)) / (n2 - n1)
         if parts:
-            res["parts"] = _parts(_inclusive(d1), _inclusive(d2), n2 - n1, per_step)
+            res["parts"] = _parts(_exclusive(d1), _exclusive(d2), n2 - n1, per_step)
     return res
 
 
