@@ -308,3 +308,35 @@ subroutine core_dynamics_sens(nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp
                          atol, every, max_steps, ptab, qout, qdout, qddout, lamout, eout, sq, &
                          sqd, sqdd, iinfo, rinfo, redundant, status, msg)
 end subroutine core_dynamics_sens
+
+! ------------------------------------------------------------------ design sweeps
+! One analysis (1 kinematics, 2 inverse dynamics, 3 statics, 4 dynamics) for ncase parameter
+! sets: vtab (2, nv) names the entries each case sets (table 1 rpar, 2 bmass flattened, 3
+! grav, 4 fpar; 1-based index), vals (nv, ncase) their values, opens (2, no) the open phases
+! to set again from q0 (index in rpar, row of Phi); settings in iset, rset (mbd_batch). nlam
+! is neq (0 for kinematics), ne 4 (0 for kinematics); nrow the output rows per case.
+subroutine core_batch(analysis, nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp, fpar, nq, &
+                      q0, v0, nv, vtab, ncase, vals, no, opens, iset, rset, neq, nrow, nlam, ne, &
+                      qout, qdout, qddout, lamout, eout, iinfo, rinfo, qsing, dep, redundant, &
+                      status, msg)
+  use iso_c_binding, only: c_double, c_int
+  use mbd_batch, only: batch_run
+  implicit none
+  integer(c_int), intent(in) :: analysis, nb, nc, np, nf, nfp, nq, nv, ncase, no, neq, nrow
+  integer(c_int), intent(in) :: nlam, ne
+  integer(c_int), intent(in) :: ctab(8, nc), ftab(6, nf), vtab(2, nv), opens(2, no), iset(8)
+  real(c_double), intent(in) :: rpar(np), bmass(2, nb), grav(2), fpar(nfp), q0(nq), v0(nq)
+  real(c_double), intent(in) :: vals(nv, ncase), rset(12)
+  real(c_double), intent(out) :: qout(nq, nrow, ncase), qdout(nq, nrow, ncase)
+  real(c_double), intent(out) :: qddout(nq, nrow, ncase), lamout(nlam, nrow, ncase)
+  real(c_double), intent(out) :: eout(ne, nrow, ncase)
+  integer(c_int), intent(out) :: iinfo(10, ncase), dep(neq, ncase), redundant(neq, ncase)
+  real(c_double), intent(out) :: rinfo(10, ncase), qsing(nq, ncase)
+  integer(c_int), intent(out) :: status(ncase)
+  character(len=512), intent(out) :: msg(ncase)
+  !f2py intent(hide) :: nc, np, nf, nfp, nq, nv, ncase, no
+  !f2py threadsafe
+  call batch_run(analysis, nb, ctab, rpar, bmass, grav, ftab, fpar, q0, v0, vtab, vals, opens, &
+                 iset, rset, qout, qdout, qddout, lamout, eout, iinfo, rinfo, qsing, dep, &
+                 redundant, status, msg)
+end subroutine core_batch

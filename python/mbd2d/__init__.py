@@ -20,6 +20,7 @@ from .errors import (AnalysisError, AssemblyError, ConvergenceError, CoreError,
 from .model import Model, load, loads
 from .results import (BodyResult, DofReport, DynamicsResult, KinematicsResult, Reaction,
                       StaticsResult)
+from .studies import ToleranceResult, grid, sweep, tolerance, write_sweep
 
 __version__ = "0.1.0"
 
@@ -29,4 +30,5 @@ __all__ = ["load", "loads", "Model", "TimeFunction", "Harmonic", "KinematicsResu
            "AssemblyError", "InconsistentConstraintsError", "ConvergenceError",
            "SingularJacobianError", "SingularConfigurationError", "ToggleError", "CoreError",
            "InsufficientMemoryError", "MbdWarning", "RedundantConstraintWarning",
-           "SingularPassageWarning", "__version__"]
+           "SingularPassageWarning", "sweep", "grid", "tolerance", "ToleranceResult",
+           "write_sweep", "__version__"]

@@ -4,13 +4,17 @@ from __future__ import annotations
 
 import math
 import warnings
+from types import SimpleNamespace
 from typing import Any
+
+import numpy as np
 
 from ..binding import core
 from ..binding.pack import pack, pack_dynamics
 from ..binding.status import ASSEMBLY_FAILED, INCONSISTENT, INTEGRATOR_FAILED, OK, error_for
+from ..binding.tables import Packed
 from ..description.builder import ModelDescription
-from ..errors import ModelError, RedundantConstraintWarning
+from ..errors import MbdError, ModelError, RedundantConstraintWarning
 from ..results.dynamics import DynamicsResult
 from ..validate import number, whole
 from .failures import assembly_failed, bad_entry, inconsistent_at, row_names
@@ -33,39 +37,10 @@ def run_dynamics(model: ModelDescription, t_end: float, steps: int, method: str 
     t0, t_end, steps = check_span(t0, t_end, steps)
     nout = output_rows(steps, every)
     every = int(every)
-    nmax = MAX_STEPS_DEFAULT if max_steps is None else \
-        whole(max_steps, "max_steps", "dynamics", 1, INT32_MAX)
-    method = DEFAULT_METHOD if method is None else method
-    if method not in METHODS:
-        raise ModelError(f"unknown method {method!r}; use one of {', '.join(METHODS)}",
-                         "dynamics")
-
-    def opt(v: Any, name: str, lo: float, hi: float, default: float) -> float:
-        if v is None:
-            return default
-        x = number(v, name, "dynamics")
-        if not lo <= x <= hi:
-            raise ModelError(f"{name} must be in [{lo:g}, {hi:g}], got {v!r}", "dynamics")
-        return x
-
-    rtol_v = opt(rtol, "rtol", 1e-14, 1.0, 0.0)
-    atol_v = opt(atol, "atol", 1e-16, 1e6, 0.0)
-    h_v = opt(h, "h", 1e-12, math.inf, 0.0)
-    if method == "baumgarte-rk4" and h is None:
-        raise ModelError("baumgarte-rk4 is a fixed-step method: give h (for example h=1e-3)",
-                         "dynamics")
-    if h is not None and method in ("dopri5", "partitioned"):
-        raise ModelError(f"{method} chooses its own steps from rtol and atol; h is for "
-                         "generalized-alpha and baumgarte-rk4", "dynamics")
-    rho_v = opt(rho_inf, "rho_inf", 0.0, 1.0, -1.0)
-    if method == "generalized-alpha" and h is None and rho_v >= 0.99:
-        # undamped, the algorithmic accelerations carry an oscillation the error
-        # estimate reads as error; the step then collapses
-        raise ModelError(f"error-controlled generalized-alpha needs numerical damping: "
-                         f"rho_inf={rho_v:g} is too close to 1; use rho_inf <= 0.9 or give "
-                         "a fixed step h", "dynamics")
-    alpha_v = opt(alpha, "alpha", 0.0, 1e9, -1.0)
-    beta_v = opt(beta, "beta", 0.0, 1e9, -1.0)
+    st = dynamics_settings(method, rtol, atol, h, rho_inf, alpha, beta, max_steps)
+    method, nmax = st.method, st.max_steps
+    rtol_v, atol_v, h_v, rho_v, alpha_v, beta_v = (st.rtol, st.atol, st.h, st.rho_inf,
+                                                   st.alpha, st.beta)
     params = requested(model, sensitivities)
     if params and method != "dopri5":
         raise ModelError(f"sensitivities are integrated with dopri5 (the variational "
@@ -103,25 +78,87 @@ def run_dynamics(model: ModelDescription, t_end: float, steps: int, method: str 
                       "of motion; the reported multipliers are the minimum-norm set (the "
                       "reactions are statically indeterminate)", RedundantConstraintWarning,
                       stacklevel=3)
-    if status == OK and bad is None:
+    exc = dynamics_error(model, p, out, res, t, bad, method, t0)
+    if exc is None:
         return res
+    raise exc
+
+
+def dynamics_error(model: ModelDescription, p: Packed, out: Any, res: DynamicsResult,
+                   t: np.ndarray, bad: int | None, method: str, t0: float) -> MbdError | None:
+    """The exception a forward dynamics run ends in, or None when it completed (``out`` as
+    :func:`mbd2d.binding.core.dynamics` returns it; the other arguments as
+    :func:`mbd2d.analysis.kinematics.kinematics_error`; p the tables of the model run)."""
+    status, iinfo, rinfo = out.status, out.iinfo, out.rinfo
+    if status == OK and bad is None:
+        return None
     text = out.msg
     last = f"t = {res.t[-1]:.6g} s" if len(res.t) else "no output rows"
     kept = f"Results up to {last} are kept in the exception's .results."
     if status == OK:
-        raise error_for("dynamics", INTEGRATOR_FAILED,
-                        f"{method}: the solution became non-finite at t = {t[bad]:.6g} s (a "
-                        f"blow-up: try a smaller rtol or h, or another method). {kept}",
-                        t=t[bad], results=res)
+        return error_for("dynamics", INTEGRATOR_FAILED,
+                         f"{method}: the solution became non-finite at t = {t[bad]:.6g} s (a "
+                         f"blow-up: try a smaller rtol or h, or another method). {kept}",
+                         t=t[bad], results=res)
     if status < 0:
-        raise error_for("dynamics", status, text, entry=bad_entry(model, int(iinfo[1])))
+        return error_for("dynamics", status, text, entry=bad_entry(model, int(iinfo[1])))
     tf = float(rinfo[0])
     if status == ASSEMBLY_FAILED:
-        raise assembly_failed("dynamics", model, 0.0, 0, t0, res)
+        return assembly_failed("dynamics", model, 0.0, 0, t0, res)
     if status == INCONSISTENT and not len(res.t):
-        raise inconsistent_at("dynamics", model, p, t0, res, f"{method}: {text}")
+        return inconsistent_at("dynamics", model, p, t0, res, f"{method}: {text}")
     if status == INTEGRATOR_FAILED:
         text = f"{method}: {text}. {kept}"
     else:
         text = f"{method}: {text}"
-    raise error_for("dynamics", status, text, t=tf, results=res)
+    return error_for("dynamics", status, text, t=tf, results=res)
+
+
+def dynamics_settings(method: str | None = None, rtol: float | None = None,
+                      atol: float | None = None, h: float | None = None,
+                      rho_inf: float | None = None, alpha: float | None = None,
+                      beta: float | None = None, max_steps: Any = None) -> SimpleNamespace:
+    """The integrator settings checked, as the core takes them: ``method`` (name), ``code``,
+    ``rtol``, ``atol``, ``h`` (0: the core's default), ``rho_inf``, ``alpha``, ``beta`` (< 0:
+    default) and ``max_steps``.
+
+    Raises
+    ------
+    ModelError
+        For an unknown method or a setting out of range or of the wrong method.
+    """
+    nmax = MAX_STEPS_DEFAULT if max_steps is None else \
+        whole(max_steps, "max_steps", "dynamics", 1, INT32_MAX)
+    method = DEFAULT_METHOD if method is None else method
+    if method not in METHODS:
+        raise ModelError(f"unknown method {method!r}; use one of {', '.join(METHODS)}",
+                         "dynamics")
+
+    def opt(v: Any, name: str, lo: float, hi: float, default: float) -> float:
+        if v is None:
+            return default
+        x = number(v, name, "dynamics")
+        if not lo <= x <= hi:
+            raise ModelError(f"{name} must be in [{lo:g}, {hi:g}], got {v!r}", "dynamics")
+        return x
+
+    rtol_v = opt(rtol, "rtol", 1e-14, 1.0, 0.0)
+    atol_v = opt(atol, "atol", 1e-16, 1e6, 0.0)
+    h_v = opt(h, "h", 1e-12, math.inf, 0.0)
+    if method == "baumgarte-rk4" and h is None:
+        raise ModelError("baumgarte-rk4 is a fixed-step method: give h (for example h=1e-3)",
+                         "dynamics")
+    if h is not None and method in ("dopri5", "partitioned"):
+        raise ModelError(f"{method} chooses its own steps from rtol and atol; h is for "
+                         "generalized-alpha and baumgarte-rk4", "dynamics")
+    rho_v = opt(rho_inf, "rho_inf", 0.0, 1.0, -1.0)
+    if method == "generalized-alpha" and h is None and rho_v >= 0.99:
+        # undamped, the algorithmic accelerations carry an oscillation the error
+        # estimate reads as error; the step then collapses
+        raise ModelError(f"error-controlled generalized-alpha needs numerical damping: "
+                         f"rho_inf={rho_v:g} is too close to 1; use rho_inf <= 0.9 or give "
+                         "a fixed step h", "dynamics")
+    alpha_v = opt(alpha, "alpha", 0.0, 1e9, -1.0)
+    beta_v = opt(beta, "beta", 0.0, 1e9, -1.0)
+    return SimpleNamespace(method=method, code=METHODS[method], rtol=rtol_v, atol=atol_v,
+                           h=h_v, rho_inf=rho_v, alpha=alpha_v, beta=beta_v, max_steps=nmax)

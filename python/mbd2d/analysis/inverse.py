@@ -5,11 +5,14 @@ from __future__ import annotations
 import warnings
 from typing import Any
 
+import numpy as np
+
 from ..binding import core
 from ..binding.pack import pack, pack_dynamics
 from ..binding.status import NO_CONVERGENCE, OK, error_for
+from ..binding.tables import Packed
 from ..description.builder import ModelDescription
-from ..errors import RedundantConstraintWarning
+from ..errors import MbdError, RedundantConstraintWarning
 from ..results.dynamics import DynamicsResult
 from .failures import BAD_FORCE, bad_entry, kinematic_failure, row_names
 from .outputs import dynamics_result, finite_part
@@ -58,14 +61,25 @@ def run_inverse(model: ModelDescription, t_end: float, steps: int, t0: float = 0
         warnings.warn(f"redundant constraints: {', '.join(red_rows)}; the multipliers are the "
                       "minimum-norm set (the reactions are statically indeterminate)",
                       RedundantConstraintWarning, stacklevel=3)
-    if status == OK and bad is None:
+    exc = inverse_error(model, p, out, res, t, bad)
+    if exc is None:
         return res
+    raise exc
+
+
+def inverse_error(model: ModelDescription, p: Packed, out: Any, res: DynamicsResult,
+                  t: np.ndarray, bad: int | None) -> MbdError | None:
+    """The exception an inverse dynamics run ends in, or None when it completed (arguments
+    as :func:`mbd2d.analysis.kinematics.kinematics_error`)."""
+    status, iinfo = out.status, out.iinfo
+    if status == OK and bad is None:
+        return None
     if status == OK:
-        raise error_for("inverse", NO_CONVERGENCE,
-                        f"the run gave non-finite values at t = {t[bad]:.6g} s; results up to "
-                        f"there ({bad} rows) are kept in the exception's .results", t=t[bad],
-                        results=res)
+        return error_for("inverse", NO_CONVERGENCE,
+                         f"the run gave non-finite values at t = {t[bad]:.6g} s; results up to "
+                         f"there ({bad} rows) are kept in the exception's .results", t=t[bad],
+                         results=res)
     if status < 0 and iinfo[1] <= BAD_FORCE:
-        raise error_for("inverse", status, out.msg, entry=bad_entry(model, int(iinfo[1])))
-    raise kinematic_failure("inverse", model, p, status, out.msg, iinfo, out.rinfo, out.qsing,
-                            out.dep, out.red, res)
+        return error_for("inverse", status, out.msg, entry=bad_entry(model, int(iinfo[1])))
+    return kinematic_failure("inverse", model, p, status, out.msg, iinfo, out.rinfo, out.qsing,
+                             out.dep, out.red, res)

@@ -16,7 +16,7 @@ import numpy as np
 from .. import _core
 from ..errors import InsufficientMemoryError
 from .status import MEMORY_ADVICE
-from .tables import DynamicTables, Packed, decode
+from .tables import BatchTables, DynamicTables, Packed, decode
 
 
 def _named(names: str, fn: Callable[..., tuple[Any, ...]], *args: Any, numbers: float = 0,
@@ -36,8 +36,12 @@ def _named(names: str, fn: Callable[..., tuple[Any, ...]], *args: Any, numbers: 
                                       nbytes) from None
     fields = dict(zip(names.split(), out, strict=True))
     if "msg" in fields:
-        fields["msg"] = decode(fields["msg"])
-    fields["status"] = int(fields["status"])
+        if np.ndim(fields["msg"]):       # a batch: one message per case
+            fields["msg"] = [decode(m) for m in fields["msg"]]
+        else:
+            fields["msg"] = decode(fields["msg"])
+    if np.ndim(fields["status"]) == 0:
+        fields["status"] = int(fields["status"])
     return SimpleNamespace(**fields)
 
 
@@ -186,3 +190,23 @@ def reactions_dp(p: Packed, ptab: np.ndarray, q: np.ndarray, t: np.ndarray, lam:
     return _named("dreac drloc status msg", _core.core_reactions_dp, p.nb, p.ctab, p.rpar,
                   ptab, q, t, lam, sq, slam,
                   numbers=12 * p.ctab.shape[1] * ptab.shape[1] * len(np.atleast_1d(t)))
+
+
+# ------------------------------------------------------------------ design sweeps
+
+def batch(b: BatchTables, vals: np.ndarray) -> dict[str, Any]:
+    """One analysis for every case (column) of vals (nv, ncase), in one core call
+    (``fortran/mbd_batch.f90``). Returns the core's arrays by name, the case last: ``q``,
+    ``qd``, ``qdd`` (nq, nrow, ncase), ``lam`` (nlam, nrow, ncase), ``e`` (ne, nrow, ncase),
+    ``iinfo``, ``rinfo`` (10, ncase), ``qsing`` (nq, ncase), ``dep``, ``red`` (neq, ncase),
+    ``status`` (ncase) and ``msg`` (ncase, text). A module-level function of plain arrays, so
+    that worker processes and Dask workers can run it."""
+    vals = np.asfortranarray(vals, dtype=np.float64)
+    ncase = vals.shape[1]
+    out = _named("q qd qdd lam e iinfo rinfo qsing dep red status msg", _core.core_batch,
+                 analysis=b.analysis, nb=b.nb, ctab=b.ctab, rpar=b.rpar, bmass=b.bmass,
+                 grav=b.grav, ftab=b.ftab, fpar=b.fpar, q0=b.q0, v0=b.v0, vtab=b.vtab,
+                 vals=vals, opens=b.opens, iset=b.iset, rset=b.rset, neq=b.neq, nrow=b.nrow,
+                 nlam=b.nlam, ne=b.ne,
+                 numbers=ncase * ((3 * b.nq + b.nlam + b.ne) * b.nrow + 2 * b.neq + b.nq + 20))
+    return vars(out)
