@@ -15,14 +15,15 @@ SUFFIXES = (".nc", ".csv")
 
 
 def _netcdf_engine() -> str:
-    """An installed netCDF writer for xarray: h5netcdf, else netCDF4."""
-    for engine in ("h5netcdf", "netCDF4"):
+    """An installed netCDF writer for xarray: h5netcdf (with h5py), else netCDF4."""
+    for engine, modules in (("h5netcdf", ("h5netcdf", "h5py")), ("netcdf4", ("netCDF4",))):
         try:
-            __import__(engine)
+            for m in modules:
+                __import__(m)
         except ImportError:
             continue
-        return engine.lower()
-    raise ImportError(f"writing netCDF needs h5netcdf or netCDF4: {EXTRA}")
+        return engine
+    raise ImportError(f"writing netCDF needs h5netcdf and h5py (or netCDF4): {EXTRA}")
 
 
 def write_sweep(ds: Any, path: str | Path) -> None:
