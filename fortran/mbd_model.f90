@@ -123,7 +123,6 @@ contains
     logical, allocatable :: geom(:)
     real(wp) :: rref(8)
     character(len=MSG_LEN) :: sub
-    character(len=16) :: ks
 
     status = MBD_OK; msg = ''; bad = 0
     if (size(ctab, 1) /= NCT) then
@@ -163,7 +162,6 @@ contains
     do k = 1, nc
       kind = ctab(1, k); bi = ctab(2, k); bj = ctab(3, k)
       off = ctab(6, k); len = ctab(7, k)
-      write (ks, '(i0)') k
       bad = k
       if (.not. con_known(kind)) then
         status = MBD_BAD_INPUT; write (msg, '(a,i0)') 'unknown constraint kind ', kind; return
