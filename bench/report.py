@@ -144,6 +144,28 @@ def scaling_targets(results: dict) -> list[Row]:
                     t.get("met") if t.get("ms_per_step") is not None else None)]
 
 
+def study_targets(results: dict) -> list[Row]:
+    """Sweeps >= 10x cheaper per variant than a with_params loop; sensitivities of 4
+    parameters <= 2x the analysis alone."""
+    pv = get(results, "sweep", "per_variant") or {}
+    ratio = pv.get("ratio_loop_over_batched")
+    us = pv.get("us_per_variant") or {}
+    out = [_target("sweep, 10-step kinematics: per-variant cost >= 10x below a with_params "
+                   "loop", f"{fmt(ratio, '.1f')}x ({fmt(us.get('loop'), '.0f')} us -> "
+                   f"{fmt(us.get('batched'), '.0f')} us; core alone "
+                   f"{fmt(us.get('core'), '.0f')} us)" if ratio else "not measured",
+                   None if ratio is None else ratio >= 10.0,
+                   failed(results.get("sweep")) or "same run, interleaved")]
+    rows = get(results, "sensitivities", "rows") or []
+    ratios = [r.get("ratio") for r in rows if r.get("ratio")]
+    out.append(_target("sensitivities of 4 parameters: <= 2x the analysis alone",
+                       ", ".join(f"{r['case'].split(',')[0]} {r['ratio']:.2f}x" for r in rows
+                                 if r.get("ratio")) or "not measured",
+                       None if not ratios else max(ratios) <= 2.0,
+                       failed(results.get("sensitivities")) or "wall time, same run"))
+    return out
+
+
 def runtime_target(results: dict) -> list[Row]:
     """`make bench` in under 10 minutes (the run itself, without the install)."""
     total = get(results, "meta", "total_runtime_s")
@@ -155,7 +177,7 @@ def runtime_target(results: dict) -> list[Row]:
 def targets(results: dict) -> list[Row]:
     """Every target with its measured figure and whether it is met (None: not measured)."""
     return (kinematics_targets(results) + peer_targets(results) + scaling_targets(results)
-            + runtime_target(results))
+            + study_targets(results) + runtime_target(results))
 
 
 def met_text(met: bool | None) -> str:
@@ -347,6 +369,59 @@ def memory_section(results: dict, charts: dict, out: Path, base: Path) -> str:
             + image(charts, "memory", out, base, "memory"))
 
 
+def sweep_section(results: dict) -> str:
+    """Per-variant cost of sweeps and the Dask throughput."""
+    sw = results.get("sweep")
+    if failed(sw):
+        return f"Failed: {failed(sw)}\n"
+    pv = sw.get("per_variant") or {}
+    us = pv.get("us_per_variant") or {}
+    over = pv.get("overhead_us_per_variant") or {}
+    parts = [f"Per-variant cost of a {pv.get('steps')}-step kinematic run of the crank-rocker "
+             f"({pv.get('model')}, `{pv.get('parameter')}` over {pv.get('variants')} values), "
+             "best-of-{0} wall time, interleaved: a Python loop of `model.with_params(...)"
+             ".kinematics(...)`, one `mbd2d.sweep(..., workers=1)` (one process, the Dataset "
+             "included), and one core call per variant on the packed base model (the floor "
+             "of any batching).\n".format(pv.get("repeats")),
+             table(("", "us per variant", "of which around the core's own run"),
+                   [("loop: with_params + kinematics", fmt(us.get("loop"), ".0f"),
+                     fmt(over.get("loop"), ".0f")),
+                    ("batched: mbd2d.sweep", fmt(us.get("batched"), ".1f"),
+                     fmt(over.get("batched"), ".1f")),
+                    ("core alone (one core_kinematics call)", fmt(us.get("core"), ".1f"),
+                     "0")]),
+             f"Loop / batched: **{fmt(pv.get('ratio_loop_over_batched'), '.1f')}x**; batched "
+             f"/ core alone: {fmt(pv.get('batched_over_core'), '.2f')}.\n"]
+    tp = sw.get("throughput") or {}
+    rows = [(r["runner"], fmt(r.get("variants_per_s"), ".0f"), fmt(r.get("seconds"), ".3f"),
+             "yes" if r.get("identical_to_serial") else "**no**") for r in tp.get("rows", [])]
+    parts.append(f"Throughput: {tp.get('cases')} variants of a {tp.get('steps')}-step run "
+                 "(best of the repeats after a warm-up sweep; Dask LocalCluster with process "
+                 "workers of 1 thread, started before the timing).\n")
+    if tp.get("dask_unavailable"):
+        parts.append(f"Dask unavailable: {tp['dask_unavailable']}.\n")
+    parts.append(table(("runner", "variants / s", "s", "identical to the serial Dataset"),
+                       rows))
+    return "\n".join(parts)
+
+
+def sensitivities_section(results: dict) -> str:
+    """Cost ratio of each analysis with 4 parameters' sensitivities to the analysis alone."""
+    se = results.get("sensitivities")
+    if failed(se):
+        return f"Failed: {failed(se)}\n"
+    rows = [(r["case"], fmt(r.get("base_us_per_step"), ".2f"),
+             fmt(r.get("sens_us_per_step"), ".2f"), fmt(r.get("ratio"), ".2f"),
+             " / ".join(str(x) for x in r.get("integrator_steps", [])) or "–")
+            for r in se.get("rows", [])]
+    return (f"Wall time per output step of the public call with and without "
+            f"`sensitivities=[4 names]` ({se.get('steps')} steps at h = 1 ms, best of "
+            f"{se.get('repeats')}, interleaved; bench/sensitivities.py). Callgrind "
+            "instruction ratios of the core alone are in docs/sensitivities.md.\n\n"
+            + table(("case", "us/step", "with sensitivities", "ratio",
+                     "integrator steps"), rows))
+
+
 def notes_section(results: dict) -> str:
     """Quick mode, failures and section run times."""
     meta = results.get("meta") or {}
@@ -401,6 +476,8 @@ def results_markdown(results: dict, charts: dict[str, str], md_path: Path, out: 
              "## Kinematics speed\n", kinematics_section(results),
              "## Scaling with model size\n", scaling_section(results, charts, out, base),
              "## Memory of long runs\n", memory_section(results, charts, out, base),
+             "## Design sweeps\n", sweep_section(results),
+             "## Sensitivity cost\n", sensitivities_section(results),
              "## Notes\n", notes_section(results)]
     return "\n".join(parts)
 

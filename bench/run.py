@@ -9,7 +9,11 @@ Sections (each in its own try/except: a failure is recorded and the rest runs):
    (bench/peers_exudyn.py), with the ratios at equal accuracy;
 4. kinematics speed: Fortran loop, Python stepper, plain NumPy (bench/kinematics_speed.py);
 5. scaling of kinematics with N (bench/scaling.py);
-6. memory of 10^6 output steps (bench/memory.py).
+6. memory of 10^6 output steps (bench/memory.py);
+7. design sweeps: per-variant cost batched vs a with_params loop, Dask LocalCluster
+   throughput with 1 and 2 workers (bench/sweep.py);
+8. cost of design sensitivities, 4 parameters against the analysis alone
+   (bench/sensitivities.py).
 
 Writes bench/results/*.json and *.png, bench/RESULTS.md and bench/README_headline.md
 (bench/report.py). The whole run is sized to finish in well under 10 minutes on a 2-core
@@ -41,9 +45,12 @@ import memory  # noqa: E402
 import peers_exudyn  # noqa: E402
 import report  # noqa: E402
 import scaling  # noqa: E402
+import sensitivities  # noqa: E402
+import sweep as sweeps  # noqa: E402
 import work_precision  # noqa: E402
 
-SECTIONS = ("environment", "work_precision", "peers", "kinematics", "scaling", "memory")
+SECTIONS = ("environment", "work_precision", "peers", "kinematics", "scaling", "memory",
+            "sweep", "sensitivities")
 
 
 # ===================================================================== JSON
@@ -136,6 +143,16 @@ def section_memory(quick: bool) -> dict:
     return memory.memory(steps=100_000 if quick else memory.STEPS)
 
 
+def section_sweep(quick: bool) -> dict:
+    """Per-variant cost of sweeps and the Dask LocalCluster throughput."""
+    return sweeps.measure(quick=quick)
+
+
+def section_sensitivities(quick: bool) -> dict:
+    """Each analysis with 4 parameters' sensitivities against the analysis alone."""
+    return sensitivities.measure(500 if quick else 20_000, 2 if quick else 5, quick)
+
+
 def failure(e: BaseException) -> dict:
     """The record of a failed section."""
     return {"failed": True, "error": f"{type(e).__name__}: {e}",
@@ -218,7 +235,8 @@ def main(argv: Sequence[str] | None = None) -> dict:
     fns: dict[str, Callable[[bool], dict]] = {
         "environment": environment.collect, "work_precision": section_work_precision,
         "peers": section_peers, "kinematics": section_kinematics,
-        "scaling": section_scaling, "memory": section_memory}
+        "scaling": section_scaling, "memory": section_memory, "sweep": section_sweep,
+        "sensitivities": section_sensitivities}
     results = {name: run_section(name, fns[name], a.quick) for name in SECTIONS
                if name in wanted}
     derive(results)
