@@ -5,7 +5,9 @@ Usage::
     python examples/demo.py [--out DIR]
 
 Writes ``NAME_mechanism.png`` and ``NAME_timeseries.png`` for each example to DIR (default
-``examples/output/`` next to this script). The seed four-bar is non-Grashof: driven past its
+``examples/output/`` next to this script), and the design study's three pictures
+(examples/design_study.py: a sweep of the crank-rocker's coupler length, the sensitivities
+of the rocker angle, the tolerance of a coupler point). The seed four-bar is non-Grashof: driven past its
 toggle it raises :class:`mbd2d.SingularConfigurationError`, which is the expected outcome;
 its partial results are drawn with the toggle configuration marked.
 
@@ -104,8 +106,21 @@ def main(argv: list[str] | None = None) -> int:
         if problem:
             problems.append(f"{name}: {problem}")
 
+    total = len(runs) + 1
+    try:                         # the design study: sweeps, sensitivities, tolerances
+        import design_study
+        problem, files = design_study.run(out)
+        written += files
+        print("design_study: " + ", ".join(Path(f).name for f in files) + f" in {out}")
+        if problem:
+            problems.append(f"design_study: {problem}")
+    except Exception as exc:  # report every example, then fail
+        traceback.print_exc()
+        problems.append(f"design_study: {type(exc).__name__}: {exc}")
+        print(f"design_study: FAILED ({type(exc).__name__})")
+
     print()
-    print(f"summary: {len(runs) - len(problems)}/{len(runs)} examples as expected, "
+    print(f"summary: {total - len(problems)}/{total} examples as expected, "
           f"{len(written)} PNG files in {out}")
     for p in problems:
         print(f"  unexpected: {p}")
