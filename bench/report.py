@@ -376,28 +376,26 @@ def sweep_section(results: dict) -> str:
         return f"Failed: {failed(sw)}\n"
     pv = sw.get("per_variant") or {}
     us = pv.get("us_per_variant") or {}
-    over = pv.get("overhead_us_per_variant") or {}
     parts = [f"Per-variant cost of a {pv.get('steps')}-step kinematic run of the crank-rocker "
              f"({pv.get('model')}, `{pv.get('parameter')}` over {pv.get('variants')} values), "
              "best-of-{0} wall time, interleaved: a Python loop of `model.with_params(...)"
              ".kinematics(...)`, one `mbd2d.sweep(..., workers=1)` (one process, the Dataset "
              "included), and one core call per variant on the packed base model (the floor "
              "of any batching).\n".format(pv.get("repeats")),
-             table(("", "us per variant", "of which around the core's own run"),
-                   [("loop: with_params + kinematics", fmt(us.get("loop"), ".0f"),
-                     fmt(over.get("loop"), ".0f")),
-                    ("batched: mbd2d.sweep", fmt(us.get("batched"), ".1f"),
-                     fmt(over.get("batched"), ".1f")),
-                    ("core alone (one core_kinematics call)", fmt(us.get("core"), ".1f"),
-                     "0")]),
+             table(("", "us per variant"),
+                   [("loop: with_params + kinematics", fmt(us.get("loop"), ".0f")),
+                    ("batched: mbd2d.sweep", fmt(us.get("batched"), ".1f")),
+                    ("one core_kinematics call per variant (packed once)",
+                     fmt(us.get("core"), ".1f"))]),
              f"Loop / batched: **{fmt(pv.get('ratio_loop_over_batched'), '.1f')}x**; batched "
              f"/ core alone: {fmt(pv.get('batched_over_core'), '.2f')}.\n"]
     tp = sw.get("throughput") or {}
     rows = [(r["runner"], fmt(r.get("variants_per_s"), ".0f"), fmt(r.get("seconds"), ".3f"),
              "yes" if r.get("identical_to_serial") else "**no**") for r in tp.get("rows", [])]
-    parts.append(f"Throughput: {tp.get('cases')} variants of a {tp.get('steps')}-step run "
-                 "(best of the repeats after a warm-up sweep; Dask LocalCluster with process "
-                 "workers of 1 thread, started before the timing).\n")
+    parts.append(f"Throughput: {tp.get('cases')} variants of a {tp.get('steps')}-step run, "
+                 f"every {tp.get('every')}th row kept (best of the repeats after a warm-up "
+                 "sweep; Dask LocalCluster with process workers of 1 thread, started before "
+                 "the timing).\n")
     if tp.get("dask_unavailable"):
         parts.append(f"Dask unavailable: {tp['dask_unavailable']}.\n")
     parts.append(table(("runner", "variants / s", "s", "identical to the serial Dataset"),

@@ -89,9 +89,7 @@ def synthetic_results(stepper: bool = True, exudyn: bool = True) -> dict:
             "work_precision": {"failed": True, "error": "RuntimeError: boom"},
             "sweep": {"per_variant": {"ratio_loop_over_batched": 12.0, "steps": 10,
                                       "us_per_variant": {"loop": 840.0, "batched": 70.0,
-                                                         "core": 65.0},
-                                      "overhead_us_per_variant": {"loop": 775.0,
-                                                                  "batched": 5.0}},
+                                                         "core": 65.0}},
                       "throughput": {"cases": 10, "steps": 200, "rows": [
                           {"runner": "Dask LocalCluster, 2 worker(s)", "seconds": 1.0,
                            "variants_per_s": 10.0, "identical_to_serial": True}]}},

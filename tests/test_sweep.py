@@ -332,6 +332,7 @@ def test_process_pool_gives_the_serial_result(monkeypatch: pytest.MonkeyPatch) -
     cases = fourbar_cases(23)
     serial = mbd2d.sweep(m, cases, t_end=1.0, steps=30, workers=1)
     monkeypatch.setattr(runner, "POOL_MIN_SECONDS", 0.0)
+    monkeypatch.setattr(runner, "PROBE_SECONDS", 0.0)
     pooled = mbd2d.sweep(m, cases, t_end=1.0, steps=30, workers=2)
     assert serial.identical(pooled)
     assert (serial.status.values != 0).any() and (serial.status.values == 0).any()
@@ -343,7 +344,7 @@ def test_dask_local_cluster_gives_the_serial_result() -> None:
     cases = fourbar_cases(17)
     serial = mbd2d.sweep(m, cases, t_end=1.0, steps=30, workers=1)
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                                  dashboard_address=None) as cluster, \
+                                  dashboard_address=":0") as cluster, \
             distributed.Client(cluster) as client:
         remote = mbd2d.sweep(m, cases, client=client, t_end=1.0, steps=30)
         tol = mbd2d.tolerance(m, {"joint.B.points.0.0": 1e-3}, client=client, samples=20,

@@ -22,8 +22,10 @@ from ..errors import CoreError, ModelError
 from ..validate import whole
 from .progress import progress_bar
 
-#: cases run in this process first, to measure the cost of one
+#: cases of the first chunk run in this process (the cost of a case is measured on them)
 FIRST_CHUNK = 4
+#: time run in this process before a process pool may take over [s]
+PROBE_SECONDS = 0.2
 #: estimated time of the remaining cases above which a process pool is started [s]
 POOL_MIN_SECONDS = 1.0
 #: chunks per worker (a pool or a Dask cluster): small enough to balance the load
@@ -103,22 +105,22 @@ def run(b: BatchTables, vals: np.ndarray, client: Any = None, workers: Any = Non
 
 
 def _local(b: BatchTables, vals: np.ndarray, workers: int, out: Outputs, bar: Any) -> None:
-    """The first cases here, timed; the rest in a process pool when they would take long
-    enough, else here in chunks."""
+    """Chunks here, timed; once they have run PROBE_SECONDS, the rest goes to a process pool
+    when it would take more than POOL_MIN_SECONDS here."""
     n = vals.shape[1]
-    first = min(n, FIRST_CHUNK)
     t0 = time.perf_counter()
-    bar.update(out.store(0, core.batch(b, vals[:, :first])))
-    per_case = max((time.perf_counter() - t0) / first, 1e-7)
-    if first == n:
-        return
-    rest = n - first
-    if workers > 1 and per_case * rest > POOL_MIN_SECONDS:
-        _pool(b, vals, first, workers, out, bar)
-        return
-    size = max(1, int(SERIAL_CHUNK_SECONDS / per_case))
-    for lo in range(first, n, size):
-        bar.update(out.store(lo, core.batch(b, vals[:, lo:min(lo + size, n)])))
+    done, size = 0, FIRST_CHUNK
+    while done < n:
+        hi = min(n, done + size)
+        bar.update(out.store(done, core.batch(b, vals[:, done:hi])))
+        done = hi
+        elapsed = time.perf_counter() - t0
+        per_case = max(elapsed / done, 1e-7)
+        if (workers > 1 and done < n and elapsed >= PROBE_SECONDS
+                and per_case * (n - done) > POOL_MIN_SECONDS):
+            _pool(b, vals, done, workers, out, bar)
+            return
+        size = max(1, int(SERIAL_CHUNK_SECONDS / per_case))
 
 
 def _context() -> Any:
