@@ -432,6 +432,9 @@ def test_cli_sweep(tmp_path: Any, capsys: pytest.CaptureFixture) -> None:
     assert main(["sweep", model, "--param", "joint.B.points.0.0=1:2:2", "--steps", "4",
                  "--out", str(out)]) == 2
     assert main(["sweep", model, "--param", "joint.B.points.0.0=1:2:2", "--t-end", "1",
+                 "--steps", "4", "--out", str(out), "--scheduler", "tcp://127.0.0.1:9"]) == 2
+    assert "cannot reach the Dask scheduler" in capsys.readouterr().err
+    assert main(["sweep", model, "--param", "joint.B.points.0.0=1:2:2", "--t-end", "1",
                  "--steps", "4", "--out", str(tmp_path / "s.txt")]) == 2
 
 

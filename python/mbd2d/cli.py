@@ -139,7 +139,7 @@ def _param_values(spec: str) -> tuple[str, np.ndarray]:
 
 def _sweep(model: Model, args: argparse.Namespace) -> int:
     """The sweep command: run, write, summarize."""
-    from .studies import grid, sweep, write_sweep
+    from .studies import connect, grid, sweep, write_sweep
     if not str(args.out).endswith((".nc", ".csv")):
         raise ModelError(f"--out must end in .nc or .csv, got {args.out!r}", "command line")
     values = dict(_param_values(p) for p in args.param)
@@ -160,18 +160,7 @@ def _sweep(model: Model, args: argparse.Namespace) -> int:
         kw = {"t_end": args.t_end, "steps": args.steps, "t0": args.t0, "every": args.every}
         if args.method is not None:
             kw["method"] = args.method
-    client = None
-    if args.scheduler:
-        try:
-            from distributed import Client
-        except ImportError:
-            raise ModelError("--scheduler needs the package 'distributed': pip install "
-                             "'mbd2d[sweep]'", "command line") from None
-        try:
-            client = Client(args.scheduler, timeout=10)
-        except (OSError, TimeoutError, ValueError) as exc:
-            raise ModelError(f"cannot reach the Dask scheduler at {args.scheduler!r}: {exc}",
-                             "command line") from None
+    client = connect(args.scheduler) if args.scheduler else None
     try:
         ds = sweep(model, cases, args.analysis, client, workers=args.workers, **kw)
     finally:

@@ -9,7 +9,9 @@ from __future__ import annotations
 
 from .files import write_sweep
 from .plan import ANALYSES, grid
+from .runner import connect
 from .sweep import sweep
 from .tolerance import ToleranceResult, tolerance
 
-__all__ = ["sweep", "grid", "tolerance", "ToleranceResult", "write_sweep", "ANALYSES"]
+__all__ = ["sweep", "grid", "tolerance", "ToleranceResult", "write_sweep", "connect",
+           "ANALYSES"]

@@ -165,4 +165,26 @@ def _dask(b: BatchTables, vals: np.ndarray, client: Any, out: Outputs, bar: Any)
         bar.update(out.store(start[f.key], f.result()))
 
 
-__all__ = ["Outputs", "run", "chunks", "cores"]
+def connect(address: str, timeout: float = 10.0) -> Any:
+    """A distributed.Client of the Dask scheduler at address (``tcp://host:8786``).
+
+    Raises
+    ------
+    ModelError
+        When the scheduler cannot be reached.
+    ImportError
+        Without the package distributed.
+    """
+    try:
+        from distributed import Client
+    except ImportError:
+        raise ImportError("a Dask scheduler needs the package 'distributed': pip install "
+                          "'mbd2d[sweep]'") from None
+    try:
+        return Client(address, timeout=timeout)
+    except (OSError, TimeoutError, ValueError) as exc:
+        raise ModelError(f"cannot reach the Dask scheduler at {address!r}: {exc}",
+                         "scheduler") from None
+
+
+__all__ = ["Outputs", "run", "chunks", "cores", "connect"]
