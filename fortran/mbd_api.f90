@@ -440,6 +440,16 @@ contains
     end do
   end subroutine api_profile
 
+  !> The report's iinfo(2) after a failed build: the offending constraint (> 0), body
+  !! (-body) or force (-1000000 - force); 0 when none.
+  pure integer function bad_code(bad, badf)
+    integer, intent(in) :: bad                  !! offending constraint (model_build)
+    integer, intent(in) :: badf                 !! force (> 0) or -body (model_add_dynamics)
+    bad_code = bad
+    if (badf > 0) bad_code = -1000000 - badf
+    if (badf < 0) bad_code = badf
+  end function bad_code
+
   !> Build a model with masses and forces (bad: offending constraint > 0 or force > 0 with
   !! kind flag; body errors come back as bad = -body).
   subroutine build_dynamic(nb, ctab, rpar, bmass, grav, ftab, fpar, m, status, msg, bad, badf)
@@ -511,7 +521,7 @@ contains
     call build_dynamic(nb, ctab, rpar, bmass, grav, ftab, fpar, m, status, msg, bad, badf)
     if (status /= MBD_OK) then
       qout = zero; qdout = zero; qddout = zero; iinfo = 0; rinfo = zero
-      iinfo(2) = bad; if (badf /= 0) iinfo(2) = -1000000 - badf
+      iinfo(2) = bad_code(bad, badf)
       qsing = zero; dep = 0; redundant = 0; tpass = zero
       return
     end if
@@ -613,7 +623,7 @@ contains
     iinfo = 0; rinfo = zero; redundant = 0
     qout = zero; qdout = zero; qddout = zero; lamout = zero; eout = zero
     call build_dynamic(nb, ctab, rpar, bmass, grav, ftab, fpar, m, status, msg, bad, badf)
-    iinfo(2) = bad; if (badf /= 0) iinfo(2) = -1000000 - badf
+    iinfo(2) = bad_code(bad, badf)
     if (status /= MBD_OK) return
     if (.not. (finite(q0) .and. finite(v0) .and. finite(t0) .and. finite(t1) .and. &
                finite([rtol, atol, h, rho_inf, balpha, bbeta]))) then
@@ -709,7 +719,7 @@ contains
     integer :: bad, badf, ierr
     q = zero; lam = zero; stable = 0; resid = zero; iinfo = 0
     call build_dynamic(nb, ctab, rpar, bmass, grav, ftab, fpar, m, status, msg, bad, badf)
-    iinfo(2) = bad; if (badf /= 0) iinfo(2) = -1000000 - badf
+    iinfo(2) = bad_code(bad, badf)
     if (status /= MBD_OK) return
     if (.not. (finite(q0) .and. finite(t))) then
       call not_finite('q0 and t', status, msg); return
@@ -901,7 +911,7 @@ contains
     qout = zero; qdout = zero; qddout = zero; lamout = zero; eout = zero
     sq = zero; sqd = zero; sqdd = zero
     call build_dynamic(nb, ctab, rpar, bmass, grav, ftab, fpar, m, status, msg, bad, badf)
-    iinfo(2) = bad; if (badf /= 0) iinfo(2) = -1000000 - badf
+    iinfo(2) = bad_code(bad, badf)
     if (status /= MBD_OK) return
     if (.not. (finite(q0) .and. finite(v0) .and. finite(t0) .and. finite(t1) .and. &
                finite([rtol, atol]))) then

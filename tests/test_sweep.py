@@ -162,7 +162,8 @@ def test_gear_pair_inverse_dynamics() -> None:
              "joint.mesh.radii.1": [1.5, 1.4, 1.55, 1.5],
              "joint.O2.points.0.0": [2.0, 2.0, 2.0, 2.1],
              "joint.O2.points.1.1": [0.0, 0.01, 0.0, 0.0],
-             "body.wheel.mass": [3.0, 2.5, 4.0, 3.0], "body.pinion.inertia": [0.02, 0.03, 0.01, 0.02],
+             "body.wheel.mass": [3.0, 2.5, 4.0, 3.0],
+             "body.pinion.inertia": [0.02, 0.03, 0.01, 0.02],
              "model.gravity.1": [-9.81, -1.6, 0.0, -9.81],
              "joint.mesh.pressure_angle": [0.35, 0.3, 0.0, 0.25]}
     ds = check_all(m, cases, "inverse_dynamics", t_end=0.5, steps=10)
@@ -441,3 +442,46 @@ def test_cli_sweep(tmp_path: Any, capsys: pytest.CaptureFixture) -> None:
 def load_example_path(name: str) -> Any:
     from conftest import example_path
     return example_path(name)
+
+
+# ------------------------------------------------------------------ hostile values
+
+HOSTILE = [1e300, -1e300, 0.0, 1e-300, 5e-324, 1e15, -1e15, 1e-12]
+
+
+@pytest.mark.parametrize("example, name, analysis, kw", [
+    ("fourbar_grashof.toml", "joint.B.points.0.0", "kinematics", {}),
+    ("fourbar_grashof.toml", "joint.O4.points.1.0", "kinematics", {}),
+    ("fourbar_grashof.toml", "driver.motor.f.poly.1", "kinematics", {}),
+    ("slider_crank.toml", "joint.guide.axes.0.1", "kinematics", {}),
+    ("cam_follower.toml", "joint.contact.profile.circle.radius", "kinematics", {}),
+    ("pendulum_spring.toml", "force.torsion.stiffness", "statics", {}),
+    ("pendulum_spring.toml", "body.bar.inertia", "dynamics", {"max_steps": 20000}),
+    (None, "joint.mesh.radii.0", "inverse_dynamics", {}),
+    (None, "body.wheel.mass", "inverse_dynamics", {}),
+    (None, "model.gravity.1", "dynamics", {"max_steps": 20000})])
+def test_hostile_values(example: str | None, name: str, analysis: str, kw: dict) -> None:
+    """Huge, tiny, zero and subnormal values: every variant gives a status and what it
+    gives alone (a typed error or a finite result), and the sweep goes on."""
+    m = gear_pair() if example is None else load_example(example)
+    t = {} if analysis == "statics" else {"t_end": 0.5, "steps": 5}
+    ds = check_all(m, {name: HOSTILE}, analysis, **t, **kw)
+    q = ds.q.values
+    ok = ds.status.values == 0
+    assert np.isfinite(q[ok]).all()
+    assert all(m for m, s in zip(ds.message.values, ds.status.values) if s != 0)
+
+
+def test_a_bad_mass_names_the_body() -> None:
+    """The core's code of a bad body in a dynamic build names that body (it named no entry
+    and failed with an IndexError in inverse dynamics)."""
+    m = gear_pair().with_params({"body.wheel.mass": -1.0})
+    for run in (lambda: m.inverse_dynamics(0.5, 5), lambda: m.dynamics(0.5, 5), m.statics):
+        with pytest.raises(mbd2d.ModelError, match="body 'wheel'.*finite and >= 0"):
+            run()
+
+
+def test_too_large_a_sweep_is_refused_before_it_runs() -> None:
+    m = load_example("fourbar_grashof.toml")
+    with pytest.raises(mbd2d.InsufficientMemoryError, match="sweep"):
+        mbd2d.sweep(m, {"joint.B.points.0.0": np.full(10**6, 1.75)}, t_end=1.0, steps=10**5)

@@ -14,7 +14,7 @@ from ..binding.tables import Packed
 from ..description.builder import ModelDescription
 from ..errors import MbdError, RedundantConstraintWarning
 from ..results.dynamics import DynamicsResult
-from .failures import BAD_FORCE, bad_entry, kinematic_failure, row_names
+from .failures import bad_entry, kinematic_failure, row_names
 from .outputs import dynamics_result, finite_part
 from .sensitivities import attach, check_status, requested, table
 from .settings import (check_memory, check_solver, check_span, output_rows, output_steps,
@@ -79,7 +79,7 @@ def inverse_error(model: ModelDescription, p: Packed, out: Any, res: DynamicsRes
                          f"the run gave non-finite values at t = {t[bad]:.6g} s; results up to "
                          f"there ({bad} rows) are kept in the exception's .results", t=t[bad],
                          results=res)
-    if status < 0 and iinfo[1] <= BAD_FORCE:
+    if status < 0 and iinfo[1] < 0:          # a force or a body (masses)
         return error_for("inverse", status, out.msg, entry=bad_entry(model, int(iinfo[1])))
     return kinematic_failure("inverse", model, p, status, out.msg, iinfo, out.rinfo, out.qsing,
                              out.dep, out.red, res)

@@ -4,7 +4,7 @@ first-order propagation through the exact sensitivities beside a Monte Carlo est
 For independent parameters p_k with standard deviations sigma_k, an output y(p) has to first
 order the variance
 
-    var(y) = sum_k (dy/dp_k sigma_k)**2        (the diagonal of S Sigma S^T, Sigma = diag(sigma**2))
+    var(y) = sum_k (dy/dp_k sigma_k)**2      (the diagonal of S Sigma S^T, Sigma = diag(sigma^2))
 
 with S = dy/dp from the core (docs/sensitivities.md). The Monte Carlo estimate draws N
 variants with p_k ~ Normal(p_k0, sigma_k), runs them as one sweep (:func:`mbd2d.sweep`, so in
