@@ -16,7 +16,8 @@ Sections (each in its own try/except: a failure is recorded and the rest runs):
    (bench/sensitivities.py).
 
 Writes bench/results/*.json and *.png, bench/RESULTS.md and bench/README_headline.md
-(bench/report.py). The whole run is sized to finish in well under 10 minutes on a 2-core
+(bench/report.py). With --only, the other sections come from their results files of an
+earlier run (the report says which). The whole run is sized to finish in well under 10 minutes on a 2-core
 machine; --quick is a smoke test of the same code.
 
     python bench/run.py [--quick] [--out DIR] [--only SECTION ...]
@@ -174,6 +175,24 @@ def run_section(name: str, fn: Callable[[bool], dict], quick: bool) -> dict:
 
 
 # ===================================================================== charts
+def earlier_sections(out: Path, names: Sequence[str]) -> dict[str, dict]:
+    """The results of sections not run now (``--only``), from their files of an earlier run,
+    so that the report stays whole."""
+    found: dict[str, dict] = {}
+    for name in names:
+        path = out / f"{name}.json"
+        if not path.is_file():
+            continue
+        try:
+            data = json.loads(path.read_text(encoding="utf-8"))
+        except (OSError, ValueError):
+            continue
+        if name == "environment":
+            data = data.get("environment") or {}
+        found[name] = data
+    return found
+
+
 def draw_charts(results: dict, out: Path) -> dict[str, str]:
     """Every PNG; returns {chart name: file name} of the charts that were drawn."""
     charts: dict[str, str] = {}
@@ -237,15 +256,19 @@ def main(argv: Sequence[str] | None = None) -> dict:
         "peers": section_peers, "kinematics": section_kinematics,
         "scaling": section_scaling, "memory": section_memory, "sweep": section_sweep,
         "sensitivities": section_sensitivities}
-    results = {name: run_section(name, fns[name], a.quick) for name in SECTIONS
-               if name in wanted}
+    ran = {name: run_section(name, fns[name], a.quick) for name in SECTIONS if name in wanted}
+    earlier = earlier_sections(out, [n for n in SECTIONS if n not in wanted])
+    results = {name: ran.get(name, earlier.get(name)) for name in SECTIONS
+               if name in ran or name in earlier}
     derive(results)
     env = results.get("environment")
     if env is not None:
         env["load_average_end"] = os.getloadavg()
     total = time.perf_counter() - t_start
     results["meta"] = {"quick": a.quick, "sections": list(wanted), "total_runtime_s": total,
-                       "command": "python bench/run.py" + (" --quick" if a.quick else "")}
+                       "earlier": sorted(earlier),
+                       "command": "python bench/run.py" + (" --quick" if a.quick else "")
+                       + (" --only " + " ".join(wanted) if a.only else "")}
     print("\n=== charts and report", flush=True)
     charts = draw_charts(results, out)
     for name, data in results.items():
