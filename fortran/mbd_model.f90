@@ -16,7 +16,9 @@
 !!   bmass(2, nb)     mass and moment of inertia about the centre of mass (>= 0)
 !!   grav(2)          gravity vector
 !!   ftab(NFT, nf)    one column per force element: 1 kind, 2 body i, 3 body j (0 = ground),
-!!                    4 offset of its raw parameters in fpar, 5 their number, 6 reserved
+!!                    4 offset of its raw parameters in fpar, 5 their number, 6 the joint
+!!                    (constraint index) of a joint friction element (kind FRC_FRICTION; its
+!!                    bodies are the joint's), else 0
 !!   fpar(:)          raw force parameters (layouts in mbd_forces)
 !! Nondimensional models (model_build with nondim): the analyses work in units of the model's
 !! length scale L (lref: the largest joint point, size or position, or with forces spring
@@ -38,7 +40,8 @@ module mbd_model
                              CON_GEAR, CON_ABSOLUTE, CON_POINT_LINE, DRV_ABS, DRV_REL_DIST
   use mbd_joint_gear, only: CARRIER_SLOT
   use mbd_forces, only: force_known, force_raw_length, force_prepare, force_exponents, &
-                        FRC_TORQUE, FRC_POINT
+                        FRC_TORQUE, FRC_POINT, FRC_FRICTION, force_is_contact
+  use mbd_contact, only: friction_prepare, FRIC_STICK_SLIP
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   implicit none
   private
@@ -78,6 +81,10 @@ module mbd_model
     integer, allocatable :: floc(:, :)    !! (NLOC, nf) local slot -> global coordinate
     integer, allocatable :: fpo(:), fpn(:)  !! prepared force parameters: offset and length
     real(wp), allocatable :: fp(:)        !! prepared force parameter pool
+    integer, allocatable :: fref(:)       !! joint of a joint friction element, else 0
+    integer :: ncontact = 0               !! contact elements
+    integer :: nfric = 0                  !! joint friction elements
+    integer :: nstick = 0                 !! of which stick-slip
   end type model_t
 
 contains
@@ -351,6 +358,8 @@ contains
       if (force_raw_length(kind, fpar(off:off + len - 1)) /= len) cycle
       if (.not. all(ieee_is_finite(fpar(off:off + len - 1)))) cycle
       call force_exponents(kind, fpar(off:off + len - 1), ex(1:len))
+      if (force_is_contact(kind)) ex(7) = 0        ! a threshold velocity, not a length
+      if (kind == FRC_FRICTION) ex(4) = 0
       if (any(ex(1:len) == -1)) &
         big = max(big, maxval(abs(fpar(off:off + len - 1)), mask=ex(1:len) == -1))
     end do
@@ -367,15 +376,19 @@ contains
     integer, intent(out) :: status              !! MBD_OK or < 0
     character(len=MSG_LEN), intent(out) :: msg  !! what is wrong
     integer, intent(out) :: bad                 !! offending force (> 0) or body (< 0)
-    integer :: k, nf, kind, bi, bj, off, len, total, ist
-    real(wp), allocatable :: prep(:), pool(:)
+    integer :: k, nf, kind, bi, bj, off, len, total, ist, jc
+    real(wp), allocatable :: prep(:), pool(:), fr(:), scl(:)
     integer, allocatable :: ex(:)
+    real(wp) :: meff
     character(len=MSG_LEN) :: sub
     status = MBD_OK; msg = ''; bad = 0
     if (size(bmass, 1) /= 2 .or. size(bmass, 2) /= m%nb .or. size(ftab, 1) /= NFT) then
       status = MBD_BAD_INPUT; msg = 'mass or force table has the wrong shape'; return
     end if
-    allocate (m%mdiag(m%nq))
+    allocate (m%mdiag(m%nq), stat=ist)
+    if (ist /= 0) then
+      status = MBD_BAD_INPUT; msg = 'not enough memory for the mass table'; return
+    end if
     m%mdiag = 0.0_wp
     do k = 1, m%nb
       if (.not. all(ieee_is_finite(bmass(:, k))) .or. .not. all(bmass(:, k) >= 0.0_wp)) then
@@ -400,8 +413,12 @@ contains
     end if
     nf = size(ftab, 2)
     m%nf = nf
-    allocate (m%fkind(nf), m%fbi(nf), m%fbj(nf), m%floc(NLOC, nf), m%fpo(nf), m%fpn(nf))
-    allocate (pool(0))
+    allocate (m%fkind(nf), m%fbi(nf), m%fbj(nf), m%floc(NLOC, nf), m%fpo(nf), m%fpn(nf), &
+              m%fref(nf), pool(0), stat=ist)
+    if (ist /= 0) then
+      status = MBD_BAD_INPUT; msg = 'not enough memory for the force tables'; return
+    end if
+    m%fref = 0
     total = 0
     do k = 1, nf
       bad = k
@@ -411,6 +428,18 @@ contains
       end if
       if (bi < 0 .or. bi > m%nb .or. bj < 0 .or. bj > m%nb) then
         status = MBD_BAD_BODY; msg = 'force body index out of range'; return
+      end if
+      jc = 0
+      if (kind == FRC_FRICTION) then
+        jc = ftab(6, k)
+        if (jc < 1 .or. jc > m%nc) then
+          status = MBD_BAD_INPUT; msg = 'joint friction refers to no joint'; return
+        end if
+        if (m%kind(jc) /= CON_REVOLUTE .and. m%kind(jc) /= CON_TRANSLATIONAL) then
+          status = MBD_BAD_INPUT
+          msg = 'friction is available on revolute and translational joints'; return
+        end if
+        bi = m%bi(jc); bj = m%bj(jc)
       end if
       if (kind == FRC_TORQUE .or. kind == FRC_POINT) then
         bj = 0
@@ -429,17 +458,33 @@ contains
       if (force_raw_length(kind, fpar(off:off + len - 1)) /= len) then
         status = MBD_BAD_PARAM; msg = 'force parameters are malformed'; return
       end if
-      allocate (ex(len), stat=ist)
+      allocate (ex(len), fr(len), scl(len), stat=ist)
       if (ist /= 0) then
         status = MBD_BAD_INPUT; msg = 'not enough memory for the force tables'; return
       end if
-      call force_exponents(kind, fpar(off:off + len - 1), ex)
-      if (.not. all(ieee_is_finite(fpar(off:off + len - 1) * m%lref**ex))) then
+      call force_exponents(kind, fpar(off:off + len - 1), ex, fr)
+      scl = fpar(off:off + len - 1) * m%lref**ex
+      if (any(abs(fr) > 0.0_wp)) scl = scl * m%lref**fr
+      if (.not. all(ieee_is_finite(scl))) then
         status = MBD_BAD_PARAM
         msg = 'a force parameter is too large for the model''s length scale'; return
       end if
-      call force_prepare(kind, fpar(off:off + len - 1) * m%lref**ex, prep, status, sub)
-      deallocate (ex)
+      if (kind == FRC_FRICTION) then
+        call friction_prepare(m%kind(jc) == CON_REVOLUTE, scl, prep, status, sub)
+      else
+        ! effective mass of a contact pair (ground: infinite)
+        meff = 0.0_wp
+        if (bi > 0 .and. bj > 0) then
+          if (m%mdiag(3 * bi - 2) > 0.0_wp .and. m%mdiag(3 * bj - 2) > 0.0_wp) meff = &
+            m%mdiag(3 * bi - 2) * m%mdiag(3 * bj - 2) / (m%mdiag(3 * bi - 2) + m%mdiag(3 * bj - 2))
+        else if (bi > 0) then
+          meff = m%mdiag(3 * bi - 2)
+        else if (bj > 0) then
+          meff = m%mdiag(3 * bj - 2)
+        end if
+        call force_prepare(kind, scl, prep, status, sub, meff)
+      end if
+      deallocate (ex, fr, scl)
       if (status /= MBD_OK) then
         msg = sub; return
       end if
@@ -449,6 +494,12 @@ contains
       m%floc(:, k) = 0
       if (bi > 0) m%floc(1:3, k) = [3 * bi - 2, 3 * bi - 1, 3 * bi]
       if (bj > 0) m%floc(4:6, k) = [3 * bj - 2, 3 * bj - 1, 3 * bj]
+      m%fref(k) = jc
+      if (force_is_contact(kind)) m%ncontact = m%ncontact + 1
+      if (kind == FRC_FRICTION) then
+        m%nfric = m%nfric + 1
+        if (nint(prep(3)) == FRIC_STICK_SLIP) m%nstick = m%nstick + 1
+      end if
     end do
     bad = 0
     call move_alloc(pool, m%fp)

@@ -11,7 +11,7 @@ module mbd_status
   public :: MBD_BAD_INPUT, MBD_BAD_BODY, MBD_BAD_PARAM, MBD_BAD_COUNT, MBD_BAD_SETTING
   public :: MBD_SINGULAR, MBD_NO_CONVERGENCE, MBD_SINGULAR_CONFIG, MBD_ASSEMBLY_FAILED
   public :: MBD_LAPACK, MBD_INCONSISTENT, MBD_BRANCH_SWITCH, MBD_INTEGRATOR_FAILED
-  public :: MBD_USER_ABORT
+  public :: MBD_USER_ABORT, MBD_NO_MEMORY
 
   integer, parameter :: MSG_LEN = 512            !! length of every message string
 
@@ -32,4 +32,5 @@ module mbd_status
   integer, parameter :: MBD_BRANCH_SWITCH = 7    !! solution left its assembly branch
   integer, parameter :: MBD_INTEGRATOR_FAILED = 8 !! step size underflow, blow-up
   integer, parameter :: MBD_USER_ABORT = 9       !! a user callback asked to stop
+  integer, parameter :: MBD_NO_MEMORY = 10       !! an allocation failed
 end module mbd_status
