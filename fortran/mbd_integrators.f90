@@ -915,6 +915,10 @@ contains
     real(wp) :: ju(w%na, w%na), b(w%na)
     integer :: piv(w%na), it
     character(len=MSG_LEN) :: lmsg
+    stf = MBD_OK
+    if (w%na == 0) then
+      c%vf(c%iv) = vdot; return
+    end if
     do it = 1, 25
       call assemble_dense(m, c%qf, w%qz, t, w%phi, w%nu, w%gam, w%asm, w%jac)
       ju = w%jac(w%rows, c%iu)
@@ -947,6 +951,12 @@ contains
     real(wp), allocatable :: work(:)
     integer :: jp(m%nq), info
     character(len=MSG_LEN) :: lmsg
+    integer :: kk
+    if (w%na == 0) then                       ! free bodies: every coordinate independent
+      c%iu = [integer ::]; c%iv = [(kk, kk=1, m%nq)]; c%ni = m%nq
+      c%st%partitions = c%st%partitions + 1
+      stf = MBD_OK; return
+    end if
     call assemble_dense(m, c%qf, w%qz, t, w%phi, w%nu, w%gam, w%asm, w%jac)
     a = w%jac(w%rows, :)
     jp = 0
@@ -988,6 +998,8 @@ contains
     real(wp) :: rc, a(w%na, m%nq), tau(w%na), wq(1)
     real(wp), allocatable :: work(:)
     integer :: jp(m%nq), info, stat
+    needs_partition = .false.
+    if (w%na == 0) return
     call assemble_dense(m, c%qf, w%qz, t, w%phi, w%nu, w%gam, w%asm, w%jac)
     rc = rcond_cols(w, c%iu)
     a = w%jac(w%rows, :)

@@ -138,9 +138,8 @@ contains
     if (nb > MAX_BODIES .or. nc > 3 * MAX_BODIES) then
       status = MBD_BAD_INPUT; msg = 'the model is too large for the dense solver'; return
     end if
-    if (nc < 1) then
-      status = MBD_BAD_INPUT; msg = 'the model has no joints or drivers'; return
-    end if
+    ! no constraints at all: free bodies (a dynamic model held together by contacts); the
+    ! front end allows it only then, and kinematics rejects it by its count of equations
     m%nb = nb; m%nc = nc
     allocate (m%kind(nc), m%suba(nc), m%subb(nc), m%bi(nc), m%bj(nc), m%row0(nc), &
               m%nrow(nc), m%loc(NLOC, nc), m%po(nc), m%pn(nc), stat=ist)

@@ -13,6 +13,7 @@ from ..description.builder import ModelDescription
 from ..errors import ModelError, RedundantConstraintWarning
 from ..results.dynamics import DynamicsResult
 from ..validate import number, whole
+from .contacts import MAX_EVENTS, check_method, has_events, report_pulls
 from .failures import assembly_failed, bad_entry, inconsistent_at, row_names
 from .outputs import dynamics_result, finite_part
 from .settings import check_memory, check_span, output_rows, output_steps, time_grid
@@ -65,12 +66,16 @@ def run_dynamics(model: ModelDescription, t_end: float, steps: int, method: str 
                          "a fixed step h", "dynamics")
     alpha_v = opt(alpha, "alpha", 0.0, 1e9, -1.0)
     beta_v = opt(beta, "beta", 0.0, 1e9, -1.0)
+    check_method(model, method)
     p = pack(model)
     d = pack_dynamics(model, p)
-    check_memory(nout, 3 * p.nq + p.neq + 4, "dynamics", dense=(p.nq + p.neq, p.nq + p.neq))
+    nel = d.ftab.shape[1]
+    check_memory(nout, 3 * p.nq + p.neq + 4 + 6 * nel, "dynamics",
+                 dense=(p.nq + p.neq, p.nq + p.neq))
     idx = output_steps(steps, every)
+    maxev = MAX_EVENTS if has_events(model) else 1
     out = core.dynamics(p, d, t0, t_end, steps, METHODS[method], rtol_v, atol_v, h_v, rho_v,
-                        alpha_v, beta_v, every, nout, nmax)
+                        alpha_v, beta_v, every, nout, nmax, maxev)
     iinfo, rinfo, status = out.iinfo, out.rinfo, out.status
     n = int(iinfo[0])
     t = time_grid(t0, t_end, steps, idx)
@@ -80,8 +85,11 @@ def run_dynamics(model: ModelDescription, t_end: float, steps: int, method: str 
              "iteration_matrices": int(iinfo[6]), "factorizations": int(iinfo[9]),
              "partitions": int(iinfo[7]),
              "h_min": float(rinfo[1]) if iinfo[2] else None,
-             "h_max": float(rinfo[2]) if iinfo[2] else None, "redundant_rows": red_rows}
+             "h_max": float(rinfo[2]) if iinfo[2] else None, "redundant_rows": red_rows,
+             "events": int(out.nev), "events_not_kept": max(0, int(out.nev) - maxev)}
     res, bad = finite_part(dynamics_result(model, p, t, n, out, stats, status == OK))
+    if status == OK and bad is None:
+        report_pulls(model, p, res)
     if red_rows:
         warnings.warn(f"redundant constraints: {', '.join(red_rows)} are left out of the equations "
                       "of motion; the reported multipliers are the minimum-norm set (the "

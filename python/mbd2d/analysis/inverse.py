@@ -11,6 +11,7 @@ from ..binding.status import NO_CONVERGENCE, OK, error_for
 from ..description.builder import ModelDescription
 from ..errors import RedundantConstraintWarning
 from ..results.dynamics import DynamicsResult
+from .contacts import MAX_EVENTS, report_pulls
 from .failures import BAD_FORCE, bad_entry, kinematic_failure, row_names
 from .outputs import dynamics_result, finite_part
 from .settings import (check_memory, check_solver, check_span, output_rows, output_steps,
@@ -30,10 +31,11 @@ def run_inverse(model: ModelDescription, t_end: float, steps: int, t0: float = 0
     p = pack(model)
     require_determined(p, model)
     d = pack_dynamics(model, p)
-    check_memory(nout, 3 * p.nq + p.neq + 4, "inverse dynamics",
+    check_memory(nout, 3 * p.nq + p.neq + 4 + 6 * d.ftab.shape[1], "inverse dynamics",
                  dense=(p.nq + p.neq, p.nq + p.neq))
     idx = output_steps(steps, every)
-    out = core.inverse(p, d, t0, t_end, steps, tol_v, int(every), code, nout)
+    maxev = MAX_EVENTS if model.contacts else 1
+    out = core.inverse(p, d, t0, t_end, steps, tol_v, int(every), code, nout, maxev)
     iinfo, status = out.iinfo, out.status
     n = int(iinfo[0])
     t = time_grid(t0, t_end, steps, idx)
@@ -41,8 +43,11 @@ def run_inverse(model: ModelDescription, t_end: float, steps: int, t0: float = 0
     stats = {"newton_corrections": int(iinfo[5]), "factorizations": int(iinfo[6]),
              "rejected_steps": int(iinfo[7]), "rank": int(iinfo[8]),
              "redundant_rows": red_rows,
-             "singular_passages": [float(x) for x in out.tpass[:min(int(iinfo[9]), 64)]]}
+             "singular_passages": [float(x) for x in out.tpass[:min(int(iinfo[9]), 64)]],
+             "events": int(out.nev)}
     res, bad = finite_part(dynamics_result(model, p, t, n, out, stats, status == OK))
+    if status == OK and bad is None:
+        report_pulls(model, p, res)
     if red_rows:
         warnings.warn(f"redundant constraints: {', '.join(red_rows)}; the multipliers are the "
                       "minimum-norm set (the reactions are statically indeterminate)",

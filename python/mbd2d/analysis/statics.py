@@ -10,6 +10,7 @@ from ..binding.status import (ASSEMBLY_FAILED, INCONSISTENT, NO_CONVERGENCE, OK,
 from ..description.builder import ModelDescription
 from ..results.statics import StaticsResult
 from ..validate import number
+from .contacts import check_statics
 from .failures import assembly_failed, bad_entry, inconsistent_at
 from .settings import check_memory
 
@@ -19,6 +20,7 @@ STABILITY = {1: "stable", 0: "unstable", -1: "neutral", 2: "fully constrained"}
 def run_statics(model: ModelDescription, t: float = 0.0) -> StaticsResult:
     """Static equilibrium near the q0 estimates; see :meth:`mbd2d.Model.statics`."""
     t = number(t, "t", "statics")
+    check_statics(model)
     p = pack(model)
     d = pack_dynamics(model, p)
     check_memory(0, 0, "statics", dense=(p.nq + p.neq, p.nq + p.neq))
