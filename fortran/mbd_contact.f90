@@ -29,7 +29,7 @@
 !!   flores              Fn = k delta**n (1 + 8 (1 - e) / (5 e) delta_dot / v0)
 !!                       (Flores, Machado, Silva & Martins 2011)
 !!   v0: the penetration rate at the onset of the contact (its state, set by the event
-!!   location of the integrators; max(|delta_dot|, V0_MIN) while unknown).
+!!   location of the integrators; max(|delta_dot|, V0_MIN) where no mode is tracked).
 !! Regularized Coulomb (mu, mu_s, threshold v_e, an Adams-like C1 curve):
 !!   |v| <= v_e: mu(v) = mu_s (3 a - a**3) / 2, a = v / v_e;  v_e < |v| < 2 v_e: mu_s blends
 !!   to mu (smoothstep);  |v| >= 2 v_e: mu sign(v).
@@ -67,6 +67,7 @@ module mbd_contact
   integer, parameter :: LAW_FLORES = 5
   integer, parameter :: FRIC_STICK_SLIP = 1
   integer, parameter :: NCS = 2      !! state columns of an element: [mode, v0]
+  integer, parameter, public :: MODE_UNTRACKED = -1   !! a contact without a tracked mode
   integer, parameter :: NEO = 6      !! output columns of an element (see contact_eval)
   integer, parameter :: NHEAD = 8    !! prepared head [law, k, n, e, mu, mu_s, v_e, damping]
   integer, parameter :: NRAWHEAD = 7 !! raw head
@@ -396,13 +397,14 @@ contains
             dl = ssub(sconst(r1 + r2), ssqrt(vdot(d, d)))
             u = d%v / dd
           else
-            dl = sconst(-(r1 + r2)); u = [one, zero]; far = .true.   ! concentric: degenerate
+            dl = sconst(r1 + r2); u = [one, zero]; far = .true.   ! concentric: no normal
           end if
           n = u
           xp = cj%v + (r2 - half * dl%v) * u
         else
           if (dd <= half * (r2 - r1)) then
             dl = sconst(dd - (r2 - r1)); far = .true.          ! well inside the clearance
+            if (dd > zero) dl%vd = dot_product(d%v, d%vd) / dd  ! (its rate, for the events)
             return
           end if
           dl = ssub(ssqrt(vdot(d, d)), sconst(r2 - r1))
@@ -504,7 +506,7 @@ contains
   end function nearest_alpha
 
   !> The penetration of a contact and its rate (for event location): far contacts return a
-  !! negative bound and rate 0.
+  !! negative bound (and its rate where known, else 0).
   pure subroutine contact_gap(geo, p, si, sj, x, dv, dr)
     integer, intent(in) :: geo                !! geometry kind
     real(wp), intent(in) :: p(:)              !! prepared parameters
@@ -516,12 +518,13 @@ contains
     logical :: far
     call geometry(geo, p, si, sj, x, dl, n, xp, far)
     dv = dl%v; dr = dl%vd
-    if (far) dr = zero
   end subroutine contact_gap
 
-  !> Generalized force, potential energy and outputs of a contact at a local state.
-  !! st = [mode, v0]: mode 1 closed (v0 its impact speed), otherwise v0 is provisional
-  !! (max(|delta_dot|, V0_MIN)). out = [Fn, Ft, delta, v_t, X(2)].
+  !! Generalized force, potential energy and outputs of a contact at a local state.
+  !! st = [mode, v0]: mode 1 closed (v0 its impact speed); 0 open (the integrators track the
+  !! modes: no force until the onset is located and the mode changed, so that the forces
+  !! are smooth within a step); -1 untracked (statics: a force wherever delta > 0, with
+  !! v0 = max(|delta_dot|, V0_MIN)). out = [Fn, Ft, delta, v_t, X(2)].
   pure subroutine contact_eval(geo, p, si, sj, x, st, ql_force, v, out)
     integer, intent(in) :: geo                !! geometry kind
     real(wp), intent(in) :: p(:)              !! prepared parameters
@@ -539,6 +542,7 @@ contains
     call geometry(geo, p, si, sj, x, dl, n, xp, far)
     out(3) = dl%v
     if (far .or. .not. (dl%v > zero)) return
+    if (nint(st(1)) == 0) return             ! open (tracked): no force until the onset
     out(5:6) = xp
     law = nint(p(1)); kk = p(2); ex = p(3); dd = dl%v
     ! normal force

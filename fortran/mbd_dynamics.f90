@@ -31,7 +31,7 @@ module mbd_dynamics
   use mbd_model, only: model_t, model_slots
   use mbd_constraints, only: con_is_driver
   use mbd_forces, only: force_eval, FRC_SPRING, FRC_ROTSPRING, FRC_FRICTION, force_is_contact
-  use mbd_contact, only: NCS, NEO, joint_slip, joint_normal_load, joint_friction_force, &
+  use mbd_contact, only: NCS, NEO, MODE_UNTRACKED, joint_slip, joint_normal_load, joint_friction_force, &
                          reg_mu, contact_damped
   use mbd_points, only: kloc, kscal, local_state
   use mbd_constraints, only: CON_REVOLUTE
@@ -127,6 +127,9 @@ contains
       return
     end if
     w%cst = zero; w%fnl = zero; w%ffr = zero
+    do k = 1, nf
+      if (force_is_contact(m%fkind(k))) w%cst(1, k) = MODE_UNTRACKED
+    end do
     j = 0
     do k = 1, nf
       if (m%fkind(k) == FRC_FRICTION) then

@@ -10,7 +10,8 @@
 !! A step from ta to tb is searched with the quintic Hermite dense output of its two end
 !! states (mbd_interp): a sign change of g, or for a contact an extremum of delta inside the
 !! step (delta_dot changes sign: a short impact or a short separation that the end points
-!! miss); the crossing is bracketed by the Illinois method (regula falsi with halving, a
+!! miss), and for a contact within reach of the step (the bounding test delta(ta) +
+!! 2 h max|delta_dot| > 0) NSAMPLE points inside it; the crossing is bracketed by the Illinois method (regula falsi with halving, a
 !! bisection every third iteration) to the width the dead-centre search of kinematics
 !! reaches, 1e-10 max(1, |t|) s. events_find returns the right end of the earliest bracket
 !! (on the new side): the integrator takes its step again to there, then events_switch
@@ -20,7 +21,7 @@
 !! Event records: [t, element, kind, value]; value: the impact speed delta_dot (onset), the
 !! separation speed -delta_dot (separation), the friction force (stick, slip, reversal).
 module mbd_events
-  use mbd_kinds, only: wp, zero, one, half
+  use mbd_kinds, only: wp, zero, one, two, half
   use mbd_status, only: MBD_OK, MBD_NO_MEMORY, MSG_LEN
   use mbd_model, only: model_t
   use mbd_points, only: kloc, kscal
@@ -39,6 +40,7 @@ module mbd_events
   !> relative slip speed below which a joint starts stuck (L / s)
   real(wp), parameter :: V_REST = 1.0e-9_wp
   integer, parameter :: MAXIT = 200    !! root-finding iterations
+  integer, parameter :: NSAMPLE = 7    !! interior samples of a step for a contact in reach
 
   !> The event log: records beyond its capacity are counted, not kept.
   type :: ev_log_t
@@ -289,6 +291,14 @@ contains
         if (status /= MBD_OK) return
         if (gm > zero) call locate(k, ta, ga(k), tm, gm, tr)
       end if
+      if (tr > tb .and. force_is_contact(m%fkind(k)) .and. &
+          ga(k) + two * (tb - ta) * max(abs(gda(k)), abs(gdb(k))) > zero) then
+        ! within reach in this step (the bounding test passed): sample the dense output, so
+        ! that a contact crossed and left between the samples of the ends is not missed
+        call sample(k, tm, gm)
+        if (status /= MBD_OK) return
+        if (gm > zero) call locate(k, ta, ga(k), tm, gm, tr)
+      end if
       if (status /= MBD_OK) return
       if (tr <= tb .and. (kev == 0 .or. tr < te)) then
         te = tr; kev = k
@@ -336,6 +346,21 @@ contains
       end do
       tright = hi
     end subroutine locate
+
+    !> The first of NSAMPLE interior points of the step where g_kk > 0 (tfirst, gfirst);
+    !! gfirst <= 0 when there is none.
+    subroutine sample(kk, tfirst, gfirst)
+      integer, intent(in) :: kk
+      real(wp), intent(out) :: tfirst, gfirst
+      real(wp) :: gdt
+      integer :: i
+      gfirst = -one; tfirst = tb
+      do i = 1, NSAMPLE
+        tfirst = ta + (tb - ta) * i / (NSAMPLE + 1)
+        gfirst = g_at(kk, tfirst, gdt)
+        if (status /= MBD_OK .or. gfirst > zero) return
+      end do
+    end subroutine sample
 
     !> The zero of a contact's rate in [t0, t1] (gd(t0) > 0 > gd(t1)) by bisection, and g
     !! there.

@@ -20,7 +20,7 @@
 !! state (open or closed, the impact speed), passed in st; joint friction needs the joint's
 !! multipliers and is evaluated by mbd_dynamics (force_eval returns zero for it).
 module mbd_forces
-  use mbd_kinds, only: wp, zero, half
+  use mbd_kinds, only: wp, zero, half, one
   use mbd_status, only: MBD_OK, MBD_BAD_PARAM, MSG_LEN
   use mbd_points, only: NLOC, kloc, local_state, kvec, kscal, body_point, body_angle, vsub, &
                         vdot, ssqrt, ssub
@@ -213,7 +213,7 @@ contains
       ql_force = tau * a%d
       v = half * p(1) * (a%v - p(3))**2
     case (FRC_CONTACT0:FRC_CONTACT1)
-      sto = zero
+      sto = [-one, zero]                       ! untracked
       if (present(st)) sto = st
       call contact_eval(kind - FRC_CONTACT0 + 1, p, si, sj, x, sto, ql_force, v, oo)
       if (present(out)) out = oo

@@ -528,6 +528,19 @@ contains
       ! e = (6 beta - 1) (q_{n+1} - q_n - h q_dot_n - h^2 q_ddot_n / 2)
       if (conv .and. .not. fixed) err = err_norm(c, (6 * bet - 1) * &
                                                  (qn - q - h * qd - half * h * h * qdd), q, qn)
+      kev = 0
+      if (conv .and. c%events) then
+        ! an event inside the step: error-controlled steps are taken again to end there
+        call events_find(m, w, t, q, qd, qdd, tnew, qn, vn, an, te, kev, stt)
+        if (stt /= MBD_OK) then
+          call event_failure(c, tnew, status, msg); return
+        end if
+        if (kev > 0 .and. .not. fixed .and. te < tnew - event_tol(t, tnew)) then
+          c%st%rejected = c%st%rejected + 1
+          h = te - t
+          cycle
+        end if
+      end if
       if (.not. conv .or. (.not. fixed .and. err > one)) then
         c%st%rejected = c%st%rejected + 1
         if (fixed) then
@@ -547,19 +560,6 @@ contains
           return
         end if
         cycle
-      end if
-      kev = 0
-      if (c%events) then
-        ! an event inside the step: take it again to end at the event
-        call events_find(m, w, t, q, qd, qdd, tnew, qn, vn, an, te, kev, stt)
-        if (stt /= MBD_OK) then
-          call event_failure(c, tnew, status, msg); return
-        end if
-        if (kev > 0 .and. .not. fixed .and. te < tnew - event_tol(t, tnew)) then
-          c%st%rejected = c%st%rejected + 1
-          h = te - t
-          cycle
-        end if
       end if
       accn = accn + (1 - af) / (1 - am) * an
       nprev = c%nout
@@ -679,6 +679,18 @@ contains
           return
         end if
         err = 10.0_wp
+      else if (c%events .and. .not. fixed) then
+        ! an event inside the trial step (its end state is the last stage's): take the step
+        ! again to end at the event, whatever its error (the modes, and so the forces, are
+        ! fixed within a step: the part before the event is smooth)
+        call events_find(m, w, t, qa, va, aa, tnew, c%qf, c%vf, c%af, te, kev, stt)
+        if (stt /= MBD_OK) then
+          err = 10.0_wp
+        else if (kev > 0 .and. te < tnew - event_tol(t, tnew)) then
+          c%st%rejected = c%st%rejected + 1
+          h = te - t; fsal = .false.
+          cycle
+        end if
       end if
       if (err > one) then
         c%st%rejected = c%st%rejected + 1
@@ -712,15 +724,10 @@ contains
       end if
       kev = 0
       if (c%events) then
-        ! an event inside the step: take it again to end at the event
+        ! events of the accepted step (fixed steps: at its end; adaptive: at most at its end)
         call events_find(m, w, t, qa, va, aa, tnew, c%qf, c%vf, c%af, te, kev, stt)
         if (stt /= MBD_OK) then
           call event_failure(c, tnew, status, msg); return
-        end if
-        if (kev > 0 .and. .not. fixed .and. te < tnew - event_tol(t, tnew)) then
-          c%st%rejected = c%st%rejected + 1
-          h = te - t; fsal = .false.
-          cycle
         end if
       end if
       nprev = c%nout
