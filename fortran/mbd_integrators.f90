@@ -32,6 +32,7 @@ module mbd_integrators
   use mbd_status, only: MBD_OK, MBD_BAD_SETTING, MBD_SINGULAR, MBD_NO_CONVERGENCE, &
                         MBD_INTEGRATOR_FAILED, MBD_LAPACK, MSG_LEN, MBD_NO_MEMORY
   use mbd_model, only: model_t
+  use mbd_forces, only: FRC_FRICTION
   use mbd_assemble, only: assemble_dense, assemble_blocks, scatter_dense
   use mbd_linsolve, only: lu_factor, lu_solve, lapack_status, lu_factor_small, lu_solve_small
   use mbd_lapack, only: dgeqp3, dgecon
@@ -400,7 +401,7 @@ contains
     integer, parameter :: GA_SLOW = 6            ! iterations that ask for new K, C
     integer, parameter :: GA_MAXIT = 30          ! iterations before the step fails
     real(wp) :: am, af, gam, bet, bp, gp, h, t, err, tnew, facc, v, hprev, dqn, dqp, dtol
-    real(wp) :: rtol_dyn, cf, kmax, cmax, fmax, qmax, vmax, rmax, te
+    real(wp) :: rtol_dyn, cf, kmax, cmax, fmax, qmax, vmax, rmax, te, mufric
     real(wp) :: q(m%nq), qd(m%nq), qdd(m%nq), acc(m%nq), lam(m%neq)
     real(wp) :: qn(m%nq), vn(m%nq), an(m%nq), accn(m%nq), lamn(m%neq), dq(m%nq), ap(m%nq)
     real(wp) :: res(m%nq + w%na), kt(m%nq, m%nq), ct(m%nq, m%nq)
@@ -416,6 +417,10 @@ contains
     cf = (1 - af) / (1 - am)             ! weight of q_ddot_{n+1} in a_{n+1}
     fixed = c%opts%h > zero
     have_kc = .false.; new_kc = .false.
+    mufric = zero                        ! the largest friction coefficient of a joint
+    do k = 1, m%nf
+      if (m%fkind(k) == FRC_FRICTION) mufric = max(mufric, m%fp(m%fpo(k)), m%fp(m%fpo(k) + 1))
+    end do
     kt = zero; ct = zero; kmax = zero; cmax = zero
     q = c%qf; qd = c%vf; qdd = c%af; lam = c%lam
     t = c%t0
@@ -480,6 +485,10 @@ contains
             qmax = max(qmax, abs(qn(k))); vmax = max(vmax, abs(vn(k)))
           end do
           rtol_dyn = max(GA_RTOL * fmax, 100 * epsilon(one) * (kmax * qmax + cmax * vmax))
+          ! joint friction mu N(lambda): lambda_{n+1} carries the rounding of q amplified by
+          ! b' (above), and so does the friction it loads
+          if (mufric > zero) rtol_dyn = max(rtol_dyn, 100 * epsilon(one) * mufric * bp * &
+                                            maxval(m%mdiag) * qmax)
           do k = 1, na
             res(n + k) = bp * w%phi(w%rows(k))
             if (.not. abs(res(n + k)) <= huge(one)) finite = .false.
