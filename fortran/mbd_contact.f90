@@ -367,13 +367,14 @@ contains
   !> Penetration delta (kscal: value, gradient, rate), the unit direction n of the normal
   !! force on body i, the contact point X (global) and far (the bounding test: no contact
   !! possible, delta%v is then only a negative bound).
-  pure subroutine geometry(geo, p, si, sj, x, dl, n, xp, far)
+  pure subroutine geometry(geo, p, si, sj, x, dl, n, xp, far, exact)
     integer, intent(in) :: geo, si, sj
     real(wp), intent(in) :: p(:)
     type(kloc), intent(in) :: x
     type(kscal), intent(out) :: dl
     real(wp), intent(out) :: n(2), xp(2)
     logical, intent(out) :: far
+    logical, intent(in), optional :: exact     ! no bounding test: the gap itself
     type(kvec) :: ci, cj, d, nv
     real(wp) :: dd, r1, r2, u(2)
     far = .false.; n = [one, zero]; xp = zero
@@ -413,19 +414,20 @@ contains
           xp = cj%v + (r2 + half * dl%v) * u
         end if
       case (GEO_FOLLOWER_PROFILE)
-        call follower_profile(g, si, sj, x, dl, n, xp, far)
+        call follower_profile(g, si, sj, x, dl, n, xp, far, exact)
       end select
     end associate
   end subroutine geometry
 
   !> The follower-profile penetration (see the banner); g = the geometry part.
-  pure subroutine follower_profile(g, si, sj, x, dl, n, xp, far)
+  pure subroutine follower_profile(g, si, sj, x, dl, n, xp, far, exact)
     real(wp), intent(in) :: g(:)
     integer, intent(in) :: si, sj
     type(kloc), intent(in) :: x
     type(kscal), intent(out) :: dl
     real(wp), intent(out) :: n(2), xp(2)
     logical, intent(out) :: far
+    logical, intent(in), optional :: exact
     type(kvec) :: fp, cp, nv, mv
     real(wp) :: fc(2), mc(2), ri(2), ca, sa, a, c0(2), c1(2), c2(2), c3(2), n0(2), n1(2), n2(2)
     real(wp) :: rho, gap
@@ -451,7 +453,9 @@ contains
         gap = hypot(fc(1) - cen(1), fc(2) - cen(2)) - rb - merge(rho, zero, fol == 2)
       end if
       if (gap > zero) then
-        far = .true.; dl = sconst(-gap); return
+        far = .true.; dl = sconst(-gap)
+        if (.not. present(exact)) return
+        if (.not. exact) return
       end if
       a = nearest_alpha(prof, pp, fol, fc, mc)
       call profile_eval(prof, pp, a, c0, c1, c2, c3)
@@ -525,7 +529,7 @@ contains
   !! modes: no force until the onset is located and the mode changed, so that the forces
   !! are smooth within a step); -1 untracked (statics: a force wherever delta > 0, with
   !! v0 = max(|delta_dot|, V0_MIN)). out = [Fn, Ft, delta, v_t, X(2)].
-  pure subroutine contact_eval(geo, p, si, sj, x, st, ql_force, v, out)
+  pure subroutine contact_eval(geo, p, si, sj, x, st, ql_force, v, out, exact)
     integer, intent(in) :: geo                !! geometry kind
     real(wp), intent(in) :: p(:)              !! prepared parameters
     integer, intent(in) :: si, sj             !! slot ids
@@ -534,12 +538,13 @@ contains
     real(wp), intent(out) :: ql_force(NLOC)   !! generalized force on the local slots
     real(wp), intent(out) :: v                !! potential energy
     real(wp), intent(out) :: out(NEO)         !! outputs
+    logical, intent(in), optional :: exact    !! the gap itself even when far (outputs)
     type(kscal) :: dl
     real(wp) :: n(2), xp(2), t(2), vrel(2), vt, fn, ft, v0, fe, dd, kk, ex
     logical :: far
     integer :: law
     ql_force = zero; v = zero; out = zero
-    call geometry(geo, p, si, sj, x, dl, n, xp, far)
+    call geometry(geo, p, si, sj, x, dl, n, xp, far, exact)
     out(3) = dl%v
     if (far .or. .not. (dl%v > zero)) return
     if (nint(st(1)) == 0) return             ! open (tracked): no force until the onset

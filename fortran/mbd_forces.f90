@@ -215,8 +215,12 @@ contains
     case (FRC_CONTACT0:FRC_CONTACT1)
       sto = [-one, zero]                       ! untracked
       if (present(st)) sto = st
-      call contact_eval(kind - FRC_CONTACT0 + 1, p, si, sj, x, sto, ql_force, v, oo)
-      if (present(out)) out = oo
+      if (present(out)) then
+        call contact_eval(kind - FRC_CONTACT0 + 1, p, si, sj, x, sto, ql_force, v, out, &
+                          exact=.true.)
+      else
+        call contact_eval(kind - FRC_CONTACT0 + 1, p, si, sj, x, sto, ql_force, v, oo)
+      end if
     end select
   end subroutine force_eval
 
