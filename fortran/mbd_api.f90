@@ -14,10 +14,13 @@
 module mbd_api
   use mbd_kinds, only: wp, zero, one
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
-  use mbd_status, only: MBD_OK, MBD_BAD_COUNT, MBD_BAD_PARAM, MBD_INCONSISTENT, MSG_LEN
+  use mbd_status, only: MBD_OK, MBD_BAD_COUNT, MBD_BAD_PARAM, MBD_INCONSISTENT, MBD_NO_MEMORY, &
+                        MSG_LEN
+  use mbd_memory, only: REAL_BYTES, mem_fail
   use mbd_points, only: NLOC, MAXROW
   use mbd_model, only: model_t, model_build, model_add_dynamics, model_force_size
-  use mbd_dynamics, only: dyn_work_t, dyn_init, dyn_velocity, dyn_multipliers, dyn_reactions, &
+  use mbd_dynamics, only: dyn_work_t, dyn_init, dyn_memory_check, dyn_velocity, &
+                          dyn_multipliers, dyn_reactions, &
                           gen_forces, kinetic_energy, dyn_element_outputs
   use mbd_events, only: ev_log_t, ev_log_init, events_switch, events_active
   use mbd_forces, only: force_is_contact, FRC_FRICTION
@@ -33,10 +36,15 @@ module mbd_api
                             SOLVER_BANDED, kin_newton, kin_vel_acc
   use mbd_status, only: MBD_BAD_SETTING
   use mbd_profiles, only: profile_raw_length, profile_prepare, profile_eval
+  use mbd_sensitivity, only: sens_t, sens_setup, sens_eval_d, sens_trig
+  use mbd_assemble, only: scatter_dense
+  use mbd_sens_dynamics, only: sens_multipliers, sens_reactions, sens_statics, sens_dopri5, &
+                               sens_initial
   implicit none
   private
   public :: NINFO, api_sizes, api_eval, api_kinematics, api_profile, api_analyze, api_kin_step
   public :: api_inverse, api_dynamics, api_statics, api_reactions, api_cam_forces
+  public :: api_eval_d, api_reactions_dp, api_dynamics_sens
 
   integer, parameter :: NINFO = 10   !! length of the report arrays
 
@@ -102,6 +110,48 @@ contains
       end if
     end do
   end subroutine units
+
+  !> Sensitivities (rows, np[, outputs]) in model units: with p' = p L**e the core's
+  !! derivatives d(.)'/dp' become d(.)/dp = u d(.)'/dp' dp'/dp (dp'/dp = sens%pscale; u the
+  !! unit of each row, multiplied, or with divide divided); with back, the inverse.
+  subroutine sens_units(m, sens, a, u, divide, back)
+    type(model_t), intent(in) :: m              !! model (its length unit lref)
+    type(sens_t), intent(in) :: sens            !! parameters (pscale)
+    real(wp), intent(inout) :: a(:, :, :)       !! (rows, np, outputs)
+    real(wp), intent(in) :: u(:)                !! unit of each row
+    logical, intent(in) :: divide               !! divide by u
+    logical, intent(in), optional :: back       !! the inverse conversion
+    real(wp) :: f(size(a, 1), size(a, 2))
+    integer :: k, j
+    logical :: inv
+    if (.not. (m%lref > one .or. m%lref < one)) return
+    inv = .false.
+    if (present(back)) inv = back
+    do k = 1, size(a, 2)          ! one factor per row and parameter (exact: powers of 2)
+      if (divide .neqv. inv) then
+        f(:, k) = sens%pscale(k) / u
+      else
+        f(:, k) = sens%pscale(k) * u
+      end if
+      if (inv) f(:, k) = (one / sens%pscale(k)**2) * f(:, k)
+    end do
+    do j = 1, size(a, 3)
+      a(:, :, j) = a(:, :, j) * f
+    end do
+  end subroutine sens_units
+
+  !> sens_units for one output (rows, np).
+  subroutine sens_units2(m, sens, a, u, divide)
+    type(model_t), intent(in) :: m              !! model
+    type(sens_t), intent(in) :: sens            !! parameters (pscale)
+    real(wp), intent(inout) :: a(:, :)          !! (rows, np)
+    real(wp), intent(in) :: u(:)                !! unit of each row
+    logical, intent(in) :: divide               !! divide by u
+    real(wp) :: b(size(a, 1), size(a, 2), 1)
+    b(:, :, 1) = a
+    call sens_units(m, sens, b, u, divide)
+    a = b(:, :, 1)
+  end subroutine sens_units2
 
   !> The residual rep%resid in model units (that of the worst constraint's first row).
   pure real(wp) function resid_units(m, resid, worst)
@@ -179,7 +229,8 @@ contains
         size(jac, 1) /= m%neq .or. size(jac, 2) /= m%nq) then
       status = MBD_BAD_COUNT; msg = 'array sizes do not match the model'; return
     end if
-    call asm_init(m, aw)
+    call asm_init(m, aw, status, msg)
+    if (status /= MBD_OK) return
     call assemble_dense(m, q, qd, t, phi, nu, gam, aw, jac)
     if (.not. (finite(phi) .and. finite(jac) .and. finite(nu) .and. finite(gam))) then
       status = MBD_BAD_PARAM
@@ -190,7 +241,7 @@ contains
   !> Kinematic analysis: the whole time loop in one call.
   subroutine api_kinematics(nb, ctab, rpar, q0, t0, t1, nsteps, tol, maxit, tmin, every, &
                             solver, qout, qdout, qddout, iinfo, rinfo, qsing, dep, redundant, &
-                            tpass, status, msg)
+                            tpass, status, msg, ptab, sq, sqd, sqdd)
     integer, intent(in) :: nb                   !! moving bodies
     integer, intent(in) :: ctab(:, :)           !! constraint table
     real(wp), intent(in) :: rpar(:)             !! raw parameters
@@ -212,15 +263,33 @@ contains
     real(wp), intent(out) :: tpass(:)           !! times of singular passages (MAXPASS)
     integer, intent(out) :: status              !! MBD_OK, < 0 input, > 0 numerical
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    !> design parameters (mbd_sensitivity; (2, np)) and, with them, dq/dp, dq_dot/dp,
+    !! dq_ddot/dp at the outputs, each (nq, np, kin_out_count(nsteps, every))
+    integer, intent(in), optional :: ptab(:, :)
+    real(wp), intent(out), optional :: sq(:, :, :), sqd(:, :, :), sqdd(:, :, :)
     type(model_t) :: m
     type(kin_opts_t) :: opts
     type(kin_report_t) :: rep
+    type(sens_t) :: sens
     integer :: bad
     iinfo = 0; rinfo = zero; qsing = zero; dep = 0; redundant = 0; tpass = zero
     qout = zero; qdout = zero; qddout = zero
+    if (present(ptab)) then
+      sq = zero; sqd = zero; sqdd = zero      ! (kin_run writes them; for the early returns)
+    end if
     call model_build(nb, ctab, rpar, m, status, msg, bad, nondim=.true.)
     iinfo(2) = bad
     if (status /= MBD_OK) return
+    if (present(ptab)) then
+      if (any(shape(sq) /= [m%nq, size(ptab, 2), size(qout, 2)]) .or. &
+          any(shape(sqd) /= shape(sq)) .or. any(shape(sqdd) /= shape(sq))) then
+        status = MBD_BAD_COUNT; msg = 'sensitivity arrays do not match the model'; return
+      end if
+      call sens_setup(m, ctab, rpar, ptab, sens, status, msg, bad)
+      if (status /= MBD_OK) then
+        iinfo(2) = -2000000 - bad; return
+      end if
+    end if
     if (.not. (finite(q0) .and. finite(t0) .and. finite(t1) .and. finite(tol) .and. &
                finite(tmin))) then
       call not_finite('q0, the times and the tolerances', status, msg); return
@@ -247,7 +316,15 @@ contains
     if (tol > zero) opts%tol = tol
     if (maxit > 0) opts%maxit = maxit
     if (tmin > zero) opts%tmin = tmin
-    call kin_run(m, q0 / m%cunit, t0, t1, nsteps, opts, qout, qdout, qddout, rep, status, msg)
+    if (present(ptab)) then
+      call kin_run(m, q0 / m%cunit, t0, t1, nsteps, opts, qout, qdout, qddout, rep, status, &
+                   msg, sens, sq, sqd, sqdd)
+      call sens_units(m, sens, sq, m%cunit, .false.)
+      call sens_units(m, sens, sqd, m%cunit, .false.)
+      call sens_units(m, sens, sqdd, m%cunit, .false.)
+    else
+      call kin_run(m, q0 / m%cunit, t0, t1, nsteps, opts, qout, qdout, qddout, rep, status, msg)
+    end if
     call units(m, qout, m%cunit, .false.); call units(m, qdout, m%cunit, .false.)
     call units(m, qddout, m%cunit, .false.)
     iinfo(1) = rep%ndone; iinfo(3) = rep%driver; iinfo(4) = rep%worst
@@ -285,7 +362,7 @@ contains
     type(kin_report_t) :: rep
     type(kin_work_t) :: w
     real(wp) :: h
-    integer :: bad, lev
+    integer :: bad, lev, ierr
     call model_build(nb, ctab, rpar, m, status, msg, bad, nondim=.true.)
     if (status /= MBD_OK) return
     if (size(q) /= m%nq .or. size(qd) /= m%nq .or. size(qdd) /= m%nq .or. m%neq /= m%nq) then
@@ -300,17 +377,20 @@ contains
     end if
     if (tol > zero) opts%tol = tol
     if (maxit > 0) opts%maxit = maxit
-    call kin_work_init(m, w)
+    call kin_work_init(m, w, status, msg)
+    if (status /= MBD_OK) return
     w%tol = opts%tol * m%lscale
     q = q / m%cunit; qd = qd / m%cunit; qdd = qdd / m%cunit
-    call step()
-    q = q * m%cunit; qd = qd * m%cunit; qdd = qdd * m%cunit
-  contains
-    subroutine step()
+    step: block                                ! in the core's units; any exit converts back
       if (assemble == 1) then
-        allocate (rep%qsing(m%nq), rep%dep(m%neq), rep%redundant(m%neq))
+        allocate (rep%qsing(m%nq), rep%dep(m%neq), rep%redundant(m%neq), stat=ierr)
+        if (ierr /= 0) then
+          call mem_fail(REAL_BYTES * (real(m%nq, wp) + m%neq), 'the assembly report', &
+                        'use a smaller model', status, msg)
+          exit step
+        end if
         call kin_assemble(m, w, q, t, opts, rep, status, msg)
-        if (status /= MBD_OK) return
+        if (status /= MBD_OK) exit step
       else
         h = t - t_prev
         q = q + h * (qd + (0.5_wp * h) * qdd)     ! q(t) ~ q + h q_dot + h**2/2 q_ddot
@@ -318,11 +398,12 @@ contains
       call kin_newton(m, w, q, t, opts%maxit, status)
       if (status /= MBD_OK) then
         write (msg, '(a,es22.15)') 'Newton-Raphson failed (or J is singular) at t = ', t
-        return
+        exit step
       end if
       call kin_vel_acc(m, w, q, t, qd, qdd, status, lev)
       if (status /= MBD_OK) msg = 'velocities or accelerations could not be solved'
-    end subroutine step
+    end block step
+    q = q * m%cunit; qd = qd * m%cunit; qdd = qdd * m%cunit
   end subroutine api_kin_step
 
   !> Degrees of freedom and redundancy at the configuration assembled from q0 at time t:
@@ -349,7 +430,7 @@ contains
     type(kin_opts_t) :: opts
     type(kin_report_t) :: rep
     type(kin_work_t) :: w
-    integer :: bad
+    integer :: bad, ierr
     q = zero; rank = 0; mobility = 0; redundant = 0; dep = 0; resid = zero; worst = 0
     call model_build(nb, ctab, rpar, m, status, msg, bad, nondim=.true.)
     worst = bad
@@ -362,9 +443,15 @@ contains
       status = MBD_BAD_COUNT; msg = 'array sizes do not match the model'; return
     end if
     if (tol > zero) opts%tol = tol
-    call kin_work_init(m, w)
+    call kin_work_init(m, w, status, msg)
+    if (status /= MBD_OK) return
     w%tol = opts%tol * m%lscale
-    allocate (rep%qsing(m%nq), rep%dep(m%neq), rep%redundant(m%neq))
+    allocate (rep%qsing(m%nq), rep%dep(m%neq), rep%redundant(m%neq), stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail(REAL_BYTES * (real(m%nq, wp) + m%neq), 'the assembly report', &
+                    'use a smaller model', status, msg)
+      return
+    end if
     rep%qsing = zero; rep%dep = 0; rep%redundant = 0
     q = q0 / m%cunit
     call kin_assemble(m, w, q, t, opts, rep, status, msg)
@@ -424,9 +511,14 @@ contains
     real(wp), intent(in) :: q(:), qd(:), t
     real(wp), intent(out) :: e(4)
     real(wp) :: v
+    integer :: j
     call assemble_dense(m, q, w%qz, t, w%phi, w%nu, w%gam, w%asm, w%jac)
     e(3) = maxval(abs(w%phi) * m%rowunit)
-    e(4) = maxval(abs(matmul(w%jac, qd) - w%nu) * m%rowunit)
+    w%phi = -w%nu                ! J q_dot - nu by columns (matmul would make a temporary)
+    do j = 1, size(qd)
+      w%phi = w%phi + w%jac(:, j) * qd(j)
+    end do
+    e(4) = maxval(abs(w%phi) * m%rowunit)
     call gen_forces(m, q, qd, t, w%force, v)
     e(1) = kinetic_energy(m, qd); e(2) = v
   end subroutine state_measures
@@ -434,12 +526,10 @@ contains
   !> Inverse dynamics: a kinematic run, then at every output the multipliers
   !! lambda (minimum norm over all rows) of J^T lambda = Q - M q_ddot, and the energies.
   !! iinfo/rinfo as api_kinematics; iinfo(2) = -force index for a bad force.
-  !! Contacts are force elements at the kinematic states; their onsets and separations are
-  !! found at the outputs (evo, nev as api_dynamics); joint friction (regularized) enters
-  !! the multipliers; eo(NEO, nf, rows) the element outputs.
   subroutine api_inverse(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, t0, t1, nsteps, tol, &
                          every, solver, qout, qdout, qddout, lamout, eout, iinfo, rinfo, qsing, &
-                         dep, redundant, tpass, status, msg, eo, evo, nev)
+                         dep, redundant, tpass, status, msg, ptab, sq, sqd, sqdd, slam, eo, &
+                         evo, nev)
     integer, intent(in) :: nb, ctab(:, :), ftab(:, :), nsteps
     real(wp), intent(in) :: rpar(:), bmass(:, :), grav(2), fpar(:), q0(:), t0, t1, tol
     integer, intent(in) :: every                !! store every k-th output (and the last)
@@ -453,17 +543,29 @@ contains
     integer, intent(out) :: dep(:), redundant(:)
     integer, intent(out) :: status              !! MBD_OK, < 0 input, > 0 numerical
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
-    real(wp), intent(out) :: eo(:, :, :)        !! (NEO, nf, rows) element outputs
-    real(wp), intent(out) :: evo(:, :)          !! (4, maxev) contact events
-    integer, intent(out) :: nev                 !! events found
+    !> design parameters (2, np) and, with them, dq/dp, dq_dot/dp, dq_ddot/dp (nq, np, rows)
+    !! and dlambda/dp (neq, np, rows) at the outputs
+    integer, intent(in), optional :: ptab(:, :)
+    real(wp), intent(out), optional :: sq(:, :, :), sqd(:, :, :), sqdd(:, :, :), slam(:, :, :)
+    !> contacts and friction: the element outputs (NEO, nf, rows) and the contact events found
+    !! at the outputs (4, capacity), their number
+    real(wp), intent(out), optional :: eo(:, :, :), evo(:, :)
+    integer, intent(out), optional :: nev
     type(model_t) :: m
     type(dyn_work_t) :: w
+    type(sens_t) :: sens
     type(ev_log_t) :: log
     integer :: bad, badf, k, st
     real(wp) :: t
     logical :: changed
     character(len=MSG_LEN) :: lmsg
-    lamout = zero; eout = zero; eo = zero; evo = zero; nev = 0
+    lamout = zero; eout = zero
+    if (present(eo)) eo = zero
+    if (present(evo)) evo = zero
+    if (present(nev)) nev = 0
+    if (present(ptab)) then
+      sq = zero; sqd = zero; sqdd = zero; slam = zero
+    end if
     call build_dynamic(nb, ctab, rpar, bmass, grav, ftab, fpar, m, status, msg, bad, badf)
     if (status /= MBD_OK) then
       qout = zero; qdout = zero; qddout = zero; iinfo = 0; rinfo = zero
@@ -471,15 +573,48 @@ contains
       qsing = zero; dep = 0; redundant = 0; tpass = zero
       return
     end if
-    call api_kinematics(nb, ctab, rpar, q0, t0, t1, nsteps, tol, 0, zero, every, solver, qout, &
-                        qdout, qddout, iinfo, rinfo, qsing, dep, redundant, tpass, status, msg)
+    ! the multipliers are dense: check the memory before the (possibly long) kinematic run
+    call dyn_memory_check(m, status, msg)
+    if (status /= MBD_OK) then
+      qout = zero; qdout = zero; qddout = zero; iinfo = 0; rinfo = zero
+      qsing = zero; dep = 0; redundant = 0; tpass = zero
+      return
+    end if
+    if (present(ptab)) then
+      if (size(slam, 1) /= m%neq .or. any(shape(slam) /= [m%neq, shape(sq(1, :, :))])) then
+        status = MBD_BAD_COUNT; msg = 'sensitivity arrays do not match the model'; return
+      end if
+      call sens_setup(m, ctab, rpar, ptab, sens, status, msg, bad, ftab, fpar)
+      if (status /= MBD_OK) then
+        iinfo = 0; iinfo(2) = -2000000 - bad; return
+      end if
+      call api_kinematics(nb, ctab, rpar, q0, t0, t1, nsteps, tol, 0, zero, every, solver, &
+                          qout, qdout, qddout, iinfo, rinfo, qsing, dep, redundant, tpass, &
+                          status, msg, ptab, sq, sqd, sqdd)
+    else
+      call api_kinematics(nb, ctab, rpar, q0, t0, t1, nsteps, tol, 0, zero, every, solver, &
+                          qout, qdout, qddout, iinfo, rinfo, qsing, dep, redundant, tpass, &
+                          status, msg)
+    end if
     if (iinfo(1) < 1) return
     ! the multipliers in the core's units (so the rank decisions do not depend on the unit)
     call units(m, qout, m%cunit, .true.); call units(m, qdout, m%cunit, .true.)
     call units(m, qddout, m%cunit, .true.)
     call dyn_init(m, w, qout(:, 1), t0, 1.0e-12_wp, st, lmsg)
-    if (st == MBD_OK) call ev_log_init(log, size(evo, 2), st)
+    if (present(ptab)) then
+      call sens_units(m, sens, sq, m%cunit, .false., back=.true.)
+      call sens_units(m, sens, sqd, m%cunit, .false., back=.true.)
+      call sens_units(m, sens, sqdd, m%cunit, .false., back=.true.)
+    end if
     if (st == MBD_OK) then
+      k = 1
+      if (present(evo)) k = size(evo, 2)
+      call ev_log_init(log, k, st)
+      if (st /= MBD_OK) lmsg = 'not enough memory for the event log'
+    end if
+    if (st == MBD_NO_MEMORY) then
+      status = st; msg = lmsg
+    else if (st == MBD_OK) then
       do k = 1, iinfo(1)
         ! column k holds output min((k - 1) every, nsteps)
         t = t0 + (t1 - t0) * (real(min((k - 1) * every, nsteps), wp) / max(nsteps, 1))
@@ -489,14 +624,28 @@ contains
                                                  changed, st)
         call dyn_multipliers(m, w, qout(:, k), qdout(:, k), qddout(:, k), t, lamout(:, k), &
                              st, lmsg)
+        if (st == MBD_NO_MEMORY) then
+          status = st; msg = lmsg; exit
+        end if
         call state_measures(m, w, qout(:, k), qdout(:, k), t, eout(:, k))
-        if (m%nf > 0) call dyn_element_outputs(m, w, qout(:, k), qdout(:, k), t, eo(:, :, k))
+        if (present(eo) .and. m%nf > 0) call dyn_element_outputs(m, w, qout(:, k), &
+                                                                 qdout(:, k), t, eo(:, :, k))
+        if (present(ptab)) call sens_multipliers(m, sens, qout(:, k), qdout(:, k), &
+                                                 qddout(:, k), t, w%jac, lamout(:, k), &
+                                                 sq(:, :, k), sqd(:, :, k), sqdd(:, :, k), &
+                                                 slam(:, :, k), st, lmsg)
       end do
-      call events_out(m, log, evo, nev)
+      if (present(evo) .and. present(nev)) call events_out(m, log, evo, nev)
     end if
     call units(m, qout, m%cunit, .false.); call units(m, qdout, m%cunit, .false.)
     call units(m, qddout, m%cunit, .false.); call units(m, lamout, m%rowunit, .true.)
-    call element_units(m, eo)
+    if (present(ptab)) then
+      call sens_units(m, sens, sq, m%cunit, .false.)
+      call sens_units(m, sens, sqd, m%cunit, .false.)
+      call sens_units(m, sens, sqdd, m%cunit, .false.)
+      call sens_units(m, sens, slam, m%rowunit, .true.)
+    end if
+    if (present(eo)) call element_units(m, eo)
   end subroutine api_inverse
 
   !> Forward dynamics: assembly of q0, the velocity v0 projected onto J q_dot = nu (kinetic
@@ -538,7 +687,7 @@ contains
     type(dyn_stats_t) :: dst
     real(wp), allocatable :: q(:), qd(:)
     real(wp) :: t, lscale
-    integer :: bad, badf, k, ko, nout
+    integer :: bad, badf, k, ko, nout, ierr
     iinfo = 0; rinfo = zero; redundant = 0
     qout = zero; qdout = zero; qddout = zero; lamout = zero; eout = zero
     eo = zero; evo = zero; nev = 0
@@ -558,11 +707,21 @@ contains
         size(redundant) /= m%neq) then
       status = MBD_BAD_COUNT; msg = 'array sizes do not match the model'; return
     end if
+    ! the dense dynamics must fit (checked before the assembly allocates its dense J)
+    call dyn_memory_check(m, status, msg)
+    if (status /= MBD_OK) return
     ! assembly at t0 (Levenberg-Marquardt; any number of equations)
-    call kin_work_init(m, kw)
+    call kin_work_init(m, kw, status, msg)
+    if (status /= MBD_OK) return
     lscale = m%lscale
     kw%tol = kopts%tol * lscale
-    allocate (q(m%nq), qd(m%nq), rep%qsing(m%nq), rep%dep(m%neq), rep%redundant(m%neq))
+    allocate (q(m%nq), qd(m%nq), rep%qsing(m%nq), stat=ierr)
+    if (ierr == 0) allocate (rep%dep(m%neq), rep%redundant(m%neq), stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail(REAL_BYTES * (3 * real(m%nq, wp) + m%neq), 'the state vectors', &
+                    'use a smaller model', status, msg)
+      return
+    end if
     q = q0 / m%cunit
     call kin_assemble(m, kw, q, t0, kopts, rep, status, msg)
     if (status /= MBD_OK) then
@@ -617,20 +776,25 @@ contains
   !> Static equilibrium near the assembled q0 at time t, its multipliers and stability
   !! (1 stable, 0 unstable, -1 neutral, 2 no free motion).
   subroutine api_statics(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, t, q, lam, stable, resid, &
-                         iinfo, status, msg)
+                         iinfo, status, msg, ptab, sq, slam)
     integer, intent(in) :: nb, ctab(:, :), ftab(:, :)
     real(wp), intent(in) :: rpar(:), bmass(:, :), grav(2), fpar(:), q0(:), t
     real(wp), intent(out) :: q(:), lam(:), resid
     integer, intent(out) :: stable, iinfo(NINFO)
     integer, intent(out) :: status              !! MBD_OK, < 0 input, > 0 numerical
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    !> design parameters (2, np) and, with them, dq/dp (nq, np) and dlambda/dp (neq, np) at
+    !! the equilibrium
+    integer, intent(in), optional :: ptab(:, :)
+    real(wp), intent(out), optional :: sq(:, :), slam(:, :)
+    type(sens_t) :: sens
     type(model_t) :: m
     type(dyn_work_t) :: w
     type(kin_work_t) :: kw
     type(kin_opts_t) :: kopts
     type(kin_report_t) :: rep
     real(wp) :: lscale
-    integer :: bad, badf
+    integer :: bad, badf, ierr
     q = zero; lam = zero; stable = 0; resid = zero; iinfo = 0
     call build_dynamic(nb, ctab, rpar, bmass, grav, ftab, fpar, m, status, msg, bad, badf)
     iinfo(2) = bad; if (badf /= 0) iinfo(2) = -1000000 - badf
@@ -641,14 +805,38 @@ contains
     if (size(q0) /= m%nq .or. size(q) /= m%nq .or. size(lam) /= m%neq) then
       status = MBD_BAD_COUNT; msg = 'array sizes do not match the model'; return
     end if
-    call kin_work_init(m, kw)
+    call dyn_memory_check(m, status, msg)
+    if (status /= MBD_OK) return
+    call kin_work_init(m, kw, status, msg)
+    if (status /= MBD_OK) return
     lscale = m%lscale
     kw%tol = kopts%tol * lscale
-    allocate (rep%qsing(m%nq), rep%dep(m%neq), rep%redundant(m%neq))
+    allocate (rep%qsing(m%nq), rep%dep(m%neq), rep%redundant(m%neq), stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail(REAL_BYTES * (real(m%nq, wp) + m%neq), 'the assembly report', &
+                    'use a smaller model', status, msg)
+      return
+    end if
     q = q0 / m%cunit
     call kin_assemble(m, kw, q, t, kopts, rep, status, msg)
     if (status == MBD_OK) call dyn_init(m, w, q, t, kw%tol, status, msg)
+    if (status == MBD_OK .and. present(ptab)) then
+      sq = zero; slam = zero
+      if (any(shape(sq) /= [m%nq, size(ptab, 2)]) .or. &
+          any(shape(slam) /= [m%neq, size(ptab, 2)])) then
+        status = MBD_BAD_COUNT; msg = 'sensitivity arrays do not match the model'; return
+      end if
+      call sens_setup(m, ctab, rpar, ptab, sens, status, msg, bad, ftab, fpar)
+      if (status /= MBD_OK) then
+        iinfo(2) = -2000000 - bad; return
+      end if
+    end if
     if (status == MBD_OK) call statics_solve(m, w, q, t, lam, stable, resid, status, msg)
+    if (status == MBD_OK .and. present(ptab)) then
+      call sens_statics(m, sens, w%rows, q, t, lam, sq, slam, status, msg)
+      call sens_units2(m, sens, sq, m%cunit, .false.)
+      call sens_units2(m, sens, slam, m%rowunit, .true.)
+    end if
     q = q * m%cunit; lam = lam / m%rowunit
   end subroutine api_statics
 
@@ -662,7 +850,7 @@ contains
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
     type(model_t) :: m
     type(dyn_work_t) :: w
-    integer :: bad, k
+    integer :: bad, k, ierr
     reac = zero; rloc = zero
     call model_build(nb, ctab, rpar, m, status, msg, bad)
     if (status /= MBD_OK) return
@@ -673,13 +861,208 @@ contains
         size(q, 2) /= size(t) .or. size(lam, 2) /= size(t) .or. size(reac, 3) /= size(t)) then
       status = MBD_BAD_COUNT; msg = 'array sizes do not match the model'; return
     end if
-    allocate (w%phi(m%neq), w%nu(m%neq), w%gam(m%neq), w%qz(m%nq))
-    call asm_init(m, w%asm)
+    allocate (w%phi(m%neq), w%nu(m%neq), w%gam(m%neq), w%qz(m%nq), stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail(REAL_BYTES * (3 * real(m%neq, wp) + m%nq), 'the reaction work arrays', &
+                    'use a smaller model', status, msg)
+      return
+    end if
+    call asm_init(m, w%asm, status, msg)
+    if (status /= MBD_OK) return
     w%qz = zero
     do k = 1, size(t)
       call dyn_reactions(m, w, q(:, k), t(k), lam(:, k), reac(:, :, k), rloc(:, :, k))
     end do
   end subroutine api_reactions
+
+  !> Changes of Phi, J, nu and gamma along a direction (dq, dq_dot) and one design parameter
+  !! (ptab(:, 1); an empty table: none) at (q, q_dot, t), each evaluated analytically on dual
+  !! numbers (mbd_dual): Phi_q dq + Phi_p, J_q dq + J_p, nu_p, gamma_q dq + gamma_q_dot dq_dot
+  !! + gamma_p. For checks by finite differences.
+  subroutine api_eval_d(nb, ctab, rpar, q, qd, t, dq, dqd, ptab, tphi, tjac, tnu, tgam, status, &
+                        msg, bad)
+    integer, intent(in) :: nb                   !! moving bodies
+    integer, intent(in) :: ctab(:, :)           !! constraint table
+    real(wp), intent(in) :: rpar(:)             !! raw parameters
+    real(wp), intent(in) :: q(:), qd(:)         !! state (nq)
+    real(wp), intent(in) :: t                   !! time
+    real(wp), intent(in) :: dq(:), dqd(:)       !! direction (nq)
+    integer, intent(in) :: ptab(:, :)           !! (2, 0 or 1) the parameter
+    real(wp), intent(out) :: tphi(:)            !! change of Phi (neq)
+    real(wp), intent(out) :: tjac(:, :)         !! change of J (neq x nq)
+    real(wp), intent(out) :: tnu(:), tgam(:)    !! changes of nu, gamma (neq)
+    integer, intent(out) :: status              !! MBD_OK or < 0
+    character(len=MSG_LEN), intent(out) :: msg  !! what is wrong
+    integer, intent(out) :: bad                 !! offending constraint, or 0
+    type(model_t) :: m
+    type(asm_work_t) :: aw
+    type(sens_t) :: sens
+    integer :: k
+    tphi = zero; tjac = zero; tnu = zero; tgam = zero
+    call model_build(nb, ctab, rpar, m, status, msg, bad)
+    if (status /= MBD_OK) return
+    if (.not. (finite(q) .and. finite(qd) .and. finite(t) .and. finite(dq) .and. &
+               finite(dqd))) then
+      call not_finite('the state and the direction', status, msg); return
+    end if
+    if (size(q) /= m%nq .or. size(qd) /= m%nq .or. size(dq) /= m%nq .or. &
+        size(dqd) /= m%nq .or. size(tphi) /= m%neq .or. size(tjac, 1) /= m%neq .or. &
+        size(tjac, 2) /= m%nq .or. size(ptab, 2) > 1) then
+      status = MBD_BAD_COUNT; msg = 'array sizes do not match the model'; return
+    end if
+    call sens_setup(m, ctab, rpar, ptab, sens, status, msg, bad)
+    if (status /= MBD_OK) return
+    k = size(ptab, 2)
+    call asm_init(m, aw, status, msg)
+    if (status /= MBD_OK) return
+    call sens_trig(m, sens, q)
+    call sens_eval_d(m, sens, k, q, qd, dq, dqd, t, tphi, tnu, tgam, aw%jb)
+    call scatter_dense(aw, tjac)
+  end subroutine api_eval_d
+
+  !> Changes of the reactions (as api_reactions) along design parameters at many states:
+  !! dreac, drloc (6, nc, np, nt), from dq/dp (nq, np, nt) and dlambda/dp (neq, np, nt).
+  subroutine api_reactions_dp(nb, ctab, rpar, ptab, q, t, lam, sq, slam, dreac, drloc, status, &
+                              msg)
+    integer, intent(in) :: nb, ctab(:, :)
+    real(wp), intent(in) :: rpar(:)
+    integer, intent(in) :: ptab(:, :)
+    real(wp), intent(in) :: q(:, :), t(:), lam(:, :), sq(:, :, :), slam(:, :, :)
+    real(wp), intent(out) :: dreac(:, :, :, :), drloc(:, :, :, :)
+    integer, intent(out) :: status              !! MBD_OK or < 0
+    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    type(model_t) :: m
+    type(sens_t) :: sens
+    integer :: bad, k
+    dreac = zero; drloc = zero
+    call model_build(nb, ctab, rpar, m, status, msg, bad)
+    if (status /= MBD_OK) return
+    if (.not. (finite(q) .and. finite(t) .and. finite(lam))) then
+      call not_finite('q, t and lambda', status, msg); return
+    end if
+    if (size(q, 1) /= m%nq .or. size(lam, 1) /= m%neq .or. size(q, 2) /= size(t) .or. &
+        size(lam, 2) /= size(t) .or. any(shape(sq) /= [m%nq, size(ptab, 2), size(t)]) .or. &
+        any(shape(slam) /= [m%neq, size(ptab, 2), size(t)]) .or. &
+        any(shape(dreac) /= [6, m%nc, size(ptab, 2), size(t)]) .or. &
+        any(shape(drloc) /= shape(dreac))) then
+      status = MBD_BAD_COUNT; msg = 'array sizes do not match the model'; return
+    end if
+    call sens_setup(m, ctab, rpar, ptab, sens, status, msg, bad)
+    if (status /= MBD_OK) return
+    do k = 1, size(t)
+      call sens_reactions(m, sens, q(:, k), t(k), lam(:, k), sq(:, :, k), slam(:, :, k), &
+                          dreac(:, :, :, k), drloc(:, :, :, k))
+    end do
+  end subroutine api_reactions_dp
+
+  !> Forward dynamics by dopri5 with design sensitivities (mbd_sens_dynamics): as
+  !! api_dynamics (method dopri5; iinfo 1 outputs, 2 bad entry, 3 steps, 4 rejected, 6
+  !! right-hand sides, 9 active rows; rinfo 1 failure time, 2 and 3 smallest and largest step)
+  !! plus sq, sqd, sqdd (nq, np, rows), the sensitivities of q, q_dot and q_ddot.
+  subroutine api_dynamics_sens(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, v0, t0, t1, &
+                               nsteps, rtol, atol, every, max_steps, ptab, qout, qdout, qddout, &
+                               lamout, eout, sq, sqd, sqdd, iinfo, rinfo, redundant, status, msg)
+    integer, intent(in) :: nb, ctab(:, :), ftab(:, :), nsteps, every, max_steps
+    real(wp), intent(in) :: rpar(:), bmass(:, :), grav(2), fpar(:), q0(:), v0(:), t0, t1
+    real(wp), intent(in) :: rtol, atol          !! tolerances (<= 0: defaults 1e-6, 1e-8)
+    integer, intent(in) :: ptab(:, :)           !! design parameters (2, np)
+    real(wp), intent(out) :: qout(:, :), qdout(:, :), qddout(:, :)  !! (nq, rows)
+    real(wp), intent(out) :: lamout(:, :)       !! (neq, rows)
+    real(wp), intent(out) :: eout(:, :)         !! (4, rows) energies, drift
+    real(wp), intent(out) :: sq(:, :, :), sqd(:, :, :), sqdd(:, :, :)  !! (nq, np, rows)
+    integer, intent(out) :: iinfo(NINFO)
+    real(wp), intent(out) :: rinfo(NINFO)
+    integer, intent(out) :: redundant(:)
+    integer, intent(out) :: status              !! MBD_OK, < 0 input, > 0 numerical
+    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    type(model_t) :: m
+    type(dyn_work_t) :: w
+    type(kin_work_t) :: kw
+    type(kin_opts_t) :: kopts
+    type(kin_report_t) :: rep
+    type(sens_t) :: sens
+    real(wp), allocatable :: q(:), qd(:), s0(:, :), sd0(:, :)
+    real(wp) :: t, r_tol, a_tol, hmm(2), tfail
+    integer :: bad, badf, k, ko, nout, st, stats(3)
+    character(len=MSG_LEN) :: lmsg
+    iinfo = 0; rinfo = zero; redundant = 0
+    qout = zero; qdout = zero; qddout = zero; lamout = zero; eout = zero
+    sq = zero; sqd = zero; sqdd = zero
+    call build_dynamic(nb, ctab, rpar, bmass, grav, ftab, fpar, m, status, msg, bad, badf)
+    iinfo(2) = bad; if (badf /= 0) iinfo(2) = -1000000 - badf
+    if (status /= MBD_OK) return
+    if (.not. (finite(q0) .and. finite(v0) .and. finite(t0) .and. finite(t1) .and. &
+               finite([rtol, atol]))) then
+      call not_finite('q0, v0, the times and the settings', status, msg); return
+    end if
+    if (nsteps < 0 .or. .not. (t1 > t0) .or. every < 1 .or. max_steps < 1) then
+      status = MBD_BAD_SETTING
+      msg = 'steps must be >= 0, every >= 1, max_steps >= 1 and t_end > t0'; return
+    end if
+    if (size(q0) /= m%nq .or. size(v0) /= m%nq .or. size(qout, 1) /= m%nq .or. &
+        size(qout, 2) /= output_rows(nsteps, every) .or. size(lamout, 1) /= m%neq .or. &
+        size(redundant) /= m%neq .or. &
+        any(shape(sq) /= [m%nq, size(ptab, 2), size(qout, 2)]) .or. &
+        any(shape(sqd) /= shape(sq)) .or. any(shape(sqdd) /= shape(sq))) then
+      status = MBD_BAD_COUNT; msg = 'array sizes do not match the model'; return
+    end if
+    call sens_setup(m, ctab, rpar, ptab, sens, status, msg, bad, ftab, fpar)
+    if (status /= MBD_OK) then
+      iinfo(2) = -2000000 - bad; return
+    end if
+    call dyn_memory_check(m, status, msg)
+    if (status /= MBD_OK) return
+    call kin_work_init(m, kw, status, msg)
+    if (status /= MBD_OK) return
+    kw%tol = kopts%tol * m%lscale
+    allocate (q(m%nq), qd(m%nq), rep%qsing(m%nq), rep%dep(m%neq), rep%redundant(m%neq), &
+              s0(m%nq, sens%np), sd0(m%nq, sens%np), stat=st)
+    if (st /= 0) then
+      call mem_fail(REAL_BYTES * (3 * real(m%nq, wp) * (1 + sens%np) + m%neq), &
+                    'the state and its sensitivities', 'use fewer parameters', status, msg)
+      return
+    end if
+    q = q0 / m%cunit
+    call kin_assemble(m, kw, q, t0, kopts, rep, status, msg)
+    if (status /= MBD_OK) then
+      rinfo(1) = t0; return
+    end if
+    call dyn_init(m, w, q, t0, kw%tol, status, msg)
+    if (status /= MBD_OK) return
+    iinfo(9) = w%na
+    do k = 1, m%neq
+      if (.not. any(w%rows == k)) redundant(k) = 1
+    end do
+    call dyn_velocity(m, w, q, t0, v0 / m%cunit, qd, status)
+    if (status /= MBD_OK) then
+      msg = 'the initial velocities cannot be made consistent: the mass matrix is singular '// &
+            'on the motions the constraints allow (a body without mass or inertia?)'
+      return
+    end if
+    call sens_initial(m, w, sens, q, qd, t0, s0, sd0, status, msg)
+    if (status /= MBD_OK) return
+    r_tol = 1.0e-6_wp; a_tol = 1.0e-8_wp
+    if (rtol > zero) r_tol = rtol
+    if (atol > zero) a_tol = atol
+    call sens_dopri5(m, w, sens, q, qd, s0, sd0, t0, t1, nsteps, every, r_tol, a_tol, &
+                     max_steps, qout, qdout, qddout, sq, sqd, sqdd, nout, stats, hmm, tfail, &
+                     status, msg)
+    iinfo(1) = nout; iinfo(3) = stats(1); iinfo(4) = stats(2); iinfo(6) = stats(3)
+    rinfo(2) = hmm(1); rinfo(3) = hmm(2)
+    if (status /= MBD_OK) rinfo(1) = tfail
+    do k = 1, nout
+      ko = output_index(nsteps, every, k)
+      t = t0 + (t1 - t0) * (real(ko, wp) / max(nsteps, 1))
+      if (ko == nsteps) t = t1
+      call dyn_multipliers(m, w, qout(:, k), qdout(:, k), qddout(:, k), t, lamout(:, k), st, lmsg)
+      call state_measures(m, w, qout(:, k), qdout(:, k), t, eout(:, k))
+    end do
+    call units(m, qout, m%cunit, .false.); call units(m, qdout, m%cunit, .false.)
+    call units(m, qddout, m%cunit, .false.); call units(m, lamout, m%rowunit, .true.)
+    call sens_units(m, sens, sq, m%cunit, .false.)
+    call sens_units(m, sens, sqd, m%cunit, .false.)
+    call sens_units(m, sens, sqdd, m%cunit, .false.)
+  end subroutine api_dynamics_sens
 
   !> Normal force of each cam joint on its follower at many states: fn(nc, nt), positive
   !! when the profile pushes the follower away, negative when the joint must pull it onto
@@ -695,7 +1078,7 @@ contains
     type(model_t) :: m
     type(dyn_work_t) :: w
     real(wp) :: reac(6, size(ctab, 2)), rloc(6, size(ctab, 2)), ql(NLOC), nv(2)
-    integer :: bad, k, i, s
+    integer :: bad, k, i, s, ierr
     fn = zero
     call model_build(nb, ctab, rpar, m, status, msg, bad)
     if (status /= MBD_OK) return
@@ -706,8 +1089,14 @@ contains
         size(q, 2) /= size(t) .or. size(lam, 2) /= size(t) .or. size(fn, 2) /= size(t)) then
       status = MBD_BAD_COUNT; msg = 'array sizes do not match the model'; return
     end if
-    allocate (w%phi(m%neq), w%nu(m%neq), w%gam(m%neq), w%qz(m%nq))
-    call asm_init(m, w%asm)
+    allocate (w%phi(m%neq), w%nu(m%neq), w%gam(m%neq), w%qz(m%nq), stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail(REAL_BYTES * (3 * real(m%neq, wp) + m%nq), 'the reaction arrays', &
+                    'use a smaller model', status, msg)
+      return
+    end if
+    call asm_init(m, w%asm, status, msg)
+    if (status /= MBD_OK) return
     w%qz = zero
     do i = 1, size(t)
       call dyn_reactions(m, w, q(:, i), t(i), lam(:, i), reac, rloc)

@@ -7,38 +7,53 @@
 !! once (asm_init). No allocation here.
 module mbd_assemble
   use mbd_kinds, only: wp, zero, one
+  use mbd_status, only: MBD_OK, MSG_LEN
+  use mbd_memory, only: REAL_BYTES, mem_fail
   use mbd_points, only: NLOC, MAXROW, kloc
   use mbd_model, only: model_t, model_slots
   use mbd_constraints, only: con_eval, con_init_extra
   implicit none
   private
   public :: asm_work_t, asm_init, assemble_blocks, scatter_dense, assemble_dense, init_extras, &
-            gather_local
+            gather_local, blocks_jv, blocks_jtv
 
   !> Work arrays of the assembly, allocated once per analysis.
   type :: asm_work_t
     real(wp), allocatable :: jb(:, :, :)   !! local Jacobian blocks (MAXROW, NLOC, nc)
     real(wp), allocatable :: cb(:), sb(:)  !! cos and sin of each body's angle (0:nb; 0 ground)
     !> the nonzeros of the blocks: jb(src(i)) goes to J(dst(i)) and column col(i) (flat
-    !! column-major indices into jb and the dense neq x nq J)
+    !! column-major indices into jb and the dense neq x nq J; dst = 0 when J has more than
+    !! huge(1) entries)
     integer, allocatable :: src(:), dst(:), col(:)
   end type asm_work_t
 
 contains
 
-  !> Allocate the assembly work arrays for model m.
-  pure subroutine asm_init(m, a)
+  !> Allocate the assembly work arrays for model m. The dense map (dst) is built only when
+  !! the dense J has fewer than huge(1) entries (a larger one could not be allocated anyway).
+  pure subroutine asm_init(m, a, status, msg)
     type(model_t), intent(in) :: m         !! model
     type(asm_work_t), intent(out) :: a     !! work arrays
-    integer :: k, s, r, n
-    allocate (a%jb(MAXROW, NLOC, m%nc), a%cb(0:m%nb), a%sb(0:m%nb))
-    a%jb = zero
-    a%cb = one; a%sb = zero
+    integer, intent(out) :: status         !! MBD_OK or MBD_NO_MEMORY
+    character(len=MSG_LEN), intent(inout) :: msg  !! explanation (on a failure)
+    integer :: k, s, r, n, ierr
+    logical :: dense_map
+    status = MBD_OK
     n = 0
     do k = 1, m%nc
       n = n + m%nrow(k) * count(m%loc(:, k) > 0)
     end do
-    allocate (a%src(n), a%dst(n), a%col(n))
+    allocate (a%jb(MAXROW, NLOC, m%nc), a%cb(0:m%nb), a%sb(0:m%nb), stat=ierr)
+    if (ierr == 0) allocate (a%src(n), a%dst(n), a%col(n), stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail(REAL_BYTES * (MAXROW * NLOC * real(m%nc, wp) + 2 * real(m%nb, wp)) + &
+                    12 * real(n, wp), 'the constraint blocks', 'use a smaller model', &
+                    status, msg)
+      return
+    end if
+    a%jb = zero
+    a%cb = one; a%sb = zero
+    dense_map = real(m%neq, wp) * real(m%nq, wp) < real(huge(n), wp)
     n = 0
     do k = 1, m%nc
       do s = 1, NLOC
@@ -47,7 +62,8 @@ contains
           n = n + 1
           a%src(n) = r + MAXROW * (s - 1 + NLOC * (k - 1))
           a%col(n) = m%loc(s, k)
-          a%dst(n) = m%row0(k) + r - 1 + m%neq * (m%loc(s, k) - 1)
+          a%dst(n) = 0
+          if (dense_map) a%dst(n) = m%row0(k) + r - 1 + m%neq * (m%loc(s, k) - 1)
         end do
       end do
     end do
@@ -151,6 +167,48 @@ contains
     call assemble_blocks(m, q, qd, t, phi, nu, gam, a)
     call scatter_dense(a, jac)
   end subroutine assemble_dense
+
+  !> y = J x from the local blocks of the last assembly (no dense J).
+  pure subroutine blocks_jv(m, a, x, y)
+    type(model_t), intent(in) :: m        !! model
+    type(asm_work_t), intent(in) :: a     !! work arrays with the blocks
+    real(wp), intent(in) :: x(:)          !! vector (nq)
+    real(wp), intent(out) :: y(:)         !! J x (neq)
+    integer :: k, s, c, r0, i
+    do k = 1, m%nc
+      r0 = m%row0(k) - 1
+      do i = 1, m%nrow(k)
+        y(r0 + i) = zero
+      end do
+      do s = 1, NLOC
+        c = m%loc(s, k)
+        if (c == 0) cycle
+        do i = 1, m%nrow(k)
+          y(r0 + i) = y(r0 + i) + a%jb(i, s, k) * x(c)
+        end do
+      end do
+    end do
+  end subroutine blocks_jv
+
+  !> x = J^T y from the local blocks of the last assembly (no dense J).
+  pure subroutine blocks_jtv(m, a, y, x)
+    type(model_t), intent(in) :: m        !! model
+    type(asm_work_t), intent(in) :: a     !! work arrays with the blocks
+    real(wp), intent(in) :: y(:)          !! vector (neq)
+    real(wp), intent(out) :: x(:)         !! J^T y (nq)
+    integer :: k, s, c, r0, i
+    x = zero
+    do k = 1, m%nc
+      r0 = m%row0(k) - 1
+      do s = 1, NLOC
+        c = m%loc(s, k)
+        if (c == 0) cycle
+        do i = 1, m%nrow(k)
+          x(c) = x(c) + a%jb(i, s, k) * y(r0 + i)
+        end do
+      end do
+    end do
+  end subroutine blocks_jtv
 
   !> Starting values of the extra coordinates (cam contact parameters) from the bodies in q.
   pure subroutine init_extras(m, q)

@@ -32,12 +32,14 @@
 module mbd_band
   use mbd_kinds, only: wp, zero, one
   use mbd_status, only: MBD_OK, MBD_BAD_INPUT, MBD_SINGULAR, MSG_LEN
+  use mbd_memory, only: REAL_BYTES, mem_fail, mem_check
   use mbd_lapack, only: dgbtrf, dgbtrs, dgbcon, dlacn2
   use mbd_linsolve, only: lapack_status
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   implicit none
   private
-  public :: band_t, band_plan, band_zero, band_norm1, band_factor, band_rcond, band_solve
+  public :: band_t, band_plan, band_move, band_zero, band_norm1, band_factor, band_rcond, &
+            band_solve
 
   !> A planned band matrix: the ordering, the band storage, the factors and all workspace.
   type :: band_t
@@ -67,6 +69,7 @@ contains
     integer, allocatable :: rptr(:), rcol(:), cptr(:), crow(:), aptr(:), adj(:), order(:)
     integer, allocatable :: prow(:), pcol(:)
     integer :: k, kl, ku, ldab, ierr
+    character(len=*), parameter :: HINT = 'use a smaller model'
     status = MBD_OK; msg = ''
     if (n < 1) then
       status = MBD_BAD_INPUT
@@ -89,8 +92,13 @@ contains
     end do
 
     ! structure by rows and by columns, repeats removed
-    call compress(n, rows, cols, rptr, rcol)
-    call compress(n, cols, rows, cptr, crow)
+    call compress(n, rows, cols, rptr, rcol, ierr)
+    if (ierr == 0) call compress(n, cols, rows, cptr, crow, ierr)
+    if (ierr /= 0) then
+      call mem_fail(16 * (real(n, wp) + size(rows)), 'the band plan (structure of J)', HINT, &
+                    status, msg)
+      return
+    end if
     do k = 1, n
       if (rptr(k + 1) == rptr(k)) then
         status = MBD_SINGULAR
@@ -107,31 +115,70 @@ contains
     end do
 
     ! columns: reverse Cuthill-McKee on the structure of J^T J
-    call column_graph(n, rptr, rcol, cptr, crow, aptr, adj)
-    allocate (order(n), pcol(n), prow(n))
-    call rcm(n, aptr, adj, order)
+    call column_graph(n, rptr, rcol, cptr, crow, aptr, adj, ierr)
+    if (ierr == 0) allocate (order(n), pcol(n), prow(n), stat=ierr)
+    if (ierr == 0) call rcm(n, aptr, adj, order, ierr)
+    if (ierr /= 0) then
+      call mem_fail(4 * (8 * real(n, wp) + size(rows)), 'the band ordering (graph of J^T J)', &
+                    HINT, status, msg)
+      return
+    end if
     do k = 1, n
       pcol(order(k)) = k
     end do
     ! rows: follow their columns
-    call order_rows(n, rptr, rcol, pcol, prow, kl, ku)
+    call order_rows(n, rptr, rcol, pcol, prow, kl, ku, ierr)
+    if (ierr /= 0) then
+      call mem_fail(4 * 8 * real(n, wp), 'the band ordering (rows)', HINT, status, msg)
+      return
+    end if
 
     ldab = 2 * kl + ku + 1
-    allocate (b%ab(ldab, n), stat=ierr)
+    ! storage (ldab, n) for the factors and 3 n + n + n reals, n + n integers of workspace
+    call mem_check(REAL_BYTES * (real(ldab, wp) + 5) * n, 'the band storage of J', &
+                   'the structure is not banded enough: use a smaller model', status, msg)
+    if (status /= MBD_OK) return
+    allocate (b%ab(ldab, n), b%ipiv(n), b%work(3 * n), b%iwork(n), b%rhs(n), stat=ierr)
     if (ierr /= 0) then
-      status = MBD_BAD_INPUT
-      write (msg, '(a,i0,a,i0,a,i0,a,i0,a)') 'band_plan: cannot allocate the band storage (', &
-        ldab, ' x ', n, '): the structure is not banded (kl = ', kl, ', ku = ', ku, ')'
+      write (msg, '(a,i0,a,i0,a,i0,a,i0,a)') 'the band storage of J (', ldab, ' x ', n, &
+        '; kl = ', kl, ', ku = ', ku, ')'
+      call mem_fail(REAL_BYTES * (real(ldab, wp) + 5) * n, trim(msg), &
+                    'the structure is not banded enough: use a smaller model', status, msg)
       return
     end if
     b%ab = zero
-    allocate (b%ipiv(n), b%work(3 * n), b%iwork(n), b%rhs(n))
     b%ipiv = 0
     b%n = n; b%kl = kl; b%ku = ku; b%ldab = ldab
-    b%perm_sign = perm_parity(prow) * perm_parity(pcol)
+    call perm_parity(prow, b%iwork, ierr)
+    call perm_parity(pcol, b%iwork, k)
+    b%perm_sign = ierr * k
     call move_alloc(prow, b%prow)
     call move_alloc(pcol, b%pcol)
   end subroutine band_plan
+
+  !> Move a plan (and its storage) from one band_t to another without copying: an intrinsic
+  !! assignment would allocate, and could not report a failure.
+  pure subroutine band_move(from, to)
+    type(band_t), intent(inout) :: from   !! plan; empty on return
+    type(band_t), intent(inout) :: to     !! receives it
+    to%n = from%n; to%kl = from%kl; to%ku = from%ku; to%ldab = from%ldab
+    to%perm_sign = from%perm_sign; to%factored = from%factored
+    if (allocated(to%prow)) deallocate (to%prow)
+    if (allocated(to%pcol)) deallocate (to%pcol)
+    if (allocated(to%ab)) deallocate (to%ab)
+    if (allocated(to%ipiv)) deallocate (to%ipiv)
+    if (allocated(to%work)) deallocate (to%work)
+    if (allocated(to%iwork)) deallocate (to%iwork)
+    if (allocated(to%rhs)) deallocate (to%rhs)
+    if (allocated(from%prow)) call move_alloc(from%prow, to%prow)
+    if (allocated(from%pcol)) call move_alloc(from%pcol, to%pcol)
+    if (allocated(from%ab)) call move_alloc(from%ab, to%ab)
+    if (allocated(from%ipiv)) call move_alloc(from%ipiv, to%ipiv)
+    if (allocated(from%work)) call move_alloc(from%work, to%work)
+    if (allocated(from%iwork)) call move_alloc(from%iwork, to%iwork)
+    if (allocated(from%rhs)) call move_alloc(from%rhs, to%rhs)
+    from%n = 0; from%factored = .false.
+  end subroutine band_move
 
   !> Clear the matrix before an assembly: rows kl+1..ldab of ab, the part dgbtrf reads
   !! (it clears its fill rows 1..kl itself).
@@ -159,13 +206,17 @@ contains
 
   !> LU factorization in place, B = P L U (dgbtrf). On success the factors stay in b for
   !! band_solve and band_rcond until the next band_zero.
-  subroutine band_factor(b, status, msg, detsign, pivratio)
+  !! With regularize, an exactly singular U (MBD_SINGULAR) is still kept as factors, its zero
+  !! pivots replaced by eps max |u_ii|: solves with it then give the inverse-iteration
+  !! direction of the null space (for a diagnosis, not for a solution).
+  subroutine band_factor(b, status, msg, detsign, pivratio, regularize)
     type(band_t), intent(inout) :: b             !! assembled band matrix; factors on return
     integer, intent(out) :: status               !! MBD_OK, MBD_SINGULAR, MBD_BAD_INPUT or
                                                  !! MBD_LAPACK
     character(len=MSG_LEN), intent(out) :: msg   !! explanation
     integer, intent(out), optional :: detsign    !! sign of det J (original order); 0 if singular
     real(wp), intent(out), optional :: pivratio  !! min |u_ii| / max |u_ii|; 0 if singular
+    logical, intent(in), optional :: regularize  !! keep singular factors (zero pivots lifted)
     integer :: info, k, sgn, d
     real(wp) :: u, umin, umax
     status = MBD_OK; msg = ''
@@ -187,6 +238,15 @@ contains
       status = MBD_SINGULAR
       write (msg, '(a,i0,a,i0,a)') 'Jacobian is singular: band pivot ', info, &
         ' (column ', findloc(b%pcol, info, dim=1), ') is zero'
+      if (.not. present(regularize)) return
+      if (.not. regularize) return
+      d = b%kl + b%ku + 1
+      umax = maxval(abs(b%ab(d, :)))
+      if (.not. umax > zero) umax = one
+      do k = 1, b%n
+        if (abs(b%ab(d, k)) < epsilon(one) * umax) b%ab(d, k) = epsilon(one) * umax
+      end do
+      b%factored = .true.
       return
     end if
     call lapack_status('dgbtrf', info, status, msg)
@@ -312,14 +372,16 @@ contains
 
   !> Compressed lists from (key, val) pairs: the distinct vals of key k are
   !! idx(ptr(k):ptr(k+1)-1), in first-seen order. Indices are in 1..n.
-  pure subroutine compress(n, key, val, ptr, idx)
+  pure subroutine compress(n, key, val, ptr, idx, ierr)
     integer, intent(in) :: n                       !! number of keys
     integer, intent(in) :: key(:), val(:)          !! pairs
     integer, allocatable, intent(out) :: ptr(:)    !! n + 1 pointers
     integer, allocatable, intent(out) :: idx(:)    !! values, repeats removed
+    integer, intent(out) :: ierr                   !! allocation status (0 ok)
     integer, allocatable :: next(:), mark(:)
     integer :: k, i, k0, w
-    allocate (ptr(n + 1), idx(size(key)), next(n), mark(n))
+    allocate (ptr(n + 1), idx(size(key)), next(n), mark(n), stat=ierr)
+    if (ierr /= 0) return
     ptr = 0
     do k = 1, size(key)
       ptr(key(k) + 1) = ptr(key(k) + 1) + 1
@@ -351,15 +413,17 @@ contains
   end subroutine compress
 
   !> Adjacency of the column graph (the structure of J^T J without its diagonal).
-  pure subroutine column_graph(n, rptr, rcol, cptr, crow, aptr, adj)
+  pure subroutine column_graph(n, rptr, rcol, cptr, crow, aptr, adj, ierr)
     integer, intent(in) :: n                      !! number of columns
     integer, intent(in) :: rptr(:), rcol(:)       !! columns of each row
     integer, intent(in) :: cptr(:), crow(:)       !! rows of each column
     integer, allocatable, intent(out) :: aptr(:)  !! n + 1 pointers
     integer, allocatable, intent(out) :: adj(:)   !! neighbours of each column
+    integer, intent(out) :: ierr                  !! allocation status (0 ok)
     integer, allocatable :: mark(:)
     integer :: c, k, m, d, pass, w
-    allocate (aptr(n + 1), mark(n), adj(0))
+    allocate (aptr(n + 1), mark(n), adj(0), stat=ierr)
+    if (ierr /= 0) return
     do pass = 1, 2
       mark = 0
       w = 1
@@ -380,20 +444,23 @@ contains
       aptr(n + 1) = w
       if (pass == 1) then
         deallocate (adj)
-        allocate (adj(w - 1))
+        allocate (adj(w - 1), stat=ierr)
+        if (ierr /= 0) return
       end if
     end do
   end subroutine column_graph
 
   !> Reverse Cuthill-McKee: order(k) is the node placed k-th.
-  pure subroutine rcm(n, aptr, adj, order)
+  pure subroutine rcm(n, aptr, adj, order, ierr)
     integer, intent(in) :: n                 !! number of nodes
     integer, intent(in) :: aptr(:), adj(:)   !! adjacency
     integer, intent(out) :: order(:)         !! the ordering (n)
+    integer, intent(out) :: ierr             !! allocation status (0 ok)
     integer, allocatable :: deg(:), lvl(:), queue(:)
     logical, allocatable :: done(:)
     integer :: s, root, last, head, first, k, w, v, i, j
-    allocate (deg(n), lvl(n), queue(n), done(n))
+    allocate (deg(n), lvl(n), queue(n), done(n), stat=ierr)
+    if (ierr /= 0) return
     deg = aptr(2:n + 1) - aptr(1:n)
     lvl = 0
     done = .false.
@@ -492,15 +559,18 @@ contains
 
   !> Row positions from the column positions: the best of three stable sorts by the first
   !! (lo) and last (hi) new column of each row, by kl + ku and then kl.
-  pure subroutine order_rows(n, rptr, rcol, pcol, prow, kl, ku)
+  pure subroutine order_rows(n, rptr, rcol, pcol, prow, kl, ku, ierr)
     integer, intent(in) :: n                  !! number of rows
     integer, intent(in) :: rptr(:), rcol(:)   !! columns of each row
     integer, intent(in) :: pcol(:)            !! column positions
     integer, intent(out) :: prow(:)           !! row positions
     integer, intent(out) :: kl, ku            !! resulting band widths
+    integer, intent(out) :: ierr              !! allocation status (0 ok)
     integer, allocatable :: lo(:), hi(:), mid(:), idx(:), tmp(:), cnt(:)
     integer :: r, k, cand, l, u
-    allocate (lo(n), hi(n), mid(n), idx(n), tmp(n), cnt(0:2 * n + 1))
+    kl = 0; ku = 0
+    allocate (lo(n), hi(n), mid(n), idx(n), tmp(n), cnt(0:2 * n + 1), stat=ierr)
+    if (ierr /= 0) return
     do r = 1, n
       lo(r) = n; hi(r) = 1
       do k = rptr(r), rptr(r + 1) - 1
@@ -563,23 +633,23 @@ contains
   end subroutine sort_stable
 
   !> Sign of a permutation: (-1)**(n - number of cycles).
-  pure integer function perm_parity(p) result(sgn)
-    integer, intent(in) :: p(:)   !! a permutation of 1..size(p)
-    logical, allocatable :: seen(:)
+  pure subroutine perm_parity(p, seen, sgn)
+    integer, intent(in) :: p(:)        !! a permutation of 1..size(p)
+    integer, intent(inout) :: seen(:)  !! workspace (size(p)): 1 for the elements visited
+    integer, intent(out) :: sgn        !! the sign
     integer :: i, j
-    allocate (seen(size(p)))
-    seen = .false.
+    seen(1:size(p)) = 0
     sgn = 1
     do i = 1, size(p)
-      if (seen(i)) cycle
+      if (seen(i) == 1) cycle
       j = p(i)
-      seen(i) = .true.
+      seen(i) = 1
       do while (j /= i)   ! each further element of the cycle is one transposition
-        seen(j) = .true.
+        seen(j) = 1
         sgn = -sgn
         j = p(j)
       end do
     end do
-  end function perm_parity
+  end subroutine perm_parity
 
 end module mbd_band

@@ -25,14 +25,14 @@
 !! direction of the pin force; translational: the sign of the normal force).
 module mbd_dynamics
   use mbd_kinds, only: wp, zero, one, half
-  use mbd_status, only: MBD_OK, MBD_SINGULAR, MBD_NO_CONVERGENCE, MBD_LAPACK, MSG_LEN, &
-                        MBD_NO_MEMORY
+  use mbd_status, only: MBD_OK, MBD_SINGULAR, MBD_NO_CONVERGENCE, MBD_LAPACK, MSG_LEN
+  use mbd_memory, only: REAL_BYTES, mem_check, mem_fail
   use mbd_points, only: NLOC, rot
   use mbd_model, only: model_t, model_slots
   use mbd_constraints, only: con_is_driver
   use mbd_forces, only: force_eval, FRC_SPRING, FRC_ROTSPRING, FRC_FRICTION, force_is_contact
-  use mbd_contact, only: NCS, NEO, MODE_UNTRACKED, joint_slip, joint_normal_load, joint_friction_force, &
-                         reg_mu, contact_damped
+  use mbd_contact, only: NCS, NEO, MODE_UNTRACKED, joint_slip, joint_normal_load, &
+                         joint_friction_force, reg_mu, contact_damped
   use mbd_points, only: kloc, kscal, local_state
   use mbd_constraints, only: CON_REVOLUTE
   use mbd_assemble, only: asm_work_t, asm_init, assemble_blocks, assemble_dense
@@ -41,7 +41,8 @@ module mbd_dynamics
   use mbd_lapack, only: dgelsy, dgecon
   implicit none
   private
-  public :: dyn_work_t, dyn_init, gen_forces, kinetic_energy, dyn_accel, dyn_velocity, &
+  public :: dyn_work_t, dyn_init, dyn_memory_check, gen_forces, kinetic_energy, dyn_accel, &
+            dyn_velocity, &
             dyn_project_pos, dyn_multipliers, dyn_reactions, dyn_tangent, dyn_solve, &
             dyn_jt_lam, dyn_damped, friction_forces, dyn_element_outputs, element_state, &
             element_slip
@@ -52,6 +53,9 @@ module mbd_dynamics
 
   !> 1/cond_1 of the augmented matrix below which it is solved by rank-revealing least squares
   real(wp), parameter :: AUG_RCOND = 1.0e-9_wp
+  !> what to change when the dense dynamics does not fit
+  character(len=*), parameter :: DYN_HINT = 'dynamics, statics and inverse dynamics solve ' // &
+    'with dense matrices of the size of J: use a model with fewer coordinates'
 
   !> Work arrays and the active (independent) constraint rows.
   type :: dyn_work_t
@@ -63,6 +67,11 @@ module mbd_dynamics
     type(asm_work_t) :: asm               !! assembly work arrays
     real(wp), allocatable :: aug(:, :), rhs(:), force(:), ja(:, :)
     integer, allocatable :: apiv(:)
+    !> workspace, so that no solve allocates: dgecon (cw 4 (nq + na), iw), the metric (nq),
+    !! the multipliers' J^T (jt), right-hand side (bls) and pivots (jpvt), and the copy of the
+    !! augmented matrix a rank-revealing solve works on (acopy, lswork for dgelsy, jp)
+    real(wp), allocatable :: cw(:), metric(:), jt(:, :), bls(:), acopy(:, :), lswork(:)
+    integer, allocatable :: iw(:), jpvt(:), jp(:)
     integer :: nsolve = 0                 !! augmented factorizations
     integer :: nrank = 0                  !! rank-revealing fallback solves
     logical :: lsq = .false.              !! the last factorization was nearly singular
@@ -80,30 +89,78 @@ module mbd_dynamics
 
 contains
 
+  !> Bytes of the dense dynamics of a model with nq coordinates and neq equations: J, its
+  !! transpose, [M J^T; J 0] and a copy, and the integrators' tangent and iteration matrices
+  !! (K, C: nq x nq; generalized-alpha: nq + neq square).
+  pure real(wp) function dyn_bytes(nq, neq) result(b)
+    integer, intent(in) :: nq, neq   !! coordinates, equations
+    real(wp) :: n, e
+    n = real(nq, wp); e = real(neq, wp)
+    b = REAL_BYTES * (2 * n * e + 3 * (n + e)**2 + 2 * n**2 + 12 * (n + e))
+  end function dyn_bytes
+
+  !> MBD_NO_MEMORY (and what to change) when the dense dynamics of m (dyn_bytes) cannot fit.
+  subroutine dyn_memory_check(m, status, msg)
+    type(model_t), intent(in) :: m                 !! model
+    integer, intent(out) :: status                 !! MBD_OK or MBD_NO_MEMORY
+    character(len=MSG_LEN), intent(inout) :: msg   !! explanation (on a failure)
+    character(len=MSG_LEN) :: what
+    write (what, '(a,i0,a,i0,a)') 'the dense dynamics (', m%neq, ' equations, ', m%nq, &
+      ' coordinates)'
+    call mem_check(dyn_bytes(m%nq, m%neq), trim(what), DYN_HINT, status, msg)
+  end subroutine dyn_memory_check
+
   !> Allocate, and choose the active rows by the rank of J at q (redundant rows out).
+  !! The whole dense footprint (dyn_bytes) is checked against the memory first.
   subroutine dyn_init(m, w, q, t, tol, status, msg)
     type(model_t), intent(in) :: m              !! model with dynamics data
     type(dyn_work_t), intent(out) :: w          !! work arrays
     real(wp), intent(in) :: q(:)                !! configuration
     real(wp), intent(in) :: t                   !! time
     real(wp), intent(in) :: tol                 !! absolute position tolerance
-    integer, intent(out) :: status              !! MBD_OK or MBD_LAPACK
+    integer, intent(out) :: status              !! MBD_OK, MBD_LAPACK or MBD_NO_MEMORY
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
     integer, allocatable :: red(:)
-    integer :: rank, r, na
+    integer :: rank, r, na, ierr, nt, info
+    real(wp) :: wq(1), rdum(1)
+    character(len=MSG_LEN) :: what
+    msg = ''
     w%n = m%nq; w%neq = m%neq; w%tol = tol
-    allocate (w%phi(m%neq), w%nu(m%neq), w%gam(m%neq), w%jac(m%neq, m%nq), &
-              w%qz(m%nq), w%force(m%nq), red(m%neq))
-    call asm_init(m, w%asm)
+    write (what, '(a,i0,a,i0,a)') 'the dense dynamics (', m%neq, ' equations, ', m%nq, &
+      ' coordinates)'
+    call dyn_memory_check(m, status, msg)
+    if (status /= MBD_OK) return
+    allocate (w%phi(m%neq), w%nu(m%neq), w%gam(m%neq), w%jac(m%neq, m%nq), stat=ierr)
+    if (ierr == 0) allocate (w%qz(m%nq), w%force(m%nq), red(m%neq), w%metric(m%nq), stat=ierr)
+    if (ierr == 0) allocate (w%jt(m%nq, m%neq), w%bls(max(m%nq, m%neq)), w%jpvt(m%neq), stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail(REAL_BYTES * 2 * real(m%neq, wp) * m%nq, trim(what), DYN_HINT, status, msg)
+      return
+    end if
+    call asm_init(m, w%asm, status, msg)
+    if (status /= MBD_OK) return
     w%qz = zero
     call assemble_dense(m, q, w%qz, t, w%phi, w%nu, w%gam, w%asm, w%jac)
     call row_rank(w%jac, rank, red, status, msg)
     if (status /= MBD_OK) return
     na = count(red == 0)
     w%na = na
-    w%rows = pack([(r, r=1, m%neq)], red == 0)
-    allocate (w%aug(m%nq + na, m%nq + na), w%rhs(m%nq + na), w%apiv(m%nq + na), &
-              w%ja(na, m%nq))
+    nt = m%nq + na
+    call dgelsy(nt, nt, 1, rdum, nt, rdum, nt, red, AUG_RCOND, rank, wq, -1, info)
+    allocate (w%rows(na), w%aug(nt, nt), w%rhs(nt), w%apiv(nt), w%ja(na, m%nq), stat=ierr)
+    if (ierr == 0) allocate (w%cw(4 * nt), w%iw(nt), w%jp(nt), w%acopy(nt, nt), stat=ierr)
+    if (ierr == 0) allocate (w%lswork(max(1, int(wq(1)))), stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail(REAL_BYTES * (real(nt, wp)**2 + real(na, wp) * m%nq), trim(what), DYN_HINT, &
+                    status, msg)
+      return
+    end if
+    na = 0
+    do r = 1, m%neq
+      if (red(r) /= 0) cycle
+      na = na + 1
+      w%rows(na) = r
+    end do
     call alloc_elements(m, w, status, msg)
     if (status /= MBD_OK) return
     w%s = one
@@ -123,7 +180,8 @@ contains
               w%avec(nr), w%cf(nr), w%dn(2, nr), w%fpiv(nr), w%fpos(2, nr), stat=ist)
     status = MBD_OK; msg = ''
     if (ist /= 0) then
-      status = MBD_NO_MEMORY; msg = 'not enough memory for the contact and friction arrays'
+      call mem_fail(REAL_BYTES * (real(nr, wp) * (2 * m%nq + w%na + nr + 8) + 4 * nf), &
+                    'the contact and friction arrays', DYN_HINT, status, msg)
       return
     end if
     w%cst = zero; w%fnl = zero; w%ffr = zero
@@ -302,18 +360,25 @@ contains
     real(wp), intent(in) :: metric(:)     ! diagonal of the upper-left block
     integer, intent(out) :: status
     character(len=MSG_LEN) :: msg
-    real(wp) :: anorm, rc, cw(4 * (m%nq + w%na)), pr
-    integer :: iw(m%nq + w%na), info, k, nt
+    real(wp) :: anorm, rc, pr, umin, umax
+    integer :: info, k, nt
     call build_aug(m, w, metric)
     nt = m%nq + w%na
-    anorm = maxval(sum(abs(w%aug), dim=1))
+    anorm = zero
+    do k = 1, nt
+      anorm = max(anorm, sum(abs(w%aug(:, k))))
+    end do
     call lu_factor(w%aug, w%apiv, status, msg)
     w%nsolve = w%nsolve + 1
     w%lsq = status /= MBD_OK
     if (.not. w%lsq) then
-      pr = minval([(abs(w%aug(k, k)), k=1, nt)]) / maxval([(abs(w%aug(k, k)), k=1, nt)])
+      umin = huge(one); umax = zero
+      do k = 1, nt
+        umin = min(umin, abs(w%aug(k, k))); umax = max(umax, abs(w%aug(k, k)))
+      end do
+      pr = umin / umax
       if (pr < 1.0e-6_wp) then
-        call dgecon('1', nt, w%aug, nt, anorm, rc, cw, iw, info)
+        call dgecon('1', nt, w%aug, nt, anorm, rc, w%cw, w%iw, info)
         w%lsq = rc < AUG_RCOND
       end if
     end if
@@ -328,15 +393,27 @@ contains
     type(model_t), intent(in) :: m
     type(dyn_work_t), intent(inout) :: w
     real(wp), intent(in) :: metric(:)
-    integer :: i, n
+    integer :: i, j, n
     n = m%nq
-    w%ja = w%jac(w%rows, :)
+    do j = 1, n          ! (loops: a vector subscript or transpose() would make temporaries)
+      do i = 1, w%na
+        w%ja(i, j) = w%jac(w%rows(i), j)
+      end do
+    end do
     w%aug = zero
     do i = 1, n
       w%aug(i, i) = metric(i)
     end do
-    w%aug(1:n, n + 1:) = w%s * transpose(w%ja)
-    w%aug(n + 1:, 1:n) = w%s * w%ja
+    do j = 1, w%na
+      do i = 1, n
+        w%aug(i, n + j) = w%s * w%ja(j, i)
+      end do
+    end do
+    do j = 1, n
+      do i = 1, w%na
+        w%aug(n + i, j) = w%s * w%ja(i, j)
+      end do
+    end do
   end subroutine build_aug
 
   !> Another right-hand side with the last augmented matrix (Baumgarte's modified gamma).
@@ -354,19 +431,16 @@ contains
     real(wp), intent(inout) :: rhs(:)
     integer, intent(out) :: status
     character(len=MSG_LEN) :: msg
-    real(wp) :: a(size(w%aug, 1), size(w%aug, 2)), wq(1)
-    real(wp), allocatable :: work(:)
-    integer :: jp(size(w%aug, 2)), rank, info, nt
+    integer :: rank, info, nt
     if (.not. w%lsq) then
       call lu_solve(w%aug, w%apiv, rhs, status, msg)
       return
     end if
     nt = size(rhs)
-    a = w%aug
-    jp = 0
-    call dgelsy(nt, nt, 1, a, nt, rhs, nt, jp, AUG_RCOND, rank, wq, -1, info)
-    allocate (work(max(1, int(wq(1)))))
-    call dgelsy(nt, nt, 1, a, nt, rhs, nt, jp, AUG_RCOND, rank, work, size(work), info)
+    w%acopy = w%aug
+    w%jp = 0
+    call dgelsy(nt, nt, 1, w%acopy, nt, rhs, nt, w%jp, AUG_RCOND, rank, w%lswork, &
+                size(w%lswork), info)
     call lapack_status('dgelsy', info, status, msg)
     w%nrank = w%nrank + 1
   end subroutine solve_aug
@@ -383,14 +457,14 @@ contains
     real(wp), intent(out) :: lam(:)          !! multipliers (neq)
     integer, intent(out) :: status           !! MBD_OK or MBD_SINGULAR
     real(wp) :: v
-    integer :: n
+    integer :: n, k
     n = m%nq
     call assemble_dense(m, q, qd, t, w%phi, w%nu, w%gam, w%asm, w%jac)
     call gen_forces(m, q, qd, t, w%force, v, cst=w%cst)
     call factor_aug(m, w, m%mdiag, status)
     if (status /= MBD_OK) return
     w%rhs(1:n) = w%force
-    w%rhs(n + 1:) = w%s * w%gam(w%rows)
+    call gather_rows(w, w%gam, w%s)
     call solve_aug(w, w%rhs, status)
     if (status /= MBD_OK) return
     if (m%nfric > 0) then
@@ -399,7 +473,9 @@ contains
     end if
     qdd = w%rhs(1:n)
     lam = zero
-    lam(w%rows) = w%s * w%rhs(n + 1:)
+    do k = 1, w%na                 ! (loops: vector subscripts make heap temporaries)
+      lam(w%rows(k)) = w%s * w%rhs(n + k)
+    end do
   end subroutine dyn_accel
 
   !> The joint friction forces with the factored augmented matrix (see the banner): on entry
@@ -521,6 +597,18 @@ contains
     end function grad_n
   end subroutine friction_solve
 
+  !> w%rhs(nq + k) = f x(rows(k)) over the active rows (a loop: a vector subscript would
+  !! make a heap temporary at every call).
+  pure subroutine gather_rows(w, x, f)
+    type(dyn_work_t), intent(inout) :: w
+    real(wp), intent(in) :: x(:)
+    real(wp), intent(in) :: f
+    integer :: k
+    do k = 1, w%na
+      w%rhs(w%n + k) = f * x(w%rows(k))
+    end do
+  end subroutine gather_rows
+
   !> Velocities consistent with J q_dot = nu, nearest to v0 in kinetic energy:
   !! [M J^T; J 0][q_dot; mu] = [M v0; nu]. Massless coordinates get the unit metric.
   subroutine dyn_velocity(m, w, q, t, v0, qd, status)
@@ -531,15 +619,14 @@ contains
     real(wp), intent(in) :: v0(:)            !! velocity estimate
     real(wp), intent(out) :: qd(:)           !! consistent velocities
     integer, intent(out) :: status           !! MBD_OK or MBD_SINGULAR
-    real(wp) :: metric(m%nq)
     integer :: n
     n = m%nq
-    metric = merge(m%mdiag, w%s, m%mdiag > zero)
+    w%metric = merge(m%mdiag, w%s, m%mdiag > zero)
     call assemble_dense(m, q, w%qz, t, w%phi, w%nu, w%gam, w%asm, w%jac)
-    call factor_aug(m, w, metric, status)
+    call factor_aug(m, w, w%metric, status)
     if (status /= MBD_OK) return
-    w%rhs(1:n) = metric * v0
-    w%rhs(n + 1:) = w%s * w%nu(w%rows)
+    w%rhs(1:n) = w%metric * v0
+    call gather_rows(w, w%nu, w%s)
     call solve_aug(w, w%rhs, status)
     qd = w%rhs(1:n)
   end subroutine dyn_velocity
@@ -552,18 +639,17 @@ contains
     real(wp), intent(inout) :: q(:)          !! configuration, projected
     real(wp), intent(in) :: t                !! time
     integer, intent(out) :: status           !! MBD_OK, MBD_NO_CONVERGENCE or MBD_SINGULAR
-    real(wp) :: metric(m%nq)
     integer :: it, n
     n = m%nq
-    metric = one
+    w%metric = one
     do it = 1, 20
       call assemble_dense(m, q, w%qz, t, w%phi, w%nu, w%gam, w%asm, w%jac)
       status = MBD_OK
       if (maxval(abs(w%phi)) <= w%tol) return
-      call factor_aug(m, w, metric, status)
+      call factor_aug(m, w, w%metric, status)
       if (status /= MBD_OK) return
       w%rhs(1:n) = zero
-      w%rhs(n + 1:) = -w%s * w%phi(w%rows)
+      call gather_rows(w, w%phi, -w%s)
       call solve_aug(w, w%rhs, status)
       q = q + w%rhs(1:n)
     end do
@@ -583,14 +669,14 @@ contains
     real(wp), intent(in) :: q(:), qd(:), qdd(:)  !! state and accelerations
     real(wp), intent(in) :: t                 !! time
     real(wp), intent(out) :: lam(:)           !! multipliers (neq)
-    integer, intent(out) :: status            !! MBD_OK or MBD_LAPACK
+    integer, intent(out) :: status            !! MBD_OK, MBD_LAPACK or MBD_NO_MEMORY
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
-    real(wp) :: jt(m%nq, m%neq), b(max(m%nq, m%neq)), v, rhs0(m%nq)
+    real(wp) :: v, rhs0(m%nq), dn(2, max(1, m%nfric)), dnew(2), c, fn
     type(kloc) :: x
     type(kscal) :: u
-    real(wp) :: dn(2, max(1, m%nfric)), dnew(2), c, fn
     integer :: it, bb, k, jc, s, mode
     logical :: settled
+    msg = ''
     call assemble_dense(m, q, qd, t, w%phi, w%nu, w%gam, w%asm, w%jac)
     call gen_forces(m, q, qd, t, w%force, v, cst=w%cst)
     rhs0 = w%force - m%mdiag * qdd
@@ -604,7 +690,7 @@ contains
         if (m%floc(s, k) > 0) rhs0(m%floc(s, k)) = rhs0(m%floc(s, k)) + w%ffr(k) * u%d(s)
       end do
     end do
-    jt = transpose(w%jac)
+    w%jt = transpose(w%jac)
     call solve_ls(lam, status)
     if (status /= MBD_OK .or. m%nfric == 0) return
     dn = zero
@@ -612,7 +698,7 @@ contains
       dn(:, bb) = grad_dir(bb, lam)
     end do
     do it = 1, FRIC_MAXIT
-      jt = transpose(w%jac)
+      w%jt = transpose(w%jac)
       do bb = 1, m%nfric
         k = w%fidx(bb); jc = m%fref(k)
         mode = nint(w%cst(1, k))
@@ -626,9 +712,10 @@ contains
         end if
         do s = 1, NLOC
           if (m%floc(s, k) == 0) cycle
-          jt(m%floc(s, k), m%row0(jc)) = jt(m%floc(s, k), m%row0(jc)) - c * u%d(s) * dn(1, bb)
-          jt(m%floc(s, k), m%row0(jc) + 1) = jt(m%floc(s, k), m%row0(jc) + 1) - &
-                                              c * u%d(s) * dn(2, bb)
+          w%jt(m%floc(s, k), m%row0(jc)) = w%jt(m%floc(s, k), m%row0(jc)) - &
+                                           c * u%d(s) * dn(1, bb)
+          w%jt(m%floc(s, k), m%row0(jc) + 1) = w%jt(m%floc(s, k), m%row0(jc) + 1) - &
+                                               c * u%d(s) * dn(2, bb)
         end do
         w%ffr(k) = c
       end do
@@ -649,38 +736,46 @@ contains
       if (nint(w%cst(1, k)) /= MODE_STUCK) w%ffr(k) = w%ffr(k) * fn
     end do
   contains
-    !> lambda from jt (destroyed) and rhs0.
+    !> lambda from w%jt (destroyed) and rhs0.
     subroutine solve_ls(l, st)
       real(wp), intent(out) :: l(:)
       integer, intent(out) :: st
-      real(wp) :: jt2(m%nq, m%neq), wq(1)
+      real(wp) :: wq(1)
       real(wp), allocatable :: work(:)
-      integer :: jpvt(m%neq), rank, info, lwork
+      integer :: rank, info, lwork, ierr
       logical :: full
       st = MBD_OK
-      b = zero
-      b(1:m%nq) = rhs0
+      w%bls = zero
+      w%bls(1:m%nq) = rhs0
       if (w%na == m%neq .and. m%neq <= m%nq) then
-        ! independent rows: the unique solution, by a plain Householder QR (no allocation)
-        jt2 = jt
-        call ls_small(jt2, b, full)
+        ! independent rows: the unique solution, by a plain Householder QR (no allocation);
+        ! ls_small spoils w%jt, which is rebuilt by the caller for the next solve
+        w%acopy(1:m%nq, 1:m%neq) = w%jt
+        call ls_small(w%jt, w%bls, full)
         if (full) then
-          l = b(1:m%neq); return
+          l = w%bls(1:m%neq); return
         end if
-        b = zero
-        b(1:m%nq) = rhs0
+        w%jt = w%acopy(1:m%nq, 1:m%neq)
+        w%bls = zero
+        w%bls(1:m%nq) = rhs0
       end if
-      jt2 = jt
-      jpvt = 0
-      call dgelsy(m%nq, m%neq, 1, jt2, m%nq, b, size(b), jpvt, 1.0e-10_wp, rank, wq, -1, info)
+      w%jpvt = 0
+      call dgelsy(m%nq, m%neq, 1, w%jt, m%nq, w%bls, size(w%bls), w%jpvt, 1.0e-10_wp, rank, &
+                  wq, -1, info)
       lwork = max(1, int(wq(1)))
-      allocate (work(lwork))
-      call dgelsy(m%nq, m%neq, 1, jt2, m%nq, b, size(b), jpvt, 1.0e-10_wp, rank, work, lwork, &
-                  info)
+      allocate (work(lwork), stat=ierr)
+      if (ierr /= 0) then
+        l = zero
+        call mem_fail(REAL_BYTES * lwork, 'the least-squares multipliers', &
+                      'use a smaller model', st, msg)
+        return
+      end if
+      call dgelsy(m%nq, m%neq, 1, w%jt, m%nq, w%bls, size(w%bls), w%jpvt, 1.0e-10_wp, rank, &
+                  work, lwork, info)
       call lapack_status('dgelsy', info, st, msg)
-      l = b(1:m%neq)
+      l = w%bls(1:m%neq)
     end subroutine solve_ls
-    !> grad N of friction element bb at multipliers l.
+    !> grad N of friction element bx at multipliers l.
     function grad_dir(bx, l) result(g)
       integer, intent(in) :: bx
       real(wp), intent(in) :: l(:)

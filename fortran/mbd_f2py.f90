@@ -124,7 +124,7 @@ subroutine core_inverse(nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp, fpar
   !f2py intent(hide) :: nc, np, nf, nfp, nq
   call api_inverse(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, t0, t1, nsteps, tol, every, &
                    solver, qout, qdout, qddout, lamout, eout, iinfo, rinfo, qsing, dep, &
-                   redundant, tpass, status, msg, eo, evo, nev)
+                   redundant, tpass, status, msg, eo=eo, evo=evo, nev=nev)
 end subroutine core_inverse
 
 ! every >= 1: only the outputs k = 0, every, 2 every, ... and k = nsteps are stored; nrow is
@@ -190,6 +190,134 @@ subroutine core_reactions(nb, nc, ctab, np, rpar, nq, neq, nt, q, t, lam, reac, 
   !f2py intent(hide) :: nc, np, nq, neq, nt
   call api_reactions(nb, ctab, rpar, q, t, lam, reac, rloc, status, msg)
 end subroutine core_reactions
+
+! ------------------------------------------------------------------ design sensitivities
+! A design parameter is a column (table, index) of ptab: table 1 rpar, 2 bmass (flattened
+! (2, nb)), 3 grav, 4 fpar (mbd_sensitivity).
+
+subroutine core_eval_d(nb, nc, ctab, np, rpar, nq, neq, q, qd, t, dq, dqd, npar, ptab, tphi, &
+                       tjac, tnu, tgam, status, msg, bad)
+  use iso_c_binding, only: c_double, c_int
+  use mbd_api, only: api_eval_d
+  implicit none
+  integer(c_int), intent(in) :: nb, nc, np, nq, neq, npar
+  integer(c_int), intent(in) :: ctab(8, nc), ptab(2, npar)
+  real(c_double), intent(in) :: rpar(np), q(nq), qd(nq), t, dq(nq), dqd(nq)
+  real(c_double), intent(out) :: tphi(neq), tjac(neq, nq), tnu(neq), tgam(neq)
+  integer(c_int), intent(out) :: status, bad
+  character(len=512), intent(out) :: msg
+  !f2py intent(hide) :: nc, np, nq, npar
+  call api_eval_d(nb, ctab, rpar, q, qd, t, dq, dqd, ptab, tphi, tjac, tnu, tgam, status, msg, &
+                  bad)
+end subroutine core_eval_d
+
+subroutine core_kinematics_sens(nb, nc, ctab, np, rpar, nq, neq, q0, t0, t1, nsteps, tol, &
+                                maxit, tmin, every, solver, nout, npar, ptab, qout, qdout, &
+                                qddout, sq, sqd, sqdd, iinfo, rinfo, qsing, dep, redundant, &
+                                tpass, status, msg)
+  use iso_c_binding, only: c_double, c_int
+  use mbd_api, only: api_kinematics
+  implicit none
+  integer(c_int), intent(in) :: nb, nc, np, nq, neq, nsteps, maxit, every, solver, nout, npar
+  integer(c_int), intent(in) :: ctab(8, nc), ptab(2, npar)
+  real(c_double), intent(in) :: rpar(np), q0(nq), t0, t1, tol, tmin
+  real(c_double), intent(out) :: qout(nq, nout), qdout(nq, nout), qddout(nq, nout)
+  real(c_double), intent(out) :: sq(nq, npar, nout), sqd(nq, npar, nout), sqdd(nq, npar, nout)
+  integer(c_int), intent(out) :: iinfo(10)
+  real(c_double), intent(out) :: rinfo(10)
+  real(c_double), intent(out) :: qsing(nq)
+  integer(c_int), intent(out) :: dep(neq), redundant(neq)
+  real(c_double), intent(out) :: tpass(64)
+  integer(c_int), intent(out) :: status
+  character(len=512), intent(out) :: msg
+  !f2py intent(hide) :: nc, np, nq, npar
+  !f2py threadsafe
+  call api_kinematics(nb, ctab, rpar, q0, t0, t1, nsteps, tol, maxit, tmin, every, solver, &
+                      qout, qdout, qddout, iinfo, rinfo, qsing, dep, redundant, tpass, &
+                      status, msg, ptab, sq, sqd, sqdd)
+end subroutine core_kinematics_sens
+
+subroutine core_inverse_sens(nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp, fpar, nq, neq, &
+                             q0, t0, t1, nsteps, tol, every, solver, nout, npar, ptab, qout, &
+                             qdout, qddout, lamout, eout, sq, sqd, sqdd, slam, iinfo, rinfo, &
+                             qsing, dep, redundant, tpass, status, msg)
+  use iso_c_binding, only: c_double, c_int
+  use mbd_api, only: api_inverse
+  implicit none
+  integer(c_int), intent(in) :: nb, nc, np, nf, nfp, nq, neq, nsteps, every, solver, nout, npar
+  integer(c_int), intent(in) :: ctab(8, nc), ftab(6, nf), ptab(2, npar)
+  real(c_double), intent(in) :: rpar(np), bmass(2, nb), grav(2), fpar(nfp), q0(nq), t0, t1, tol
+  real(c_double), intent(out) :: qout(nq, nout), qdout(nq, nout)
+  real(c_double), intent(out) :: qddout(nq, nout), lamout(neq, nout)
+  real(c_double), intent(out) :: eout(4, nout)
+  real(c_double), intent(out) :: sq(nq, npar, nout), sqd(nq, npar, nout), sqdd(nq, npar, nout)
+  real(c_double), intent(out) :: slam(neq, npar, nout)
+  integer(c_int), intent(out) :: iinfo(10), dep(neq), redundant(neq), status
+  real(c_double), intent(out) :: rinfo(10), qsing(nq), tpass(64)
+  character(len=512), intent(out) :: msg
+  !f2py intent(hide) :: nc, np, nf, nfp, nq, npar
+  call api_inverse(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, t0, t1, nsteps, tol, every, &
+                   solver, qout, qdout, qddout, lamout, eout, iinfo, rinfo, qsing, dep, &
+                   redundant, tpass, status, msg, ptab, sq, sqd, sqdd, slam)
+end subroutine core_inverse_sens
+
+subroutine core_statics_sens(nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp, fpar, nq, neq, &
+                             q0, t, npar, ptab, q, lam, sq, slam, stable, resid, iinfo, status, &
+                             msg)
+  use iso_c_binding, only: c_double, c_int
+  use mbd_api, only: api_statics
+  implicit none
+  integer(c_int), intent(in) :: nb, nc, np, nf, nfp, nq, neq, npar
+  integer(c_int), intent(in) :: ctab(8, nc), ftab(6, nf), ptab(2, npar)
+  real(c_double), intent(in) :: rpar(np), bmass(2, nb), grav(2), fpar(nfp), q0(nq), t
+  real(c_double), intent(out) :: q(nq), lam(neq), sq(nq, npar), slam(neq, npar), resid
+  integer(c_int), intent(out) :: stable, iinfo(10), status
+  character(len=512), intent(out) :: msg
+  !f2py intent(hide) :: nc, np, nf, nfp, nq, npar
+  call api_statics(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, t, q, lam, stable, resid, &
+                   iinfo, status, msg, ptab, sq, slam)
+end subroutine core_statics_sens
+
+subroutine core_reactions_dp(nb, nc, ctab, np, rpar, nq, neq, nt, npar, ptab, q, t, lam, sq, &
+                             slam, dreac, drloc, status, msg)
+  use iso_c_binding, only: c_double, c_int
+  use mbd_api, only: api_reactions_dp
+  implicit none
+  integer(c_int), intent(in) :: nb, nc, np, nq, neq, nt, npar
+  integer(c_int), intent(in) :: ctab(8, nc), ptab(2, npar)
+  real(c_double), intent(in) :: rpar(np), q(nq, nt), t(nt), lam(neq, nt)
+  real(c_double), intent(in) :: sq(nq, npar, nt), slam(neq, npar, nt)
+  real(c_double), intent(out) :: dreac(6, nc, npar, nt), drloc(6, nc, npar, nt)
+  integer(c_int), intent(out) :: status
+  character(len=512), intent(out) :: msg
+  !f2py intent(hide) :: nc, np, nq, neq, nt, npar
+  call api_reactions_dp(nb, ctab, rpar, ptab, q, t, lam, sq, slam, dreac, drloc, status, msg)
+end subroutine core_reactions_dp
+
+subroutine core_dynamics_sens(nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp, fpar, nq, neq, &
+                              q0, v0, t0, t1, nsteps, rtol, atol, every, max_steps, nrow, npar, &
+                              ptab, qout, qdout, qddout, lamout, eout, sq, sqd, sqdd, iinfo, &
+                              rinfo, redundant, status, msg)
+  use iso_c_binding, only: c_double, c_int
+  use mbd_api, only: api_dynamics_sens
+  implicit none
+  integer(c_int), intent(in) :: nb, nc, np, nf, nfp, nq, neq, nsteps, every, max_steps, nrow
+  integer(c_int), intent(in) :: npar
+  integer(c_int), intent(in) :: ctab(8, nc), ftab(6, nf), ptab(2, npar)
+  real(c_double), intent(in) :: rpar(np), bmass(2, nb), grav(2), fpar(nfp), q0(nq), v0(nq)
+  real(c_double), intent(in) :: t0, t1, rtol, atol
+  real(c_double), intent(out) :: qout(nq, nrow), qdout(nq, nrow)
+  real(c_double), intent(out) :: qddout(nq, nrow), lamout(neq, nrow)
+  real(c_double), intent(out) :: eout(4, nrow)
+  real(c_double), intent(out) :: sq(nq, npar, nrow), sqd(nq, npar, nrow), sqdd(nq, npar, nrow)
+  integer(c_int), intent(out) :: iinfo(10), redundant(neq), status
+  real(c_double), intent(out) :: rinfo(10)
+  character(len=512), intent(out) :: msg
+  !f2py intent(hide) :: nc, np, nf, nfp, nq, npar
+  call api_dynamics_sens(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, v0, t0, t1, nsteps, rtol, &
+                         atol, every, max_steps, ptab, qout, qdout, qddout, lamout, eout, sq, &
+                         sqd, sqdd, iinfo, rinfo, redundant, status, msg)
+end subroutine core_dynamics_sens
 
 ! Normal force of each cam joint on its follower at states q (nq, nt), times t and
 ! multipliers lam: fn(nc, nt), negative where the joint must pull the follower onto its profile.

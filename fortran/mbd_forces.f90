@@ -24,7 +24,10 @@ module mbd_forces
   use mbd_status, only: MBD_OK, MBD_BAD_PARAM, MSG_LEN
   use mbd_points, only: NLOC, kloc, local_state, kvec, kscal, body_point, body_angle, vsub, &
                         vdot, ssqrt, ssub
-  use mbd_functions, only: fun_eval, fun_length, fun_check, fun_exponents
+  use mbd_functions, only: fun_eval, fun_length, fun_check, fun_exponents, fun_eval_d, &
+                           fun_is_count
+  use mbd_dual, only: dloc, dvec, dscal, dual_state, body_point, body_angle, vsub, vdot, ssqrt, &
+                      ssub
   use mbd_contact, only: NCS, NEO, contact_raw_length, contact_prepare, contact_exponents, &
                          contact_eval, friction_raw_length, friction_exponents
   implicit none
@@ -32,7 +35,7 @@ module mbd_forces
   public :: FRC_SPRING, FRC_TORQUE, FRC_POINT, FRC_ROTSPRING, FRC_CONTACT0, FRC_CONTACT1
   public :: FRC_FRICTION
   public :: force_known, force_raw_length, force_prepare, force_eval, force_exponents
-  public :: force_is_contact
+  public :: force_is_contact, force_is_count, force_eval_d
 
   integer, parameter :: FRC_SPRING = 1, FRC_TORQUE = 2, FRC_POINT = 3, FRC_ROTSPRING = 4
   !> contacts: kind FRC_CONTACT0 + geometry - 1 (mbd_contact GEO_*), up to FRC_CONTACT1
@@ -223,5 +226,81 @@ contains
       end if
     end select
   end subroutine force_eval
+
+  !> True when raw entry j of a force is a count of one of its functions.
+  pure logical function force_is_count(kind, raw, j)
+    integer, intent(in) :: kind      !! force kind
+    real(wp), intent(in) :: raw(:)   !! raw parameters
+    integer, intent(in) :: j         !! raw entry
+    integer :: nf
+    force_is_count = .false.
+    select case (kind)
+    case (FRC_SPRING)
+      if (j >= 8) force_is_count = fun_is_count(raw(8:), j - 7)
+    case (FRC_TORQUE)
+      force_is_count = fun_is_count(raw, j)
+    case (FRC_POINT)
+      nf = fun_length(raw(3:))
+      if (j >= 3 .and. j < 3 + nf) force_is_count = fun_is_count(raw(3:), j - 2)
+      if (j >= 3 + nf) force_is_count = fun_is_count(raw(3 + nf:), j - 2 - nf)
+    case (FRC_ROTSPRING)
+      if (j >= 4) force_is_count = fun_is_count(raw(4:), j - 3)
+    end select
+  end function force_is_count
+
+  !> Change of the generalized force of one element along a direction (dq, dq_dot of the
+  !! local slots) and a change tp of its parameters (prepared = raw), by the product rule
+  !! on dual points (mbd_dual):
+  !!   spring      Q = -T L_q,  dT = dk (L - L0) + k (dL - dL0) + dc L_dot + c dL_dot - df
+  !!   torque      dQ_theta = df         point  dQ = dF J_P^T + F dJ_P^T
+  !!   rotational  Q = tau a_q, dtau = -dk (a - a0) - k (da - da0) - dc a_dot - c da_dot + df
+  pure subroutine force_eval_d(kind, p, tp, si, sj, ql, qdl, tq, tqd, t, tforce)
+    integer, intent(in) :: kind             !! force kind
+    real(wp), intent(in) :: p(:), tp(:)     !! prepared parameters and their change
+    integer, intent(in) :: si, sj           !! slot ids of the bodies (0 = ground)
+    real(wp), intent(in) :: ql(NLOC), qdl(NLOC)  !! local coordinates and velocities
+    real(wp), intent(in) :: tq(NLOC), tqd(NLOC)  !! direction
+    real(wp), intent(in) :: t               !! time
+    real(wp), intent(out) :: tforce(NLOC)   !! change of the generalized force
+    type(dloc) :: x
+    type(dvec) :: d, pt
+    type(dscal) :: l, a
+    real(wp) :: f, f1, f2, tf, tf1, tf2, fy, tfy, tension, ttension, tau, ttau
+    integer :: nf
+    tforce = zero
+    x = dual_state(local_state(ql, qdl), tq, tqd)
+    select case (kind)
+    case (FRC_SPRING)
+      d = vsub(body_point(x, sj, p(3:4), tp(3:4)), body_point(x, si, p(1:2), tp(1:2)))
+      call fun_eval(p(8:), t, f, f1, f2)
+      call fun_eval_d(p(8:), tp(8:), t, tf, tf1, tf2)
+      if (dot_product(d%a%v, d%a%v) > zero) then
+        l = ssqrt(vdot(d, d))
+        tension = p(5) * (l%a%v - p(7)) + p(6) * l%a%vd - f
+        ttension = tp(5) * (l%a%v - p(7)) + p(5) * (l%t%v - tp(7)) + tp(6) * l%a%vd + &
+                   p(6) * l%t%vd - tf
+        tforce = -ttension * l%a%d - tension * l%t%d
+      end if
+    case (FRC_TORQUE)
+      call fun_eval_d(p, tp, t, tf, tf1, tf2)
+      if (si > 0) tforce(3) = tf
+    case (FRC_POINT)
+      pt = body_point(x, si, p(1:2), tp(1:2))
+      nf = fun_length(p(3:))
+      call fun_eval(p(3:), t, f, f1, f2)
+      call fun_eval(p(3 + nf:), t, fy, f1, f2)
+      call fun_eval_d(p(3:), tp(3:), t, tf, tf1, tf2)
+      call fun_eval_d(p(3 + nf:), tp(3 + nf:), t, tfy, tf1, tf2)
+      tforce = tf * pt%a%d(1, :) + f * pt%t%d(1, :) + tfy * pt%a%d(2, :) + fy * pt%t%d(2, :)
+    case (FRC_ROTSPRING)
+      a = ssub(body_angle(x, sj), body_angle(x, si))
+      call fun_eval(p(4:), t, f, f1, f2)
+      call fun_eval_d(p(4:), tp(4:), t, tf, tf1, tf2)
+      tau = -p(1) * (a%a%v - p(3)) - p(2) * a%a%vd + f
+      ttau = -tp(1) * (a%a%v - p(3)) - p(1) * (a%t%v - tp(3)) - tp(2) * a%a%vd - &
+             p(2) * a%t%vd + tf
+      tforce = ttau * a%a%d + tau * a%t%d
+    end select
+  end subroutine force_eval_d
 
 end module mbd_forces

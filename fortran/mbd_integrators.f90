@@ -30,7 +30,8 @@
 module mbd_integrators
   use mbd_kinds, only: wp, zero, one, half, two
   use mbd_status, only: MBD_OK, MBD_BAD_SETTING, MBD_SINGULAR, MBD_NO_CONVERGENCE, &
-                        MBD_INTEGRATOR_FAILED, MBD_LAPACK, MSG_LEN, MBD_NO_MEMORY
+                        MBD_INTEGRATOR_FAILED, MBD_LAPACK, MBD_NO_MEMORY, MSG_LEN
+  use mbd_memory, only: REAL_BYTES, mem_fail
   use mbd_model, only: model_t
   use mbd_forces, only: FRC_FRICTION
   use mbd_assemble, only: assemble_dense, assemble_blocks, scatter_dense
@@ -47,6 +48,9 @@ module mbd_integrators
   private
   public :: dyn_opts_t, dyn_stats_t, METH_GENALPHA, METH_DOPRI5, METH_RK4, METH_PARTITIONED
   public :: integrate, output_rows, output_index, MAX_STEPS_DEFAULT
+  ! the Dormand-Prince 5(4) tableau, also used by the sensitivity integrator (mbd_sens_dynamics)
+  public :: C2, C3, C4, C5, A21, A31, A32, A41, A42, A43, A51, A52, A53, A54, A61, A62, A63, &
+            A64, A65, A71, A73, A74, A75, A76, E1, E3, E4, E5, E6, E7
 
   integer, parameter :: METH_GENALPHA = 1, METH_DOPRI5 = 2, METH_RK4 = 3, METH_PARTITIONED = 4
   !> Default step limit: it ends a run whose steps collapse without underflowing, after
@@ -139,7 +143,6 @@ contains
     type(ev_log_t), intent(inout), optional :: log  !! event log (capacity set by the caller)
     real(wp), intent(out), optional :: eo(:, :, :)  !! element outputs (NEO, nf, rows)
     type(itg_t) :: c
-    integer :: ist
     status = MBD_OK; msg = ''; nout = 0
     qo = zero; vo = zero; ao = zero; lo = zero
     if (present(eo)) eo = zero
@@ -160,9 +163,12 @@ contains
     end if
     c%opts = opts; c%t0 = t0; c%t1 = t1; c%nsteps = nsteps; c%every = every
     allocate (c%qf(m%nq), c%vf(m%nq), c%af(m%nq), c%lam(m%neq), c%cso(size(w%cst, 1), &
-              m%nf, merge(size(qo, 2), 0, m%ncontact + m%nfric > 0)), stat=ist)
-    if (ist /= 0) then
-      status = MBD_NO_MEMORY; msg = 'not enough memory for the integrator''s arrays'; return
+              m%nf, merge(size(qo, 2), 0, m%ncontact + m%nfric > 0)), stat=status)
+    if (status /= 0) then
+      call mem_fail(REAL_BYTES * (3 * real(m%nq, wp) + m%neq + 2 * real(m%nf, wp) * &
+                    merge(size(qo, 2), 0, m%ncontact + m%nfric > 0)), 'the integrator state', &
+                    'use a smaller model', status, msg)
+      return
     end if
     if (present(log)) c%log = log
     c%events = events_active(m)
@@ -632,7 +638,9 @@ contains
     if (partitioned) then
       call partition(m, w, c, c%t0, stt)
       if (stt /= MBD_OK) then
-        status = stt; msg = 'partitioned: cannot choose independent coordinates'; return
+        status = stt; msg = 'partitioned: cannot choose independent coordinates'
+        if (stt == MBD_NO_MEMORY) msg = 'not enough memory for the partition (QR of J)'
+        return
       end if
     end if
     fixed = c%opts%method == METH_RK4
@@ -647,7 +655,12 @@ contains
     else
       h = initial_step(c)
     end if
-    call pack_state(c, y, ynew, k, e)
+    call pack_state(c, y, ynew, k, e, stt)
+    if (stt /= 0) then
+      call mem_fail(REAL_BYTES * 10 * size(c%qf), 'the integrator stages', &
+                    'use a smaller model', status, msg)
+      return
+    end if
     fsal = .false.
     qa = c%qf; va = c%vf; aa = c%af          ! the state at the start of the step
     c%qs = qa; c%vs = va; c%as = aa; c%ts = t
@@ -777,7 +790,12 @@ contains
             write (msg, '(a,es12.5)') 'partitioned: no well-conditioned partition at t = ', t
             return
           end if
-          call pack_state(c, y, ynew, k, e)
+          call pack_state(c, y, ynew, k, e, stt)
+          if (stt /= 0) then
+            call mem_fail(REAL_BYTES * 10 * size(c%qf), 'the integrator stages', &
+                          'use a smaller model', status, msg)
+            return
+          end if
           fsal = .false.
         end if
       end if
@@ -785,18 +803,22 @@ contains
   end subroutine run_explicit
 
   !> The integrated state y from the full state: (q, q_dot), or (v, v_dot) when partitioned.
-  subroutine pack_state(c, y, ynew, k, e)
+  subroutine pack_state(c, y, ynew, k, e, ierr)
     type(itg_t), intent(in) :: c
     real(wp), allocatable, intent(inout) :: y(:), ynew(:), k(:, :), e(:)
-    integer :: ny
+    integer, intent(out) :: ierr          ! allocation status (0 ok)
+    integer :: ny, nh
+    nh = size(c%qf)
+    if (c%ni > 0) nh = c%ni
+    ny = 2 * nh
+    if (allocated(y)) deallocate (y, ynew, k, e)
+    allocate (y(ny), ynew(ny), k(ny, 7), e(ny), stat=ierr)
+    if (ierr /= 0) return
     if (c%ni > 0) then
-      y = [c%qf(c%iv), c%vf(c%iv)]
+      y(1:nh) = c%qf(c%iv); y(nh + 1:) = c%vf(c%iv)
     else
-      y = [c%qf, c%vf]
+      y(1:nh) = c%qf; y(nh + 1:) = c%vf
     end if
-    ny = size(y)
-    if (allocated(ynew)) deallocate (ynew, k, e)
-    allocate (ynew(ny), k(ny, 7), e(ny))
   end subroutine pack_state
 
   !> After an accepted step: the full consistent state at tn in c (dopri5: projected).
@@ -977,7 +999,10 @@ contains
     a = w%jac(w%rows, :)
     jp = 0
     call dgeqp3(w%na, m%nq, a, w%na, jp, tau, wq, -1, info)
-    allocate (work(max(1, int(wq(1)))))
+    allocate (work(max(1, int(wq(1)))), stat=stf)
+    if (stf /= 0) then
+      stf = MBD_NO_MEMORY; return
+    end if
     call dgeqp3(w%na, m%nq, a, w%na, jp, tau, work, size(work), info)
     call lapack_status('dgeqp3', info, stf, lmsg)
     if (stf /= MBD_OK) return

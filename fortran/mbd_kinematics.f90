@@ -28,18 +28,20 @@ module mbd_kinematics
   use mbd_kinds, only: wp, zero, one, half
   use mbd_status, only: MBD_OK, MBD_BAD_SETTING, MBD_BAD_COUNT, MBD_SINGULAR, &
                         MBD_NO_CONVERGENCE, MBD_SINGULAR_CONFIG, MBD_ASSEMBLY_FAILED, &
-                        MBD_LAPACK, MBD_INCONSISTENT, MSG_LEN
+                        MBD_LAPACK, MBD_INCONSISTENT, MBD_NO_MEMORY, MSG_LEN
+  use mbd_memory, only: REAL_BYTES, mem_check, mem_fail
   use mbd_points, only: NLOC, MAXROW
   use mbd_model, only: model_t
   use mbd_constraints, only: con_is_driver, con_name
   use mbd_assemble, only: asm_work_t, asm_init, assemble_blocks, assemble_dense, scatter_dense, &
-                          init_extras
-  use mbd_band, only: band_t, band_plan, band_zero, band_norm1, band_factor, &
+                          init_extras, blocks_jv, blocks_jtv
+  use mbd_band, only: band_t, band_plan, band_move, band_zero, band_norm1, band_factor, &
                       band_rcond, band_solve
   use mbd_linsolve, only: lu_factor, lu_solve, lu_det_sign, svd_null, row_rank, qr_factor, &
-                          qr_solve, qr_lwork
+                          qr_solve, qr_lwork, lu_solve_rows
   use mbd_lapack, only: dgels, dgecon, dtrcon
   use mbd_interp, only: hermite5
+  use mbd_sensitivity, only: sens_t, sens_hessian, sens_params, sens_kin_rhs
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   implicit none
   private
@@ -64,7 +66,14 @@ module mbd_kinematics
   !! n / BAND_RATIO wide
   integer, parameter :: BAND_MIN_N = 60, BAND_RATIO = 4
   integer, parameter :: BAND_ASSEMBLY_MAXIT = 50  !! Newton iterations of a banded assembly
+  !> largest dense Levenberg-Marquardt assembly (J and [J; mu I]) allowed in band mode (bytes):
+  !! n up to about 1670; larger banded models assemble by damped Newton on the band
+  real(wp), parameter :: DENSE_FALLBACK = 64.0_wp * 1048576
   real(wp), parameter :: PRED_ACCEPT = 1.0e-2_wp  !! fraction of tol a start must meet
+  !> what to change when the dense J does not fit
+  character(len=*), parameter :: DENSE_HINT = 'the dense solver keeps J as a full matrix: ' // &
+    'for kinematics of a large square model use the banded solver (solver="banded"), ' // &
+    'otherwise a smaller model'
 
   !> Settings of a kinematic analysis.
   type :: kin_opts_t
@@ -91,7 +100,8 @@ module mbd_kinematics
     real(wp) :: resid = zero        !! least-squares residual of the last solve
     integer :: newton_its = 0       !! Newton corrections taken
     integer :: lu_count = 0         !! factorizations
-    logical :: banded = .false.     !! J is factored in band storage (w%jac only on demand)
+    logical :: banded = .false.     !! J is factored in band storage (no dense J but for a
+                                    !! small model's Levenberg-Marquardt assembly)
     type(band_t) :: band            !! band plan, storage and factors
     real(wp) :: anorm = zero        !! ||J D||_1 of the band matrix before factoring
   end type kin_work_t
@@ -120,27 +130,46 @@ module mbd_kinematics
 
 contains
 
-  !> Allocate work arrays for model m; with a band plan J is kept in band storage and the
-  !! dense J is allocated only when a diagnosis needs it (dense_j).
-  subroutine kin_work_init(m, w, band)
+  !> Allocate work arrays for model m; with a band plan J is kept in band storage (the plan
+  !! is moved into w) and no n x n array is allocated. A dense J is checked against the
+  !! memory first (mem_check); a failed allocation is MBD_NO_MEMORY.
+  subroutine kin_work_init(m, w, status, msg, band)
     type(model_t), intent(in) :: m                 !! model
     type(kin_work_t), intent(out) :: w             !! work arrays
-    type(band_t), intent(in), optional :: band     !! band plan of J (square J only)
-    integer :: nr
+    integer, intent(out) :: status                 !! MBD_OK or MBD_NO_MEMORY
+    character(len=MSG_LEN), intent(inout) :: msg   !! explanation (on a failure)
+    type(band_t), intent(inout), optional :: band  !! band plan of J (square J only), moved
+    integer :: nr, ierr, lq
+    real(wp) :: bytes
+    character(len=MSG_LEN) :: what
+    status = MBD_OK
     nr = max(m%neq, m%nq)
-    allocate (w%phi(m%neq), w%nu(m%neq), w%gam(m%neq), &
-              w%qz(m%nq), w%ipiv(m%nq), w%rhs(nr), w%dq(m%nq), &
-              w%tau(m%nq), w%jpvt(m%nq), w%cs(m%nq), w%cwork(4 * m%nq), w%iwork(m%nq))
     if (present(band)) then
       w%banded = band%n == m%nq .and. m%neq == m%nq
     end if
-    if (w%banded) then
-      w%band = band
-      allocate (w%qrwork(1))
-    else
-      allocate (w%jac(m%neq, m%nq), w%qrwork(qr_lwork(m%neq, m%nq)))
+    ! vectors: phi, nu, gam (neq); qz, rhs, dq, tau, cs, cwork (4) (<= nr); 3 integer ones
+    bytes = REAL_BYTES * (3 * real(m%neq, wp) + 11 * real(nr, wp))
+    lq = 1
+    write (what, '(a,i0,a,i0,a)') 'the dense constraint Jacobian J (', m%neq, ' x ', m%nq, ')'
+    if (.not. w%banded) then
+      lq = qr_lwork(m%neq, m%nq)
+      bytes = bytes + REAL_BYTES * (real(m%neq, wp) * m%nq + lq)
+      call mem_check(bytes, trim(what), DENSE_HINT, status, msg)
+      if (status /= MBD_OK) return
     end if
-    call asm_init(m, w%asm)
+    allocate (w%phi(m%neq), w%nu(m%neq), w%gam(m%neq), w%qz(m%nq), w%ipiv(m%nq), stat=ierr)
+    if (ierr == 0) allocate (w%rhs(nr), w%dq(m%nq), w%tau(m%nq), w%jpvt(m%nq), stat=ierr)
+    if (ierr == 0) allocate (w%cs(m%nq), w%cwork(4 * m%nq), w%iwork(m%nq), stat=ierr)
+    if (ierr == 0) allocate (w%qrwork(lq), stat=ierr)
+    if (ierr == 0 .and. .not. w%banded) allocate (w%jac(m%neq, m%nq), stat=ierr)
+    if (ierr /= 0) then
+      if (w%banded) what = 'the kinematic work arrays'
+      call mem_fail(bytes, trim(what), DENSE_HINT, status, msg)
+      return
+    end if
+    if (w%banded) call band_move(band, w%band)
+    call asm_init(m, w%asm, status, msg)
+    if (status /= MBD_OK) return
     w%qz = zero
     w%cs = one
   end subroutine kin_work_init
@@ -151,9 +180,30 @@ contains
     type(band_t), intent(out) :: band           !! plan
     integer, intent(out) :: status              !! MBD_OK or the failure of band_plan
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
-    type(asm_work_t) :: a
-    call asm_init(m, a)       ! its map: J(dst) = J(row, col), dst = row + neq (col - 1)
-    call band_plan(m%nq, mod(a%dst - 1, m%neq) + 1, a%col, band, status, msg)
+    integer, allocatable :: rows(:), cols(:)
+    integer :: k, s, r, n, ierr
+    msg = ''
+    n = 0
+    do k = 1, m%nc
+      n = n + m%nrow(k) * count(m%loc(:, k) > 0)
+    end do
+    allocate (rows(n), cols(n), stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail(8 * real(n, wp), 'the structure of J', 'use a smaller model', status, msg)
+      return
+    end if
+    n = 0
+    do k = 1, m%nc
+      do s = 1, NLOC
+        if (m%loc(s, k) == 0) cycle
+        do r = 1, m%nrow(k)
+          n = n + 1
+          rows(n) = m%row0(k) + r - 1
+          cols(n) = m%loc(s, k)
+        end do
+      end do
+    end do
+    call band_plan(m%nq, rows, cols, band, status, msg)
   end subroutine kin_band_plan
 
   !> Phi, nu, gamma at (q, q_dot, t) and J D in the solver's storage: dense J in w%jac
@@ -188,13 +238,13 @@ contains
     w%anorm = band_norm1(w%band)
   end subroutine assemble_j
 
-  !> Phi, nu, gamma and the dense, unscaled J in w%jac (allocated here in band mode).
+  !> Phi, nu, gamma and the dense, unscaled J in w%jac (dense mode only: the band path
+  !! has no n x n array and makes its diagnoses from the band and the blocks).
   subroutine dense_j(m, w, q, qd, t)
     type(model_t), intent(in) :: m          !! model
-    type(kin_work_t), intent(inout) :: w    !! work arrays
+    type(kin_work_t), intent(inout) :: w    !! work arrays (dense mode)
     real(wp), intent(in) :: q(:), qd(:)     !! coordinates and velocities
     real(wp), intent(in) :: t               !! time
-    if (.not. allocated(w%jac)) allocate (w%jac(m%neq, m%nq))
     call assemble_dense(m, q, qd, t, w%phi, w%nu, w%gam, w%asm, w%jac)
   end subroutine dense_j
 
@@ -265,6 +315,37 @@ contains
     x = x * w%cs
   end subroutine solve
 
+  !> Solve J X = B for several right-hand sides with the factors (as solve), B given as rows
+  !! bt = B^T (n rounded up to a multiple of 4, neq; padding rows zero) and overwritten; the
+  !! dense LU by plain loops over all of them at once.
+  subroutine solve_cols(w, bt, x)
+    type(kin_work_t), intent(inout) :: w   !! work arrays with the factors
+    real(wp), intent(inout) :: bt(:, :)    !! right-hand sides as rows (4 k, neq), spoiled
+    real(wp), intent(out) :: x(:, :)       !! solutions (nq, n)
+    real(wp) :: b(size(bt, 2))
+    integer :: k
+    if (w%lsq .or. w%banded) then
+      do k = 1, size(x, 2)
+        b = bt(k, :)
+        call solve(w, b, x(:, k))
+      end do
+      return
+    end if
+    call lu_solve_rows(w%jac, w%ipiv, bt)
+    do k = 1, size(x, 2)
+      x(:, k) = bt(k, :) * w%cs
+    end do
+  end subroutine solve_cols
+
+  !> The Newton correction w%dq from J dq = -Phi with the factors (Phi negated in place and
+  !! back: an expression argument -w%phi would be a heap temporary at every iteration).
+  subroutine solve_newton(w)
+    type(kin_work_t), intent(inout) :: w   !! work arrays with the factors and Phi
+    w%phi = -w%phi
+    call solve(w, w%phi, w%dq)
+    w%phi = -w%phi
+  end subroutine solve_newton
+
   !> Newton-Raphson on Phi(q, t) = 0 from q. On success w holds the factors of J(q) at the
   !! returned q and w%nu = nu(q, t). In least-squares mode a correction that no longer
   !! reduces Phi while ||Phi|| > tol means the redundant constraints contradict:
@@ -291,7 +372,7 @@ contains
       ! the accuracy of a Newton correction (quadratic: far below tol), not just tol
       if (res <= merge(PRED_ACCEPT * w%tol, w%tol, it == 0)) return
       if (it == maxit) exit
-      call solve(w, -w%phi, w%dq)
+      call solve_newton(w)
       if (w%lsq .and. maxval(abs(w%dq)) <= 1.0e-3_wp * w%tol .and. res > w%tol) then
         status = MBD_INCONSISTENT; return
       end if
@@ -339,6 +420,10 @@ contains
   !! residual and the constraint with the largest residual are reported; if J is rank
   !! deficient there, the rows that contradict each other (those with a residual: at the
   !! minimum Phi is orthogonal to the range of J) are flagged in rep%dep, MBD_INCONSISTENT.
+  !! Band mode: Newton from the estimates; if it fails, Levenberg-Marquardt on a dense J as
+  !! above while its arrays stay below DENSE_FALLBACK, otherwise Newton damped by backtracking
+  !! on ||Phi||_2 (band_assemble, no n x n array; its failure is MBD_ASSEMBLY_FAILED without
+  !! the rank diagnosis).
   subroutine kin_assemble(m, w, q, t, opts, rep, status, msg)
     type(model_t), intent(in) :: m           !! model
     type(kin_work_t), intent(inout) :: w     !! work arrays
@@ -349,25 +434,44 @@ contains
     integer, intent(out) :: status           !! MBD_OK, MBD_ASSEMBLY_FAILED, MBD_INCONSISTENT
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
     real(wp), allocatable :: aug(:, :), rhs(:), work(:), qt(:), phit(:)
-    real(wp) :: mu, f, ft, wq(1), dmax, pmax
-    integer :: it, n, neq, info, lwork, i, k, rank, st
+    real(wp) :: mu, f, ft, wq(1), dmax, pmax, bytes
+    integer :: it, n, neq, info, lwork, i, k, rank, st, ierr
     integer, allocatable :: flags(:)
+    character(len=*), parameter :: WHAT = 'the assembly (Levenberg-Marquardt on the dense J)'
 
     status = MBD_OK; msg = ''
     n = m%nq; neq = m%neq
     call init_extras(m, q)
-    allocate (qt(n))
+    allocate (qt(n), stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail(REAL_BYTES * n, WHAT, DENSE_HINT, status, msg); return
+    end if
+    call dgels('N', neq + n, n, 1, wq, neq + n, wq, neq + n, wq, -1, info)
+    lwork = max(1, int(wq(1)))
+    bytes = REAL_BYTES * ((real(neq, wp) + n) * (n + 1) + neq + lwork)
     if (w%banded) then
-      ! large square models: plain Newton first (dense least squares as the fallback)
+      ! square models in band storage: plain Newton first
       qt = q
       call kin_newton(m, w, q, t, BAND_ASSEMBLY_MAXIT, st)
       if (st == MBD_OK) return
       q = qt
+      if (bytes + REAL_BYTES * real(neq, wp) * n > DENSE_FALLBACK) then
+        ! large: damped Newton on the band (no n x n array)
+        call band_assemble(m, w, q, t, opts%assembly_maxit, qt, rep, status, msg)
+        return
+      end if
+      ! small enough for the dense Levenberg-Marquardt below: its J, for this assembly only
+      if (.not. allocated(w%jac)) allocate (w%jac(neq, n), stat=ierr)
+      if (ierr /= 0) then
+        call mem_fail(REAL_BYTES * real(neq, wp) * n, WHAT, DENSE_HINT, status, msg); return
+      end if
     end if
-    allocate (aug(neq + n, n), rhs(neq + n), phit(neq))
-    call dgels('N', neq + n, n, 1, aug, neq + n, rhs, neq + n, wq, -1, info)
-    lwork = max(1, int(wq(1)))
-    allocate (work(lwork))
+    call mem_check(bytes, WHAT, DENSE_HINT, status, msg)
+    if (status /= MBD_OK) return
+    allocate (aug(neq + n, n), rhs(neq + n), phit(neq), work(lwork), stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail(bytes, WHAT, DENSE_HINT, status, msg); return
+    end if
     call dense_j(m, w, q, w%qz, t)
     f = norm2(w%phi)
     dmax = zero
@@ -405,8 +509,14 @@ contains
     rep%worst = m%con_of_row(maxloc(abs(w%phi), 1))
     rep%t_fail = t
     rep%qsing = q
-    allocate (flags(neq))
+    allocate (flags(neq), stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail(4 * real(neq, wp), WHAT, DENSE_HINT, status, msg); return
+    end if
     call row_rank(w%jac, rank, flags, st, msg)
+    if (st == MBD_NO_MEMORY) then
+      status = st; return
+    end if
     if (st == MBD_OK .and. rank < neq) then
       status = MBD_INCONSISTENT
       rep%rank = rank
@@ -422,62 +532,141 @@ contains
     end if
   end subroutine kin_assemble
 
+  !> Assembly in band mode, after plain Newton failed: Newton steps J dq = -Phi damped by
+  !! backtracking, q + s dq with s halved until ||Phi||_2 falls by the fraction 1e-4 s
+  !! (Armijo), to ||Phi||_inf <= tol. Band LU only: no n x n array. On failure q is the best
+  !! configuration found and rep names the residual and its largest constraint.
+  subroutine band_assemble(m, w, q, t, maxit, qt, rep, status, msg)
+    type(model_t), intent(in) :: m           !! model (square J, band plan in w)
+    type(kin_work_t), intent(inout) :: w     !! work arrays
+    real(wp), intent(inout) :: q(:)          !! estimates, then the assembled configuration
+    real(wp), intent(in) :: t                !! time
+    integer, intent(in) :: maxit             !! iterations
+    real(wp), intent(inout) :: qt(:)         !! workspace (nq)
+    type(kin_report_t), intent(inout) :: rep !! failure details
+    integer, intent(out) :: status           !! MBD_OK or MBD_ASSEMBLY_FAILED
+    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    real(wp), parameter :: SMIN = 1.0e-10_wp
+    real(wp) :: f, ft, s
+    integer :: it, st, neq
+    status = MBD_OK; msg = ''
+    neq = m%neq
+    do it = 1, maxit
+      call assemble_j(m, w, q, w%qz, t)
+      if (maxval(abs(w%phi)) <= w%tol) return
+      f = norm2(w%phi)
+      call factor(w, st)
+      if (st /= MBD_OK) exit
+      call solve_newton(w)
+      s = one
+      do while (s >= SMIN)
+        qt = q + s * w%dq
+        call assemble_blocks(m, qt, w%qz, t, w%rhs(1:neq), w%nu, w%gam, w%asm)
+        ft = norm2(w%rhs(1:neq))
+        if (ft <= (one - 1.0e-4_wp * s) * f) exit
+        s = half * s
+      end do
+      if (s < SMIN) exit
+      q = qt
+    end do
+    call assemble_blocks(m, q, w%qz, t, w%phi, w%nu, w%gam, w%asm)
+    rep%resid = maxval(abs(w%phi))
+    if (rep%resid <= 1.0e3_wp * w%tol) return     ! kin_run's Newton polishes (as dense LM)
+    rep%worst = m%con_of_row(maxloc(abs(w%phi), 1))
+    rep%t_fail = t
+    rep%qsing = q
+    status = MBD_ASSEMBLY_FAILED
+    write (msg, '(a,es10.3,a,i0,a)') 'assembly failed: no configuration satisfies the '// &
+      'constraints near the estimates (banded solver: damped Newton); smallest residual '// &
+      '||Phi|| = ', rep%resid, ', largest in constraint ', rep%worst, &
+      ' ('//trim(con_name(m%kind(rep%worst)))//')'
+  end subroutine band_assemble
+
   !> Rank of J at q and the redundant rows (1 in redundant: rows that repeat what the rows
-  !! before them impose, see row_rank).
+  !! before them impose, see row_rank). Dense mode only.
   !! mobility: nq minus the rank of the kinematic (non-driver) rows.
   subroutine kin_rank(m, w, q, t, rank, mobility, redundant, status, msg)
     type(model_t), intent(in) :: m           !! model
-    type(kin_work_t), intent(inout) :: w     !! work arrays
+    type(kin_work_t), intent(inout) :: w     !! work arrays (dense mode)
     real(wp), intent(in) :: q(:)             !! configuration
     real(wp), intent(in) :: t                !! time
     integer, intent(out) :: rank             !! rank of J
     integer, intent(out) :: mobility         !! degrees of freedom of the joints alone
     integer, intent(out) :: redundant(:)     !! 1 for a redundant row (neq)
-    integer, intent(out) :: status           !! MBD_OK or MBD_LAPACK
+    integer, intent(out) :: status           !! MBD_OK, MBD_LAPACK or MBD_NO_MEMORY
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
-    integer, allocatable :: flags(:), krows(:)
-    integer :: r, nk, rk
+    integer, allocatable :: flags(:)
+    real(wp), allocatable :: jk(:, :)
+    integer :: r, nk, rk, ierr
+    mobility = 0
     call dense_j(m, w, q, w%qz, t)
     call row_rank(w%jac, rank, redundant, status, msg)
     if (status /= MBD_OK) return
-    krows = pack([(r, r=1, m%neq)], [(.not. con_is_driver(m%kind(m%con_of_row(r))), r=1, m%neq)])
-    nk = size(krows)
+    nk = 0
+    do r = 1, m%neq
+      if (.not. con_is_driver(m%kind(m%con_of_row(r)))) nk = nk + 1
+    end do
     if (nk == 0) then
       mobility = m%nq
-    else
-      allocate (flags(nk))
-      call row_rank(w%jac(krows, :), rk, flags, status, msg)
-      mobility = m%nq - rk
+      return
     end if
+    ! the kinematic rows of J, copied (a vector subscript would be an unchecked temporary)
+    allocate (flags(nk), jk(nk, m%nq), stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail(REAL_BYTES * nk * real(m%nq, wp), 'the rank analysis of J (dense)', &
+                    DENSE_HINT, status, msg)
+      return
+    end if
+    nk = 0
+    do r = 1, m%neq
+      if (con_is_driver(m%kind(m%con_of_row(r)))) cycle
+      nk = nk + 1
+      jk(nk, :) = w%jac(r, :)
+    end do
+    call row_rank(jk, rk, flags, status, msg)
+    mobility = m%nq - rk
   end subroutine kin_rank
 
   !> SVD of the column-scaled J at q: which rows became dependent and which driver can no
-  !! longer be met.
+  !! longer be met. Band mode: the smallest singular triple by inverse iteration and the
+  !! largest by power iteration (band_singular), one dependent set (deficiency 1).
   subroutine kin_singular_report(m, w, q, t, rep, status, msg)
     type(model_t), intent(in) :: m           !! model
     type(kin_work_t), intent(inout) :: w     !! work arrays
     real(wp), intent(in) :: q(:)             !! configuration
     real(wp), intent(in) :: t                !! time
     type(kin_report_t), intent(inout) :: rep !! filled: smin, smax, dep, driver, qsing
-    integer, intent(out) :: status           !! MBD_OK or MBD_LAPACK
+    integer, intent(out) :: status           !! MBD_OK, MBD_LAPACK or MBD_NO_MEMORY
     character(len=MSG_LEN), intent(out) :: msg  !! description
     real(wp), allocatable :: sv(:), u(:), v(:)
     real(wp) :: umax, best
-    integer :: r, k
+    integer :: r, k, ierr
     character(len=MSG_LEN) :: rows
-    allocate (sv(min(m%neq, m%nq)), u(m%neq), v(m%nq))
-    call dense_j(m, w, q, w%qz, t)
-    ! columns to unit length, so lengths and angles weigh alike: J D, D = diag(1/|J_k|)
-    do k = 1, m%nq
-      umax = norm2(w%jac(:, k))
-      if (umax > zero) w%jac(:, k) = w%jac(:, k) / umax
-    end do
-    call svd_null(w%jac, sv, u, v, status, msg)
-    if (status /= MBD_OK) return
+    msg = ''
+    allocate (sv(min(m%neq, m%nq)), u(m%neq), v(m%nq), stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail(REAL_BYTES * 3 * real(max(m%neq, m%nq), wp), 'the singular report', &
+                    'use a smaller model', status, msg)
+      return
+    end if
+    if (w%banded) then
+      call band_singular(m, w, q, t, sv(size(sv)), sv(1), u, v, status, msg)
+      if (status /= MBD_OK) return
+      rep%deficiency = 1
+    else
+      call dense_j(m, w, q, w%qz, t)
+      ! columns to unit length, so lengths and angles weigh alike: J D, D = diag(1/|J_k|)
+      do k = 1, m%nq
+        umax = norm2(w%jac(:, k))
+        if (umax > zero) w%jac(:, k) = w%jac(:, k) / umax
+      end do
+      call svd_null(w%jac, sv, u, v, status, msg)
+      if (status /= MBD_OK) return
+      rep%deficiency = max(1, count(sv < DEP_TOL * sv(1)))
+    end if
     rep%qsing = q
     rep%t_fail = t
     rep%smax = sv(1); rep%smin = sv(size(sv))
-    rep%deficiency = max(1, count(sv < DEP_TOL * sv(1)))
     umax = maxval(abs(u))
     rep%dep = merge(1, 0, abs(u) > DEP_TOL * umax)
     rep%driver = 0; best = zero
@@ -502,12 +691,93 @@ contains
     end if
   end subroutine kin_singular_report
 
+  !> Band-mode diagnosis of a (nearly) singular J at q without a dense J. A = J D, the columns
+  !! of J at q scaled to unit length (D, from the blocks), factored in the band (an exactly
+  !! zero pivot lifted to eps max |u_ii|). The smallest singular triple A v = s u, A^T u = s v
+  !! by inverse iteration, v <- A^-1 u, u <- A^-T v (each normalized), s_min = ||A v||; the
+  !! largest by power iteration on A^T A, s_max = ||A x||, the products from the blocks.
+  !! w%cs is restored; the band holds the factors of A at q on return.
+  subroutine band_singular(m, w, q, t, smin, smax, u, v, status, msg)
+    type(model_t), intent(in) :: m           !! model (square J, band mode)
+    type(kin_work_t), intent(inout) :: w     !! work arrays
+    real(wp), intent(in) :: q(:)             !! configuration
+    real(wp), intent(in) :: t                !! time
+    real(wp), intent(out) :: smin, smax      !! extreme singular values of A (estimates)
+    real(wp), intent(out) :: u(:), v(:)      !! left and right vectors of smin (neq, nq)
+    integer, intent(out) :: status           !! MBD_OK, MBD_LAPACK or MBD_NO_MEMORY
+    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    integer, parameter :: INV_IT = 8, POW_IT = 30
+    real(wp), allocatable :: cs0(:), x(:), y(:)
+    real(wp) :: nrm
+    integer :: i, it, ierr, st
+    msg = ''
+    smin = zero; smax = zero; u = zero; v = zero
+    allocate (cs0(m%nq), x(m%nq), y(m%nq), stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail(3 * REAL_BYTES * m%nq, 'the singular report', 'use a smaller model', &
+                    status, msg)
+      return
+    end if
+    status = MBD_OK
+    cs0 = w%cs
+    call column_scale(m, w, q, t)
+    call assemble_j(m, w, q, w%qz, t)
+    call band_factor(w%band, st, msg, regularize=.true.)
+    if (.not. w%band%factored) then
+      w%cs = cs0
+      status = MBD_LAPACK
+      msg = 'the band factorization of J failed at the singular configuration: ' // trim(msg)
+      return
+    end if
+    msg = ''
+    ! largest: power iteration on A^T A with products from the blocks (assembled at q)
+    do i = 1, m%nq
+      x(i) = one + half * sin(real(i, wp))
+    end do
+    x = x / norm2(x)
+    do it = 1, POW_IT
+      y = w%cs * x
+      call blocks_jv(m, w%asm, y, u)
+      call blocks_jtv(m, w%asm, u, y)
+      y = w%cs * y
+      nrm = norm2(y)
+      if (.not. (nrm > zero .and. nrm <= huge(one))) exit
+      x = y / nrm
+    end do
+    y = w%cs * x
+    call blocks_jv(m, w%asm, y, u)
+    smax = norm2(u)
+    ! smallest: inverse iteration with the band factors
+    do i = 1, m%neq
+      u(i) = one + half * cos(real(i, wp))
+    end do
+    u = u / norm2(u)
+    do it = 1, INV_IT
+      v = u
+      call band_solve(w%band, v, st, msg)
+      nrm = norm2(v)
+      if (st /= MBD_OK .or. .not. (nrm > zero .and. nrm <= huge(one))) exit
+      v = v / nrm
+      u = v
+      call band_solve(w%band, u, st, msg, transpose=.true.)
+      nrm = norm2(u)
+      if (st /= MBD_OK .or. .not. (nrm > zero .and. nrm <= huge(one))) exit
+      u = u / nrm
+    end do
+    msg = ''
+    y = w%cs * v
+    call blocks_jv(m, w%asm, y, x)
+    smin = norm2(x)
+    w%cs = cs0
+  end subroutine band_singular
+
   !> Kinematic analysis at nsteps + 1 uniform times from t0 to t1, the whole loop here.
   !! q0: estimates of the body coordinates (extras are estimated). Outputs k = 0, e, 2e, ...
   !! and nsteps (e = opts%every) are stored, in columns 1, 2, ... (kin_out_count of them).
   !! On a singular configuration the outputs up to it are filled (rep%ndone columns) and
   !! status is MBD_SINGULAR_CONFIG with rep describing the configuration.
-  subroutine kin_run(m, q0, t0, t1, nsteps, opts, qout, qdout, qddout, rep, status, msg)
+  subroutine kin_run(m, q0, t0, t1, nsteps, opts, qout, qdout, qddout, rep, status, msg, &
+                     sens, sq, sqd, sqdd)
     type(model_t), intent(in) :: m             !! model
     real(wp), intent(in) :: q0(:)              !! estimates (nq)
     real(wp), intent(in) :: t0, t1             !! time span
@@ -519,20 +789,39 @@ contains
     type(kin_report_t), intent(out) :: rep     !! what happened
     integer, intent(out) :: status             !! MBD_OK or the failure
     character(len=MSG_LEN), intent(out) :: msg !! explanation
+    !> design parameters (mbd_sensitivity): with them, sq, sqd, sqdd (nq, np, outputs) get
+    !! dq/dp, dq_dot/dp and dq_ddot/dp at every stored output
+    type(sens_t), intent(inout), optional :: sens
+    real(wp), intent(out), optional :: sq(:, :, :), sqd(:, :, :), sqdd(:, :, :)
     type(kin_work_t) :: w
     type(band_t) :: band
+    logical, allocatable :: post(:)   ! outputs whose sensitivities are computed at the end
     real(wp), allocatable :: q(:), qd(:), qdd(:), qn(:), qp(:), q3(:), q4(:), q5(:), d1(:), &
                              qddn(:), qdn(:)
     real(wp), allocatable :: qa(:), qda(:), qdda(:), qb(:), qdb(:), qddb(:)
     real(wp) :: t, h, hcur, hh, tt, target, lscale, ts, ta, d, hprev, hprev2
     real(wp) :: pcur, phist(2), thist(2)   ! pivot ratios and times of the last accepted states
     integer :: nhist
-    integer :: k, j, c, st, detprev, mobility, lev, nsub, nderiv
+    integer :: k, j, c, st, detprev, mobility, lev, nsub, nderiv, ierr
     logical :: last, ok
 
     status = MBD_OK; msg = ''
     qout = zero; qdout = zero; qddout = zero
-    allocate (rep%qsing(m%nq), rep%dep(m%neq), rep%redundant(m%neq))
+    if (present(sens)) then
+      allocate (post(size(qout, 2)), stat=ierr)
+      if (ierr /= 0) then
+        call mem_fail(4.0_wp * size(qout, 2), 'the sensitivity bookkeeping', &
+                      'use fewer outputs (every)', status, msg)
+        return
+      end if
+      post = .false.
+    end if
+    allocate (rep%qsing(m%nq), rep%dep(m%neq), rep%redundant(m%neq), stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail(REAL_BYTES * (real(m%nq, wp) + m%neq), 'the kinematic report', &
+                    'use a smaller model', status, msg)
+      return
+    end if
     rep%qsing = zero; rep%dep = 0; rep%redundant = 0
     if (nsteps < 0 .or. .not. (abs(t1 - t0) <= huge(one)) .or. .not. (opts%tol > zero)) then
       status = MBD_BAD_SETTING; msg = 'steps must be >= 0, times finite, tolerance > 0'; return
@@ -559,21 +848,28 @@ contains
         if (opts%solver == SOLVER_BANDED .or. &
             BAND_RATIO * (band%kl + band%ku + 1) <= m%nq) rep%solver = SOLVER_BANDED
         rep%kl = band%kl; rep%ku = band%ku
-      else if (opts%solver == SOLVER_BANDED) then
-        status = MBD_SINGULAR; return
+      else if (opts%solver == SOLVER_BANDED .or. st == MBD_NO_MEMORY) then
+        status = merge(MBD_NO_MEMORY, MBD_SINGULAR, st == MBD_NO_MEMORY); return
       end if
       msg = ''
     end if
     if (rep%solver == SOLVER_BANDED) then
-      call kin_work_init(m, w, band)
+      call kin_work_init(m, w, status, msg, band)
     else
-      call kin_work_init(m, w)
+      call kin_work_init(m, w, status, msg)
     end if
+    if (status /= MBD_OK) return
     lscale = m%lscale
     w%tol = opts%tol * lscale
-    allocate (q(m%nq), qd(m%nq), qdd(m%nq), qn(m%nq), qp(m%nq), q3(m%nq), q4(m%nq), q5(m%nq), &
-              d1(m%nq), qddn(m%nq), &
-              qdn(m%nq), qa(m%nq), qda(m%nq), qdda(m%nq), qb(m%nq), qdb(m%nq), qddb(m%nq))
+    allocate (q(m%nq), qd(m%nq), qdd(m%nq), qn(m%nq), qp(m%nq), q3(m%nq), stat=ierr)
+    if (ierr == 0) allocate (q4(m%nq), q5(m%nq), d1(m%nq), qddn(m%nq), qdn(m%nq), stat=ierr)
+    if (ierr == 0) allocate (qa(m%nq), qda(m%nq), qdda(m%nq), qb(m%nq), stat=ierr)
+    if (ierr == 0) allocate (qdb(m%nq), qddb(m%nq), stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail(17 * REAL_BYTES * m%nq, 'the kinematic state vectors', &
+                    'use a smaller model', status, msg)
+      return
+    end if
     q = q0
     call kin_assemble(m, w, q, t0, opts, rep, status, msg)
     if (status /= MBD_OK) then
@@ -587,6 +883,17 @@ contains
     if (m%neq == m%nq) call kin_newton(m, w, q, t0, opts%maxit, st)
     if (st == MBD_OK .and. w%pivratio >= NEAR_SING) then
       rep%rank = m%nq
+    else if (w%banded) then
+      ! no dense rank analysis in band mode: the singular report estimates the deficiency
+      call kin_singular_report(m, w, q, t0, rep, st, msg)
+      if (st /= MBD_OK) then
+        status = st; call count_work(); return
+      end if
+      rep%rank = m%nq - rep%deficiency
+      status = MBD_SINGULAR
+      write (msg, '(a,es9.2,a,a)') 'the assembled configuration is singular (banded solver: '// &
+        'sigma_min/sigma_max of the column-scaled J about ', rep%smin / rep%smax, '): ', trim(msg)
+      call count_work(); return
     else
       call kin_rank(m, w, q, t0, rep%rank, mobility, rep%redundant, status, msg)
       if (status /= MBD_OK) then
@@ -603,6 +910,9 @@ contains
       if (w%lsq) call kin_newton(m, w, q, t0, opts%maxit, st)
       if (st /= MBD_OK .or. w%pivratio < NEAR_SING) then
         call kin_singular_report(m, w, q, t0, rep, k, msg)
+        if (k == MBD_NO_MEMORY) then
+          status = k; call count_work(); return
+        end if
         status = MBD_SINGULAR
         write (msg, '(a,i0,a,i0,a,a)') 'the assembled configuration is singular (J has rank ', &
           rep%rank, ' for ', m%nq, ' coordinates): ', trim(msg)
@@ -619,6 +929,8 @@ contains
       call count_work(); return
     end if
     qout(:, 1) = q; qdout(:, 1) = qd; qddout(:, 1) = qdd
+    if (present(sens)) call kin_sens(m, w, sens, q, qd, qdd, t0, sq(:, :, 1), sqd(:, :, 1), &
+                                     sqdd(:, :, 1))
     rep%ndone = 1
     detprev = w%detsign
     call forget_derivatives()
@@ -683,7 +995,8 @@ contains
       ! the configuration at t is singular (to tmin): pass through it or stop
       call kin_singular_report(m, w, q, t, rep, st, msg)
       if (st /= MBD_OK) then
-        status = MBD_LAPACK; call count_work(); return
+        status = merge(MBD_NO_MEMORY, MBD_LAPACK, st == MBD_NO_MEMORY)
+        call count_work(); return
       end if
       if (rep%smin > SING_RATIO * rep%smax) then
         ! J is regular here: not a dead centre but a failed step
@@ -724,6 +1037,7 @@ contains
             call hermite5(ta, qa, qda, qdda, ts + d, qn, qdn, qddn, out_time(j), qout(:, c), &
                           qdout(:, c), qddout(:, c))
             rep%ndone = max(rep%ndone, c)
+            if (present(sens)) post(c) = .true.
           end if
           if (j >= k) k = j + 1
         end if
@@ -764,17 +1078,22 @@ contains
     !! Taylor prediction by O(h**3).
     logical function smooth_velocity(hs)
       real(wp), intent(in) :: hs
-      real(wp) :: vpred(size(qd))
-      vpred = qd + hs * (qdd + (half * hs) * q3)
-      smooth_velocity = maxval(abs(qdn - vpred)) <= &
-        VJUMP_RATIO * (maxval(abs(qd)) + maxval(abs(vpred - qd))) + 1.0e3_wp * w%tol
+      real(wp) :: vp, jump, dv
+      integer :: i
+      ! v_pred = q_dot + h (q_ddot + h/2 q3), element by element (no array temporary)
+      jump = zero; dv = zero
+      do i = 1, size(qd)
+        vp = qd(i) + hs * (qdd(i) + (half * hs) * q3(i))
+        jump = max(jump, abs(qdn(i) - vp)); dv = max(dv, abs(vp - qd(i)))
+      end do
+      smooth_velocity = jump <= VJUMP_RATIO * (maxval(abs(qd)) + dv) + 1.0e3_wp * w%tol
     end function smooth_velocity
 
     !> One more Newton correction at tp (when J is poorly conditioned).
     subroutine polish(tp)
       real(wp), intent(in) :: tp
       integer :: st2
-      call solve(w, -w%phi, w%dq)
+      call solve_newton(w)
       qn = qn + w%dq
       call assemble_j(m, w, qn, w%qz, tp)
       call factor(w, st2)
@@ -877,6 +1196,8 @@ contains
       cc = column(kk)
       if (cc > 0) then
         qout(:, cc) = q; qdout(:, cc) = qd; qddout(:, cc) = qdd
+        if (present(sens)) call kin_sens(m, w, sens, q, qd, qdd, t, sq(:, :, cc), &
+                                         sqd(:, :, cc), sqdd(:, :, cc))
         if (w%pivratio < ANCHOR_PIV) call refine_output(cc)
         rep%ndone = cc
       end if
@@ -904,6 +1225,7 @@ contains
       end do
       call hermite5(t - dd, qa, qda, qdda, t + dd, qn, qdn, qddn, t, qout(:, cc), &
                     qdout(:, cc), qddout(:, cc))
+      if (present(sens)) post(cc) = .true.
     end subroutine refine_output
 
     !> Redundant constraints disagree at position (0), velocity (1) or acceleration (2)
@@ -924,10 +1246,44 @@ contains
     end subroutine inconsistent
 
     subroutine count_work()
+      integer :: cc, st3
       rep%newton_its = w%newton_its; rep%lu_count = w%lu_count
+      if (.not. allocated(post)) return
+      ! interpolated outputs: sensitivities from a factorization at the output itself
+      do cc = 1, min(rep%ndone, size(post))
+        if (.not. post(cc)) cycle
+        tt = t0 + (t1 - t0) * (real(min((cc - 1) * opts%every, nsteps), wp) / max(nsteps, 1))
+        if (cc == size(qout, 2)) tt = t1
+        call assemble_j(m, w, qout(:, cc), w%qz, tt)
+        call factor(w, st3)
+        if (st3 == MBD_OK) call kin_sens(m, w, sens, qout(:, cc), qdout(:, cc), qddout(:, cc), &
+                                         tt, sq(:, :, cc), sqd(:, :, cc), sqdd(:, :, cc))
+      end do
+      post = .false.
     end subroutine count_work
 
   end subroutine kin_run
+
+  !> Sensitivities at a converged state (q, q_dot, q_ddot) whose J factors are in w:
+  !! J s = -Phi_p, J s_dot = nu_p - J_p q_dot - Hv s, J s_ddot = gamma_p - J_p q_ddot - Ha s
+  !! - 2 Hv s_dot (mbd_sensitivity), three solves with the same factors per parameter.
+  subroutine kin_sens(m, w, s, q, qd, qdd, t, sq, sqd, sqdd)
+    type(model_t), intent(in) :: m           !! model
+    type(kin_work_t), intent(inout) :: w     !! work arrays with the factors of J(q)
+    type(sens_t), intent(inout) :: s         !! parameters and blocks
+    real(wp), intent(in) :: q(:), qd(:), qdd(:)  !! state and accelerations
+    real(wp), intent(in) :: t                !! time
+    real(wp), intent(out) :: sq(:, :), sqd(:, :), sqdd(:, :)  !! (nq, np)
+    s%cb = w%asm%cb; s%sb = w%asm%sb          ! the angles' cos and sin of the assembly at q
+    call sens_hessian(m, s, q, qd, qdd, t)
+    call sens_params(m, s, q, qd, qdd, t)
+    call sens_kin_rhs(s, 1, sq, sqd, s%rhs)
+    call solve_cols(w, s%rhs, sq)
+    call sens_kin_rhs(s, 2, sq, sqd, s%rhs)
+    call solve_cols(w, s%rhs, sqd)
+    call sens_kin_rhs(s, 3, sq, sqd, s%rhs)
+    call solve_cols(w, s%rhs, sqdd)
+  end subroutine kin_sens
 
   !> Stored outputs of a run of nsteps intervals keeping every e-th (and the last).
   pure integer function kin_out_count(nsteps, e) result(n)

@@ -12,26 +12,43 @@
 !!   params <np>
 !!   <np reals, any number per line, no comments inside this block>
 !!   end
-!! The constraint columns are the flat table of mbd_model; tol, maxit, tmin <= 0 mean default.
+!! The constraint columns are the flat table of mbd_model; tol, maxit, tmin = 0 mean default.
+!!
+!! Nothing in the file is trusted: every line has exactly its fields, every number is finite
+!! and in range (steps 1..MAX_STEPS, maxit 0..MAX_ITER, tol 0 or MIN_TOL..1, tmin >= 0, as the
+!! Python front end requires), and a count (bodies, constraints, params) is checked against the
+!! lines and characters left in the file and against the memory before anything is allocated.
+!! Every failure is MBD_BAD_INPUT (MBD_NO_MEMORY for a count the memory cannot hold) with a
+!! message "FILE:LINE: what".
 module mbd_mbdfile
-  use mbd_kinds, only: wp, zero
-  use mbd_status, only: MBD_OK, MBD_BAD_INPUT, MSG_LEN
+  use mbd_kinds, only: wp, zero, one
+  use mbd_status, only: MBD_OK, MBD_BAD_INPUT, MBD_NO_MEMORY, MSG_LEN
   use mbd_model, only: NCT
+  use mbd_memory, only: REAL_BYTES, mem_check, mem_fail
+  use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+  use, intrinsic :: iso_fortran_env, only: int64
   implicit none
   private
-  public :: NAME_LEN, mbd_spec_t, mbd_read
+  public :: NAME_LEN, MAX_STEPS, mbd_spec_t, mbd_read
 
-  integer, parameter :: NAME_LEN = 64   !! longest body or constraint name
+  integer, parameter :: NAME_LEN = 64             !! longest body or constraint name
+  integer, parameter :: LINE_LEN = 4096           !! longest line
+  integer, parameter :: MAX_STEPS = 1000000000    !! output intervals (as the Python front end)
+  integer, parameter :: MAX_ITER = 1000000        !! Newton iterations (as the Python front end)
+  real(wp), parameter :: MIN_TOL = 1.0e-15_wp     !! smallest tolerance (as the Python front end)
 
-  !> The contents of a model file.
+  !> The contents of a model file (and where each part was read, for messages).
   type :: mbd_spec_t
     character(len=NAME_LEN) :: name = ''
     character(len=NAME_LEN) :: analysis = 'kinematics'
     real(wp) :: t0 = zero, t_end = zero, tol = zero, tmin = zero
     integer :: steps = 0, maxit = 0, nb = 0, nc = 0
+    integer :: steps_line = 0             !! line of "steps" (0: not given)
+    integer :: bodies_line = 0            !! line of "bodies"
     character(len=NAME_LEN), allocatable :: body_names(:), con_names(:)
     real(wp), allocatable :: q0(:, :)     !! (3, nb)
     integer, allocatable :: ctab(:, :)    !! (NCT, nc)
+    integer, allocatable :: con_line(:)   !! line of each constraint
     real(wp), allocatable :: rpar(:)
   end type mbd_spec_t
 
@@ -41,105 +58,226 @@ contains
   subroutine mbd_read(path, spec, status, msg)
     character(len=*), intent(in) :: path        !! file to read
     type(mbd_spec_t), intent(out) :: spec       !! contents
-    integer, intent(out) :: status              !! MBD_OK or MBD_BAD_INPUT
+    integer, intent(out) :: status              !! MBD_OK, MBD_BAD_INPUT or MBD_NO_MEMORY
     character(len=MSG_LEN), intent(out) :: msg  !! what is wrong
-    integer :: u, ios, lineno, i, n, version
-    character(len=4096) :: line
+    integer :: u, ios, lineno, i, k, ierr, ndata, nread, ntok, pos, n
+    integer(int64) :: chars_left, big
+    character(len=LINE_LEN) :: line
     character(len=NAME_LEN) :: key
-    logical :: have_header, done
+    character(len=LINE_LEN) :: tok
+    logical :: have_header, done, seen_b, seen_c, seen_p
     status = MBD_OK; msg = ''
+    ! first pass: the data lines (not blank, not comments) and their characters
     open (newunit=u, file=path, status='old', action='read', iostat=ios)
     if (ios /= 0) then
       status = MBD_BAD_INPUT; msg = 'cannot open model file ' // trim(path); return
     end if
-    lineno = 0; have_header = .false.; done = .false.
-    allocate (spec%body_names(0), spec%con_names(0), spec%q0(3, 0), spec%ctab(NCT, 0), &
-              spec%rpar(0))
+    ndata = 0; chars_left = 0; lineno = 0
+    do
+      read (u, '(a)', iostat=ios) line
+      if (ios /= 0) exit
+      lineno = lineno + 1
+      line = adjustl(line)
+      if (len_trim(line) == 0 .or. line(1:1) == '#') cycle
+      ndata = ndata + 1
+      chars_left = chars_left + len_trim(line) + 1
+    end do
+    if (.not. is_iostat_end(ios)) then
+      call fail('cannot read the file (not a text file?)'); close (u); return
+    end if
+    if (ndata == 0) then
+      call fail('the file is empty (or not a regular file)'); close (u); return
+    end if
+    rewind (u)
+    lineno = 0; nread = 0
+    have_header = .false.; done = .false.; seen_b = .false.; seen_c = .false.
+    seen_p = .false.
+    allocate (spec%body_names(0), spec%con_names(0), spec%q0(3, 0), stat=ierr)
+    if (ierr == 0) allocate (spec%ctab(NCT, 0), spec%con_line(0), spec%rpar(0), stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail(zero, 'the model file', 'free some memory', status, msg); close (u); return
+    end if
     do
       call next_line(ios)
       if (ios /= 0) exit
-      read (line, *, iostat=ios) key
-      if (ios /= 0) call fail('cannot read a keyword')
-      if (status /= MBD_OK) exit
+      ntok = count_tokens(line)
+      pos = 1
+      call next_token(line, pos, tok)
+      key = tok(1:NAME_LEN)
       if (.not. have_header .and. key /= 'mbd2d') then
         call fail('not an mbd2d model file (first line must be "mbd2d 1")'); exit
       end if
       select case (key)
       case ('mbd2d')
-        read (line, *, iostat=ios) key, version
-        if (ios /= 0 .or. version /= 1) call fail('unsupported format version')
-        have_header = .true.
-      case ('name')
-        read (line, *, iostat=ios) key, spec%name
-      case ('analysis')
-        read (line, *, iostat=ios) key, spec%analysis
-      case ('t0')
-        read (line, *, iostat=ios) key, spec%t0
-      case ('t_end')
-        read (line, *, iostat=ios) key, spec%t_end
-      case ('steps')
-        read (line, *, iostat=ios) key, spec%steps
-      case ('tol')
-        read (line, *, iostat=ios) key, spec%tol
-      case ('maxit')
-        read (line, *, iostat=ios) key, spec%maxit
-      case ('tmin')
-        read (line, *, iostat=ios) key, spec%tmin
-      case ('bodies')
-        read (line, *, iostat=ios) key, n
-        if (ios /= 0 .or. n < 0) then
-          call fail('bad body count'); exit
+        if (ntok /= 2) then
+          call fail('the header line is "mbd2d 1"'); exit
         end if
-        spec%nb = n
+        call next_token(line, pos, tok)
+        if (.not. read_int(tok, big)) big = -1
+        if (big /= 1) then
+          call fail('unsupported format version "' // trim(tok) // '" (this reader knows 1)')
+          exit
+        end if
+        have_header = .true.
+      case ('name', 'analysis')
+        if (ntok /= 2) then
+          call fail('"' // trim(key) // '" takes one word'); exit
+        end if
+        call next_token(line, pos, tok)
+        if (key == 'name') spec%name = tok(1:NAME_LEN)
+        if (key == 'analysis') spec%analysis = tok(1:NAME_LEN)
+      case ('t0', 't_end', 'tol', 'tmin')
+        if (.not. one_real(spec_real(key))) exit
+      case ('steps')
+        if (.not. one_int(big)) exit
+        if (big < 1 .or. big > MAX_STEPS) then
+          call fail_int('steps must be a whole number from 1 to ', int(MAX_STEPS, int64), &
+                        ' (the number of output intervals)', big)
+          exit
+        end if
+        spec%steps = int(big); spec%steps_line = lineno
+      case ('maxit')
+        if (.not. one_int(big)) exit
+        if (big < 0 .or. big > MAX_ITER) then
+          call fail_int('maxit must be a whole number from 0 (default) to ', &
+                        int(MAX_ITER, int64), '', big)
+          exit
+        end if
+        spec%maxit = int(big)
+      case ('bodies')
+        if (seen_b) then
+          call fail('"bodies" is given twice'); exit
+        end if
+        seen_b = .true.
+        if (.not. count_ok(n, 'body', 1)) exit
+        spec%nb = n; spec%bodies_line = lineno
+        call mem_check(real(n, wp) * (NAME_LEN + 3 * REAL_BYTES), 'the bodies', &
+                       'give fewer bodies', status, msg)
+        if (status /= MBD_OK) then
+          call where_prefix(); exit
+        end if
         deallocate (spec%body_names, spec%q0)
-        allocate (spec%body_names(n), spec%q0(3, n))
+        allocate (spec%body_names(n), spec%q0(3, n), stat=ierr)
+        if (ierr /= 0) then
+          call mem_fail(real(n, wp) * (NAME_LEN + 3 * REAL_BYTES), 'the bodies', &
+                        'give fewer bodies', status, msg)
+          call where_prefix(); exit
+        end if
+        spec%q0 = zero
         do i = 1, n
           call next_line(ios)
-          if (ios == 0) read (line, *, iostat=ios) spec%body_names(i), spec%q0(:, i)
-          if (ios /= 0) then
-            call fail('bad body line'); exit
+          if (ios /= 0) exit
+          if (count_tokens(line) /= 4) then
+            call fail('bad body line: NAME X0 Y0 THETA0 expected'); exit
           end if
+          pos = 1
+          call next_token(line, pos, tok)
+          spec%body_names(i) = tok(1:NAME_LEN)
+          do k = 1, 3
+            call next_token(line, pos, tok)
+            if (.not. real_ok(tok, spec%q0(k, i))) exit
+          end do
+          if (status /= MBD_OK) exit
         end do
       case ('constraints')
-        read (line, *, iostat=ios) key, n
-        if (ios /= 0 .or. n < 0) then
-          call fail('bad constraint count'); exit
+        if (seen_c) then
+          call fail('"constraints" is given twice'); exit
         end if
+        seen_c = .true.
+        if (.not. count_ok(n, 'constraint', 1)) exit
         spec%nc = n
-        deallocate (spec%con_names, spec%ctab)
-        allocate (spec%con_names(n), spec%ctab(NCT, n))
-        spec%ctab = 0
+        call mem_check(real(n, wp) * (NAME_LEN + 4 * NCT + 4), 'the constraints', &
+                       'give fewer constraints', status, msg)
+        if (status /= MBD_OK) then
+          call where_prefix(); exit
+        end if
+        deallocate (spec%con_names, spec%ctab, spec%con_line)
+        allocate (spec%con_names(n), spec%ctab(NCT, n), spec%con_line(n), stat=ierr)
+        if (ierr /= 0) then
+          call mem_fail(real(n, wp) * (NAME_LEN + 4 * NCT + 4), 'the constraints', &
+                        'give fewer constraints', status, msg)
+          call where_prefix(); exit
+        end if
+        spec%ctab = 0; spec%con_line = 0
         do i = 1, n
           call next_line(ios)
-          if (ios == 0) read (line, *, iostat=ios) spec%con_names(i), spec%ctab(1:7, i)
-          if (ios /= 0) then
-            call fail('bad constraint line'); exit
+          if (ios /= 0) exit
+          spec%con_line(i) = lineno
+          if (count_tokens(line) /= 8) then
+            call fail('bad constraint line: NAME KIND BODY_I BODY_J SUB_A SUB_B OFFSET '// &
+                      'LENGTH expected')
+            exit
           end if
+          pos = 1
+          call next_token(line, pos, tok)
+          spec%con_names(i) = tok(1:NAME_LEN)
+          do k = 1, 7
+            call next_token(line, pos, tok)
+            if (.not. read_int(tok, big)) then
+              call fail('"' // trim(tok) // '" is not a whole number'); exit
+            end if
+            if (abs(big) > huge(1)) then
+              call fail('"' // trim(tok(1:40)) // '": a constraint entry must lie within '// &
+                        '+-2147483647')
+              exit
+            end if
+            spec%ctab(k, i) = int(big)
+          end do
+          if (status /= MBD_OK) exit
         end do
       case ('params')
-        read (line, *, iostat=ios) key, n
-        if (ios /= 0 .or. n < 0) then
-          call fail('bad parameter count'); exit
+        if (seen_p) then
+          call fail('"params" is given twice'); exit
+        end if
+        seen_p = .true.
+        if (.not. count_ok(n, 'parameter', 0)) exit
+        call mem_check(REAL_BYTES * n, 'the parameters', 'give fewer parameters', status, msg)
+        if (status /= MBD_OK) then
+          call where_prefix(); exit
         end if
         deallocate (spec%rpar)
-        allocate (spec%rpar(n))
-        if (n > 0) read (u, *, iostat=ios) spec%rpar
-        if (ios /= 0) call fail('cannot read the parameters')
+        allocate (spec%rpar(n), stat=ierr)
+        if (ierr /= 0) then
+          call mem_fail(REAL_BYTES * n, 'the parameters', 'give fewer parameters', status, msg)
+          call where_prefix(); exit
+        end if
+        i = 0
+        do while (i < n)
+          call next_line(ios)
+          if (ios /= 0) exit
+          pos = 1
+          do
+            call next_token(line, pos, tok)
+            if (len_trim(tok) == 0) exit
+            if (i == n) then
+              call fail('more numbers than the parameter count'); exit
+            end if
+            i = i + 1
+            if (.not. real_ok(tok, spec%rpar(i))) exit
+          end do
+          if (status /= MBD_OK) exit
+        end do
       case ('end')
+        if (ntok /= 1) then
+          call fail('"end" stands alone'); exit
+        end if
         done = .true.
       case default
         call fail('unknown keyword "' // trim(key) // '"')
       end select
       if (status /= MBD_OK .or. done) exit
-      if (ios /= 0) then
-        call fail('cannot read the value of "' // trim(key) // '"'); exit
-      end if
+      if (ios /= 0) exit
     end do
     close (u)
     if (status == MBD_OK .and. .not. done) then
-      status = MBD_BAD_INPUT; msg = trim(path) // ': missing "end" line (file truncated?)'
+      status = MBD_BAD_INPUT
+      write (msg, '(a,a,i0,a)') trim(path), ':', lineno, ': missing "end" line: the file ends '// &
+        'before it (truncated?)'
     end if
   contains
+
+    !> The next data line into `line` (comments and blank lines skipped); iostat /= 0 at the
+    !! end of the file, where status is set unless a block is still open.
     subroutine next_line(iostat)
       integer, intent(out) :: iostat
       do
@@ -147,14 +285,207 @@ contains
         if (iostat /= 0) return
         lineno = lineno + 1
         line = adjustl(line)
-        if (len_trim(line) > 0 .and. line(1:1) /= '#') return
+        if (len_trim(line) == 0 .or. line(1:1) == '#') cycle
+        nread = nread + 1
+        chars_left = chars_left - len_trim(line) - 1
+        if (len_trim(line) >= LINE_LEN) then
+          write (tok, '(a,i0,a)') 'line longer than ', LINE_LEN - 1, ' characters'
+          call fail(trim(tok)); iostat = 1
+        end if
+        return
       end do
     end subroutine next_line
+
+    !> A count on the current line: a whole number >= lo, no more than the lines left (one per
+    !! item; for parameters, every number takes at least two characters).
+    logical function count_ok(nn, what, lo)
+      integer, intent(out) :: nn
+      character(len=*), intent(in) :: what
+      integer, intent(in) :: lo
+      integer(int64) :: c, room
+      count_ok = .false.; nn = 0
+      if (.not. one_int(c)) return
+      if (what == 'parameter') then
+        room = (chars_left + 1) / 2
+      else
+        room = ndata - nread
+      end if
+      if (c < lo) then
+        call fail_int('the ' // what // ' count must be at least ', int(lo, int64), '', c)
+        return
+      end if
+      if (c > room) then
+        if (what == 'parameter') then
+          call fail_int('more parameters than the rest of the file can hold (at most ', room, &
+                        '): the count does not match the file (truncated or edited?)', c)
+        else
+          call fail_int('more ' // what // ' lines than the file has left (', room, &
+                        '): the count does not match the file (truncated or edited?)', c)
+        end if
+        return
+      end if
+      nn = int(c)
+      count_ok = .true.
+    end function count_ok
+
+    !> The keyword's one whole-number value.
+    logical function one_int(v)
+      integer(int64), intent(out) :: v
+      one_int = .false.; v = 0
+      if (ntok /= 2) then
+        call fail('"' // trim(key) // '" takes one whole number'); return
+      end if
+      call next_token(line, pos, tok)
+      if (.not. read_int(tok, v)) then
+        call fail('"' // trim(key) // '": "' // trim(tok(1:40)) // '" is not a whole number')
+        return
+      end if
+      one_int = .true.
+    end function one_int
+
+    !> The keyword's one real value, checked and stored.
+    logical function one_real(which)
+      integer, intent(in) :: which
+      real(wp) :: x
+      one_real = .false.
+      if (ntok /= 2) then
+        call fail('"' // trim(key) // '" takes one number'); return
+      end if
+      call next_token(line, pos, tok)
+      if (.not. real_ok(tok, x)) return
+      select case (which)
+      case (1); spec%t0 = x
+      case (2); spec%t_end = x
+      case (3)
+        if (.not. (x <= zero .and. x >= zero) .and. .not. (x >= MIN_TOL .and. x < one)) then
+          call fail('tol must be 0 (default) or from 1e-15 to below 1'); return
+        end if
+        spec%tol = x
+      case (4)
+        if (x < zero) then
+          call fail('tmin must be >= 0 (0: default)'); return
+        end if
+        spec%tmin = x
+      end select
+      one_real = .true.
+    end function one_real
+
+    integer function spec_real(k2)
+      character(len=*), intent(in) :: k2
+      select case (k2)
+      case ('t0'); spec_real = 1
+      case ('t_end'); spec_real = 2
+      case ('tol'); spec_real = 3
+      case default; spec_real = 4
+      end select
+    end function spec_real
+
+    !> A finite real number from a token, or fail.
+    logical function real_ok(t, x)
+      character(len=*), intent(in) :: t
+      real(wp), intent(out) :: x
+      integer :: i2, io
+      real_ok = .false.; x = zero
+      do i2 = 1, len_trim(t)
+        if (index('0123456789+-.eEdD', t(i2:i2)) == 0) then
+          call fail('"' // trim(t(1:40)) // '" is not a number'); return
+        end if
+      end do
+      read (t, *, iostat=io) x
+      if (io /= 0) then
+        call fail('"' // trim(t(1:40)) // '" is not a number'); return
+      end if
+      if (.not. ieee_is_finite(x)) then
+        call fail('"' // trim(t(1:40)) // '" is not a finite number'); return
+      end if
+      real_ok = .true.
+    end function real_ok
+
+    !> '"KEY VALUE": what LIMIT after' as a failure.
+    subroutine fail_int(what, limit, after, v)
+      character(len=*), intent(in) :: what, after
+      integer(int64), intent(in) :: limit, v
+      character(len=MSG_LEN) :: s
+      write (s, '(a,a,a,i0,a,a,i0,a)') '"', trim(key), ' ', v, '": ', what, limit, after
+      call fail(trim(s))
+    end subroutine fail_int
+
     subroutine fail(what)
       character(len=*), intent(in) :: what
       status = MBD_BAD_INPUT
       write (msg, '(a,a,i0,a,a)') trim(path), ':', lineno, ': ', what
     end subroutine fail
+
+    !> "FILE:LINE: " in front of a memory message.
+    subroutine where_prefix()
+      character(len=MSG_LEN) :: s
+      write (s, '(a,a,i0,a,a)') trim(path), ':', lineno, ': ', trim(msg)
+      msg = s
+    end subroutine where_prefix
   end subroutine mbd_read
+
+  !> Number of whitespace-separated tokens in a line.
+  pure integer function count_tokens(line) result(n)
+    character(len=*), intent(in) :: line   !! the line
+    integer :: i
+    logical :: inside
+    n = 0; inside = .false.
+    do i = 1, len_trim(line)
+      if (line(i:i) == ' ' .or. line(i:i) == achar(9) .or. line(i:i) == achar(13)) then
+        inside = .false.
+      else if (.not. inside) then
+        inside = .true.; n = n + 1
+      end if
+    end do
+  end function count_tokens
+
+  !> The next whitespace-separated token from line(pos:), pos moved past it ('' at the end).
+  pure subroutine next_token(line, pos, tok)
+    character(len=*), intent(in) :: line    !! the line
+    integer, intent(inout) :: pos           !! where to start; after the token on return
+    character(len=*), intent(out) :: tok    !! the token
+    integer :: i0, n
+    n = len_trim(line)
+    tok = ''
+    do while (pos <= n)
+      if (.not. blank(line(pos:pos))) exit
+      pos = pos + 1
+    end do
+    i0 = pos
+    do while (pos <= n)
+      if (blank(line(pos:pos))) exit
+      pos = pos + 1
+    end do
+    if (pos > i0) tok = line(i0:pos - 1)
+  contains
+    pure logical function blank(c)
+      character, intent(in) :: c
+      blank = c == ' ' .or. c == achar(9) .or. c == achar(13)
+    end function blank
+  end subroutine next_token
+
+  !> A whole number (digits with an optional sign) from a token; beyond 18 digits the value
+  !! is +-huge(v), so that it fails every range check as the number it is.
+  logical function read_int(t, v)
+    character(len=*), intent(in) :: t     !! token
+    integer(int64), intent(out) :: v      !! its value
+    integer :: i, i0, n, d
+    logical :: neg
+    read_int = .false.; v = 0
+    n = len_trim(t)
+    if (n == 0) return
+    neg = t(1:1) == '-'
+    i0 = 1
+    if (t(1:1) == '-' .or. t(1:1) == '+') i0 = 2
+    if (n < i0) return
+    do i = i0, n
+      d = index('0123456789', t(i:i)) - 1
+      if (d < 0) return
+      if (v < 10_int64**17) v = 10 * v + d
+      if (i - i0 + 1 > 18) v = huge(v)
+    end do
+    if (neg) v = -v
+    read_int = .true.
+  end function read_int
 
 end module mbd_mbdfile

@@ -33,6 +33,7 @@
 module mbd_model
   use mbd_kinds, only: wp, one
   use mbd_status, only: MBD_OK, MBD_BAD_INPUT, MBD_BAD_BODY, MBD_BAD_PARAM, MSG_LEN
+  use mbd_memory, only: REAL_BYTES, mem_fail
   use mbd_points, only: NLOC
   use mbd_constraints, only: con_known, con_nrow, con_nextra, con_raw_length, &
                              con_prepare, con_name, con_exponents, con_row_power, &
@@ -51,6 +52,7 @@ module mbd_model
   integer, parameter :: NCT = 8   !! rows of the constraint table
   integer, parameter :: NFT = 6   !! rows of the force table
   integer, parameter :: MAX_BODIES = 1000000   !! keeps 3 nb and the row counts in range
+  character(len=*), parameter :: HINT = 'use a smaller model'
   !> the range of length scales a nondimensional model accepts (model units)
   real(wp), parameter :: LSCALE_MIN = 1.0e-12_wp, LSCALE_MAX = 1.0e12_wp
 
@@ -119,10 +121,14 @@ contains
     logical, intent(in), optional :: nondim     !! in units of the length scale (see banner)
     !> largest point or length of the force elements (model_force_size), also geometry
     real(wp), intent(in), optional :: lforce
-    integer :: nc, k, kind, bi, bj, off, len, nexp, row, extra, ref, total, r, ist
-    real(wp), allocatable :: prep(:), pool(:), refp(:), raw(:), rref(:)
+    integer :: nc, k, kind, bi, bj, off, len, nexp, row, extra, ref, total, r, ierr
+    real(wp), allocatable :: prep(:), pool(:), refp(:)
+    ! work arrays for one constraint's raw parameters, allocated once (size(rpar) bounds
+    ! every well-formed slice): exponents, geometry mask, parameters in the model's units
+    real(wp), allocatable :: raw(:)
     integer, allocatable :: ex(:)
     logical, allocatable :: geom(:)
+    real(wp) :: rref(8)
     character(len=MSG_LEN) :: sub
     character(len=16) :: ks
 
@@ -141,16 +147,24 @@ contains
     ! no constraints at all: free bodies (a dynamic model held together by contacts); the
     ! front end allows it only then, and kinematics rejects it by its count of equations
     m%nb = nb; m%nc = nc
-    allocate (m%kind(nc), m%suba(nc), m%subb(nc), m%bi(nc), m%bj(nc), m%row0(nc), &
-              m%nrow(nc), m%loc(NLOC, nc), m%po(nc), m%pn(nc), stat=ist)
-    if (ist /= 0) then
-      status = MBD_BAD_INPUT; msg = 'not enough memory for the model tables'; return
+    allocate (m%kind(nc), m%suba(nc), m%subb(nc), m%bi(nc), m%bj(nc), stat=ierr)
+    if (ierr == 0) allocate (m%row0(nc), m%nrow(nc), m%loc(NLOC, nc), stat=ierr)
+    if (ierr == 0) allocate (m%po(nc), m%pn(nc), pool(8 * nc), stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail(4 * (NLOC + 9 + 16) * real(nc, wp), 'the constraint tables', HINT, &
+                    status, msg)
+      return
+    end if
+    allocate (raw(size(rpar)), ex(size(rpar)), geom(size(rpar)), stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail((REAL_BYTES + 8) * size(rpar), 'the constraint parameters', HINT, &
+                    status, msg)
+      return
     end if
     if (present(nondim)) then
       if (nondim) call choose_lref(status)
       if (status /= MBD_OK) return
     end if
-    allocate (pool(0))
     row = 0; extra = 0; total = 0
     do k = 1, nc
       kind = ctab(1, k); bi = ctab(2, k); bj = ctab(3, k)
@@ -229,16 +243,17 @@ contains
         msg = trim(con_name(kind)) // ' ' // trim(msg)
         return
       end if
-      raw = scaled(kind, ctab(4, k), ctab(5, k), rpar(off:off + len - 1))
+      call scale_raw(kind, ctab(4, k), ctab(5, k), rpar(off:off + len - 1), raw(1:len))
       if (kind == DRV_REL_DIST) then
         ! prepare the referenced joint again to read its prepared parameters
-        rref = scaled(CON_TRANSLATIONAL, 0, 0, rpar(ctab(6, ref):ctab(6, ref) + 7))
+        call scale_raw(CON_TRANSLATIONAL, 0, 0, rpar(ctab(6, ref):ctab(6, ref) + 7), rref)
         call con_prepare(CON_TRANSLATIONAL, 0, 0, rref, [real(wp) ::], refp, status, sub)
         if (status == MBD_OK) then
-          call con_prepare(kind, ctab(4, k), ctab(5, k), raw, refp, prep, status, sub)
+          call con_prepare(kind, ctab(4, k), ctab(5, k), raw(1:len), refp, prep, status, sub)
         end if
       else
-        call con_prepare(kind, ctab(4, k), ctab(5, k), raw, [real(wp) ::], prep, status, sub)
+        call con_prepare(kind, ctab(4, k), ctab(5, k), raw(1:len), [real(wp) ::], prep, &
+                         status, sub)
       end if
       if (status /= MBD_OK) then
         msg = trim(con_name(kind)) // ': ' // trim(sub); return
@@ -252,8 +267,14 @@ contains
       m%kind(k) = kind; m%suba(k) = ctab(4, k); m%subb(k) = ctab(5, k)
       m%bi(k) = bi; m%bj(k) = bj
       m%row0(k) = row + 1; m%nrow(k) = con_nrow(kind); row = row + m%nrow(k)
-      m%po(k) = total + 1; m%pn(k) = size(prep); total = total + size(prep)
-      pool = [pool, prep]
+      m%po(k) = total + 1; m%pn(k) = size(prep)
+      call append(pool, total, prep, ierr)
+      if (ierr /= 0) then
+        bad = 0
+        call mem_fail(2 * REAL_BYTES * (total + size(prep)), 'the constraint parameters', &
+                      HINT, status, msg)
+        return
+      end if
       ! local slots -> global coordinates
       m%loc(:, k) = 0
       if (bi > 0) m%loc(1:3, k) = [3 * bi - 2, 3 * bi - 1, 3 * bi]
@@ -267,11 +288,13 @@ contains
     bad = 0
     m%neq = row
     m%nq = 3 * nb + extra
-    call move_alloc(pool, m%p)
-    allocate (m%con_of_row(m%neq), m%rowunit(m%neq), m%cunit(m%nq), stat=ist)
-    if (ist /= 0) then
-      status = MBD_BAD_INPUT; msg = 'not enough memory for the model tables'; return
+    allocate (m%p(total), m%con_of_row(m%neq), m%rowunit(m%neq), m%cunit(m%nq), stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail(REAL_BYTES * (total + m%neq + m%nq) + 4 * real(m%neq, wp), &
+                    'the constraint parameters', HINT, status, msg)
+      return
     end if
+    m%p = pool(1:total)
     do k = 1, nc
       m%con_of_row(m%row0(k):m%row0(k) + m%nrow(k) - 1) = k
       do r = 1, m%nrow(k)
@@ -285,18 +308,19 @@ contains
 
   contains
 
-    !> Raw parameters in the model's units (p L**e; unchanged when L = 1).
-    function scaled(kd, sa, sb, rw) result(rs)
-      integer, intent(in) :: kd, sa, sb
-      real(wp), intent(in) :: rw(:)
-      real(wp) :: rs(size(rw))
-      integer :: e(size(rw))
-      logical :: g(size(rw))
+    !> Raw parameters in the model's units: rs = rw L**e (rs = rw when L = 1); the
+    !! exponents go to the host's ex (no allocation per call).
+    subroutine scale_raw(kd, sa, sb, rw, rs)
+      integer, intent(in) :: kd, sa, sb      !! constraint kind and sub-kinds
+      real(wp), intent(in) :: rw(:)          !! raw parameters in model units
+      real(wp), intent(out) :: rs(:)         !! (size(rw)) the same in the model's units
+      integer :: n
+      n = size(rw)
       rs = rw
       if (.not. (m%lref > one .or. m%lref < one)) return
-      call con_exponents(kd, sa, sb, rw, e, g)
-      rs = rw * m%lref**e
-    end function scaled
+      call con_exponents(kd, sa, sb, rw, ex(1:n), geom(1:n))
+      rs = rw * m%lref**ex(1:n)
+    end subroutine scale_raw
 
     !> L: the largest geometry entry of the well-formed constraints (and of the forces),
     !! rounded down to a power of 2 (1 when there is none); a largest entry outside
@@ -313,15 +337,11 @@ contains
         if (con_raw_length(kd, ctab(4, kk), rpar(o:o + n - 1)) /= n) cycle
         if (.not. all(ieee_is_finite(rpar(o:o + n - 1)))) cycle
         if (kd == CON_CAM .and. (ctab(4, kk) < 1 .or. ctab(4, kk) > 3)) cycle
-        if (allocated(ex)) deallocate (ex, geom)
-        allocate (ex(n), geom(n), stat=ist)
-        if (ist /= 0) then
-          st = MBD_BAD_INPUT; msg = 'not enough memory for the model tables'; return
-        end if
-        call con_exponents(kd, ctab(4, kk), ctab(5, kk), rpar(o:o + n - 1), ex, geom)
-        if (any(geom)) then
-          if (maxval(abs(rpar(o:o + n - 1)), mask=geom) > big) then
-            big = maxval(abs(rpar(o:o + n - 1)), mask=geom); kbig = kk
+        call con_exponents(kd, ctab(4, kk), ctab(5, kk), rpar(o:o + n - 1), ex(1:n), &
+                           geom(1:n))
+        if (any(geom(1:n))) then
+          if (maxval(abs(rpar(o:o + n - 1)), mask=geom(1:n)) > big) then
+            big = maxval(abs(rpar(o:o + n - 1)), mask=geom(1:n)); kbig = kk
           end if
         end if
       end do
@@ -375,8 +395,10 @@ contains
     integer, intent(out) :: status              !! MBD_OK or < 0
     character(len=MSG_LEN), intent(out) :: msg  !! what is wrong
     integer, intent(out) :: bad                 !! offending force (> 0) or body (< 0)
-    integer :: k, nf, kind, bi, bj, off, len, total, ist, jc
-    real(wp), allocatable :: prep(:), pool(:), fr(:), scl(:)
+    integer :: k, nf, kind, bi, bj, off, len, total, ierr, jc
+    real(wp), allocatable :: prep(:), pool(:)
+    ! one force's exponents and parameters in the model's units, allocated once
+    real(wp), allocatable :: sc(:), fr(:)
     integer, allocatable :: ex(:)
     real(wp) :: meff
     character(len=MSG_LEN) :: sub
@@ -384,9 +406,9 @@ contains
     if (size(bmass, 1) /= 2 .or. size(bmass, 2) /= m%nb .or. size(ftab, 1) /= NFT) then
       status = MBD_BAD_INPUT; msg = 'mass or force table has the wrong shape'; return
     end if
-    allocate (m%mdiag(m%nq), stat=ist)
-    if (ist /= 0) then
-      status = MBD_BAD_INPUT; msg = 'not enough memory for the mass table'; return
+    allocate (m%mdiag(m%nq), stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail(REAL_BYTES * m%nq, 'the mass matrix', HINT, status, msg); return
     end if
     m%mdiag = 0.0_wp
     do k = 1, m%nb
@@ -412,12 +434,17 @@ contains
     end if
     nf = size(ftab, 2)
     m%nf = nf
-    allocate (m%fkind(nf), m%fbi(nf), m%fbj(nf), m%floc(NLOC, nf), m%fpo(nf), m%fpn(nf), &
-              m%fref(nf), pool(0), stat=ist)
-    if (ist /= 0) then
-      status = MBD_BAD_INPUT; msg = 'not enough memory for the force tables'; return
+    allocate (m%fkind(nf), m%fbi(nf), m%fbj(nf), m%floc(NLOC, nf), stat=ierr)
+    if (ierr == 0) allocate (m%fpo(nf), m%fpn(nf), m%fref(nf), pool(8 * nf), stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail(4 * (NLOC + 5 + 16) * real(nf, wp), 'the force tables', HINT, status, msg)
+      return
     end if
-    m%fref = 0
+    allocate (sc(size(fpar)), ex(size(fpar)), fr(size(fpar)), stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail((REAL_BYTES + 4) * size(fpar), 'the force parameters', HINT, status, msg)
+      return
+    end if
     total = 0
     do k = 1, nf
       bad = k
@@ -457,19 +484,15 @@ contains
       if (force_raw_length(kind, fpar(off:off + len - 1)) /= len) then
         status = MBD_BAD_PARAM; msg = 'force parameters are malformed'; return
       end if
-      allocate (ex(len), fr(len), scl(len), stat=ist)
-      if (ist /= 0) then
-        status = MBD_BAD_INPUT; msg = 'not enough memory for the force tables'; return
-      end if
-      call force_exponents(kind, fpar(off:off + len - 1), ex, fr)
-      scl = fpar(off:off + len - 1) * m%lref**ex
-      if (any(abs(fr) > 0.0_wp)) scl = scl * m%lref**fr
-      if (.not. all(ieee_is_finite(scl))) then
+      call force_exponents(kind, fpar(off:off + len - 1), ex(1:len), fr(1:len))
+      sc(1:len) = fpar(off:off + len - 1) * m%lref**ex(1:len)
+      if (any(abs(fr(1:len)) > 0.0_wp)) sc(1:len) = sc(1:len) * m%lref**fr(1:len)
+      if (.not. all(ieee_is_finite(sc(1:len)))) then
         status = MBD_BAD_PARAM
         msg = 'a force parameter is too large for the model''s length scale'; return
       end if
       if (kind == FRC_FRICTION) then
-        call friction_prepare(m%kind(jc) == CON_REVOLUTE, scl, prep, status, sub)
+        call friction_prepare(m%kind(jc) == CON_REVOLUTE, sc(1:len), prep, status, sub)
       else
         ! effective mass of a contact pair (ground: infinite)
         meff = 0.0_wp
@@ -481,15 +504,20 @@ contains
         else if (bj > 0) then
           meff = m%mdiag(3 * bj - 2)
         end if
-        call force_prepare(kind, scl, prep, status, sub, meff)
+        call force_prepare(kind, sc(1:len), prep, status, sub, meff)
       end if
-      deallocate (ex, fr, scl)
       if (status /= MBD_OK) then
         msg = sub; return
       end if
       m%fkind(k) = kind; m%fbi(k) = bi; m%fbj(k) = bj
-      m%fpo(k) = total + 1; m%fpn(k) = size(prep); total = total + size(prep)
-      pool = [pool, prep]
+      m%fpo(k) = total + 1; m%fpn(k) = size(prep)
+      call append(pool, total, prep, ierr)
+      if (ierr /= 0) then
+        bad = 0
+        call mem_fail(2 * REAL_BYTES * (total + size(prep)), 'the force parameters', HINT, &
+                      status, msg)
+        return
+      end if
       m%floc(:, k) = 0
       if (bi > 0) m%floc(1:3, k) = [3 * bi - 2, 3 * bi - 1, 3 * bi]
       if (bj > 0) m%floc(4:6, k) = [3 * bj - 2, 3 * bj - 1, 3 * bj]
@@ -501,7 +529,30 @@ contains
       end if
     end do
     bad = 0
-    call move_alloc(pool, m%fp)
+    allocate (m%fp(total), stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail(REAL_BYTES * total, 'the force parameters', HINT, status, msg); return
+    end if
+    m%fp = pool(1:total)
   end subroutine model_add_dynamics
+
+  !> pool(total + 1:total + size(x)) = x, the capacity doubled when it runs out (a pool built
+  !! by concatenation would cost O(nc**2) copies).
+  pure subroutine append(pool, total, x, ierr)
+    real(wp), allocatable, intent(inout) :: pool(:)  !! the pool (its size is the capacity)
+    integer, intent(inout) :: total                  !! entries in use
+    real(wp), intent(in) :: x(:)                     !! entries to add
+    integer, intent(out) :: ierr                     !! allocation status (0 ok)
+    real(wp), allocatable :: bigger(:)
+    ierr = 0
+    if (total + size(x) > size(pool)) then
+      allocate (bigger(max(2 * size(pool), total + size(x), 16)), stat=ierr)
+      if (ierr /= 0) return
+      bigger(1:total) = pool(1:total)
+      call move_alloc(bigger, pool)
+    end if
+    pool(total + 1:total + size(x)) = x
+    total = total + size(x)
+  end subroutine append
 
 end module mbd_model

@@ -19,9 +19,12 @@
 !! they reduce the residual of the equilibrium equations, ||g|| / F + ||Phi|| / l (F the
 !! force scale, l the model's length scale), and stop where it no longer halves: round-off.
 !! The signs of the eigenvalues of H at the end give the stability.
+!! Memory: the dense work arrays (five n x n) are checked and allocated once per call, with
+!! MBD_NO_MEMORY when they cannot be had; the iterations allocate nothing.
 module mbd_statics
   use mbd_kinds, only: wp, zero, one, half, eps
   use mbd_status, only: MBD_OK, MBD_NO_CONVERGENCE, MBD_LAPACK, MSG_LEN
+  use mbd_memory, only: REAL_BYTES, mem_check, mem_fail
   use mbd_model, only: model_t
   use mbd_assemble, only: assemble_dense
   use mbd_lapack, only: dgesvd, dsyev
@@ -38,6 +41,8 @@ module mbd_statics
   !> ||g|| / F above which no equilibrium was found (F: the largest load, Q or J^T lambda)
   real(wp), parameter :: RESID_FAIL = 1.0e-8_wp
   real(wp), parameter :: RANK_TOL = 1.0e-10_wp  !! singular values of J taken as zero
+  character(len=*), parameter :: HINT = 'statics solves with dense matrices of the size of ' &
+    // 'J: use a model with fewer coordinates'
 
 contains
 
@@ -51,21 +56,30 @@ contains
     real(wp), intent(out) :: lam(:)             !! multipliers (neq)
     integer, intent(out) :: stable              !! stability of the equilibrium
     real(wp), intent(out) :: resid              !! final ||N^T Q||_inf / F (F: the loads)
-    integer, intent(out) :: status              !! MBD_OK, MBD_NO_CONVERGENCE, MBD_LAPACK
+    integer, intent(out) :: status  !! MBD_OK, MBD_NO_CONVERGENCE, MBD_LAPACK, MBD_NO_MEMORY
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    ! work arrays, allocated once: h holds H, then its eigenvectors; r, c, dqz and qt are
+    ! vectors of the steps; work is LAPACK's workspace (grown when a query asks for more)
     real(wp), allocatable :: nb(:, :), h(:, :), ev(:), g(:), dz(:), dqn(:), kt(:, :), &
-                             ct(:, :), qt(:), ja(:, :), sv(:), u(:, :), vt(:, :), work(:)
-    real(wp) :: v0, vt1, alpha, emax, fscale, vnoise, e0, e1, gn, pn, slope
+                             ct(:, :), qt(:), ja(:, :), sv(:), u(:, :), vt(:, :), work(:), &
+                             r(:), c(:), dqz(:)
+    real(wp) :: v0, vt1, alpha, emax, fscale, vnoise, e0, e1, gn, pn, slope, bytes
     integer :: it, ls, nfree, n, na, stp, ist, nu
     logical :: local
-    character(len=MSG_LEN) :: lmsg
+    character(len=MSG_LEN) :: lmsg, what
     status = MBD_OK; msg = ''; stable = 2; resid = zero
     n = m%nq; na = w%na; nu = min(na, n)
-    allocate (nb(n, n), h(n, n), ev(n), g(n), dz(n), dqn(n), kt(n, n), ct(n, n), qt(n), &
-              ja(max(na, 1), n), sv(max(nu, 1)), u(max(na, 1), max(nu, 1)), vt(n, n), &
-              work(1), stat=ist)
+    bytes = REAL_BYTES * (5 * real(n, wp)**2 + real(max(na, 1), wp) * (n + max(nu, 1)) &
+                          + 10 * real(n, wp) + max(nu, 1))
+    write (what, '(a,i0,a)') 'the statics work arrays (', n, ' coordinates, dense)'
+    call mem_check(bytes, trim(what), HINT, status, msg)
+    if (status /= MBD_OK) return
+    allocate (nb(n, n), h(n, n), kt(n, n), ct(n, n), vt(n, n), stat=ist)
+    if (ist == 0) allocate (ev(n), g(n), dz(n), dqn(n), qt(n), r(n), c(n), dqz(n), stat=ist)
+    if (ist == 0) allocate (ja(max(na, 1), n), sv(max(nu, 1)), u(max(na, 1), max(nu, 1)), &
+                            work(1), stat=ist)
     if (ist /= 0) then
-      status = MBD_NO_CONVERGENCE; msg = 'statics: not enough memory for the work arrays'
+      call mem_fail(bytes, trim(what), HINT, status, msg)
       return
     end if
     call dyn_project_pos(m, w, q, t, status)
@@ -80,7 +94,9 @@ contains
       if (nfree == 0) exit                    ! nothing can move: q is the equilibrium
       gn = maxval(abs(g(1:nfree)))
       if (.not. (gn > zero .or. maxval(abs(dqn)) > zero)) exit   ! exactly balanced
-      call newton_step()
+      call newton_step(status)
+      if (status /= MBD_OK) return
+      call null_mul(dz, dqz)                   ! the step in q: N dz
       if (.not. local) then
         ! V can judge a step only while the decrease it predicts exceeds its rounding
         slope = dot_product(g(1:nfree), dz(1:nfree))
@@ -89,7 +105,7 @@ contains
         else
           alpha = one
           do ls = 1, MAXLS
-            qt = q + alpha * matmul(nb(:, 1:nfree), dz(1:nfree))
+            qt = q + alpha * dqz
             call dyn_project_pos(m, w, qt, t, stp)
             if (stp == MBD_OK) then
               vt1 = potential(qt)
@@ -107,7 +123,7 @@ contains
       end if
       ! local Newton on the equilibrium equations: full steps while the residual falls
       e0 = merit(gn, pn)
-      qt = q + dqn + matmul(nb(:, 1:nfree), dz(1:nfree))
+      qt = q + dqn + dqz
       call reduce(qt, status)
       if (status /= MBD_OK) return
       if (nfree == 0) then
@@ -130,7 +146,8 @@ contains
         'unbalanced load is ', resid, ' times the loads'
       return
     end if
-    call eigen(h(1:nfree, 1:nfree), ev(1:nfree), .false., stp)
+    call eigen(.false., status)
+    if (status /= MBD_OK) return
     emax = max(maxval(abs(ev(1:nfree))), tiny(one))
     if (minval(ev(1:nfree)) > 1.0e-9_wp * emax) then
       stable = 1
@@ -146,29 +163,29 @@ contains
     subroutine reduce(qa, st)
       real(wp), intent(in) :: qa(:)
       integer, intent(out) :: st
-      real(wp) :: wq(1), c(max(nu, 1))
-      integer :: info, rk, k, lw
+      real(wp) :: wq(1)
+      integer :: info, rk, k, lw, i, j
       st = MBD_OK
       call dyn_multipliers(m, w, qa, w%qz, w%qz, t, lam, stp, lmsg)  ! also J and Q at qa
-      fscale = max(maxval(abs(w%force)), maxval(abs(matmul(lam, w%jac))), tiny(one))
+      r = matmul(lam, w%jac)                           ! J^T lambda
+      fscale = max(maxval(abs(w%force)), maxval(abs(r)), tiny(one))
       pn = zero
-      if (na > 0) pn = maxval(abs(w%phi(w%rows)))
+      do i = 1, na                                     ! row gathers as loops (no temporary)
+        pn = max(pn, abs(w%phi(w%rows(i))))
+      end do
       v0 = potential(qa)
       vnoise = V_NOISE * (abs(v0) + scale_of_v(qa))
       ! SVD of the active rows: J_a = U S V^T; N = the last columns of V
       dqn = zero
       rk = 0
       if (na > 0) then
-        ja(1:na, :) = w%jac(w%rows, :)
+        do i = 1, na
+          ja(i, :) = w%jac(w%rows(i), :)
+        end do
         call dgesvd('S', 'A', na, n, ja, size(ja, 1), sv, u, size(u, 1), vt, n, wq, -1, info)
         lw = max(1, int(wq(1)))
-        if (size(work) < lw) then
-          deallocate (work)
-          allocate (work(lw), stat=info)
-          if (info /= 0) then
-            st = MBD_NO_CONVERGENCE; msg = 'statics: not enough memory for the SVD'; return
-          end if
-        end if
+        call grow_work(lw, st)
+        if (st /= MBD_OK) return
         call dgesvd('S', 'A', na, n, ja, size(ja, 1), sv, u, size(u, 1), vt, n, work, &
                     size(work), info)
         if (info /= 0) then
@@ -178,7 +195,11 @@ contains
         rk = count(sv(1:nu) > RANK_TOL * maxval(sv(1:nu)))
         ! dq_n = -V_r S_r^-1 U_r^T Phi_a
         do k = 1, rk
-          c(k) = -dot_product(u(1:na, k), w%phi(w%rows)) / sv(k)
+          c(k) = zero
+          do i = 1, na
+            c(k) = c(k) - u(i, k) * w%phi(w%rows(i))
+          end do
+          c(k) = c(k) / sv(k)
         end do
         do k = 1, rk
           dqn = dqn + c(k) * vt(k, :)
@@ -194,24 +215,59 @@ contains
       nb(:, 1:nfree) = transpose(vt(rk + 1:n, :))
       g(1:nfree) = matmul(w%force, nb(:, 1:nfree))     ! N^T Q (= -reduced gradient of V)
       call dyn_tangent(m, w, qa, w%qz, t, lam, kt, ct)
-      kt = half * (kt + transpose(kt))
-      h(1:nfree, 1:nfree) = matmul(transpose(nb(:, 1:nfree)), matmul(kt, nb(:, 1:nfree)))
+      do j = 1, n                                      ! K_sym = (K + K^T) / 2
+        do i = 1, j - 1
+          kt(i, j) = half * (kt(i, j) + kt(j, i)); kt(j, i) = kt(i, j)
+        end do
+      end do
+      ct(:, 1:nfree) = matmul(kt, nb(:, 1:nfree))      ! ct (the damping) is not needed: K N
+      h(1:nfree, 1:nfree) = matmul(transpose(nb(:, 1:nfree)), ct(:, 1:nfree))
     end subroutine reduce
+
+    !> y = N dz (the first nfree columns of nb).
+    subroutine null_mul(x, y)
+      real(wp), intent(in) :: x(:)       !! (>= nfree) reduced step
+      real(wp), intent(out) :: y(:)      !! (n) the step in q
+      integer :: k
+      y = zero
+      do k = 1, nfree
+        y = y + x(k) * nb(:, k)
+      end do
+    end subroutine null_mul
+
+    !> work has at least lw entries (MBD_NO_MEMORY when it cannot grow).
+    subroutine grow_work(lw, st)
+      integer, intent(in) :: lw
+      integer, intent(out) :: st
+      integer :: ierr
+      st = MBD_OK
+      if (size(work) >= lw) return
+      deallocate (work)
+      allocate (work(lw), stat=ierr)
+      if (ierr /= 0) then
+        call mem_fail(REAL_BYTES * lw, 'the LAPACK workspace of the statics', HINT, st, msg)
+        allocate (work(1), stat=ierr)
+      end if
+    end subroutine grow_work
 
     !> dz from H dz = g - N^T K dq_n, saddle-free: |eigenvalues| bounded below (a flat
     !! direction gets a gradient step of about the model's length scale).
-    subroutine newton_step()
-      real(wp) :: r(nfree), hv(nfree, nfree), e(nfree)
-      integer :: k, st2
-      r = g(1:nfree) - matmul(matmul(dqn, kt), nb(:, 1:nfree))
-      hv = h(1:nfree, 1:nfree)
-      call eigen(hv, e, .true., st2)
-      emax = max(1.0e-8_wp * maxval(abs(e)), norm2(g(1:nfree)) / m%lscale, tiny(one))
-      dz(1:nfree) = matmul(transpose(hv), r)
+    !! H is overwritten by its eigenvectors (reduce computes it again).
+    subroutine newton_step(st)
+      integer, intent(out) :: st      !! MBD_OK or MBD_NO_MEMORY
+      integer :: k
+      qt = matmul(dqn, kt)                               ! (K dq_n)^T, K symmetric
+      r(1:nfree) = matmul(qt, nb(:, 1:nfree))
+      r(1:nfree) = g(1:nfree) - r(1:nfree)
+      call eigen(.true., st)
+      if (st /= MBD_OK) return
+      emax = max(1.0e-8_wp * maxval(abs(ev(1:nfree))), norm2(g(1:nfree)) / m%lscale, &
+                 tiny(one))
+      dz(1:nfree) = matmul(transpose(h(1:nfree, 1:nfree)), r(1:nfree))
       do k = 1, nfree
-        dz(k) = dz(k) / max(abs(e(k)), emax)
+        r(k) = dz(k) / max(abs(ev(k)), emax)
       end do
-      dz(1:nfree) = matmul(hv, dz(1:nfree))
+      dz(1:nfree) = matmul(h(1:nfree, 1:nfree), r(1:nfree))
     end subroutine newton_step
 
     !> Residual of the equilibrium equations, relative to the force and length scales.
@@ -239,23 +295,20 @@ contains
       end do
     end function scale_of_v
 
-    !> Eigenvalues (and, when vectors, the vectors in a) of a symmetric matrix.
-    subroutine eigen(a, e, vectors, st)
-      real(wp), intent(inout) :: a(:, :)
-      real(wp), intent(out) :: e(:)
+    !> Eigenvalues of H (h(1:nfree, 1:nfree)) in ev(1:nfree), and when vectors, the
+    !! eigenvectors in h. st: MBD_OK or MBD_NO_MEMORY (the workspace); a dsyev that does not
+    !! converge leaves what it has (the step or stability test uses it as it is).
+    subroutine eigen(vectors, st)
       logical, intent(in) :: vectors
       integer, intent(out) :: st
       real(wp) :: wq(1)
-      real(wp), allocatable :: wk(:)
-      integer :: nn, info
+      integer :: info
       character(len=1) :: job
-      nn = size(a, 1)
       job = merge('V', 'N', vectors)
-      call dsyev(job, 'U', nn, a, nn, e, wq, -1, info)
-      allocate (wk(max(1, int(wq(1)))), stat=st)
-      if (st /= 0) return
-      call dsyev(job, 'U', nn, a, nn, e, wk, size(wk), info)
-      st = info
+      call dsyev(job, 'U', nfree, h, n, ev, wq, -1, info)
+      call grow_work(max(1, int(wq(1))), st)
+      if (st /= MBD_OK) return
+      call dsyev(job, 'U', nfree, h, n, ev, work, size(work), info)
     end subroutine eigen
   end subroutine statics_solve
 

@@ -32,5 +32,6 @@ module mbd_status
   integer, parameter :: MBD_BRANCH_SWITCH = 7    !! solution left its assembly branch
   integer, parameter :: MBD_INTEGRATOR_FAILED = 8 !! step size underflow, blow-up
   integer, parameter :: MBD_USER_ABORT = 9       !! a user callback asked to stop
-  integer, parameter :: MBD_NO_MEMORY = 10       !! an allocation failed
+  !> an allocation failed, or would exceed the memory an analysis may use (mbd_memory)
+  integer, parameter :: MBD_NO_MEMORY = 10
 end module mbd_status

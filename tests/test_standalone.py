@@ -39,7 +39,7 @@ def test_matches_python(tmp_path: Path, solver: str, name: str) -> None:
     model.export(mbd, t_end=1.0, steps=200)
     out = tmp_path / "fortran.csv"
     r = subprocess.run([solver, str(mbd), str(out)], capture_output=True, text=True, timeout=60)
-    assert r.returncode == 0, r.stdout + r.stderr
+    assert r.returncode == 0, r.stderr
     res = model.kinematics(t_end=1.0, steps=200)
     py = tmp_path / "python.csv"
     res.to_csv(py)
@@ -57,8 +57,8 @@ def test_toggle_partial_output(tmp_path: Path, solver: str) -> None:
     out = tmp_path / "seed.csv"
     r = subprocess.run([solver, str(mbd), str(out)], capture_output=True, text=True, timeout=60)
     assert r.returncode == 3
-    assert "Singular configuration (dead centre) at t = 0.88591864" in r.stdout
-    assert '"motor"' in r.stdout
+    assert "Singular configuration (dead centre) at t = 0.88591864" in r.stderr
+    assert '"motor"' in r.stderr
     _, rows = read_csv(out)
     with pytest.raises(mbd2d.SingularConfigurationError) as err:
         model.kinematics(t_end=1.0, steps=1000)
@@ -89,10 +89,10 @@ def test_bad_files(tmp_path: Path, solver: str, content: str, needle: str) -> No
     r = subprocess.run([solver, str(f), str(tmp_path / "o.csv")], capture_output=True,
                        text=True, timeout=60)
     assert r.returncode == 2
-    assert needle in r.stdout
+    assert needle in r.stderr
 
 
 def test_missing_file(tmp_path: Path, solver: str) -> None:
     r = subprocess.run([solver, str(tmp_path / "none.mbd"), str(tmp_path / "o.csv")],
                        capture_output=True, text=True, timeout=60)
-    assert r.returncode == 2 and "cannot open" in r.stdout
+    assert r.returncode == 2 and "cannot open" in r.stderr

@@ -2,11 +2,16 @@
 !!
 !!   mbd2d-solve MODEL.mbd OUT.csv
 !! Writes the CSV the Python path writes (t, then NAME.x ... NAME.theta_ddot per body).
-!! Exit codes: 0 ok, 2 bad input, 3 singular configuration (partial output written),
-!! 4 other numerical failure (partial output written). Messages go to standard output.
+!! Exit codes: 0 ok, 2 bad input (a malformed file, or counts too large for the memory),
+!! 3 singular configuration (partial output written), 4 other numerical failure (partial
+!! output written). Messages go to standard error, each starting "mbd2d-solve: ".
+!! Nothing is allocated before the counts are checked (mbd_read) and the outputs, held in
+!! memory, are checked against it (mem_check).
 program mbd2d_solve
+  use, intrinsic :: iso_fortran_env, only: error_unit
   use mbd_kinds, only: wp
-  use mbd_status, only: MBD_OK, MBD_SINGULAR_CONFIG, MSG_LEN
+  use mbd_status, only: MBD_OK, MBD_SINGULAR_CONFIG, MBD_NO_MEMORY, MSG_LEN
+  use mbd_memory, only: REAL_BYTES, mem_check
   use mbd_mbdfile, only: mbd_spec_t, mbd_read
   use mbd_constraints, only: con_nrow
   use mbd_api, only: NINFO, api_sizes, api_kinematics
@@ -15,19 +20,23 @@ program mbd2d_solve
   type(mbd_spec_t) :: spec
   character(len=1024) :: model_path, out_path
   character(len=MSG_LEN) :: msg
-  integer :: status, bad, nq, neq, k, iinfo(NINFO)
-  real(wp) :: rinfo(NINFO)
+  integer :: status, bad, nq, neq, k, iinfo(NINFO), ierr
+  real(wp) :: rinfo(NINFO), bytes
   real(wp), allocatable :: q0(:), qout(:, :), qdout(:, :), qddout(:, :), qsing(:), tpass(:)
   integer, allocatable :: dep(:), redundant(:)
 
   if (command_argument_count() /= 2) then
-    write (*, '(a)') 'usage: mbd2d-solve MODEL.mbd OUT.csv'
-    write (*, '(a)') '  runs the analysis in a model file written by `mbd2d export` and writes a CSV'
     if (command_argument_count() == 1) then
       call get_command_argument(1, model_path)
-      if (model_path == '-h' .or. model_path == '--help') stop
+      if (model_path == '-h' .or. model_path == '--help') then
+        write (*, '(a)') 'usage: mbd2d-solve MODEL.mbd OUT.csv'
+        write (*, '(a)') '  runs the analysis in a model file written by `mbd2d export` and '// &
+          'writes a CSV'
+        stop
+      end if
     end if
-    stop 2, quiet=.true.
+    call die(2, 'usage: mbd2d-solve MODEL.mbd OUT.csv (runs the analysis in a model file '// &
+             'written by `mbd2d export` and writes a CSV)')
   end if
   call get_command_argument(1, model_path)
   call get_command_argument(2, out_path)
@@ -37,16 +46,28 @@ program mbd2d_solve
   if (spec%analysis /= 'kinematics') call die(2, 'analysis "' // trim(spec%analysis) // &
     '" is not supported by mbd2d-solve (kinematics only)')
   call api_sizes(spec%nb, spec%ctab, spec%rpar, nq, neq, status, msg, bad)
-  if (status /= MBD_OK) call die(2, trim(where(bad)) // trim(msg))
+  if (status /= MBD_OK) call die(2, where(bad, msg))
+  if (spec%steps_line == 0) call die(2, trim(model_path) // ': the file gives no "steps" line')
 
-  allocate (q0(nq), qout(nq, spec%steps + 1), qdout(nq, spec%steps + 1), &
-            qddout(nq, spec%steps + 1), qsing(nq), dep(neq), redundant(neq), tpass(MAXPASS))
+  ! the outputs (3 nq numbers per output time) are held in memory until the CSV is written
+  bytes = REAL_BYTES * (3 * real(nq, wp) * (real(spec%steps, wp) + 1) + 2 * nq + 2 * neq)
+  call mem_check(bytes, 'the outputs (3 x ' // trim(itoa(nq)) // ' numbers at ' // &
+                 trim(itoa(spec%steps)) // ' + 1 times)', 'give fewer steps', status, msg)
+  if (status /= MBD_OK) call die(2, trim(model_path) // ':' // trim(itoa(spec%steps_line)) // &
+                                 ': ' // trim(msg))
+  allocate (q0(nq), qsing(nq), dep(neq), redundant(neq), tpass(MAXPASS), stat=ierr)
+  if (ierr == 0) allocate (qout(nq, spec%steps + 1), qdout(nq, spec%steps + 1), stat=ierr)
+  if (ierr == 0) allocate (qddout(nq, spec%steps + 1), stat=ierr)
+  if (ierr /= 0) call die(2, trim(model_path) // ':' // trim(itoa(spec%steps_line)) // &
+                          ': not enough memory for the outputs of ' // trim(itoa(spec%steps)) // &
+                          ' steps; give fewer steps')
   q0 = 0.0_wp
   q0(1:3 * spec%nb) = reshape(spec%q0, [3 * spec%nb])
   call api_kinematics(spec%nb, spec%ctab, spec%rpar, q0, spec%t0, spec%t_end, spec%steps, &
                       spec%tol, spec%maxit, spec%tmin, 1, 0, qout, qdout, qddout, iinfo, rinfo, &
                       qsing, dep, redundant, tpass, status, msg)
-  if (status < 0) call die(2, trim(where(iinfo(2))) // trim(msg))
+  if (status < 0) call die(2, where(iinfo(2), msg))
+  if (status == MBD_NO_MEMORY) call die(2, trim(msg))
   call write_csv(trim(out_path), iinfo(1))
   if (status == MBD_SINGULAR_CONFIG) then
     call die(3, trim(singular_message()))
@@ -56,17 +77,27 @@ program mbd2d_solve
 
 contains
 
-  function where(k) result(s)
+  !> "FILE:LINE: constraint "NAME": TEXT" for constraint k (TEXT alone for k outside 1..nc).
+  function where(k, text) result(s)
     integer, intent(in) :: k
-    character(len=MSG_LEN) :: s
-    s = ''
-    if (k > 0) s = 'constraint "' // trim(spec%con_names(k)) // '": '
+    character(len=*), intent(in) :: text
+    character(len=2 * MSG_LEN) :: s
+    s = text
+    if (k > 0 .and. k <= spec%nc) s = trim(model_path) // ':' // &
+      trim(itoa(spec%con_line(k))) // ': constraint "' // trim(spec%con_names(k)) // '": ' // &
+      trim(text)
   end function where
+
+  function itoa(i) result(s)
+    integer, intent(in) :: i
+    character(len=16) :: s
+    write (s, '(i0)') i
+  end function itoa
 
   function worst() result(s)
     character(len=MSG_LEN) :: s
     s = ''
-    if (iinfo(4) > 0) s = ' ("' // trim(spec%con_names(iinfo(4))) // '")'
+    if (iinfo(4) > 0 .and. iinfo(4) <= spec%nc) s = ' ("' // trim(spec%con_names(iinfo(4))) // '")'
   end function worst
 
   function rows_written() result(s)
@@ -91,7 +122,7 @@ contains
     if (ts(1:1) == '.') ts = '0' // trim(ts)
     if (ts(1:2) == '-.') ts = '-0' // ts(2:)
     s = 'Singular configuration (dead centre) at t = ' // trim(ts) // ' s: '
-    if (iinfo(3) > 0) then
+    if (iinfo(3) > 0 .and. iinfo(3) <= spec%nc) then
       s = trim(s) // ' driver "' // trim(spec%con_names(iinfo(3))) // &
           '" can no longer be met, because the constraints' // trim(names) // &
           ' became dependent (J lost rank).'
@@ -111,30 +142,33 @@ contains
     real(wp) :: t
     open (newunit=u, file=path, status='replace', action='write', iostat=ios)
     if (ios /= 0) call die(2, 'cannot write ' // path)
-    write (u, '(a)', advance='no') 't'
+    write (u, '(a)', advance='no', iostat=ios) 't'
     do b = 1, spec%nb
       do i = 1, 9
-        write (u, '(a)', advance='no') ',' // trim(spec%body_names(b)) // trim(sfx(i))
+        if (ios == 0) write (u, '(a)', advance='no', iostat=ios) ',' // &
+          trim(spec%body_names(b)) // trim(sfx(i))
       end do
     end do
-    write (u, '(a)') ''
+    if (ios == 0) write (u, '(a)', iostat=ios) ''
     do k = 1, nrows
+      if (ios /= 0) exit
       t = spec%t0 + (spec%t_end - spec%t0) * (real(k - 1, wp) / max(spec%steps, 1))
       if (k == spec%steps + 1) t = spec%t_end
-      write (u, '(es24.16e3)', advance='no') t
+      write (u, '(es24.16e3)', advance='no', iostat=ios) t
       do b = 1, spec%nb
-        write (u, '(9(",",es24.16e3))', advance='no') qout(3 * b - 2:3 * b, k), &
-          qdout(3 * b - 2:3 * b, k), qddout(3 * b - 2:3 * b, k)
+        if (ios == 0) write (u, '(9(",",es24.16e3))', advance='no', iostat=ios) &
+          qout(3 * b - 2:3 * b, k), qdout(3 * b - 2:3 * b, k), qddout(3 * b - 2:3 * b, k)
       end do
-      write (u, '(a)') ''
+      if (ios == 0) write (u, '(a)', iostat=ios) ''
     end do
     close (u)
+    if (ios /= 0) call die(2, 'cannot write ' // path // ' (disk full?)')
   end subroutine write_csv
 
   subroutine die(code, text)
     integer, intent(in) :: code
     character(len=*), intent(in) :: text
-    write (*, '(a)') 'mbd2d-solve: ' // text
+    write (error_unit, '(a)') 'mbd2d-solve: ' // trim(text)
     select case (code)
     case (2); stop 2, quiet=.true.
     case (3); stop 3, quiet=.true.

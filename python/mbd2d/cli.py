@@ -17,7 +17,8 @@ import sys
 import textwrap
 from typing import Sequence
 
-from .errors import AnalysisError, MbdError, ModelError, SingularConfigurationError
+from .errors import (AnalysisError, InsufficientMemoryError, MbdError, ModelError,
+                     SingularConfigurationError)
 from .model import Model, load
 from .results import StaticsResult
 
@@ -123,6 +124,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         return EXIT_OK
     except ModelError as exc:
         _say(f"mbd2d: error in the model or the command: {exc}")
+        return EXIT_INPUT
+    except InsufficientMemoryError as exc:      # too large for this machine: change the input
+        _say(f"mbd2d: {exc}")
         return EXIT_INPUT
     except AnalysisError as exc:
         if args.command in ("check", "statics"):

@@ -133,9 +133,11 @@ class CoreError(MbdError):
 
 
 class InsufficientMemoryError(MbdError, MemoryError):
-    """An analysis needs more memory than it can get (refused before the run from an estimate,
-    or an allocation that failed). The message says how much was asked and what to change:
-    fewer steps, ``every=k`` to keep fewer output rows, ``solver="banded"`` for large models.
+    """An analysis needs more memory than it can get (the core's status 10): refused before
+    the run from an estimate, refused by the core before allocating a request above half the
+    physical memory (or above what is free), or an allocation that failed. The message says
+    how much was asked and what to change: fewer steps, ``every=k`` to keep fewer output rows,
+    ``solver="banded"`` for large models. The process and its earlier results are unharmed.
 
     Attributes
     ----------

@@ -23,8 +23,10 @@ from .analysis.kinematics import run_kinematics
 from .analysis.mbdfile import export as export_mbd
 from .analysis.statics import run_statics
 from .binding.pack import pack
+from .binding.params import open_values
 from .description import toml_io
 from .description.builder import ModelDescription
+from .description.parameters import parameter_list
 from .results import DofReport, DynamicsResult, KinematicsResult, StaticsResult
 
 
@@ -56,10 +58,27 @@ class Model(ModelDescription):
         p = pack(self)
         return p.neq, p.nq
 
+    def parameters(self) -> dict[str, float | None]:
+        """Every design parameter by name, with its value (see
+        :meth:`~mbd2d.description.builder.ModelDescription.parameters`); a gear or rolling
+        phase left open gets the value the core takes from the q0 estimates.
+
+        Examples
+        --------
+        >>> import mbd2d
+        >>> p = mbd2d.load("examples/fourbar_grashof.toml").parameters()
+        >>> p["driver.motor.f.poly.1"], p["model.gravity.1"]
+        (6.283185307179586, -9.81)
+        """
+        values = super().parameters()
+        if any(v is None for v in values.values()):
+            values.update(open_values(pack(self), parameter_list(self)))
+        return values
+
     # ------------------------------------------------------------------ analyses
     def kinematics(self, t_end: float, steps: int, t0: float = 0.0, tol: float | None = None,
-                   maxit: int | None = None, every: int = 1,
-                   solver: str = "auto") -> KinematicsResult:
+                   maxit: int | None = None, every: int = 1, solver: str = "auto",
+                   sensitivities: Any = None) -> KinematicsResult:
         """Kinematic analysis at steps + 1 uniform times from t0 to t_end.
 
         The whole time loop runs in the Fortran core. Assembly refines the q0 estimates at t0.
@@ -85,6 +104,12 @@ class Model(ModelDescription):
             reverse Cuthill-McKee ordering. "auto" picks the band for square J with at least
             60 coordinates whose band is at most a quarter of them wide
             (``res.stats["solver"]`` says which ran).
+        sensitivities : list of str, optional
+            Design parameters (names from :meth:`parameters`) to differentiate with respect
+            to: the result then has ``dq_dp``, ``dqd_dp``, ``dqdd_dp``, each (rows,
+            n_coordinates, n_params), and ``res.sensitivity(body, name)``. They come from
+            the differentiated constraint equations, J dq/dp = -Phi_p and so on, solved
+            with each step's factorization (exact to round-off; see docs/sensitivities.md).
 
         Returns
         -------
@@ -110,9 +135,9 @@ class Model(ModelDescription):
         """
         if self.has_masses() and maxit is None:
             return run_inverse(self, t_end=t_end, steps=steps, t0=t0, tol=tol, every=every,
-                               solver=solver)
+                               solver=solver, sensitivities=sensitivities)
         return run_kinematics(self, t_end=t_end, steps=steps, t0=t0, tol=tol, maxit=maxit,
-                              every=every, solver=solver)
+                              every=every, solver=solver, sensitivities=sensitivities)
 
     def analyze_dof(self, t: float = 0.0, tol: float | None = None) -> DofReport:
         """Degrees of freedom and redundant constraints at the configuration assembled from
@@ -140,12 +165,17 @@ class Model(ModelDescription):
         return analyze_dof(self, t=t, tol=tol)
 
     def inverse_dynamics(self, t_end: float, steps: int, t0: float = 0.0,
-                         tol: float | None = None, every: int = 1,
-                         solver: str = "auto") -> DynamicsResult:
+                         tol: float | None = None, every: int = 1, solver: str = "auto",
+                         sensitivities: Any = None) -> DynamicsResult:
         """Kinematics of the driven model plus, at every output time, the multipliers lambda
         (J^T lambda = Q - M q_ddot), the joint reactions (``res.reaction(name)``), the driver
         efforts (``res.effort(name)``) and the energies. ``every`` and ``solver`` as in
         :meth:`kinematics` (the multipliers are computed at the kept outputs only).
+
+        With ``sensitivities=[names]`` (geometry, masses, inertias, gravity, force and
+        driver parameters) the result also has the kinematic sensitivities of
+        :meth:`kinematics`, ``dlam_dp`` (rows, neq, n_params), ``res.effort_dp(driver)``
+        (rows, n_params) and ``res.reaction_dp(name)``.
 
         Raises
         ------
@@ -155,13 +185,13 @@ class Model(ModelDescription):
             As :meth:`kinematics`.
         """
         return run_inverse(self, t_end=t_end, steps=steps, t0=t0, tol=tol, every=every,
-                           solver=solver)
+                           solver=solver, sensitivities=sensitivities)
 
     def dynamics(self, t_end: float, steps: int, method: str | None = None,
                  rtol: float | None = None, atol: float | None = None, h: float | None = None,
                  rho_inf: float | None = None, alpha: float | None = None,
-                 beta: float | None = None, t0: float = 0.0,
-                 every: int = 1, max_steps: int | None = None) -> DynamicsResult:
+                 beta: float | None = None, t0: float = 0.0, every: int = 1,
+                 max_steps: int | None = None, sensitivities: Any = None) -> DynamicsResult:
         """Forward dynamics of M q_ddot + J^T lambda = Q, Phi = 0 from the assembled q0 and
         v0 (projected onto J q_dot = nu), outputs at steps + 1 uniform times (every
         every-th of them kept).
@@ -197,6 +227,12 @@ class Model(ModelDescription):
             ends a run whose steps collapse; a long run at a tight tolerance (or a fixed h
             that needs more steps) raises it. When it is reached the run stops with an
             IntegrationError that says so, the results up to then kept.
+        sensitivities : list of str, optional
+            Design parameters to differentiate with respect to (dopri5 only): the
+            variational equations are integrated with the state, under the same error
+            control, giving ``dq_dp``, ``dqd_dp``, ``dqdd_dp`` (rows, n_coordinates,
+            n_params). The start's sensitivities are those of the assembled q0 (the minimum-
+            norm change) and of the projected v0.
 
         Returns
         -------
@@ -220,11 +256,13 @@ class Model(ModelDescription):
         """
         return run_dynamics(self, t_end=t_end, steps=steps, method=method, rtol=rtol,
                             atol=atol, h=h, rho_inf=rho_inf, alpha=alpha, beta=beta, t0=t0,
-                            every=every, max_steps=max_steps)
+                            every=every, max_steps=max_steps, sensitivities=sensitivities)
 
-    def statics(self, t: float = 0.0) -> StaticsResult:
+    def statics(self, t: float = 0.0, sensitivities: Any = None) -> StaticsResult:
         """Static equilibrium under gravity, springs and loads (drivers held at t), with the
-        multipliers, reactions (``res.reaction(name)``) and stability.
+        multipliers, reactions (``res.reaction(name)``) and stability. With
+        ``sensitivities=[names]`` also ``eq.dq_dp`` (n_coordinates, n_params) and
+        ``eq.dlam_dp``, the derivatives of the equilibrium.
 
         Raises
         ------
@@ -233,7 +271,7 @@ class Model(ModelDescription):
         SingularJacobianError
             If the equilibrium is not unique (a free motion without stiffness).
         """
-        return run_statics(self, t=t)
+        return run_statics(self, t=t, sensitivities=sensitivities)
 
     # ------------------------------------------------------------------ at one state
     def phi(self, q: Any, t: float = 0.0) -> np.ndarray:

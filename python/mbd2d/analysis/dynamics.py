@@ -16,6 +16,7 @@ from ..validate import number, whole
 from .contacts import MAX_EVENTS, check_method, has_events, report_pulls
 from .failures import assembly_failed, bad_entry, inconsistent_at, row_names
 from .outputs import dynamics_result, finite_part
+from .sensitivities import attach, check_status, requested, table
 from .settings import check_memory, check_span, output_rows, output_steps, time_grid
 
 METHODS = {"generalized-alpha": 1, "dopri5": 2, "baumgarte-rk4": 3, "partitioned": 4}
@@ -28,7 +29,7 @@ def run_dynamics(model: ModelDescription, t_end: float, steps: int, method: str 
                  rtol: float | None = None, atol: float | None = None, h: float | None = None,
                  rho_inf: float | None = None, alpha: float | None = None,
                  beta: float | None = None, t0: float = 0.0, every: Any = 1,
-                 max_steps: Any = None) -> DynamicsResult:
+                 max_steps: Any = None, sensitivities: Any = None) -> DynamicsResult:
     """Forward dynamics in one core call; see :meth:`mbd2d.Model.dynamics`."""
     t0, t_end, steps = check_span(t0, t_end, steps)
     nout = output_rows(steps, every)
@@ -67,15 +68,25 @@ def run_dynamics(model: ModelDescription, t_end: float, steps: int, method: str 
     alpha_v = opt(alpha, "alpha", 0.0, 1e9, -1.0)
     beta_v = opt(beta, "beta", 0.0, 1e9, -1.0)
     check_method(model, method)
+    params = requested(model, sensitivities)
+    if params and method != "dopri5":
+        raise ModelError(f"sensitivities are integrated with dopri5 (the variational "
+                         f"equations with the state); method {method!r} has none",
+                         "dynamics")
     p = pack(model)
     d = pack_dynamics(model, p)
-    nel = d.ftab.shape[1]
-    check_memory(nout, 3 * p.nq + p.neq + 4 + 6 * nel, "dynamics",
-                 dense=(p.nq + p.neq, p.nq + p.neq))
+    npar = len(params) if params else 0
+    check_memory(nout, 3 * p.nq * (1 + npar) + p.neq + 4 + 6 * d.ftab.shape[1], "dynamics")
     idx = output_steps(steps, every)
     maxev = MAX_EVENTS if has_events(model) else 1
-    out = core.dynamics(p, d, t0, t_end, steps, METHODS[method], rtol_v, atol_v, h_v, rho_v,
-                        alpha_v, beta_v, every, nout, nmax, maxev)
+    if params:
+        ptab = table(p, params, d)
+        out = core.dynamics_sens(p, d, t0, t_end, steps, rtol_v, atol_v, every, nmax, nout,
+                                 ptab)
+        check_status(out.status, out.iinfo, out.msg, params)
+    else:
+        out = core.dynamics(p, d, t0, t_end, steps, METHODS[method], rtol_v, atol_v, h_v,
+                            rho_v, alpha_v, beta_v, every, nout, nmax, maxev)
     iinfo, rinfo, status = out.iinfo, out.rinfo, out.status
     n = int(iinfo[0])
     t = time_grid(t0, t_end, steps, idx)
@@ -86,8 +97,12 @@ def run_dynamics(model: ModelDescription, t_end: float, steps: int, method: str 
              "partitions": int(iinfo[7]),
              "h_min": float(rinfo[1]) if iinfo[2] else None,
              "h_max": float(rinfo[2]) if iinfo[2] else None, "redundant_rows": red_rows,
-             "events": int(out.nev), "events_not_kept": max(0, int(out.nev) - maxev)}
-    res, bad = finite_part(dynamics_result(model, p, t, n, out, stats, status == OK))
+             "events": int(getattr(out, "nev", 0)),
+             "events_not_kept": max(0, int(getattr(out, "nev", 0)) - maxev)}
+    res = dynamics_result(model, p, t, n, out, stats, status == OK)
+    if params:
+        attach(res, out, params, n, ptab)
+    res, bad = finite_part(res)
     if status == OK and bad is None:
         report_pulls(model, p, res)
     if red_rows:

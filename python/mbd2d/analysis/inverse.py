@@ -14,12 +14,14 @@ from ..results.dynamics import DynamicsResult
 from .contacts import MAX_EVENTS, report_pulls
 from .failures import BAD_FORCE, bad_entry, kinematic_failure, row_names
 from .outputs import dynamics_result, finite_part
+from .sensitivities import attach, check_status, requested, table
 from .settings import (check_memory, check_solver, check_span, output_rows, output_steps,
                        require_determined, solver_code, time_grid)
 
 
 def run_inverse(model: ModelDescription, t_end: float, steps: int, t0: float = 0.0,
-                tol: float | None = None, every: Any = 1, solver: str = "auto") -> DynamicsResult:
+                tol: float | None = None, every: Any = 1, solver: str = "auto",
+                sensitivities: Any = None) -> DynamicsResult:
     """Kinematics plus the multipliers, energies and (on demand) reactions at every output.
 
     See :meth:`mbd2d.Model.inverse_dynamics`.
@@ -28,14 +30,21 @@ def run_inverse(model: ModelDescription, t_end: float, steps: int, t0: float = 0
     tol_v, _ = check_solver(tol, None)
     nout = output_rows(steps, every)
     code = solver_code(solver)
+    params = requested(model, sensitivities)
     p = pack(model)
     require_determined(p, model)
     d = pack_dynamics(model, p)
-    check_memory(nout, 3 * p.nq + p.neq + 4 + 6 * d.ftab.shape[1], "inverse dynamics",
-                 dense=(p.nq + p.neq, p.nq + p.neq))
+    npar = len(params) if params else 0
+    check_memory(nout, (3 * p.nq + p.neq) * (1 + npar) + 4 + 6 * d.ftab.shape[1],
+                 "inverse dynamics")
     idx = output_steps(steps, every)
-    maxev = MAX_EVENTS if model.contacts else 1
-    out = core.inverse(p, d, t0, t_end, steps, tol_v, int(every), code, nout, maxev)
+    if params:
+        ptab = table(p, params, d)
+        out = core.inverse_sens(p, d, t0, t_end, steps, tol_v, int(every), code, nout, ptab)
+        check_status(out.status, out.iinfo, out.msg, params)
+    else:
+        maxev = MAX_EVENTS if model.contacts else 1
+        out = core.inverse(p, d, t0, t_end, steps, tol_v, int(every), code, nout, maxev)
     iinfo, status = out.iinfo, out.status
     n = int(iinfo[0])
     t = time_grid(t0, t_end, steps, idx)
@@ -44,8 +53,11 @@ def run_inverse(model: ModelDescription, t_end: float, steps: int, t0: float = 0
              "rejected_steps": int(iinfo[7]), "rank": int(iinfo[8]),
              "redundant_rows": red_rows,
              "singular_passages": [float(x) for x in out.tpass[:min(int(iinfo[9]), 64)]],
-             "events": int(out.nev)}
-    res, bad = finite_part(dynamics_result(model, p, t, n, out, stats, status == OK))
+             "events": int(getattr(out, "nev", 0))}
+    res = dynamics_result(model, p, t, n, out, stats, status == OK)
+    if params:
+        attach(res, out, params, n, ptab)
+    res, bad = finite_part(res)
     if status == OK and bad is None:
         report_pulls(model, p, res)
     if red_rows:

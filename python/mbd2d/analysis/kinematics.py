@@ -13,26 +13,34 @@ from ..errors import RedundantConstraintWarning, SingularPassageWarning
 from ..results.kinematics import KinematicsResult
 from .failures import kinematic_failure, row_names
 from .outputs import finite_part
+from .sensitivities import attach, check_status, requested, table
 from .settings import (check_memory, check_solver, check_span, output_rows, output_steps,
                        require_determined, solver_code, time_grid)
 
 
 def run_kinematics(model: ModelDescription, t_end: float, steps: int, t0: float = 0.0,
                    tol: float | None = None, maxit: int | None = None,
-                   tmin: float | None = None, every: Any = 1,
-                   solver: str = "auto") -> KinematicsResult:
+                   tmin: float | None = None, every: Any = 1, solver: str = "auto",
+                   sensitivities: Any = None) -> KinematicsResult:
     """Run a kinematic analysis in one core call; see :meth:`mbd2d.Model.kinematics`."""
     t0, t_end, steps = check_span(t0, t_end, steps)
     tol_v, maxit_v = check_solver(tol, maxit)
     nout = output_rows(steps, every)
     code = solver_code(solver)
+    params = requested(model, sensitivities)
     p = pack(model)
     require_determined(p, model)
-    check_memory(nout, 3 * p.nq, "kinematics",
-                 dense=(p.neq, p.nq) if solver == "dense" else None)
+    npar = len(params) if params else 0
+    check_memory(nout, 3 * p.nq * (1 + npar), "kinematics")
     idx = output_steps(steps, every)
-    out = core.kinematics(p, t0, t_end, steps, tol_v, maxit_v, float(tmin or 0.0), int(every),
-                          code, nout)
+    if params:
+        ptab = table(p, params)
+        out = core.kinematics_sens(p, t0, t_end, steps, tol_v, maxit_v, float(tmin or 0.0),
+                                   int(every), code, nout, ptab)
+        check_status(out.status, out.iinfo, out.msg, params)
+    else:
+        out = core.kinematics(p, t0, t_end, steps, tol_v, maxit_v, float(tmin or 0.0),
+                              int(every), code, nout)
     iinfo, rinfo, tpass, status = out.iinfo, out.rinfo, out.tpass, out.status
     n = int(iinfo[0])
     t = time_grid(t0, t_end, steps, idx)
@@ -51,6 +59,8 @@ def run_kinematics(model: ModelDescription, t_end: float, steps: int, t0: float 
                                   "solver": "banded" if int(rinfo[4]) == 2 else "dense",
                                   "band": (int(rinfo[5]), int(rinfo[6]))},
                            complete=status == OK, model=model)
+    if params:
+        attach(res, out, params, n, ptab)
     res, bad = finite_part(res)
     if red_rows and status in (OK, SINGULAR_CONFIG, NO_CONVERGENCE):
         warnings.warn(f"redundant constraints: {', '.join(red_rows)} repeat what the other "

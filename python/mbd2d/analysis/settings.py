@@ -86,23 +86,20 @@ def physical_memory() -> float:
         return 8.0 * 2**30
 
 
-def check_memory(rows: int, columns: int, analysis: str = "analysis",
-                 dense: tuple[int, int] | None = None) -> None:
-    """Refuse a run whose memory cannot fit in half the physical memory, before anything is
-    allocated: the output arrays (rows x columns numbers, held twice: the core's and the
-    result's) and, when ``dense`` = (m, n) is given, a dense m x n matrix of the core's.
+def check_memory(rows: int, columns: int, analysis: str = "analysis") -> None:
+    """Refuse a run whose output arrays (rows x columns numbers, held twice: the core's and
+    the result's) cannot fit in half the physical memory, before anything is allocated. The
+    core checks its own work arrays (the dense matrices) before it allocates them and
+    returns NO_MEMORY with their size (mbd_memory.f90).
 
     Raises
     ------
     InsufficientMemoryError
         With the size asked and what to change.
     """
-    outputs = 2.0 * 8.0 * rows * columns
-    need = outputs + (8.0 * dense[0] * dense[1] if dense else 0.0)
+    need = 2.0 * 8.0 * rows * columns
     if need > 0.5 * physical_memory():
         parts = f"{rows} output rows x {columns} numbers, twice"
-        if dense:
-            parts += f", and a dense {dense[0]} x {dense[1]} matrix"
         raise InsufficientMemoryError(
             f"{analysis}: the run would need {need / 2**30:.3g} GiB ({parts}), more than half "
             f"of this machine's {physical_memory() / 2**30:.3g} GiB; {MEMORY_ADVICE}", need)

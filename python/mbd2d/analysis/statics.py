@@ -1,6 +1,8 @@
 """Statics front door: static equilibrium near the q0 estimates, in one core call."""
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from ..binding import core
@@ -12,19 +14,25 @@ from ..results.statics import StaticsResult
 from ..validate import number
 from .contacts import check_statics
 from .failures import assembly_failed, bad_entry, inconsistent_at
-from .settings import check_memory
+from .sensitivities import check_status, requested, table
 
 STABILITY = {1: "stable", 0: "unstable", -1: "neutral", 2: "fully constrained"}
 
 
-def run_statics(model: ModelDescription, t: float = 0.0) -> StaticsResult:
+def run_statics(model: ModelDescription, t: float = 0.0,
+                sensitivities: Any = None) -> StaticsResult:
     """Static equilibrium near the q0 estimates; see :meth:`mbd2d.Model.statics`."""
     t = number(t, "t", "statics")
     check_statics(model)
+    params = requested(model, sensitivities)
     p = pack(model)
     d = pack_dynamics(model, p)
-    check_memory(0, 0, "statics", dense=(p.nq + p.neq, p.nq + p.neq))
-    out = core.statics(p, d, t)
+    if params:
+        ptab = table(p, params, d)
+        out = core.statics_sens(p, d, t, ptab)
+        check_status(out.status, out.iinfo, out.msg, params)
+    else:
+        out = core.statics(p, d, t)
     status, text = out.status, out.msg
     if status < 0:
         raise error_for("statics", status, text, entry=bad_entry(model, int(out.iinfo[1])))
@@ -44,8 +52,16 @@ def run_statics(model: ModelDescription, t: float = 0.0) -> StaticsResult:
         raise error_for("statics", NO_CONVERGENCE, "the equilibrium iteration gave non-finite "
                         "values; give q0 closer to an equilibrium", t=t,
                         residual=float(out.resid))
-    return StaticsResult(t=t, q=out.q, lam=out.lam,
-                         stability=STABILITY.get(int(out.stable), "unknown"),
-                         residual=float(out.resid), body_names=p.body_names,
-                         coordinate_names=p.coordinate_names, row_labels=p.row_labels,
-                         model=model, packed=p)
+    res = StaticsResult(t=t, q=out.q, lam=out.lam,
+                        stability=STABILITY.get(int(out.stable), "unknown"),
+                        residual=float(out.resid), body_names=p.body_names,
+                        coordinate_names=p.coordinate_names, row_labels=p.row_labels,
+                        model=model, packed=p)
+    if params:
+        if not (np.isfinite(out.sq).all() and np.isfinite(out.slam).all()):
+            raise error_for("statics", NO_CONVERGENCE, "the sensitivities of the equilibrium "
+                            "are not finite (the equilibrium is not isolated)", t=t,
+                            residual=float(out.resid))
+        res.parameter_names = [prm.name for prm in params]
+        res.dq_dp, res.dlam_dp, res.ptab = out.sq.copy(), out.slam.copy(), ptab
+    return res

@@ -19,18 +19,21 @@ from .status import MEMORY_ADVICE
 from .tables import DynamicTables, Packed, decode
 
 
-def _named(names: str, fn: Callable[..., tuple[Any, ...]], *args: Any,
+def _named(names: str, fn: Callable[..., tuple[Any, ...]], *args: Any, numbers: float = 0,
            **kwargs: Any) -> SimpleNamespace:
-    """Call the core and name its output tuple; ``msg`` decoded to text. The output arrays
-    f2py allocates for the call failing to fit in memory is an InsufficientMemoryError."""
+    """Call the core and name its output tuple; ``msg`` decoded to text. The arrays f2py
+    allocates for the call (its outputs, about ``numbers`` float64 values) failing to fit in
+    memory is an InsufficientMemoryError naming their size."""
     try:
         out = fn(*args, **kwargs)
     except InsufficientMemoryError:
         raise
     except MemoryError:
         what = getattr(fn, "__name__", "the core")
-        raise InsufficientMemoryError(f"the core's arrays for {what} could not be allocated; "
-                                      f"{MEMORY_ADVICE}") from None
+        nbytes = 8.0 * numbers
+        raise InsufficientMemoryError(f"allocating the core's arrays for {what} (about "
+                                      f"{nbytes / 2**20:.1f} MiB) failed; {MEMORY_ADVICE}",
+                                      nbytes) from None
     fields = dict(zip(names.split(), out, strict=True))
     if "msg" in fields:
         fields["msg"] = decode(fields["msg"])
@@ -40,7 +43,8 @@ def _named(names: str, fn: Callable[..., tuple[Any, ...]], *args: Any,
 
 def sizes(nb: int, ctab: np.ndarray, rpar: np.ndarray) -> SimpleNamespace:
     """Check the tables; ``nq``, ``neq``, ``status``, ``msg``, ``bad`` (1-based constraint)."""
-    return _named("nq neq status msg bad", _core.core_sizes, nb, ctab, rpar)
+    return _named("nq neq status msg bad", _core.core_sizes, nb, ctab, rpar,
+                  numbers=np.size(rpar) + np.size(ctab) / 2)   # the inputs, if copied
 
 
 def evaluate(nb: int, ctab: np.ndarray, rpar: np.ndarray, neq: int, q: np.ndarray,
@@ -48,7 +52,7 @@ def evaluate(nb: int, ctab: np.ndarray, rpar: np.ndarray, neq: int, q: np.ndarra
     """Phi, J, nu and gamma at a state: ``phi``, ``jac``, ``nu``, ``gam``, ``status``, ``msg``,
     ``bad``."""
     return _named("phi jac nu gam status msg bad", _core.core_eval, nb, ctab, rpar, neq, q, qd,
-                  float(t))
+                  float(t), numbers=neq * (len(q) + 3))
 
 
 def kinematics(p: Packed, t0: float, t1: float, steps: int, tol: float, maxit: int,
@@ -57,7 +61,7 @@ def kinematics(p: Packed, t0: float, t1: float, steps: int, tol: float, maxit: i
     ``qsing``, ``dep``, ``red``, ``tpass``, ``status``, ``msg``."""
     return _named("q qd qdd iinfo rinfo qsing dep red tpass status msg", _core.core_kinematics,
                   p.nb, p.ctab, p.rpar, p.neq, p.q0, t0, t1, steps, tol, maxit, tmin, every,
-                  solver, nout)
+                  solver, nout, numbers=3 * p.nq * nout + p.nq + 2 * p.neq)
 
 
 def kin_step(p: Packed, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, t_prev: float,
@@ -72,12 +76,13 @@ def analyze(p: Packed, t: float, tol: float) -> SimpleNamespace:
     """Rank and redundancy at the assembled configuration: ``q``, ``rank``, ``mobility``,
     ``red``, ``dep``, ``resid``, ``worst``, ``status``, ``msg``."""
     return _named("q rank mobility red dep resid worst status msg", _core.core_analyze, p.nb,
-                  p.ctab, p.rpar, p.neq, p.q0, t, tol)
+                  p.ctab, p.rpar, p.neq, p.q0, t, tol, numbers=p.nq + 2 * p.neq)
 
 
 def profile(kind: int, raw: np.ndarray, alphas: np.ndarray) -> SimpleNamespace:
     """Points c(alpha) of a closed profile curve: ``pts`` (2, n), ``status``, ``msg``."""
-    return _named("pts status msg", _core.core_profile, kind, raw, alphas)
+    return _named("pts status msg", _core.core_profile, kind, raw, alphas,
+                  numbers=2 * len(alphas))
 
 
 def inverse(p: Packed, d: DynamicTables, t0: float, t1: float, steps: int, tol: float,
@@ -89,7 +94,9 @@ def inverse(p: Packed, d: DynamicTables, t0: float, t1: float, steps: int, tol: 
     return _named("q qd qdd lam e iinfo rinfo qsing dep red tpass status msg eo evo nev",
                   _core.core_inverse, ctab=p.ctab, rpar=p.rpar, bmass=d.bmass, grav=d.grav,
                   ftab=d.ftab, fpar=d.fpar, neq=p.neq, q0=p.q0, t0=t0, t1=t1, nsteps=steps,
-                  tol=tol, every=every, solver=solver, nout=nout, maxev=max(1, maxev))
+                  tol=tol, every=every, solver=solver, nout=nout, maxev=max(1, maxev),
+                  numbers=(3 * p.nq + p.neq + 4 + 6 * d.ftab.shape[1]) * nout + p.nq
+                  + 2 * p.neq + 4 * maxev)
 
 
 def dynamics(p: Packed, d: DynamicTables, t0: float, t1: float, steps: int, method: int,
@@ -104,7 +111,9 @@ def dynamics(p: Packed, d: DynamicTables, t0: float, t1: float, steps: int, meth
                   fpar=d.fpar, neq=p.neq, q0=p.q0, v0=d.v0, t0=t0, t1=t1, nsteps=steps,
                   method=method, rtol=rtol, atol=atol, h=h, rho_inf=rho_inf, balpha=alpha,
                   bbeta=beta, every=every, nrow=nrow, max_steps=max_steps,
-                  maxev=max(1, maxev))
+                  maxev=max(1, maxev),
+                  numbers=(3 * p.nq + p.neq + 4 + 6 * d.ftab.shape[1]) * nrow + p.neq
+                  + 4 * maxev)
 
 
 def statics(p: Packed, d: DynamicTables, t: float) -> SimpleNamespace:
@@ -112,7 +121,7 @@ def statics(p: Packed, d: DynamicTables, t: float) -> SimpleNamespace:
     ``msg``."""
     return _named("q lam stable resid iinfo status msg", _core.core_statics, ctab=p.ctab,
                   rpar=p.rpar, bmass=d.bmass, grav=d.grav, ftab=d.ftab, fpar=d.fpar,
-                  neq=p.neq, q0=p.q0, t=t)
+                  neq=p.neq, q0=p.q0, t=t, numbers=p.nq + p.neq)
 
 
 def cam_forces(p: Packed, q: np.ndarray, t: np.ndarray, lam: np.ndarray) -> SimpleNamespace:
@@ -126,4 +135,68 @@ def reactions(p: Packed, q: np.ndarray, t: np.ndarray, lam: np.ndarray) -> Simpl
     """Joint reactions at states q (nq, nt), times t (nt) and multipliers lam (neq, nt):
     ``reac`` and ``rloc`` (6, nc, nt), ``status``, ``msg``."""
     return _named("reac rloc status msg", _core.core_reactions, p.nb, p.ctab, p.rpar, q, t,
-                  lam)
+                  lam, numbers=12 * p.ctab.shape[1] * len(np.atleast_1d(t)))
+
+
+# ------------------------------------------------------------------ design sensitivities
+# ptab: int32 (2, np), Fortran order: per design parameter its table (1 rpar, 2 bmass
+# flattened (2, nb), 3 grav, 4 fpar) and 1-based index (see fortran/mbd_sensitivity.f90).
+
+def eval_d(p: Packed, rpar: np.ndarray, q: np.ndarray, qd: np.ndarray, t: float,
+           dq: np.ndarray, dqd: np.ndarray, ptab: np.ndarray) -> SimpleNamespace:
+    """Changes of Phi, J, nu and gamma along a direction (dq, dqd) and at most one design
+    parameter: ``tphi``, ``tjac``, ``tnu``, ``tgam``, ``status``, ``msg``, ``bad``."""
+    return _named("tphi tjac tnu tgam status msg bad", _core.core_eval_d, p.nb, p.ctab, rpar,
+                  p.neq, q, qd, float(t), dq, dqd, ptab)
+
+
+def kinematics_sens(p: Packed, t0: float, t1: float, steps: int, tol: float, maxit: int,
+                    tmin: float, every: int, solver: int, nout: int,
+                    ptab: np.ndarray) -> SimpleNamespace:
+    """A kinematic run with sensitivities: as :func:`kinematics` plus ``sq``, ``sqd``,
+    ``sqdd`` (nq, np, nout)."""
+    return _named("q qd qdd sq sqd sqdd iinfo rinfo qsing dep red tpass status msg",
+                  _core.core_kinematics_sens, p.nb, p.ctab, p.rpar, p.neq, p.q0, t0, t1, steps,
+                  tol, maxit, tmin, every, solver, nout, ptab,
+                  numbers=3 * p.nq * nout * (1 + ptab.shape[1]))
+
+
+def inverse_sens(p: Packed, d: DynamicTables, t0: float, t1: float, steps: int, tol: float,
+                 every: int, solver: int, nout: int, ptab: np.ndarray) -> SimpleNamespace:
+    """Inverse dynamics with sensitivities: as :func:`inverse` plus ``sq``, ``sqd``, ``sqdd``
+    (nq, np, nout) and ``slam`` (neq, np, nout)."""
+    return _named("q qd qdd lam e sq sqd sqdd slam iinfo rinfo qsing dep red tpass status msg",
+                  _core.core_inverse_sens, ctab=p.ctab, rpar=p.rpar, bmass=d.bmass,
+                  grav=d.grav, ftab=d.ftab, fpar=d.fpar, neq=p.neq, q0=p.q0, t0=t0, t1=t1,
+                  nsteps=steps, tol=tol, every=every, solver=solver, nout=nout, ptab=ptab,
+                  numbers=(3 * p.nq + p.neq) * nout * (1 + ptab.shape[1]))
+
+
+def dynamics_sens(p: Packed, d: DynamicTables, t0: float, t1: float, steps: int, rtol: float,
+                  atol: float, every: int, max_steps: int, nrow: int,
+                  ptab: np.ndarray) -> SimpleNamespace:
+    """Forward dynamics by dopri5 with sensitivities: ``q``, ``qd``, ``qdd``, ``lam``, ``e``,
+    ``sq``, ``sqd``, ``sqdd``, ``iinfo``, ``rinfo``, ``red``, ``status``, ``msg``."""
+    return _named("q qd qdd lam e sq sqd sqdd iinfo rinfo red status msg",
+                  _core.core_dynamics_sens, ctab=p.ctab, rpar=p.rpar, bmass=d.bmass,
+                  grav=d.grav, ftab=d.ftab, fpar=d.fpar, neq=p.neq, q0=p.q0, v0=d.v0, t0=t0,
+                  t1=t1, nsteps=steps, rtol=rtol, atol=atol, every=every, max_steps=max_steps,
+                  nrow=nrow, ptab=ptab,
+                  numbers=(3 * p.nq + p.neq) * nrow * (1 + ptab.shape[1]))
+
+
+def statics_sens(p: Packed, d: DynamicTables, t: float, ptab: np.ndarray) -> SimpleNamespace:
+    """Static equilibrium with sensitivities: ``q``, ``lam``, ``sq`` (nq, np), ``slam``
+    (neq, np), ``stable``, ``resid``, ``iinfo``, ``status``, ``msg``."""
+    return _named("q lam sq slam stable resid iinfo status msg", _core.core_statics_sens,
+                  ctab=p.ctab, rpar=p.rpar, bmass=d.bmass, grav=d.grav, ftab=d.ftab,
+                  fpar=d.fpar, neq=p.neq, q0=p.q0, t=t, ptab=ptab)
+
+
+def reactions_dp(p: Packed, ptab: np.ndarray, q: np.ndarray, t: np.ndarray, lam: np.ndarray,
+                 sq: np.ndarray, slam: np.ndarray) -> SimpleNamespace:
+    """Changes of the reactions along the parameters: ``dreac``, ``drloc``
+    (6, nc, np, nt), ``status``, ``msg``."""
+    return _named("dreac drloc status msg", _core.core_reactions_dp, p.nb, p.ctab, p.rpar,
+                  ptab, q, t, lam, sq, slam,
+                  numbers=12 * p.ctab.shape[1] * ptab.shape[1] * len(np.atleast_1d(t)))

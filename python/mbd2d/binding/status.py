@@ -31,7 +31,7 @@ INCONSISTENT = 6        # redundant constraints that contradict
 BRANCH_SWITCH = 7       # solution left its assembly branch
 INTEGRATOR_FAILED = 8   # step size underflow, blow-up
 USER_ABORT = 9          # a user callback asked to stop
-NO_MEMORY = 10          # an allocation failed (the message gives the size)
+NO_MEMORY = 10          # an allocation failed or would not fit (mbd_memory.f90)
 
 #: Every status the core defines, by name.
 STATUS_NAMES = {

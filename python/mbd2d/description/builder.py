@@ -29,6 +29,8 @@ from .functions import as_function
 from .joints import (COORDINATES, PRESSURE_ANGLE, Absolute, Cam, Constraint, Distance, Gear,
                      PinInSlot, PointOnCurve, PointOnLine, RackPinion, Revolute, RollingDisc,
                      Translational, Weld, joint_keys, parse_follower, parse_profile)
+from .parameters import parameter_list
+from .parameters import with_params as _with_params
 
 
 class ModelDescription:
@@ -591,6 +593,43 @@ class ModelDescription:
         the equation's word from :data:`~mbd2d.description.joints.ROW_WORDS` (for example
         ``O2.x``, ``guide.angle``, ``motor.theta``)."""
         return [r for c in self.constraints for r in c.rows()]
+
+    # ------------------------------------------------------------------ design parameters
+    def parameters(self) -> dict[str, float | None]:
+        """Every design parameter by name, with its value.
+
+        A name is the entry's path in the model file: ``joint.A.points.1.0`` (x of joint
+        A's point on its second body), ``joint.guide.axes.0.1``, ``body.crank.mass``,
+        ``force.s1.stiffness``, ``driver.motor.f.poly.1``, ``model.gravity.1`` (see
+        :mod:`mbd2d.description.parameters`). A gear or rolling phase left open has the value
+        None here (:meth:`mbd2d.Model.parameters` gives the value taken from q0).
+
+        Examples
+        --------
+        >>> import mbd2d
+        >>> mbd2d.load("examples/fourbar_grashof.toml").parameters()["joint.A.points.1.0"]
+        -1.75
+        """
+        return {p.name: p.value for p in parameter_list(self)}
+
+    def with_params(self, values: Mapping[str, Any]) -> "ModelDescription":
+        """A new model with the named parameters set to the given values; this model is
+        left unchanged.
+
+        Raises
+        ------
+        ModelError
+            For an unknown name (the message names it and suggests the closest names) or a
+            value that is not a finite number.
+
+        Examples
+        --------
+        >>> import mbd2d
+        >>> m = mbd2d.load("examples/fourbar_grashof.toml")
+        >>> m.with_params({"joint.B.points.0.0": 1.8}).parameters()["joint.B.points.0.0"]
+        1.8
+        """
+        return _with_params(self, values)
 
     def has_masses(self) -> bool:
         """Every body has a mass and an inertia (dynamics and inverse dynamics can run)."""

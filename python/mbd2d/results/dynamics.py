@@ -13,6 +13,7 @@ from .contacts import (ContactEvent, ContactHistory, FrictionEvent, FrictionHist
 from .files import writing
 from .kinematics import KinematicsResult
 from .reactions import Reaction, reaction_arrays, reaction_of
+from .sensitivities import parameter_index, reaction_dp_arrays, reaction_dp_of
 
 
 @dataclass(repr=False)
@@ -38,6 +39,8 @@ class DynamicsResult(KinematicsResult):
     elements : numpy.ndarray
         (n, number of force elements, 6) outputs of the forces, contacts and joint frictions
         (``element_names``); read them with :meth:`contact` and :meth:`friction`.
+    dlam_dp : numpy.ndarray or None
+        With ``sensitivities=[...]`` of inverse dynamics: d lambda / d p (n, neq, n_params).
     """
 
     lam: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
@@ -52,7 +55,10 @@ class DynamicsResult(KinematicsResult):
     contacts: list[ContactEvent] = field(default_factory=list)
     friction_events: list[FrictionEvent] = field(default_factory=list)
     lift_off: list[LiftOff] = field(default_factory=list)
+    dlam_dp: np.ndarray | None = None
+    ptab: Any = None
     _reac: Any = None
+    _reac_dp: Any = None
 
     @property
     def energy(self) -> np.ndarray:
@@ -82,6 +88,48 @@ class DynamicsResult(KinematicsResult):
             raise KeyError(f"no driver {name!r}")
         row = self.packed.row_owner.index(names.index(name))
         return -self.lam[:, row]
+
+    def effort_dp(self, name: str) -> np.ndarray:
+        """Sensitivities of the effort of the driver called name to the design parameters,
+        shape (n, n_params) (columns in the order of ``parameter_names``).
+
+        Raises
+        ------
+        KeyError
+            If there is no such driver or the run computed no multiplier sensitivities.
+        """
+        names = self.packed.constraint_names
+        if name not in names or not self.packed.driver_flags[names.index(name)]:
+            raise KeyError(f"no driver {name!r}")
+        if self.dlam_dp is None:
+            raise KeyError("this result has no effort sensitivities: run inverse dynamics "
+                           "with sensitivities=[names]")
+        row = self.packed.row_owner.index(names.index(name))
+        return -self.dlam_dp[:, row, :]
+
+    def reaction_dp(self, name: str) -> Reaction:
+        """Sensitivities of the reaction of the joint or driver called name: a Reaction
+        whose arrays are (n, n_params), the changes of fx, fy, mz, ... per parameter.
+
+        Raises
+        ------
+        KeyError
+            If there is no such joint or driver, or no multiplier sensitivities.
+        """
+        if self.dlam_dp is None or self.dq_dp is None:
+            raise KeyError("this result has no reaction sensitivities: run inverse dynamics "
+                           "with sensitivities=[names]")
+        if self._reac_dp is None:
+            self._reac_dp = reaction_dp_arrays(self.packed, self.ptab, self.q, self.t,
+                                               self.lam, self.dq_dp, self.dlam_dp)
+        return reaction_dp_of(self.packed, self.model, name, *self._reac_dp)
+
+    def multiplier_dp(self, row: str, name: str) -> np.ndarray:
+        """d lambda / d p of a row (by its label) for one parameter, over time."""
+        if self.dlam_dp is None:
+            raise KeyError("this result has no multiplier sensitivities")
+        return self.dlam_dp[:, self.row_labels.index(row),
+                            parameter_index(self.parameter_names, name)]
 
     def multiplier(self, row: str) -> np.ndarray:
         """The multiplier of a row by its label (see ``model.constraint_rows()``).

@@ -10,6 +10,7 @@ import numpy as np
 
 from ..validate import vector
 from .files import writing
+from .sensitivities import LEVELS, body_columns, parameter_index
 
 SUFFIXES = ("x", "y", "theta", "x_dot", "y_dot", "theta_dot", "x_ddot", "y_ddot", "theta_ddot")
 
@@ -46,6 +47,11 @@ class KinematicsResult:
         Newton corrections, LU factorizations, rejected steps, tolerance used.
     complete : bool
         False when the run stopped early (see the exception that carried this result).
+    parameter_names : list of str
+        The design parameters of ``sensitivities=[...]`` (empty without them).
+    dq_dp, dqd_dp, dqdd_dp : numpy.ndarray or None
+        Their sensitivities d q / d p, d q_dot / d p, d q_ddot / d p, each
+        (n, n_coordinates, n_params), computed in the core (None without them).
     """
 
     t: np.ndarray
@@ -57,6 +63,10 @@ class KinematicsResult:
     stats: dict[str, Any] = field(default_factory=dict)
     complete: bool = True
     model: Any = None
+    parameter_names: list[str] = field(default_factory=list)
+    dq_dp: np.ndarray | None = None
+    dqd_dp: np.ndarray | None = None
+    dqdd_dp: np.ndarray | None = None
 
     def body(self, name: str) -> BodyResult:
         """Histories of the body called name.
@@ -74,6 +84,30 @@ class KinematicsResult:
         q, qd, qdd = self.q[:, c], self.qd[:, c], self.qdd[:, c]
         return BodyResult(name, q[:, 0], q[:, 1], q[:, 2], qd[:, 0], qd[:, 1], qd[:, 2],
                           qdd[:, 0], qdd[:, 1], qdd[:, 2])
+
+    def sensitivity(self, body: str, name: str, of: str = "q") -> np.ndarray:
+        """d(x, y, theta)/dp of a body over time, shape (n, 3), for the design parameter
+        called name; ``of`` = "qd" or "qdd" for the velocities' or accelerations'.
+
+        Raises
+        ------
+        KeyError
+            For an unknown body, a parameter the run was not asked for, or a bad ``of``.
+
+        Examples
+        --------
+        >>> import mbd2d
+        >>> m = mbd2d.load("examples/fourbar_grashof.toml")
+        >>> res = m.kinematics(1.0, 10, sensitivities=["joint.B.points.0.0"])
+        >>> res.sensitivity("rocker", "joint.B.points.0.0").shape
+        (11, 3)
+        """
+        if of not in LEVELS:
+            raise KeyError(f"of must be one of {', '.join(LEVELS)}, got {of!r}")
+        k = parameter_index(self.parameter_names, name)
+        arr = {"q": self.dq_dp, "qd": self.dqd_dp, "qdd": self.dqdd_dp}[of]
+        assert arr is not None
+        return arr[:, body_columns(self.body_names, body), k]
 
     def point(self, name: str, s: Any) -> np.ndarray:
         """Global path r + A(theta) s' of a point s' fixed in a body, shape (n, 2)."""

@@ -1,0 +1,235 @@
+"""Large models and failed allocations: a typed error, never a dead process.
+
+Each case runs in its own Python process (a crash, a runtime abort of the Fortran library or
+an out-of-memory kill is seen as its exit status), most under an address-space limit
+(``RLIMIT_AS``) so that no test can eat the machine's memory.
+
+Oracles: the N-four-bar's closed form (every crank turns with the driver, theta = pi/2 - t;
+the couplers translate), the peak resident memory of the process (``ru_maxrss``), and for the
+allocation failures only the documented behaviour (``InsufficientMemoryError``, a
+``MemoryError``, naming the size asked).
+"""
+from __future__ import annotations
+
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import mbd2d
+
+ROOT = Path(__file__).resolve().parents[1]
+EX = ROOT / "examples"
+
+PRELUDE = f"""
+import json, math, resource, sys
+sys.path.insert(0, {str(EX)!r})
+import numpy as np
+import mbd2d
+from nfourbar import build
+
+def vm_bytes():
+    for line in open("/proc/self/status"):
+        if line.startswith("VmSize:"):
+            return int(line.split()[1]) * 1024
+
+def limit(extra_mib):
+    soft, hard = resource.getrlimit(resource.RLIMIT_AS)
+    resource.setrlimit(resource.RLIMIT_AS, (vm_bytes() + extra_mib * 2**20, hard))
+    return soft, hard
+
+def unlimit(old):
+    resource.setrlimit(resource.RLIMIT_AS, old)
+
+def outcome(call):
+    try:
+        call()
+        return ["ok", ""]
+    except mbd2d.InsufficientMemoryError as e:
+        return ["InsufficientMemoryError", str(e)]
+    except MemoryError as e:
+        return ["MemoryError", str(e)]
+    except Exception as e:
+        return [type(e).__name__, str(e)]
+"""
+
+
+def run_child(body: str, timeout: float = 240.0) -> dict:
+    """Run PRELUDE + body in a fresh interpreter; the body prints one JSON line last."""
+    code = PRELUDE + textwrap.dedent(body)
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                       timeout=timeout)
+    assert r.returncode == 0, (f"the process died (exit {r.returncode}, a negative code is "
+                               f"a signal): {r.stderr[-3000:]}")
+    return json.loads(r.stdout.strip().splitlines()[-1])
+
+
+def test_ten_thousand_loop_kinematics_runs_banded_in_little_memory() -> None:
+    """N = 10000 (60,003 coordinates): once a 28.8 GB dense J and a dead process, now the
+    band path, no n x n array: peak RSS of the whole process well under 400 MiB."""
+    out = run_child("""
+        n = 10000
+        model = build(n)
+        before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+        old = limit(2048)              # far below the dense J: any n x n array would fail
+        res = model.kinematics(t_end=0.3, steps=3)
+        unlimit(old)
+        peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+        print(json.dumps({"t": res.t.tolist(), "q": res.q.tolist(), "qd": res.qd.tolist(),
+                          "qdd": res.qdd.tolist(), "solver": res.stats["solver"],
+                          "peak_mib": peak / 1024, "before_mib": before / 1024}))
+    """)
+    assert out["solver"] == "banded"
+    assert out["peak_mib"] < 400, out["peak_mib"]
+    t = np.array(out["t"])
+    q, qd, qdd = (np.array(out[k]) for k in ("q", "qd", "qdd"))
+    n = 10000
+    th = np.pi / 2 - t[:, None]
+    # cranks k = 0..n (bodies 0..n), couplers after them: x = k + cos(th)/2, y = sin(th)/2
+    k = np.arange(n + 1)[None, :]
+    np.testing.assert_allclose(q[:, 2:3 * (n + 1):3], np.broadcast_to(th, (len(t), n + 1)),
+                               rtol=0, atol=1e-11)
+    np.testing.assert_allclose(q[:, 0:3 * (n + 1):3], k + 0.5 * np.cos(th), rtol=0, atol=1e-11)
+    np.testing.assert_allclose(q[:, 1:3 * (n + 1):3], 0.5 * np.sin(th) + 0 * k, rtol=0,
+                               atol=1e-11)
+    np.testing.assert_allclose(qd[:, 2:3 * (n + 1):3], -1.0, rtol=0, atol=1e-10)
+    np.testing.assert_allclose(qdd[:, 2:3 * (n + 1):3], 0.0, rtol=0, atol=1e-9)
+    # couplers: x = k + 1/2 + cos(th), y = sin(th), theta = 0
+    kc = np.arange(n)[None, :]
+    c0 = 3 * (n + 1)
+    np.testing.assert_allclose(q[:, c0::3], kc + 0.5 + np.cos(th), rtol=0, atol=1e-11)
+    np.testing.assert_allclose(q[:, c0 + 1::3], np.sin(th) + 0 * kc, rtol=0, atol=1e-11)
+    np.testing.assert_allclose(q[:, c0 + 2::3], 0.0, rtol=0, atol=1e-11)
+
+
+def test_a_failed_dense_allocation_is_a_typed_error() -> None:
+    """The dense J of 11,403 coordinates (1 GB) under a 400 MiB address-space allowance: the
+    allocation fails inside the core, which returns a status; the process lives on and can
+    run again once the limit is lifted."""
+    out = run_child("""
+        model = build(1900)
+        old = limit(400)
+        first = outcome(lambda: model.kinematics(t_end=0.1, steps=2, solver="dense"))
+        unlimit(old)
+        again = outcome(lambda: build(3).kinematics(t_end=0.1, steps=2))
+        print(json.dumps({"first": first, "again": again}))
+    """)
+    kind, text = out["first"]
+    assert kind == "InsufficientMemoryError", out
+    assert "11403 x 11403" in text and "996.2 MiB" in text, text
+    assert "banded" in text, text                      # what to change
+    assert out["again"][0] == "ok"
+    assert issubclass(mbd2d.InsufficientMemoryError, MemoryError)
+    assert issubclass(mbd2d.InsufficientMemoryError, mbd2d.MbdError)
+
+
+def test_every_allocation_of_the_band_path_fails_cleanly() -> None:
+    """Address-space allowances from 1 MiB up to enough: each run of N = 10000 kinematics
+    ends in success or a MemoryError (the core's typed one, or NumPy's for the arrays
+    Python allocates), never an abort; at least one failure is the core's."""
+    out = run_child("""
+        model = build(10000)
+        res = {}
+        for mib in (1, 4, 8, 12, 16, 24, 32, 48, 256):
+            old = limit(mib)
+            res[mib] = outcome(lambda: model.kinematics(t_end=0.01, steps=3))
+            unlimit(old)
+        print(json.dumps(res))
+    """)
+    kinds = {k: v[0] for k, v in out.items()}
+    assert set(kinds.values()) <= {"ok", "InsufficientMemoryError", "MemoryError"}, out
+    assert "InsufficientMemoryError" in kinds.values(), out
+    assert kinds["256"] == "ok", out
+    for kind, text in out.values():
+        if kind == "InsufficientMemoryError":
+            assert "MiB" in text and "allocating" in text, text
+
+
+def test_dense_analyses_of_a_huge_model_refuse_before_allocating() -> None:
+    """Dynamics, statics and inverse dynamics are dense today: at N = 10000 they need
+    hundreds of GB and refuse at once, naming the size (under a 2 GiB address-space limit,
+    so that a missed check fails the test instead of filling the machine)."""
+    out = run_child("""
+        model = build(10000, driven=False, omega0=1.0)     # 1 kg bars, free
+        driven = build(10000, omega0=1.0)                   # the same, driven
+        old = limit(2048)
+        print(json.dumps({
+            "dynamics": outcome(lambda: model.dynamics(t_end=0.01, steps=2)),
+            "statics": outcome(lambda: model.statics()),
+            "inverse_dynamics": outcome(lambda: driven.inverse_dynamics(t_end=0.01, steps=2))}))
+    """)
+    for analysis, (kind, text) in out.items():
+        assert kind == "InsufficientMemoryError", (analysis, kind, text)
+        assert re.search(r"the dense dynamics \(6000[23] equations, 60003 coordinates\) would "
+                         r"need [0-9.]+ GiB", text), (analysis, text)
+        assert "fewer coordinates" in text, (analysis, text)
+
+
+def test_banded_singular_report_agrees_with_the_dense_svd() -> None:
+    """The band path diagnoses a dead centre without a dense J (inverse and power iteration
+    on the band factors); the dense path by the SVD. Same time, driver, dependent
+    constraints, and sigma_min / sigma_max within a few per cent."""
+    model = mbd2d.load(EX / "fourbar_seed.toml")
+    got = {}
+    for solver in ("dense", "banded"):
+        with pytest.raises(mbd2d.SingularConfigurationError) as ei:
+            model.kinematics(t_end=2.0, steps=200, solver=solver)
+        e = ei.value
+        got[solver] = (e.t, e.driver, e.dependent, e.sigma_min / e.sigma_max)
+    d, b = got["dense"], got["banded"]
+    assert abs(d[0] - b[0]) < 1e-9 and d[1] == b[1] == "motor" and d[2] == b[2]
+    assert abs(b[3] / d[3] - 1) < 0.05, (d[3], b[3])
+
+
+MALLOC_COUNTER = r"""
+#define _GNU_SOURCE
+#include <dlfcn.h>
+#include <stdio.h>
+#include <stdlib.h>
+static long n_malloc = 0;
+static void *(*real_malloc)(size_t) = 0;
+void *malloc(size_t s) {
+  if (!real_malloc) real_malloc = (void *(*)(size_t)) dlsym(RTLD_NEXT, "malloc");
+  n_malloc++;
+  return real_malloc(s);
+}
+__attribute__((destructor)) static void report(void) {
+  fprintf(stderr, "MALLOC_COUNT %ld\n", n_malloc);
+}
+"""
+
+
+def test_the_kinematic_loop_allocates_nothing_per_step(tmp_path: Path) -> None:
+    """mbd2d-solve under a malloc counter (LD_PRELOAD): 10x the steps, the same number of
+    allocations, on the dense path (four-bar) and the band path (N-four-bar, 75 coordinates).
+    Before: one heap temporary per step or Newton iteration (an array expression passed as
+    an argument, an automatic array)."""
+    from test_standalone import find_solver
+    sys.path.insert(0, str(EX))
+    from nfourbar import build
+    cc = shutil.which("cc") or shutil.which("gcc")
+    assert cc, "the C compiler that built the package"
+    src = tmp_path / "count.c"
+    src.write_text(MALLOC_COUNTER)
+    lib = tmp_path / "count.so"
+    subprocess.run([cc, "-O2", "-shared", "-fPIC", str(src), "-o", str(lib), "-ldl"],
+                   check=True, capture_output=True)
+    solver = find_solver()
+    models = {"dense": mbd2d.load(EX / "fourbar_grashof.toml"), "banded": build(12)}
+    for path, model in models.items():
+        counts = []
+        for steps in (100, 1000):
+            f = tmp_path / f"{path}.mbd"
+            model.export(f, t_end=1.0, steps=steps)
+            r = subprocess.run([solver, str(f), str(tmp_path / "o.csv")], capture_output=True,
+                               text=True, timeout=60, env={**os.environ, "LD_PRELOAD": str(lib)})
+            assert r.returncode == 0, r.stderr
+            counts.append(int(r.stderr.split("MALLOC_COUNT")[-1]))
+        assert counts[0] == counts[1], (path, counts)
