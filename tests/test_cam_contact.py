@@ -124,3 +124,13 @@ def test_follower_profile_penetration_against_the_closed_form(follower):
     np.testing.assert_allclose(fn, 1e9 * np.maximum(ref, 0.0)**1.5, rtol=1e-9, atol=1e-9)
     on = [x for x in res.contacts if x.kind == "onset"]
     assert on and all(abs(r) < 0.02 for r in np.interp([x.t for x in on], res.t, ref))
+
+
+def test_the_example_runs_and_draws(tmp_path):
+    import importlib.util
+    spec = importlib.util.spec_from_file_location("cam_liftoff", EXAMPLE.with_suffix(".py"))
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    assert mod.main(["--out", str(tmp_path)]) == 0
+    assert (tmp_path / "cam_liftoff_mechanism.png").stat().st_size > 10_000
+    assert (tmp_path / "cam_liftoff_history.png").stat().st_size > 10_000
