@@ -9,7 +9,9 @@ Sections (each in its own try/except: a failure is recorded and the rest runs):
    (bench/peers_exudyn.py), with the ratios at equal accuracy;
 4. kinematics speed: Fortran loop, Python stepper, plain NumPy (bench/kinematics_speed.py);
 5. scaling of kinematics with N (bench/scaling.py);
-6. memory of 10^6 output steps (bench/memory.py).
+6. memory of 10^6 output steps (bench/memory.py);
+7. contacts (bench/contact.py): the clearance-joint crank-slider against the ideal joint and
+   over the restitution, and the cost of far contact pairs.
 
 Writes bench/results/*.json and *.png, bench/RESULTS.md and bench/README_headline.md
 (bench/report.py). The whole run is sized to finish in well under 10 minutes on a 2-core
@@ -35,6 +37,7 @@ BENCH = Path(__file__).resolve().parent
 if str(BENCH) not in sys.path:
     sys.path.insert(0, str(BENCH))
 
+import contact  # noqa: E402
 import environment  # noqa: E402
 import kinematics_speed  # noqa: E402
 import memory  # noqa: E402
@@ -43,7 +46,8 @@ import report  # noqa: E402
 import scaling  # noqa: E402
 import work_precision  # noqa: E402
 
-SECTIONS = ("environment", "work_precision", "peers", "kinematics", "scaling", "memory")
+SECTIONS = ("environment", "work_precision", "peers", "kinematics", "scaling", "memory",
+            "contact")
 
 
 # ===================================================================== JSON
@@ -136,6 +140,11 @@ def section_memory(quick: bool) -> dict:
     return memory.memory(steps=100_000 if quick else memory.STEPS)
 
 
+def section_contact(quick: bool) -> dict:
+    """Cost of the clearance joint (ratio to the ideal joint, over e) and of far pairs."""
+    return contact.study(repeats=1 if quick else 3, quick=quick)
+
+
 def failure(e: BaseException) -> dict:
     """The record of a failed section."""
     return {"failed": True, "error": f"{type(e).__name__}: {e}",
@@ -180,6 +189,9 @@ def draw_charts(results: dict, out: Path) -> dict[str, str]:
     if "rows" in results.get("memory", {}):
         charts["memory"] = try_chart(lambda: memory.chart(results["memory"],
                                                           out / "memory.png"))
+    if "clearance" in results.get("contact", {}):
+        charts["contact"] = try_chart(lambda: contact.chart(results["contact"],
+                                                            out / "contact.png"))
     return {k: v for k, v in charts.items() if v}
 
 
@@ -218,7 +230,7 @@ def main(argv: Sequence[str] | None = None) -> dict:
     fns: dict[str, Callable[[bool], dict]] = {
         "environment": environment.collect, "work_precision": section_work_precision,
         "peers": section_peers, "kinematics": section_kinematics,
-        "scaling": section_scaling, "memory": section_memory}
+        "scaling": section_scaling, "memory": section_memory, "contact": section_contact}
     results = {name: run_section(name, fns[name], a.quick) for name in SECTIONS
                if name in wanted}
     derive(results)

@@ -509,6 +509,63 @@ contains
     end do
   end function nearest_alpha
 
+  !> The penetration of a circle contact from the positions alone (no derivatives): the
+  !! cheap first test of contact_eval.
+  pure real(wp) function plain_penetration(geo, p, si, sj, x) result(d)
+    integer, intent(in) :: geo, si, sj
+    real(wp), intent(in) :: p(:)
+    type(kloc), intent(in) :: x
+    real(wp) :: dr
+    call plain_gap(geo, p, si, sj, x, d, dr)
+  end function plain_penetration
+
+  !> Penetration and its rate of a circle contact from positions and velocities (no
+  !! Jacobians): circle-line d = R - n . (C - P), d_dot = -n_dot . (C - P) - n . (C - P)_dot;
+  !! circle pairs from e = C_i - C_j, |e|_dot = e . e_dot / |e|.
+  pure subroutine plain_gap(geo, p, si, sj, x, d, dr)
+    integer, intent(in) :: geo, si, sj
+    real(wp), intent(in) :: p(:)
+    type(kloc), intent(in) :: x
+    real(wp), intent(out) :: d, dr
+    real(wp) :: ci(2), cj(2), vi(2), vj(2), nv(2), nd(2), e(2), ed(2), le
+    associate (g => p(NHEAD + 1:))
+      call place(si, g(1:2), ci, vi)
+      call place(sj, g(4:5), cj, vj)
+      e = ci - cj; ed = vi - vj
+      select case (geo)
+      case (GEO_CIRCLE_LINE)
+        call place(sj, g(6:7), nv, nd, direction=.true.)
+        d = g(3) - dot_product(nv, e)
+        dr = -dot_product(nd, e) - dot_product(nv, ed)
+      case (GEO_CIRCLE_CIRCLE)
+        le = hypot(e(1), e(2))
+        d = g(3) + g(6) - le
+        dr = zero
+        if (le > zero) dr = -dot_product(e, ed) / le
+      case default
+        le = hypot(e(1), e(2))
+        d = le - (g(6) - g(3))
+        dr = zero
+        if (le > zero) dr = dot_product(e, ed) / le
+      end select
+    end associate
+  contains
+    !> A body point (or direction) u and its velocity.
+    pure subroutine place(slot, u, w, wd, direction)
+      integer, intent(in) :: slot
+      real(wp), intent(in) :: u(2)
+      real(wp), intent(out) :: w(2), wd(2)
+      logical, intent(in), optional :: direction
+      w = u; wd = zero
+      if (slot == 0) return
+      w = [x%c(slot) * u(1) - x%s(slot) * u(2), x%s(slot) * u(1) + x%c(slot) * u(2)]
+      wd = perp(w) * x%qd(3 * slot)
+      if (present(direction)) return
+      w = w + x%q(3 * slot - 2:3 * slot - 1)
+      wd = wd + x%qd(3 * slot - 2:3 * slot - 1)
+    end subroutine place
+  end subroutine plain_gap
+
   !> The penetration of a contact and its rate (for event location): far contacts return a
   !! negative bound (and its rate where known, else 0).
   pure subroutine contact_gap(geo, p, si, sj, x, dv, dr)
@@ -520,6 +577,10 @@ contains
     type(kscal) :: dl
     real(wp) :: n(2), xp(2)
     logical :: far
+    if (geo /= GEO_FOLLOWER_PROFILE) then
+      call plain_gap(geo, p, si, sj, x, dv, dr)
+      return
+    end if
     call geometry(geo, p, si, sj, x, dl, n, xp, far)
     dv = dl%v; dr = dl%vd
   end subroutine contact_gap
@@ -544,6 +605,11 @@ contains
     logical :: far
     integer :: law
     ql_force = zero; v = zero; out = zero
+    if (geo /= GEO_FOLLOWER_PROFILE) then
+      ! the bounding test: the gap from the plain positions, before any derivative
+      out(3) = plain_penetration(geo, p, si, sj, x)
+      if (.not. (out(3) > zero)) return
+    end if
     call geometry(geo, p, si, sj, x, dl, n, xp, far, exact)
     out(3) = dl%v
     if (far .or. .not. (dl%v > zero)) return

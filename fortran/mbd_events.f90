@@ -305,15 +305,33 @@ contains
       end if
     end do
   contains
-    !> g of element kk at time t on the dense output.
+    !> g of element kk at time t on the dense output (a contact or a sliding joint alone; a
+    !! stuck joint needs the solve of the whole system).
     real(wp) function g_at(kk, t, gdt)
       integer, intent(in) :: kk
       real(wp), intent(in) :: t
       real(wp), intent(out) :: gdt
       real(wp) :: q(m%nq), v(m%nq), a(m%nq), gg(m%nf), gd(m%nf)
+      type(kloc) :: x
+      type(kscal) :: u
       call hermite5(ta, qa, va, aa, tb, qb, vb, ab, t, q, v, a)
-      call values(m, w, q, v, t, gg, gd, status)
-      g_at = gg(kk); gdt = gd(kk)
+      gdt = zero
+      if (force_is_contact(m%fkind(kk))) then
+        x = element_state(m, kk, q, v)
+        call contact_gap(m%fkind(kk) - FRC_CONTACT0 + 1, &
+                         m%fp(m%fpo(kk):m%fpo(kk) + m%fpn(kk) - 1), &
+                         merge(1, 0, m%fbi(kk) > 0), merge(2, 0, m%fbj(kk) > 0), x, g_at, gdt)
+        if (nint(w%cst(1, kk)) == 1) then
+          g_at = -g_at; gdt = -gdt
+        end if
+      else if (nint(w%cst(1, kk)) /= MODE_STUCK) then
+        x = element_state(m, kk, q, v)
+        u = element_slip(m, kk, x)
+        g_at = -nint(w%cst(1, kk)) * u%vd
+      else
+        call values(m, w, q, v, t, gg, gd, status)
+        g_at = gg(kk); gdt = gd(kk)
+      end if
     end function g_at
 
     !> Bracket the crossing of g_kk in [t0, t1] (g(t0) <= 0 < g(t1)) to width tol.
@@ -368,14 +386,16 @@ contains
       integer, intent(in) :: kk
       real(wp), intent(in) :: t0, t1
       real(wp), intent(out) :: tmid, gmid
-      real(wp) :: lo, hi, gdt
+      real(wp) :: lo, hi, gdt, rate
       integer :: it
       lo = t0; hi = t1
+      rate = max(abs(gda(kk)), abs(gdb(kk)))
       do it = 1, MAXIT
         tmid = half * (lo + hi)
         gmid = g_at(kk, tmid, gdt)
         if (status /= MBD_OK) return
         if (gmid > zero .or. hi - lo <= tol) exit
+        if (gmid + (hi - lo) * max(rate, abs(gdt)) < zero) exit   ! out of reach here
         if (gdt > zero) then
           lo = tmid
         else
