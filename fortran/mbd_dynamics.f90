@@ -304,7 +304,7 @@ contains
   !! contacts); vload adds the potential of the loads frozen at t (statics). Contacts read
   !! their states cst (absent: open); joint friction is added only when the multipliers lam
   !! are given (friction_forces).
-  pure subroutine gen_forces(m, q, qd, t, force, v, vload, cst, lam)
+  pure subroutine gen_forces(m, q, qd, t, force, v, vload, cst, lam, fmag)
     type(model_t), intent(in) :: m        !! model
     real(wp), intent(in) :: q(:), qd(:)   !! state
     real(wp), intent(in) :: t             !! time
@@ -313,9 +313,12 @@ contains
     real(wp), intent(out), optional :: vload  !! potential of the loads at t
     real(wp), intent(in), optional :: cst(:, :)  !! element states (NCS, nf)
     real(wp), intent(in), optional :: lam(:)     !! multipliers: add joint friction
-    real(wp) :: ql(NLOC), qdl(NLOC), fl(NLOC), vk, vl, vls
+    !> the largest generalized force of one element or weight (a scale of the loads, which
+    !! may cancel in Q: a body resting on a contact)
+    real(wp), intent(out), optional :: fmag
+    real(wp) :: ql(NLOC), qdl(NLOC), fl(NLOC), vk, vl, vls, fm
     integer :: k, s, si, sj
-    force = zero; v = zero; vls = zero
+    force = zero; v = zero; vls = zero; fm = zero
     do k = 1, m%nb
       force(3 * k - 2:3 * k - 1) = m%mdiag(3 * k - 2) * m%grav
       v = v - m%mdiag(3 * k - 2) * dot_product(m%grav, q(3 * k - 2:3 * k - 1))
@@ -339,9 +342,11 @@ contains
       do s = 1, NLOC
         if (m%floc(s, k) > 0) force(m%floc(s, k)) = force(m%floc(s, k)) + fl(s)
       end do
+      fm = max(fm, maxval(abs(fl)))
       v = v + vk; vls = vls + vl
     end do
     if (present(vload)) vload = vls
+    if (present(fmag)) fmag = max(fm, maxval(abs(force)))
     if (present(lam) .and. m%nfric > 0) call friction_forces(m, q, qd, lam, force, cst)
   end subroutine gen_forces
 

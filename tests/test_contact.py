@@ -246,3 +246,12 @@ friction = { mu = 0.3 }
 """
     res = mbd2d.loads(text).dynamics(0.4, 40)
     assert res.contacts[0].t == pytest.approx(math.sqrt(2 * 0.4 / G), abs=1e-8)
+
+
+@pytest.mark.parametrize("law,k", [("hertz", 1e7), ("linear", 1e6)])
+def test_statics_rests_the_ball_on_its_contact(law, k):
+    """Statics carries contacts as elastic elements: the ball sinks to k delta**n = m g."""
+    m = ball(law, 1.0, h0=R - 1e-4, k=k)
+    res = m.statics()
+    n = 1.0 if law == "linear" else N_EXP
+    assert R - res.q[1] == pytest.approx((G / k)**(1 / n), rel=1e-8)
