@@ -423,6 +423,27 @@ def sensitivities_section(results: dict) -> str:
                      "integrator steps"), rows))
 
 
+def contact_section(results: dict, charts: dict, out: Path, base: Path) -> str:
+    """Tables of the contact costs (bench/contact.py)."""
+    con = results.get("contact")
+    if con is None:
+        return "Not run.\n"
+    if failed(con):
+        return f"Failed: {failed(con)}\n"
+    cl = con.get("clearance", {})
+    rows = [(r["case"], fmt(1e3 * r["seconds"], ".1f"), fmt(r["ratio"], ".1f"), r["steps"],
+             r["rejected"], r["events"], fmt(r["us_per_rhs"], ".1f")) for r in cl.get("rows", [])]
+    far = con.get("far_pairs", {})
+    frows = [(r["case"], fmt(r["us_per_rhs"], ".1f"), fmt(r.get("per_rhs_ratio"), ".2f"),
+              fmt(r.get("us_per_pair_per_rhs"), ".2f")) for r in far.get("rows", [])]
+    return (f"{cl.get('model')}, two crank turns, {cl.get('method')} rtol {cl.get('rtol')}; "
+            "best of the repeats, ratio to the ideal joint in the same run.\n\n"
+            + table(("case", "ms", "x ideal", "steps", "rejected", "events", "us / rhs"), rows)
+            + "\n" + image(charts, "contact", out, base, "clearance joint cost")
+            + f"\n{far.get('model')}: cost per right-hand side (the bounding test per pair).\n\n"
+            + table(("case", "us / rhs", "x none", "us per pair"), frows) + "\n")
+
+
 def notes_section(results: dict) -> str:
     """Quick mode, failures and section run times."""
     meta = results.get("meta") or {}
@@ -483,6 +504,7 @@ def results_markdown(results: dict, charts: dict[str, str], md_path: Path, out: 
              "## Memory of long runs\n", memory_section(results, charts, out, base),
              "## Design sweeps\n", sweep_section(results),
              "## Sensitivity cost\n", sensitivities_section(results),
+             "## Contacts\n", contact_section(results, charts, out, base),
              "## Notes\n", notes_section(results)]
     return "\n".join(parts)
 

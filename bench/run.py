@@ -13,7 +13,9 @@ Sections (each in its own try/except: a failure is recorded and the rest runs):
 7. design sweeps: per-variant cost batched vs a with_params loop, Dask LocalCluster
    throughput with 1 and 2 workers (bench/sweep.py);
 8. cost of design sensitivities, 4 parameters against the analysis alone
-   (bench/sensitivities.py).
+   (bench/sensitivities.py);
+9. contacts (bench/contact.py): the clearance-joint crank-slider against the ideal joint and
+   over the restitution, and the cost of far contact pairs.
 
 Writes bench/results/*.json and *.png, bench/RESULTS.md and bench/README_headline.md
 (bench/report.py). With --only, the other sections come from their results files of an
@@ -40,6 +42,7 @@ BENCH = Path(__file__).resolve().parent
 if str(BENCH) not in sys.path:
     sys.path.insert(0, str(BENCH))
 
+import contact  # noqa: E402
 import environment  # noqa: E402
 import kinematics_speed  # noqa: E402
 import memory  # noqa: E402
@@ -51,7 +54,7 @@ import sweep as sweeps  # noqa: E402
 import work_precision  # noqa: E402
 
 SECTIONS = ("environment", "work_precision", "peers", "kinematics", "scaling", "memory",
-            "sweep", "sensitivities")
+            "sweep", "sensitivities", "contact")
 
 
 # ===================================================================== JSON
@@ -154,6 +157,11 @@ def section_sensitivities(quick: bool) -> dict:
     return sensitivities.measure(500 if quick else 20_000, 2 if quick else 5, quick)
 
 
+def section_contact(quick: bool) -> dict:
+    """Cost of the clearance joint (ratio to the ideal joint, over e) and of far pairs."""
+    return contact.study(repeats=1 if quick else 3, quick=quick)
+
+
 def failure(e: BaseException) -> dict:
     """The record of a failed section."""
     return {"failed": True, "error": f"{type(e).__name__}: {e}",
@@ -216,6 +224,9 @@ def draw_charts(results: dict, out: Path) -> dict[str, str]:
     if "rows" in results.get("memory", {}):
         charts["memory"] = try_chart(lambda: memory.chart(results["memory"],
                                                           out / "memory.png"))
+    if "clearance" in results.get("contact", {}):
+        charts["contact"] = try_chart(lambda: contact.chart(results["contact"],
+                                                            out / "contact.png"))
     return {k: v for k, v in charts.items() if v}
 
 
@@ -255,7 +266,7 @@ def main(argv: Sequence[str] | None = None) -> dict:
         "environment": environment.collect, "work_precision": section_work_precision,
         "peers": section_peers, "kinematics": section_kinematics,
         "scaling": section_scaling, "memory": section_memory, "sweep": section_sweep,
-        "sensitivities": section_sensitivities}
+        "sensitivities": section_sensitivities, "contact": section_contact}
     ran = {name: run_section(name, fns[name], a.quick) for name in SECTIONS if name in wanted}
     earlier = earlier_sections(out, [n for n in SECTIONS if n not in wanted])
     results = {name: ran.get(name, earlier.get(name)) for name in SECTIONS

@@ -17,6 +17,7 @@ from ..description.builder import ModelDescription
 from ..errors import MbdError, ModelError, RedundantConstraintWarning
 from ..results.dynamics import DynamicsResult
 from ..validate import number, whole
+from .contacts import MAX_EVENTS, check_method, has_events, report_pulls
 from .failures import assembly_failed, bad_entry, inconsistent_at, row_names
 from .outputs import dynamics_result, finite_part
 from .sensitivities import attach, check_status, requested, table
@@ -41,6 +42,7 @@ def run_dynamics(model: ModelDescription, t_end: float, steps: int, method: str 
     method, nmax = st.method, st.max_steps
     rtol_v, atol_v, h_v, rho_v, alpha_v, beta_v = (st.rtol, st.atol, st.h, st.rho_inf,
                                                    st.alpha, st.beta)
+    check_method(model, method)
     params = requested(model, sensitivities)
     if params and method != "dopri5":
         raise ModelError(f"sensitivities are integrated with dopri5 (the variational "
@@ -49,8 +51,9 @@ def run_dynamics(model: ModelDescription, t_end: float, steps: int, method: str 
     p = pack(model)
     d = pack_dynamics(model, p)
     npar = len(params) if params else 0
-    check_memory(nout, 3 * p.nq * (1 + npar) + p.neq + 4, "dynamics")
+    check_memory(nout, 3 * p.nq * (1 + npar) + p.neq + 4 + 6 * d.ftab.shape[1], "dynamics")
     idx = output_steps(steps, every)
+    maxev = MAX_EVENTS if has_events(model) else 1
     if params:
         ptab = table(p, params, d)
         out = core.dynamics_sens(p, d, t0, t_end, steps, rtol_v, atol_v, every, nmax, nout,
@@ -58,7 +61,7 @@ def run_dynamics(model: ModelDescription, t_end: float, steps: int, method: str 
         check_status(out.status, out.iinfo, out.msg, params)
     else:
         out = core.dynamics(p, d, t0, t_end, steps, METHODS[method], rtol_v, atol_v, h_v,
-                            rho_v, alpha_v, beta_v, every, nout, nmax)
+                            rho_v, alpha_v, beta_v, every, nout, nmax, maxev)
     iinfo, rinfo, status = out.iinfo, out.rinfo, out.status
     n = int(iinfo[0])
     t = time_grid(t0, t_end, steps, idx)
@@ -68,11 +71,15 @@ def run_dynamics(model: ModelDescription, t_end: float, steps: int, method: str 
              "iteration_matrices": int(iinfo[6]), "factorizations": int(iinfo[9]),
              "partitions": int(iinfo[7]),
              "h_min": float(rinfo[1]) if iinfo[2] else None,
-             "h_max": float(rinfo[2]) if iinfo[2] else None, "redundant_rows": red_rows}
+             "h_max": float(rinfo[2]) if iinfo[2] else None, "redundant_rows": red_rows,
+             "events": int(getattr(out, "nev", 0)),
+             "events_not_kept": max(0, int(getattr(out, "nev", 0)) - maxev)}
     res = dynamics_result(model, p, t, n, out, stats, status == OK)
     if params:
         attach(res, out, params, n, ptab)
     res, bad = finite_part(res)
+    if status == OK and bad is None:
+        report_pulls(model, p, res)
     if red_rows:
         warnings.warn(f"redundant constraints: {', '.join(red_rows)} are left out of the equations "
                       "of motion; the reported multipliers are the minimum-norm set (the "

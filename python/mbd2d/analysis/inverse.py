@@ -14,7 +14,8 @@ from ..binding.tables import Packed
 from ..description.builder import ModelDescription
 from ..errors import MbdError, RedundantConstraintWarning
 from ..results.dynamics import DynamicsResult
-from .failures import bad_entry, kinematic_failure, row_names
+from .contacts import MAX_EVENTS, report_pulls
+from .failures import BAD_FORCE, bad_entry, kinematic_failure, row_names
 from .outputs import dynamics_result, finite_part
 from .sensitivities import attach, check_status, requested, table
 from .settings import (check_memory, check_solver, check_span, output_rows, output_steps,
@@ -37,14 +38,16 @@ def run_inverse(model: ModelDescription, t_end: float, steps: int, t0: float = 0
     require_determined(p, model)
     d = pack_dynamics(model, p)
     npar = len(params) if params else 0
-    check_memory(nout, (3 * p.nq + p.neq) * (1 + npar) + 4, "inverse dynamics")
+    check_memory(nout, (3 * p.nq + p.neq) * (1 + npar) + 4 + 6 * d.ftab.shape[1],
+                 "inverse dynamics")
     idx = output_steps(steps, every)
     if params:
         ptab = table(p, params, d)
         out = core.inverse_sens(p, d, t0, t_end, steps, tol_v, int(every), code, nout, ptab)
         check_status(out.status, out.iinfo, out.msg, params)
     else:
-        out = core.inverse(p, d, t0, t_end, steps, tol_v, int(every), code, nout)
+        maxev = MAX_EVENTS if model.contacts else 1
+        out = core.inverse(p, d, t0, t_end, steps, tol_v, int(every), code, nout, maxev)
     iinfo, status = out.iinfo, out.status
     n = int(iinfo[0])
     t = time_grid(t0, t_end, steps, idx)
@@ -52,11 +55,14 @@ def run_inverse(model: ModelDescription, t_end: float, steps: int, t0: float = 0
     stats = {"newton_corrections": int(iinfo[5]), "factorizations": int(iinfo[6]),
              "rejected_steps": int(iinfo[7]), "rank": int(iinfo[8]),
              "redundant_rows": red_rows,
-             "singular_passages": [float(x) for x in out.tpass[:min(int(iinfo[9]), 64)]]}
+             "singular_passages": [float(x) for x in out.tpass[:min(int(iinfo[9]), 64)]],
+             "events": int(getattr(out, "nev", 0))}
     res = dynamics_result(model, p, t, n, out, stats, status == OK)
     if params:
         attach(res, out, params, n, ptab)
     res, bad = finite_part(res)
+    if status == OK and bad is None:
+        report_pulls(model, p, res)
     if red_rows:
         warnings.warn(f"redundant constraints: {', '.join(red_rows)}; the multipliers are the "
                       "minimum-norm set (the reactions are statically indeterminate)",

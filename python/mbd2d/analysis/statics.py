@@ -14,6 +14,7 @@ from ..description.builder import ModelDescription
 from ..errors import MbdError
 from ..results.statics import StaticsResult
 from ..validate import number
+from .contacts import check_statics
 from .failures import assembly_failed, bad_entry, inconsistent_at
 from .sensitivities import check_status, requested, table
 
@@ -24,6 +25,7 @@ def run_statics(model: ModelDescription, t: float = 0.0,
                 sensitivities: Any = None) -> StaticsResult:
     """Static equilibrium near the q0 estimates; see :meth:`mbd2d.Model.statics`."""
     t = number(t, "t", "statics")
+    check_statics(model)
     params = requested(model, sensitivities)
     p = pack(model)
     d = pack_dynamics(model, p)
