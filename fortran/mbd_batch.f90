@@ -19,6 +19,7 @@ module mbd_batch
   use mbd_memory, only: REAL_BYTES, mem_fail
   use mbd_api, only: NINFO, api_kinematics, api_inverse, api_statics, api_dynamics, api_eval
   use mbd_kinematics, only: MAXPASS
+  use mbd_contact, only: NEO
   implicit none
   private
   public :: batch_run, NISET, NRSET
@@ -60,8 +61,9 @@ contains
     integer, intent(out) :: status(:)           !! (ncase) each case's status
     character(len=MSG_LEN), intent(out) :: msg(:)  !! (ncase) and message
     real(wp), allocatable :: r(:), bm(:, :), fp(:), phi(:), jac(:, :), nu(:), gam(:), zq(:)
-    real(wp) :: g(2), tpass(MAXPASS), resid
-    integer :: c, k, nq, neq, ncase, st, bad, stable, ierr
+    real(wp), allocatable :: eo(:, :, :)      ! element outputs of a dynamics case (not kept)
+    real(wp) :: g(2), tpass(MAXPASS), resid, evo(4, 1)
+    integer :: c, k, nq, neq, ncase, st, bad, stable, ierr, nev
     character(len=MSG_LEN) :: lmsg
     qout = zero; qdout = zero; qddout = zero; lamout = zero; eout = zero
     iinfo = 0; rinfo = zero; qsing = zero; dep = 0; redundant = 0
@@ -74,9 +76,10 @@ contains
     allocate (r(size(rpar)), bm(size(bmass, 1), size(bmass, 2)), fp(size(fpar)), stat=ierr)
     if (ierr == 0 .and. size(opens, 2) > 0) &
       allocate (phi(neq), jac(neq, nq), nu(neq), gam(neq), zq(nq), stat=ierr)
+    if (ierr == 0) allocate (eo(NEO, size(ftab, 2), size(qout, 2)), stat=ierr)
     if (ierr /= 0) then
       call mem_fail(REAL_BYTES * (size(rpar) + size(bmass) + size(fpar) + &
-                    real(neq, wp) * (nq + 3)), 'the tables of a case', 'use a smaller model', &
+                    real(neq, wp) * (nq + 3) + real(NEO, wp) * size(ftab, 2) * size(qout, 2)), 'the tables of a case', 'use a smaller model', &
                     st, lmsg)
       status = st; msg = lmsg; return
     end if
@@ -117,7 +120,7 @@ contains
                           iset(5), rset(5), rset(6), rset(7), rset(8), rset(9), rset(10), &
                           iset(3), qout(:, :, c), qdout(:, :, c), qddout(:, :, c), &
                           lamout(:, :, c), eout(:, :, c), iinfo(:, c), rinfo(:, c), &
-                          redundant(:, c), status(c), msg(c), iset(6))
+                          redundant(:, c), status(c), msg(c), iset(6), eo, evo, nev)
       end select
     end do
 
