@@ -79,7 +79,8 @@ contains
     if (ierr == 0) allocate (eo(NEO, size(ftab, 2), size(qout, 2)), stat=ierr)
     if (ierr /= 0) then
       call mem_fail(REAL_BYTES * (size(rpar) + size(bmass) + size(fpar) + &
-                    real(neq, wp) * (nq + 3) + real(NEO, wp) * size(ftab, 2) * size(qout, 2)), 'the tables of a case', 'use a smaller model', &
+                    real(neq, wp) * (nq + 3) + real(NEO, wp) * size(ftab, 2) * size(qout, 2)), &
+                    'the tables of a case', 'use a smaller model', &
                     st, lmsg)
       status = st; msg = lmsg; return
     end if
