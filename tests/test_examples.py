@@ -133,4 +133,4 @@ def test_demo_script(tmp_path: Path) -> None:
     for kind in ["curves", "sensitivity", "tolerance"]:
         assert (out / f"design_study_{kind}.png").stat().st_size > 0
     assert "hit a dead centre" in proc.stdout
-    assert "summary: 5/5" in proc.stdout
+    assert "summary: 6/6" in proc.stdout
