@@ -7,6 +7,8 @@ PY := $(VENV)/bin/python
 export PATH := $(abspath $(VENV))/bin:$(PATH)
 
 PYDEPS := numpy meson meson-python ninja pytest hypothesis matplotlib scipy
+# the sweep extra (pyproject.toml): design sweeps, tolerance analysis, Dask, netCDF
+PYDEPS += xarray dask distributed h5netcdf h5py pandas tqdm
 SOURCES := $(wildcard fortran/*.f90 fortran/app/*.f90 python/mbd2d/*.py python/mbd2d/*/*.py) meson.build pyproject.toml
 
 .PHONY: demo test bench system install clean help

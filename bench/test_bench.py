@@ -87,6 +87,15 @@ def synthetic_results(stepper: bool = True, exudyn: bool = True) -> dict:
             "memory": {"rows": [{"analysis": "kinematics", "every": 1000, "steps": 10,
                                  "run_mib": 1.0, "available": True}]},
             "work_precision": {"failed": True, "error": "RuntimeError: boom"},
+            "sweep": {"per_variant": {"ratio_loop_over_batched": 12.0, "steps": 10,
+                                      "us_per_variant": {"loop": 840.0, "batched": 70.0,
+                                                         "core": 65.0}},
+                      "throughput": {"cases": 10, "steps": 200, "rows": [
+                          {"runner": "Dask LocalCluster, 2 worker(s)", "seconds": 1.0,
+                           "variants_per_s": 10.0, "identical_to_serial": True}]}},
+            "sensitivities": {"steps": 100, "repeats": 1, "rows": [
+                {"case": "kinematics four-bar, 4 parameters", "base_us_per_step": 1.0,
+                 "sens_us_per_step": 2.5, "ratio": 2.5}]},
             "meta": {"total_runtime_s": 300.0, "quick": False, "command": "python bench/run.py"}}
 
 
@@ -98,6 +107,9 @@ def test_targets_on_synthetic_results() -> None:
     assert met["free four-bar: >= 5x faster than Exudyn at equal accuracy"] is True
     assert met["kinematic stepping: >= 50x faster than Exudyn"] is False
     assert met["kinematics, N-four-bar N = 1000: <= 2 ms per step"] is True
+    assert met["sweep, 10-step kinematics: per-variant cost >= 10x below a with_params "
+               "loop"] is True
+    assert met["sensitivities of 4 parameters: <= 2x the analysis alone"] is False
     assert all(v is not None for v in met.values())
 
 
@@ -112,7 +124,7 @@ def test_missing_sections_are_not_measured(tmp_path: Path) -> None:
     tg = report.targets(res)
     assert [t["met"] for t in tg][:-1] == [None] * (len(tg) - 1)
     md = report.results_markdown(res, {}, tmp_path / "RESULTS.md", tmp_path / "results")
-    assert md.count("Failed: not run") == 5
+    assert md.count("Failed: not run") == 7
 
 
 def test_report_renders_failures_and_missing_stepper(tmp_path: Path) -> None:
@@ -121,6 +133,8 @@ def test_report_renders_failures_and_missing_stepper(tmp_path: Path) -> None:
     assert "## Targets" in md and "Failed: RuntimeError: boom" in md
     assert "not available (no KinematicStepper)" in md
     assert "Section **work_precision failed**" in md
+    assert "## Design sweeps" in md and "Loop / batched: **12.0x**" in md
+    assert "## Sensitivity cost" in md
     head = report.headline_markdown(res, {}, tmp_path)
     assert head.startswith("## Performance") and "| target |" in head
 

@@ -14,12 +14,13 @@ from .analysis.stepping import KinematicStepper
 from .description.functions import Harmonic, TimeFunction
 from .errors import (AnalysisError, AssemblyError, ConvergenceError, CoreError,
                      InconsistentConstraintsError, InsufficientMemoryError, IntegrationError,
-                     MbdError, MbdWarning, ModelError, RedundantConstraintWarning,
+                     LiftOffWarning, MbdError, MbdWarning, ModelError, RedundantConstraintWarning,
                      SingularConfigurationError, SingularJacobianError, SingularPassageWarning,
                      ToggleError)
 from .model import Model, load, loads
 from .results import (BodyResult, DofReport, DynamicsResult, KinematicsResult, Reaction,
                       StaticsResult)
+from .studies import ToleranceResult, grid, sweep, tolerance, write_sweep
 
 __version__ = "0.1.0"
 
@@ -29,4 +30,5 @@ __all__ = ["load", "loads", "Model", "TimeFunction", "Harmonic", "KinematicsResu
            "AssemblyError", "InconsistentConstraintsError", "ConvergenceError",
            "SingularJacobianError", "SingularConfigurationError", "ToggleError", "CoreError",
            "InsufficientMemoryError", "MbdWarning", "RedundantConstraintWarning",
-           "SingularPassageWarning", "__version__"]
+           "SingularPassageWarning", "LiftOffWarning", "sweep", "grid", "tolerance",
+           "ToleranceResult", "write_sweep", "__version__"]

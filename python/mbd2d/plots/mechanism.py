@@ -10,6 +10,7 @@ from ..errors import ModelError
 from ..validate import GROUND
 from .canvas import (GROUND_COLOUR, PALETTE, STOP_COLOUR, import_matplotlib, new_figure,
                      shade)
+from .contacts import contact_extent, draw_contacts
 from .geometry import (Motion, Poses, TracePoint, body_axis, body_points, check_trace,
                        convex_hull, profile_points, slide_axis, snapshot_rows)
 
@@ -92,6 +93,7 @@ def plot_mechanism(result: Motion, times: Sequence[float] | None = None,
         for body, s in zip(j.bodies, getattr(j, "points", ())):
             if body == GROUND:
                 extent.append(np.array([s], dtype=float))
+    extent += contact_extent(model, full, n)
     allp = np.vstack(extent)
     scale = float(max(np.ptp(allp[:, 0]), np.ptp(allp[:, 1]), 1e-9))
 
@@ -221,6 +223,9 @@ def plot_mechanism(result: Motion, times: Sequence[float] | None = None,
                             for k, r in enumerate(rows)])
             ax.plot(cp[:, 0], cp[:, 1], ls="none", marker="o", ms=3.5, mfc="k", mec="k",
                     zorder=z(m) + 0.2)
+
+    # ---- contacts (bold while touching)
+    draw_contacts(ax, model, snap, rows, result, shade_of, z, scale)
 
     # ---- joints: pins, ground pivots
     for j in model.joints:
