@@ -15,7 +15,7 @@ module mbd_assemble
   implicit none
   private
   public :: asm_work_t, asm_init, assemble_blocks, scatter_dense, assemble_dense, init_extras, &
-            gather_local, blocks_jv, blocks_jtv, scatter_values
+            gather_local, blocks_jv, blocks_jtv, scatter_values, asm_turn
 
   !> Work arrays of the assembly, allocated once per analysis.
   type :: asm_work_t
@@ -249,6 +249,21 @@ contains
       end do
     end do
   end subroutine blocks_jtv
+
+  !> The bodies' cos and sin after their angles changed by dq(3 b), a change within a few units
+  !! in the last place: cos(th + d) = c - s d, sin(th + d) = s + c d (the d**2 terms are below
+  !! rounding).
+  pure subroutine asm_turn(m, a, dq)
+    type(model_t), intent(in) :: m            !! model
+    type(asm_work_t), intent(inout) :: a      !! cos and sin of the angles
+    real(wp), intent(in) :: dq(:)             !! change of the coordinates (tiny)
+    real(wp) :: c, d
+    integer :: b
+    do b = 1, m%nb
+      d = dq(3 * b); c = a%cb(b)
+      a%cb(b) = c - a%sb(b) * d; a%sb(b) = a%sb(b) + c * d
+    end do
+  end subroutine asm_turn
 
   !> Starting values of the extra coordinates (cam contact parameters) from the bodies in q.
   pure subroutine init_extras(m, q)

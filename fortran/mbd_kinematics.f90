@@ -34,12 +34,13 @@ module mbd_kinematics
   use mbd_model, only: model_t
   use mbd_constraints, only: con_is_driver, con_name
   use mbd_assemble, only: asm_work_t, asm_init, assemble_blocks, assemble_dense, scatter_dense, &
-                          init_extras, blocks_jv, blocks_jtv, scatter_values
+                          init_extras, blocks_jv, blocks_jtv, scatter_values, asm_turn
   use mbd_band, only: band_t, band_plan, band_move, band_zero, band_norm1, band_factor, &
                       band_rcond, band_solve
   use mbd_linsolve, only: lu_factor, lu_solve, lu_det_sign, svd_null, row_rank, qr_factor, &
                           qr_solve, qr_lwork, lu_solve_rows
-  use mbd_splu, only: splu_t, splu_init, splu_plan, splu_factor, splu_solve, splu_pos, LMAX
+  use mbd_splu, only: splu_t, splu_init, splu_plan, splu_factor, splu_solve, splu_solve2, &
+                      splu_pos, LMAX
   use mbd_lapack, only: dgels, dgecon, dtrcon
   use mbd_interp, only: hermite5
   use mbd_sensitivity, only: sens_t, sens_hessian, sens_params, sens_kin_rhs
@@ -74,7 +75,9 @@ module mbd_kinematics
   !> largest dense Levenberg-Marquardt assembly (J and [J; mu I]) allowed in band mode (bytes):
   !! n up to about 1670; larger banded models assemble by damped Newton on the band
   real(wp), parameter :: DENSE_FALLBACK = 64.0_wp * 1048576
-  real(wp), parameter :: PRED_ACCEPT = 1.0e-2_wp  !! fraction of tol a start must meet
+  !> a start is taken without a correction when the correction is below RES_ULPS units in the
+  !! last place of every coordinate (of max(|q_i|, 1))
+  real(wp), parameter :: RES_ULPS = 4.0_wp
   !> what to change when the dense J does not fit
   character(len=*), parameter :: DENSE_HINT = 'the dense solver keeps J as a full matrix: ' // &
     'for kinematics of a large square model use the banded solver (solver="banded"), ' // &
@@ -120,6 +123,10 @@ module mbd_kinematics
     integer, allocatable :: ssrc(:), scol(:), spos(:)
     integer :: snon = 0
     real(wp) :: offpat = zero       !! sum |entries| outside the sparse pattern (must be 0)
+    !> the velocity J q_dot = nu solved together with the Newton correction of a start taken
+    !! (kin_newton); kin_vel_acc uses it while the factors stay
+    real(wp), allocatable :: qdp(:)
+    logical :: vel_ready = .false.
   end type kin_work_t
 
   !> What happened: counters, redundancy, and the singular or failed configuration.
@@ -203,7 +210,7 @@ contains
     integer, allocatable :: rows(:), cols(:)
     integer :: ne, ierr
     ne = size(w%asm%src)
-    allocate (rows(ne), cols(ne), w%ssrc(ne), w%scol(ne), w%spos(ne), stat=ierr)
+    allocate (rows(ne), cols(ne), w%ssrc(ne), w%scol(ne), w%spos(ne), w%qdp(m%nq), stat=ierr)
     if (ierr /= 0) then
       call mem_fail(12 * real(ne, wp), 'the sparse LU of J', DENSE_HINT, status, msg)
       return
@@ -304,7 +311,7 @@ contains
     integer :: i, k, n, info
     real(wp) :: anorm, colsum, umin, umax
     w%lu_count = w%lu_count + 1
-    w%spfact = .false.
+    w%spfact = .false.; w%vel_ready = .false.
     if (w%sparse .and. .not. w%lsq) then
       call sparse_factor(w, status)
       if (w%spfact .or. status == MBD_NO_MEMORY) return
@@ -466,11 +473,30 @@ contains
       if (it == 0) res0 = res
       call factor(w, status)
       if (status /= MBD_OK) return
-      ! a start that meets tol is taken only well inside it: the converged positions keep
-      ! the accuracy of a Newton correction (quadratic: far below tol), not just tol
-      if (res <= merge(PRED_ACCEPT * w%tol, w%tol, it == 0)) return
+      if (it > 0 .and. res <= w%tol) return
       if (it == maxit) exit
-      call solve_newton(w)
+      if (it == 0 .and. res <= w%tol .and. w%spfact) then
+        ! the correction and the velocity in one pass (the velocity kept if the start is)
+        w%phi = -w%phi
+        call splu_solve2(w%sp, w%phi, w%nu, w%dq, w%qdp, w%cs)
+        w%phi = -w%phi
+        w%vel_ready = .true.
+      else
+        call solve_newton(w)
+      end if
+      ! a start that meets tol is taken only when a Newton correction would not move it:
+      ! within RES_ULPS units in the last place of each coordinate, so that the positions
+      ! keep the accuracy of a correction (quadratic: far below tol), not just tol
+      if (it == 0 .and. res <= w%tol) then
+        if (below_resolution(size(q), q, w%dq)) then
+          ! taken with its correction: J, nu and the factors of the start serve (they differ
+          ! in the last places); the angles' cos and sin turned by the correction
+          q = q + w%dq
+          call asm_turn(m, w%asm, w%dq)
+          return
+        end if
+      end if
+      w%vel_ready = .false.
       if (w%lsq .and. maxval(abs(w%dq)) <= 1.0e-3_wp * w%tol .and. res > w%tol) then
         status = MBD_INCONSISTENT; return
       end if
@@ -494,7 +520,12 @@ contains
     integer, intent(out) :: status          !! MBD_OK or MBD_INCONSISTENT
     integer, intent(out), optional :: level !! 1 velocity, 2 acceleration (when inconsistent)
     status = MBD_OK
-    call solve(w, w%nu, qd)
+    if (w%vel_ready) then
+      qd = w%qdp                 ! solved with kin_newton's last correction
+      w%vel_ready = .false.
+    else
+      call solve(w, w%nu, qd)
+    end if
     if (w%lsq) then
       if (w%resid > 1.0e-8_wp * (one + maxval(abs(w%nu)))) status = MBD_INCONSISTENT
     end if
@@ -1518,6 +1549,20 @@ contains
     real(wp), intent(out) :: x(n)
     x = zero
   end subroutine zero_fill
+
+  !> The Newton correction dq is within RES_ULPS units in the last place of each coordinate:
+  !! |dq_i| <= RES_ULPS eps max(|q_i|, 1).
+  pure logical function below_resolution(n, q, dq) result(below)
+    integer, intent(in) :: n
+    real(wp), intent(in) :: q(n), dq(n)
+    real(wp) :: worst
+    integer :: i
+    worst = zero
+    do i = 1, n
+      worst = max(worst, abs(dq(i)) / max(abs(q(i)), one))
+    end do
+    below = worst <= RES_ULPS * epsilon(one)
+  end function below_resolution
 
   !> x = a, y = b, z = c.
   pure subroutine copy3(n, a, b, c, x, y, z)

@@ -24,7 +24,7 @@ module mbd_splu
   use mbd_memory, only: REAL_BYTES, mem_fail
   implicit none
   private
-  public :: splu_t, splu_init, splu_plan, splu_factor, splu_solve, splu_pos, LMAX, TAU
+  public :: splu_t, splu_init, splu_plan, splu_factor, splu_solve, splu_solve2, splu_pos, LMAX, TAU
 
   real(wp), parameter :: TAU = 0.5_wp   !! pivot threshold of a plan (|l_ik| <= 1/TAU = 2)
   real(wp), parameter :: LMAX = 4.0_wp  !! largest multiplier a replayed factorization keeps
@@ -42,7 +42,7 @@ module mbd_splu
     integer, allocatable :: at(:, :)      !! (n, n) position of A(i, j) in val (0: not stored)
     real(wp), allocatable :: val(:)       !! (n**2) values: A before factor, L and U after
     real(wp), allocatable :: rinv(:)      !! (n) 1 / u_kk
-    real(wp), allocatable :: y(:)         !! (n) work vector of the solves
+    real(wp), allocatable :: y(:), y2(:)  !! (n) work vectors of the solves
     integer, allocatable :: prow(:), pcol(:)  !! (n) step k pivots on A(prow(k), pcol(k))
     integer, allocatable :: diag(:)       !! (n) position of u_kk
     integer, allocatable :: lptr(:), lpos(:), lrow(:)  !! L by columns: entries, step rows
@@ -73,7 +73,7 @@ contains
     sp%n = n
     nn = n * n
     allocate (sp%struct(n, n), sp%seen(n, n), sp%at(n, n), sp%val(nn), sp%rinv(n), &
-              sp%y(n), sp%prow(n), sp%pcol(n), sp%diag(n), sp%lptr(n + 1), sp%lpos(nn), &
+              sp%y(n), sp%y2(n), sp%prow(n), sp%pcol(n), sp%diag(n), sp%lptr(n + 1), sp%lpos(nn), &
               sp%lrow(nn), sp%uptr(n + 1), sp%upos(nn), sp%urow(nn), sp%optr(n + 1), &
               sp%fill(nn), sp%a(n, n), sp%s(n, n), sp%lcol(nn), sp%bpos(nn), sp%brow(nn), &
               sp%bcol(nn), stat=ierr)
@@ -325,6 +325,47 @@ contains
       x(pcol(k)) = y(k) * cs(pcol(k))
     end do
   end subroutine solve_kernel
+
+  !> x1 = A^-1 b1 and x2 = A^-1 b2 in one pass over the factors (as splu_solve, each x
+  !! multiplied by the column scale cs).
+  pure subroutine splu_solve2(sp, b1, b2, x1, x2, cs)
+    type(splu_t), intent(inout) :: sp                !! factors (and the work vectors)
+    real(wp), intent(in) :: b1(:), b2(:)             !! right-hand sides (A's rows)
+    real(wp), intent(inout) :: x1(:), x2(:)          !! solutions (A's columns)
+    real(wp), intent(in) :: cs(:)                    !! column scale
+    call solve2_kernel(sp%n, sp%lptr(sp%n + 1) - 1, sp%nu, sp%prow, sp%pcol, sp%lpos, &
+                       sp%lrow, sp%lcol, sp%bpos, sp%brow, sp%bcol, sp%rinv, sp%val, sp%y, &
+                       sp%y2, b1, b2, x1, x2, cs)
+  end subroutine splu_solve2
+
+  !> splu_solve2 on plain arrays.
+  pure subroutine solve2_kernel(n, nl, nu, prow, pcol, lpos, lrow, lcol, bpos, brow, bcol, &
+                                rinv, val, y, z, b1, b2, x1, x2, cs)
+    integer, intent(in) :: n, nl, nu
+    integer, intent(in) :: prow(n), pcol(n), lpos(nl), lrow(nl), lcol(nl)
+    integer, intent(in) :: bpos(nu), brow(nu), bcol(nu)
+    real(wp), intent(in) :: rinv(n), val(*), b1(n), b2(n), cs(n)
+    real(wp), intent(out) :: y(n), z(n), x1(n), x2(n)
+    integer :: k, p
+    real(wp) :: v
+    do k = 1, n
+      y(k) = b1(prow(k)); z(k) = b2(prow(k))
+    end do
+    do p = 1, nl
+      v = val(lpos(p))
+      y(lrow(p)) = y(lrow(p)) - v * y(lcol(p)); z(lrow(p)) = z(lrow(p)) - v * z(lcol(p))
+    end do
+    do k = 1, n
+      y(k) = y(k) * rinv(k); z(k) = z(k) * rinv(k)
+    end do
+    do p = 1, nu
+      v = val(bpos(p))
+      y(brow(p)) = y(brow(p)) - v * y(bcol(p)); z(brow(p)) = z(brow(p)) - v * z(bcol(p))
+    end do
+    do k = 1, n
+      x1(pcol(k)) = y(k) * cs(pcol(k)); x2(pcol(k)) = z(k) * cs(pcol(k))
+    end do
+  end subroutine solve2_kernel
 
   !> Position in sp%val that A(i, j) is written to, 0 when the plan does not hold it (the
   !! entry must then be zero: a fill position is zeroed before each factorization).
