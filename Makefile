@@ -47,6 +47,8 @@ $(VENV)/.bench-ok: $(VENV)/.deps-ok
 	$(PY) -m pip install -q --disable-pip-version-check $(BENCHDEPS)
 	$(PY) -m pip install -q --disable-pip-version-check exudyn || \
 		echo "exudyn could not be installed: the benchmarks run without the peer comparison"
+	command -v valgrind >/dev/null 2>&1 || ./tools/system-deps.sh valgrind || \
+		echo "valgrind could not be installed: the benchmarks run without instruction counts"
 	touch $@
 
 bench: install $(VENV)/.bench-ok

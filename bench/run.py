@@ -7,7 +7,8 @@ Sections (each in its own try/except: a failure is recorded and the rest runs):
    Andrews' squeezer to 0.03 s, IFToMM N-four-bar;
 3. peers: Exudyn generalized-alpha on the free four-bar and Exudyn kinematic stepping
    (bench/peers_exudyn.py), with the ratios at equal accuracy;
-4. kinematics speed: Fortran loop, Python stepper, plain NumPy (bench/kinematics_speed.py);
+4. kinematics speed: Fortran loop, Python stepper, plain NumPy (bench/kinematics_speed.py),
+   and the four-bar's instructions per step by part under callgrind (bench/callgrind.py);
 5. scaling of kinematics with N (bench/scaling.py);
 6. memory of 10^6 output steps (bench/memory.py);
 7. design sweeps: per-variant cost batched vs a with_params loop, Dask LocalCluster
@@ -44,6 +45,7 @@ if str(BENCH) not in sys.path:
 
 import contact  # noqa: E402
 import environment  # noqa: E402
+import callgrind  # noqa: E402
 import kinematics_speed  # noqa: E402
 import memory  # noqa: E402
 import peers_exudyn  # noqa: E402
@@ -132,9 +134,14 @@ def section_peers(quick: bool) -> dict:
 
 
 def section_kinematics(quick: bool) -> dict:
-    """The three ways of running kinematics, at h = 1 ms, with the ratios."""
-    return {"h": kinematics_speed.H, "quick": quick,
-            "rows": kinematics_speed.compare(kinematics_speed.H, repeats=5, quick=quick)}
+    """The three ways of running kinematics, at h = 1 ms, with the ratios, and the four-bar's
+    instructions per step (callgrind) at h = 1 ms and 0.1 ms."""
+    rows = kinematics_speed.compare(kinematics_speed.H, repeats=5, quick=quick)
+    try:
+        cg = callgrind.callgrind(callgrind.H_VALUES[:1] if quick else callgrind.H_VALUES)
+    except Exception as e:  # noqa: BLE001 - the timings stand without the counts
+        cg = {"available": False, "reason": f"{type(e).__name__}: {e}"}
+    return {"h": kinematics_speed.H, "quick": quick, "rows": rows, "callgrind": cg}
 
 
 def section_scaling(quick: bool) -> dict:

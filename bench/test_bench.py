@@ -79,7 +79,14 @@ def synthetic_results(stepper: bool = True, exudyn: bool = True) -> dict:
                             "exudyn_best": "loop", "mbd2d": {"us_per_step": 2.0}}}
     return {"environment": {"cpu_model": "cpu", "cores": 2, "os": "os (kernel)",
                             "git": {"commit": "abc"}, "load_average_start": (0.1, 0, 0)},
-            "kinematics": {"rows": {report.FOURBAR: kin_row, report.SLIDER: dict(kin_row)}},
+            "kinematics": {"rows": {report.FOURBAR: kin_row, report.SLIDER: dict(kin_row)},
+                           "callgrind": {"available": True, "valgrind": "valgrind-3.19.0",
+                                         "rows": [{"h": 1e-3, "instructions_per_step": 9000.0,
+                                                   "newton_corrections_per_step": 0.02,
+                                                   "lu_per_step": 1.02,
+                                                   "parts": {"assembly": 5000.0, "LU": 700.0,
+                                                             "solves": 1300.0,
+                                                             "loop": 2000.0}}]}},
             "peers": peers,
             "scaling": {"banded_slope": 1.02, "dense_slope": 2.9, "banded_available": True,
                         "rows": {"dense": [], "banded": []},
@@ -102,7 +109,9 @@ def synthetic_results(stepper: bool = True, exudyn: bool = True) -> dict:
 def test_targets_on_synthetic_results() -> None:
     tg = {t["target"]: t for t in report.targets(synthetic_results())}
     met = {name: t["met"] for name, t in tg.items()}
-    assert met["kinematics, four-bar, Fortran loop: <= 1 us/step"] is True
+    kin = "kinematics, four-bar, Fortran loop: <= 1 us/step (h = 1 ms and 0.1 ms)"
+    assert met[kin] is True
+    assert "9.0k instructions at h = 1 ms" in tg[kin]["figure"]
     assert met["kinematics: Fortran loop >= 100x faster than plain NumPy"] is True
     assert met["free four-bar: >= 5x faster than Exudyn at equal accuracy"] is True
     assert met["kinematic stepping: >= 50x faster than Exudyn"] is False
@@ -143,3 +152,32 @@ def test_memory_chart_with_an_unavailable_case(tmp_path: Path) -> None:
     data = {"rows": [{"analysis": "kinematics", "every": 1, "steps": 10, "run_mib": 3.0},
                      {"analysis": "dynamics", "every": 1000, "steps": 10, "available": False}]}
     assert memory.chart(data, tmp_path / "m.png").stat().st_size > 0
+
+
+def test_kinematic_target_needs_both_step_sizes() -> None:
+    """<= 1 us/step is met only when h = 0.1 ms meets it too."""
+    res = synthetic_results()
+    res["kinematics"]["rows"][report.FOURBAR]["fortran_loop_h1e-4"]["us_per_step"] = 1.2
+    tg = {t["target"]: t["met"] for t in report.targets(res)}
+    assert tg["kinematics, four-bar, Fortran loop: <= 1 us/step (h = 1 ms and 0.1 ms)"] is False
+
+
+def test_callgrind_table_in_report() -> None:
+    """The instructions per step and their parts appear in the kinematics section."""
+    res = synthetic_results()
+    md = report.kinematics_section(res)
+    assert "Instructions per step (callgrind)" in md
+    assert "| 1 ms | 9,000 | 5,000 (56%) | 700 (8%) | 1,300 (14%) | 2,000 (22%) |" in md
+    res["kinematics"]["callgrind"] = {"available": False, "reason": "valgrind is not installed"}
+    assert "not measured (valgrind is not installed)" in report.kinematics_section(res)
+
+
+def test_callgrind_parts_count_each_function_once() -> None:
+    """Own instructions per function: every function in one part, the rest is the loop."""
+    import callgrind
+    d1 = {"__mbd_assemble_MOD_assemble_blocks": 100, "__sincos_fma": 10,
+          "__mbd_splu_MOD_splu_factor": 50, "__mbd_splu_MOD_splu_solve2": 20,
+          "__mbd_kinematics_MOD_kin_loop.constprop.0": 30}
+    d2 = {k: 3 * v for k, v in d1.items()}
+    parts = callgrind._parts(d1, d2, 2, total=(3 - 1) * 210 / 2)
+    assert parts == {"assembly": 110.0, "LU": 50.0, "solves": 20.0, "loop": 30.0}

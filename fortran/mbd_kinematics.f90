@@ -477,9 +477,7 @@ contains
       if (it == maxit) exit
       if (it == 0 .and. res <= w%tol .and. w%spfact) then
         ! the correction and the velocity in one pass (the velocity kept if the start is)
-        w%phi = -w%phi
         call splu_solve2(w%sp, w%phi, w%nu, w%dq, w%qdp, w%cs)
-        w%phi = -w%phi
         w%vel_ready = .true.
       else
         call solve_newton(w)
@@ -1555,13 +1553,13 @@ contains
   pure logical function below_resolution(n, q, dq) result(below)
     integer, intent(in) :: n
     real(wp), intent(in) :: q(n), dq(n)
-    real(wp) :: worst
+    real(wp), parameter :: ULP = RES_ULPS * epsilon(one)
     integer :: i
-    worst = zero
+    below = .false.
     do i = 1, n
-      worst = max(worst, abs(dq(i)) / max(abs(q(i)), one))
+      if (abs(dq(i)) > ULP * max(abs(q(i)), one)) return
     end do
-    below = worst <= RES_ULPS * epsilon(one)
+    below = .true.
   end function below_resolution
 
   !> x = a, y = b, z = c.

@@ -326,8 +326,8 @@ contains
     end do
   end subroutine solve_kernel
 
-  !> x1 = A^-1 b1 and x2 = A^-1 b2 in one pass over the factors (as splu_solve, each x
-  !! multiplied by the column scale cs).
+  !> x1 = -A^-1 b1 (a Newton correction from Phi = b1) and x2 = A^-1 b2 in one pass over the
+  !! factors (as splu_solve, each x multiplied by the column scale cs).
   pure subroutine splu_solve2(sp, b1, b2, x1, x2, cs)
     type(splu_t), intent(inout) :: sp                !! factors (and the work vectors)
     real(wp), intent(in) :: b1(:), b2(:)             !! right-hand sides (A's rows)
@@ -349,7 +349,7 @@ contains
     integer :: k, p
     real(wp) :: v
     do k = 1, n
-      y(k) = b1(prow(k)); z(k) = b2(prow(k))
+      y(k) = -b1(prow(k)); z(k) = b2(prow(k))
     end do
     do p = 1, nl
       v = val(lpos(p))
