@@ -319,7 +319,8 @@ def kinematics_section(results: dict) -> str:
                      fmt(r.get("ratio_numpy_over_stepper"), ".0f"),
                      fmt(get(r, "agreement_numpy_vs_mbd2d", "q_rel"), ".0e")))
     intro = ("Microseconds per output step (position + velocity + acceleration), best-of-5 "
-             "wall time over the run, at h = 1 ms (every step needs a Newton correction): "
+             "wall time over the run, at h = 1 ms (100 s, 100 crank turns) and, for (a), "
+             "also at h = 0.1 ms (10 s): "
              "(a) the time loop in the Fortran core, one call per analysis; (b) one "
              "`mbd2d.KinematicStepper.step(t)` call (one core call) per step from a Python "
              "loop; (c) bench/numpy_kinematics.py, the same algorithm in plain NumPy. "
@@ -347,7 +348,8 @@ def callgrind_section(kin: dict) -> str:
     intro = ("#### Instructions per step (callgrind)\n\nThe four-bar "
              "(examples/fourbar_grashof.toml) in the core's time loop under "
              "`valgrind --tool=callgrind`, collection on inside `kin_run` only; per step = "
-             "(I(3000 steps) - I(1000 steps)) / 2000, so the setup cancels. Parts: each "
+             "(I(3000 steps) - I(1000 steps)) / 2000 (crank turns 1 to 3 at h = 1 ms), so "
+             "the setup cancels. Parts: each "
              "function's own instructions by name (assembly of Phi, J, nu, gamma with sin/cos; "
              "the sparse LU; the triangular solves; the rest of the loop: predictor, step "
              "acceptance, checks, output). Stable on a shared machine, unlike wall time. "

@@ -6,10 +6,10 @@ J q_dot = nu and for J q_ddot = gamma; a predicted start is taken with its corre
 the correction is below a few units in the last place. This holds the loop, at both step sizes
 of issue 11, to the closed forms of tests/test_closed_forms.py (hand-derived loop closure,
 Cramer's rule for the rates, the cams' lift laws), with the error bounds of the README's
-accuracy table: each quantity's worst error over a full turn at most the table's value for that
+accuracy table as it stood before the faster step (360 steps, every step with a Newton
+correction): each quantity's worst error over a full turn at most the table's value for that
 mechanism, or 100 units in the last place of the quantity's largest magnitude where the table's
-value is below that rounding floor (the table was measured at 360 steps, where every step takes
-a Newton correction).
+value is below that rounding floor.
 """
 from __future__ import annotations
 
