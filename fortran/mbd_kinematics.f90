@@ -914,9 +914,9 @@ contains
     real(wp), intent(in) :: t0, t1             !! time span
     integer, intent(in) :: nsteps              !! output intervals
     type(kin_opts_t), intent(in) :: opts       !! settings
-    real(wp), contiguous, intent(out) :: qout(:, :)    !! coordinates (nq, kin_out_count)
-    real(wp), contiguous, intent(out) :: qdout(:, :)   !! velocities
-    real(wp), contiguous, intent(out) :: qddout(:, :)  !! accelerations
+    real(wp), intent(out) :: qout(:, :)        !! coordinates (nq, kin_out_count)
+    real(wp), intent(out) :: qdout(:, :)       !! velocities
+    real(wp), intent(out) :: qddout(:, :)      !! accelerations
     type(kin_report_t), intent(out) :: rep     !! what happened
     integer, intent(out) :: status             !! MBD_OK or the failure
     character(len=MSG_LEN), intent(out) :: msg !! explanation
@@ -924,15 +924,13 @@ contains
     !! dq/dp, dq_dot/dp and dq_ddot/dp at every stored output
     type(sens_t), intent(inout), optional :: sens
     real(wp), intent(out), optional :: sq(:, :, :), sqd(:, :, :), sqdd(:, :, :)
-    integer :: c0, n
+    integer :: c0
     call kin_loop(m, q0, t0, t1, nsteps, opts, qout, qdout, qddout, rep, status, msg, &
                   sens, sq, sqd, sqdd)
     ! the outputs not computed are zero (set here, not before the loop: no pass over them)
-    c0 = max(rep%ndone, 0); n = size(qout, 1)
+    c0 = max(rep%ndone, 0)
     if (c0 < size(qout, 2)) then
-      call zero_fill(n * (size(qout, 2) - c0), qout(:, c0 + 1:))
-      call zero_fill(n * (size(qout, 2) - c0), qdout(:, c0 + 1:))
-      call zero_fill(n * (size(qout, 2) - c0), qddout(:, c0 + 1:))
+      qout(:, c0 + 1:) = zero; qdout(:, c0 + 1:) = zero; qddout(:, c0 + 1:) = zero
     end if
   end subroutine kin_run
 
@@ -944,9 +942,9 @@ contains
     real(wp), intent(in) :: t0, t1             !! time span
     integer, intent(in) :: nsteps              !! output intervals
     type(kin_opts_t), intent(in) :: opts       !! settings
-    real(wp), contiguous, intent(out) :: qout(:, :)    !! coordinates (nq, kin_out_count)
-    real(wp), contiguous, intent(out) :: qdout(:, :)   !! velocities
-    real(wp), contiguous, intent(out) :: qddout(:, :)  !! accelerations
+    real(wp), intent(out) :: qout(:, :)        !! coordinates (nq, kin_out_count)
+    real(wp), intent(out) :: qdout(:, :)       !! velocities
+    real(wp), intent(out) :: qddout(:, :)      !! accelerations
     type(kin_report_t), intent(out) :: rep     !! what happened
     integer, intent(out) :: status             !! MBD_OK or the failure
     character(len=MSG_LEN), intent(out) :: msg !! explanation
@@ -1540,13 +1538,6 @@ contains
       fin = fin + (qdn(i) - qdn(i)) + (qddn(i) - qddn(i))    ! 0, or NaN if not finite
     end do
   end subroutine velocity_jump
-
-  !> x = 0 (an array of any shape, by sequence association).
-  pure subroutine zero_fill(n, x)
-    integer, intent(in) :: n
-    real(wp), intent(out) :: x(n)
-    x = zero
-  end subroutine zero_fill
 
   !> The Newton correction dq is within RES_ULPS units in the last place of each coordinate:
   !! |dq_i| <= RES_ULPS eps max(|q_i|, 1).
