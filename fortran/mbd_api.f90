@@ -377,7 +377,7 @@ contains
     end if
     if (tol > zero) opts%tol = tol
     if (maxit > 0) opts%maxit = maxit
-    call kin_work_init(m, w, status, msg)
+    call kin_work_init(m, w, status, msg, sparse=.false.)     ! one step: the dense LU
     if (status /= MBD_OK) return
     w%tol = opts%tol * m%lscale
     q = q / m%cunit; qd = qd / m%cunit; qdd = qdd / m%cunit

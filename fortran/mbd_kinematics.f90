@@ -156,12 +156,15 @@ contains
   !> Allocate work arrays for model m; with a band plan J is kept in band storage (the plan
   !! is moved into w) and no n x n array is allocated. A dense J is checked against the
   !! memory first (mem_check); a failed allocation is MBD_NO_MEMORY.
-  subroutine kin_work_init(m, w, status, msg, band)
+  subroutine kin_work_init(m, w, status, msg, band, sparse)
     type(model_t), intent(in) :: m                 !! model
     type(kin_work_t), intent(out) :: w             !! work arrays
     integer, intent(out) :: status                 !! MBD_OK or MBD_NO_MEMORY
     character(len=MSG_LEN), intent(inout) :: msg   !! explanation (on a failure)
     type(band_t), intent(inout), optional :: band  !! band plan of J (square J only), moved
+    !> the sparse LU may serve a small square J (default); .false. for a single step, where
+    !! planning its pivot order would cost more than the dense LU it replaces
+    logical, intent(in), optional :: sparse
     integer :: nr, ierr, lq
     real(wp) :: bytes
     character(len=MSG_LEN) :: what
@@ -195,6 +198,9 @@ contains
     if (status /= MBD_OK) return
     w%qz = zero
     w%cs = one
+    if (present(sparse)) then
+      if (.not. sparse) return
+    end if
     if (.not. w%banded .and. m%neq == m%nq .and. m%nq <= SPARSE_MAX_N) then
       call sparse_init(m, w, status, msg)
     end if
