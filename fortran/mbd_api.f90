@@ -15,6 +15,7 @@ module mbd_api
   use mbd_kinds, only: wp, zero, one
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use mbd_status, only: MBD_OK, MBD_BAD_COUNT, MBD_BAD_PARAM, MBD_INCONSISTENT, MBD_NO_MEMORY, &
+                        MBD_NO_CONVERGENCE, &
                         MSG_LEN
   use mbd_memory, only: REAL_BYTES, mem_fail
   use mbd_points, only: NLOC, MAXROW
@@ -394,6 +395,12 @@ contains
       else
         h = t - t_prev
         q = q + h * (qd + (0.5_wp * h) * qdd)     ! q(t) ~ q + h q_dot + h**2/2 q_ddot
+        if (.not. finite(q)) then
+          status = MBD_NO_CONVERGENCE
+          write (msg, '(a,es22.15,a)') 'the start predicted for t = ', t, &
+            ' is non-finite (a step far too long for Newton-Raphson)'
+          exit step
+        end if
       end if
       call kin_newton(m, w, q, t, opts%maxit, status)
       if (status /= MBD_OK) then
