@@ -6,7 +6,9 @@ PYTHON ?= python3
 PY := $(VENV)/bin/python
 export PATH := $(abspath $(VENV))/bin:$(PATH)
 
-PYDEPS := numpy meson meson-python ninja pytest hypothesis matplotlib pillow tqdm scipy
+PYDEPS := numpy meson meson-python ninja pytest hypothesis matplotlib pillow scipy
+# the sweep extra (pyproject.toml): design sweeps, tolerance analysis, Dask, netCDF
+PYDEPS += xarray dask distributed h5netcdf h5py pandas tqdm
 SOURCES := $(wildcard fortran/*.f90 fortran/app/*.f90 python/mbd2d/*.py python/mbd2d/*/*.py) meson.build pyproject.toml
 
 .PHONY: demo test bench system install clean help
@@ -51,6 +53,8 @@ $(VENV)/.bench-ok: $(VENV)/.deps-ok
 	$(PY) -m pip install -q --disable-pip-version-check $(BENCHDEPS)
 	$(PY) -m pip install -q --disable-pip-version-check exudyn || \
 		echo "exudyn could not be installed: the benchmarks run without the peer comparison"
+	command -v valgrind >/dev/null 2>&1 || ./tools/system-deps.sh valgrind || \
+		echo "valgrind could not be installed: the benchmarks run without instruction counts"
 	touch $@
 
 bench: install $(VENV)/.bench-ok

@@ -14,13 +14,14 @@ from .analysis.stepping import KinematicStepper
 from .description.functions import Harmonic, TimeFunction
 from .errors import (AnalysisError, AssemblyError, ConvergenceError, CoreError,
                      InconsistentConstraintsError, InsufficientMemoryError, IntegrationError,
-                     MbdError, MbdWarning, ModelError, RedundantConstraintWarning,
+                     LiftOffWarning, MbdError, MbdWarning, ModelError, RedundantConstraintWarning,
                      SingularConfigurationError, SingularJacobianError, SingularPassageWarning,
                      ToggleError)
 from .model import Model, load, loads
 from .plots import animate, plot_mechanism, plot_paths, plot_timeseries
 from .results import (BodyResult, DofReport, DynamicsResult, KinematicsResult, PointResult,
                       Reaction, StaticsResult)
+from .studies import ToleranceResult, grid, sweep, tolerance, write_sweep
 
 __version__ = "0.1.0"
 
@@ -31,5 +32,6 @@ __all__ = ["load", "loads", "Model", "TimeFunction", "Harmonic", "KinematicsResu
            "AssemblyError", "InconsistentConstraintsError", "ConvergenceError",
            "SingularJacobianError", "SingularConfigurationError", "ToggleError", "CoreError",
            "InsufficientMemoryError", "MbdWarning", "RedundantConstraintWarning",
-           "SingularPassageWarning", "plot_mechanism", "plot_paths", "plot_timeseries",
-           "animate", "__version__"]
+           "SingularPassageWarning", "LiftOffWarning", "plot_mechanism", "plot_paths",
+           "plot_timeseries", "animate", "sweep", "grid", "tolerance", "ToleranceResult",
+           "write_sweep", "__version__"]

@@ -5,6 +5,9 @@
     mbd2d dynamics MODEL.toml --t-end T --steps N --out OUT.csv [--method M --rtol R --atol A --h H
                    --max-steps S]
     mbd2d statics MODEL.toml [--t T] [--out OUT.csv]
+    mbd2d sweep MODEL.toml --param NAME=START:STOP:NUM ... [--grid] --t-end T --steps N
+                --out sweep.nc|sweep.csv [--analysis A --t0 T0 --every K --workers W
+                --scheduler ADDRESS]
     mbd2d check MODEL.toml
     mbd2d export MODEL.toml OUT.mbd [--analysis A] --t-end T --steps N [settings of A]
     mbd2d plot MODEL.toml --t-end T --steps N --out FIG.png
@@ -29,6 +32,8 @@ import argparse
 import sys
 import textwrap
 from typing import Any, Sequence
+
+import numpy as np
 
 from . import plots
 from .errors import (AnalysisError, InsufficientMemoryError, MbdError, ModelError,
@@ -126,6 +131,27 @@ def _parser() -> argparse.ArgumentParser:
                    "taken (default 0)")
     s.add_argument("--out", default=None, help="also write the equilibrium as CSV")
     _columns(s, energy=False)
+    w = sub.add_parser("sweep", help="one analysis of many variants (design parameters "
+                       "swept): netCDF or CSV")
+    w.add_argument("model", help="model file (.toml)")
+    w.add_argument("--param", action="append", required=True, metavar="NAME=START:STOP:NUM",
+                   help="a design parameter (see model.parameters()) and NUM values from "
+                   "START to STOP; repeat for more parameters")
+    w.add_argument("--grid", action="store_true", help="every combination of the values "
+                   "(default: the i-th value of every parameter together; equal NUM)")
+    w.add_argument("--analysis", default="kinematics",
+                   choices=["kinematics", "inverse_dynamics", "statics", "dynamics"],
+                   help="the analysis (default kinematics)")
+    w.add_argument("--t-end", type=float, default=None, help="final time")
+    w.add_argument("--steps", type=int, default=None, help="output intervals")
+    w.add_argument("--t0", type=float, default=0.0, help="start time (statics: its time)")
+    w.add_argument("--every", type=int, default=1, help="keep every k-th row (and the last)")
+    w.add_argument("--method", default=None, help="dynamics: the integrator")
+    w.add_argument("--out", required=True, help="output file, .nc (netCDF) or .csv")
+    w.add_argument("--workers", type=int, default=None,
+                   help="local worker processes (default: every core)")
+    w.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                   help="run on the Dask cluster of this scheduler (tcp://host:8786)")
     c = sub.add_parser("check", help="degrees of freedom and redundant constraints")
     c.add_argument("model", help="model file (.toml)")
     c.add_argument("--t", type=float, default=0.0, help="time of the check (default 0)")
@@ -263,6 +289,58 @@ def _write(res: Any, args: argparse.Namespace) -> str:
         return _picture(res, args)
     res.save(args.out, **_outputs(args))
     return args.out
+def _param_values(spec: str) -> tuple[str, np.ndarray]:
+    """NAME=START:STOP:NUM as the name and NUM values from START to STOP."""
+    name, eq, rng = spec.partition("=")
+    parts = rng.split(":")
+    try:
+        if not eq or len(parts) != 3:
+            raise ValueError
+        start, stop, num = float(parts[0]), float(parts[1]), int(parts[2])
+    except ValueError:
+        raise ModelError(f"--param {spec!r}: write NAME=START:STOP:NUM, for example "
+                         "joint.B.points.0.0=1.5:2.0:11", "command line") from None
+    if num < 1 or not (np.isfinite(start) and np.isfinite(stop)):
+        raise ModelError(f"--param {spec!r}: NUM must be >= 1 and START, STOP finite",
+                         "command line")
+    return name.strip(), np.linspace(start, stop, num)
+
+
+def _sweep(model: Model, args: argparse.Namespace) -> int:
+    """The sweep command: run, write, summarize."""
+    from .studies import connect, grid, sweep, write_sweep
+    if not str(args.out).endswith((".nc", ".csv")):
+        raise ModelError(f"--out must end in .nc or .csv, got {args.out!r}", "command line")
+    values = dict(_param_values(p) for p in args.param)
+    if args.grid:
+        cases = grid(values)
+    else:
+        counts = {len(v) for v in values.values()}
+        if len(counts) != 1:
+            raise ModelError("without --grid every --param needs the same NUM (the i-th "
+                             "values form case i); use --grid for every combination",
+                             "command line")
+        cases = values
+    if args.analysis == "statics":
+        kw: dict = {"t": args.t0}
+    else:
+        if args.t_end is None or args.steps is None:
+            raise ModelError(f"{args.analysis} needs --t-end and --steps", "command line")
+        kw = {"t_end": args.t_end, "steps": args.steps, "t0": args.t0, "every": args.every}
+        if args.method is not None:
+            kw["method"] = args.method
+    client = connect(args.scheduler) if args.scheduler else None
+    try:
+        ds = sweep(model, cases, args.analysis, client, workers=args.workers, **kw)
+    finally:
+        if client is not None:
+            client.close()
+    write_sweep(ds, args.out)
+    failed = int(ds.attrs["failed"])
+    print(f"wrote {ds.sizes['case']} cases ({failed} failed) to {args.out}")
+    for j in np.flatnonzero(ds.status.values != 0)[:5]:
+        _say(f"  case {int(j)}: {ds.message.values[j]}")
+    return EXIT_OK
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -290,6 +368,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             print(f"wrote {args.out} ({args.analysis}; run it with mbd2d-solve "
                   f"{args.out} OUT.csv)")
             return EXIT_OK
+        if args.command == "sweep":
+            return _sweep(model, args)
         _check_out(args)
         _trace(getattr(args, "trace", None))       # a malformed --trace fails before the run
         res = _run(model, args, getattr(args, "analysis", args.command))
@@ -320,6 +400,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     except MbdError as exc:
         _say(f"mbd2d: {exc}")
         return EXIT_NUMERICAL
+    except ImportError as exc:                  # an optional package (the sweep extra)
+        _say(f"mbd2d: {exc}")
+        return EXIT_INPUT
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -28,7 +28,8 @@ def bad_entry(model: ModelDescription, bad: int) -> str:
     """How messages name the entry the core's ``bad`` code points at: a force (<= BAD_FORCE),
     a body (< 0), a joint or driver (> 0), or the model (0)."""
     if bad <= BAD_FORCE:
-        return model.forces[BAD_FORCE - bad - 1].describe()
+        name, what, e = model.force_elements()[BAD_FORCE - bad - 1]
+        return f"joint '{name}' friction" if what == "friction" else e.describe()
     if bad < 0:
         return f"body '{model.bodies[-bad - 1].name}'"
     if bad > 0:

@@ -11,6 +11,7 @@ from ..description.joints import Cam, Translational
 from ..errors import ModelError
 from ..validate import GROUND
 from .canvas import GROUND_COLOUR, PALETTE
+from .contacts import ContactDrawer
 from .elements import (BodyLink, CamDrawer, Element, Look, ReactionDrawer, Updater,
                        convex_hull, drawer_for)
 from .geometry import Motion, Poses, TracePoint, check_trace
@@ -86,6 +87,7 @@ class Scene:
             cls = drawer_for(item)
             if cls is not None:
                 self.items.append(cls(item, self))
+        self.items += [ContactDrawer(c, self) for c in getattr(model, "contacts", [])]
         self.traces = [TraceDrawer(tp, self, i) for i, tp in enumerate(self.trace)]
 
         # attachment points of each body (its origin first) and the bodies drawn by others
