@@ -24,6 +24,7 @@ program mbd2d_solve
                      api_reactions
   use mbd_kinematics, only: MAXPASS, kin_out_count
   use mbd_integrators, only: output_index
+  use mbd_contact, only: NEO
   implicit none
   type(mbd_spec_t) :: spec
   character(len=1024) :: model_path, out_path
@@ -32,7 +33,9 @@ program mbd2d_solve
   real(wp) :: rinfo(NINFO), bytes, resid
   real(wp), allocatable :: q0(:), v0(:), qout(:, :), qdout(:, :), qddout(:, :), qsing(:), &
                            tpass(:), lamout(:, :), eout(:, :), tout(:), reac(:, :, :), &
-                           rloc(:, :, :), fpar(:)
+                           rloc(:, :, :), fpar(:), eo(:, :, :)
+  real(wp) :: evo(4, 1)
+  integer :: nev
   integer, allocatable :: dep(:), redundant(:), ftab(:, :)
   logical :: dynamic
 
@@ -87,6 +90,8 @@ program mbd2d_solve
             eout(4, merge(nrows, 1, dynamic)), stat=ierr)
   if (ierr == 0) allocate (qout(nq, nrows), qdout(nq, nrows), qddout(nq, nrows), stat=ierr)
   if (ierr == 0) allocate (ftab(NFT, spec%nf), fpar(max(1, size(spec%fpar))), stat=ierr)
+  if (ierr == 0) allocate (eo(NEO, spec%nf, merge(nrows, 0, spec%analysis == 'dynamics')), &
+                           stat=ierr)
   if (ierr /= 0) call die(2, trim(model_path) // ':' // trim(itoa(spec%steps_line)) // &
                           ': not enough memory for the outputs of ' // trim(itoa(spec%steps)) // &
                           ' steps; give fewer steps')
@@ -116,7 +121,7 @@ program mbd2d_solve
                       v0, spec%t0, spec%t_end, spec%steps, spec%method, spec%rtol, spec%atol, &
                       spec%h, spec%rho_inf, spec%alpha, spec%beta, spec%every, qout, qdout, &
                       qddout, lamout, eout, iinfo, rinfo, redundant, status, msg, &
-                      spec%max_steps)
+                      spec%max_steps, eo, evo, nev)
     nout = iinfo(1)
   case default   ! statics
     call api_statics(spec%nb, spec%ctab, spec%rpar, spec%bmass, spec%grav, ftab, fpar, q0, &
