@@ -97,14 +97,14 @@ def test_the_core_publishes_its_count_and_stops_when_asked():
     ctl = core.new_ctl()
     ctl[1] = 1
     out = core.dynamics(p, d, 0.0, 1.0, 100, 2, 0.0, 0.0, 0.0, -1.0, -1.0, -1.0, 1, 101, 0,
-                        ctl)
+                        ctl=ctl)
     assert out.status == USER_ABORT and 1 <= out.iinfo[0] < 101   # stops after a step
     assert out.iinfo[0] == ctl[0]
     mm = mbd2d.load(EX / "fourbar_masses.toml")
     p = pack(mm)
     d = pack_dynamics(mm, p)
     ctl = core.new_ctl()
-    out = core.inverse(p, d, 0.0, 1.0, 100, 0.0, 1, 0, 101, ctl)
+    out = core.inverse(p, d, 0.0, 1.0, 100, 0.0, 1, 0, 101, ctl=ctl)
     assert out.status == 0 and ctl[0] == 202
 
 

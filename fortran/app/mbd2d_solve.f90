@@ -25,7 +25,18 @@ program mbd2d_solve
   use mbd_kinematics, only: MAXPASS, kin_out_count
   use mbd_integrators, only: output_index
   use mbd_contact, only: NEO
+  use iso_c_binding, only: c_char, c_double, c_int
   implicit none
+  interface
+    !> x as "%.16e" into buf(len); the length written (number_format.c)
+    function format_e16(x, buf, len) result(n) bind(C, name='mbd_format_e16')
+      import :: c_char, c_double, c_int
+      real(c_double), value :: x
+      character(kind=c_char), intent(out) :: buf(*)
+      integer(c_int), value :: len
+      integer(c_int) :: n
+    end function format_e16
+  end interface
   type(mbd_spec_t) :: spec
   character(len=1024) :: model_path, out_path
   character(len=MSG_LEN) :: msg
@@ -244,27 +255,26 @@ contains
 
   !> A number as Python's "%.16e": 17 significant digits, a lower-case e and an exponent of
   !! at least two digits (-1.2345678901234567e-05, 0.0000000000000000e+00, 1.0e+100 style);
-  !! nan, inf and -inf as Python writes them.
-  function num(x) result(s)
+  !! nan, inf and -inf as Python writes them. C's snprintf writes the digits (number_format.c):
+  !! a Fortran internal write would allocate on every call.
+  !! s(1:n) gets the text (no trim of a function result: that allocates too).
+  subroutine num(x, s, n)
     real(wp), intent(in) :: x
-    character(len=32) :: s
-    character(len=32) :: raw
-    integer :: ie, e, io
+    character(len=32), intent(out) :: s
+    integer, intent(out) :: n
+    character(kind=c_char) :: buf(32)
+    integer :: i
     if (ieee_is_nan(x)) then
-      s = 'nan'; return
+      s = 'nan'; n = 3; return
     else if (.not. ieee_is_finite(x)) then
-      s = merge('inf ', '-inf', x > 0.0_wp); return
+      s = merge('inf ', '-inf', x > 0.0_wp); n = merge(3, 4, x > 0.0_wp); return
     end if
-    write (raw, '(es25.16e3)') x
-    raw = adjustl(raw)
-    ie = index(raw, 'E')
-    read (raw(ie + 1:), *, iostat=io) e
-    if (abs(e) < 100) then
-      write (s, '(a,a,sp,i3.2)') raw(1:ie - 1), 'e', e
-    else
-      write (s, '(a,a,sp,i4.3)') raw(1:ie - 1), 'e', e
-    end if
-  end function num
+    n = max(0, min(int(format_e16(real(x, c_double), buf, 32_c_int)), 31))
+    s = ''
+    do i = 1, n
+      s(i:i) = buf(i)
+    end do
+  end subroutine num
 
   subroutine write_csv(path)
     character(len=*), intent(in) :: path
@@ -277,6 +287,8 @@ contains
       'energy', 'drift_position', 'drift_velocity']
     real(wp), allocatable :: v(:)
     logical :: st
+    character(len=32) :: word
+    integer :: nw
     st = spec%analysis == 'statics'
     ncols = 1 + merge(5, 9, st) * spec%nb + 5 + neq + 6 * spec%nc + spec%nc
     allocate (v(ncols), stat=ierr)
@@ -323,9 +335,11 @@ contains
     do k = 1, nout
       if (ios /= 0) exit
       call row_values(k, v, i)
-      write (u, '(a)', advance='no', iostat=ios) trim(num(v(1)))
+      call num(v(1), word, nw)
+      write (u, '(a)', advance='no', iostat=ios) word(1:nw)
       do c = 2, i
-        if (ios == 0) write (u, '(a,a)', advance='no', iostat=ios) ',', trim(num(v(c)))
+        call num(v(c), word, nw)
+        if (ios == 0) write (u, '(a,a)', advance='no', iostat=ios) ',', word(1:nw)
       end do
       if (ios == 0) write (u, '(a)', iostat=ios) ''
     end do
