@@ -142,6 +142,11 @@ def export(model: ModelDescription, path: str | Path, t_end: float | None = None
         raise ModelError(f"unknown analysis {analysis!r}; use one of {', '.join(ANALYSES)}",
                          "export")
     words = _outputs(outputs, analysis)
+    held = [name for name, what, _ in model.force_elements() if what != "force"]
+    if held and analysis != "kinematics":
+        raise ModelError(f"the .mbd file of mbd2d-solve holds no contacts or joint friction "
+                         f"({', '.join(held)}); run this model from Python or the mbd2d "
+                         "command", "export")
     p = pack(model)
     lines = [header(), f"mbd2d {FORMAT}",
              f"name {model.name.replace(' ', '_') or 'model'}", f"analysis {analysis}"]
