@@ -72,14 +72,8 @@ def compare(label: str, base: Callable[[], Any], sens: Callable[[], Any], repeat
     return row
 
 
-def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--steps", type=int, default=20_000)
-    ap.add_argument("--repeats", type=int, default=7)
-    ap.add_argument("--quick", action="store_true", help="small smoke run")
-    ap.add_argument("--out", type=Path, default=BENCH / "results" / "sensitivities.json")
-    a = ap.parse_args(argv)
-    steps, reps = (500, 2) if a.quick else (a.steps, a.repeats)
+def measure(steps: int, reps: int, quick: bool = False) -> dict[str, Any]:
+    """Every case, interleaved best-of-reps; the rows and the settings."""
     t_end = steps * 1e-3                          # h = 1 ms
     rows = []
 
@@ -103,7 +97,7 @@ def main(argv: list[str] | None = None) -> int:
                         steps))
     free = free_slider_crank()
     pd = ["force.s1.stiffness", "body.rod.mass", "body.crank.inertia", "model.gravity.1"]
-    t_dyn = 2.0 if a.quick else 10.0
+    t_dyn = 2.0 if quick else 10.0
     rows.append(compare("dopri5 free slider-crank, 4 parameters",
                         lambda: free.dynamics(t_dyn, 200, rtol=1e-8, atol=1e-8),
                         lambda: free.dynamics(t_dyn, 200, rtol=1e-8, atol=1e-8,
@@ -112,10 +106,21 @@ def main(argv: list[str] | None = None) -> int:
         extra = f"  steps {r['integrator_steps']}" if "integrator_steps" in r else ""
         print(f"{r['case']:46s} {r['base_us_per_step']:9.2f} us  {r['sens_us_per_step']:9.2f} us"
               f"  ratio {r['ratio']:5.2f}{'' if r['meets_target'] else '  (above 2x)'}{extra}")
+    return {"target_ratio": TARGET, "steps": steps, "repeats": reps, "quick": quick,
+            "rows": rows}
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--steps", type=int, default=20_000)
+    ap.add_argument("--repeats", type=int, default=7)
+    ap.add_argument("--quick", action="store_true", help="small smoke run")
+    ap.add_argument("--out", type=Path, default=BENCH / "results" / "sensitivities.json")
+    a = ap.parse_args(argv)
+    steps, reps = (500, 2) if a.quick else (a.steps, a.repeats)
+    data = measure(steps, reps, a.quick)
     a.out.parent.mkdir(parents=True, exist_ok=True)
-    a.out.write_text(json.dumps({"target_ratio": TARGET, "steps": steps, "repeats": reps,
-                                 "quick": a.quick, "rows": rows}, indent=1) + "\n",
-                     encoding="utf-8")
+    a.out.write_text(json.dumps(data, indent=1) + "\n", encoding="utf-8")
     return 0
 
 

@@ -15,20 +15,27 @@ module mbd_api
   use mbd_kinds, only: wp, zero, one
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use mbd_status, only: MBD_OK, MBD_BAD_COUNT, MBD_BAD_PARAM, MBD_INCONSISTENT, MBD_NO_MEMORY, &
+                        MBD_NO_CONVERGENCE, &
                         MSG_LEN
   use mbd_memory, only: REAL_BYTES, mem_fail
   use mbd_points, only: NLOC, MAXROW
   use mbd_model, only: model_t, model_build, model_add_dynamics, model_force_size
   use mbd_dynamics, only: dyn_work_t, dyn_init, dyn_memory_check, dyn_velocity, &
                           dyn_multipliers, dyn_reactions, &
-                          gen_forces, kinetic_energy
+                          gen_forces, kinetic_energy, dyn_element_outputs
+  use mbd_events, only: ev_log_t, ev_log_init, events_switch, events_active
+  use mbd_forces, only: force_is_contact, FRC_FRICTION
+  use mbd_contact, only: NEO
+  use mbd_constraints, only: CON_CAM
+  use mbd_joint_cam, only: cam_outward_normal
+  use mbd_points, only: local_state
   use mbd_integrators, only: dyn_opts_t, dyn_stats_t, integrate, output_rows, output_index
   use mbd_statics, only: statics_solve
   use mbd_assemble, only: assemble_dense, asm_work_t, asm_init
   use mbd_kinematics, only: kin_opts_t, kin_report_t, kin_work_t, kin_run, kin_work_init, &
                             kin_assemble, kin_rank, kin_out_count, MAXPASS, SOLVER_AUTO, &
                             SOLVER_BANDED, kin_newton, kin_vel_acc
-  use mbd_status, only: MBD_BAD_SETTING
+  use mbd_status, only: MBD_BAD_SETTING, MBD_USER_ABORT
   use mbd_profiles, only: profile_raw_length, profile_prepare, profile_eval
   use mbd_sensitivity, only: sens_t, sens_setup, sens_eval_d, sens_trig
   use mbd_assemble, only: scatter_dense
@@ -37,7 +44,7 @@ module mbd_api
   implicit none
   private
   public :: NINFO, api_sizes, api_eval, api_kinematics, api_profile, api_analyze, api_kin_step
-  public :: api_inverse, api_dynamics, api_statics, api_reactions
+  public :: api_inverse, api_dynamics, api_statics, api_reactions, api_cam_forces
   public :: api_eval_d, api_reactions_dp, api_dynamics_sens
 
   integer, parameter :: NINFO = 10   !! length of the report arrays
@@ -156,6 +163,48 @@ contains
     if (worst > 0 .and. worst <= m%nc) resid_units = resid * m%rowunit(m%row0(worst))
   end function resid_units
 
+  !> Element outputs eo(NEO, nf, rows) in model units: contacts [Fn, Ft, penetration,
+  !! sliding speed, contact point]; joint friction [normal load, friction force, 0, slip
+  !! speed, stuck flag, friction moment]. Forces are F L in the core, lengths x / L.
+  subroutine element_units(m, eo)
+    type(model_t), intent(in) :: m
+    real(wp), intent(inout) :: eo(:, :, :)
+    integer :: k
+    real(wp) :: l
+    l = m%lref
+    if (.not. (l > one .or. l < one)) return
+    do k = 1, size(eo, 2)
+      if (force_is_contact(m%fkind(k))) then
+        eo(1:2, k, :) = eo(1:2, k, :) / l; eo(3:6, k, :) = eo(3:6, k, :) * l
+      else if (m%fkind(k) == FRC_FRICTION) then
+        eo(1:2, k, :) = eo(1:2, k, :) / l; eo(4, k, :) = eo(4, k, :) * l
+      end if
+    end do
+  end subroutine element_units
+
+  !> The event log as records evo(4, :) [t, element, kind, value] in model units (contact
+  !! speeds x L, friction forces / L); nev the number of events (more than size(evo, 2):
+  !! the later ones were not kept).
+  subroutine events_out(m, log, evo, nev)
+    type(model_t), intent(in) :: m
+    type(ev_log_t), intent(in) :: log
+    real(wp), intent(out) :: evo(:, :)
+    integer, intent(out) :: nev
+    integer :: r, k
+    evo = zero
+    nev = log%n
+    do r = 1, min(log%n, size(evo, 2), size(log%rec, 2))
+      evo(:, r) = log%rec(:, r)
+      k = nint(evo(2, r))
+      if (k < 1 .or. k > m%nf) cycle
+      if (force_is_contact(m%fkind(k))) then
+        evo(4, r) = evo(4, r) * m%lref
+      else
+        evo(4, r) = evo(4, r) / m%lref
+      end if
+    end do
+  end subroutine events_out
+
   !> Phi, J, nu and gamma at (q, q_dot, t).
   subroutine api_eval(nb, ctab, rpar, q, qd, t, phi, jac, nu, gam, status, msg, bad)
     integer, intent(in) :: nb                   !! moving bodies
@@ -193,7 +242,7 @@ contains
   !> Kinematic analysis: the whole time loop in one call.
   subroutine api_kinematics(nb, ctab, rpar, q0, t0, t1, nsteps, tol, maxit, tmin, every, &
                             solver, qout, qdout, qddout, iinfo, rinfo, qsing, dep, redundant, &
-                            tpass, status, msg, ptab, sq, sqd, sqdd)
+                            tpass, status, msg, ptab, sq, sqd, sqdd, ctl)
     integer, intent(in) :: nb                   !! moving bodies
     integer, intent(in) :: ctab(:, :)           !! constraint table
     real(wp), intent(in) :: rpar(:)             !! raw parameters
@@ -219,6 +268,9 @@ contains
     !! dq_ddot/dp at the outputs, each (nq, np, kin_out_count(nsteps, every))
     integer, intent(in), optional :: ptab(:, :)
     real(wp), intent(out), optional :: sq(:, :, :), sqd(:, :, :), sqdd(:, :, :)
+    !> progress, shared with a caller in another thread (2): ctl(1) the outputs stored so
+    !! far, ctl(2) /= 0 asks the run to stop (MBD_USER_ABORT, the outputs so far kept)
+    integer, intent(inout), optional, volatile :: ctl(:)
     type(model_t) :: m
     type(kin_opts_t) :: opts
     type(kin_report_t) :: rep
@@ -270,12 +322,13 @@ contains
     if (tmin > zero) opts%tmin = tmin
     if (present(ptab)) then
       call kin_run(m, q0 / m%cunit, t0, t1, nsteps, opts, qout, qdout, qddout, rep, status, &
-                   msg, sens, sq, sqd, sqdd)
+                   msg, sens, sq, sqd, sqdd, ctl=ctl)
       call sens_units(m, sens, sq, m%cunit, .false.)
       call sens_units(m, sens, sqd, m%cunit, .false.)
       call sens_units(m, sens, sqdd, m%cunit, .false.)
     else
-      call kin_run(m, q0 / m%cunit, t0, t1, nsteps, opts, qout, qdout, qddout, rep, status, msg)
+      call kin_run(m, q0 / m%cunit, t0, t1, nsteps, opts, qout, qdout, qddout, rep, status, &
+                   msg, ctl=ctl)
     end if
     call units(m, qout, m%cunit, .false.); call units(m, qdout, m%cunit, .false.)
     call units(m, qddout, m%cunit, .false.)
@@ -329,7 +382,7 @@ contains
     end if
     if (tol > zero) opts%tol = tol
     if (maxit > 0) opts%maxit = maxit
-    call kin_work_init(m, w, status, msg)
+    call kin_work_init(m, w, status, msg, sparse=.false.)     ! one step: the dense LU
     if (status /= MBD_OK) return
     w%tol = opts%tol * m%lscale
     q = q / m%cunit; qd = qd / m%cunit; qdd = qdd / m%cunit
@@ -346,6 +399,12 @@ contains
       else
         h = t - t_prev
         q = q + h * (qd + (0.5_wp * h) * qdd)     ! q(t) ~ q + h q_dot + h**2/2 q_ddot
+        if (.not. finite(q)) then
+          status = MBD_NO_CONVERGENCE
+          write (msg, '(a,es22.15,a)') 'the start predicted for t = ', t, &
+            ' is non-finite (a step far too long for Newton-Raphson)'
+          exit step
+        end if
       end if
       call kin_newton(m, w, q, t, opts%maxit, status)
       if (status /= MBD_OK) then
@@ -440,6 +499,16 @@ contains
     end do
   end subroutine api_profile
 
+  !> The report's iinfo(2) after a failed build: the offending constraint (> 0), body
+  !! (-body) or force (-1000000 - force); 0 when none.
+  pure integer function bad_code(bad, badf)
+    integer, intent(in) :: bad                  !! offending constraint (model_build)
+    integer, intent(in) :: badf                 !! force (> 0) or -body (model_add_dynamics)
+    bad_code = bad
+    if (badf > 0) bad_code = -1000000 - badf
+    if (badf < 0) bad_code = badf
+  end function bad_code
+
   !> Build a model with masses and forces (bad: offending constraint > 0 or force > 0 with
   !! kind flag; body errors come back as bad = -body).
   subroutine build_dynamic(nb, ctab, rpar, bmass, grav, ftab, fpar, m, status, msg, bad, badf)
@@ -480,7 +549,8 @@ contains
   !! iinfo/rinfo as api_kinematics; iinfo(2) = -force index for a bad force.
   subroutine api_inverse(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, t0, t1, nsteps, tol, &
                          every, solver, qout, qdout, qddout, lamout, eout, iinfo, rinfo, qsing, &
-                         dep, redundant, tpass, status, msg, ptab, sq, sqd, sqdd, slam)
+                         dep, redundant, tpass, status, msg, ptab, sq, sqd, sqdd, slam, eo, &
+                         evo, nev, ctl)
     integer, intent(in) :: nb, ctab(:, :), ftab(:, :), nsteps
     real(wp), intent(in) :: rpar(:), bmass(:, :), grav(2), fpar(:), q0(:), t0, t1, tol
     integer, intent(in) :: every                !! store every k-th output (and the last)
@@ -498,20 +568,32 @@ contains
     !! and dlambda/dp (neq, np, rows) at the outputs
     integer, intent(in), optional :: ptab(:, :)
     real(wp), intent(out), optional :: sq(:, :, :), sqd(:, :, :), sqdd(:, :, :), slam(:, :, :)
+    !> contacts and friction: the element outputs (NEO, nf, rows) and the contact events found
+    !! at the outputs (4, capacity), their number
+    real(wp), intent(out), optional :: eo(:, :, :), evo(:, :)
+    integer, intent(out), optional :: nev
+    !> progress as in api_kinematics: the kinematic pass counts the outputs, the multipliers'
+    !! pass counts on from there (2 x outputs in all)
+    integer, intent(inout), optional, volatile :: ctl(:)
     type(model_t) :: m
     type(dyn_work_t) :: w
     type(sens_t) :: sens
+    type(ev_log_t) :: log
     integer :: bad, badf, k, st
     real(wp) :: t
+    logical :: changed
     character(len=MSG_LEN) :: lmsg
     lamout = zero; eout = zero
+    if (present(eo)) eo = zero
+    if (present(evo)) evo = zero
+    if (present(nev)) nev = 0
     if (present(ptab)) then
       sq = zero; sqd = zero; sqdd = zero; slam = zero
     end if
     call build_dynamic(nb, ctab, rpar, bmass, grav, ftab, fpar, m, status, msg, bad, badf)
     if (status /= MBD_OK) then
       qout = zero; qdout = zero; qddout = zero; iinfo = 0; rinfo = zero
-      iinfo(2) = bad; if (badf /= 0) iinfo(2) = -1000000 - badf
+      iinfo(2) = bad_code(bad, badf)
       qsing = zero; dep = 0; redundant = 0; tpass = zero
       return
     end if
@@ -536,7 +618,7 @@ contains
     else
       call api_kinematics(nb, ctab, rpar, q0, t0, t1, nsteps, tol, 0, zero, every, solver, &
                           qout, qdout, qddout, iinfo, rinfo, qsing, dep, redundant, tpass, &
-                          status, msg)
+                          status, msg, ctl=ctl)
     end if
     if (iinfo(1) < 1) return
     ! the multipliers in the core's units (so the rank decisions do not depend on the unit)
@@ -548,6 +630,12 @@ contains
       call sens_units(m, sens, sqd, m%cunit, .false., back=.true.)
       call sens_units(m, sens, sqdd, m%cunit, .false., back=.true.)
     end if
+    if (st == MBD_OK) then
+      k = 1
+      if (present(evo)) k = size(evo, 2)
+      call ev_log_init(log, k, st)
+      if (st /= MBD_OK) lmsg = 'not enough memory for the event log'
+    end if
     if (st == MBD_NO_MEMORY) then
       status = st; msg = lmsg
     else if (st == MBD_OK) then
@@ -555,17 +643,32 @@ contains
         ! column k holds output min((k - 1) every, nsteps)
         t = t0 + (t1 - t0) * (real(min((k - 1) * every, nsteps), wp) / max(nsteps, 1))
         if (k == size(qout, 2)) t = t1
+        ! contacts open and close at the outputs (the motion is given)
+        if (events_active(m)) call events_switch(m, w, t, qout(:, k), qdout(:, k), log, &
+                                                 changed, st)
         call dyn_multipliers(m, w, qout(:, k), qdout(:, k), qddout(:, k), t, lamout(:, k), &
                              st, lmsg)
         if (st == MBD_NO_MEMORY) then
           status = st; msg = lmsg; exit
         end if
         call state_measures(m, w, qout(:, k), qdout(:, k), t, eout(:, k))
+        if (present(ctl)) then
+          ctl(1) = size(qout, 2) + k
+          if (ctl(2) /= 0 .and. k < iinfo(1)) then
+            status = MBD_USER_ABORT; iinfo(1) = k; rinfo(1) = t
+            write (msg, '(a,es12.5,a)') 'stopped on request at t = ', t, &
+              ' (the outputs so far are kept)'
+            exit
+          end if
+        end if
+        if (present(eo) .and. m%nf > 0) call dyn_element_outputs(m, w, qout(:, k), &
+                                                                 qdout(:, k), t, eo(:, :, k))
         if (present(ptab)) call sens_multipliers(m, sens, qout(:, k), qdout(:, k), &
                                                  qddout(:, k), t, w%jac, lamout(:, k), &
                                                  sq(:, :, k), sqd(:, :, k), sqdd(:, :, k), &
                                                  slam(:, :, k), st, lmsg)
       end do
+      if (present(evo) .and. present(nev)) call events_out(m, log, evo, nev)
     end if
     call units(m, qout, m%cunit, .false.); call units(m, qdout, m%cunit, .false.)
     call units(m, qddout, m%cunit, .false.); call units(m, lamout, m%rowunit, .true.)
@@ -575,6 +678,7 @@ contains
       call sens_units(m, sens, sqdd, m%cunit, .false.)
       call sens_units(m, sens, slam, m%rowunit, .true.)
     end if
+    if (present(eo)) call element_units(m, eo)
   end subroutine api_inverse
 
   !> Forward dynamics: assembly of q0, the velocity v0 projected onto J q_dot = nu (kinetic
@@ -586,7 +690,8 @@ contains
   !! rinfo: 1 time of a failure, 2 smallest step, 3 largest step.
   subroutine api_dynamics(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, v0, t0, t1, nsteps, &
                           method, rtol, atol, h, rho_inf, balpha, bbeta, every, qout, qdout, &
-                          qddout, lamout, eout, iinfo, rinfo, redundant, status, msg, max_steps)
+                          qddout, lamout, eout, iinfo, rinfo, redundant, status, msg, max_steps, &
+                          eo, evo, nev, ctl)
     integer, intent(in) :: nb, ctab(:, :), ftab(:, :), nsteps, method
     integer, intent(in) :: every                !! store every every-th output (and the last)
     real(wp), intent(in) :: rpar(:), bmass(:, :), grav(2), fpar(:), q0(:), v0(:), t0, t1
@@ -600,6 +705,14 @@ contains
     integer, intent(out) :: status              !! MBD_OK, < 0 input, > 0 numerical
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
     integer, intent(in) :: max_steps            !! step limit (accepted + rejected); 0: default
+    real(wp), intent(out) :: eo(:, :, :)        !! (NEO, nf, rows) element outputs
+    !> (4, capacity) events [t, element (force index), kind (1 onset, 2 separation, 3 stick,
+    !! 4 slip, 5 reversal), value (impact or separation speed; friction force)]
+    real(wp), intent(out) :: evo(:, :)
+    integer, intent(out) :: nev                 !! events (beyond size(evo, 2): not kept)
+    type(ev_log_t) :: log
+    !> progress as in api_kinematics (the rows stored so far; a request to stop)
+    integer, intent(inout), optional, volatile :: ctl(:)
     type(model_t) :: m
     type(dyn_work_t) :: w
     type(kin_work_t) :: kw
@@ -612,8 +725,9 @@ contains
     integer :: bad, badf, k, ko, nout, ierr
     iinfo = 0; rinfo = zero; redundant = 0
     qout = zero; qdout = zero; qddout = zero; lamout = zero; eout = zero
+    eo = zero; evo = zero; nev = 0
     call build_dynamic(nb, ctab, rpar, bmass, grav, ftab, fpar, m, status, msg, bad, badf)
-    iinfo(2) = bad; if (badf /= 0) iinfo(2) = -1000000 - badf
+    iinfo(2) = bad_code(bad, badf)
     if (status /= MBD_OK) return
     if (.not. (finite(q0) .and. finite(v0) .and. finite(t0) .and. finite(t1) .and. &
                finite([rtol, atol, h, rho_inf, balpha, bbeta]))) then
@@ -668,8 +782,16 @@ contains
     if (balpha >= zero) opts%balpha = balpha
     if (bbeta >= zero) opts%bbeta = bbeta
     if (max_steps > 0) opts%max_steps = max_steps
+    if (size(eo, 1) /= NEO .or. size(eo, 2) /= m%nf .or. size(eo, 3) /= size(qout, 2)) then
+      status = MBD_BAD_COUNT; msg = 'element output array sizes do not match the model'; return
+    end if
+    call ev_log_init(log, size(evo, 2), status)
+    if (status /= MBD_OK) then
+      msg = 'not enough memory for the event log'; return
+    end if
     call integrate(m, w, q, qd, t0, t1, nsteps, every, opts, qout, qdout, qddout, lamout, nout, &
-                   dst, status, msg)
+                   dst, status, msg, log, eo, ctl)
+    call events_out(m, log, evo, nev)
     iinfo(1) = nout; iinfo(3) = dst%steps; iinfo(4) = dst%rejected; iinfo(5) = dst%newton
     iinfo(6) = dst%rhs; iinfo(7) = dst%jacobians; iinfo(8) = dst%partitions
     iinfo(10) = dst%factorizations
@@ -683,6 +805,7 @@ contains
     end do
     call units(m, qout, m%cunit, .false.); call units(m, qdout, m%cunit, .false.)
     call units(m, qddout, m%cunit, .false.); call units(m, lamout, m%rowunit, .true.)
+    call element_units(m, eo)
   end subroutine api_dynamics
 
   !> Static equilibrium near the assembled q0 at time t, its multipliers and stability
@@ -709,7 +832,7 @@ contains
     integer :: bad, badf, ierr
     q = zero; lam = zero; stable = 0; resid = zero; iinfo = 0
     call build_dynamic(nb, ctab, rpar, bmass, grav, ftab, fpar, m, status, msg, bad, badf)
-    iinfo(2) = bad; if (badf /= 0) iinfo(2) = -1000000 - badf
+    iinfo(2) = bad_code(bad, badf)
     if (status /= MBD_OK) return
     if (.not. (finite(q0) .and. finite(t))) then
       call not_finite('q0 and t', status, msg); return
@@ -901,7 +1024,7 @@ contains
     qout = zero; qdout = zero; qddout = zero; lamout = zero; eout = zero
     sq = zero; sqd = zero; sqdd = zero
     call build_dynamic(nb, ctab, rpar, bmass, grav, ftab, fpar, m, status, msg, bad, badf)
-    iinfo(2) = bad; if (badf /= 0) iinfo(2) = -1000000 - badf
+    iinfo(2) = bad_code(bad, badf)
     if (status /= MBD_OK) return
     if (.not. (finite(q0) .and. finite(v0) .and. finite(t0) .and. finite(t1) .and. &
                finite([rtol, atol]))) then
@@ -975,5 +1098,59 @@ contains
     call sens_units(m, sens, sqd, m%cunit, .false.)
     call sens_units(m, sens, sqdd, m%cunit, .false.)
   end subroutine api_dynamics_sens
+
+  !> Normal force of each cam joint on its follower at many states: fn(nc, nt), positive
+  !! when the profile pushes the follower away, negative when the joint must pull it onto
+  !! the profile (a real follower would lift off); zero for other constraints.
+  !! fn = F_j . n, F_j the reaction on the follower, n the profile's outward normal at the
+  !! contact (for a flat face -m).
+  subroutine api_cam_forces(nb, ctab, rpar, q, t, lam, fn, status, msg)
+    integer, intent(in) :: nb, ctab(:, :)
+    real(wp), intent(in) :: rpar(:), q(:, :), t(:), lam(:, :)
+    real(wp), intent(out) :: fn(:, :)
+    integer, intent(out) :: status              !! MBD_OK or < 0
+    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    type(model_t) :: m
+    type(dyn_work_t) :: w
+    real(wp) :: reac(6, size(ctab, 2)), rloc(6, size(ctab, 2)), ql(NLOC), nv(2)
+    integer :: bad, k, i, s, ierr
+    fn = zero
+    call model_build(nb, ctab, rpar, m, status, msg, bad)
+    if (status /= MBD_OK) return
+    if (.not. (finite(q) .and. finite(t) .and. finite(lam))) then
+      call not_finite('q, t and lambda', status, msg); return
+    end if
+    if (size(q, 1) /= m%nq .or. size(lam, 1) /= m%neq .or. size(fn, 1) /= m%nc .or. &
+        size(q, 2) /= size(t) .or. size(lam, 2) /= size(t) .or. size(fn, 2) /= size(t)) then
+      status = MBD_BAD_COUNT; msg = 'array sizes do not match the model'; return
+    end if
+    allocate (w%phi(m%neq), w%nu(m%neq), w%gam(m%neq), w%qz(m%nq), stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail(REAL_BYTES * (3 * real(m%neq, wp) + m%nq), 'the reaction arrays', &
+                    'use a smaller model', status, msg)
+      return
+    end if
+    call asm_init(m, w%asm, status, msg)
+    if (status /= MBD_OK) return
+    w%qz = zero
+    do i = 1, size(t)
+      call dyn_reactions(m, w, q(:, i), t(i), lam(:, i), reac, rloc)
+      do k = 1, m%nc
+        if (m%kind(k) /= CON_CAM) cycle
+        do s = 1, NLOC
+          ql(s) = zero
+          if (m%loc(s, k) > 0) ql(s) = q(m%loc(s, k), i)
+        end do
+        nv = cam_outward_normal(m%suba(k), m%subb(k), m%p(m%po(k):m%po(k) + m%pn(k) - 1), &
+                                merge(1, 0, m%bi(k) > 0), merge(2, 0, m%bj(k) > 0), &
+                                local_state(ql, ql * zero))
+        if (m%bj(k) > 0) then
+          fn(k, i) = dot_product(reac(4:5, k), nv)
+        else
+          fn(k, i) = -dot_product(reac(1:2, k), nv)
+        end if
+      end do
+    end do
+  end subroutine api_cam_forces
 
 end module mbd_api

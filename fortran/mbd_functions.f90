@@ -4,7 +4,7 @@
 !! Returns f, df/dt and d2f/dt2 (the driver's nu = f' and its time term in gamma = f'').
 module mbd_functions
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
-  use mbd_kinds, only: wp, zero
+  use mbd_kinds, only: wp, zero, half
   use mbd_status, only: MBD_OK, MBD_BAD_PARAM, MSG_LEN
   implicit none
   private
@@ -98,7 +98,7 @@ contains
     real(wp), intent(out) :: f2    !! d2f/dt2
     integer :: np, nh, k, o
     real(wp) :: a, w, ph, s, c
-    np = nint(p(1))
+    np = int(p(1) + half)          ! the counts are whole numbers >= 0 (fun_check): nint
     f = zero; f1 = zero; f2 = zero
     ! Horner for c_0 + c_1 t + ... and its two derivatives
     do k = np, 1, -1
@@ -106,7 +106,7 @@ contains
       f1 = f1 * t + f
       f = f * t + p(1 + k)
     end do
-    nh = nint(p(np + 2))
+    nh = int(p(np + 2) + half)
     do k = 1, nh
       o = np + 2 + 3 * (k - 1)
       a = p(o + 1); w = p(o + 2); ph = p(o + 3)

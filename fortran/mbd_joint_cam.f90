@@ -23,7 +23,7 @@ module mbd_joint_cam
   implicit none
   private
   public :: FOL_POINT, FOL_ROLLER, FOL_FLAT, ALPHA_SLOT
-  public :: cam_raw_length, cam_prepare, cam_eval, cam_init_alpha
+  public :: cam_raw_length, cam_prepare, cam_eval, cam_init_alpha, cam_outward_normal
   public :: cam_prepare_d, cam_eval_d, cam_is_count
 
   integer, parameter :: FOL_POINT = 1, FOL_ROLLER = 2, FOL_FLAT = 3
@@ -148,6 +148,26 @@ contains
       end if
     end do
   end function cam_init_alpha
+
+  !> The profile's outward unit normal (global) at the contact of the local state x: point
+  !! and roller followers A_i n(alpha); a flat face -A_j m'.
+  pure function cam_outward_normal(prof, fol, p, si, sj, x) result(nv)
+    integer, intent(in) :: prof, fol        !! profile and follower kinds
+    real(wp), intent(in) :: p(:)            !! prepared parameters
+    integer, intent(in) :: si, sj           !! slot ids
+    type(kloc), intent(in) :: x             !! local state
+    real(wp) :: nv(2), c0(2), c1(2), c2(2), c3(2), n0(2), n1(2), n2(2)
+    type(kvec) :: a
+    if (fol == FOL_FLAT) then
+      a = body_vector(x, sj, p(3:4))
+      nv = -a%v
+    else
+      call profile_eval(prof, p(5:), x%q(ALPHA_SLOT), c0, c1, c2, c3)
+      call profile_normal(c1, c2, c3, n0, n1, n2)
+      a = curve_vector(x, si, 0, n0, n1, n2)
+      nv = a%v
+    end if
+  end function cam_outward_normal
 
   !> True when raw entry j is a count of the profile (no derivative with respect to it).
   pure logical function cam_is_count(prof, j)

@@ -63,7 +63,7 @@ contains
     real(wp), allocatable :: nb(:, :), h(:, :), ev(:), g(:), dz(:), dqn(:), kt(:, :), &
                              ct(:, :), qt(:), ja(:, :), sv(:), u(:, :), vt(:, :), work(:), &
                              r(:), c(:), dqz(:)
-    real(wp) :: v0, vt1, alpha, emax, fscale, vnoise, e0, e1, gn, pn, slope, bytes
+    real(wp) :: v0, vt1, alpha, emax, fscale, vnoise, e0, e1, gn, pn, slope, bytes, fmag
     integer :: it, ls, nfree, n, na, stp, ist, nu
     logical :: local
     character(len=MSG_LEN) :: lmsg, what
@@ -174,6 +174,7 @@ contains
         pn = max(pn, abs(w%phi(w%rows(i))))
       end do
       v0 = potential(qa)
+      fscale = max(fscale, fmag)           ! loads that balance each other (a contact)
       vnoise = V_NOISE * (abs(v0) + scale_of_v(qa))
       ! SVD of the active rows: J_a = U S V^T; N = the last columns of V
       dqn = zero
@@ -280,7 +281,7 @@ contains
     real(wp) function potential(qa)
       real(wp), intent(in) :: qa(:)
       real(wp) :: v, vl
-      call gen_forces(m, qa, w%qz, t, w%force, v, vl)
+      call gen_forces(m, qa, w%qz, t, w%force, v, vl, fmag=fmag)
       potential = v + vl
     end function potential
 

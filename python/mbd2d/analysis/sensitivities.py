@@ -25,6 +25,12 @@ def requested(model: Any, names: Sequence[str] | None) -> list[Parameter] | None
     """
     if names is None:
         return None
+    fric = [j.name for j in model.joints if getattr(j, "friction", None) is not None]
+    if getattr(model, "contacts", None) or fric:
+        raise ModelError("design sensitivities do not carry contacts or joint friction "
+                         f"({', '.join([c.name for c in model.contacts] + fric)}): their "
+                         "events make the motion non-smooth in the parameters; run without "
+                         "sensitivities=", "sensitivities")
     params = find(model, names, "sensitivities")
     if not params:
         raise ModelError("sensitivities=[] names no parameter; give parameter names "

@@ -9,9 +9,12 @@ from ..binding import core
 from ..binding.pack import pack, pack_dynamics
 from ..binding.status import (ASSEMBLY_FAILED, INCONSISTENT, NO_CONVERGENCE, OK, SINGULAR,
                               error_for)
+from ..binding.tables import Packed
 from ..description.builder import ModelDescription
+from ..errors import MbdError
 from ..results.statics import StaticsResult
 from ..validate import number
+from .contacts import check_statics
 from .failures import assembly_failed, bad_entry, inconsistent_at
 from .sensitivities import check_status, requested, table
 
@@ -22,6 +25,7 @@ def run_statics(model: ModelDescription, t: float = 0.0,
                 sensitivities: Any = None) -> StaticsResult:
     """Static equilibrium near the q0 estimates; see :meth:`mbd2d.Model.statics`."""
     t = number(t, "t", "statics")
+    check_statics(model)
     params = requested(model, sensitivities)
     p = pack(model)
     d = pack_dynamics(model, p)
@@ -31,25 +35,9 @@ def run_statics(model: ModelDescription, t: float = 0.0,
         check_status(out.status, out.iinfo, out.msg, params)
     else:
         out = core.statics(p, d, t)
-    status, text = out.status, out.msg
-    if status < 0:
-        raise error_for("statics", status, text, entry=bad_entry(model, int(out.iinfo[1])))
-    if status == ASSEMBLY_FAILED:
-        raise assembly_failed("statics", model, float(out.resid), 0, t, None)
-    if status == INCONSISTENT:
-        raise inconsistent_at("statics", model, p, t, None, text)
-    if status == NO_CONVERGENCE:
-        text = f"{text} (no equilibrium found near the q0 estimates; give q0 closer to one)"
-    elif status == SINGULAR:
-        text = (f"{text} (the equilibrium is not unique: a motion without stiffness, such as "
-                "a free rotation, is left; add a spring or a driver)")
-    if status != OK:
-        raise error_for("statics", status, text, t=t, residual=float(out.resid))
-    if not (np.isfinite(out.q).all() and np.isfinite(out.lam).all()
-            and np.isfinite(out.resid)):
-        raise error_for("statics", NO_CONVERGENCE, "the equilibrium iteration gave non-finite "
-                        "values; give q0 closer to an equilibrium", t=t,
-                        residual=float(out.resid))
+    exc = statics_error(model, p, out, t)
+    if exc is not None:
+        raise exc
     res = StaticsResult(t=t, q=out.q, lam=out.lam,
                         stability=STABILITY.get(int(out.stable), "unknown"),
                         residual=float(out.resid), body_names=p.body_names,
@@ -63,3 +51,32 @@ def run_statics(model: ModelDescription, t: float = 0.0,
         res.parameter_names = [prm.name for prm in params]
         res.dq_dp, res.dlam_dp, res.ptab = out.sq.copy(), out.slam.copy(), ptab
     return res
+
+
+def statics_error(model: ModelDescription, p: Packed, out: Any, t: float) -> MbdError | None:
+    """The exception a statics call ends in, or None when it found a finite equilibrium.
+
+    ``out`` carries the core's ``status``, ``msg``, ``iinfo``, ``q``, ``lam`` and ``resid``
+    (as :func:`mbd2d.binding.core.statics` returns them); p the tables of the model solved
+    (a rank analysis of them names contradicting constraints).
+    """
+    status, text = out.status, out.msg
+    if status < 0:
+        return error_for("statics", status, text, entry=bad_entry(model, int(out.iinfo[1])))
+    if status == ASSEMBLY_FAILED:
+        return assembly_failed("statics", model, float(out.resid), 0, t, None)
+    if status == INCONSISTENT:
+        return inconsistent_at("statics", model, p, t, None, text)
+    if status == NO_CONVERGENCE:
+        text = f"{text} (no equilibrium found near the q0 estimates; give q0 closer to one)"
+    elif status == SINGULAR:
+        text = (f"{text} (the equilibrium is not unique: a motion without stiffness, such as "
+                "a free rotation, is left; add a spring or a driver)")
+    if status != OK:
+        return error_for("statics", status, text, t=t, residual=float(out.resid))
+    if not (np.isfinite(out.q).all() and np.isfinite(out.lam).all()
+            and np.isfinite(out.resid)):
+        return error_for("statics", NO_CONVERGENCE, "the equilibrium iteration gave non-finite "
+                         "values; give q0 closer to an equilibrium", t=t,
+                         residual=float(out.resid))
+    return None

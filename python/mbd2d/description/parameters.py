@@ -289,4 +289,21 @@ def with_params(model: Any, values: Mapping[str, Any]) -> Any:
     return new
 
 
-__all__ = ["Parameter", "TABLES", "parameter_list", "find", "with_params"]
+def constraints_with(model: Any, params: Iterable[Parameter],
+                     values: Iterable[float]) -> list[Any]:
+    """The model's constraints (joints, then drivers) with the given joint and driver
+    parameters set to values: a new list in which only the changed entries are new; the
+    model is unchanged. Parameters of other sections are left out."""
+    cons = list(model.constraints)
+    nj = len(model.joints)
+    for p, v in zip(params, values):
+        if p.section not in ("joint", "driver"):
+            continue
+        k = p.index + (nj if p.section == "driver" else 0)
+        e = cons[k]
+        cons[k] = dataclasses.replace(e, **{p.field: _replaced(getattr(e, p.field), p.path,
+                                                               float(v))})
+    return cons
+
+
+__all__ = ["Parameter", "TABLES", "parameter_list", "find", "with_params", "constraints_with"]

@@ -6,6 +6,7 @@
     [[driver]]         name, type, body, coordinate, bodies, joint, f
     [[force]]          name, type, bodies, body, points, point, stiffness, damping, length0,
                        angle0, f, fx, fy
+    [[contact]]        name, type, bodies, circle, line, profile, follower, law, friction
 
 Every key goes through the builder methods of
 :class:`~mbd2d.description.builder.ModelDescription`, so a TOML model and a model built in code
@@ -22,10 +23,11 @@ from typing import Any, Mapping, TypeVar
 from ..errors import ModelError
 from ..validate import only_keys, table
 from .builder import ModelDescription
+from .contacts import CONTACT_KEYS
 
 M = TypeVar("M", bound=ModelDescription)
 
-SECTIONS = {"model", "body", "joint", "driver", "force"}
+SECTIONS = {"model", "body", "joint", "driver", "force", "contact"}
 
 
 def load(path: str | Path, cls: type[M] = ModelDescription) -> M:  # type: ignore[assignment]
@@ -105,7 +107,8 @@ def from_dict(data: Mapping[str, Any], source: str = "<dict>",
     unknown = set(data) - SECTIONS
     if unknown:
         raise ModelError(f"unknown section(s) {sorted(unknown)}; sections are "
-                         "[model], [[body]], [[joint]], [[driver]]", source)
+                         "[model], [[body]], [[joint]], [[driver]], [[force]], [[contact]]",
+                         source)
     head = table(data.get("model", {}), "[model]", source)
     only_keys(head, {"name", "gravity"}, "[model]")
     name = head.get("name", Path(source).stem if source.endswith(".toml") else "model")
@@ -141,6 +144,18 @@ def from_dict(data: Mapping[str, Any], source: str = "<dict>",
             raise ModelError("missing key 'type' (spring, torque, point, rotational-spring)",
                              entry)
         model.add_force(**fe)
+    for i, ce in enumerate(_entries(data, "contact", source)):
+        entry = f"[[contact]] #{i + 1}" + _named(ce)
+        ce = dict(table(ce, "[[contact]]", entry))
+        only_keys(ce, set(ce) | {"type"}, entry)
+        if "type" not in ce:
+            raise ModelError("missing key 'type' (circle-line, circle-circle, "
+                             "circle-in-circle, follower-profile)", entry)
+        ctype = ce["type"]
+        if isinstance(ctype, str) and ctype in CONTACT_KEYS:
+            allowed, required = CONTACT_KEYS[ctype]
+            only_keys(ce, allowed | {"name", "type"}, entry, required=sorted(required))
+        model.add_contact(**ce)
     return model
 
 

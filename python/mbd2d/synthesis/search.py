@@ -16,6 +16,7 @@ from typing import Any, Callable, Mapping, Sequence
 import numpy as np
 
 from ..errors import ModelError
+from ..studies.runner import _context, cores
 from ..validate import whole
 from .problem import Evaluation, Problem
 from .tasks import Task
@@ -27,12 +28,10 @@ def run_all(fn: Callable[[Any], Any], items: Sequence[Any], client: Any = None,
             workers: int | None = 1) -> list[Any]:
     """fn over items, results in order: THE one place where synthesis spreads work.
 
-    ``client``: a Dask distributed client (anything with ``map`` and ``gather``) or a
+    ``client``: a Dask distributed client (anything with ``map`` and ``gather``: the client
+    :func:`mbd2d.sweep` takes, or :func:`mbd2d.studies.connect`'s) or a
     ``concurrent.futures`` executor (``submit``); without one, ``workers`` local processes
-    (1: in this process).
-
-    This is the seam for :func:`mbd2d.sweep`'s executor (issue 10 section 3): until that
-    lands, this function is the executor.
+    (1: in this process; None: every core, as a sweep), started as the sweeps start theirs.
     """
     items = list(items)
     if client is not None:
@@ -42,10 +41,10 @@ def run_all(fn: Callable[[Any], Any], items: Sequence[Any], client: Any = None,
             return [f.result() for f in [client.submit(fn, it) for it in items]]
         raise ModelError("client must be a Dask client (map, gather) or a concurrent.futures "
                          "executor (submit)", "synthesize")
-    n = 1 if workers is None else int(workers)
+    n = cores() if workers is None else int(workers)
     if n <= 1 or len(items) <= 1:
         return [fn(it) for it in items]
-    with ProcessPoolExecutor(max_workers=min(n, len(items))) as pool:
+    with ProcessPoolExecutor(max_workers=min(n, len(items)), mp_context=_context()) as pool:
         return list(pool.map(fn, items))
 
 
