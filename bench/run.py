@@ -7,12 +7,22 @@ Sections (each in its own try/except: a failure is recorded and the rest runs):
    Andrews' squeezer to 0.03 s, IFToMM N-four-bar;
 3. peers: Exudyn generalized-alpha on the free four-bar and Exudyn kinematic stepping
    (bench/peers_exudyn.py), with the ratios at equal accuracy;
-4. kinematics speed: Fortran loop, Python stepper, plain NumPy (bench/kinematics_speed.py);
+4. kinematics speed: Fortran loop, Python stepper, plain NumPy (bench/kinematics_speed.py),
+   and the four-bar's instructions per step by part under callgrind (bench/callgrind.py);
 5. scaling of kinematics with N (bench/scaling.py);
-6. memory of 10^6 output steps (bench/memory.py).
+6. memory of 10^6 output steps (bench/memory.py);
+7. design sweeps: per-variant cost batched vs a with_params loop, Dask LocalCluster
+   throughput with 1 and 2 workers (bench/sweep.py);
+8. cost of design sensitivities, 4 parameters against the analysis alone
+   (bench/sensitivities.py);
+9. contacts (bench/contact.py): the clearance-joint crank-slider against the ideal joint and
+   over the restitution, and the cost of far contact pairs;
+10. linkage synthesis: the three standard four-bar path-generation cases of the literature,
+   mbd2d against the published errors and pylinkage (bench/synthesis.py).
 
 Writes bench/results/*.json and *.png, bench/RESULTS.md and bench/README_headline.md
-(bench/report.py). The whole run is sized to finish in well under 10 minutes on a 2-core
+(bench/report.py). With --only, the other sections come from their results files of an
+earlier run (the report says which). The whole run is sized to finish in well under 10 minutes on a 2-core
 machine; --quick is a smoke test of the same code.
 
     python bench/run.py [--quick] [--out DIR] [--only SECTION ...]
@@ -35,15 +45,21 @@ BENCH = Path(__file__).resolve().parent
 if str(BENCH) not in sys.path:
     sys.path.insert(0, str(BENCH))
 
+import contact  # noqa: E402
 import environment  # noqa: E402
+import callgrind  # noqa: E402
 import kinematics_speed  # noqa: E402
 import memory  # noqa: E402
 import peers_exudyn  # noqa: E402
 import report  # noqa: E402
 import scaling  # noqa: E402
+import sensitivities  # noqa: E402
+import sweep as sweeps  # noqa: E402
+import synthesis  # noqa: E402
 import work_precision  # noqa: E402
 
-SECTIONS = ("environment", "work_precision", "peers", "kinematics", "scaling", "memory")
+SECTIONS = ("environment", "work_precision", "peers", "kinematics", "scaling", "memory",
+            "sweep", "sensitivities", "contact", "synthesis")
 
 
 # ===================================================================== JSON
@@ -121,9 +137,14 @@ def section_peers(quick: bool) -> dict:
 
 
 def section_kinematics(quick: bool) -> dict:
-    """The three ways of running kinematics, at h = 1 ms, with the ratios."""
-    return {"h": kinematics_speed.H, "quick": quick,
-            "rows": kinematics_speed.compare(kinematics_speed.H, repeats=5, quick=quick)}
+    """The three ways of running kinematics, at h = 1 ms, with the ratios, and the four-bar's
+    instructions per step (callgrind) at h = 1 ms and 0.1 ms."""
+    rows = kinematics_speed.compare(kinematics_speed.H, repeats=5, quick=quick)
+    try:
+        cg = callgrind.callgrind(callgrind.H_VALUES[:1] if quick else callgrind.H_VALUES)
+    except Exception as e:  # noqa: BLE001 - the timings stand without the counts
+        cg = {"available": False, "reason": f"{type(e).__name__}: {e}"}
+    return {"h": kinematics_speed.H, "quick": quick, "rows": rows, "callgrind": cg}
 
 
 def section_scaling(quick: bool) -> dict:
@@ -134,6 +155,26 @@ def section_scaling(quick: bool) -> dict:
 def section_memory(quick: bool) -> dict:
     """Peak memory of 10^6 output steps (10^5 with --quick)."""
     return memory.memory(steps=100_000 if quick else memory.STEPS)
+
+
+def section_sweep(quick: bool) -> dict:
+    """Per-variant cost of sweeps and the Dask LocalCluster throughput."""
+    return sweeps.measure(quick=quick)
+
+
+def section_sensitivities(quick: bool) -> dict:
+    """Each analysis with 4 parameters' sensitivities against the analysis alone."""
+    return sensitivities.measure(500 if quick else 20_000, 2 if quick else 5, quick)
+
+
+def section_contact(quick: bool) -> dict:
+    """Cost of the clearance joint (ratio to the ideal joint, over e) and of far pairs."""
+    return contact.study(repeats=1 if quick else 3, quick=quick)
+
+
+def section_synthesis(quick: bool) -> dict:
+    """Four-bar path generation: published errors, mbd2d, pylinkage."""
+    return synthesis.study(quick=quick)
 
 
 def failure(e: BaseException) -> dict:
@@ -157,6 +198,24 @@ def run_section(name: str, fn: Callable[[bool], dict], quick: bool) -> dict:
 
 
 # ===================================================================== charts
+def earlier_sections(out: Path, names: Sequence[str]) -> dict[str, dict]:
+    """The results of sections not run now (``--only``), from their files of an earlier run,
+    so that the report stays whole."""
+    found: dict[str, dict] = {}
+    for name in names:
+        path = out / f"{name}.json"
+        if not path.is_file():
+            continue
+        try:
+            data = json.loads(path.read_text(encoding="utf-8"))
+        except (OSError, ValueError):
+            continue
+        if name == "environment":
+            data = data.get("environment") or {}
+        found[name] = data
+    return found
+
+
 def draw_charts(results: dict, out: Path) -> dict[str, str]:
     """Every PNG; returns {chart name: file name} of the charts that were drawn."""
     charts: dict[str, str] = {}
@@ -180,6 +239,9 @@ def draw_charts(results: dict, out: Path) -> dict[str, str]:
     if "rows" in results.get("memory", {}):
         charts["memory"] = try_chart(lambda: memory.chart(results["memory"],
                                                           out / "memory.png"))
+    if "clearance" in results.get("contact", {}):
+        charts["contact"] = try_chart(lambda: contact.chart(results["contact"],
+                                                            out / "contact.png"))
     return {k: v for k, v in charts.items() if v}
 
 
@@ -218,20 +280,26 @@ def main(argv: Sequence[str] | None = None) -> dict:
     fns: dict[str, Callable[[bool], dict]] = {
         "environment": environment.collect, "work_precision": section_work_precision,
         "peers": section_peers, "kinematics": section_kinematics,
-        "scaling": section_scaling, "memory": section_memory}
-    results = {name: run_section(name, fns[name], a.quick) for name in SECTIONS
-               if name in wanted}
+        "scaling": section_scaling, "memory": section_memory, "sweep": section_sweep,
+        "sensitivities": section_sensitivities, "contact": section_contact,
+        "synthesis": section_synthesis}
+    ran = {name: run_section(name, fns[name], a.quick) for name in SECTIONS if name in wanted}
+    earlier = earlier_sections(out, [n for n in SECTIONS if n not in wanted])
+    results = {name: ran.get(name, earlier.get(name)) for name in SECTIONS
+               if name in ran or name in earlier}
     derive(results)
     env = results.get("environment")
     if env is not None:
         env["load_average_end"] = os.getloadavg()
     total = time.perf_counter() - t_start
     results["meta"] = {"quick": a.quick, "sections": list(wanted), "total_runtime_s": total,
-                       "command": "python bench/run.py" + (" --quick" if a.quick else "")}
+                       "earlier": sorted(earlier),
+                       "command": "python bench/run.py" + (" --quick" if a.quick else "")
+                       + (" --only " + " ".join(wanted) if a.only else "")}
     print("\n=== charts and report", flush=True)
     charts = draw_charts(results, out)
     for name, data in results.items():
-        if name not in ("environment", "meta"):
+        if name not in ("environment", "meta") and name in wanted:
             write_json(out / f"{name}.json", data, env)
     write_json(out / "environment.json", {"environment": env or {}, "meta": results["meta"]},
                None)

@@ -79,7 +79,14 @@ def synthetic_results(stepper: bool = True, exudyn: bool = True) -> dict:
                             "exudyn_best": "loop", "mbd2d": {"us_per_step": 2.0}}}
     return {"environment": {"cpu_model": "cpu", "cores": 2, "os": "os (kernel)",
                             "git": {"commit": "abc"}, "load_average_start": (0.1, 0, 0)},
-            "kinematics": {"rows": {report.FOURBAR: kin_row, report.SLIDER: dict(kin_row)}},
+            "kinematics": {"rows": {report.FOURBAR: kin_row, report.SLIDER: dict(kin_row)},
+                           "callgrind": {"available": True, "valgrind": "valgrind-3.19.0",
+                                         "rows": [{"h": 1e-3, "instructions_per_step": 9000.0,
+                                                   "newton_corrections_per_step": 0.02,
+                                                   "lu_per_step": 1.02,
+                                                   "parts": {"assembly": 5000.0, "LU": 700.0,
+                                                             "solves": 1300.0,
+                                                             "loop": 2000.0}}]}},
             "peers": peers,
             "scaling": {"banded_slope": 1.02, "dense_slope": 2.9, "banded_available": True,
                         "rows": {"dense": [], "banded": []},
@@ -87,17 +94,31 @@ def synthetic_results(stepper: bool = True, exudyn: bool = True) -> dict:
             "memory": {"rows": [{"analysis": "kinematics", "every": 1000, "steps": 10,
                                  "run_mib": 1.0, "available": True}]},
             "work_precision": {"failed": True, "error": "RuntimeError: boom"},
+            "sweep": {"per_variant": {"ratio_loop_over_batched": 12.0, "steps": 10,
+                                      "us_per_variant": {"loop": 840.0, "batched": 70.0,
+                                                         "core": 65.0}},
+                      "throughput": {"cases": 10, "steps": 200, "rows": [
+                          {"runner": "Dask LocalCluster, 2 worker(s)", "seconds": 1.0,
+                           "variants_per_s": 10.0, "identical_to_serial": True}]}},
+            "sensitivities": {"steps": 100, "repeats": 1, "rows": [
+                {"case": "kinematics four-bar, 4 parameters", "base_us_per_step": 1.0,
+                 "sens_us_per_step": 2.5, "ratio": 2.5}]},
             "meta": {"total_runtime_s": 300.0, "quick": False, "command": "python bench/run.py"}}
 
 
 def test_targets_on_synthetic_results() -> None:
     tg = {t["target"]: t for t in report.targets(synthetic_results())}
     met = {name: t["met"] for name, t in tg.items()}
-    assert met["kinematics, four-bar, Fortran loop: <= 1 us/step"] is True
+    kin = "kinematics, four-bar, Fortran loop: <= 1 us/step (h = 1 ms and 0.1 ms)"
+    assert met[kin] is True
+    assert "9.0k instructions at h = 1 ms" in tg[kin]["figure"]
     assert met["kinematics: Fortran loop >= 100x faster than plain NumPy"] is True
     assert met["free four-bar: >= 5x faster than Exudyn at equal accuracy"] is True
     assert met["kinematic stepping: >= 50x faster than Exudyn"] is False
     assert met["kinematics, N-four-bar N = 1000: <= 2 ms per step"] is True
+    assert met["sweep, 10-step kinematics: per-variant cost >= 10x below a with_params "
+               "loop"] is True
+    assert met["sensitivities of 4 parameters: <= 2x the analysis alone"] is False
     assert all(v is not None for v in met.values())
 
 
@@ -112,7 +133,7 @@ def test_missing_sections_are_not_measured(tmp_path: Path) -> None:
     tg = report.targets(res)
     assert [t["met"] for t in tg][:-1] == [None] * (len(tg) - 1)
     md = report.results_markdown(res, {}, tmp_path / "RESULTS.md", tmp_path / "results")
-    assert md.count("Failed: not run") == 5
+    assert md.count("Failed: not run") == 7
 
 
 def test_report_renders_failures_and_missing_stepper(tmp_path: Path) -> None:
@@ -121,6 +142,8 @@ def test_report_renders_failures_and_missing_stepper(tmp_path: Path) -> None:
     assert "## Targets" in md and "Failed: RuntimeError: boom" in md
     assert "not available (no KinematicStepper)" in md
     assert "Section **work_precision failed**" in md
+    assert "## Design sweeps" in md and "Loop / batched: **12.0x**" in md
+    assert "## Sensitivity cost" in md
     head = report.headline_markdown(res, {}, tmp_path)
     assert head.startswith("## Performance") and "| target |" in head
 
@@ -129,3 +152,32 @@ def test_memory_chart_with_an_unavailable_case(tmp_path: Path) -> None:
     data = {"rows": [{"analysis": "kinematics", "every": 1, "steps": 10, "run_mib": 3.0},
                      {"analysis": "dynamics", "every": 1000, "steps": 10, "available": False}]}
     assert memory.chart(data, tmp_path / "m.png").stat().st_size > 0
+
+
+def test_kinematic_target_needs_both_step_sizes() -> None:
+    """<= 1 us/step is met only when h = 0.1 ms meets it too."""
+    res = synthetic_results()
+    res["kinematics"]["rows"][report.FOURBAR]["fortran_loop_h1e-4"]["us_per_step"] = 1.2
+    tg = {t["target"]: t["met"] for t in report.targets(res)}
+    assert tg["kinematics, four-bar, Fortran loop: <= 1 us/step (h = 1 ms and 0.1 ms)"] is False
+
+
+def test_callgrind_table_in_report() -> None:
+    """The instructions per step and their parts appear in the kinematics section."""
+    res = synthetic_results()
+    md = report.kinematics_section(res)
+    assert "Instructions per step (callgrind)" in md
+    assert "| 1 ms | 9,000 | 5,000 (56%) | 700 (8%) | 1,300 (14%) | 2,000 (22%) |" in md
+    res["kinematics"]["callgrind"] = {"available": False, "reason": "valgrind is not installed"}
+    assert "not measured (valgrind is not installed)" in report.kinematics_section(res)
+
+
+def test_callgrind_parts_count_each_function_once() -> None:
+    """Own instructions per function: every function in one part, the rest is the loop."""
+    import callgrind
+    d1 = {"__mbd_assemble_MOD_assemble_blocks": 100, "__sincos_fma": 10,
+          "__mbd_splu_MOD_splu_factor": 50, "__mbd_splu_MOD_splu_solve2": 20,
+          "__mbd_kinematics_MOD_kin_loop.constprop.0": 30}
+    d2 = {k: 3 * v for k, v in d1.items()}
+    parts = callgrind._parts(d1, d2, 2, total=(3 - 1) * 210 / 2)
+    assert parts == {"assembly": 110.0, "LU": 50.0, "solves": 20.0, "loop": 30.0}

@@ -5,7 +5,11 @@ Usage::
     python examples/demo.py [--out DIR]
 
 Writes ``NAME_mechanism.png`` and ``NAME_timeseries.png`` for each example to DIR (default
-``examples/output/`` next to this script). The seed four-bar is non-Grashof: driven past its
+``examples/output/`` next to this script), animations ``fourbar_grashof.gif`` (with its
+coupler curve) and ``slider_crank.gif``, the cam lift-off pictures, and the design study's
+three pictures (examples/design_study.py: a sweep of the crank-rocker's coupler length, the
+sensitivities of the rocker angle, the tolerance of a coupler point). The seed four-bar is
+non-Grashof: driven past its
 toggle it raises :class:`mbd2d.SingularConfigurationError`, which is the expected outcome;
 its partial results are drawn with the toggle configuration marked.
 
@@ -63,28 +67,60 @@ def run_seed(path: Path, out: Path) -> tuple[str, Any, list[str]]:
             "completed", res, save_figures(res, out / path.stem))
 
 
-def run_full(path: Path, out: Path, trace: list[tuple[str, tuple[float, float]]] | None = None
-             ) -> tuple[str, Any, list[str]]:
-    """A full crank turn; expect a complete result."""
+def run_full(path: Path, out: Path, trace: list[tuple[str, tuple[float, float]]] | None = None,
+             gif: bool = False) -> tuple[str, Any, list[str]]:
+    """A full crank turn; expect a complete result (and animate it when gif)."""
     res = mbd2d.load(path).kinematics(t_end=1.0, steps=360)
     files = save_figures(res, out / path.stem, trace=trace)
+    if gif:
+        files.append(res.animate(out / f"{path.stem}.gif", fps=30, speed=0.5, trace=trace))
     return ("" if res.complete else "the run did not complete"), res, files
+
+
+def synthesis_example(out: Path) -> int:
+    """examples/synthesis_straight_line.py (its exit code)."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("synthesis_straight_line",
+                                                  HERE / "synthesis_straight_line.py")
+    assert spec is not None and spec.loader is not None
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return int(mod.main(["--out", str(out)]))
+
+
+def run_liftoff(path: Path, out: Path) -> tuple[str, Any, list[str]]:
+    """The fast cam whose follower lifts off (examples/cam_liftoff.py): forward dynamics
+    with a follower-profile contact; expect the first lift-off where the bilateral cam
+    joint would start to pull."""
+    sys.path.insert(0, str(HERE))
+    import cam_liftoff
+    code = cam_liftoff.main(["--out", str(out)])
+    res = mbd2d.load(path).dynamics(0.2, 400)
+    files = [str(out / f"cam_liftoff{kind}") for kind in ("_mechanism.png", "_history.png",
+                                                         ".gif")]
+    return ("" if code == 0 else "the follower did not lift off where the cam joint would "
+            "pull"), res, files
 
 
 def main(argv: list[str] | None = None) -> int:
     """Run the examples; return the exit code."""
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--out", type=Path, default=HERE / "output",
-                    help="directory for the PNG files (default: examples/output/)")
+                    help="directory for the pictures (default: examples/output/)")
+    ap.add_argument("--no-synthesis", action="store_true",
+                    help="skip the linkage-synthesis example (it takes tens of seconds)")
     args = ap.parse_args(argv)
     out: Path = args.out
     out.mkdir(parents=True, exist_ok=True)
 
     runs: list[tuple[str, Callable[[Path, Path], tuple[str, Any, list[str]]]]] = [
         ("fourbar_seed", run_seed),
-        ("fourbar_grashof", lambda p, o: run_full(p, o, trace=[("coupler", (0.0, 1.0))])),
-        ("slider_crank", run_full),
+        ("fourbar_grashof", lambda p, o: run_full(p, o, trace=[("coupler", (0.0, 1.0))],
+                                                  gif=True)),
+        ("slider_crank", lambda p, o: run_full(p, o, gif=True)),
         ("cam_follower", run_full),
+        ("cam_liftoff", run_liftoff),
     ]
     problems: list[str] = []
     written: list[str] = []
@@ -104,9 +140,35 @@ def main(argv: list[str] | None = None) -> int:
         if problem:
             problems.append(f"{name}: {problem}")
 
+    total = len(runs) + 1
+    try:                         # the design study: sweeps, sensitivities, tolerances
+        import design_study
+        problem, files = design_study.run(out)
+        written += files
+        print("design_study: " + ", ".join(Path(f).name for f in files) + f" in {out}")
+        if problem:
+            problems.append(f"design_study: {problem}")
+    except Exception as exc:  # report every example, then fail
+        traceback.print_exc()
+        problems.append(f"design_study: {type(exc).__name__}: {exc}")
+        print(f"design_study: FAILED ({type(exc).__name__})")
+
+    if not args.no_synthesis:
+        print("\nsynthesis_straight_line (linkage synthesis, issue 14):")
+        try:
+            if synthesis_example(out) != 0:
+                problems.append("synthesis_straight_line: the design is not straighter than "
+                                "the start")
+        except Exception as exc:  # report every example, then fail
+            traceback.print_exc()
+            problems.append(f"synthesis_straight_line: {type(exc).__name__}: {exc}")
+        total += 1
+
     print()
-    print(f"summary: {len(runs) - len(problems)}/{len(runs)} examples as expected, "
-          f"{len(written)} PNG files in {out}")
+    pngs = sum(f.endswith(".png") for f in written)
+    gifs = sum(f.endswith(".gif") for f in written)
+    print(f"summary: {total - len(problems)}/{total} examples as expected, "
+          f"{pngs} PNG files and {gifs} GIF animations in {out}")
     for p in problems:
         print(f"  unexpected: {p}")
     return 1 if problems else 0

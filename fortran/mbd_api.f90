@@ -15,25 +15,38 @@ module mbd_api
   use mbd_kinds, only: wp, zero, one
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use mbd_status, only: MBD_OK, MBD_BAD_COUNT, MBD_BAD_PARAM, MBD_INCONSISTENT, MBD_NO_MEMORY, &
+                        MBD_NO_CONVERGENCE, &
                         MSG_LEN
   use mbd_memory, only: REAL_BYTES, mem_fail
   use mbd_points, only: NLOC, MAXROW
   use mbd_model, only: model_t, model_build, model_add_dynamics, model_force_size
   use mbd_dynamics, only: dyn_work_t, dyn_init, dyn_memory_check, dyn_velocity, &
                           dyn_multipliers, dyn_reactions, dyn_assemble, dyn_choose, dyn_jv, &
-                          gen_forces, kinetic_energy, SOLVER_DENSE
+                          gen_forces, kinetic_energy, dyn_element_outputs, SOLVER_DENSE, &
+                          SOLVER_AUTO
+  use mbd_events, only: ev_log_t, ev_log_init, events_switch, events_active
+  use mbd_forces, only: force_is_contact, FRC_FRICTION
+  use mbd_contact, only: NEO
+  use mbd_constraints, only: CON_CAM
+  use mbd_joint_cam, only: cam_outward_normal
+  use mbd_points, only: local_state
   use mbd_integrators, only: dyn_opts_t, dyn_stats_t, integrate, output_rows, output_index
   use mbd_statics, only: statics_solve
   use mbd_assemble, only: assemble_dense, assemble_blocks, asm_work_t, asm_init
   use mbd_kinematics, only: kin_opts_t, kin_report_t, kin_work_t, kin_run, kin_work_init, &
                             kin_assemble, kin_rank, kin_out_count, MAXPASS, SOLVER_AUTO, &
                             SOLVER_BANDED, kin_newton, kin_vel_acc
-  use mbd_status, only: MBD_BAD_SETTING
+  use mbd_status, only: MBD_BAD_SETTING, MBD_USER_ABORT
   use mbd_profiles, only: profile_raw_length, profile_prepare, profile_eval
+  use mbd_sensitivity, only: sens_t, sens_setup, sens_eval_d, sens_trig
+  use mbd_assemble, only: scatter_dense
+  use mbd_sens_dynamics, only: sens_multipliers, sens_reactions, sens_statics, sens_dopri5, &
+                               sens_initial
   implicit none
   private
   public :: NINFO, api_sizes, api_eval, api_kinematics, api_profile, api_analyze, api_kin_step
-  public :: api_inverse, api_dynamics, api_statics, api_reactions
+  public :: api_inverse, api_dynamics, api_statics, api_reactions, api_cam_forces
+  public :: api_eval_d, api_reactions_dp, api_dynamics_sens
 
   integer, parameter :: NINFO = 10   !! length of the report arrays
 
@@ -100,6 +113,48 @@ contains
     end do
   end subroutine units
 
+  !> Sensitivities (rows, np[, outputs]) in model units: with p' = p L**e the core's
+  !! derivatives d(.)'/dp' become d(.)/dp = u d(.)'/dp' dp'/dp (dp'/dp = sens%pscale; u the
+  !! unit of each row, multiplied, or with divide divided); with back, the inverse.
+  subroutine sens_units(m, sens, a, u, divide, back)
+    type(model_t), intent(in) :: m              !! model (its length unit lref)
+    type(sens_t), intent(in) :: sens            !! parameters (pscale)
+    real(wp), intent(inout) :: a(:, :, :)       !! (rows, np, outputs)
+    real(wp), intent(in) :: u(:)                !! unit of each row
+    logical, intent(in) :: divide               !! divide by u
+    logical, intent(in), optional :: back       !! the inverse conversion
+    real(wp) :: f(size(a, 1), size(a, 2))
+    integer :: k, j
+    logical :: inv
+    if (.not. (m%lref > one .or. m%lref < one)) return
+    inv = .false.
+    if (present(back)) inv = back
+    do k = 1, size(a, 2)          ! one factor per row and parameter (exact: powers of 2)
+      if (divide .neqv. inv) then
+        f(:, k) = sens%pscale(k) / u
+      else
+        f(:, k) = sens%pscale(k) * u
+      end if
+      if (inv) f(:, k) = (one / sens%pscale(k)**2) * f(:, k)
+    end do
+    do j = 1, size(a, 3)
+      a(:, :, j) = a(:, :, j) * f
+    end do
+  end subroutine sens_units
+
+  !> sens_units for one output (rows, np).
+  subroutine sens_units2(m, sens, a, u, divide)
+    type(model_t), intent(in) :: m              !! model
+    type(sens_t), intent(in) :: sens            !! parameters (pscale)
+    real(wp), intent(inout) :: a(:, :)          !! (rows, np)
+    real(wp), intent(in) :: u(:)                !! unit of each row
+    logical, intent(in) :: divide               !! divide by u
+    real(wp) :: b(size(a, 1), size(a, 2), 1)
+    b(:, :, 1) = a
+    call sens_units(m, sens, b, u, divide)
+    a = b(:, :, 1)
+  end subroutine sens_units2
+
   !> The residual rep%resid in model units (that of the worst constraint's first row).
   pure real(wp) function resid_units(m, resid, worst)
     type(model_t), intent(in) :: m              !! model
@@ -108,6 +163,48 @@ contains
     resid_units = resid * m%lref
     if (worst > 0 .and. worst <= m%nc) resid_units = resid * m%rowunit(m%row0(worst))
   end function resid_units
+
+  !> Element outputs eo(NEO, nf, rows) in model units: contacts [Fn, Ft, penetration,
+  !! sliding speed, contact point]; joint friction [normal load, friction force, 0, slip
+  !! speed, stuck flag, friction moment]. Forces are F L in the core, lengths x / L.
+  subroutine element_units(m, eo)
+    type(model_t), intent(in) :: m
+    real(wp), intent(inout) :: eo(:, :, :)
+    integer :: k
+    real(wp) :: l
+    l = m%lref
+    if (.not. (l > one .or. l < one)) return
+    do k = 1, size(eo, 2)
+      if (force_is_contact(m%fkind(k))) then
+        eo(1:2, k, :) = eo(1:2, k, :) / l; eo(3:6, k, :) = eo(3:6, k, :) * l
+      else if (m%fkind(k) == FRC_FRICTION) then
+        eo(1:2, k, :) = eo(1:2, k, :) / l; eo(4, k, :) = eo(4, k, :) * l
+      end if
+    end do
+  end subroutine element_units
+
+  !> The event log as records evo(4, :) [t, element, kind, value] in model units (contact
+  !! speeds x L, friction forces / L); nev the number of events (more than size(evo, 2):
+  !! the later ones were not kept).
+  subroutine events_out(m, log, evo, nev)
+    type(model_t), intent(in) :: m
+    type(ev_log_t), intent(in) :: log
+    real(wp), intent(out) :: evo(:, :)
+    integer, intent(out) :: nev
+    integer :: r, k
+    evo = zero
+    nev = log%n
+    do r = 1, min(log%n, size(evo, 2), size(log%rec, 2))
+      evo(:, r) = log%rec(:, r)
+      k = nint(evo(2, r))
+      if (k < 1 .or. k > m%nf) cycle
+      if (force_is_contact(m%fkind(k))) then
+        evo(4, r) = evo(4, r) * m%lref
+      else
+        evo(4, r) = evo(4, r) / m%lref
+      end if
+    end do
+  end subroutine events_out
 
   !> Phi, J, nu and gamma at (q, q_dot, t).
   subroutine api_eval(nb, ctab, rpar, q, qd, t, phi, jac, nu, gam, status, msg, bad)
@@ -146,7 +243,7 @@ contains
   !> Kinematic analysis: the whole time loop in one call.
   subroutine api_kinematics(nb, ctab, rpar, q0, t0, t1, nsteps, tol, maxit, tmin, every, &
                             solver, qout, qdout, qddout, iinfo, rinfo, qsing, dep, redundant, &
-                            tpass, status, msg)
+                            tpass, status, msg, ptab, sq, sqd, sqdd, ctl)
     integer, intent(in) :: nb                   !! moving bodies
     integer, intent(in) :: ctab(:, :)           !! constraint table
     real(wp), intent(in) :: rpar(:)             !! raw parameters
@@ -168,15 +265,36 @@ contains
     real(wp), intent(out) :: tpass(:)           !! times of singular passages (MAXPASS)
     integer, intent(out) :: status              !! MBD_OK, < 0 input, > 0 numerical
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    !> design parameters (mbd_sensitivity; (2, np)) and, with them, dq/dp, dq_dot/dp,
+    !! dq_ddot/dp at the outputs, each (nq, np, kin_out_count(nsteps, every))
+    integer, intent(in), optional :: ptab(:, :)
+    real(wp), intent(out), optional :: sq(:, :, :), sqd(:, :, :), sqdd(:, :, :)
+    !> progress, shared with a caller in another thread (2): ctl(1) the outputs stored so
+    !! far, ctl(2) /= 0 asks the run to stop (MBD_USER_ABORT, the outputs so far kept)
+    integer, intent(inout), optional, volatile :: ctl(:)
     type(model_t) :: m
     type(kin_opts_t) :: opts
     type(kin_report_t) :: rep
+    type(sens_t) :: sens
     integer :: bad
     iinfo = 0; rinfo = zero; qsing = zero; dep = 0; redundant = 0; tpass = zero
     qout = zero; qdout = zero; qddout = zero
+    if (present(ptab)) then
+      sq = zero; sqd = zero; sqdd = zero      ! (kin_run writes them; for the early returns)
+    end if
     call model_build(nb, ctab, rpar, m, status, msg, bad, nondim=.true.)
     iinfo(2) = bad
     if (status /= MBD_OK) return
+    if (present(ptab)) then
+      if (any(shape(sq) /= [m%nq, size(ptab, 2), size(qout, 2)]) .or. &
+          any(shape(sqd) /= shape(sq)) .or. any(shape(sqdd) /= shape(sq))) then
+        status = MBD_BAD_COUNT; msg = 'sensitivity arrays do not match the model'; return
+      end if
+      call sens_setup(m, ctab, rpar, ptab, sens, status, msg, bad)
+      if (status /= MBD_OK) then
+        iinfo(2) = -2000000 - bad; return
+      end if
+    end if
     if (.not. (finite(q0) .and. finite(t0) .and. finite(t1) .and. finite(tol) .and. &
                finite(tmin))) then
       call not_finite('q0, the times and the tolerances', status, msg); return
@@ -203,7 +321,16 @@ contains
     if (tol > zero) opts%tol = tol
     if (maxit > 0) opts%maxit = maxit
     if (tmin > zero) opts%tmin = tmin
-    call kin_run(m, q0 / m%cunit, t0, t1, nsteps, opts, qout, qdout, qddout, rep, status, msg)
+    if (present(ptab)) then
+      call kin_run(m, q0 / m%cunit, t0, t1, nsteps, opts, qout, qdout, qddout, rep, status, &
+                   msg, sens, sq, sqd, sqdd, ctl=ctl)
+      call sens_units(m, sens, sq, m%cunit, .false.)
+      call sens_units(m, sens, sqd, m%cunit, .false.)
+      call sens_units(m, sens, sqdd, m%cunit, .false.)
+    else
+      call kin_run(m, q0 / m%cunit, t0, t1, nsteps, opts, qout, qdout, qddout, rep, status, &
+                   msg, ctl=ctl)
+    end if
     call units(m, qout, m%cunit, .false.); call units(m, qdout, m%cunit, .false.)
     call units(m, qddout, m%cunit, .false.)
     iinfo(1) = rep%ndone; iinfo(3) = rep%driver; iinfo(4) = rep%worst
@@ -256,7 +383,7 @@ contains
     end if
     if (tol > zero) opts%tol = tol
     if (maxit > 0) opts%maxit = maxit
-    call kin_work_init(m, w, status, msg)
+    call kin_work_init(m, w, status, msg, sparse=.false.)     ! one step: the dense LU
     if (status /= MBD_OK) return
     w%tol = opts%tol * m%lscale
     q = q / m%cunit; qd = qd / m%cunit; qdd = qdd / m%cunit
@@ -273,6 +400,12 @@ contains
       else
         h = t - t_prev
         q = q + h * (qd + (0.5_wp * h) * qdd)     ! q(t) ~ q + h q_dot + h**2/2 q_ddot
+        if (.not. finite(q)) then
+          status = MBD_NO_CONVERGENCE
+          write (msg, '(a,es22.15,a)') 'the start predicted for t = ', t, &
+            ' is non-finite (a step far too long for Newton-Raphson)'
+          exit step
+        end if
       end if
       call kin_newton(m, w, q, t, opts%maxit, status)
       if (status /= MBD_OK) then
@@ -367,6 +500,16 @@ contains
     end do
   end subroutine api_profile
 
+  !> The report's iinfo(2) after a failed build: the offending constraint (> 0), body
+  !! (-body) or force (-1000000 - force); 0 when none.
+  pure integer function bad_code(bad, badf)
+    integer, intent(in) :: bad                  !! offending constraint (model_build)
+    integer, intent(in) :: badf                 !! force (> 0) or -body (model_add_dynamics)
+    bad_code = bad
+    if (badf > 0) bad_code = -1000000 - badf
+    if (badf < 0) bad_code = badf
+  end function bad_code
+
   !> Build a model with masses and forces (bad: offending constraint > 0 or force > 0 with
   !! kind flag; body errors come back as bad = -body).
   subroutine build_dynamic(nb, ctab, rpar, bmass, grav, ftab, fpar, m, status, msg, bad, badf)
@@ -405,7 +548,8 @@ contains
   !! solver as for dynamics (dyn_choose).
   subroutine api_inverse(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, t0, t1, nsteps, tol, &
                          every, solver, qout, qdout, qddout, lamout, eout, iinfo, rinfo, qsing, &
-                         dep, redundant, tpass, status, msg)
+                         dep, redundant, tpass, status, msg, ptab, sq, sqd, sqdd, slam, eo, &
+                         evo, nev, ctl)
     integer, intent(in) :: nb, ctab(:, :), ftab(:, :), nsteps
     real(wp), intent(in) :: rpar(:), bmass(:, :), grav(2), fpar(:), q0(:), t0, t1, tol
     integer, intent(in) :: every                !! store every k-th output (and the last)
@@ -419,36 +563,82 @@ contains
     integer, intent(out) :: dep(:), redundant(:)
     integer, intent(out) :: status              !! MBD_OK, < 0 input, > 0 numerical
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    !> design parameters (2, np) and, with them, dq/dp, dq_dot/dp, dq_ddot/dp (nq, np, rows)
+    !! and dlambda/dp (neq, np, rows) at the outputs
+    integer, intent(in), optional :: ptab(:, :)
+    real(wp), intent(out), optional :: sq(:, :, :), sqd(:, :, :), sqdd(:, :, :), slam(:, :, :)
+    !> contacts and friction: the element outputs (NEO, nf, rows) and the contact events found
+    !! at the outputs (4, capacity), their number
+    real(wp), intent(out), optional :: eo(:, :, :), evo(:, :)
+    integer, intent(out), optional :: nev
+    !> progress as in api_kinematics: the kinematic pass counts the outputs, the multipliers'
+    !! pass counts on from there (2 x outputs in all)
+    integer, intent(inout), optional, volatile :: ctl(:)
     type(model_t) :: m
     type(dyn_work_t) :: w
+    type(sens_t) :: sens
+    type(ev_log_t) :: log
     integer :: bad, badf, k, st, path, kl, ku
     real(wp) :: t
+    logical :: changed
     character(len=MSG_LEN) :: lmsg
     lamout = zero; eout = zero
+    if (present(eo)) eo = zero
+    if (present(evo)) evo = zero
+    if (present(nev)) nev = 0
+    if (present(ptab)) then
+      sq = zero; sqd = zero; sqdd = zero; slam = zero
+    end if
     call build_dynamic(nb, ctab, rpar, bmass, grav, ftab, fpar, m, status, msg, bad, badf)
     if (status /= MBD_OK) then
       qout = zero; qdout = zero; qddout = zero; iinfo = 0; rinfo = zero
-      iinfo(2) = bad; if (badf /= 0) iinfo(2) = -1000000 - badf
+      iinfo(2) = bad_code(bad, badf)
       qsing = zero; dep = 0; redundant = 0; tpass = zero
       return
     end if
     ! the multipliers' path (dense or band, as dynamics; solver as for the kinematics);
     ! a dense one must fit: check before the (possibly long) kinematic run
     call dyn_choose(m, solver, path, kl, ku, status, msg)
+    if (status == MBD_OK .and. present(ptab)) path = SOLVER_DENSE   ! sensitivities: dense J
     if (status == MBD_OK .and. path == SOLVER_DENSE) call dyn_memory_check(m, status, msg)
     if (status /= MBD_OK) then
       qout = zero; qdout = zero; qddout = zero; iinfo = 0; rinfo = zero
       qsing = zero; dep = 0; redundant = 0; tpass = zero
       return
     end if
-    call api_kinematics(nb, ctab, rpar, q0, t0, t1, nsteps, tol, 0, zero, every, solver, qout, &
-                        qdout, qddout, iinfo, rinfo, qsing, dep, redundant, tpass, status, msg)
+    if (present(ptab)) then
+      if (size(slam, 1) /= m%neq .or. any(shape(slam) /= [m%neq, shape(sq(1, :, :))])) then
+        status = MBD_BAD_COUNT; msg = 'sensitivity arrays do not match the model'; return
+      end if
+      call sens_setup(m, ctab, rpar, ptab, sens, status, msg, bad, ftab, fpar)
+      if (status /= MBD_OK) then
+        iinfo = 0; iinfo(2) = -2000000 - bad; return
+      end if
+      call api_kinematics(nb, ctab, rpar, q0, t0, t1, nsteps, tol, 0, zero, every, solver, &
+                          qout, qdout, qddout, iinfo, rinfo, qsing, dep, redundant, tpass, &
+                          status, msg, ptab, sq, sqd, sqdd)
+    else
+      call api_kinematics(nb, ctab, rpar, q0, t0, t1, nsteps, tol, 0, zero, every, solver, &
+                          qout, qdout, qddout, iinfo, rinfo, qsing, dep, redundant, tpass, &
+                          status, msg, ctl=ctl)
+    end if
     rinfo(8) = path
     if (iinfo(1) < 1) return
     ! the multipliers in the core's units (so the rank decisions do not depend on the unit)
     call units(m, qout, m%cunit, .true.); call units(m, qdout, m%cunit, .true.)
     call units(m, qddout, m%cunit, .true.)
     call dyn_init(m, w, qout(:, 1), t0, 1.0e-12_wp, st, lmsg, path)
+    if (present(ptab)) then
+      call sens_units(m, sens, sq, m%cunit, .false., back=.true.)
+      call sens_units(m, sens, sqd, m%cunit, .false., back=.true.)
+      call sens_units(m, sens, sqdd, m%cunit, .false., back=.true.)
+    end if
+    if (st == MBD_OK) then
+      k = 1
+      if (present(evo)) k = size(evo, 2)
+      call ev_log_init(log, k, st)
+      if (st /= MBD_OK) lmsg = 'not enough memory for the event log'
+    end if
     if (st == MBD_NO_MEMORY) then
       status = st; msg = lmsg
     else if (st == MBD_OK) then
@@ -456,16 +646,42 @@ contains
         ! column k holds output min((k - 1) every, nsteps)
         t = t0 + (t1 - t0) * (real(min((k - 1) * every, nsteps), wp) / max(nsteps, 1))
         if (k == size(qout, 2)) t = t1
+        ! contacts open and close at the outputs (the motion is given)
+        if (events_active(m)) call events_switch(m, w, t, qout(:, k), qdout(:, k), log, &
+                                                 changed, st)
         call dyn_multipliers(m, w, qout(:, k), qdout(:, k), qddout(:, k), t, lamout(:, k), &
                              st, lmsg)
         if (st == MBD_NO_MEMORY) then
           status = st; msg = lmsg; exit
         end if
         call state_measures(m, w, qout(:, k), qdout(:, k), t, eout(:, k))
+        if (present(ctl)) then
+          ctl(1) = size(qout, 2) + k
+          if (ctl(2) /= 0 .and. k < iinfo(1)) then
+            status = MBD_USER_ABORT; iinfo(1) = k; rinfo(1) = t
+            write (msg, '(a,es12.5,a)') 'stopped on request at t = ', t, &
+              ' (the outputs so far are kept)'
+            exit
+          end if
+        end if
+        if (present(eo) .and. m%nf > 0) call dyn_element_outputs(m, w, qout(:, k), &
+                                                                 qdout(:, k), t, eo(:, :, k))
+        if (present(ptab)) call sens_multipliers(m, sens, qout(:, k), qdout(:, k), &
+                                                 qddout(:, k), t, w%jac, lamout(:, k), &
+                                                 sq(:, :, k), sqd(:, :, k), sqdd(:, :, k), &
+                                                 slam(:, :, k), st, lmsg)
       end do
+      if (present(evo) .and. present(nev)) call events_out(m, log, evo, nev)
     end if
     call units(m, qout, m%cunit, .false.); call units(m, qdout, m%cunit, .false.)
     call units(m, qddout, m%cunit, .false.); call units(m, lamout, m%rowunit, .true.)
+    if (present(ptab)) then
+      call sens_units(m, sens, sq, m%cunit, .false.)
+      call sens_units(m, sens, sqd, m%cunit, .false.)
+      call sens_units(m, sens, sqdd, m%cunit, .false.)
+      call sens_units(m, sens, slam, m%rowunit, .true.)
+    end if
+    if (present(eo)) call element_units(m, eo)
   end subroutine api_inverse
 
   !> Forward dynamics: assembly of q0, the velocity v0 projected onto J q_dot = nu (kinetic
@@ -482,7 +698,7 @@ contains
   subroutine api_dynamics(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, v0, t0, t1, nsteps, &
                           method, rtol, atol, h, rho_inf, balpha, bbeta, every, qout, qdout, &
                           qddout, lamout, eout, iinfo, rinfo, redundant, status, msg, max_steps, &
-                          solver)
+                          eo, evo, nev, ctl, solver)
     integer, intent(in) :: nb, ctab(:, :), ftab(:, :), nsteps, method
     integer, intent(in) :: every                !! store every every-th output (and the last)
     real(wp), intent(in) :: rpar(:), bmass(:, :), grav(2), fpar(:), q0(:), v0(:), t0, t1
@@ -496,7 +712,15 @@ contains
     integer, intent(out) :: status              !! MBD_OK, < 0 input, > 0 numerical
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
     integer, intent(in) :: max_steps            !! step limit (accepted + rejected); 0: default
-    integer, intent(in) :: solver               !! 0 auto, 1 dense, 2 banded
+    real(wp), intent(out) :: eo(:, :, :)        !! (NEO, nf, rows) element outputs
+    !> (4, capacity) events [t, element (force index), kind (1 onset, 2 separation, 3 stick,
+    !! 4 slip, 5 reversal), value (impact or separation speed; friction force)]
+    real(wp), intent(out) :: evo(:, :)
+    integer, intent(out) :: nev                 !! events (beyond size(evo, 2): not kept)
+    type(ev_log_t) :: log
+    !> progress as in api_kinematics (the rows stored so far; a request to stop)
+    integer, intent(inout), optional, volatile :: ctl(:)
+    integer, intent(in), optional :: solver     !! 0 auto (default), 1 dense, 2 banded
     type(model_t) :: m
     type(dyn_work_t) :: w
     type(kin_opts_t) :: kopts
@@ -507,8 +731,9 @@ contains
     integer :: bad, badf, k, ko, nout, ierr, path, kl, ku
     iinfo = 0; rinfo = zero; redundant = 0
     qout = zero; qdout = zero; qddout = zero; lamout = zero; eout = zero
+    eo = zero; evo = zero; nev = 0
     call build_dynamic(nb, ctab, rpar, bmass, grav, ftab, fpar, m, status, msg, bad, badf)
-    iinfo(2) = bad; if (badf /= 0) iinfo(2) = -1000000 - badf
+    iinfo(2) = bad_code(bad, badf)
     if (status /= MBD_OK) return
     if (.not. (finite(q0) .and. finite(v0) .and. finite(t0) .and. finite(t1) .and. &
                finite([rtol, atol, h, rho_inf, balpha, bbeta]))) then
@@ -523,7 +748,7 @@ contains
         size(redundant) /= m%neq) then
       status = MBD_BAD_COUNT; msg = 'array sizes do not match the model'; return
     end if
-    call dyn_choose(m, solver, path, kl, ku, status, msg)
+    call dyn_choose(m, solver_or_auto(solver), path, kl, ku, status, msg)
     if (status /= MBD_OK) return
     rinfo(5) = path; rinfo(6) = kl; rinfo(7) = ku
     ! the dense dynamics must fit (checked before the assembly allocates its dense J)
@@ -564,8 +789,16 @@ contains
     if (balpha >= zero) opts%balpha = balpha
     if (bbeta >= zero) opts%bbeta = bbeta
     if (max_steps > 0) opts%max_steps = max_steps
+    if (size(eo, 1) /= NEO .or. size(eo, 2) /= m%nf .or. size(eo, 3) /= size(qout, 2)) then
+      status = MBD_BAD_COUNT; msg = 'element output array sizes do not match the model'; return
+    end if
+    call ev_log_init(log, size(evo, 2), status)
+    if (status /= MBD_OK) then
+      msg = 'not enough memory for the event log'; return
+    end if
     call integrate(m, w, q, qd, t0, t1, nsteps, every, opts, qout, qdout, qddout, lamout, nout, &
-                   dst, status, msg)
+                   dst, status, msg, log, eo, ctl)
+    call events_out(m, log, evo, nev)
     iinfo(1) = nout; iinfo(3) = dst%steps; iinfo(4) = dst%rejected; iinfo(5) = dst%newton
     iinfo(6) = dst%rhs; iinfo(7) = dst%jacobians; iinfo(8) = dst%partitions
     iinfo(10) = dst%factorizations
@@ -582,6 +815,7 @@ contains
     end do
     call units(m, qout, m%cunit, .false.); call units(m, qdout, m%cunit, .false.)
     call units(m, qddout, m%cunit, .false.); call units(m, lamout, m%rowunit, .true.)
+    call element_units(m, eo)
   end subroutine api_dynamics
 
   !> The assembly at the start of dynamics and statics: Levenberg-Marquardt from the q0
@@ -623,21 +857,26 @@ contains
   !! 2 banded (dyn_choose); iinfo(5) the path taken (1 dense, 2 banded), iinfo(6), iinfo(7)
   !! the band widths of the saddle-point matrix.
   subroutine api_statics(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, t, q, lam, stable, resid, &
-                         iinfo, status, msg, solver)
+                         iinfo, status, msg, ptab, sq, slam, solver)
     integer, intent(in) :: nb, ctab(:, :), ftab(:, :)
     real(wp), intent(in) :: rpar(:), bmass(:, :), grav(2), fpar(:), q0(:), t
     real(wp), intent(out) :: q(:), lam(:), resid
     integer, intent(out) :: stable, iinfo(NINFO)
     integer, intent(out) :: status              !! MBD_OK, < 0 input, > 0 numerical
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
-    integer, intent(in) :: solver               !! 0 auto, 1 dense, 2 banded
+    !> design parameters (2, np) and, with them, dq/dp (nq, np) and dlambda/dp (neq, np) at
+    !! the equilibrium
+    integer, intent(in), optional :: ptab(:, :)
+    real(wp), intent(out), optional :: sq(:, :), slam(:, :)
+    type(sens_t) :: sens
+    integer, intent(in), optional :: solver     !! 0 auto (default), 1 dense, 2 banded
     type(model_t) :: m
     type(dyn_work_t) :: w
     type(kin_opts_t) :: kopts
     integer :: bad, badf, path, kl, ku
     q = zero; lam = zero; stable = 0; resid = zero; iinfo = 0
     call build_dynamic(nb, ctab, rpar, bmass, grav, ftab, fpar, m, status, msg, bad, badf)
-    iinfo(2) = bad; if (badf /= 0) iinfo(2) = -1000000 - badf
+    iinfo(2) = bad_code(bad, badf)
     if (status /= MBD_OK) return
     if (.not. (finite(q0) .and. finite(t))) then
       call not_finite('q0 and t', status, msg); return
@@ -645,7 +884,8 @@ contains
     if (size(q0) /= m%nq .or. size(q) /= m%nq .or. size(lam) /= m%neq) then
       status = MBD_BAD_COUNT; msg = 'array sizes do not match the model'; return
     end if
-    call dyn_choose(m, solver, path, kl, ku, status, msg)
+    call dyn_choose(m, solver_or_auto(solver), path, kl, ku, status, msg)
+    if (status == MBD_OK .and. present(ptab)) path = SOLVER_DENSE   ! sensitivities: dense J
     if (status /= MBD_OK) return
     iinfo(5) = path; iinfo(6) = kl; iinfo(7) = ku
     if (path == SOLVER_DENSE) call dyn_memory_check(m, status, msg)
@@ -655,10 +895,33 @@ contains
     if (status == MBD_OK) call dyn_init(m, w, q, t, kopts%tol * m%lscale, status, msg, path)
     if (status == MBD_OK) then
       iinfo(6) = w%sd%kl; iinfo(7) = w%sd%ku
-      call statics_solve(m, w, q, t, lam, stable, resid, status, msg)
+    end if
+    if (status == MBD_OK .and. present(ptab)) then
+      sq = zero; slam = zero
+      if (any(shape(sq) /= [m%nq, size(ptab, 2)]) .or. &
+          any(shape(slam) /= [m%neq, size(ptab, 2)])) then
+        status = MBD_BAD_COUNT; msg = 'sensitivity arrays do not match the model'; return
+      end if
+      call sens_setup(m, ctab, rpar, ptab, sens, status, msg, bad, ftab, fpar)
+      if (status /= MBD_OK) then
+        iinfo(2) = -2000000 - bad; return
+      end if
+    end if
+    if (status == MBD_OK) call statics_solve(m, w, q, t, lam, stable, resid, status, msg)
+    if (status == MBD_OK .and. present(ptab)) then
+      call sens_statics(m, sens, w%rows, q, t, lam, sq, slam, status, msg)
+      call sens_units2(m, sens, sq, m%cunit, .false.)
+      call sens_units2(m, sens, slam, m%rowunit, .true.)
     end if
     q = q * m%cunit; lam = lam / m%rowunit
   end subroutine api_statics
+
+  !> An optional solver argument: 0 (auto) when absent.
+  pure integer function solver_or_auto(solver)
+    integer, intent(in), optional :: solver     !! 0 auto, 1 dense, 2 banded
+    solver_or_auto = SOLVER_AUTO
+    if (present(solver)) solver_or_auto = solver
+  end function solver_or_auto
 
   !> Reactions of every constraint at many states: reac(6, nc, nt) global
   !! [Fx_i, Fy_i, Mz_i, Fx_j, Fy_j, Mz_j], rloc the same in the body frames.
@@ -694,5 +957,248 @@ contains
       call dyn_reactions(m, w, q(:, k), t(k), lam(:, k), reac(:, :, k), rloc(:, :, k))
     end do
   end subroutine api_reactions
+
+  !> Changes of Phi, J, nu and gamma along a direction (dq, dq_dot) and one design parameter
+  !! (ptab(:, 1); an empty table: none) at (q, q_dot, t), each evaluated analytically on dual
+  !! numbers (mbd_dual): Phi_q dq + Phi_p, J_q dq + J_p, nu_p, gamma_q dq + gamma_q_dot dq_dot
+  !! + gamma_p. For checks by finite differences.
+  subroutine api_eval_d(nb, ctab, rpar, q, qd, t, dq, dqd, ptab, tphi, tjac, tnu, tgam, status, &
+                        msg, bad)
+    integer, intent(in) :: nb                   !! moving bodies
+    integer, intent(in) :: ctab(:, :)           !! constraint table
+    real(wp), intent(in) :: rpar(:)             !! raw parameters
+    real(wp), intent(in) :: q(:), qd(:)         !! state (nq)
+    real(wp), intent(in) :: t                   !! time
+    real(wp), intent(in) :: dq(:), dqd(:)       !! direction (nq)
+    integer, intent(in) :: ptab(:, :)           !! (2, 0 or 1) the parameter
+    real(wp), intent(out) :: tphi(:)            !! change of Phi (neq)
+    real(wp), intent(out) :: tjac(:, :)         !! change of J (neq x nq)
+    real(wp), intent(out) :: tnu(:), tgam(:)    !! changes of nu, gamma (neq)
+    integer, intent(out) :: status              !! MBD_OK or < 0
+    character(len=MSG_LEN), intent(out) :: msg  !! what is wrong
+    integer, intent(out) :: bad                 !! offending constraint, or 0
+    type(model_t) :: m
+    type(asm_work_t) :: aw
+    type(sens_t) :: sens
+    integer :: k
+    tphi = zero; tjac = zero; tnu = zero; tgam = zero
+    call model_build(nb, ctab, rpar, m, status, msg, bad)
+    if (status /= MBD_OK) return
+    if (.not. (finite(q) .and. finite(qd) .and. finite(t) .and. finite(dq) .and. &
+               finite(dqd))) then
+      call not_finite('the state and the direction', status, msg); return
+    end if
+    if (size(q) /= m%nq .or. size(qd) /= m%nq .or. size(dq) /= m%nq .or. &
+        size(dqd) /= m%nq .or. size(tphi) /= m%neq .or. size(tjac, 1) /= m%neq .or. &
+        size(tjac, 2) /= m%nq .or. size(ptab, 2) > 1) then
+      status = MBD_BAD_COUNT; msg = 'array sizes do not match the model'; return
+    end if
+    call sens_setup(m, ctab, rpar, ptab, sens, status, msg, bad)
+    if (status /= MBD_OK) return
+    k = size(ptab, 2)
+    call asm_init(m, aw, status, msg)
+    if (status /= MBD_OK) return
+    call sens_trig(m, sens, q)
+    call sens_eval_d(m, sens, k, q, qd, dq, dqd, t, tphi, tnu, tgam, aw%jb)
+    call scatter_dense(aw, tjac)
+  end subroutine api_eval_d
+
+  !> Changes of the reactions (as api_reactions) along design parameters at many states:
+  !! dreac, drloc (6, nc, np, nt), from dq/dp (nq, np, nt) and dlambda/dp (neq, np, nt).
+  subroutine api_reactions_dp(nb, ctab, rpar, ptab, q, t, lam, sq, slam, dreac, drloc, status, &
+                              msg)
+    integer, intent(in) :: nb, ctab(:, :)
+    real(wp), intent(in) :: rpar(:)
+    integer, intent(in) :: ptab(:, :)
+    real(wp), intent(in) :: q(:, :), t(:), lam(:, :), sq(:, :, :), slam(:, :, :)
+    real(wp), intent(out) :: dreac(:, :, :, :), drloc(:, :, :, :)
+    integer, intent(out) :: status              !! MBD_OK or < 0
+    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    type(model_t) :: m
+    type(sens_t) :: sens
+    integer :: bad, k
+    dreac = zero; drloc = zero
+    call model_build(nb, ctab, rpar, m, status, msg, bad)
+    if (status /= MBD_OK) return
+    if (.not. (finite(q) .and. finite(t) .and. finite(lam))) then
+      call not_finite('q, t and lambda', status, msg); return
+    end if
+    if (size(q, 1) /= m%nq .or. size(lam, 1) /= m%neq .or. size(q, 2) /= size(t) .or. &
+        size(lam, 2) /= size(t) .or. any(shape(sq) /= [m%nq, size(ptab, 2), size(t)]) .or. &
+        any(shape(slam) /= [m%neq, size(ptab, 2), size(t)]) .or. &
+        any(shape(dreac) /= [6, m%nc, size(ptab, 2), size(t)]) .or. &
+        any(shape(drloc) /= shape(dreac))) then
+      status = MBD_BAD_COUNT; msg = 'array sizes do not match the model'; return
+    end if
+    call sens_setup(m, ctab, rpar, ptab, sens, status, msg, bad)
+    if (status /= MBD_OK) return
+    do k = 1, size(t)
+      call sens_reactions(m, sens, q(:, k), t(k), lam(:, k), sq(:, :, k), slam(:, :, k), &
+                          dreac(:, :, :, k), drloc(:, :, :, k))
+    end do
+  end subroutine api_reactions_dp
+
+  !> Forward dynamics by dopri5 with design sensitivities (mbd_sens_dynamics): as
+  !! api_dynamics (method dopri5; iinfo 1 outputs, 2 bad entry, 3 steps, 4 rejected, 6
+  !! right-hand sides, 9 active rows; rinfo 1 failure time, 2 and 3 smallest and largest step)
+  !! plus sq, sqd, sqdd (nq, np, rows), the sensitivities of q, q_dot and q_ddot.
+  subroutine api_dynamics_sens(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, v0, t0, t1, &
+                               nsteps, rtol, atol, every, max_steps, ptab, qout, qdout, qddout, &
+                               lamout, eout, sq, sqd, sqdd, iinfo, rinfo, redundant, status, msg)
+    integer, intent(in) :: nb, ctab(:, :), ftab(:, :), nsteps, every, max_steps
+    real(wp), intent(in) :: rpar(:), bmass(:, :), grav(2), fpar(:), q0(:), v0(:), t0, t1
+    real(wp), intent(in) :: rtol, atol          !! tolerances (<= 0: defaults 1e-6, 1e-8)
+    integer, intent(in) :: ptab(:, :)           !! design parameters (2, np)
+    real(wp), intent(out) :: qout(:, :), qdout(:, :), qddout(:, :)  !! (nq, rows)
+    real(wp), intent(out) :: lamout(:, :)       !! (neq, rows)
+    real(wp), intent(out) :: eout(:, :)         !! (4, rows) energies, drift
+    real(wp), intent(out) :: sq(:, :, :), sqd(:, :, :), sqdd(:, :, :)  !! (nq, np, rows)
+    integer, intent(out) :: iinfo(NINFO)
+    real(wp), intent(out) :: rinfo(NINFO)
+    integer, intent(out) :: redundant(:)
+    integer, intent(out) :: status              !! MBD_OK, < 0 input, > 0 numerical
+    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    type(model_t) :: m
+    type(dyn_work_t) :: w
+    type(kin_work_t) :: kw
+    type(kin_opts_t) :: kopts
+    type(kin_report_t) :: rep
+    type(sens_t) :: sens
+    real(wp), allocatable :: q(:), qd(:), s0(:, :), sd0(:, :)
+    real(wp) :: t, r_tol, a_tol, hmm(2), tfail
+    integer :: bad, badf, k, ko, nout, st, stats(3)
+    character(len=MSG_LEN) :: lmsg
+    iinfo = 0; rinfo = zero; redundant = 0
+    qout = zero; qdout = zero; qddout = zero; lamout = zero; eout = zero
+    sq = zero; sqd = zero; sqdd = zero
+    call build_dynamic(nb, ctab, rpar, bmass, grav, ftab, fpar, m, status, msg, bad, badf)
+    iinfo(2) = bad_code(bad, badf)
+    if (status /= MBD_OK) return
+    if (.not. (finite(q0) .and. finite(v0) .and. finite(t0) .and. finite(t1) .and. &
+               finite([rtol, atol]))) then
+      call not_finite('q0, v0, the times and the settings', status, msg); return
+    end if
+    if (nsteps < 0 .or. .not. (t1 > t0) .or. every < 1 .or. max_steps < 1) then
+      status = MBD_BAD_SETTING
+      msg = 'steps must be >= 0, every >= 1, max_steps >= 1 and t_end > t0'; return
+    end if
+    if (size(q0) /= m%nq .or. size(v0) /= m%nq .or. size(qout, 1) /= m%nq .or. &
+        size(qout, 2) /= output_rows(nsteps, every) .or. size(lamout, 1) /= m%neq .or. &
+        size(redundant) /= m%neq .or. &
+        any(shape(sq) /= [m%nq, size(ptab, 2), size(qout, 2)]) .or. &
+        any(shape(sqd) /= shape(sq)) .or. any(shape(sqdd) /= shape(sq))) then
+      status = MBD_BAD_COUNT; msg = 'array sizes do not match the model'; return
+    end if
+    call sens_setup(m, ctab, rpar, ptab, sens, status, msg, bad, ftab, fpar)
+    if (status /= MBD_OK) then
+      iinfo(2) = -2000000 - bad; return
+    end if
+    call dyn_memory_check(m, status, msg)
+    if (status /= MBD_OK) return
+    call kin_work_init(m, kw, status, msg)
+    if (status /= MBD_OK) return
+    kw%tol = kopts%tol * m%lscale
+    allocate (q(m%nq), qd(m%nq), rep%qsing(m%nq), rep%dep(m%neq), rep%redundant(m%neq), &
+              s0(m%nq, sens%np), sd0(m%nq, sens%np), stat=st)
+    if (st /= 0) then
+      call mem_fail(REAL_BYTES * (3 * real(m%nq, wp) * (1 + sens%np) + m%neq), &
+                    'the state and its sensitivities', 'use fewer parameters', status, msg)
+      return
+    end if
+    q = q0 / m%cunit
+    call kin_assemble(m, kw, q, t0, kopts, rep, status, msg)
+    if (status /= MBD_OK) then
+      rinfo(1) = t0; return
+    end if
+    call dyn_init(m, w, q, t0, kw%tol, status, msg)
+    if (status /= MBD_OK) return
+    iinfo(9) = w%na
+    do k = 1, m%neq
+      if (.not. any(w%rows == k)) redundant(k) = 1
+    end do
+    call dyn_velocity(m, w, q, t0, v0 / m%cunit, qd, status)
+    if (status /= MBD_OK) then
+      msg = 'the initial velocities cannot be made consistent: the mass matrix is singular '// &
+            'on the motions the constraints allow (a body without mass or inertia?)'
+      return
+    end if
+    call sens_initial(m, w, sens, q, qd, t0, s0, sd0, status, msg)
+    if (status /= MBD_OK) return
+    r_tol = 1.0e-6_wp; a_tol = 1.0e-8_wp
+    if (rtol > zero) r_tol = rtol
+    if (atol > zero) a_tol = atol
+    call sens_dopri5(m, w, sens, q, qd, s0, sd0, t0, t1, nsteps, every, r_tol, a_tol, &
+                     max_steps, qout, qdout, qddout, sq, sqd, sqdd, nout, stats, hmm, tfail, &
+                     status, msg)
+    iinfo(1) = nout; iinfo(3) = stats(1); iinfo(4) = stats(2); iinfo(6) = stats(3)
+    rinfo(2) = hmm(1); rinfo(3) = hmm(2)
+    if (status /= MBD_OK) rinfo(1) = tfail
+    do k = 1, nout
+      ko = output_index(nsteps, every, k)
+      t = t0 + (t1 - t0) * (real(ko, wp) / max(nsteps, 1))
+      if (ko == nsteps) t = t1
+      call dyn_multipliers(m, w, qout(:, k), qdout(:, k), qddout(:, k), t, lamout(:, k), st, lmsg)
+      call state_measures(m, w, qout(:, k), qdout(:, k), t, eout(:, k))
+    end do
+    call units(m, qout, m%cunit, .false.); call units(m, qdout, m%cunit, .false.)
+    call units(m, qddout, m%cunit, .false.); call units(m, lamout, m%rowunit, .true.)
+    call sens_units(m, sens, sq, m%cunit, .false.)
+    call sens_units(m, sens, sqd, m%cunit, .false.)
+    call sens_units(m, sens, sqdd, m%cunit, .false.)
+  end subroutine api_dynamics_sens
+
+  !> Normal force of each cam joint on its follower at many states: fn(nc, nt), positive
+  !! when the profile pushes the follower away, negative when the joint must pull it onto
+  !! the profile (a real follower would lift off); zero for other constraints.
+  !! fn = F_j . n, F_j the reaction on the follower, n the profile's outward normal at the
+  !! contact (for a flat face -m).
+  subroutine api_cam_forces(nb, ctab, rpar, q, t, lam, fn, status, msg)
+    integer, intent(in) :: nb, ctab(:, :)
+    real(wp), intent(in) :: rpar(:), q(:, :), t(:), lam(:, :)
+    real(wp), intent(out) :: fn(:, :)
+    integer, intent(out) :: status              !! MBD_OK or < 0
+    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    type(model_t) :: m
+    type(dyn_work_t) :: w
+    real(wp) :: reac(6, size(ctab, 2)), rloc(6, size(ctab, 2)), ql(NLOC), nv(2)
+    integer :: bad, k, i, s, ierr
+    fn = zero
+    call model_build(nb, ctab, rpar, m, status, msg, bad)
+    if (status /= MBD_OK) return
+    if (.not. (finite(q) .and. finite(t) .and. finite(lam))) then
+      call not_finite('q, t and lambda', status, msg); return
+    end if
+    if (size(q, 1) /= m%nq .or. size(lam, 1) /= m%neq .or. size(fn, 1) /= m%nc .or. &
+        size(q, 2) /= size(t) .or. size(lam, 2) /= size(t) .or. size(fn, 2) /= size(t)) then
+      status = MBD_BAD_COUNT; msg = 'array sizes do not match the model'; return
+    end if
+    allocate (w%phi(m%neq), w%nu(m%neq), w%gam(m%neq), w%qz(m%nq), stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail(REAL_BYTES * (3 * real(m%neq, wp) + m%nq), 'the reaction arrays', &
+                    'use a smaller model', status, msg)
+      return
+    end if
+    call asm_init(m, w%asm, status, msg)
+    if (status /= MBD_OK) return
+    w%qz = zero
+    do i = 1, size(t)
+      call dyn_reactions(m, w, q(:, i), t(i), lam(:, i), reac, rloc)
+      do k = 1, m%nc
+        if (m%kind(k) /= CON_CAM) cycle
+        do s = 1, NLOC
+          ql(s) = zero
+          if (m%loc(s, k) > 0) ql(s) = q(m%loc(s, k), i)
+        end do
+        nv = cam_outward_normal(m%suba(k), m%subb(k), m%p(m%po(k):m%po(k) + m%pn(k) - 1), &
+                                merge(1, 0, m%bi(k) > 0), merge(2, 0, m%bj(k) > 0), &
+                                local_state(ql, ql * zero))
+        if (m%bj(k) > 0) then
+          fn(k, i) = dot_product(reac(4:5, k), nv)
+        else
+          fn(k, i) = -dot_product(reac(1:2, k), nv)
+        end if
+      end do
+    end do
+  end subroutine api_cam_forces
 
 end module mbd_api

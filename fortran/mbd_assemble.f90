@@ -15,12 +15,14 @@ module mbd_assemble
   implicit none
   private
   public :: asm_work_t, asm_init, assemble_blocks, scatter_dense, assemble_dense, init_extras, &
-            gather_local, blocks_jv, blocks_jtv
+            gather_local, blocks_jv, blocks_jtv, scatter_values, asm_turn
 
   !> Work arrays of the assembly, allocated once per analysis.
   type :: asm_work_t
     real(wp), allocatable :: jb(:, :, :)   !! local Jacobian blocks (MAXROW, NLOC, nc)
     real(wp), allocatable :: cb(:), sb(:)  !! cos and sin of each body's angle (0:nb; 0 ground)
+    real(wp), allocatable :: qx(:), qdx(:) !! q and q_dot with a zero in front (0:nq): slot
+                                           !! loc = 0 reads the zero
     !> the nonzeros of the blocks: jb(src(i)) goes to J(dst(i)) and column col(i) (flat
     !! column-major indices into jb and the dense neq x nq J; dst = 0 when J has more than
     !! huge(1) entries)
@@ -43,7 +45,8 @@ contains
     do k = 1, m%nc
       n = n + m%nrow(k) * count(m%loc(:, k) > 0)
     end do
-    allocate (a%jb(MAXROW, NLOC, m%nc), a%cb(0:m%nb), a%sb(0:m%nb), stat=ierr)
+    allocate (a%jb(MAXROW, NLOC, m%nc), a%cb(0:m%nb), a%sb(0:m%nb), a%qx(0:m%nq), &
+              a%qdx(0:m%nq), stat=ierr)
     if (ierr == 0) allocate (a%src(n), a%dst(n), a%col(n), stat=ierr)
     if (ierr /= 0) then
       call mem_fail(REAL_BYTES * (MAXROW * NLOC * real(m%nc, wp) + 2 * real(m%nb, wp)) + &
@@ -52,7 +55,7 @@ contains
       return
     end if
     a%jb = zero
-    a%cb = one; a%sb = zero
+    a%cb = one; a%sb = zero; a%qx = zero; a%qdx = zero
     dense_map = real(m%neq, wp) * real(m%nq, wp) < real(huge(n), wp)
     n = 0
     do k = 1, m%nc
@@ -99,7 +102,7 @@ contains
     logical, intent(in), optional :: same_q   !! the last call had the same q
     type(kloc) :: x
     real(wp) :: ph(MAXROW), nv(MAXROW), ga(MAXROW)
-    integer :: k, r0, nr, si, sj, b, s, c
+    integer :: k, r0, nr, si, sj, b, s, i
     logical :: reuse
     reuse = .false.
     if (present(same_q)) reuse = same_q
@@ -108,13 +111,12 @@ contains
         a%cb(b) = cos(q(3 * b)); a%sb(b) = sin(q(3 * b))
       end do
     end if
+    do i = 1, m%nq
+      a%qx(i) = q(i); a%qdx(i) = qd(i)
+    end do
     do k = 1, m%nc
-      do s = 1, NLOC
-        c = m%loc(s, k)
-        x%q(s) = zero; x%qd(s) = zero
-        if (c > 0) then
-          x%q(s) = q(c); x%qd(s) = qd(c)
-        end if
+      do s = 1, NLOC                   ! the constraint's slots (zero where it has none)
+        x%q(s) = a%qx(m%loc(s, k)); x%qd(s) = a%qdx(m%loc(s, k))
       end do
       x%c(1) = a%cb(m%bi(k)); x%c(2) = a%cb(m%bj(k))
       x%s(1) = a%sb(m%bi(k)); x%s(2) = a%sb(m%bj(k))
@@ -122,9 +124,15 @@ contains
       ! each constraint writes whole rows of its block (put_vec, put_scal): no zero fill
       call con_eval(m%kind(k), m%suba(k), m%subb(k), m%p(m%po(k):m%po(k) + m%pn(k) - 1), &
                     si, sj, x, t, ph, a%jb(:, :, k), nv, ga)
-      r0 = m%row0(k) - 1; nr = m%nrow(k)
-      phi(r0 + 1:r0 + nr) = ph(1:nr); nu(r0 + 1:r0 + nr) = nv(1:nr)
-      gam(r0 + 1:r0 + nr) = ga(1:nr)
+      r0 = m%row0(k); nr = m%nrow(k)
+      ! row by row (a slice copy of variable length would be three memcpy calls)
+      phi(r0) = ph(1); nu(r0) = nv(1); gam(r0) = ga(1)
+      if (nr >= 2) then
+        phi(r0 + 1) = ph(2); nu(r0 + 1) = nv(2); gam(r0 + 1) = ga(2)
+        if (nr >= 3) then
+          phi(r0 + 2) = ph(3); nu(r0 + 2) = nv(3); gam(r0 + 2) = ga(3)
+        end if
+      end if
     end do
   end subroutine assemble_blocks
 
@@ -155,6 +163,38 @@ contains
       end do
     end if
   end subroutine scatter_flat
+
+  !> The blocks' entries (times the column scale cs) written straight into a solver's value
+  !! vector through a map of entries (src(i): flat index into the blocks, col(i): column of J,
+  !! pos(i): place in val): val(pos(i)) = jb(src(i)) cs(col(i)) for i <= non; off: the sum of
+  !! |jb(src(i))| over i > non (entries the solver's pattern leaves out, which must be zero;
+  !! NaN propagates).
+  pure subroutine scatter_values(a, src, col, pos, non, cs, val, off)
+    type(asm_work_t), intent(in) :: a           !! blocks
+    integer, intent(in) :: src(:), col(:), pos(:)  !! the map
+    integer, intent(in) :: non                  !! entries written
+    real(wp), intent(in) :: cs(:)               !! column scale
+    real(wp), intent(inout) :: val(:)           !! values
+    real(wp), intent(out) :: off                !! sum of the entries left out
+    call scatter_pos(size(src), non, src, col, pos, a%jb, size(a%jb), cs, size(cs), val, off)
+  end subroutine scatter_values
+
+  !> scatter_values over a flat (column-major) view of the blocks.
+  pure subroutine scatter_pos(ne, non, src, col, pos, jb, nb, cs, nc, val, off)
+    integer, intent(in) :: ne, non, nb, nc
+    integer, intent(in) :: src(ne), col(ne), pos(ne)
+    real(wp), intent(in) :: jb(nb), cs(nc)
+    real(wp), intent(inout) :: val(*)
+    real(wp), intent(out) :: off
+    integer :: i
+    do i = 1, non
+      val(pos(i)) = jb(src(i)) * cs(col(i))
+    end do
+    off = zero
+    do i = non + 1, ne
+      off = off + abs(jb(src(i)))
+    end do
+  end subroutine scatter_pos
 
   !> Phi, nu, gamma and the dense J in one call.
   pure subroutine assemble_dense(m, q, qd, t, phi, nu, gam, a, jac)
@@ -209,6 +249,21 @@ contains
       end do
     end do
   end subroutine blocks_jtv
+
+  !> The bodies' cos and sin after their angles changed by dq(3 b), a change within a few units
+  !! in the last place: cos(th + d) = c - s d, sin(th + d) = s + c d (the d**2 terms are below
+  !! rounding).
+  pure subroutine asm_turn(m, a, dq)
+    type(model_t), intent(in) :: m            !! model
+    type(asm_work_t), intent(inout) :: a      !! cos and sin of the angles
+    real(wp), intent(in) :: dq(:)             !! change of the coordinates (tiny)
+    real(wp) :: c, d
+    integer :: b
+    do b = 1, m%nb
+      d = dq(3 * b); c = a%cb(b)
+      a%cb(b) = c - a%sb(b) * d; a%sb(b) = a%sb(b) + c * d
+    end do
+  end subroutine asm_turn
 
   !> Starting values of the extra coordinates (cam contact parameters) from the bodies in q.
   pure subroutine init_extras(m, q)

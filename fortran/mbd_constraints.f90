@@ -11,25 +11,31 @@
 module mbd_constraints
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use mbd_kinds, only: wp
-  use mbd_status, only: MBD_OK, MBD_BAD_INPUT, MBD_BAD_PARAM, MSG_LEN
+  use mbd_status, only: MBD_OK, MBD_BAD_INPUT, MBD_BAD_PARAM, MBD_NO_MEMORY, MSG_LEN
   use mbd_points, only: NLOC, MAXROW, kloc
-  use mbd_functions, only: fun_length, fun_check, fun_exponents
+  use mbd_dual, only: dloc
+  use mbd_functions, only: fun_length, fun_check, fun_exponents, fun_is_count
   use mbd_profiles, only: profile_exponents
-  use mbd_joint_revolute, only: revolute_prepare, revolute_eval
-  use mbd_joint_translational, only: translational_prepare, translational_eval
-  use mbd_joint_cam, only: cam_raw_length, cam_prepare, cam_eval, cam_init_alpha, ALPHA_SLOT
-  use mbd_joint_distance, only: distance_prepare, distance_eval
-  use mbd_joint_point_line, only: point_line_prepare, point_line_eval
-  use mbd_joint_weld, only: weld_prepare, weld_eval
-  use mbd_joint_gear, only: gear_prepare, gear_eval, GEAR_RAW_LEN
-  use mbd_joint_rolling, only: rolling_prepare, rolling_eval
-  use mbd_drivers, only: driver_eval, DRV_ABS, DRV_REL_ANGLE, DRV_REL_DIST
+  use mbd_joint_revolute, only: revolute_prepare, revolute_eval, revolute_eval_d
+  use mbd_joint_translational, only: translational_prepare, translational_eval, &
+                                     translational_prepare_d, translational_eval_d
+  use mbd_joint_cam, only: cam_raw_length, cam_prepare, cam_eval, cam_init_alpha, ALPHA_SLOT, &
+                           cam_prepare_d, cam_eval_d, cam_is_count
+  use mbd_joint_distance, only: distance_prepare, distance_eval, distance_eval_d
+  use mbd_joint_point_line, only: point_line_prepare, point_line_eval, point_line_prepare_d, &
+                                  point_line_eval_d
+  use mbd_joint_weld, only: weld_prepare, weld_eval, weld_eval_d
+  use mbd_joint_gear, only: gear_prepare, gear_eval, GEAR_RAW_LEN, gear_prepare_d, gear_eval_d
+  use mbd_joint_rolling, only: rolling_prepare, rolling_eval, rolling_prepare_d, rolling_eval_d
+  use mbd_drivers, only: driver_eval, driver_eval_d, DRV_ABS, DRV_REL_ANGLE, DRV_REL_DIST, &
+                         TRANS_PREP_LEN
   implicit none
   private
   public :: CON_REVOLUTE, CON_TRANSLATIONAL, CON_CAM, CON_DISTANCE, CON_POINT_LINE, CON_WELD, &
             CON_GEAR, CON_RACK, CON_ROLLING, CON_ABSOLUTE, DRV_ABS, DRV_REL_ANGLE, DRV_REL_DIST
   public :: con_known, con_nrow, con_nextra, con_is_driver, con_raw_length, con_prepare
   public :: con_eval, con_init_extra, con_name, con_exponents, con_row_power
+  public :: con_is_count, con_prepare_d, con_eval_d, con_linear, con_affine_r
 
   integer, parameter :: CON_REVOLUTE = 1, CON_TRANSLATIONAL = 2, CON_CAM = 3, CON_DISTANCE = 4
   integer, parameter :: CON_POINT_LINE = 5, CON_WELD = 6, CON_GEAR = 7, CON_RACK = 8
@@ -263,5 +269,130 @@ contains
     real(wp), intent(inout) :: ql(NLOC)      !! local coordinates
     if (kind == CON_CAM) ql(ALPHA_SLOT) = cam_init_alpha(suba, subb, p, si, sj, ql)
   end subroutine con_init_extra
+
+  !> Phi is linear in q (J constant, gamma free of q): absolute constraints and drivers,
+  !! relative-angle drivers. Their second derivatives in q vanish.
+  pure logical function con_linear(kind)
+    integer, intent(in) :: kind   !! kind code
+    select case (kind)
+    case (CON_ABSOLUTE, DRV_ABS, DRV_REL_ANGLE)
+      con_linear = .true.
+    case default
+      con_linear = .false.
+    end select
+  end function con_linear
+
+  !> Phi is affine in the body positions r_i, r_j, so no second derivative involves a
+  !! position slot: points compared (revolute, weld: r_i + A_i s'_i - r_j - A_j s'_j), or a
+  !! line fixed in ground (translational, point on line with body i ground: h . (P_j - P_i)
+  !! with a constant h).
+  pure logical function con_affine_r(kind, bi)
+    integer, intent(in) :: kind   !! kind code
+    integer, intent(in) :: bi     !! first body (0 ground)
+    con_affine_r = kind == CON_REVOLUTE .or. kind == CON_WELD .or. con_linear(kind) .or. &
+                   ((kind == CON_TRANSLATIONAL .or. kind == CON_POINT_LINE) .and. bi == 0)
+  end function con_affine_r
+
+  !> True when raw entry j of a constraint is a count (a function's or a profile's), which
+  !! no derivative can be taken with respect to.
+  pure logical function con_is_count(kind, suba, raw, j)
+    integer, intent(in) :: kind, suba  !! kind and first sub-kind
+    real(wp), intent(in) :: raw(:)     !! raw parameters
+    integer, intent(in) :: j           !! raw entry
+    select case (kind)
+    case (CON_CAM)
+      con_is_count = cam_is_count(suba, j)
+    case (DRV_ABS, DRV_REL_ANGLE, DRV_REL_DIST)
+      con_is_count = fun_is_count(raw, j)
+    case default
+      con_is_count = .false.
+    end select
+  end function con_is_count
+
+  !> Change tprep of the prepared parameters when raw(j) changes by one (the derivative of
+  !! con_prepare; j must not be a count). A relative-distance driver's own entries come after
+  !! the TRANS_PREP_LEN prepared entries of its joint (whose changes mbd_sensitivity adds).
+  subroutine con_prepare_d(kind, suba, subb, raw, j, tprep, status, msg)
+    integer, intent(in) :: kind, suba, subb        !! kind and sub-kinds
+    real(wp), intent(in) :: raw(:)                 !! raw parameters (exact length)
+    integer, intent(in) :: j                       !! raw entry
+    real(wp), allocatable, intent(out) :: tprep(:) !! change of the prepared parameters
+    integer, intent(out) :: status                 !! MBD_OK or the failure
+    character(len=MSG_LEN), intent(out) :: msg     !! what went wrong
+    integer :: n
+    status = MBD_OK; msg = ''
+    select case (kind)
+    case (CON_CAM)
+      call cam_prepare_d(suba, subb, raw, j, tprep, status, msg)
+      return
+    case (CON_TRANSLATIONAL); n = 9
+    case (CON_GEAR); n = 12
+    case (CON_POINT_LINE); n = 7
+    case (CON_RACK, CON_ROLLING); n = 8
+    case (CON_ABSOLUTE); n = 3
+    case (DRV_REL_DIST); n = TRANS_PREP_LEN + size(raw)
+    case default; n = size(raw)
+    end select
+    allocate (tprep(n), stat=status)
+    if (status /= 0) then
+      status = MBD_NO_MEMORY; msg = 'out of memory'; return
+    end if
+    tprep = 0.0_wp
+    select case (kind)
+    case (CON_TRANSLATIONAL)
+      call translational_prepare_d(raw, j, tprep)
+    case (CON_GEAR)
+      call gear_prepare_d(subb, raw, j, tprep)
+    case (CON_POINT_LINE)
+      call point_line_prepare_d(raw, j, tprep)
+    case (CON_RACK, CON_ROLLING)
+      call rolling_prepare_d(raw, j, tprep)
+    case (CON_ABSOLUTE)
+      tprep(2) = 1.0_wp                   ! prepared [1, value, 0]: the constant function
+    case (DRV_REL_DIST)
+      tprep(TRANS_PREP_LEN + j) = 1.0_wp
+    case default
+      tprep(j) = 1.0_wp
+    end select
+  end subroutine con_prepare_d
+
+  !> Changes of the rows of Phi, the local J block, nu and gamma along the direction in x
+  !! and the change tp of the prepared parameters (mbd_dual).
+  pure subroutine con_eval_d(kind, suba, subb, p, tp, si, sj, x, t, tphi, tjl, tnu, tgam)
+    integer, intent(in) :: kind, suba, subb  !! kind and sub-kinds
+    real(wp), intent(in) :: p(:), tp(:)      !! prepared parameters and their change
+    integer, intent(in) :: si, sj            !! slot ids of the two bodies (0 = ground)
+    type(dloc), intent(in) :: x              !! local state and direction
+    real(wp), intent(in) :: t                !! time
+    real(wp), intent(inout) :: tphi(MAXROW)  !! changes of the rows of Phi
+    real(wp), intent(inout) :: tjl(MAXROW, NLOC)  !! change of the local block of J
+    real(wp), intent(inout) :: tnu(MAXROW)   !! changes of the rows of nu
+    real(wp), intent(inout) :: tgam(MAXROW)  !! changes of the rows of gamma
+    tnu = 0.0_wp
+    select case (kind)
+    case (CON_REVOLUTE)
+      call revolute_eval_d(p, tp, si, sj, x, tphi, tjl, tgam)
+    case (CON_TRANSLATIONAL)
+      call translational_eval_d(p, tp, si, sj, x, tphi, tjl, tgam)
+    case (CON_CAM)
+      call cam_eval_d(suba, subb, p, tp, si, sj, x, tphi, tjl, tgam)
+    case (CON_DISTANCE)
+      call distance_eval_d(p, tp, si, sj, x, tphi, tjl, tgam)
+    case (CON_POINT_LINE)
+      call point_line_eval_d(p, tp, si, sj, x, tphi, tjl, tgam)
+    case (CON_WELD)
+      call weld_eval_d(p, tp, si, sj, x, tphi, tjl, tgam)
+    case (CON_GEAR)
+      call gear_eval_d(subb, p, tp, si, sj, x, tphi, tjl, tgam)
+    case (CON_RACK)
+      call rolling_eval_d(.false., p, tp, si, sj, x, tphi, tjl, tgam)
+    case (CON_ROLLING)
+      call rolling_eval_d(.true., p, tp, si, sj, x, tphi, tjl, tgam)
+    case (CON_ABSOLUTE)
+      call driver_eval_d(DRV_ABS, suba, p, tp, si, sj, x, t, tphi, tjl, tnu, tgam)
+    case default
+      call driver_eval_d(kind, suba, p, tp, si, sj, x, t, tphi, tjl, tnu, tgam)
+    end select
+  end subroutine con_eval_d
 
 end module mbd_constraints

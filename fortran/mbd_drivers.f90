@@ -9,12 +9,13 @@
 module mbd_drivers
   use mbd_kinds, only: wp
   use mbd_points, only: NLOC, MAXROW, kloc, kscal, body_angle, ssub, put_scal
-  use mbd_functions, only: fun_eval
-  use mbd_joint_translational, only: slide_distance
+  use mbd_functions, only: fun_eval, fun_eval_d
+  use mbd_joint_translational, only: slide_distance, slide_distance_d
+  use mbd_dual, only: dloc, dscal, slot_value, body_angle, ssub, put_scal
   implicit none
   private
   public :: DRV_ABS, DRV_REL_ANGLE, DRV_REL_DIST, TRANS_PREP_LEN
-  public :: driver_eval
+  public :: driver_eval, driver_eval_d
 
   integer, parameter :: DRV_ABS = 101, DRV_REL_ANGLE = 102, DRV_REL_DIST = 103
   integer, parameter :: TRANS_PREP_LEN = 9   !! length of a prepared translational joint
@@ -50,5 +51,35 @@ contains
     nu(1) = f1
     gam(1) = gam(1) + f2
   end subroutine driver_eval
+
+  !> Changes of the driver's row along a direction and a change tp of its parameters
+  !! (mbd_dual): Phi = g - f, nu = f', gamma = -ar_g + f'' with the function's changes
+  !! from fun_eval_d.
+  pure subroutine driver_eval_d(kind, sub, p, tp, si, sj, x, t, tphi, tjl, tnu, tgam)
+    integer, intent(in) :: kind, sub        !! driver kind; absolute: coordinate 1..3
+    real(wp), intent(in) :: p(:), tp(:)     !! prepared parameters and their change
+    integer, intent(in) :: si, sj           !! slot ids of the bodies
+    type(dloc), intent(in) :: x             !! local state and direction
+    real(wp), intent(in) :: t               !! time
+    real(wp), intent(inout) :: tphi(MAXROW), tjl(MAXROW, NLOC)  !! changes (row 1)
+    real(wp), intent(inout) :: tnu(MAXROW), tgam(MAXROW)        !! changes (row 1)
+    type(dscal) :: g
+    real(wp) :: tf, tf1, tf2
+    select case (kind)
+    case (DRV_ABS)
+      g = slot_value(x, sub)
+      call fun_eval_d(p, tp, t, tf, tf1, tf2)
+    case (DRV_REL_ANGLE)
+      g = ssub(body_angle(x, sj), body_angle(x, si))
+      call fun_eval_d(p, tp, t, tf, tf1, tf2)
+    case default  ! DRV_REL_DIST
+      g = slide_distance_d(p(1:TRANS_PREP_LEN), tp(1:TRANS_PREP_LEN), si, sj, x)
+      call fun_eval_d(p(TRANS_PREP_LEN + 1:), tp(TRANS_PREP_LEN + 1:), t, tf, tf1, tf2)
+    end select
+    call put_scal(g, tphi(1), tjl(1, :), tgam(1))
+    tphi(1) = tphi(1) - tf
+    tnu(1) = tf1
+    tgam(1) = tgam(1) + tf2
+  end subroutine driver_eval_d
 
 end module mbd_drivers

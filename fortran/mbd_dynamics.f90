@@ -22,6 +22,17 @@
 !! QR, LU of the saddle-point matrices) for small models, band (mbd_saddle, mbd_band: no
 !! n x n array; the rank analysis by a band Cholesky of J J^T) for large ones; auto picks
 !! the band for at least SADDLE_BAND_MIN_N coordinates whose saddle-point band is narrow.
+!!
+!! Contacts and joint friction (mbd_contact): contact forces are part of Q (they read the
+!! contact state w%cst: open or closed, impact speed). A joint's friction force a_b along its
+!! slip direction g_b = du/dq depends on the multipliers through the normal load N(lambda),
+!! which is homogeneous of degree 1 (N = grad N . lambda), so with the direction of grad N
+!! fixed the friction is linear in lambda and is solved exactly with the factored matrix A:
+!!   x = y0 + sum_b a_b z_b,  A y0 = [Q; s gamma],  A z_b = [g_b; 0],
+!!   sliding b:  a_b = c_b grad N_b . lambda(x)     (c_b = -mu(u_dot), or -mu sign)
+!!   stuck b:    g_b . q_ddot(x) = -u_ar           (a locked constraint; a_b its force)
+!! a small dense system in a; only the directions of grad N are iterated (revolute: the
+!! direction of the pin force; translational: the sign of the normal force).
 module mbd_dynamics
   use, intrinsic :: iso_fortran_env, only: int64
   use mbd_kinds, only: wp, zero, one, half
@@ -30,11 +41,15 @@ module mbd_dynamics
   use mbd_memory, only: REAL_BYTES, mem_check, mem_fail
   use mbd_points, only: NLOC, rot
   use mbd_model, only: model_t, model_slots
-  use mbd_constraints, only: con_is_driver, con_name
-  use mbd_forces, only: force_eval, FRC_SPRING, FRC_ROTSPRING
+  use mbd_constraints, only: con_is_driver, con_name, CON_REVOLUTE
+  use mbd_forces, only: force_eval, FRC_SPRING, FRC_ROTSPRING, FRC_FRICTION, force_is_contact
+  use mbd_contact, only: NCS, NEO, MODE_UNTRACKED, joint_slip, joint_normal_load, &
+                         joint_friction_force, reg_mu, contact_damped
+  use mbd_points, only: kloc, kscal, local_state
   use mbd_assemble, only: asm_work_t, asm_init, assemble_blocks, assemble_dense, blocks_jv, &
                           blocks_jtv, init_extras
-  use mbd_linsolve, only: row_rank, lapack_status, ls_small, RANK_TOL
+  use mbd_linsolve, only: row_rank, lapack_status, ls_small, RANK_TOL, lu_factor_small, &
+                          lu_solve_small
   use mbd_lapack, only: dgelsy
   use mbd_saddle, only: saddle_t, saddle_plan, saddle_factor, saddle_solve, saddle_row_rank, &
                         SADDLE_BAND_MIN_N, SADDLE_BAND_RATIO
@@ -44,7 +59,12 @@ module mbd_dynamics
             dyn_velocity, &
             dyn_project_pos, dyn_multipliers, dyn_reactions, dyn_tangent, dyn_solve, &
             dyn_jt_lam, dyn_damped, dyn_assemble, dyn_choose, dyn_jv, dyn_null_basis, &
-            SOLVER_AUTO, SOLVER_DENSE, SOLVER_BANDED
+            SOLVER_AUTO, SOLVER_DENSE, SOLVER_BANDED, friction_forces, dyn_element_outputs, &
+            element_state, element_slip
+  public :: MODE_STUCK
+
+  integer, parameter :: MODE_STUCK = 2   !! friction mode of a stuck joint (w%cst(1, k))
+  integer, parameter :: FRIC_MAXIT = 30  !! iterations on the directions of the normal loads
 
   integer, parameter :: SOLVER_AUTO = 0, SOLVER_DENSE = 1, SOLVER_BANDED = 2  !! as kinematics
   !> what to change when the dense dynamics does not fit
@@ -68,6 +88,7 @@ module mbd_dynamics
     !> dense multipliers' workspace: J^T (jt), right-hand side (bls), pivots (jpvt); the
     !! metric (nq)
     real(wp), allocatable :: metric(:), jt(:, :), bls(:)
+    real(wp), allocatable :: acopy(:, :)  !! a copy of jt (dense multipliers with friction)
     integer, allocatable :: jpvt(:)
     !> pattern of K by columns (rows krow(kptr(c):kptr(c+1)-1) of column c) and the column
     !! groups of the differences (columns gcol(gptr(g):gptr(g+1)-1) of group g)
@@ -77,6 +98,16 @@ module mbd_dynamics
     integer :: nsolve = 0                 !! augmented factorizations
     integer :: nrank = 0                  !! rank-revealing fallback solves
     logical :: lsq = .false.              !! the last factorization was nearly singular
+    ! contacts and friction
+    !> state of each force element (NCS, nf): contact [1 closed / 0 open, impact speed];
+    !! joint friction [mode: 0 regularized, +-1 sliding with that sign, 2 stuck]
+    real(wp), allocatable :: cst(:, :)
+    real(wp), allocatable :: fnl(:), ffr(:)   !! (nf) normal load and friction force
+    integer, allocatable :: fidx(:)           !! (nfric) force index of each friction element
+    real(wp), allocatable :: gf(:, :), zf(:, :), y0(:), gaf(:)  !! directions, responses
+    real(wp), allocatable :: amat(:, :), avec(:), cf(:), dn(:, :)
+    integer, allocatable :: fpiv(:)
+    integer, allocatable :: fpos(:, :)        !! (2, nfric) active positions of the joint rows
   end type dyn_work_t
 
 contains
@@ -88,7 +119,7 @@ contains
     integer, intent(in) :: nq, neq   !! coordinates, equations
     real(wp) :: n, e
     n = real(nq, wp); e = real(neq, wp)
-    b = REAL_BYTES * (2 * n * e + 3 * (n + e)**2 + 12 * (n + e))
+    b = REAL_BYTES * (3 * n * e + 3 * (n + e)**2 + 12 * (n + e))
   end function dyn_bytes
 
   !> MBD_NO_MEMORY (and what to change) when the dense dynamics of m (dyn_bytes) cannot fit.
@@ -123,6 +154,13 @@ contains
       msg = 'solver must be 0 (auto), 1 (dense) or 2 (banded)'; return
     end if
     if (solver == SOLVER_DENSE) return
+    if (m%nfric > 0) then           ! joint friction's multipliers: the dense least squares
+      if (solver == SOLVER_BANDED) then
+        status = MBD_BAD_SETTING
+        msg = 'joint friction needs the dense solver (solver="dense" or "auto")'
+      end if
+      return
+    end if
     if (solver == SOLVER_AUTO .and. m%nq < SADDLE_BAND_MIN_N) return
     call saddle_plan(m, [(r, r=1, m%neq)], SOLVER_BANDED, sd, status, msg)
     if (status /= MBD_OK) then
@@ -166,7 +204,7 @@ contains
                              stat=ierr)
     if (ierr == 0 .and. w%solver == SOLVER_DENSE) &
       allocate (w%jac(m%neq, m%nq), w%jt(m%nq, m%neq), w%bls(max(m%nq, m%neq)), &
-                w%jpvt(m%neq), stat=ierr)
+                w%jpvt(m%neq), w%acopy(m%nq, m%neq), stat=ierr)
     if (ierr /= 0) then
       call mem_fail(REAL_BYTES * 2 * real(m%neq, wp) * m%nq, trim(what), DYN_HINT, status, msg)
       return
@@ -197,6 +235,8 @@ contains
       na = na + 1
       w%rows(na) = r
     end do
+    call alloc_elements(m, w, status, msg)
+    if (status /= MBD_OK) return
     w%s = one
     if (any(m%mdiag > zero)) w%s = sum(m%mdiag, mask=m%mdiag > zero) / count(m%mdiag > zero)
     call saddle_plan(m, w%rows, w%solver, w%sd, status, msg, index1=.true.)
@@ -326,23 +366,164 @@ contains
     end function slot
   end subroutine tangent_pattern
 
-  !> Applied generalized forces Q(q, q_dot, t) and the potential energy V (gravity, springs);
-  !! vload adds the potential of the loads frozen at t (statics).
-  pure subroutine gen_forces(m, q, qd, t, force, v, vload)
+  !> The work arrays of contacts and friction (element states, friction solve).
+  subroutine alloc_elements(m, w, status, msg)
+    type(model_t), intent(in) :: m
+    type(dyn_work_t), intent(inout) :: w
+    integer, intent(out) :: status
+    character(len=MSG_LEN), intent(out) :: msg
+    integer :: nf, nr, k, j, ist, i, r
+    nf = m%nf; nr = m%nfric
+    allocate (w%cst(NCS, nf), w%fnl(nf), w%ffr(nf), w%fidx(nr), w%gf(m%nq, nr), &
+              w%zf(m%nq + w%na, nr), w%y0(m%nq + w%na), w%gaf(nr), w%amat(nr, nr), &
+              w%avec(nr), w%cf(nr), w%dn(2, nr), w%fpiv(nr), w%fpos(2, nr), stat=ist)
+    status = MBD_OK; msg = ''
+    if (ist /= 0) then
+      call mem_fail(REAL_BYTES * (real(nr, wp) * (2 * m%nq + w%na + nr + 8) + 4 * nf), &
+                    'the contact and friction arrays', DYN_HINT, status, msg)
+      return
+    end if
+    w%cst = zero; w%fnl = zero; w%ffr = zero
+    do k = 1, nf
+      if (force_is_contact(m%fkind(k))) w%cst(1, k) = MODE_UNTRACKED
+    end do
+    j = 0
+    do k = 1, nf
+      if (m%fkind(k) == FRC_FRICTION) then
+        j = j + 1; w%fidx(j) = k
+        w%fpos(:, j) = 0
+        do i = 1, 2
+          do r = 1, w%na
+            if (w%rows(r) == m%row0(m%fref(k)) + i - 1) w%fpos(i, j) = r
+          end do
+        end do
+      end if
+    end do
+  end subroutine alloc_elements
+
+  !> The local state of force element k (its slots' coordinates and velocities).
+  pure function element_state(m, k, q, qd) result(x)
+    type(model_t), intent(in) :: m        !! model
+    integer, intent(in) :: k              !! force element
+    real(wp), intent(in) :: q(:), qd(:)   !! state
+    type(kloc) :: x
+    real(wp) :: ql(NLOC), qdl(NLOC)
+    integer :: s
+    do s = 1, NLOC
+      ql(s) = zero; qdl(s) = zero
+      if (m%floc(s, k) > 0) then
+        ql(s) = q(m%floc(s, k)); qdl(s) = qd(m%floc(s, k))
+      end if
+    end do
+    x = local_state(ql, qdl)
+  end function element_state
+
+  !> Slip coordinate of joint friction element k (mbd_contact joint_slip).
+  pure function element_slip(m, k, x) result(u)
+    type(model_t), intent(in) :: m
+    integer, intent(in) :: k
+    type(kloc), intent(in) :: x
+    type(kscal) :: u
+    integer :: jc, o
+    jc = m%fref(k); o = m%fpo(k)
+    u = joint_slip(m%kind(jc) == CON_REVOLUTE, m%p(m%po(jc):m%po(jc) + m%pn(jc) - 1), &
+                   m%fp(o + 4), merge(1, 0, m%fbi(k) > 0), merge(2, 0, m%fbj(k) > 0), x)
+  end function element_slip
+
+  !> Add the joint friction forces at multipliers lam to force (elements not stuck; mode
+  !! from cst, regularized without it); fnl, ffr return each element's normal load and
+  !! friction force.
+  pure subroutine friction_forces(m, q, qd, lam, force, cst, fnl, ffr)
+    type(model_t), intent(in) :: m              !! model
+    real(wp), intent(in) :: q(:), qd(:)         !! state
+    real(wp), intent(in) :: lam(:)              !! multipliers (neq)
+    real(wp), intent(inout) :: force(:)         !! Q (nq), friction added
+    real(wp), intent(in), optional :: cst(:, :) !! element states
+    real(wp), intent(inout), optional :: fnl(:), ffr(:)  !! (nf) loads and forces
+    type(kloc) :: x
+    type(kscal) :: u
+    real(wp) :: fn, f
+    integer :: k, jc, mode, s
+    do k = 1, m%nf
+      if (m%fkind(k) /= FRC_FRICTION) cycle
+      mode = 0
+      if (present(cst)) mode = nint(cst(1, k))
+      if (mode == MODE_STUCK) cycle
+      jc = m%fref(k)
+      x = element_state(m, k, q, qd)
+      u = element_slip(m, k, x)
+      fn = joint_normal_load(m%kind(jc) == CON_REVOLUTE, lam(m%row0(jc):m%row0(jc) + 1))
+      f = joint_friction_force(m%fp(m%fpo(k):m%fpo(k) + 4), mode, u%vd, fn)
+      do s = 1, NLOC
+        if (m%floc(s, k) > 0) force(m%floc(s, k)) = force(m%floc(s, k)) + f * u%d(s)
+      end do
+      if (present(fnl)) fnl(k) = fn
+      if (present(ffr)) ffr(k) = f
+    end do
+  end subroutine friction_forces
+
+  !> Outputs of every force element at a state (core units), eo(NEO, nf): contacts [Fn, Ft,
+  !! penetration, sliding speed, contact point]; joint friction [normal load, friction force
+  !! along the slip, 0, slip speed, 1 when stuck, friction moment (revolute)] from the last
+  !! solve's loads (w%fnl, w%ffr); other elements zero.
+  subroutine dyn_element_outputs(m, w, q, qd, t, eo)
+    type(model_t), intent(in) :: m              !! model
+    type(dyn_work_t), intent(inout) :: w        !! work arrays (states, last loads)
+    real(wp), intent(in) :: q(:), qd(:)         !! state
+    real(wp), intent(in) :: t                   !! time
+    real(wp), intent(out) :: eo(:, :)           !! (NEO, nf)
+    real(wp) :: ql(NLOC), qdl(NLOC), fl(NLOC), vk, vl
+    type(kloc) :: x
+    type(kscal) :: u
+    integer :: k, s, jc
+    eo = zero
+    do k = 1, m%nf
+      if (force_is_contact(m%fkind(k))) then
+        do s = 1, NLOC
+          ql(s) = zero; qdl(s) = zero
+          if (m%floc(s, k) > 0) then
+            ql(s) = q(m%floc(s, k)); qdl(s) = qd(m%floc(s, k))
+          end if
+        end do
+        call force_eval(m%fkind(k), m%fp(m%fpo(k):m%fpo(k) + m%fpn(k) - 1), &
+                        merge(1, 0, m%fbi(k) > 0), merge(2, 0, m%fbj(k) > 0), ql, qdl, t, &
+                        fl, vk, vl, st=w%cst(:, k), out=eo(:, k))
+      else if (m%fkind(k) == FRC_FRICTION) then
+        jc = m%fref(k)
+        x = element_state(m, k, q, qd)
+        u = element_slip(m, k, x)
+        eo(1, k) = w%fnl(k); eo(2, k) = w%ffr(k); eo(4, k) = u%vd
+        if (nint(w%cst(1, k)) == MODE_STUCK) eo(5, k) = one
+        if (m%kind(jc) == CON_REVOLUTE) eo(6, k) = w%ffr(k) * m%fp(m%fpo(k) + 4)
+      end if
+    end do
+  end subroutine dyn_element_outputs
+
+  !> Applied generalized forces Q(q, q_dot, t) and the potential energy V (gravity, springs,
+  !! contacts); vload adds the potential of the loads frozen at t (statics). Contacts read
+  !! their states cst (absent: open); joint friction is added only when the multipliers lam
+  !! are given (friction_forces).
+  pure subroutine gen_forces(m, q, qd, t, force, v, vload, cst, lam, fmag)
     type(model_t), intent(in) :: m        !! model
     real(wp), intent(in) :: q(:), qd(:)   !! state
     real(wp), intent(in) :: t             !! time
     real(wp), intent(out) :: force(:)     !! Q (nq)
     real(wp), intent(out) :: v            !! potential energy
     real(wp), intent(out), optional :: vload  !! potential of the loads at t
-    real(wp) :: ql(NLOC), qdl(NLOC), fl(NLOC), vk, vl, vls
+    real(wp), intent(in), optional :: cst(:, :)  !! element states (NCS, nf)
+    real(wp), intent(in), optional :: lam(:)     !! multipliers: add joint friction
+    !> the largest generalized force of one element or weight (a scale of the loads, which
+    !! may cancel in Q: a body resting on a contact)
+    real(wp), intent(out), optional :: fmag
+    real(wp) :: ql(NLOC), qdl(NLOC), fl(NLOC), vk, vl, vls, fm
     integer :: k, s, si, sj
-    force = zero; v = zero; vls = zero
+    force = zero; v = zero; vls = zero; fm = zero
     do k = 1, m%nb
       force(3 * k - 2:3 * k - 1) = m%mdiag(3 * k - 2) * m%grav
       v = v - m%mdiag(3 * k - 2) * dot_product(m%grav, q(3 * k - 2:3 * k - 1))
     end do
     do k = 1, m%nf
+      if (m%fkind(k) == FRC_FRICTION) cycle
       do s = 1, NLOC
         ql(s) = zero; qdl(s) = zero
         if (m%floc(s, k) > 0) then
@@ -350,14 +531,22 @@ contains
         end if
       end do
       si = merge(1, 0, m%fbi(k) > 0); sj = merge(2, 0, m%fbj(k) > 0)
-      call force_eval(m%fkind(k), m%fp(m%fpo(k):m%fpo(k) + m%fpn(k) - 1), si, sj, ql, qdl, t, &
-                      fl, vk, vl)
+      if (present(cst)) then
+        call force_eval(m%fkind(k), m%fp(m%fpo(k):m%fpo(k) + m%fpn(k) - 1), si, sj, ql, qdl, &
+                        t, fl, vk, vl, st=cst(:, k))
+      else
+        call force_eval(m%fkind(k), m%fp(m%fpo(k):m%fpo(k) + m%fpn(k) - 1), si, sj, ql, qdl, &
+                        t, fl, vk, vl)
+      end if
       do s = 1, NLOC
         if (m%floc(s, k) > 0) force(m%floc(s, k)) = force(m%floc(s, k)) + fl(s)
       end do
+      fm = max(fm, maxval(abs(fl)))
       v = v + vk; vls = vls + vl
     end do
     if (present(vload)) vload = vls
+    if (present(fmag)) fmag = max(fm, maxval(abs(force)))
+    if (present(lam) .and. m%nfric > 0) call friction_forces(m, q, qd, lam, force, cst)
   end subroutine gen_forces
 
   !> T = q_dot^T M q_dot / 2.
@@ -423,18 +612,142 @@ contains
     integer :: n, k
     n = m%nq
     call assemble(m, w, q, qd, t)
-    call gen_forces(m, q, qd, t, w%force, v)
+    call gen_forces(m, q, qd, t, w%force, v, cst=w%cst)
     call factor_aug(w, m%mdiag, status)
     if (status /= MBD_OK) return
     w%rhs(1:n) = w%force
     call gather_rows(w, w%gam, w%s)
     call dyn_solve(w, w%rhs, status)
+    if (status /= MBD_OK) return
+    if (m%nfric > 0) then
+      call friction_solve(m, w, q, qd, status)
+      if (status /= MBD_OK) return
+    end if
     qdd = w%rhs(1:n)
     lam = zero
     do k = 1, w%na                 ! (loops: vector subscripts make heap temporaries)
       lam(w%rows(k)) = w%s * w%rhs(n + k)
     end do
   end subroutine dyn_accel
+
+  !> The joint friction forces with the factored augmented matrix (see the banner): on entry
+  !! w%rhs holds y0 (the solution without joint friction), on return the solution with it;
+  !! w%force gains the friction forces, w%fnl and w%ffr the loads and forces. An iteration
+  !! on the directions of the normal loads that does not settle is MBD_NO_CONVERGENCE (a
+  !! self-locking joint: the friction cannot be resolved, Painleve's paradox).
+  subroutine friction_solve(m, w, q, qd, status)
+    type(model_t), intent(in) :: m
+    type(dyn_work_t), intent(inout) :: w
+    real(wp), intent(in) :: q(:), qd(:)
+    integer, intent(out) :: status
+    type(kloc) :: x
+    type(kscal) :: u
+    real(wp) :: lamb(2), dnew(2), nr
+    integer :: b, d, k, n, jc, s, it, mode, nb
+    logical :: settled
+    n = m%nq; nb = m%nfric
+    status = MBD_OK
+    w%y0 = w%rhs
+    ! directions g_b, lock right-hand sides, responses z_b = A^-1 [g_b; 0]
+    do b = 1, nb
+      k = w%fidx(b)
+      x = element_state(m, k, q, qd)
+      u = element_slip(m, k, x)
+      w%gf(:, b) = zero
+      do s = 1, NLOC
+        if (m%floc(s, k) > 0) w%gf(m%floc(s, k), b) = w%gf(m%floc(s, k), b) + u%d(s)
+      end do
+      w%gaf(b) = -u%ar
+      mode = nint(w%cst(1, k))
+      if (mode == 0) then
+        w%cf(b) = -reg_mu(u%vd, m%fp(m%fpo(k)), m%fp(m%fpo(k) + 1), m%fp(m%fpo(k) + 3))
+      else if (mode /= MODE_STUCK) then
+        w%cf(b) = -m%fp(m%fpo(k)) * mode
+      else
+        w%cf(b) = zero
+      end if
+      w%zf(1:n, b) = w%gf(:, b); w%zf(n + 1:, b) = zero
+      call dyn_solve(w, w%zf(:, b), status)
+      if (status /= MBD_OK) return
+      ! the starting direction of grad N from the frictionless multipliers
+      w%dn(:, b) = grad_n(b, w%y0)
+    end do
+    settled = .false.
+    do it = 1, FRIC_MAXIT
+      ! the small system in the amplitudes a
+      do b = 1, nb
+        k = w%fidx(b)
+        if (nint(w%cst(1, k)) == MODE_STUCK) then
+          do d = 1, nb
+            w%amat(b, d) = dot_product(w%gf(:, b), w%zf(1:n, d))
+          end do
+          w%avec(b) = w%gaf(b) - dot_product(w%gf(:, b), w%y0(1:n))
+        else
+          do d = 1, nb
+            w%amat(b, d) = -w%cf(b) * dot_product(w%dn(:, b), joint_lam(b, w%zf(:, d)))
+          end do
+          w%amat(b, b) = w%amat(b, b) + one
+          w%avec(b) = w%cf(b) * dot_product(w%dn(:, b), joint_lam(b, w%y0))
+        end if
+      end do
+      call lu_factor_small(w%amat, w%fpiv, status)
+      if (status /= MBD_OK) then
+        status = MBD_NO_CONVERGENCE; return
+      end if
+      call lu_solve_small(w%amat, w%fpiv, w%avec)
+      w%rhs = w%y0
+      do d = 1, nb
+        w%rhs = w%rhs + w%avec(d) * w%zf(:, d)
+      end do
+      ! the directions of the normal loads at the new multipliers
+      settled = .true.
+      do b = 1, nb
+        dnew = grad_n(b, w%rhs)
+        if (maxval(abs(dnew - w%dn(:, b))) > 1.0e-12_wp) settled = .false.
+        w%dn(:, b) = dnew
+      end do
+      if (settled) exit
+    end do
+    if (.not. settled) then
+      status = MBD_NO_CONVERGENCE; return
+    end if
+    do b = 1, nb
+      k = w%fidx(b); jc = m%fref(k)
+      lamb = joint_lam(b, w%rhs)
+      nr = joint_normal_load(m%kind(jc) == CON_REVOLUTE, lamb)
+      w%fnl(k) = nr; w%ffr(k) = w%avec(b)
+      w%force = w%force + w%avec(b) * w%gf(:, b)
+    end do
+  contains
+    !> The multipliers (2) of friction element b's joint from a solution vector (zero on
+    !! rows not active).
+    function joint_lam(bb, xs) result(l)
+      integer, intent(in) :: bb
+      real(wp), intent(in) :: xs(:)
+      real(wp) :: l(2)
+      integer :: i
+      l = zero
+      do i = 1, 2
+        if (w%fpos(i, bb) > 0) l(i) = w%s * xs(n + w%fpos(i, bb))
+      end do
+    end function joint_lam
+    !> grad N of element b at the multipliers of a solution vector: revolute lambda/|lambda|,
+    !! translational (sign(lambda_1), 0).
+    function grad_n(bb, xs) result(g)
+      integer, intent(in) :: bb
+      real(wp), intent(in) :: xs(:)
+      real(wp) :: g(2), l(2), a
+      l = joint_lam(bb, xs)
+      g = zero
+      if (m%kind(m%fref(w%fidx(bb))) == CON_REVOLUTE) then
+        a = hypot(l(1), l(2))
+        if (a > zero) g = l / a
+      else
+        if (l(1) > zero) g(1) = one
+        if (l(1) < zero) g(1) = -one
+      end if
+    end function grad_n
+  end subroutine friction_solve
 
   !> w%rhs(nq + k) = f x(rows(k)) over the active rows (a loop: a vector subscript would
   !! make a heap temporary at every call).
@@ -502,6 +815,10 @@ contains
   !! indeterminate and this is the smallest set (LAPACK dgelsy). Band path: the least-squares
   !! lambda of the active rows, [s I, s Ja^T; s Ja, 0][x; lambda_a / s] = [Q - M q_ddot; 0]
   !! (x the part of the load no multiplier balances), zero on the redundant rows.
+  !! Joint friction (not stuck)
+  !! depends on lambda: with the directions of the normal loads fixed it is linear,
+  !! J^T l - sum_b g_b c_b grad N_b . l_b = Q - M q_ddot, and the directions are iterated;
+  !! a stuck joint's friction is the last solve's (w%ffr).
   subroutine dyn_multipliers(m, w, q, qd, qdd, t, lam, status, msg)
     type(model_t), intent(in) :: m            !! model
     type(dyn_work_t), intent(inout) :: w      !! work arrays
@@ -510,14 +827,15 @@ contains
     real(wp), intent(out) :: lam(:)           !! multipliers (neq)
     integer, intent(out) :: status            !! MBD_OK, MBD_LAPACK or MBD_NO_MEMORY
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
-    real(wp) :: v, wq(1)
-    real(wp), allocatable :: work(:)
-    integer :: rank, info, lwork, ierr, k, n
-    logical :: full
+    real(wp) :: v, rhs0(m%nq), dn(2, max(1, m%nfric)), dnew(2), c, fn
+    type(kloc) :: x
+    type(kscal) :: u
+    integer :: it, bb, k, jc, s, mode, n
+    logical :: settled
     msg = ''
     call assemble(m, w, q, qd, t)
-    call gen_forces(m, q, qd, t, w%force, v)
-    if (w%solver == SOLVER_BANDED) then
+    call gen_forces(m, q, qd, t, w%force, v, cst=w%cst)
+    if (w%solver == SOLVER_BANDED) then      ! (no joint friction here: dyn_choose)
       n = m%nq
       lam = zero
       w%metric = w%s
@@ -533,35 +851,119 @@ contains
       end do
       return
     end if
+    rhs0 = w%force - m%mdiag * qdd
+    ! stuck joints: their last friction force is a known load
+    do bb = 1, m%nfric
+      k = w%fidx(bb)
+      if (nint(w%cst(1, k)) /= MODE_STUCK) cycle
+      x = element_state(m, k, q, qd)
+      u = element_slip(m, k, x)
+      do s = 1, NLOC
+        if (m%floc(s, k) > 0) rhs0(m%floc(s, k)) = rhs0(m%floc(s, k)) + w%ffr(k) * u%d(s)
+      end do
+    end do
     w%jt = transpose(w%jac)
-    w%bls = zero
-    w%bls(1:m%nq) = w%force - m%mdiag * qdd
-    status = MBD_OK
-    if (w%na == m%neq .and. m%neq <= m%nq) then
-      ! independent rows: the unique solution, by a plain Householder QR (no allocation)
-      call ls_small(w%jt, w%bls, full)
-      if (full) then
-        lam = w%bls(1:m%neq); return
-      end if
+    call solve_ls(lam, status)
+    if (status /= MBD_OK .or. m%nfric == 0) return
+    dn = zero
+    do bb = 1, m%nfric
+      dn(:, bb) = grad_dir(bb, lam)
+    end do
+    do it = 1, FRIC_MAXIT
       w%jt = transpose(w%jac)
+      do bb = 1, m%nfric
+        k = w%fidx(bb); jc = m%fref(k)
+        mode = nint(w%cst(1, k))
+        if (mode == MODE_STUCK) cycle
+        x = element_state(m, k, q, qd)
+        u = element_slip(m, k, x)
+        if (mode == 0) then
+          c = -reg_mu(u%vd, m%fp(m%fpo(k)), m%fp(m%fpo(k) + 1), m%fp(m%fpo(k) + 3))
+        else
+          c = -m%fp(m%fpo(k)) * mode
+        end if
+        do s = 1, NLOC
+          if (m%floc(s, k) == 0) cycle
+          w%jt(m%floc(s, k), m%row0(jc)) = w%jt(m%floc(s, k), m%row0(jc)) - &
+                                           c * u%d(s) * dn(1, bb)
+          w%jt(m%floc(s, k), m%row0(jc) + 1) = w%jt(m%floc(s, k), m%row0(jc) + 1) - &
+                                               c * u%d(s) * dn(2, bb)
+        end do
+        w%ffr(k) = c
+      end do
+      call solve_ls(lam, status)
+      if (status /= MBD_OK) return
+      settled = .true.
+      do bb = 1, m%nfric
+        dnew = grad_dir(bb, lam)
+        if (maxval(abs(dnew - dn(:, bb))) > 1.0e-12_wp) settled = .false.
+        dn(:, bb) = dnew
+      end do
+      if (settled) exit
+    end do
+    do bb = 1, m%nfric
+      k = w%fidx(bb); jc = m%fref(k)
+      fn = joint_normal_load(m%kind(jc) == CON_REVOLUTE, lam(m%row0(jc):m%row0(jc) + 1))
+      w%fnl(k) = fn
+      if (nint(w%cst(1, k)) /= MODE_STUCK) w%ffr(k) = w%ffr(k) * fn
+    end do
+  contains
+    !> lambda from w%jt (destroyed) and rhs0.
+    subroutine solve_ls(l, st)
+      real(wp), intent(out) :: l(:)
+      integer, intent(out) :: st
+      real(wp) :: wq(1)
+      real(wp), allocatable :: work(:)
+      integer :: rank, info, lwork, ierr
+      logical :: full
+      st = MBD_OK
       w%bls = zero
-      w%bls(1:m%nq) = w%force - m%mdiag * qdd
-    end if
-    w%jpvt = 0
-    call dgelsy(m%nq, m%neq, 1, w%jt, m%nq, w%bls, size(w%bls), w%jpvt, 1.0e-10_wp, rank, wq, &
-                -1, info)
-    lwork = max(1, int(wq(1)))
-    allocate (work(lwork), stat=ierr)
-    if (ierr /= 0) then
-      lam = zero
-      call mem_fail(REAL_BYTES * lwork, 'the least-squares multipliers', 'use a smaller model', &
-                    status, msg)
-      return
-    end if
-    call dgelsy(m%nq, m%neq, 1, w%jt, m%nq, w%bls, size(w%bls), w%jpvt, 1.0e-10_wp, rank, work, &
-                lwork, info)
-    call lapack_status('dgelsy', info, status, msg)
-    lam = w%bls(1:m%neq)
+      w%bls(1:m%nq) = rhs0
+      if (w%na == m%neq .and. m%neq <= m%nq) then
+        ! independent rows: the unique solution, by a plain Householder QR (no allocation);
+        ! ls_small spoils w%jt, which is rebuilt by the caller for the next solve
+        w%acopy(1:m%nq, 1:m%neq) = w%jt
+        call ls_small(w%jt, w%bls, full)
+        if (full) then
+          l = w%bls(1:m%neq); return
+        end if
+        w%jt = w%acopy(1:m%nq, 1:m%neq)
+        w%bls = zero
+        w%bls(1:m%nq) = rhs0
+      end if
+      w%jpvt = 0
+      call dgelsy(m%nq, m%neq, 1, w%jt, m%nq, w%bls, size(w%bls), w%jpvt, 1.0e-10_wp, rank, &
+                  wq, -1, info)
+      lwork = max(1, int(wq(1)))
+      allocate (work(lwork), stat=ierr)
+      if (ierr /= 0) then
+        l = zero
+        call mem_fail(REAL_BYTES * lwork, 'the least-squares multipliers', &
+                      'use a smaller model', st, msg)
+        return
+      end if
+      call dgelsy(m%nq, m%neq, 1, w%jt, m%nq, w%bls, size(w%bls), w%jpvt, 1.0e-10_wp, rank, &
+                  work, lwork, info)
+      call lapack_status('dgelsy', info, st, msg)
+      l = w%bls(1:m%neq)
+    end subroutine solve_ls
+    !> grad N of friction element bx at multipliers l.
+    function grad_dir(bx, l) result(g)
+      integer, intent(in) :: bx
+      real(wp), intent(in) :: l(:)
+      real(wp) :: g(2), a, l2(2)
+      integer :: j0
+      j0 = m%row0(m%fref(w%fidx(bx)))
+      l2 = l(j0:j0 + 1)
+      g = zero
+      if (m%kind(m%fref(w%fidx(bx))) == CON_REVOLUTE) then
+        a = hypot(l2(1), l2(2))
+        if (a > zero) g = l2 / a
+      else
+        if (l2(1) > zero) g(1) = one
+        if (l2(1) < zero) g(1) = -one
+      end if
+    end function grad_dir
   end subroutine dyn_multipliers
 
   !> An orthonormal basis nb (nq x ni, ni = nq - na) of the null space of J_a at q: the
@@ -881,7 +1283,7 @@ contains
       real(wp) :: v
       integer :: j
       call assemble_blocks(m, qa, qda, t, w%phi, w%nu, w%gam, w%asm)
-      call gen_forces(m, qa, qda, t, w%force, v)
+      call gen_forces(m, qa, qda, t, w%force, v, cst=w%cst, lam=lam)
       call dyn_jt_lam(m, w%asm%jb, lam, r)
       do j = 1, m%nq
         r(j) = r(j) - w%force(j)
@@ -925,6 +1327,12 @@ contains
         if (abs(m%fp(o + 5)) > zero) dyn_damped = .true.
       case (FRC_ROTSPRING)
         if (abs(m%fp(o + 1)) > zero) dyn_damped = .true.
+      case (FRC_FRICTION)
+        dyn_damped = .true.
+      case default
+        if (force_is_contact(m%fkind(k))) then
+          if (contact_damped(m%fp(o:o + m%fpn(k) - 1))) dyn_damped = .true.
+        end if
       end select
     end do
   end function dyn_damped

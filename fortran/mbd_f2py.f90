@@ -31,13 +31,16 @@ subroutine core_eval(nb, nc, ctab, np, rpar, nq, neq, q, qd, t, phi, jac, nu, ga
 end subroutine core_eval
 
 subroutine core_kinematics(nb, nc, ctab, np, rpar, nq, neq, q0, t0, t1, nsteps, tol, &
-                           maxit, tmin, every, solver, nout, qout, qdout, qddout, iinfo, rinfo, &
-                           qsing, dep, redundant, tpass, status, msg)
+                           maxit, tmin, every, solver, nout, ctl, qout, qdout, qddout, iinfo, &
+                           rinfo, qsing, dep, redundant, tpass, status, msg)
   use iso_c_binding, only: c_double, c_int
   use mbd_api, only: api_kinematics
   implicit none
   integer(c_int), intent(in) :: nb, nc, np, nq, neq, nsteps, maxit, every, solver, nout
   integer(c_int), intent(in) :: ctab(8, nc)
+  !> progress: ctl(1) outputs stored so far, ctl(2) /= 0 stops the run (read and written
+  !! while the call runs, from another thread)
+  integer(c_int), intent(inout) :: ctl(2)
   real(c_double), intent(in) :: rpar(np), q0(nq), t0, t1, tol, tmin
   real(c_double), intent(out) :: qout(nq, nout), qdout(nq, nout), qddout(nq, nout)
   integer(c_int), intent(out) :: iinfo(10)
@@ -51,7 +54,7 @@ subroutine core_kinematics(nb, nc, ctab, np, rpar, nq, neq, q0, t0, t1, nsteps, 
   !f2py threadsafe
   call api_kinematics(nb, ctab, rpar, q0, t0, t1, nsteps, tol, maxit, tmin, every, solver, &
                       qout, qdout, qddout, iinfo, rinfo, qsing, dep, redundant, tpass, &
-                      status, msg)
+                      status, msg, ctl=ctl)
 end subroutine core_kinematics
 
 subroutine core_kin_step(nb, nc, ctab, np, rpar, nq, q, qd, qdd, t_prev, t, tol, maxit, &
@@ -102,13 +105,19 @@ subroutine core_profile(kind, np, raw, na, alpha, pts, status, msg)
 end subroutine core_profile
 
 subroutine core_inverse(nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp, fpar, nq, neq, q0, &
-                        t0, t1, nsteps, tol, every, solver, nout, qout, qdout, qddout, lamout, &
-                        eout, iinfo, rinfo, qsing, dep, redundant, tpass, status, msg)
+                        t0, t1, nsteps, tol, every, solver, nout, ctl, qout, qdout, qddout, &
+                        lamout, eout, iinfo, rinfo, qsing, dep, redundant, tpass, status, &
+                        msg, maxev, eo, evo, nev)
   use iso_c_binding, only: c_double, c_int
   use mbd_api, only: api_inverse
   implicit none
   integer(c_int), intent(in) :: nb, nc, np, nf, nfp, nq, neq, nsteps, every, solver, nout
+  integer(c_int), intent(in) :: maxev
+  !f2py integer(c_int) optional, intent(in) :: maxev = 1
   integer(c_int), intent(in) :: ctab(8, nc), ftab(6, nf)
+  !> progress: ctl(1) outputs stored so far, ctl(2) /= 0 stops the run (read and written
+  !! while the call runs, from another thread)
+  integer(c_int), intent(inout) :: ctl(2)
   real(c_double), intent(in) :: rpar(np), bmass(2, nb), grav(2), fpar(nfp), q0(nq), t0, t1, tol
   real(c_double), intent(out) :: qout(nq, nout), qdout(nq, nout)
   real(c_double), intent(out) :: qddout(nq, nout), lamout(neq, nout)
@@ -116,28 +125,37 @@ subroutine core_inverse(nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp, fpar
   integer(c_int), intent(out) :: iinfo(10), dep(neq), redundant(neq), status
   real(c_double), intent(out) :: rinfo(10), qsing(nq), tpass(64)
   character(len=512), intent(out) :: msg
+  real(c_double), intent(out) :: eo(6, nf, nout), evo(4, maxev)
+  integer(c_int), intent(out) :: nev
   !f2py intent(hide) :: nc, np, nf, nfp, nq
+  !f2py threadsafe
   call api_inverse(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, t0, t1, nsteps, tol, every, &
                    solver, qout, qdout, qddout, lamout, eout, iinfo, rinfo, qsing, dep, &
-                   redundant, tpass, status, msg)
+                   redundant, tpass, status, msg, ctl=ctl, eo=eo, evo=evo, nev=nev)
 end subroutine core_inverse
 
 ! every >= 1: only the outputs k = 0, every, 2 every, ... and k = nsteps are stored; nrow is
 ! their count, nsteps / every + 1, plus 1 when every does not divide nsteps.
 ! max_steps: the limit on accepted plus rejected steps (0, the default: the core's default).
 ! solver: 0 auto (the default), 1 dense, 2 banded linear algebra.
+! maxev: the events kept (evo(4, maxev): t, force element, kind, value; nev: how many
+! happened); eo(6, nf, nrow): the outputs of each force element (contacts, joint friction).
 subroutine core_dynamics(nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp, fpar, nq, neq, &
                          q0, v0, t0, t1, nsteps, method, rtol, atol, h, rho_inf, balpha, bbeta, &
-                         every, nrow, qout, qdout, qddout, lamout, eout, iinfo, rinfo, &
-                         redundant, status, msg, max_steps, solver)
+                         every, nrow, ctl, qout, qdout, qddout, lamout, eout, iinfo, &
+                         rinfo, redundant, status, msg, max_steps, maxev, eo, evo, nev, solver)
   use iso_c_binding, only: c_double, c_int
   use mbd_api, only: api_dynamics
   implicit none
   integer(c_int), intent(in) :: nb, nc, np, nf, nfp, nq, neq, nsteps, method, every, nrow
-  integer(c_int), intent(in) :: max_steps, solver
+  integer(c_int), intent(in) :: max_steps, maxev, solver
   !f2py integer(c_int) optional, intent(in) :: max_steps = 0
+  !f2py integer(c_int) optional, intent(in) :: maxev = 1
   !f2py integer(c_int) optional, intent(in) :: solver = 0
   integer(c_int), intent(in) :: ctab(8, nc), ftab(6, nf)
+  !> progress: ctl(1) outputs stored so far, ctl(2) /= 0 stops the run (read and written
+  !! while the call runs, from another thread)
+  integer(c_int), intent(inout) :: ctl(2)
   real(c_double), intent(in) :: rpar(np), bmass(2, nb), grav(2), fpar(nfp), q0(nq), v0(nq)
   real(c_double), intent(in) :: t0, t1, rtol, atol, h, rho_inf, balpha, bbeta
   real(c_double), intent(out) :: qout(nq, nrow), qdout(nq, nrow)
@@ -146,10 +164,14 @@ subroutine core_dynamics(nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp, fpa
   integer(c_int), intent(out) :: iinfo(10), redundant(neq), status
   real(c_double), intent(out) :: rinfo(10)
   character(len=512), intent(out) :: msg
+  real(c_double), intent(out) :: eo(6, nf, nrow), evo(4, maxev)
+  integer(c_int), intent(out) :: nev
   !f2py intent(hide) :: nc, np, nf, nfp, nq
+  !f2py threadsafe
   call api_dynamics(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, v0, t0, t1, nsteps, method, &
                     rtol, atol, h, rho_inf, balpha, bbeta, every, qout, qdout, qddout, lamout, &
-                    eout, iinfo, rinfo, redundant, status, msg, max_steps, solver)
+                    eout, iinfo, rinfo, redundant, status, msg, max_steps, eo, evo, nev, &
+                    ctl=ctl, solver=solver)
 end subroutine core_dynamics
 
 ! solver: 0 auto (the default), 1 dense, 2 banded linear algebra.
@@ -168,7 +190,7 @@ subroutine core_statics(nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp, fpar
   !f2py integer(c_int) optional, intent(in) :: solver = 0
   !f2py intent(hide) :: nc, np, nf, nfp, nq
   call api_statics(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, t, q, lam, stable, resid, &
-                   iinfo, status, msg, solver)
+                   iinfo, status, msg, solver=solver)
 end subroutine core_statics
 
 subroutine core_reactions(nb, nc, ctab, np, rpar, nq, neq, nt, q, t, lam, reac, rloc, status, &
@@ -185,3 +207,218 @@ subroutine core_reactions(nb, nc, ctab, np, rpar, nq, neq, nt, q, t, lam, reac, 
   !f2py intent(hide) :: nc, np, nq, neq, nt
   call api_reactions(nb, ctab, rpar, q, t, lam, reac, rloc, status, msg)
 end subroutine core_reactions
+
+subroutine core_conditioning(nb, nc, ctab, np, rpar, nq, nt, q, t, cond, status, msg)
+  use iso_c_binding, only: c_double, c_int
+  use mbd_measures, only: api_conditioning
+  implicit none
+  integer(c_int), intent(in) :: nb, nc, np, nq, nt
+  integer(c_int), intent(in) :: ctab(8, nc)
+  real(c_double), intent(in) :: rpar(np), q(nq, nt), t(nt)
+  real(c_double), intent(out) :: cond(nt)
+  integer(c_int), intent(out) :: status
+  character(len=512), intent(out) :: msg
+  !f2py intent(hide) :: nc, np, nq, nt
+  call api_conditioning(nb, ctab, rpar, q, t, cond, status, msg)
+end subroutine core_conditioning
+
+subroutine core_influence(nb, nc, ctab, np, rpar, nq, nt, q, t, row, u, ok, status, msg)
+  use iso_c_binding, only: c_double, c_int
+  use mbd_measures, only: api_influence
+  implicit none
+  integer(c_int), intent(in) :: nb, nc, np, nq, nt, row
+  integer(c_int), intent(in) :: ctab(8, nc)
+  real(c_double), intent(in) :: rpar(np), q(nq, nt), t(nt)
+  real(c_double), intent(out) :: u(nq, nt)
+  integer(c_int), intent(out) :: ok(nt), status
+  character(len=512), intent(out) :: msg
+  !f2py intent(hide) :: nc, np, nq, nt
+  call api_influence(nb, ctab, rpar, q, t, row, u, ok, status, msg)
+end subroutine core_influence
+
+subroutine core_fun_values(np, p, nt, t, f, f1, f2, status, msg)
+  use iso_c_binding, only: c_double, c_int
+  use mbd_measures, only: api_fun_values
+  implicit none
+  integer(c_int), intent(in) :: np, nt
+  real(c_double), intent(in) :: p(np), t(nt)
+  real(c_double), intent(out) :: f(nt), f1(nt), f2(nt)
+  integer(c_int), intent(out) :: status
+  character(len=512), intent(out) :: msg
+  !f2py intent(hide) :: np, nt
+  call api_fun_values(p, t, f, f1, f2, status, msg)
+end subroutine core_fun_values
+! ------------------------------------------------------------------ design sensitivities
+! A design parameter is a column (table, index) of ptab: table 1 rpar, 2 bmass (flattened
+! (2, nb)), 3 grav, 4 fpar (mbd_sensitivity).
+
+subroutine core_eval_d(nb, nc, ctab, np, rpar, nq, neq, q, qd, t, dq, dqd, npar, ptab, tphi, &
+                       tjac, tnu, tgam, status, msg, bad)
+  use iso_c_binding, only: c_double, c_int
+  use mbd_api, only: api_eval_d
+  implicit none
+  integer(c_int), intent(in) :: nb, nc, np, nq, neq, npar
+  integer(c_int), intent(in) :: ctab(8, nc), ptab(2, npar)
+  real(c_double), intent(in) :: rpar(np), q(nq), qd(nq), t, dq(nq), dqd(nq)
+  real(c_double), intent(out) :: tphi(neq), tjac(neq, nq), tnu(neq), tgam(neq)
+  integer(c_int), intent(out) :: status, bad
+  character(len=512), intent(out) :: msg
+  !f2py intent(hide) :: nc, np, nq, npar
+  call api_eval_d(nb, ctab, rpar, q, qd, t, dq, dqd, ptab, tphi, tjac, tnu, tgam, status, msg, &
+                  bad)
+end subroutine core_eval_d
+
+subroutine core_kinematics_sens(nb, nc, ctab, np, rpar, nq, neq, q0, t0, t1, nsteps, tol, &
+                                maxit, tmin, every, solver, nout, npar, ptab, qout, qdout, &
+                                qddout, sq, sqd, sqdd, iinfo, rinfo, qsing, dep, redundant, &
+                                tpass, status, msg)
+  use iso_c_binding, only: c_double, c_int
+  use mbd_api, only: api_kinematics
+  implicit none
+  integer(c_int), intent(in) :: nb, nc, np, nq, neq, nsteps, maxit, every, solver, nout, npar
+  integer(c_int), intent(in) :: ctab(8, nc), ptab(2, npar)
+  real(c_double), intent(in) :: rpar(np), q0(nq), t0, t1, tol, tmin
+  real(c_double), intent(out) :: qout(nq, nout), qdout(nq, nout), qddout(nq, nout)
+  real(c_double), intent(out) :: sq(nq, npar, nout), sqd(nq, npar, nout), sqdd(nq, npar, nout)
+  integer(c_int), intent(out) :: iinfo(10)
+  real(c_double), intent(out) :: rinfo(10)
+  real(c_double), intent(out) :: qsing(nq)
+  integer(c_int), intent(out) :: dep(neq), redundant(neq)
+  real(c_double), intent(out) :: tpass(64)
+  integer(c_int), intent(out) :: status
+  character(len=512), intent(out) :: msg
+  !f2py intent(hide) :: nc, np, nq, npar
+  !f2py threadsafe
+  call api_kinematics(nb, ctab, rpar, q0, t0, t1, nsteps, tol, maxit, tmin, every, solver, &
+                      qout, qdout, qddout, iinfo, rinfo, qsing, dep, redundant, tpass, &
+                      status, msg, ptab, sq, sqd, sqdd)
+end subroutine core_kinematics_sens
+
+subroutine core_inverse_sens(nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp, fpar, nq, neq, &
+                             q0, t0, t1, nsteps, tol, every, solver, nout, npar, ptab, qout, &
+                             qdout, qddout, lamout, eout, sq, sqd, sqdd, slam, iinfo, rinfo, &
+                             qsing, dep, redundant, tpass, status, msg)
+  use iso_c_binding, only: c_double, c_int
+  use mbd_api, only: api_inverse
+  implicit none
+  integer(c_int), intent(in) :: nb, nc, np, nf, nfp, nq, neq, nsteps, every, solver, nout, npar
+  integer(c_int), intent(in) :: ctab(8, nc), ftab(6, nf), ptab(2, npar)
+  real(c_double), intent(in) :: rpar(np), bmass(2, nb), grav(2), fpar(nfp), q0(nq), t0, t1, tol
+  real(c_double), intent(out) :: qout(nq, nout), qdout(nq, nout)
+  real(c_double), intent(out) :: qddout(nq, nout), lamout(neq, nout)
+  real(c_double), intent(out) :: eout(4, nout)
+  real(c_double), intent(out) :: sq(nq, npar, nout), sqd(nq, npar, nout), sqdd(nq, npar, nout)
+  real(c_double), intent(out) :: slam(neq, npar, nout)
+  integer(c_int), intent(out) :: iinfo(10), dep(neq), redundant(neq), status
+  real(c_double), intent(out) :: rinfo(10), qsing(nq), tpass(64)
+  character(len=512), intent(out) :: msg
+  !f2py intent(hide) :: nc, np, nf, nfp, nq, npar
+  call api_inverse(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, t0, t1, nsteps, tol, every, &
+                   solver, qout, qdout, qddout, lamout, eout, iinfo, rinfo, qsing, dep, &
+                   redundant, tpass, status, msg, ptab, sq, sqd, sqdd, slam)
+end subroutine core_inverse_sens
+
+subroutine core_statics_sens(nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp, fpar, nq, neq, &
+                             q0, t, npar, ptab, q, lam, sq, slam, stable, resid, iinfo, status, &
+                             msg)
+  use iso_c_binding, only: c_double, c_int
+  use mbd_api, only: api_statics
+  implicit none
+  integer(c_int), intent(in) :: nb, nc, np, nf, nfp, nq, neq, npar
+  integer(c_int), intent(in) :: ctab(8, nc), ftab(6, nf), ptab(2, npar)
+  real(c_double), intent(in) :: rpar(np), bmass(2, nb), grav(2), fpar(nfp), q0(nq), t
+  real(c_double), intent(out) :: q(nq), lam(neq), sq(nq, npar), slam(neq, npar), resid
+  integer(c_int), intent(out) :: stable, iinfo(10), status
+  character(len=512), intent(out) :: msg
+  !f2py intent(hide) :: nc, np, nf, nfp, nq, npar
+  call api_statics(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, t, q, lam, stable, resid, &
+                   iinfo, status, msg, ptab, sq, slam)
+end subroutine core_statics_sens
+
+subroutine core_reactions_dp(nb, nc, ctab, np, rpar, nq, neq, nt, npar, ptab, q, t, lam, sq, &
+                             slam, dreac, drloc, status, msg)
+  use iso_c_binding, only: c_double, c_int
+  use mbd_api, only: api_reactions_dp
+  implicit none
+  integer(c_int), intent(in) :: nb, nc, np, nq, neq, nt, npar
+  integer(c_int), intent(in) :: ctab(8, nc), ptab(2, npar)
+  real(c_double), intent(in) :: rpar(np), q(nq, nt), t(nt), lam(neq, nt)
+  real(c_double), intent(in) :: sq(nq, npar, nt), slam(neq, npar, nt)
+  real(c_double), intent(out) :: dreac(6, nc, npar, nt), drloc(6, nc, npar, nt)
+  integer(c_int), intent(out) :: status
+  character(len=512), intent(out) :: msg
+  !f2py intent(hide) :: nc, np, nq, neq, nt, npar
+  call api_reactions_dp(nb, ctab, rpar, ptab, q, t, lam, sq, slam, dreac, drloc, status, msg)
+end subroutine core_reactions_dp
+
+subroutine core_dynamics_sens(nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp, fpar, nq, neq, &
+                              q0, v0, t0, t1, nsteps, rtol, atol, every, max_steps, nrow, npar, &
+                              ptab, qout, qdout, qddout, lamout, eout, sq, sqd, sqdd, iinfo, &
+                              rinfo, redundant, status, msg)
+  use iso_c_binding, only: c_double, c_int
+  use mbd_api, only: api_dynamics_sens
+  implicit none
+  integer(c_int), intent(in) :: nb, nc, np, nf, nfp, nq, neq, nsteps, every, max_steps, nrow
+  integer(c_int), intent(in) :: npar
+  integer(c_int), intent(in) :: ctab(8, nc), ftab(6, nf), ptab(2, npar)
+  real(c_double), intent(in) :: rpar(np), bmass(2, nb), grav(2), fpar(nfp), q0(nq), v0(nq)
+  real(c_double), intent(in) :: t0, t1, rtol, atol
+  real(c_double), intent(out) :: qout(nq, nrow), qdout(nq, nrow)
+  real(c_double), intent(out) :: qddout(nq, nrow), lamout(neq, nrow)
+  real(c_double), intent(out) :: eout(4, nrow)
+  real(c_double), intent(out) :: sq(nq, npar, nrow), sqd(nq, npar, nrow), sqdd(nq, npar, nrow)
+  integer(c_int), intent(out) :: iinfo(10), redundant(neq), status
+  real(c_double), intent(out) :: rinfo(10)
+  character(len=512), intent(out) :: msg
+  !f2py intent(hide) :: nc, np, nf, nfp, nq, npar
+  call api_dynamics_sens(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, v0, t0, t1, nsteps, rtol, &
+                         atol, every, max_steps, ptab, qout, qdout, qddout, lamout, eout, sq, &
+                         sqd, sqdd, iinfo, rinfo, redundant, status, msg)
+end subroutine core_dynamics_sens
+
+! ------------------------------------------------------------------ design sweeps
+! One analysis (1 kinematics, 2 inverse dynamics, 3 statics, 4 dynamics) for ncase parameter
+! sets: vtab (2, nv) names the entries each case sets (table 1 rpar, 2 bmass flattened, 3
+! grav, 4 fpar; 1-based index), vals (nv, ncase) their values, opens (2, no) the open phases
+! to set again from q0 (index in rpar, row of Phi); settings in iset, rset (mbd_batch). nlam
+! is neq (0 for kinematics), ne 4 (0 for kinematics); nrow the output rows per case.
+subroutine core_batch(analysis, nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp, fpar, nq, &
+                      q0, v0, nv, vtab, ncase, vals, no, opens, iset, rset, neq, nrow, nlam, ne, &
+                      qout, qdout, qddout, lamout, eout, iinfo, rinfo, qsing, dep, redundant, &
+                      status, msg)
+  use iso_c_binding, only: c_double, c_int
+  use mbd_batch, only: batch_run
+  implicit none
+  integer(c_int), intent(in) :: analysis, nb, nc, np, nf, nfp, nq, nv, ncase, no, neq, nrow
+  integer(c_int), intent(in) :: nlam, ne
+  integer(c_int), intent(in) :: ctab(8, nc), ftab(6, nf), vtab(2, nv), opens(2, no), iset(8)
+  real(c_double), intent(in) :: rpar(np), bmass(2, nb), grav(2), fpar(nfp), q0(nq), v0(nq)
+  real(c_double), intent(in) :: vals(nv, ncase), rset(12)
+  real(c_double), intent(out) :: qout(nq, nrow, ncase), qdout(nq, nrow, ncase)
+  real(c_double), intent(out) :: qddout(nq, nrow, ncase), lamout(nlam, nrow, ncase)
+  real(c_double), intent(out) :: eout(ne, nrow, ncase)
+  integer(c_int), intent(out) :: iinfo(10, ncase), dep(neq, ncase), redundant(neq, ncase)
+  real(c_double), intent(out) :: rinfo(10, ncase), qsing(nq, ncase)
+  integer(c_int), intent(out) :: status(ncase)
+  character(len=512), intent(out) :: msg(ncase)
+  !f2py intent(hide) :: nc, np, nf, nfp, nq, nv, ncase, no
+  !f2py threadsafe
+  call batch_run(analysis, nb, ctab, rpar, bmass, grav, ftab, fpar, q0, v0, vtab, vals, opens, &
+                 iset, rset, qout, qdout, qddout, lamout, eout, iinfo, rinfo, qsing, dep, &
+                 redundant, status, msg)
+end subroutine core_batch
+! Normal force of each cam joint on its follower at states q (nq, nt), times t and
+! multipliers lam: fn(nc, nt), negative where the joint must pull the follower onto its profile.
+subroutine core_cam_forces(nb, nc, ctab, np, rpar, nq, neq, nt, q, t, lam, fn, status, msg)
+  use iso_c_binding, only: c_double, c_int
+  use mbd_api, only: api_cam_forces
+  implicit none
+  integer(c_int), intent(in) :: nb, nc, np, nq, neq, nt
+  integer(c_int), intent(in) :: ctab(8, nc)
+  real(c_double), intent(in) :: rpar(np), q(nq, nt), t(nt), lam(neq, nt)
+  real(c_double), intent(out) :: fn(nc, nt)
+  integer(c_int), intent(out) :: status
+  character(len=512), intent(out) :: msg
+  !f2py intent(hide) :: nc, np, nq, neq, nt
+  call api_cam_forces(nb, ctab, rpar, q, t, lam, fn, status, msg)
+end subroutine core_cam_forces

@@ -14,25 +14,45 @@
 !!   spring     [s'_i(2), s'_j(2), k, c, L0, f...]      rotational [k, c, a0, f...]
 !!   torque     [f...]                                  point      [s'(2), fx..., fy...]
 !! (f: an encoded function of time, mbd_functions.)
+!! Contacts (kinds 5-8: circle-line, circle-circle, circle-in-circle, follower-profile) and
+!! joint friction (kind 9, the force table's row 6 names its joint) are force elements too;
+!! their parameters, laws and geometry are in mbd_contact. A contact's force depends on its
+!! state (open or closed, the impact speed), passed in st; joint friction needs the joint's
+!! multipliers and is evaluated by mbd_dynamics (force_eval returns zero for it).
 module mbd_forces
-  use mbd_kinds, only: wp, zero, half
+  use mbd_kinds, only: wp, zero, half, one
   use mbd_status, only: MBD_OK, MBD_BAD_PARAM, MSG_LEN
   use mbd_points, only: NLOC, kloc, local_state, kvec, kscal, body_point, body_angle, vsub, &
                         vdot, ssqrt, ssub
-  use mbd_functions, only: fun_eval, fun_length, fun_check, fun_exponents
+  use mbd_functions, only: fun_eval, fun_length, fun_check, fun_exponents, fun_eval_d, &
+                           fun_is_count
+  use mbd_dual, only: dloc, dvec, dscal, dual_state, body_point, body_angle, vsub, vdot, ssqrt, &
+                      ssub
+  use mbd_contact, only: NCS, NEO, contact_raw_length, contact_prepare, contact_exponents, &
+                         contact_eval, friction_raw_length, friction_exponents
   implicit none
   private
-  public :: FRC_SPRING, FRC_TORQUE, FRC_POINT, FRC_ROTSPRING
+  public :: FRC_SPRING, FRC_TORQUE, FRC_POINT, FRC_ROTSPRING, FRC_CONTACT0, FRC_CONTACT1
+  public :: FRC_FRICTION
   public :: force_known, force_raw_length, force_prepare, force_eval, force_exponents
+  public :: force_is_contact, force_is_count, force_eval_d
 
   integer, parameter :: FRC_SPRING = 1, FRC_TORQUE = 2, FRC_POINT = 3, FRC_ROTSPRING = 4
+  !> contacts: kind FRC_CONTACT0 + geometry - 1 (mbd_contact GEO_*), up to FRC_CONTACT1
+  integer, parameter :: FRC_CONTACT0 = 5, FRC_CONTACT1 = 8
+  integer, parameter :: FRC_FRICTION = 9   !! friction of a joint (force table row 6)
 
 contains
 
   pure logical function force_known(kind)
     integer, intent(in) :: kind   !! force kind
-    force_known = kind >= FRC_SPRING .and. kind <= FRC_ROTSPRING
+    force_known = kind >= FRC_SPRING .and. kind <= FRC_FRICTION
   end function force_known
+
+  pure logical function force_is_contact(kind)
+    integer, intent(in) :: kind   !! force kind
+    force_is_contact = kind >= FRC_CONTACT0 .and. kind <= FRC_CONTACT1
+  end function force_is_contact
 
   !> Expected raw length given the data, or -1 when malformed.
   pure integer function force_raw_length(kind, raw)
@@ -57,19 +77,35 @@ contains
       if (size(raw) < 4) return
       n1 = fun_length(raw(4:))
       if (n1 > 0) force_raw_length = 3 + n1
+    case (FRC_CONTACT0:FRC_CONTACT1)
+      force_raw_length = contact_raw_length(kind - FRC_CONTACT0 + 1, raw)
+    case (FRC_FRICTION)
+      force_raw_length = friction_raw_length()
     end select
   end function force_raw_length
 
-  !> Check raw parameters (finite, k >= 0, c >= 0, L0 >= 0); prepared = raw.
-  subroutine force_prepare(kind, raw, prep, status, msg)
+  !> Check raw parameters (finite, k >= 0, c >= 0, L0 >= 0); prepared = raw. Contacts are
+  !! prepared by mbd_contact (meff: the pair's effective mass, for the linear law); joint
+  !! friction by mbd_model (it needs its joint).
+  subroutine force_prepare(kind, raw, prep, status, msg, meff)
     integer, intent(in) :: kind                    !! force kind
     real(wp), intent(in) :: raw(:)                 !! raw parameters (exact length)
     real(wp), allocatable, intent(out) :: prep(:)  !! prepared parameters
     integer, intent(out) :: status                 !! MBD_OK or MBD_BAD_PARAM
     character(len=MSG_LEN), intent(out) :: msg     !! what is wrong
+    real(wp), intent(in), optional :: meff         !! effective mass of a contact pair
     integer :: nf
+    real(wp) :: me
     status = MBD_OK; msg = ''
     select case (kind)
+    case (FRC_CONTACT0:FRC_CONTACT1)
+      me = zero
+      if (present(meff)) me = meff
+      call contact_prepare(kind - FRC_CONTACT0 + 1, raw, me, prep, status, msg)
+      return
+    case (FRC_FRICTION)
+      prep = raw
+      return
     case (FRC_SPRING)
       if (.not. (raw(5) >= zero .and. raw(6) >= zero .and. raw(7) >= zero)) then
         status = MBD_BAD_PARAM
@@ -98,13 +134,24 @@ contains
   !! parameter p becomes p L**e. With lengths over L, masses m L**2 and forces F L (the
   !! generalized forces conjugate to x / L), stiffness and damping of a spring take L**2, its
   !! points and free length L**-1, its actuator force L; torques and rotational springs stay.
-  pure subroutine force_exponents(kind, raw, ex)
+  !! Contact stiffnesses k (F = k delta**n) take L**(1 + n): fr returns the non-integer part
+  !! n (the scale is p L**(ex + fr)).
+  pure subroutine force_exponents(kind, raw, ex, fr)
     integer, intent(in) :: kind      !! force kind
     real(wp), intent(in) :: raw(:)   !! raw parameters (well formed, exact length)
     integer, intent(out) :: ex(:)    !! exponents (size(raw))
+    real(wp), intent(out), optional :: fr(:)   !! fractional exponents added to ex
+    real(wp) :: frl(size(raw))
     integer :: nf
     ex = 0
+    frl = zero
+    if (present(fr)) fr = zero
     select case (kind)
+    case (FRC_CONTACT0:FRC_CONTACT1)
+      call contact_exponents(kind - FRC_CONTACT0 + 1, raw, ex, frl)
+      if (present(fr)) fr = frl
+    case (FRC_FRICTION)
+      call friction_exponents(ex)
     case (FRC_SPRING)
       ex(1:4) = -1; ex(5:6) = 2; ex(7) = -1
       call fun_exponents(raw(8:), 1, ex(8:))
@@ -116,8 +163,9 @@ contains
     end select
   end subroutine force_exponents
 
-  !> Generalized force over the local slots and potential energy of one element.
-  pure subroutine force_eval(kind, p, si, sj, ql, qdl, t, ql_force, v, vload)
+  !> Generalized force over the local slots and potential energy of one element; a contact
+  !! reads its state st (mbd_contact; absent: open) and returns its outputs in out.
+  pure subroutine force_eval(kind, p, si, sj, ql, qdl, t, ql_force, v, vload, st, out)
     integer, intent(in) :: kind             !! force kind
     real(wp), intent(in) :: p(:)            !! prepared parameters
     integer, intent(in) :: si, sj           !! slot ids of the bodies (0 = ground)
@@ -127,12 +175,16 @@ contains
     real(wp), intent(out) :: ql_force(NLOC) !! generalized force on the local slots
     real(wp), intent(out) :: v              !! potential energy
     real(wp), intent(out) :: vload          !! potential of the loads frozen at t
+    real(wp), intent(in), optional :: st(NCS)    !! contact state
+    real(wp), intent(out), optional :: out(NEO)  !! contact outputs
+    real(wp) :: sto(NCS), oo(NEO)
     type(kvec) :: d, pt
     type(kscal) :: l, a
     type(kloc) :: x
     real(wp) :: f, f1, f2, fy, tension, tau
     integer :: nf
     ql_force = zero; v = zero; vload = zero
+    if (present(out)) out = zero
     x = local_state(ql, qdl)
     select case (kind)
     case (FRC_SPRING)
@@ -163,7 +215,92 @@ contains
       tau = -p(1) * (a%v - p(3)) - p(2) * a%vd + f
       ql_force = tau * a%d
       v = half * p(1) * (a%v - p(3))**2
+    case (FRC_CONTACT0:FRC_CONTACT1)
+      sto = [-one, zero]                       ! untracked
+      if (present(st)) sto = st
+      if (present(out)) then
+        call contact_eval(kind - FRC_CONTACT0 + 1, p, si, sj, x, sto, ql_force, v, out, &
+                          exact=.true.)
+      else
+        call contact_eval(kind - FRC_CONTACT0 + 1, p, si, sj, x, sto, ql_force, v, oo)
+      end if
     end select
   end subroutine force_eval
+
+  !> True when raw entry j of a force is a count of one of its functions.
+  pure logical function force_is_count(kind, raw, j)
+    integer, intent(in) :: kind      !! force kind
+    real(wp), intent(in) :: raw(:)   !! raw parameters
+    integer, intent(in) :: j         !! raw entry
+    integer :: nf
+    force_is_count = .false.
+    select case (kind)
+    case (FRC_SPRING)
+      if (j >= 8) force_is_count = fun_is_count(raw(8:), j - 7)
+    case (FRC_TORQUE)
+      force_is_count = fun_is_count(raw, j)
+    case (FRC_POINT)
+      nf = fun_length(raw(3:))
+      if (j >= 3 .and. j < 3 + nf) force_is_count = fun_is_count(raw(3:), j - 2)
+      if (j >= 3 + nf) force_is_count = fun_is_count(raw(3 + nf:), j - 2 - nf)
+    case (FRC_ROTSPRING)
+      if (j >= 4) force_is_count = fun_is_count(raw(4:), j - 3)
+    end select
+  end function force_is_count
+
+  !> Change of the generalized force of one element along a direction (dq, dq_dot of the
+  !! local slots) and a change tp of its parameters (prepared = raw), by the product rule
+  !! on dual points (mbd_dual):
+  !!   spring      Q = -T L_q,  dT = dk (L - L0) + k (dL - dL0) + dc L_dot + c dL_dot - df
+  !!   torque      dQ_theta = df         point  dQ = dF J_P^T + F dJ_P^T
+  !!   rotational  Q = tau a_q, dtau = -dk (a - a0) - k (da - da0) - dc a_dot - c da_dot + df
+  pure subroutine force_eval_d(kind, p, tp, si, sj, ql, qdl, tq, tqd, t, tforce)
+    integer, intent(in) :: kind             !! force kind
+    real(wp), intent(in) :: p(:), tp(:)     !! prepared parameters and their change
+    integer, intent(in) :: si, sj           !! slot ids of the bodies (0 = ground)
+    real(wp), intent(in) :: ql(NLOC), qdl(NLOC)  !! local coordinates and velocities
+    real(wp), intent(in) :: tq(NLOC), tqd(NLOC)  !! direction
+    real(wp), intent(in) :: t               !! time
+    real(wp), intent(out) :: tforce(NLOC)   !! change of the generalized force
+    type(dloc) :: x
+    type(dvec) :: d, pt
+    type(dscal) :: l, a
+    real(wp) :: f, f1, f2, tf, tf1, tf2, fy, tfy, tension, ttension, tau, ttau
+    integer :: nf
+    tforce = zero
+    x = dual_state(local_state(ql, qdl), tq, tqd)
+    select case (kind)
+    case (FRC_SPRING)
+      d = vsub(body_point(x, sj, p(3:4), tp(3:4)), body_point(x, si, p(1:2), tp(1:2)))
+      call fun_eval(p(8:), t, f, f1, f2)
+      call fun_eval_d(p(8:), tp(8:), t, tf, tf1, tf2)
+      if (dot_product(d%a%v, d%a%v) > zero) then
+        l = ssqrt(vdot(d, d))
+        tension = p(5) * (l%a%v - p(7)) + p(6) * l%a%vd - f
+        ttension = tp(5) * (l%a%v - p(7)) + p(5) * (l%t%v - tp(7)) + tp(6) * l%a%vd + &
+                   p(6) * l%t%vd - tf
+        tforce = -ttension * l%a%d - tension * l%t%d
+      end if
+    case (FRC_TORQUE)
+      call fun_eval_d(p, tp, t, tf, tf1, tf2)
+      if (si > 0) tforce(3) = tf
+    case (FRC_POINT)
+      pt = body_point(x, si, p(1:2), tp(1:2))
+      nf = fun_length(p(3:))
+      call fun_eval(p(3:), t, f, f1, f2)
+      call fun_eval(p(3 + nf:), t, fy, f1, f2)
+      call fun_eval_d(p(3:), tp(3:), t, tf, tf1, tf2)
+      call fun_eval_d(p(3 + nf:), tp(3 + nf:), t, tfy, tf1, tf2)
+      tforce = tf * pt%a%d(1, :) + f * pt%t%d(1, :) + tfy * pt%a%d(2, :) + fy * pt%t%d(2, :)
+    case (FRC_ROTSPRING)
+      a = ssub(body_angle(x, sj), body_angle(x, si))
+      call fun_eval(p(4:), t, f, f1, f2)
+      call fun_eval_d(p(4:), tp(4:), t, tf, tf1, tf2)
+      tau = -p(1) * (a%a%v - p(3)) - p(2) * a%a%vd + f
+      ttau = -tp(1) * (a%a%v - p(3)) - p(1) * (a%t%v - tp(3)) - tp(2) * a%a%vd - &
+             p(2) * a%t%vd + tf
+      tforce = ttau * a%a%d + tau * a%t%d
+    end select
+  end subroutine force_eval_d
 
 end module mbd_forces

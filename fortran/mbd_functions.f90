@@ -4,11 +4,11 @@
 !! Returns f, df/dt and d2f/dt2 (the driver's nu = f' and its time term in gamma = f'').
 module mbd_functions
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
-  use mbd_kinds, only: wp, zero
+  use mbd_kinds, only: wp, zero, half
   use mbd_status, only: MBD_OK, MBD_BAD_PARAM, MSG_LEN
   implicit none
   private
-  public :: fun_eval, fun_check, fun_length, fun_exponents
+  public :: fun_eval, fun_check, fun_length, fun_exponents, fun_eval_d, fun_is_count
 
   real(wp), parameter :: FMAX = 1.0e100_wp   !! largest coefficient
   real(wp), parameter :: OMAX = 1.0e12_wp    !! largest angular frequency
@@ -98,7 +98,7 @@ contains
     real(wp), intent(out) :: f2    !! d2f/dt2
     integer :: np, nh, k, o
     real(wp) :: a, w, ph, s, c
-    np = nint(p(1))
+    np = int(p(1) + half)          ! the counts are whole numbers >= 0 (fun_check): nint
     f = zero; f1 = zero; f2 = zero
     ! Horner for c_0 + c_1 t + ... and its two derivatives
     do k = np, 1, -1
@@ -106,7 +106,7 @@ contains
       f1 = f1 * t + f
       f = f * t + p(1 + k)
     end do
-    nh = nint(p(np + 2))
+    nh = int(p(np + 2) + half)
     do k = 1, nh
       o = np + 2 + 3 * (k - 1)
       a = p(o + 1); w = p(o + 2); ph = p(o + 3)
@@ -116,5 +116,43 @@ contains
       f2 = f2 - a * w * w * s
     end do
   end subroutine fun_eval
+
+  !> True when entry i (1-based) of the encoded function p is a count (np or nh), which no
+  !! derivative can be taken with respect to.
+  pure logical function fun_is_count(p, i)
+    real(wp), intent(in) :: p(:)   !! encoded function
+    integer, intent(in) :: i       !! entry
+    fun_is_count = i == 1 .or. i == nint(p(1)) + 2
+  end function fun_is_count
+
+  !> Changes tf, tf1, tf2 of f(t), f'(t), f''(t) when the coefficients change by tp (the
+  !! counts must not change). Polynomial terms are linear; a harmonic A sin(w t + phi) gives
+  !!   d/dA   = (s, w c, -w**2 s),   d/dphi = (A c, -A w s, -A w**2 c),
+  !!   d/dw   = (A t c, A c - A w t s, -2 A w s - A w**2 t c),   s, c = sin, cos(w t + phi).
+  pure subroutine fun_eval_d(p, tp, t, tf, tf1, tf2)
+    real(wp), intent(in) :: p(:)   !! encoded function
+    real(wp), intent(in) :: tp(:)  !! change of its coefficients
+    real(wp), intent(in) :: t      !! time
+    real(wp), intent(out) :: tf, tf1, tf2  !! changes of f, f', f''
+    integer :: np, nh, k, o
+    real(wp) :: a, w, s, c, ta, tw, tph
+    np = nint(p(1))
+    tf = zero; tf1 = zero; tf2 = zero
+    do k = np, 1, -1
+      tf2 = tf2 * t + 2 * tf1
+      tf1 = tf1 * t + tf
+      tf = tf * t + tp(1 + k)
+    end do
+    nh = nint(p(np + 2))
+    do k = 1, nh
+      o = np + 2 + 3 * (k - 1)
+      a = p(o + 1); w = p(o + 2)
+      ta = tp(o + 1); tw = tp(o + 2); tph = tp(o + 3)
+      s = sin(w * t + p(o + 3)); c = cos(w * t + p(o + 3))
+      tf = tf + ta * s + a * c * (t * tw + tph)
+      tf1 = tf1 + ta * w * c + a * tw * c - a * w * s * (t * tw + tph)
+      tf2 = tf2 - ta * w * w * s - 2 * a * w * tw * s - a * w * w * c * (t * tw + tph)
+    end do
+  end subroutine fun_eval_d
 
 end module mbd_functions

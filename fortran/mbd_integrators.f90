@@ -20,13 +20,22 @@
 !!                       from J_u u_dot = nu - J_v v_dot, at every stage; re-partitioned when
 !!                       J_u becomes 4x worse conditioned than the choice of a QR with
 !!                       column pivoting (dgeqp3) at the current state.
+!! Contacts and stick-slip joints (mbd_events): every method tracks their modes and records
+!! their events; the error-controlled ones (dopri5, partitioned, generalized-alpha without h)
+!! take a step that crosses an event again, to end at the event (located on the step's
+!! dense output), and change the modes there; the fixed-step ones change them at the end of
+!! the step that crossed (the event's located time is recorded). After a change the step
+!! restarts (dopri5: no first-same-as-last; generalized-alpha: q_ddot and a from the new
+!! modes). The modes at each output are kept for its multipliers and element outputs.
 module mbd_integrators
   use mbd_kinds, only: wp, zero, one, half, two
   use mbd_status, only: MBD_OK, MBD_BAD_SETTING, MBD_SINGULAR, MBD_NO_CONVERGENCE, &
-                        MBD_INTEGRATOR_FAILED, MBD_LAPACK, MBD_NO_MEMORY, MSG_LEN
+                        MBD_INTEGRATOR_FAILED, MBD_LAPACK, MBD_NO_MEMORY, MBD_USER_ABORT, &
+                        MSG_LEN
   use mbd_memory, only: REAL_BYTES, mem_fail
   use mbd_model, only: model_t
   use mbd_points, only: NLOC, MAXROW
+  use mbd_forces, only: FRC_FRICTION
   use mbd_assemble, only: assemble_dense, assemble_blocks, blocks_jv
   use mbd_linsolve, only: lu_factor, lu_solve, lapack_status
   use mbd_lapack, only: dgesvd, dgeqp3, dgecon
@@ -35,12 +44,17 @@ module mbd_integrators
   use mbd_saddle, only: saddle_t, saddle_plan, saddle_factor, saddle_solve
   use mbd_dynamics, only: dyn_work_t, dyn_accel, dyn_velocity, dyn_project_pos, gen_forces, &
                           kinetic_energy, dyn_tangent, dyn_solve, dyn_jt_lam, dyn_multipliers, &
-                          dyn_jv, dyn_null_basis, SOLVER_DENSE
+                          dyn_jv, dyn_null_basis, SOLVER_DENSE, dyn_element_outputs
+  use mbd_events, only: ev_log_t, events_active, events_init, events_find, events_switch, &
+                        event_tol
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   implicit none
   private
   public :: dyn_opts_t, dyn_stats_t, METH_GENALPHA, METH_DOPRI5, METH_RK4, METH_PARTITIONED
   public :: integrate, output_rows, output_index, MAX_STEPS_DEFAULT
+  ! the Dormand-Prince 5(4) tableau, also used by the sensitivity integrator (mbd_sens_dynamics)
+  public :: C2, C3, C4, C5, A21, A31, A32, A41, A42, A43, A51, A52, A53, A54, A61, A62, A63, &
+            A64, A65, A71, A73, A74, A75, A76, E1, E3, E4, E5, E6, E7
 
   integer, parameter :: METH_GENALPHA = 1, METH_DOPRI5 = 2, METH_RK4 = 3, METH_PARTITIONED = 4
   !> Default step limit: it ends a run whose steps collapse without underflowing, after
@@ -91,6 +105,9 @@ module mbd_integrators
     real(wp), allocatable :: qf(:), vf(:), af(:), lam(:)   !! last full state
     real(wp) :: ts = zero                   !! start of the current step
     real(wp), allocatable :: qs(:), vs(:), as(:)          !! full state there
+    logical :: events = .false.             !! contacts or stick-slip joints: track modes
+    type(ev_log_t) :: log                   !! events
+    real(wp), allocatable :: cso(:, :, :)   !! (NCS, nf, rows) element modes at the outputs
   end type itg_t
 
   !> partitioned: re-partition when J_u is this many times worse conditioned than the best
@@ -118,8 +135,10 @@ contains
   !! nout returns the number of rows written (all, unless a failure stopped the run).
   !! The multipliers lo at every output are those of the index-1 equations at the output
   !! state (see finish_outputs).
+  !! With contacts or stick-slip joints, log (allocated by ev_log_init) returns the events
+  !! and eo(NEO, nf, rows) the element outputs at the stored rows (dyn_element_outputs).
   subroutine integrate(m, w, q, qd, t0, t1, nsteps, every, opts, qo, vo, ao, lo, nout, st, &
-                       status, msg)
+                       status, msg, log, eo, ctl)
     type(model_t), intent(in) :: m               !! model
     type(dyn_work_t), intent(inout) :: w         !! dynamics work arrays (dyn_init done)
     real(wp), intent(inout) :: q(:), qd(:)       !! consistent initial state, then final
@@ -133,9 +152,15 @@ contains
     type(dyn_stats_t), intent(out) :: st         !! counters
     integer, intent(out) :: status               !! MBD_OK or a failure
     character(len=MSG_LEN), intent(out) :: msg   !! explanation
+    type(ev_log_t), intent(inout), optional :: log  !! event log (capacity set by the caller)
+    real(wp), intent(out), optional :: eo(:, :, :)  !! element outputs (NEO, nf, rows)
+    !> progress, shared with a caller in another thread: ctl(1) gets the rows stored so far,
+    !! ctl(2) /= 0 asks the run to stop (MBD_USER_ABORT, the rows so far kept)
+    integer, intent(inout), optional, volatile :: ctl(:)
     type(itg_t) :: c
     status = MBD_OK; msg = ''; nout = 0
     qo = zero; vo = zero; ao = zero; lo = zero
+    if (present(eo)) eo = zero
     if (opts%method == METH_RK4 .and. .not. (opts%h > zero)) then
       status = MBD_BAD_SETTING; msg = 'baumgarte-rk4 needs a step h > 0'; return
     end if
@@ -145,12 +170,28 @@ contains
     if (every < 1 .or. size(qo, 2) /= output_rows(nsteps, every)) then
       status = MBD_BAD_SETTING; msg = 'every must be >= 1 and the outputs sized for it'; return
     end if
+    if (m%nstick > 0 .and. (opts%method == METH_GENALPHA .or. opts%method == METH_RK4)) then
+      status = MBD_BAD_SETTING
+      msg = 'stick-slip friction runs in dopri5 and partitioned; use the regularized '// &
+            'friction model with generalized-alpha or baumgarte-rk4'
+      return
+    end if
     c%opts = opts; c%t0 = t0; c%t1 = t1; c%nsteps = nsteps; c%every = every
-    allocate (c%qf(m%nq), c%vf(m%nq), c%af(m%nq), c%lam(m%neq), stat=status)
+    allocate (c%qf(m%nq), c%vf(m%nq), c%af(m%nq), c%lam(m%neq), c%cso(size(w%cst, 1), &
+              m%nf, merge(size(qo, 2), 0, m%ncontact + m%nfric > 0)), stat=status)
     if (status /= 0) then
-      call mem_fail(REAL_BYTES * (3 * real(m%nq, wp) + m%neq), 'the integrator state', &
+      call mem_fail(REAL_BYTES * (3 * real(m%nq, wp) + m%neq + 2 * real(m%nf, wp) * &
+                    merge(size(qo, 2), 0, m%ncontact + m%nfric > 0)), 'the integrator state', &
                     'use a smaller model', status, msg)
       return
+    end if
+    if (present(log)) c%log = log
+    c%events = events_active(m)
+    if (c%events) then
+      call events_init(m, w, q, qd, t0, status)
+      if (status /= MBD_OK) then
+        msg = 'the contact and friction modes at the start cannot be resolved'; return
+      end if
     end if
     c%qf = q; c%vf = qd
     call dyn_accel(m, w, q, qd, t0, c%af, c%lam, status)
@@ -159,22 +200,36 @@ contains
     end if
     qo(:, 1) = q; vo(:, 1) = qd; ao(:, 1) = c%af
     c%nout = 1; c%kout = 1
+    call save_modes(w, c, 1)
     if (nsteps > 0) then
       select case (opts%method)
       case (METH_GENALPHA)
-        call run_genalpha(m, w, c, qo, vo, ao, status, msg)
+        call run_genalpha(m, w, c, qo, vo, ao, status, msg, ctl)
       case (METH_DOPRI5, METH_RK4)
-        call run_explicit(m, w, c, .false., qo, vo, ao, status, msg)
+        call run_explicit(m, w, c, .false., qo, vo, ao, status, msg, ctl)
       case (METH_PARTITIONED)
-        call run_explicit(m, w, c, .true., qo, vo, ao, status, msg)
+        call run_explicit(m, w, c, .true., qo, vo, ao, status, msg, ctl)
       case default
         status = MBD_BAD_SETTING; msg = 'unknown integration method'
       end select
     end if
     nout = c%nout; st = c%st
     q = c%qf; qd = c%vf
-    call finish_outputs(m, w, c, qo, vo, ao, lo)
+    call finish_outputs(m, w, c, qo, vo, ao, lo, eo)
+    if (present(log)) log = c%log
   end subroutine integrate
+
+  !> Keep the element modes for the output rows r0 .. c%nout (just written).
+  subroutine save_modes(w, c, r0)
+    type(dyn_work_t), intent(in) :: w
+    type(itg_t), intent(inout) :: c
+    integer, intent(in) :: r0
+    integer :: r
+    if (size(c%cso, 3) == 0) return
+    do r = r0, c%nout
+      c%cso(:, :, r) = w%cst
+    end do
+  end subroutine save_modes
 
   !> The accelerations and multipliers at the stored outputs, from the index-1 equations at
   !! the output state (accel_at), for every method. For the explicit methods these are what
@@ -190,30 +245,38 @@ contains
   !! position, Baumgarte's stabilized accelerations) the minimum-norm solution of
   !! J^T lambda = Q - M q_ddot over all rows. If the solve fails at a state, the row keeps
   !! its accelerations and lambda follows from them.
-  subroutine finish_outputs(m, w, c, qo, vo, ao, lo)
+  subroutine finish_outputs(m, w, c, qo, vo, ao, lo, eo)
     type(model_t), intent(in) :: m
     type(dyn_work_t), intent(inout) :: w
     type(itg_t), intent(in) :: c
     real(wp), intent(in) :: qo(:, :), vo(:, :)
     real(wp), intent(inout) :: ao(:, :), lo(:, :)
-    real(wp) :: t, a1(m%nq), lam(m%neq)
+    real(wp), intent(inout), optional :: eo(:, :, :)
+    real(wp) :: t, a1(m%nq), lam(m%neq), cfinal(size(w%cst, 1), size(w%cst, 2))
     integer :: r, stt
     character(len=MSG_LEN) :: lmsg
+    cfinal = w%cst
     do r = 1, c%nout
       t = c%t0
       if (c%nsteps > 0) t = out_time(c, output_index(c%nsteps, c%every, r))
+      if (size(c%cso, 3) > 0) w%cst = c%cso(:, :, r)   ! the modes of the output's step
       call accel_at(m, w, c%opts, qo(:, r), vo(:, r), t, a1, lam, stt)
       if (stt == MBD_OK) then
         if (c%opts%method /= METH_GENALPHA) ao(:, r) = a1
         if (w%na == m%neq .and. .not. w%lsq .and. c%opts%method /= METH_RK4) then
           lo(:, r) = lam                ! independent rows: the solve's lambda is the one
-          cycle
+        else
+          call dyn_multipliers(m, w, qo(:, r), vo(:, r), a1, t, lo(:, r), stt, lmsg)
         end if
       else
         a1 = ao(:, r)
+        call dyn_multipliers(m, w, qo(:, r), vo(:, r), a1, t, lo(:, r), stt, lmsg)
       end if
-      call dyn_multipliers(m, w, qo(:, r), vo(:, r), a1, t, lo(:, r), stt, lmsg)
+      if (present(eo)) then
+        if (size(eo, 2) > 0) call dyn_element_outputs(m, w, qo(:, r), vo(:, r), t, eo(:, :, r))
+      end if
     end do
+    w%cst = cfinal
   end subroutine finish_outputs
 
   !> More steps to take: fixed steps count to nfix, adaptive ones run to t1.
@@ -249,6 +312,20 @@ contains
         ': raise max_steps (command line: --max-steps), or loosen rtol and atol'
     end if
   end subroutine step_limit
+
+  !> The modes of contacts or stick-slip joints could not be resolved at t (a solve failed
+  !! there, or the friction of a joint locks itself).
+  subroutine event_failure(c, t, status, msg)
+    type(itg_t), intent(inout) :: c
+    real(wp), intent(in) :: t
+    integer, intent(out) :: status
+    character(len=MSG_LEN), intent(out) :: msg
+    status = MBD_INTEGRATOR_FAILED
+    c%st%t_fail = t
+    write (msg, '(a,es12.5,a)') 'the contact and friction modes could not be resolved at t = ', &
+      t, ' (the equations are singular there, or a joint''s friction locks it: '// &
+      'a smaller friction coefficient)'
+  end subroutine event_failure
 
   !> Number of fixed steps of about h that span (t0, t1) (capped at huge(0), not overflowing).
   integer function fixed_steps(c)
@@ -290,6 +367,24 @@ contains
       c%kout = c%kout + 1
     end do
   end subroutine emit
+
+  !> Publish the rows stored so far in ctl(1); .true. (with MBD_USER_ABORT) when the caller
+  !! asked the run to stop (ctl(2) /= 0). Without ctl, nothing.
+  logical function stopped(c, t, status, msg, ctl)
+    type(itg_t), intent(inout) :: c
+    real(wp), intent(in) :: t
+    integer, intent(inout) :: status
+    character(len=MSG_LEN), intent(inout) :: msg
+    integer, intent(inout), optional, volatile :: ctl(:)
+    stopped = .false.
+    if (.not. present(ctl)) return
+    ctl(1) = c%nout
+    if (ctl(2) == 0) return
+    stopped = .true.
+    status = MBD_USER_ABORT
+    c%st%t_fail = t
+    write (msg, '(a,es12.5,a)') 'stopped on request at t = ', t, ' (the rows so far are kept)'
+  end function stopped
 
   !> Rows stored for nsteps output intervals, keeping k = 0, every, 2 every, ... and nsteps.
   pure integer function output_rows(nsteps, every)
@@ -335,10 +430,11 @@ contains
   !! Converged: |Phi| <= w%tol, the last correction below 1e-3 (atol + rtol |q|), and the
   !! residual of M q_ddot + J^T lambda = Q below GA_RTOL of its largest term, so that the
   !! result is that of full Newton (a stale S only changes the iteration count).
-  subroutine run_genalpha(m, w, c, qo, vo, ao, status, msg)
+  subroutine run_genalpha(m, w, c, qo, vo, ao, status, msg, ctl)
     type(model_t), intent(in) :: m
     type(dyn_work_t), intent(inout) :: w
     type(itg_t), intent(inout) :: c
+    integer, intent(inout), optional, volatile :: ctl(:)   !! progress (see integrate)
     real(wp), intent(inout) :: qo(:, :), vo(:, :), ao(:, :)
     integer, intent(out) :: status
     character(len=MSG_LEN), intent(out) :: msg
@@ -347,14 +443,14 @@ contains
     integer, parameter :: GA_SLOW = 6            ! iterations that ask for new K, C
     integer, parameter :: GA_MAXIT = 30          ! iterations before the step fails
     real(wp) :: am, af, gam, bet, bp, gp, h, t, err, tnew, facc, v, hprev, dqn, dqp, dtol
-    real(wp) :: rtol_dyn, cf, kmax, cmax, fmax, qmax, vmax, rmax
+    real(wp) :: rtol_dyn, cf, kmax, cmax, fmax, qmax, vmax, rmax, te, mufric
     real(wp) :: q(m%nq), qd(m%nq), qdd(m%nq), acc(m%nq), lam(m%neq)
     real(wp) :: qn(m%nq), vn(m%nq), an(m%nq), accn(m%nq), lamn(m%neq), dq(m%nq), ap(m%nq)
     real(wp) :: res(m%nq + w%na), dg(m%nq)
     real(wp), allocatable :: kv(:), cv(:), kc(:)   ! K, C and K + g' C on the pattern
     type(saddle_t) :: sg                            ! the iteration matrix S
-    integer :: it, n, stt, nfix, na, attempt, nkc, k, nnz
-    logical :: fixed, conv, have_kc, new_kc, finite
+    integer :: it, n, stt, nfix, na, attempt, nkc, k, nnz, kev, nprev
+    logical :: fixed, conv, have_kc, new_kc, finite, changed
     status = MBD_OK; msg = ''
     n = m%nq; na = w%na
     ! S = [M b' + K + g' C, b' J^T; b' J, 0] on the path of w (dense: plain-loop LU)
@@ -376,6 +472,10 @@ contains
     cf = (1 - af) / (1 - am)             ! weight of q_ddot_{n+1} in a_{n+1}
     fixed = c%opts%h > zero
     have_kc = .false.; new_kc = .false.
+    mufric = zero                        ! the largest friction coefficient of a joint
+    do k = 1, m%nf
+      if (m%fkind(k) == FRC_FRICTION) mufric = max(mufric, m%fp(m%fpo(k)), m%fp(m%fpo(k) + 1))
+    end do
     kv = zero; cv = zero; kmax = zero; cmax = zero
     q = c%qf; qd = c%vf; qdd = c%af; lam = c%lam
     t = c%t0
@@ -426,7 +526,7 @@ contains
         dq = zero; dqp = huge(one)
         do it = 1, GA_MAXIT
           call assemble_blocks(m, qn, vn, tnew, w%phi, w%nu, w%gam, w%asm)
-          call gen_forces(m, qn, vn, tnew, w%force, v)
+          call gen_forces(m, qn, vn, tnew, w%force, v, cst=w%cst, lam=lamn)
           ! r = M q_ddot + J^T lambda - Q;  r_c = b' Phi
           call dyn_jt_lam(m, w%asm%jb, lamn, res(1:n))
           ! the residual tolerance is GA_RTOL of the largest term, but not below the change
@@ -440,6 +540,10 @@ contains
             qmax = max(qmax, abs(qn(k))); vmax = max(vmax, abs(vn(k)))
           end do
           rtol_dyn = max(GA_RTOL * fmax, 100 * epsilon(one) * (kmax * qmax + cmax * vmax))
+          ! joint friction mu N(lambda): lambda_{n+1} carries the rounding of q amplified by
+          ! b' (above), and so does the friction it loads
+          if (mufric > zero) rtol_dyn = max(rtol_dyn, 100 * epsilon(one) * mufric * bp * &
+                                            maxval(m%mdiag) * qmax)
           do k = 1, na
             res(n + k) = bp * w%phi(w%rows(k))
             if (.not. abs(res(n + k)) <= huge(one)) finite = .false.
@@ -497,6 +601,19 @@ contains
       ! e = (6 beta - 1) (q_{n+1} - q_n - h q_dot_n - h^2 q_ddot_n / 2)
       if (conv .and. .not. fixed) err = err_norm(c, (6 * bet - 1) * &
                                                  (qn - q - h * qd - half * h * h * qdd), q, qn)
+      kev = 0
+      if (conv .and. c%events) then
+        ! an event inside the step: error-controlled steps are taken again to end there
+        call events_find(m, w, t, q, qd, qdd, tnew, qn, vn, an, te, kev, stt)
+        if (stt /= MBD_OK) then
+          call event_failure(c, tnew, status, msg); return
+        end if
+        if (kev > 0 .and. .not. fixed .and. te < tnew - event_tol(t, tnew)) then
+          c%st%rejected = c%st%rejected + 1
+          h = te - t
+          cycle
+        end if
+      end if
       if (.not. conv .or. (.not. fixed .and. err > one)) then
         c%st%rejected = c%st%rejected + 1
         if (fixed) then
@@ -518,10 +635,27 @@ contains
         cycle
       end if
       accn = accn + (1 - af) / (1 - am) * an
+      nprev = c%nout
       call emit(c, qo, vo, ao, t, q, qd, qdd, tnew, qn, vn, an)
+      call save_modes(w, c, nprev + 1)
       c%st%steps = c%st%steps + 1
       c%st%hmin = min(c%st%hmin, h); c%st%hmax = max(c%st%hmax, h)
+      if (stopped(c, tnew, status, msg, ctl)) then
+        c%qf = qn; c%vf = vn; c%af = an; c%lam = lamn
+        return
+      end if
       t = tnew; q = qn; qd = vn; qdd = an; acc = accn; lam = lamn
+      if (kev > 0) then
+        ! change the modes; restart from the accelerations of the new modes
+        call events_switch(m, w, t, q, qd, c%log, changed, stt, trec=te)
+        if (stt == MBD_OK .and. changed) then
+          call dyn_accel(m, w, q, qd, t, qdd, lam, stt)
+          acc = qdd; hprev = zero
+        end if
+        if (stt /= MBD_OK) then
+          call event_failure(c, t, status, msg); return
+        end if
+      end if
       if (.not. fixed) then
         facc = min(1.5_wp, max(0.2_wp, 0.8_wp * max(err, 1.0e-10_wp)**(-one / 3)))
         h = h * facc
@@ -531,7 +665,7 @@ contains
   end subroutine run_genalpha
 
   ! -------------------------------------------------------------------- explicit methods
-  subroutine run_explicit(m, w, c, partitioned, qo, vo, ao, status, msg)
+  subroutine run_explicit(m, w, c, partitioned, qo, vo, ao, status, msg, ctl)
     type(model_t), intent(in) :: m
     type(dyn_work_t), intent(inout) :: w
     type(itg_t), intent(inout) :: c
@@ -539,10 +673,11 @@ contains
     real(wp), intent(inout) :: qo(:, :), vo(:, :), ao(:, :)
     integer, intent(out) :: status
     character(len=MSG_LEN), intent(out) :: msg
+    integer, intent(inout), optional, volatile :: ctl(:)   !! progress (see integrate)
     real(wp), allocatable :: y(:), ynew(:), k(:, :), e(:)
-    real(wp) :: t, h, tnew, err, fac, qa(m%nq), va(m%nq), aa(m%nq)
-    integer :: stt, nprev
-    logical :: fixed, fsal
+    real(wp) :: t, h, tnew, err, fac, qa(m%nq), va(m%nq), aa(m%nq), te
+    integer :: stt, nprev, kev
+    logical :: fixed, fsal, changed
     integer :: nfix
     status = MBD_OK; msg = ''
     c%baumgarte = c%opts%method == METH_RK4
@@ -612,6 +747,18 @@ contains
           return
         end if
         err = 10.0_wp
+      else if (c%events .and. .not. fixed) then
+        ! an event inside the trial step (its end state is the last stage's): take the step
+        ! again to end at the event, whatever its error (the modes, and so the forces, are
+        ! fixed within a step: the part before the event is smooth)
+        call events_find(m, w, t, qa, va, aa, tnew, c%qf, c%vf, c%af, te, kev, stt)
+        if (stt /= MBD_OK) then
+          err = 10.0_wp
+        else if (kev > 0 .and. te < tnew - event_tol(t, tnew)) then
+          c%st%rejected = c%st%rejected + 1
+          h = te - t; fsal = .false.
+          cycle
+        end if
       end if
       if (err > one) then
         c%st%rejected = c%st%rejected + 1
@@ -643,13 +790,39 @@ contains
           return
         end if
       end if
+      kev = 0
+      if (c%events) then
+        ! events of the accepted step (fixed steps: at its end; adaptive: at most at its end)
+        call events_find(m, w, t, qa, va, aa, tnew, c%qf, c%vf, c%af, te, kev, stt)
+        if (stt /= MBD_OK) then
+          call event_failure(c, tnew, status, msg); return
+        end if
+      end if
       nprev = c%nout
       call emit(c, qo, vo, ao, t, qa, va, aa, tnew, c%qf, c%vf, c%af)
       if (partitioned) call complete_outputs(m, w, c, qo, vo, nprev + 1)
+      call save_modes(w, c, nprev + 1)
+      if (kev > 0) then
+        ! change the modes at the end of the step (located time recorded) and restart
+        call events_switch(m, w, tnew, c%qf, c%vf, c%log, changed, stt, trec=te)
+        if (stt == MBD_OK .and. changed) then
+          if (partitioned) then
+            ynew(1:c%ni) = c%qf(c%iv); ynew(c%ni + 1:) = c%vf(c%iv)
+          else
+            ynew(1:m%nq) = c%qf; ynew(m%nq + 1:) = c%vf
+          end if
+          call accel(m, w, c, tnew, stt)
+          fsal = .false.
+        end if
+        if (stt /= MBD_OK) then
+          call event_failure(c, tnew, status, msg); return
+        end if
+      end if
       qa = c%qf; va = c%vf; aa = c%af
       c%qs = qa; c%vs = va; c%as = aa; c%ts = tnew
       c%st%steps = c%st%steps + 1
       c%st%hmin = min(c%st%hmin, h); c%st%hmax = max(c%st%hmax, h)
+      if (stopped(c, tnew, status, msg, ctl)) return
       t = tnew
       y = ynew
       if (.not. fixed) then
@@ -830,6 +1003,10 @@ contains
     integer, intent(out) :: stf
     integer :: it, k
     character(len=MSG_LEN) :: lmsg
+    stf = MBD_OK
+    if (w%na == 0) then
+      c%vf(c%iv) = vdot; return
+    end if
     if (w%solver /= SOLVER_DENSE) then
       call solve_dependent_band()
       return
@@ -968,6 +1145,12 @@ contains
     integer, intent(out) :: stf
     integer :: info, k
     character(len=MSG_LEN) :: lmsg
+    integer :: kk
+    if (w%na == 0) then                       ! free bodies: every coordinate independent
+      c%iu = [integer ::]; c%iv = [(kk, kk=1, m%nq)]; c%ni = m%nq
+      c%st%partitions = c%st%partitions + 1
+      stf = MBD_OK; return
+    end if
     call assemble_dense(m, c%qf, w%qz, t, w%phi, w%nu, w%gam, w%asm, w%jac)
     do k = 1, w%na
       c%qa(k, :) = w%jac(w%rows(k), :)
@@ -1153,7 +1336,7 @@ contains
     real(wp) :: now, best
     integer :: stt
     needs_partition = .false.
-    if (c%ni <= 0) return
+    if (c%ni <= 0 .or. w%na == 0) return
     if (w%solver == SOLVER_DENSE) then
       call qr_choice(m, w, c, t, c%jp, stt)
       now = rcond_cols(w, c, c%iu)

@@ -7,9 +7,10 @@ module mbd_joint_distance
   use mbd_kinds, only: wp, zero
   use mbd_status, only: MBD_OK, MBD_BAD_PARAM, MSG_LEN
   use mbd_points, only: NLOC, MAXROW, kloc, kvec, body_point, vsub, vdot, sconst, ssub, put_scal
+  use mbd_dual, only: dloc, dvec, body_point, vsub, vdot, sconst, ssub, put_scal
   implicit none
   private
-  public :: distance_prepare, distance_eval
+  public :: distance_prepare, distance_eval, distance_eval_d
 
 contains
 
@@ -36,5 +37,17 @@ contains
     d = vsub(body_point(x, sj, p(3:4)), body_point(x, si, p(1:2)))
     call put_scal(ssub(vdot(d, d), sconst(p(5)**2)), phi(1), jl(1, :), gam(1))
   end subroutine distance_eval
+
+  !> Change of the row along a direction and a parameter change tp (mbd_dual).
+  pure subroutine distance_eval_d(p, tp, si, sj, x, tphi, tjl, tgam)
+    real(wp), intent(in) :: p(:), tp(:)     !! prepared parameters and their change
+    integer, intent(in) :: si, sj           !! slot ids of the two bodies (0 = ground)
+    type(dloc), intent(in) :: x             !! local state and direction
+    real(wp), intent(inout) :: tphi(MAXROW), tjl(MAXROW, NLOC), tgam(MAXROW)  !! 1 row
+    type(dvec) :: d
+    d = vsub(body_point(x, sj, p(3:4), tp(3:4)), body_point(x, si, p(1:2), tp(1:2)))
+    call put_scal(ssub(vdot(d, d), sconst(p(5)**2, 2 * p(5) * tp(5))), tphi(1), tjl(1, :), &
+                  tgam(1))
+  end subroutine distance_eval_d
 
 end module mbd_joint_distance

@@ -32,9 +32,12 @@ module mbd_joint_gear
   use mbd_status, only: MBD_OK, MBD_BAD_PARAM, MSG_LEN
   use mbd_points, only: NLOC, MAXROW, kloc, kvec, kscal, body_angle, body_point, slot_value, &
                         ssub, sadd, sscale, sconst, vsub, vdot, vcross, put_scal
+  use mbd_dual, only: dloc, dvec, dscal, body_angle, body_point, slot_value, ssub, sadd, sscale, &
+                      sconst, vsub, vdot, vcross, put_scal
   implicit none
   private
   public :: GEAR_EXTERNAL, GEAR_INTERNAL, CARRIER_SLOT, GEAR_RAW_LEN, gear_prepare, gear_eval
+  public :: gear_prepare_d, gear_eval_d
 
   integer, parameter :: GEAR_EXTERNAL = 1, GEAR_INTERNAL = 2
   integer, parameter :: CARRIER_SLOT = 7
@@ -113,5 +116,90 @@ contains
     a%vd = a%d(:, CARRIER_SLOT) * thd
     a%ar = -a%v * thd**2
   end function carrier_vector
+
+  !> Change of the prepared parameters when raw(j) changes by one: kappa / d0 with
+  !! kappa = R_i +- R_j; rho = -sign(kappa) tan(psi) changes by -sign(kappa) (1 + tan**2);
+  !! the centres a' move d0 = |a'_j - a'_i| by u' . da and u' by (da - u' (u' . da)) / d0.
+  pure subroutine gear_prepare_d(kind, raw, j, tprep)
+    integer, intent(in) :: kind             !! GEAR_EXTERNAL or GEAR_INTERNAL
+    real(wp), intent(in) :: raw(:)          !! raw parameters (GEAR_RAW_LEN)
+    integer, intent(in) :: j                !! raw entry
+    real(wp), intent(out) :: tprep(:)       !! change of the prepared parameters (12)
+    real(wp) :: kappa, d0, u(2), da(2), dd0, sgn
+    sgn = one
+    if (kind == GEAR_INTERNAL) sgn = -one
+    kappa = raw(1) + sgn * raw(2)
+    u = raw(11:12) - raw(9:10)
+    d0 = hypot(u(1), u(2)); u = u / d0
+    tprep = zero
+    select case (j)
+    case (1)
+      tprep(1) = one; tprep(4) = one / d0
+    case (2)
+      tprep(2) = one; tprep(4) = sgn / d0
+    case (3)
+      tprep(3) = one
+    case (4)
+      tprep(5) = -sign(one, kappa) * (one + tan(raw(4))**2)
+    case (5:8)
+      tprep(j + 1) = one
+    case (9:12)
+      da = zero
+      if (j <= 10) then
+        da(j - 8) = -one
+      else
+        da(j - 10) = one
+      end if
+      dd0 = dot_product(u, da)
+      tprep(10:11) = (da - u * dd0) / d0
+      tprep(12) = dd0
+      tprep(4) = -kappa * dd0 / d0**2
+    end select
+  end subroutine gear_prepare_d
+
+  !> Change of the row along a direction and a parameter change tp (mbd_dual).
+  pure subroutine gear_eval_d(kind, p, tp, si, sj, x, tphi, tjl, tgam)
+    integer, intent(in) :: kind             !! GEAR_EXTERNAL or GEAR_INTERNAL
+    real(wp), intent(in) :: p(:), tp(:)     !! prepared parameters and their change
+    integer, intent(in) :: si, sj           !! slot ids of the gears
+    type(dloc), intent(in) :: x             !! local state and direction
+    real(wp), intent(inout) :: tphi(MAXROW), tjl(MAXROW, NLOC), tgam(MAXROW)  !! 1 row
+    type(dscal) :: ai, aj, c, angles
+    type(dvec) :: w, e
+    real(wp) :: sgn
+    c = slot_value(x, CARRIER_SLOT)
+    ai = ssub(body_angle(x, si), c)
+    aj = ssub(body_angle(x, sj), c)
+    sgn = one
+    if (kind == GEAR_INTERNAL) sgn = -one
+    angles = ssub(sadd(sscale(p(1), tp(1), ai), sscale(sgn * p(2), sgn * tp(2), aj)), &
+                  sconst(p(3), tp(3)))
+    w = vsub(body_point(x, sj, p(8:9), tp(8:9)), body_point(x, si, p(6:7), tp(6:7)))
+    e = carrier_vector_d(x, p(10:11), tp(10:11))
+    call put_scal(sadd(sadd(angles, sscale(-p(4), -tp(4), vcross(e, w))), &
+                       sscale(p(5), tp(5), ssub(vdot(e, w), sconst(p(12), tp(12))))), &
+                  tphi(1), tjl(1, :), tgam(1))
+  end subroutine gear_eval_d
+
+  !> carrier_vector and its change (as a body vector of mbd_dual, turning with the carrier
+  !! angle in CARRIER_SLOT): with v = A_c u', e = A_c tu',
+  !! t_v = perp(v) dth + e, t_d = -v dth + perp(e), t_vd = t_d thd + perp(v) dthd,
+  !! t_ar = -(perp(v) dth + e) thd**2 - 2 v thd dthd.
+  pure function carrier_vector_d(x, u, tu) result(a)
+    type(dloc), intent(in) :: x     !! local state and direction
+    real(wp), intent(in) :: u(2)    !! vector in the carrier frame
+    real(wp), intent(in) :: tu(2)   !! its change
+    type(dvec) :: a
+    real(wp) :: cs, sn, thd, dth, dthd, e(2), pv(2)
+    a%a = carrier_vector(x%x, u)
+    cs = cos(x%x%q(CARRIER_SLOT)); sn = sin(x%x%q(CARRIER_SLOT))
+    thd = x%x%qd(CARRIER_SLOT); dth = x%tq(CARRIER_SLOT); dthd = x%tqd(CARRIER_SLOT)
+    e = [cs * tu(1) - sn * tu(2), sn * tu(1) + cs * tu(2)]
+    pv = [-a%a%v(2), a%a%v(1)]
+    a%t%v = pv * dth + e
+    a%t%d(:, CARRIER_SLOT) = -a%a%v * dth + [-e(2), e(1)]
+    a%t%vd = a%t%d(:, CARRIER_SLOT) * thd + pv * dthd
+    a%t%ar = -(pv * dth + e) * thd**2 - 2 * a%a%v * thd * dthd
+  end function carrier_vector_d
 
 end module mbd_joint_gear

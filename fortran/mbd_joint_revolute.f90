@@ -8,9 +8,10 @@ module mbd_joint_revolute
   use mbd_kinds, only: wp, zero, one
   use mbd_status, only: MBD_OK, MSG_LEN
   use mbd_points, only: NLOC, MAXROW, kloc, point_terms
+  use mbd_dual, only: dloc, point_terms_d
   implicit none
   private
-  public :: revolute_prepare, revolute_eval
+  public :: revolute_prepare, revolute_eval, revolute_eval_d
 
 contains
 
@@ -48,5 +49,24 @@ contains
     end if
     gam(1:2) = aj - ai                      ! gamma = A_i s'_i thd_i**2 - A_j s'_j thd_j**2
   end subroutine revolute_eval
+
+  !> Changes of the rows of Phi, J and gamma along a direction (x) and a change tp of the
+  !! parameters (mbd_dual), from the two points' terms and their changes:
+  !! dPhi = dP_i - dP_j, dJ = [0, d(B_i s'_i), 0, -d(B_j s'_j)], dgamma = d(ar_j) - d(ar_i).
+  pure subroutine revolute_eval_d(p, tp, si, sj, x, tphi, tjl, tgam)
+    real(wp), intent(in) :: p(:), tp(:)     !! prepared parameters and their change
+    integer, intent(in) :: si, sj           !! slot ids of the two bodies (0 = ground)
+    type(dloc), intent(in) :: x             !! local state and direction
+    real(wp), intent(inout) :: tphi(MAXROW), tjl(MAXROW, NLOC), tgam(MAXROW)  !! 2 rows
+    real(wp) :: pi(2), bi(2), ai(2), pj(2), bj(2), aj(2), tpi(2), tbi(2), tai(2), tpj(2), &
+                tbj(2), taj(2)
+    call point_terms_d(x, si, p(1:2), tp(1:2), pi, bi, ai, tpi, tbi, tai)
+    call point_terms_d(x, sj, p(3:4), tp(3:4), pj, bj, aj, tpj, tbj, taj)
+    tphi(1:2) = tpi - tpj
+    tjl(1:2, :) = zero
+    if (si > 0) tjl(1:2, 3) = tbi
+    if (sj > 0) tjl(1:2, 6) = -tbj
+    tgam(1:2) = taj - tai
+  end subroutine revolute_eval_d
 
 end module mbd_joint_revolute

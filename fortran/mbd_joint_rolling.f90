@@ -16,9 +16,11 @@ module mbd_joint_rolling
   use mbd_status, only: MBD_OK, MBD_BAD_PARAM, MSG_LEN
   use mbd_points, only: NLOC, MAXROW, kloc, kvec, kscal, body_point, body_vector, body_angle, &
                         vsub, vdot, vcross, ssub, sadd, sscale, sconst, put_scal
+  use mbd_dual, only: dloc, dvec, dscal, body_point, body_vector, body_angle, vsub, vdot, &
+                      vcross, ssub, sadd, sscale, sconst, put_scal
   implicit none
   private
-  public :: rolling_prepare, rolling_eval
+  public :: rolling_prepare, rolling_eval, rolling_prepare_d, rolling_eval_d
 
 contains
 
@@ -59,5 +61,45 @@ contains
                   phi(1), jl(1, :), gam(1))
     if (contact) call put_scal(ssub(sscale(sgn, e), sconst(p(7))), phi(2), jl(2, :), gam(2))
   end subroutine rolling_eval
+
+  !> Change of the prepared parameters when raw(j) changes by one: the unit direction
+  !! u^ = u/|u| changes by (e - u^ (u^ . e))/|u|.
+  pure subroutine rolling_prepare_d(raw, j, tprep)
+    real(wp), intent(in) :: raw(:)          !! raw parameters
+    integer, intent(in) :: j                !! raw entry
+    real(wp), intent(out) :: tprep(:)       !! change of the prepared parameters (8)
+    real(wp) :: n, uh(2), e(2)
+    tprep = zero
+    select case (j)
+    case (5, 6)
+      n = hypot(raw(5), raw(6)); uh = raw(5:6) / n
+      e = zero; e(j - 4) = one
+      tprep(5:6) = (e - uh * dot_product(uh, e)) / n
+    case default
+      tprep(j) = one
+    end select
+  end subroutine rolling_prepare_d
+
+  !> Changes of the rows along a direction and a parameter change tp (mbd_dual); the side
+  !! sigma = sign(e) is held.
+  pure subroutine rolling_eval_d(contact, p, tp, si, sj, x, tphi, tjl, tgam)
+    logical, intent(in) :: contact          !! add the contact row (rolling disc)
+    real(wp), intent(in) :: p(:), tp(:)     !! prepared parameters and their change
+    integer, intent(in) :: si, sj           !! slot ids: circle body, line body
+    type(dloc), intent(in) :: x             !! local state and direction
+    real(wp), intent(inout) :: tphi(MAXROW), tjl(MAXROW, NLOC), tgam(MAXROW)  !! 1 or 2 rows
+    type(dvec) :: u, d
+    type(dscal) :: e, rel
+    real(wp) :: sgn
+    u = body_vector(x, sj, p(5:6), tp(5:6))
+    d = vsub(body_point(x, si, p(1:2), tp(1:2)), body_point(x, sj, p(3:4), tp(3:4)))
+    e = vcross(u, d)
+    sgn = merge(-one, one, e%a%v < zero)
+    rel = ssub(body_angle(x, si), body_angle(x, sj))
+    call put_scal(ssub(sadd(vdot(u, d), sscale(sgn * p(7), sgn * tp(7), rel)), &
+                       sconst(p(8), tp(8))), tphi(1), tjl(1, :), tgam(1))
+    if (contact) call put_scal(ssub(sscale(sgn, e), sconst(p(7), tp(7))), tphi(2), tjl(2, :), &
+                               tgam(2))
+  end subroutine rolling_eval_d
 
 end module mbd_joint_rolling

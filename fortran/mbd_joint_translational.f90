@@ -13,9 +13,12 @@ module mbd_joint_translational
   use mbd_status, only: MBD_OK, MBD_BAD_PARAM, MSG_LEN
   use mbd_points, only: NLOC, MAXROW, kloc, kscal, body_point, body_vector, body_angle, vsub, &
                         vdot, ssub, sconst, put_scal, perp
+  use mbd_dual, only: dloc, dscal, body_point, body_vector, body_angle, vsub, vdot, ssub, &
+                      sconst, put_scal
   implicit none
   private
   public :: translational_prepare, translational_eval, slide_distance
+  public :: translational_prepare_d, translational_eval_d, slide_distance_d
 
 contains
 
@@ -68,5 +71,60 @@ contains
     call put_scal(s1, phi(1), jl(1, :), gam(1))
     call put_scal(s2, phi(2), jl(2, :), gam(2))
   end subroutine translational_eval
+
+  !> Change of the prepared parameters when raw(j) changes by one: the unit axis
+  !! u^ = u/|u| changes by (e - u^ (u^ . e))/|u|, and theta0 = atan2(u_i) - atan2(u_j) by
+  !! (u_x e_y - u_y e_x)/|u|**2 (with a minus for u_j).
+  pure subroutine translational_prepare_d(raw, j, tprep)
+    real(wp), intent(in) :: raw(:)          !! [s'_i, s'_j, u'_i, u'_j]
+    integer, intent(in) :: j                !! raw entry
+    real(wp), intent(out) :: tprep(:)       !! change of the prepared parameters (9)
+    real(wp) :: n, uh(2), e(2), du(2)
+    tprep = zero
+    select case (j)
+    case (1:4)
+      tprep(j) = 1.0_wp
+    case (5, 6)
+      n = hypot(raw(5), raw(6)); uh = raw(5:6) / n
+      e = zero; e(j - 4) = 1.0_wp
+      du = (e - uh * dot_product(uh, e)) / n
+      tprep(5:6) = du; tprep(7:8) = perp(du)
+      tprep(9) = (raw(5) * e(2) - raw(6) * e(1)) / n**2
+    case (7, 8)
+      n = hypot(raw(7), raw(8))
+      e = zero; e(j - 6) = 1.0_wp
+      tprep(9) = -(raw(7) * e(2) - raw(8) * e(1)) / n**2
+    end select
+  end subroutine translational_prepare_d
+
+  !> The slide and its change along a direction and a parameter change tp (mbd_dual).
+  pure function slide_distance_d(p, tp, si, sj, x) result(s)
+    real(wp), intent(in) :: p(:), tp(:)     !! prepared parameters and their change
+    integer, intent(in) :: si, sj           !! slot ids of the two bodies
+    type(dloc), intent(in) :: x             !! local state and direction
+    type(dscal) :: s
+    s = relative_along_d(p, tp, p(5:6), tp(5:6), si, sj, x)
+  end function slide_distance_d
+
+  pure function relative_along_d(p, tp, u, tu, si, sj, x) result(s)
+    real(wp), intent(in) :: p(:), tp(:), u(2), tu(2)
+    integer, intent(in) :: si, sj
+    type(dloc), intent(in) :: x
+    type(dscal) :: s
+    s = vdot(body_vector(x, si, u, tu), &
+             vsub(body_point(x, sj, p(3:4), tp(3:4)), body_point(x, si, p(1:2), tp(1:2))))
+  end function relative_along_d
+
+  !> Changes of the rows along a direction and a parameter change tp (mbd_dual).
+  pure subroutine translational_eval_d(p, tp, si, sj, x, tphi, tjl, tgam)
+    real(wp), intent(in) :: p(:), tp(:)     !! prepared parameters and their change
+    integer, intent(in) :: si, sj           !! slot ids of the two bodies (0 = ground)
+    type(dloc), intent(in) :: x             !! local state and direction
+    real(wp), intent(inout) :: tphi(MAXROW), tjl(MAXROW, NLOC), tgam(MAXROW)  !! 2 rows
+    call put_scal(relative_along_d(p, tp, p(7:8), tp(7:8), si, sj, x), tphi(1), tjl(1, :), &
+                  tgam(1))
+    call put_scal(ssub(ssub(body_angle(x, sj), body_angle(x, si)), sconst(p(9), tp(9))), &
+                  tphi(2), tjl(2, :), tgam(2))
+  end subroutine translational_eval_d
 
 end module mbd_joint_translational

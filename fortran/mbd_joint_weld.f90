@@ -7,10 +7,11 @@ module mbd_joint_weld
   use mbd_kinds, only: wp
   use mbd_status, only: MBD_OK, MSG_LEN
   use mbd_points, only: NLOC, MAXROW, kloc, body_angle, ssub, sconst, put_scal
-  use mbd_joint_revolute, only: revolute_eval
+  use mbd_joint_revolute, only: revolute_eval, revolute_eval_d
+  use mbd_dual, only: dloc, body_angle, ssub, sconst, put_scal
   implicit none
   private
-  public :: weld_prepare, weld_eval
+  public :: weld_prepare, weld_eval, weld_eval_d
 
 contains
 
@@ -34,5 +35,16 @@ contains
     call put_scal(ssub(ssub(body_angle(x, sj), body_angle(x, si)), sconst(p(5))), &
                   phi(3), jl(3, :), gam(3))
   end subroutine weld_eval
+
+  !> Changes of the rows along a direction and a parameter change tp (mbd_dual).
+  pure subroutine weld_eval_d(p, tp, si, sj, x, tphi, tjl, tgam)
+    real(wp), intent(in) :: p(:), tp(:)     !! prepared parameters and their change
+    integer, intent(in) :: si, sj           !! slot ids
+    type(dloc), intent(in) :: x             !! local state and direction
+    real(wp), intent(inout) :: tphi(MAXROW), tjl(MAXROW, NLOC), tgam(MAXROW)  !! 3 rows
+    call revolute_eval_d(p(1:4), tp(1:4), si, sj, x, tphi, tjl, tgam)
+    call put_scal(ssub(ssub(body_angle(x, sj), body_angle(x, si)), sconst(p(5), tp(5))), &
+                  tphi(3), tjl(3, :), tgam(3))
+  end subroutine weld_eval_d
 
 end module mbd_joint_weld

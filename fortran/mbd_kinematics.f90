@@ -28,19 +28,23 @@ module mbd_kinematics
   use mbd_kinds, only: wp, zero, one, half
   use mbd_status, only: MBD_OK, MBD_BAD_SETTING, MBD_BAD_COUNT, MBD_SINGULAR, &
                         MBD_NO_CONVERGENCE, MBD_SINGULAR_CONFIG, MBD_ASSEMBLY_FAILED, &
-                        MBD_LAPACK, MBD_INCONSISTENT, MBD_NO_MEMORY, MSG_LEN
+                        MBD_LAPACK, MBD_INCONSISTENT, MBD_NO_MEMORY, MBD_USER_ABORT, &
+                        MSG_LEN
   use mbd_memory, only: REAL_BYTES, mem_check, mem_fail
   use mbd_points, only: NLOC, MAXROW
   use mbd_model, only: model_t
   use mbd_constraints, only: con_is_driver, con_name
   use mbd_assemble, only: asm_work_t, asm_init, assemble_blocks, assemble_dense, scatter_dense, &
-                          init_extras, blocks_jv, blocks_jtv
+                          init_extras, blocks_jv, blocks_jtv, scatter_values, asm_turn
   use mbd_band, only: band_t, band_plan, band_move, band_zero, band_norm1, band_factor, &
                       band_rcond, band_solve
   use mbd_linsolve, only: lu_factor, lu_solve, lu_det_sign, svd_null, row_rank, qr_factor, &
-                          qr_solve, qr_lwork
+                          qr_solve, qr_lwork, lu_solve_rows
+  use mbd_splu, only: splu_t, splu_init, splu_plan, splu_factor, splu_solve, splu_solve2, &
+                      splu_pos, LMAX
   use mbd_lapack, only: dgels, dgecon, dtrcon
   use mbd_interp, only: hermite5
+  use mbd_sensitivity, only: sens_t, sens_hessian, sens_params, sens_kin_rhs
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   implicit none
   private
@@ -65,10 +69,16 @@ module mbd_kinematics
   !! n / BAND_RATIO wide
   integer, parameter :: BAND_MIN_N = 60, BAND_RATIO = 4
   integer, parameter :: BAND_ASSEMBLY_MAXIT = 50  !! Newton iterations of a banded assembly
+  !> dense mode, square J up to this order: sparse LU with a replayed pivot order (mbd_splu)
+  integer, parameter :: SPARSE_MAX_N = 60
+  !> divided differences of the accelerations in the predictor (its error O(h**(order + 3)))
+  integer, parameter :: PRED_ORDER = 5
   !> largest dense Levenberg-Marquardt assembly (J and [J; mu I]) allowed in band mode (bytes):
   !! n up to about 1670; larger banded models assemble by damped Newton on the band
   real(wp), parameter :: DENSE_FALLBACK = 64.0_wp * 1048576
-  real(wp), parameter :: PRED_ACCEPT = 1.0e-2_wp  !! fraction of tol a start must meet
+  !> a start is taken without a correction when the correction is below RES_ULPS units in the
+  !! last place of every coordinate (of max(|q_i|, 1))
+  real(wp), parameter :: RES_ULPS = 4.0_wp
   !> what to change when the dense J does not fit
   character(len=*), parameter :: DENSE_HINT = 'the dense solver keeps J as a full matrix: ' // &
     'for kinematics of a large square model use the banded solver (solver="banded"), ' // &
@@ -103,6 +113,21 @@ module mbd_kinematics
                                     !! small model's Levenberg-Marquardt assembly)
     type(band_t) :: band            !! band plan, storage and factors
     real(wp) :: anorm = zero        !! ||J D||_1 of the band matrix before factoring
+    !> small square J in dense mode: J D assembled straight into the sparse LU's values and
+    !! factored in its planned pivot order; LAPACK's dense LU where that order is no longer
+    !! stable (replanned) or J D is poorly conditioned (pivot ratio below COND_CHECK)
+    logical :: sparse = .false.
+    logical :: spfact = .false.     !! the factors in use are the sparse ones
+    type(splu_t) :: sp              !! sparse LU plan, values and factors
+    !> the blocks' entries for the sparse values: flat index into the blocks, column, place
+    !! in sp%val; the first snon are in the pattern, the others must be zero
+    integer, allocatable :: ssrc(:), scol(:), spos(:)
+    integer :: snon = 0
+    real(wp) :: offpat = zero       !! sum |entries| outside the sparse pattern (must be 0)
+    !> the velocity J q_dot = nu solved together with the Newton correction of a start taken
+    !! (kin_newton); kin_vel_acc uses it while the factors stay
+    real(wp), allocatable :: qdp(:)
+    logical :: vel_ready = .false.
   end type kin_work_t
 
   !> What happened: counters, redundancy, and the singular or failed configuration.
@@ -132,12 +157,15 @@ contains
   !> Allocate work arrays for model m; with a band plan J is kept in band storage (the plan
   !! is moved into w) and no n x n array is allocated. A dense J is checked against the
   !! memory first (mem_check); a failed allocation is MBD_NO_MEMORY.
-  subroutine kin_work_init(m, w, status, msg, band)
+  subroutine kin_work_init(m, w, status, msg, band, sparse)
     type(model_t), intent(in) :: m                 !! model
     type(kin_work_t), intent(out) :: w             !! work arrays
     integer, intent(out) :: status                 !! MBD_OK or MBD_NO_MEMORY
     character(len=MSG_LEN), intent(inout) :: msg   !! explanation (on a failure)
     type(band_t), intent(inout), optional :: band  !! band plan of J (square J only), moved
+    !> the sparse LU may serve a small square J (default); .false. for a single step, where
+    !! planning its pivot order would cost more than the dense LU it replaces
+    logical, intent(in), optional :: sparse
     integer :: nr, ierr, lq
     real(wp) :: bytes
     character(len=MSG_LEN) :: what
@@ -171,7 +199,38 @@ contains
     if (status /= MBD_OK) return
     w%qz = zero
     w%cs = one
+    if (present(sparse)) then
+      if (.not. sparse) return
+    end if
+    if (.not. w%banded .and. m%neq == m%nq .and. m%nq <= SPARSE_MAX_N) then
+      call sparse_init(m, w, status, msg)
+    end if
   end subroutine kin_work_init
+
+  !> The sparse LU of J (structure from the blocks' map); an entry written twice keeps the
+  !! dense LU (status MBD_OK, w%sparse false).
+  subroutine sparse_init(m, w, status, msg)
+    type(model_t), intent(in) :: m                 !! model (square J)
+    type(kin_work_t), intent(inout) :: w           !! work arrays (assembly map set)
+    integer, intent(out) :: status                 !! MBD_OK or MBD_NO_MEMORY
+    character(len=MSG_LEN), intent(inout) :: msg   !! explanation (on a failure)
+    integer, allocatable :: rows(:), cols(:)
+    integer :: ne, ierr
+    ne = size(w%asm%src)
+    allocate (rows(ne), cols(ne), w%ssrc(ne), w%scol(ne), w%spos(ne), w%qdp(m%nq), stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail(12 * real(ne, wp), 'the sparse LU of J', DENSE_HINT, status, msg)
+      return
+    end if
+    rows = mod(w%asm%dst - 1, m%neq) + 1
+    cols = w%asm%col
+    w%spos = 0; w%ssrc = w%asm%src; w%scol = w%asm%col; w%snon = 0
+    call splu_init(m%nq, rows, cols, w%sp, status, msg)
+    w%sparse = status == MBD_OK
+    if (status == MBD_SINGULAR) then
+      status = MBD_OK; msg = ''
+    end if
+  end subroutine sparse_init
 
   !> Band plan of J from its structure (the nonzeros of the constraint blocks).
   subroutine kin_band_plan(m, band, status, msg)
@@ -214,6 +273,10 @@ contains
     real(wp), intent(in) :: t               !! time
     integer :: k, s, r, c, r0, d0, jc, ir
     call assemble_blocks(m, q, qd, t, w%phi, w%nu, w%gam, w%asm)
+    if (w%sparse) then
+      call scatter_values(w%asm, w%ssrc, w%scol, w%spos, w%snon, w%cs, w%sp%val, w%offpat)
+      return
+    end if
     if (.not. w%banded) then
       call scatter_dense(w%asm, w%jac, w%cs)      ! J D, scaled here
       return
@@ -255,6 +318,12 @@ contains
     integer :: i, k, n, info
     real(wp) :: anorm, colsum, umin, umax
     w%lu_count = w%lu_count + 1
+    w%spfact = .false.; w%vel_ready = .false.
+    if (w%sparse .and. .not. w%lsq) then
+      call sparse_factor(w, status)
+      if (w%spfact .or. status == MBD_NO_MEMORY) return
+      call scatter_dense(w%asm, w%jac, w%cs)      ! the dense LU below, of the same J D
+    end if
     if (w%banded) then
       ! B = P_r J D P_c^T = P L U (dgbtrf); 1/cond_1 estimated only where it may matter
       call band_factor(w%band, status, msg, w%detsign, w%pivratio)
@@ -292,6 +361,45 @@ contains
     end if
   end subroutine factor
 
+  !> Factor J D (assembled into w%sp%val) in the planned pivot order; plan again (on the
+  !! dense J D) when there is no plan, an entry outside the pattern is non-zero, a pivot is
+  !! zero or a multiplier exceeds LMAX. w%spfact: the sparse factors are good (pivot ratio
+  !! >= COND_CHECK); otherwise the caller factors densely (status MBD_OK) or MBD_NO_MEMORY.
+  subroutine sparse_factor(w, status)
+    type(kin_work_t), intent(inout) :: w   !! work arrays
+    integer, intent(out) :: status         !! MBD_OK or MBD_NO_MEMORY
+    character(len=MSG_LEN) :: msg
+    real(wp) :: lmax
+    integer :: st, e, r, p, pass, ne
+    status = MBD_OK
+    st = MBD_SINGULAR
+    lmax = zero
+    if (w%sp%planned .and. w%offpat <= zero) &
+      call splu_factor(w%sp, st, lmax, w%detsign, w%pivratio)
+    if (st /= MBD_OK .or. .not. lmax <= LMAX) then
+      call scatter_dense(w%asm, w%jac, w%cs)
+      call splu_plan(w%sp, w%jac, st, msg)
+      if (st == MBD_NO_MEMORY) status = st
+      if (st /= MBD_OK) return
+      ! the map: the entries the pattern holds first
+      w%snon = 0
+      do pass = 1, 2
+        do e = 1, size(w%spos)
+          r = mod(w%asm%dst(e) - 1, size(w%jac, 1)) + 1
+          p = splu_pos(w%sp, r, w%asm%col(e))
+          if ((p > 0) .neqv. (pass == 1)) cycle
+          w%snon = w%snon + 1
+          w%ssrc(w%snon) = w%asm%src(e); w%scol(w%snon) = w%asm%col(e); w%spos(w%snon) = p
+        end do
+        if (pass == 1) ne = w%snon
+      end do
+      w%snon = ne
+      call splu_factor(w%sp, st, lmax, w%detsign, w%pivratio)
+      if (st /= MBD_OK) return
+    end if
+    w%spfact = w%pivratio >= COND_CHECK
+  end subroutine sparse_factor
+
   !> Solve J x = b with the factors (least squares in QR mode; w%resid is its residual).
   subroutine solve(w, b, x)
     type(kin_work_t), intent(inout) :: w   !! work arrays with the factors
@@ -299,6 +407,11 @@ contains
     real(wp), intent(out) :: x(:)          !! solution (nq)
     integer :: st
     character(len=MSG_LEN) :: msg
+    if (w%spfact) then
+      call splu_solve(w%sp, b, x, w%cs)       ! x = D (J D)^-1 b
+      w%resid = zero
+      return
+    end if
     if (w%lsq) then
       w%rhs(1:size(b)) = b
       call qr_solve(w%jac, w%jpvt, w%tau, w%rhs(1:size(b)), x, w%resid, w%qrwork)
@@ -313,6 +426,28 @@ contains
     end if
     x = x * w%cs
   end subroutine solve
+
+  !> Solve J X = B for several right-hand sides with the factors (as solve), B given as rows
+  !! bt = B^T (n rounded up to a multiple of 4, neq; padding rows zero) and overwritten; the
+  !! dense LU by plain loops over all of them at once.
+  subroutine solve_cols(w, bt, x)
+    type(kin_work_t), intent(inout) :: w   !! work arrays with the factors
+    real(wp), intent(inout) :: bt(:, :)    !! right-hand sides as rows (4 k, neq), spoiled
+    real(wp), intent(out) :: x(:, :)       !! solutions (nq, n)
+    real(wp) :: b(size(bt, 2))
+    integer :: k
+    if (w%lsq .or. w%banded .or. w%spfact) then
+      do k = 1, size(x, 2)
+        b = bt(k, :)
+        call solve(w, b, x(:, k))
+      end do
+      return
+    end if
+    call lu_solve_rows(w%jac, w%ipiv, bt)
+    do k = 1, size(x, 2)
+      x(:, k) = bt(k, :) * w%cs
+    end do
+  end subroutine solve_cols
 
   !> The Newton correction w%dq from J dq = -Phi with the factors (Phi negated in place and
   !! back: an expression argument -w%phi would be a heap temporary at every iteration).
@@ -345,11 +480,28 @@ contains
       if (it == 0) res0 = res
       call factor(w, status)
       if (status /= MBD_OK) return
-      ! a start that meets tol is taken only well inside it: the converged positions keep
-      ! the accuracy of a Newton correction (quadratic: far below tol), not just tol
-      if (res <= merge(PRED_ACCEPT * w%tol, w%tol, it == 0)) return
+      if (it > 0 .and. res <= w%tol) return
       if (it == maxit) exit
-      call solve_newton(w)
+      if (it == 0 .and. res <= w%tol .and. w%spfact) then
+        ! the correction and the velocity in one pass (the velocity kept if the start is)
+        call splu_solve2(w%sp, w%phi, w%nu, w%dq, w%qdp, w%cs)
+        w%vel_ready = .true.
+      else
+        call solve_newton(w)
+      end if
+      ! a start that meets tol is taken only when a Newton correction would not move it:
+      ! within RES_ULPS units in the last place of each coordinate, so that the positions
+      ! keep the accuracy of a correction (quadratic: far below tol), not just tol
+      if (it == 0 .and. res <= w%tol) then
+        if (below_resolution(size(q), q, w%dq)) then
+          ! taken with its correction: J, nu and the factors of the start serve (they differ
+          ! in the last places); the angles' cos and sin turned by the correction
+          q = q + w%dq
+          call asm_turn(m, w%asm, w%dq)
+          return
+        end if
+      end if
+      w%vel_ready = .false.
       if (w%lsq .and. maxval(abs(w%dq)) <= 1.0e-3_wp * w%tol .and. res > w%tol) then
         status = MBD_INCONSISTENT; return
       end if
@@ -373,9 +525,16 @@ contains
     integer, intent(out) :: status          !! MBD_OK or MBD_INCONSISTENT
     integer, intent(out), optional :: level !! 1 velocity, 2 acceleration (when inconsistent)
     status = MBD_OK
-    call solve(w, w%nu, qd)
-    if (w%resid > 1.0e-8_wp * (one + maxval(abs(w%nu)))) then
-      status = MBD_INCONSISTENT
+    if (w%vel_ready) then
+      qd = w%qdp                 ! solved with kin_newton's last correction
+      w%vel_ready = .false.
+    else
+      call solve(w, w%nu, qd)
+    end if
+    if (w%lsq) then
+      if (w%resid > 1.0e-8_wp * (one + maxval(abs(w%nu)))) status = MBD_INCONSISTENT
+    end if
+    if (status == MBD_INCONSISTENT) then
       if (present(level)) level = 1
       call dense_j(m, w, q, w%qz, t)
       w%phi = matmul(w%jac, qd) - w%nu
@@ -383,8 +542,10 @@ contains
     end if
     call assemble_blocks(m, q, qd, t, w%phi, w%nu, w%gam, w%asm, same_q=.true.)
     call solve(w, w%gam, qdd)
-    if (w%resid > 1.0e-8_wp * (one + maxval(abs(w%gam)))) then
-      status = MBD_INCONSISTENT
+    if (w%lsq) then
+      if (w%resid > 1.0e-8_wp * (one + maxval(abs(w%gam)))) status = MBD_INCONSISTENT
+    end if
+    if (status == MBD_INCONSISTENT) then
       if (present(level)) level = 2
       call dense_j(m, w, q, qd, t)
       w%phi = matmul(w%jac, qdd) - w%gam
@@ -753,7 +914,8 @@ contains
   !! and nsteps (e = opts%every) are stored, in columns 1, 2, ... (kin_out_count of them).
   !! On a singular configuration the outputs up to it are filled (rep%ndone columns) and
   !! status is MBD_SINGULAR_CONFIG with rep describing the configuration.
-  subroutine kin_run(m, q0, t0, t1, nsteps, opts, qout, qdout, qddout, rep, status, msg)
+  subroutine kin_run(m, q0, t0, t1, nsteps, opts, qout, qdout, qddout, rep, status, msg, &
+                     sens, sq, sqd, sqdd, ctl)
     type(model_t), intent(in) :: m             !! model
     real(wp), intent(in) :: q0(:)              !! estimates (nq)
     real(wp), intent(in) :: t0, t1             !! time span
@@ -765,19 +927,69 @@ contains
     type(kin_report_t), intent(out) :: rep     !! what happened
     integer, intent(out) :: status             !! MBD_OK or the failure
     character(len=MSG_LEN), intent(out) :: msg !! explanation
+    !> design parameters (mbd_sensitivity): with them, sq, sqd, sqdd (nq, np, outputs) get
+    !! dq/dp, dq_dot/dp and dq_ddot/dp at every stored output
+    type(sens_t), intent(inout), optional :: sens
+    real(wp), intent(out), optional :: sq(:, :, :), sqd(:, :, :), sqdd(:, :, :)
+    !> progress, shared with a caller in another thread: ctl(1) gets the outputs stored so
+    !! far, ctl(2) /= 0 asks the run to stop (MBD_USER_ABORT, the outputs so far kept)
+    integer, intent(inout), optional, volatile :: ctl(:)
+    integer :: c0
+    call kin_loop(m, q0, t0, t1, nsteps, opts, qout, qdout, qddout, rep, status, msg, &
+                  sens, sq, sqd, sqdd, ctl)
+    ! the outputs not computed are zero (set here, not before the loop: no pass over them)
+    c0 = max(rep%ndone, 0)
+    if (c0 < size(qout, 2)) then
+      qout(:, c0 + 1:) = zero; qdout(:, c0 + 1:) = zero; qddout(:, c0 + 1:) = zero
+    end if
+  end subroutine kin_run
+
+  !> kin_run's work (the outputs beyond rep%ndone are left as they are).
+  subroutine kin_loop(m, q0, t0, t1, nsteps, opts, qout, qdout, qddout, rep, status, msg, &
+                     sens, sq, sqd, sqdd, ctl)
+    type(model_t), intent(in) :: m             !! model
+    real(wp), intent(in) :: q0(:)              !! estimates (nq)
+    real(wp), intent(in) :: t0, t1             !! time span
+    integer, intent(in) :: nsteps              !! output intervals
+    type(kin_opts_t), intent(in) :: opts       !! settings
+    real(wp), intent(out) :: qout(:, :)        !! coordinates (nq, kin_out_count)
+    real(wp), intent(out) :: qdout(:, :)       !! velocities
+    real(wp), intent(out) :: qddout(:, :)      !! accelerations
+    type(kin_report_t), intent(out) :: rep     !! what happened
+    integer, intent(out) :: status             !! MBD_OK or the failure
+    character(len=MSG_LEN), intent(out) :: msg !! explanation
+    !> design parameters (mbd_sensitivity): with them, sq, sqd, sqdd (nq, np, outputs) get
+    !! dq/dp, dq_dot/dp and dq_ddot/dp at every stored output
+    type(sens_t), intent(inout), optional :: sens
+    real(wp), intent(out), optional :: sq(:, :, :), sqd(:, :, :), sqdd(:, :, :)
+    !> progress (see kin_run)
+    integer, intent(inout), optional, volatile :: ctl(:)
     type(kin_work_t) :: w
     type(band_t) :: band
-    real(wp), allocatable :: q(:), qd(:), qdd(:), qn(:), qp(:), q3(:), q4(:), q5(:), d1(:), &
-                             qddn(:), qdn(:)
+    logical, allocatable :: post(:)   ! outputs whose sensitivities are computed at the end
+    real(wp), allocatable :: q(:), qd(:), qdd(:), qn(:), qp(:), qddn(:), qdn(:)
+    !> divided differences d_j = a[t_k, ..., t_(k-j)] of the accelerations (PRED_ORDER, nq)
+    real(wp), allocatable :: dd(:, :)
+    real(wp) :: tau(0:PRED_ORDER)  ! tau_j = t_k - t_(k-j) (tau_0 = 0)
+    ! the predictor's weights and the step and tau they were computed for
+    real(wp) :: wt(PRED_ORDER), wt_h, wt_tau(0:PRED_ORDER)
     real(wp), allocatable :: qa(:), qda(:), qdda(:), qb(:), qdb(:), qddb(:)
-    real(wp) :: t, h, hcur, hh, tt, target, lscale, ts, ta, d, hprev, hprev2
+    real(wp) :: t, h, hcur, hh, tt, target, lscale, ts, ta, d
     real(wp) :: pcur, phist(2), thist(2)   ! pivot ratios and times of the last accepted states
     integer :: nhist
     integer :: k, j, c, st, detprev, mobility, lev, nsub, nderiv, ierr
     logical :: last, ok
 
     status = MBD_OK; msg = ''
-    qout = zero; qdout = zero; qddout = zero
+    if (present(sens)) then
+      allocate (post(size(qout, 2)), stat=ierr)
+      if (ierr /= 0) then
+        call mem_fail(4.0_wp * size(qout, 2), 'the sensitivity bookkeeping', &
+                      'use fewer outputs (every)', status, msg)
+        return
+      end if
+      post = .false.
+    end if
     allocate (rep%qsing(m%nq), rep%dep(m%neq), rep%redundant(m%neq), stat=ierr)
     if (ierr /= 0) then
       call mem_fail(REAL_BYTES * (real(m%nq, wp) + m%neq), 'the kinematic report', &
@@ -823,8 +1035,8 @@ contains
     if (status /= MBD_OK) return
     lscale = m%lscale
     w%tol = opts%tol * lscale
-    allocate (q(m%nq), qd(m%nq), qdd(m%nq), qn(m%nq), qp(m%nq), q3(m%nq), stat=ierr)
-    if (ierr == 0) allocate (q4(m%nq), q5(m%nq), d1(m%nq), qddn(m%nq), qdn(m%nq), stat=ierr)
+    allocate (q(m%nq), qd(m%nq), qdd(m%nq), qn(m%nq), qp(m%nq), stat=ierr)
+    if (ierr == 0) allocate (dd(PRED_ORDER, m%nq), qddn(m%nq), qdn(m%nq), stat=ierr)
     if (ierr == 0) allocate (qa(m%nq), qda(m%nq), qdda(m%nq), qb(m%nq), stat=ierr)
     if (ierr == 0) allocate (qdb(m%nq), qddb(m%nq), stat=ierr)
     if (ierr /= 0) then
@@ -891,6 +1103,8 @@ contains
       call count_work(); return
     end if
     qout(:, 1) = q; qdout(:, 1) = qd; qddout(:, 1) = qdd
+    if (present(sens)) call kin_sens(m, w, sens, q, qd, qdd, t0, sq(:, :, 1), sqd(:, :, 1), &
+                                     sqdd(:, :, 1))
     rep%ndone = 1
     detprev = w%detsign
     call forget_derivatives()
@@ -917,14 +1131,7 @@ contains
       last = hcur >= (target - t) * (one - 1.0e-9_wp)
       hh = merge(target - t, hcur, last)
       tt = merge(target, t + hh, last)
-      ! the acceleration extrapolated by its Newton polynomial through the last four,
-      ! a(s) = a + d1 s + d2 s (s + h1) + d3 s (s + h1) (s + h1 + h2)  (d1, d2, d3 its divided
-      ! differences, h1, h2 the last steps), integrated twice: q + h q_dot + h**2/2 a
-      ! + h**3/6 (d1 + h1 d2 + h1 (h1 + h2) d3) + h**4/12 (d2 + (2 h1 + h2) d3) + h**5/20 d3
-      qp = q + hh * (qd + (half * hh) * (qdd + (hh / 3.0_wp) * (q3 + hprev * q4 + &
-                     hprev * (hprev + hprev2) * q5) + (hh * hh / 6.0_wp) * (q4 + &
-                     (2 * hprev + hprev2) * q5) + (hh**3 / 10.0_wp) * q5))
-      qn = qp
+      call predict(hh)
       call kin_newton(m, w, qn, tt, opts%maxit, st)
       ok = st == MBD_OK .and. on_branch(JUMP_RATIO) .and. w%pivratio >= NEAR_SING
       if (ok .and. .not. w%lsq) ok = w%detsign == detprev
@@ -934,13 +1141,21 @@ contains
         if (st /= MBD_OK) then
           call inconsistent(tt, lev); return
         end if
-        ok = smooth_velocity(hh) .and. all(ieee_is_finite(qdn)) .and. &
-             all(ieee_is_finite(qddn))
+        ok = smooth_velocity(hh)
       end if
       if (ok) then
         pcur = w%pivratio
         call accept()
         if (last) call store(k)
+        if (present(ctl)) then
+          ctl(1) = rep%ndone
+          if (ctl(2) /= 0) then
+            status = MBD_USER_ABORT; rep%t_fail = tt
+            write (msg, '(a,es12.5,a)') 'stopped on request at t = ', tt, &
+              ' (the outputs so far are kept)'
+            call count_work(); return
+          end if
+        end if
         call quiet_passage()
         hcur = min(2 * hh, h)
         cycle
@@ -997,6 +1212,7 @@ contains
             call hermite5(ta, qa, qda, qdda, ts + d, qn, qdn, qddn, out_time(j), qout(:, c), &
                           qdout(:, c), qddout(:, c))
             rep%ndone = max(rep%ndone, c)
+            if (present(sens)) post(c) = .true.
           end if
           if (j >= k) k = j + 1
         end if
@@ -1029,23 +1245,59 @@ contains
     !> The Newton correction is small against the predicted motion: same branch.
     logical function on_branch(ratio)
       real(wp), intent(in) :: ratio
-      on_branch = maxval(abs(qn - qp)) <= max(ratio * maxval(abs(qp - q)), 1.0e3_wp * w%tol)
+      real(wp) :: corr, motion
+      call max_diffs(size(q), qn, qp, q, corr, motion)
+      on_branch = corr <= max(ratio * motion, 1.0e3_wp * w%tol)
     end function on_branch
+
+    !> The predictor qp at t + hs: the acceleration extrapolated by its Newton polynomial
+    !! through the last PRED_ORDER + 1 accelerations, a(s) = a + sum_j d_j w_j(s) with
+    !! w_j(s) = s (s + tau_1) ... (s + tau_(j-1)), integrated twice:
+    !! qp = q + hs q_dot + hs**2/2 a + sum_j W_j d_j, W_j = int_0^hs (hs - s) w_j(s) ds
+    !! = sum_n c_jn hs**(n+2) / ((n + 1)(n + 2)) (c_jn: the coefficients of w_j). Error
+    !! O(hs**(PRED_ORDER + 3)) once the divided differences are known.
+    subroutine predict(hs)
+      real(wp), intent(in) :: hs
+      !> 1 / ((n + 1)(n + 2)), n = 0, 1, ...
+      real(wp), parameter :: RDEN(0:7) = one / [2, 6, 12, 20, 30, 42, 56, 72]
+      real(wp) :: c(0:PRED_ORDER), hp(0:PRED_ORDER), x, hpow
+      integer :: jj, n
+      ! the weights depend on hs and the last steps only: kept while those stay (to 1e-10;
+      ! any predictor is a start for Newton, whose tolerance decides)
+      if (abs(hs - wt_h) <= 1.0e-10_wp * hs .and. &
+          all(abs(tau - wt_tau) <= 1.0e-10_wp * hs)) then
+        call pred_sum(size(q), hs, half * hs * hs, wt, q, qd, qdd, dd, qp, qn)
+        return
+      end if
+      wt_h = hs; wt_tau = tau
+      hpow = hs * hs
+      do n = 0, PRED_ORDER                      ! hs**(n+2) / ((n + 1)(n + 2))
+        hp(n) = hpow * RDEN(n); hpow = hpow * hs
+      end do
+      c = zero; c(0) = one                      ! w_0 = 1
+      do jj = 1, PRED_ORDER                     ! w_j = w_(j-1) (s + tau_(j-1))
+        do n = jj, 1, -1
+          c(n) = c(n - 1) + tau(jj - 1) * c(n)
+        end do
+        c(0) = tau(jj - 1) * c(0)
+        x = zero
+        do n = 0, jj
+          x = x + c(n) * hp(n)
+        end do
+        wt(jj) = x
+      end do
+      call pred_sum(size(q), hs, hp(0), wt, q, qd, qdd, dd, qp, qn)
+    end subroutine predict
 
     !> The new velocity continues the old one: at a switch to another branch through a
     !! singular point the velocity jumps by O(|q_dot|), in smooth motion it differs from its
     !! Taylor prediction by O(h**3).
     logical function smooth_velocity(hs)
       real(wp), intent(in) :: hs
-      real(wp) :: vp, jump, dv
-      integer :: i
-      ! v_pred = q_dot + h (q_ddot + h/2 q3), element by element (no array temporary)
-      jump = zero; dv = zero
-      do i = 1, size(qd)
-        vp = qd(i) + hs * (qdd(i) + (half * hs) * q3(i))
-        jump = max(jump, abs(qdn(i) - vp)); dv = max(dv, abs(vp - qd(i)))
-      end do
-      smooth_velocity = jump <= VJUMP_RATIO * (maxval(abs(qd)) + dv) + 1.0e3_wp * w%tol
+      real(wp) :: jump, dv, vmax, fin
+      call velocity_jump(size(q), hs, qd, qdd, dd, qdn, qddn, jump, dv, vmax, fin)
+      smooth_velocity = jump <= VJUMP_RATIO * (vmax + dv) + 1.0e3_wp * w%tol .and. &
+                        fin == zero
     end function smooth_velocity
 
     !> One more Newton correction at tp (when J is poorly conditioned).
@@ -1080,7 +1332,7 @@ contains
     end function anchor
 
     subroutine forget_derivatives()
-      q3 = zero; q4 = zero; q5 = zero; hprev = zero; hprev2 = zero; nderiv = 0
+      dd = zero; tau = zero; nderiv = 0; wt_h = -one
       nhist = 0
     end subroutine forget_derivatives
 
@@ -1128,24 +1380,23 @@ contains
       if (anchor(tx)) pivot_at = w%pivratio
     end function pivot_at
 
+    !> Take the step to (tt, qn, qdn, qddn): the divided differences of the accelerations with
+    !! the new one, d_j <- (d_(j-1)new - d_(j-1)old) / (t_(k+1) - t_(k+1-j)) (d_0 = q_ddot),
+    !! each once j + 1 accelerations are known; tau_j <- hs + tau_(j-1).
     subroutine accept()
-      ! divided differences of the accelerations: d1 = a[k+1, k], d2 = a[k+1, k, k-1],
-      ! d3 = a[k+1, k, k-1, k-2] (each valid once enough accelerations are known)
-      d1 = (qddn - qdd) / (tt - t)
-      if (nderiv >= 2) then
-        q5 = ((d1 - q3) / (tt - t + hprev) - q4) / (tt - t + hprev + hprev2)
-      else
-        q5 = zero
-      end if
-      if (nderiv >= 1) then
-        q4 = (d1 - q3) / (tt - t + hprev)
-      else
-        q4 = zero
-      end if
-      q3 = d1
-      hprev2 = hprev; hprev = tt - t
+      real(wp) :: rden(PRED_ORDER), hs
+      integer :: jj
+      hs = tt - t
+      do jj = 1, PRED_ORDER           ! d_j stays zero until j + 1 accelerations are known
+        rden(jj) = zero
+        if (jj <= nderiv + 1) rden(jj) = one / (hs + tau(jj - 1))
+      end do
+      call accept_state(size(q), rden, qn, qdn, qddn, q, qd, qdd, dd)
+      do jj = PRED_ORDER, 1, -1
+        tau(jj) = hs + tau(jj - 1)
+      end do
       nderiv = nderiv + 1
-      q = qn; qd = qdn; qdd = qddn; t = tt
+      t = tt
     end subroutine accept
 
     subroutine store(kk)
@@ -1154,7 +1405,9 @@ contains
       nsub = 0
       cc = column(kk)
       if (cc > 0) then
-        qout(:, cc) = q; qdout(:, cc) = qd; qddout(:, cc) = qdd
+        call copy3(size(q), q, qd, qdd, qout(:, cc), qdout(:, cc), qddout(:, cc))
+        if (present(sens)) call kin_sens(m, w, sens, q, qd, qdd, t, sq(:, :, cc), &
+                                         sqd(:, :, cc), sqdd(:, :, cc))
         if (w%pivratio < ANCHOR_PIV) call refine_output(cc)
         rep%ndone = cc
       end if
@@ -1182,6 +1435,7 @@ contains
       end do
       call hermite5(t - dd, qa, qda, qdda, t + dd, qn, qdn, qddn, t, qout(:, cc), &
                     qdout(:, cc), qddout(:, cc))
+      if (present(sens)) post(cc) = .true.
     end subroutine refine_output
 
     !> Redundant constraints disagree at position (0), velocity (1) or acceleration (2)
@@ -1202,10 +1456,134 @@ contains
     end subroutine inconsistent
 
     subroutine count_work()
+      integer :: cc, st3
       rep%newton_its = w%newton_its; rep%lu_count = w%lu_count
+      if (.not. allocated(post)) return
+      ! interpolated outputs: sensitivities from a factorization at the output itself
+      do cc = 1, min(rep%ndone, size(post))
+        if (.not. post(cc)) cycle
+        tt = t0 + (t1 - t0) * (real(min((cc - 1) * opts%every, nsteps), wp) / max(nsteps, 1))
+        if (cc == size(qout, 2)) tt = t1
+        call assemble_j(m, w, qout(:, cc), w%qz, tt)
+        call factor(w, st3)
+        if (st3 == MBD_OK) call kin_sens(m, w, sens, qout(:, cc), qdout(:, cc), qddout(:, cc), &
+                                         tt, sq(:, :, cc), sqd(:, :, cc), sqdd(:, :, cc))
+      end do
+      post = .false.
     end subroutine count_work
 
-  end subroutine kin_run
+  end subroutine kin_loop
+
+  !> Sensitivities at a converged state (q, q_dot, q_ddot) whose J factors are in w:
+  !! J s = -Phi_p, J s_dot = nu_p - J_p q_dot - Hv s, J s_ddot = gamma_p - J_p q_ddot - Ha s
+  !! - 2 Hv s_dot (mbd_sensitivity), three solves with the same factors per parameter.
+  subroutine kin_sens(m, w, s, q, qd, qdd, t, sq, sqd, sqdd)
+    type(model_t), intent(in) :: m           !! model
+    type(kin_work_t), intent(inout) :: w     !! work arrays with the factors of J(q)
+    type(sens_t), intent(inout) :: s         !! parameters and blocks
+    real(wp), intent(in) :: q(:), qd(:), qdd(:)  !! state and accelerations
+    real(wp), intent(in) :: t                !! time
+    real(wp), intent(out) :: sq(:, :), sqd(:, :), sqdd(:, :)  !! (nq, np)
+    s%cb = w%asm%cb; s%sb = w%asm%sb          ! the angles' cos and sin of the assembly at q
+    call sens_hessian(m, s, q, qd, qdd, t)
+    call sens_params(m, s, q, qd, qdd, t)
+    call sens_kin_rhs(s, 1, sq, sqd, s%rhs)
+    call solve_cols(w, s%rhs, sq)
+    call sens_kin_rhs(s, 2, sq, sqd, s%rhs)
+    call solve_cols(w, s%rhs, sqd)
+    call sens_kin_rhs(s, 3, sq, sqd, s%rhs)
+    call solve_cols(w, s%rhs, sqdd)
+  end subroutine kin_sens
+
+  !> The predictor's sum qp = q + hs q_dot + hp0 q_ddot + sum_j wt_j d_j; qn = qp (explicit
+  !! shapes: the loops of the time step see plain arrays).
+  pure subroutine pred_sum(n, hs, hp0, wt, q, qd, qdd, dd, qp, qn)
+    integer, intent(in) :: n
+    real(wp), intent(in) :: hs, hp0, wt(PRED_ORDER), q(n), qd(n), qdd(n), dd(PRED_ORDER, n)
+    real(wp), intent(out) :: qp(n), qn(n)
+    real(wp) :: x
+    integer :: i, j
+    do i = 1, n
+      x = hs * qd(i) + hp0 * qdd(i)
+      do j = 1, PRED_ORDER
+        x = x + wt(j) * dd(j, i)
+      end do
+      qp(i) = q(i) + x; qn(i) = qp(i)
+    end do
+  end subroutine pred_sum
+
+  !> The accepted state (qn, qdn, qddn) becomes (q, qd, qdd); the divided differences take the
+  !! new acceleration: d_j <- (d_(j-1)new - d_(j-1)old) rden_j (d_0 = q_ddot).
+  pure subroutine accept_state(n, rden, qn, qdn, qddn, q, qd, qdd, dd)
+    integer, intent(in) :: n
+    real(wp), intent(in) :: rden(PRED_ORDER), qn(n), qdn(n), qddn(n)
+    real(wp), intent(inout) :: q(n), qd(n), qdd(n), dd(PRED_ORDER, n)
+    real(wp) :: dn, dnew, dold
+    integer :: i, j
+    do i = 1, n
+      dnew = qddn(i); dold = qdd(i)
+      do j = 1, PRED_ORDER
+        dn = (dnew - dold) * rden(j)
+        dold = dd(j, i); dd(j, i) = dn; dnew = dn
+      end do
+      q(i) = qn(i); qd(i) = qdn(i); qdd(i) = qddn(i)
+    end do
+  end subroutine accept_state
+
+  !> corr = max |qn - qp| (the Newton correction), motion = max |qp - q| (the predicted one).
+  pure subroutine max_diffs(n, qn, qp, q, corr, motion)
+    integer, intent(in) :: n
+    real(wp), intent(in) :: qn(n), qp(n), q(n)
+    real(wp), intent(out) :: corr, motion
+    integer :: i
+    corr = zero; motion = zero
+    do i = 1, n
+      corr = max(corr, abs(qn(i) - qp(i))); motion = max(motion, abs(qp(i) - q(i)))
+    end do
+  end subroutine max_diffs
+
+  !> The velocity against its prediction v_p = q_dot + h (q_ddot + h/2 d_1): jump =
+  !! max |qdn - v_p|, dv = max |v_p - q_dot|, vmax = max |q_dot|; fin is 0 when qdn and qddn
+  !! are finite, NaN otherwise.
+  pure subroutine velocity_jump(n, hs, qd, qdd, dd, qdn, qddn, jump, dv, vmax, fin)
+    integer, intent(in) :: n
+    real(wp), intent(in) :: hs, qd(n), qdd(n), dd(PRED_ORDER, n), qdn(n), qddn(n)
+    real(wp), intent(out) :: jump, dv, vmax, fin
+    real(wp) :: vp
+    integer :: i
+    jump = zero; dv = zero; vmax = zero; fin = zero
+    do i = 1, n
+      vp = qd(i) + hs * (qdd(i) + (half * hs) * dd(1, i))
+      jump = max(jump, abs(qdn(i) - vp)); dv = max(dv, abs(vp - qd(i)))
+      vmax = max(vmax, abs(qd(i)))
+      fin = fin + (qdn(i) - qdn(i)) + (qddn(i) - qddn(i))    ! 0, or NaN if not finite
+    end do
+  end subroutine velocity_jump
+
+  !> The Newton correction dq is within RES_ULPS units in the last place of each coordinate:
+  !! |dq_i| <= RES_ULPS eps max(|q_i|, 1).
+  pure logical function below_resolution(n, q, dq) result(below)
+    integer, intent(in) :: n
+    real(wp), intent(in) :: q(n), dq(n)
+    real(wp), parameter :: ULP = RES_ULPS * epsilon(one)
+    integer :: i
+    below = .false.
+    do i = 1, n
+      if (abs(dq(i)) > ULP * max(abs(q(i)), one)) return
+    end do
+    below = .true.
+  end function below_resolution
+
+  !> x = a, y = b, z = c.
+  pure subroutine copy3(n, a, b, c, x, y, z)
+    integer, intent(in) :: n
+    real(wp), intent(in) :: a(n), b(n), c(n)
+    real(wp), intent(out) :: x(n), y(n), z(n)
+    integer :: i
+    do i = 1, n
+      x(i) = a(i); y(i) = b(i); z(i) = c(i)
+    end do
+  end subroutine copy3
 
   !> Stored outputs of a run of nsteps intervals keeping every e-th (and the last).
   pure integer function kin_out_count(nsteps, e) result(n)

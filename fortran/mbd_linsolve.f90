@@ -21,7 +21,7 @@ module mbd_linsolve
   implicit none
   private
   public :: lapack_status, lu_factor, lu_solve, lu_det_sign, svd_null, row_rank
-  public :: lu_factor_small, lu_solve_small, ls_small
+  public :: lu_factor_small, lu_solve_small, ls_small, lu_solve_rows, ls_small_cols
   public :: qr_factor, qr_solve, qr_lwork, RANK_TOL
 
   integer, parameter :: SMALL_N = 48   !! below this the unblocked dgetf2 is faster
@@ -172,6 +172,82 @@ contains
       end do
     end do
   end subroutine lu_solve_small
+
+  !> ls_small for several right-hand sides at once: min ||A X - B|| column by column, B
+  !! (m, nrhs) overwritten by X in its first n rows; ok false (A, B spoiled) when A is
+  !! numerically rank deficient.
+  pure subroutine ls_small_cols(a, b, ok)
+    real(wp), intent(inout) :: a(:, :)          !! A, overwritten by the factorization
+    real(wp), intent(inout) :: b(:, :)          !! B (m, nrhs), then X in b(1:n, :)
+    logical, intent(out) :: ok                  !! A had full column rank
+    real(wp), parameter :: LS_RTOL = 1.0e-8_wp
+    integer :: mm, n, k, j
+    real(wp) :: alpha, nrm, vtv, f, rmax, rmin
+    mm = size(a, 1); n = size(a, 2)
+    ok = .false.
+    do k = 1, n
+      nrm = norm2(a(k:mm, k))
+      alpha = -sign(nrm, a(k, k))
+      if (nrm <= zero) return
+      a(k, k) = a(k, k) - alpha
+      vtv = dot_product(a(k:mm, k), a(k:mm, k))
+      do j = k + 1, n
+        f = 2 * dot_product(a(k:mm, k), a(k:mm, j)) / vtv
+        a(k:mm, j) = a(k:mm, j) - f * a(k:mm, k)
+      end do
+      do j = 1, size(b, 2)
+        f = 2 * dot_product(a(k:mm, k), b(k:mm, j)) / vtv
+        b(k:mm, j) = b(k:mm, j) - f * a(k:mm, k)
+      end do
+      a(k, k) = alpha
+    end do
+    rmin = minval([(abs(a(k, k)), k=1, n)]); rmax = maxval([(abs(a(k, k)), k=1, n)])
+    if (rmin < LS_RTOL * rmax) return
+    do j = 1, size(b, 2)
+      do k = n, 1, -1
+        b(k, j) = (b(k, j) - dot_product(a(k, k + 1:n), b(k + 1:n, j))) / a(k, k)
+      end do
+    end do
+    ok = .true.
+  end subroutine ls_small_cols
+
+  !> Solve A X = B for several right-hand sides with LU factors (dgetf2/dgetrf or
+  !! lu_factor_small), the right-hand sides stored as rows: bt = B^T (4 k, n), so each step
+  !! of the substitutions is a vector operation over 4 of them at a time (fixed length: the
+  !! compiler unrolls it). bt is overwritten by X^T; its row count is a multiple of 4 (pad
+  !! with zero rows).
+  pure subroutine lu_solve_rows(a, ipiv, bt)
+    real(wp), intent(in) :: a(:, :)             !! LU factors
+    integer, intent(in) :: ipiv(:)              !! pivot rows
+    real(wp), intent(inout) :: bt(:, :)         !! B^T (4 k, n), then X^T
+    integer :: n, i, k, p, c
+    real(wp) :: tmp(4), f
+    n = size(a, 1)
+    do c = 1, size(bt, 1) - 3, 4
+      do k = 1, n                               ! P B (the row interchanges in order)
+        p = ipiv(k)
+        if (p /= k) then
+          tmp = bt(c:c + 3, k); bt(c:c + 3, k) = bt(c:c + 3, p); bt(c:c + 3, p) = tmp
+        end if
+      end do
+      do k = 1, n                               ! L Y = P B (zero multipliers skipped)
+        do i = k + 1, n
+          f = a(i, k)
+          if (abs(f) <= zero) cycle
+          bt(c:c + 3, i) = bt(c:c + 3, i) - f * bt(c:c + 3, k)
+        end do
+      end do
+      do k = n, 1, -1                           ! U X = Y
+        f = one / a(k, k)
+        bt(c:c + 3, k) = bt(c:c + 3, k) * f
+        do i = 1, k - 1
+          f = a(i, k)
+          if (abs(f) <= zero) cycle
+          bt(c:c + 3, i) = bt(c:c + 3, i) - f * bt(c:c + 3, k)
+        end do
+      end do
+    end do
+  end subroutine lu_solve_rows
 
   !> Least squares min ||A x - b|| for A (m x n), m >= n, of full column rank, by Householder
   !! QR in plain loops (A = Q R, x = R^-1 (Q^T b)(1:n)); no allocation. ok is false (and a, b

@@ -1,18 +1,32 @@
-!> mbd_mbdfile: read the plain-text model file written by `mbd2d export`.
+!> mbd_mbdfile: read the plain-text model file written by `mbd2d export` (docs/mbd-format.md).
 !!
-!! Format 1 (whitespace separated; '#' starts a comment line; names have no spaces):
-!!   mbd2d 1
+!! Format 2 (whitespace separated; '#' starts a comment line; names have no spaces; format 1,
+!! the kinematics-only subset, is read too):
+!!   mbd2d 2
 !!   name <model name>
-!!   analysis kinematics
-!!   t0 <time>   t_end <time>   steps <n>   tol <x>   maxit <n>   tmin <x>   (one per line)
+!!   analysis kinematics | inverse-dynamics | dynamics | statics
+!!   t0 <time>   t_end <time>   steps <n>   every <k>                  (one per line)
+!!   tol <x>   maxit <n>   tmin <x>   solver auto|dense|banded           (kinematic runs)
+!!   method generalized-alpha|dopri5|baumgarte-rk4|partitioned   rtol <x>   atol <x>   h <x>
+!!   rho_inf <x>   alpha <x>   beta <x>   max_steps <n>                  (dynamics)
+!!   t <time>                                                           (statics)
+!!   outputs <energy | multipliers | reactions | efforts ...>           (optional columns)
+!!   gravity <gx> <gy>
 !!   bodies <nb>
-!!   <name> <x0> <y0> <theta0>                       (nb lines)
+!!   <name> <x0> <y0> <theta0> [<mass> <inertia> <vx0> <vy0> <omega0>]   (nb lines)
 !!   constraints <nc>
 !!   <name> <kind> <body i> <body j> <sub a> <sub b> <offset> <length>   (nc lines)
 !!   params <np>
 !!   <np reals, any number per line, no comments inside this block>
+!!   labels <neq>
+!!   <neq row labels NAME.WORD, any number per line>
+!!   forces <nf>
+!!   <name> <kind> <body i> <body j> <offset> <length>                  (nf lines)
+!!   fparams <np>
+!!   <np reals>
 !!   end
-!! The constraint columns are the flat table of mbd_model; tol, maxit, tmin = 0 mean default.
+!! The constraint and force columns are the flat tables of mbd_model; tol, maxit, tmin, rtol,
+!! atol, h and max_steps = 0 and rho_inf, alpha, beta = -1 mean the core's defaults.
 !!
 !! Nothing in the file is trusted: every line has exactly its fields, every number is finite
 !! and in range (steps 1..MAX_STEPS, maxit 0..MAX_ITER, tol 0 or MIN_TOL..1, tmin >= 0, as the
@@ -23,19 +37,28 @@
 module mbd_mbdfile
   use mbd_kinds, only: wp, zero, one
   use mbd_status, only: MBD_OK, MBD_BAD_INPUT, MBD_NO_MEMORY, MSG_LEN
-  use mbd_model, only: NCT
+  use mbd_model, only: NCT, NFT
   use mbd_memory, only: REAL_BYTES, mem_check, mem_fail
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use, intrinsic :: iso_fortran_env, only: int64
   implicit none
   private
-  public :: NAME_LEN, MAX_STEPS, mbd_spec_t, mbd_read
+  public :: NAME_LEN, MAX_STEPS, mbd_spec_t, mbd_read, ANALYSES
 
   integer, parameter :: NAME_LEN = 64             !! longest body or constraint name
   integer, parameter :: LINE_LEN = 4096           !! longest line
   integer, parameter :: MAX_STEPS = 1000000000    !! output intervals (as the Python front end)
   integer, parameter :: MAX_ITER = 1000000        !! Newton iterations (as the Python front end)
   real(wp), parameter :: MIN_TOL = 1.0e-15_wp     !! smallest tolerance (as the Python front end)
+  integer, parameter :: INT32_MAX = huge(1)       !! largest step limit
+  !> the analyses a file can hold
+  character(len=16), parameter :: ANALYSES(4) = [character(len=16) :: 'kinematics', &
+    'inverse-dynamics', 'dynamics', 'statics']
+  !> linear solvers (codes 0, 1, 2) and dynamics methods (codes 1 .. 4) by name
+  character(len=8), parameter :: SOLVER_WORDS(0:2) = [character(len=8) :: 'auto', 'dense', &
+    'banded']
+  character(len=20), parameter :: METHOD_WORDS(4) = [character(len=20) :: &
+    'generalized-alpha', 'dopri5', 'baumgarte-rk4', 'partitioned']
 
   !> The contents of a model file (and where each part was read, for messages).
   type :: mbd_spec_t
@@ -50,6 +73,28 @@ module mbd_mbdfile
     integer, allocatable :: ctab(:, :)    !! (NCT, nc)
     integer, allocatable :: con_line(:)   !! line of each constraint
     real(wp), allocatable :: rpar(:)
+    integer :: version = 1                !! format version
+    ! settings of the analyses (0 or -1: the core's default)
+    integer :: every = 1                  !! keep every k-th output
+    integer :: solver = 0                 !! 0 auto, 1 dense, 2 banded
+    integer :: method = 2                 !! 1 generalized-alpha, 2 dopri5, 3 rk4, 4 partitioned
+    integer :: max_steps = 0              !! integrator step limit (0: default)
+    real(wp) :: rtol = zero, atol = zero, h = zero
+    real(wp) :: rho_inf = -one, alpha = -one, beta = -one
+    real(wp) :: tstat = zero              !! statics: the time of loads and drivers
+    real(wp) :: grav(2) = zero            !! gravity
+    !> optional output columns
+    logical :: out_energy = .false., out_lam = .false., out_reac = .false., out_eff = .false.
+    ! masses, forces and row labels (dynamic analyses)
+    logical :: have_masses = .false.      !! body lines carry mass, inertia and v0
+    real(wp), allocatable :: bmass(:, :)  !! (2, nb) mass, inertia
+    real(wp), allocatable :: v0(:, :)     !! (3, nb) initial velocities
+    integer :: nf = 0
+    character(len=NAME_LEN), allocatable :: force_names(:)
+    integer, allocatable :: ftab(:, :)    !! (NFT, nf)
+    real(wp), allocatable :: fpar(:)
+    integer :: nlabels = -1               !! row labels given (-1: none)
+    character(len=NAME_LEN), allocatable :: labels(:)
   end type mbd_spec_t
 
 contains
@@ -65,7 +110,8 @@ contains
     character(len=LINE_LEN) :: line
     character(len=NAME_LEN) :: key
     character(len=LINE_LEN) :: tok
-    logical :: have_header, done, seen_b, seen_c, seen_p
+    logical :: have_header, done, seen_b, seen_c, seen_p, seen_f, seen_fp, seen_l
+    real(wp) :: x
     status = MBD_OK; msg = ''
     ! first pass: the data lines (not blank, not comments) and their characters
     open (newunit=u, file=path, status='old', action='read', iostat=ios)
@@ -91,9 +137,11 @@ contains
     rewind (u)
     lineno = 0; nread = 0
     have_header = .false.; done = .false.; seen_b = .false.; seen_c = .false.
-    seen_p = .false.
+    seen_p = .false.; seen_f = .false.; seen_fp = .false.; seen_l = .false.
     allocate (spec%body_names(0), spec%con_names(0), spec%q0(3, 0), stat=ierr)
     if (ierr == 0) allocate (spec%ctab(NCT, 0), spec%con_line(0), spec%rpar(0), stat=ierr)
+    if (ierr == 0) allocate (spec%bmass(2, 0), spec%v0(3, 0), spec%force_names(0), &
+                             spec%ftab(NFT, 0), spec%fpar(0), spec%labels(0), stat=ierr)
     if (ierr /= 0) then
       call mem_fail(zero, 'the model file', 'free some memory', status, msg); close (u); return
     end if
@@ -114,10 +162,12 @@ contains
         end if
         call next_token(line, pos, tok)
         if (.not. read_int(tok, big)) big = -1
-        if (big /= 1) then
-          call fail('unsupported format version "' // trim(tok) // '" (this reader knows 1)')
+        if (big /= 1 .and. big /= 2) then
+          call fail('unsupported format version "' // trim(tok) // '" (this reader knows 1 '// &
+                    'and 2)')
           exit
         end if
+        spec%version = int(big)
         have_header = .true.
       case ('name', 'analysis')
         if (ntok /= 2) then
@@ -125,9 +175,85 @@ contains
         end if
         call next_token(line, pos, tok)
         if (key == 'name') spec%name = tok(1:NAME_LEN)
-        if (key == 'analysis') spec%analysis = tok(1:NAME_LEN)
+        if (key == 'analysis') then
+          if (.not. any(ANALYSES == tok(1:16)) .or. len_trim(tok) > 16) then
+            call fail('unknown analysis "' // trim(tok(1:40)) // '"; one of kinematics, '// &
+                      'inverse-dynamics, dynamics, statics')
+            exit
+          end if
+          spec%analysis = tok(1:NAME_LEN)
+        end if
       case ('t0', 't_end', 'tol', 'tmin')
         if (.not. one_real(spec_real(key))) exit
+      case ('rtol', 'atol', 'h', 'rho_inf', 'alpha', 'beta', 't')
+        if (.not. setting_real(x)) exit
+        select case (key)
+        case ('rtol'); spec%rtol = x
+        case ('atol'); spec%atol = x
+        case ('h'); spec%h = x
+        case ('rho_inf'); spec%rho_inf = x
+        case ('alpha'); spec%alpha = x
+        case ('beta'); spec%beta = x
+        case default; spec%tstat = x
+        end select
+      case ('every')
+        if (.not. one_int(big)) exit
+        if (big < 1 .or. big > MAX_STEPS) then
+          call fail_int('every must be a whole number from 1 to ', int(MAX_STEPS, int64), &
+                        '', big)
+          exit
+        end if
+        spec%every = int(big)
+      case ('max_steps')
+        if (.not. one_int(big)) exit
+        if (big < 0 .or. big > INT32_MAX) then
+          call fail_int('max_steps must be a whole number from 0 (default) to ', &
+                        int(INT32_MAX, int64), '', big)
+          exit
+        end if
+        spec%max_steps = int(big)
+      case ('solver', 'method')
+        if (ntok /= 2) then
+          call fail('"' // trim(key) // '" takes one word'); exit
+        end if
+        call next_token(line, pos, tok)
+        if (key == 'solver') then
+          k = word_index(SOLVER_WORDS, tok)
+          if (k < 1) then
+            call fail('unknown solver "' // trim(tok(1:40)) // '"; auto, dense or banded'); exit
+          end if
+          spec%solver = k - 1
+        else
+          k = word_index(METHOD_WORDS, tok)
+          if (k < 1) then
+            call fail('unknown method "' // trim(tok(1:40)) // '"; generalized-alpha, '// &
+                      'dopri5, baumgarte-rk4 or partitioned')
+            exit
+          end if
+          spec%method = k
+        end if
+      case ('gravity')
+        if (ntok /= 3) then
+          call fail('"gravity" takes two numbers'); exit
+        end if
+        do k = 1, 2
+          call next_token(line, pos, tok)
+          if (.not. real_ok(tok, spec%grav(k))) exit
+        end do
+      case ('outputs')
+        do k = 2, ntok
+          call next_token(line, pos, tok)
+          select case (tok)
+          case ('energy'); spec%out_energy = .true.
+          case ('multipliers'); spec%out_lam = .true.
+          case ('reactions'); spec%out_reac = .true.
+          case ('efforts'); spec%out_eff = .true.
+          case default
+            call fail('unknown output "' // trim(tok(1:40)) // '"; energy, multipliers, '// &
+                      'reactions or efforts')
+            exit
+          end select
+        end do
       case ('steps')
         if (.not. one_int(big)) exit
         if (big < 1 .or. big > MAX_STEPS) then
@@ -164,11 +290,23 @@ contains
           call where_prefix(); exit
         end if
         spec%q0 = zero
+        deallocate (spec%bmass, spec%v0)
+        allocate (spec%bmass(2, n), spec%v0(3, n), stat=ierr)
+        if (ierr /= 0) then
+          call mem_fail(real(n, wp) * 5 * REAL_BYTES, 'the bodies', 'give fewer bodies', &
+                        status, msg)
+          call where_prefix(); exit
+        end if
+        spec%bmass = zero; spec%v0 = zero
         do i = 1, n
           call next_line(ios)
           if (ios /= 0) exit
-          if (count_tokens(line) /= 4) then
-            call fail('bad body line: NAME X0 Y0 THETA0 expected'); exit
+          ntok = count_tokens(line)
+          if (i == 1) spec%have_masses = ntok == 9
+          if (ntok /= merge(9, 4, spec%have_masses)) then
+            call fail('bad body line: NAME X0 Y0 THETA0 expected, or NAME X0 Y0 THETA0 MASS '// &
+                      'INERTIA VX0 VY0 OMEGA0 on every body line')
+            exit
           end if
           pos = 1
           call next_token(line, pos, tok)
@@ -176,6 +314,17 @@ contains
           do k = 1, 3
             call next_token(line, pos, tok)
             if (.not. real_ok(tok, spec%q0(k, i))) exit
+          end do
+          if (status /= MBD_OK) exit
+          if (.not. spec%have_masses) cycle
+          do k = 1, 2
+            call next_token(line, pos, tok)
+            if (.not. real_ok(tok, spec%bmass(k, i))) exit
+          end do
+          do k = 1, 3
+            if (status /= MBD_OK) exit
+            call next_token(line, pos, tok)
+            if (.not. real_ok(tok, spec%v0(k, i))) exit
           end do
           if (status /= MBD_OK) exit
         end do
@@ -257,6 +406,101 @@ contains
           end do
           if (status /= MBD_OK) exit
         end do
+      case ('fparams')
+        if (seen_fp) then
+          call fail('"fparams" is given twice'); exit
+        end if
+        seen_fp = .true.
+        if (.not. count_ok(n, 'force parameter', 0)) exit
+        call mem_check(REAL_BYTES * n, 'the force parameters', 'give fewer forces', status, msg)
+        if (status /= MBD_OK) then
+          call where_prefix(); exit
+        end if
+        deallocate (spec%fpar)
+        allocate (spec%fpar(n), stat=ierr)
+        if (ierr /= 0) then
+          call mem_fail(REAL_BYTES * n, 'the force parameters', 'give fewer forces', status, msg)
+          call where_prefix(); exit
+        end if
+        if (.not. read_reals(spec%fpar)) exit
+      case ('labels')
+        if (seen_l) then
+          call fail('"labels" is given twice'); exit
+        end if
+        seen_l = .true.
+        if (.not. count_ok(n, 'label', 0)) exit
+        call mem_check(real(n, wp) * NAME_LEN, 'the row labels', 'give fewer constraints', &
+                       status, msg)
+        if (status /= MBD_OK) then
+          call where_prefix(); exit
+        end if
+        deallocate (spec%labels)
+        allocate (spec%labels(n), stat=ierr)
+        if (ierr /= 0) then
+          call mem_fail(real(n, wp) * NAME_LEN, 'the row labels', 'give fewer constraints', &
+                        status, msg)
+          call where_prefix(); exit
+        end if
+        spec%nlabels = n
+        i = 0
+        do while (i < n)
+          call next_line(ios)
+          if (ios /= 0) exit
+          pos = 1
+          do
+            call next_token(line, pos, tok)
+            if (len_trim(tok) == 0) exit
+            if (i == n) then
+              call fail('more labels than the label count'); exit
+            end if
+            i = i + 1
+            spec%labels(i) = tok(1:NAME_LEN)
+          end do
+          if (status /= MBD_OK) exit
+        end do
+      case ('forces')
+        if (seen_f) then
+          call fail('"forces" is given twice'); exit
+        end if
+        seen_f = .true.
+        if (.not. count_ok(n, 'force', 0)) exit
+        spec%nf = n
+        call mem_check(real(n, wp) * (NAME_LEN + 4 * NFT), 'the forces', 'give fewer forces', &
+                       status, msg)
+        if (status /= MBD_OK) then
+          call where_prefix(); exit
+        end if
+        deallocate (spec%force_names, spec%ftab)
+        allocate (spec%force_names(n), spec%ftab(NFT, n), stat=ierr)
+        if (ierr /= 0) then
+          call mem_fail(real(n, wp) * (NAME_LEN + 4 * NFT), 'the forces', 'give fewer forces', &
+                        status, msg)
+          call where_prefix(); exit
+        end if
+        spec%ftab = 0
+        do i = 1, n
+          call next_line(ios)
+          if (ios /= 0) exit
+          if (count_tokens(line) /= NFT) then
+            call fail('bad force line: NAME KIND BODY_I BODY_J OFFSET LENGTH expected'); exit
+          end if
+          pos = 1
+          call next_token(line, pos, tok)
+          spec%force_names(i) = tok(1:NAME_LEN)
+          do k = 1, NFT - 1
+            call next_token(line, pos, tok)
+            if (.not. read_int(tok, big)) then
+              call fail('"' // trim(tok) // '" is not a whole number'); exit
+            end if
+            if (abs(big) > huge(1)) then
+              call fail('"' // trim(tok(1:40)) // '": a force entry must lie within '// &
+                        '+-2147483647')
+              exit
+            end if
+            spec%ftab(k, i) = int(big)
+          end do
+          if (status /= MBD_OK) exit
+        end do
       case ('end')
         if (ntok /= 1) then
           call fail('"end" stands alone'); exit
@@ -305,7 +549,7 @@ contains
       integer(int64) :: c, room
       count_ok = .false.; nn = 0
       if (.not. one_int(c)) return
-      if (what == 'parameter') then
+      if (what == 'parameter' .or. what == 'force parameter' .or. what == 'label') then
         room = (chars_left + 1) / 2
       else
         room = ndata - nread
@@ -315,9 +559,9 @@ contains
         return
       end if
       if (c > room) then
-        if (what == 'parameter') then
-          call fail_int('more parameters than the rest of the file can hold (at most ', room, &
-                        '): the count does not match the file (truncated or edited?)', c)
+        if (what == 'parameter' .or. what == 'force parameter' .or. what == 'label') then
+          call fail_int('more ' // what // 's than the rest of the file can hold (at most ', &
+                        room, '): the count does not match the file (truncated or edited?)', c)
         else
           call fail_int('more ' // what // ' lines than the file has left (', room, &
                         '): the count does not match the file (truncated or edited?)', c)
@@ -369,6 +613,67 @@ contains
       end select
       one_real = .true.
     end function one_real
+
+    !> The keyword's one finite real, in the range of its setting (0 or -1 for the default).
+    logical function setting_real(v)
+      real(wp), intent(out) :: v
+      logical :: dflt
+      setting_real = .false.; v = zero
+      if (ntok /= 2) then
+        call fail('"' // trim(key) // '" takes one number'); return
+      end if
+      call next_token(line, pos, tok)
+      if (.not. real_ok(tok, v)) return
+      select case (key)
+      case ('rtol')
+        if (.not. (is_zero(v) .or. (v >= 1.0e-14_wp .and. v <= one))) then
+          call fail('rtol must be 0 (default) or from 1e-14 to 1'); return
+        end if
+      case ('atol')
+        if (.not. (is_zero(v) .or. (v >= 1.0e-16_wp .and. v <= 1.0e6_wp))) then
+          call fail('atol must be 0 (default) or from 1e-16 to 1e6'); return
+        end if
+      case ('h')
+        if (.not. (is_zero(v) .or. v >= 1.0e-12_wp)) then
+          call fail('h must be 0 (none) or at least 1e-12'); return
+        end if
+      case ('rho_inf')
+        dflt = v <= -one .and. v >= -one
+        if (.not. (dflt .or. (v >= zero .and. v <= one))) then
+          call fail('rho_inf must be -1 (default) or from 0 to 1'); return
+        end if
+      case ('alpha', 'beta')
+        dflt = v <= -one .and. v >= -one
+        if (.not. (dflt .or. (v >= zero .and. v <= 1.0e9_wp))) then
+          call fail(trim(key) // ' must be -1 (default) or from 0 to 1e9'); return
+        end if
+      end select
+      setting_real = .true.
+    end function setting_real
+
+    !> The numbers of a block (any number per line) into x, exactly size(x) of them.
+    logical function read_reals(xs)
+      real(wp), intent(out) :: xs(:)
+      integer :: j
+      read_reals = .false.
+      xs = zero
+      j = 0
+      do while (j < size(xs))
+        call next_line(ios)
+        if (ios /= 0) return
+        pos = 1
+        do
+          call next_token(line, pos, tok)
+          if (len_trim(tok) == 0) exit
+          if (j == size(xs)) then
+            call fail('more numbers than the count'); return
+          end if
+          j = j + 1
+          if (.not. real_ok(tok, xs(j))) return
+        end do
+      end do
+      read_reals = .true.
+    end function read_reals
 
     integer function spec_real(k2)
       character(len=*), intent(in) :: k2
@@ -423,6 +728,25 @@ contains
       msg = s
     end subroutine where_prefix
   end subroutine mbd_read
+
+  !> Position of a word in a list (0: not there).
+  pure integer function word_index(words, w) result(k)
+    character(len=*), intent(in) :: words(:)   !! the list
+    character(len=*), intent(in) :: w          !! the word
+    integer :: i
+    k = 0
+    if (len_trim(w) > len(words)) return
+    do i = 1, size(words)
+      if (words(i) == w) then
+        k = i; return
+      end if
+    end do
+  end function word_index
+
+  pure logical function is_zero(x)
+    real(wp), intent(in) :: x
+    is_zero = x <= zero .and. x >= zero
+  end function is_zero
 
   !> Number of whitespace-separated tokens in a line.
   pure integer function count_tokens(line) result(n)

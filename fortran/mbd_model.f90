@@ -16,7 +16,9 @@
 !!   bmass(2, nb)     mass and moment of inertia about the centre of mass (>= 0)
 !!   grav(2)          gravity vector
 !!   ftab(NFT, nf)    one column per force element: 1 kind, 2 body i, 3 body j (0 = ground),
-!!                    4 offset of its raw parameters in fpar, 5 their number, 6 reserved
+!!                    4 offset of its raw parameters in fpar, 5 their number, 6 the joint
+!!                    (constraint index) of a joint friction element (kind FRC_FRICTION; its
+!!                    bodies are the joint's), else 0
 !!   fpar(:)          raw force parameters (layouts in mbd_forces)
 !! Nondimensional models (model_build with nondim): the analyses work in units of the model's
 !! length scale L (lref: the largest joint point, size or position, or with forces spring
@@ -39,7 +41,8 @@ module mbd_model
                              CON_GEAR, CON_ABSOLUTE, CON_POINT_LINE, DRV_ABS, DRV_REL_DIST
   use mbd_joint_gear, only: CARRIER_SLOT
   use mbd_forces, only: force_known, force_raw_length, force_prepare, force_exponents, &
-                        FRC_TORQUE, FRC_POINT
+                        FRC_TORQUE, FRC_POINT, FRC_FRICTION, force_is_contact
+  use mbd_contact, only: friction_prepare, FRIC_STICK_SLIP
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   implicit none
   private
@@ -80,6 +83,10 @@ module mbd_model
     integer, allocatable :: floc(:, :)    !! (NLOC, nf) local slot -> global coordinate
     integer, allocatable :: fpo(:), fpn(:)  !! prepared force parameters: offset and length
     real(wp), allocatable :: fp(:)        !! prepared force parameter pool
+    integer, allocatable :: fref(:)       !! joint of a joint friction element, else 0
+    integer :: ncontact = 0               !! contact elements
+    integer :: nfric = 0                  !! joint friction elements
+    integer :: nstick = 0                 !! of which stick-slip
   end type model_t
 
 contains
@@ -123,7 +130,6 @@ contains
     logical, allocatable :: geom(:)
     real(wp) :: rref(8)
     character(len=MSG_LEN) :: sub
-    character(len=16) :: ks
 
     status = MBD_OK; msg = ''; bad = 0
     if (size(ctab, 1) /= NCT) then
@@ -137,9 +143,8 @@ contains
     if (nb > MAX_BODIES .or. nc > 3 * MAX_BODIES) then
       status = MBD_BAD_INPUT; msg = 'the model is too large for the dense solver'; return
     end if
-    if (nc < 1) then
-      status = MBD_BAD_INPUT; msg = 'the model has no joints or drivers'; return
-    end if
+    ! no constraints at all: free bodies (a dynamic model held together by contacts); the
+    ! front end allows it only then, and kinematics rejects it by its count of equations
     m%nb = nb; m%nc = nc
     allocate (m%kind(nc), m%suba(nc), m%subb(nc), m%bi(nc), m%bj(nc), stat=ierr)
     if (ierr == 0) allocate (m%row0(nc), m%nrow(nc), m%loc(NLOC, nc), stat=ierr)
@@ -163,7 +168,6 @@ contains
     do k = 1, nc
       kind = ctab(1, k); bi = ctab(2, k); bj = ctab(3, k)
       off = ctab(6, k); len = ctab(7, k)
-      write (ks, '(i0)') k
       bad = k
       if (.not. con_known(kind)) then
         status = MBD_BAD_INPUT; write (msg, '(a,i0)') 'unknown constraint kind ', kind; return
@@ -371,6 +375,8 @@ contains
       if (force_raw_length(kind, fpar(off:off + len - 1)) /= len) cycle
       if (.not. all(ieee_is_finite(fpar(off:off + len - 1)))) cycle
       call force_exponents(kind, fpar(off:off + len - 1), ex(1:len))
+      if (force_is_contact(kind)) ex(7) = 0        ! a threshold velocity, not a length
+      if (kind == FRC_FRICTION) ex(4) = 0
       if (any(ex(1:len) == -1)) &
         big = max(big, maxval(abs(fpar(off:off + len - 1)), mask=ex(1:len) == -1))
     end do
@@ -387,11 +393,12 @@ contains
     integer, intent(out) :: status              !! MBD_OK or < 0
     character(len=MSG_LEN), intent(out) :: msg  !! what is wrong
     integer, intent(out) :: bad                 !! offending force (> 0) or body (< 0)
-    integer :: k, nf, kind, bi, bj, off, len, total, ierr
+    integer :: k, nf, kind, bi, bj, off, len, total, ierr, jc
     real(wp), allocatable :: prep(:), pool(:)
     ! one force's exponents and parameters in the model's units, allocated once
-    real(wp), allocatable :: sc(:)
+    real(wp), allocatable :: sc(:), fr(:)
     integer, allocatable :: ex(:)
+    real(wp) :: meff
     character(len=MSG_LEN) :: sub
     status = MBD_OK; msg = ''; bad = 0
     if (size(bmass, 1) /= 2 .or. size(bmass, 2) /= m%nb .or. size(ftab, 1) /= NFT) then
@@ -426,12 +433,12 @@ contains
     nf = size(ftab, 2)
     m%nf = nf
     allocate (m%fkind(nf), m%fbi(nf), m%fbj(nf), m%floc(NLOC, nf), stat=ierr)
-    if (ierr == 0) allocate (m%fpo(nf), m%fpn(nf), pool(8 * nf), stat=ierr)
+    if (ierr == 0) allocate (m%fpo(nf), m%fpn(nf), m%fref(nf), pool(8 * nf), stat=ierr)
     if (ierr /= 0) then
       call mem_fail(4 * (NLOC + 5 + 16) * real(nf, wp), 'the force tables', HINT, status, msg)
       return
     end if
-    allocate (sc(size(fpar)), ex(size(fpar)), stat=ierr)
+    allocate (sc(size(fpar)), ex(size(fpar)), fr(size(fpar)), stat=ierr)
     if (ierr /= 0) then
       call mem_fail((REAL_BYTES + 4) * size(fpar), 'the force parameters', HINT, status, msg)
       return
@@ -445,6 +452,18 @@ contains
       end if
       if (bi < 0 .or. bi > m%nb .or. bj < 0 .or. bj > m%nb) then
         status = MBD_BAD_BODY; msg = 'force body index out of range'; return
+      end if
+      jc = 0
+      if (kind == FRC_FRICTION) then
+        jc = ftab(6, k)
+        if (jc < 1 .or. jc > m%nc) then
+          status = MBD_BAD_INPUT; msg = 'joint friction refers to no joint'; return
+        end if
+        if (m%kind(jc) /= CON_REVOLUTE .and. m%kind(jc) /= CON_TRANSLATIONAL) then
+          status = MBD_BAD_INPUT
+          msg = 'friction is available on revolute and translational joints'; return
+        end if
+        bi = m%bi(jc); bj = m%bj(jc)
       end if
       if (kind == FRC_TORQUE .or. kind == FRC_POINT) then
         bj = 0
@@ -463,13 +482,28 @@ contains
       if (force_raw_length(kind, fpar(off:off + len - 1)) /= len) then
         status = MBD_BAD_PARAM; msg = 'force parameters are malformed'; return
       end if
-      call force_exponents(kind, fpar(off:off + len - 1), ex(1:len))
+      call force_exponents(kind, fpar(off:off + len - 1), ex(1:len), fr(1:len))
       sc(1:len) = fpar(off:off + len - 1) * m%lref**ex(1:len)
+      if (any(abs(fr(1:len)) > 0.0_wp)) sc(1:len) = sc(1:len) * m%lref**fr(1:len)
       if (.not. all(ieee_is_finite(sc(1:len)))) then
         status = MBD_BAD_PARAM
         msg = 'a force parameter is too large for the model''s length scale'; return
       end if
-      call force_prepare(kind, sc(1:len), prep, status, sub)
+      if (kind == FRC_FRICTION) then
+        call friction_prepare(m%kind(jc) == CON_REVOLUTE, sc(1:len), prep, status, sub)
+      else
+        ! effective mass of a contact pair (ground: infinite)
+        meff = 0.0_wp
+        if (bi > 0 .and. bj > 0) then
+          if (m%mdiag(3 * bi - 2) > 0.0_wp .and. m%mdiag(3 * bj - 2) > 0.0_wp) meff = &
+            m%mdiag(3 * bi - 2) * m%mdiag(3 * bj - 2) / (m%mdiag(3 * bi - 2) + m%mdiag(3 * bj - 2))
+        else if (bi > 0) then
+          meff = m%mdiag(3 * bi - 2)
+        else if (bj > 0) then
+          meff = m%mdiag(3 * bj - 2)
+        end if
+        call force_prepare(kind, sc(1:len), prep, status, sub, meff)
+      end if
       if (status /= MBD_OK) then
         msg = sub; return
       end if
@@ -485,6 +519,12 @@ contains
       m%floc(:, k) = 0
       if (bi > 0) m%floc(1:3, k) = [3 * bi - 2, 3 * bi - 1, 3 * bi]
       if (bj > 0) m%floc(4:6, k) = [3 * bj - 2, 3 * bj - 1, 3 * bj]
+      m%fref(k) = jc
+      if (force_is_contact(kind)) m%ncontact = m%ncontact + 1
+      if (kind == FRC_FRICTION) then
+        m%nfric = m%nfric + 1
+        if (nint(prep(3)) == FRIC_STICK_SLIP) m%nstick = m%nstick + 1
+      end if
     end do
     bad = 0
     allocate (m%fp(total), stat=ierr)

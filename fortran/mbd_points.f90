@@ -25,6 +25,65 @@ module mbd_points
   public :: vsub, vadd, vscale, vdot, vcross, ssub, sadd, sscale, ssqrt, sconst
   public :: put_vec, put_scal
 
+  ! generic names: mbd_dual adds the directional-derivative versions
+  interface body_point
+    module procedure body_point_k
+  end interface body_point
+  interface body_vector
+    module procedure body_vector_k
+  end interface body_vector
+  interface curve_point
+    module procedure curve_point_k
+  end interface curve_point
+  interface curve_vector
+    module procedure curve_vector_k
+  end interface curve_vector
+  interface body_angle
+    module procedure body_angle_k
+  end interface body_angle
+  interface slot_value
+    module procedure slot_value_k
+  end interface slot_value
+  interface const_vec
+    module procedure const_vec_k
+  end interface const_vec
+  interface vsub
+    module procedure vsub_k
+  end interface vsub
+  interface vadd
+    module procedure vadd_k
+  end interface vadd
+  interface vscale
+    module procedure vscale_k
+  end interface vscale
+  interface vdot
+    module procedure vdot_k
+  end interface vdot
+  interface vcross
+    module procedure vcross_k
+  end interface vcross
+  interface ssub
+    module procedure ssub_k
+  end interface ssub
+  interface sadd
+    module procedure sadd_k
+  end interface sadd
+  interface sscale
+    module procedure sscale_k
+  end interface sscale
+  interface ssqrt
+    module procedure ssqrt_k
+  end interface ssqrt
+  interface sconst
+    module procedure sconst_k
+  end interface sconst
+  interface put_vec
+    module procedure put_vec_k
+  end interface put_vec
+  interface put_scal
+    module procedure put_scal_k
+  end interface put_scal
+
   integer, parameter :: NLOC = 7    !! local coordinate slots: body i (1-3), body j (4-6), extra (7)
   integer, parameter :: MAXROW = 3  !! most rows any constraint writes
 
@@ -89,16 +148,16 @@ contains
   end function local_state
 
   !> A constant vector (a point or a direction fixed in ground).
-  pure function const_vec(u) result(a)
+  pure function const_vec_k(u) result(a)
     real(wp), intent(in) :: u(2)  !! global components
     type(kvec) :: a
     a%v = u
-  end function const_vec
+  end function const_vec_k
 
   !> Body vector A(theta) u(alpha) with u depending on the extra slot (aslot > 0) or not.
   !! v = A u, d_theta = B u = perp(A u), d_alpha = A u1,
   !! ar = -A u thd**2 + 2 B u1 thd ald + A u2 ald**2.
-  pure function curve_vector(x, slot, aslot, u, u1, u2) result(a)
+  pure function curve_vector_k(x, slot, aslot, u, u1, u2) result(a)
     type(kloc), intent(in) :: x        !! local state
     integer, intent(in) :: slot        !! 0 ground, 1 first body, 2 second body
     integer, intent(in) :: aslot       !! 0, or the slot of the curve parameter
@@ -134,10 +193,10 @@ contains
       a%vd = a%vd + au1 * ald
       a%ar = a%ar + two * [-au1(2), au1(1)] * thd * ald + au2 * ald**2
     end if
-  end function curve_vector
+  end function curve_vector_k
 
   !> Body point r + A(theta) s(alpha) on a curve fixed in the body.
-  pure function curve_point(x, slot, aslot, s, s1, s2) result(a)
+  pure function curve_point_k(x, slot, aslot, s, s1, s2) result(a)
     type(kloc), intent(in) :: x        !! local state
     integer, intent(in) :: slot        !! 0 ground, 1 first body, 2 second body
     integer, intent(in) :: aslot       !! slot of the curve parameter
@@ -152,7 +211,7 @@ contains
     a%v = a%v + x%q(c + 1:c + 2)
     a%d(1, c + 1) = one; a%d(2, c + 2) = one
     a%vd = a%vd + x%qd(c + 1:c + 2)
-  end function curve_point
+  end function curve_point_k
 
   !> A body point's terms without the product-rule algebra (the joints that only compare
   !! points use these): P = r + A s', the theta column of its Jacobian [I, B s'], its
@@ -182,7 +241,7 @@ contains
   end subroutine point_terms
 
   !> Body point P = r + A s':  d = [I, B s'], vd = r_dot + B s' thd, ar = -A s' thd**2.
-  pure function body_point(x, slot, s) result(a)
+  pure function body_point_k(x, slot, s) result(a)
     type(kloc), intent(in) :: x        !! local state
     integer, intent(in) :: slot        !! 0 ground (s is global), 1 or 2
     real(wp), intent(in) :: s(2)       !! point in the body frame
@@ -201,19 +260,19 @@ contains
     a%d(1, c + 3) = -au(2); a%d(2, c + 3) = au(1)                ! B s' = perp(A s')
     a%vd = x%qd(c + 1:c + 2) + [-au(2), au(1)] * thd
     a%ar = -au * thd**2
-  end function body_point
+  end function body_point_k
 
   !> Body-fixed direction u = A u':  d_theta = B u', ar = -A u' thd**2.
-  pure function body_vector(x, slot, u) result(a)
+  pure function body_vector_k(x, slot, u) result(a)
     type(kloc), intent(in) :: x        !! local state
     integer, intent(in) :: slot        !! 0 ground, 1 or 2
     real(wp), intent(in) :: u(2)       !! vector in the body frame
     type(kvec) :: a
     a = curve_vector(x, slot, 0, u, [zero, zero], [zero, zero])
-  end function body_vector
+  end function body_vector_k
 
   !> The absolute angle theta of a body (zero for ground).
-  pure function body_angle(x, slot) result(a)
+  pure function body_angle_k(x, slot) result(a)
     type(kloc), intent(in) :: x        !! local state
     integer, intent(in) :: slot        !! 0 ground, 1 or 2
     type(kscal) :: a
@@ -221,50 +280,50 @@ contains
     if (slot == 0) return
     c = 3 * (slot - 1)
     a%v = x%q(c + 3); a%d(c + 3) = one; a%vd = x%qd(c + 3)
-  end function body_angle
+  end function body_angle_k
 
   !> A local coordinate as a scalar quantity (0 when the slot maps to nothing).
-  pure function slot_value(x, s) result(a)
+  pure function slot_value_k(x, s) result(a)
     type(kloc), intent(in) :: x        !! local state
     integer, intent(in) :: s           !! slot
     type(kscal) :: a
     a%v = x%q(s); a%d(s) = one; a%vd = x%qd(s)
-  end function slot_value
+  end function slot_value_k
 
   !> a - b.
-  pure function vsub(a, b) result(c)
+  pure function vsub_k(a, b) result(c)
     type(kvec), intent(in) :: a, b  !! operands
     type(kvec) :: c
     c%v = a%v - b%v; c%d = a%d - b%d; c%vd = a%vd - b%vd; c%ar = a%ar - b%ar
-  end function vsub
+  end function vsub_k
 
   !> a + b.
-  pure function vadd(a, b) result(c)
+  pure function vadd_k(a, b) result(c)
     type(kvec), intent(in) :: a, b  !! operands
     type(kvec) :: c
     c%v = a%v + b%v; c%d = a%d + b%d; c%vd = a%vd + b%vd; c%ar = a%ar + b%ar
-  end function vadd
+  end function vadd_k
 
   !> s a for a constant s.
-  pure function vscale(s, a) result(c)
+  pure function vscale_k(s, a) result(c)
     real(wp), intent(in) :: s      !! constant factor
     type(kvec), intent(in) :: a    !! vector
     type(kvec) :: c
     c%v = s * a%v; c%d = s * a%d; c%vd = s * a%vd; c%ar = s * a%ar
-  end function vscale
+  end function vscale_k
 
   !> a . b:  d = a^T db + b^T da,  ar = a.ar_b + b.ar_a + 2 a_dot.b_dot.
-  pure function vdot(a, b) result(c)
+  pure function vdot_k(a, b) result(c)
     type(kvec), intent(in) :: a, b  !! operands
     type(kscal) :: c
     c%v = dot_product(a%v, b%v)
     c%d = a%v(1) * b%d(1, :) + a%v(2) * b%d(2, :) + b%v(1) * a%d(1, :) + b%v(2) * a%d(2, :)
     c%vd = dot_product(a%v, b%vd) + dot_product(a%vd, b%v)
     c%ar = dot_product(a%v, b%ar) + dot_product(b%v, a%ar) + two * dot_product(a%vd, b%vd)
-  end function vdot
+  end function vdot_k
 
   !> a x b = a1 b2 - a2 b1, with the same product rule.
-  pure function vcross(a, b) result(c)
+  pure function vcross_k(a, b) result(c)
     type(kvec), intent(in) :: a, b  !! operands
     type(kscal) :: c
     c%v = cross(a%v, b%v)
@@ -276,63 +335,63 @@ contains
       real(wp), intent(in) :: x(2), y(2)
       cross = x(1) * y(2) - x(2) * y(1)
     end function cross
-  end function vcross
+  end function vcross_k
 
   !> a - b for scalars.
-  pure function ssub(a, b) result(c)
+  pure function ssub_k(a, b) result(c)
     type(kscal), intent(in) :: a, b  !! operands
     type(kscal) :: c
     c%v = a%v - b%v; c%d = a%d - b%d; c%vd = a%vd - b%vd; c%ar = a%ar - b%ar
-  end function ssub
+  end function ssub_k
 
   !> a + b for scalars.
-  pure function sadd(a, b) result(c)
+  pure function sadd_k(a, b) result(c)
     type(kscal), intent(in) :: a, b  !! operands
     type(kscal) :: c
     c%v = a%v + b%v; c%d = a%d + b%d; c%vd = a%vd + b%vd; c%ar = a%ar + b%ar
-  end function sadd
+  end function sadd_k
 
   !> s a for a constant s.
-  pure function sscale(s, a) result(c)
+  pure function sscale_k(s, a) result(c)
     real(wp), intent(in) :: s      !! constant factor
     type(kscal), intent(in) :: a   !! scalar
     type(kscal) :: c
     c%v = s * a%v; c%d = s * a%d; c%vd = s * a%vd; c%ar = s * a%ar
-  end function sscale
+  end function sscale_k
 
   !> A constant scalar.
-  pure function sconst(s) result(c)
+  pure function sconst_k(s) result(c)
     real(wp), intent(in) :: s   !! value
     type(kscal) :: c
     c%v = s
-  end function sconst
+  end function sconst_k
 
   !> sqrt(a):  d = a_d / (2 v),  ar = a_ar / (2 v) - a_dot**2 / (4 v**3).
-  pure function ssqrt(a) result(c)
+  pure function ssqrt_k(a) result(c)
     type(kscal), intent(in) :: a   !! argument (> 0)
     type(kscal) :: c
     c%v = sqrt(a%v)
     c%d = a%d * (half / c%v)
     c%vd = a%vd * (half / c%v)
     c%ar = a%ar * (half / c%v) - a%vd**2 / (4.0_wp * c%v**3)
-  end function ssqrt
+  end function ssqrt_k
 
   !> Write a vector quantity as two constraint rows: Phi = v, J = d, gamma = -ar.
-  pure subroutine put_vec(a, phi, jl, gam)
+  pure subroutine put_vec_k(a, phi, jl, gam)
     type(kvec), intent(in) :: a           !! the constraint vector
     real(wp), intent(inout) :: phi(:)     !! rows of Phi (2)
     real(wp), intent(inout) :: jl(:, :)   !! local Jacobian rows (2 x NLOC)
     real(wp), intent(inout) :: gam(:)     !! rows of gamma (2)
     phi(1:2) = a%v; jl(1:2, :) = a%d; gam(1:2) = -a%ar
-  end subroutine put_vec
+  end subroutine put_vec_k
 
   !> Write a scalar quantity as one constraint row.
-  pure subroutine put_scal(a, phi, jl, gam)
+  pure subroutine put_scal_k(a, phi, jl, gam)
     type(kscal), intent(in) :: a          !! the constraint scalar
     real(wp), intent(inout) :: phi        !! row of Phi
     real(wp), intent(inout) :: jl(:)      !! local Jacobian row (NLOC)
     real(wp), intent(inout) :: gam        !! row of gamma
     phi = a%v; jl = a%d; gam = -a%ar
-  end subroutine put_scal
+  end subroutine put_scal_k
 
 end module mbd_points

@@ -71,7 +71,7 @@ contains
                              ct(:, :), qt(:), ja(:, :), sv(:), u(:, :), vt(:, :), work(:), &
                              r(:), c(:), dqz(:), kv(:), cv(:)
     integer, allocatable :: ktr(:)
-    real(wp) :: v0, vt1, alpha, emax, fscale, vnoise, e0, e1, gn, pn, slope, bytes
+    real(wp) :: v0, vt1, alpha, emax, fscale, vnoise, e0, e1, gn, pn, slope, bytes, fmag
     integer :: it, ls, nfree, n, na, stp, ist, nu, nnz, nn, nf0
     logical :: local, band
     character(len=MSG_LEN) :: lmsg, what
@@ -231,6 +231,7 @@ contains
         return
       end if
       v0 = potential(qa)
+      fscale = max(fscale, fmag)           ! loads that balance each other (a contact)
       vnoise = V_NOISE * (abs(v0) + scale_of_v(qa))
       ! SVD of the active rows: J_a = U S V^T; N = the last columns of V
       if (na > 0) then
@@ -375,7 +376,7 @@ contains
     real(wp) function potential(qa)
       real(wp), intent(in) :: qa(:)
       real(wp) :: v, vl
-      call gen_forces(m, qa, w%qz, t, w%force, v, vl)
+      call gen_forces(m, qa, w%qz, t, w%force, v, vl, fmag=fmag)
       potential = v + vl
     end function potential
 

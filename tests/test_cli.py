@@ -96,3 +96,55 @@ def test_bad_steps(tmp_path: Path, steps: str) -> None:
     r = cli("kinematics", str(EX / "slider_crank.toml"), "--t-end", "1", "--steps", steps,
             "--out", str(tmp_path / "x.csv"))
     assert r.returncode == 2 and "steps" in r.stderr and "Traceback" not in r.stderr
+
+
+def test_inverse_dynamics_and_optional_columns(tmp_path: Path) -> None:
+    """inverse-dynamics writes the driver efforts by default; every result command takes the
+    optional columns, equal to the API's results."""
+    model = EX / "fourbar_masses.toml"
+    out = tmp_path / "inv.csv"
+    r = cli("inverse-dynamics", str(model), "--t-end", "1", "--steps", "20", "--out", str(out))
+    assert r.returncode == 0, r.stderr
+    header, rows = read_csv(out)
+    res = mbd2d.load(model).inverse_dynamics(1.0, 20)
+    assert header[-1] == "motor.effort" and len(header) == 1 + 27 + 1
+    np.testing.assert_array_equal(rows[:, -1], res.effort("motor"))
+    out = tmp_path / "dyn.csv"
+    r = cli("dynamics", str(EX / "pendulum_spring.toml"), "--t-end", "1", "--steps", "10",
+            "--out", str(out), "--energy", "--multipliers", "--reactions")
+    assert r.returncode == 0, r.stderr
+    header, rows = read_csv(out)
+    dyn = mbd2d.load(EX / "pendulum_spring.toml").dynamics(1.0, 10)
+    assert header[10:] == ["kinetic", "potential", "energy", "drift_position",
+                           "drift_velocity", "lambda.pivot.x", "lambda.pivot.y", "pivot.fx",
+                           "pivot.fy", "pivot.mz", "pivot.fx_j", "pivot.fy_j", "pivot.mz_j"]
+    np.testing.assert_array_equal(rows[:, 12], dyn.energy)
+    np.testing.assert_array_equal(rows[:, 15:17], dyn.lam)
+    np.testing.assert_array_equal(rows[:, 21], dyn.reaction("pivot").fy_j)
+    r = cli("kinematics", str(EX / "fourbar_grashof.toml"), "--t-end", "1", "--steps", "10",
+            "--out", str(tmp_path / "k.csv"), "--reactions")
+    assert r.returncode == 2 and "need multipliers" in " ".join(r.stderr.split())
+    out = tmp_path / "eq.csv"
+    r = cli("statics", str(EX / "pendulum_spring.toml"), "--out", str(out), "--reactions")
+    assert r.returncode == 0, r.stderr
+    header, rows = read_csv(out)
+    assert header[:6] == ["t", "bar.x", "bar.y", "bar.theta", "stable", "residual"]
+    assert rows[0, 4] == 1.0                                   # stable
+
+
+def test_export_every_analysis_from_the_command_line(tmp_path: Path) -> None:
+    for analysis, extra in (("kinematics", []), ("inverse-dynamics", ["--efforts"]),
+                            ("dynamics", ["--method", "baumgarte-rk4", "--h", "1e-3",
+                                          "--energy"]),
+                            ("statics", ["--t", "0.5", "--multipliers"])):
+        mbd = tmp_path / f"{analysis}.mbd"
+        span = [] if analysis == "statics" else ["--t-end", "1", "--steps", "10"]
+        r = cli("export", str(EX / "fourbar_masses.toml"), str(mbd), "--analysis", analysis,
+                *span, *extra)
+        assert r.returncode == 0, r.stderr
+        text = mbd.read_text()
+        assert f"\nanalysis {analysis}\n" in text
+    assert "\nmethod baumgarte-rk4\n" in (tmp_path / "dynamics.mbd").read_text()
+    r = cli("export", str(EX / "fourbar_masses.toml"), str(tmp_path / "x.mbd"), "--analysis",
+            "dynamics")
+    assert r.returncode == 2 and "needs t_end and steps" in r.stderr

@@ -118,14 +118,22 @@ def test_import_does_not_need_matplotlib() -> None:
 def test_demo_script(tmp_path: Path) -> None:
     pytest.importorskip("matplotlib")
     out = tmp_path / "pngs"
-    proc = subprocess.run([sys.executable, str(EXAMPLES / "demo.py"), "--out", str(out)],
+    proc = subprocess.run([sys.executable, str(EXAMPLES / "demo.py"), "--out", str(out),
+                           "--no-synthesis"],
                           cwd=tmp_path, capture_output=True, text=True, timeout=600)
     assert proc.returncode == 0, proc.stdout + proc.stderr
     pngs = sorted(out.glob("*.png"))
-    assert len(pngs) == 8, [p.name for p in pngs]
+    assert len(pngs) == 13, [p.name for p in pngs]
     for name in ["fourbar_seed", "fourbar_grashof", "slider_crank", "cam_follower"]:
         for kind in ["mechanism", "timeseries"]:
             p = out / f"{name}_{kind}.png"
             assert p.is_file() and p.stat().st_size > 0
+    gifs = sorted(p.name for p in out.glob("*.gif"))
+    for kind in ["mechanism", "history"]:                      # the lifting cam follower
+        assert (out / f"cam_liftoff_{kind}.png").stat().st_size > 0
     assert "Singular configuration" in proc.stdout
-    assert "summary: 4/4" in proc.stdout
+    for kind in ["curves", "sensitivity", "tolerance"]:
+        assert (out / f"design_study_{kind}.png").stat().st_size > 0
+    assert "hit a dead centre" in proc.stdout
+    assert "summary: 6/6" in proc.stdout and "GIF animations" in proc.stdout
+    assert gifs == ["cam_liftoff.gif", "fourbar_grashof.gif", "slider_crank.gif"]

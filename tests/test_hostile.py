@@ -620,8 +620,9 @@ ALL_KEYS = sorted({k for a, _ in joint_keys().values() for k in a}
 # ------------------------------------------------------------------------------------------
 # checks (run in the worker)
 # ------------------------------------------------------------------------------------------
-ALLOWED_WARNINGS = (mbd2d.RedundantConstraintWarning, mbd2d.SingularPassageWarning)
-AUTO_NAME = re.compile(r"(joint|driver|force)\d+")
+ALLOWED_WARNINGS = (mbd2d.RedundantConstraintWarning, mbd2d.SingularPassageWarning,
+                    mbd2d.LiftOffWarning)   # a cam that must pull its follower: a report
+AUTO_NAME = re.compile(r"(joint|driver|force|contact)\d+")
 FIXED_ENTRIES = {"[model]", "model", "analysis", "state", "<dict>", "<string>", "stepping",
                  "dynamics", "statics"}
 
@@ -971,7 +972,8 @@ def check_core(fn: str, args: tuple[Any, ...]) -> str:
         assert 0 <= bad <= nc, f"bad = {bad} for {nc} constraints"
         if status == 0:
             nb = _c_int(args[0])
-            assert 3 * nb <= nq <= 3 * nb + nc and 1 <= neq <= 3 * nc, \
+            # nc = 0: free bodies (a contact model), no equations
+            assert 3 * nb <= nq <= 3 * nb + nc and min(nc, 1) <= neq <= 3 * nc, \
                 f"status 0 but sizes nq = {nq}, neq = {neq} for nb = {nb}, nc = {nc}"
     elif fn == "core_eval":
         phi, jac, nu, gam, status, msg, bad = out

@@ -34,7 +34,8 @@ TIMEOUT = 30.0
 CODES = {0, 2, 3, 4}
 EXAMPLES = ["fourbar_grashof", "fourbar_seed", "fourbar_redundant", "slider_crank",
             "cam_follower", "door_two_hinges", "parallelogram_extra_link"]
-COUNT_KEYS = ("bodies", "constraints", "params", "steps", "maxit")
+COUNT_KEYS = ("bodies", "constraints", "params", "steps", "maxit", "every", "labels", "forces",
+              "fparams", "max_steps")
 # (no counts that are valid and merely large: 1e9 steps need 216 GB of outputs and more)
 HUGE = [-1, -7, -2**31, -2**31 - 1, 2**31 - 1, 2**31, 2**32 + 1, 10**9, 10**9 + 1, 10**10,
         10**12, 2**63 - 1, 2**63, 10**19, 10**30]
@@ -56,6 +57,20 @@ def bases(tmp_path_factory: pytest.TempPathFactory) -> list[bytes]:
     for k, model in enumerate(models):
         f = d / f"base{k}.mbd"
         model.export(f, t_end=1.0, steps=40)
+        out.append(f.read_bytes())
+    # every analysis of format 2, with masses, forces, settings and output columns
+    heavy = mbd2d.load(EX / "fourbar_masses.toml")
+    swing = mbd2d.load(EX / "pendulum_spring.toml")
+    cols = ["energy", "multipliers", "reactions", "efforts"]
+    for k, (model, kw) in enumerate([
+            (heavy, {"analysis": "inverse-dynamics", "t_end": 1.0, "steps": 40,
+                     "outputs": cols}),
+            (swing, {"analysis": "dynamics", "t_end": 1.0, "steps": 40,
+                     "method": "generalized-alpha", "h": 1e-3, "outputs": cols}),
+            (heavy, {"analysis": "dynamics", "t_end": 0.5, "steps": 20, "rtol": 1e-7}),
+            (swing, {"analysis": "statics", "outputs": ["multipliers", "reactions"]})]):
+        f = d / f"dyn{k}.mbd"
+        model.export(f, **kw)
         out.append(f.read_bytes())
     return out
 

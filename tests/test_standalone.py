@@ -2,15 +2,20 @@
 from __future__ import annotations
 
 import os
+import re
 import shutil
 import subprocess
 import sys
 from pathlib import Path
 
+import warnings
+
 import numpy as np
 import pytest
 
 import mbd2d
+from mbd2d.description import joints as J
+from mbd2d.description.forces import FORCE_KEYS
 from mbd2d.results import read_csv
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -71,8 +76,8 @@ def test_file_is_documented(tmp_path: Path) -> None:
     mbd = tmp_path / "m.mbd"
     mbd2d.load(EX / "cam_follower.toml").export(mbd, t_end=1.0, steps=10)
     text = mbd.read_text()
-    assert text.startswith("# mbd2d model file, format 1")
-    for key in ("bodies", "constraints", "params", "KIND: 1 revolute", "end"):
+    assert text.startswith("# mbd2d model file, format 2")
+    for key in ("bodies", "constraints", "params", "KIND (joints): 1 revolute", "end"):
         assert key in text
 
 
@@ -96,3 +101,208 @@ def test_missing_file(tmp_path: Path, solver: str) -> None:
     r = subprocess.run([solver, str(tmp_path / "none.mbd"), str(tmp_path / "o.csv")],
                        capture_output=True, text=True, timeout=60)
     assert r.returncode == 2 and "cannot open" in r.stderr
+
+
+# ----------------------------------------------------------------------------- every analysis
+from mbd2d.analysis.mbdfile import DRIVER_KINDS, FORCE_KINDS, JOINT_KINDS  # noqa: E402
+
+ALL = ["energy", "multipliers", "reactions", "efforts"]
+
+
+def solve_and_compare(tmp_path: Path, exe: str, model: mbd2d.Model, py_result,
+                      name: str, **export) -> str:
+    """Export, run mbd2d-solve, and compare its CSV with the Python result's: the same
+    header, the same numbers to 1e-12 (relative, with an absolute floor of 1e-12 times the
+    column's largest value) and, as both write '%.16e', the same text. Returns the CSV."""
+    mbd = tmp_path / f"{name}.mbd"
+    model.export(mbd, **export)
+    out = tmp_path / f"{name}_solve.csv"
+    r = subprocess.run([exe, str(mbd), str(out)], capture_output=True, text=True,
+                       timeout=120)
+    assert r.returncode == 0, r.stderr
+    py = tmp_path / f"{name}_python.csv"
+    py_result.to_csv(py, **{k: True for k in export.get("outputs") or []})
+    hf, rf = read_csv(out)
+    hp, rp = read_csv(py)
+    assert hf == hp
+    assert rf.shape == rp.shape
+    scale = np.maximum(np.abs(rp).max(axis=0), 1.0)
+    np.testing.assert_allclose(rf, rp, rtol=1e-12, atol=0)
+    assert np.all(np.abs(rf - rp) <= 1e-12 * scale)
+    assert out.read_text() == py.read_text()
+    return out.read_text()
+
+
+@pytest.mark.parametrize("name, every, solver_name", [("fourbar_grashof", 1, "dense"),
+                                                      ("cam_follower", 7, "auto"),
+                                                      ("door_two_hinges", 3, "auto")])
+def test_kinematics_settings(tmp_path: Path, solver: str, name: str, every: int,
+                             solver_name: str) -> None:
+    model = mbd2d.load(EX / f"{name}.toml")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", mbd2d.RedundantConstraintWarning)
+        res = model.kinematics(t_end=1.0, steps=100, every=every, solver=solver_name)
+    solve_and_compare(tmp_path, solver, model, res, name, t_end=1.0, steps=100, every=every,
+                      solver=solver_name)
+
+
+def test_inverse_dynamics_every_column(tmp_path: Path, solver: str) -> None:
+    model = mbd2d.load(EX / "fourbar_masses.toml")
+    res = model.inverse_dynamics(t_end=1.0, steps=120, every=2)
+    text = solve_and_compare(tmp_path, solver, model, res, "inverse", t_end=1.0, steps=120,
+                             every=2, analysis="inverse-dynamics", outputs=ALL)
+    assert "motor.effort" in text.splitlines()[0] and "lambda.O2.x" in text.splitlines()[0]
+
+
+@pytest.mark.parametrize("method, settings", [
+    ("dopri5", {"rtol": 1e-9, "atol": 1e-10}),
+    ("dopri5", {}),
+    ("generalized-alpha", {"h": 2e-3, "rho_inf": 0.6}),
+    ("generalized-alpha", {"rtol": 1e-5, "atol": 1e-7, "rho_inf": 0.8}),
+    ("baumgarte-rk4", {"h": 1e-3, "alpha": 5.0, "beta": 8.0}),
+    ("partitioned", {"rtol": 1e-8, "atol": 1e-9, "max_steps": 10**6}),
+])
+def test_dynamics_each_method(tmp_path: Path, solver: str, method: str, settings: dict) -> None:
+    """A free four-bar with a spring (no driver) and a driven one with masses."""
+    sys.path.insert(0, str(EX))
+    import free_fourbar
+
+    for k, model in enumerate((free_fourbar.build(), mbd2d.load(EX / "fourbar_masses.toml"))):
+        res = model.dynamics(t_end=1.0, steps=50, method=method, **settings)
+        solve_and_compare(tmp_path, solver, model, res, f"dyn{k}", t_end=1.0, steps=50,
+                          analysis="dynamics", method=method, outputs=ALL, **settings)
+
+
+def test_statics_and_the_number_format(tmp_path: Path, solver: str) -> None:
+    """Statics with its columns; the time column carries numbers whose text shows the format
+    of both writers: three-digit exponents, a subnormal, the largest double, minus zero."""
+    model = mbd2d.load(EX / "pendulum_spring.toml")
+    firsts = []
+    for k, t in enumerate([0.0, 1e-200, 5e-324, 1.7976931348623157e308, -0.0, 1e150]):
+        res = model.statics(t=t)
+        text = solve_and_compare(tmp_path, solver, model, res, f"statics{k}",
+                                 analysis="statics", t=t,
+                                 outputs=["multipliers", "reactions", "efforts"])
+        firsts.append(text.splitlines()[1].split(",")[0])
+        assert float(firsts[-1]) == t
+    assert firsts[0] == "0.0000000000000000e+00" and firsts[4] == "-0.0000000000000000e+00"
+    assert re.fullmatch(r"\d\.\d{16}e-\d{3}", firsts[1]), firsts[1]     # 3-digit exponents
+    assert firsts[2] == "4.9406564584124654e-324"                      # the smallest subnormal
+    assert firsts[3] == "1.7976931348623157e+308"
+
+
+def test_partial_results_of_every_analysis_match(tmp_path: Path, solver: str) -> None:
+    """The seed four-bar with masses stops at its toggle: inverse dynamics writes the rows up
+    to there in both paths (exit code 3)."""
+    text = (EX / "fourbar_seed.toml").read_text()
+    for b in ("crank", "coupler", "rocker"):
+        text = text.replace(f'name = "{b}"\n', f'name = "{b}"\nmass = 1.0\ninertia = 0.1\n')
+    model = mbd2d.loads(text)
+    with pytest.raises(mbd2d.SingularConfigurationError) as info:
+        model.inverse_dynamics(t_end=1.0, steps=200)
+    mbd = tmp_path / "seed.mbd"
+    model.export(mbd, t_end=1.0, steps=200, analysis="inverse-dynamics", outputs=ALL)
+    out = tmp_path / "seed.csv"
+    r = subprocess.run([solver, str(mbd), str(out)], capture_output=True, text=True, timeout=60)
+    assert r.returncode == 3 and "dead centre" in r.stderr
+    py = tmp_path / "py.csv"
+    info.value.results.to_csv(py, **{k: True for k in ALL})
+    assert out.read_text() == py.read_text()
+
+
+def test_header_lists_every_kind_and_the_docs_describe_them(tmp_path: Path) -> None:
+    """The file's header and docs/mbd-format.md name every joint, driver and force kind the
+    format holds, with its code."""
+    mbd = tmp_path / "m.mbd"
+    mbd2d.load(EX / "fourbar_grashof.toml").export(mbd, t_end=1.0, steps=10)
+    text = mbd.read_text()
+    doc = (ROOT / "docs" / "mbd-format.md").read_text()
+    types = set(J.joint_keys()) | {"absolute driver", "relative-angle driver",
+                                   "relative-distance driver"} | set(FORCE_KEYS)
+    listed = {t for _, t, _ in JOINT_KINDS + DRIVER_KINDS + FORCE_KINDS}
+    assert listed == types
+    for code, kind, _ in JOINT_KINDS + DRIVER_KINDS + FORCE_KINDS:
+        assert f"{code} {kind}" in text, kind
+        assert f"| {code} | `{kind}` |" in doc, kind
+    for key in ("analysis", "every", "method", "rtol", "max_steps", "outputs", "gravity",
+                "labels", "forces", "fparams"):
+        assert f"`{key}" in doc, key
+
+
+def test_format_1_files_still_run(tmp_path: Path, solver: str) -> None:
+    """A kinematics file of format 1 (no every, solver or labels) runs as before."""
+    model = mbd2d.load(EX / "slider_crank.toml")
+    mbd = tmp_path / "v2.mbd"
+    model.export(mbd, t_end=1.0, steps=20)
+    lines = mbd.read_text().splitlines()
+    lines = lines[:next(i for i, ln in enumerate(lines) if ln.startswith("labels"))]
+    keep = [ln for ln in lines if not ln.startswith(("every", "solver", "mbd2d 2"))]
+    v1 = tmp_path / "v1.mbd"
+    v1.write_text("mbd2d 1\n" + "\n".join(keep + ["end"]) + "\n")
+    out = tmp_path / "v1.csv"
+    r = subprocess.run([solver, str(v1), str(out)], capture_output=True, text=True, timeout=60)
+    assert r.returncode == 0, r.stderr
+    _, rows = read_csv(out)
+    np.testing.assert_allclose(rows[:, 1:], model.kinematics(1.0, 20).table()[1][:, 1:],
+                               rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("change, needle", [
+    (("analysis inverse-dynamics", "analysis sideways"), "unknown analysis"),
+    (("method dopri5", "method euler"), "unknown method"),
+    (("rtol ", "rtol 5.0 #"), "rtol must be 0"),
+    (("h ", "h 1e-20 #"), "h must be 0"),
+    (("rho_inf ", "rho_inf 2.0 #"), "rho_inf must be -1"),
+    (("max_steps ", "max_steps -3 #"), "max_steps must be a whole number"),
+    (("every ", "every 0 #"), "every must be a whole number"),
+    (("outputs ", "outputs energy torque #"), "unknown output"),
+    (("forces 0", "forces 100000"), "more force lines than the file has left"),
+    (("forces 0", "forces 1"), "bad force line"),
+    (("labels 9", "labels 5"), "more labels than the label count"),
+    (("gravity ", "gravity 1.0 #"), "gravity"),
+])
+def test_bad_settings_name_their_line(tmp_path: Path, solver: str, change: tuple,
+                                      needle: str) -> None:
+    model = mbd2d.load(EX / "fourbar_masses.toml")
+    mbd = tmp_path / "d.mbd"
+    analysis = "inverse-dynamics" if "analysis" in change[0] else "dynamics"
+    model.export(mbd, t_end=1.0, steps=10, analysis=analysis, outputs=["energy"])
+    lines = mbd.read_text().splitlines()
+    i = next(k for k, ln in enumerate(lines) if ln.startswith(change[0]))
+    if change[1].endswith("#"):
+        lines[i] = change[1][:-1]
+    else:
+        lines[i] = lines[i].replace(change[0], change[1])
+    bad = tmp_path / "bad.mbd"
+    bad.write_text("\n".join(lines) + "\n")
+    r = subprocess.run([solver, str(bad), str(tmp_path / "o.csv")], capture_output=True,
+                       text=True, timeout=60)
+    assert r.returncode == 2, r.stderr
+    assert needle in r.stderr and r.stderr.startswith("mbd2d-solve: "), r.stderr
+
+
+def test_dynamics_needs_masses_in_the_file(tmp_path: Path, solver: str) -> None:
+    model = mbd2d.load(EX / "pendulum_spring.toml")
+    mbd = tmp_path / "d.mbd"
+    model.export(mbd, t_end=1.0, steps=10, analysis="dynamics")
+    lines = [" ".join(ln.split()[:4]) if ln.startswith("bar ") else ln
+             for ln in mbd.read_text().splitlines()]
+    mbd.write_text("\n".join(lines) + "\n")
+    r = subprocess.run([solver, str(mbd), str(tmp_path / "o.csv")], capture_output=True,
+                       text=True, timeout=60)
+    assert r.returncode == 2 and "needs the masses" in r.stderr
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    ({"analysis": "kinematics", "outputs": ["reactions"]}, "need multipliers"),
+    ({"analysis": "statics", "outputs": ["energy"]}, "no energy"),
+    ({"analysis": "dynamics", "method": "baumgarte-rk4"}, "give h"),
+    ({"analysis": "sideways"}, "unknown analysis"),
+    ({"analysis": "dynamics", "outputs": ["torque"]}, "unknown output"),
+    ({"analysis": "inverse-dynamics", "t_end": None}, "needs t_end"),
+])
+def test_export_checks_like_a_run(tmp_path: Path, kwargs: dict, match: str) -> None:
+    model = mbd2d.load(EX / "fourbar_masses.toml")
+    kw = {"t_end": 1.0, "steps": 10, **kwargs}
+    with pytest.raises(mbd2d.ModelError, match=match):
+        model.export(tmp_path / "x.mbd", **kw)

@@ -116,10 +116,11 @@ def _fake(model: mbd2d.Model, fn: str, status: int, nout: int = 3, finite: bool 
                     status, msg)
         if fn == "core_inverse":
             return (rows, rows * 0, rows * 0, np.zeros((neq, nout)), np.zeros((4, nout)), i10,
-                    r10, np.zeros(nq), ivec, ivec, np.zeros(64), status, msg)
+                    r10, np.zeros(nq), ivec, ivec, np.zeros(64), status, msg,
+                    np.zeros((6, 0, nout)), np.zeros((4, 1)), 0)
         if fn == "core_dynamics":
             return (rows, rows * 0, rows * 0, np.zeros((neq, nout)), np.zeros((4, nout)), i10,
-                    r10, ivec, status, msg)
+                    r10, ivec, status, msg, np.zeros((6, 0, nout)), np.zeros((4, 1)), 0)
         if fn == "core_statics":
             return p.q0, np.zeros(neq), 1, 0.0, i10, status, msg
         if fn == "core_kin_step":

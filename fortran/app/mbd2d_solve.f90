@@ -1,29 +1,54 @@
 !> mbd2d-solve: run a model file written by `mbd2d export`, without Python.
 !!
 !!   mbd2d-solve MODEL.mbd OUT.csv
-!! Writes the CSV the Python path writes (t, then NAME.x ... NAME.theta_ddot per body).
+!! Runs the file's analysis (kinematics, inverse dynamics, dynamics or statics, with its
+!! settings) and writes the CSV the Python path writes for it: t, then NAME.x ... NAME.theta_ddot
+!! per body (statics: NAME.x, NAME.y, NAME.theta, stable, residual), then the optional columns
+!! the file's "outputs" line asks for (energy, multipliers, reactions, efforts), every number
+!! as Python's "%.16e" (docs/mbd-format.md).
 !! Exit codes: 0 ok, 2 bad input (a malformed file, or counts too large for the memory),
 !! 3 singular configuration (partial output written), 4 other numerical failure (partial
-!! output written). Messages go to standard error, each starting "mbd2d-solve: ".
-!! Nothing is allocated before the counts are checked (mbd_read) and the outputs, held in
-!! memory, are checked against it (mem_check).
+!! output written when there is any). Messages go to standard error, each starting
+!! "mbd2d-solve: ". Nothing is allocated before the counts are checked (mbd_read) and the
+!! outputs, held in memory, are checked against it (mem_check).
 program mbd2d_solve
   use, intrinsic :: iso_fortran_env, only: error_unit
+  use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan
   use mbd_kinds, only: wp
   use mbd_status, only: MBD_OK, MBD_SINGULAR_CONFIG, MBD_NO_MEMORY, MSG_LEN
   use mbd_memory, only: REAL_BYTES, mem_check
   use mbd_mbdfile, only: mbd_spec_t, mbd_read
-  use mbd_constraints, only: con_nrow
-  use mbd_api, only: NINFO, api_sizes, api_kinematics
-  use mbd_kinematics, only: MAXPASS
+  use mbd_model, only: NFT
+  use mbd_constraints, only: con_nrow, con_is_driver
+  use mbd_api, only: NINFO, api_sizes, api_kinematics, api_inverse, api_dynamics, api_statics, &
+                     api_reactions
+  use mbd_kinematics, only: MAXPASS, kin_out_count
+  use mbd_integrators, only: output_index
+  use mbd_contact, only: NEO
+  use iso_c_binding, only: c_char, c_double, c_int
   implicit none
+  interface
+    !> x as "%.16e" into buf(len); the length written (number_format.c)
+    function format_e16(x, buf, len) result(n) bind(C, name='mbd_format_e16')
+      import :: c_char, c_double, c_int
+      real(c_double), value :: x
+      character(kind=c_char), intent(out) :: buf(*)
+      integer(c_int), value :: len
+      integer(c_int) :: n
+    end function format_e16
+  end interface
   type(mbd_spec_t) :: spec
   character(len=1024) :: model_path, out_path
   character(len=MSG_LEN) :: msg
-  integer :: status, bad, nq, neq, k, iinfo(NINFO), ierr
-  real(wp) :: rinfo(NINFO), bytes
-  real(wp), allocatable :: q0(:), qout(:, :), qdout(:, :), qddout(:, :), qsing(:), tpass(:)
-  integer, allocatable :: dep(:), redundant(:)
+  integer :: status, bad, nq, neq, nrows, nout, iinfo(NINFO), ierr, stable
+  real(wp) :: rinfo(NINFO), bytes, resid
+  real(wp), allocatable :: q0(:), v0(:), qout(:, :), qdout(:, :), qddout(:, :), qsing(:), &
+                           tpass(:), lamout(:, :), eout(:, :), tout(:), reac(:, :, :), &
+                           rloc(:, :, :), fpar(:), eo(:, :, :)
+  real(wp) :: evo(4, 1)
+  integer :: nev
+  integer, allocatable :: dep(:), redundant(:), ftab(:, :)
+  logical :: dynamic
 
   if (command_argument_count() /= 2) then
     if (command_argument_count() == 1) then
@@ -43,32 +68,93 @@ program mbd2d_solve
 
   call mbd_read(trim(model_path), spec, status, msg)
   if (status /= MBD_OK) call die(2, trim(msg))
-  if (spec%analysis /= 'kinematics') call die(2, 'analysis "' // trim(spec%analysis) // &
-    '" is not supported by mbd2d-solve (kinematics only)')
   call api_sizes(spec%nb, spec%ctab, spec%rpar, nq, neq, status, msg, bad)
   if (status /= MBD_OK) call die(2, where(bad, msg))
-  if (spec%steps_line == 0) call die(2, trim(model_path) // ': the file gives no "steps" line')
+  dynamic = spec%analysis /= 'kinematics'
+  if (spec%analysis /= 'statics' .and. spec%steps_line == 0) &
+    call die(2, trim(model_path) // ': the file gives no "steps" line')
+  if (dynamic .and. .not. spec%have_masses) call die(2, trim(model_path) // ': ' // &
+    trim(spec%analysis) // ' needs the masses: body lines NAME X0 Y0 THETA0 MASS INERTIA '// &
+    'VX0 VY0 OMEGA0')
+  if (.not. dynamic .and. (spec%out_energy .or. spec%out_lam .or. spec%out_reac .or. &
+                           spec%out_eff)) &
+    call die(2, trim(model_path) // ': the outputs energy, multipliers, reactions and '// &
+             'efforts need inverse-dynamics, dynamics or statics')
+  if (spec%nlabels >= 0 .and. spec%nlabels /= neq) call die(2, trim(model_path) // &
+    ': ' // trim(itoa(spec%nlabels)) // ' labels for ' // trim(itoa(neq)) // ' rows of Phi')
+  if (spec%analysis == 'statics' .and. spec%out_energy) call die(2, trim(model_path) // &
+    ': statics has no energy output')
 
-  ! the outputs (3 nq numbers per output time) are held in memory until the CSV is written
-  bytes = REAL_BYTES * (3 * real(nq, wp) * (real(spec%steps, wp) + 1) + 2 * nq + 2 * neq)
+  ! the states (q, q_dot, q_ddot), multipliers, energies and reactions of every output are
+  ! held in memory until the CSV is written
+  nrows = 1
+  if (spec%analysis /= 'statics') nrows = kin_out_count(spec%steps, spec%every)
+  bytes = REAL_BYTES * (real(nrows, wp) * (3 * real(nq, wp) + merge(neq + 5, 0, dynamic)) + &
+                        2 * nq + 2 * neq)
+  if (spec%out_reac) bytes = bytes + REAL_BYTES * 12 * real(spec%nc, wp) * nrows
   call mem_check(bytes, 'the outputs (3 x ' // trim(itoa(nq)) // ' numbers at ' // &
                  trim(itoa(spec%steps)) // ' + 1 times)', 'give fewer steps', status, msg)
   if (status /= MBD_OK) call die(2, trim(model_path) // ':' // trim(itoa(spec%steps_line)) // &
                                  ': ' // trim(msg))
-  allocate (q0(nq), qsing(nq), dep(neq), redundant(neq), tpass(MAXPASS), stat=ierr)
-  if (ierr == 0) allocate (qout(nq, spec%steps + 1), qdout(nq, spec%steps + 1), stat=ierr)
-  if (ierr == 0) allocate (qddout(nq, spec%steps + 1), stat=ierr)
+  allocate (q0(nq), v0(nq), qsing(nq), dep(neq), redundant(neq), tpass(MAXPASS), &
+            tout(nrows), lamout(neq, merge(nrows, 1, dynamic)), &
+            eout(4, merge(nrows, 1, dynamic)), stat=ierr)
+  if (ierr == 0) allocate (qout(nq, nrows), qdout(nq, nrows), qddout(nq, nrows), stat=ierr)
+  if (ierr == 0) allocate (ftab(NFT, spec%nf), fpar(max(1, size(spec%fpar))), stat=ierr)
+  if (ierr == 0) allocate (eo(NEO, spec%nf, merge(nrows, 0, spec%analysis == 'dynamics')), &
+                           stat=ierr)
   if (ierr /= 0) call die(2, trim(model_path) // ':' // trim(itoa(spec%steps_line)) // &
                           ': not enough memory for the outputs of ' // trim(itoa(spec%steps)) // &
                           ' steps; give fewer steps')
-  q0 = 0.0_wp
+  q0 = 0.0_wp; v0 = 0.0_wp
   q0(1:3 * spec%nb) = reshape(spec%q0, [3 * spec%nb])
-  call api_kinematics(spec%nb, spec%ctab, spec%rpar, q0, spec%t0, spec%t_end, spec%steps, &
-                      spec%tol, spec%maxit, spec%tmin, 1, 0, qout, qdout, qddout, iinfo, rinfo, &
-                      qsing, dep, redundant, tpass, status, msg)
-  if (status < 0) call die(2, where(iinfo(2), msg))
+  v0(1:3 * spec%nb) = reshape(spec%v0, [3 * spec%nb])
+  ftab = spec%ftab
+  fpar = 0.0_wp
+  fpar(1:size(spec%fpar)) = spec%fpar
+  qout = 0.0_wp; qdout = 0.0_wp; qddout = 0.0_wp; lamout = 0.0_wp; eout = 0.0_wp
+  iinfo = 0; rinfo = 0.0_wp
+
+  select case (spec%analysis)
+  case ('kinematics')
+    call api_kinematics(spec%nb, spec%ctab, spec%rpar, q0, spec%t0, spec%t_end, spec%steps, &
+                        spec%tol, spec%maxit, spec%tmin, spec%every, spec%solver, qout, qdout, &
+                        qddout, iinfo, rinfo, qsing, dep, redundant, tpass, status, msg)
+    nout = iinfo(1)
+  case ('inverse-dynamics')
+    call api_inverse(spec%nb, spec%ctab, spec%rpar, spec%bmass, spec%grav, ftab, fpar, q0, &
+                     spec%t0, spec%t_end, spec%steps, spec%tol, spec%every, spec%solver, qout, &
+                     qdout, qddout, lamout, eout, iinfo, rinfo, qsing, dep, redundant, tpass, &
+                     status, msg)
+    nout = iinfo(1)
+  case ('dynamics')
+    call api_dynamics(spec%nb, spec%ctab, spec%rpar, spec%bmass, spec%grav, ftab, fpar, q0, &
+                      v0, spec%t0, spec%t_end, spec%steps, spec%method, spec%rtol, spec%atol, &
+                      spec%h, spec%rho_inf, spec%alpha, spec%beta, spec%every, qout, qdout, &
+                      qddout, lamout, eout, iinfo, rinfo, redundant, status, msg, &
+                      spec%max_steps, eo, evo, nev)
+    nout = iinfo(1)
+  case default   ! statics
+    call api_statics(spec%nb, spec%ctab, spec%rpar, spec%bmass, spec%grav, ftab, fpar, q0, &
+                     spec%tstat, qout(:, 1), lamout(:, 1), stable, resid, iinfo, status, msg)
+    nout = merge(1, 0, status == MBD_OK)
+  end select
+  if (status < 0) then
+    if (iinfo(2) <= -1000000) then
+      call die(2, force_where(-1000000 - iinfo(2), msg))
+    else if (iinfo(2) < 0) then
+      call die(2, trim(model_path) // ': body "' // &
+               trim(spec%body_names(min(spec%nb, -iinfo(2)))) // '": ' // trim(msg))
+    end if
+    call die(2, where(iinfo(2), msg))
+  end if
   if (status == MBD_NO_MEMORY) call die(2, trim(msg))
-  call write_csv(trim(out_path), iinfo(1))
+  if (spec%analysis == 'statics' .and. status /= MBD_OK) call die(4, trim(msg) // &
+    ' (no equilibrium written)')
+  nout = max(0, min(nout, nrows))
+  call times()
+  if (spec%out_reac .and. nout > 0) call reactions()
+  call write_csv(trim(out_path))
   if (status == MBD_SINGULAR_CONFIG) then
     call die(3, trim(singular_message()))
   else if (status /= MBD_OK) then
@@ -76,6 +162,29 @@ program mbd2d_solve
   end if
 
 contains
+
+  !> The output times: row k holds output output_index(steps, every, k), as the core.
+  subroutine times()
+    integer :: k, ko
+    if (spec%analysis == 'statics') then
+      tout = spec%tstat; return
+    end if
+    do k = 1, nrows
+      ko = output_index(spec%steps, spec%every, k)
+      tout(k) = spec%t0 + (spec%t_end - spec%t0) * (real(ko, wp) / spec%steps)
+      if (ko == spec%steps) tout(k) = spec%t_end
+    end do
+  end subroutine times
+
+  !> The reactions of every constraint at the written rows (the core, as the Python path).
+  subroutine reactions()
+    integer :: st
+    allocate (reac(6, spec%nc, nout), rloc(6, spec%nc, nout), stat=ierr)
+    if (ierr /= 0) call die(2, 'not enough memory for the reactions; give fewer steps')
+    call api_reactions(spec%nb, spec%ctab, spec%rpar, qout(:, 1:nout), tout(1:nout), &
+                       lamout(:, 1:nout), reac, rloc, st, msg)
+    if (st /= MBD_OK) call die(4, 'the reactions could not be computed: ' // trim(msg))
+  end subroutine reactions
 
   !> "FILE:LINE: constraint "NAME": TEXT" for constraint k (TEXT alone for k outside 1..nc).
   function where(k, text) result(s)
@@ -88,6 +197,16 @@ contains
       trim(text)
   end function where
 
+  !> "FILE: force "NAME": TEXT" for force k.
+  function force_where(k, text) result(s)
+    integer, intent(in) :: k
+    character(len=*), intent(in) :: text
+    character(len=2 * MSG_LEN) :: s
+    s = trim(model_path) // ': ' // trim(text)
+    if (k > 0 .and. k <= spec%nf) s = trim(model_path) // ': force "' // &
+      trim(spec%force_names(k)) // '": ' // trim(text)
+  end function force_where
+
   function itoa(i) result(s)
     integer, intent(in) :: i
     character(len=16) :: s
@@ -97,12 +216,13 @@ contains
   function worst() result(s)
     character(len=MSG_LEN) :: s
     s = ''
+    if (spec%analysis == 'dynamics') return
     if (iinfo(4) > 0 .and. iinfo(4) <= spec%nc) s = ' ("' // trim(spec%con_names(iinfo(4))) // '")'
   end function worst
 
   function rows_written() result(s)
     character(len=MSG_LEN) :: s
-    write (s, '(a,i0,a,a)') 'Wrote ', iinfo(1), ' rows to ', trim(out_path)
+    write (s, '(a,i0,a,a)') 'Wrote ', nout, ' rows to ', trim(out_path)
   end function rows_written
 
   !> One paragraph: when, which driver, which constraints, what to do.
@@ -133,37 +253,153 @@ contains
         'the link lengths. ' // trim(rows_written()) // '.'
   end function singular_message
 
-  subroutine write_csv(path, nrows)
+  !> A number as Python's "%.16e": 17 significant digits, a lower-case e and an exponent of
+  !! at least two digits (-1.2345678901234567e-05, 0.0000000000000000e+00, 1.0e+100 style);
+  !! nan, inf and -inf as Python writes them. C's snprintf writes the digits (number_format.c):
+  !! a Fortran internal write would allocate on every call.
+  !! s(1:n) gets the text (no trim of a function result: that allocates too).
+  subroutine num(x, s, n)
+    real(wp), intent(in) :: x
+    character(len=32), intent(out) :: s
+    integer, intent(out) :: n
+    character(kind=c_char) :: buf(32)
+    integer :: i
+    if (ieee_is_nan(x)) then
+      s = 'nan'; n = 3; return
+    else if (.not. ieee_is_finite(x)) then
+      s = merge('inf ', '-inf', x > 0.0_wp); n = merge(3, 4, x > 0.0_wp); return
+    end if
+    n = max(0, min(int(format_e16(real(x, c_double), buf, 32_c_int)), 31))
+    s = ''
+    do i = 1, n
+      s(i:i) = buf(i)
+    end do
+  end subroutine num
+
+  subroutine write_csv(path)
     character(len=*), intent(in) :: path
-    integer, intent(in) :: nrows
-    integer :: u, ios, i, b
+    integer :: u, ios, i, b, k, c, r, ncols
     character(len=*), parameter :: sfx(9) = [character(len=12) :: '.x', '.y', '.theta', &
       '.x_dot', '.y_dot', '.theta_dot', '.x_ddot', '.y_ddot', '.theta_ddot']
-    real(wp) :: t
+    character(len=*), parameter :: rw(6) = [character(len=6) :: 'fx', 'fy', 'mz', 'fx_j', &
+      'fy_j', 'mz_j']
+    character(len=*), parameter :: ew(5) = [character(len=16) :: 'kinetic', 'potential', &
+      'energy', 'drift_position', 'drift_velocity']
+    real(wp), allocatable :: v(:)
+    logical :: st
+    character(len=32) :: word
+    integer :: nw
+    st = spec%analysis == 'statics'
+    ncols = 1 + merge(5, 9, st) * spec%nb + 5 + neq + 6 * spec%nc + spec%nc
+    allocate (v(ncols), stat=ierr)
+    if (ierr /= 0) call die(2, 'not enough memory to write ' // path)
     open (newunit=u, file=path, status='replace', action='write', iostat=ios)
     if (ios /= 0) call die(2, 'cannot write ' // path)
+    ! header
     write (u, '(a)', advance='no', iostat=ios) 't'
     do b = 1, spec%nb
-      do i = 1, 9
-        if (ios == 0) write (u, '(a)', advance='no', iostat=ios) ',' // &
-          trim(spec%body_names(b)) // trim(sfx(i))
+      do i = 1, merge(3, 9, st)
+        call put(u, ios, ',' // trim(spec%body_names(b)) // trim(sfx(i)))
       end do
     end do
+    if (st) call put(u, ios, ',stable,residual')
+    if (spec%out_energy) then
+      do i = 1, 5
+        call put(u, ios, ',' // trim(ew(i)))
+      end do
+    end if
+    if (spec%out_lam) then
+      do r = 1, neq
+        if (spec%nlabels == neq) then
+          call put(u, ios, ',lambda.' // trim(spec%labels(r)))
+        else
+          call put(u, ios, ',lambda.row' // trim(itoa(r)))
+        end if
+      end do
+    end if
+    if (spec%out_reac) then
+      do c = 1, spec%nc
+        do i = 1, 6
+          call put(u, ios, ',' // trim(spec%con_names(c)) // '.' // trim(rw(i)))
+        end do
+      end do
+    end if
+    if (spec%out_eff) then
+      do c = 1, spec%nc
+        if (con_is_driver(spec%ctab(1, c))) &
+          call put(u, ios, ',' // trim(spec%con_names(c)) // '.effort')
+      end do
+    end if
     if (ios == 0) write (u, '(a)', iostat=ios) ''
-    do k = 1, nrows
+    ! rows
+    do k = 1, nout
       if (ios /= 0) exit
-      t = spec%t0 + (spec%t_end - spec%t0) * (real(k - 1, wp) / max(spec%steps, 1))
-      if (k == spec%steps + 1) t = spec%t_end
-      write (u, '(es24.16e3)', advance='no', iostat=ios) t
-      do b = 1, spec%nb
-        if (ios == 0) write (u, '(9(",",es24.16e3))', advance='no', iostat=ios) &
-          qout(3 * b - 2:3 * b, k), qdout(3 * b - 2:3 * b, k), qddout(3 * b - 2:3 * b, k)
+      call row_values(k, v, i)
+      call num(v(1), word, nw)
+      write (u, '(a)', advance='no', iostat=ios) word(1:nw)
+      do c = 2, i
+        call num(v(c), word, nw)
+        if (ios == 0) write (u, '(a,a)', advance='no', iostat=ios) ',', word(1:nw)
       end do
       if (ios == 0) write (u, '(a)', iostat=ios) ''
     end do
     close (u)
     if (ios /= 0) call die(2, 'cannot write ' // path // ' (disk full?)')
   end subroutine write_csv
+
+  !> Write text without a newline (nothing once a write has failed).
+  subroutine put(u, ios, text)
+    integer, intent(in) :: u
+    integer, intent(inout) :: ios
+    character(len=*), intent(in) :: text
+    if (ios == 0) write (u, '(a)', advance='no', iostat=ios) text
+  end subroutine put
+
+  !> The numbers of row k, in the order of the header; n of them.
+  subroutine row_values(k, v, n)
+    integer, intent(in) :: k
+    real(wp), intent(out) :: v(:)
+    integer, intent(out) :: n
+    integer :: b, c, r0, nr
+    n = 1
+    v(1) = tout(k)
+    do b = 1, spec%nb
+      if (spec%analysis == 'statics') then
+        v(n + 1:n + 3) = qout(3 * b - 2:3 * b, k); n = n + 3
+      else
+        v(n + 1:n + 3) = qout(3 * b - 2:3 * b, k)
+        v(n + 4:n + 6) = qdout(3 * b - 2:3 * b, k)
+        v(n + 7:n + 9) = qddout(3 * b - 2:3 * b, k)
+        n = n + 9
+      end if
+    end do
+    if (spec%analysis == 'statics') then
+      v(n + 1) = real(stable, wp); v(n + 2) = resid; n = n + 2
+    end if
+    if (spec%out_energy) then
+      ! kinetic, potential, their sum, the drift of positions and velocities
+      v(n + 1) = eout(1, k); v(n + 2) = eout(2, k); v(n + 3) = eout(1, k) + eout(2, k)
+      v(n + 4) = eout(3, k); v(n + 5) = eout(4, k); n = n + 5
+    end if
+    if (spec%out_lam) then
+      v(n + 1:n + neq) = lamout(:, k); n = n + neq
+    end if
+    if (spec%out_reac) then
+      do c = 1, spec%nc
+        v(n + 1:n + 6) = reac(:, c, k); n = n + 6
+      end do
+    end if
+    if (spec%out_eff) then
+      r0 = 1
+      do c = 1, spec%nc
+        nr = con_nrow(spec%ctab(1, c))
+        if (con_is_driver(spec%ctab(1, c))) then
+          v(n + 1) = -lamout(r0, k); n = n + 1
+        end if
+        r0 = r0 + nr
+      end do
+    end if
+  end subroutine row_values
 
   subroutine die(code, text)
     integer, intent(in) :: code

@@ -14,19 +14,25 @@ from .analysis.stepping import KinematicStepper
 from .description.functions import Harmonic, TimeFunction
 from .errors import (AnalysisError, AssemblyError, ConvergenceError, CoreError,
                      InconsistentConstraintsError, InsufficientMemoryError, IntegrationError,
-                     MbdError, MbdWarning, ModelError, RedundantConstraintWarning,
+                     LiftOffWarning, MbdError, MbdWarning, ModelError, RedundantConstraintWarning,
                      SingularConfigurationError, SingularJacobianError, SingularPassageWarning,
                      ToggleError)
 from .model import Model, load, loads
-from .results import (BodyResult, DofReport, DynamicsResult, KinematicsResult, Reaction,
-                      StaticsResult)
+from .plots import animate, plot_mechanism, plot_paths, plot_timeseries
+from .results import (BodyResult, DofReport, DynamicsResult, KinematicsResult, PointResult,
+                      Reaction, StaticsResult)
+from .studies import ToleranceResult, grid, sweep, tolerance, write_sweep
+from .synthesis import SynthesisResult, synthesize
 
 __version__ = "0.1.0"
 
 __all__ = ["load", "loads", "Model", "TimeFunction", "Harmonic", "KinematicsResult",
-           "BodyResult", "DynamicsResult", "KinematicStepper", "StaticsResult", "Reaction",
+           "BodyResult", "PointResult", "DynamicsResult", "KinematicStepper", "StaticsResult",
+           "Reaction",
            "DofReport", "MbdError", "ModelError", "AnalysisError", "IntegrationError",
            "AssemblyError", "InconsistentConstraintsError", "ConvergenceError",
            "SingularJacobianError", "SingularConfigurationError", "ToggleError", "CoreError",
            "InsufficientMemoryError", "MbdWarning", "RedundantConstraintWarning",
-           "SingularPassageWarning", "__version__"]
+           "SingularPassageWarning", "LiftOffWarning", "plot_mechanism", "plot_paths",
+           "plot_timeseries", "animate", "sweep", "grid", "tolerance", "ToleranceResult",
+           "write_sweep", "synthesize", "SynthesisResult", "__version__"]

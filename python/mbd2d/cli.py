@@ -1,11 +1,28 @@
 """The ``mbd2d`` command line.
 
     mbd2d kinematics MODEL.toml --t-end T --steps N --out OUT.csv|OUT.npz [--every K --solver S]
-    mbd2d export MODEL.toml OUT.mbd --t-end T --steps N
-    mbd2d check MODEL.toml
+    mbd2d inverse-dynamics MODEL.toml --t-end T --steps N --out OUT.csv [--every K --solver S]
     mbd2d dynamics MODEL.toml --t-end T --steps N --out OUT.csv [--method M --rtol R --atol A --h H
                    --max-steps S --solver S]
-    mbd2d statics MODEL.toml [--t T --solver S]
+    mbd2d statics MODEL.toml [--t T --solver S] [--out OUT.csv]
+    mbd2d sweep MODEL.toml --param NAME=START:STOP:NUM ... [--grid] --t-end T --steps N
+                --out sweep.nc|sweep.csv [--analysis A --t0 T0 --every K --workers W
+                --scheduler ADDRESS]
+    mbd2d synthesize TASK.toml --out BEST.toml [--starts K --seed S --workers N]
+    mbd2d check MODEL.toml
+    mbd2d export MODEL.toml OUT.mbd [--analysis A] --t-end T --steps N [settings of A]
+    mbd2d plot MODEL.toml --t-end T --steps N --out FIG.png
+               [--what mechanism|paths|time-series|forces|energy] [--analysis A] [--trace B:X,Y]
+    mbd2d animate MODEL.toml --t-end T --steps N --out MOTION.gif|MOTION.mp4 [--fps F --speed S]
+
+The result commands take optional columns: ``--energy`` (kinetic, potential, total energy,
+drift), ``--multipliers``, ``--reactions`` and ``--efforts`` (need multipliers: inverse
+dynamics, dynamics, statics, or kinematics of a model with masses; inverse-dynamics writes
+the efforts unless ``--no-efforts``). ``export`` writes them into the file for mbd2d-solve.
+
+``plot`` and ``animate`` run the analysis ``--analysis`` (default ``auto``: kinematics of a
+driven model, with the inverse dynamics when every body has a mass; dynamics otherwise) and
+draw it; a run that stops at a dead centre is drawn up to there (exit code 3).
 
 Exit codes: 0 ok, 2 bad input, 3 singular configuration (partial output written),
 4 other numerical failure (partial output written when there is any).
@@ -15,66 +32,208 @@ from __future__ import annotations
 import argparse
 import sys
 import textwrap
-from typing import Sequence
+from typing import Any, Sequence
 
+import numpy as np
+
+from . import plots
 from .errors import (AnalysisError, InsufficientMemoryError, MbdError, ModelError,
                      SingularConfigurationError)
 from .model import Model, load
+from .description import toml_io
 from .results import StaticsResult
+from .results.files import OUTPUTS
+from .synthesis import SynthesisResult, load_task, synthesize
 
 EXIT_OK, EXIT_INPUT, EXIT_SINGULAR, EXIT_NUMERICAL = 0, 2, 3, 4
+ANALYSES = ("auto", "kinematics", "inverse-dynamics", "dynamics")
+PICTURES = ("mechanism", "paths", "time-series", "forces", "energy")
+
+
+def _span(p: argparse.ArgumentParser) -> None:
+    p.add_argument("model", help="model file (.toml)")
+    p.add_argument("--t-end", type=float, required=True, help="final time")
+    p.add_argument("--steps", type=int, required=True, help="output intervals (rows = steps + 1)")
+    p.add_argument("--t0", type=float, default=0.0, help="start time (default 0)")
+
+
+def _dynamics_settings(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--method", default=None,
+                   help="dopri5 (default), generalized-alpha, baumgarte-rk4 or partitioned")
+    p.add_argument("--rtol", type=float, default=None, help="relative tolerance (adaptive)")
+    p.add_argument("--atol", type=float, default=None, help="absolute tolerance (adaptive)")
+    p.add_argument("--h", type=float, default=None, help="fixed step (generalized-alpha, "
+                   "baumgarte-rk4)")
+    p.add_argument("--rho-inf", type=float, default=None, help="generalized-alpha rho_inf")
+    p.add_argument("--alpha", type=float, default=None, help="Baumgarte alpha")
+    p.add_argument("--beta", type=float, default=None, help="Baumgarte beta")
+    p.add_argument("--max-steps", type=int, default=None, help="limit on the integrator's "
+                   "steps, accepted and rejected (default 10000000)")
+
+
+def _columns(p: argparse.ArgumentParser, energy: bool = True, efforts: bool = False) -> None:
+    """The optional output columns."""
+    if energy:
+        p.add_argument("--energy", action="store_true",
+                       help="columns kinetic, potential, energy, drift_position, drift_velocity")
+    p.add_argument("--multipliers", action="store_true",
+                   help="a column lambda.LABEL per row of Phi")
+    p.add_argument("--reactions", action="store_true", help="columns NAME.fx, NAME.fy, "
+                   "NAME.mz (on the first body) and NAME.fx_j, NAME.fy_j, NAME.mz_j per joint "
+                   "and driver")
+    p.add_argument("--efforts", action=argparse.BooleanOptionalAction, default=efforts,
+                   help="a column NAME.effort per driver" + (" (default)" if efforts else ""))
+
+
+def _outputs(args: argparse.Namespace) -> dict[str, bool]:
+    return {k: bool(getattr(args, k, False)) for k in OUTPUTS if getattr(args, k, False)}
+
+
+def _picture_settings(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--analysis", default="auto", choices=ANALYSES,
+                   help="auto (default): kinematics of a driven model (with the inverse "
+                   "dynamics when it has masses), else dynamics")
+    p.add_argument("--trace", action="append", default=None, metavar="BODY:X,Y",
+                   help="draw the path of the point (X, Y) of BODY (repeatable)")
+    p.add_argument("--forces", action="store_true",
+                   help="draw the joints' reaction forces as arrows (needs masses)")
+    p.add_argument("--length-unit", default="m", help="unit of length on the axes (default m)")
+    p.add_argument("--dpi", type=int, default=None, help="dots per inch")
+    _dynamics_settings(p)
 
 
 def _parser() -> argparse.ArgumentParser:
     ap = argparse.ArgumentParser(prog="mbd2d", description="Planar multibody analysis.")
     sub = ap.add_subparsers(dest="command", required=True)
     k = sub.add_parser("kinematics", help="kinematic analysis of a driven model")
-    k.add_argument("model", help="model file (.toml)")
-    k.add_argument("--t-end", type=float, required=True, help="final time")
-    k.add_argument("--steps", type=int, required=True, help="output intervals (rows = steps + 1)")
-    k.add_argument("--t0", type=float, default=0.0, help="start time (default 0)")
+    _span(k)
     k.add_argument("--out", required=True, help="output file, .csv or .npz")
     k.add_argument("--tol", type=float, default=None, help="Newton tolerance (default 1e-12)")
     k.add_argument("--every", type=int, default=1, help="write every k-th row (and the last)")
     k.add_argument("--solver", default="auto", choices=["auto", "dense", "banded"],
                    help="linear solver (default auto: banded LU for large chains)")
+    _columns(k)
+    i = sub.add_parser("inverse-dynamics", help="kinematics of a driven model with masses, "
+                       "with driver efforts, multipliers and reactions")
+    _span(i)
+    i.add_argument("--out", required=True, help="output file, .csv or .npz")
+    i.add_argument("--tol", type=float, default=None, help="Newton tolerance (default 1e-12)")
+    i.add_argument("--every", type=int, default=1, help="write every k-th row (and the last)")
+    i.add_argument("--solver", default="auto", choices=["auto", "dense", "banded"],
+                   help="linear solver (default auto: banded LU for large chains)")
+    _columns(i, efforts=True)
     d = sub.add_parser("dynamics", help="forward dynamics")
-    d.add_argument("model", help="model file (.toml) with masses")
-    d.add_argument("--t-end", type=float, required=True, help="final time")
-    d.add_argument("--steps", type=int, required=True, help="output intervals (rows = steps + 1)")
-    d.add_argument("--t0", type=float, default=0.0, help="start time (default 0)")
+    _span(d)
     d.add_argument("--out", required=True, help="output file, .csv or .npz")
-    d.add_argument("--method", default=None,
-                   help="dopri5 (default), generalized-alpha, baumgarte-rk4 or partitioned")
-    d.add_argument("--rtol", type=float, default=None, help="relative tolerance (adaptive)")
-    d.add_argument("--atol", type=float, default=None, help="absolute tolerance (adaptive)")
-    d.add_argument("--h", type=float, default=None, help="fixed step (generalized-alpha, "
-                   "baumgarte-rk4)")
-    d.add_argument("--rho-inf", type=float, default=None, help="generalized-alpha rho_inf")
-    d.add_argument("--alpha", type=float, default=None, help="Baumgarte alpha")
-    d.add_argument("--beta", type=float, default=None, help="Baumgarte beta")
+    _dynamics_settings(d)
     d.add_argument("--every", type=int, default=1, help="write every k-th row (and the last)")
-    d.add_argument("--max-steps", type=int, default=None, help="limit on the integrator's "
-                   "steps, accepted and rejected (default 10000000)")
     d.add_argument("--solver", default="auto", choices=["auto", "dense", "banded"],
                    help="linear algebra (default auto: band LU for large chains)")
+    _columns(d)
     s = sub.add_parser("statics", help="static equilibrium and reactions")
     s.add_argument("model", help="model file (.toml) with masses")
     s.add_argument("--t", type=float, default=0.0, help="time at which loads and drivers are "
                    "taken (default 0)")
     s.add_argument("--solver", default="auto", choices=["auto", "dense", "banded"],
                    help="linear algebra (default auto: band LU for large chains)")
+    s.add_argument("--out", default=None, help="also write the equilibrium as CSV")
+    _columns(s, energy=False)
+    w = sub.add_parser("sweep", help="one analysis of many variants (design parameters "
+                       "swept): netCDF or CSV")
+    w.add_argument("model", help="model file (.toml)")
+    w.add_argument("--param", action="append", required=True, metavar="NAME=START:STOP:NUM",
+                   help="a design parameter (see model.parameters()) and NUM values from "
+                   "START to STOP; repeat for more parameters")
+    w.add_argument("--grid", action="store_true", help="every combination of the values "
+                   "(default: the i-th value of every parameter together; equal NUM)")
+    w.add_argument("--analysis", default="kinematics",
+                   choices=["kinematics", "inverse_dynamics", "statics", "dynamics"],
+                   help="the analysis (default kinematics)")
+    w.add_argument("--t-end", type=float, default=None, help="final time")
+    w.add_argument("--steps", type=int, default=None, help="output intervals")
+    w.add_argument("--t0", type=float, default=0.0, help="start time (statics: its time)")
+    w.add_argument("--every", type=int, default=1, help="keep every k-th row (and the last)")
+    w.add_argument("--method", default=None, help="dynamics: the integrator")
+    w.add_argument("--out", required=True, help="output file, .nc (netCDF) or .csv")
+    w.add_argument("--workers", type=int, default=None,
+                   help="local worker processes (default: every core)")
+    w.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                   help="run on the Dask cluster of this scheduler (tcp://host:8786)")
     c = sub.add_parser("check", help="degrees of freedom and redundant constraints")
     c.add_argument("model", help="model file (.toml)")
     c.add_argument("--t", type=float, default=0.0, help="time of the check (default 0)")
-    e = sub.add_parser("export", help="write a model file for the standalone mbd2d-solve")
+    e = sub.add_parser("export", help="write a model file with its analysis for the standalone "
+                       "mbd2d-solve")
     e.add_argument("model", help="model file (.toml)")
     e.add_argument("out", help="output model file (.mbd)")
-    e.add_argument("--t-end", type=float, required=True, help="final time")
-    e.add_argument("--steps", type=int, required=True, help="output intervals")
+    e.add_argument("--analysis", default="kinematics", choices=ANALYSES[1:] + ("statics",),
+                   help="the analysis mbd2d-solve runs (default kinematics)")
+    e.add_argument("--t-end", type=float, default=None, help="final time (not for statics)")
+    e.add_argument("--steps", type=int, default=None, help="output intervals")
     e.add_argument("--t0", type=float, default=0.0, help="start time (default 0)")
+    e.add_argument("--every", type=int, default=1, help="keep every k-th row (and the last)")
     e.add_argument("--tol", type=float, default=None, help="Newton tolerance (default 1e-12)")
+    e.add_argument("--solver", default="auto", choices=["auto", "dense", "banded"],
+                   help="linear solver of kinematic runs (default auto)")
+    e.add_argument("--t", type=float, default=0.0, help="statics: time of loads and drivers")
+    _dynamics_settings(e)
+    _columns(e)
+    p = sub.add_parser("plot", help="run an analysis and draw it (PNG, SVG or PDF)")
+    _span(p)
+    p.add_argument("--out", required=True, help="picture file (.png, .svg or .pdf)")
+    p.add_argument("--what", default="mechanism", choices=PICTURES,
+                   help="mechanism (default): snapshots; paths: point paths; time-series: "
+                   "positions, velocities, accelerations; forces: driver efforts and joint "
+                   "reactions; energy: energies and constraint drift")
+    _picture_settings(p)
+    a = sub.add_parser("animate", help="run an analysis and animate it (GIF or MP4)")
+    _span(a)
+    a.add_argument("--out", required=True, help="animation file (.gif, or .mp4 with ffmpeg)")
+    a.add_argument("--fps", type=float, default=30.0, help="frames per second (default 30)")
+    a.add_argument("--speed", type=float, default=1.0,
+                   help="seconds of the run per second of animation (default 1: real time)")
+    a.add_argument("--max-frames", type=int, default=300, help="at most this many frames")
+    _picture_settings(a)
+    y = sub.add_parser("synthesize", help="fit a mechanism to a task (linkage synthesis)")
+    y.add_argument("task", help="task file (.toml): model, free parameters, bounds, targets")
+    y.add_argument("--out", required=True, help="best model, written as a model file (.toml)")
+    y.add_argument("--starts", type=int, default=None, help="local solves (default: the task "
+                   "file's, else 8)")
+    y.add_argument("--seed", type=int, default=None, help="Latin-hypercube seed")
+    y.add_argument("--workers", type=int, default=1, help="local processes (default 1)")
     return ap
+
+
+def _synthesis_report(res: SynthesisResult) -> str:
+    """The best design, its error per target and the defects met, as text."""
+    lines = [f"best design: error {res.error:.6g} (sum of squared target errors), objective "
+             f"{res.objective:.6g}, {len(res.history)} local solve(s), {res.seconds:.2f} s"]
+    lines += [f"  {n:28s} = {v:.12g}" for n, v in res.values.items()]
+    lines.append("error per target: " + ", ".join(f"{e:.3g}" for e in res.residuals))
+    lines.append("target times: " + ", ".join(f"{t:.6g}" for t in res.times))
+    for name, v in res.terms.items():
+        lines.append(f"  {name}: {v:.6g}")
+    if res.rejected:
+        lines.append(f"rejected candidates: {len(res.rejected)} ("
+                     + ", ".join(f"{k} x{n}" for k, n in res.defect_reasons.items()) + ")")
+    return "\n".join(lines)
+
+
+def _synthesize(args: argparse.Namespace) -> int:
+    tf = load_task(args.task)
+    opts = dict(tf.options)
+    if args.starts is not None:
+        opts["starts"] = args.starts
+    if args.seed is not None:
+        opts["seed"] = args.seed
+    res = synthesize(tf.model, tf.free, tf.task, bounds=tf.bounds, constraints=tf.constraints,
+                     workers=args.workers, **opts)
+    print(_synthesis_report(res))
+    header = (f"mbd2d synthesize {args.task}: error {res.error:.9g}\n"
+              + "\n".join(f"{n} = {v:.15g}" for n, v in res.values.items()))
+    toml_io.dump(res.model, args.out, header=header)
+    print(f"wrote {args.out}")
+    return EXIT_OK
 
 
 def _say(text: str) -> None:
@@ -98,34 +257,174 @@ def _statics_report(model: Model, st: StaticsResult) -> str:
     return "\n".join(lines)
 
 
+def _trace(items: list[str] | None) -> list[tuple[str, tuple[float, float]]] | None:
+    """--trace BODY:X,Y entries."""
+    if not items:
+        return None
+    out = []
+    for item in items:
+        body, sep, xy = item.rpartition(":")
+        try:
+            x, y = (float(v) for v in xy.split(","))
+        except ValueError:
+            sep = ""
+        if not sep or not body:
+            raise ModelError(f"--trace takes BODY:X,Y (for example coupler:0,1), got {item!r}",
+                             "command line")
+        out.append((body, (x, y)))
+    return out
+
+
+def _dynamics_kwargs(args: argparse.Namespace) -> dict[str, Any]:
+    return {"method": args.method, "rtol": args.rtol, "atol": args.atol, "h": args.h,
+            "rho_inf": args.rho_inf, "alpha": args.alpha, "beta": args.beta,
+            "max_steps": args.max_steps}
+
+
+def _run(model: Model, args: argparse.Namespace, analysis: str) -> Any:
+    """The result of the analysis a command asks for."""
+    span = {"t_end": args.t_end, "steps": args.steps, "t0": args.t0}
+    if analysis == "auto":
+        neq, nq = model.counts()
+        analysis = "kinematics" if neq >= nq else "dynamics"
+    if analysis == "dynamics":
+        return model.dynamics(**span, every=getattr(args, "every", 1), **_dynamics_kwargs(args),
+                              solver=getattr(args, "solver", "auto"))
+    if analysis == "inverse-dynamics":
+        return model.inverse_dynamics(**span, tol=getattr(args, "tol", None),
+                                      every=getattr(args, "every", 1),
+                                      solver=getattr(args, "solver", "auto"))
+    return model.kinematics(**span, tol=getattr(args, "tol", None),
+                            every=getattr(args, "every", 1),
+                            solver=getattr(args, "solver", "auto"))
+
+
+def _picture(res: Any, args: argparse.Namespace) -> str:
+    """Draw a result as the plot or animate command asks; returns the file written."""
+    trace = _trace(args.trace)
+    extra = {} if args.dpi is None else {"dpi": args.dpi}
+    if args.command == "animate":
+        return plots.animate(res, args.out, fps=args.fps, speed=args.speed, trace=trace,
+                             forces=args.forces, max_frames=args.max_frames,
+                             length_unit=args.length_unit, **extra)
+    if args.what == "mechanism":
+        fig = plots.plot_mechanism(res, trace=trace, forces=args.forces,
+                                   length_unit=args.length_unit)
+    elif args.what == "paths":
+        fig = plots.plot_paths(res, trace, length_unit=args.length_unit)
+    else:
+        kind = {"time-series": "motion"}.get(args.what, args.what)
+        fig = plots.plot_timeseries(res, kind=kind, length_unit=args.length_unit)
+    return plots.save_figure(fig, args.out, **extra)
+
+
+def _check_out(args: argparse.Namespace) -> None:
+    if args.command in ("kinematics", "dynamics", "inverse-dynamics"):
+        ok = (".csv", ".npz")
+    elif args.command == "plot":
+        ok = (".png", ".svg", ".pdf")
+    else:
+        ok = (".gif", ".mp4")
+    if not str(args.out).lower().endswith(ok):
+        raise ModelError(f"--out must end in {' or '.join(ok)}, got {args.out!r}",
+                         "command line")
+
+
+def _write(res: Any, args: argparse.Namespace) -> str:
+    """Write a (possibly partial) result where the command puts it."""
+    if args.command in ("plot", "animate"):
+        return _picture(res, args)
+    res.save(args.out, **_outputs(args))
+    return args.out
+def _param_values(spec: str) -> tuple[str, np.ndarray]:
+    """NAME=START:STOP:NUM as the name and NUM values from START to STOP."""
+    name, eq, rng = spec.partition("=")
+    parts = rng.split(":")
+    try:
+        if not eq or len(parts) != 3:
+            raise ValueError
+        start, stop, num = float(parts[0]), float(parts[1]), int(parts[2])
+    except ValueError:
+        raise ModelError(f"--param {spec!r}: write NAME=START:STOP:NUM, for example "
+                         "joint.B.points.0.0=1.5:2.0:11", "command line") from None
+    if num < 1 or not (np.isfinite(start) and np.isfinite(stop)):
+        raise ModelError(f"--param {spec!r}: NUM must be >= 1 and START, STOP finite",
+                         "command line")
+    return name.strip(), np.linspace(start, stop, num)
+
+
+def _sweep(model: Model, args: argparse.Namespace) -> int:
+    """The sweep command: run, write, summarize."""
+    from .studies import connect, grid, sweep, write_sweep
+    if not str(args.out).endswith((".nc", ".csv")):
+        raise ModelError(f"--out must end in .nc or .csv, got {args.out!r}", "command line")
+    values = dict(_param_values(p) for p in args.param)
+    if args.grid:
+        cases = grid(values)
+    else:
+        counts = {len(v) for v in values.values()}
+        if len(counts) != 1:
+            raise ModelError("without --grid every --param needs the same NUM (the i-th "
+                             "values form case i); use --grid for every combination",
+                             "command line")
+        cases = values
+    if args.analysis == "statics":
+        kw: dict = {"t": args.t0}
+    else:
+        if args.t_end is None or args.steps is None:
+            raise ModelError(f"{args.analysis} needs --t-end and --steps", "command line")
+        kw = {"t_end": args.t_end, "steps": args.steps, "t0": args.t0, "every": args.every}
+        if args.method is not None:
+            kw["method"] = args.method
+    client = connect(args.scheduler) if args.scheduler else None
+    try:
+        ds = sweep(model, cases, args.analysis, client, workers=args.workers, **kw)
+    finally:
+        if client is not None:
+            client.close()
+    write_sweep(ds, args.out)
+    failed = int(ds.attrs["failed"])
+    print(f"wrote {ds.sizes['case']} cases ({failed} failed) to {args.out}")
+    for j in np.flatnonzero(ds.status.values != 0)[:5]:
+        _say(f"  case {int(j)}: {ds.message.values[j]}")
+    return EXIT_OK
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit code."""
     args = _parser().parse_args(argv)
     try:
+        if args.command == "synthesize":
+            return _synthesize(args)
         model = load(args.model)
         if args.command == "check":
             print(model.analyze_dof(t=args.t))
             return EXIT_OK
         if args.command == "statics":
-            print(_statics_report(model, model.statics(t=args.t, solver=args.solver)))
+            st = model.statics(t=args.t, solver=args.solver)
+            print(_statics_report(model, st))
+            if args.out is not None:
+                if not str(args.out).endswith(".csv"):
+                    raise ModelError(f"--out must end in .csv, got {args.out!r}", "command line")
+                st.to_csv(args.out, **_outputs(args))
+                print(f"wrote the equilibrium to {args.out}")
             return EXIT_OK
         if args.command == "export":
-            model.export(args.out, t_end=args.t_end, steps=args.steps, t0=args.t0, tol=args.tol)
-            print(f"wrote {args.out}")
+            extra = _dynamics_kwargs(args) if args.analysis == "dynamics" else {}
+            model.export(args.out, t_end=args.t_end, steps=args.steps, t0=args.t0, tol=args.tol,
+                         analysis=args.analysis, every=args.every, solver=args.solver, t=args.t,
+                         outputs=list(_outputs(args)), **extra)
+            print(f"wrote {args.out} ({args.analysis}; run it with mbd2d-solve "
+                  f"{args.out} OUT.csv)")
             return EXIT_OK
-        if not str(args.out).endswith((".csv", ".npz")):
-            raise ModelError(f"--out must end in .csv or .npz, got {args.out!r}", "command line")
-        if args.command == "dynamics":
-            res = model.dynamics(t_end=args.t_end, steps=args.steps, t0=args.t0,
-                                 method=args.method, rtol=args.rtol, atol=args.atol, h=args.h,
-                                 rho_inf=args.rho_inf, alpha=args.alpha, beta=args.beta,
-                                 every=args.every, max_steps=args.max_steps,
-                                 solver=args.solver)
-        else:
-            res = model.kinematics(t_end=args.t_end, steps=args.steps, t0=args.t0, tol=args.tol,
-                                   every=args.every, solver=args.solver)
-        res.save(args.out)
-        print(f"wrote {len(res.t)} rows to {args.out}")
+        if args.command == "sweep":
+            return _sweep(model, args)
+        _check_out(args)
+        _trace(getattr(args, "trace", None))       # a malformed --trace fails before the run
+        res = _run(model, args, getattr(args, "analysis", args.command))
+        _write(res, args)
+        what = "rows, drawn," if args.command in ("plot", "animate") else "rows"
+        print(f"wrote {len(res.t)} {what} to {args.out}")
         return EXIT_OK
     except ModelError as exc:
         _say(f"mbd2d: error in the model or the command: {exc}")
@@ -134,19 +433,25 @@ def main(argv: Sequence[str] | None = None) -> int:
         _say(f"mbd2d: {exc}")
         return EXIT_INPUT
     except AnalysisError as exc:
-        if args.command in ("check", "statics"):
+        if args.command in ("check", "statics", "synthesize"):
             _say(f"mbd2d: {exc}")
             return EXIT_NUMERICAL
-        if exc.results is not None and len(exc.results.t):
-            exc.results.save(args.out)
         _say(f"mbd2d: {exc}")
         if exc.results is not None and len(exc.results.t):
+            try:
+                _write(exc.results, args)
+            except MbdError as err:
+                _say(f"mbd2d: the partial results could not be written: {err}")
+                return EXIT_INPUT
             print(f"wrote {len(exc.results.t)} rows (up to t = {exc.results.t[-1]:.6g}) to "
                   f"{args.out}", file=sys.stderr)
         return EXIT_SINGULAR if isinstance(exc, SingularConfigurationError) else EXIT_NUMERICAL
     except MbdError as exc:
         _say(f"mbd2d: {exc}")
         return EXIT_NUMERICAL
+    except ImportError as exc:                  # an optional package (the sweep extra)
+        _say(f"mbd2d: {exc}")
+        return EXIT_INPUT
 
 
 if __name__ == "__main__":  # pragma: no cover

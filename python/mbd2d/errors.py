@@ -122,6 +122,11 @@ class SingularPassageWarning(MbdWarning):
     branch it started on."""
 
 
+class LiftOffWarning(MbdWarning):
+    """A cam joint must pull its follower onto the profile somewhere in the run: a real
+    follower would lift off there (``res.lift_off`` lists the intervals)."""
+
+
 class CoreError(MbdError):
     """The Fortran core reported an internal error (a LAPACK argument error, or a status the
     analysis cannot produce); a bug."""
@@ -150,4 +155,4 @@ __all__ = ["MbdError", "ModelError", "AnalysisError", "AssemblyError",
            "IntegrationError",
            "SingularConfigurationError", "ToggleError", "CoreError", "InsufficientMemoryError",
            "MbdWarning",
-           "RedundantConstraintWarning", "SingularPassageWarning"]
+           "RedundantConstraintWarning", "SingularPassageWarning", "LiftOffWarning"]

@@ -11,10 +11,11 @@ Examples
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any, Mapping, Sequence
 
 import numpy as np
 
+from . import plots
 from .analysis.dof import analyze_dof
 from .analysis.dynamics import run_dynamics
 from .analysis.evaluate import evaluate
@@ -23,8 +24,11 @@ from .analysis.kinematics import run_kinematics
 from .analysis.mbdfile import export as export_mbd
 from .analysis.statics import run_statics
 from .binding.pack import pack
+from .binding.params import open_values
 from .description import toml_io
 from .description.builder import ModelDescription
+from .errors import MbdError
+from .description.parameters import parameter_list
 from .results import DofReport, DynamicsResult, KinematicsResult, StaticsResult
 
 
@@ -56,10 +60,27 @@ class Model(ModelDescription):
         p = pack(self)
         return p.neq, p.nq
 
+    def parameters(self) -> dict[str, float | None]:
+        """Every design parameter by name, with its value (see
+        :meth:`~mbd2d.description.builder.ModelDescription.parameters`); a gear or rolling
+        phase left open gets the value the core takes from the q0 estimates.
+
+        Examples
+        --------
+        >>> import mbd2d
+        >>> p = mbd2d.load("examples/fourbar_grashof.toml").parameters()
+        >>> p["driver.motor.f.poly.1"], p["model.gravity.1"]
+        (6.283185307179586, -9.81)
+        """
+        values = super().parameters()
+        if any(v is None for v in values.values()):
+            values.update(open_values(pack(self), parameter_list(self)))
+        return values
+
     # ------------------------------------------------------------------ analyses
     def kinematics(self, t_end: float, steps: int, t0: float = 0.0, tol: float | None = None,
-                   maxit: int | None = None, every: int = 1,
-                   solver: str = "auto") -> KinematicsResult:
+                   maxit: int | None = None, every: int = 1, solver: str = "auto",
+                   sensitivities: Any = None, progress: bool | None = None) -> KinematicsResult:
         """Kinematic analysis at steps + 1 uniform times from t0 to t_end.
 
         The whole time loop runs in the Fortran core. Assembly refines the q0 estimates at t0.
@@ -85,6 +106,17 @@ class Model(ModelDescription):
             reverse Cuthill-McKee ordering. "auto" picks the band for square J with at least
             60 coordinates whose band is at most a quarter of them wide
             (``res.stats["solver"]`` says which ran).
+        sensitivities : list of str, optional
+            Design parameters (names from :meth:`parameters`) to differentiate with respect
+            to: the result then has ``dq_dp``, ``dqd_dp``, ``dqdd_dp``, each (rows,
+            n_coordinates, n_params), and ``res.sensitivity(body, name)``. They come from
+            the differentiated constraint equations, J dq/dp = -Phi_p and so on, solved
+            with each step's factorization (exact to round-off; see docs/sensitivities.md).
+        progress : bool, optional
+            A progress bar (tqdm) while the core runs: None (default) shows it when the run
+            lasts more than about 2 s on a terminal or in a notebook, True always, False
+            never. The results are the same bit for bit (one core call either way); Ctrl-C
+            stops the run at its next step.
 
         Returns
         -------
@@ -110,9 +142,10 @@ class Model(ModelDescription):
         """
         if self.has_masses() and maxit is None:
             return run_inverse(self, t_end=t_end, steps=steps, t0=t0, tol=tol, every=every,
-                               solver=solver)
+                               solver=solver, sensitivities=sensitivities, progress=progress)
         return run_kinematics(self, t_end=t_end, steps=steps, t0=t0, tol=tol, maxit=maxit,
-                              every=every, solver=solver)
+                              every=every, solver=solver, sensitivities=sensitivities,
+                              progress=progress)
 
     def analyze_dof(self, t: float = 0.0, tol: float | None = None) -> DofReport:
         """Degrees of freedom and redundant constraints at the configuration assembled from
@@ -140,12 +173,19 @@ class Model(ModelDescription):
         return analyze_dof(self, t=t, tol=tol)
 
     def inverse_dynamics(self, t_end: float, steps: int, t0: float = 0.0,
-                         tol: float | None = None, every: int = 1,
-                         solver: str = "auto") -> DynamicsResult:
+                         tol: float | None = None, every: int = 1, solver: str = "auto",
+                         sensitivities: Any = None,
+                         progress: bool | None = None) -> DynamicsResult:
         """Kinematics of the driven model plus, at every output time, the multipliers lambda
         (J^T lambda = Q - M q_ddot), the joint reactions (``res.reaction(name)``), the driver
         efforts (``res.effort(name)``) and the energies. ``every`` and ``solver`` as in
         :meth:`kinematics` (the multipliers are computed at the kept outputs only).
+
+        With ``sensitivities=[names]`` (geometry, masses, inertias, gravity, force and
+        driver parameters) the result also has the kinematic sensitivities of
+        :meth:`kinematics`, ``dlam_dp`` (rows, neq, n_params), ``res.effort_dp(driver)``
+        (rows, n_params) and ``res.reaction_dp(name)``. ``progress`` as in :meth:`kinematics`
+        (the bar counts the kinematic pass, then the multipliers').
 
         Raises
         ------
@@ -155,14 +195,14 @@ class Model(ModelDescription):
             As :meth:`kinematics`.
         """
         return run_inverse(self, t_end=t_end, steps=steps, t0=t0, tol=tol, every=every,
-                           solver=solver)
+                           solver=solver, sensitivities=sensitivities, progress=progress)
 
     def dynamics(self, t_end: float, steps: int, method: str | None = None,
                  rtol: float | None = None, atol: float | None = None, h: float | None = None,
                  rho_inf: float | None = None, alpha: float | None = None,
-                 beta: float | None = None, t0: float = 0.0,
-                 every: int = 1, max_steps: int | None = None,
-                 solver: str = "auto") -> DynamicsResult:
+                 beta: float | None = None, t0: float = 0.0, every: int = 1,
+                 max_steps: int | None = None, sensitivities: Any = None,
+                 progress: bool | None = None, solver: str = "auto") -> DynamicsResult:
         """Forward dynamics of M q_ddot + J^T lambda = Q, Phi = 0 from the assembled q0 and
         v0 (projected onto J q_dot = nu), outputs at steps + 1 uniform times (every
         every-th of them kept).
@@ -198,6 +238,14 @@ class Model(ModelDescription):
             ends a run whose steps collapse; a long run at a tight tolerance (or a fixed h
             that needs more steps) raises it. When it is reached the run stops with an
             IntegrationError that says so, the results up to then kept.
+        sensitivities : list of str, optional
+            Design parameters to differentiate with respect to (dopri5 only): the
+            variational equations are integrated with the state, under the same error
+            control, giving ``dq_dp``, ``dqd_dp``, ``dqdd_dp`` (rows, n_coordinates,
+            n_params). The start's sensitivities are those of the assembled q0 (the minimum-
+            norm change) and of the projected v0.
+        progress : bool, optional
+            A progress bar while the core integrates, as in :meth:`kinematics`.
         solver : {"auto", "dense", "banded"}, optional
             Linear algebra of every saddle-point solve ([M J^T; J 0], generalized-alpha's
             iteration matrix, the projections, the consistent start, the multipliers):
@@ -229,12 +277,17 @@ class Model(ModelDescription):
         """
         return run_dynamics(self, t_end=t_end, steps=steps, method=method, rtol=rtol,
                             atol=atol, h=h, rho_inf=rho_inf, alpha=alpha, beta=beta, t0=t0,
-                            every=every, max_steps=max_steps, solver=solver)
+                            every=every, max_steps=max_steps, sensitivities=sensitivities,
+                            progress=progress, solver=solver)
 
-    def statics(self, t: float = 0.0, solver: str = "auto") -> StaticsResult:
+    def statics(self, t: float = 0.0, sensitivities: Any = None,
+                solver: str = "auto") -> StaticsResult:
         """Static equilibrium under gravity, springs and loads (drivers held at t), with the
-        multipliers, reactions (``res.reaction(name)``) and stability. ``solver`` as in
-        :meth:`dynamics` (``res.stats["solver"]`` says which ran).
+        multipliers, reactions (``res.reaction(name)``) and stability. With
+        ``sensitivities=[names]`` also ``eq.dq_dp`` (n_coordinates, n_params) and
+        ``eq.dlam_dp``, the derivatives of the equilibrium. ``solver`` as in
+        :meth:`dynamics` (``res.stats["solver"]`` says which ran; sensitivities use the dense
+        path).
 
         Raises
         ------
@@ -243,7 +296,7 @@ class Model(ModelDescription):
         SingularJacobianError
             If the equilibrium is not unique (a free motion without stiffness).
         """
-        return run_statics(self, t=t, solver=solver)
+        return run_statics(self, t=t, sensitivities=sensitivities, solver=solver)
 
     # ------------------------------------------------------------------ at one state
     def phi(self, q: Any, t: float = 0.0) -> np.ndarray:
@@ -262,11 +315,85 @@ class Model(ModelDescription):
         """gamma(q, q_dot, t), the right-hand side of J q_ddot = gamma, computed by the core."""
         return evaluate(self, q, qd, t)[3]
 
+    # ------------------------------------------------------------------ pictures
+    def configuration(self, t: float = 0.0) -> plots.Configuration:
+        """The model assembled at time t from its q0 estimates, as a one-row motion for the
+        pictures; the q0 estimates themselves when assembly fails (``.note`` says so)."""
+        try:
+            return plots.Configuration(self, self.analyze_dof(t=t).q, t)
+        except MbdError as exc:
+            q0 = pack(self).q0
+            return plots.Configuration(self, q0, t, note=f"q0 estimates (assembly failed: "
+                                       f"{type(exc).__name__})")
+
+    def plot(self, t: float = 0.0, **kwargs: Any) -> Any:
+        """The model assembled at time t: :func:`mbd2d.plot_mechanism` (returns the Axes).
+
+        Examples
+        --------
+        >>> import mbd2d
+        >>> ax = mbd2d.load("examples/slider_crank.toml").plot()
+        """
+        conf = self.configuration(t)
+        kwargs.setdefault("title", f"{self.name}" + (f": {conf.note}" if conf.note else
+                                                     f" at t = {t:g} s"))
+        return plots.plot_mechanism(conf, **kwargs)
+
+    def _repr_png_(self) -> bytes | None:
+        """The assembled model's picture, for Jupyter (None when it cannot be drawn)."""
+        try:
+            conf = self.configuration()
+            title = f"{self.name}" + (f": {conf.note}" if conf.note else "")
+            return plots.png_bytes(conf, title=title)
+        except (ImportError, MbdError, ValueError):
+            return None
+
     # ------------------------------------------------------------------ files
-    def export(self, path: str, t_end: float, steps: int, t0: float = 0.0,
-               tol: float | None = None, maxit: int | None = None) -> None:
-        """Write a plain-text model file for the standalone ``mbd2d-solve``."""
-        export_mbd(self, path, t_end=t_end, steps=steps, t0=t0, tol=tol, maxit=maxit)
+    def export(self, path: str | Path, t_end: float | None = None, steps: int | None = None,
+               t0: float = 0.0, tol: float | None = None, maxit: int | None = None,
+               analysis: str = "kinematics", every: int = 1, solver: str = "auto",
+               method: str | None = None, rtol: float | None = None,
+               atol: float | None = None, h: float | None = None,
+               rho_inf: float | None = None, alpha: float | None = None,
+               beta: float | None = None, max_steps: int | None = None, t: float = 0.0,
+               outputs: Sequence[str] | None = None) -> None:
+        """Write a plain-text model file that the standalone ``mbd2d-solve`` runs without
+        Python (format: docs/mbd-format.md), with the analysis and its settings.
+
+        Parameters
+        ----------
+        path : str or pathlib.Path
+            The file to write (.mbd).
+        t_end, steps, t0, every : float, int, float, int
+            The output times, as for the analyses (not for statics).
+        analysis : {"kinematics", "inverse-dynamics", "dynamics", "statics"}
+            The analysis ``mbd2d-solve`` runs.
+        tol, maxit, solver
+            As :meth:`kinematics` (``tol`` and ``solver`` also for inverse dynamics).
+        method, rtol, atol, h, rho_inf, alpha, beta, max_steps
+            As :meth:`dynamics`.
+        t : float
+            Statics: the time of loads and drivers.
+        outputs : list of str, optional
+            Optional CSV columns: "energy", "multipliers", "reactions", "efforts" (not for
+            kinematics; no energy for statics), as ``res.to_csv(path, energy=True, ...)``.
+
+        Raises
+        ------
+        ModelError
+            If the model or a setting is invalid (checked as for a Python run).
+
+        Examples
+        --------
+        >>> import mbd2d
+        >>> m = mbd2d.load("examples/fourbar_masses.toml")
+        >>> m.export("/tmp/fourbar.mbd", t_end=1.0, steps=100, analysis="dynamics",
+        ...          method="generalized-alpha", h=1e-3, outputs=["energy", "reactions"])
+        """
+        export_mbd(self, path, t_end=t_end, steps=steps, t0=t0, tol=tol, maxit=maxit,
+                   analysis=analysis, every=every, solver=solver, method=method, rtol=rtol,
+                   atol=atol, h=h, rho_inf=rho_inf, alpha=alpha, beta=beta,
+                   max_steps=max_steps, t=t, outputs=outputs)
 
 
 def load(path: str | Path) -> Model:

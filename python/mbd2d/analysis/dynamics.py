@@ -4,17 +4,24 @@ from __future__ import annotations
 
 import math
 import warnings
+from dataclasses import dataclass
 from typing import Any
+
+import numpy as np
 
 from ..binding import core
 from ..binding.pack import pack, pack_dynamics
 from ..binding.status import ASSEMBLY_FAILED, INCONSISTENT, INTEGRATOR_FAILED, OK, error_for
+from ..binding.tables import Packed
 from ..description.builder import ModelDescription
-from ..errors import ModelError, RedundantConstraintWarning
+from ..errors import MbdError, ModelError, RedundantConstraintWarning
 from ..results.dynamics import DynamicsResult
 from ..validate import number, whole
+from .contacts import MAX_EVENTS, check_method, has_events, report_pulls
 from .failures import assembly_failed, bad_entry, inconsistent_at, row_names
 from .outputs import dynamics_result, finite_part
+from .progress import run_core
+from .sensitivities import attach, check_status, requested, table
 from .settings import (check_memory, check_span, output_rows, output_steps, solver_code,
                        time_grid)
 
@@ -24,20 +31,36 @@ MAX_STEPS_DEFAULT = 10_000_000     # the core's default limit on accepted + reje
 INT32_MAX = 2**31 - 1
 
 
-def run_dynamics(model: ModelDescription, t_end: float, steps: int, method: str | None = None,
-                 rtol: float | None = None, atol: float | None = None, h: float | None = None,
-                 rho_inf: float | None = None, alpha: float | None = None,
-                 beta: float | None = None, t0: float = 0.0, every: Any = 1,
-                 max_steps: Any = None, solver: str = "auto") -> DynamicsResult:
-    """Forward dynamics in one core call; see :meth:`mbd2d.Model.dynamics`."""
-    t0, t_end, steps = check_span(t0, t_end, steps)
-    code = solver_code(solver)
-    nout = output_rows(steps, every)
-    every = int(every)
+@dataclass(frozen=True)
+class DynamicsSettings:
+    """Checked settings of a dynamics run, as the core takes them (0 or -1: its default)."""
+
+    method: str
+    code: int
+    rtol: float
+    atol: float
+    h: float
+    rho_inf: float
+    alpha: float
+    beta: float
+    max_steps: int
+
+
+def dynamics_settings(method: str | None = None, rtol: Any = None, atol: Any = None,
+                      h: Any = None, rho_inf: Any = None, alpha: Any = None, beta: Any = None,
+                      max_steps: Any = None) -> DynamicsSettings:
+    """Check the settings of :meth:`mbd2d.Model.dynamics` and give them as the core takes
+    them (the same numbers for a Python run and an exported file).
+
+    Raises
+    ------
+    ModelError
+        For an unknown method, a setting out of range, or one the method does not use.
+    """
     nmax = MAX_STEPS_DEFAULT if max_steps is None else \
         whole(max_steps, "max_steps", "dynamics", 1, INT32_MAX)
     method = DEFAULT_METHOD if method is None else method
-    if method not in METHODS:
+    if not isinstance(method, str) or method not in METHODS:
         raise ModelError(f"unknown method {method!r}; use one of {', '.join(METHODS)}",
                          "dynamics")
 
@@ -67,12 +90,49 @@ def run_dynamics(model: ModelDescription, t_end: float, steps: int, method: str 
                          "a fixed step h", "dynamics")
     alpha_v = opt(alpha, "alpha", 0.0, 1e9, -1.0)
     beta_v = opt(beta, "beta", 0.0, 1e9, -1.0)
+    return DynamicsSettings(method, METHODS[method], rtol_v, atol_v, h_v, rho_v, alpha_v,
+                            beta_v, nmax)
+
+
+def run_dynamics(model: ModelDescription, t_end: float, steps: int, method: str | None = None,
+                 rtol: float | None = None, atol: float | None = None, h: float | None = None,
+                 rho_inf: float | None = None, alpha: float | None = None,
+                 beta: float | None = None, t0: float = 0.0, every: Any = 1,
+                 max_steps: Any = None, sensitivities: Any = None,
+                 progress: bool | None = None, solver: str = "auto") -> DynamicsResult:
+    """Forward dynamics in one core call; see :meth:`mbd2d.Model.dynamics`."""
+    t0, t_end, steps = check_span(t0, t_end, steps)
+    code = solver_code(solver)
+    nout = output_rows(steps, every)
+    every = int(every)
+    st = dynamics_settings(method, rtol, atol, h, rho_inf, alpha, beta, max_steps)
+    method, nmax = st.method, st.max_steps
+    rtol_v, atol_v, h_v, rho_v, alpha_v, beta_v = (st.rtol, st.atol, st.h, st.rho_inf,
+                                                   st.alpha, st.beta)
+    check_method(model, method)
+    params = requested(model, sensitivities)
+    if params and method != "dopri5":
+        raise ModelError(f"sensitivities are integrated with dopri5 (the variational "
+                         f"equations with the state); method {method!r} has none",
+                         "dynamics")
     p = pack(model)
     d = pack_dynamics(model, p)
-    check_memory(nout, 3 * p.nq + p.neq + 4, "dynamics")
+    npar = len(params) if params else 0
+    check_memory(nout, 3 * p.nq * (1 + npar) + p.neq + 4 + 6 * d.ftab.shape[1], "dynamics")
     idx = output_steps(steps, every)
-    out = core.dynamics(p, d, t0, t_end, steps, METHODS[method], rtol_v, atol_v, h_v, rho_v,
-                        alpha_v, beta_v, every, nout, nmax, code)
+    maxev = MAX_EVENTS if has_events(model) else 1
+    if params:
+        ptab = table(p, params, d)
+        out = core.dynamics_sens(p, d, t0, t_end, steps, rtol_v, atol_v, every, nmax, nout,
+                                 ptab)
+        check_status(out.status, out.iinfo, out.msg, params)
+    else:
+        fixed = (t_end - t0) / h_v if h_v > 0 else 0.0
+        out = run_core(lambda ctl: core.dynamics(p, d, t0, t_end, steps, METHODS[method],
+                                                 rtol_v, atol_v, h_v, rho_v, alpha_v, beta_v,
+                                                 every, nout, nmax, maxev, ctl, code),
+                       nout, f"dynamics ({method})", progress,
+                       max(float(steps), fixed) * float(p.nq + p.neq)**2)
     iinfo, rinfo, status = out.iinfo, out.rinfo, out.status
     n = int(iinfo[0])
     t = time_grid(t0, t_end, steps, idx)
@@ -84,32 +144,51 @@ def run_dynamics(model: ModelDescription, t_end: float, steps: int, method: str 
              "h_min": float(rinfo[1]) if iinfo[2] else None,
              "h_max": float(rinfo[2]) if iinfo[2] else None, "redundant_rows": red_rows,
              "solver": "banded" if int(rinfo[4]) == 2 else "dense",
-             "band": (int(rinfo[5]), int(rinfo[6]))}
-    res, bad = finite_part(dynamics_result(model, p, t, n, out, stats, status == OK))
+             "band": (int(rinfo[5]), int(rinfo[6])),
+             "events": int(getattr(out, "nev", 0)),
+             "events_not_kept": max(0, int(getattr(out, "nev", 0)) - maxev)}
+    res = dynamics_result(model, p, t, n, out, stats, status == OK)
+    if params:
+        attach(res, out, params, n, ptab)
+    res, bad = finite_part(res)
+    if status == OK and bad is None:
+        report_pulls(model, p, res)
     if red_rows:
         warnings.warn(f"redundant constraints: {', '.join(red_rows)} are left out of the equations "
                       "of motion; the reported multipliers are the minimum-norm set (the "
                       "reactions are statically indeterminate)", RedundantConstraintWarning,
                       stacklevel=3)
-    if status == OK and bad is None:
+    exc = dynamics_error(model, p, out, res, t, bad, method, t0)
+    if exc is None:
         return res
+    raise exc
+
+
+def dynamics_error(model: ModelDescription, p: Packed, out: Any, res: DynamicsResult,
+                   t: np.ndarray, bad: int | None, method: str, t0: float) -> MbdError | None:
+    """The exception a forward dynamics run ends in, or None when it completed (``out`` as
+    :func:`mbd2d.binding.core.dynamics` returns it; the other arguments as
+    :func:`mbd2d.analysis.kinematics.kinematics_error`; p the tables of the model run)."""
+    status, iinfo, rinfo = out.status, out.iinfo, out.rinfo
+    if status == OK and bad is None:
+        return None
     text = out.msg
     last = f"t = {res.t[-1]:.6g} s" if len(res.t) else "no output rows"
     kept = f"Results up to {last} are kept in the exception's .results."
     if status == OK:
-        raise error_for("dynamics", INTEGRATOR_FAILED,
-                        f"{method}: the solution became non-finite at t = {t[bad]:.6g} s (a "
-                        f"blow-up: try a smaller rtol or h, or another method). {kept}",
-                        t=t[bad], results=res)
+        return error_for("dynamics", INTEGRATOR_FAILED,
+                         f"{method}: the solution became non-finite at t = {t[bad]:.6g} s (a "
+                         f"blow-up: try a smaller rtol or h, or another method). {kept}",
+                         t=t[bad], results=res)
     if status < 0:
-        raise error_for("dynamics", status, text, entry=bad_entry(model, int(iinfo[1])))
+        return error_for("dynamics", status, text, entry=bad_entry(model, int(iinfo[1])))
     tf = float(rinfo[0])
     if status == ASSEMBLY_FAILED:
-        raise assembly_failed("dynamics", model, 0.0, 0, t0, res)
+        return assembly_failed("dynamics", model, 0.0, 0, t0, res)
     if status == INCONSISTENT and not len(res.t):
-        raise inconsistent_at("dynamics", model, p, t0, res, f"{method}: {text}")
+        return inconsistent_at("dynamics", model, p, t0, res, f"{method}: {text}")
     if status == INTEGRATOR_FAILED:
         text = f"{method}: {text}. {kept}"
     else:
         text = f"{method}: {text}"
-    raise error_for("dynamics", status, text, t=tf, results=res)
+    return error_for("dynamics", status, text, t=tf, results=res)

@@ -28,7 +28,8 @@ def bad_entry(model: ModelDescription, bad: int) -> str:
     """How messages name the entry the core's ``bad`` code points at: a force (<= BAD_FORCE),
     a body (< 0), a joint or driver (> 0), or the model (0)."""
     if bad <= BAD_FORCE:
-        return model.forces[BAD_FORCE - bad - 1].describe()
+        name, what, e = model.force_elements()[BAD_FORCE - bad - 1]
+        return f"joint '{name}' friction" if what == "friction" else e.describe()
     if bad < 0:
         return f"body '{model.bodies[-bad - 1].name}'"
     if bad > 0:
@@ -111,6 +112,7 @@ def kinematic_failure(analysis: str, model: ModelDescription, p: Packed, status:
                  f"{', '.join(dep_names)} became dependent"
                  if driver else f"the constraints {', '.join(dep_names)} became dependent")
         if status == SINGULAR_CONFIG:
+            res.stats["dead_centre"] = t     # marked on the time axes of the pictures
             text = (f"Singular configuration (dead centre) at t = {t:.10f} s: {where} "
                     f"(J lost rank; sigma_min/sigma_max = {ratio:.1e}). The mechanism cannot "
                     "move further as driven: end the run before this time, or change the "

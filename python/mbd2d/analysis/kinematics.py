@@ -5,33 +5,48 @@ from __future__ import annotations
 import warnings
 from typing import Any
 
+import numpy as np
+
 from ..binding import core
 from ..binding.pack import pack
 from ..binding.status import NO_CONVERGENCE, OK, SINGULAR_CONFIG, error_for
+from ..binding.tables import Packed
 from ..description.builder import ModelDescription
-from ..errors import RedundantConstraintWarning, SingularPassageWarning
+from ..errors import MbdError, RedundantConstraintWarning, SingularPassageWarning
 from ..results.kinematics import KinematicsResult
 from .failures import kinematic_failure, row_names
 from .outputs import finite_part
+from .progress import run_core
+from .sensitivities import attach, check_status, requested, table
 from .settings import (check_memory, check_solver, check_span, output_rows, output_steps,
                        require_determined, solver_code, time_grid)
 
 
 def run_kinematics(model: ModelDescription, t_end: float, steps: int, t0: float = 0.0,
                    tol: float | None = None, maxit: int | None = None,
-                   tmin: float | None = None, every: Any = 1,
-                   solver: str = "auto") -> KinematicsResult:
+                   tmin: float | None = None, every: Any = 1, solver: str = "auto",
+                   sensitivities: Any = None, progress: bool | None = None) -> KinematicsResult:
     """Run a kinematic analysis in one core call; see :meth:`mbd2d.Model.kinematics`."""
     t0, t_end, steps = check_span(t0, t_end, steps)
     tol_v, maxit_v = check_solver(tol, maxit)
     nout = output_rows(steps, every)
     code = solver_code(solver)
+    params = requested(model, sensitivities)
     p = pack(model)
     require_determined(p, model)
-    check_memory(nout, 3 * p.nq, "kinematics")
+    npar = len(params) if params else 0
+    check_memory(nout, 3 * p.nq * (1 + npar), "kinematics")
     idx = output_steps(steps, every)
-    out = core.kinematics(p, t0, t_end, steps, tol_v, maxit_v, float(tmin or 0.0), int(every),
-                          code, nout)
+    if params:
+        ptab = table(p, params)
+        out = core.kinematics_sens(p, t0, t_end, steps, tol_v, maxit_v, float(tmin or 0.0),
+                                   int(every), code, nout, ptab)
+        check_status(out.status, out.iinfo, out.msg, params)
+    else:
+        out = run_core(lambda ctl: core.kinematics(p, t0, t_end, steps, tol_v, maxit_v,
+                                                   float(tmin or 0.0), int(every), code, nout,
+                                                   ctl),
+                       nout, "kinematics", progress, float(steps) * (p.nq + p.neq))
     iinfo, rinfo, tpass, status = out.iinfo, out.rinfo, out.tpass, out.status
     n = int(iinfo[0])
     t = time_grid(t0, t_end, steps, idx)
@@ -50,6 +65,8 @@ def run_kinematics(model: ModelDescription, t_end: float, steps: int, t0: float 
                                   "solver": "banded" if int(rinfo[4]) == 2 else "dense",
                                   "band": (int(rinfo[5]), int(rinfo[6]))},
                            complete=status == OK, model=model)
+    if params:
+        attach(res, out, params, n, ptab)
     res, bad = finite_part(res)
     if red_rows and status in (OK, SINGULAR_CONFIG, NO_CONVERGENCE):
         warnings.warn(f"redundant constraints: {', '.join(red_rows)} repeat what the other "
@@ -62,12 +79,31 @@ def run_kinematics(model: ModelDescription, t_end: float, steps: int, t0: float 
         warnings.warn(f"passed through {npass} singular configuration(s) (bifurcation points, "
                       f"J lost rank) at t = {times}{' ...' if npass > 5 else ''} s and stayed on "
                       "the branch the run started on", SingularPassageWarning, stacklevel=3)
-    if status == OK and bad is None:
+    exc = kinematics_error(model, p, out, res, t, bad)
+    if exc is None:
         return res
-    if status == OK:
-        raise error_for("kinematics", NO_CONVERGENCE,
-                        f"the run gave non-finite values at t = {t[bad]:.6g} s; results up to "
-                        f"there ({bad} rows) are kept in the exception's .results", t=t[bad],
-                        results=res)
-    raise kinematic_failure("kinematics", model, p, status, out.msg, iinfo, rinfo, out.qsing,
-                            out.dep, out.red, res)
+    raise exc
+
+
+def kinematics_error(model: ModelDescription, p: Packed, out: Any, res: KinematicsResult,
+                     t: np.ndarray, bad: int | None) -> MbdError | None:
+    """The exception a kinematic run ends in, or None when it completed.
+
+    Parameters
+    ----------
+    model, p : the model and its tables
+    out : the core's outputs (``status``, ``msg``, ``iinfo``, ``rinfo``, ``qsing``, ``dep``,
+        ``red``), as :func:`mbd2d.binding.core.kinematics` returns them
+    res : the result up to the failure
+    t : the output times
+    bad : its first row with a non-finite number (None: all finite)
+    """
+    if out.status == OK and bad is None:
+        return None
+    if out.status == OK:
+        return error_for("kinematics", NO_CONVERGENCE,
+                         f"the run gave non-finite values at t = {t[bad]:.6g} s; results up to "
+                         f"there ({bad} rows) are kept in the exception's .results", t=t[bad],
+                         results=res)
+    return kinematic_failure("kinematics", model, p, out.status, out.msg, out.iinfo, out.rinfo,
+                             out.qsing, out.dep, out.red, res)

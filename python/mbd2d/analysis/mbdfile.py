@@ -1,77 +1,209 @@
 """Export to the plain-text model file read by the standalone ``mbd2d-solve``.
 
-The format is documented at the top of every file written and in
-``fortran/mbd_mbdfile.f90``. Reals are written with 17 significant digits, so the file
-round-trips exactly and ``mbd2d-solve`` reproduces the Python results.
+Every analysis can be exported: kinematics, inverse dynamics, dynamics (each method with its
+settings) and statics, with the optional output columns. The settings are checked exactly as
+for a Python run and written as the core takes them, and reals are written with 17
+significant digits, so ``mbd2d-solve`` makes the same core call and writes the same CSV as
+``res.to_csv`` (docs/mbd-format.md; the format is also described at the top of every file).
 """
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any, Sequence
 
-from ..binding.pack import pack
-from ..binding.tables import NCT
+from ..binding.pack import pack, pack_dynamics
+from ..binding.tables import NCT, NFT
 from ..description.builder import ModelDescription
-from ..results.files import write_text
-from .settings import check_solver, check_span, require_determined
+from ..description.drivers import AbsoluteDriver, RelativeAngleDriver, RelativeDistanceDriver
+from ..description.forces import PointForce, RotationalSpring, Spring, Torque
+from ..description.joints import (Absolute, Cam, Distance, Gear, PinInSlot, PointOnCurve,
+                                  PointOnLine, RackPinion, Revolute, RollingDisc, Translational,
+                                  Weld)
+from ..errors import ModelError
+from ..results.files import OUTPUTS, write_text
+from ..validate import number
+from .dynamics import dynamics_settings
+from .settings import (SOLVERS, check_solver, check_span, output_rows, require_determined,
+                       solver_code)
 
-HEADER = """\
-# mbd2d model file, format 1 (written by `mbd2d export`; run with `mbd2d-solve FILE OUT.csv`)
-# Plain text, whitespace separated. Lines starting with '#' are comments.
-#   mbd2d 1                      format and version
-#   name NAME                    model name
-#   analysis kinematics          the analysis to run
-#   t0, t_end, steps             output times t0 + k (t_end - t0) / steps, k = 0..steps
-#   tol, maxit, tmin             Newton tolerance, iterations, singular-time resolution (0 = default)
-#   bodies NB, then NB lines     NAME x0 y0 theta0 (rough estimates; assembly refines them)
-#   constraints NC, then NC lines
-#        NAME KIND BODY_I BODY_J SUB_A SUB_B OFFSET LENGTH
-#        KIND: 1 revolute, 2 translational, 3 cam, 101 absolute driver,
-#              102 relative-angle driver, 103 relative-distance driver
-#        BODY_I, BODY_J: 1-based body numbers, 0 = ground
-#        SUB_A: cam profile (1 circle, 2 spline, 3 fourier); absolute driver coordinate
-#               (1 x, 2 y, 3 theta); relative-distance driver: number of its joint
-#        SUB_B: cam follower (1 point, 2 roller, 3 flat)
-#        OFFSET, LENGTH: the constraint's slice of the parameter list (1-based)
-#   params NP, then NP reals     parameters, 4 per line, no comments inside
-#        revolute       s_i(2) s_j(2)
-#        translational  s_i(2) s_j(2) axis_i(2) axis_j(2)
-#        cam            follower(4: point x y 0 0 | roller x y r 0 | flat x y nx ny),
-#                       profile (circle cx cy R | spline n x1 y1 .. xn yn |
-#                       fourier cx cy K a0 a1 b1 .. aK bK)
-#        driver f(t)    np c0 .. c_{np-1} nh (A omega phase) x nh
-#   end
-"""
+FORMAT = 2
+#: the analyses a file can hold
+ANALYSES = ("kinematics", "inverse-dynamics", "dynamics", "statics")
+#: every kind code the format holds: (code, type, parameters in the params list)
+JOINT_KINDS = [(c.kind, c.type, d) for c, d in [
+    (Revolute, "s_i(2) s_j(2)"),
+    (Translational, "s_i(2) s_j(2) axis_i(2) axis_j(2)"),
+    (Cam, "follower(4), profile (SUB_A: 1 circle, 2 spline, 3 fourier; SUB_B: 1 point, "
+          "2 roller, 3 flat)"),
+    (Distance, "s_i(2) s_j(2) distance"),
+    (PointOnLine, "s_i(2) s_j(2) axis(2) offset"),
+    (Weld, "s_i(2) s_j(2) angle"),
+    (Gear, "R_i R_j phase pressure_angle c_i(2) c_j(2) a_i(2) a_j(2) (SUB_A carrier body, "
+           "SUB_B 1 external, 2 internal)"),
+    (RackPinion, "center(2) point(2) axis(2) radius phase"),
+    (RollingDisc, "center(2) point(2) axis(2) radius phase"),
+    (Absolute, "value (SUB_A: 1 x, 2 y, 3 theta)"),
+]] + [(PinInSlot.kind, "revolute-translational", "as point-on-line"),
+      (PointOnCurve.kind, "point-on-curve", "as cam")]
+DRIVER_KINDS = [(AbsoluteDriver.kind, "absolute driver", "f(t) (SUB_A: 1 x, 2 y, 3 theta)"),
+                (RelativeAngleDriver.kind, "relative-angle driver", "f(t)"),
+                (RelativeDistanceDriver.kind, "relative-distance driver",
+                 "f(t) (SUB_A: its translational joint)")]
+FORCE_KINDS = [(Spring.kind, "spring", "s_i(2) s_j(2) stiffness damping length0 f(t)"),
+               (Torque.kind, "torque", "f(t)"),
+               (PointForce.kind, "point", "s(2) fx(t) fy(t)"),
+               (RotationalSpring.kind, "rotational-spring", "stiffness damping angle0 f(t)")]
+
+
+def header() -> str:
+    """The comment block at the top of every file: the format and every kind it holds."""
+    lines = [
+        f"# mbd2d model file, format {FORMAT} (written by `mbd2d export`; run with "
+        "`mbd2d-solve FILE OUT.csv`; docs/mbd-format.md)",
+        "# Plain text, whitespace separated. Lines starting with '#' are comments.",
+        "#   mbd2d 2                      format and version",
+        "#   name NAME                    model name",
+        "#   analysis A                   kinematics | inverse-dynamics | dynamics | statics",
+        "#   t0, t_end, steps, every      outputs t0 + k (t_end - t0) / steps, k = 0..steps, "
+        "every k-th kept",
+        "#   tol, maxit, tmin, solver     Newton tolerance, iterations, singular-time "
+        "resolution (0 = default); auto | dense | banded",
+        "#   method, rtol, atol, h, rho_inf, alpha, beta, max_steps   dynamics (0, or -1 for "
+        "rho_inf, alpha, beta: default)",
+        "#   t                            statics: the time of loads and drivers",
+        "#   outputs W ...                optional CSV columns: energy multipliers reactions "
+        "efforts",
+        "#   gravity GX GY",
+        "#   bodies NB, then NB lines     NAME x0 y0 theta0 [mass inertia vx0 vy0 omega0]",
+        "#   constraints NC, then NC lines",
+        "#        NAME KIND BODY_I BODY_J SUB_A SUB_B OFFSET LENGTH",
+        "#        BODY_I, BODY_J: 1-based body numbers, 0 = ground; OFFSET, LENGTH: the",
+        "#        constraint's slice of the parameter list (1-based)",
+        "#        KIND (joints): " + ", ".join(f"{k} {t}" for k, t, _ in JOINT_KINDS),
+        "#        KIND (drivers): " + ", ".join(f"{k} {t}" for k, t, _ in DRIVER_KINDS),
+        "#   params NP, then NP reals     per constraint kind:",
+    ]
+    for k, t, d in JOINT_KINDS + DRIVER_KINDS:
+        lines.append(f"#        {k:3d} {t:24s} {d}")
+    lines += [
+        "#        f(t) = np c0 .. c_{np-1} nh (A omega phase) x nh",
+        "#   labels NEQ, then NEQ words   NAME.WORD of each row of Phi (multiplier columns)",
+        "#   forces NF, then NF lines     NAME KIND BODY_I BODY_J OFFSET LENGTH",
+        "#        KIND (forces): " + ", ".join(f"{k} {t}" for k, t, _ in FORCE_KINDS),
+        "#   fparams NP, then NP reals    per force kind:",
+    ]
+    for k, t, d in FORCE_KINDS:
+        lines.append(f"#        {k:3d} {t:24s} {d}")
+    lines.append("#   end")
+    return "\n".join(lines)
 
 
 def _r(x: float) -> str:
-    return f"{x:.17e}"
+    return f"{float(x):.17e}"
 
 
-def export(model: ModelDescription, path: str | Path, t_end: float, steps: int, t0: float = 0.0,
-           tol: float | None = None, maxit: int | None = None) -> None:
-    """Write a model file for ``mbd2d-solve``.
+def _outputs(outputs: Any, analysis: str) -> list[str]:
+    if outputs is None:
+        return []
+    if isinstance(outputs, str):
+        outputs = [outputs]
+    try:
+        words = [str(w) for w in outputs]
+    except TypeError:
+        raise ModelError(f"outputs must be a list of {', '.join(OUTPUTS)}, got {outputs!r}",
+                         "export") from None
+    for w in words:
+        if w not in OUTPUTS:
+            raise ModelError(f"unknown output {w!r}; the optional columns are "
+                             f"{', '.join(OUTPUTS)}", "export")
+    if words and analysis == "kinematics":
+        raise ModelError(f"{', '.join(words)} need multipliers: export inverse-dynamics, "
+                         "dynamics or statics", "export")
+    if "energy" in words and analysis == "statics":
+        raise ModelError("statics has no energy output", "export")
+    return [w for w in OUTPUTS if w in words]
+
+
+def export(model: ModelDescription, path: str | Path, t_end: float | None = None,
+           steps: int | None = None, t0: float = 0.0, tol: float | None = None,
+           maxit: int | None = None, analysis: str = "kinematics", every: Any = 1,
+           solver: str = "auto", method: str | None = None, rtol: Any = None,
+           atol: Any = None, h: Any = None, rho_inf: Any = None, alpha: Any = None,
+           beta: Any = None, max_steps: Any = None, t: float = 0.0,
+           outputs: Sequence[str] | None = None) -> None:
+    """Write a model file for ``mbd2d-solve``; see :meth:`mbd2d.Model.export`.
 
     Raises
     ------
     ModelError
         If the model or the settings are invalid (checked as for a Python run).
     """
-    t0, t_end, steps = check_span(t0, t_end, steps)
-    tol_v, maxit_v = check_solver(tol, maxit)
+    if not isinstance(analysis, str) or analysis not in ANALYSES:
+        raise ModelError(f"unknown analysis {analysis!r}; use one of {', '.join(ANALYSES)}",
+                         "export")
+    words = _outputs(outputs, analysis)
+    held = [name for name, what, _ in model.force_elements() if what != "force"]
+    if held and analysis != "kinematics":
+        raise ModelError(f"the .mbd file of mbd2d-solve holds no contacts or joint friction "
+                         f"({', '.join(held)}); run this model from Python or the mbd2d "
+                         "command", "export")
     p = pack(model)
-    require_determined(p, model)
-    lines = [HEADER.rstrip("\n"), "mbd2d 1", f"name {model.name.replace(' ', '_') or 'model'}",
-             "analysis kinematics", f"t0 {_r(t0)}", f"t_end {_r(t_end)}", f"steps {steps}",
-             f"tol {_r(tol_v)}", f"maxit {maxit_v}", f"tmin {_r(0.0)}",
-             f"bodies {p.nb}"]
-    for name, b in zip(p.body_names, model.bodies):
-        lines.append(f"{name} {_r(b.q0[0])} {_r(b.q0[1])} {_r(b.q0[2])}")
+    lines = [header(), f"mbd2d {FORMAT}",
+             f"name {model.name.replace(' ', '_') or 'model'}", f"analysis {analysis}"]
+    if analysis != "statics":
+        if t_end is None or steps is None:
+            raise ModelError(f"{analysis} needs t_end and steps", "export")
+        t0, t_end, steps = check_span(t0, t_end, steps)
+        output_rows(steps, every)                      # checks every
+        lines += [f"t0 {_r(t0)}", f"t_end {_r(t_end)}", f"steps {steps}",
+                  f"every {int(every)}"]
+    if analysis in ("kinematics", "inverse-dynamics"):
+        tol_v, maxit_v = check_solver(tol, maxit if analysis == "kinematics" else None)
+        solver_code(solver)
+        require_determined(p, model)
+        lines += [f"tol {_r(tol_v)}", f"solver {solver}"]
+        if analysis == "kinematics":
+            lines += [f"maxit {maxit_v}", f"tmin {_r(0.0)}"]
+    elif analysis == "dynamics":
+        st = dynamics_settings(method, rtol, atol, h, rho_inf, alpha, beta, max_steps)
+        lines += [f"method {st.method}", f"rtol {_r(st.rtol)}", f"atol {_r(st.atol)}",
+                  f"h {_r(st.h)}", f"rho_inf {_r(st.rho_inf)}", f"alpha {_r(st.alpha)}",
+                  f"beta {_r(st.beta)}", f"max_steps {st.max_steps}"]
+    else:
+        lines.append(f"t {_r(number(t, 't', 'export'))}")
+    if words:
+        lines.append("outputs " + " ".join(words))
+    dyn = pack_dynamics(model, p) if analysis != "kinematics" else None
+    if dyn is not None:
+        lines.append(f"gravity {_r(dyn.grav[0])} {_r(dyn.grav[1])}")
+    lines.append(f"bodies {p.nb}")
+    for i, (name, b) in enumerate(zip(p.body_names, model.bodies)):
+        row = f"{name} {_r(b.q0[0])} {_r(b.q0[1])} {_r(b.q0[2])}"
+        if dyn is not None:
+            row += " " + " ".join(_r(v) for v in (*dyn.bmass[:, i], *dyn.v0[3 * i:3 * i + 3]))
+        lines.append(row)
     lines.append(f"constraints {p.nc}")
     for k, name in enumerate(p.constraint_names):
         lines.append(f"{name} " + " ".join(str(int(v)) for v in p.ctab[:NCT - 1, k]))
-    n = len(p.rpar)
-    lines.append(f"params {n}")
-    for i in range(0, n, 4):
-        lines.append(" ".join(_r(float(v)) for v in p.rpar[i:i + 4]))
+    lines += _reals("params", p.rpar)
+    lines.append(f"labels {len(p.row_labels)}")
+    for i in range(0, len(p.row_labels), 6):
+        lines.append(" ".join(p.row_labels[i:i + 6]))
+    if dyn is not None:
+        lines.append(f"forces {dyn.ftab.shape[1]}")
+        for k, f in enumerate(model.forces):
+            lines.append(f"{f.name} " + " ".join(str(int(v)) for v in dyn.ftab[:NFT - 1, k]))
+        lines += _reals("fparams", dyn.fpar)
     lines.append("end")
     write_text(path, "\n".join(lines) + "\n", "export")
+
+
+def _reals(key: str, values: Any) -> list[str]:
+    n = len(values)
+    out = [f"{key} {n}"]
+    for i in range(0, n, 4):
+        out.append(" ".join(_r(float(v)) for v in values[i:i + 4]))
+    return out
+
+
+__all__ = ["export", "header", "ANALYSES", "FORMAT", "SOLVERS"]

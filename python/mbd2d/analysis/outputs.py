@@ -9,6 +9,7 @@ import numpy as np
 
 from ..binding.tables import Packed
 from ..description.builder import ModelDescription
+from ..results.contacts import element_arrays, events_from
 from ..results.dynamics import DynamicsResult
 from ..results.kinematics import KinematicsResult
 
@@ -16,7 +17,7 @@ R = TypeVar("R", bound=KinematicsResult)
 
 #: arrays of a result with one row per output time
 ROW_FIELDS = ("t", "q", "qd", "qdd", "lam", "kinetic", "potential", "drift_position",
-              "drift_velocity")
+              "drift_velocity", "elements", "dq_dp", "dqd_dp", "dqdd_dp", "dlam_dp")
 
 
 def dynamics_result(model: ModelDescription, p: Packed, t: np.ndarray, n: int, out: Any,
@@ -24,12 +25,20 @@ def dynamics_result(model: ModelDescription, p: Packed, t: np.ndarray, n: int, o
     """The first n output rows of an inverse or forward dynamics run (``out`` from
     :mod:`mbd2d.binding.core`)."""
     e = out.e
+    names = [(name, what) for name, what, _ in model.force_elements()]
+    eo = getattr(out, "eo", None)
+    if eo is None:                      # a sensitivity run: no element outputs
+        eo = np.zeros((6, len(names), max(n, 0)))
+    contacts, friction = (events_from(out.evo, int(out.nev), names) if hasattr(out, "evo")
+                          else ([], []))
     return DynamicsResult(t=t[:n], q=out.q.T[:n].copy(), qd=out.qd.T[:n].copy(),
                           qdd=out.qdd.T[:n].copy(), body_names=p.body_names,
                           coordinate_names=p.coordinate_names, stats=stats, complete=complete,
                           model=model, lam=out.lam.T[:n].copy(), kinetic=e[0, :n].copy(),
                           potential=e[1, :n].copy(), drift_position=e[2, :n].copy(),
-                          drift_velocity=e[3, :n].copy(), row_labels=p.row_labels, packed=p)
+                          drift_velocity=e[3, :n].copy(), row_labels=p.row_labels, packed=p,
+                          elements=element_arrays(eo, n), element_names=names,
+                          contacts=contacts, friction_events=friction)
 
 
 def first_nonfinite_row(*arrays: np.ndarray) -> int | None:
@@ -50,7 +59,7 @@ def first_nonfinite_row(*arrays: np.ndarray) -> int | None:
 def finite_part(res: R) -> tuple[R, int | None]:
     """The result cut before its first row with a non-finite number (marked incomplete),
     and that row's index; the result itself and None when every number is finite."""
-    names = [f for f in ROW_FIELDS if hasattr(res, f)]
+    names = [f for f in ROW_FIELDS if getattr(res, f, None) is not None]
     k = first_nonfinite_row(*(getattr(res, f) for f in names))
     if k is None:
         return res, None

@@ -16,7 +16,7 @@ import numpy as np
 from .. import _core
 from ..errors import InsufficientMemoryError
 from .status import MEMORY_ADVICE
-from .tables import DynamicTables, Packed, decode
+from .tables import BatchTables, DynamicTables, Packed, decode
 
 
 def _named(names: str, fn: Callable[..., tuple[Any, ...]], *args: Any, numbers: float = 0,
@@ -36,8 +36,12 @@ def _named(names: str, fn: Callable[..., tuple[Any, ...]], *args: Any, numbers: 
                                       nbytes) from None
     fields = dict(zip(names.split(), out, strict=True))
     if "msg" in fields:
-        fields["msg"] = decode(fields["msg"])
-    fields["status"] = int(fields["status"])
+        if np.ndim(fields["msg"]):       # a batch: one message per case
+            fields["msg"] = [decode(m) for m in fields["msg"]]
+        else:
+            fields["msg"] = decode(fields["msg"])
+    if np.ndim(fields["status"]) == 0:
+        fields["status"] = int(fields["status"])
     return SimpleNamespace(**fields)
 
 
@@ -55,13 +59,22 @@ def evaluate(nb: int, ctab: np.ndarray, rpar: np.ndarray, neq: int, q: np.ndarra
                   float(t), numbers=neq * (len(q) + 3))
 
 
+def new_ctl() -> np.ndarray:
+    """The progress array a time loop shares while it runs (read and written from another
+    thread): [0] outputs done so far, [1] set to 1 to ask the run to stop."""
+    return np.zeros(2, dtype=np.int32)
+
+
 def kinematics(p: Packed, t0: float, t1: float, steps: int, tol: float, maxit: int,
-               tmin: float, every: int, solver: int, nout: int) -> SimpleNamespace:
+               tmin: float, every: int, solver: int, nout: int,
+               ctl: np.ndarray | None = None) -> SimpleNamespace:
     """The whole kinematic run: ``q``, ``qd``, ``qdd`` (nq, nout), ``iinfo``, ``rinfo``,
-    ``qsing``, ``dep``, ``red``, ``tpass``, ``status``, ``msg``."""
+    ``qsing``, ``dep``, ``red``, ``tpass``, ``status``, ``msg``. ``ctl``: see
+    :func:`new_ctl` (the core releases the GIL while it runs)."""
     return _named("q qd qdd iinfo rinfo qsing dep red tpass status msg", _core.core_kinematics,
                   p.nb, p.ctab, p.rpar, p.neq, p.q0, t0, t1, steps, tol, maxit, tmin, every,
-                  solver, nout, numbers=3 * p.nq * nout + p.nq + 2 * p.neq)
+                  solver, nout, new_ctl() if ctl is None else ctl,
+                  numbers=3 * p.nq * nout + p.nq + 2 * p.neq)
 
 
 def kin_step(p: Packed, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, t_prev: float,
@@ -86,28 +99,39 @@ def profile(kind: int, raw: np.ndarray, alphas: np.ndarray) -> SimpleNamespace:
 
 
 def inverse(p: Packed, d: DynamicTables, t0: float, t1: float, steps: int, tol: float,
-            every: int, solver: int, nout: int) -> SimpleNamespace:
+            every: int, solver: int, nout: int, maxev: int = 1,
+            ctl: np.ndarray | None = None) -> SimpleNamespace:
     """Kinematics plus multipliers and energies: ``q``, ``qd``, ``qdd``, ``lam``, ``e``,
-    ``iinfo``, ``rinfo``, ``qsing``, ``dep``, ``red``, ``tpass``, ``status``, ``msg``."""
-    return _named("q qd qdd lam e iinfo rinfo qsing dep red tpass status msg",
+    ``iinfo``, ``rinfo``, ``qsing``, ``dep``, ``red``, ``tpass``, ``status``, ``msg``, the
+    force elements' outputs ``eo`` (6, nf, nout) and the contact events ``evo`` (4, maxev),
+    ``nev`` (found at the outputs). ``ctl``: see :func:`new_ctl`; ctl[0] runs to 2 nout
+    (kinematics, then multipliers)."""
+    return _named("q qd qdd lam e iinfo rinfo qsing dep red tpass status msg eo evo nev",
                   _core.core_inverse, ctab=p.ctab, rpar=p.rpar, bmass=d.bmass, grav=d.grav,
                   ftab=d.ftab, fpar=d.fpar, neq=p.neq, q0=p.q0, t0=t0, t1=t1, nsteps=steps,
-                  tol=tol, every=every, solver=solver, nout=nout,
-                  numbers=(3 * p.nq + p.neq + 4) * nout + p.nq + 2 * p.neq)
+                  tol=tol, every=every, solver=solver, nout=nout, maxev=max(1, maxev),
+                  ctl=new_ctl() if ctl is None else ctl,
+                  numbers=(3 * p.nq + p.neq + 4 + 6 * d.ftab.shape[1]) * nout + p.nq
+                  + 2 * p.neq + 4 * maxev)
 
 
 def dynamics(p: Packed, d: DynamicTables, t0: float, t1: float, steps: int, method: int,
              rtol: float, atol: float, h: float, rho_inf: float, alpha: float, beta: float,
-             every: int, nrow: int, max_steps: int, solver: int = 0) -> SimpleNamespace:
+             every: int, nrow: int, max_steps: int, maxev: int = 1,
+             ctl: np.ndarray | None = None, solver: int = 0) -> SimpleNamespace:
     """Forward dynamics: ``q``, ``qd``, ``qdd``, ``lam``, ``e``, ``iinfo``, ``rinfo``, ``red``,
-    ``status``, ``msg``. max_steps: the limit on accepted plus rejected steps; solver: 0 auto,
+    ``status``, ``msg``, the force elements' outputs ``eo`` (6, nf, nrow) and the events
+    ``evo`` (4, maxev: t, element, kind, value), ``nev`` (how many happened). max_steps: the
+    limit on accepted plus rejected steps. ``ctl``: see :func:`new_ctl`; solver: 0 auto,
     1 dense, 2 banded."""
-    return _named("q qd qdd lam e iinfo rinfo red status msg", _core.core_dynamics,
+    return _named("q qd qdd lam e iinfo rinfo red status msg eo evo nev", _core.core_dynamics,
                   ctab=p.ctab, rpar=p.rpar, bmass=d.bmass, grav=d.grav, ftab=d.ftab,
                   fpar=d.fpar, neq=p.neq, q0=p.q0, v0=d.v0, t0=t0, t1=t1, nsteps=steps,
                   method=method, rtol=rtol, atol=atol, h=h, rho_inf=rho_inf, balpha=alpha,
-                  bbeta=beta, every=every, nrow=nrow, max_steps=max_steps, solver=solver,
-                  numbers=(3 * p.nq + p.neq + 4) * nrow + p.neq)
+                  bbeta=beta, every=every, nrow=nrow, max_steps=max_steps,
+                  maxev=max(1, maxev), ctl=new_ctl() if ctl is None else ctl, solver=solver,
+                  numbers=(3 * p.nq + p.neq + 4 + 6 * d.ftab.shape[1]) * nrow + p.neq
+                  + 4 * maxev)
 
 
 def statics(p: Packed, d: DynamicTables, t: float, solver: int = 0) -> SimpleNamespace:
@@ -118,8 +142,118 @@ def statics(p: Packed, d: DynamicTables, t: float, solver: int = 0) -> SimpleNam
                   neq=p.neq, q0=p.q0, t=t, solver=solver, numbers=p.nq + p.neq)
 
 
+def cam_forces(p: Packed, q: np.ndarray, t: np.ndarray, lam: np.ndarray) -> SimpleNamespace:
+    """Normal force of every cam joint on its follower at states q (nq, nt), times t and
+    multipliers lam (neq, nt): ``fn`` (nc, nt; negative: the joint pulls), ``status``,
+    ``msg``."""
+    return _named("fn status msg", _core.core_cam_forces, p.nb, p.ctab, p.rpar, q, t, lam)
+
+
 def reactions(p: Packed, q: np.ndarray, t: np.ndarray, lam: np.ndarray) -> SimpleNamespace:
     """Joint reactions at states q (nq, nt), times t (nt) and multipliers lam (neq, nt):
     ``reac`` and ``rloc`` (6, nc, nt), ``status``, ``msg``."""
     return _named("reac rloc status msg", _core.core_reactions, p.nb, p.ctab, p.rpar, q, t,
                   lam, numbers=12 * p.ctab.shape[1] * len(np.atleast_1d(t)))
+
+
+def conditioning(p: Packed, q: np.ndarray, t: np.ndarray) -> SimpleNamespace:
+    """sigma_min / sigma_max of the column-scaled J (the core's units) at states q (nq, nt)
+    and times t (nt): ``cond`` (nt), ``status``, ``msg``."""
+    return _named("cond status msg", _core.core_conditioning, p.nb, p.ctab, p.rpar, q, t,
+                  numbers=np.size(t))
+
+
+def influence(p: Packed, q: np.ndarray, t: np.ndarray, row: int) -> SimpleNamespace:
+    """Influence coefficients dq/ds of the quantity driven by row ``row`` (1-based) at states
+    q (nq, nt) and times t (nt): ``u`` (nq, nt), ``ok`` (nt; 0 where J is singular),
+    ``status``, ``msg``."""
+    return _named("u ok status msg", _core.core_influence, p.nb, p.ctab, p.rpar, q, t,
+                  int(row), numbers=np.size(q) + np.size(t))
+
+
+def fun_values(p: np.ndarray, t: np.ndarray) -> SimpleNamespace:
+    """f(t), f'(t), f''(t) of an encoded function of time (``TimeFunction.encode()``) at the
+    times t: ``f``, ``f1``, ``f2``, ``status``, ``msg``."""
+    return _named("f f1 f2 status msg", _core.core_fun_values, p, t, numbers=3 * np.size(t))
+# ------------------------------------------------------------------ design sensitivities
+# ptab: int32 (2, np), Fortran order: per design parameter its table (1 rpar, 2 bmass
+# flattened (2, nb), 3 grav, 4 fpar) and 1-based index (see fortran/mbd_sensitivity.f90).
+
+def eval_d(p: Packed, rpar: np.ndarray, q: np.ndarray, qd: np.ndarray, t: float,
+           dq: np.ndarray, dqd: np.ndarray, ptab: np.ndarray) -> SimpleNamespace:
+    """Changes of Phi, J, nu and gamma along a direction (dq, dqd) and at most one design
+    parameter: ``tphi``, ``tjac``, ``tnu``, ``tgam``, ``status``, ``msg``, ``bad``."""
+    return _named("tphi tjac tnu tgam status msg bad", _core.core_eval_d, p.nb, p.ctab, rpar,
+                  p.neq, q, qd, float(t), dq, dqd, ptab)
+
+
+def kinematics_sens(p: Packed, t0: float, t1: float, steps: int, tol: float, maxit: int,
+                    tmin: float, every: int, solver: int, nout: int,
+                    ptab: np.ndarray) -> SimpleNamespace:
+    """A kinematic run with sensitivities: as :func:`kinematics` plus ``sq``, ``sqd``,
+    ``sqdd`` (nq, np, nout)."""
+    return _named("q qd qdd sq sqd sqdd iinfo rinfo qsing dep red tpass status msg",
+                  _core.core_kinematics_sens, p.nb, p.ctab, p.rpar, p.neq, p.q0, t0, t1, steps,
+                  tol, maxit, tmin, every, solver, nout, ptab,
+                  numbers=3 * p.nq * nout * (1 + ptab.shape[1]))
+
+
+def inverse_sens(p: Packed, d: DynamicTables, t0: float, t1: float, steps: int, tol: float,
+                 every: int, solver: int, nout: int, ptab: np.ndarray) -> SimpleNamespace:
+    """Inverse dynamics with sensitivities: as :func:`inverse` plus ``sq``, ``sqd``, ``sqdd``
+    (nq, np, nout) and ``slam`` (neq, np, nout)."""
+    return _named("q qd qdd lam e sq sqd sqdd slam iinfo rinfo qsing dep red tpass status msg",
+                  _core.core_inverse_sens, ctab=p.ctab, rpar=p.rpar, bmass=d.bmass,
+                  grav=d.grav, ftab=d.ftab, fpar=d.fpar, neq=p.neq, q0=p.q0, t0=t0, t1=t1,
+                  nsteps=steps, tol=tol, every=every, solver=solver, nout=nout, ptab=ptab,
+                  numbers=(3 * p.nq + p.neq) * nout * (1 + ptab.shape[1]))
+
+
+def dynamics_sens(p: Packed, d: DynamicTables, t0: float, t1: float, steps: int, rtol: float,
+                  atol: float, every: int, max_steps: int, nrow: int,
+                  ptab: np.ndarray) -> SimpleNamespace:
+    """Forward dynamics by dopri5 with sensitivities: ``q``, ``qd``, ``qdd``, ``lam``, ``e``,
+    ``sq``, ``sqd``, ``sqdd``, ``iinfo``, ``rinfo``, ``red``, ``status``, ``msg``."""
+    return _named("q qd qdd lam e sq sqd sqdd iinfo rinfo red status msg",
+                  _core.core_dynamics_sens, ctab=p.ctab, rpar=p.rpar, bmass=d.bmass,
+                  grav=d.grav, ftab=d.ftab, fpar=d.fpar, neq=p.neq, q0=p.q0, v0=d.v0, t0=t0,
+                  t1=t1, nsteps=steps, rtol=rtol, atol=atol, every=every, max_steps=max_steps,
+                  nrow=nrow, ptab=ptab,
+                  numbers=(3 * p.nq + p.neq) * nrow * (1 + ptab.shape[1]))
+
+
+def statics_sens(p: Packed, d: DynamicTables, t: float, ptab: np.ndarray) -> SimpleNamespace:
+    """Static equilibrium with sensitivities: ``q``, ``lam``, ``sq`` (nq, np), ``slam``
+    (neq, np), ``stable``, ``resid``, ``iinfo``, ``status``, ``msg``."""
+    return _named("q lam sq slam stable resid iinfo status msg", _core.core_statics_sens,
+                  ctab=p.ctab, rpar=p.rpar, bmass=d.bmass, grav=d.grav, ftab=d.ftab,
+                  fpar=d.fpar, neq=p.neq, q0=p.q0, t=t, ptab=ptab)
+
+
+def reactions_dp(p: Packed, ptab: np.ndarray, q: np.ndarray, t: np.ndarray, lam: np.ndarray,
+                 sq: np.ndarray, slam: np.ndarray) -> SimpleNamespace:
+    """Changes of the reactions along the parameters: ``dreac``, ``drloc``
+    (6, nc, np, nt), ``status``, ``msg``."""
+    return _named("dreac drloc status msg", _core.core_reactions_dp, p.nb, p.ctab, p.rpar,
+                  ptab, q, t, lam, sq, slam,
+                  numbers=12 * p.ctab.shape[1] * ptab.shape[1] * len(np.atleast_1d(t)))
+
+
+# ------------------------------------------------------------------ design sweeps
+
+def batch(b: BatchTables, vals: np.ndarray) -> dict[str, Any]:
+    """One analysis for every case (column) of vals (nv, ncase), in one core call
+    (``fortran/mbd_batch.f90``). Returns the core's arrays by name, the case last: ``q``,
+    ``qd``, ``qdd`` (nq, nrow, ncase), ``lam`` (nlam, nrow, ncase), ``e`` (ne, nrow, ncase),
+    ``iinfo``, ``rinfo`` (10, ncase), ``qsing`` (nq, ncase), ``dep``, ``red`` (neq, ncase),
+    ``status`` (ncase) and ``msg`` (ncase, text). A module-level function of plain arrays, so
+    that worker processes and Dask workers can run it."""
+    vals = np.asfortranarray(vals, dtype=np.float64)
+    ncase = vals.shape[1]
+    out = _named("q qd qdd lam e iinfo rinfo qsing dep red status msg", _core.core_batch,
+                 analysis=b.analysis, nb=b.nb, ctab=b.ctab, rpar=b.rpar, bmass=b.bmass,
+                 grav=b.grav, ftab=b.ftab, fpar=b.fpar, q0=b.q0, v0=b.v0, vtab=b.vtab,
+                 vals=vals, opens=b.opens, iset=b.iset, rset=b.rset, neq=b.neq, nrow=b.nrow,
+                 nlam=b.nlam, ne=b.ne,
+                 numbers=ncase * ((3 * b.nq + b.nlam + b.ne) * b.nrow + 2 * b.neq + b.nq + 20))
+    return vars(out)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..description.builder import ModelDescription
+from ..description.friction import FRICTION_KIND
 from ..errors import ModelError
 from . import core
 from .status import error_for
@@ -25,7 +26,7 @@ def pack(model: ModelDescription) -> Packed:
     if not model.bodies:
         raise ModelError("the model has no moving bodies; add a [[body]]", "model")
     cons = model.constraints
-    if not cons:
+    if not cons and not getattr(model, "contacts", None):
         raise ModelError("the model has no joints or drivers; add a [[joint]] or [[driver]]",
                          "model")
     body_idx = {b.name: i + 1 for i, b in enumerate(model.bodies)}
@@ -41,7 +42,7 @@ def pack(model: ModelDescription) -> Packed:
         cols.append([c.kind, body_idx[c.bodies[0]], body_idx[c.bodies[1]], suba, subb,
                      len(rpar) + 1, len(params), 0])
         rpar.extend(params)
-    ctab = np.asfortranarray(np.array(cols, dtype=np.int32).T)
+    ctab = np.asfortranarray(np.array(cols, dtype=np.int32).reshape(-1, NCT).T)
     rp = np.array(rpar if rpar else [0.0], dtype=np.float64)
     out = core.sizes(len(model.bodies), ctab, rp)
     nq, neq, bad = int(out.nq), int(out.neq), int(out.bad)
@@ -70,6 +71,8 @@ def pack(model: ModelDescription) -> Packed:
 
 def pack_dynamics(model: ModelDescription, p: Packed) -> DynamicTables:
     """Masses (2, nb), gravity, the force table (NFT, nf), force parameters and v0 (nq).
+    The force elements are the forces, the contacts and the joint frictions
+    (``model.force_elements()``).
 
     Raises
     ------
@@ -86,10 +89,16 @@ def pack_dynamics(model: ModelDescription, p: Packed) -> DynamicTables:
     body_idx["ground"] = 0
     cols: list[list[int]] = []
     fpar: list[float] = []
-    for f in model.forces:
-        raw = f.raw()
-        cols.append([f.kind, body_idx[f.bodies[0]], body_idx[f.bodies[1]], len(fpar) + 1,
-                     len(raw), 0])
+    joint_idx = {j.name: k + 1 for k, j in enumerate(model.joints)}
+    for _, what, e in model.force_elements():
+        if what == "friction":
+            raw = e.friction.raw()
+            cols.append([FRICTION_KIND, body_idx[e.bodies[0]], body_idx[e.bodies[1]],
+                         len(fpar) + 1, len(raw), joint_idx[e.name]])
+        else:
+            raw = e.raw()
+            cols.append([e.kind, body_idx[e.bodies[0]], body_idx[e.bodies[1]], len(fpar) + 1,
+                         len(raw), 0])
         fpar.extend(raw)
     ftab = np.asfortranarray(np.array(cols, dtype=np.int32).reshape(-1, NFT).T)
     fp = np.array(fpar if fpar else [0.0])

@@ -84,6 +84,8 @@ ERRORS: dict[str, Table] = {
     "sizes": _INPUT_ONLY,
     "reactions": _INPUT_ONLY,
     "profile": _INPUT_ONLY,
+    # mechanism measures at the states of a run (conditioning, influence coefficients)
+    "measures": _INPUT_ONLY,
 }
 
 #: What to change when memory runs out, for messages.

@@ -48,3 +48,34 @@ def decode(raw: bytes | str) -> str:
     if isinstance(raw, bytes):
         raw = raw.decode("utf-8", "replace")
     return raw.strip()
+
+
+@dataclass
+class BatchTables:
+    """Everything one batch call of the core needs besides the case values (see
+    ``fortran/mbd_batch.f90``): the model's tables once, the entries each case sets, the
+    open phases to set again, and the analysis settings. Picklable: worker processes and
+    Dask workers get it whole."""
+
+    analysis: int               # 1 kinematics, 2 inverse dynamics, 3 statics, 4 dynamics
+    nb: int
+    ctab: np.ndarray            # int32 (NCT, nc)
+    rpar: np.ndarray            # float64
+    bmass: np.ndarray           # float64 (2, nb); zeros for kinematics
+    grav: np.ndarray            # float64 (2,)
+    ftab: np.ndarray            # int32 (NFT, nf)
+    fpar: np.ndarray            # float64
+    q0: np.ndarray              # float64 (nq,)
+    v0: np.ndarray              # float64 (nq,)
+    vtab: np.ndarray            # int32 (2, nv): (table, 1-based index) of each value row
+    opens: np.ndarray           # int32 (2, no): (rpar index, row of Phi) of the open phases
+    iset: np.ndarray            # int32 (8,) integer settings
+    rset: np.ndarray            # float64 (12,) real settings
+    neq: int
+    nrow: int                   # output rows per case
+    nlam: int                   # neq for the analyses with multipliers, else 0
+    ne: int                     # 4 for the analyses with energies, else 0
+
+    @property
+    def nq(self) -> int:
+        return len(self.q0)

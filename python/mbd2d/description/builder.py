@@ -21,12 +21,16 @@ from ..errors import ModelError
 from ..validate import (GROUND, as_list, check_name, choice, nonzero_vector, number, only_keys,
                         pairs, positive, vector)
 from .bodies import Body
+from .contacts import CONTACT_KEYS, CONTACT_TYPES, Contact, contact_geometry, parse_law
 from .drivers import AbsoluteDriver, Driver, RelativeAngleDriver, RelativeDistanceDriver
 from .forces import FORCE_KEYS, Force, PointForce, RotationalSpring, Spring, Torque
+from .friction import NO_FRICTION, parse_friction
 from .functions import as_function
 from .joints import (COORDINATES, PRESSURE_ANGLE, Absolute, Cam, Constraint, Distance, Gear,
                      PinInSlot, PointOnCurve, PointOnLine, RackPinion, Revolute, RollingDisc,
                      Translational, Weld, joint_keys, parse_follower, parse_profile)
+from .parameters import parameter_list
+from .parameters import with_params as _with_params
 
 
 class ModelDescription:
@@ -58,6 +62,7 @@ class ModelDescription:
         self.joints: list[Constraint] = []
         self.drivers: list[Driver] = []
         self.forces: list[Force] = []
+        self.contacts: list[Contact] = []
 
     # ------------------------------------------------------------------ lookups
     def body_index(self, name: str, entry: str, allow_ground: bool = True) -> int:
@@ -88,11 +93,11 @@ class ModelDescription:
     def _names(self) -> set[str]:
         # entries are appended: only the new ones are added to the cached set (a shorter
         # list rebuilds it), so building a large model stays linear
-        lists = (self.bodies, self.joints, self.drivers, self.forces)
+        lists = (self.bodies, self.joints, self.drivers, self.forces, self.contacts)
         key = tuple(len(x) for x in lists)
-        old, names = self.__dict__.get("_names_cache", ((0, 0, 0, 0), set()))
+        old, names = self.__dict__.get("_names_cache", ((0, 0, 0, 0, 0), set()))
         if any(k < o for k, o in zip(key, old)):
-            old, names = (0, 0, 0, 0), set()
+            old, names = (0, 0, 0, 0, 0), set()
         if key != old:
             for x, o in zip(lists, old):
                 names.update(e.name for e in x[o:])
@@ -104,7 +109,8 @@ class ModelDescription:
         or the automatic ``joint<k>``, ``driver<k>``, ``force<k>`` where k counts the
         entries of that section, this one included (the k-th ``[[joint]]`` of a file)."""
         if name is None:
-            k = len({"joint": self.joints, "driver": self.drivers, "force": self.forces}[section])
+            k = len({"joint": self.joints, "driver": self.drivers, "force": self.forces,
+                     "contact": self.contacts}[section])
             name = f"{section}{k + 1}"
             if name == GROUND or name in self._names():
                 raise ModelError(f"this {section} has no name, and its automatic name {name!r} "
@@ -185,20 +191,34 @@ class ModelDescription:
         return name, f"joint '{name}' ({kind})"
 
     def add_revolute(self, bodies: Sequence[str], points: Sequence[Sequence[float]],
-                     name: str | None = None) -> Revolute:
+                     name: str | None = None, friction: Mapping[str, Any] | None = None,
+                     pin_radius: float | None = None) -> Revolute:
         """Revolute joint: points[0] on bodies[0] coincides with points[1] on bodies[1].
 
-        Points are in each body's frame (a ground point is global).
+        Points are in each body's frame (a ground point is global). ``friction``:
+        ``{mu, mu_static, model, threshold, pin_radius}`` (see
+        :mod:`mbd2d.description.friction`): a friction moment mu N pin_radius against the
+        relative rotation, N the magnitude of the pin force (the friction circle);
+        ``pin_radius`` may be given here instead of in the table.
         """
         name, entry = self._start("revolute", name)
-        return self._add(Revolute(name, self._two_bodies(bodies, entry),
-                                  pairs(points, 2, "points", entry)))  # type: ignore[return-value]
+        bb = self._two_bodies(bodies, entry)
+        pts = pairs(points, 2, "points", entry)
+        fr = None
+        if friction is not None:
+            fr = parse_friction(friction, entry, revolute=True, pin_radius=pin_radius)
+        elif pin_radius is not None:
+            raise ModelError("pin_radius is the radius of the friction circle: give it with "
+                             "friction = { mu = ... }", entry)
+        return self._add(Revolute(name, bb, pts, fr))  # type: ignore[return-value]
 
     def add_translational(self, bodies: Sequence[str], points: Sequence[Sequence[float]],
-                          axes: Sequence[Sequence[float]],
-                          name: str | None = None) -> Translational:
+                          axes: Sequence[Sequence[float]], name: str | None = None,
+                          friction: Mapping[str, Any] | None = None) -> Translational:
         """Translational joint: the point on bodies[1] slides along the line through points[0]
-        with direction axes[0] (in bodies[0]); axes[1] (in bodies[1]) stays parallel to it."""
+        with direction axes[0] (in bodies[0]); axes[1] (in bodies[1]) stays parallel to it.
+        ``friction``: ``{mu, mu_static, model, threshold}``, a force mu N along the axis
+        against the slide, N the normal reaction (the moment reaction is not a load here)."""
         name, entry = self._start("translational", name)
         bb = self._two_bodies(bodies, entry)
         pts = pairs(points, 2, "points", entry)
@@ -206,7 +226,8 @@ class ModelDescription:
         if isinstance(axes, (str, bytes)) or not isinstance(axes, Sequence) or len(axes) != 2:
             raise ModelError(f"axes must be a list of two [x, y] directions, got {axes!r}", entry)
         ax = (nonzero_vector(axes[0], "axes[0]", entry), nonzero_vector(axes[1], "axes[1]", entry))
-        return self._add(Translational(name, bb, pts, ax))  # type: ignore[return-value]
+        fr = None if friction is None else parse_friction(friction, entry)
+        return self._add(Translational(name, bb, pts, ax, fr))  # type: ignore[return-value]
 
     def add_cam(self, bodies: Sequence[str], profile: Mapping[str, Any],
                 follower: Mapping[str, Any], name: str | None = None) -> Cam:
@@ -436,6 +457,70 @@ class ModelDescription:
         only_keys(kw, allowed | {"name"}, entry, required=sorted(required))
         return builders[type](**kw)
 
+    # ------------------------------------------------------------------ contacts
+    def add_contact(self, type: str, bodies: Sequence[str], law: Mapping[str, Any],
+                    circle: Any = None, line: Mapping[str, Any] | None = None,
+                    profile: Mapping[str, Any] | None = None,
+                    follower: Mapping[str, Any] | None = None,
+                    friction: Mapping[str, Any] | None = None,
+                    name: str | None = None) -> Contact:
+        """A penalty contact between a surface of bodies[0] and one of bodies[1] (dynamics).
+
+        Parameters
+        ----------
+        type : {'circle-line', 'circle-circle', 'circle-in-circle', 'follower-profile'}
+            circle-line: ``circle`` {center, radius} on bodies[0] against ``line`` {point,
+            normal} on bodies[1], the solid on the side opposite the normal;
+            circle-circle: ``circle`` = [{...}, {...}], the outer surfaces of two circles;
+            circle-in-circle: ``circle`` = [pin, hole], a pin of bodies[0] in a larger hole
+            of bodies[1] (a revolute joint with clearance);
+            follower-profile: the cam ``profile`` on bodies[0] and the ``follower`` on
+            bodies[1], in the forms of :meth:`add_cam`; the follower can lift off.
+        law : mapping
+            ``{model, stiffness, exponent, restitution}``: model 'linear' (spring-dashpot),
+            'hertz' (elastic), 'hunt-crossley', 'lankarani-nikravesh' or 'flores' (Fn = k
+            delta**exponent with hysteresis damping from the restitution); exponent default
+            1.5 (1 for linear), restitution default 1.
+        friction : mapping, optional
+            ``{mu, mu_static, threshold}``: regularized Coulomb friction at the contact point.
+
+        Returns
+        -------
+        Contact
+        """
+        entry = f"contact {name!r} ({type})" if isinstance(name, str) \
+            else f"contact #{len(self.contacts) + 1} ({type})"
+        if not isinstance(type, str) or type not in CONTACT_TYPES:
+            raise ModelError(f"unknown contact type {type!r}; known: "
+                             f"{', '.join(CONTACT_TYPES)}", entry)
+        name = self._new_name(name, "contact", entry)
+        entry = f"contact '{name}' ({type})"
+        bb = self._two_bodies(bodies, entry)
+        given = {"circle": circle, "line": line, "profile": profile, "follower": follower}
+        allowed, required = CONTACT_KEYS[type]
+        for key, value in given.items():
+            if value is not None and key not in allowed:
+                raise ModelError(f"a {type} contact has no '{key}'; its keys: "
+                                 f"{sorted(allowed)}", entry)
+            if value is None and key in required:
+                raise ModelError(f"missing key '{key}'", entry)
+        geom, pkind, fkind = contact_geometry(type, entry, **given)
+        lw = parse_law(law, entry)
+        fr = NO_FRICTION if friction is None else parse_friction(friction, entry, joint=False)
+        c = Contact(name, type, bb, geom, lw, fr, pkind, fkind)
+        self.contacts.append(c)
+        return c
+
+    def force_elements(self) -> list[tuple[str, str, Any]]:
+        """The force elements in the core's order: (name, what, entry) for the forces, the
+        contacts, then the friction of each joint that has one (``what`` is 'force',
+        'contact' or 'friction'; a friction is named by its joint)."""
+        out: list[tuple[str, str, Any]] = [(f.name, "force", f) for f in self.forces]
+        out += [(c.name, "contact", c) for c in self.contacts]
+        out += [(j.name, "friction", j) for j in self.joints
+                if getattr(j, "friction", None) is not None]
+        return out
+
     def add_driver(self, type: str, f: Any, name: str | None = None, body: str | None = None,
                    coordinate: str | None = None, bodies: Sequence[str] | None = None,
                    joint: str | None = None) -> Driver:
@@ -509,6 +594,43 @@ class ModelDescription:
         ``O2.x``, ``guide.angle``, ``motor.theta``)."""
         return [r for c in self.constraints for r in c.rows()]
 
+    # ------------------------------------------------------------------ design parameters
+    def parameters(self) -> dict[str, float | None]:
+        """Every design parameter by name, with its value.
+
+        A name is the entry's path in the model file: ``joint.A.points.1.0`` (x of joint
+        A's point on its second body), ``joint.guide.axes.0.1``, ``body.crank.mass``,
+        ``force.s1.stiffness``, ``driver.motor.f.poly.1``, ``model.gravity.1`` (see
+        :mod:`mbd2d.description.parameters`). A gear or rolling phase left open has the value
+        None here (:meth:`mbd2d.Model.parameters` gives the value taken from q0).
+
+        Examples
+        --------
+        >>> import mbd2d
+        >>> mbd2d.load("examples/fourbar_grashof.toml").parameters()["joint.A.points.1.0"]
+        -1.75
+        """
+        return {p.name: p.value for p in parameter_list(self)}
+
+    def with_params(self, values: Mapping[str, Any]) -> "ModelDescription":
+        """A new model with the named parameters set to the given values; this model is
+        left unchanged.
+
+        Raises
+        ------
+        ModelError
+            For an unknown name (the message names it and suggests the closest names) or a
+            value that is not a finite number.
+
+        Examples
+        --------
+        >>> import mbd2d
+        >>> m = mbd2d.load("examples/fourbar_grashof.toml")
+        >>> m.with_params({"joint.B.points.0.0": 1.8}).parameters()["joint.B.points.0.0"]
+        1.8
+        """
+        return _with_params(self, values)
+
     def has_masses(self) -> bool:
         """Every body has a mass and an inertia (dynamics and inverse dynamics can run)."""
         return bool(self.bodies) and all(b.mass is not None and b.inertia is not None
@@ -516,6 +638,7 @@ class ModelDescription:
 
     def __repr__(self) -> str:
         forces = f", {len(self.forces)} forces" if self.forces else ""
+        forces += f", {len(self.contacts)} contacts" if self.contacts else ""
         return (f"{type(self).__name__}({self.name!r}: {len(self.bodies)} bodies, "
                 f"{len(self.joints)} joints, "
                 f"{len(self.drivers)} drivers{forces})")

@@ -13,6 +13,7 @@ from typing import Any, Callable, ClassVar, Mapping, Sequence
 
 from ..errors import ModelError
 from ..validate import as_list, nonzero_vector, only_keys, pairs, positive, table, vector
+from .friction import Friction
 
 PROFILE_KINDS = {"circle": 1, "spline": 2, "fourier": 3}
 FOLLOWER_KINDS = {"point": 1, "roller": 2, "flat": 3}
@@ -87,9 +88,11 @@ class Constraint:
 
 @dataclass
 class Revolute(Constraint):
-    """Revolute joint: the two points coincide."""
+    """Revolute joint: the two points coincide; optional friction (friction circle of the
+    pin radius, :mod:`mbd2d.description.friction`)."""
 
     points: tuple[tuple[float, float], tuple[float, float]] = ((0.0, 0.0), (0.0, 0.0))
+    friction: Friction | None = None
     type: ClassVar[str] = "revolute"
     kind: ClassVar[int] = 1
     labels: ClassVar[tuple[str, ...]] = ("x", "y")
@@ -100,10 +103,12 @@ class Revolute(Constraint):
 
 @dataclass
 class Translational(Constraint):
-    """Translational joint: point j stays on the line of body i; the axes stay parallel."""
+    """Translational joint: point j stays on the line of body i; the axes stay parallel;
+    optional friction (normal load from the normal row's multiplier)."""
 
     points: tuple[tuple[float, float], tuple[float, float]] = ((0.0, 0.0), (0.0, 0.0))
     axes: tuple[tuple[float, float], tuple[float, float]] = ((1.0, 0.0), (1.0, 0.0))
+    friction: Friction | None = None
     type: ClassVar[str] = "translational"
     kind: ClassVar[int] = 2
     labels: ClassVar[tuple[str, ...]] = ("normal", "angle")
@@ -375,8 +380,9 @@ def parse_follower(spec: Any, entry: str) -> tuple[str, tuple[float, float, floa
 def joint_keys() -> Mapping[str, tuple[set[str], set[str]]]:
     """TOML keys of each joint type: (allowed, required)."""
     return {
-        "revolute": ({"bodies", "points"}, {"bodies", "points"}),
-        "translational": ({"bodies", "points", "axes"}, {"bodies", "points", "axes"}),
+        "revolute": ({"bodies", "points", "friction", "pin_radius"}, {"bodies", "points"}),
+        "translational": ({"bodies", "points", "axes", "friction"},
+                          {"bodies", "points", "axes"}),
         "cam": ({"bodies", "profile", "follower"}, {"bodies", "profile", "follower"}),
         "point-on-curve": ({"bodies", "curve", "point"}, {"bodies", "curve", "point"}),
         "distance": ({"bodies", "points", "distance"}, {"bodies", "points", "distance"}),

@@ -6,6 +6,7 @@
     [[driver]]         name, type, body, coordinate, bodies, joint, f
     [[force]]          name, type, bodies, body, points, point, stiffness, damping, length0,
                        angle0, f, fx, fy
+    [[contact]]        name, type, bodies, circle, line, profile, follower, law, friction
 
 Every key goes through the builder methods of
 :class:`~mbd2d.description.builder.ModelDescription`, so a TOML model and a model built in code
@@ -22,10 +23,11 @@ from typing import Any, Mapping, TypeVar
 from ..errors import ModelError
 from ..validate import only_keys, table
 from .builder import ModelDescription
+from .contacts import CONTACT_KEYS
 
 M = TypeVar("M", bound=ModelDescription)
 
-SECTIONS = {"model", "body", "joint", "driver", "force"}
+SECTIONS = {"model", "body", "joint", "driver", "force", "contact"}
 
 
 def load(path: str | Path, cls: type[M] = ModelDescription) -> M:  # type: ignore[assignment]
@@ -105,7 +107,8 @@ def from_dict(data: Mapping[str, Any], source: str = "<dict>",
     unknown = set(data) - SECTIONS
     if unknown:
         raise ModelError(f"unknown section(s) {sorted(unknown)}; sections are "
-                         "[model], [[body]], [[joint]], [[driver]]", source)
+                         "[model], [[body]], [[joint]], [[driver]], [[force]], [[contact]]",
+                         source)
     head = table(data.get("model", {}), "[model]", source)
     only_keys(head, {"name", "gravity"}, "[model]")
     name = head.get("name", Path(source).stem if source.endswith(".toml") else "model")
@@ -141,4 +144,194 @@ def from_dict(data: Mapping[str, Any], source: str = "<dict>",
             raise ModelError("missing key 'type' (spring, torque, point, rotational-spring)",
                              entry)
         model.add_force(**fe)
+    for i, ce in enumerate(_entries(data, "contact", source)):
+        entry = f"[[contact]] #{i + 1}" + _named(ce)
+        ce = dict(table(ce, "[[contact]]", entry))
+        only_keys(ce, set(ce) | {"type"}, entry)
+        if "type" not in ce:
+            raise ModelError("missing key 'type' (circle-line, circle-circle, "
+                             "circle-in-circle, follower-profile)", entry)
+        ctype = ce["type"]
+        if isinstance(ctype, str) and ctype in CONTACT_KEYS:
+            allowed, required = CONTACT_KEYS[ctype]
+            only_keys(ce, allowed | {"name", "type"}, entry, required=sorted(required))
+        model.add_contact(**ce)
     return model
+
+
+# ------------------------------------------------------------------ writing
+
+def _function_dict(f: Any) -> dict[str, Any]:
+    """A TimeFunction as its TOML table."""
+    out: dict[str, Any] = {"poly": [float(c) for c in f.poly]}
+    if f.harmonic:
+        out["harmonic"] = [{"amplitude": h.amplitude, "omega": h.omega, "phase": h.phase}
+                           for h in f.harmonic]
+    return out
+
+
+def _profile_dict(kind: str, prof: tuple[float, ...]) -> dict[str, Any]:
+    """A packed profile (see joints.parse_profile) as its TOML table."""
+    if kind == "circle":
+        return {"circle": {"center": [prof[0], prof[1]], "radius": prof[2]}}
+    if kind == "spline":
+        n = int(prof[0])
+        return {"spline": {"points": [[prof[1 + 2 * i], prof[2 + 2 * i]] for i in range(n)]}}
+    k = int(prof[2])
+    a = [prof[3]] + [prof[4 + 2 * i] for i in range(k)]
+    b = [prof[5 + 2 * i] for i in range(k)]
+    return {"fourier": {"center": [prof[0], prof[1]], "a": a, "b": b}}
+
+
+def _follower_dict(kind: str, f: tuple[float, ...]) -> dict[str, Any]:
+    if kind == "point":
+        return {"point": [f[0], f[1]]}
+    if kind == "roller":
+        return {"roller": {"center": [f[0], f[1]], "radius": f[2]}}
+    return {"flat": {"point": [f[0], f[1]], "normal": [f[2], f[3]]}}
+
+
+def _pairs(p: Any) -> list[list[float]]:
+    return [[float(v) for v in xy] for xy in p]
+
+
+def _joint_dict(c: Any) -> dict[str, Any]:
+    """A joint as its [[joint]] table (the keys of :func:`joints.joint_keys`)."""
+    t = c.type
+    out: dict[str, Any] = {"name": c.name, "type": t}
+    if t == "absolute":
+        out.update(body=c.bodies[0], coordinate=c.coordinate, value=c.value)
+        return out
+    out["bodies"] = list(c.bodies)
+    if t == "cam":
+        out.update(profile=_profile_dict(c.profile_kind, c.profile),
+                   follower=_follower_dict(c.follower_kind, c.follower))
+    elif t == "point-on-curve":
+        out.update(curve=_profile_dict(c.profile_kind, c.profile),
+                   point=[c.follower[0], c.follower[1]])
+    elif t in ("rack-pinion", "rolling-disc"):
+        out.update(center=list(c.center), point=list(c.point), axis=list(c.axis),
+                   radius=c.radius)
+        if c.phase is not None:
+            out["phase"] = c.phase
+    elif t == "gear":
+        out.update(radii=list(c.radii), internal=c.internal, carrier=c.carrier,
+                   pressure_angle=c.pressure_angle)
+        if c.phase is not None:
+            out["phase"] = c.phase
+        if c.centers is not None:
+            out["centers"] = _pairs(c.centers)
+    else:
+        out["points"] = _pairs(c.points)
+        if t == "translational":
+            out["axes"] = _pairs(c.axes)
+        elif t == "distance":
+            out["distance"] = c.distance
+        elif t in ("point-on-line", "revolute-translational"):
+            out.update(axis=list(c.axis), offset=c.offset)
+        elif t == "weld":
+            out["angle"] = c.angle
+    return out
+
+
+def _driver_dict(d: Any) -> dict[str, Any]:
+    out: dict[str, Any] = {"name": d.name, "type": d.type}
+    if d.type == "absolute":
+        out.update(body=d.bodies[0], coordinate=d.coordinate)
+    elif d.type == "relative-angle":
+        out["bodies"] = list(d.bodies)
+    else:
+        out["joint"] = d.joint
+    out["f"] = _function_dict(d.f)
+    return out
+
+
+def _force_dict(f: Any) -> dict[str, Any]:
+    out: dict[str, Any] = {"name": f.name, "type": f.type}
+    if f.type == "spring":
+        out.update(bodies=list(f.bodies), points=_pairs(f.points), stiffness=f.stiffness,
+                   damping=f.damping, length0=f.length0, f=_function_dict(f.f))
+    elif f.type == "torque":
+        out.update(body=f.bodies[0], f=_function_dict(f.f))
+    elif f.type == "point":
+        out.update(body=f.bodies[0], point=list(f.point), fx=_function_dict(f.fx),
+                   fy=_function_dict(f.fy))
+    else:
+        out.update(bodies=list(f.bodies), stiffness=f.stiffness, damping=f.damping,
+                   angle0=f.angle0, f=_function_dict(f.f))
+    return out
+
+
+def to_dict(model: ModelDescription) -> dict[str, Any]:
+    """The model as parsed TOML (nested dicts and lists): :func:`from_dict` of it builds the
+    same model (every parameter, q0 and v0 estimate, name and option).
+
+    Examples
+    --------
+    >>> m = load("examples/fourbar_seed.toml")
+    >>> from_dict(to_dict(m)).parameters() == m.parameters()
+    True
+    """
+    bodies = []
+    for b in model.bodies:
+        e: dict[str, Any] = {"name": b.name, "q0": [float(v) for v in b.q0]}
+        if b.mass is not None:
+            e["mass"] = b.mass
+        if b.inertia is not None:
+            e["inertia"] = b.inertia
+        if any(v != 0.0 for v in b.v0):
+            e["v0"] = [float(v) for v in b.v0]
+        bodies.append(e)
+    out: dict[str, Any] = {"model": {"name": model.name,
+                                     "gravity": [float(g) for g in model.gravity]},
+                           "body": bodies, "joint": [_joint_dict(j) for j in model.joints],
+                           "driver": [_driver_dict(d) for d in model.drivers]}
+    if model.forces:
+        out["force"] = [_force_dict(f) for f in model.forces]
+    return out
+
+
+def _value(v: Any) -> str:
+    """One TOML value (inline form)."""
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, (int, float)):
+        return repr(float(v))
+    if isinstance(v, str):
+        return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    if isinstance(v, Mapping):
+        return "{ " + ", ".join(f"{k} = {_value(x)}" for k, x in v.items()) + " }"
+    return "[" + ", ".join(_value(x) for x in v) + "]"
+
+
+def dumps(model: ModelDescription, header: str = "") -> str:
+    """The model as TOML text in the format :func:`loads` reads (numbers written exactly,
+    with ``repr``), optionally after comment lines ``header``.
+
+    Examples
+    --------
+    >>> text = dumps(load("examples/fourbar_grashof.toml"))
+    >>> loads(text).parameters() == load("examples/fourbar_grashof.toml").parameters()
+    True
+    """
+    data = to_dict(model)
+    lines = [f"# {line}".rstrip() for line in header.splitlines()]
+    lines += ["[model]"] + [f"{k} = {_value(v)}" for k, v in data["model"].items()]
+    for section in ("body", "joint", "driver", "force"):
+        for entry in data.get(section, []):
+            lines += ["", f"[[{section}]]"] + [f"{k} = {_value(v)}" for k, v in entry.items()]
+    return "\n".join(lines) + "\n"
+
+
+def dump(model: ModelDescription, path: str | Path, header: str = "") -> None:
+    """Write the model to a TOML file (see :func:`dumps`).
+
+    Raises
+    ------
+    ModelError
+        If the file cannot be written.
+    """
+    try:
+        Path(path).write_text(dumps(model, header), encoding="utf-8")
+    except OSError as exc:
+        raise ModelError(f"cannot write the model file: {exc.strerror}", str(path)) from None

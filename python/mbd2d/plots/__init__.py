@@ -1,12 +1,13 @@
-"""Layer 4, the pictures: mechanism snapshots, time series, PNG output.
+"""Layer 4, the pictures: the mechanism at snapshots, paths, time series, animations.
 
 matplotlib is imported only when a function here is called, so ``import mbd2d`` does not
 need it. Figures are drawn on the non-interactive Agg canvas and are not registered with
 ``pyplot`` (nothing to close, no figure leak in loops).
 
-Everything drawn is post-processing of the result: body poses come from
-:class:`~mbd2d.results.KinematicsResult`, cam profile points from the Fortran core
-(through :mod:`mbd2d.binding.core`); body-local points are placed with r + A(theta) s.
+Everything drawn is post-processing of the result: body poses come from the result, cam
+profile points and load values from the Fortran core (through :mod:`mbd2d.binding.core`);
+body-local points are placed with r + A(theta) s. How each element is drawn lives in
+:mod:`.elements` (one class per kind, in one table).
 
 Examples
 --------
@@ -19,11 +20,13 @@ Examples
 """
 from __future__ import annotations
 
+from .animation import InlineAnimation, animate, ffmpeg_available
 from .canvas import STOP_COLOUR
-from .files import save_figures
-from .geometry import Motion, TracePoint
-from .mechanism import plot_mechanism
+from .files import png_bytes, save_figure, save_figures
+from .geometry import Configuration, Motion, TracePoint
+from .mechanism import default_points, plot_mechanism, plot_paths
 from .timeseries import plot_timeseries
 
-__all__ = ["plot_mechanism", "plot_timeseries", "save_figures", "STOP_COLOUR", Motion,
-           "TracePoint"]
+__all__ = ["plot_mechanism", "plot_paths", "plot_timeseries", "animate", "save_figures",
+           "save_figure", "png_bytes", "InlineAnimation", "ffmpeg_available", "Configuration",
+           "default_points", "STOP_COLOUR", "Motion", "TracePoint"]

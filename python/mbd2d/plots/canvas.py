@@ -13,6 +13,11 @@ if TYPE_CHECKING:  # pragma: no cover
 #: Colour of the configuration where an incomplete run stopped.
 STOP_COLOUR = "#d62728"
 GROUND_COLOUR = "0.35"
+#: Applied loads (point forces, torques) and joint reactions drawn as arrows.
+LOAD_COLOUR = "#e6550d"
+REACTION_COLOUR = "#7b3294"
+#: Singular passages marked on time axes.
+PASSAGE_COLOUR = "#8c564b"
 PALETTE = ["#1f77b4", "#ff7f0e", "#2ca02c", "#9467bd", "#8c564b", "#e377c2", "#17becf",
            "#bcbd22", "#7f7f7f"]
 

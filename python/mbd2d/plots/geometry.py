@@ -1,19 +1,21 @@
 """Geometry of the pictures: body poses at output rows, body-local points placed with
-r + A(theta) s, cam profile points from the core, and the checks of what to draw.
+r + A(theta) s, cam profile points and load values from the core, and the checks of what to
+draw.
 
 The pictures read a result through the small :class:`Motion` protocol (times, coordinates,
 per-body histories and the model description), so this layer does not depend on the results
-classes.
+classes. :class:`Configuration` is a Motion of one configuration (a model before any run).
 """
 from __future__ import annotations
 
-from typing import Any, Protocol, Sequence
+from types import SimpleNamespace
+from typing import Any, Protocol
 
 import numpy as np
 
 from ..binding import core
 from ..binding.status import error_for
-from ..description.joints import PROFILE_KINDS, Cam, Revolute, Translational
+from ..description.joints import PROFILE_KINDS, Cam
 from ..errors import ModelError
 from ..validate import GROUND
 
@@ -21,7 +23,12 @@ TracePoint = tuple[str, tuple[float, float]]
 
 
 class Motion(Protocol):
-    """What the pictures read from a result (a :class:`~mbd2d.KinematicsResult` is one)."""
+    """What the pictures read from a result (a :class:`~mbd2d.KinematicsResult` is one).
+
+    ``stats`` (a dict, optional) may hold ``singular_passages`` and ``dead_centre`` (times),
+    marked on time axes; ``reaction(name)`` and ``effort(name)`` (optional, results with
+    multipliers) give the reactions drawn as arrows and plotted against time.
+    """
 
     t: np.ndarray
     q: np.ndarray
@@ -33,8 +40,28 @@ class Motion(Protocol):
     def body(self, name: str) -> Any:
         """Histories x, y, theta (and derivatives) of a body, as attributes."""
 
-    def point(self, name: str, s: Any) -> np.ndarray:
-        """Global path (n, 2) of a point fixed in a body."""
+
+class Configuration:
+    """One configuration q of a model as a :class:`Motion` with one row (time t)."""
+
+    def __init__(self, model: Any, q: Any, t: float = 0.0, note: str = "") -> None:
+        self.model = model
+        self.t = np.array([float(t)])
+        self.q = np.atleast_2d(np.asarray(q, dtype=float))
+        self.qd = np.zeros_like(self.q)
+        self.qdd = np.zeros_like(self.q)
+        self.body_names = [b.name for b in model.bodies]
+        self.coordinate_names = list(model.coordinate_names)
+        self.complete = True
+        self.stats: dict[str, Any] = {}
+        self.note = note
+
+    def body(self, name: str) -> Any:
+        i = self.body_names.index(name)
+        x, y, th = self.q[:, 3 * i], self.q[:, 3 * i + 1], self.q[:, 3 * i + 2]
+        z = np.zeros(1)
+        return SimpleNamespace(x=x, y=y, theta=th, x_dot=z, y_dot=z, theta_dot=z, x_ddot=z,
+                               y_ddot=z, theta_ddot=z)
 
 
 class Poses:
@@ -84,6 +111,15 @@ def profile_points(cam: Cam, alphas: np.ndarray) -> np.ndarray:
     return np.asarray(out.pts).T
 
 
+def function_values(f: Any, t: np.ndarray, entry: str) -> np.ndarray:
+    """f(t) of a :class:`~mbd2d.TimeFunction` at the times t, from the core."""
+    out = core.fun_values(np.ascontiguousarray(f.encode(), dtype=np.float64),
+                          np.ascontiguousarray(t, dtype=np.float64))
+    if out.status != 0:
+        raise error_for("eval", out.status, out.msg, entry=entry)
+    return np.asarray(out.f, dtype=float).copy()
+
+
 def convex_hull(pts: np.ndarray) -> np.ndarray:
     """Convex hull (counterclockwise) of a few 2-D points; collinear points give the two
     extremes."""
@@ -108,32 +144,17 @@ def convex_hull(pts: np.ndarray) -> np.ndarray:
     return np.array(h, dtype=float)
 
 
-def body_points(model: Any,
-                trace: Sequence[TracePoint]) -> dict[str, list[tuple[float, float]]]:
-    """Local points of each moving body: its origin, its joint points, traced points."""
-    pts: dict[str, list[tuple[float, float]]] = {b.name: [(0.0, 0.0)] for b in model.bodies}
-    for j in model.joints:
-        if isinstance(j, (Revolute, Translational)):
-            for body, s in zip(j.bodies, j.points):
-                if body != GROUND:
-                    pts[body].append((float(s[0]), float(s[1])))
-        elif isinstance(j, Cam) and j.bodies[1] != GROUND:
-            pts[j.bodies[1]].append((float(j.follower[0]), float(j.follower[1])))
-    for body, s in trace:
-        if body != GROUND:
-            pts[body].append((float(s[0]), float(s[1])))
-    return pts
-
-
 def check_trace(result: Motion, trace: Any) -> list[TracePoint]:
     if trace is None:
         return []
     out: list[TracePoint] = []
+    if isinstance(trace, (str, bytes)):
+        raise ModelError(f"must be a list of (body_name, (sx, sy)), got {trace!r}", "trace")
     for item in trace:
         try:
             body, s = item
             sx, sy = float(s[0]), float(s[1])
-            if len(s) != 2:
+            if len(s) != 2 or not (np.isfinite(sx) and np.isfinite(sy)):
                 raise ValueError
         except (TypeError, ValueError):
             raise ModelError(f"entries must be (body_name, (sx, sy)), got {item!r}", "trace") \
@@ -144,11 +165,11 @@ def check_trace(result: Motion, trace: Any) -> list[TracePoint]:
     return out
 
 
-def snapshot_rows(result: Motion, times: Any) -> np.ndarray:
-    """Output rows to draw: a few evenly spaced ones, or the rows nearest to times."""
+def snapshot_rows(result: Motion, times: Any, count: int = 6) -> np.ndarray:
+    """Output rows to draw: ``count`` evenly spaced ones, or the rows nearest to times."""
     n = len(result.t)
     if times is None:
-        k = min(n, 6)
+        k = min(n, count)
         rows = np.unique(np.round(np.linspace(0, n - 1, k)).astype(int))
     else:
         try:
@@ -169,16 +190,15 @@ def snapshot_rows(result: Motion, times: Any) -> np.ndarray:
     return rows
 
 
-def slide_axis(model: Any, body: str) -> tuple[float, float] | None:
-    """The axis, in the body frame, of the first translational joint of body; None if none."""
-    for j in model.joints:
-        if isinstance(j, Translational) and body in j.bodies:
-            v = j.axes[j.bodies.index(body)]
-            return (float(v[0]), float(v[1]))
-    return None
-
-
-def body_axis(model: Any, body: str) -> float:
-    """Angle in the body frame of its slide axis (for drawing blocks); 0 if none."""
-    v = slide_axis(model, body)
-    return 0.0 if v is None else float(np.arctan2(v[1], v[0]))
+def frame_rows(result: Motion, fps: float, speed: float, max_frames: int) -> np.ndarray:
+    """Rows shown by an animation at fps frames per second of the run's time divided by
+    speed: the row nearest each frame's time, at most max_frames (evenly spaced), always the
+    first and last."""
+    n = len(result.t)
+    span = float(result.t[-1] - result.t[0]) if n else 0.0
+    want = int(round(fps * span / speed)) + 1 if span > 0 else 1
+    k = max(2, min(want, max_frames, n)) if n > 1 else 1
+    times = np.linspace(result.t[0], result.t[-1], k)
+    rows = np.abs(result.t[None, :] - times[:, None]).argmin(axis=1)
+    rows[0], rows[-1] = 0, n - 1
+    return rows

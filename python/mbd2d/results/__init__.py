@@ -7,12 +7,15 @@ Results hold data and answer questions about it; pictures of a result are drawn 
 """
 from __future__ import annotations
 
+from .contacts import ContactEvent, ContactHistory, FrictionEvent, FrictionHistory, LiftOff
 from .dof import DofReport
 from .dynamics import DynamicsResult
 from .files import read_csv
 from .kinematics import SUFFIXES, BodyResult, KinematicsResult
+from .points import PointResult
 from .reactions import Reaction
 from .statics import StaticsResult
 
 __all__ = ["BodyResult", "KinematicsResult", "DynamicsResult", "StaticsResult", "Reaction",
-           "DofReport", "SUFFIXES", "read_csv"]
+           "DofReport", "PointResult", "SUFFIXES", "read_csv", "ContactEvent", "FrictionEvent",
+           "LiftOff", "ContactHistory", "FrictionHistory"]

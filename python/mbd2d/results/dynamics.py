@@ -8,9 +8,18 @@ from typing import Any
 
 import numpy as np
 
-from .files import writing
+from .contacts import (ContactEvent, ContactHistory, FrictionEvent, FrictionHistory, LiftOff,
+                       history)
+from .files import check_outputs, writing
 from .kinematics import KinematicsResult
 from .reactions import Reaction, reaction_arrays, reaction_of
+from .sensitivities import parameter_index, reaction_dp_arrays, reaction_dp_of
+
+
+#: columns of ``energy=True`` in a table
+ENERGY_COLUMNS = ("kinetic", "potential", "energy", "drift_position", "drift_velocity")
+#: the reaction columns of a constraint, NAME.WORD (the Reaction attributes)
+REACTION_WORDS = ("fx", "fy", "mz", "fx_j", "fy_j", "mz_j")
 
 
 @dataclass(repr=False)
@@ -26,6 +35,18 @@ class DynamicsResult(KinematicsResult):
         Kinetic energy q_dot^T M q_dot / 2 and potential energy (gravity and springs).
     drift_position, drift_velocity : numpy.ndarray
         ||Phi||_inf and ||J q_dot - nu||_inf at each output.
+    contacts : list of ContactEvent
+        Onsets and separations of the contacts (time, contact, kind, speed); forward
+        dynamics locates them in time, inverse dynamics at the output times.
+    friction_events : list of FrictionEvent
+        Stick, slip and reversal of the stick-slip joints.
+    lift_off : list of LiftOff
+        Intervals where a cam joint would have to pull its follower onto the profile.
+    elements : numpy.ndarray
+        (n, number of force elements, 6) outputs of the forces, contacts and joint frictions
+        (``element_names``); read them with :meth:`contact` and :meth:`friction`.
+    dlam_dp : numpy.ndarray or None
+        With ``sensitivities=[...]`` of inverse dynamics: d lambda / d p (n, neq, n_params).
     """
 
     lam: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
@@ -35,7 +56,15 @@ class DynamicsResult(KinematicsResult):
     drift_velocity: np.ndarray = field(default_factory=lambda: np.zeros(0))
     row_labels: list[str] = field(default_factory=list)
     packed: Any = None
+    elements: np.ndarray = field(default_factory=lambda: np.zeros((0, 0, 6)))
+    element_names: list[tuple[str, str]] = field(default_factory=list)
+    contacts: list[ContactEvent] = field(default_factory=list)
+    friction_events: list[FrictionEvent] = field(default_factory=list)
+    lift_off: list[LiftOff] = field(default_factory=list)
+    dlam_dp: np.ndarray | None = None
+    ptab: Any = None
     _reac: Any = None
+    _reac_dp: Any = None
 
     @property
     def energy(self) -> np.ndarray:
@@ -66,6 +95,48 @@ class DynamicsResult(KinematicsResult):
         row = self.packed.row_owner.index(names.index(name))
         return -self.lam[:, row]
 
+    def effort_dp(self, name: str) -> np.ndarray:
+        """Sensitivities of the effort of the driver called name to the design parameters,
+        shape (n, n_params) (columns in the order of ``parameter_names``).
+
+        Raises
+        ------
+        KeyError
+            If there is no such driver or the run computed no multiplier sensitivities.
+        """
+        names = self.packed.constraint_names
+        if name not in names or not self.packed.driver_flags[names.index(name)]:
+            raise KeyError(f"no driver {name!r}")
+        if self.dlam_dp is None:
+            raise KeyError("this result has no effort sensitivities: run inverse dynamics "
+                           "with sensitivities=[names]")
+        row = self.packed.row_owner.index(names.index(name))
+        return -self.dlam_dp[:, row, :]
+
+    def reaction_dp(self, name: str) -> Reaction:
+        """Sensitivities of the reaction of the joint or driver called name: a Reaction
+        whose arrays are (n, n_params), the changes of fx, fy, mz, ... per parameter.
+
+        Raises
+        ------
+        KeyError
+            If there is no such joint or driver, or no multiplier sensitivities.
+        """
+        if self.dlam_dp is None or self.dq_dp is None:
+            raise KeyError("this result has no reaction sensitivities: run inverse dynamics "
+                           "with sensitivities=[names]")
+        if self._reac_dp is None:
+            self._reac_dp = reaction_dp_arrays(self.packed, self.ptab, self.q, self.t,
+                                               self.lam, self.dq_dp, self.dlam_dp)
+        return reaction_dp_of(self.packed, self.model, name, *self._reac_dp)
+
+    def multiplier_dp(self, row: str, name: str) -> np.ndarray:
+        """d lambda / d p of a row (by its label) for one parameter, over time."""
+        if self.dlam_dp is None:
+            raise KeyError("this result has no multiplier sensitivities")
+        return self.dlam_dp[:, self.row_labels.index(row),
+                            parameter_index(self.parameter_names, name)]
+
     def multiplier(self, row: str) -> np.ndarray:
         """The multiplier of a row by its label (see ``model.constraint_rows()``).
 
@@ -78,11 +149,101 @@ class DynamicsResult(KinematicsResult):
             raise KeyError(f"no row {row!r}; rows: {', '.join(self.row_labels)}")
         return self.lam[:, self.row_labels.index(row)]
 
-    def to_npz(self, path: str | Path) -> None:
-        """t, q, qd, qdd, the multipliers and energies, and the names."""
+    def contact(self, name: str) -> ContactHistory:
+        """Normal and friction force, penetration, sliding speed and contact point of the
+        contact called name over the output times.
+
+        Raises
+        ------
+        KeyError
+            If there is no such contact.
+        """
+        return history(self.elements, self.element_names, name, "contact")
+
+    def friction(self, name: str) -> FrictionHistory:
+        """Normal load, friction force and moment, slip speed and sticking of the joint
+        called name (a revolute or translational joint with friction).
+
+        Raises
+        ------
+        KeyError
+            If there is no such joint with friction.
+        """
+        return history(self.elements, self.element_names, name, "friction")
+
+    def table(self, energy: bool = False, multipliers: bool = False, reactions: bool = False,
+              efforts: bool = False, **unknown: bool) -> tuple[list[str], np.ndarray]:
+        """Header and rows of the CSV: the motion columns of
+        :meth:`KinematicsResult.table`, then the optional columns asked for, in this order:
+
+        * ``energy``: kinetic, potential, energy, drift_position, drift_velocity;
+        * ``multipliers``: ``lambda.LABEL`` for every row of Phi (``row_labels``);
+        * ``reactions``: ``NAME.fx``, ``NAME.fy``, ``NAME.mz`` (force and moment of the
+          joint or driver on its first body, global, moment about its centre of mass) and
+          ``NAME.fx_j``, ``NAME.fy_j``, ``NAME.mz_j`` (on its second body), every
+          constraint in file order;
+        * ``efforts``: ``NAME.effort``, what each driver supplies;
+
+        and always, for each contact, NAME.normal_force, NAME.friction_force,
+        NAME.penetration, NAME.sliding_speed, and for each joint with friction
+        NAME.normal_load, NAME.friction_force, NAME.sliding_speed.
+
+        ``mbd2d-solve`` writes the same columns for an exported file (``outputs``).
+        """
+        check_outputs(unknown, (), "table")
+        header, rows = self._motion_table()
+        blocks = [rows]
+        if energy:
+            header += list(ENERGY_COLUMNS)
+            blocks.append(np.column_stack([self.kinetic, self.potential, self.energy,
+                                           self.drift_position, self.drift_velocity]))
+        if multipliers:
+            header += [f"lambda.{r}" for r in self.row_labels]
+            blocks.append(self.lam)
+        if reactions:
+            g, _ = self._reactions()
+            for k, name in enumerate(self.packed.constraint_names):
+                header += [f"{name}.{w}" for w in REACTION_WORDS]
+                blocks.append(g[:, k, :])
+        if efforts:
+            names = self.packed.constraint_names
+            for k, name in enumerate(names):
+                if self.packed.driver_flags[k]:
+                    header.append(f"{name}.effort")
+                    blocks.append(self.effort(name)[:, None])
+        for k, (name, what) in enumerate(self.element_names):
+            if what == "contact":
+                words, idx = ("normal_force", "friction_force", "penetration",
+                              "sliding_speed"), (0, 1, 2, 3)
+            elif what == "friction":
+                words, idx = ("normal_load", "friction_force", "sliding_speed"), (0, 1, 3)
+            else:
+                continue
+            header += [f"{name}.{w}" for w in words]
+            blocks.append(np.column_stack([self.elements[:, k, i] for i in idx]))
+        return header, np.hstack(blocks)
+
+    def to_npz(self, path: str | Path, reactions: bool = False, efforts: bool = False,
+               **always: bool) -> None:
+        """t, q, qd, qdd, the multipliers and energies, the force elements' outputs, and
+        the names; with
+        ``reactions=True`` also ``reactions`` (n, nc, 6: as the table's reaction columns)
+        and with ``efforts=True`` ``efforts`` (n, n_drivers)."""
+        check_outputs(always, ("energy", "multipliers"), "to_npz")
+        extra: dict[str, np.ndarray] = {}
+        if reactions:
+            extra["reactions"] = self._reactions()[0]
+        if efforts:
+            drivers = [n for n, d in zip(self.packed.constraint_names, self.packed.driver_flags)
+                       if d]
+            extra["efforts"] = np.column_stack([self.effort(n) for n in drivers]) if drivers \
+                else np.zeros((len(self.t), 0))
+            extra["driver_names"] = np.array(drivers)
         with writing(path, "to_npz") as p:
             np.savez(p, t=self.t, q=self.q, qd=self.qd, qdd=self.qdd, lam=self.lam,
                      kinetic=self.kinetic, potential=self.potential,
                      drift_position=self.drift_position, drift_velocity=self.drift_velocity,
                      coordinate_names=np.array(self.coordinate_names),
-                     body_names=np.array(self.body_names), row_labels=np.array(self.row_labels))
+                     body_names=np.array(self.body_names), row_labels=np.array(self.row_labels),
+                     elements=self.elements,
+                     element_names=np.array([n for n, _ in self.element_names]), **extra)

@@ -8,8 +8,23 @@ from typing import Any
 
 import numpy as np
 
+from .. import plots
+from ..errors import MbdError
 from ..validate import vector
-from .files import writing
+from . import measures
+from .files import check_outputs, write_csv, writing
+from .points import PointResult
+from .sensitivities import LEVELS, body_columns, parameter_index
+
+
+def repr_png(obj: Any) -> bytes | None:
+    """PNG of a result's mechanism picture for notebooks; None (plain text shown instead)
+    when matplotlib is missing or the picture cannot be drawn."""
+    try:
+        return plots.png_bytes(obj)
+    except (ImportError, MbdError, ValueError):
+        return None
+
 
 SUFFIXES = ("x", "y", "theta", "x_dot", "y_dot", "theta_dot", "x_ddot", "y_ddot", "theta_ddot")
 
@@ -46,6 +61,11 @@ class KinematicsResult:
         Newton corrections, LU factorizations, rejected steps, tolerance used.
     complete : bool
         False when the run stopped early (see the exception that carried this result).
+    parameter_names : list of str
+        The design parameters of ``sensitivities=[...]`` (empty without them).
+    dq_dp, dqd_dp, dqdd_dp : numpy.ndarray or None
+        Their sensitivities d q / d p, d q_dot / d p, d q_ddot / d p, each
+        (n, n_coordinates, n_params), computed in the core (None without them).
     """
 
     t: np.ndarray
@@ -57,6 +77,10 @@ class KinematicsResult:
     stats: dict[str, Any] = field(default_factory=dict)
     complete: bool = True
     model: Any = None
+    parameter_names: list[str] = field(default_factory=list)
+    dq_dp: np.ndarray | None = None
+    dqd_dp: np.ndarray | None = None
+    dqdd_dp: np.ndarray | None = None
 
     def body(self, name: str) -> BodyResult:
         """Histories of the body called name.
@@ -75,15 +99,221 @@ class KinematicsResult:
         return BodyResult(name, q[:, 0], q[:, 1], q[:, 2], qd[:, 0], qd[:, 1], qd[:, 2],
                           qdd[:, 0], qdd[:, 1], qdd[:, 2])
 
-    def point(self, name: str, s: Any) -> np.ndarray:
-        """Global path r + A(theta) s' of a point s' fixed in a body, shape (n, 2)."""
+    def sensitivity(self, body: str, name: str, of: str = "q") -> np.ndarray:
+        """d(x, y, theta)/dp of a body over time, shape (n, 3), for the design parameter
+        called name; ``of`` = "qd" or "qdd" for the velocities' or accelerations'.
+
+        Raises
+        ------
+        KeyError
+            For an unknown body, a parameter the run was not asked for, or a bad ``of``.
+
+        Examples
+        --------
+        >>> import mbd2d
+        >>> m = mbd2d.load("examples/fourbar_grashof.toml")
+        >>> res = m.kinematics(1.0, 10, sensitivities=["joint.B.points.0.0"])
+        >>> res.sensitivity("rocker", "joint.B.points.0.0").shape
+        (11, 3)
+        """
+        if of not in LEVELS:
+            raise KeyError(f"of must be one of {', '.join(LEVELS)}, got {of!r}")
+        k = parameter_index(self.parameter_names, name)
+        arr = {"q": self.dq_dp, "qd": self.dqd_dp, "qdd": self.dqdd_dp}[of]
+        assert arr is not None
+        return arr[:, body_columns(self.body_names, body), k]
+
+    def point(self, name: str, s: Any) -> PointResult:
+        """Position, velocity and acceleration of a point fixed in a body.
+
+        Parameters
+        ----------
+        name : str
+            The body.
+        s : sequence of two floats
+            The point in the body's frame.
+
+        Returns
+        -------
+        PointResult
+            ``.r``, ``.v``, ``.a`` (n, 2) global position, velocity, acceleration (also
+            ``.x``, ``.y``, ``.x_dot``, ..., ``.speed``); indexing it indexes ``.r``.
+
+        Raises
+        ------
+        ModelError
+            If s is not two finite numbers.
+        KeyError
+            If there is no such body.
+
+        Examples
+        --------
+        >>> import mbd2d
+        >>> res = mbd2d.load("examples/fourbar_grashof.toml").kinematics(t_end=1.0, steps=4)
+        >>> p = res.point("coupler", [0.0, 1.0])
+        >>> p.r.shape, p.v.shape, p.a.shape
+        ((5, 2), (5, 2), (5, 2))
+        """
         sx, sy = vector(s, 2, "s", "point")
         b = self.body(name)
-        c, sn = np.cos(b.theta), np.sin(b.theta)
-        return np.column_stack([b.x + c * sx - sn * sy, b.y + sn * sx + c * sy])
+        q = np.column_stack([b.x, b.y, b.theta])
+        qd = np.column_stack([b.x_dot, b.y_dot, b.theta_dot])
+        qdd = np.column_stack([b.x_ddot, b.y_ddot, b.theta_ddot])
+        return PointResult.of(name, (sx, sy), q, qd, qdd)
 
-    def table(self) -> tuple[list[str], np.ndarray]:
-        """Header and rows of the CSV: t, then NAME.x ... NAME.theta_ddot per body."""
+    # ------------------------------------------------------------------ mechanism measures
+    def transmission_angle(self, joint: str, output: str | None = None) -> np.ndarray:
+        """Transmission angle at a revolute joint between a coupler and an output link.
+
+        mu is the angle between the coupler (from ``joint`` to the coupler's other revolute
+        joint) and the output link (from ``joint`` to its other pivot), in [0, pi]; pi/2 is
+        ideal, and designers keep it within about pi/2 +- 50 deg. For an output that slides
+        (a translational joint), mu = pi/2 - the acute angle between the coupler and the
+        slide, in [0, pi/2]. A four-bar a (crank), b (coupler), c (rocker), d (ground) has
+        cos mu = (b^2 + c^2 - a^2 - d^2 + 2 a d cos theta2) / (2 b c).
+
+        Parameters
+        ----------
+        joint : str
+            The revolute joint between the coupler and the output link (e.g. "B").
+        output : str, optional
+            Which of its bodies is the output link (default: its second body).
+
+        Returns
+        -------
+        numpy.ndarray
+            mu in radians at every output time.
+
+        Raises
+        ------
+        ModelError
+            If the joint or the bodies around it do not form a coupler and an output link.
+
+        Examples
+        --------
+        >>> import mbd2d
+        >>> res = mbd2d.load("examples/fourbar_grashof.toml").kinematics(t_end=1.0, steps=4)
+        >>> res.transmission_angle("B").shape
+        (5,)
+        """
+        return measures.transmission_angle(self, joint, output)
+
+    def velocity_ratio(self, input: str, output: str, via: str | None = None) -> np.ndarray:
+        """d(output)/d(input) along the motion: the kinematic influence coefficients.
+
+        Each quantity is a coordinate name (``"rocker.theta"``, ``"slider.x"``, see
+        ``coordinate_names``) or a driver name (the quantity it prescribes). Both are
+        differentiated by the quantity s of one driver, the others held (J u = e_s, solved
+        by the core at every output): ``via``, else whichever of input and output is a
+        driver, else the model's only driver. The ratio is a property of the configuration,
+        defined even where the driver stands still.
+
+        Returns
+        -------
+        numpy.ndarray
+            dY/dX at every output; +-inf where the input stands still (its dead centre or
+            limit position); inf where J is singular for the driver.
+
+        Raises
+        ------
+        ModelError
+            If a name is neither a driver nor a coordinate, or a quantity does not move with
+            the driver at all.
+        """
+        dx, dy, ok = measures.rates(self, input, output, via)
+        return measures.ratio(dy, dx, ok, np.inf)
+
+    def mechanical_advantage(self, input: str, output: str,
+                             via: str | None = None) -> np.ndarray:
+        """The mechanical advantage from input to output: the load at the output that a unit
+        effort at the input balances, by virtual work the inverse of the velocity ratio,
+        d(input)/d(output) (e.g. output force per input torque for a crank and a slider).
+        Quantities and ``via`` as in :meth:`velocity_ratio`.
+
+        Returns
+        -------
+        numpy.ndarray
+            At every output time; signed (negative when the output moves against the
+            input); +-inf where the output stands still (a limit position, the toggle a
+            press uses); 0 where J is singular for the driver.
+
+        Raises
+        ------
+        ModelError
+            As :meth:`velocity_ratio`.
+
+        Examples
+        --------
+        >>> import mbd2d
+        >>> res = mbd2d.load("examples/slider_crank.toml").kinematics(t_end=0.5, steps=4)
+        >>> ma = res.mechanical_advantage("motor", "slider.x")   # N per N m
+        >>> ma.shape
+        (5,)
+        """
+        dx, dy, ok = measures.rates(self, input, output, via)
+        return measures.ratio(dx, dy, ok, 0.0)
+
+    def dead_centre_distance(self) -> np.ndarray:
+        """Distance to a dead centre at every output: sigma_min / sigma_max of the
+        constraint Jacobian J, computed by the core with lengths in units of the model's
+        length scale and the columns of J scaled to unit length (the measure the kinematics
+        uses to call a configuration singular). It is 0 at a dead centre (toggle) or
+        bifurcation and near a toggle falls like sqrt(t* - t). Each output costs an SVD of
+        the dense J (a few microseconds for a four-bar, seconds for thousands of
+        coordinates: keep fewer rows with ``every``).
+
+        Returns
+        -------
+        numpy.ndarray
+            Values in [0, 1] at every output time.
+        """
+        return measures.dead_centre_distance(self)
+
+    # ------------------------------------------------------------------ pictures
+    def plot(self, times: Any = None, trace: Any = None, forces: bool = False,
+             **kwargs: Any) -> Any:
+        """The mechanism at a few times with traced paths: :func:`mbd2d.plot_mechanism`
+        (returns the matplotlib Axes)."""
+        return plots.plot_mechanism(self, times=times, trace=trace, forces=forces, **kwargs)
+
+    def plot_paths(self, points: Any = None, **kwargs: Any) -> Any:
+        """Paths of body points over the run: :func:`mbd2d.plot_paths` (returns the
+        Axes)."""
+        return plots.plot_paths(self, points, **kwargs)
+
+    def plot_timeseries(self, bodies: Any = None, kind: str = "motion", **kwargs: Any) -> Any:
+        """Quantities against time: :func:`mbd2d.plot_timeseries` (returns the Figure)."""
+        return plots.plot_timeseries(self, bodies=bodies, kind=kind, **kwargs)
+
+    def animate(self, path: Any = None, fps: float = 30, trace: Any = None,
+                forces: bool = False, **kwargs: Any) -> Any:
+        """Animate the run: a GIF (Pillow) or MP4 (ffmpeg) at ``path``, or without a path an
+        inline HTML animation for Jupyter; see :func:`mbd2d.plots.animate` for ``speed``,
+        ``max_frames``, ``size``, ``dpi`` and the rest.
+
+        Examples
+        --------
+        >>> import mbd2d
+        >>> res = mbd2d.load("examples/fourbar_grashof.toml").kinematics(t_end=1.0, steps=60)
+        >>> res.animate("/tmp/crank_rocker.gif", fps=15, trace=[("coupler", [0.0, 1.0])])
+        '/tmp/crank_rocker.gif'
+        """
+        return plots.animate(self, path, fps=fps, trace=trace, forces=forces, **kwargs)
+
+    def _repr_png_(self) -> bytes | None:
+        """The mechanism picture, for Jupyter (None when it cannot be drawn)."""
+        return repr_png(self)
+
+    def table(self, **outputs: bool) -> tuple[list[str], np.ndarray]:
+        """Header and rows of the CSV: t, then NAME.x ... NAME.theta_ddot per body.
+
+        A kinematic result has no optional columns (``energy``, ``multipliers``,
+        ``reactions``, ``efforts`` need a DynamicsResult): asking for one is a ModelError.
+        """
+        check_outputs(outputs, (), "table")
+        return self._motion_table()
+
+    def _motion_table(self) -> tuple[list[str], np.ndarray]:
         header = ["t"] + [f"{b}.{s}" for b in self.body_names for s in SUFFIXES]
         nb = len(self.body_names)
         blocks = [self.t[:, None]]
@@ -92,26 +322,26 @@ class KinematicsResult:
             blocks += [self.q[:, c], self.qd[:, c], self.qdd[:, c]]
         return header, np.hstack(blocks)
 
-    def to_csv(self, path: str | Path) -> None:
-        """Write the CSV (17 significant digits)."""
-        header, rows = self.table()
-        with writing(path, "to_csv") as p:
-            np.savetxt(p, rows, delimiter=",", header=",".join(header), comments="",
-                       fmt="%.17g")
+    def to_csv(self, path: str | Path, **outputs: bool) -> None:
+        """Write the CSV (the columns of :meth:`table`; every number with 17 significant
+        digits, ``%.16e``, as ``mbd2d-solve`` writes them)."""
+        header, rows = self.table(**outputs)
+        write_csv(path, header, rows, "to_csv")
 
-    def to_npz(self, path: str | Path) -> None:
+    def to_npz(self, path: str | Path, **outputs: bool) -> None:
         """Write t, q, qd, qdd and the names to a NumPy .npz archive."""
+        check_outputs(outputs, (), "to_npz")
         with writing(path, "to_npz") as p:
             np.savez(p, t=self.t, q=self.q, qd=self.qd, qdd=self.qdd,
                      coordinate_names=np.array(self.coordinate_names),
                      body_names=np.array(self.body_names))
 
-    def save(self, path: str | Path) -> None:
-        """Write .csv or .npz by the file suffix."""
+    def save(self, path: str | Path, **outputs: bool) -> None:
+        """Write .csv or .npz by the file suffix (optional columns as :meth:`table`)."""
         if str(path).endswith(".npz"):
-            self.to_npz(path)
+            self.to_npz(path, **outputs)
         else:
-            self.to_csv(path)
+            self.to_csv(path, **outputs)
 
     def __repr__(self) -> str:
         span = f"t = {self.t[0]:g} .. {self.t[-1]:g}" if len(self.t) else "no rows"

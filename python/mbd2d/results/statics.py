@@ -6,13 +6,24 @@ from typing import Any
 
 import numpy as np
 
+from .. import plots
+from .dynamics import REACTION_WORDS
+from .files import check_outputs, write_csv
+from .kinematics import repr_png
 from .reactions import Reaction, reaction_arrays, reaction_of
+from .sensitivities import body_columns, parameter_index, reaction_dp_arrays, reaction_dp_of
+
+
+#: the core's stability codes (the ``stable`` column of a table)
+STABILITY_CODES = {"stable": 1, "unstable": 0, "neutral": -1, "fully constrained": 2}
 
 
 @dataclass
 class StaticsResult:
     """A static equilibrium: configuration, multipliers, reactions and stability;
-    ``residual`` is the unbalanced load ||N^T Q||_inf relative to the largest load."""
+    ``residual`` is the unbalanced load ||N^T Q||_inf relative to the largest load. With
+    ``sensitivities=[...]`` also ``dq_dp`` (nq, n_params) and ``dlam_dp`` (neq, n_params),
+    the derivatives of the equilibrium and its multipliers."""
 
     t: float
     q: np.ndarray
@@ -26,6 +37,10 @@ class StaticsResult:
     packed: Any = None
     #: the linear-algebra path: {"solver": "dense" | "banded", "band": (kl, ku)}
     stats: dict = field(default_factory=dict)
+    parameter_names: list[str] = field(default_factory=list)
+    dq_dp: np.ndarray | None = None
+    dlam_dp: np.ndarray | None = None
+    ptab: Any = None
 
     def body(self, name: str) -> tuple[float, float, float]:
         """(x, y, theta) of a body at the equilibrium (KeyError if there is none)."""
@@ -38,6 +53,70 @@ class StaticsResult:
         """The reaction of a joint or driver at the equilibrium (arrays of length 1)."""
         return reaction_of(self.packed, self.model, name, lambda: reaction_arrays(
             self.packed, self.q[None, :], np.array([self.t]), self.lam[None, :]))
+
+    def configuration(self) -> Any:
+        """The equilibrium as a one-row motion for the pictures."""
+        return plots.Configuration(self.model, self.q, self.t)
+
+    def plot(self, **kwargs: Any) -> Any:
+        """The mechanism at the equilibrium: :func:`mbd2d.plot_mechanism` (returns the
+        Axes)."""
+        kwargs.setdefault("title", f"{getattr(self.model, 'name', 'model')}: equilibrium "
+                          f"({self.stability})")
+        return plots.plot_mechanism(self.configuration(), **kwargs)
+
+    def _repr_png_(self) -> bytes | None:
+        """The equilibrium's picture, for Jupyter."""
+        return repr_png(self.configuration())
+    def sensitivity(self, body: str, name: str) -> np.ndarray:
+        """d(x, y, theta)/dp of a body at the equilibrium for the parameter called name."""
+        k = parameter_index(self.parameter_names, name)
+        assert self.dq_dp is not None
+        return self.dq_dp[body_columns(self.body_names, body), k]
+
+    def reaction_dp(self, name: str) -> Reaction:
+        """Sensitivities of a joint's or driver's reaction (arrays (1, n_params))."""
+        if self.dq_dp is None or self.dlam_dp is None:
+            raise KeyError("this result has no sensitivities: run statics with "
+                           "sensitivities=[names]")
+        g, loc = reaction_dp_arrays(self.packed, self.ptab, self.q[None, :],
+                                    np.array([self.t]), self.lam[None, :], self.dq_dp[None],
+                                    self.dlam_dp[None])
+        return reaction_dp_of(self.packed, self.model, name, g, loc)
+
+    def table(self, multipliers: bool = False, reactions: bool = False, efforts: bool = False,
+              **unknown: bool) -> tuple[list[str], np.ndarray]:
+        """Header and the one row of the CSV: t, NAME.x, NAME.y, NAME.theta per body,
+        ``stable`` (1 stable, 0 unstable, -1 neutral, 2 fully constrained), ``residual``,
+        then optional columns as :meth:`DynamicsResult.table` (``multipliers``,
+        ``reactions``, ``efforts``; ``mbd2d-solve`` writes the same)."""
+        check_outputs(unknown, (), "table")
+        nb = len(self.body_names)
+        header = ["t"] + [f"{b}.{s}" for b in self.body_names for s in ("x", "y", "theta")]
+        header += ["stable", "residual"]
+        row = [self.t, *self.q[:3 * nb], STABILITY_CODES.get(self.stability, 0), self.residual]
+        if multipliers:
+            header += [f"lambda.{r}" for r in self.row_labels]
+            row += list(self.lam)
+        if reactions or efforts:
+            g, _ = reaction_arrays(self.packed, self.q[None, :], np.array([self.t]),
+                                   self.lam[None, :])
+        names = self.packed.constraint_names
+        if reactions:
+            for k, name in enumerate(names):
+                header += [f"{name}.{w}" for w in REACTION_WORDS]
+                row += list(g[0, k, :])
+        if efforts:
+            for k, name in enumerate(names):
+                if self.packed.driver_flags[k]:
+                    header.append(f"{name}.effort")
+                    row.append(-self.lam[self.packed.row_owner.index(k)])
+        return header, np.array([row], dtype=float)
+
+    def to_csv(self, path: Any, **outputs: bool) -> None:
+        """Write the table (:meth:`table`) as CSV, numbers as every mbd2d CSV."""
+        header, rows = self.table(**outputs)
+        write_csv(path, header, rows, "to_csv")
 
     def multiplier(self, row: str) -> float:
         """The multiplier of a row by its label (KeyError if no row has it)."""

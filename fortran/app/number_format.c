@@ -1,0 +1,9 @@
+/* mbd2d-solve's number format without Fortran internal I/O (which allocates per statement
+ * in libgfortran): x as C's and Python's "%.16e" (17 significant digits, correctly rounded,
+ * lower-case e, an exponent of at least two digits) into buf; returns the length. */
+#include <stdio.h>
+
+int mbd_format_e16(double x, char *buf, int len)
+{
+    return snprintf(buf, (size_t) len, "%.16e", x);
+}

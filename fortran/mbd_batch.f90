@@ -1,0 +1,179 @@
+!> mbd_batch: one analysis over many parameter sets (design sweeps) in one call.
+!!
+!! The model's flat tables (mbd_model) are given once. For each case c the entries named in
+!! vtab(2, nv) take the values vals(:, c); vtab addresses an entry as a design parameter is
+!! addressed (mbd_sensitivity): table 1 rpar, 2 bmass (flattened (2, nb)), 3 grav, 4 fpar, and
+!! the 1-based index in it. Phases left open in the description (rack-pinion, rolling disc)
+!! are then set again so that their equation holds at the q0 estimates, as the front end
+!! does when it packs a model (its phase row of Phi at (q0, q_dot = 0, t = 0) with the phase
+!! set to 0). The analysis then runs through mbd_api on the tables so changed: the model is
+!! rebuilt from them (its length scale, every prepared parameter: unit axes, spline
+!! coefficients, gear geometry), so a case gives the numbers a run of its own tables gives,
+!! bit for bit.
+!!
+!! Outputs are per case (last dimension); a failing case keeps its status, message and the
+!! rows it computed, and the next case runs.
+module mbd_batch
+  use mbd_kinds, only: wp, zero
+  use mbd_status, only: MBD_OK, MBD_BAD_INPUT, MBD_BAD_SETTING, MSG_LEN
+  use mbd_memory, only: REAL_BYTES, mem_fail
+  use mbd_api, only: NINFO, api_kinematics, api_inverse, api_statics, api_dynamics, api_eval
+  use mbd_kinematics, only: MAXPASS
+  use mbd_contact, only: NEO
+  implicit none
+  private
+  public :: batch_run, NISET, NRSET
+  public :: BATCH_KINEMATICS, BATCH_INVERSE, BATCH_STATICS, BATCH_DYNAMICS
+
+  !> analyses
+  integer, parameter :: BATCH_KINEMATICS = 1, BATCH_INVERSE = 2, BATCH_STATICS = 3, &
+                        BATCH_DYNAMICS = 4
+  !> settings: iset = [nsteps, maxit, every, solver, method, max_steps, 0, 0];
+  !! rset = [t0, t1, tol, tmin, rtol, atol, h, rho_inf, alpha, beta, t (statics), 0]
+  integer, parameter :: NISET = 8, NRSET = 12
+
+contains
+
+  !> Run the analysis for every case. Output shapes: qout, qdout, qddout (nq, rows, ncase),
+  !! lamout (neq or 0, rows, ncase), eout (4 or 0, rows, ncase); iinfo, rinfo (NINFO, ncase)
+  !! as the analysis reports them (statics: rinfo(1) residual, rinfo(2) stability code);
+  !! qsing (nq, ncase), dep and redundant (neq, ncase). Statics writes row 1.
+  subroutine batch_run(analysis, nb, ctab, rpar, bmass, grav, ftab, fpar, q0, v0, vtab, vals, &
+                       opens, iset, rset, qout, qdout, qddout, lamout, eout, iinfo, rinfo, &
+                       qsing, dep, redundant, status, msg)
+    integer, intent(in) :: analysis             !! BATCH_KINEMATICS ... BATCH_DYNAMICS
+    integer, intent(in) :: nb                   !! moving bodies
+    integer, intent(in) :: ctab(:, :), ftab(:, :)  !! constraint and force tables
+    real(wp), intent(in) :: rpar(:), bmass(:, :), grav(2), fpar(:)  !! the model's numbers
+    real(wp), intent(in) :: q0(:), v0(:)        !! estimates and initial velocities (nq)
+    integer, intent(in) :: vtab(:, :)           !! (2, nv) the entries each case sets
+    real(wp), intent(in) :: vals(:, :)          !! (nv, ncase) their values
+    !> (2, no) open phases: their index in rpar and their row of Phi
+    integer, intent(in) :: opens(:, :)
+    integer, intent(in) :: iset(NISET)          !! integer settings (see NISET)
+    real(wp), intent(in) :: rset(NRSET)         !! real settings (see NRSET)
+    real(wp), intent(out) :: qout(:, :, :), qdout(:, :, :), qddout(:, :, :)
+    real(wp), intent(out) :: lamout(:, :, :), eout(:, :, :)
+    integer, intent(out) :: iinfo(:, :)         !! (NINFO, ncase)
+    real(wp), intent(out) :: rinfo(:, :)        !! (NINFO, ncase)
+    real(wp), intent(out) :: qsing(:, :)        !! (nq, ncase)
+    integer, intent(out) :: dep(:, :), redundant(:, :)  !! (neq, ncase)
+    integer, intent(out) :: status(:)           !! (ncase) each case's status
+    character(len=MSG_LEN), intent(out) :: msg(:)  !! (ncase) and message
+    real(wp), allocatable :: r(:), bm(:, :), fp(:), phi(:), jac(:, :), nu(:), gam(:), zq(:)
+    real(wp), allocatable :: eo(:, :, :)      ! element outputs of a dynamics case (not kept)
+    real(wp) :: g(2), tpass(MAXPASS), resid, evo(4, 1)
+    integer :: c, k, nq, neq, ncase, st, bad, stable, ierr, nev
+    character(len=MSG_LEN) :: lmsg
+    qout = zero; qdout = zero; qddout = zero; lamout = zero; eout = zero
+    iinfo = 0; rinfo = zero; qsing = zero; dep = 0; redundant = 0
+    ncase = size(vals, 2); nq = size(q0); neq = size(dep, 1)
+    status = MBD_OK; msg = ''
+    call check(st, lmsg)
+    if (st /= MBD_OK) then
+      status = st; msg = lmsg; return
+    end if
+    allocate (r(size(rpar)), bm(size(bmass, 1), size(bmass, 2)), fp(size(fpar)), stat=ierr)
+    if (ierr == 0 .and. size(opens, 2) > 0) &
+      allocate (phi(neq), jac(neq, nq), nu(neq), gam(neq), zq(nq), stat=ierr)
+    if (ierr == 0) allocate (eo(NEO, size(ftab, 2), size(qout, 2)), stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail(REAL_BYTES * (size(rpar) + size(bmass) + size(fpar) + &
+                    real(neq, wp) * (nq + 3) + real(NEO, wp) * size(ftab, 2) * size(qout, 2)), &
+                    'the tables of a case', 'use a smaller model', &
+                    st, lmsg)
+      status = st; msg = lmsg; return
+    end if
+    do c = 1, ncase
+      r = rpar; bm = bmass; g = grav; fp = fpar
+      do k = 1, size(vtab, 2)
+        select case (vtab(1, k))
+        case (1); r(vtab(2, k)) = vals(k, c)
+        case (2); bm(2 - mod(vtab(2, k), 2), (vtab(2, k) + 1) / 2) = vals(k, c)
+        case (3); g(vtab(2, k)) = vals(k, c)
+        case default; fp(vtab(2, k)) = vals(k, c)
+        end select
+      end do
+      if (size(opens, 2) > 0) then
+        ! as packing does: the phase row of Phi at (q0, 0, t = 0) with the phase set to 0
+        zq = zero
+        r(opens(1, :)) = zero
+        call api_eval(nb, ctab, r, q0, zq, zero, phi, jac, nu, gam, st, lmsg, bad)
+        r(opens(1, :)) = phi(opens(2, :))
+      end if
+      select case (analysis)
+      case (BATCH_KINEMATICS)
+        call api_kinematics(nb, ctab, r, q0, rset(1), rset(2), iset(1), rset(3), iset(2), &
+                            rset(4), iset(3), iset(4), qout(:, :, c), qdout(:, :, c), &
+                            qddout(:, :, c), iinfo(:, c), rinfo(:, c), qsing(:, c), dep(:, c), &
+                            redundant(:, c), tpass, status(c), msg(c))
+      case (BATCH_INVERSE)
+        call api_inverse(nb, ctab, r, bm, g, ftab, fp, q0, rset(1), rset(2), iset(1), rset(3), &
+                         iset(3), iset(4), qout(:, :, c), qdout(:, :, c), qddout(:, :, c), &
+                         lamout(:, :, c), eout(:, :, c), iinfo(:, c), rinfo(:, c), qsing(:, c), &
+                         dep(:, c), redundant(:, c), tpass, status(c), msg(c))
+      case (BATCH_STATICS)
+        call api_statics(nb, ctab, r, bm, g, ftab, fp, q0, rset(11), qout(:, 1, c), &
+                         lamout(:, 1, c), stable, resid, iinfo(:, c), status(c), msg(c))
+        rinfo(1, c) = resid; rinfo(2, c) = real(stable, wp)
+      case default
+        call api_dynamics(nb, ctab, r, bm, g, ftab, fp, q0, v0, rset(1), rset(2), iset(1), &
+                          iset(5), rset(5), rset(6), rset(7), rset(8), rset(9), rset(10), &
+                          iset(3), qout(:, :, c), qdout(:, :, c), qddout(:, :, c), &
+                          lamout(:, :, c), eout(:, :, c), iinfo(:, c), rinfo(:, c), &
+                          redundant(:, c), status(c), msg(c), iset(6), eo, evo, nev)
+      end select
+    end do
+
+  contains
+
+    !> The tables and output shapes agree with each other (a wrong call is refused whole).
+    subroutine check(st, text)
+      integer, intent(out) :: st
+      character(len=MSG_LEN), intent(out) :: text
+      integer :: j, n(4), nrow
+      st = MBD_BAD_INPUT; text = ''
+      n = [size(rpar), size(bmass), 2, size(fpar)]
+      nrow = size(qout, 2)
+      if (analysis < BATCH_KINEMATICS .or. analysis > BATCH_DYNAMICS) then
+        text = 'batch: unknown analysis'; st = MBD_BAD_SETTING; return
+      end if
+      if (size(vtab, 1) /= 2 .or. size(vals, 1) /= size(vtab, 2) .or. size(opens, 1) /= 2) then
+        text = 'batch: the value table and the values do not match'; return
+      end if
+      do j = 1, size(vtab, 2)
+        if (vtab(1, j) < 1 .or. vtab(1, j) > 4) then
+          text = 'batch: a value table entry names no table'; return
+        end if
+        if (vtab(2, j) < 1 .or. vtab(2, j) > n(vtab(1, j))) then
+          text = 'batch: a value table index is out of range'; return
+        end if
+      end do
+      if (any(opens(1, :) < 1) .or. any(opens(1, :) > size(rpar)) .or. &
+          any(opens(2, :) < 1) .or. any(opens(2, :) > neq)) then
+        text = 'batch: an open phase is out of range'; return
+      end if
+      if (size(v0) /= nq .or. any(shape(qdout) /= shape(qout)) .or. &
+          any(shape(qddout) /= shape(qout)) .or. size(qout, 1) /= nq .or. &
+          size(qout, 3) /= ncase .or. size(lamout, 2) /= nrow .or. &
+          size(lamout, 3) /= ncase .or. size(eout, 2) /= nrow .or. size(eout, 3) /= ncase .or. &
+          size(iinfo, 1) /= NINFO .or. size(iinfo, 2) /= ncase .or. &
+          any(shape(rinfo) /= shape(iinfo)) .or. size(qsing, 1) /= nq .or. &
+          size(qsing, 2) /= ncase .or. size(dep, 2) /= ncase .or. &
+          any(shape(redundant) /= shape(dep)) .or. size(status) /= ncase .or. &
+          size(msg) /= ncase) then
+        text = 'batch: output arrays do not match'; return
+      end if
+      if (analysis /= BATCH_KINEMATICS .and. (size(lamout, 1) /= neq .or. &
+          size(eout, 1) /= 4)) then
+        text = 'batch: multiplier or energy arrays do not match'; return
+      end if
+      if (analysis == BATCH_STATICS .and. nrow /= 1) then
+        text = 'batch: statics has one output row'; return
+      end if
+      st = MBD_OK
+    end subroutine check
+
+  end subroutine batch_run
+
+end module mbd_batch

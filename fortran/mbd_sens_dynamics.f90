@@ -1,0 +1,526 @@
+!> mbd_sens_dynamics: design sensitivities of the multipliers (inverse dynamics, reactions,
+!! driver efforts) and of static equilibria, from the blocks of mbd_sensitivity.
+!!
+!! Inverse dynamics, J^T lambda = Q(q, q_dot, t; p) - M(p) q_ddot, differentiated along a
+!! kinematic sensitivity (s, s_dot, s_ddot) of parameter p:
+!!   J^T dlambda = Q_q s + Q_q_dot s_dot + Q_p - M_p q_ddot - M s_ddot - K_lam s - J_p^T lambda
+!! with K_lam = (J^T lambda)_q = sum_r lambda_r (Phi_r)_qq. Solved like the multipliers
+!! (minimum norm; with independent rows the unique dlambda).
+!! Reactions g_k = -J_k^T lambda_k (mbd_dynamics) change by -(dJ_k^T lambda_k + J_k^T
+!! dlambda_k), dJ_k = J_k,q s + J_k,p, and their body-frame components A^T g by
+!! A^T dg + dA^T g, dA = B(theta) dtheta.
+!! Statics, J^T lambda = Q(q, 0, t; p), Phi(q, t; p) = 0, differentiated at the equilibrium:
+!!   [K_lam - Q_q, J_a^T; J_a, 0] [s; dlambda_a] = [Q_p - J_p^T lambda; -Phi_p,a]
+!! over the independent rows a (redundant rows keep dlambda = 0).
+!! Forward dynamics (index 1, dopri5) by direct differentiation: with the state (q, q_dot) the
+!! sensitivities (S, S_dot) of every parameter are integrated, S_ddot from
+!!   [M J^T; J 0] [S_ddot; dlambda] = [dQ - M_p q_ddot - K_lam S - J_p^T lambda;
+!!                                     gamma_p - J_p q_ddot - Ha S - 2 Hv S_dot]
+!! (dQ = Q_q S + Q_q_dot S_dot + Q_p) with the factors of the step's augmented matrix, and the
+!! error control covers them (Dormand-Prince 5(4) on all components). After each step S is
+!! projected like q: onto J S = -Phi_p (minimum norm) and S_dot onto J S_dot = nu_p - J_p q_dot
+!! - Hv S (kinetic-energy metric), the linearized projections of q and q_dot.
+module mbd_sens_dynamics
+  use mbd_kinds, only: wp, zero, one
+  use mbd_status, only: MBD_OK, MBD_SINGULAR, MBD_NO_MEMORY, MSG_LEN
+  use mbd_points, only: NLOC, MAXROW, rot, drot
+  use mbd_model, only: model_t
+  use mbd_assemble, only: asm_work_t, asm_init, assemble_blocks, assemble_dense
+  use mbd_sensitivity, only: sens_t, sens_trig, sens_hessian, sens_params, sens_klam, &
+                             sens_klam_list, &
+                             sens_jpt_lam, sens_force_d, sens_force_jac
+  use mbd_linsolve, only: lu_factor, lu_solve, lapack_status, ls_small_cols
+  use mbd_lapack, only: dgelsy
+  use mbd_status, only: MBD_INTEGRATOR_FAILED, MBD_BAD_SETTING
+  use mbd_dynamics, only: dyn_work_t, dyn_accel, dyn_solve, dyn_project_pos, dyn_velocity
+  use mbd_integrators, only: output_rows, C2, C3, C4, C5, A21, A31, A32, A41, A42, A43, A51, &
+                             A52, A53, A54, A61, A62, A63, A64, A65, A71, A73, A74, A75, A76, &
+                             E1, E3, E4, E5, E6, E7
+  use mbd_interp, only: hermite5
+  use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+  implicit none
+  private
+  public :: sens_multipliers, sens_reactions, sens_statics, sens_dopri5, sens_initial
+
+contains
+
+  !> dlambda/dp (neq, np) at one output of an inverse dynamics run, from the kinematic
+  !! sensitivities sq, sqd, sqdd (nq, np) there; jac is J at q.
+  subroutine sens_multipliers(m, s, q, qd, qdd, t, jac, lam, sq, sqd, sqdd, slam, status, msg)
+    type(model_t), intent(in) :: m              !! model with dynamics data
+    type(sens_t), intent(inout) :: s            !! parameters and blocks
+    real(wp), intent(in) :: q(:), qd(:), qdd(:) !! state and accelerations
+    real(wp), intent(in) :: t                   !! time
+    real(wp), intent(in) :: jac(:, :)           !! J at q (neq, nq)
+    real(wp), intent(in) :: lam(:)              !! multipliers (neq)
+    real(wp), intent(in) :: sq(:, :), sqd(:, :), sqdd(:, :)  !! (nq, np)
+    real(wp), intent(out) :: slam(:, :)         !! (neq, np)
+    integer, intent(out) :: status              !! MBD_OK or MBD_LAPACK / MBD_NO_MEMORY
+    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    real(wp), allocatable :: jt(:, :), b(:, :), y(:), jpb(:, :, :), work(:), bb(:, :)
+    logical :: full
+    real(wp) :: wq(1)
+    integer, allocatable :: jpvt(:)
+    integer :: k, nq, neq, np, rank, info, st
+    status = MBD_OK; msg = ''
+    nq = m%nq; neq = m%neq; np = s%np
+    slam = zero
+    if (np == 0) return
+    allocate (jt(nq, neq), b(max(nq, neq), np), y(nq), jpb(MAXROW, NLOC, m%nc), jpvt(neq), &
+              bb(max(nq, neq), np), stat=st)
+    if (st /= 0) then
+      status = MBD_NO_MEMORY; msg = 'out of memory for the multiplier sensitivities'; return
+    end if
+    call sens_trig(m, s, q)
+    call sens_hessian(m, s, q, qd, qdd, t)
+    call sens_klam_list(m, s, lam)
+    b = zero
+    do k = 1, np
+      call sens_force_d(m, s, k, q, qd, sq(:, k), sqd(:, k), t, y)   ! Q_q s + Q_qd s_dot + Q_p
+      b(1:nq, k) = y - s%tmass(:, k) * qdd - m%mdiag * sqdd(:, k)
+      call sens_klam(s, sq(:, k), y)
+      b(1:nq, k) = b(1:nq, k) - y
+      call sens_jpt_lam(m, s, k, q, t, lam, y, jpb)
+      b(1:nq, k) = b(1:nq, k) - y
+    end do
+    ! J^T dlambda = b: Householder least squares (independent rows, the unique solution),
+    ! or the minimum-norm one by dgelsy when J^T is rank deficient (redundant rows)
+    if (neq <= nq) then
+      jt = transpose(jac)
+      bb = b
+      call ls_small_cols(jt, bb, full)
+      if (full) then
+        slam = bb(1:neq, :); return
+      end if
+    end if
+    jt = transpose(jac)
+    jpvt = 0
+    call dgelsy(nq, neq, np, jt, nq, b, size(b, 1), jpvt, 1.0e-10_wp, rank, wq, -1, info)
+    allocate (work(max(1, int(wq(1)))), stat=st)
+    if (st /= 0) then
+      status = MBD_NO_MEMORY; msg = 'out of memory for the multiplier sensitivities'; return
+    end if
+    call dgelsy(nq, neq, np, jt, nq, b, size(b, 1), jpvt, 1.0e-10_wp, rank, work, size(work), &
+                info)
+    call lapack_status('dgelsy', info, status, msg)
+    slam = b(1:neq, :)
+  end subroutine sens_multipliers
+
+  !> Changes of the reactions (mbd_dynamics dyn_reactions) of every constraint at one state
+  !! along each parameter: dreac, drloc (6, nc, np), from dq/dp (sq) and dlambda/dp (slam).
+  subroutine sens_reactions(m, s, q, t, lam, sq, slam, dreac, drloc)
+    type(model_t), intent(in) :: m              !! model
+    type(sens_t), intent(inout) :: s            !! parameters and blocks
+    real(wp), intent(in) :: q(:), t             !! configuration, time
+    real(wp), intent(in) :: lam(:)              !! multipliers (neq)
+    real(wp), intent(in) :: sq(:, :)            !! dq/dp (nq, np)
+    real(wp), intent(in) :: slam(:, :)          !! dlambda/dp (neq, np)
+    real(wp), intent(out) :: dreac(:, :, :), drloc(:, :, :)  !! (6, nc, np)
+    type(asm_work_t) :: a
+    real(wp) :: phi(m%neq), nu(m%neq), gam(m%neq), y(m%nq), g(NLOC), dg(NLOC), sl(NLOC), &
+                jpb(MAXROW, NLOC, m%nc), dj(MAXROW, NLOC), th, dth
+    integer :: k, c, r0, nr, j, b, off, st
+    character(len=MSG_LEN) :: lmsg
+    dreac = zero; drloc = zero
+    call asm_init(m, a, st, lmsg)
+    if (st /= MBD_OK) return
+    call assemble_blocks(m, q, s%zq, t, phi, nu, gam, a)
+    call sens_trig(m, s, q)
+    call sens_hessian(m, s, q, s%zq, s%zq, t)
+    dreac = zero; drloc = zero
+    do k = 1, s%np
+      call sens_jpt_lam(m, s, k, q, t, lam, y, jpb)
+      do c = 1, m%nc
+        r0 = m%row0(c); nr = m%nrow(c)
+        ! dJ_c = sum over slots of hs(:, :, j) s_j + J_p
+        do j = 1, NLOC
+          sl(j) = zero
+          if (m%loc(j, c) > 0) sl(j) = sq(m%loc(j, c), k)
+        end do
+        dj = jpb(:, :, c)
+        do j = 1, NLOC
+          dj = dj + s%hs(:, :, j, c) * sl(j)
+        end do
+        g = -matmul(lam(r0:r0 + nr - 1), a%jb(1:nr, :, c))
+        dg = -matmul(slam(r0:r0 + nr - 1, k), a%jb(1:nr, :, c)) - &
+             matmul(lam(r0:r0 + nr - 1), dj(1:nr, :))
+        dreac(:, c, k) = dg(1:6)
+        drloc(:, c, k) = dg(1:6)
+        do j = 1, 2
+          b = m%bi(c); off = 0
+          if (j == 2) then
+            b = m%bj(c); off = 3
+          end if
+          if (b > 0) then
+            th = q(3 * b); dth = sq(3 * b, k)
+            drloc(off + 1:off + 2, c, k) = matmul(transpose(rot(th)), dg(off + 1:off + 2)) + &
+              dth * matmul(transpose(drot(th)), g(off + 1:off + 2))
+          else
+            dreac(off + 1:off + 3, c, k) = zero; drloc(off + 1:off + 3, c, k) = zero
+          end if
+        end do
+      end do
+    end do
+  end subroutine sens_reactions
+
+  !> dq/dp (nq, np) and dlambda/dp (neq, np) at a static equilibrium (q, lam) at time t;
+  !! rows: the independent constraint rows (the others get dlambda = 0).
+  subroutine sens_statics(m, s, rows, q, t, lam, sq, slam, status, msg)
+    type(model_t), intent(in) :: m              !! model with dynamics data
+    type(sens_t), intent(inout) :: s            !! parameters and blocks
+    integer, intent(in) :: rows(:)              !! independent constraint rows
+    real(wp), intent(in) :: q(:), t             !! equilibrium and time
+    real(wp), intent(in) :: lam(:)              !! multipliers (neq)
+    real(wp), intent(out) :: sq(:, :)           !! dq/dp (nq, np)
+    real(wp), intent(out) :: slam(:, :)         !! dlambda/dp (neq, np)
+    integer, intent(out) :: status              !! MBD_OK or MBD_SINGULAR
+    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    type(asm_work_t) :: a
+    real(wp), allocatable :: kk(:, :), kq(:, :), aug(:, :), rhs(:), y(:), e(:), jpb(:, :, :), &
+                             phi(:), nu(:), gam(:), jac(:, :), z(:)
+    integer, allocatable :: ipiv(:)
+    integer :: n, na, i, k, st
+    status = MBD_OK; msg = ''
+    n = m%nq; na = size(rows)
+    sq = zero; slam = zero
+    allocate (kk(n, n), kq(n, n), aug(n + na, n + na), rhs(n + na), y(n), e(n), &
+              jpb(MAXROW, NLOC, m%nc), phi(m%neq), nu(m%neq), gam(m%neq), jac(m%neq, n), &
+              z(n), ipiv(n + na), stat=st)
+    if (st /= 0) then
+      status = MBD_NO_MEMORY; msg = 'out of memory for the statics sensitivities'; return
+    end if
+    z = zero
+    call asm_init(m, a, status, msg)
+    if (status /= MBD_OK) return
+    call assemble_dense(m, q, z, t, phi, nu, gam, a, jac)
+    call sens_trig(m, s, q)
+    call sens_hessian(m, s, q, z, z, t)
+    call sens_params(m, s, q, z, z, t)
+    ! K = K_lam - Q_q, column by column
+    call sens_force_jac(m, q, z, t, kq)
+    call sens_klam_list(m, s, lam)
+    do i = 1, n
+      e = zero; e(i) = one
+      call sens_klam(s, e, y)
+      kk(:, i) = y - kq(:, i)
+    end do
+    aug = zero
+    aug(1:n, 1:n) = kk
+    aug(1:n, n + 1:) = transpose(jac(rows, :))
+    aug(n + 1:, 1:n) = jac(rows, :)
+    call lu_factor(aug, ipiv, status, msg)
+    if (status /= MBD_OK) then
+      msg = 'statics sensitivities: the equilibrium is not isolated (singular stiffness on '// &
+            'the free motions)'
+      return
+    end if
+    do k = 1, s%np
+      call sens_force_d(m, s, k, q, z, z, z, t, y)          ! Q_p
+      rhs(1:n) = y
+      call sens_jpt_lam(m, s, k, q, t, lam, y, jpb)
+      rhs(1:n) = rhs(1:n) - y
+      rhs(n + 1:) = -s%phip(k, rows)
+      call lu_solve(aug, ipiv, rhs, status, msg)
+      if (status /= MBD_OK) return
+      sq(:, k) = rhs(1:n)
+      slam(rows, k) = rhs(n + 1:)
+    end do
+  end subroutine sens_statics
+
+  !> Forward dynamics with sensitivities by dopri5 from the consistent state (q, qd) at t0 and
+  !! its sensitivities (sq, sqd) (nq, np); outputs as mbd_integrators' integrate, with
+  !! so, sdo, sddo (nq, np, rows) the sensitivities of q, q_dot, q_ddot.
+  !! stats: 1 steps, 2 rejected, 3 right-hand sides; hmm(1:2) smallest and largest step.
+  subroutine sens_dopri5(m, w, s, q, qd, sq, sqd, t0, t1, nsteps, every, rtol, atol, &
+                         max_steps, qo, vo, ao, so, sdo, sddo, nout, stats, hmm, t_fail, &
+                         status, msg)
+    type(model_t), intent(in) :: m              !! model with dynamics data
+    type(dyn_work_t), intent(inout) :: w        !! dynamics work arrays (dyn_init done)
+    type(sens_t), intent(inout) :: s            !! parameters and blocks
+    real(wp), intent(inout) :: q(:), qd(:)      !! consistent state at t0, then final
+    real(wp), intent(inout) :: sq(:, :), sqd(:, :)  !! its sensitivities (nq, np), then final
+    real(wp), intent(in) :: t0, t1              !! time span
+    integer, intent(in) :: nsteps, every        !! output intervals, decimation
+    real(wp), intent(in) :: rtol, atol          !! tolerances (all components)
+    integer, intent(in) :: max_steps            !! step limit
+    real(wp), intent(out) :: qo(:, :), vo(:, :), ao(:, :)       !! (nq, rows)
+    real(wp), intent(out) :: so(:, :, :), sdo(:, :, :), sddo(:, :, :)  !! (nq, np, rows)
+    integer, intent(out) :: nout                !! rows written
+    integer, intent(out) :: stats(3)            !! steps, rejected, right-hand sides
+    real(wp), intent(out) :: hmm(2)             !! smallest, largest step
+    real(wp), intent(out) :: t_fail             !! time reached at a failure
+    integer, intent(out) :: status              !! MBD_OK or a failure
+    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    real(wp), allocatable :: y(:), yn(:), k(:, :), e(:), za(:), zda(:), zdda(:), lam(:), &
+                             zz(:), zzd(:), zzdd(:)
+    real(wp) :: t, h, tnew, err, fac, sc
+    integer :: n, np, nz, st, kout
+    logical :: fsal
+    status = MBD_OK; msg = ''; nout = 0; stats = 0; hmm = [huge(one), zero]; t_fail = t0
+    qo = zero; vo = zero; ao = zero; so = zero; sdo = zero; sddo = zero
+    n = m%nq; np = s%np; nz = n * (1 + np)
+    if (.not. (rtol > zero .and. atol > zero) .or. every < 1 .or. &
+        size(qo, 2) /= output_rows(nsteps, every)) then
+      status = MBD_BAD_SETTING; msg = 'rtol, atol > 0, every >= 1 and outputs sized for it'
+      return
+    end if
+    allocate (y(2 * nz), yn(2 * nz), k(2 * nz, 7), e(2 * nz), za(nz), zda(nz), zdda(nz), &
+              lam(m%neq), zz(nz), zzd(nz), zzdd(nz), stat=st)
+    if (st /= 0) then
+      status = MBD_NO_MEMORY; msg = 'out of memory for the sensitivity integration'; return
+    end if
+    y(1:n) = q; y(n + 1:nz) = reshape(sq, [n * np])
+    y(nz + 1:nz + n) = qd; y(nz + n + 1:) = reshape(sqd, [n * np])
+    t = t0
+    call rhs(t, y, k(:, 1), st)
+    if (st /= MBD_OK) then
+      status = st; msg = 'the mass matrix and constraints give a singular system at the start'
+      return
+    end if
+    za = y(1:nz); zda = y(nz + 1:); zdda = k(nz + 1:, 1)
+    call put(1, za, zda, zdda)
+    nout = 1; kout = 1
+    fsal = .true.
+    if (nsteps == 0) return
+    sc = maxval(abs(zdda) / (atol + rtol * abs(za)))
+    h = (t1 - t0) / nsteps
+    if (sc > zero) h = min(h, 0.1_wp * sqrt(one / sc))
+    h = max(h, 1.0e-10_wp * abs(t1 - t0))
+    do while (t < t1 - 1.0e-14_wp * abs(t1 - t0))
+      if (stats(1) + stats(2) >= max_steps) then
+        status = MBD_INTEGRATOR_FAILED
+        write (msg, '(a,i0,a,es12.5)') 'more than ', max_steps, ' steps before t = ', t
+        return
+      end if
+      t_fail = t
+      h = min(h, t1 - t)
+      tnew = t + h
+      call step(st)
+      if (st == MBD_OK .and. all(ieee_is_finite(yn))) then
+        err = sqrt(sum((e / (atol + rtol * max(abs(y), abs(yn))))**2) / size(e))
+      else
+        err = 10.0_wp
+      end if
+      if (err > one) then
+        stats(2) = stats(2) + 1
+        fsal = .false.
+        h = h * max(0.2_wp, 0.9_wp * err**(-0.2_wp))
+        if (h < 1.0e-14_wp * max(one, abs(t))) then
+          status = MBD_INTEGRATOR_FAILED
+          write (msg, '(a,es12.5)') 'step size underflow at t = ', t
+          return
+        end if
+        cycle
+      end if
+      ! accepted: project onto the constraints (state and sensitivities), then the rates
+      call project(tnew, yn, st)
+      if (st == MBD_OK) call rhs(tnew, yn, k(:, 1), st)
+      if (st /= MBD_OK) then
+        status = MBD_INTEGRATOR_FAILED
+        write (msg, '(a,es12.5)') 'the constraints could not be satisfied after the step '// &
+          'to t = ', tnew
+        return
+      end if
+      fsal = .true.
+      call emit(t, tnew)
+      za = yn(1:nz); zda = yn(nz + 1:); zdda = k(nz + 1:, 1)
+      stats(1) = stats(1) + 1
+      hmm = [min(hmm(1), h), max(hmm(2), h)]
+      t = tnew
+      y = yn
+      fac = min(5.0_wp, max(0.2_wp, 0.9_wp * max(err, 1.0e-10_wp)**(-0.2_wp)))
+      h = h * fac
+    end do
+    q = y(1:n); qd = y(nz + 1:nz + n)
+    sq = reshape(y(n + 1:nz), [n, np]); sqd = reshape(y(nz + n + 1:), [n, np])
+  contains
+
+    !> One Dormand-Prince step from (t, y) with k(:, 1) = f(t, y) known: yn, e.
+    subroutine step(stp)
+      integer, intent(out) :: stp
+      if (.not. fsal) then
+        call rhs(t, y, k(:, 1), stp)
+        if (stp /= MBD_OK) return
+      end if
+      call rhs(t + C2 * h, y + h * A21 * k(:, 1), k(:, 2), stp)
+      if (stp /= MBD_OK) return
+      call rhs(t + C3 * h, y + h * (A31 * k(:, 1) + A32 * k(:, 2)), k(:, 3), stp)
+      if (stp /= MBD_OK) return
+      call rhs(t + C4 * h, y + h * (A41 * k(:, 1) + A42 * k(:, 2) + A43 * k(:, 3)), k(:, 4), stp)
+      if (stp /= MBD_OK) return
+      call rhs(t + C5 * h, y + h * (A51 * k(:, 1) + A52 * k(:, 2) + A53 * k(:, 3) + &
+               A54 * k(:, 4)), k(:, 5), stp)
+      if (stp /= MBD_OK) return
+      call rhs(t + h, y + h * (A61 * k(:, 1) + A62 * k(:, 2) + A63 * k(:, 3) + A64 * k(:, 4) + &
+               A65 * k(:, 5)), k(:, 6), stp)
+      if (stp /= MBD_OK) return
+      yn = y + h * (A71 * k(:, 1) + A73 * k(:, 3) + A74 * k(:, 4) + A75 * k(:, 5) + &
+                    A76 * k(:, 6))
+      call rhs(t + h, yn, k(:, 7), stp)
+      if (stp /= MBD_OK) return
+      e = h * (E1 * k(:, 1) + E3 * k(:, 3) + E4 * k(:, 4) + E5 * k(:, 5) + E6 * k(:, 6) + &
+               E7 * k(:, 7))
+    end subroutine step
+
+    !> f(t, y): (z_dot, z_ddot), z = (q, S): q_ddot from the index-1 system, each S_ddot from
+    !! its differentiation with the same factors.
+    subroutine rhs(tt, yy, f, stp)
+      real(wp), intent(in) :: tt, yy(:)
+      real(wp), intent(out) :: f(:)
+      integer, intent(out) :: stp
+      real(wp) :: qq(n), vv(n), aa(n), r(n + w%na), y1(n), sk(n), sdk(n), jpb(MAXROW, NLOC, m%nc)
+      integer :: kk, i, o
+      stats(3) = stats(3) + 1
+      qq = yy(1:n); vv = yy(nz + 1:nz + n)
+      call dyn_accel(m, w, qq, vv, tt, aa, lam, stp)
+      if (stp /= MBD_OK) return
+      f(1:nz) = yy(nz + 1:)
+      f(nz + 1:nz + n) = aa
+      call sens_trig(m, s, qq)
+      call sens_hessian(m, s, qq, vv, aa, tt)
+      call sens_params(m, s, qq, vv, aa, tt)
+      call sens_klam_list(m, s, lam)
+      do kk = 1, np
+        o = n * kk
+        sk = yy(o + 1:o + n); sdk = yy(nz + o + 1:nz + o + n)
+        call sens_force_d(m, s, kk, qq, vv, sk, sdk, tt, y1)
+        r(1:n) = y1 - s%tmass(:, kk) * aa
+        call sens_klam(s, sk, y1)
+        r(1:n) = r(1:n) - y1
+        call sens_jpt_lam(m, s, kk, qq, tt, lam, y1, jpb)
+        r(1:n) = r(1:n) - y1
+        s%work = s%ap(kk, :)
+        do i = 1, s%nnz
+          s%work(s%nzr(i)) = s%work(s%nzr(i)) - s%nza(i) * sk(s%nzc(i)) - &
+                             2 * s%nzv(i) * sdk(s%nzc(i))
+        end do
+        r(n + 1:) = w%s * s%work(w%rows)
+        call dyn_solve(w, r, stp)
+        if (stp /= MBD_OK) return
+        f(nz + o + 1:nz + o + n) = r(1:n)
+      end do
+    end subroutine rhs
+
+    !> Project q, q_dot (mbd_dynamics) and then S, S_dot (project_sens).
+    subroutine project(tt, yy, stp)
+      real(wp), intent(in) :: tt
+      real(wp), intent(inout) :: yy(:)
+      integer, intent(out) :: stp
+      real(wp) :: qq(n), vv(n), v0(n)
+      qq = yy(1:n); v0 = yy(nz + 1:nz + n)
+      call dyn_project_pos(m, w, qq, tt, stp)
+      if (stp /= MBD_OK) return
+      call dyn_velocity(m, w, qq, tt, v0, vv, stp)
+      if (stp /= MBD_OK) return
+      yy(1:n) = qq; yy(nz + 1:nz + n) = vv
+      call project_sens(m, w, s, tt, yy, stp)
+    end subroutine project
+
+    !> The stored outputs in (ta, tb] by quintic Hermite interpolation of z = (q, S).
+    subroutine emit(ta, tb)
+      real(wp), intent(in) :: ta, tb
+      real(wp) :: tk
+      do while (kout <= nsteps)
+        tk = t0 + (t1 - t0) * (real(kout, wp) / nsteps)
+        if (kout == nsteps) tk = t1
+        if (tk > tb + 1.0e-12_wp * abs(t1 - t0)) exit
+        if (mod(kout, every) == 0 .or. kout == nsteps) then
+          call hermite5(ta, za, zda, zdda, tb, yn(1:nz), yn(nz + 1:), k(nz + 1:, 1), tk, zz, &
+                        zzd, zzdd)
+          nout = nout + 1
+          call put(nout, zz, zzd, zzdd)
+        end if
+        kout = kout + 1
+      end do
+    end subroutine emit
+
+    subroutine put(row, z1, z2, z3)
+      integer, intent(in) :: row
+      real(wp), intent(in) :: z1(:), z2(:), z3(:)
+      qo(:, row) = z1(1:n); vo(:, row) = z2(1:n); ao(:, row) = z3(1:n)
+      so(:, :, row) = reshape(z1(n + 1:), [n, np])
+      sdo(:, :, row) = reshape(z2(n + 1:), [n, np])
+      sddo(:, :, row) = reshape(z3(n + 1:), [n, np])
+    end subroutine put
+  end subroutine sens_dopri5
+
+  !> Project the sensitivities in the packed state yy = (q, S, q_dot, S_dot) (q, q_dot
+  !! consistent) onto the linearized constraints: S onto J S = -Phi_p by the minimum-norm
+  !! change, S_dot onto J S_dot = nu_p - J_p q_dot - Hv S nearest in the kinetic metric.
+  subroutine project_sens(m, w, s, tt, yy, stp)
+    type(model_t), intent(in) :: m              !! model with dynamics data
+    type(dyn_work_t), intent(in) :: w           !! dynamics work arrays (active rows, scale)
+    type(sens_t), intent(inout) :: s            !! parameters and blocks
+    real(wp), intent(in) :: tt                  !! time
+    real(wp), intent(inout) :: yy(:)            !! packed state
+    integer, intent(out) :: stp                 !! MBD_OK or MBD_SINGULAR
+    real(wp) :: vv(m%nq), met(m%nq), aug(m%nq + w%na, m%nq + w%na), r(m%nq + w%na), &
+                aug2(m%nq + w%na, m%nq + w%na), phi(m%neq), nu(m%neq), gam(m%neq), &
+                jac(m%neq, m%nq), z(m%nq), hvs(m%neq)
+    integer :: piv(m%nq + w%na), piv2(m%nq + w%na), kk, o, i, n, nz
+    type(asm_work_t) :: a
+    character(len=MSG_LEN) :: lmsg
+    n = m%nq; nz = n * (1 + s%np)
+    vv = yy(nz + 1:nz + n)
+    z = zero
+    call asm_init(m, a, stp, lmsg)
+    if (stp /= MBD_OK) return
+    call assemble_dense(m, yy(1:n), vv, tt, phi, nu, gam, a, jac)
+    call sens_trig(m, s, yy(1:n))
+    call sens_hessian(m, s, yy(1:n), vv, z, tt)
+    call sens_params(m, s, yy(1:n), vv, z, tt)
+    met = merge(m%mdiag, w%s, m%mdiag > zero)
+    aug = zero; aug2 = zero
+    do i = 1, n
+      aug(i, i) = one; aug2(i, i) = met(i)
+    end do
+    aug(1:n, n + 1:) = transpose(jac(w%rows, :)); aug(n + 1:, 1:n) = jac(w%rows, :)
+    aug2(1:n, n + 1:) = aug(1:n, n + 1:); aug2(n + 1:, 1:n) = aug(n + 1:, 1:n)
+    call lu_factor(aug, piv, stp, lmsg)
+    if (stp == MBD_OK) call lu_factor(aug2, piv2, stp, lmsg)
+    if (stp /= MBD_OK) return
+    do kk = 1, s%np
+      o = n * kk
+      ! S <- S + dS, [I J^T; J 0][dS; mu] = [0; -(J S + Phi_p)]
+      r = zero
+      r(n + 1:) = -(matmul(jac(w%rows, :), yy(o + 1:o + n)) + s%phip(kk, w%rows))
+      call lu_solve(aug, piv, r, stp, lmsg)
+      if (stp /= MBD_OK) return
+      yy(o + 1:o + n) = yy(o + 1:o + n) + r(1:n)
+      ! S_dot nearest in M to its value with J S_dot = nu_p - J_p q_dot - Hv S
+      hvs = s%vp(kk, :)
+      do i = 1, s%nnz
+        hvs(s%nzr(i)) = hvs(s%nzr(i)) - s%nzv(i) * yy(o + s%nzc(i))
+      end do
+      r(1:n) = met * yy(nz + o + 1:nz + o + n)
+      r(n + 1:) = hvs(w%rows)
+      call lu_solve(aug2, piv2, r, stp, lmsg)
+      if (stp /= MBD_OK) return
+      yy(nz + o + 1:nz + o + n) = r(1:n)
+    end do
+  end subroutine project_sens
+
+  !> Sensitivities of the consistent initial state of forward dynamics: the assembled q
+  !! changes by the minimum-norm solution of J S = -Phi_p, the projected q_dot by the
+  !! kinetic-energy-nearest solution of J S_dot = nu_p - J_p q_dot - Hv S (as their
+  !! projections from the estimates).
+  subroutine sens_initial(m, w, s, q, qd, t, sq, sqd, status, msg)
+    type(model_t), intent(in) :: m              !! model with dynamics data
+    type(dyn_work_t), intent(inout) :: w        !! dynamics work arrays (dyn_init done)
+    type(sens_t), intent(inout) :: s            !! parameters and blocks
+    real(wp), intent(in) :: q(:), qd(:), t      !! consistent state
+    real(wp), intent(out) :: sq(:, :), sqd(:, :)  !! (nq, np)
+    integer, intent(out) :: status              !! MBD_OK or MBD_SINGULAR
+    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    real(wp) :: y(2 * m%nq * (1 + s%np))
+    integer :: n, nz
+    n = m%nq; nz = n * (1 + s%np)
+    y = zero
+    y(1:n) = q; y(nz + 1:nz + n) = qd
+    msg = ''
+    call project_sens(m, w, s, t, y, status)
+    if (status /= MBD_OK) msg = 'the initial sensitivities cannot be made consistent'
+    sq = reshape(y(n + 1:nz), [n, s%np]); sqd = reshape(y(nz + n + 1:), [n, s%np])
+  end subroutine sens_initial
+
+end module mbd_sens_dynamics

@@ -1,0 +1,660 @@
+!> mbd_sensitivity: design parameters and the derivatives the sensitivity equations need.
+!!
+!! A parameter is an entry of one of the flat tables the front end hands over, named in a
+!! table ptab(2, np) by (table, index):  1 rpar (a constraint's raw parameter), 2 bmass
+!! (flattened (2, nb): mass of body b at 2 b - 1, inertia at 2 b), 3 grav (1 x, 2 y), 4 fpar
+!! (a force's raw parameter). sens_setup turns each into the change of the prepared
+!! parameter pools (the chain rule through each joint's prepare: axis normalisation, spline
+!! coefficients, ...), of the mass matrix and of gravity. Masses, gravity and forces do not
+!! enter the kinematics: without dynamics data their columns are zero (and force indices are
+!! checked only with the force table).
+!!
+!! Differentiating Phi(q, t; p) = 0, J q_dot = nu and J q_ddot = gamma along a motion gives,
+!! with s = dq/dp (Haug, Computer-Aided Kinematics and Dynamics, sec. 6.5):
+!!   J s       = -Phi_p
+!!   J s_dot   = nu_p - J_p q_dot - Hv s                           Hv = (J q_dot)_q
+!!   J s_ddot  = gamma_p - J_p q_ddot - Ha s - 2 Hv s_dot           Ha = (J q_ddot - gamma)_q
+!! (gamma_q_dot = -2 Hv for constraints quadratic in q_dot). Hv and Ha come from the local
+!! Hessian of each constraint, hs(:, :, j) = dJ_loc/dq_slot_j, evaluated by dual numbers
+!! (mbd_dual) along each slot of the constraint; Phi_p, J_p, nu_p, gamma_p along each
+!! parameter's change of the prepared pool. All are local blocks in the layout of J's
+!! blocks (MAXROW x NLOC per constraint); products with them go through the slot map.
+module mbd_sensitivity
+  use mbd_kinds, only: wp, zero, one
+  use mbd_status, only: MBD_OK, MBD_BAD_PARAM, MBD_BAD_INPUT, MBD_NO_MEMORY, MSG_LEN
+  use mbd_points, only: NLOC, MAXROW, kloc, local_state
+  use mbd_dual, only: dloc
+  use mbd_model, only: model_t, NCT, NFT
+  use mbd_constraints, only: con_eval_d, con_prepare_d, con_is_count, con_name, con_linear, &
+                             con_affine_r, con_exponents, &
+                             CON_TRANSLATIONAL, DRV_REL_DIST
+  use mbd_forces, only: force_eval_d, force_is_count, force_exponents
+  implicit none
+  private
+  public :: sens_t, PT_RPAR, PT_MASS, PT_GRAV, PT_FPAR
+  public :: sens_setup, sens_trig, sens_hessian, sens_params, sens_kin_rhs, block_apply, &
+            block_apply_t, block_apply_cols, &
+            sens_klam, sens_klam_list, sens_jpt_lam, sens_force_d, sens_force_jac, sens_eval_d
+
+  integer, parameter :: PT_RPAR = 1, PT_MASS = 2, PT_GRAV = 3, PT_FPAR = 4  !! table ids
+
+  !> The parameters and the work arrays of the sensitivity equations.
+  type :: sens_t
+    integer :: np = 0                        !! parameters
+    integer, allocatable :: ptab(:, :)       !! (2, np) table and index of each
+    !> (np) dp'/dp: a nondimensional model (mbd_model) works with p' = p L**e; the
+    !! sensitivities the core computes are with respect to p'
+    real(wp), allocatable :: pscale(:)
+    real(wp), allocatable :: tp(:, :)        !! (size(m%p), np) change of the prepared pool
+    logical, allocatable :: caff(:, :)       !! (nc, np) the constraint's parameters change
+    real(wp), allocatable :: tfp(:, :)       !! (size(m%fp), np) change of the force pool
+    logical, allocatable :: faff(:, :)       !! (nf, np) the force's parameters change
+    real(wp), allocatable :: tmass(:, :)     !! (nq, np) change of the mass matrix diagonal
+    real(wp), allocatable :: tgrav(:, :)     !! (2, np) change of gravity
+    ! local blocks at the current state (sens_hessian)
+    real(wp), allocatable :: hs(:, :, :, :)  !! (MAXROW, NLOC, NLOC, nc) dJ_loc / dq_slot
+    real(wp), allocatable :: hv(:, :, :)     !! (MAXROW, NLOC, nc) (J q_dot)_q
+    real(wp), allocatable :: ha(:, :, :)     !! (MAXROW, NLOC, nc) (J q_ddot - gamma)_q
+    ! parameter parts at the current state (sens_params), (np, neq): a row per parameter
+    real(wp), allocatable :: phip(:, :)      !! Phi_p
+    real(wp), allocatable :: vp(:, :)        !! nu_p - J_p q_dot
+    real(wp), allocatable :: ap(:, :)        !! gamma_p - J_p q_ddot
+    real(wp), allocatable :: work(:)         !! (neq)
+    !> (npad, neq) right-hand sides as rows, npad = np rounded up to a multiple of 4 (the
+    !! padding rows stay zero: lu_solve_rows works on 4 at a time)
+    real(wp), allocatable :: rhs(:, :)
+    logical :: curved = .true.               !! some constraint is not linear in q
+    real(wp), allocatable :: cb(:), sb(:)    !! (0:nb) cos and sin of the body angles (sens_trig)
+    ! the nonzeros of Hv and Ha (sens_hessian): row, column, values
+    integer :: nnz = 0
+    integer, allocatable :: nzr(:), nzc(:)
+    real(wp), allocatable :: nzv(:), nza(:)
+    ! the nonzeros of K_lambda (sens_klam_list): row, column, value
+    integer :: kln = 0
+    integer, allocatable :: klr(:), klc(:)
+    real(wp), allocatable :: klv(:)
+    real(wp), allocatable :: zp(:)           !! zeros, the longest prepared slice
+    real(wp), allocatable :: zq(:)           !! zeros (nq)
+  end type sens_t
+
+contains
+
+  !> Check the parameter table and build the changes of the prepared pools.
+  !! bad returns the offending parameter (column of ptab), 0 when none.
+  subroutine sens_setup(m, ctab, rpar, ptab, s, status, msg, bad, ftab, fpar)
+    type(model_t), intent(in) :: m              !! built model
+    integer, intent(in) :: ctab(:, :)           !! constraint table (NCT, nc)
+    real(wp), intent(in) :: rpar(:)             !! raw constraint parameters
+    integer, intent(in) :: ptab(:, :)           !! (2, np) parameter table
+    type(sens_t), intent(out) :: s              !! parameters and work arrays
+    integer, intent(out) :: status              !! MBD_OK or < 0
+    character(len=MSG_LEN), intent(out) :: msg  !! what is wrong
+    integer, intent(out) :: bad                 !! offending parameter
+    integer, intent(in), optional :: ftab(:, :) !! force table (NFT, nf), for dynamics
+    real(wp), intent(in), optional :: fpar(:)   !! raw force parameters
+    real(wp), allocatable :: tprep(:), raw(:)
+    integer :: k, i, c, d, j, off, len, st, nfp
+    integer, allocatable :: fe(:)
+    logical :: dyn
+    status = MBD_OK; msg = ''; bad = 0
+    if (size(ptab, 1) /= 2) then
+      status = MBD_BAD_INPUT; msg = 'the parameter table must have 2 rows'; return
+    end if
+    dyn = allocated(m%mdiag) .and. present(ftab) .and. present(fpar)
+    s%np = size(ptab, 2)
+    nfp = 0
+    if (dyn) nfp = size(m%fp)
+    allocate (s%ptab(2, s%np), s%pscale(s%np), s%tp(size(m%p), s%np), s%caff(m%nc, s%np), &
+              s%tfp(nfp, s%np), s%faff(m%nf, s%np), s%tmass(m%nq, s%np), s%tgrav(2, s%np), &
+              s%hs(MAXROW, NLOC, NLOC, m%nc), s%hv(MAXROW, NLOC, m%nc), &
+              s%ha(MAXROW, NLOC, m%nc), s%phip(s%np, m%neq), s%vp(s%np, m%neq), &
+              s%ap(s%np, m%neq), s%work(m%neq), s%rhs(4 * ((s%np + 3) / 4), m%neq), &
+              s%zp(maxval(m%pn)), s%zq(m%nq), &
+              s%cb(0:m%nb), s%sb(0:m%nb), s%nzr(NLOC * m%neq), s%nzc(NLOC * m%neq), &
+              s%nzv(NLOC * m%neq), s%nza(NLOC * m%neq), s%klr(NLOC * NLOC * m%nc), &
+              s%klc(NLOC * NLOC * m%nc), s%klv(NLOC * NLOC * m%nc), stat=st)
+    if (st /= 0) then
+      status = MBD_NO_MEMORY; msg = 'out of memory for the sensitivity arrays'; return
+    end if
+    s%ptab = ptab
+    s%tp = zero; s%caff = .false.; s%tfp = zero; s%faff = .false.; s%tmass = zero
+    s%tgrav = zero; s%hs = zero; s%hv = zero; s%ha = zero; s%zp = zero
+    s%cb = one; s%sb = zero; s%rhs = zero; s%pscale = one; s%zq = zero
+    do k = 1, s%np
+      bad = k
+      i = ptab(2, k)
+      select case (ptab(1, k))
+      case (PT_RPAR)
+        if (i < 1 .or. i > size(rpar)) then
+          call fail('constraint parameter index out of range'); return
+        end if
+        c = owner(ctab(6, :), ctab(7, :), i)
+        if (c == 0) then
+          call fail('the constraint parameter belongs to no constraint'); return
+        end if
+        off = ctab(6, c); len = ctab(7, c); j = i - off + 1
+        if (con_is_count(ctab(1, c), ctab(4, c), rpar(off:off + len - 1), j)) then
+          call fail('is a count, not a continuous parameter'); return
+        end if
+        raw = scaled_raw(ctab(1, c), ctab(4, c), ctab(5, c), rpar(off:off + len - 1), j, &
+                         s%pscale(k))
+        call con_prepare_d(ctab(1, c), ctab(4, c), ctab(5, c), raw, j, tprep, status, msg)
+        if (status /= MBD_OK) return
+        call put_prep(c, tprep, k)
+        if (ctab(1, c) == CON_TRANSLATIONAL) then
+          ! relative-distance drivers on this joint carry its prepared parameters in front
+          do d = 1, m%nc
+            if (ctab(1, d) == DRV_REL_DIST .and. ctab(4, d) == c) then
+              s%tp(m%po(d):m%po(d) + size(tprep) - 1, k) = tprep
+              s%caff(d, k) = .true.
+            end if
+          end do
+        end if
+      case (PT_MASS)
+        if (i < 1 .or. i > 2 * m%nb) then
+          call fail('mass table index out of range'); return
+        end if
+        c = (i + 1) / 2
+        if (mod(i, 2) == 1) then
+          s%tmass(3 * c - 2:3 * c - 1, k) = one
+          s%pscale(k) = m%lref**2                  ! masses x L**2
+        else
+          s%tmass(3 * c, k) = one
+        end if
+      case (PT_GRAV)
+        if (i < 1 .or. i > 2) then
+          call fail('gravity index must be 1 or 2'); return
+        end if
+        s%tgrav(i, k) = one
+        s%pscale(k) = one / m%lref                 ! gravity / L
+      case (PT_FPAR)
+        if (.not. dyn) cycle            ! no forces in a kinematic model: no change
+        if (i < 1 .or. i > size(fpar)) then
+          call fail('force parameter index out of range'); return
+        end if
+        c = owner(ftab(4, :), ftab(5, :), i)
+        if (c == 0) then
+          call fail('the force parameter belongs to no force'); return
+        end if
+        j = i - ftab(4, c) + 1
+        if (force_is_count(ftab(1, c), fpar(ftab(4, c):ftab(4, c) + ftab(5, c) - 1), j)) then
+          call fail('is a count, not a continuous parameter'); return
+        end if
+        s%tfp(m%fpo(c) + j - 1, k) = one          ! forces: prepared = raw
+        s%faff(c, k) = .true.
+        allocate (fe(ftab(5, c)), stat=st)
+        if (st /= 0) then
+          status = MBD_NO_MEMORY; msg = 'out of memory'; return
+        end if
+        call force_exponents(ftab(1, c), fpar(ftab(4, c):ftab(4, c) + ftab(5, c) - 1), fe)
+        s%pscale(k) = m%lref**fe(j)
+        deallocate (fe)
+      case default
+        call fail('unknown parameter table (1 constraints, 2 masses, 3 gravity, 4 forces)')
+        return
+      end select
+    end do
+    bad = 0
+  contains
+    !> A constraint's raw parameters as the nondimensional model has them (p L**e), and the
+    !! factor dp'/dp = L**e of entry jj.
+    function scaled_raw(kd, sa, sb, rw, jj, f) result(rs)
+      integer, intent(in) :: kd, sa, sb, jj
+      real(wp), intent(in) :: rw(:)
+      real(wp), intent(out) :: f
+      real(wp) :: rs(size(rw))
+      integer :: e(size(rw))
+      logical :: g(size(rw))
+      rs = rw; f = one
+      if (.not. (m%lref > one .or. m%lref < one)) return
+      call con_exponents(kd, sa, sb, rw, e, g)
+      rs = rw * m%lref**e
+      f = m%lref**e(jj)
+    end function scaled_raw
+
+    !> The element whose slice [off, off + len) holds index ii (0 when none).
+    pure integer function owner(offs, lens, ii)
+      integer, intent(in) :: offs(:), lens(:), ii
+      integer :: e
+      owner = 0
+      do e = 1, size(offs)
+        if (ii >= offs(e) .and. ii < offs(e) + lens(e)) then
+          owner = e; return
+        end if
+      end do
+    end function owner
+
+    subroutine put_prep(cc, tpr, kk)
+      integer, intent(in) :: cc, kk
+      real(wp), intent(in) :: tpr(:)
+      if (size(tpr) /= m%pn(cc)) then
+        status = MBD_BAD_PARAM
+        msg = trim(con_name(m%kind(cc))) // ': prepared parameter change has the wrong length'
+        return
+      end if
+      s%tp(m%po(cc):m%po(cc) + m%pn(cc) - 1, kk) = tpr
+      s%caff(cc, kk) = .true.
+    end subroutine put_prep
+
+    subroutine fail(what)
+      character(len=*), intent(in) :: what
+      status = MBD_BAD_PARAM
+      write (msg, '(a,i0,a,i0,a,i0,a,a)') 'parameter ', k, ' (table ', ptab(1, k), ', entry ', &
+        ptab(2, k), '): ', what
+    end subroutine fail
+  end subroutine sens_setup
+
+  !> cos and sin of every body angle at q, for the evaluations that follow at the same q.
+  pure subroutine sens_trig(m, s, q)
+    type(model_t), intent(in) :: m           !! model
+    type(sens_t), intent(inout) :: s         !! cache (out)
+    real(wp), intent(in) :: q(:)             !! configuration
+    integer :: b
+    do b = 1, m%nb
+      s%cb(b) = cos(q(3 * b)); s%sb(b) = sin(q(3 * b))
+    end do
+  end subroutine sens_trig
+
+  !> The local state of constraint k at (q, q_dot) and its slots' accelerations (cos and sin
+  !! from sens_trig).
+  pure subroutine gather(m, s, k, q, qd, qdd, xd, qddl)
+    type(model_t), intent(in) :: m
+    type(sens_t), intent(in) :: s
+    integer, intent(in) :: k
+    real(wp), intent(in) :: q(:), qd(:), qdd(:)
+    type(dloc), intent(out) :: xd          ! the state, with a zero direction
+    real(wp), intent(out) :: qddl(NLOC)
+    integer :: j, c
+    do j = 1, NLOC
+      c = m%loc(j, k)
+      xd%x%q(j) = zero; xd%x%qd(j) = zero; qddl(j) = zero
+      if (c > 0) then
+        xd%x%q(j) = q(c); xd%x%qd(j) = qd(c); qddl(j) = qdd(c)
+      end if
+    end do
+    xd%x%c(1) = s%cb(m%bi(k)); xd%x%c(2) = s%cb(m%bj(k))
+    xd%x%s(1) = s%sb(m%bi(k)); xd%x%s(2) = s%sb(m%bj(k))
+    xd%tq = zero; xd%tqd = zero
+  end subroutine gather
+
+  !> Local Hessian blocks at (q, q_dot, q_ddot, t): for each constraint and each of its
+  !! slots j, the dual evaluation along dq = e_j gives hs(:, :, j) = dJ_loc/dq_j and
+  !! d ar/dq_j = -dgamma/dq_j; then hv(:, j) = hs(:, :, j) q_dot_loc and
+  !! ha(:, j) = hs(:, :, j) q_ddot_loc + d ar/dq_j (and their nonzeros in a list).
+  !! sens_trig first.
+  pure subroutine sens_hessian(m, s, q, qd, qdd, t)
+    type(model_t), intent(in) :: m             !! model
+    type(sens_t), intent(inout) :: s           !! blocks (out)
+    real(wp), intent(in) :: q(:), qd(:), qdd(:)  !! state and accelerations
+    real(wp), intent(in) :: t                  !! time
+    type(dloc) :: x
+    real(wp) :: qddl(NLOC), tphi(MAXROW), tnu(MAXROW), tgam(MAXROW)
+    integer :: k, j, nr, si, sj, r
+    s%curved = .false.
+    s%nnz = 0
+    do k = 1, m%nc
+      if (con_linear(m%kind(k))) cycle          ! blocks stay zero (sens_setup)
+      s%curved = .true.
+      call gather(m, s, k, q, qd, qdd, x, qddl)
+      si = merge(1, 0, m%bi(k) > 0); sj = merge(2, 0, m%bj(k) > 0)
+      nr = m%nrow(k)
+      do j = 1, NLOC
+        if (m%loc(j, k) == 0) cycle
+        if (con_affine_r(m%kind(k), m%bi(k)) .and. j /= 3 .and. j /= 6) cycle   ! zero blocks
+        x%tq(j) = one
+        call con_eval_d(m%kind(k), m%suba(k), m%subb(k), m%p(m%po(k):m%po(k) + m%pn(k) - 1), &
+                        s%zp(1:m%pn(k)), si, sj, x, t, tphi, s%hs(:, :, j, k), tnu, tgam)
+        x%tq(j) = zero
+        do r = 1, nr
+          s%hv(r, j, k) = dot_product(s%hs(r, :, j, k), x%x%qd)
+          s%ha(r, j, k) = dot_product(s%hs(r, :, j, k), qddl) - tgam(r)
+          if (abs(s%hv(r, j, k)) > zero .or. abs(s%ha(r, j, k)) > zero) then
+            s%nnz = s%nnz + 1
+            s%nzr(s%nnz) = m%row0(k) + r - 1; s%nzc(s%nnz) = m%loc(j, k)
+            s%nzv(s%nnz) = s%hv(r, j, k); s%nza(s%nnz) = s%ha(r, j, k)
+          end if
+        end do
+      end do
+    end do
+  end subroutine sens_hessian
+
+  !> Parameter parts at (q, q_dot, q_ddot, t): Phi_p, nu_p - J_p q_dot and
+  !! gamma_p - J_p q_ddot, each a column per parameter (zero rows for unaffected
+  !! constraints), from the dual evaluation along the parameter's change (dq = 0).
+  pure subroutine sens_params(m, s, q, qd, qdd, t)
+    type(model_t), intent(in) :: m             !! model
+    type(sens_t), intent(inout) :: s           !! parameter parts (out)
+    real(wp), intent(in) :: q(:), qd(:), qdd(:)  !! state and accelerations
+    real(wp), intent(in) :: t                  !! time
+    type(dloc) :: x
+    real(wp) :: qddl(NLOC), tphi(MAXROW), tjl(MAXROW, NLOC), tnu(MAXROW), tgam(MAXROW)
+    integer :: k, c, nr, si, sj, r, r0
+    s%phip = zero; s%vp = zero; s%ap = zero
+    do c = 1, m%nc
+      if (.not. any(s%caff(c, :))) cycle
+      call gather(m, s, c, q, qd, qdd, x, qddl)
+      si = merge(1, 0, m%bi(c) > 0); sj = merge(2, 0, m%bj(c) > 0)
+      nr = m%nrow(c); r0 = m%row0(c) - 1
+      do k = 1, s%np
+        if (.not. s%caff(c, k)) cycle
+        call con_eval_d(m%kind(c), m%suba(c), m%subb(c), m%p(m%po(c):m%po(c) + m%pn(c) - 1), &
+                        s%tp(m%po(c):m%po(c) + m%pn(c) - 1, k), si, sj, x, &
+                        t, tphi, tjl, tnu, tgam)
+        do r = 1, nr
+          s%phip(k, r0 + r) = tphi(r)
+          s%vp(k, r0 + r) = tnu(r) - dot_product(tjl(r, :), x%x%qd)
+          s%ap(k, r0 + r) = tgam(r) - dot_product(tjl(r, :), qddl)
+        end do
+      end do
+    end do
+  end subroutine sens_params
+
+  !> Changes of Phi, nu, gamma (neq) and of the local J blocks (MAXROW, NLOC, nc) along a
+  !! direction (dq, dq_dot) and parameter k (k = 0: none): every constraint evaluated on
+  !! dual numbers. sens_trig first.
+  pure subroutine sens_eval_d(m, s, k, q, qd, dq, dqd, t, tphi, tnu, tgam, tjb)
+    type(model_t), intent(in) :: m             !! model
+    type(sens_t), intent(in) :: s              !! parameters
+    integer, intent(in) :: k                   !! parameter, or 0
+    real(wp), intent(in) :: q(:), qd(:)        !! state
+    real(wp), intent(in) :: dq(:), dqd(:)      !! direction
+    real(wp), intent(in) :: t                  !! time
+    real(wp), intent(out) :: tphi(:), tnu(:), tgam(:)  !! (neq)
+    real(wp), intent(out) :: tjb(:, :, :)      !! (MAXROW, NLOC, nc)
+    type(dloc) :: x
+    real(wp) :: qddl(NLOC), ph(MAXROW), nv(MAXROW), ga(MAXROW)
+    integer :: c, si, sj, r0, nr
+    tjb = zero
+    do c = 1, m%nc
+      call gather(m, s, c, q, qd, qd, x, qddl)
+      call gather_dir(c, x%tq, x%tqd)
+      si = merge(1, 0, m%bi(c) > 0); sj = merge(2, 0, m%bj(c) > 0)
+      ph = zero; nv = zero; ga = zero
+      if (k > 0) then
+        call con_eval_d(m%kind(c), m%suba(c), m%subb(c), m%p(m%po(c):m%po(c) + m%pn(c) - 1), &
+                        s%tp(m%po(c):m%po(c) + m%pn(c) - 1, k), si, sj, &
+                        x, t, ph, tjb(:, :, c), nv, ga)
+      else
+        call con_eval_d(m%kind(c), m%suba(c), m%subb(c), m%p(m%po(c):m%po(c) + m%pn(c) - 1), &
+                        s%zp(1:m%pn(c)), si, sj, x, t, ph, &
+                        tjb(:, :, c), nv, ga)
+      end if
+      r0 = m%row0(c) - 1; nr = m%nrow(c)
+      tphi(r0 + 1:r0 + nr) = ph(1:nr); tnu(r0 + 1:r0 + nr) = nv(1:nr)
+      tgam(r0 + 1:r0 + nr) = ga(1:nr)
+    end do
+  contains
+    pure subroutine gather_dir(cc, a, b)
+      integer, intent(in) :: cc
+      real(wp), intent(out) :: a(NLOC), b(NLOC)
+      integer :: jj
+      do jj = 1, NLOC
+        a(jj) = zero; b(jj) = zero
+        if (m%loc(jj, cc) > 0) then
+          a(jj) = dq(m%loc(jj, cc)); b(jj) = dqd(m%loc(jj, cc))
+        end if
+      end do
+    end subroutine gather_dir
+  end subroutine sens_eval_d
+
+  !> y = B x for local blocks B (MAXROW, NLOC, nc) in J's layout (y: neq, x: nq).
+  pure subroutine block_apply(m, b, x, y)
+    type(model_t), intent(in) :: m           !! model
+    real(wp), intent(in) :: b(:, :, :)       !! local blocks
+    real(wp), intent(in) :: x(:)             !! (nq)
+    real(wp), intent(out) :: y(:)            !! (neq)
+    integer :: k, j, c, r, r0
+    y = zero
+    do k = 1, m%nc
+      r0 = m%row0(k) - 1
+      do j = 1, NLOC
+        c = m%loc(j, k)
+        if (c == 0) cycle
+        do r = 1, m%nrow(k)
+          y(r0 + r) = y(r0 + r) + b(r, j, k) * x(c)
+        end do
+      end do
+    end do
+  end subroutine block_apply
+
+  !> y = B^T l for local blocks B in J's layout (y: nq, l: neq).
+  pure subroutine block_apply_t(m, b, l, y)
+    type(model_t), intent(in) :: m           !! model
+    real(wp), intent(in) :: b(:, :, :)       !! local blocks
+    real(wp), intent(in) :: l(:)             !! (neq)
+    real(wp), intent(out) :: y(:)            !! (nq)
+    integer :: k, j, c, r, r0
+    y = zero
+    do k = 1, m%nc
+      r0 = m%row0(k) - 1
+      do j = 1, NLOC
+        c = m%loc(j, k)
+        if (c == 0) cycle
+        do r = 1, m%nrow(k)
+          y(c) = y(c) + b(r, j, k) * l(r0 + r)
+        end do
+      end do
+    end do
+  end subroutine block_apply_t
+
+  !> Y = B X for local blocks B in J's layout, X (nq, n), Y (neq, n): block_apply on n
+  !! columns at once.
+  pure subroutine block_apply_cols(m, b, x, y)
+    type(model_t), intent(in) :: m           !! model
+    real(wp), intent(in) :: b(:, :, :)       !! local blocks
+    real(wp), intent(in) :: x(:, :)          !! (nq, n)
+    real(wp), intent(inout) :: y(:, :)       !! (neq, n), added to
+    integer :: k, j, c, r, r0, i
+    do k = 1, m%nc
+      r0 = m%row0(k) - 1
+      do j = 1, NLOC
+        c = m%loc(j, k)
+        if (c == 0) cycle
+        do r = 1, m%nrow(k)
+          if (abs(b(r, j, k)) <= zero) cycle
+          do i = 1, size(x, 2)
+            y(r0 + r, i) = y(r0 + r, i) + b(r, j, k) * x(c, i)
+          end do
+        end do
+      end do
+    end do
+  end subroutine block_apply_cols
+
+  !> Right-hand sides of the sensitivity equations of all parameters at one level, a row per
+  !! parameter (np, neq), given the solutions of the levels before: level 1 -Phi_p;
+  !! 2 nu_p - J_p q_dot - Hv s; 3 gamma_p - J_p q_ddot - Ha s - 2 Hv s_dot.
+  !! sens_hessian and sens_params first.
+  pure subroutine sens_kin_rhs(s, level, sq, sqd, rhs)
+    type(sens_t), intent(in) :: s            !! blocks and parameter parts
+    integer, intent(in) :: level             !! 1 position, 2 velocity, 3 acceleration
+    real(wp), intent(in) :: sq(:, :), sqd(:, :)  !! s and s_dot (nq, np), as far as known
+    real(wp), intent(inout) :: rhs(:, :)     !! (np or more, neq): rows 1 .. np written
+    integer :: i, n, r, c
+    select case (level)
+    case (1)
+      rhs(1:s%np, :) = -s%phip
+    case (2)
+      rhs(1:s%np, :) = s%vp
+      do n = 1, s%nnz
+        r = s%nzr(n); c = s%nzc(n)
+        do i = 1, s%np
+          rhs(i, r) = rhs(i, r) - s%nzv(n) * sq(c, i)
+        end do
+      end do
+    case default
+      rhs(1:s%np, :) = s%ap
+      do n = 1, s%nnz
+        r = s%nzr(n); c = s%nzc(n)
+        do i = 1, s%np
+          rhs(i, r) = rhs(i, r) - s%nza(n) * sq(c, i) - 2 * s%nzv(n) * sqd(c, i)
+        end do
+      end do
+    end select
+  end subroutine sens_kin_rhs
+
+  !> K_lambda = (J^T lambda)_q = sum over rows of lambda_r (Phi_r)_qq as a list of its
+  !! nonzeros (row, column, value), from the local Hessian blocks (sens_hessian at the same q).
+  pure subroutine sens_klam_list(m, s, lam)
+    type(model_t), intent(in) :: m           !! model
+    type(sens_t), intent(inout) :: s         !! Hessian blocks; the list (out)
+    real(wp), intent(in) :: lam(:)           !! multipliers (neq)
+    integer :: k, i, j, r, r0, ci, cj
+    real(wp) :: acc
+    s%kln = 0
+    do k = 1, m%nc
+      if (con_linear(m%kind(k))) cycle
+      r0 = m%row0(k) - 1
+      do j = 1, NLOC
+        cj = m%loc(j, k)
+        if (cj == 0) cycle
+        do i = 1, NLOC
+          ci = m%loc(i, k)
+          if (ci == 0) cycle
+          acc = zero
+          do r = 1, m%nrow(k)
+            acc = acc + lam(r0 + r) * s%hs(r, i, j, k)
+          end do
+          if (abs(acc) <= zero) cycle
+          s%kln = s%kln + 1
+          s%klr(s%kln) = ci; s%klc(s%kln) = cj; s%klv(s%kln) = acc
+        end do
+      end do
+    end do
+  end subroutine sens_klam_list
+
+  !> y = K_lambda x from the list of sens_klam_list.
+  pure subroutine sens_klam(s, x, y)
+    type(sens_t), intent(in) :: s            !! the list
+    real(wp), intent(in) :: x(:)             !! direction (nq)
+    real(wp), intent(out) :: y(:)            !! (nq)
+    integer :: n
+    y = zero
+    do n = 1, s%kln
+      y(s%klr(n)) = y(s%klr(n)) + s%klv(n) * x(s%klc(n))
+    end do
+  end subroutine sens_klam
+
+  !> y = J_p^T lambda for parameter k at (q, t), and jpb, the change of the local J blocks
+  !! (MAXROW, NLOC, nc) along the parameter (zero for unaffected constraints).
+  pure subroutine sens_jpt_lam(m, s, k, q, t, lam, y, jpb)
+    type(model_t), intent(in) :: m           !! model
+    type(sens_t), intent(in) :: s            !! parameters
+    integer, intent(in) :: k                 !! parameter
+    real(wp), intent(in) :: q(:), t          !! configuration, time
+    real(wp), intent(in) :: lam(:)           !! multipliers (neq)
+    real(wp), intent(out) :: y(:)            !! (nq)
+    real(wp), intent(out) :: jpb(:, :, :)    !! (MAXROW, NLOC, nc)
+    type(dloc) :: x
+    real(wp) :: qddl(NLOC), tphi(MAXROW), tnu(MAXROW), tgam(MAXROW)
+    integer :: c, si, sj, j, r
+    jpb = zero
+    do c = 1, m%nc
+      if (.not. s%caff(c, k)) cycle
+      call gather(m, s, c, q, s%zq, s%zq, x, qddl)
+      si = merge(1, 0, m%bi(c) > 0); sj = merge(2, 0, m%bj(c) > 0)
+      call con_eval_d(m%kind(c), m%suba(c), m%subb(c), m%p(m%po(c):m%po(c) + m%pn(c) - 1), &
+                      s%tp(m%po(c):m%po(c) + m%pn(c) - 1, k), si, sj, x, t, &
+                      tphi, jpb(:, :, c), tnu, tgam)
+    end do
+    y = zero
+    do c = 1, m%nc
+      if (.not. s%caff(c, k)) cycle
+      do j = 1, NLOC
+        if (m%loc(j, c) == 0) cycle
+        do r = 1, m%nrow(c)
+          y(m%loc(j, c)) = y(m%loc(j, c)) + jpb(r, j, c) * lam(m%row0(c) + r - 1)
+        end do
+      end do
+    end do
+  end subroutine sens_jpt_lam
+
+  !> Change of the applied generalized force Q along (dq, dq_dot) and parameter k
+  !! (k = 0: no parameter change): forces by dual evaluation, gravity m g by the changes of
+  !! the masses and of g.
+  pure subroutine sens_force_d(m, s, k, q, qd, dq, dqd, t, y)
+    type(model_t), intent(in) :: m           !! model with dynamics data
+    type(sens_t), intent(in) :: s            !! parameters
+    integer, intent(in) :: k                 !! parameter, or 0
+    real(wp), intent(in) :: q(:), qd(:)      !! state
+    real(wp), intent(in) :: dq(:), dqd(:)    !! direction
+    real(wp), intent(in) :: t                !! time
+    real(wp), intent(out) :: y(:)            !! (nq)
+    real(wp) :: ql(NLOC), qdl(NLOC), tql(NLOC), tqdl(NLOC), fl(NLOC), tpz(size(m%fp))
+    integer :: f, j, c, si, sj, b
+    y = zero
+    if (k > 0) then
+      do b = 1, m%nb
+        y(3 * b - 2:3 * b - 1) = s%tmass(3 * b - 2, k) * m%grav + &
+                                 m%mdiag(3 * b - 2) * s%tgrav(:, k)
+      end do
+    end if
+    tpz = zero
+    do f = 1, m%nf
+      do j = 1, NLOC
+        c = m%floc(j, f)
+        ql(j) = zero; qdl(j) = zero; tql(j) = zero; tqdl(j) = zero
+        if (c > 0) then
+          ql(j) = q(c); qdl(j) = qd(c); tql(j) = dq(c); tqdl(j) = dqd(c)
+        end if
+      end do
+      si = merge(1, 0, m%fbi(f) > 0); sj = merge(2, 0, m%fbj(f) > 0)
+      if (k > 0) then
+        call force_eval_d(m%fkind(f), m%fp(m%fpo(f):m%fpo(f) + m%fpn(f) - 1), &
+                          s%tfp(m%fpo(f):m%fpo(f) + m%fpn(f) - 1, k), si, sj, ql, qdl, &
+                          tql, tqdl, t, fl)
+      else
+        call force_eval_d(m%fkind(f), m%fp(m%fpo(f):m%fpo(f) + m%fpn(f) - 1), &
+                          tpz(m%fpo(f):m%fpo(f) + m%fpn(f) - 1), si, sj, ql, qdl, &
+                          tql, tqdl, t, fl)
+      end if
+      do j = 1, NLOC
+        c = m%floc(j, f)
+        if (c > 0) y(c) = y(c) + fl(j)
+      end do
+    end do
+  end subroutine sens_force_d
+
+  !> Dense Jacobians of the applied forces, kq = dQ/dq and (optionally) kv = dQ/dq_dot,
+  !! from the dual evaluation of each force along its slots (nq x nq each).
+  pure subroutine sens_force_jac(m, q, qd, t, kq, kv)
+    type(model_t), intent(in) :: m           !! model with dynamics data
+    real(wp), intent(in) :: q(:), qd(:)      !! state
+    real(wp), intent(in) :: t                !! time
+    real(wp), intent(out) :: kq(:, :)        !! dQ/dq
+    real(wp), intent(out), optional :: kv(:, :)  !! dQ/dq_dot
+    real(wp) :: ql(NLOC), qdl(NLOC), e(NLOC), fl(NLOC), tpz(size(m%fp))
+    real(wp), parameter :: z(NLOC) = zero
+    integer :: f, i, j, c, si, sj
+    kq = zero
+    if (present(kv)) kv = zero
+    tpz = zero
+    do f = 1, m%nf
+      do j = 1, NLOC
+        c = m%floc(j, f)
+        ql(j) = zero; qdl(j) = zero
+        if (c > 0) then
+          ql(j) = q(c); qdl(j) = qd(c)
+        end if
+      end do
+      si = merge(1, 0, m%fbi(f) > 0); sj = merge(2, 0, m%fbj(f) > 0)
+      do j = 1, NLOC
+        c = m%floc(j, f)
+        if (c == 0) cycle
+        e = zero; e(j) = one
+        call force_eval_d(m%fkind(f), m%fp(m%fpo(f):m%fpo(f) + m%fpn(f) - 1), &
+                          tpz(m%fpo(f):m%fpo(f) + m%fpn(f) - 1), si, sj, ql, qdl, e, z, t, fl)
+        do i = 1, NLOC
+          if (m%floc(i, f) > 0) kq(m%floc(i, f), c) = kq(m%floc(i, f), c) + fl(i)
+        end do
+        if (present(kv)) then
+          call force_eval_d(m%fkind(f), m%fp(m%fpo(f):m%fpo(f) + m%fpn(f) - 1), &
+                            tpz(m%fpo(f):m%fpo(f) + m%fpn(f) - 1), si, sj, ql, qdl, z, e, t, fl)
+          do i = 1, NLOC
+            if (m%floc(i, f) > 0) kv(m%floc(i, f), c) = kv(m%floc(i, f), c) + fl(i)
+          end do
+        end if
+      end do
+    end do
+  end subroutine sens_force_jac
+
+end module mbd_sensitivity

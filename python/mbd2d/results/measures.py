@@ -1,0 +1,245 @@
+"""Quantities a linkage is judged by, over a run: transmission angle, velocity ratio and
+mechanical advantage, and the distance to a dead centre.
+
+* Transmission angle (Norton, *Design of Machinery*, ch. 4): at the joint B where a two-force
+  coupler (its other joint A) drives the output link, mu is the angle between the coupler
+  B->A and the output link B->P (P its other pivot): in [0, pi], best at pi/2, and for a
+  four-bar cos mu = (b^2 + c^2 - a^2 - d^2 + 2 a d cos theta2) / (2 b c). When the output
+  slides (a translational joint), the ideal direction of the force is along the slide:
+  mu = pi/2 - delta, delta the acute angle between the coupler and the slide axis (in
+  [0, pi/2]; pi/2 when the coupler pushes along the slide).
+* Velocity ratio and mechanical advantage (virtual work): each quantity X (a coordinate, or
+  the quantity a driver prescribes) moves by dX/ds per unit of the quantity s a driver D
+  moves, the other drivers held: the kinematic influence coefficients, computed by the core
+  (J u = e_D). The velocity ratio is dY/dX = (dY/ds)/(dX/ds); the mechanical advantage, the
+  load at Y that an effort at X balances, is its inverse dX/dY (power in = power out).
+* Distance to a dead centre: sigma_min / sigma_max of the column-scaled J in the core's
+  units, computed by the core; 0 at a singular configuration.
+"""
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ..binding import core
+from ..binding.pack import pack
+from ..binding.status import OK, error_for
+from ..binding.tables import Packed
+from ..description.joints import PointOnLine, Revolute, Translational
+from ..errors import ModelError
+from ..validate import GROUND
+
+
+def packed_of(res: Any) -> Packed:
+    """The flat tables of the result's model (packed once per result)."""
+    p = getattr(res, "packed", None)
+    if p is None:
+        model = getattr(res, "model", None)
+        if model is None:
+            raise ModelError("the result carries no model (result.model is None)", "result")
+        p = pack(model)
+        try:
+            res.packed = p
+        except AttributeError:  # pragma: no cover - frozen results
+            pass
+    return p
+
+
+def _states(res: Any) -> tuple[np.ndarray, np.ndarray]:
+    if len(res.t) == 0:
+        raise ModelError("the result has no rows", "result")
+    return np.asfortranarray(res.q.T, dtype=np.float64), np.ascontiguousarray(res.t,
+                                                                              dtype=np.float64)
+
+
+# ----------------------------------------------------------------------------- dead centres
+def dead_centre_distance(res: Any) -> np.ndarray:
+    """sigma_min / sigma_max of the column-scaled J at every output (the core)."""
+    p = packed_of(res)
+    q, t = _states(res)
+    out = core.conditioning(p, q, t)
+    if out.status != OK:
+        raise error_for("measures", out.status, out.msg, entry="dead_centre_distance")
+    return np.asarray(out.cond, dtype=float).copy()
+
+
+# ----------------------------------------------------------------------------- ratios
+def _driver(res: Any, name: str) -> tuple[int, Any] | None:
+    """(first row, driver) of the driver called name; None if name is no driver."""
+    p = packed_of(res)
+    names = p.constraint_names
+    if name in names and p.driver_flags[names.index(name)]:
+        k = names.index(name)
+        return p.row_owner.index(k), res.model.constraints[k]
+    return None
+
+
+def _quantity(res: Any, name: Any, what: str) -> tuple[str, int]:
+    """('driver', row) or ('coordinate', column) of a quantity's name."""
+    if not isinstance(name, str):
+        raise ModelError(f"{what} must be a driver name or a coordinate name, got {name!r}",
+                         what)
+    d = _driver(res, name)
+    if d is not None:
+        return "driver", d[0]
+    if name in res.coordinate_names:
+        return "coordinate", res.coordinate_names.index(name)
+    drivers = [c.name for c in res.model.constraints if c.is_driver]
+    raise ModelError(f"no driver or coordinate {name!r}; drivers: {', '.join(drivers)}; "
+                     f"coordinates: {', '.join(res.coordinate_names)}", what)
+
+
+def _reference(res: Any, x: tuple[str, int], y: tuple[str, int], via: Any) -> int:
+    """Row of the driver whose motion relates X and Y."""
+    if via is not None:
+        kind, row = _quantity(res, via, "via")
+        if kind != "driver":
+            raise ModelError(f"via must name a driver, got the coordinate {via!r}", "via")
+        return row
+    for kind, row in (x, y):
+        if kind == "driver":
+            return row
+    drivers = [c.name for c in res.model.constraints if c.is_driver]
+    if len(drivers) != 1:
+        raise ModelError("neither quantity is a driver and the model has "
+                         f"{len(drivers)} drivers ({', '.join(drivers)}): name the one that "
+                         "moves them with via=", "via")
+    row = _driver(res, drivers[0])
+    assert row is not None
+    return row[0]
+
+
+def influence(res: Any, row: int) -> tuple[np.ndarray, np.ndarray]:
+    """(n, nq) dq/ds of the quantity driven by Phi's row ``row`` (0-based), and (n,) flags:
+    False where J is singular there."""
+    p = packed_of(res)
+    q, t = _states(res)
+    out = core.influence(p, q, t, row + 1)
+    if out.status != OK:
+        raise error_for("measures", out.status, out.msg, entry="velocity_ratio")
+    return np.asarray(out.u).T.copy(), np.asarray(out.ok) == 1
+
+
+def _rate(u: np.ndarray, q: tuple[str, int], ref: int) -> np.ndarray:
+    kind, i = q
+    if kind == "coordinate":
+        return u[:, i]
+    return np.full(len(u), 1.0 if i == ref else 0.0)
+
+
+def rates(res: Any, x: Any, y: Any, via: Any = None) -> tuple[np.ndarray, np.ndarray,
+                                                              np.ndarray]:
+    """dX/ds, dY/ds and the regular-row flags for the reference driver s.
+
+    Raises
+    ------
+    ModelError
+        If a name is neither a driver nor a coordinate, no driver relates them, or a
+        quantity does not move with the driver at all.
+    """
+    qx, qy = _quantity(res, x, "input"), _quantity(res, y, "output")
+    ref = _reference(res, qx, qy, via)
+    u, ok = influence(res, ref)
+    dx, dy = _rate(u, qx, ref), _rate(u, qy, ref)
+    scale = float(np.abs(u).max()) if u.size else 0.0
+    for name, q, d in ((x, qx, dx), (y, qy, dy)):
+        # a driver other than the reference is held: 0 by definition (independent drivers)
+        if q[0] == "coordinate" and not float(np.abs(d).max()) > 1e-12 * scale:
+            raise ModelError(f"{name!r} does not move with the driver "
+                             f"'{res.model.constraints[packed_of(res).row_owner[ref]].name}' "
+                             "(its influence coefficient is zero throughout): no ratio to it",
+                             "velocity_ratio")
+    return dx, dy, ok
+
+
+def ratio(num: np.ndarray, den: np.ndarray, ok: np.ndarray, singular: float) -> np.ndarray:
+    """num / den, +-inf where only den vanishes; ``singular`` where J was singular."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        r = num / den
+    r = np.where(den == 0.0, np.copysign(np.inf, num), r)
+    r = np.where((den == 0.0) & (num == 0.0), singular, r)
+    return np.where(ok, r, singular)
+
+
+# ----------------------------------------------------------------------------- transmission
+def _joint(res: Any, name: Any) -> Any:
+    for c in res.model.joints:
+        if c.name == name:
+            return c
+    names = [c.name for c in res.model.joints]
+    raise ModelError(f"no joint {name!r}; joints: {', '.join(names)}", "transmission_angle")
+
+
+def _other_revolute(res: Any, body: str, joint: Any) -> Any:
+    for c in res.model.joints:
+        if c is not joint and isinstance(c, Revolute) and body in c.bodies:
+            return c
+    return None
+
+
+def _global(res: Any, body: str, s: Any) -> np.ndarray:
+    if body == GROUND:
+        return np.broadcast_to(np.asarray(s, dtype=float), (len(res.t), 2))
+    return res.point(body, s).r
+
+
+def _direction(res: Any, body: str, v: Any) -> np.ndarray:
+    if body == GROUND:
+        d = np.broadcast_to(np.asarray(v, dtype=float), (len(res.t), 2))
+    else:
+        th = res.body(body).theta
+        c, sn = np.cos(th), np.sin(th)
+        d = np.column_stack([c * v[0] - sn * v[1], sn * v[0] + c * v[1]])
+    return d / np.hypot(d[:, 0], d[:, 1])[:, None]
+
+
+def transmission_angle(res: Any, joint: Any, output: Any = None) -> np.ndarray:
+    """The transmission angle at a revolute joint between a coupler and an output link
+    (radians, one value per output row); see the module banner.
+
+    Raises
+    ------
+    ModelError
+        If the joint is not a revolute joint between two moving bodies, ``output`` is not
+        one of its bodies, the coupler has no second revolute joint, or the output link
+        neither turns about a second revolute joint nor slides in a translational joint.
+    """
+    j = _joint(res, joint)
+    entry = "transmission_angle"
+    if not isinstance(j, Revolute):
+        raise ModelError(f"joint {joint!r} is a {j.type} joint; the transmission angle is "
+                         "taken at the revolute joint between the coupler and the output link",
+                         entry)
+    out = j.bodies[1] if output is None else output
+    if out not in j.bodies or out == GROUND:
+        raise ModelError(f"output must be one of the moving bodies of joint {joint!r} "
+                         f"({', '.join(b for b in j.bodies if b != GROUND)}), got {out!r}",
+                         entry)
+    cpl = j.bodies[1 - j.bodies.index(out)]
+    if cpl == GROUND:
+        raise ModelError(f"joint {joint!r} joins {out!r} to ground: there is no coupler",
+                         entry)
+    b = _global(res, out, j.points[j.bodies.index(out)])
+    ja = _other_revolute(res, cpl, j)
+    if ja is None:
+        raise ModelError(f"the coupler {cpl!r} has no second revolute joint: its force line "
+                         "runs between its two joints", entry)
+    a = _global(res, cpl, ja.points[ja.bodies.index(cpl)])
+    e = a - b
+    e = e / np.hypot(e[:, 0], e[:, 1])[:, None]
+    jp = _other_revolute(res, out, j)
+    if jp is not None:
+        pb = jp.bodies.index(out)
+        pv = _global(res, jp.bodies[1 - pb], jp.points[1 - pb]) - b
+        pv = pv / np.hypot(pv[:, 0], pv[:, 1])[:, None]
+        return np.arccos(np.clip(np.einsum("ij,ij->i", e, pv), -1.0, 1.0))
+    for c in res.model.joints:
+        if isinstance(c, (Translational, PointOnLine)) and out in c.bodies:
+            k = 0 if isinstance(c, PointOnLine) else c.bodies.index(out)
+            axis = c.axis if isinstance(c, PointOnLine) else c.axes[k]
+            owner = c.bodies[0] if isinstance(c, PointOnLine) else c.bodies[k]
+            u = _direction(res, owner, axis)
+            return np.arcsin(np.clip(np.abs(np.einsum("ij,ij->i", e, u)), 0.0, 1.0))
+    raise ModelError(f"the output link {out!r} neither turns about a second revolute joint "
+                     "nor slides in a translational joint", entry)

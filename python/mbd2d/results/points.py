@@ -1,0 +1,105 @@
+"""A point fixed in a body: its global position, velocity and acceleration over a run.
+
+For a point with local coordinates s' in body i (r_i, theta_i), A(theta) the rotation matrix
+and B = dA/dtheta (Haug, ch. 2; Nikravesh, ch. 2)::
+
+    r_P     = r_i + A s'
+    r_P_dot = r_i_dot + theta_dot B s'                       (B s' = A s' turned by +90 deg)
+    r_P_ddot = r_i_ddot + theta_ddot B s' - theta_dot**2 A s'
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+
+@dataclass
+class PointResult:
+    """Position, velocity and acceleration of a body point at the output times.
+
+    Attributes
+    ----------
+    body : str
+        The body the point is fixed in.
+    s : tuple of float
+        The point in the body's frame.
+    r, v, a : numpy.ndarray
+        Global position, velocity and acceleration, each (n, 2): columns x and y.
+
+    Indexing the result indexes the positions, so ``res.point("rod", s)[:, 0]`` is the
+    x path, as before the velocities were added.
+    """
+
+    body: str
+    s: tuple[float, float]
+    r: np.ndarray
+    v: np.ndarray
+    a: np.ndarray
+
+    @classmethod
+    def of(cls, body: str, s: tuple[float, float], q: np.ndarray, qd: np.ndarray,
+           qdd: np.ndarray) -> "PointResult":
+        """The point s of a body from its (n, 3) coordinates, velocities, accelerations."""
+        th, w, al = q[:, 2], qd[:, 2], qdd[:, 2]
+        c, sn = np.cos(th), np.sin(th)
+        as_ = np.column_stack([c * s[0] - sn * s[1], sn * s[0] + c * s[1]])   # A s'
+        bs = np.column_stack([-as_[:, 1], as_[:, 0]])                       # B s'
+        r = q[:, :2] + as_
+        v = qd[:, :2] + w[:, None] * bs
+        a = qdd[:, :2] + al[:, None] * bs - (w**2)[:, None] * as_
+        return cls(body, s, r, v, a)
+
+    @property
+    def x(self) -> np.ndarray:
+        """Global x of the point."""
+        return self.r[:, 0]
+
+    @property
+    def y(self) -> np.ndarray:
+        """Global y of the point."""
+        return self.r[:, 1]
+
+    @property
+    def x_dot(self) -> np.ndarray:
+        """Velocity, x component."""
+        return self.v[:, 0]
+
+    @property
+    def y_dot(self) -> np.ndarray:
+        """Velocity, y component."""
+        return self.v[:, 1]
+
+    @property
+    def x_ddot(self) -> np.ndarray:
+        """Acceleration, x component."""
+        return self.a[:, 0]
+
+    @property
+    def y_ddot(self) -> np.ndarray:
+        """Acceleration, y component."""
+        return self.a[:, 1]
+
+    @property
+    def speed(self) -> np.ndarray:
+        """|v|."""
+        return np.hypot(self.v[:, 0], self.v[:, 1])
+
+    # the positions as an (n, 2) array
+    @property
+    def shape(self) -> tuple[int, ...]:
+        return self.r.shape
+
+    def __len__(self) -> int:
+        return len(self.r)
+
+    def __getitem__(self, key: Any) -> Any:
+        return self.r[key]
+
+    def __array__(self, dtype: Any = None, copy: Any = None) -> np.ndarray:
+        return self.r if dtype is None else self.r.astype(dtype)
+
+    def __repr__(self) -> str:
+        return (f"PointResult({self.body!r}, s=({self.s[0]:g}, {self.s[1]:g}), "
+                f"{len(self.r)} rows: r, v, a)")

@@ -1,0 +1,176 @@
+"""A sweep's outputs as an ``xarray.Dataset``: per case its status and message (the text the
+analysis would raise for that variant alone), its rows up to a failure, NaN after them."""
+from __future__ import annotations
+
+from types import SimpleNamespace
+from typing import Any, Sequence
+
+import numpy as np
+
+from ..analysis.dynamics import dynamics_error
+from ..analysis.inverse import inverse_error
+from ..analysis.kinematics import kinematics_error
+from ..analysis.outputs import dynamics_result, finite_part
+from ..analysis.statics import STABILITY, statics_error
+from ..binding.pack import pack
+from ..binding.status import INCONSISTENT, OK
+from ..description.builder import ModelDescription
+from ..errors import MbdError
+from ..results.kinematics import KinematicsResult
+from .plan import Plan
+from .runner import Outputs
+
+#: the extra that holds xarray, for messages
+EXTRA = "pip install 'mbd2d[sweep]' (xarray, dask[distributed], h5netcdf, pandas, tqdm)"
+
+
+def xarray() -> Any:
+    """The xarray module.
+
+    Raises
+    ------
+    ImportError
+        Naming the extra to install when it is missing.
+    """
+    try:
+        import xarray as xr
+    except ImportError:
+        raise ImportError(f"sweeps and tolerance analyses return an xarray.Dataset: {EXTRA}") \
+            from None
+    return xr
+
+
+def _case(out: Outputs, j: int) -> SimpleNamespace:
+    """Case j of the batch outputs, shaped as the front doors' core outputs."""
+    a = out.arrays
+    return SimpleNamespace(status=int(out.status[j]), msg=out.msg[j],
+                           **{k: a[k][..., j] for k in a},
+                           resid=float(a["rinfo"][0, j]))
+
+
+def _finite_rows(pl: Plan, out: Outputs) -> np.ndarray:
+    """(nrow, ncase): every output of the row is finite."""
+    a = out.arrays
+    fin = np.ones(a["q"].shape[1:], dtype=bool)
+    for k in ("q", "qd", "qdd", "lam", "e"):
+        if a[k].shape[0]:
+            fin &= np.isfinite(a[k]).all(axis=0)
+    return fin
+
+
+def outcomes(pl: Plan, model: ModelDescription, out: Outputs, names: Sequence[str],
+             values: np.ndarray) -> tuple[np.ndarray, np.ndarray, list[str]]:
+    """Rows kept, status and message of every case.
+
+    A case that completed has status 0 and an empty message. Any other case has the status
+    of the exception its analysis raises for that variant alone (``err.status``; the core's
+    status for bad input) and that exception's text, and keeps the rows that exception
+    carries.
+    """
+    ncase = len(out.status)
+    a = out.arrays
+    if pl.analysis == "statics":
+        n = np.where(out.status == OK, 1, 0)
+    else:
+        n = a["iinfo"][0].astype(np.int64).clip(0, pl.tables.nrow)
+    fin = _finite_rows(pl, out)
+    inside = np.arange(fin.shape[0])[:, None] < n[None, :]
+    clean = (out.status == OK) & ~((~fin) & inside).any(axis=0)
+    if pl.analysis == "statics":
+        clean &= np.isfinite(a["rinfo"][0])
+    rows = np.where(clean, n, 0)
+    status = np.zeros(ncase, dtype=np.int32)
+    messages = [""] * ncase
+    for j in np.flatnonzero(~clean):
+        exc = _failure(pl, model, _case(out, int(j)), int(n[j]), names, values[:, j])
+        if exc is None:          # pragma: no cover - the same test as the front door's
+            rows[j] = n[j]
+            continue
+        kept = getattr(exc, "results", None)
+        rows[j] = len(kept.t) if kept is not None and hasattr(kept, "t") else 0
+        status[j] = int(getattr(exc, "status", 0) or out.status[j])
+        messages[j] = str(exc)
+    return rows, status, messages
+
+
+def _failure(pl: Plan, model: ModelDescription, c: SimpleNamespace, n: int,
+             names: Sequence[str], values: np.ndarray) -> MbdError | None:
+    """The exception the analysis raises for case c alone."""
+    p, t = pl.packed, pl.times
+
+    def own() -> Any:             # the case's own tables (a rank analysis runs on them)
+        return pack(model.with_params(dict(zip(names, values.tolist()))))
+
+    try:
+        if pl.analysis == "statics":
+            return statics_error(model, own() if c.status == INCONSISTENT else p, c, pl.t0)
+        if pl.analysis == "kinematics":
+            res: Any = KinematicsResult(t=t[:n], q=c.q.T[:n].copy(), qd=c.qd.T[:n].copy(),
+                                        qdd=c.qdd.T[:n].copy(), body_names=p.body_names,
+                                        coordinate_names=p.coordinate_names, complete=False,
+                                        model=model)
+            res, bad = finite_part(res)
+            return kinematics_error(model, p, c, res, t, bad)
+        res = dynamics_result(model, p, t, n, c, {}, False)
+        res, bad = finite_part(res)
+        if pl.analysis == "inverse":
+            return inverse_error(model, p, c, res, t, bad)
+        if c.status == INCONSISTENT and not len(res.t):
+            p = own()
+        return dynamics_error(model, p, c, res, t, bad, pl.method, pl.t0)
+    except MbdError as exc:       # the variant's own tables are bad
+        return exc
+
+
+def to_dataset(pl: Plan, analysis: str, model: ModelDescription, out: Outputs,
+               names: Sequence[str], values: np.ndarray) -> Any:
+    """The Dataset of a sweep (see :func:`mbd2d.sweep`)."""
+    xr = xarray()
+    rows, status, messages = outcomes(pl, model, out, names, values)
+    p, b = pl.packed, pl.tables
+    keep = np.arange(b.nrow)[None, :] < rows[:, None]          # (ncase, nrow)
+
+    def per_case(x: np.ndarray) -> np.ndarray:
+        v = np.ascontiguousarray(np.transpose(x, (2, 1, 0)))   # (ncase, nrow, k)
+        v[~keep] = np.nan
+        return v
+
+    a = out.arrays
+    cube = ("case", "time", "coordinate")
+    data: dict[str, Any] = {"q": (cube, per_case(a["q"])), "qd": (cube, per_case(a["qd"])),
+                            "qdd": (cube, per_case(a["qdd"]))}
+    coords: dict[str, Any] = {"case": np.arange(len(status)), "time": pl.times,
+                              "coordinate": list(p.coordinate_names)}
+    if b.nlam:
+        lam = per_case(a["lam"])
+        data["lam"] = (("case", "time", "equation"), lam)
+        coords["equation"] = list(p.row_labels)
+        drivers = [k for k, f in enumerate(p.driver_flags) if f]
+        if drivers:
+            data["effort"] = (("case", "time", "driver"),
+                              -lam[:, :, [p.row_owner.index(k) for k in drivers]])
+            coords["driver"] = [p.constraint_names[k] for k in drivers]
+        e = per_case(a["e"])
+        if pl.analysis != "statics":
+            data["kinetic"] = (("case", "time"), e[:, :, 0])
+            data["potential"] = (("case", "time"), e[:, :, 1])
+    if pl.analysis == "statics":
+        ok = rows > 0
+        data["stability"] = ("case", np.array(
+            [STABILITY.get(int(s), "unknown") if k else "" for s, k in zip(a["rinfo"][1], ok)],
+            dtype=object))
+        data["residual"] = ("case", np.where(ok, a["rinfo"][0], np.nan))
+    data["status"] = ("case", status)
+    data["message"] = ("case", np.array(messages, dtype=object))
+    for k, name in enumerate(names):
+        coords[name] = ("case", values[k].copy())
+    attrs = {"analysis": analysis, "run": pl.analysis, "model": model.name,
+             "parameters": ", ".join(names),
+             "settings": ", ".join(f"{k}={v!r}" for k, v in pl.settings.items()),
+             "failed": int((status != 0).sum())}
+    if pl.method:
+        attrs["method"] = pl.method
+    return xr.Dataset(data, coords=coords, attrs=attrs)
+
+
+__all__ = ["to_dataset", "outcomes", "xarray", "EXTRA"]

@@ -1,0 +1,205 @@
+"""Tolerance analysis (mbd2d.tolerance): the first-order standard deviations against a
+closed-form propagation computed here without mbd2d (the crank-rocker's loop solved by
+circle intersection and differentiated by Richardson-extrapolated central differences), and
+the Monte Carlo estimate against the first-order one within the Monte Carlo error for small
+sigma (the sample standard deviation of N normal draws has a relative standard error of
+1/sqrt(2 (N - 1))).
+"""
+from __future__ import annotations
+
+import math
+from typing import Any, Callable
+
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose
+
+import mbd2d
+
+from conftest import load_example
+
+pytest.importorskip("xarray")
+
+#: the crank-rocker (examples/fourbar_grashof.toml): crank a, coupler b, rocker c, ground d
+#: as the parameters that set them (each length grows one for one with its parameter)
+LINKS = {"joint.A.points.0.0": "a", "joint.B.points.0.0": "b", "joint.O4.points.0.0": "c",
+         "joint.O4.points.1.0": "d"}
+NOMINAL = {"a": 1.0, "b": 3.5, "c": 2.5, "d": 3.0}
+SIGMA = {"joint.A.points.0.0": 2e-3, "joint.B.points.0.0": 1e-3, "joint.O4.points.0.0": 3e-3,
+         "joint.O4.points.1.0": 1.5e-3}
+T_END, STEPS = 1.0, 20
+COUPLER_POINT = (0.5, 0.8)       # in the coupler's frame (A at (-1.75, 0), B at (1.75, 0))
+
+
+def loop(t: np.ndarray, a: float, b: float, c: float, d: float) -> dict[str, np.ndarray]:
+    """Closed-form crank-rocker: crank angle 2 pi t about O2 = 0, O4 = (d, 0); B on the
+    circles |B - A| = b, |B - O4| = c, on the upper branch (as assembled). Returns the rocker
+    angle (its frame's x axis from B to O4) and the coupler point."""
+    th = 2 * np.pi * t
+    ax, ay = a * np.cos(th), a * np.sin(th)
+    ex, ey = d - ax, -ay                            # A -> O4
+    e = np.hypot(ex, ey)
+    u = (b**2 - c**2 + e**2) / (2 * e)              # along A -> O4 to the chord
+    h = np.sqrt(b**2 - u**2)
+    bx = ax + (u * ex - h * ey) / e                 # the branch with B above the line
+    by = ay + (u * ey + h * ex) / e
+    rocker = np.arctan2(-by, d - bx)
+    th3 = np.arctan2(by - ay, bx - ax)
+    sx, sy = COUPLER_POINT[0] + 1.75, COUPLER_POINT[1]     # from A, in the coupler frame
+    px = ax + np.cos(th3) * sx - np.sin(th3) * sy
+    py = ay + np.sin(th3) * sx + np.cos(th3) * sy
+    return {"rocker": rocker, "px": px, "py": py}
+
+
+def derivative(f: Callable[[float], np.ndarray], x: float, h: float = 1e-3) -> np.ndarray:
+    """df/dx by central differences at h and h/2, Richardson-extrapolated (error h**4)."""
+    d1 = (f(x + h) - f(x - h)) / (2 * h)
+    d2 = (f(x + h / 2) - f(x - h / 2)) / h
+    return (4 * d2 - d1) / 3
+
+
+def closed_form_std(key: str, t: np.ndarray) -> np.ndarray:
+    """First-order standard deviation of a closed-form output under SIGMA."""
+    var = np.zeros_like(t)
+    for name, link in LINKS.items():
+        def f(x: float, link: str = link) -> np.ndarray:
+            return loop(t, **{**NOMINAL, link: x})[key]
+        var += (derivative(f, NOMINAL[link]) * SIGMA[name]) ** 2
+    return np.sqrt(var)
+
+
+@pytest.fixture(scope="module")
+def tol() -> Any:
+    m = load_example("fourbar_grashof.toml")
+    return mbd2d.tolerance(m, SIGMA, samples=2000, workers=1, t_end=T_END, steps=STEPS)
+
+
+def test_the_closed_form_is_the_model() -> None:
+    """The test's loop solution reproduces the nominal run (so it is the right oracle)."""
+    res = load_example("fourbar_grashof.toml").kinematics(T_END, STEPS)
+    cf = loop(res.t, **NOMINAL)
+    assert_allclose(res.body("rocker").theta, cf["rocker"], atol=1e-11)
+    assert_allclose(res.point("coupler", COUPLER_POINT), np.column_stack([cf["px"], cf["py"]]),
+                    atol=1e-11)
+
+
+def test_linear_estimate_is_the_closed_form_propagation(tol: Any) -> None:
+    t = tol.dataset.time.values
+    lin = tol.dataset.q_std_linear.sel(coordinate="rocker.theta").values
+    assert_allclose(lin, closed_form_std("rocker", t), rtol=1e-8)
+    pt = tol.point("coupler", COUPLER_POINT)
+    assert_allclose(pt.x_std_linear.values, closed_form_std("px", t), rtol=1e-8)
+    assert_allclose(pt.y_std_linear.values, closed_form_std("py", t), rtol=1e-8)
+    assert_allclose(pt.x.values, loop(t, **NOMINAL)["px"], atol=1e-11)
+
+
+def test_monte_carlo_agrees_within_its_error(tol: Any) -> None:
+    ds = tol.dataset
+    n = ds.attrs["samples"] - ds.attrs["failed"]
+    assert ds.attrs["failed"] == 0 and n == 2000
+    se = 1.0 / math.sqrt(2 * (n - 1))          # relative standard error of a sample std
+    for out in ("q", "qd", "qdd"):
+        lin, mc = ds[f"{out}_std_linear"].values, ds[f"{out}_std_mc"].values
+        moving = lin > 1e-9 * np.abs(ds[out].values).max()
+        assert moving.sum() > 20
+        assert np.abs(mc[moving] / lin[moving] - 1).max() < 5 * se, out
+        # the crank does not depend on these parameters: no scatter at all
+        assert_allclose(mc[~moving], 0.0, atol=1e-12)
+        # the mean is the nominal value within its own error (the bias is second order)
+        err = np.abs(ds[f"{out}_mean_mc"].values - ds[out].values)[moving]
+        assert (err < 5 * lin[moving] / math.sqrt(n)).all(), out
+    pt = tol.point("coupler", COUPLER_POINT)
+    for c in ("x", "y"):
+        r = pt[f"{c}_std_mc"].values / pt[f"{c}_std_linear"].values
+        assert np.abs(r - 1).max() < 5 * se
+
+
+def test_large_scatter_shows_the_nonlinearity() -> None:
+    """With sigma a tenth of the coupler length the first-order estimate no longer holds
+    everywhere (where the first-order scatter passes through zero, the second-order one does
+    not): the two differ by far more than the Monte Carlo error."""
+    m = load_example("fourbar_grashof.toml")
+    tol = mbd2d.tolerance(m, {"joint.B.points.0.0": 0.25}, samples=1000, workers=1,
+                          t_end=T_END, steps=STEPS)
+    ds = tol.dataset
+    n = ds.attrs["samples"] - ds.attrs["failed"]
+    lin, mc = ds.q_std_linear.values, ds.q_std_mc.values
+    moving = lin > 1e-9
+    assert np.abs(mc[moving] / lin[moving] - 1).max() > 20 / math.sqrt(2 * (n - 1))
+
+
+def slider_crank_with_masses() -> mbd2d.Model:
+    m = load_example("slider_crank.toml")
+    for b, (ms, j) in zip(m.bodies, [(2.0, 0.3), (1.5, 1.1), (0.8, 0.05)]):
+        b.mass, b.inertia = ms, j
+    return m
+
+
+def test_inverse_dynamics_effort_linear_in_masses() -> None:
+    """The motor torque is linear in the masses and inertias: the first-order standard
+    deviation is exact, and Monte Carlo agrees within its error at any sigma."""
+    m = slider_crank_with_masses()
+    sig = {"body.rod.mass": 0.3, "body.slider.mass": 0.2, "body.rod.inertia": 0.1}
+    tol = mbd2d.tolerance(m, sig, "inverse_dynamics", samples=1500, workers=1, t_end=1.0,
+                          steps=12)
+    ds = tol.dataset
+    lin, mc = ds.effort_std_linear.values[:, 0], ds.effort_std_mc.values[:, 0]
+    assert np.abs(mc / lin - 1).max() < 5 / math.sqrt(2 * (1500 - 1))
+    # the linear estimate by hand: effort = e0 + sum_k (d effort / d m_k) m_k exactly
+    base = m.inverse_dynamics(1.0, 12).effort("motor")
+    var = np.zeros_like(base)
+    for name, s in sig.items():
+        value = m.parameters()[name]
+        step = m.with_params({name: value + 1.0}).inverse_dynamics(1.0, 12).effort("motor")
+        var += ((step - base) * s) ** 2
+    assert_allclose(lin, np.sqrt(var), rtol=1e-9, atol=1e-12)
+    assert "effort_std_linear" in ds and ds.effort.dims == ("time", "driver")
+
+
+def test_statics_tolerance() -> None:
+    """Spring pendulum equilibrium k theta + m g a cos(theta) = 0 (a = 0.5): d theta / dk
+    by implicit differentiation, -theta / (k - m g a sin theta)."""
+    m = load_example("pendulum_spring.toml")
+    tol = mbd2d.tolerance(m, {"force.torsion.stiffness": 0.05}, "statics", samples=1000,
+                          workers=1)
+    eq = m.statics()
+    th = eq.body("bar")[2]
+    k, g, a = 10.0, 9.81, 0.5
+    assert abs(k * th + g * a * math.cos(th)) < 1e-12
+    dth = -th / (k - g * a * math.sin(th))
+    lin = float(tol.dataset.q_std_linear.sel(coordinate="bar.theta").values[0])
+    assert_allclose(lin, abs(dth) * 0.05, rtol=1e-9)
+    mc = float(tol.dataset.q_std_mc.sel(coordinate="bar.theta").values[0])
+    assert abs(mc / lin - 1) < 5 / math.sqrt(2 * 999)
+
+
+def test_no_monte_carlo_and_bad_inputs() -> None:
+    m = load_example("fourbar_grashof.toml")
+    tol = mbd2d.tolerance(m, {"joint.B.points.0.0": 1e-3}, samples=0, t_end=1.0, steps=4)
+    assert tol.samples is None and "q_std_mc" not in tol.dataset
+    assert np.isnan(tol.point("coupler", (0, 0)).x_std_mc.values).all()
+    assert "1 parameters, 0 samples" in repr(tol)
+    for sig, kw, match in (({"joint.B.points.0.0": -1.0}, {}, ">= 0"),
+                           ({"joint.B.points.0.9": 1.0}, {}, "did you mean"),
+                           ({"joint.B.points.0.0": float("nan")}, {}, "finite"),
+                           ({}, {}, "dict"),
+                           ({"joint.B.points.0.0": 1e-3}, {"samples": 1}, "at least 2"),
+                           ({"joint.B.points.0.0": 1e-3}, {"samples": -3}, "samples"),
+                           ({"joint.B.points.0.0": 1e-3}, {"rtol": 1.0}, "the settings are")):
+        with pytest.raises(mbd2d.ModelError, match=match):
+            mbd2d.tolerance(m, sig, t_end=1.0, steps=4, **kw)
+    with pytest.raises(mbd2d.ModelError, match="unknown analysis"):
+        mbd2d.tolerance(m, {"joint.B.points.0.0": 1e-3}, "kin", t_end=1.0, steps=4)
+    with pytest.raises(KeyError, match="no body"):
+        tol.point("crank2", (0, 0))
+    with pytest.raises(mbd2d.ModelError, match="dopri5"):
+        mbd2d.tolerance(load_example("pendulum_spring.toml"), {"body.bar.mass": 0.1},
+                        "dynamics", method="generalized-alpha", h=1e-3, t_end=1.0, steps=4)
+
+
+def test_nominal_failure_is_raised() -> None:
+    """A nominal design that hits a dead centre has no sensitivities over the cycle: the
+    analysis's own exception."""
+    m = load_example("fourbar_grashof.toml").with_params({"joint.B.points.0.0": -0.6})
+    with pytest.raises(mbd2d.SingularConfigurationError):
+        mbd2d.tolerance(m, {"joint.B.points.0.0": 1e-3}, samples=4, t_end=1.0, steps=10)
