@@ -22,8 +22,7 @@ module mbd_api
   use mbd_model, only: model_t, model_build, model_add_dynamics, model_force_size
   use mbd_dynamics, only: dyn_work_t, dyn_init, dyn_memory_check, dyn_velocity, &
                           dyn_multipliers, dyn_reactions, dyn_assemble, dyn_choose, dyn_jv, &
-                          gen_forces, kinetic_energy, dyn_element_outputs, SOLVER_DENSE, &
-                          SOLVER_AUTO
+                          gen_forces, kinetic_energy, dyn_element_outputs, SOLVER_DENSE
   use mbd_events, only: ev_log_t, ev_log_init, events_switch, events_active
   use mbd_forces, only: force_is_contact, FRC_FRICTION
   use mbd_contact, only: NEO
