@@ -1147,8 +1147,7 @@ contains
     character(len=MSG_LEN) :: lmsg
     integer :: kk
     if (w%na == 0) then                       ! free bodies: every coordinate independent
-      c%iu = [integer ::]; c%iv = [(kk, kk=1, m%nq)]; c%ni = m%nq
-      c%st%partitions = c%st%partitions + 1
+      jp = [(kk, kk=1, m%nq)]
       stf = MBD_OK; return
     end if
     call assemble_dense(m, c%qf, w%qz, t, w%phi, w%nu, w%gam, w%asm, w%jac)
