@@ -185,7 +185,27 @@ def runtime_target(results: dict) -> list[Row]:
 def targets(results: dict) -> list[Row]:
     """Every target with its measured figure and whether it is met (None: not measured)."""
     return (kinematics_targets(results) + peer_targets(results) + scaling_targets(results)
-            + study_targets(results) + runtime_target(results))
+            + dynamics_scaling_targets(results) + study_targets(results)
+            + runtime_target(results))
+
+
+def dynamics_scaling_targets(results: dict) -> list[Row]:
+    """Issue 11: generalized-alpha at N = 1000 <= 5 ms/step, setup < 1 s, slope <= 1.15
+    from N = 100 to 10,000 (each method)."""
+    ds = results.get("dynamics_scaling")
+    if failed(ds):
+        return [_target("dynamics scaling with N", "not measured", None, failed(ds))]
+    at = (ds.get("n1000") or {}).get("generalized-alpha") or {}
+    out = [_target("free N-four-bar, generalized-alpha h = 1 ms, N = 1000: <= 5 ms/step",
+                   f"{fmt(at.get('ms_per_step'), '.2f')} ms/step",
+                   None if at.get("ms_per_step") is None else at["ms_per_step"] <= 5.0),
+           _target("the same: setup at N = 1000 under 1 s",
+                   f"{fmt(at.get('setup_s'), '.3f')} s",
+                   None if at.get("setup_s") is None else at["setup_s"] < 1.0)]
+    for method, sl in (ds.get("slopes") or {}).items():
+        out.append(_target(f"dynamics ({method}): log-log slope <= 1.15, N = 100 to 10,000",
+                           f"slope {fmt(sl, '.2f')}", None if sl is None else sl <= 1.15))
+    return out
 
 
 def met_text(met: bool | None) -> str:
@@ -495,6 +515,27 @@ def sensitivities_section(results: dict) -> str:
                      "integrator steps"), rows))
 
 
+def dynamics_scaling_section(results: dict, charts: dict, out: Path, base: Path) -> str:
+    """Table and chart of the dynamics cost against N (bench/dynamics_scaling.py)."""
+    ds = results.get("dynamics_scaling")
+    if failed(ds):
+        return f"Failed: {failed(ds)}\n"
+    parts = [f"{ds.get('model')}; settings {ds.get('settings')}. CPU time per integrator step "
+             "of a short run and the setup (the first call, one step); the dense path is the "
+             "baseline of the same run.\n",
+             image(charts, "dynamics_scaling", out, base, "dynamics cost against N")]
+    rows = []
+    for key, rs in (ds.get("rows") or {}).items():
+        for r in rs:
+            rows.append((key, r["n"], r["coordinates"], fmt(r["ms_per_step"], ".3f"),
+                         fmt(r["setup_s"], ".3f"), r["steps"]))
+    parts.append(table(("method / path", "N", "coordinates", "ms / step", "setup s", "steps"),
+                       rows))
+    parts.append("Log-log slopes (band path, N = 100 to the largest): " + ", ".join(
+        f"{k} {fmt(v, '.2f')}" for k, v in (ds.get("slopes") or {}).items()) + ".\n")
+    return "\n".join(parts)
+
+
 def contact_section(results: dict, charts: dict, out: Path, base: Path) -> str:
     """Tables of the contact costs (bench/contact.py)."""
     con = results.get("contact")
@@ -576,6 +617,8 @@ def results_markdown(results: dict, charts: dict[str, str], md_path: Path, out: 
              "## Memory of long runs\n", memory_section(results, charts, out, base),
              "## Design sweeps\n", sweep_section(results),
              "## Sensitivity cost\n", sensitivities_section(results),
+             "## Dynamics against model size\n",
+             dynamics_scaling_section(results, charts, out, base),
              "## Contacts\n", contact_section(results, charts, out, base),
              "## Linkage synthesis: literature cases and pylinkage\n",
              synthesis_section(results),

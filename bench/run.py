@@ -18,7 +18,9 @@ Sections (each in its own try/except: a failure is recorded and the rest runs):
 9. contacts (bench/contact.py): the clearance-joint crank-slider against the ideal joint and
    over the restitution, and the cost of far contact pairs;
 10. linkage synthesis: the three standard four-bar path-generation cases of the literature,
-   mbd2d against the published errors and pylinkage (bench/synthesis.py).
+   mbd2d against the published errors and pylinkage (bench/synthesis.py);
+11. dynamics against N: the free N-four-bar with generalized-alpha and dopri5, band and
+   dense paths (bench/dynamics_scaling.py).
 
 Writes bench/results/*.json and *.png, bench/RESULTS.md and bench/README_headline.md
 (bench/report.py). With --only, the other sections come from their results files of an
@@ -46,6 +48,7 @@ if str(BENCH) not in sys.path:
     sys.path.insert(0, str(BENCH))
 
 import contact  # noqa: E402
+import dynamics_scaling  # noqa: E402
 import environment  # noqa: E402
 import callgrind  # noqa: E402
 import kinematics_speed  # noqa: E402
@@ -59,7 +62,7 @@ import synthesis  # noqa: E402
 import work_precision  # noqa: E402
 
 SECTIONS = ("environment", "work_precision", "peers", "kinematics", "scaling", "memory",
-            "sweep", "sensitivities", "contact", "synthesis")
+            "sweep", "sensitivities", "contact", "synthesis", "dynamics_scaling")
 
 
 # ===================================================================== JSON
@@ -172,6 +175,11 @@ def section_contact(quick: bool) -> dict:
     return contact.study(repeats=1 if quick else 3, quick=quick)
 
 
+def section_dynamics_scaling(quick: bool) -> dict:
+    """Dynamics of the free N-four-bar against N (band and dense paths)."""
+    return dynamics_scaling.study(quick=quick)
+
+
 def section_synthesis(quick: bool) -> dict:
     """Four-bar path generation: published errors, mbd2d, pylinkage."""
     return synthesis.study(quick=quick)
@@ -239,6 +247,9 @@ def draw_charts(results: dict, out: Path) -> dict[str, str]:
     if "rows" in results.get("memory", {}):
         charts["memory"] = try_chart(lambda: memory.chart(results["memory"],
                                                           out / "memory.png"))
+    if "rows" in (results.get("dynamics_scaling") or {}):
+        charts["dynamics_scaling"] = try_chart(lambda: dynamics_scaling.chart(
+            results["dynamics_scaling"], out / "dynamics_scaling.png"))
     if "clearance" in results.get("contact", {}):
         charts["contact"] = try_chart(lambda: contact.chart(results["contact"],
                                                             out / "contact.png"))
@@ -282,7 +293,7 @@ def main(argv: Sequence[str] | None = None) -> dict:
         "peers": section_peers, "kinematics": section_kinematics,
         "scaling": section_scaling, "memory": section_memory, "sweep": section_sweep,
         "sensitivities": section_sensitivities, "contact": section_contact,
-        "synthesis": section_synthesis}
+        "synthesis": section_synthesis, "dynamics_scaling": section_dynamics_scaling}
     ran = {name: run_section(name, fns[name], a.quick) for name in SECTIONS if name in wanted}
     earlier = earlier_sections(out, [n for n in SECTIONS if n not in wanted])
     results = {name: ran.get(name, earlier.get(name)) for name in SECTIONS

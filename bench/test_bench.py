@@ -103,6 +103,14 @@ def synthetic_results(stepper: bool = True, exudyn: bool = True) -> dict:
             "sensitivities": {"steps": 100, "repeats": 1, "rows": [
                 {"case": "kinematics four-bar, 4 parameters", "base_us_per_step": 1.0,
                  "sens_us_per_step": 2.5, "ratio": 2.5}]},
+            "dynamics_scaling": {"model": "free N-four-bar", "settings": {}, "rows": {
+                "generalized-alpha/banded": [
+                    {"n": 100, "coordinates": 603, "ms_per_step": 0.3, "setup_s": 0.01,
+                     "steps": 50},
+                    {"n": 1000, "coordinates": 6003, "ms_per_step": 3.0, "setup_s": 0.06,
+                     "steps": 50}]},
+                "slopes": {"generalized-alpha": 1.0},
+                "n1000": {"generalized-alpha": {"ms_per_step": 3.0, "setup_s": 0.06}}},
             "meta": {"total_runtime_s": 300.0, "quick": False, "command": "python bench/run.py"}}
 
 
@@ -119,6 +127,8 @@ def test_targets_on_synthetic_results() -> None:
     assert met["sweep, 10-step kinematics: per-variant cost >= 10x below a with_params "
                "loop"] is True
     assert met["sensitivities of 4 parameters: <= 2x the analysis alone"] is False
+    assert met["free N-four-bar, generalized-alpha h = 1 ms, N = 1000: <= 5 ms/step"] is True
+    assert met["dynamics (generalized-alpha): log-log slope <= 1.15, N = 100 to 10,000"] is True
     assert all(v is not None for v in met.values())
 
 
@@ -133,7 +143,7 @@ def test_missing_sections_are_not_measured(tmp_path: Path) -> None:
     tg = report.targets(res)
     assert [t["met"] for t in tg][:-1] == [None] * (len(tg) - 1)
     md = report.results_markdown(res, {}, tmp_path / "RESULTS.md", tmp_path / "results")
-    assert md.count("Failed: not run") == 7
+    assert md.count("Failed: not run") == 9
 
 
 def test_report_renders_failures_and_missing_stepper(tmp_path: Path) -> None:
