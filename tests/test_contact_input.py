@@ -117,3 +117,20 @@ def test_export_for_mbd2d_solve_refuses_contacts_and_friction(tmp_path):
         with pytest.raises(mbd2d.ModelError, match="no contacts or joint friction"):
             m.export(tmp_path / "c.mbd", analysis=analysis, **kw)
     assert not (tmp_path / "c.mbd").exists()
+
+
+def test_sweeps_carry_contacts():
+    """A dynamics sweep of a model with a contact gives each case exactly as the variant run
+    alone (the batch passes the contact outputs and events through)."""
+    pytest.importorskip("xarray")
+    import numpy as np
+    ex = Path(__file__).resolve().parents[1] / "examples"
+    m = mbd2d.load(ex / "cam_liftoff.toml")
+    k0 = m.parameters()["force.spring.stiffness"]
+    ks = [0.5 * k0, k0]
+    ds = mbd2d.sweep(m, {"force.spring.stiffness": ks}, "dynamics", t_end=0.05, steps=20,
+                     workers=1, progress=False)
+    assert list(ds.status.values) == [0, 0]
+    for i, k in enumerate(ks):
+        alone = m.with_params({"force.spring.stiffness": k}).dynamics(0.05, 20)
+        assert np.array_equal(np.asarray(ds["q"][i]), alone.q)
