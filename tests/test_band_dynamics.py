@@ -199,3 +199,25 @@ def test_band_path_through_the_singular_passages() -> None:
         th = res.q[:, 2::3][:, :n + 1]
         assert np.abs(th - th[:, :1]).max() < 1e-8
         assert np.abs(th[:, 0] - ref).max() < bound
+
+
+@pytest.mark.parametrize("method, kw", [("dopri5", {"rtol": 1e-8, "atol": 1e-10}),
+                                        ("generalized-alpha", {"h": 1e-3})])
+def test_band_path_carries_contacts(method, kw):
+    """A free N-four-bar (75 coordinates: the band path by default) whose coupler hits a floor:
+    the band run gives the dense run's motion, contact events and contact force."""
+    m = build(12, driven=False, omega0=2.0)
+    m.add_contact("circle-line", ["coupler5", "ground"],
+                  circle={"center": [0.0, 0.0], "radius": 0.1},
+                  line={"point": [0.0, 0.3], "normal": [0.0, 1.0]},
+                  law={"model": "hunt-crossley", "stiffness": 1e6, "exponent": 1.5,
+                       "restitution": 0.8}, name="floor")
+    runs = {s: m.dynamics(1.0, 100, method=method, solver=s, **kw)
+            for s in ("dense", "banded", "auto")}
+    assert runs["auto"].stats["solver"] == "banded"
+    d, b = runs["dense"], runs["banded"]
+    assert len(d.contacts) == len(b.contacts) >= 1
+    assert [e.kind for e in d.contacts] == [e.kind for e in b.contacts]
+    np.testing.assert_allclose(b.q, d.q, rtol=0, atol=1e-9)
+    fd, fb = d.contact("floor").normal_force, b.contact("floor").normal_force
+    np.testing.assert_allclose(fb, fd, rtol=0, atol=1e-9 * max(1.0, float(np.abs(fd).max())))
