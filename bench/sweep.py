@@ -50,7 +50,7 @@ def best(fn: Callable[[], Any], repeats: int) -> float:
     return t
 
 
-def per_variant(n: int, repeats: int, steps: int = 10) -> dict[str, Any]:
+def per_variant(n: int, repeats: int, steps: int = 10, t_end: float = 1.0) -> dict[str, Any]:
     """Loop, batched and core-alone cost per variant (us), interleaved best-of-repeats."""
     from mbd2d.binding import core
     from mbd2d.binding.pack import pack
@@ -60,17 +60,17 @@ def per_variant(n: int, repeats: int, steps: int = 10) -> dict[str, Any]:
 
     def loop() -> None:
         for v in values:
-            m.with_params({NAME: float(v)}).kinematics(1.0, steps)
+            m.with_params({NAME: float(v)}).kinematics(t_end, steps)
 
     def batched() -> None:
-        ds = mbd2d.sweep(m, {NAME: values}, t_end=1.0, steps=steps, workers=1, progress=False)
+        ds = mbd2d.sweep(m, {NAME: values}, t_end=t_end, steps=steps, workers=1, progress=False)
         assert int(ds.attrs["failed"]) == 0
 
     p = pack(m)
 
     def core_alone() -> None:
         for _ in values:
-            core.kinematics(p, 0.0, 1.0, steps, 0.0, 0, 0.0, 1, 0, steps + 1)
+            core.kinematics(p, 0.0, t_end, steps, 0.0, 0, 0.0, 1, 0, steps + 1)
 
     batched()                                   # imports (xarray) and caches out of the way
     t = {"loop": float("inf"), "batched": float("inf"), "core": float("inf")}

@@ -39,7 +39,7 @@ module mbd_kinematics
   use mbd_band, only: band_t, band_plan, band_move, band_zero, band_norm1, band_factor, &
                       band_rcond, band_solve
   use mbd_linsolve, only: lu_factor, lu_solve, lu_det_sign, svd_null, row_rank, qr_factor, &
-                          qr_solve, qr_lwork, lu_solve_rows
+                          qr_solve, qr_lwork, lu_solve_rows, lu_factor_small, lu_solve_small
   use mbd_splu, only: splu_t, splu_init, splu_plan, splu_factor, splu_solve, splu_solve2, &
                       splu_pos, LMAX
   use mbd_lapack, only: dgels, dgecon, dtrcon
@@ -69,6 +69,12 @@ module mbd_kinematics
   !! n / BAND_RATIO wide
   integer, parameter :: BAND_MIN_N = 60, BAND_RATIO = 4
   integer, parameter :: BAND_ASSEMBLY_MAXIT = 50  !! Newton iterations of a banded assembly
+  !> the assembly's Newton start (square J, dense mode): iterations, and the largest step
+  !! taken (lengths in units of the model's length scale, angles in rad)
+  integer, parameter :: START_NEWTON_MAXIT = 12
+  real(wp), parameter :: START_NEWTON_STEP = 0.25_wp
+  !> plain-loop LU up to this order, LAPACK beyond
+  integer, parameter :: SMALL_LU_N = 32
   !> dense mode, square J up to this order: sparse LU with a replayed pivot order (mbd_splu)
   integer, parameter :: SPARSE_MAX_N = 60
   !> divided differences of the accelerations in the predictor (its error O(h**(order + 3)))
@@ -552,6 +558,47 @@ contains
     end if
   end subroutine kin_vel_acc
 
+  !> The assembly's first try for a square J in dense mode: Newton, J dq = -Phi, from the
+  !! estimates, each step accepted as Levenberg-Marquardt accepts one (||Phi||_2 falls) and
+  !! only while it is short (max |dq| <= START_NEWTON_STEP: no jump to another branch where
+  !! the damped steps would stay near the estimates). True when ||Phi||_inf <= tol; false
+  !! (q then is wherever it stopped) on a longer step, a rise, a singular J or no
+  !! convergence within START_NEWTON_MAXIT iterations.
+  logical function start_newton(m, w, q, t) result(ok)
+    type(model_t), intent(in) :: m          !! model
+    type(kin_work_t), intent(inout) :: w    !! work arrays (dense mode, w%jac n x n)
+    real(wp), intent(inout) :: q(:)         !! estimates, then the iterate
+    real(wp), intent(in) :: t               !! time
+    real(wp) :: f, fprev
+    integer :: it, st
+    character(len=MSG_LEN) :: msg
+    ok = .false.
+    fprev = huge(one)
+    do it = 0, START_NEWTON_MAXIT
+      call dense_j(m, w, q, w%qz, t)
+      f = norm2(w%phi)
+      if (.not. f < fprev) return                      ! a rise, NaN or overflow
+      if (maxval(abs(w%phi)) <= w%tol) then
+        ok = .true.; return
+      end if
+      if (it == START_NEWTON_MAXIT) return
+      w%dq = -w%phi
+      if (size(q) <= SMALL_LU_N) then
+        call lu_factor_small(w%jac, w%ipiv, st)
+        if (st /= MBD_OK) return
+        call lu_solve_small(w%jac, w%ipiv, w%dq)
+      else
+        call lu_factor(w%jac, w%ipiv, st, msg)
+        if (st /= MBD_OK) return
+        call lu_solve(w%jac, w%ipiv, w%dq, st, msg)
+        if (st /= MBD_OK) return
+      end if
+      if (.not. maxval(abs(w%dq)) <= START_NEWTON_STEP) return
+      q = q + w%dq
+      fprev = f
+    end do
+  end function start_newton
+
   !> Assemble: from rough estimates q (extras are estimated here) minimize ||Phi(q, t)||^2 by
   !! Levenberg-Marquardt (steps from the least-squares problem [J; sqrt(mu) I] dq = [-Phi; 0],
   !! dgels), to ||Phi||_inf <= tol. Works for any number of equations. On failure the
@@ -603,6 +650,13 @@ contains
       if (ierr /= 0) then
         call mem_fail(REAL_BYTES * real(neq, wp) * n, WHAT, DENSE_HINT, status, msg); return
       end if
+    end if
+    if (.not. w%banded .and. .not. w%lsq .and. neq == n) then
+      ! square J: the Newton steps Levenberg-Marquardt would take as mu -> 0, while they
+      ! are short and reduce ||Phi||_2; otherwise Levenberg-Marquardt from the estimates
+      qt = q
+      if (start_newton(m, w, q, t)) return
+      q = qt
     end if
     call mem_check(bytes, WHAT, DENSE_HINT, status, msg)
     if (status /= MBD_OK) return

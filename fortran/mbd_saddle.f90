@@ -407,11 +407,20 @@ contains
         call band_factor(sd%b, status, msg)
         return
       end if
-      anorm = band_norm1(sd%b)
+      ! ||A||_1 only where it is used (a small pivot ratio): the matrix is filled again and,
+      ! for the condition estimate, factored again (the same factors), which keeps a pass
+      ! over the whole band out of every well-conditioned factorization
       call band_factor(sd%b, status, msg, pivratio=pr)
+      anorm = zero
       if (status == MBD_OK .and. pr < 1.0e-6_wp) then
-        call band_rcond(sd%b, anorm, rc, info, msg)
-        sd%lsq = info == MBD_OK .and. rc < AUG_RCOND
+        call fill(ee)
+        anorm = band_norm1(sd%b)
+        call band_factor(sd%b, status, msg)
+        sd%lsq = status /= MBD_OK
+        if (status == MBD_OK) then
+          call band_rcond(sd%b, anorm, rc, info, msg)
+          sd%lsq = info == MBD_OK .and. rc < AUG_RCOND
+        end if
       else
         sd%lsq = status /= MBD_OK
       end if
@@ -419,6 +428,7 @@ contains
       if (sd%lsq) then
         ! keep the matrix, then factor it with the constraint block regularized
         call fill(ee)
+        if (anorm <= zero) anorm = band_norm1(sd%b)
         sd%bcopy = sd%b%ab
         call fill(ee + AUG_RCOND * anorm)
         call band_factor(sd%b, status, msg)
