@@ -149,6 +149,13 @@ def scaling_targets(results: dict) -> list[Row]:
                     t.get("met") if t.get("ms_per_step") is not None else None)]
 
 
+def short_steps_text(results: dict) -> str:
+    """'; at h = 10 ms: R x' from the sweep's second setting, or ''."""
+    sp = get(results, "sweep", "per_variant_short_steps") or {}
+    r = sp.get("ratio_loop_over_batched")
+    return f"; 10 steps of 10 ms: {fmt(r, '.1f')}x" if r else ""
+
+
 def study_targets(results: dict) -> list[Row]:
     """Sweeps >= 10x cheaper per variant than a with_params loop; sensitivities of 4
     parameters <= 2x the analysis alone."""
@@ -160,7 +167,8 @@ def study_targets(results: dict) -> list[Row]:
                    f"{fmt(us.get('batched'), '.0f')} us; core alone "
                    f"{fmt(us.get('core'), '.0f')} us)" if ratio else "not measured",
                    None if ratio is None else ratio >= 10.0,
-                   failed(results.get("sweep")) or "same run, interleaved")]
+                   failed(results.get("sweep")) or "one crank turn in 10 steps; same run, "
+                   "interleaved" + short_steps_text(results))]
     rows = get(results, "sensitivities", "rows") or []
     ratios = [r.get("ratio") for r in rows if r.get("ratio")]
     out.append(_target("sensitivities of 4 parameters: <= 2x the analysis alone",
@@ -487,7 +495,16 @@ def sweep_section(results: dict) -> str:
                     ("one core_kinematics call per variant (packed once)",
                      fmt(us.get("core"), ".1f"))]),
              f"Loop / batched: **{fmt(pv.get('ratio_loop_over_batched'), '.1f')}x**; batched "
-             f"/ core alone: {fmt(pv.get('batched_over_core'), '.2f')}.\n"]
+             f"/ core alone: {fmt(pv.get('batched_over_core'), '.2f')} (one crank turn in "
+             f"{pv.get('steps')} steps).\n"]
+    sp = sw.get("per_variant_short_steps") or {}
+    if sp:
+        su = sp.get("us_per_variant") or {}
+        parts.append(f"The same over {fmt(sp.get('t_end'), 'g')} s (h = "
+                     f"{fmt(1e3 * sp['t_end'] / sp['steps'], 'g')} ms): loop "
+                     f"{fmt(su.get('loop'), '.0f')} us, batched {fmt(su.get('batched'), '.1f')} "
+                     f"us, core alone {fmt(su.get('core'), '.1f')} us; loop / batched "
+                     f"**{fmt(sp.get('ratio_loop_over_batched'), '.1f')}x**.\n")
     tp = sw.get("throughput") or {}
     rows = [(r["runner"], fmt(r.get("variants_per_s"), ".0f"), fmt(r.get("seconds"), ".3f"),
              "yes" if r.get("identical_to_serial") else "**no**") for r in tp.get("rows", [])]

@@ -105,6 +105,7 @@ contains
     logical, allocatable :: ract(:), cact(:)
     integer, allocatable :: otgt(:), ol(:), ou(:)
     integer :: srow(sp%n), scol(sp%n)    ! step of A's row i, column j
+    integer :: rcnt(sp%n), ccnt(sp%n)    ! active entries of row i, column j in the pattern
     status = MBD_OK
     sp%planned = .false.
     n = sp%n
@@ -119,6 +120,9 @@ contains
     ract = .true.; cact = .true.
     sp%sgn = 1
     nops = 0
+    do i = 1, n
+      rcnt(i) = count(sp%s(i, :)); ccnt(i) = count(sp%s(:, i))
+    end do
     ! elimination on the pattern (with fill) and the values, choosing the pivots
     do k = 1, n
       best = huge(1); bi = 0; bj = 0; brel = zero
@@ -129,11 +133,11 @@ contains
           if (ract(i) .and. sp%s(i, j)) cmax = max(cmax, abs(sp%a(i, j)))
         end do
         if (.not. cmax > zero) cycle
-        nc = count(ract .and. sp%s(:, j)) - 1
+        nc = ccnt(j) - 1
         do i = 1, n
           if (.not. (ract(i) .and. sp%s(i, j))) cycle
           if (abs(sp%a(i, j)) < TAU * cmax) cycle
-          nr = count(cact .and. sp%s(i, :)) - 1
+          nr = rcnt(i) - 1
           cost = nr * nc
           ! ties: the larger pivot relative to its column
           if (cost < best .or. (cost == best .and. abs(sp%a(i, j)) / cmax > brel)) then
@@ -146,11 +150,21 @@ contains
       end if
       sp%prow(k) = bi; sp%pcol(k) = bj
       ract(bi) = .false.; cact(bj) = .false.
+      ! the counts without the pivot's row and column (kept for the active ones only)
+      do j = 1, n
+        if (cact(j) .and. sp%s(bi, j)) ccnt(j) = ccnt(j) - 1
+      end do
+      do i = 1, n
+        if (ract(i) .and. sp%s(i, bj)) rcnt(i) = rcnt(i) - 1
+      end do
       do i = 1, n
         if (.not. (ract(i) .and. sp%s(i, bj))) cycle
         f = sp%a(i, bj) / sp%a(bi, bj)
         do j = 1, n
           if (.not. (cact(j) .and. sp%s(bi, j))) cycle
+          if (.not. sp%s(i, j)) then        ! fill
+            rcnt(i) = rcnt(i) + 1; ccnt(j) = ccnt(j) + 1
+          end if
           sp%s(i, j) = .true.
           sp%a(i, j) = sp%a(i, j) - f * sp%a(bi, j)
           nops = nops + 1
