@@ -41,7 +41,7 @@ module mbd_kinematics
   use mbd_linsolve, only: lu_factor, lu_solve, lu_det_sign, svd_null, row_rank, qr_factor, &
                           qr_solve, qr_lwork, lu_solve_rows, lu_factor_small, lu_solve_small
   use mbd_splu, only: splu_t, splu_init, splu_plan, splu_factor, splu_solve, splu_solve2, &
-                      splu_pos, LMAX
+                      splu_solve_rows, splu_pos, LMAX
   use mbd_lapack, only: dgels, dgecon, dtrcon
   use mbd_interp, only: hermite5
   use mbd_sensitivity, only: sens_t, sens_hessian, sens_params, sens_kin_rhs
@@ -442,7 +442,11 @@ contains
     real(wp), intent(out) :: x(:, :)       !! solutions (nq, n)
     real(wp) :: b(size(bt, 2))
     integer :: k
-    if (w%lsq .or. w%banded .or. w%spfact) then
+    if (w%spfact) then
+      call splu_solve_rows(w%sp, bt, x, w%cs)
+      return
+    end if
+    if (w%lsq .or. w%banded) then
       do k = 1, size(x, 2)
         b = bt(k, :)
         call solve(w, b, x(:, k))

@@ -24,7 +24,8 @@ module mbd_splu
   use mbd_memory, only: REAL_BYTES, mem_fail
   implicit none
   private
-  public :: splu_t, splu_init, splu_plan, splu_factor, splu_solve, splu_solve2, splu_pos, LMAX, TAU
+  public :: splu_t, splu_init, splu_plan, splu_factor, splu_solve, splu_solve2, splu_solve_rows, &
+            splu_pos, LMAX, TAU
 
   real(wp), parameter :: TAU = 0.5_wp   !! pivot threshold of a plan (|l_ik| <= 1/TAU = 2)
   real(wp), parameter :: LMAX = 4.0_wp  !! largest multiplier a replayed factorization keeps
@@ -43,6 +44,7 @@ module mbd_splu
     real(wp), allocatable :: val(:)       !! (n**2) values: A before factor, L and U after
     real(wp), allocatable :: rinv(:)      !! (n) 1 / u_kk
     real(wp), allocatable :: y(:), y2(:)  !! (n) work vectors of the solves
+    real(wp), allocatable :: y4(:, :)     !! (4, n) work of the solves by rows (splu_solve_rows)
     integer, allocatable :: prow(:), pcol(:)  !! (n) step k pivots on A(prow(k), pcol(k))
     integer, allocatable :: diag(:)       !! (n) position of u_kk
     integer, allocatable :: lptr(:), lpos(:), lrow(:)  !! L by columns: entries, step rows
@@ -76,7 +78,7 @@ contains
               sp%y(n), sp%y2(n), sp%prow(n), sp%pcol(n), sp%diag(n), sp%lptr(n + 1), sp%lpos(nn), &
               sp%lrow(nn), sp%uptr(n + 1), sp%upos(nn), sp%urow(nn), sp%optr(n + 1), &
               sp%fill(nn), sp%a(n, n), sp%s(n, n), sp%lcol(nn), sp%bpos(nn), sp%brow(nn), &
-              sp%bcol(nn), stat=ierr)
+              sp%bcol(nn), sp%y4(4, n), stat=ierr)
     if (ierr /= 0) then
       call mem_fail(REAL_BYTES * 4 * real(nn, wp), 'the sparse LU of J', &
                     'use a smaller model', status, msg)
@@ -339,6 +341,53 @@ contains
       x(pcol(k)) = y(k) * cs(pcol(k))
     end do
   end subroutine solve_kernel
+
+  !> X = D A^-1 B for several right-hand sides given as rows, bt = B^T (a multiple of 4 rows,
+  !! padding zero), four at a time through the factors (each column's operations those of
+  !! splu_solve, in the same order); x (n, ncol) takes the first ncol of them.
+  pure subroutine splu_solve_rows(sp, bt, x, cs)
+    type(splu_t), intent(inout) :: sp                !! factors (and the work block)
+    real(wp), intent(in) :: bt(:, :)                 !! right-hand sides as rows (4 k, n)
+    real(wp), intent(inout) :: x(:, :)               !! solutions (A's columns, ncol)
+    real(wp), intent(in) :: cs(:)                    !! column scale
+    integer :: g
+    do g = 1, size(bt, 1) - 3, 4
+      if (g > size(x, 2)) exit
+      call rows_kernel(sp%n, sp%lptr(sp%n + 1) - 1, sp%nu, sp%prow, sp%pcol, sp%lpos, &
+                       sp%lrow, sp%lcol, sp%bpos, sp%brow, sp%bcol, sp%rinv, sp%val, sp%y4, &
+                       size(bt, 1), bt, x, g, cs)
+    end do
+  end subroutine splu_solve_rows
+
+  !> Four right-hand sides (rows g .. g + 3 of bt) through the factors; columns g .. g + 3
+  !! of x.
+  pure subroutine rows_kernel(n, nl, nu, prow, pcol, lpos, lrow, lcol, bpos, brow, bcol, &
+                              rinv, val, y, ldb, bt, x, g, cs)
+    integer, intent(in) :: n, nl, nu, g, ldb
+    integer, intent(in) :: prow(n), pcol(n), lpos(nl), lrow(nl), lcol(nl)
+    integer, intent(in) :: bpos(nu), brow(nu), bcol(nu)
+    real(wp), intent(in) :: rinv(n), val(*), bt(ldb, n), cs(n)
+    real(wp), intent(out) :: y(4, n)
+    real(wp), intent(inout) :: x(:, :)
+    integer :: k, p, i
+    do k = 1, n                                      ! y = P b
+      y(:, k) = bt(g:g + 3, prow(k))
+    end do
+    do p = 1, nl                                     ! L z = y (unit diagonal)
+      y(:, lrow(p)) = y(:, lrow(p)) - val(lpos(p)) * y(:, lcol(p))
+    end do
+    do k = 1, n                                      ! diag(1/u_kk) z
+      y(:, k) = y(:, k) * rinv(k)
+    end do
+    do p = 1, nu                                     ! U1 w = diag(1/u_kk) z
+      y(:, brow(p)) = y(:, brow(p)) - val(bpos(p)) * y(:, bcol(p))
+    end do
+    do i = 1, min(4, size(x, 2) - g + 1)             ! x = D Q w
+      do k = 1, n
+        x(pcol(k), g + i - 1) = y(i, k) * cs(pcol(k))
+      end do
+    end do
+  end subroutine rows_kernel
 
   !> x1 = -A^-1 b1 (a Newton correction from Phi = b1) and x2 = A^-1 b2 in one pass over the
   !! factors (as splu_solve, each x multiplied by the column scale cs).
