@@ -129,6 +129,24 @@ def peer_targets(results: dict) -> list[Row]:
     return [dyn, kin]
 
 
+def chain_targets(results: dict) -> list[Row]:
+    """>= 3x Exudyn's generalized-alpha on the N-four-bar at N = 100 and 1000, equal h."""
+    pc = results.get("peers_chain")
+    name = "free N-four-bar, generalized-alpha: >= 3x faster than Exudyn at N = 100 and 1000"
+    why = failed(pc) or (f"Exudyn unavailable: {pc.get('unavailable')}"
+                         if pc and pc.get("unavailable") else None)
+    if pc is None or why:
+        return [_target(name, f"not measured ({why or 'not run'})", None)]
+    rows = [r for r in pc.get("rows", []) if r["n"] in (100, 1000)]
+    if not rows:
+        return [_target(name, "not measured", None)]
+    fig = ", ".join(f"N = {r['n']} h = {r['h']:g}: {fmt(r.get('ratio'), '.1f')}x (errors "
+                    f"{fmt(r['mbd2d'].get('error'), '.1e')} / "
+                    f"{fmt(r['exudyn'].get('error'), '.1e')})" for r in rows)
+    return [_target(name, fig, bool(pc.get("meets_target")),
+                    "equal h, errors against the reduced one-dof equation")]
+
+
 def scaling_targets(results: dict) -> list[Row]:
     """About linear in N (banded path) and N = 1000 at <= 2 ms per step."""
     sc = results.get("scaling")
@@ -192,7 +210,8 @@ def runtime_target(results: dict) -> list[Row]:
 
 def targets(results: dict) -> list[Row]:
     """Every target with its measured figure and whether it is met (None: not measured)."""
-    return (kinematics_targets(results) + peer_targets(results) + scaling_targets(results)
+    return (kinematics_targets(results) + peer_targets(results) + chain_targets(results)
+            + scaling_targets(results)
             + dynamics_scaling_targets(results) + study_targets(results)
             + runtime_target(results))
 
@@ -287,6 +306,34 @@ def work_precision_section(results: dict, charts: dict, out: Path, base: Path) -
                      f"({fmt(data.get('runtime_s'), '.0f')} s)</summary>\n\n{wp_table(data)}"
                      "\n</details>\n")
     return "\n".join(parts)
+
+
+def chain_section(results: dict) -> str:
+    """Exudyn and mbd2d on the free N-four-bar (bench/peers_exudyn_chain.py)."""
+    pc = results.get("peers_chain")
+    if pc is None:
+        return "Not run.\n"
+    if failed(pc):
+        return f"Failed: {failed(pc)}\n"
+    if pc.get("unavailable"):
+        return f"Exudyn unavailable: {pc['unavailable']}.\n"
+    rows = []
+    for r in pc.get("rows", []):
+        a, b = r["mbd2d"], r["exudyn"]
+        rows.append((r["n"], f"{r['h']:g}", fmt(a.get("ms_per_step"), ".3f"),
+                     fmt(b.get("ms_per_step"), ".3f"), fmt(r.get("ratio"), ".1f"),
+                     fmt(a.get("error"), ".2e"), fmt(b.get("error"), ".2e"),
+                     f"{a.get('newton_iterations')} / {b.get('newton_iterations')}"
+                     + (f" ({b.get('message')})" if b.get("message") else "")))
+    return "\n".join([
+        f"{pc.get('model')}, {pc.get('t_end')} s from the upright start, generalized-alpha "
+        f"(rho_inf = {pc.get('rho_inf')}) at fixed h in both codes, Exudyn "
+        f"{pc.get('exudyn_version')} with its sparse solver (EigenSparse). Error: the first "
+        "crank's angle against the reduced one-degree-of-freedom equation (DOP853, 1e-13), "
+        "largest over the outputs. Time: best wall time of the solve call (see "
+        "bench/peers_exudyn_chain.py).\n",
+        table(("N", "h", "mbd2d ms/step", "Exudyn ms/step", "Exudyn / mbd2d", "mbd2d error",
+               "Exudyn error", "Newton iterations mbd2d / Exudyn"), rows)])
 
 
 def peers_section(results: dict) -> str:
@@ -638,6 +685,7 @@ def results_markdown(results: dict, charts: dict[str, str], md_path: Path, out: 
              "## Work precision of the dynamics methods\n",
              work_precision_section(results, charts, out, base),
              "## Peers: Exudyn\n", peers_section(results),
+             "### The free N-four-bar (large model)\n", chain_section(results),
              "## Kinematics speed\n", kinematics_section(results),
              "## Scaling with model size\n", scaling_section(results, charts, out, base),
              "## Memory of long runs\n", memory_section(results, charts, out, base),

@@ -54,6 +54,7 @@ import callgrind  # noqa: E402
 import kinematics_speed  # noqa: E402
 import memory  # noqa: E402
 import peers_exudyn  # noqa: E402
+import peers_exudyn_chain  # noqa: E402
 import report  # noqa: E402
 import scaling  # noqa: E402
 import sensitivities  # noqa: E402
@@ -62,7 +63,7 @@ import synthesis  # noqa: E402
 import work_precision  # noqa: E402
 
 SECTIONS = ("environment", "work_precision", "peers", "kinematics", "scaling", "memory",
-            "sweep", "sensitivities", "contact", "synthesis", "dynamics_scaling")
+            "sweep", "sensitivities", "contact", "synthesis", "dynamics_scaling", "peers_chain")
 
 
 # ===================================================================== JSON
@@ -180,6 +181,14 @@ def section_dynamics_scaling(quick: bool) -> dict:
     return dynamics_scaling.study(quick=quick)
 
 
+def section_peers_chain(quick: bool) -> dict:
+    """Exudyn and mbd2d, generalized-alpha on the free N-four-bar (N = 10, 100, 1000)."""
+    ok, info = peers_exudyn.available()
+    print(f" Exudyn: {info}" if ok else f" Exudyn NOT available: {info}", flush=True)
+    return peers_exudyn_chain.study((10, 100) if quick else peers_exudyn_chain.N_VALUES,
+                                    (1e-3,) if quick else (1e-3, 5e-4), 1 if quick else 2)
+
+
 def section_synthesis(quick: bool) -> dict:
     """Four-bar path generation: published errors, mbd2d, pylinkage."""
     return synthesis.study(quick=quick)
@@ -293,7 +302,8 @@ def main(argv: Sequence[str] | None = None) -> dict:
         "peers": section_peers, "kinematics": section_kinematics,
         "scaling": section_scaling, "memory": section_memory, "sweep": section_sweep,
         "sensitivities": section_sensitivities, "contact": section_contact,
-        "synthesis": section_synthesis, "dynamics_scaling": section_dynamics_scaling}
+        "synthesis": section_synthesis, "dynamics_scaling": section_dynamics_scaling,
+        "peers_chain": section_peers_chain}
     ran = {name: run_section(name, fns[name], a.quick) for name in SECTIONS if name in wanted}
     earlier = earlier_sections(out, [n for n in SECTIONS if n not in wanted])
     results = {name: ran.get(name, earlier.get(name)) for name in SECTIONS

@@ -356,6 +356,25 @@ def test_dask_local_cluster_gives_the_serial_result() -> None:
     assert tol.dataset.identical(local.dataset)
 
 
+def test_back_to_back_dask_sweeps_of_one_model() -> None:
+    """Sweeps of the same model one right after another on one client (as a benchmark or a
+    notebook does): each shares the model under a key of its own; with the content's hash
+    as the key, about one in four of them was cancelled for 'lost dependencies' while the
+    scheduler released the previous sweep's copy."""
+    distributed = pytest.importorskip("distributed")
+    m = load_example("fourbar_grashof.toml")
+    cases = {"joint.B.points.0.0": np.linspace(1.6, 1.9, 1000)}
+    kw = {"t_end": 1.0, "steps": 400, "every": 50, "progress": False}
+    serial = mbd2d.sweep(m, cases, workers=1, **kw)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True,
+                                      dashboard_address=":0") as cluster, \
+                distributed.Client(cluster) as client:
+            runs = [mbd2d.sweep(m, cases, client=client, **kw) for _ in range(8)]
+    assert all(serial.identical(r) for r in runs)
+
+
 def test_chunks_cover_the_cases() -> None:
     for n, parts in ((1, 8), (10, 3), (23, 8), (5, 50)):
         c = runner.chunks(2, 2 + n, parts)

@@ -158,7 +158,10 @@ def _dask(b: BatchTables, vals: np.ndarray, client: Any, out: Outputs, bar: Any)
     info = client.scheduler_info()
     nworkers = max(1, len(info.get("workers", {})))
     parts = chunks(0, vals.shape[1], CHUNKS_PER_WORKER * nworkers)
-    shared = client.scatter(b, broadcast=True)
+    # a key of its own for each sweep (hash=False): with the content's hash, a sweep of the
+    # same model right after another gets the same key while the scheduler still releases
+    # the last sweep's copy, and its tasks are cancelled for "lost dependencies"
+    shared = client.scatter(b, broadcast=True, hash=False)
     futures = [client.submit(core.batch, shared, vals[:, a:z], pure=False) for a, z in parts]
     start = {f.key: a for f, (a, _) in zip(futures, parts)}
     for f in dask_completed(futures):
