@@ -100,6 +100,8 @@ module mbd_integrators
     real(wp), allocatable :: nb(:, :), gw(:, :), gn(:), nsq(:, :), sv(:), svw(:)
     integer, allocatable :: sel(:), mark(:)
     real(wp), allocatable :: ju(:, :), ub(:), px(:), qa(:, :), tau(:), qwork(:), cw(:)
+    real(wp), allocatable :: vw(:)          !! (ni) an output's v_dot (complete_outputs)
+    real(wp), allocatable :: qkeep(:), vkeep(:)  !! (nq) the state kept by complete_outputs
     integer, allocatable :: upiv(:), usrc(:), upos(:), jp(:), iw(:)
     type(band_t) :: bu
     real(wp), allocatable :: qf(:), vf(:), af(:), lam(:)   !! last full state
@@ -446,7 +448,7 @@ contains
     real(wp) :: rtol_dyn, cf, kmax, cmax, fmax, qmax, vmax, rmax, te, mufric
     real(wp) :: q(m%nq), qd(m%nq), qdd(m%nq), acc(m%nq), lam(m%neq)
     real(wp) :: qn(m%nq), vn(m%nq), an(m%nq), accn(m%nq), lamn(m%neq), dq(m%nq), ap(m%nq)
-    real(wp) :: res(m%nq + w%na), dg(m%nq)
+    real(wp) :: res(m%nq + w%na), dg(m%nq), ew(m%nq)
     real(wp), allocatable :: kv(:), cv(:), kc(:)   ! K, C and K + g' C on the pattern
     type(saddle_t) :: sg                            ! the iteration matrix S
     integer :: it, n, stt, nfix, na, attempt, nkc, k, nnz, kev, nprev
@@ -599,8 +601,10 @@ contains
       ! local error estimate: the step's position error is (beta - 1/6) h^3 q''', and the
       ! distance of q_{n+1} from its second-order Taylor prediction is h^3 q'''/6, so
       ! e = (6 beta - 1) (q_{n+1} - q_n - h q_dot_n - h^2 q_ddot_n / 2)
-      if (conv .and. .not. fixed) err = err_norm(c, (6 * bet - 1) * &
-                                                 (qn - q - h * qd - half * h * h * qdd), q, qn)
+      if (conv .and. .not. fixed) then
+        ew = (6 * bet - 1) * (qn - q - h * qd - half * h * h * qdd)   ! (no heap temporary)
+        err = err_norm(c, ew, q, qn)
+      end if
       kev = 0
       if (conv .and. c%events) then
         ! an event inside the step: error-controlled steps are taken again to end there
@@ -674,8 +678,8 @@ contains
     integer, intent(out) :: status
     character(len=MSG_LEN), intent(out) :: msg
     integer, intent(inout), optional, volatile :: ctl(:)   !! progress (see integrate)
-    real(wp), allocatable :: y(:), ynew(:), k(:, :), e(:)
-    real(wp) :: t, h, tnew, err, fac, qa(m%nq), va(m%nq), aa(m%nq), te
+    real(wp), allocatable :: y(:), ynew(:), k(:, :), e(:), ys(:)   ! ys: a stage's state
+    real(wp) :: t, h, tnew, err, fac, qa(m%nq), va(m%nq), aa(m%nq), te, dev, move
     integer :: stt, nprev, kev
     logical :: fixed, fsal, changed
     integer :: nfix
@@ -701,7 +705,7 @@ contains
     else
       h = initial_step(c)
     end if
-    call pack_state(c, y, ynew, k, e, stt)
+    call pack_state(c, y, ynew, k, e, ys, stt)
     if (stt /= 0) then
       call mem_fail(REAL_BYTES * 10 * size(c%qf), 'the integrator stages', &
                     'use a smaller model', status, msg)
@@ -723,10 +727,10 @@ contains
         h = tnew - t
       end if
       if (fixed) then
-        call rk4_step(m, w, c, t, y, h, ynew, k, stt)
+        call rk4_step(m, w, c, t, y, h, ynew, k, ys, stt)
         err = zero
       else
-        call dopri5_step(m, w, c, t, y, h, ynew, k, e, fsal, stt)
+        call dopri5_step(m, w, c, t, y, h, ynew, k, e, ys, fsal, stt)
         if (stt == MBD_OK) err = err_norm(c, e, y, ynew)
       end if
       if (stt == MBD_OK .and. partitioned) then
@@ -734,8 +738,8 @@ contains
         ! moved them off their Taylor prediction (a switch of branch at a singular point)
         call rhs(m, w, c, tnew, ynew, e, stt)
         if (stt == MBD_OK) then
-          if (maxval(abs(c%qf(c%iu) - predicted(c, tnew))) > &
-              half * maxval(abs(predicted(c, tnew) - c%qs(c%iu))) + 1.0e3_wp * w%tol) err = 10.0_wp
+          call prediction_gaps(c, tnew, dev, move)
+          if (dev > half * move + 1.0e3_wp * w%tol) err = 10.0_wp
         end if
         fsal = .false.
       end if
@@ -772,7 +776,7 @@ contains
         cycle
       end if
       ! accepted: the full state at the end, projected (dopri5) or completed (partitioned)
-      call finish_step(m, w, c, partitioned, tnew, ynew, fsal, stt)
+      call finish_step(m, w, c, partitioned, tnew, ynew, fsal, e, ys, stt)
       if (stt /= MBD_OK) then
         status = MBD_INTEGRATOR_FAILED
         write (msg, '(a,es12.5)') 'the constraints could not be satisfied after the step to t = ', &
@@ -837,7 +841,7 @@ contains
             write (msg, '(a,es12.5)') 'partitioned: no well-conditioned partition at t = ', t
             return
           end if
-          call pack_state(c, y, ynew, k, e, stt)
+          call pack_state(c, y, ynew, k, e, ys, stt)
           if (stt /= 0) then
             call mem_fail(REAL_BYTES * 10 * size(c%qf), 'the integrator stages', &
                           'use a smaller model', status, msg)
@@ -850,16 +854,16 @@ contains
   end subroutine run_explicit
 
   !> The integrated state y from the full state: (q, q_dot), or (v, v_dot) when partitioned.
-  subroutine pack_state(c, y, ynew, k, e, ierr)
+  subroutine pack_state(c, y, ynew, k, e, ys, ierr)
     type(itg_t), intent(in) :: c
-    real(wp), allocatable, intent(inout) :: y(:), ynew(:), k(:, :), e(:)
+    real(wp), allocatable, intent(inout) :: y(:), ynew(:), k(:, :), e(:), ys(:)
     integer, intent(out) :: ierr          ! allocation status (0 ok)
     integer :: ny, nh
     nh = size(c%qf)
     if (c%ni > 0) nh = c%ni
     ny = 2 * nh
-    if (allocated(y)) deallocate (y, ynew, k, e)
-    allocate (y(ny), ynew(ny), k(ny, 7), e(ny), stat=ierr)
+    if (allocated(y)) deallocate (y, ynew, k, e, ys)
+    allocate (y(ny), ynew(ny), k(ny, 7), e(ny), ys(ny), stat=ierr)
     if (ierr /= 0) return
     if (c%ni > 0) then
       y(1:nh) = c%qf(c%iv); y(nh + 1:) = c%vf(c%iv)
@@ -869,7 +873,7 @@ contains
   end subroutine pack_state
 
   !> After an accepted step: the full consistent state at tn in c (dopri5: projected).
-  subroutine finish_step(m, w, c, partitioned, tn, yn, fsal, stf)
+  subroutine finish_step(m, w, c, partitioned, tn, yn, fsal, f, ys, stf)
     type(model_t), intent(in) :: m
     type(dyn_work_t), intent(inout) :: w
     type(itg_t), intent(inout) :: c
@@ -877,8 +881,9 @@ contains
     real(wp), intent(in) :: tn
     real(wp), intent(inout) :: yn(:)
     logical, intent(inout) :: fsal
+    real(wp), intent(out) :: f(:)                 !! workspace (size(yn)): y'
+    real(wp), intent(inout) :: ys(:)              !! workspace (size(yn))
     integer, intent(out) :: stf
-    real(wp) :: f(size(yn)), v0(m%nq)
     if (partitioned) then
       call rhs(m, w, c, tn, yn, f, stf)          ! solves u, u_dot and the accelerations
       return
@@ -887,8 +892,8 @@ contains
     stf = MBD_OK
     if (c%opts%method == METH_DOPRI5) then
       call dyn_project_pos(m, w, c%qf, tn, stf)
-      v0 = c%vf
-      if (stf == MBD_OK) call dyn_velocity(m, w, c%qf, tn, v0, c%vf, stf)
+      ys(1:m%nq) = c%vf                          ! the velocity before its projection
+      if (stf == MBD_OK) call dyn_velocity(m, w, c%qf, tn, ys(1:m%nq), c%vf, stf)
       yn(1:m%nq) = c%qf; yn(m%nq + 1:) = c%vf
       fsal = .false.
     end if
@@ -904,12 +909,15 @@ contains
     real(wp), intent(in) :: t, y(:)
     real(wp), intent(out) :: f(:)
     integer, intent(out) :: stf
-    integer :: nn
+    integer :: nn, k
     c%st%rhs = c%st%rhs + 1
     nn = m%nq
     if (c%ni > 0) then
-      c%qf(c%iv) = y(1:c%ni)
-      if (allocated(c%qs)) c%qf(c%iu) = predicted(c, t)   ! Newton starts on the branch
+      ! (loops: vector subscripts and an array function would be heap temporaries per call)
+      do k = 1, c%ni
+        c%qf(c%iv(k)) = y(k)
+      end do
+      if (allocated(c%qs)) call predict_dependent(c, t)   ! Newton starts on the branch
       call solve_dependent(m, w, c, t, y(c%ni + 1:), stf)
       if (stf /= MBD_OK) return
     else
@@ -918,20 +926,44 @@ contains
     call accel(m, w, c, t, stf)
     if (stf /= MBD_OK) return
     if (c%ni > 0) then
-      f(1:c%ni) = c%vf(c%iv); f(c%ni + 1:) = c%af(c%iv)
+      do k = 1, c%ni
+        f(k) = c%vf(c%iv(k)); f(c%ni + k) = c%af(c%iv(k))
+      end do
     else
       f(1:nn) = c%vf; f(nn + 1:) = c%af
     end if
   end subroutine rhs
 
-  !> Taylor prediction of the dependent coordinates at t from the step's start state.
-  pure function predicted(c, t) result(u)
+  !> Taylor prediction of the dependent coordinates at t from the step's start state,
+  !! u = u_s + dt (u_dot_s + dt/2 u_ddot_s), into c%qf.
+  pure subroutine predict_dependent(c, t)
+    type(itg_t), intent(inout) :: c
+    real(wp), intent(in) :: t
+    real(wp) :: dt
+    integer :: k, i
+    dt = t - c%ts
+    do k = 1, size(c%iu)
+      i = c%iu(k)
+      c%qf(i) = c%qs(i) + dt * (c%vs(i) + half * dt * c%as(i))
+    end do
+  end subroutine predict_dependent
+
+  !> dev = max |u - u_pred(t)| (the dependent coordinates against their Taylor prediction)
+  !! and move = max |u_pred(t) - u_s| (the predicted motion).
+  pure subroutine prediction_gaps(c, t, dev, move)
     type(itg_t), intent(in) :: c
     real(wp), intent(in) :: t
-    real(wp) :: u(size(c%iu)), dt
+    real(wp), intent(out) :: dev, move
+    real(wp) :: dt, u
+    integer :: k, i
     dt = t - c%ts
-    u = c%qs(c%iu) + dt * (c%vs(c%iu) + half * dt * c%as(c%iu))
-  end function predicted
+    dev = zero; move = zero
+    do k = 1, size(c%iu)
+      i = c%iu(k)
+      u = c%qs(i) + dt * (c%vs(i) + half * dt * c%as(i))
+      dev = max(dev, abs(c%qf(i) - u)); move = max(move, abs(u - c%qs(i)))
+    end do
+  end subroutine prediction_gaps
 
   !> Accelerations at c's full state; Baumgarte-stabilized for RK4.
   subroutine accel(m, w, c, t, stf)
@@ -978,18 +1010,20 @@ contains
     type(itg_t), intent(inout) :: c
     real(wp), intent(inout) :: qo(:, :), vo(:, :)
     integer, intent(in) :: r0
-    real(wp) :: qf(m%nq), vf(m%nq)
-    integer :: r, stt, newton
-    qf = c%qf; vf = c%vf; newton = c%st%newton
+    integer :: r, stt, newton, k
+    c%qkeep = c%qf; c%vkeep = c%vf; newton = c%st%newton
     do r = r0, c%nout
       c%qf = qo(:, r); c%vf = vo(:, r)
+      do k = 1, c%ni
+        c%vw(k) = vo(c%iv(k), r)
+      end do
       call solve_dependent(m, w, c, out_time(c, output_index(c%nsteps, c%every, r)), &
-                           vo(c%iv, r), stt)
+                           c%vw, stt)
       if (stt == MBD_OK) then
         qo(:, r) = c%qf; vo(:, r) = c%vf
       end if
     end do
-    c%qf = qf; c%vf = vf; c%st%newton = newton
+    c%qf = c%qkeep; c%vf = c%vkeep; c%st%newton = newton
   end subroutine complete_outputs
 
   !> Dependent coordinates u from Phi(u, v) = 0 (Newton with J_u), then u_dot from
@@ -1001,11 +1035,13 @@ contains
     type(itg_t), intent(inout) :: c
     real(wp), intent(in) :: t, vdot(:)
     integer, intent(out) :: stf
-    integer :: it, k
+    integer :: it, k, j
+    real(wp) :: acc
     character(len=MSG_LEN) :: lmsg
     stf = MBD_OK
+    ! (loops throughout: vector subscripts would be heap temporaries at every call)
     if (w%na == 0) then
-      c%vf(c%iv) = vdot; return
+      call put_v(); return
     end if
     if (w%solver /= SOLVER_DENSE) then
       call solve_dependent_band()
@@ -1013,8 +1049,10 @@ contains
     end if
     do it = 1, 25
       call assemble_dense(m, c%qf, w%qz, t, w%phi, w%nu, w%gam, w%asm, w%jac)
-      do k = 1, w%na
-        c%ju(k, :) = w%jac(w%rows(k), c%iu)
+      do j = 1, w%na
+        do k = 1, w%na
+          c%ju(k, j) = w%jac(w%rows(k), c%iu(j))
+        end do
       end do
       call lu_factor(c%ju, c%upiv, stf, lmsg)
       if (stf /= MBD_OK) return
@@ -1023,19 +1061,33 @@ contains
         c%ub(k) = -w%phi(w%rows(k))
       end do
       call lu_solve(c%ju, c%upiv, c%ub, stf, lmsg)
-      c%qf(c%iu) = c%qf(c%iu) + c%ub
+      do k = 1, w%na
+        c%qf(c%iu(k)) = c%qf(c%iu(k)) + c%ub(k)
+      end do
       c%st%newton = c%st%newton + 1
     end do
     if (maxval(abs(w%phi)) > w%tol) then
       stf = MBD_NO_CONVERGENCE; return
     end if
-    c%vf(c%iv) = vdot
+    call put_v()
     do k = 1, w%na
-      c%ub(k) = w%nu(w%rows(k)) - dot_product(w%jac(w%rows(k), c%iv), vdot)
+      acc = zero
+      do j = 1, c%ni
+        acc = acc + w%jac(w%rows(k), c%iv(j)) * vdot(j)
+      end do
+      c%ub(k) = w%nu(w%rows(k)) - acc
     end do
     call lu_solve(c%ju, c%upiv, c%ub, stf, lmsg)
-    c%vf(c%iu) = c%ub
+    do k = 1, w%na
+      c%vf(c%iu(k)) = c%ub(k)
+    end do
   contains
+    !> v_dot into the full velocity.
+    subroutine put_v()
+      do k = 1, c%ni
+        c%vf(c%iv(k)) = vdot(k)
+      end do
+    end subroutine put_v
     !> The same with J_u in band storage, J_v v_dot from the blocks (no dense J).
     subroutine solve_dependent_band()
       do it = 1, 25
@@ -1057,7 +1109,7 @@ contains
       if (maxval(abs(w%phi)) > w%tol) then
         stf = MBD_NO_CONVERGENCE; return
       end if
-      c%vf(c%iv) = vdot
+      call put_v()
       c%px = zero                                ! J_v v_dot = J x, x = v_dot on v, 0 on u
       do k = 1, c%ni
         c%px(c%iv(k)) = vdot(k)
@@ -1164,13 +1216,18 @@ contains
     type(dyn_work_t), intent(inout) :: w
     type(itg_t), intent(inout) :: c
     integer, intent(in) :: cols(:)
-    real(wp) :: anorm
-    integer :: stf, info, k
+    real(wp) :: anorm, colsum
+    integer :: stf, info, k, j
     character(len=MSG_LEN) :: lmsg
-    do k = 1, w%na
-      c%ju(k, :) = w%jac(w%rows(k), cols)
+    anorm = zero                          ! ||J_u||_1 (loops: no heap temporaries)
+    do j = 1, w%na
+      colsum = zero
+      do k = 1, w%na
+        c%ju(k, j) = w%jac(w%rows(k), cols(j))
+        colsum = colsum + abs(c%ju(k, j))
+      end do
+      anorm = max(anorm, colsum)
     end do
-    anorm = maxval(sum(abs(c%ju), dim=1))
     rc = zero
     call lu_factor(c%ju, c%upiv, stf, lmsg)
     if (stf /= MBD_OK) return
@@ -1190,7 +1247,8 @@ contains
     na = w%na; ni = m%nq - na
     call dgesvd('N', 'N', ni, ni, adum, max(ni, 1), sdum, udum, 1, vdum, 1, wq, -1, stf)
     lw = max(1, int(wq(1)), 5 * ni)
-    allocate (c%iv(ni), c%iu(na), c%ub(na), c%px(m%nq), stat=stf)
+    allocate (c%iv(ni), c%iu(na), c%ub(na), c%px(m%nq), c%vw(ni), c%qkeep(m%nq), &
+              c%vkeep(m%nq), stat=stf)
     if (stf == 0 .and. w%solver == SOLVER_DENSE) then
       ! J_u, the QR's copy of J and its workspace, dgecon's
       call dgeqp3(na, m%nq, adum, max(na, 1), c%upiv, sdum, wq, -1, stf)
@@ -1353,34 +1411,40 @@ contains
   end function needs_partition
 
   !> One classical Runge-Kutta step.
-  subroutine rk4_step(m, w, c, t, y, h, yn, k, stf)
+  subroutine rk4_step(m, w, c, t, y, h, yn, k, ys, stf)
     type(model_t), intent(in) :: m
     type(dyn_work_t), intent(inout) :: w
     type(itg_t), intent(inout) :: c
     real(wp), intent(in) :: t, y(:), h
     real(wp), intent(out) :: yn(:)
     real(wp), intent(inout) :: k(:, :)
+    real(wp), intent(inout) :: ys(:)          !! a stage's state (workspace: expressions as
+                                              !! arguments would be heap temporaries)
     integer, intent(out) :: stf
     call rhs(m, w, c, t, y, k(:, 1), stf)
     if (stf /= MBD_OK) return
-    call rhs(m, w, c, t + half * h, y + half * h * k(:, 1), k(:, 2), stf)
+    ys = y + half * h * k(:, 1)
+    call rhs(m, w, c, t + half * h, ys, k(:, 2), stf)
     if (stf /= MBD_OK) return
-    call rhs(m, w, c, t + half * h, y + half * h * k(:, 2), k(:, 3), stf)
+    ys = y + half * h * k(:, 2)
+    call rhs(m, w, c, t + half * h, ys, k(:, 3), stf)
     if (stf /= MBD_OK) return
-    call rhs(m, w, c, t + h, y + h * k(:, 3), k(:, 4), stf)
+    ys = y + h * k(:, 3)
+    call rhs(m, w, c, t + h, ys, k(:, 4), stf)
     if (stf /= MBD_OK) return
     yn = y + h / 6 * (k(:, 1) + 2 * k(:, 2) + 2 * k(:, 3) + k(:, 4))
   end subroutine rk4_step
 
   !> One Dormand-Prince 5(4) step; e is the embedded error estimate. k(:, 1) is reused from
   !! the last stage of the previous step when fsal is true (first same as last).
-  subroutine dopri5_step(m, w, c, t, y, h, yn, k, e, fsal, stf)
+  subroutine dopri5_step(m, w, c, t, y, h, yn, k, e, ys, fsal, stf)
     type(model_t), intent(in) :: m
     type(dyn_work_t), intent(inout) :: w
     type(itg_t), intent(inout) :: c
     real(wp), intent(in) :: t, y(:), h
     real(wp), intent(out) :: yn(:), e(:)
     real(wp), intent(inout) :: k(:, :)
+    real(wp), intent(inout) :: ys(:)          !! a stage's state (workspace)
     logical, intent(inout) :: fsal
     integer, intent(out) :: stf
     stf = MBD_OK
@@ -1388,18 +1452,21 @@ contains
       call rhs(m, w, c, t, y, k(:, 1), stf)
       if (stf /= MBD_OK) return
     end if
-    call rhs(m, w, c, t + C2 * h, y + h * A21 * k(:, 1), k(:, 2), stf)
+    ! the stages' states in ys (expressions as arguments would be heap temporaries)
+    ys = y + h * A21 * k(:, 1)
+    call rhs(m, w, c, t + C2 * h, ys, k(:, 2), stf)
     if (stf /= MBD_OK) return
-    call rhs(m, w, c, t + C3 * h, y + h * (A31 * k(:, 1) + A32 * k(:, 2)), k(:, 3), stf)
+    ys = y + h * (A31 * k(:, 1) + A32 * k(:, 2))
+    call rhs(m, w, c, t + C3 * h, ys, k(:, 3), stf)
     if (stf /= MBD_OK) return
-    call rhs(m, w, c, t + C4 * h, y + h * (A41 * k(:, 1) + A42 * k(:, 2) + A43 * k(:, 3)), &
-             k(:, 4), stf)
+    ys = y + h * (A41 * k(:, 1) + A42 * k(:, 2) + A43 * k(:, 3))
+    call rhs(m, w, c, t + C4 * h, ys, k(:, 4), stf)
     if (stf /= MBD_OK) return
-    call rhs(m, w, c, t + C5 * h, y + h * (A51 * k(:, 1) + A52 * k(:, 2) + A53 * k(:, 3) + &
-             A54 * k(:, 4)), k(:, 5), stf)
+    ys = y + h * (A51 * k(:, 1) + A52 * k(:, 2) + A53 * k(:, 3) + A54 * k(:, 4))
+    call rhs(m, w, c, t + C5 * h, ys, k(:, 5), stf)
     if (stf /= MBD_OK) return
-    call rhs(m, w, c, t + h, y + h * (A61 * k(:, 1) + A62 * k(:, 2) + A63 * k(:, 3) + &
-             A64 * k(:, 4) + A65 * k(:, 5)), k(:, 6), stf)
+    ys = y + h * (A61 * k(:, 1) + A62 * k(:, 2) + A63 * k(:, 3) + A64 * k(:, 4) + A65 * k(:, 5))
+    call rhs(m, w, c, t + h, ys, k(:, 6), stf)
     if (stf /= MBD_OK) return
     yn = y + h * (A71 * k(:, 1) + A73 * k(:, 3) + A74 * k(:, 4) + A75 * k(:, 5) + A76 * k(:, 6))
     call rhs(m, w, c, t + h, yn, k(:, 7), stf)
