@@ -11,11 +11,12 @@ module mbd_assemble
   use mbd_memory, only: REAL_BYTES, mem_fail
   use mbd_points, only: NLOC, MAXROW, kloc
   use mbd_model, only: model_t, model_slots
-  use mbd_constraints, only: con_eval, con_init_extra
+  use mbd_constraints, only: con_eval, con_init_extra, CON_REVOLUTE
+  use mbd_joint_revolute, only: revolute_rows, revolute_gamma
   implicit none
   private
   public :: asm_work_t, asm_init, assemble_blocks, scatter_dense, assemble_dense, init_extras, &
-            gather_local, blocks_jv, blocks_jtv, scatter_values, asm_turn
+            gather_local, blocks_jv, blocks_jtv, scatter_values, asm_turn, assemble_gamma
 
   !> Work arrays of the assembly, allocated once per analysis.
   type :: asm_work_t
@@ -115,6 +116,15 @@ contains
       a%qx(i) = q(i); a%qdx(i) = qd(i)
     end do
     do k = 1, m%nc
+      r0 = m%row0(k)
+      if (m%kind(k) == CON_REVOLUTE) then
+        ! the commonest joint from the bodies' states directly (the rows of revolute_eval)
+        call revolute_rows(m%p(m%po(k)), m%bi(k), m%bj(k), a%qx, a%qdx, a%cb, a%sb, ph, &
+                           a%jb(1, 1, k), ga)
+        phi(r0) = ph(1); phi(r0 + 1) = ph(2); gam(r0) = ga(1); gam(r0 + 1) = ga(2)
+        nu(r0) = zero; nu(r0 + 1) = zero
+        cycle
+      end if
       do s = 1, NLOC                   ! the constraint's slots (zero where it has none)
         x%q(s) = a%qx(m%loc(s, k)); x%qd(s) = a%qdx(m%loc(s, k))
       end do
@@ -124,7 +134,7 @@ contains
       ! each constraint writes whole rows of its block (put_vec, put_scal): no zero fill
       call con_eval(m%kind(k), m%suba(k), m%subb(k), m%p(m%po(k):m%po(k) + m%pn(k) - 1), &
                     si, sj, x, t, ph, a%jb(:, :, k), nv, ga)
-      r0 = m%row0(k); nr = m%nrow(k)
+      nr = m%nrow(k)
       ! row by row (a slice copy of variable length would be three memcpy calls)
       phi(r0) = ph(1); nu(r0) = nv(1); gam(r0) = ga(1)
       if (nr >= 2) then
@@ -135,6 +145,43 @@ contains
       end if
     end do
   end subroutine assemble_blocks
+
+  !> gamma alone at new velocities q_dot and the q of the last assembly (its cos and sin):
+  !! J q_ddot = gamma after J q_dot = nu. The revolutes' rows from their own formula; every
+  !! other constraint evaluated whole (its block of J rewritten with the same values).
+  pure subroutine assemble_gamma(m, q, qd, t, gam, a)
+    type(model_t), intent(in) :: m            !! model
+    real(wp), intent(in) :: q(:)              !! coordinates of the last assembly (nq)
+    real(wp), intent(in) :: qd(:)             !! velocities (nq)
+    real(wp), intent(in) :: t                 !! time
+    real(wp), intent(out) :: gam(:)           !! gamma (neq)
+    type(asm_work_t), intent(inout) :: a      !! work: blocks and body cos, sin
+    type(kloc) :: x
+    real(wp) :: ph(MAXROW), nv(MAXROW), ga(MAXROW)
+    integer :: k, r0, s, i
+    do i = 1, m%nq
+      a%qx(i) = q(i); a%qdx(i) = qd(i)
+    end do
+    do k = 1, m%nc
+      r0 = m%row0(k)
+      if (m%kind(k) == CON_REVOLUTE) then
+        call revolute_gamma(m%p(m%po(k)), m%bi(k), m%bj(k), a%qdx, a%cb, a%sb, ga)
+        gam(r0) = ga(1); gam(r0 + 1) = ga(2)
+        cycle
+      end if
+      do s = 1, NLOC
+        x%q(s) = a%qx(m%loc(s, k)); x%qd(s) = a%qdx(m%loc(s, k))
+      end do
+      x%c(1) = a%cb(m%bi(k)); x%c(2) = a%cb(m%bj(k))
+      x%s(1) = a%sb(m%bi(k)); x%s(2) = a%sb(m%bj(k))
+      call con_eval(m%kind(k), m%suba(k), m%subb(k), m%p(m%po(k):m%po(k) + m%pn(k) - 1), &
+                    merge(1, 0, m%bi(k) > 0), merge(2, 0, m%bj(k) > 0), x, t, ph, &
+                    a%jb(:, :, k), nv, ga)
+      do i = 1, m%nrow(k)
+        gam(r0 + i - 1) = ga(i)
+      end do
+    end do
+  end subroutine assemble_gamma
 
   !> Place the local blocks into a dense J (neq x nq), or J D (D = diag(cs)) with a column
   !! scale, through the map of asm_init.

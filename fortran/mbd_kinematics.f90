@@ -34,7 +34,7 @@ module mbd_kinematics
   use mbd_points, only: NLOC, MAXROW
   use mbd_model, only: model_t
   use mbd_constraints, only: con_is_driver, con_name
-  use mbd_assemble, only: asm_work_t, asm_init, assemble_blocks, assemble_dense, scatter_dense, &
+  use mbd_assemble, only: asm_work_t, asm_init, assemble_blocks, assemble_gamma, assemble_dense, scatter_dense, &
                           init_extras, blocks_jv, blocks_jtv, scatter_values, asm_turn
   use mbd_band, only: band_t, band_plan, band_move, band_zero, band_norm1, band_factor, &
                       band_rcond, band_solve
@@ -83,7 +83,7 @@ module mbd_kinematics
   !! n up to about 1670; larger banded models assemble by damped Newton on the band
   real(wp), parameter :: DENSE_FALLBACK = 64.0_wp * 1048576
   !> a start is taken without a correction when the correction is below RES_ULPS units in the
-  !! last place of every coordinate (of max(|q_i|, 1))
+  !! last place of every coordinate (of max(|q_i|, 1, L |theta|): below_resolution)
   real(wp), parameter :: RES_ULPS = 4.0_wp
   !> what to change when the dense J does not fit
   character(len=*), parameter :: DENSE_HINT = 'the dense solver keeps J as a full matrix: ' // &
@@ -503,7 +503,7 @@ contains
       ! within RES_ULPS units in the last place of each coordinate, so that the positions
       ! keep the accuracy of a correction (quadratic: far below tol), not just tol
       if (it == 0 .and. res <= w%tol) then
-        if (below_resolution(size(q), q, w%dq)) then
+        if (below_resolution(size(q), m%nb, m%lscale, q, w%dq)) then
           ! taken with its correction: J, nu and the factors of the start serve (they differ
           ! in the last places); the angles' cos and sin turned by the correction
           q = q + w%dq
@@ -550,7 +550,7 @@ contains
       w%phi = matmul(w%jac, qd) - w%nu
       return
     end if
-    call assemble_blocks(m, q, qd, t, w%phi, w%nu, w%gam, w%asm, same_q=.true.)
+    call assemble_gamma(m, q, qd, t, w%gam, w%asm)      ! J (its factors) and nu stay
     call solve(w, w%gam, qdd)
     if (w%lsq) then
       if (w%resid > 1.0e-8_wp * (one + maxval(abs(w%gam)))) status = MBD_INCONSISTENT
@@ -1618,16 +1618,26 @@ contains
     end do
   end subroutine velocity_jump
 
-  !> The Newton correction dq is within RES_ULPS units in the last place of each coordinate:
-  !! |dq_i| <= RES_ULPS eps max(|q_i|, 1).
-  pure logical function below_resolution(n, q, dq) result(below)
-    integer, intent(in) :: n
+  !> The Newton correction dq is within RES_ULPS units in the last place of each coordinate
+  !! or of what the angles resolve: a point at distance L from a body's origin moves by
+  !! L ulp(theta) when theta changes by one unit in its last place, so positions are known
+  !! no better than L eps |theta| (L: the model's length scale). With
+  !! ref = max(1, L max_b |theta_b|):  |dq_i| <= RES_ULPS eps max(|q_i|, ref).
+  pure logical function below_resolution(n, nb, lscale, q, dq) result(below)
+    integer, intent(in) :: n, nb
+    real(wp), intent(in) :: lscale
     real(wp), intent(in) :: q(n), dq(n)
     real(wp), parameter :: ULP = RES_ULPS * epsilon(one)
+    real(wp) :: ref
     integer :: i
     below = .false.
+    ref = zero
+    do i = 1, nb
+      ref = max(ref, abs(q(3 * i)))
+    end do
+    ref = max(one, lscale * ref)
     do i = 1, n
-      if (abs(dq(i)) > ULP * max(abs(q(i)), one)) return
+      if (abs(dq(i)) > ULP * max(abs(q(i)), ref)) return
     end do
     below = .true.
   end function below_resolution

@@ -147,7 +147,9 @@ def test_short_or_unwatched_runs_make_the_plain_call(monkeypatch, recorder):
     assert threads == [] and recorder.made == []
     monkeypatch.setattr(P, "_interactive", lambda: True)
     monkeypatch.setattr(P, "DELAY", 0.0)
-    m.kinematics(100.0, 10**5, every=100)          # watched: a thread, and the bar at once
+    # watched: a thread, and the bar once the run outlasts the first poll (10**6 steps,
+    # about 0.5 s; 10**5 steps now end within POLL)
+    m.kinematics(1000.0, 10**6, every=1000)
     assert threads == [1] and len(recorder.made) == 1
 
 
