@@ -15,7 +15,7 @@ from ..description.builder import ModelDescription
 from ..errors import MbdError, RedundantConstraintWarning, SingularPassageWarning
 from ..results.kinematics import KinematicsResult
 from .failures import kinematic_failure, row_names
-from .outputs import finite_part
+from .outputs import finite_part, rows
 from .progress import run_core
 from .sensitivities import attach, check_status, requested, table
 from .settings import (check_memory, check_solver, check_span, output_rows, output_steps,
@@ -52,8 +52,8 @@ def run_kinematics(model: ModelDescription, t_end: float, steps: int, t0: float 
     t = time_grid(t0, t_end, steps, idx)
     npass = int(iinfo[9])
     red_cons, red_rows = row_names(p, model, out.red)
-    res = KinematicsResult(t=t[:n], q=out.q.T[:n].copy(), qd=out.qd.T[:n].copy(),
-                           qdd=out.qdd.T[:n].copy(), body_names=p.body_names,
+    res = KinematicsResult(t=t[:n], q=rows(out.q, n), qd=rows(out.qd, n),
+                           qdd=rows(out.qdd, n), body_names=p.body_names,
                            coordinate_names=p.coordinate_names,
                            stats={"newton_corrections": int(iinfo[5]),
                                   "factorizations": int(iinfo[6]),

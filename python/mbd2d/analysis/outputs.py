@@ -20,6 +20,16 @@ ROW_FIELDS = ("t", "q", "qd", "qdd", "lam", "kinetic", "potential", "drift_posit
               "drift_velocity", "elements", "dq_dp", "dqd_dp", "dqdd_dp", "dlam_dp")
 
 
+def rows(a: np.ndarray, n: int) -> np.ndarray:
+    """The first n output rows of a core array whose columns are the outputs.
+
+    A view when every column is kept (the transpose of f2py's Fortran-order array is
+    C-contiguous: no copy of a long run), a copy of the part otherwise (the unused tail is
+    not kept alive).
+    """
+    return a.T if n == a.shape[-1] else a.T[:n].copy()
+
+
 def dynamics_result(model: ModelDescription, p: Packed, t: np.ndarray, n: int, out: Any,
                     stats: dict[str, Any], complete: bool) -> DynamicsResult:
     """The first n output rows of an inverse or forward dynamics run (``out`` from
@@ -31,10 +41,10 @@ def dynamics_result(model: ModelDescription, p: Packed, t: np.ndarray, n: int, o
         eo = np.zeros((6, len(names), max(n, 0)))
     contacts, friction = (events_from(out.evo, int(out.nev), names) if hasattr(out, "evo")
                           else ([], []))
-    return DynamicsResult(t=t[:n], q=out.q.T[:n].copy(), qd=out.qd.T[:n].copy(),
-                          qdd=out.qdd.T[:n].copy(), body_names=p.body_names,
+    return DynamicsResult(t=t[:n], q=rows(out.q, n), qd=rows(out.qd, n),
+                          qdd=rows(out.qdd, n), body_names=p.body_names,
                           coordinate_names=p.coordinate_names, stats=stats, complete=complete,
-                          model=model, lam=out.lam.T[:n].copy(), kinetic=e[0, :n].copy(),
+                          model=model, lam=rows(out.lam, n), kinetic=e[0, :n].copy(),
                           potential=e[1, :n].copy(), drift_position=e[2, :n].copy(),
                           drift_velocity=e[3, :n].copy(), row_labels=p.row_labels, packed=p,
                           elements=element_arrays(eo, n), element_names=names,
@@ -49,6 +59,9 @@ def first_nonfinite_row(*arrays: np.ndarray) -> int | None:
         a = np.asarray(a)
         if a.size == 0:
             continue
+        with np.errstate(over="ignore", invalid="ignore"):
+            if np.isfinite(a.sum()):    # a finite sum: every entry is finite (a fast test)
+                continue
         rows = ~np.isfinite(a.reshape(a.shape[0], -1)).all(axis=1)
         if rows.any():
             k = int(np.argmax(rows))
