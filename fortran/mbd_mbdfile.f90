@@ -21,7 +21,8 @@
 !!   labels <neq>
 !!   <neq row labels NAME.WORD, any number per line>
 !!   forces <nf>
-!!   <name> <kind> <body i> <body j> <offset> <length>                  (nf lines)
+!!   <name> <kind> <body i> <body j> <offset> <length> [<joint>]        (nf lines; the
+!!                              contacts and joint frictions too: <joint> is a friction's joint)
 !!   fparams <np>
 !!   <np reals>
 !!   end
@@ -105,7 +106,7 @@ contains
     type(mbd_spec_t), intent(out) :: spec       !! contents
     integer, intent(out) :: status              !! MBD_OK, MBD_BAD_INPUT or MBD_NO_MEMORY
     character(len=MSG_LEN), intent(out) :: msg  !! what is wrong
-    integer :: u, ios, lineno, i, k, ierr, ndata, nread, ntok, pos, n
+    integer :: u, ios, lineno, i, k, ierr, ndata, nread, ntok, pos, n, ntf
     integer(int64) :: chars_left, big
     character(len=LINE_LEN) :: line
     character(len=NAME_LEN) :: key
@@ -333,7 +334,7 @@ contains
           call fail('"constraints" is given twice'); exit
         end if
         seen_c = .true.
-        if (.not. count_ok(n, 'constraint', 1)) exit
+        if (.not. count_ok(n, 'constraint', 0)) exit
         spec%nc = n
         call mem_check(real(n, wp) * (NAME_LEN + 4 * NCT + 4), 'the constraints', &
                        'give fewer constraints', status, msg)
@@ -481,13 +482,15 @@ contains
         do i = 1, n
           call next_line(ios)
           if (ios /= 0) exit
-          if (count_tokens(line) /= NFT) then
-            call fail('bad force line: NAME KIND BODY_I BODY_J OFFSET LENGTH expected'); exit
+          ntf = count_tokens(line)
+          if (ntf /= NFT .and. ntf /= NFT + 1) then
+            call fail('bad force line: NAME KIND BODY_I BODY_J OFFSET LENGTH [JOINT] '// &
+                      'expected'); exit
           end if
           pos = 1
           call next_token(line, pos, tok)
           spec%force_names(i) = tok(1:NAME_LEN)
-          do k = 1, NFT - 1
+          do k = 1, ntf - 1          ! JOINT (column NFT): a joint friction's constraint
             call next_token(line, pos, tok)
             if (.not. read_int(tok, big)) then
               call fail('"' // trim(tok) // '" is not a whole number'); exit

@@ -108,17 +108,6 @@ def test_sensitivities_refuse_contacts():
         m.dynamics(0.1, 10, sensitivities=["ball.mass"])
 
 
-def test_export_for_mbd2d_solve_refuses_contacts_and_friction(tmp_path):
-    """The .mbd file holds no contacts or joint friction: exporting a dynamic analysis of
-    such a model is a ModelError naming them."""
-    ex = Path(__file__).resolve().parents[1] / "examples"
-    m = mbd2d.load(ex / "cam_liftoff.toml")
-    for analysis, kw in (("dynamics", {"t_end": 0.05, "steps": 10}), ("statics", {})):
-        with pytest.raises(mbd2d.ModelError, match="no contacts or joint friction"):
-            m.export(tmp_path / "c.mbd", analysis=analysis, **kw)
-    assert not (tmp_path / "c.mbd").exists()
-
-
 def test_sweeps_carry_contacts():
     """A dynamics sweep of a model with a contact gives each case exactly as the variant run
     alone (the batch passes the contact outputs and events through)."""

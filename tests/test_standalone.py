@@ -1,6 +1,7 @@
 """The standalone executable mbd2d-solve reproduces the Python path from an exported file."""
 from __future__ import annotations
 
+import math
 import os
 import re
 import shutil
@@ -15,6 +16,7 @@ import pytest
 
 import mbd2d
 from mbd2d.description import joints as J
+from mbd2d.description.contacts import CONTACT_TYPES
 from mbd2d.description.forces import FORCE_KEYS
 from mbd2d.results import read_csv
 
@@ -104,7 +106,8 @@ def test_missing_file(tmp_path: Path, solver: str) -> None:
 
 
 # ----------------------------------------------------------------------------- every analysis
-from mbd2d.analysis.mbdfile import DRIVER_KINDS, FORCE_KINDS, JOINT_KINDS  # noqa: E402
+from mbd2d.analysis.mbdfile import (DRIVER_KINDS, ELEMENT_KINDS, FORCE_KINDS,  # noqa: E402
+                                    JOINT_KINDS)
 
 ALL = ["energy", "multipliers", "reactions", "efforts"]
 
@@ -210,6 +213,61 @@ def test_partial_results_of_every_analysis_match(tmp_path: Path, solver: str) ->
     assert out.read_text() == py.read_text()
 
 
+def contact_models() -> list[tuple[str, mbd2d.Model]]:
+    """A cam whose follower lifts off (follower-profile contact), a ball bouncing on the floor
+    and against a wall disc (circle-line, circle-circle, contact friction), a pin with
+    clearance (circle-in-circle), a pendulum with a rubbing pin and a block on a rough guide
+    (joint friction, stick-slip and regularized)."""
+    law = {"model": "hunt-crossley", "stiffness": 1e6, "restitution": 0.8}
+    ball = mbd2d.Model("ball")
+    ball.add_body("ball", q0=[0.0, 0.3, 0.0], mass=1.0, inertia=0.004, v0=[1.0, 0.0, 0.0])
+    ball.add_body("disc", q0=[0.6, 0.1, 0.0], mass=2.0, inertia=0.02)
+    ball.add_contact("circle-line", ["ball", "ground"], name="floor",
+                     circle={"center": [0, 0], "radius": 0.1},
+                     line={"point": [0, 0], "normal": [0, 1]}, law=law,
+                     friction={"mu": 0.3})
+    ball.add_contact("circle-circle", ["ball", "disc"], name="hit",
+                     circle=[{"center": [0, 0], "radius": 0.1},
+                             {"center": [0, 0], "radius": 0.1}], law=law)
+    ball.add_contact("circle-line", ["disc", "ground"], name="rest",
+                     circle={"center": [0, 0], "radius": 0.1},
+                     line={"point": [0, 0], "normal": [0, 1]}, law=law)
+    pin = mbd2d.Model("clearance")
+    pin.add_body("arm", q0=[0.5, 0.0, 0.0], mass=1.0, inertia=0.02)
+    pin.add_contact("circle-in-circle", ["arm", "ground"], name="pin",
+                    circle=[{"center": [-0.5, 0.0], "radius": 0.02},
+                            {"center": [0.0, 0.0], "radius": 0.021}], law=law)
+    pend = mbd2d.Model("rubbing")
+    pend.add_body("bob", q0=[0.5 * math.sin(1.0), -0.5 * math.cos(1.0), 1.0], mass=1.0,
+                  inertia=0.0)
+    pend.add_revolute(["ground", "bob"], [[0, 0], [0, 0.5]], name="pin",
+                      friction={"mu": 0.3, "mu_static": 0.35, "pin_radius": 0.05,
+                                "model": "stick-slip"})
+    block = mbd2d.Model("guide")
+    block.add_body("block", q0=[0.0, 0.0, 0.0], mass=2.0, inertia=0.1, v0=[1.0, 0.0, 0.0])
+    block.add_translational(["ground", "block"], [[0, 0], [0, 0]], [[1, 0], [1, 0]],
+                            name="slide", friction={"mu": 0.2})
+    return [("cam", mbd2d.load(EX / "cam_liftoff.toml")), ("ball", ball), ("pin", pin),
+            ("pendulum", pend), ("block", block)]
+
+
+@pytest.mark.parametrize("k", range(5))
+def test_contacts_and_friction_run_in_mbd2d_solve(tmp_path: Path, solver: str, k: int) -> None:
+    """Every contact type and joint friction goes through the file: mbd2d-solve writes the
+    Python run's CSV, every column, in dynamics (dopri5 and generalized-alpha where the
+    model allows), and statics and inverse dynamics where the model has them."""
+    name, model = contact_models()[k]
+    methods = ["dopri5"] if name == "pendulum" else ["dopri5", "generalized-alpha"]
+    for method in methods:
+        res = model.dynamics(t_end=0.3, steps=30, method=method)
+        solve_and_compare(tmp_path, solver, model, res, f"{name}_{method}", t_end=0.3,
+                          steps=30, analysis="dynamics", method=method, outputs=ALL)
+    if name == "pin":
+        res = model.statics()
+        solve_and_compare(tmp_path, solver, model, res, f"{name}_statics", analysis="statics",
+                          outputs=["multipliers", "reactions", "efforts"])
+
+
 def test_header_lists_every_kind_and_the_docs_describe_them(tmp_path: Path) -> None:
     """The file's header and docs/mbd-format.md name every joint, driver and force kind the
     format holds, with its code."""
@@ -218,10 +276,11 @@ def test_header_lists_every_kind_and_the_docs_describe_them(tmp_path: Path) -> N
     text = mbd.read_text()
     doc = (ROOT / "docs" / "mbd-format.md").read_text()
     types = set(J.joint_keys()) | {"absolute driver", "relative-angle driver",
-                                   "relative-distance driver"} | set(FORCE_KEYS)
-    listed = {t for _, t, _ in JOINT_KINDS + DRIVER_KINDS + FORCE_KINDS}
+                                   "relative-distance driver"} | set(FORCE_KEYS) | \
+        set(CONTACT_TYPES) | {"friction"}
+    listed = {t for _, t, _ in JOINT_KINDS + DRIVER_KINDS + FORCE_KINDS + ELEMENT_KINDS}
     assert listed == types
-    for code, kind, _ in JOINT_KINDS + DRIVER_KINDS + FORCE_KINDS:
+    for code, kind, _ in JOINT_KINDS + DRIVER_KINDS + FORCE_KINDS + ELEMENT_KINDS:
         assert f"{code} {kind}" in text, kind
         assert f"| {code} | `{kind}` |" in doc, kind
     for key in ("analysis", "every", "method", "rtol", "max_steps", "outputs", "gravity",

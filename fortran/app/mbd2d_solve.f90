@@ -4,8 +4,9 @@
 !! Runs the file's analysis (kinematics, inverse dynamics, dynamics or statics, with its
 !! settings) and writes the CSV the Python path writes for it: t, then NAME.x ... NAME.theta_ddot
 !! per body (statics: NAME.x, NAME.y, NAME.theta, stable, residual), then the optional columns
-!! the file's "outputs" line asks for (energy, multipliers, reactions, efforts), every number
-!! as Python's "%.16e" (docs/mbd-format.md).
+!! the file's "outputs" line asks for (energy, multipliers, reactions, efforts), then each
+!! contact's and joint friction's columns (dynamic runs), every number as Python's "%.16e"
+!! (docs/mbd-format.md).
 !! Exit codes: 0 ok, 2 bad input (a malformed file, or counts too large for the memory),
 !! 3 singular configuration (partial output written), 4 other numerical failure (partial
 !! output written when there is any). Messages go to standard error, each starting
@@ -25,6 +26,7 @@ program mbd2d_solve
   use mbd_kinematics, only: MAXPASS, kin_out_count
   use mbd_integrators, only: output_index
   use mbd_contact, only: NEO
+  use mbd_forces, only: force_is_contact, FRC_FRICTION
   use iso_c_binding, only: c_char, c_double, c_int
   implicit none
   interface
@@ -48,7 +50,7 @@ program mbd2d_solve
   real(wp) :: evo(4, 1)
   integer :: nev
   integer, allocatable :: dep(:), redundant(:), ftab(:, :)
-  logical :: dynamic
+  logical :: dynamic, elements
 
   if (command_argument_count() /= 2) then
     if (command_argument_count() == 1) then
@@ -101,8 +103,9 @@ program mbd2d_solve
             eout(4, merge(nrows, 1, dynamic)), stat=ierr)
   if (ierr == 0) allocate (qout(nq, nrows), qdout(nq, nrows), qddout(nq, nrows), stat=ierr)
   if (ierr == 0) allocate (ftab(NFT, spec%nf), fpar(max(1, size(spec%fpar))), stat=ierr)
-  if (ierr == 0) allocate (eo(NEO, spec%nf, merge(nrows, 0, spec%analysis == 'dynamics')), &
-                           stat=ierr)
+  ! the outputs of the force elements (contacts, joint frictions): dynamic runs over time
+  elements = spec%analysis == 'dynamics' .or. spec%analysis == 'inverse-dynamics'
+  if (ierr == 0) allocate (eo(NEO, spec%nf, merge(nrows, 0, elements)), stat=ierr)
   if (ierr /= 0) call die(2, trim(model_path) // ':' // trim(itoa(spec%steps_line)) // &
                           ': not enough memory for the outputs of ' // trim(itoa(spec%steps)) // &
                           ' steps; give fewer steps')
@@ -125,7 +128,7 @@ program mbd2d_solve
     call api_inverse(spec%nb, spec%ctab, spec%rpar, spec%bmass, spec%grav, ftab, fpar, q0, &
                      spec%t0, spec%t_end, spec%steps, spec%tol, spec%every, spec%solver, qout, &
                      qdout, qddout, lamout, eout, iinfo, rinfo, qsing, dep, redundant, tpass, &
-                     status, msg)
+                     status, msg, eo=eo, evo=evo, nev=nev)
     nout = iinfo(1)
   case ('dynamics')
     call api_dynamics(spec%nb, spec%ctab, spec%rpar, spec%bmass, spec%grav, ftab, fpar, q0, &
@@ -285,12 +288,17 @@ contains
       'fy_j', 'mz_j']
     character(len=*), parameter :: ew(5) = [character(len=16) :: 'kinetic', 'potential', &
       'energy', 'drift_position', 'drift_velocity']
+    ! each contact's and joint friction's columns (the Python table's, always written)
+    character(len=*), parameter :: cw(4) = [character(len=16) :: 'normal_force', &
+      'friction_force', 'penetration', 'sliding_speed']
+    character(len=*), parameter :: fw(3) = [character(len=16) :: 'normal_load', &
+      'friction_force', 'sliding_speed']
     real(wp), allocatable :: v(:)
     logical :: st
     character(len=32) :: word
     integer :: nw
     st = spec%analysis == 'statics'
-    ncols = 1 + merge(5, 9, st) * spec%nb + 5 + neq + 6 * spec%nc + spec%nc
+    ncols = 1 + merge(5, 9, st) * spec%nb + 5 + neq + 6 * spec%nc + spec%nc + 4 * spec%nf
     allocate (v(ncols), stat=ierr)
     if (ierr /= 0) call die(2, 'not enough memory to write ' // path)
     open (newunit=u, file=path, status='replace', action='write', iostat=ios)
@@ -328,6 +336,19 @@ contains
       do c = 1, spec%nc
         if (con_is_driver(spec%ctab(1, c))) &
           call put(u, ios, ',' // trim(spec%con_names(c)) // '.effort')
+      end do
+    end if
+    if (elements) then
+      do c = 1, spec%nf
+        if (force_is_contact(spec%ftab(1, c))) then
+          do i = 1, 4
+            call put(u, ios, ',' // trim(spec%force_names(c)) // '.' // trim(cw(i)))
+          end do
+        else if (spec%ftab(1, c) == FRC_FRICTION) then
+          do i = 1, 3
+            call put(u, ios, ',' // trim(spec%force_names(c)) // '.' // trim(fw(i)))
+          end do
+        end if
       end do
     end if
     if (ios == 0) write (u, '(a)', iostat=ios) ''
@@ -397,6 +418,15 @@ contains
           v(n + 1) = -lamout(r0, k); n = n + 1
         end if
         r0 = r0 + nr
+      end do
+    end if
+    if (elements) then
+      do c = 1, spec%nf
+        if (force_is_contact(spec%ftab(1, c))) then
+          v(n + 1:n + 4) = eo(1:4, c, k); n = n + 4
+        else if (spec%ftab(1, c) == FRC_FRICTION) then
+          v(n + 1) = eo(1, c, k); v(n + 2) = eo(2, c, k); v(n + 3) = eo(4, c, k); n = n + 3
+        end if
       end do
     end if
   end subroutine row_values

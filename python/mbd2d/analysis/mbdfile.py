@@ -14,8 +14,10 @@ from typing import Any, Sequence
 from ..binding.pack import pack, pack_dynamics
 from ..binding.tables import NCT, NFT
 from ..description.builder import ModelDescription
+from ..description.contacts import CONTACT_TYPES
 from ..description.drivers import AbsoluteDriver, RelativeAngleDriver, RelativeDistanceDriver
 from ..description.forces import PointForce, RotationalSpring, Spring, Torque
+from ..description.friction import FRICTION_KIND
 from ..description.joints import (Absolute, Cam, Distance, Gear, PinInSlot, PointOnCurve,
                                   PointOnLine, RackPinion, Revolute, RollingDisc, Translational,
                                   Weld)
@@ -53,6 +55,19 @@ FORCE_KINDS = [(Spring.kind, "spring", "s_i(2) s_j(2) stiffness damping length0 
                (Torque.kind, "torque", "f(t)"),
                (PointForce.kind, "point", "s(2) fx(t) fy(t)"),
                (RotationalSpring.kind, "rotational-spring", "stiffness damping angle0 f(t)")]
+_LAW = "law k n e mu mu_s threshold (law: 1 linear 2 hertz 3 hunt-crossley " \
+       "4 lankarani-nikravesh 5 flores)"
+#: the contacts and the joint frictions, force elements after the forces (JOINT: the
+#: friction's constraint number, the seventh column of its force line)
+ELEMENT_KINDS = [
+    (CONTACT_TYPES["circle-line"], "circle-line", f"{_LAW} circle(3) point(2) normal(2)"),
+    (CONTACT_TYPES["circle-circle"], "circle-circle", f"{_LAW} circle_i(3) circle_j(3)"),
+    (CONTACT_TYPES["circle-in-circle"], "circle-in-circle", f"{_LAW} pin(3) hole(3)"),
+    (CONTACT_TYPES["follower-profile"], "follower-profile",
+     f"{_LAW} follower code(1) follower(4) profile code(1) profile (as cam)"),
+    (FRICTION_KIND, "friction", "mu mu_s model (0 regularized, 1 stick-slip) threshold "
+                                "pin_radius; JOINT its joint"),
+]
 
 
 def header() -> str:
@@ -88,11 +103,13 @@ def header() -> str:
     lines += [
         "#        f(t) = np c0 .. c_{np-1} nh (A omega phase) x nh",
         "#   labels NEQ, then NEQ words   NAME.WORD of each row of Phi (multiplier columns)",
-        "#   forces NF, then NF lines     NAME KIND BODY_I BODY_J OFFSET LENGTH",
+        "#   forces NF, then NF lines     NAME KIND BODY_I BODY_J OFFSET LENGTH [JOINT]",
         "#        KIND (forces): " + ", ".join(f"{k} {t}" for k, t, _ in FORCE_KINDS),
+        "#        KIND (contacts, joint friction): "
+        + ", ".join(f"{k} {t}" for k, t, _ in ELEMENT_KINDS),
         "#   fparams NP, then NP reals    per force kind:",
     ]
-    for k, t, d in FORCE_KINDS:
+    for k, t, d in FORCE_KINDS + ELEMENT_KINDS:
         lines.append(f"#        {k:3d} {t:24s} {d}")
     lines.append("#   end")
     return "\n".join(lines)
@@ -142,11 +159,6 @@ def export(model: ModelDescription, path: str | Path, t_end: float | None = None
         raise ModelError(f"unknown analysis {analysis!r}; use one of {', '.join(ANALYSES)}",
                          "export")
     words = _outputs(outputs, analysis)
-    held = [name for name, what, _ in model.force_elements() if what != "force"]
-    if held and analysis != "kinematics":
-        raise ModelError(f"the .mbd file of mbd2d-solve holds no contacts or joint friction "
-                         f"({', '.join(held)}); run this model from Python or the mbd2d "
-                         "command", "export")
     p = pack(model)
     lines = [header(), f"mbd2d {FORMAT}",
              f"name {model.name.replace(' ', '_') or 'model'}", f"analysis {analysis}"]
@@ -191,8 +203,9 @@ def export(model: ModelDescription, path: str | Path, t_end: float | None = None
         lines.append(" ".join(p.row_labels[i:i + 6]))
     if dyn is not None:
         lines.append(f"forces {dyn.ftab.shape[1]}")
-        for k, f in enumerate(model.forces):
-            lines.append(f"{f.name} " + " ".join(str(int(v)) for v in dyn.ftab[:NFT - 1, k]))
+        for k, (name, _, _) in enumerate(model.force_elements()):
+            col = dyn.ftab[:, k] if dyn.ftab[NFT - 1, k] else dyn.ftab[:NFT - 1, k]
+            lines.append(f"{name} " + " ".join(str(int(v)) for v in col))
         lines += _reals("fparams", dyn.fpar)
     lines.append("end")
     write_text(path, "\n".join(lines) + "\n", "export")
