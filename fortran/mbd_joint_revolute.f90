@@ -12,7 +12,7 @@ module mbd_joint_revolute
   implicit none
   private
   public :: revolute_prepare, revolute_eval, revolute_eval_d, revolute_rows, &
-            revolute_gamma
+            revolute_gamma, revolute_second, revolute_param
 
 contains
 
@@ -130,5 +130,65 @@ contains
       gam(2) = gam(2) - (s(bj) * p(3) + c(bj) * p(4)) * w2
     end if
   end subroutine revolute_gamma
+
+  !> Second derivatives for the sensitivity equations, in closed form (the rows of
+  !! revolute_eval_d along d theta_i and d theta_j): for side 1 (body i, theta slot 3) and
+  !! side 2 (body j, slot 6), with u_i = A_i s'_i, u_j = A_j s'_j,
+  !!   dJ(:, 3)/dtheta_i = -u_i,           dgamma/dtheta_i = B_i s'_i thd_i**2 = perp(u_i) thd_i**2
+  !!   dJ(:, 6)/dtheta_j = +u_j,           dgamma/dtheta_j = -perp(u_j) thd_j**2
+  !! and hv = (dJ/dtheta) q_dot, ha = (dJ/dtheta) q_ddot - dgamma/dtheta (mbd_sensitivity).
+  !! The sides of ground are not written.
+  pure subroutine revolute_second(p, gi, gj, ci, si, wi, ai, cj, sj, wj, aj, hcol, hv, ha)
+    real(wp), intent(in) :: p(4)            !! [s'_i, s'_j]
+    logical, intent(in) :: gi, gj           !! body i, body j moves
+    real(wp), intent(in) :: ci, si, wi, ai  !! body i: cos, sin, theta_dot, theta_ddot
+    real(wp), intent(in) :: cj, sj, wj, aj  !! body j: the same
+    real(wp), intent(inout) :: hcol(2, 2)   !! d(theta column of J)/dtheta, per side
+    real(wp), intent(inout) :: hv(2, 2), ha(2, 2)  !! per side
+    real(wp) :: ux, uy
+    if (gi) then
+      ux = ci * p(1) - si * p(2); uy = si * p(1) + ci * p(2)
+      hcol(1, 1) = -ux; hcol(2, 1) = -uy
+      hv(1, 1) = -ux * wi; hv(2, 1) = -uy * wi
+      ha(1, 1) = -ux * ai + uy * wi**2; ha(2, 1) = -uy * ai - ux * wi**2
+    end if
+    if (gj) then
+      ux = cj * p(3) - sj * p(4); uy = sj * p(3) + cj * p(4)
+      hcol(1, 2) = ux; hcol(2, 2) = uy
+      hv(1, 2) = ux * wj; hv(2, 2) = uy * wj
+      ha(1, 2) = ux * aj - uy * wj**2; ha(2, 2) = uy * aj + ux * wj**2
+    end if
+  end subroutine revolute_second
+
+  !> The parameter parts for a change tp of [s'_i, s'_j] in closed form (revolute_eval_d
+  !! with dq = 0; the rows are linear in s', so p itself does not enter): with u = A t s' and v = B t s' = perp(u) of each moving body,
+  !!   Phi_p = u_i - u_j  (a ground point: its change itself),
+  !!   nu_p - J_p q_dot = -v_i thd_i + v_j thd_j,
+  !!   gamma_p - J_p q_ddot = u_i thd_i**2 - v_i thdd_i - u_j thd_j**2 + v_j thdd_j.
+  pure subroutine revolute_param(tp, gi, gj, ci, si, wi, ai, cj, sj, wj, aj, tphi, vp, ap)
+    real(wp), intent(in) :: tp(4)           !! change of [s'_i, s'_j]
+    logical, intent(in) :: gi, gj           !! body i, body j moves
+    real(wp), intent(in) :: ci, si, wi, ai  !! body i: cos, sin, theta_dot, theta_ddot
+    real(wp), intent(in) :: cj, sj, wj, aj  !! body j: the same
+    real(wp), intent(out) :: tphi(2), vp(2), ap(2)
+    real(wp) :: ux, uy
+    tphi = zero; vp = zero; ap = zero
+    if (gi) then
+      ux = ci * tp(1) - si * tp(2); uy = si * tp(1) + ci * tp(2)
+      tphi(1) = ux; tphi(2) = uy
+      vp(1) = uy * wi; vp(2) = -ux * wi                            ! -perp(u) thd
+      ap(1) = ux * wi**2 + uy * ai; ap(2) = uy * wi**2 - ux * ai   ! u thd**2 - perp(u) thdd
+    else
+      tphi(1) = tp(1); tphi(2) = tp(2)
+    end if
+    if (gj) then
+      ux = cj * tp(3) - sj * tp(4); uy = sj * tp(3) + cj * tp(4)
+      tphi(1) = tphi(1) - ux; tphi(2) = tphi(2) - uy
+      vp(1) = vp(1) - uy * wj; vp(2) = vp(2) + ux * wj
+      ap(1) = ap(1) - ux * wj**2 - uy * aj; ap(2) = ap(2) - uy * wj**2 + ux * aj
+    else
+      tphi(1) = tphi(1) - tp(3); tphi(2) = tphi(2) - tp(4)
+    end if
+  end subroutine revolute_param
 
 end module mbd_joint_revolute

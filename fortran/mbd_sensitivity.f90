@@ -27,7 +27,8 @@ module mbd_sensitivity
   use mbd_model, only: model_t, NCT, NFT
   use mbd_constraints, only: con_eval_d, con_prepare_d, con_is_count, con_name, con_linear, &
                              con_affine_r, con_exponents, &
-                             CON_TRANSLATIONAL, DRV_REL_DIST
+                             CON_TRANSLATIONAL, DRV_REL_DIST, CON_REVOLUTE
+  use mbd_joint_revolute, only: revolute_second, revolute_param
   use mbd_forces, only: force_eval_d, force_is_count, force_exponents
   implicit none
   private
@@ -295,6 +296,10 @@ contains
     do k = 1, m%nc
       if (con_linear(m%kind(k))) cycle          ! blocks stay zero (sens_setup)
       s%curved = .true.
+      if (m%kind(k) == CON_REVOLUTE) then       ! the commonest joint in closed form
+        call revolute_blocks(m, s, k, qd, qdd)
+        cycle
+      end if
       call gather(m, s, k, q, qd, qdd, x, qddl)
       si = merge(1, 0, m%bi(k) > 0); sj = merge(2, 0, m%bj(k) > 0)
       nr = m%nrow(k)
@@ -318,6 +323,34 @@ contains
     end do
   end subroutine sens_hessian
 
+  !> Revolute k: only the theta slots (3, 6) have second derivatives (revolute_second).
+  pure subroutine revolute_blocks(m, s, kk, qd, qdd)
+    type(model_t), intent(in) :: m              !! model
+    type(sens_t), intent(inout) :: s            !! blocks (out; cos and sin from sens_trig)
+    integer, intent(in) :: kk                  !! the revolute (constraint index)
+    real(wp), intent(in) :: qd(:), qdd(:)       !! velocities and accelerations
+    real(wp) :: hcol(2, 2), hvv(2, 2), haa(2, 2)
+    integer :: bi, bj, side, slot, rr
+    bi = m%bi(kk); bj = m%bj(kk)
+    call revolute_second(m%p(m%po(kk)), bi > 0, bj > 0, s%cb(bi), s%sb(bi), &
+                         qd(max(3 * bi, 1)), qdd(max(3 * bi, 1)), s%cb(bj), s%sb(bj), &
+                         qd(max(3 * bj, 1)), qdd(max(3 * bj, 1)), hcol, hvv, haa)
+    do side = 1, 2
+      slot = 3 * side
+      if (m%loc(slot, kk) == 0) cycle
+      s%hs(1:2, :, slot, kk) = zero
+      s%hs(1:2, slot, slot, kk) = hcol(:, side)
+      do rr = 1, 2
+        s%hv(rr, slot, kk) = hvv(rr, side); s%ha(rr, slot, kk) = haa(rr, side)
+        if (abs(hvv(rr, side)) > zero .or. abs(haa(rr, side)) > zero) then
+          s%nnz = s%nnz + 1
+          s%nzr(s%nnz) = m%row0(kk) + rr - 1; s%nzc(s%nnz) = m%loc(slot, kk)
+          s%nzv(s%nnz) = hvv(rr, side); s%nza(s%nnz) = haa(rr, side)
+        end if
+      end do
+    end do
+  end subroutine revolute_blocks
+
   !> Parameter parts at (q, q_dot, q_ddot, t): Phi_p, nu_p - J_p q_dot and
   !! gamma_p - J_p q_ddot, each a column per parameter (zero rows for unaffected
   !! constraints), from the dual evaluation along the parameter's change (dq = 0).
@@ -332,6 +365,10 @@ contains
     s%phip = zero; s%vp = zero; s%ap = zero
     do c = 1, m%nc
       if (.not. any(s%caff(c, :))) cycle
+      if (m%kind(c) == CON_REVOLUTE) then       ! the commonest joint in closed form
+        call revolute_parts(m, s, c, qd, qdd)
+        cycle
+      end if
       call gather(m, s, c, q, qd, qdd, x, qddl)
       si = merge(1, 0, m%bi(c) > 0); sj = merge(2, 0, m%bj(c) > 0)
       nr = m%nrow(c); r0 = m%row0(c) - 1
@@ -348,6 +385,26 @@ contains
       end do
     end do
   end subroutine sens_params
+
+  !> Revolute cc: Phi_p, nu_p - J_p q_dot, gamma_p - J_p q_ddot (revolute_param).
+  pure subroutine revolute_parts(m, s, cc, qd, qdd)
+    type(model_t), intent(in) :: m              !! model
+    type(sens_t), intent(inout) :: s            !! blocks (out; cos and sin from sens_trig)
+    integer, intent(in) :: cc                  !! the revolute (constraint index)
+    real(wp), intent(in) :: qd(:), qdd(:)       !! velocities and accelerations
+    real(wp) :: ph(2), vv(2), aa(2)
+    integer :: bi, bj, kk, rr, q0
+    bi = m%bi(cc); bj = m%bj(cc); q0 = m%row0(cc) - 1
+    do kk = 1, s%np
+      if (.not. s%caff(cc, kk)) cycle
+      call revolute_param(s%tp(m%po(cc), kk), bi > 0, bj > 0, s%cb(bi), s%sb(bi), &
+                          qd(max(3 * bi, 1)), qdd(max(3 * bi, 1)), s%cb(bj), s%sb(bj), &
+                          qd(max(3 * bj, 1)), qdd(max(3 * bj, 1)), ph, vv, aa)
+      do rr = 1, 2
+        s%phip(kk, q0 + rr) = ph(rr); s%vp(kk, q0 + rr) = vv(rr); s%ap(kk, q0 + rr) = aa(rr)
+      end do
+    end do
+  end subroutine revolute_parts
 
   !> Changes of Phi, nu, gamma (neq) and of the local J blocks (MAXROW, NLOC, nc) along a
   !! direction (dq, dq_dot) and parameter k (k = 0: none): every constraint evaluated on
@@ -469,28 +526,52 @@ contains
     integer, intent(in) :: level             !! 1 position, 2 velocity, 3 acceleration
     real(wp), intent(in) :: sq(:, :), sqd(:, :)  !! s and s_dot (nq, np), as far as known
     real(wp), intent(inout) :: rhs(:, :)     !! (np or more, neq): rows 1 .. np written
+    call kin_rhs_kernel(level, s%np, size(rhs, 1), size(rhs, 2), size(sq, 1), s%nnz, &
+                        s%nzr, s%nzc, s%nzv, s%nza, s%phip, s%vp, s%ap, sq, sqd, rhs)
+  end subroutine sens_kin_rhs
+
+  !> sens_kin_rhs on explicit shapes (the loops see plain arrays).
+  pure subroutine kin_rhs_kernel(level, np, npad, neq, nq, nnz, nzr, nzc, nzv, nza, phip, vp, &
+                                 ap, sq, sqd, rhs)
+    integer, intent(in) :: level, np, npad, neq, nq, nnz
+    integer, intent(in) :: nzr(*), nzc(*)
+    real(wp), intent(in) :: nzv(*), nza(*), phip(np, neq), vp(np, neq), ap(np, neq)
+    real(wp), intent(in) :: sq(nq, np), sqd(nq, np)
+    real(wp), intent(inout) :: rhs(npad, neq)
     integer :: i, n, r, c
     select case (level)
     case (1)
-      rhs(1:s%np, :) = -s%phip
+      do r = 1, neq
+        do i = 1, np
+          rhs(i, r) = -phip(i, r)
+        end do
+      end do
     case (2)
-      rhs(1:s%np, :) = s%vp
-      do n = 1, s%nnz
-        r = s%nzr(n); c = s%nzc(n)
-        do i = 1, s%np
-          rhs(i, r) = rhs(i, r) - s%nzv(n) * sq(c, i)
+      do r = 1, neq
+        do i = 1, np
+          rhs(i, r) = vp(i, r)
+        end do
+      end do
+      do n = 1, nnz
+        r = nzr(n); c = nzc(n)
+        do i = 1, np
+          rhs(i, r) = rhs(i, r) - nzv(n) * sq(c, i)
         end do
       end do
     case default
-      rhs(1:s%np, :) = s%ap
-      do n = 1, s%nnz
-        r = s%nzr(n); c = s%nzc(n)
-        do i = 1, s%np
-          rhs(i, r) = rhs(i, r) - s%nza(n) * sq(c, i) - 2 * s%nzv(n) * sqd(c, i)
+      do r = 1, neq
+        do i = 1, np
+          rhs(i, r) = ap(i, r)
+        end do
+      end do
+      do n = 1, nnz
+        r = nzr(n); c = nzc(n)
+        do i = 1, np
+          rhs(i, r) = rhs(i, r) - nza(n) * sq(c, i) - 2 * nzv(n) * sqd(c, i)
         end do
       end do
     end select
-  end subroutine sens_kin_rhs
+  end subroutine kin_rhs_kernel
 
   !> K_lambda = (J^T lambda)_q = sum over rows of lambda_r (Phi_r)_qq as a list of its
   !! nonzeros (row, column, value), from the local Hessian blocks (sens_hessian at the same q).
