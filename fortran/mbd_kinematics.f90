@@ -236,7 +236,34 @@ contains
     if (status == MBD_SINGULAR) then
       status = MBD_OK; msg = ''
     end if
+    if (w%sparse) call probe_pattern(m, w, rows, cols)
   end subroutine sparse_init
+
+  !> The entries of J that are non-zero at a generic configuration (no angle a multiple of
+  !! 90 degrees, no coordinate zero) join the pattern the first plan is made on: an entry
+  !! that happens to vanish at the start (a crank along x: its B s' has a zero) would
+  !! otherwise be left out and force a second plan once it moves. Depends on the model only.
+  subroutine probe_pattern(m, w, rows, cols)
+    type(model_t), intent(in) :: m                 !! model
+    type(kin_work_t), intent(inout) :: w           !! work arrays (sparse LU initialized)
+    integer, intent(in) :: rows(:), cols(:)        !! the blocks' entries in J
+    real(wp) :: qg(m%nq), v
+    integer :: i, e, f, r, sl, k
+    do i = 1, m%nq
+      qg(i) = 0.37_wp + 0.113_wp * i               ! extra coordinates as they are
+    end do
+    do i = 1, m%nb
+      qg(3 * i - 2) = qg(3 * i - 2) * m%lscale; qg(3 * i - 1) = qg(3 * i - 1) * m%lscale
+      qg(3 * i) = 0.37_wp + 0.211_wp * i           ! angles 0.58, 0.79, ... rad
+    end do
+    call assemble_blocks(m, qg, w%qz, zero, w%phi, w%nu, w%gam, w%asm)
+    do e = 1, size(w%asm%src)
+      f = w%asm%src(e) - 1                         ! flat index into jb(MAXROW, NLOC, nc)
+      r = mod(f, MAXROW) + 1; sl = mod(f / MAXROW, NLOC) + 1; k = f / (MAXROW * NLOC) + 1
+      v = w%asm%jb(r, sl, k)
+      if (ieee_is_finite(v) .and. abs(v) > zero) w%sp%seen(rows(e), cols(e)) = .true.
+    end do
+  end subroutine probe_pattern
 
   !> Band plan of J from its structure (the nonzeros of the constraint blocks).
   subroutine kin_band_plan(m, band, status, msg)
