@@ -802,6 +802,9 @@ contains
     iinfo(6) = dst%rhs; iinfo(7) = dst%jacobians; iinfo(8) = dst%partitions
     iinfo(10) = dst%factorizations
     rinfo(2) = dst%hmin; rinfo(3) = dst%hmax
+    if (dst%rc_min < huge(one)) then          ! partitioned: J_u's worst conditioning
+      rinfo(9) = dst%rc_min; rinfo(10) = dst%t_rc_min
+    end if
     if (dst%kl > 0) then                      ! generalized-alpha: its iteration matrix's
       rinfo(6) = dst%kl; rinfo(7) = dst%ku
     end if

@@ -80,6 +80,9 @@ module mbd_integrators
     integer :: kl = 0, ku = 0         !! band widths of the iteration matrix (band path)
     real(wp) :: hmin = huge(one), hmax = zero
     real(wp) :: t_fail = zero         !! time reached when a method failed
+    !> partitioned (dense J): the smallest reciprocal condition number of J_u at an
+    !! accepted step and its time (a singular configuration passed close by)
+    real(wp) :: rc_min = huge(one), t_rc_min = zero
   end type dyn_stats_t
 
   !> Run context: settings, counters, the output grid, the form of the equations and the
@@ -1397,6 +1400,9 @@ contains
     if (w%solver == SOLVER_DENSE) then
       call qr_choice(m, w, c, t, c%jp, stt)
       now = rcond_cols(w, c, c%iu)
+      if (now < c%st%rc_min) then
+        c%st%rc_min = now; c%st%t_rc_min = t
+      end if
       needs_partition = now <= zero
       if (stt /= MBD_OK) return
       needs_partition = now < REPARTITION * rcond_cols(w, c, c%jp(1:w%na))

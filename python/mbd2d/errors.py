@@ -119,7 +119,8 @@ class RedundantConstraintWarning(MbdWarning):
 
 class SingularPassageWarning(MbdWarning):
     """The run passed through singular configurations (bifurcation points) and stayed on the
-    branch it started on."""
+    branch it started on; in dynamics (partitioned), a step ended so close to one that the
+    accelerations there, and the motion after it, may be inaccurate."""
 
 
 class LiftOffWarning(MbdWarning):

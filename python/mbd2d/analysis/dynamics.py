@@ -14,7 +14,7 @@ from ..binding.pack import pack, pack_dynamics
 from ..binding.status import ASSEMBLY_FAILED, INCONSISTENT, INTEGRATOR_FAILED, OK, error_for
 from ..binding.tables import Packed
 from ..description.builder import ModelDescription
-from ..errors import MbdError, ModelError, RedundantConstraintWarning
+from ..errors import MbdError, ModelError, RedundantConstraintWarning, SingularPassageWarning
 from ..results.dynamics import DynamicsResult
 from ..validate import number, whole
 from .contacts import MAX_EVENTS, check_method, has_events, report_pulls
@@ -147,6 +147,9 @@ def run_dynamics(model: ModelDescription, t_end: float, steps: int, method: str 
              "band": (int(rinfo[5]), int(rinfo[6])),
              "events": int(getattr(out, "nev", 0)),
              "events_not_kept": max(0, int(getattr(out, "nev", 0)) - maxev)}
+    if method == "partitioned" and iinfo[2] and rinfo[9] > 0:
+        # the worst reciprocal condition of J_u at an accepted step, and when (dense J)
+        stats["ju_rcond_min"] = (float(rinfo[8]), float(rinfo[9]))
     res = dynamics_result(model, p, t, n, out, stats, status == OK)
     if params:
         attach(res, out, params, n, ptab)
@@ -158,10 +161,32 @@ def run_dynamics(model: ModelDescription, t_end: float, steps: int, method: str 
                       "of motion; the reported multipliers are the minimum-norm set (the "
                       "reactions are statically indeterminate)", RedundantConstraintWarning,
                       stacklevel=3)
+    warn_near_singular(stats)
     exc = dynamics_error(model, p, out, res, t, bad, method, t0)
     if exc is None:
         return res
     raise exc
+
+
+#: partitioned: a step accepted where J_u's reciprocal condition is below this carries
+#: acceleration errors of order eps / rcond**2 above 1e-3 (positions, velocities and
+#: accelerations lose accuracy like cond, cond**2, cond**3 next to a singular configuration)
+RCOND_WARN = math.sqrt(np.finfo(float).eps / 1e-3)
+
+
+def warn_near_singular(stats: dict[str, Any]) -> None:
+    """SingularPassageWarning when a partitioned run accepted a step next to a singular
+    configuration of its dependent coordinates (``stats["ju_rcond_min"]`` below RCOND_WARN)."""
+    rc, tc = stats.get("ju_rcond_min", (1.0, 0.0))
+    if rc >= RCOND_WARN:
+        return
+    warnings.warn(f"partitioned: a step at t = {tc:.6g} ended next to a singular configuration "
+                  f"(J_u's reciprocal condition {rc:.1e}; the steps fell to "
+                  f"h_min = {stats.get('h_min') or 0.0:.1e} s): accelerations there carry errors "
+                  f"up to eps/rcond**2 = {np.finfo(float).eps / max(rc, 1e-300)**2:.0e}, and the "
+                  "motion after it may be inaccurate. Check the energy (res.energy), or use "
+                  "rtol >= 1e-8, whose longer steps pass over such points",
+                  SingularPassageWarning, stacklevel=4)
 
 
 def dynamics_error(model: ModelDescription, p: Packed, out: Any, res: DynamicsResult,
