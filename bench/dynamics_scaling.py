@@ -49,7 +49,7 @@ def _timed(m: Any, t_end: float, method: str, solver: str, repeats: int) -> tupl
     return best, res
 
 
-def time_run(n: int, method: str, solver: str, repeats: int = 2) -> dict[str, Any]:
+def time_run(n: int, method: str, solver: str, repeats: int = 3) -> dict[str, Any]:
     """Setup (the first call, one step), the marginal CPU ms per step (the difference of a
     short and a long call) and the long call's whole time per step."""
     m = build(n, driven=False, omega0=1.0)
