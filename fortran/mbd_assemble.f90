@@ -147,8 +147,8 @@ contains
   end subroutine assemble_blocks
 
   !> gamma alone at new velocities q_dot and the q of the last assembly (its cos and sin):
-  !! J q_ddot = gamma after J q_dot = nu. The revolutes' rows from their own formula; every
-  !! other constraint evaluated whole (its block of J rewritten with the same values).
+  !! J q_ddot = gamma after J q_dot = nu. The revolutes' gamma rows alone (revolute_gamma);
+  !! every other constraint evaluated whole (its block of J rewritten with the same values).
   pure subroutine assemble_gamma(m, q, qd, t, gam, a)
     type(model_t), intent(in) :: m            !! model
     real(wp), intent(in) :: q(:)              !! coordinates of the last assembly (nq)

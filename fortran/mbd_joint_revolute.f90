@@ -7,7 +7,7 @@
 module mbd_joint_revolute
   use mbd_kinds, only: wp, zero, one
   use mbd_status, only: MBD_OK, MSG_LEN
-  use mbd_points, only: NLOC, MAXROW, kloc, point_terms
+  use mbd_points, only: NLOC, MAXROW, kloc
   use mbd_dual, only: dloc, point_terms_d
   implicit none
   private
@@ -26,7 +26,7 @@ contains
     prep = raw(1:4)
   end subroutine revolute_prepare
 
-  !> Rows of Phi, J (local block) and gamma, from the two points' terms.
+  !> Rows of Phi, J (local block) and gamma from the local state (revolute_kernel).
   pure subroutine revolute_eval(p, si, sj, x, phi, jl, gam)
     real(wp), intent(in) :: p(:)            !! prepared parameters
     integer, intent(in) :: si, sj           !! slot ids of the two bodies (0 = ground)
@@ -34,21 +34,10 @@ contains
     real(wp), intent(inout) :: phi(MAXROW)  !! rows of Phi (2 written)
     real(wp), intent(inout) :: jl(MAXROW, NLOC)  !! local block of J (2 rows written)
     real(wp), intent(inout) :: gam(MAXROW)  !! rows of gamma (2 written)
-    real(wp) :: pi(2), bi(2), vi(2), ai(2), pj(2), bj(2), vj(2), aj(2)
-    integer :: c
-    call point_terms(x, si, p(1:2), pi, bi, vi, ai)
-    call point_terms(x, sj, p(3:4), pj, bj, vj, aj)
-    phi(1:2) = pi - pj                                 ! Phi = P_i - P_j
-    jl(1:2, :) = zero                                  ! J = [I, B_i s'_i, -I, -B_j s'_j]
-    if (si > 0) then
-      c = 3 * (si - 1)
-      jl(1, c + 1) = one; jl(2, c + 2) = one; jl(1:2, c + 3) = bi
-    end if
-    if (sj > 0) then
-      c = 3 * (sj - 1)
-      jl(1, c + 1) = -one; jl(2, c + 2) = -one; jl(1:2, c + 3) = -bj
-    end if
-    gam(1:2) = aj - ai                      ! gamma = A_i s'_i thd_i**2 - A_j s'_j thd_j**2
+    real(wp) :: ph(2), ga(2)
+    call revolute_kernel(p(1:4), si > 0, sj > 0, x%q(1:2), x%c(1), x%s(1), x%qd(3), &
+                         x%q(4:5), x%c(2), x%s(2), x%qd(6), ph, jl, ga)
+    phi(1:2) = ph; gam(1:2) = ga
   end subroutine revolute_eval
 
   !> Changes of the rows of Phi, J and gamma along a direction (x) and a change tp of the
@@ -70,11 +59,9 @@ contains
     tgam(1:2) = taj - tai
   end subroutine revolute_eval_d
 
-  !> The same rows as revolute_eval straight from the bodies' states (the assembly's path
-  !! for the commonest joint: no local state gathered, no assumed-shape arguments). Body b
-  !! (0 ground) has q(3b-2:3b) and q_dot(3b-2:3b), cos and sin c(b), s(b); ground's point
-  !! p(1:2) or p(3:4) is global.
-  !! Phi = P_i - P_j, J = [I, B_i s'_i, -I, -B_j s'_j], gamma = A_i s'_i thd_i**2 - A_j s'_j thd_j**2.
+  !> The same rows straight from the bodies' states (the assembly's path for the commonest
+  !! joint: no local state gathered, no assumed-shape arguments). Body b (0 ground) has
+  !! q(3b-2:3b) and q_dot(3b-2:3b), cos and sin c(b), s(b) (c(0) = 1, s(0) = 0).
   pure subroutine revolute_rows(p, bi, bj, q, qd, c, s, phi, jl, gam)
     real(wp), intent(in) :: p(4)            !! [s'_i, s'_j]
     integer, intent(in) :: bi, bj           !! bodies (0 ground)
@@ -83,35 +70,14 @@ contains
     real(wp), intent(out) :: phi(2)         !! rows of Phi
     real(wp), intent(inout) :: jl(MAXROW, NLOC)  !! local block of J (rows 1 and 2 written)
     real(wp), intent(out) :: gam(2)         !! rows of gamma
-    real(wp) :: ax, ay, w2, px, py
-    integer :: i3
-    ! the operations of revolute_eval in its order (P_i - P_j, aj - ai): the same rounding
-    jl(1:2, :) = zero
-    if (bi > 0) then
-      i3 = 3 * bi
-      ax = c(bi) * p(1) - s(bi) * p(2); ay = s(bi) * p(1) + c(bi) * p(2)     ! A_i s'_i
-      w2 = qd(i3)**2
-      phi(1) = q(i3 - 2) + ax; phi(2) = q(i3 - 1) + ay
-      gam(1) = ax * w2; gam(2) = ay * w2
-      jl(1, 1) = one; jl(2, 2) = one; jl(1, 3) = -ay; jl(2, 3) = ax        ! [I, B_i s'_i]
-    else
-      phi(1) = p(1); phi(2) = p(2); gam(1) = zero; gam(2) = zero
-    end if
-    if (bj > 0) then
-      i3 = 3 * bj
-      ax = c(bj) * p(3) - s(bj) * p(4); ay = s(bj) * p(3) + c(bj) * p(4)     ! A_j s'_j
-      w2 = qd(i3)**2
-      px = q(i3 - 2) + ax; py = q(i3 - 1) + ay
-      phi(1) = phi(1) - px; phi(2) = phi(2) - py
-      gam(1) = gam(1) - ax * w2; gam(2) = gam(2) - ay * w2
-      jl(1, 4) = -one; jl(2, 5) = -one; jl(1, 6) = ay; jl(2, 6) = -ax      ! [-I, -B_j s'_j]
-    else
-      phi(1) = phi(1) - p(3); phi(2) = phi(2) - p(4)
-    end if
+    integer :: i3, j3
+    i3 = max(3 * bi, 3); j3 = max(3 * bj, 3)      ! ground: any body's numbers, unused
+    call revolute_kernel(p, bi > 0, bj > 0, q(i3 - 2:i3 - 1), c(bi), s(bi), qd(i3), &
+                         q(j3 - 2:j3 - 1), c(bj), s(bj), qd(j3), phi, jl, gam)
   end subroutine revolute_rows
 
-  !> gamma of the revolute alone (the velocities changed, q did not):
-  !! gamma = A_i s'_i thd_i**2 - A_j s'_j thd_j**2.
+  !> The gamma rows of revolute_kernel alone, for the second pass of a kinematic step (new
+  !! velocities at the same q): gamma = A_i s'_i thd_i**2 - A_j s'_j thd_j**2.
   pure subroutine revolute_gamma(p, bi, bj, qd, c, s, gam)
     real(wp), intent(in) :: p(4)            !! [s'_i, s'_j]
     integer, intent(in) :: bi, bj           !! bodies (0 ground)
@@ -130,6 +96,39 @@ contains
       gam(2) = gam(2) - (s(bj) * p(3) + c(bj) * p(4)) * w2
     end if
   end subroutine revolute_gamma
+
+  !> The revolute's rows from each body's position r, cos, sin and angular velocity w (g:
+  !! the body moves; a ground point p(1:2) or p(3:4) is global):
+  !! Phi = P_i - P_j, J = [I, B_i s'_i, -I, -B_j s'_j], gamma = A_i s'_i w_i**2 - A_j s'_j w_j**2.
+  pure subroutine revolute_kernel(p, gi, gj, ri, ci, si, wi, rj, cj, sj, wj, phi, jl, gam)
+    real(wp), intent(in) :: p(4)                  !! [s'_i, s'_j]
+    logical, intent(in) :: gi, gj                 !! body i, body j moves
+    real(wp), intent(in) :: ri(2), ci, si, wi     !! body i: r, cos, sin, theta_dot
+    real(wp), intent(in) :: rj(2), cj, sj, wj     !! body j: the same
+    real(wp), intent(out) :: phi(2), gam(2)       !! rows of Phi and gamma
+    real(wp), intent(inout) :: jl(MAXROW, NLOC)   !! local block of J (rows 1 and 2 written)
+    real(wp) :: ax, ay, w2, px, py
+    jl(1:2, :) = zero
+    if (gi) then
+      ax = ci * p(1) - si * p(2); ay = si * p(1) + ci * p(2)     ! A_i s'_i
+      w2 = wi**2
+      phi(1) = ri(1) + ax; phi(2) = ri(2) + ay
+      gam(1) = ax * w2; gam(2) = ay * w2
+      jl(1, 1) = one; jl(2, 2) = one; jl(1, 3) = -ay; jl(2, 3) = ax        ! [I, B_i s'_i]
+    else
+      phi(1) = p(1); phi(2) = p(2); gam(1) = zero; gam(2) = zero
+    end if
+    if (gj) then
+      ax = cj * p(3) - sj * p(4); ay = sj * p(3) + cj * p(4)     ! A_j s'_j
+      w2 = wj**2
+      px = rj(1) + ax; py = rj(2) + ay
+      phi(1) = phi(1) - px; phi(2) = phi(2) - py
+      gam(1) = gam(1) - ax * w2; gam(2) = gam(2) - ay * w2
+      jl(1, 4) = -one; jl(2, 5) = -one; jl(1, 6) = ay; jl(2, 6) = -ax      ! [-I, -B_j s'_j]
+    else
+      phi(1) = phi(1) - p(3); phi(2) = phi(2) - p(4)
+    end if
+  end subroutine revolute_kernel
 
   !> Second derivatives for the sensitivity equations, in closed form (the rows of
   !! revolute_eval_d along d theta_i and d theta_j): for side 1 (body i, theta slot 3) and
