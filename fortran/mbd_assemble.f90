@@ -101,9 +101,8 @@ contains
     real(wp), intent(out) :: gam(:)           !! gamma (neq)
     type(asm_work_t), intent(inout) :: a      !! work: blocks (out) and body cos, sin
     logical, intent(in), optional :: same_q   !! the last call had the same q
-    type(kloc) :: x
     real(wp) :: ph(MAXROW), nv(MAXROW), ga(MAXROW)
-    integer :: k, r0, nr, si, sj, b, s, i
+    integer :: k, r0, nr, b, i
     logical :: reuse
     reuse = .false.
     if (present(same_q)) reuse = same_q
@@ -125,15 +124,7 @@ contains
         nu(r0) = zero; nu(r0 + 1) = zero
         cycle
       end if
-      do s = 1, NLOC                   ! the constraint's slots (zero where it has none)
-        x%q(s) = a%qx(m%loc(s, k)); x%qd(s) = a%qdx(m%loc(s, k))
-      end do
-      x%c(1) = a%cb(m%bi(k)); x%c(2) = a%cb(m%bj(k))
-      x%s(1) = a%sb(m%bi(k)); x%s(2) = a%sb(m%bj(k))
-      si = merge(1, 0, m%bi(k) > 0); sj = merge(2, 0, m%bj(k) > 0)     ! model_slots
-      ! each constraint writes whole rows of its block (put_vec, put_scal): no zero fill
-      call con_eval(m%kind(k), m%suba(k), m%subb(k), m%p(m%po(k):m%po(k) + m%pn(k) - 1), &
-                    si, sj, x, t, ph, a%jb(:, :, k), nv, ga)
+      call eval_one(m, k, t, a, ph, nv, ga)
       nr = m%nrow(k)
       ! row by row (a slice copy of variable length would be three memcpy calls)
       phi(r0) = ph(1); nu(r0) = nv(1); gam(r0) = ga(1)
@@ -146,6 +137,27 @@ contains
     end do
   end subroutine assemble_blocks
 
+  !> Constraint k through con_eval, its local state gathered from the work arrays (q and
+  !! q_dot with a zero in front, the bodies' cos and sin): its rows of Phi, nu, gamma and its
+  !! block of J (each constraint writes whole rows of its block: no zero fill).
+  pure subroutine eval_one(m, k, t, a, ph, nv, ga)
+    type(model_t), intent(in) :: m                    !! model
+    integer, intent(in) :: k                          !! constraint
+    real(wp), intent(in) :: t                         !! time
+    type(asm_work_t), intent(inout) :: a              !! work: state in, block k out
+    real(wp), intent(out) :: ph(MAXROW), nv(MAXROW), ga(MAXROW)  !! its rows
+    type(kloc) :: x
+    integer :: s
+    do s = 1, NLOC                   ! the constraint's slots (zero where it has none)
+      x%q(s) = a%qx(m%loc(s, k)); x%qd(s) = a%qdx(m%loc(s, k))
+    end do
+    x%c(1) = a%cb(m%bi(k)); x%c(2) = a%cb(m%bj(k))
+    x%s(1) = a%sb(m%bi(k)); x%s(2) = a%sb(m%bj(k))
+    call con_eval(m%kind(k), m%suba(k), m%subb(k), m%p(m%po(k):m%po(k) + m%pn(k) - 1), &
+                  merge(1, 0, m%bi(k) > 0), merge(2, 0, m%bj(k) > 0), x, t, ph, &
+                  a%jb(:, :, k), nv, ga)          ! slot ids as model_slots
+  end subroutine eval_one
+
   !> gamma alone at new velocities q_dot and the q of the last assembly (its cos and sin):
   !! J q_ddot = gamma after J q_dot = nu. The revolutes' gamma rows alone (revolute_gamma);
   !! every other constraint evaluated whole (its block of J rewritten with the same values).
@@ -156,9 +168,8 @@ contains
     real(wp), intent(in) :: t                 !! time
     real(wp), intent(out) :: gam(:)           !! gamma (neq)
     type(asm_work_t), intent(inout) :: a      !! work: blocks and body cos, sin
-    type(kloc) :: x
     real(wp) :: ph(MAXROW), nv(MAXROW), ga(MAXROW)
-    integer :: k, r0, s, i
+    integer :: k, r0, i
     do i = 1, m%nq
       a%qx(i) = q(i); a%qdx(i) = qd(i)
     end do
@@ -169,14 +180,7 @@ contains
         gam(r0) = ga(1); gam(r0 + 1) = ga(2)
         cycle
       end if
-      do s = 1, NLOC
-        x%q(s) = a%qx(m%loc(s, k)); x%qd(s) = a%qdx(m%loc(s, k))
-      end do
-      x%c(1) = a%cb(m%bi(k)); x%c(2) = a%cb(m%bj(k))
-      x%s(1) = a%sb(m%bi(k)); x%s(2) = a%sb(m%bj(k))
-      call con_eval(m%kind(k), m%suba(k), m%subb(k), m%p(m%po(k):m%po(k) + m%pn(k) - 1), &
-                    merge(1, 0, m%bi(k) > 0), merge(2, 0, m%bj(k) > 0), x, t, ph, &
-                    a%jb(:, :, k), nv, ga)
+      call eval_one(m, k, t, a, ph, nv, ga)
       do i = 1, m%nrow(k)
         gam(r0 + i - 1) = ga(i)
       end do
