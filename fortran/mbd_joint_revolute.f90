@@ -160,7 +160,8 @@ contains
   end subroutine revolute_second
 
   !> The parameter parts for a change tp of [s'_i, s'_j] in closed form (revolute_eval_d
-  !! with dq = 0; the rows are linear in s', so p itself does not enter): with u = A t s' and v = B t s' = perp(u) of each moving body,
+  !! with dq = 0; the rows are linear in s', so p itself does not enter): with u = A t s'
+  !! and v = B t s' = perp(u) of each moving body,
   !!   Phi_p = u_i - u_j  (a ground point: its change itself),
   !!   nu_p - J_p q_dot = -v_i thd_i + v_j thd_j,
   !!   gamma_p - J_p q_ddot = u_i thd_i**2 - v_i thdd_i - u_j thd_j**2 + v_j thdd_j.

@@ -34,8 +34,9 @@ module mbd_kinematics
   use mbd_points, only: NLOC, MAXROW
   use mbd_model, only: model_t
   use mbd_constraints, only: con_is_driver, con_name
-  use mbd_assemble, only: asm_work_t, asm_init, assemble_blocks, assemble_gamma, assemble_dense, scatter_dense, &
-                          init_extras, blocks_jv, blocks_jtv, scatter_values, asm_turn
+  use mbd_assemble, only: asm_work_t, asm_init, assemble_blocks, assemble_gamma, assemble_dense, &
+                          scatter_dense, init_extras, blocks_jv, blocks_jtv, scatter_values, &
+                          asm_turn
   use mbd_band, only: band_t, band_plan, band_move, band_zero, band_norm1, band_factor, &
                       band_rcond, band_solve
   use mbd_linsolve, only: lu_factor, lu_solve, lu_det_sign, svd_null, row_rank, qr_factor, &
