@@ -13,6 +13,7 @@ module mbd_assemble
   use mbd_model, only: model_t, model_slots
   use mbd_constraints, only: con_eval, con_init_extra, CON_REVOLUTE
   use mbd_joint_revolute, only: revolute_rows, revolute_gamma
+  use mbd_drivers, only: DRV_ABS, driver_abs_row
   implicit none
   private
   public :: asm_work_t, asm_init, assemble_blocks, scatter_dense, assemble_dense, init_extras, &
@@ -123,6 +124,12 @@ contains
         phi(r0) = ph(1); phi(r0 + 1) = ph(2); gam(r0) = ga(1); gam(r0 + 1) = ga(2)
         nu(r0) = zero; nu(r0 + 1) = zero
         cycle
+      else if (m%kind(k) == DRV_ABS) then
+        ! the commonest driver from its coordinate (the row of driver_eval)
+        call driver_abs_row(m%suba(k), m%p(m%po(k):m%po(k) + m%pn(k) - 1), &
+                            a%qx(m%loc(m%suba(k), k)), t, phi(r0), a%jb(1, 1, k), nu(r0), &
+                            gam(r0))
+        cycle
       end if
       call eval_one(m, k, t, a, ph, nv, ga)
       nr = m%nrow(k)
@@ -178,6 +185,11 @@ contains
       if (m%kind(k) == CON_REVOLUTE) then
         call revolute_gamma(m%p(m%po(k)), m%bi(k), m%bj(k), a%qdx, a%cb, a%sb, ga)
         gam(r0) = ga(1); gam(r0 + 1) = ga(2)
+        cycle
+      else if (m%kind(k) == DRV_ABS) then
+        call driver_abs_row(m%suba(k), m%p(m%po(k):m%po(k) + m%pn(k) - 1), &
+                            a%qx(m%loc(m%suba(k), k)), t, ph(1), a%jb(1, 1, k), nv(1), &
+                            gam(r0))
         cycle
       end if
       call eval_one(m, k, t, a, ph, nv, ga)

@@ -15,7 +15,7 @@ module mbd_drivers
   implicit none
   private
   public :: DRV_ABS, DRV_REL_ANGLE, DRV_REL_DIST, TRANS_PREP_LEN
-  public :: driver_eval, driver_eval_d
+  public :: driver_eval, driver_eval_d, driver_abs_row
 
   integer, parameter :: DRV_ABS = 101, DRV_REL_ANGLE = 102, DRV_REL_DIST = 103
   integer, parameter :: TRANS_PREP_LEN = 9   !! length of a prepared translational joint
@@ -81,5 +81,20 @@ contains
     tnu(1) = tf1
     tgam(1) = tgam(1) + tf2
   end subroutine driver_eval_d
+
+  !> The absolute driver's row straight from its coordinate (the assembly's path; the row
+  !! driver_eval writes for DRV_ABS, in the same operations): Phi = q_c - f(t), J = e_sub
+  !! (slot sub of the body), nu = f'(t), gamma = f''(t).
+  pure subroutine driver_abs_row(sub, p, qc, t, phi, jl, nu, gam)
+    integer, intent(in) :: sub              !! coordinate slot 1, 2, 3 (x, y, theta)
+    real(wp), intent(in) :: p(:)            !! the encoded function
+    real(wp), intent(in) :: qc, t           !! the coordinate's value, time
+    real(wp), intent(out) :: phi, nu, gam   !! the row of Phi, nu, gamma
+    real(wp), intent(inout) :: jl(MAXROW, NLOC)  !! local block of J (row 1 written)
+    real(wp) :: f, f1, f2
+    call fun_eval(p, t, f, f1, f2)
+    jl(1, :) = 0.0_wp; jl(1, sub) = 1.0_wp
+    phi = qc - f; nu = f1; gam = f2
+  end subroutine driver_abs_row
 
 end module mbd_drivers
