@@ -91,8 +91,8 @@ contains
   end subroutine gather_local
 
   !> Phi, nu, gamma and the local Jacobian blocks at (q, q_dot, t). The cosine and sine of
-  !! each body's angle are computed once here (same_q: they are still those of q).
-  pure subroutine assemble_blocks(m, q, qd, t, phi, nu, gam, a, same_q)
+  !! each body's angle are computed once here (assemble_gamma reuses them at the same q).
+  pure subroutine assemble_blocks(m, q, qd, t, phi, nu, gam, a)
     type(model_t), intent(in) :: m            !! model
     real(wp), intent(in) :: q(:)              !! coordinates (nq)
     real(wp), intent(in) :: qd(:)             !! velocities (nq), for gamma
@@ -101,17 +101,11 @@ contains
     real(wp), intent(out) :: nu(:)            !! nu (neq)
     real(wp), intent(out) :: gam(:)           !! gamma (neq)
     type(asm_work_t), intent(inout) :: a      !! work: blocks (out) and body cos, sin
-    logical, intent(in), optional :: same_q   !! the last call had the same q
     real(wp) :: ph(MAXROW), nv(MAXROW), ga(MAXROW)
     integer :: k, r0, nr, b, i
-    logical :: reuse
-    reuse = .false.
-    if (present(same_q)) reuse = same_q
-    if (.not. reuse) then
-      do b = 1, m%nb
-        a%cb(b) = cos(q(3 * b)); a%sb(b) = sin(q(3 * b))
-      end do
-    end if
+    do b = 1, m%nb
+      a%cb(b) = cos(q(3 * b)); a%sb(b) = sin(q(3 * b))
+    end do
     do i = 1, m%nq
       a%qx(i) = q(i); a%qdx(i) = qd(i)
     end do
