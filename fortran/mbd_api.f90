@@ -689,9 +689,11 @@ contains
   !! iinfo: 1 outputs, 2 bad entry, 3 steps, 4 rejected, 5 Newton iterations, 6 right-hand
   !! sides, 7 iteration matrices (K, C evaluations), 8 partitions, 9 active (independent)
   !! constraint rows, 10 LU factorizations of the generalized-alpha iteration matrix.
-  !! rinfo: 1 time of a failure, 2 smallest step, 3 largest step, 5 linear solver (1 dense,
-  !! 2 banded), 6 and 7 the band widths kl and ku of the saddle-point matrix (of
-  !! generalized-alpha's iteration matrix for that method).
+  !! rinfo: 1 time of a failure, 2 smallest step, 3 largest step, 4 factorizations of the
+  !! index-1 saddle-point matrix, 5 linear solver (1 dense, 2 banded), 6 and 7 the band
+  !! widths kl and ku of the saddle-point matrix (of generalized-alpha's iteration matrix
+  !! for that method), 8 of the index-1 factorizations those through the Schur complement
+  !! (mbd_schur; band path), 9 and 10 the partitioned method's worst rcond of J_u and when.
   !! solver: 0 auto, 1 dense, 2 banded (dyn_choose); the band path assembles q0 by
   !! Levenberg-Marquardt in band storage (dyn_assemble) and never allocates n x n.
   subroutine api_dynamics(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, v0, t0, t1, nsteps, &
@@ -802,6 +804,7 @@ contains
     iinfo(6) = dst%rhs; iinfo(7) = dst%jacobians; iinfo(8) = dst%partitions
     iinfo(10) = dst%factorizations
     rinfo(2) = dst%hmin; rinfo(3) = dst%hmax
+    rinfo(4) = w%sd%nfactor; rinfo(8) = w%sd%nschur   ! index-1 factorizations, by Schur
     if (dst%rc_min < huge(one)) then          ! partitioned: J_u's worst conditioning
       rinfo(9) = dst%rc_min; rinfo(10) = dst%t_rc_min
     end if

@@ -42,6 +42,7 @@ module mbd_saddle
   use mbd_model, only: model_t
   use mbd_band, only: band_t, band_plan_perm, band_graph, band_rcm, band_zero, band_norm1, &
                       band_factor, band_rcond, band_solve, band_matvec
+  use mbd_schur, only: schur_t, schur_plan, schur_factor, schur_solve
   use mbd_linsolve, only: lu_factor, lu_solve, lu_factor_small, lu_solve_small, lapack_status
   use mbd_lapack, only: dgecon, dgelsy
   implicit none
@@ -67,7 +68,9 @@ module mbd_saddle
     logical :: full = .false.            !! A has the tangent pattern (not only its diagonal)
     logical :: lsq = .false.             !! the last index-1 factorization was nearly singular
     logical :: plain = .false.           !! factored without the near-singularity check
+    logical :: schur = .false.           !! the last factorization is the Schur complement's
     integer :: nfactor = 0               !! factorizations
+    integer :: nschur = 0                !! of them through the Schur complement
     integer :: nrank = 0                 !! nearly singular solves
     integer :: kl = 0, ku = 0            !! band widths (band path)
     !> the constraint blocks' nonzeros of active rows: jb(esrc(i)) goes to the flat storage
@@ -81,6 +84,7 @@ module mbd_saddle
     integer, allocatable :: iw(:), jp(:)
     ! band path
     type(band_t) :: b                    !! plan, storage, factors
+    type(schur_t) :: sc                  !! index-1 systems with diagonal A: mbd_schur
     real(wp), allocatable :: bcopy(:, :) !! the unregularized matrix of a nearly singular one
     real(wp), allocatable :: r(:), x(:), xw(:)  !! refinement workspace (nt)
   end type saddle_t
@@ -196,6 +200,10 @@ contains
       if (ierr == 0 .and. chk) allocate (sd%bcopy(ldab, nt), stat=ierr)
       if (ierr /= 0) then
         call mem_fail(bytes, 'the band saddle-point workspace', HINT, status, msg); return
+      end if
+      if (chk .and. .not. sd%full) then
+        call schur_plan(m, rows, sd%sc, status, msg)
+        if (status /= MBD_OK) return
       end if
     else
       ldab = nt
@@ -401,7 +409,17 @@ contains
     chk = .false.; if (present(check)) chk = check
     sd%nfactor = sd%nfactor + 1
     sd%lsq = .false.
+    sd%schur = .false.
     if (sd%banded) then
+      if (chk .and. .not. present(kv) .and. .not. abs(ee) > zero) then
+        ! diagonal, positive A and a well-conditioned Schur complement: its Cholesky
+        call schur_factor(sd%sc, d, jb, s, sd%schur)
+        status = MBD_OK
+        if (sd%schur) then
+          sd%nschur = sd%nschur + 1
+          return
+        end if
+      end if
       call fill(ee)
       if (.not. chk) then
         call band_factor(sd%b, status, msg)
@@ -540,6 +558,11 @@ contains
     integer :: rank, info, it
     if (size(rhs) /= sd%nt) then
       status = MBD_BAD_INPUT; return
+    end if
+    if (sd%schur) then
+      call schur_solve(sd%sc, rhs)
+      status = MBD_OK
+      return
     end if
     if (sd%banded) then
       if (.not. sd%lsq) then

@@ -145,6 +145,7 @@ def run_dynamics(model: ModelDescription, t_end: float, steps: int, method: str 
              "h_max": float(rinfo[2]) if iinfo[2] else None, "redundant_rows": red_rows,
              "solver": "banded" if int(rinfo[4]) == 2 else "dense",
              "band": (int(rinfo[5]), int(rinfo[6])),
+             "schur": (int(rinfo[7]), int(rinfo[3])),
              "events": int(getattr(out, "nev", 0)),
              "events_not_kept": max(0, int(getattr(out, "nev", 0)) - maxev)}
     if method == "partitioned" and iinfo[2] and rinfo[9] > 0:
