@@ -29,7 +29,8 @@ module mbd_api
   use mbd_constraints, only: CON_CAM
   use mbd_joint_cam, only: cam_outward_normal
   use mbd_points, only: local_state
-  use mbd_integrators, only: dyn_opts_t, dyn_stats_t, integrate, output_rows, output_index
+  use mbd_integrators, only: dyn_opts_t, dyn_stats_t, integrate, output_rows, output_index, &
+                              METH_PARTITIONED
   use mbd_statics, only: statics_solve
   use mbd_assemble, only: assemble_dense, assemble_blocks, asm_work_t, asm_init
   use mbd_kinematics, only: kin_opts_t, kin_report_t, kin_work_t, kin_run, kin_work_init, &
@@ -768,7 +769,10 @@ contains
     if (status /= MBD_OK) then
       rinfo(1) = t0; return
     end if
-    call dyn_init(m, w, q, t0, kopts%tol * lscale, status, msg, path)
+    ! partitioned: the method for runs through singular configurations keeps the LU of the
+    ! saddle-point matrix, whose error grows like cond, not cond^2 as the Schur complement's
+    call dyn_init(m, w, q, t0, kopts%tol * lscale, status, msg, path, &
+                  schur=method /= METH_PARTITIONED)
     if (status /= MBD_OK) return
     rinfo(6) = w%sd%kl; rinfo(7) = w%sd%ku
     iinfo(9) = w%na

@@ -176,7 +176,7 @@ contains
   !! saddle-point solver on the path (SOLVER_DENSE or SOLVER_BANDED; dyn_choose) and the
   !! pattern and column groups of the tangent. The dense path's footprint (dyn_bytes) is
   !! checked against the memory first.
-  subroutine dyn_init(m, w, q, t, tol, status, msg, solver)
+  subroutine dyn_init(m, w, q, t, tol, status, msg, solver, schur)
     type(model_t), intent(in) :: m              !! model with dynamics data
     type(dyn_work_t), intent(out) :: w          !! work arrays
     real(wp), intent(in) :: q(:)                !! configuration
@@ -185,6 +185,9 @@ contains
     integer, intent(out) :: status              !! MBD_OK, MBD_LAPACK or MBD_NO_MEMORY
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
     integer, intent(in), optional :: solver     !! path: SOLVER_DENSE (default) or _BANDED
+    !> index-1 systems through the Schur complement where it applies (default); .false.
+    !! keeps the saddle-point LU (backward stable next to singular configurations)
+    logical, intent(in), optional :: schur
     integer, allocatable :: red(:)
     integer :: rank, r, na, ierr, nt
     character(len=MSG_LEN) :: what
@@ -241,6 +244,7 @@ contains
     if (any(m%mdiag > zero)) w%s = sum(m%mdiag, mask=m%mdiag > zero) / count(m%mdiag > zero)
     call saddle_plan(m, w%rows, w%solver, w%sd, status, msg, index1=.true.)
     if (status /= MBD_OK) return
+    if (present(schur)) w%sd%use_schur = schur
     call tangent_pattern(m, w, status, msg)
   end subroutine dyn_init
 

@@ -69,6 +69,7 @@ module mbd_saddle
     logical :: lsq = .false.             !! the last index-1 factorization was nearly singular
     logical :: plain = .false.           !! factored without the near-singularity check
     logical :: schur = .false.           !! the last factorization is the Schur complement's
+    logical :: use_schur = .true.        !! index-1 systems may take the Schur complement
     integer :: nfactor = 0               !! factorizations
     integer :: nschur = 0                !! of them through the Schur complement
     integer :: nrank = 0                 !! nearly singular solves
@@ -201,10 +202,6 @@ contains
       if (ierr /= 0) then
         call mem_fail(bytes, 'the band saddle-point workspace', HINT, status, msg); return
       end if
-      if (chk .and. .not. sd%full) then
-        call schur_plan(m, rows, sd%sc, status, msg)
-        if (status /= MBD_OK) return
-      end if
     else
       ldab = nt
       perm = [(i, i=1, nt)]
@@ -217,6 +214,10 @@ contains
         call mem_fail(bytes, 'the dense saddle-point matrix', HINT, status, msg); return
       end if
       sd%a = zero
+    end if
+    if (chk .and. .not. sd%full) then         ! index-1 with diagonal A: the Schur complement
+      call schur_plan(m, rows, sd%sc, status, msg)
+      if (status /= MBD_OK) return
     end if
     ! flat positions in the storage
     do i = 1, nt
@@ -410,16 +411,16 @@ contains
     sd%nfactor = sd%nfactor + 1
     sd%lsq = .false.
     sd%schur = .false.
-    if (sd%banded) then
-      if (chk .and. .not. present(kv) .and. .not. abs(ee) > zero) then
-        ! diagonal, positive A and a well-conditioned Schur complement: its Cholesky
-        call schur_factor(sd%sc, d, jb, s, sd%schur)
-        status = MBD_OK
-        if (sd%schur) then
-          sd%nschur = sd%nschur + 1
-          return
-        end if
+    if (chk .and. sd%use_schur .and. .not. present(kv) .and. .not. abs(ee) > zero) then
+      ! diagonal, positive A and a well-conditioned Schur complement: its Cholesky
+      call schur_factor(sd%sc, d, jb, s, sd%schur)
+      status = MBD_OK
+      if (sd%schur) then
+        sd%nschur = sd%nschur + 1
+        return
       end if
+    end if
+    if (sd%banded) then
       call fill(ee)
       if (.not. chk) then
         call band_factor(sd%b, status, msg)

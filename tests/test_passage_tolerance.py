@@ -31,9 +31,12 @@ def crank_error(res: mbd2d.DynamicsResult, ref: np.ndarray) -> float:
 
 
 def test_dopri5_at_rtol_1e12_underflows_at_a_singular_passage_for_some_atol(reference):
+    """rtol 1e-12 and eleven atol from 0.6e-14 to 1.6e-14: some runs end in a step-size
+    underflow at a passage (3 of 11 measured with the index-1 systems through the Schur
+    complement, 7 of 11 with the saddle-point LU before), the others are accurate."""
     model = free_nfourbar(1)
     failures = []
-    for atol in ATOLS:
+    for atol in np.linspace(0.6e-14, 1.6e-14, 11):
         try:
             res = model.dynamics(t_end=T_END, steps=STEPS, method="dopri5", rtol=1e-12,
                                  atol=atol)
