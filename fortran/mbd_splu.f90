@@ -369,20 +369,36 @@ contains
     real(wp), intent(in) :: rinv(n), val(*), bt(ldb, n), cs(n)
     real(wp), intent(out) :: y(4, n)
     real(wp), intent(inout) :: x(:, :)
-    integer :: k, p, i
+    integer :: k, p, i, a, c
+    real(wp) :: v
+    ! (the four columns written out: array sections of extent 4 cost a loop each)
     do k = 1, n                                      ! y = P b
-      y(:, k) = bt(g:g + 3, prow(k))
+      c = prow(k)
+      y(1, k) = bt(g, c); y(2, k) = bt(g + 1, c); y(3, k) = bt(g + 2, c); y(4, k) = bt(g + 3, c)
     end do
     do p = 1, nl                                     ! L z = y (unit diagonal)
-      y(:, lrow(p)) = y(:, lrow(p)) - val(lpos(p)) * y(:, lcol(p))
+      v = val(lpos(p)); a = lrow(p); c = lcol(p)
+      y(1, a) = y(1, a) - v * y(1, c); y(2, a) = y(2, a) - v * y(2, c)
+      y(3, a) = y(3, a) - v * y(3, c); y(4, a) = y(4, a) - v * y(4, c)
     end do
     do k = 1, n                                      ! diag(1/u_kk) z
-      y(:, k) = y(:, k) * rinv(k)
+      v = rinv(k)
+      y(1, k) = y(1, k) * v; y(2, k) = y(2, k) * v; y(3, k) = y(3, k) * v; y(4, k) = y(4, k) * v
     end do
     do p = 1, nu                                     ! U1 w = diag(1/u_kk) z
-      y(:, brow(p)) = y(:, brow(p)) - val(bpos(p)) * y(:, bcol(p))
+      v = val(bpos(p)); a = brow(p); c = bcol(p)
+      y(1, a) = y(1, a) - v * y(1, c); y(2, a) = y(2, a) - v * y(2, c)
+      y(3, a) = y(3, a) - v * y(3, c); y(4, a) = y(4, a) - v * y(4, c)
     end do
-    do i = 1, min(4, size(x, 2) - g + 1)             ! x = D Q w
+    if (size(x, 2) - g >= 3) then                    ! x = D Q w
+      do k = 1, n
+        c = pcol(k); v = cs(c)
+        x(c, g) = y(1, k) * v; x(c, g + 1) = y(2, k) * v
+        x(c, g + 2) = y(3, k) * v; x(c, g + 3) = y(4, k) * v
+      end do
+      return
+    end if
+    do i = 1, size(x, 2) - g + 1
       do k = 1, n
         x(pcol(k), g + i - 1) = y(i, k) * cs(pcol(k))
       end do
