@@ -49,7 +49,7 @@ module mbd_dynamics
   use mbd_assemble, only: asm_work_t, asm_init, assemble_blocks, assemble_dense, blocks_jv, &
                           blocks_jtv, init_extras
   use mbd_linsolve, only: row_rank, lapack_status, ls_small, RANK_TOL, lu_factor_small, &
-                          lu_solve_small
+                          lu_solve_small, LS_RTOL
   use mbd_lapack, only: dgelsy
   use mbd_saddle, only: saddle_t, saddle_plan, saddle_factor, saddle_solve, saddle_row_rank, &
                         SADDLE_BAND_MIN_N, SADDLE_BAND_RATIO
@@ -923,6 +923,20 @@ contains
       st = MBD_OK
       w%bls = zero
       w%bls(1:m%nq) = rhs0
+      if (w%na == m%neq .and. m%neq == m%nq) then
+        ! square J of independent rows (a driven mechanism): J^T lambda = r by an LU of J^T
+        ! with partial pivoting, a quarter of the QR's work, trusted when its pivot ratio is
+        ! above the QR's rank threshold (otherwise the QR, then dgelsy, as below)
+        w%acopy(1:m%nq, 1:m%neq) = w%jt
+        call lu_factor_small(w%acopy, w%jpvt, st)
+        if (st == MBD_OK) then
+          if (diag_ratio(w%acopy) >= LS_RTOL) then
+            call lu_solve_small(w%acopy, w%jpvt, w%bls(1:m%nq))
+            l = w%bls(1:m%neq); return
+          end if
+        end if
+        st = MBD_OK
+      end if
       if (w%na == m%neq .and. m%neq <= m%nq) then
         ! independent rows: the unique solution, by a plain Householder QR (no allocation);
         ! ls_small spoils w%jt, which is rebuilt by the caller for the next solve
@@ -951,6 +965,18 @@ contains
       call lapack_status('dgelsy', info, st, msg)
       l = w%bls(1:m%neq)
     end subroutine solve_ls
+    !> min |a_kk| / max |a_kk| of square LU factors.
+    pure real(wp) function diag_ratio(a) result(r)
+      real(wp), intent(in) :: a(:, :)
+      integer :: k
+      real(wp) :: amin, amax
+      amin = huge(one); amax = zero
+      do k = 1, size(a, 1)
+        amin = min(amin, abs(a(k, k))); amax = max(amax, abs(a(k, k)))
+      end do
+      r = zero
+      if (amax > zero) r = amin / amax
+    end function diag_ratio
     !> grad N of friction element bx at multipliers l.
     function grad_dir(bx, l) result(g)
       integer, intent(in) :: bx

@@ -22,11 +22,13 @@ module mbd_linsolve
   private
   public :: lapack_status, lu_factor, lu_solve, lu_det_sign, svd_null, row_rank
   public :: lu_factor_small, lu_solve_small, ls_small, lu_solve_rows, ls_small_cols
-  public :: qr_factor, qr_solve, qr_lwork, RANK_TOL
+  public :: qr_factor, qr_solve, qr_lwork, RANK_TOL, LS_RTOL
 
   integer, parameter :: SMALL_N = 48   !! below this the unblocked dgetf2 is faster
   !> |R_kk| / |R_11| of the row-normalized matrix below which a row is dependent
   real(wp), parameter :: RANK_TOL = 1.0e-8_wp
+  !> least squares of full column rank: min |R_kk| / max |R_kk| of the QR at least this
+  real(wp), parameter :: LS_RTOL = 1.0e-8_wp
 
 contains
 
@@ -180,7 +182,6 @@ contains
     real(wp), intent(inout) :: a(:, :)          !! A, overwritten by the factorization
     real(wp), intent(inout) :: b(:, :)          !! B (m, nrhs), then X in b(1:n, :)
     logical, intent(out) :: ok                  !! A had full column rank
-    real(wp), parameter :: LS_RTOL = 1.0e-8_wp
     integer :: mm, n, k, j
     real(wp) :: alpha, nrm, vtv, f, rmax, rmin
     mm = size(a, 1); n = size(a, 2)
@@ -256,7 +257,6 @@ contains
     real(wp), intent(inout) :: a(:, :)          !! A, overwritten by the factorization
     real(wp), intent(inout) :: b(:)             !! b (m), then x in b(1:n)
     logical, intent(out) :: ok                  !! A had full column rank
-    real(wp), parameter :: LS_RTOL = 1.0e-8_wp
     integer :: mm, n, k, j
     real(wp) :: alpha, nrm, vtv, f, rmax, rmin
     mm = size(a, 1); n = size(a, 2)
