@@ -1336,10 +1336,15 @@ contains
       do s = 1, NLOC
         c = m%loc(s, k)
         if (c == 0) cycle
-        acc = zero
-        do i = 1, m%nrow(k)
-          acc = acc + jb(i, s, k) * lam(r0 + i)
-        end do
+        if (m%nrow(k) == 2) then              ! (most joints; the sum of the loop below)
+          acc = jb(1, s, k) * lam(r0 + 1) + jb(2, s, k) * lam(r0 + 2)
+        else
+          acc = zero
+          !GCC$ novector
+          do i = 1, m%nrow(k)
+            acc = acc + jb(i, s, k) * lam(r0 + i)
+          end do
+        end if
         r(c) = r(c) + acc
       end do
     end do
