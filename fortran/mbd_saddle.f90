@@ -42,7 +42,7 @@ module mbd_saddle
   use mbd_model, only: model_t
   use mbd_band, only: band_t, band_plan_perm, band_graph, band_rcm, band_zero, band_norm1, &
                       band_factor, band_rcond, band_solve, band_matvec
-  use mbd_schur, only: schur_t, schur_plan, schur_factor, schur_solve
+  use mbd_schur, only: schur_t, schur_plan, schur_factor, schur_solve, rows_rcm
   use mbd_linsolve, only: lu_factor, lu_solve, lu_factor_small, lu_solve_small, lapack_status
   use mbd_lapack, only: dgecon, dgelsy
   implicit none
@@ -615,10 +615,9 @@ contains
     integer, intent(out) :: rank                  !! number of independent rows
     integer, intent(out) :: status                !! MBD_OK or MBD_NO_MEMORY
     character(len=MSG_LEN), intent(out) :: msg    !! explanation
-    integer, allocatable :: cptr(:), crow(:), cslot(:), ccon(:), pr(:), pc(:), aptr(:), &
-                            adj(:), ord(:), pos(:), rowof(:), nxt(:)
+    integer, allocatable :: cptr(:), crow(:), cslot(:), ccon(:), pos(:), rowof(:), nxt(:)
     real(wp), allocatable :: g(:, :), rnorm(:)
-    integer :: neq, n, k, s, r, c, i, j, a, b, kd, ne, ierr, l, w, np
+    integer :: neq, n, k, s, r, c, i, j, a, b, kd, ne, ierr, l, w
     real(wp) :: v, dj
     status = MBD_OK; msg = ''
     neq = m%neq; n = m%nq
@@ -630,7 +629,7 @@ contains
       ne = ne + m%nrow(k) * count(m%loc(:, k) > 0)
     end do
     allocate (cptr(n + 1), crow(ne), cslot(ne), ccon(ne), rnorm(neq), pos(neq), rowof(neq), &
-              ord(neq), stat=ierr)
+              stat=ierr)
     if (ierr /= 0) goto 90
     cptr = 0
     do k = 1, m%nc
@@ -659,32 +658,11 @@ contains
       end do
     end do
     rnorm = sqrt(rnorm)
-    ! row graph: rows sharing a coordinate
-    np = 0
-    do c = 1, n
-      np = np + (cptr(c + 1) - cptr(c))**2
-    end do
-    allocate (pr(np), pc(np), stat=ierr)
-    if (ierr /= 0) goto 90
-    np = 0
-    do c = 1, n
-      do i = cptr(c), cptr(c + 1) - 1
-        do j = cptr(c), cptr(c + 1) - 1
-          np = np + 1
-          pr(np) = crow(i); pc(np) = crow(j)
-        end do
-      end do
-    end do
-    call band_graph(neq, pr, pc, aptr, adj, ierr)
-    if (ierr == 0) call band_rcm(neq, aptr, adj, ord, ierr)
+    ! the rows in reverse Cuthill-McKee order of the graph of rows sharing a coordinate
+    call rows_rcm(neq, cptr, crow, pos, kd, ierr)
     if (ierr /= 0) goto 90
     do i = 1, neq
-      pos(ord(i)) = i
-      rowof(i) = ord(i)
-    end do
-    kd = 0
-    do i = 1, np
-      kd = max(kd, abs(pos(pr(i)) - pos(pc(i))))
+      rowof(pos(i)) = i
     end do
     ! G in lower band storage: G(p, q) (p >= q, band positions) in g(1 + p - q, q)
     call mem_check(REAL_BYTES * real(kd + 1, wp) * neq, 'the rank analysis of J (band)', HINT, &

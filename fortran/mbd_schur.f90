@@ -36,7 +36,7 @@ module mbd_schur
   use mbd_band, only: band_graph, band_rcm
   implicit none
   private
-  public :: schur_t, schur_plan, schur_factor, schur_solve, SCHUR_PIVOT
+  public :: schur_t, schur_plan, schur_factor, schur_solve, rows_rcm, SCHUR_PIVOT
 
   !> min L_jj^2 / max L_jj^2 below which the Schur complement is not used
   real(wp), parameter :: SCHUR_PIVOT = 1.0e-8_wp
@@ -74,13 +74,12 @@ contains
     type(schur_t), intent(out) :: sc               !! the plan
     integer, intent(out) :: status                 !! MBD_OK or MBD_NO_MEMORY
     character(len=MSG_LEN), intent(out) :: msg     !! explanation
-    integer, allocatable :: arow(:), cptr(:), crow(:), csrc(:), nxt(:), pr(:), pc(:), &
-                            aptr(:), adj(:), ord(:)
-    integer :: n, na, ne, np, k, s, c, r, a, i, j, ierr
+    integer, allocatable :: arow(:), cptr(:), crow(:), csrc(:), nxt(:)
+    integer :: n, na, ne, k, s, c, r, a, ierr
     status = MBD_OK; msg = ''
     n = m%nq; na = size(rows)
     sc%n = n; sc%na = na
-    allocate (arow(m%neq), cptr(n + 1), sc%pos(na), ord(na), stat=ierr)
+    allocate (arow(m%neq), cptr(n + 1), sc%pos(na), stat=ierr)
     if (ierr /= 0) goto 90
     arow = 0
     do a = 1, na
@@ -118,35 +117,8 @@ contains
         end do
       end do
     end do
-    ! the row graph (rows sharing a coordinate), its reverse Cuthill-McKee order
-    np = 0
-    do c = 1, n
-      np = np + (cptr(c + 1) - cptr(c))**2
-    end do
-    allocate (pr(max(np, 1)), pc(max(np, 1)), stat=ierr)
+    call rows_rcm(na, cptr, crow, sc%pos, sc%kd, ierr)
     if (ierr /= 0) goto 90
-    np = 0
-    do c = 1, n
-      do i = cptr(c), cptr(c + 1) - 1
-        do j = cptr(c), cptr(c + 1) - 1
-          np = np + 1
-          pr(np) = crow(i); pc(np) = crow(j)
-        end do
-      end do
-    end do
-    if (na > 0) then
-      call band_graph(na, pr(1:np), pc(1:np), aptr, adj, ierr)
-      if (ierr == 0) call band_rcm(na, aptr, adj, ord, ierr)
-      if (ierr /= 0) goto 90
-    end if
-    do i = 1, na
-      sc%pos(ord(i)) = i
-    end do
-    sc%kd = 0
-    do i = 1, np
-      sc%kd = max(sc%kd, abs(sc%pos(pr(i)) - sc%pos(pc(i))))
-    end do
-    deallocate (pr, pc)
     call plan_groups(sc, cptr, crow, csrc, ierr)
     if (ierr /= 0) goto 90
     call mem_check(REAL_BYTES * (real(sc%kd + 4, wp) * na + 3 * n + 2 * ne), &
@@ -158,9 +130,49 @@ contains
     sc%planned = .true.
     return
 90  status = MBD_NO_MEMORY
-    call mem_fail(REAL_BYTES * 4 * (real(np, wp) + n + na), 'the Schur complement plan', HINT, &
+    call mem_fail(REAL_BYTES * 4 * (36 * real(n, wp) + na), 'the Schur complement plan', HINT, &
                   status, msg)
   end subroutine schur_plan
+
+  !> Reverse Cuthill-McKee order of nr rows in the graph where two rows are adjacent when
+  !! they share a coordinate (the rows at coordinate c: crow(cptr(c):cptr(c+1)-1)): pos(r)
+  !! the place of row r, kd the half band width of a matrix coupling such rows (J J^T).
+  subroutine rows_rcm(nr, cptr, crow, pos, kd, ierr)
+    integer, intent(in) :: nr                 !! rows
+    integer, intent(in) :: cptr(:), crow(:)   !! rows by coordinate (n + 1 pointers)
+    integer, intent(out) :: pos(:)            !! (nr) place of each row
+    integer, intent(out) :: kd                !! half band width
+    integer, intent(out) :: ierr              !! allocation status (0 ok)
+    integer, allocatable :: pr(:), pc(:), aptr(:), adj(:), ord(:)
+    integer :: c, i, j, np
+    kd = 0
+    np = 0
+    do c = 1, size(cptr) - 1
+      np = np + (cptr(c + 1) - cptr(c))**2
+    end do
+    allocate (pr(max(np, 1)), pc(max(np, 1)), ord(nr), stat=ierr)
+    if (ierr /= 0) return
+    np = 0
+    do c = 1, size(cptr) - 1
+      do i = cptr(c), cptr(c + 1) - 1
+        do j = cptr(c), cptr(c + 1) - 1
+          np = np + 1
+          pr(np) = crow(i); pc(np) = crow(j)
+        end do
+      end do
+    end do
+    if (nr > 0) then
+      call band_graph(nr, pr(1:np), pc(1:np), aptr, adj, ierr)
+      if (ierr == 0) call band_rcm(nr, aptr, adj, ord, ierr)
+      if (ierr /= 0) return
+    end if
+    do i = 1, nr
+      pos(ord(i)) = i
+    end do
+    do i = 1, np
+      kd = max(kd, abs(pos(pr(i)) - pos(pc(i))))
+    end do
+  end subroutine rows_rcm
 
   !> The coordinate groups (runs of coordinates whose entries name the same rows in the same
   !! order), J's entries in their layout (row by row), and the pairs of rows of each group
