@@ -42,7 +42,8 @@ module mbd_saddle
   use mbd_model, only: model_t
   use mbd_band, only: band_t, band_plan_perm, band_graph, band_rcm, band_zero, band_norm1, &
                       band_factor, band_rcond, band_solve, band_matvec
-  use mbd_schur, only: schur_t, schur_plan, schur_factor, schur_solve, rows_rcm
+  use mbd_schur, only: schur_t, schur_plan, schur_factor, schur_solve, rows_rcm, &
+                       rows_by_coordinate
   use mbd_linsolve, only: lu_factor, lu_solve, lu_factor_small, lu_solve_small, lapack_status
   use mbd_lapack, only: dgecon, dgelsy
   implicit none
@@ -615,47 +616,24 @@ contains
     integer, intent(out) :: rank                  !! number of independent rows
     integer, intent(out) :: status                !! MBD_OK or MBD_NO_MEMORY
     character(len=MSG_LEN), intent(out) :: msg    !! explanation
-    integer, allocatable :: cptr(:), crow(:), cslot(:), ccon(:), pos(:), rowof(:), nxt(:)
+    integer, allocatable :: arow(:), cptr(:), crow(:), csrc(:), pos(:), rowof(:)
     real(wp), allocatable :: g(:, :), rnorm(:)
-    integer :: neq, n, k, s, r, c, i, j, a, b, kd, ne, ierr, l, w
+    integer :: neq, n, c, i, j, a, b, kd, ne, ierr, l, w
     real(wp) :: v, dj
     status = MBD_OK; msg = ''
     neq = m%neq; n = m%nq
     redundant = 0; rank = 0
     if (neq == 0) return
-    ! the rows touching each coordinate (with the block entry), by counting
-    ne = 0
-    do k = 1, m%nc
-      ne = ne + m%nrow(k) * count(m%loc(:, k) > 0)
-    end do
-    allocate (cptr(n + 1), crow(ne), cslot(ne), ccon(ne), rnorm(neq), pos(neq), rowof(neq), &
-              stat=ierr)
+    ! the rows touching each coordinate and their block entries; the rows' lengths
+    allocate (arow(neq), rnorm(neq), pos(neq), rowof(neq), stat=ierr)
     if (ierr /= 0) goto 90
-    cptr = 0
-    do k = 1, m%nc
-      do s = 1, NLOC
-        c = m%loc(s, k)
-        if (c > 0) cptr(c + 1) = cptr(c + 1) + m%nrow(k)
-      end do
-    end do
-    cptr(1) = 1
-    do c = 1, n
-      cptr(c + 1) = cptr(c + 1) + cptr(c)
-    end do
+    arow = [(i, i=1, neq)]
+    call rows_by_coordinate(m, arow, cptr, crow, csrc, ierr)
+    if (ierr /= 0) goto 90
+    ne = size(crow)
     rnorm = zero
-    allocate (nxt(n), stat=ierr)
-    if (ierr /= 0) goto 90
-    nxt = cptr(1:n)
-    do k = 1, m%nc
-      do s = 1, NLOC
-        c = m%loc(s, k)
-        if (c == 0) cycle
-        do r = 1, m%nrow(k)
-          crow(nxt(c)) = m%row0(k) + r - 1; cslot(nxt(c)) = s; ccon(nxt(c)) = k
-          nxt(c) = nxt(c) + 1
-          rnorm(m%row0(k) + r - 1) = rnorm(m%row0(k) + r - 1) + jb(r, s, k)**2
-        end do
-      end do
+    do i = 1, ne
+      rnorm(crow(i)) = rnorm(crow(i)) + jbf(csrc(i))**2
     end do
     rnorm = sqrt(rnorm)
     ! the rows in reverse Cuthill-McKee order of the graph of rows sharing a coordinate
@@ -678,8 +656,7 @@ contains
         do j = cptr(c), cptr(c + 1) - 1
           b = crow(j)
           if (pos(a) < pos(b) .or. .not. rnorm(b) > zero) cycle
-          v = jb(a - m%row0(ccon(i)) + 1, cslot(i), ccon(i)) * &
-              jb(b - m%row0(ccon(j)) + 1, cslot(j), ccon(j)) / (rnorm(a) * rnorm(b))
+          v = jbf(csrc(i)) * jbf(csrc(j)) / (rnorm(a) * rnorm(b))
           g(1 + pos(a) - pos(b), pos(b)) = g(1 + pos(a) - pos(b), pos(b)) + v
         end do
       end do
@@ -708,8 +685,15 @@ contains
     end do
     rank = neq - count(redundant == 1)
     return
-90  call mem_fail(REAL_BYTES * 8 * real(ne, wp), 'the rank analysis of J (band)', HINT, &
-                  status, msg)
+90  call mem_fail(REAL_BYTES * 8 * (real(neq, wp) + 6 * n), 'the rank analysis of J (band)', &
+                  HINT, status, msg)
+  contains
+    !> The block entry at flat position f of jb (MAXROW, NLOC, nc).
+    pure real(wp) function jbf(f)
+      integer, intent(in) :: f
+      jbf = jb(mod(f - 1, MAXROW) + 1, mod((f - 1) / MAXROW, NLOC) + 1, &
+               (f - 1) / (MAXROW * NLOC) + 1)
+    end function jbf
   end subroutine saddle_row_rank
 
 end module mbd_saddle

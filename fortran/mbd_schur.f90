@@ -36,7 +36,8 @@ module mbd_schur
   use mbd_band, only: band_graph, band_rcm
   implicit none
   private
-  public :: schur_t, schur_plan, schur_factor, schur_solve, rows_rcm, SCHUR_PIVOT
+  public :: schur_t, schur_plan, schur_factor, schur_solve, rows_rcm, rows_by_coordinate, &
+            SCHUR_PIVOT
 
   !> min L_jj^2 / max L_jj^2 below which the Schur complement is not used
   real(wp), parameter :: SCHUR_PIVOT = 1.0e-8_wp
@@ -74,49 +75,20 @@ contains
     type(schur_t), intent(out) :: sc               !! the plan
     integer, intent(out) :: status                 !! MBD_OK or MBD_NO_MEMORY
     character(len=MSG_LEN), intent(out) :: msg     !! explanation
-    integer, allocatable :: arow(:), cptr(:), crow(:), csrc(:), nxt(:)
-    integer :: n, na, ne, k, s, c, r, a, ierr
+    integer, allocatable :: arow(:), cptr(:), crow(:), csrc(:)
+    integer :: n, na, ne, a, ierr
     status = MBD_OK; msg = ''
     n = m%nq; na = size(rows)
     sc%n = n; sc%na = na
-    allocate (arow(m%neq), cptr(n + 1), sc%pos(na), stat=ierr)
+    allocate (arow(m%neq), sc%pos(na), stat=ierr)
     if (ierr /= 0) goto 90
     arow = 0
     do a = 1, na
       arow(rows(a)) = a
     end do
-    ! J's active entries by coordinate (counted, then placed)
-    cptr = 0
-    do k = 1, m%nc
-      do s = 1, NLOC
-        c = m%loc(s, k)
-        if (c == 0) cycle
-        do r = 1, m%nrow(k)
-          if (arow(m%row0(k) + r - 1) > 0) cptr(c + 1) = cptr(c + 1) + 1
-        end do
-      end do
-    end do
-    cptr(1) = 1
-    do c = 1, n
-      cptr(c + 1) = cptr(c + 1) + cptr(c)
-    end do
-    ne = cptr(n + 1) - 1
-    allocate (crow(ne), csrc(ne), nxt(n), stat=ierr)
+    call rows_by_coordinate(m, arow, cptr, crow, csrc, ierr)
     if (ierr /= 0) goto 90
-    nxt = cptr(1:n)
-    do k = 1, m%nc
-      do s = 1, NLOC
-        c = m%loc(s, k)
-        if (c == 0) cycle
-        do r = 1, m%nrow(k)
-          a = arow(m%row0(k) + r - 1)
-          if (a == 0) cycle
-          crow(nxt(c)) = a
-          csrc(nxt(c)) = r + MAXROW * (s - 1 + NLOC * (k - 1))
-          nxt(c) = nxt(c) + 1
-        end do
-      end do
-    end do
+    ne = size(crow)
     call rows_rcm(na, cptr, crow, sc%pos, sc%kd, ierr)
     if (ierr /= 0) goto 90
     call plan_groups(sc, cptr, crow, csrc, ierr)
@@ -133,6 +105,52 @@ contains
     call mem_fail(REAL_BYTES * 4 * (36 * real(n, wp) + na), 'the Schur complement plan', HINT, &
                   status, msg)
   end subroutine schur_plan
+
+  !> J's entries of the rows arow marks (arow(equation) = its number among them, 0 not
+  !! taken) by coordinate: coordinate c has the entries cptr(c):cptr(c+1)-1, crow their
+  !! row numbers, csrc their flat positions in the blocks jb (MAXROW, NLOC, nc).
+  subroutine rows_by_coordinate(m, arow, cptr, crow, csrc, ierr)
+    type(model_t), intent(in) :: m                    !! model
+    integer, intent(in) :: arow(:)                    !! (neq) row numbers, 0 not taken
+    integer, allocatable, intent(out) :: cptr(:)      !! (nq + 1) pointers
+    integer, allocatable, intent(out) :: crow(:), csrc(:)  !! row and block position
+    integer, intent(out) :: ierr                      !! allocation status (0 ok)
+    integer, allocatable :: nxt(:)
+    integer :: k, s, c, r, a, n
+    n = m%nq
+    allocate (cptr(n + 1), nxt(n), stat=ierr)
+    if (ierr /= 0) return
+    cptr = 0
+    do k = 1, m%nc
+      do s = 1, NLOC
+        c = m%loc(s, k)
+        if (c == 0) cycle
+        do r = 1, m%nrow(k)
+          if (arow(m%row0(k) + r - 1) > 0) cptr(c + 1) = cptr(c + 1) + 1
+        end do
+      end do
+    end do
+    cptr(1) = 1
+    do c = 1, n
+      cptr(c + 1) = cptr(c + 1) + cptr(c)
+    end do
+    allocate (crow(cptr(n + 1) - 1), csrc(cptr(n + 1) - 1), stat=ierr)
+    if (ierr /= 0) return
+    nxt = cptr(1:n)
+    do k = 1, m%nc
+      do s = 1, NLOC
+        c = m%loc(s, k)
+        if (c == 0) cycle
+        do r = 1, m%nrow(k)
+          a = arow(m%row0(k) + r - 1)
+          if (a == 0) cycle
+          crow(nxt(c)) = a
+          csrc(nxt(c)) = r + MAXROW * (s - 1 + NLOC * (k - 1))
+          nxt(c) = nxt(c) + 1
+        end do
+      end do
+    end do
+  end subroutine rows_by_coordinate
 
   !> Reverse Cuthill-McKee order of nr rows in the graph where two rows are adjacent when
   !! they share a coordinate (the rows at coordinate c: crow(cptr(c):cptr(c+1)-1)): pos(r)
