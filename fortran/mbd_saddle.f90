@@ -44,6 +44,7 @@ module mbd_saddle
                       band_factor, band_rcond, band_solve, band_matvec
   use mbd_schur, only: schur_t, schur_plan, schur_factor, schur_solve, rows_rcm, &
                        rows_by_coordinate
+  use mbd_splu, only: splu_t, splu_init, splu_plan, splu_factor, splu_solve, splu_pos, LMAX
   use mbd_linsolve, only: lu_factor, lu_solve, lu_factor_small, lu_solve_small, lapack_status
   use mbd_lapack, only: dgecon, dgelsy
   implicit none
@@ -87,6 +88,12 @@ module mbd_saddle
     ! band path
     type(band_t) :: b                    !! plan, storage, factors
     type(schur_t) :: sc                  !! index-1 systems with diagonal A: mbd_schur
+    ! small dense path (plain): a sparse LU replayed in a planned pivot order (mbd_splu)
+    type(splu_t) :: sp
+    logical :: sparse = .false.          !! the sparse LU is planned for
+    logical :: spfact = .false.          !! the last factorization is the sparse one
+    integer, allocatable :: uflat(:), urow(:), ucol(:), upos(:)  !! structural entries
+    real(wp), allocatable :: ones(:), xs(:)  !! unit column scale, solution of the sparse solves
     real(wp), allocatable :: bcopy(:, :) !! the unregularized matrix of a nearly singular one
     real(wp), allocatable :: r(:), x(:), xw(:)  !! refinement workspace (nt)
   end type saddle_t
@@ -215,6 +222,7 @@ contains
         call mem_fail(bytes, 'the dense saddle-point matrix', HINT, status, msg); return
       end if
       sd%a = zero
+      if (sd%plain) call sparse_plan(sd, sr, sc)
     end if
     if (chk .and. .not. sd%full) then         ! index-1 with diagonal A: the Schur complement
       call schur_plan(m, rows, sd%sc, status, msg)
@@ -457,7 +465,10 @@ contains
     end if
     call fill(ee)
     if (sd%plain) then
-      call lu_factor_small(sd%a, sd%ipiv, status)
+      sd%spfact = .false.
+      if (sd%sparse) call sparse_factor(sd, sd%spfact)
+      status = MBD_OK
+      if (.not. sd%spfact) call lu_factor_small(sd%a, sd%ipiv, status)
       return
     end if
     if (.not. (chk .and. allocated(sd%acopy))) then
@@ -494,6 +505,97 @@ contains
       end if
     end subroutine fill
   end subroutine saddle_factor
+
+  !> The sparse LU of a small iteration matrix: its structural entries (the pieces' lists
+  !! sr, sc, repeats merged) and their places in the dense storage. Nothing is planned yet
+  !! (the first factorization plans on the values); a failure leaves the dense LU.
+  subroutine sparse_plan(sd, sr, sc)
+    type(saddle_t), intent(inout) :: sd
+    integer, intent(in) :: sr(:), sc(:)          ! rows and columns of the pieces
+    logical, allocatable :: seen(:, :)
+    integer :: i, nu, nt, ierr, st
+    character(len=MSG_LEN) :: msg
+    nt = sd%nt
+    allocate (seen(nt, nt), stat=ierr)
+    if (ierr /= 0) return
+    seen = .false.
+    nu = 0
+    do i = 1, size(sr)
+      if (seen(sr(i), sc(i))) cycle
+      seen(sr(i), sc(i)) = .true.
+      nu = nu + 1
+    end do
+    allocate (sd%urow(nu), sd%ucol(nu), sd%uflat(nu), sd%upos(nu), sd%ones(nt), sd%xs(nt), &
+              stat=ierr)
+    if (ierr /= 0) return
+    seen = .false.
+    nu = 0
+    do i = 1, size(sr)
+      if (seen(sr(i), sc(i))) cycle
+      seen(sr(i), sc(i)) = .true.
+      nu = nu + 1
+      sd%urow(nu) = sr(i); sd%ucol(nu) = sc(i); sd%uflat(nu) = sr(i) + nt * (sc(i) - 1)
+    end do
+    sd%upos = 0
+    sd%ones = one
+    msg = ''
+    call splu_init(nt, sd%urow, sd%ucol, sd%sp, st, msg)
+    sd%sparse = st == MBD_OK
+  end subroutine sparse_plan
+
+  !> Factor the filled dense matrix sd%a by the sparse LU: its values in the planned order,
+  !! a new plan (on these values) when there is none, an entry outside the planned pattern
+  !! is non-zero, a pivot is zero or a multiplier exceeds LMAX. ok false: a plan failed
+  !! too (the caller factors densely).
+  subroutine sparse_factor(sd, ok)
+    type(saddle_t), intent(inout) :: sd
+    logical, intent(out) :: ok
+    real(wp) :: lmax, ratio
+    integer :: st, sgn
+    logical :: off
+    character(len=MSG_LEN) :: msg
+    ok = .false.
+    st = MBD_SINGULAR; lmax = zero
+    if (sd%sp%planned) then
+      call gather(sd%a, sd%uflat, sd%upos, sd%sp%val, off)
+      if (.not. off) call splu_factor(sd%sp, st, lmax, sgn, ratio)
+    end if
+    if (st /= MBD_OK .or. .not. lmax <= LMAX) then
+      msg = ''
+      call splu_plan(sd%sp, sd%a, st, msg)
+      if (st /= MBD_OK) return
+      call positions()
+      call splu_factor(sd%sp, st, lmax, sgn, ratio)
+      if (st /= MBD_OK .or. .not. lmax <= LMAX) return
+    end if
+    ok = .true.
+  contains
+    !> The places of the structural entries in the new plan.
+    subroutine positions()
+      integer :: i
+      do i = 1, size(sd%upos)
+        sd%upos(i) = splu_pos(sd%sp, sd%urow(i), sd%ucol(i))
+      end do
+    end subroutine positions
+  end subroutine sparse_factor
+
+  !> The structural entries of the dense matrix a (flat positions uflat) into the sparse
+  !! plan's storage val (positions upos); off: a non-zero entry the plan does not hold.
+  pure subroutine gather(a, uflat, upos, val, off)
+    real(wp), intent(in) :: a(*)
+    integer, intent(in) :: uflat(:), upos(:)
+    real(wp), intent(inout) :: val(:)
+    logical, intent(out) :: off
+    integer :: i
+    off = .false.
+    do i = 1, size(upos)
+      if (upos(i) > 0) then
+        val(upos(i)) = a(uflat(i))
+      else if (abs(a(uflat(i))) > zero) then
+        off = .true.
+      end if
+    end do
+  end subroutine gather
 
   !> Place the pieces into flat storage: K on its pattern, += d on the diagonal of A, -e on
   !! the constraint diagonal, s J_a and s J_a^T (the order of the dense matrices before, so
@@ -585,7 +687,12 @@ contains
       return
     end if
     if (sd%plain) then
-      call lu_solve_small(sd%a, sd%ipiv, rhs)
+      if (sd%spfact) then
+        call splu_solve(sd%sp, rhs, sd%xs, sd%ones)
+        rhs = sd%xs
+      else
+        call lu_solve_small(sd%a, sd%ipiv, rhs)
+      end if
       status = MBD_OK
       return
     end if
