@@ -15,7 +15,10 @@
 !! Dense path: the matrix (n + na)^2; index-1 systems by LU (dgetf2/dgetrf) and, when nearly
 !! singular (1/cond_1 < AUG_RCOND, as at the collinear position of a parallelogram), by the
 !! rank-revealing minimum-norm least-squares solve dgelsy; the generalized-alpha matrix by
-!! the plain-loop LU (lu_factor_small).
+!! a sparse LU replayed in a pivot order planned on its values (mbd_splu; K is non-zero
+!! only in the angle columns), planned again when an entry outside the plan turns non-zero,
+!! a pivot vanishes or a multiplier grows past LMAX, and the plain-loop LU (lu_factor_small)
+!! when a plan fails.
 !! Band path (mbd_band): the rows and columns of the saddle matrix ordered by one symmetric
 !! permutation, the narrower of two (the smaller kl + ku):
 !!   interleaved  the coordinate groups (a body's x, y, theta; each extra coordinate) in
@@ -130,7 +133,7 @@ contains
     integer, intent(out) :: status                 !! MBD_OK, MBD_BAD_INPUT or MBD_NO_MEMORY
     character(len=MSG_LEN), intent(out) :: msg     !! explanation
     integer, intent(in), optional :: kptr(:), krow(:)  !! tangent pattern (full)
-    logical, intent(in), optional :: small         !! dense: plain-loop LU for iterations
+    logical, intent(in), optional :: small         !! dense: sparse / plain LU for iterations
     logical, intent(in), optional :: index1        !! workspace of nearly singular solves
     integer, allocatable :: arow(:), sr(:), sc(:), perm(:)
     integer :: n, na, nt, ne, nk, k, s, r, c, a, i, ierr, ldab
