@@ -63,6 +63,9 @@ module mbd_saddle
   integer, parameter :: SADDLE_BAND_MIN_N = 60, SADDLE_BAND_RATIO = 4
   !> bands up to this kl + ku are factored in plain loops (band_lu), wider ones by dgbtrf
   integer, parameter :: PLAIN_MAX = 64
+  !> small dense iteration matrices up to this order take the sparse LU (mbd_splu: its plan
+  !! keeps several arrays of nt^2 entries)
+  integer, parameter :: SPARSE_MAX = 64
   character(len=*), parameter :: HINT = 'use a model with fewer coordinates'
 
   !> A planned saddle-point matrix: the map from the constraint blocks, the storage and
@@ -225,7 +228,7 @@ contains
         call mem_fail(bytes, 'the dense saddle-point matrix', HINT, status, msg); return
       end if
       sd%a = zero
-      if (sd%plain) call sparse_plan(sd, sr, sc)
+      if (sd%plain .and. nt <= SPARSE_MAX) call sparse_plan(sd, sr, sc)
     end if
     if (chk .and. .not. sd%full) then         ! index-1 with diagonal A: the Schur complement
       call schur_plan(m, rows, sd%sc, status, msg)
