@@ -519,10 +519,11 @@ contains
     type(saddle_t), intent(inout) :: sd
     integer, intent(in) :: sr(:), sc(:)          ! rows and columns of the pieces
     logical, allocatable :: seen(:, :)
+    integer, allocatable :: tr(:), tc(:)
     integer :: i, nu, nt, ierr, st
     character(len=MSG_LEN) :: msg
     nt = sd%nt
-    allocate (seen(nt, nt), stat=ierr)
+    allocate (seen(nt, nt), tr(size(sr)), tc(size(sr)), stat=ierr)
     if (ierr /= 0) return
     seen = .false.
     nu = 0
@@ -530,18 +531,13 @@ contains
       if (seen(sr(i), sc(i))) cycle
       seen(sr(i), sc(i)) = .true.
       nu = nu + 1
+      tr(nu) = sr(i); tc(nu) = sc(i)
     end do
     allocate (sd%urow(nu), sd%ucol(nu), sd%uflat(nu), sd%upos(nu), sd%ones(nt), sd%xs(nt), &
               stat=ierr)
     if (ierr /= 0) return
-    seen = .false.
-    nu = 0
-    do i = 1, size(sr)
-      if (seen(sr(i), sc(i))) cycle
-      seen(sr(i), sc(i)) = .true.
-      nu = nu + 1
-      sd%urow(nu) = sr(i); sd%ucol(nu) = sc(i); sd%uflat(nu) = sr(i) + nt * (sc(i) - 1)
-    end do
+    sd%urow = tr(1:nu); sd%ucol = tc(1:nu)
+    sd%uflat = sd%urow + nt * (sd%ucol - 1)
     sd%upos = 0
     sd%ones = one
     msg = ''
