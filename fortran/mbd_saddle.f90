@@ -138,8 +138,8 @@ contains
     integer, intent(in), optional :: kptr(:), krow(:)  !! tangent pattern (full)
     logical, intent(in), optional :: small         !! dense: sparse / plain LU for iterations
     logical, intent(in), optional :: index1        !! workspace of nearly singular solves
-    integer, allocatable :: arow(:), sr(:), sc(:), perm(:)
-    integer :: n, na, nt, ne, nk, k, s, r, c, a, i, ierr, ldab
+    integer, allocatable :: arow(:), sr(:), sc(:), perm(:), cptr(:), crow(:), csrc(:)
+    integer :: n, na, nt, ne, nk, c, a, i, ierr, ldab
     real(wp) :: bytes
     logical :: chk
     status = MBD_OK; msg = ''
@@ -157,40 +157,30 @@ contains
     do a = 1, na
       arow(rows(a)) = a
     end do
-    ! the nonzeros of the active rows' blocks
-    ne = 0
-    do k = 1, m%nc
-      do r = 1, m%nrow(k)
-        if (arow(m%row0(k) + r - 1) == 0) cycle
-        ne = ne + count(m%loc(:, k) > 0)
-      end do
-    end do
+    ! the nonzeros of the active rows' blocks, by coordinate
+    call rows_by_coordinate(m, arow, cptr, crow, csrc, ierr)
+    if (ierr /= 0) then
+      call mem_fail(12 * real(n, wp), 'the saddle-point map', HINT, status, msg); return
+    end if
+    ne = size(crow)
     nk = 0
     if (sd%full) nk = kptr(n + 1) - 1
-    allocate (sd%esrc(ne), sd%epos(ne), sd%etpos(ne), sd%dpos(nt), sd%kpos(nk), &
+    allocate (sd%epos(ne), sd%etpos(ne), sd%dpos(nt), sd%kpos(nk), &
               sr(nt + 2 * ne + nk), sc(nt + 2 * ne + nk), perm(nt), stat=ierr)
     if (ierr /= 0) then
       call mem_fail(4 * (3 * real(ne, wp) + 3 * nt + 5 * ne + 3 * nk), 'the saddle-point map', &
                     HINT, status, msg)
       return
     end if
+    call move_alloc(csrc, sd%esrc)
     ! the structure: the diagonal, s J_a and s J_a^T, the tangent pattern
     do i = 1, nt
       sr(i) = i; sc(i) = i
     end do
-    ne = 0
-    do k = 1, m%nc
-      do s = 1, NLOC
-        c = m%loc(s, k)
-        if (c == 0) cycle
-        do r = 1, m%nrow(k)
-          a = arow(m%row0(k) + r - 1)
-          if (a == 0) cycle
-          ne = ne + 1
-          sd%esrc(ne) = r + MAXROW * (s - 1 + NLOC * (k - 1))
-          sr(nt + 2 * ne - 1) = n + a; sc(nt + 2 * ne - 1) = c
-          sr(nt + 2 * ne) = c; sc(nt + 2 * ne) = n + a
-        end do
+    do c = 1, n
+      do i = cptr(c), cptr(c + 1) - 1
+        sr(nt + 2 * i - 1) = n + crow(i); sc(nt + 2 * i - 1) = c
+        sr(nt + 2 * i) = c; sc(nt + 2 * i) = n + crow(i)
       end do
     end do
     if (sd%full) then
