@@ -463,27 +463,31 @@ contains
 
   !> Solve J X = B for several right-hand sides with the factors (as solve), B given as rows
   !! bt = B^T (n rounded up to a multiple of 4, neq; padding rows zero) and overwritten; the
-  !! dense LU by plain loops over all of them at once.
-  subroutine solve_cols(w, bt, x)
+  !! dense LU by plain loops over all of them at once. X is returned as columns x (nq, n) and
+  !! as rows xt (n rounded up, nq; padding rows zero).
+  subroutine solve_cols(w, bt, x, b, xt)
     type(kin_work_t), intent(inout) :: w   !! work arrays with the factors
     real(wp), intent(inout) :: bt(:, :)    !! right-hand sides as rows (4 k, neq), spoiled
     real(wp), intent(out) :: x(:, :)       !! solutions (nq, n)
-    real(wp) :: b(size(bt, 2))
+    real(wp), intent(out) :: b(:)          !! work (neq): one right-hand side at a time
+    real(wp), intent(inout) :: xt(:, :)    !! solutions as rows (4 k, nq)
     integer :: k
     if (w%spfact) then
-      call splu_solve_rows(w%sp, bt, x, w%cs)
+      call splu_solve_rows(w%sp, bt, x, w%cs, xt)
       return
     end if
     if (w%lsq .or. w%banded) then
       do k = 1, size(x, 2)
         b = bt(k, :)
         call solve(w, b, x(:, k))
+        xt(k, :) = x(:, k)
       end do
       return
     end if
     call lu_solve_rows(w%jac, w%ipiv, bt)
     do k = 1, size(x, 2)
       x(:, k) = bt(k, :) * w%cs
+      xt(k, :) = x(:, k)
     end do
   end subroutine solve_cols
 
@@ -1573,12 +1577,12 @@ contains
     s%cb = w%asm%cb; s%sb = w%asm%sb          ! the angles' cos and sin of the assembly at q
     call sens_hessian(m, s, q, qd, qdd, t)
     call sens_params(m, s, q, qd, qdd, t)
-    call sens_kin_rhs(s, 1, sq, sqd, s%rhs)
-    call solve_cols(w, s%rhs, sq)
-    call sens_kin_rhs(s, 2, sq, sqd, s%rhs)
-    call solve_cols(w, s%rhs, sqd)
-    call sens_kin_rhs(s, 3, sq, sqd, s%rhs)
-    call solve_cols(w, s%rhs, sqdd)
+    call sens_kin_rhs(s, 1, s%rhs)
+    call solve_cols(w, s%rhs, sq, s%work, s%st)
+    call sens_kin_rhs(s, 2, s%rhs)
+    call solve_cols(w, s%rhs, sqd, s%work, s%sdt)
+    call sens_kin_rhs(s, 3, s%rhs)
+    call solve_cols(w, s%rhs, sqdd, s%work, s%st)   ! (s as rows no longer needed)
   end subroutine kin_sens
 
   !> The predictor's sum qp = q + hs q_dot + hp0 q_ddot + sum_j wt_j d_j; qn = qp (explicit

@@ -56,7 +56,8 @@ module mbd_sensitivity
     real(wp), allocatable :: hs(:, :, :, :)  !! (MAXROW, NLOC, NLOC, nc) dJ_loc / dq_slot
     real(wp), allocatable :: hv(:, :, :)     !! (MAXROW, NLOC, nc) (J q_dot)_q
     real(wp), allocatable :: ha(:, :, :)     !! (MAXROW, NLOC, nc) (J q_ddot - gamma)_q
-    ! parameter parts at the current state (sens_params), (np, neq): a row per parameter
+    ! parameter parts at the current state (sens_params), (npad, neq): a row per parameter
+    ! (the padding rows and the pairs a parameter does not change stay zero)
     real(wp), allocatable :: phip(:, :)      !! Phi_p
     real(wp), allocatable :: vp(:, :)        !! nu_p - J_p q_dot
     real(wp), allocatable :: ap(:, :)        !! gamma_p - J_p q_ddot
@@ -64,6 +65,7 @@ module mbd_sensitivity
     !> (npad, neq) right-hand sides as rows, npad = np rounded up to a multiple of 4 (the
     !! padding rows stay zero: lu_solve_rows works on 4 at a time)
     real(wp), allocatable :: rhs(:, :)
+    real(wp), allocatable :: st(:, :), sdt(:, :)  !! (npad, nq) s and s_dot as rows (sens_kin_rhs)
     logical :: curved = .true.               !! some constraint is not linear in q
     real(wp), allocatable :: cb(:), sb(:)    !! (0:nb) cos and sin of the body angles (sens_trig)
     ! the nonzeros of Hv and Ha (sens_hessian): row, column, values
@@ -94,7 +96,7 @@ contains
     integer, intent(in), optional :: ftab(:, :) !! force table (NFT, nf), for dynamics
     real(wp), intent(in), optional :: fpar(:)   !! raw force parameters
     real(wp), allocatable :: tprep(:), raw(:)
-    integer :: k, i, c, d, j, off, len, st, nfp
+    integer :: k, i, c, d, j, off, len, st, nfp, npad
     integer, allocatable :: fe(:)
     logical :: dyn
     status = MBD_OK; msg = ''; bad = 0
@@ -103,13 +105,15 @@ contains
     end if
     dyn = allocated(m%mdiag) .and. present(ftab) .and. present(fpar)
     s%np = size(ptab, 2)
+    npad = 4 * ((s%np + 3) / 4)
     nfp = 0
     if (dyn) nfp = size(m%fp)
     allocate (s%ptab(2, s%np), s%pscale(s%np), s%tp(size(m%p), s%np), s%caff(m%nc, s%np), &
               s%tfp(nfp, s%np), s%faff(m%nf, s%np), s%tmass(m%nq, s%np), s%tgrav(2, s%np), &
               s%hs(MAXROW, NLOC, NLOC, m%nc), s%hv(MAXROW, NLOC, m%nc), &
-              s%ha(MAXROW, NLOC, m%nc), s%phip(s%np, m%neq), s%vp(s%np, m%neq), &
-              s%ap(s%np, m%neq), s%work(m%neq), s%rhs(4 * ((s%np + 3) / 4), m%neq), &
+              s%ha(MAXROW, NLOC, m%nc), s%phip(npad, m%neq), s%vp(npad, m%neq), &
+              s%ap(npad, m%neq), s%work(m%neq), s%rhs(npad, m%neq), &
+              s%st(npad, m%nq), s%sdt(npad, m%nq), &
               s%zp(maxval(m%pn)), s%zq(m%nq), &
               s%cb(0:m%nb), s%sb(0:m%nb), s%nzr(NLOC * m%neq), s%nzc(NLOC * m%neq), &
               s%nzv(NLOC * m%neq), s%nza(NLOC * m%neq), s%klr(NLOC * NLOC * m%nc), &
@@ -121,6 +125,8 @@ contains
     s%tp = zero; s%caff = .false.; s%tfp = zero; s%faff = .false.; s%tmass = zero
     s%tgrav = zero; s%hs = zero; s%hv = zero; s%ha = zero; s%zp = zero
     s%cb = one; s%sb = zero; s%rhs = zero; s%pscale = one; s%zq = zero
+    s%phip = zero; s%vp = zero; s%ap = zero   ! entries of unaffected pairs stay zero
+    s%st = zero; s%sdt = zero                 ! (padding rows stay zero)
     do k = 1, s%np
       bad = k
       i = ptab(2, k)
@@ -338,8 +344,7 @@ contains
     do side = 1, 2
       slot = 3 * side
       if (m%loc(slot, kk) == 0) cycle
-      s%hs(1:2, :, slot, kk) = zero
-      s%hs(1:2, slot, slot, kk) = hcol(:, side)
+      s%hs(1:2, slot, slot, kk) = hcol(:, side)   ! the block's other entries stay zero
       do rr = 1, 2
         s%hv(rr, slot, kk) = hvv(rr, side); s%ha(rr, slot, kk) = haa(rr, side)
         if (abs(hvv(rr, side)) > zero .or. abs(haa(rr, side)) > zero) then
@@ -362,7 +367,6 @@ contains
     type(dloc) :: x
     real(wp) :: qddl(NLOC), tphi(MAXROW), tjl(MAXROW, NLOC), tnu(MAXROW), tgam(MAXROW)
     integer :: k, c, nr, si, sj, r, r0
-    s%phip = zero; s%vp = zero; s%ap = zero
     do c = 1, m%nc
       if (.not. any(s%caff(c, :))) cycle
       if (m%kind(c) == CON_REVOLUTE) then       ! the commonest joint in closed form
@@ -518,56 +522,57 @@ contains
   end subroutine block_apply_cols
 
   !> Right-hand sides of the sensitivity equations of all parameters at one level, a row per
-  !! parameter (np, neq), given the solutions of the levels before: level 1 -Phi_p;
+  !! parameter (npad, neq), given the solutions of the levels before as rows in s%st, s%sdt
+  !! (npad, nq; the solves write them, padding rows zero): level 1 -Phi_p;
   !! 2 nu_p - J_p q_dot - Hv s; 3 gamma_p - J_p q_ddot - Ha s - 2 Hv s_dot.
   !! sens_hessian and sens_params first.
-  pure subroutine sens_kin_rhs(s, level, sq, sqd, rhs)
-    type(sens_t), intent(in) :: s            !! blocks and parameter parts
+  pure subroutine sens_kin_rhs(s, level, rhs)
+    type(sens_t), intent(in) :: s            !! blocks, parameter parts, s and s_dot as rows
     integer, intent(in) :: level             !! 1 position, 2 velocity, 3 acceleration
-    real(wp), intent(in) :: sq(:, :), sqd(:, :)  !! s and s_dot (nq, np), as far as known
-    real(wp), intent(inout) :: rhs(:, :)     !! (np or more, neq): rows 1 .. np written
-    call kin_rhs_kernel(level, s%np, size(rhs, 1), size(rhs, 2), size(sq, 1), s%nnz, &
-                        s%nzr, s%nzc, s%nzv, s%nza, s%phip, s%vp, s%ap, sq, sqd, rhs)
+    real(wp), intent(inout) :: rhs(:, :)     !! (npad, neq)
+    call kin_rhs_kernel(level, size(rhs, 1), size(rhs, 2), size(s%st, 2), s%nnz, &
+                        s%nzr, s%nzc, s%nzv, s%nza, s%phip, s%vp, s%ap, s%st, s%sdt, rhs)
   end subroutine sens_kin_rhs
 
-  !> sens_kin_rhs on explicit shapes (the loops see plain arrays).
-  pure subroutine kin_rhs_kernel(level, np, npad, neq, nq, nnz, nzr, nzc, nzv, nza, phip, vp, &
-                                 ap, sq, sqd, rhs)
-    integer, intent(in) :: level, np, npad, neq, nq, nnz
+  !> sens_kin_rhs on explicit shapes (the loops see plain arrays). The parameter parts and
+  !! rhs share the padded layout (npad, neq), seen here flat, so the first term is one copy;
+  !! s and s_dot come as rows too (st, sdt: (npad, nq), from the solves), so each nonzero of
+  !! Hv and Ha updates a row of rhs from a row of them, four parameters at a time.
+  pure subroutine kin_rhs_kernel(level, npad, neq, nq, nnz, nzr, nzc, nzv, nza, phip, vp, &
+                                 ap, st, sdt, rhs)
+    integer, intent(in) :: level, npad, neq, nq, nnz
     integer, intent(in) :: nzr(*), nzc(*)
-    real(wp), intent(in) :: nzv(*), nza(*), phip(np, neq), vp(np, neq), ap(np, neq)
-    real(wp), intent(in) :: sq(nq, np), sqd(nq, np)
-    real(wp), intent(inout) :: rhs(npad, neq)
-    integer :: i, n, r, c
+    real(wp), intent(in) :: nzv(*), nza(*)
+    real(wp), intent(in) :: phip(npad * neq), vp(npad * neq), ap(npad * neq)
+    real(wp), intent(in) :: st(npad * nq), sdt(npad * nq)
+    real(wp), intent(inout) :: rhs(npad * neq)
+    integer :: g, n, e, c
+    real(wp) :: v, a
     select case (level)
-    case (1)
-      do r = 1, neq
-        do i = 1, np
-          rhs(i, r) = -phip(i, r)
-        end do
+    case (1)                                         ! -Phi_p
+      do e = 1, npad * neq
+        rhs(e) = -phip(e)
       end do
-    case (2)
-      do r = 1, neq
-        do i = 1, np
-          rhs(i, r) = vp(i, r)
-        end do
-      end do
+    case (2)                                         ! nu_p - J_p q_dot - Hv s
+      rhs = vp
       do n = 1, nnz
-        r = nzr(n); c = nzc(n)
-        do i = 1, np
-          rhs(i, r) = rhs(i, r) - nzv(n) * sq(c, i)
+        e = npad * (nzr(n) - 1); c = npad * (nzc(n) - 1); v = nzv(n)
+        do g = 0, npad - 4, 4
+          rhs(e + g + 1) = rhs(e + g + 1) - v * st(c + g + 1)
+          rhs(e + g + 2) = rhs(e + g + 2) - v * st(c + g + 2)
+          rhs(e + g + 3) = rhs(e + g + 3) - v * st(c + g + 3)
+          rhs(e + g + 4) = rhs(e + g + 4) - v * st(c + g + 4)
         end do
       end do
-    case default
-      do r = 1, neq
-        do i = 1, np
-          rhs(i, r) = ap(i, r)
-        end do
-      end do
+    case default                                     ! gamma_p - J_p q_ddot - Ha s - 2 Hv s_dot
+      rhs = ap
       do n = 1, nnz
-        r = nzr(n); c = nzc(n)
-        do i = 1, np
-          rhs(i, r) = rhs(i, r) - nza(n) * sq(c, i) - 2 * nzv(n) * sqd(c, i)
+        e = npad * (nzr(n) - 1); c = npad * (nzc(n) - 1); a = nza(n); v = 2 * nzv(n)
+        do g = 0, npad - 4, 4
+          rhs(e + g + 1) = rhs(e + g + 1) - a * st(c + g + 1) - v * sdt(c + g + 1)
+          rhs(e + g + 2) = rhs(e + g + 2) - a * st(c + g + 2) - v * sdt(c + g + 2)
+          rhs(e + g + 3) = rhs(e + g + 3) - a * st(c + g + 3) - v * sdt(c + g + 3)
+          rhs(e + g + 4) = rhs(e + g + 4) - a * st(c + g + 4) - v * sdt(c + g + 4)
         end do
       end do
     end select

@@ -344,33 +344,35 @@ contains
 
   !> X = D A^-1 B for several right-hand sides given as rows, bt = B^T (a multiple of 4 rows,
   !! padding zero), four at a time through the factors (each column's operations those of
-  !! splu_solve, in the same order); x (n, ncol) takes the first ncol of them.
-  pure subroutine splu_solve_rows(sp, bt, x, cs)
+  !! splu_solve, in the same order); x (n, ncol) takes the first ncol of them and xt (4 k, n)
+  !! all of them as rows.
+  pure subroutine splu_solve_rows(sp, bt, x, cs, xt)
     type(splu_t), intent(inout) :: sp                !! factors (and the work block)
     real(wp), intent(in) :: bt(:, :)                 !! right-hand sides as rows (4 k, n)
     real(wp), intent(inout) :: x(:, :)               !! solutions (A's columns, ncol)
     real(wp), intent(in) :: cs(:)                    !! column scale
+    real(wp), intent(inout) :: xt(:, :)              !! solutions as rows (4 k, n)
     integer :: g
     do g = 1, size(bt, 1) - 3, 4
       if (g > size(x, 2)) exit
       call rows_kernel(sp%n, sp%lptr(sp%n + 1) - 1, sp%nu, sp%prow, sp%pcol, sp%lpos, &
                        sp%lrow, sp%lcol, sp%bpos, sp%brow, sp%bcol, sp%rinv, sp%val, sp%y4, &
-                       size(bt, 1), bt, x, g, cs)
+                       size(bt, 1), bt, x, g, cs, xt)
     end do
   end subroutine splu_solve_rows
 
   !> Four right-hand sides (rows g .. g + 3 of bt) through the factors; columns g .. g + 3
-  !! of x.
+  !! of x, rows g .. g + 3 of xt.
   pure subroutine rows_kernel(n, nl, nu, prow, pcol, lpos, lrow, lcol, bpos, brow, bcol, &
-                              rinv, val, y, ldb, bt, x, g, cs)
+                              rinv, val, y, ldb, bt, x, g, cs, xt)
     integer, intent(in) :: n, nl, nu, g, ldb
     integer, intent(in) :: prow(n), pcol(n), lpos(nl), lrow(nl), lcol(nl)
     integer, intent(in) :: bpos(nu), brow(nu), bcol(nu)
     real(wp), intent(in) :: rinv(n), val(*), bt(ldb, n), cs(n)
     real(wp), intent(out) :: y(4, n)
-    real(wp), intent(inout) :: x(:, :)
+    real(wp), intent(inout) :: x(:, :), xt(ldb, n)
     integer :: k, p, i, a, c
-    real(wp) :: v
+    real(wp) :: v, t1, t2, t3, t4
     ! (the four columns written out: array sections of extent 4 cost a loop each)
     do k = 1, n                                      ! y = P b
       c = prow(k)
@@ -378,8 +380,9 @@ contains
     end do
     do p = 1, nl                                     ! L z = y (unit diagonal)
       v = val(lpos(p)); a = lrow(p); c = lcol(p)
-      y(1, a) = y(1, a) - v * y(1, c); y(2, a) = y(2, a) - v * y(2, c)
-      y(3, a) = y(3, a) - v * y(3, c); y(4, a) = y(4, a) - v * y(4, c)
+      t1 = y(1, c); t2 = y(2, c); t3 = y(3, c); t4 = y(4, c)   ! (loaded first: pairs vectorize)
+      y(1, a) = y(1, a) - v * t1; y(2, a) = y(2, a) - v * t2
+      y(3, a) = y(3, a) - v * t3; y(4, a) = y(4, a) - v * t4
     end do
     do k = 1, n                                      ! diag(1/u_kk) z
       v = rinv(k)
@@ -387,20 +390,25 @@ contains
     end do
     do p = 1, nu                                     ! U1 w = diag(1/u_kk) z
       v = val(bpos(p)); a = brow(p); c = bcol(p)
-      y(1, a) = y(1, a) - v * y(1, c); y(2, a) = y(2, a) - v * y(2, c)
-      y(3, a) = y(3, a) - v * y(3, c); y(4, a) = y(4, a) - v * y(4, c)
+      t1 = y(1, c); t2 = y(2, c); t3 = y(3, c); t4 = y(4, c)
+      y(1, a) = y(1, a) - v * t1; y(2, a) = y(2, a) - v * t2
+      y(3, a) = y(3, a) - v * t3; y(4, a) = y(4, a) - v * t4
     end do
-    if (size(x, 2) - g >= 3) then                    ! x = D Q w
-      do k = 1, n
-        c = pcol(k); v = cs(c)
-        x(c, g) = y(1, k) * v; x(c, g + 1) = y(2, k) * v
-        x(c, g + 2) = y(3, k) * v; x(c, g + 3) = y(4, k) * v
+    do k = 1, n                                      ! x = D Q w, as rows
+      c = pcol(k); v = cs(c)
+      t1 = y(1, k) * v; t2 = y(2, k) * v; t3 = y(3, k) * v; t4 = y(4, k) * v
+      xt(g, c) = t1; xt(g + 1, c) = t2; xt(g + 2, c) = t3; xt(g + 3, c) = t4
+    end do
+    if (size(x, 2) - g >= 3) then                    ! and as columns
+      do c = 1, n
+        x(c, g) = xt(g, c); x(c, g + 1) = xt(g + 1, c)
+        x(c, g + 2) = xt(g + 2, c); x(c, g + 3) = xt(g + 3, c)
       end do
       return
     end if
     do i = 1, size(x, 2) - g + 1
-      do k = 1, n
-        x(pcol(k), g + i - 1) = y(i, k) * cs(pcol(k))
+      do c = 1, n
+        x(c, g + i - 1) = xt(g + i - 1, c)
       end do
     end do
   end subroutine rows_kernel
