@@ -67,7 +67,12 @@ module mbd_sensitivity
     real(wp), allocatable :: rhs(:, :)
     real(wp), allocatable :: st(:, :), sdt(:, :)  !! (npad, nq) s and s_dot as rows (sens_kin_rhs)
     logical :: curved = .true.               !! some constraint is not linear in q
+    integer, allocatable :: curv(:)          !! the constraints not linear in q
+    !> the pairs (constraint pc(e), parameter pk(e)) whose prepared parameters change, by
+    !! constraint: the only entries of phip, vp, ap sens_params writes
+    integer, allocatable :: pc(:), pk(:)
     real(wp), allocatable :: cb(:), sb(:)    !! (0:nb) cos and sin of the body angles (sens_trig)
+    real(wp), allocatable :: bst(:, :)       !! (4, 0:nb) cos, sin, theta_dot, theta_ddot
     ! the nonzeros of Hv and Ha (sens_hessian): row, column, values
     integer :: nnz = 0
     integer, allocatable :: nzr(:), nzc(:)
@@ -115,7 +120,8 @@ contains
               s%ap(npad, m%neq), s%work(m%neq), s%rhs(npad, m%neq), &
               s%st(npad, m%nq), s%sdt(npad, m%nq), &
               s%zp(maxval(m%pn)), s%zq(m%nq), &
-              s%cb(0:m%nb), s%sb(0:m%nb), s%nzr(NLOC * m%neq), s%nzc(NLOC * m%neq), &
+              s%cb(0:m%nb), s%sb(0:m%nb), s%bst(4, 0:m%nb), s%nzr(NLOC * m%neq), &
+              s%nzc(NLOC * m%neq), &
               s%nzv(NLOC * m%neq), s%nza(NLOC * m%neq), s%klr(NLOC * NLOC * m%nc), &
               s%klc(NLOC * NLOC * m%nc), s%klv(NLOC * NLOC * m%nc), stat=st)
     if (st /= 0) then
@@ -127,6 +133,7 @@ contains
     s%cb = one; s%sb = zero; s%rhs = zero; s%pscale = one; s%zq = zero
     s%phip = zero; s%vp = zero; s%ap = zero   ! entries of unaffected pairs stay zero
     s%st = zero; s%sdt = zero                 ! (padding rows stay zero)
+    s%bst = zero; s%bst(1, 0) = one
     do k = 1, s%np
       bad = k
       i = ptab(2, k)
@@ -202,6 +209,10 @@ contains
       end select
     end do
     bad = 0
+    call sens_lists(m, s, st)
+    if (st /= 0) then
+      status = MBD_NO_MEMORY; msg = 'out of memory for the sensitivity arrays'; return
+    end if
   contains
     !> A constraint's raw parameters as the nondimensional model has them (p L**e), and the
     !! factor dp'/dp = L**e of entry jj.
@@ -252,6 +263,31 @@ contains
   end subroutine sens_setup
 
   !> cos and sin of every body angle at q, for the evaluations that follow at the same q.
+  !> The constraints not linear in q and the (constraint, parameter) pairs a parameter
+  !! changes, so the per-output loops visit only those.
+  pure subroutine sens_lists(m, s, st)
+    type(model_t), intent(in) :: m           !! model
+    type(sens_t), intent(inout) :: s         !! caff set (in); curv, pc, pk (out)
+    integer, intent(out) :: st               !! allocation status
+    integer :: c, k, n
+    allocate (s%curv(count([(.not. con_linear(m%kind(c)), c = 1, m%nc)])), &
+              s%pc(count(s%caff)), s%pk(count(s%caff)), stat=st)
+    if (st /= 0) return
+    n = 0
+    do c = 1, m%nc
+      if (con_linear(m%kind(c))) cycle
+      n = n + 1; s%curv(n) = c
+    end do
+    s%curved = n > 0
+    n = 0
+    do c = 1, m%nc
+      do k = 1, s%np
+        if (.not. s%caff(c, k)) cycle
+        n = n + 1; s%pc(n) = c; s%pk(n) = k
+      end do
+    end do
+  end subroutine sens_lists
+
   pure subroutine sens_trig(m, s, q)
     type(model_t), intent(in) :: m           !! model
     type(sens_t), intent(inout) :: s         !! cache (out)
@@ -296,12 +332,11 @@ contains
     real(wp), intent(in) :: t                  !! time
     type(dloc) :: x
     real(wp) :: qddl(NLOC), tphi(MAXROW), tnu(MAXROW), tgam(MAXROW)
-    integer :: k, j, nr, si, sj, r
-    s%curved = .false.
+    integer :: k, j, nr, si, sj, r, e
+    call body_states(m, s, qd, qdd)
     s%nnz = 0
-    do k = 1, m%nc
-      if (con_linear(m%kind(k))) cycle          ! blocks stay zero (sens_setup)
-      s%curved = .true.
+    do e = 1, size(s%curv)                      ! (the linear ones' blocks stay zero)
+      k = s%curv(e)
       if (m%kind(k) == CON_REVOLUTE) then       ! the commonest joint in closed form
         call revolute_blocks(m, s, k, qd, qdd)
         cycle
@@ -336,20 +371,23 @@ contains
     integer, intent(in) :: kk                  !! the revolute (constraint index)
     real(wp), intent(in) :: qd(:), qdd(:)       !! velocities and accelerations
     real(wp) :: hcol(2, 2), hvv(2, 2), haa(2, 2)
-    integer :: bi, bj, side, slot, rr
+    integer :: side, slot, rr, col, r0, bi, bj
     bi = m%bi(kk); bj = m%bj(kk)
-    call revolute_second(m%p(m%po(kk)), bi > 0, bj > 0, s%cb(bi), s%sb(bi), &
-                         qd(max(3 * bi, 1)), qdd(max(3 * bi, 1)), s%cb(bj), s%sb(bj), &
-                         qd(max(3 * bj, 1)), qdd(max(3 * bj, 1)), hcol, hvv, haa)
+    call revolute_second(m%p(m%po(kk):m%po(kk) + 3), bi > 0, bj > 0, s%bst(1, bi), &
+                         s%bst(2, bi), s%bst(3, bi), s%bst(4, bi), s%bst(1, bj), s%bst(2, bj), &
+                         s%bst(3, bj), s%bst(4, bj), hcol, hvv, haa)
+    r0 = m%row0(kk) - 1
     do side = 1, 2
       slot = 3 * side
-      if (m%loc(slot, kk) == 0) cycle
-      s%hs(1:2, slot, slot, kk) = hcol(:, side)   ! the block's other entries stay zero
+      col = m%loc(slot, kk)
+      if (col == 0) cycle
+      s%hs(1, slot, slot, kk) = hcol(1, side)   ! the block's other entries stay zero
+      s%hs(2, slot, slot, kk) = hcol(2, side)
       do rr = 1, 2
         s%hv(rr, slot, kk) = hvv(rr, side); s%ha(rr, slot, kk) = haa(rr, side)
         if (abs(hvv(rr, side)) > zero .or. abs(haa(rr, side)) > zero) then
           s%nnz = s%nnz + 1
-          s%nzr(s%nnz) = m%row0(kk) + rr - 1; s%nzc(s%nnz) = m%loc(slot, kk)
+          s%nzr(s%nnz) = r0 + rr; s%nzc(s%nnz) = col
           s%nzv(s%nnz) = hvv(rr, side); s%nza(s%nnz) = haa(rr, side)
         end if
       end do
@@ -357,8 +395,10 @@ contains
   end subroutine revolute_blocks
 
   !> Parameter parts at (q, q_dot, q_ddot, t): Phi_p, nu_p - J_p q_dot and
-  !! gamma_p - J_p q_ddot, each a column per parameter (zero rows for unaffected
-  !! constraints), from the dual evaluation along the parameter's change (dq = 0).
+  !! gamma_p - J_p q_ddot, each a row per parameter, written for the pairs (constraint,
+  !! parameter) of s%pc, s%pk only (the other entries stay zero from sens_setup); from the
+  !! closed form for a revolute, else the dual evaluation along the parameter's change
+  !! (dq = 0).
   pure subroutine sens_params(m, s, q, qd, qdd, t)
     type(model_t), intent(in) :: m             !! model
     type(sens_t), intent(inout) :: s           !! parameter parts (out)
@@ -366,49 +406,49 @@ contains
     real(wp), intent(in) :: t                  !! time
     type(dloc) :: x
     real(wp) :: qddl(NLOC), tphi(MAXROW), tjl(MAXROW, NLOC), tnu(MAXROW), tgam(MAXROW)
-    integer :: k, c, nr, si, sj, r, r0
-    do c = 1, m%nc
-      if (.not. any(s%caff(c, :))) cycle
+    integer :: e, k, c, cprev, nr, si, sj, r, r0, bi, bj
+    call body_states(m, s, qd, qdd)
+    cprev = 0
+    do e = 1, size(s%pc)
+      c = s%pc(e); k = s%pk(e); r0 = m%row0(c) - 1
       if (m%kind(c) == CON_REVOLUTE) then       ! the commonest joint in closed form
-        call revolute_parts(m, s, c, qd, qdd)
+        bi = m%bi(c); bj = m%bj(c)
+        call revolute_param(s%tp(m%po(c):m%po(c) + 3, k), bi > 0, bj > 0, s%bst(1, bi), &
+                            s%bst(2, bi), s%bst(3, bi), s%bst(4, bi), s%bst(1, bj), &
+                            s%bst(2, bj), s%bst(3, bj), s%bst(4, bj), tphi(1:2), tnu(1:2), &
+                            tgam(1:2))
+        s%phip(k, r0 + 1) = tphi(1); s%phip(k, r0 + 2) = tphi(2)
+        s%vp(k, r0 + 1) = tnu(1); s%vp(k, r0 + 2) = tnu(2)
+        s%ap(k, r0 + 1) = tgam(1); s%ap(k, r0 + 2) = tgam(2)
         cycle
       end if
-      call gather(m, s, c, q, qd, qdd, x, qddl)
+      if (c /= cprev) call gather(m, s, c, q, qd, qdd, x, qddl)
+      cprev = c
       si = merge(1, 0, m%bi(c) > 0); sj = merge(2, 0, m%bj(c) > 0)
-      nr = m%nrow(c); r0 = m%row0(c) - 1
-      do k = 1, s%np
-        if (.not. s%caff(c, k)) cycle
-        call con_eval_d(m%kind(c), m%suba(c), m%subb(c), m%p(m%po(c):m%po(c) + m%pn(c) - 1), &
-                        s%tp(m%po(c):m%po(c) + m%pn(c) - 1, k), si, sj, x, &
-                        t, tphi, tjl, tnu, tgam)
-        do r = 1, nr
-          s%phip(k, r0 + r) = tphi(r)
-          s%vp(k, r0 + r) = tnu(r) - dot_product(tjl(r, :), x%x%qd)
-          s%ap(k, r0 + r) = tgam(r) - dot_product(tjl(r, :), qddl)
-        end do
+      nr = m%nrow(c)
+      call con_eval_d(m%kind(c), m%suba(c), m%subb(c), m%p(m%po(c):m%po(c) + m%pn(c) - 1), &
+                      s%tp(m%po(c):m%po(c) + m%pn(c) - 1, k), si, sj, x, &
+                      t, tphi, tjl, tnu, tgam)
+      do r = 1, nr
+        s%phip(k, r0 + r) = tphi(r)
+        s%vp(k, r0 + r) = tnu(r) - dot_product(tjl(r, :), x%x%qd)
+        s%ap(k, r0 + r) = tgam(r) - dot_product(tjl(r, :), qddl)
       end do
     end do
   end subroutine sens_params
 
-  !> Revolute cc: Phi_p, nu_p - J_p q_dot, gamma_p - J_p q_ddot (revolute_param).
-  pure subroutine revolute_parts(m, s, cc, qd, qdd)
+  !> Each body's [cos, sin, theta_dot, theta_ddot] in s%bst (the ground's 1, 0, 0, 0; cos and
+  !! sin from sens_trig), as the revolute's closed forms take them.
+  pure subroutine body_states(m, s, qd, qdd)
     type(model_t), intent(in) :: m              !! model
-    type(sens_t), intent(inout) :: s            !! blocks (out; cos and sin from sens_trig)
-    integer, intent(in) :: cc                  !! the revolute (constraint index)
+    type(sens_t), intent(inout) :: s            !! bst (out)
     real(wp), intent(in) :: qd(:), qdd(:)       !! velocities and accelerations
-    real(wp) :: ph(2), vv(2), aa(2)
-    integer :: bi, bj, kk, rr, q0
-    bi = m%bi(cc); bj = m%bj(cc); q0 = m%row0(cc) - 1
-    do kk = 1, s%np
-      if (.not. s%caff(cc, kk)) cycle
-      call revolute_param(s%tp(m%po(cc), kk), bi > 0, bj > 0, s%cb(bi), s%sb(bi), &
-                          qd(max(3 * bi, 1)), qdd(max(3 * bi, 1)), s%cb(bj), s%sb(bj), &
-                          qd(max(3 * bj, 1)), qdd(max(3 * bj, 1)), ph, vv, aa)
-      do rr = 1, 2
-        s%phip(kk, q0 + rr) = ph(rr); s%vp(kk, q0 + rr) = vv(rr); s%ap(kk, q0 + rr) = aa(rr)
-      end do
+    integer :: b
+    do b = 1, m%nb
+      s%bst(1, b) = s%cb(b); s%bst(2, b) = s%sb(b)
+      s%bst(3, b) = qd(3 * b); s%bst(4, b) = qdd(3 * b)
     end do
-  end subroutine revolute_parts
+  end subroutine body_states
 
   !> Changes of Phi, nu, gamma (neq) and of the local J blocks (MAXROW, NLOC, nc) along a
   !! direction (dq, dq_dot) and parameter k (k = 0: none): every constraint evaluated on

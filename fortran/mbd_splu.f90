@@ -14,9 +14,10 @@
 !!           and reports max |l_ik| (the caller plans again when it exceeds LMAX: bounded
 !!           multipliers keep the growth, hence the backward error, bounded), the sign of
 !!           det A and min |u_kk| / max |u_kk|.
-!!           U's rows are then divided by their pivots, U = diag(u_kk) U1 (U1 unit upper).
-!!   solve   A x = b: y = P b, L z = y, U1 w = diag(1/u_kk) z, x = Q w: one flat loop over the
-!!           entries of L (by columns), one over U1 (by columns, last first); no BLAS calls.
+!!           U's columns are then divided by their pivots, U = U1 diag(u_kk) (U1 unit upper).
+!!   solve   A x = b: y = P b, L z = y, U1 v = z, x = Q diag(1/u_kk) v: one flat loop over the
+!!           entries of L (by columns), one over U1 (by columns, last first), the pivots
+!!           applied with the output permutation (no pass of their own); no BLAS calls.
 !! No allocation after splu_init; the values live in val(:), indexed by at(i, j) for A(i, j).
 module mbd_splu
   use mbd_kinds, only: wp, zero, one
@@ -258,17 +259,17 @@ contains
     integer :: nl
     nl = sp%lptr(sp%n + 1) - 1
     call factor_kernel(sp%n, nl, sp%nops, sp%nfill, sp%nu, sp%diag, sp%lptr, sp%lpos, &
-                       sp%optr, sp%otgt, sp%ol, sp%ou, sp%fill, sp%upos, sp%urow, sp%val, &
+                       sp%optr, sp%otgt, sp%ol, sp%ou, sp%fill, sp%bpos, sp%bcol, sp%val, &
                        sp%rinv, status, lmax, detsign, ratio)
     if (sp%sgn < 0) detsign = -detsign
   end subroutine splu_factor
 
   !> splu_factor on plain arrays (explicit shapes: no descriptors in the loops).
   pure subroutine factor_kernel(n, nl, nops, nfill, nu, diag, lptr, lpos, optr, otgt, ol, ou, &
-                                fill, upos, urow, val, rinv, status, lmax, detsign, ratio)
+                                fill, bpos, bcol, val, rinv, status, lmax, detsign, ratio)
     integer, intent(in) :: n, nl, nops, nfill, nu
     integer, intent(in) :: diag(n), lptr(n + 1), lpos(nl), optr(n + 1), otgt(nops), ol(nops)
-    integer, intent(in) :: ou(nops), fill(nfill), upos(nu), urow(nu)
+    integer, intent(in) :: ou(nops), fill(nfill), bpos(nu), bcol(nu)
     real(wp), intent(inout) :: val(*)
     real(wp), intent(out) :: rinv(n)
     integer, intent(out) :: status, detsign
@@ -298,8 +299,8 @@ contains
         val(otgt(o)) = val(otgt(o)) - val(ol(o)) * val(ou(o))
       end do
     end do
-    do p = 1, nu                                     ! U1 = diag(1/u_kk) U
-      val(upos(p)) = val(upos(p)) * rinv(urow(p))
+    do p = 1, nu                                     ! U1 = U diag(1/u_kk)
+      val(bpos(p)) = val(bpos(p)) * rinv(bcol(p))
     end do
     ratio = umin / umax
   end subroutine factor_kernel
@@ -331,14 +332,11 @@ contains
     do p = 1, nl                                     ! L z = y (unit diagonal)
       y(lrow(p)) = y(lrow(p)) - val(lpos(p)) * y(lcol(p))
     end do
-    do k = 1, n                                      ! diag(1/u_kk) z
-      y(k) = y(k) * rinv(k)
-    end do
-    do p = 1, nu                                     ! U1 w = diag(1/u_kk) z
+    do p = 1, nu                                     ! U1 v = z
       y(brow(p)) = y(brow(p)) - val(bpos(p)) * y(bcol(p))
     end do
-    do k = 1, n                                      ! x = D Q w
-      x(pcol(k)) = y(k) * cs(pcol(k))
+    do k = 1, n                                      ! x = D Q diag(1/u_kk) v
+      x(pcol(k)) = y(k) * (rinv(k) * cs(pcol(k)))
     end do
   end subroutine solve_kernel
 
@@ -384,18 +382,14 @@ contains
       y(1, a) = y(1, a) - v * t1; y(2, a) = y(2, a) - v * t2
       y(3, a) = y(3, a) - v * t3; y(4, a) = y(4, a) - v * t4
     end do
-    do k = 1, n                                      ! diag(1/u_kk) z
-      v = rinv(k)
-      y(1, k) = y(1, k) * v; y(2, k) = y(2, k) * v; y(3, k) = y(3, k) * v; y(4, k) = y(4, k) * v
-    end do
-    do p = 1, nu                                     ! U1 w = diag(1/u_kk) z
+    do p = 1, nu                                     ! U1 v = z
       v = val(bpos(p)); a = brow(p); c = bcol(p)
       t1 = y(1, c); t2 = y(2, c); t3 = y(3, c); t4 = y(4, c)
       y(1, a) = y(1, a) - v * t1; y(2, a) = y(2, a) - v * t2
       y(3, a) = y(3, a) - v * t3; y(4, a) = y(4, a) - v * t4
     end do
-    do k = 1, n                                      ! x = D Q w, as rows
-      c = pcol(k); v = cs(c)
+    do k = 1, n                                      ! x = D Q diag(1/u_kk) v, as rows
+      c = pcol(k); v = rinv(k) * cs(c)
       t1 = y(1, k) * v; t2 = y(2, k) * v; t3 = y(3, k) * v; t4 = y(4, k) * v
       xt(g, c) = t1; xt(g + 1, c) = t2; xt(g + 2, c) = t3; xt(g + 3, c) = t4
     end do
@@ -442,15 +436,13 @@ contains
       v = val(lpos(p))
       y(lrow(p)) = y(lrow(p)) - v * y(lcol(p)); z(lrow(p)) = z(lrow(p)) - v * z(lcol(p))
     end do
-    do k = 1, n
-      y(k) = y(k) * rinv(k); z(k) = z(k) * rinv(k)
-    end do
     do p = 1, nu
       v = val(bpos(p))
       y(brow(p)) = y(brow(p)) - v * y(bcol(p)); z(brow(p)) = z(brow(p)) - v * z(bcol(p))
     end do
     do k = 1, n
-      x1(pcol(k)) = y(k) * cs(pcol(k)); x2(pcol(k)) = z(k) * cs(pcol(k))
+      v = rinv(k) * cs(pcol(k))
+      x1(pcol(k)) = y(k) * v; x2(pcol(k)) = z(k) * v
     end do
   end subroutine solve2_kernel
 
