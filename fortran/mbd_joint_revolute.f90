@@ -12,7 +12,7 @@ module mbd_joint_revolute
   implicit none
   private
   public :: revolute_prepare, revolute_eval, revolute_eval_d, revolute_rows, &
-            revolute_gamma, revolute_second, revolute_param
+            revolute_gamma, revolute_second_set, revolute_param_set
 
 contains
 
@@ -131,64 +131,75 @@ contains
   end subroutine revolute_kernel
 
   !> Second derivatives for the sensitivity equations, in closed form (the rows of
-  !! revolute_eval_d along d theta_i and d theta_j): for side 1 (body i, theta slot 3) and
-  !! side 2 (body j, slot 6), with u_i = A_i s'_i, u_j = A_j s'_j,
+  !! revolute_eval_d along d theta_i and d theta_j), for n revolutes at once (the
+  !! sensitivities' per-output loop): for side 1 (body i, theta slot 3) and side 2 (body j,
+  !! slot 6), with u_i = A_i s'_i, u_j = A_j s'_j,
   !!   dJ(:, 3)/dtheta_i = -u_i,           dgamma/dtheta_i = B_i s'_i thd_i**2 = perp(u_i) thd_i**2
   !!   dJ(:, 6)/dtheta_j = +u_j,           dgamma/dtheta_j = -perp(u_j) thd_j**2
   !! and hv = (dJ/dtheta) q_dot, ha = (dJ/dtheta) q_ddot - dgamma/dtheta (mbd_sensitivity).
-  !! The sides of ground are not written.
-  pure subroutine revolute_second(p, gi, gj, ci, si, wi, ai, cj, sj, wj, aj, hcol, hv, ha)
-    real(wp), intent(in) :: p(4)            !! [s'_i, s'_j]
-    logical, intent(in) :: gi, gj           !! body i, body j moves
-    real(wp), intent(in) :: ci, si, wi, ai  !! body i: cos, sin, theta_dot, theta_ddot
-    real(wp), intent(in) :: cj, sj, wj, aj  !! body j: the same
-    real(wp), intent(inout) :: hcol(2, 2)   !! d(theta column of J)/dtheta, per side
-    real(wp), intent(inout) :: hv(2, 2), ha(2, 2)  !! per side
-    real(wp) :: ux, uy
-    if (gi) then
-      ux = ci * p(1) - si * p(2); uy = si * p(1) + ci * p(2)
-      hcol(1, 1) = -ux; hcol(2, 1) = -uy
-      hv(1, 1) = -ux * wi; hv(2, 1) = -uy * wi
-      ha(1, 1) = -ux * ai + uy * wi**2; ha(2, 1) = -uy * ai - ux * wi**2
-    end if
-    if (gj) then
-      ux = cj * p(3) - sj * p(4); uy = sj * p(3) + cj * p(4)
-      hcol(1, 2) = ux; hcol(2, 2) = uy
-      hv(1, 2) = ux * wj; hv(2, 2) = uy * wj
-      ha(1, 2) = ux * aj - uy * wj**2; ha(2, 2) = uy * aj + ux * wj**2
-    end if
-  end subroutine revolute_second
+  !! Revolute e has its prepared parameters at p(po(e)) and bodies bi(e), bj(e) (0: ground),
+  !! whose [cos, sin, theta_dot, theta_ddot] are bst(:, b) (the ground's 1, 0, 0, 0: its side
+  !! comes out as for a body at rest, and the caller leaves it out).
+  pure subroutine revolute_second_set(n, nb, po, bi, bj, p, bst, hcol, hv, ha)
+    integer, intent(in) :: n, nb                !! revolutes, bodies
+    integer, intent(in) :: po(n), bi(n), bj(n)  !! parameter offsets and bodies
+    real(wp), intent(in) :: p(*)                !! prepared parameter pool
+    real(wp), intent(in) :: bst(4, 0:nb)        !! body states
+    real(wp), intent(out) :: hcol(2, 2, n)      !! d(theta column of J)/dtheta, per side
+    real(wp), intent(out) :: hv(2, 2, n), ha(2, 2, n)  !! per side
+    integer :: e, i, j, o
+    real(wp) :: ux, uy, w, a, w2
+    !GCC$ novector
+    do e = 1, n                                  ! (a few revolutes: no vector set-up)
+      i = bi(e); j = bj(e); o = po(e)
+      ux = bst(1, i) * p(o) - bst(2, i) * p(o + 1); uy = bst(2, i) * p(o) + bst(1, i) * p(o + 1)
+      w = bst(3, i); a = bst(4, i); w2 = w**2
+      hcol(1, 1, e) = -ux; hcol(2, 1, e) = -uy
+      hv(1, 1, e) = -ux * w; hv(2, 1, e) = -uy * w
+      ha(1, 1, e) = -ux * a + uy * w2; ha(2, 1, e) = -uy * a - ux * w2
+      ux = bst(1, j) * p(o + 2) - bst(2, j) * p(o + 3)
+      uy = bst(2, j) * p(o + 2) + bst(1, j) * p(o + 3)
+      w = bst(3, j); a = bst(4, j); w2 = w**2
+      hcol(1, 2, e) = ux; hcol(2, 2, e) = uy
+      hv(1, 2, e) = ux * w; hv(2, 2, e) = uy * w
+      ha(1, 2, e) = ux * a - uy * w2; ha(2, 2, e) = uy * a + ux * w2
+    end do
+  end subroutine revolute_second_set
 
   !> The parameter parts for a change tp of [s'_i, s'_j] in closed form (revolute_eval_d
   !! with dq = 0; the rows are linear in s', so p itself does not enter): with u = A t s'
-  !! and v = B t s' = perp(u) of each moving body,
+  !! and v = B t s' = perp(u) of each body,
   !!   Phi_p = u_i - u_j  (a ground point: its change itself),
   !!   nu_p - J_p q_dot = -v_i thd_i + v_j thd_j,
-  !!   gamma_p - J_p q_ddot = u_i thd_i**2 - v_i thdd_i - u_j thd_j**2 + v_j thdd_j.
-  pure subroutine revolute_param(tp, gi, gj, ci, si, wi, ai, cj, sj, wj, aj, tphi, vp, ap)
-    real(wp), intent(in) :: tp(4)           !! change of [s'_i, s'_j]
-    logical, intent(in) :: gi, gj           !! body i, body j moves
-    real(wp), intent(in) :: ci, si, wi, ai  !! body i: cos, sin, theta_dot, theta_ddot
-    real(wp), intent(in) :: cj, sj, wj, aj  !! body j: the same
-    real(wp), intent(out) :: tphi(2), vp(2), ap(2)
-    real(wp) :: ux, uy
-    tphi = zero; vp = zero; ap = zero
-    if (gi) then
-      ux = ci * tp(1) - si * tp(2); uy = si * tp(1) + ci * tp(2)
-      tphi(1) = ux; tphi(2) = uy
-      vp(1) = uy * wi; vp(2) = -ux * wi                            ! -perp(u) thd
-      ap(1) = ux * wi**2 + uy * ai; ap(2) = uy * wi**2 - ux * ai   ! u thd**2 - perp(u) thdd
-    else
-      tphi(1) = tp(1); tphi(2) = tp(2)
-    end if
-    if (gj) then
-      ux = cj * tp(3) - sj * tp(4); uy = sj * tp(3) + cj * tp(4)
-      tphi(1) = tphi(1) - ux; tphi(2) = tphi(2) - uy
-      vp(1) = vp(1) - uy * wj; vp(2) = vp(2) + ux * wj
-      ap(1) = ap(1) - ux * wj**2 - uy * aj; ap(2) = ap(2) - uy * wj**2 + ux * aj
-    else
-      tphi(1) = tphi(1) - tp(3); tphi(2) = tphi(2) - tp(4)
-    end if
-  end subroutine revolute_param
+  !!   gamma_p - J_p q_ddot = u_i thd_i**2 - v_i thdd_i - u_j thd_j**2 + v_j thdd_j,
+  !! for n (revolute, parameter) pairs at once: pair e takes the change
+  !! tp(po(e) .. po(e) + 3, k(e)) of its revolute's parameters, bodies bi(e), bj(e) with
+  !! states bst as in revolute_second_set (the ground's 1, 0, 0, 0 gives its point's change
+  !! itself and no velocity or acceleration part).
+  pure subroutine revolute_param_set(n, nb, ldt, ntp, po, k, bi, bj, tp, bst, tphi, vp, ap)
+    integer, intent(in) :: n, nb, ldt, ntp      !! pairs, bodies, shape of tp
+    integer, intent(in) :: po(n), k(n), bi(n), bj(n)  !! offsets, parameters, bodies
+    real(wp), intent(in) :: tp(ldt, ntp)        !! changes of the prepared pool
+    real(wp), intent(in) :: bst(4, 0:nb)        !! body states
+    real(wp), intent(out) :: tphi(2, n), vp(2, n), ap(2, n)
+    integer :: e, i, j, o, c
+    real(wp) :: ux, uy, w, a, w2
+    !GCC$ novector
+    do e = 1, n                                  ! (a few pairs: no vector set-up)
+      i = bi(e); j = bj(e); o = po(e); c = k(e)
+      ux = bst(1, i) * tp(o, c) - bst(2, i) * tp(o + 1, c)
+      uy = bst(2, i) * tp(o, c) + bst(1, i) * tp(o + 1, c)
+      w = bst(3, i); a = bst(4, i); w2 = w**2
+      tphi(1, e) = ux; tphi(2, e) = uy
+      vp(1, e) = uy * w; vp(2, e) = -ux * w                        ! -perp(u) thd
+      ap(1, e) = ux * w2 + uy * a; ap(2, e) = uy * w2 - ux * a     ! u thd**2 - perp(u) thdd
+      ux = bst(1, j) * tp(o + 2, c) - bst(2, j) * tp(o + 3, c)
+      uy = bst(2, j) * tp(o + 2, c) + bst(1, j) * tp(o + 3, c)
+      w = bst(3, j); a = bst(4, j); w2 = w**2
+      tphi(1, e) = tphi(1, e) - ux; tphi(2, e) = tphi(2, e) - uy
+      vp(1, e) = vp(1, e) - uy * w; vp(2, e) = vp(2, e) + ux * w
+      ap(1, e) = ap(1, e) - ux * w2 - uy * a; ap(2, e) = ap(2, e) - uy * w2 + ux * a
+    end do
+  end subroutine revolute_param_set
 
 end module mbd_joint_revolute

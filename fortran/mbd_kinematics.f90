@@ -461,7 +461,8 @@ contains
     x = x * w%cs
   end subroutine solve
 
-  !> Solve J X = B for several right-hand sides with the factors (as solve), B given as rows
+  !> Solve J X = B for several right-hand sides with the dense, band or QR factors (as solve;
+  !! kin_sens calls the sparse factors' solve itself), B given as rows
   !! bt = B^T (n rounded up to a multiple of 4, neq; padding rows zero) and overwritten; the
   !! dense LU by plain loops over all of them at once. X is returned as columns x (nq, n) and
   !! as rows xt (n rounded up, nq; padding rows zero).
@@ -472,10 +473,6 @@ contains
     real(wp), intent(out) :: b(:)          !! work (neq): one right-hand side at a time
     real(wp), intent(inout) :: xt(:, :)    !! solutions as rows (4 k, nq)
     integer :: k
-    if (w%spfact) then
-      call splu_solve_rows(w%sp, bt, x, w%cs, xt)
-      return
-    end if
     if (w%lsq .or. w%banded) then
       do k = 1, size(x, 2)
         b = bt(k, :)
@@ -1574,15 +1571,23 @@ contains
     real(wp), intent(in) :: q(:), qd(:), qdd(:)  !! state and accelerations
     real(wp), intent(in) :: t                !! time
     real(wp), intent(out) :: sq(:, :), sqd(:, :), sqdd(:, :)  !! (nq, np)
-    s%cb = w%asm%cb; s%sb = w%asm%sb          ! the angles' cos and sin of the assembly at q
+    s%cb(:) = w%asm%cb(:); s%sb(:) = w%asm%sb(:)   ! the angles' cos and sin of the assembly at q
     call sens_hessian(m, s, q, qd, qdd, t)
     call sens_params(m, s, q, qd, qdd, t)
-    call sens_kin_rhs(s, 1, s%rhs)
+    if (w%spfact) then                        ! the sparse factors: straight to their solves
+      call splu_solve_rows(w%sp, s%mphip, sq, w%cs, s%st)
+      call sens_kin_rhs(s, 2, s%rhs)
+      call splu_solve_rows(w%sp, s%rhs, sqd, w%cs, s%sdt)
+      call sens_kin_rhs(s, 3, s%rhs)
+      call splu_solve_rows(w%sp, s%rhs, sqdd, w%cs, s%st)   ! (s as rows no longer needed)
+      return
+    end if
+    s%rhs(:, :) = s%mphip                     ! (the dense solves overwrite their right sides)
     call solve_cols(w, s%rhs, sq, s%work, s%st)
     call sens_kin_rhs(s, 2, s%rhs)
     call solve_cols(w, s%rhs, sqd, s%work, s%sdt)
     call sens_kin_rhs(s, 3, s%rhs)
-    call solve_cols(w, s%rhs, sqdd, s%work, s%st)   ! (s as rows no longer needed)
+    call solve_cols(w, s%rhs, sqdd, s%work, s%st)
   end subroutine kin_sens
 
   !> The predictor's sum qp = q + hs q_dot + hp0 q_ddot + sum_j wt_j d_j; qn = qp (explicit

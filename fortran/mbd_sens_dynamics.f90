@@ -219,7 +219,7 @@ contains
       rhs(1:n) = y
       call sens_jpt_lam(m, s, k, q, t, lam, y, jpb)
       rhs(1:n) = rhs(1:n) - y
-      rhs(n + 1:) = -s%phip(k, rows)
+      rhs(n + 1:) = s%mphip(k, rows)
       call lu_solve(aug, ipiv, rhs, status, msg)
       if (status /= MBD_OK) return
       sq(:, k) = rhs(1:n)
@@ -483,7 +483,7 @@ contains
       o = n * kk
       ! S <- S + dS, [I J^T; J 0][dS; mu] = [0; -(J S + Phi_p)]
       r = zero
-      r(n + 1:) = -(matmul(jac(w%rows, :), yy(o + 1:o + n)) + s%phip(kk, w%rows))
+      r(n + 1:) = s%mphip(kk, w%rows) - matmul(jac(w%rows, :), yy(o + 1:o + n))
       call lu_solve(aug, piv, r, stp, lmsg)
       if (stp /= MBD_OK) return
       yy(o + 1:o + n) = yy(o + 1:o + n) + r(1:n)

@@ -28,7 +28,7 @@ module mbd_sensitivity
   use mbd_constraints, only: con_eval_d, con_prepare_d, con_is_count, con_name, con_linear, &
                              con_affine_r, con_exponents, &
                              CON_TRANSLATIONAL, DRV_REL_DIST, CON_REVOLUTE
-  use mbd_joint_revolute, only: revolute_second, revolute_param
+  use mbd_joint_revolute, only: revolute_second_set, revolute_param_set
   use mbd_forces, only: force_eval_d, force_is_count, force_exponents
   implicit none
   private
@@ -58,7 +58,7 @@ module mbd_sensitivity
     real(wp), allocatable :: ha(:, :, :)     !! (MAXROW, NLOC, nc) (J q_ddot - gamma)_q
     ! parameter parts at the current state (sens_params), (npad, neq): a row per parameter
     ! (the padding rows and the pairs a parameter does not change stay zero)
-    real(wp), allocatable :: phip(:, :)      !! Phi_p
+    real(wp), allocatable :: mphip(:, :)     !! -Phi_p (the first level's right-hand side)
     real(wp), allocatable :: vp(:, :)        !! nu_p - J_p q_dot
     real(wp), allocatable :: ap(:, :)        !! gamma_p - J_p q_ddot
     real(wp), allocatable :: work(:)         !! (neq)
@@ -67,10 +67,18 @@ module mbd_sensitivity
     real(wp), allocatable :: rhs(:, :)
     real(wp), allocatable :: st(:, :), sdt(:, :)  !! (npad, nq) s and s_dot as rows (sens_kin_rhs)
     logical :: curved = .true.               !! some constraint is not linear in q
-    integer, allocatable :: curv(:)          !! the constraints not linear in q
-    !> the pairs (constraint pc(e), parameter pk(e)) whose prepared parameters change, by
-    !! constraint: the only entries of phip, vp, ap sens_params writes
-    integer, allocatable :: pc(:), pk(:)
+    !> the revolutes (closed forms): constraint, bodies, parameter offset, first row,
+    !! theta columns (0: ground), and their blocks (2, 2, nrv) at the current state
+    integer, allocatable :: rvc(:), rvbi(:), rvbj(:), rvpo(:), rvr0(:), rvci(:), rvcj(:)
+    real(wp), allocatable :: rvh(:, :, :), rvv(:, :, :), rva(:, :, :)
+    integer, allocatable :: gen(:)           !! the other constraints not linear in q
+    !> the pairs (revolute, parameter) whose prepared parameters change: parameter,
+    !! bodies, parameter offset, first row, and their parts (2, npr) at the current state
+    integer, allocatable :: rpk(:), rpbi(:), rpbj(:), rppo(:), rpr0(:)
+    real(wp), allocatable :: rpphi(:, :), rpv(:, :), rpa(:, :)
+    !> the other pairs (constraint gpc(e), parameter gpk(e)), by constraint; with the
+    !! revolute pairs, the only entries of mphip, vp, ap sens_params writes
+    integer, allocatable :: gpc(:), gpk(:)
     real(wp), allocatable :: cb(:), sb(:)    !! (0:nb) cos and sin of the body angles (sens_trig)
     real(wp), allocatable :: bst(:, :)       !! (4, 0:nb) cos, sin, theta_dot, theta_ddot
     ! the nonzeros of Hv and Ha (sens_hessian): row, column, values
@@ -116,7 +124,7 @@ contains
     allocate (s%ptab(2, s%np), s%pscale(s%np), s%tp(size(m%p), s%np), s%caff(m%nc, s%np), &
               s%tfp(nfp, s%np), s%faff(m%nf, s%np), s%tmass(m%nq, s%np), s%tgrav(2, s%np), &
               s%hs(MAXROW, NLOC, NLOC, m%nc), s%hv(MAXROW, NLOC, m%nc), &
-              s%ha(MAXROW, NLOC, m%nc), s%phip(npad, m%neq), s%vp(npad, m%neq), &
+              s%ha(MAXROW, NLOC, m%nc), s%mphip(npad, m%neq), s%vp(npad, m%neq), &
               s%ap(npad, m%neq), s%work(m%neq), s%rhs(npad, m%neq), &
               s%st(npad, m%nq), s%sdt(npad, m%nq), &
               s%zp(maxval(m%pn)), s%zq(m%nq), &
@@ -131,7 +139,7 @@ contains
     s%tp = zero; s%caff = .false.; s%tfp = zero; s%faff = .false.; s%tmass = zero
     s%tgrav = zero; s%hs = zero; s%hv = zero; s%ha = zero; s%zp = zero
     s%cb = one; s%sb = zero; s%rhs = zero; s%pscale = one; s%zq = zero
-    s%phip = zero; s%vp = zero; s%ap = zero   ! entries of unaffected pairs stay zero
+    s%mphip = zero; s%vp = zero; s%ap = zero   ! entries of unaffected pairs stay zero
     s%st = zero; s%sdt = zero                 ! (padding rows stay zero)
     s%bst = zero; s%bst(1, 0) = one
     do k = 1, s%np
@@ -263,27 +271,48 @@ contains
   end subroutine sens_setup
 
   !> cos and sin of every body angle at q, for the evaluations that follow at the same q.
-  !> The constraints not linear in q and the (constraint, parameter) pairs a parameter
-  !! changes, so the per-output loops visit only those.
+  !> The constraints not linear in q (revolutes apart) and the (constraint, parameter) pairs
+  !! a parameter changes (revolutes apart), so the per-output loops visit only those.
   pure subroutine sens_lists(m, s, st)
     type(model_t), intent(in) :: m           !! model
-    type(sens_t), intent(inout) :: s         !! caff set (in); curv, pc, pk (out)
+    type(sens_t), intent(inout) :: s         !! caff set (in); the lists (out)
     integer, intent(out) :: st               !! allocation status
-    integer :: c, k, n
-    allocate (s%curv(count([(.not. con_linear(m%kind(c)), c = 1, m%nc)])), &
-              s%pc(count(s%caff)), s%pk(count(s%caff)), stat=st)
-    if (st /= 0) return
-    n = 0
+    integer :: c, k, nrv, ngen, npr, ngp
+    logical :: rev(m%nc), curv(m%nc)
     do c = 1, m%nc
-      if (con_linear(m%kind(c))) cycle
-      n = n + 1; s%curv(n) = c
+      rev(c) = m%kind(c) == CON_REVOLUTE
+      curv(c) = .not. con_linear(m%kind(c))
     end do
-    s%curved = n > 0
-    n = 0
+    nrv = count(rev); ngen = count(curv .and. .not. rev)
+    npr = 0; ngp = 0
+    do k = 1, s%np
+      npr = npr + count(s%caff(:, k) .and. rev); ngp = ngp + count(s%caff(:, k) .and. .not. rev)
+    end do
+    allocate (s%rvc(nrv), s%rvbi(nrv), s%rvbj(nrv), s%rvpo(nrv), s%rvr0(nrv), s%rvci(nrv), &
+              s%rvcj(nrv), s%rvh(2, 2, nrv), s%rvv(2, 2, nrv), s%rva(2, 2, nrv), s%gen(ngen), &
+              s%rpk(npr), s%rpbi(npr), s%rpbj(npr), s%rppo(npr), s%rpr0(npr), &
+              s%rpphi(2, npr), s%rpv(2, npr), s%rpa(2, npr), s%gpc(ngp), s%gpk(ngp), stat=st)
+    if (st /= 0) return
+    s%rvh = zero; s%rvv = zero; s%rva = zero
+    s%curved = any(curv)
+    nrv = 0; ngen = 0; npr = 0; ngp = 0
     do c = 1, m%nc
+      if (rev(c)) then
+        nrv = nrv + 1
+        s%rvc(nrv) = c; s%rvbi(nrv) = m%bi(c); s%rvbj(nrv) = m%bj(c); s%rvpo(nrv) = m%po(c)
+        s%rvr0(nrv) = m%row0(c); s%rvci(nrv) = m%loc(3, c); s%rvcj(nrv) = m%loc(6, c)
+      else if (curv(c)) then
+        ngen = ngen + 1; s%gen(ngen) = c
+      end if
       do k = 1, s%np
         if (.not. s%caff(c, k)) cycle
-        n = n + 1; s%pc(n) = c; s%pk(n) = k
+        if (rev(c)) then
+          npr = npr + 1
+          s%rpk(npr) = k; s%rpbi(npr) = m%bi(c); s%rpbj(npr) = m%bj(c)
+          s%rppo(npr) = m%po(c); s%rpr0(npr) = m%row0(c)
+        else
+          ngp = ngp + 1; s%gpc(ngp) = c; s%gpk(ngp) = k
+        end if
       end do
     end do
   end subroutine sens_lists
@@ -335,12 +364,14 @@ contains
     integer :: k, j, nr, si, sj, r, e
     call body_states(m, s, qd, qdd)
     s%nnz = 0
-    do e = 1, size(s%curv)                      ! (the linear ones' blocks stay zero)
-      k = s%curv(e)
-      if (m%kind(k) == CON_REVOLUTE) then       ! the commonest joint in closed form
-        call revolute_blocks(m, s, k, qd, qdd)
-        cycle
-      end if
+    if (size(s%rvc) > 0) then                   ! the revolutes in closed form
+      call revolute_second_set(size(s%rvc), m%nb, s%rvpo, s%rvbi, s%rvbj, m%p, s%bst, s%rvh, &
+                               s%rvv, s%rva)
+      call revolute_push(size(s%rvc), m%nc, s%rvc, s%rvr0, s%rvci, s%rvcj, s%rvh, s%rvv, &
+                         s%rva, s%hs, s%hv, s%ha, s%nnz, s%nzr, s%nzc, s%nzv, s%nza)
+    end if
+    do e = 1, size(s%gen)                       ! (the linear ones' blocks stay zero)
+      k = s%gen(e)
       call gather(m, s, k, q, qd, qdd, x, qddl)
       si = merge(1, 0, m%bi(k) > 0); sj = merge(2, 0, m%bj(k) > 0)
       nr = m%nrow(k)
@@ -364,41 +395,45 @@ contains
     end do
   end subroutine sens_hessian
 
-  !> Revolute k: only the theta slots (3, 6) have second derivatives (revolute_second).
-  pure subroutine revolute_blocks(m, s, kk, qd, qdd)
-    type(model_t), intent(in) :: m              !! model
-    type(sens_t), intent(inout) :: s            !! blocks (out; cos and sin from sens_trig)
-    integer, intent(in) :: kk                  !! the revolute (constraint index)
-    real(wp), intent(in) :: qd(:), qdd(:)       !! velocities and accelerations
-    real(wp) :: hcol(2, 2), hvv(2, 2), haa(2, 2)
-    integer :: side, slot, rr, col, r0, bi, bj
-    bi = m%bi(kk); bj = m%bj(kk)
-    call revolute_second(m%p(m%po(kk):m%po(kk) + 3), bi > 0, bj > 0, s%bst(1, bi), &
-                         s%bst(2, bi), s%bst(3, bi), s%bst(4, bi), s%bst(1, bj), s%bst(2, bj), &
-                         s%bst(3, bj), s%bst(4, bj), hcol, hvv, haa)
-    r0 = m%row0(kk) - 1
-    do side = 1, 2
-      slot = 3 * side
-      col = m%loc(slot, kk)
-      if (col == 0) cycle
-      s%hs(1, slot, slot, kk) = hcol(1, side)   ! the block's other entries stay zero
-      s%hs(2, slot, slot, kk) = hcol(2, side)
-      do rr = 1, 2
-        s%hv(rr, slot, kk) = hvv(rr, side); s%ha(rr, slot, kk) = haa(rr, side)
-        if (abs(hvv(rr, side)) > zero .or. abs(haa(rr, side)) > zero) then
-          s%nnz = s%nnz + 1
-          s%nzr(s%nnz) = r0 + rr; s%nzc(s%nnz) = col
-          s%nzv(s%nnz) = hvv(rr, side); s%nza(s%nnz) = haa(rr, side)
-        end if
+  !> The revolutes' blocks (revolute_second_set) into hs, hv, ha and the list of nonzeros:
+  !! only the theta slots (3, 6) of a revolute have second derivatives (the blocks' other
+  !! entries stay zero from sens_setup).
+  pure subroutine revolute_push(nrv, nc, rvc, rvr0, rvci, rvcj, h, hv, ha, hs, hvb, hab, nnz, &
+                                nzr, nzc, nzv, nza)
+    integer, intent(in) :: nrv, nc                       !! revolutes, constraints
+    integer, intent(in) :: rvc(nrv), rvr0(nrv), rvci(nrv), rvcj(nrv)
+    real(wp), intent(in) :: h(2, 2, nrv), hv(2, 2, nrv), ha(2, 2, nrv)
+    real(wp), intent(inout) :: hs(MAXROW, NLOC, NLOC, nc), hvb(MAXROW, NLOC, nc)
+    real(wp), intent(inout) :: hab(MAXROW, NLOC, nc)
+    integer, intent(inout) :: nnz                        !! nonzeros so far
+    integer, intent(inout) :: nzr(*), nzc(*)
+    real(wp), intent(inout) :: nzv(*), nza(*)
+    integer :: e, k, side, slot, col, rr
+    do e = 1, nrv
+      k = rvc(e)
+      do side = 1, 2
+        col = rvci(e)
+        if (side == 2) col = rvcj(e)
+        if (col == 0) cycle
+        slot = 3 * side
+        hs(1, slot, slot, k) = h(1, side, e); hs(2, slot, slot, k) = h(2, side, e)
+        do rr = 1, 2
+          hvb(rr, slot, k) = hv(rr, side, e); hab(rr, slot, k) = ha(rr, side, e)
+          if (abs(hv(rr, side, e)) > zero .or. abs(ha(rr, side, e)) > zero) then
+            nnz = nnz + 1
+            nzr(nnz) = rvr0(e) + rr - 1; nzc(nnz) = col
+            nzv(nnz) = hv(rr, side, e); nza(nnz) = ha(rr, side, e)
+          end if
+        end do
       end do
     end do
-  end subroutine revolute_blocks
+  end subroutine revolute_push
 
   !> Parameter parts at (q, q_dot, q_ddot, t): Phi_p, nu_p - J_p q_dot and
   !! gamma_p - J_p q_ddot, each a row per parameter, written for the pairs (constraint,
-  !! parameter) of s%pc, s%pk only (the other entries stay zero from sens_setup); from the
-  !! closed form for a revolute, else the dual evaluation along the parameter's change
-  !! (dq = 0).
+  !! parameter) of the lists only (the other entries stay zero from sens_setup): the
+  !! revolutes' in closed form, the others by the dual evaluation along the parameter's
+  !! change (dq = 0).
   pure subroutine sens_params(m, s, q, qd, qdd, t)
     type(model_t), intent(in) :: m             !! model
     type(sens_t), intent(inout) :: s           !! parameter parts (out)
@@ -406,22 +441,17 @@ contains
     real(wp), intent(in) :: t                  !! time
     type(dloc) :: x
     real(wp) :: qddl(NLOC), tphi(MAXROW), tjl(MAXROW, NLOC), tnu(MAXROW), tgam(MAXROW)
-    integer :: e, k, c, cprev, nr, si, sj, r, r0, bi, bj
+    integer :: e, k, c, cprev, nr, si, sj, r, r0
     call body_states(m, s, qd, qdd)
+    if (size(s%rpk) > 0) then
+      call revolute_param_set(size(s%rpk), m%nb, size(s%tp, 1), s%np, s%rppo, s%rpk, s%rpbi, &
+                              s%rpbj, s%tp, s%bst, s%rpphi, s%rpv, s%rpa)
+      call pairs_put(size(s%rpk), size(s%mphip, 1), size(s%mphip, 2), s%rpk, s%rpr0, s%rpphi, &
+                     s%rpv, s%rpa, s%mphip, s%vp, s%ap)
+    end if
     cprev = 0
-    do e = 1, size(s%pc)
-      c = s%pc(e); k = s%pk(e); r0 = m%row0(c) - 1
-      if (m%kind(c) == CON_REVOLUTE) then       ! the commonest joint in closed form
-        bi = m%bi(c); bj = m%bj(c)
-        call revolute_param(s%tp(m%po(c):m%po(c) + 3, k), bi > 0, bj > 0, s%bst(1, bi), &
-                            s%bst(2, bi), s%bst(3, bi), s%bst(4, bi), s%bst(1, bj), &
-                            s%bst(2, bj), s%bst(3, bj), s%bst(4, bj), tphi(1:2), tnu(1:2), &
-                            tgam(1:2))
-        s%phip(k, r0 + 1) = tphi(1); s%phip(k, r0 + 2) = tphi(2)
-        s%vp(k, r0 + 1) = tnu(1); s%vp(k, r0 + 2) = tnu(2)
-        s%ap(k, r0 + 1) = tgam(1); s%ap(k, r0 + 2) = tgam(2)
-        cycle
-      end if
+    do e = 1, size(s%gpc)
+      c = s%gpc(e); k = s%gpk(e); r0 = m%row0(c) - 1
       if (c /= cprev) call gather(m, s, c, q, qd, qdd, x, qddl)
       cprev = c
       si = merge(1, 0, m%bi(c) > 0); sj = merge(2, 0, m%bj(c) > 0)
@@ -430,12 +460,28 @@ contains
                       s%tp(m%po(c):m%po(c) + m%pn(c) - 1, k), si, sj, x, &
                       t, tphi, tjl, tnu, tgam)
       do r = 1, nr
-        s%phip(k, r0 + r) = tphi(r)
+        s%mphip(k, r0 + r) = -tphi(r)
         s%vp(k, r0 + r) = tnu(r) - dot_product(tjl(r, :), x%x%qd)
         s%ap(k, r0 + r) = tgam(r) - dot_product(tjl(r, :), qddl)
       end do
     end do
   end subroutine sens_params
+
+  !> The two-row parts of n pairs (parameter k(e), first row r0(e)) into mphip (negated),
+  !! vp, ap.
+  pure subroutine pairs_put(n, npad, neq, k, r0, tphi, tv, ta, mphip, vp, ap)
+    integer, intent(in) :: n, npad, neq, k(n), r0(n)
+    real(wp), intent(in) :: tphi(2, n), tv(2, n), ta(2, n)
+    real(wp), intent(inout) :: mphip(npad, neq), vp(npad, neq), ap(npad, neq)
+    integer :: e, i, r
+    !GCC$ novector
+    do e = 1, n
+      i = k(e); r = r0(e)
+      mphip(i, r) = -tphi(1, e); mphip(i, r + 1) = -tphi(2, e)
+      vp(i, r) = tv(1, e); vp(i, r + 1) = tv(2, e)
+      ap(i, r) = ta(1, e); ap(i, r + 1) = ta(2, e)
+    end do
+  end subroutine pairs_put
 
   !> Each body's [cos, sin, theta_dot, theta_ddot] in s%bst (the ground's 1, 0, 0, 0; cos and
   !! sin from sens_trig), as the revolute's closed forms take them.
@@ -563,40 +609,43 @@ contains
 
   !> Right-hand sides of the sensitivity equations of all parameters at one level, a row per
   !! parameter (npad, neq), given the solutions of the levels before as rows in s%st, s%sdt
-  !! (npad, nq; the solves write them, padding rows zero): level 1 -Phi_p;
-  !! 2 nu_p - J_p q_dot - Hv s; 3 gamma_p - J_p q_ddot - Ha s - 2 Hv s_dot.
+  !! (npad, nq; the solves write them, padding rows zero): level 2 nu_p - J_p q_dot - Hv s;
+  !! 3 gamma_p - J_p q_ddot - Ha s - 2 Hv s_dot (level 1's, -Phi_p, is s%mphip itself).
   !! sens_hessian and sens_params first.
   pure subroutine sens_kin_rhs(s, level, rhs)
     type(sens_t), intent(in) :: s            !! blocks, parameter parts, s and s_dot as rows
-    integer, intent(in) :: level             !! 1 position, 2 velocity, 3 acceleration
+    integer, intent(in) :: level             !! 2 velocity, 3 acceleration
     real(wp), intent(inout) :: rhs(:, :)     !! (npad, neq)
-    call kin_rhs_kernel(level, size(rhs, 1), size(rhs, 2), size(s%st, 2), s%nnz, &
-                        s%nzr, s%nzc, s%nzv, s%nza, s%phip, s%vp, s%ap, s%st, s%sdt, rhs)
+    if (level == 2) then
+      call kin_rhs_kernel(size(rhs, 1), size(rhs, 2), size(s%st, 2), s%nnz, s%nzr, s%nzc, &
+                          s%nzv, s%nzv, .false., s%vp, s%st, s%sdt, rhs)
+    else
+      call kin_rhs_kernel(size(rhs, 1), size(rhs, 2), size(s%st, 2), s%nnz, s%nzr, s%nzc, &
+                          s%nza, s%nzv, .true., s%ap, s%st, s%sdt, rhs)
+    end if
   end subroutine sens_kin_rhs
 
-  !> sens_kin_rhs on explicit shapes (the loops see plain arrays). The parameter parts and
-  !! rhs share the padded layout (npad, neq), seen here flat, so the first term is one copy;
-  !! s and s_dot come as rows too (st, sdt: (npad, nq), from the solves), so each nonzero of
-  !! Hv and Ha updates a row of rhs from a row of them, four parameters at a time.
-  pure subroutine kin_rhs_kernel(level, npad, neq, nq, nnz, nzr, nzc, nzv, nza, phip, vp, &
-                                 ap, st, sdt, rhs)
-    integer, intent(in) :: level, npad, neq, nq, nnz
+  !> sens_kin_rhs on explicit shapes (the loops see plain arrays): rhs = base - H1 s
+  !! (- 2 H2 s_dot when both). The parameter parts and rhs share the padded layout
+  !! (npad, neq), seen here flat, so the first term is one copy; s and s_dot come as rows
+  !! (st, sdt: (npad, nq)), so each nonzero updates a row of rhs from a row of them, four
+  !! parameters at a time.
+  pure subroutine kin_rhs_kernel(npad, neq, nq, nnz, nzr, nzc, h1, h2, both, base, st, sdt, &
+                                 rhs)
+    integer, intent(in) :: npad, neq, nq, nnz
     integer, intent(in) :: nzr(*), nzc(*)
-    real(wp), intent(in) :: nzv(*), nza(*)
-    real(wp), intent(in) :: phip(npad * neq), vp(npad * neq), ap(npad * neq)
-    real(wp), intent(in) :: st(npad * nq), sdt(npad * nq)
+    real(wp), intent(in) :: h1(*), h2(*)       !! values of the nonzeros (Hv or Ha, Hv)
+    logical, intent(in) :: both                !! the s_dot term too
+    real(wp), intent(in) :: base(npad * neq), st(npad * nq), sdt(npad * nq)
     real(wp), intent(inout) :: rhs(npad * neq)
     integer :: g, n, e, c
     real(wp) :: v, a
-    select case (level)
-    case (1)                                         ! -Phi_p
-      do e = 1, npad * neq
-        rhs(e) = -phip(e)
-      end do
-    case (2)                                         ! nu_p - J_p q_dot - Hv s
-      rhs = vp
+    do e = 1, npad * neq
+      rhs(e) = base(e)
+    end do
+    if (.not. both) then                       ! nu_p - J_p q_dot - Hv s
       do n = 1, nnz
-        e = npad * (nzr(n) - 1); c = npad * (nzc(n) - 1); v = nzv(n)
+        e = npad * (nzr(n) - 1); c = npad * (nzc(n) - 1); v = h1(n)
         do g = 0, npad - 4, 4
           rhs(e + g + 1) = rhs(e + g + 1) - v * st(c + g + 1)
           rhs(e + g + 2) = rhs(e + g + 2) - v * st(c + g + 2)
@@ -604,18 +653,17 @@ contains
           rhs(e + g + 4) = rhs(e + g + 4) - v * st(c + g + 4)
         end do
       end do
-    case default                                     ! gamma_p - J_p q_ddot - Ha s - 2 Hv s_dot
-      rhs = ap
-      do n = 1, nnz
-        e = npad * (nzr(n) - 1); c = npad * (nzc(n) - 1); a = nza(n); v = 2 * nzv(n)
-        do g = 0, npad - 4, 4
-          rhs(e + g + 1) = rhs(e + g + 1) - a * st(c + g + 1) - v * sdt(c + g + 1)
-          rhs(e + g + 2) = rhs(e + g + 2) - a * st(c + g + 2) - v * sdt(c + g + 2)
-          rhs(e + g + 3) = rhs(e + g + 3) - a * st(c + g + 3) - v * sdt(c + g + 3)
-          rhs(e + g + 4) = rhs(e + g + 4) - a * st(c + g + 4) - v * sdt(c + g + 4)
-        end do
+      return
+    end if
+    do n = 1, nnz                              ! gamma_p - J_p q_ddot - Ha s - 2 Hv s_dot
+      e = npad * (nzr(n) - 1); c = npad * (nzc(n) - 1); a = h1(n); v = 2 * h2(n)
+      do g = 0, npad - 4, 4
+        rhs(e + g + 1) = rhs(e + g + 1) - a * st(c + g + 1) - v * sdt(c + g + 1)
+        rhs(e + g + 2) = rhs(e + g + 2) - a * st(c + g + 2) - v * sdt(c + g + 2)
+        rhs(e + g + 3) = rhs(e + g + 3) - a * st(c + g + 3) - v * sdt(c + g + 3)
+        rhs(e + g + 4) = rhs(e + g + 4) - a * st(c + g + 4) - v * sdt(c + g + 4)
       end do
-    end select
+    end do
   end subroutine kin_rhs_kernel
 
   !> K_lambda = (J^T lambda)_q = sum over rows of lambda_r (Phi_r)_qq as a list of its
