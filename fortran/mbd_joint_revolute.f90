@@ -12,7 +12,7 @@ module mbd_joint_revolute
   implicit none
   private
   public :: revolute_prepare, revolute_eval, revolute_eval_d, revolute_rows, &
-            revolute_gamma, revolute_second_set, revolute_param_set
+            revolute_gamma, revolute_second_sides, revolute_param_sides
 
 contains
 
@@ -131,75 +131,67 @@ contains
   end subroutine revolute_kernel
 
   !> Second derivatives for the sensitivity equations, in closed form (the rows of
-  !! revolute_eval_d along d theta_i and d theta_j), for n revolutes at once (the
-  !! sensitivities' per-output loop): for side 1 (body i, theta slot 3) and side 2 (body j,
-  !! slot 6), with u_i = A_i s'_i, u_j = A_j s'_j,
+  !! revolute_eval_d along d theta_i and d theta_j): for side 1 (body i, theta slot 3) and
+  !! side 2 (body j, slot 6), with u_i = A_i s'_i, u_j = A_j s'_j,
   !!   dJ(:, 3)/dtheta_i = -u_i,           dgamma/dtheta_i = B_i s'_i thd_i**2 = perp(u_i) thd_i**2
   !!   dJ(:, 6)/dtheta_j = +u_j,           dgamma/dtheta_j = -perp(u_j) thd_j**2
-  !! and hv = (dJ/dtheta) q_dot, ha = (dJ/dtheta) q_ddot - dgamma/dtheta (mbd_sensitivity).
-  !! Revolute e has its prepared parameters at p(po(e)) and bodies bi(e), bj(e) (0: ground),
-  !! whose [cos, sin, theta_dot, theta_ddot] are bst(:, b) (the ground's 1, 0, 0, 0: its side
-  !! comes out as for a body at rest, and the caller leaves it out).
-  pure subroutine revolute_second_set(n, nb, po, bi, bj, p, bst, hcol, hv, ha)
-    integer, intent(in) :: n, nb                !! revolutes, bodies
-    integer, intent(in) :: po(n), bi(n), bj(n)  !! parameter offsets and bodies
+  !! and hv = (dJ/dtheta) q_dot, ha = (dJ/dtheta) q_ddot - dgamma/dtheta (mbd_sensitivity):
+  !! with sg = -1 on side 1 and +1 on side 2, u = A s' of the side's body,
+  !!   hcol = sg u,  hv = sg u thd,  ha = sg (u thdd - perp(u) thd**2).
+  !! For n moving sides at once (the sensitivities' per-output loop; a ground side has no
+  !! theta column): side e is body b(e) with its point s' at p(o(e)), p(o(e) + 1), sign
+  !! sg(e), and the body's [cos, sin, theta_dot, theta_ddot] in bst(:, b(e)).
+  pure subroutine revolute_second_sides(n, nb, o, b, sg, p, bst, hcol, hv, ha)
+    integer, intent(in) :: n, nb                !! sides, bodies
+    integer, intent(in) :: o(n), b(n)           !! point offsets and bodies
+    real(wp), intent(in) :: sg(n)               !! signs
     real(wp), intent(in) :: p(*)                !! prepared parameter pool
     real(wp), intent(in) :: bst(4, 0:nb)        !! body states
-    real(wp), intent(out) :: hcol(2, 2, n)      !! d(theta column of J)/dtheta, per side
-    real(wp), intent(out) :: hv(2, 2, n), ha(2, 2, n)  !! per side
-    integer :: e, i, j, o
-    real(wp) :: ux, uy, w, a, w2
+    real(wp), intent(out) :: hcol(2, n)         !! d(theta column of J)/dtheta
+    real(wp), intent(out) :: hv(2, n), ha(2, n)
+    integer :: e, i, k
+    real(wp) :: ux, uy, w, a, w2, g
     !GCC$ novector
-    do e = 1, n                                  ! (a few revolutes: no vector set-up)
-      i = bi(e); j = bj(e); o = po(e)
-      ux = bst(1, i) * p(o) - bst(2, i) * p(o + 1); uy = bst(2, i) * p(o) + bst(1, i) * p(o + 1)
+    do e = 1, n                                  ! (a few sides: no vector set-up)
+      i = b(e); k = o(e); g = sg(e)
+      ux = bst(1, i) * p(k) - bst(2, i) * p(k + 1); uy = bst(2, i) * p(k) + bst(1, i) * p(k + 1)
       w = bst(3, i); a = bst(4, i); w2 = w**2
-      hcol(1, 1, e) = -ux; hcol(2, 1, e) = -uy
-      hv(1, 1, e) = -ux * w; hv(2, 1, e) = -uy * w
-      ha(1, 1, e) = -ux * a + uy * w2; ha(2, 1, e) = -uy * a - ux * w2
-      ux = bst(1, j) * p(o + 2) - bst(2, j) * p(o + 3)
-      uy = bst(2, j) * p(o + 2) + bst(1, j) * p(o + 3)
-      w = bst(3, j); a = bst(4, j); w2 = w**2
-      hcol(1, 2, e) = ux; hcol(2, 2, e) = uy
-      hv(1, 2, e) = ux * w; hv(2, 2, e) = uy * w
-      ha(1, 2, e) = ux * a - uy * w2; ha(2, 2, e) = uy * a + ux * w2
+      hcol(1, e) = g * ux; hcol(2, e) = g * uy
+      hv(1, e) = g * (ux * w); hv(2, e) = g * (uy * w)
+      ha(1, e) = g * (ux * a - uy * w2); ha(2, e) = g * (uy * a + ux * w2)
     end do
-  end subroutine revolute_second_set
+  end subroutine revolute_second_sides
 
-  !> The parameter parts for a change tp of [s'_i, s'_j] in closed form (revolute_eval_d
+  !> The parameter parts for a change t of [s'_i, s'_j] in closed form (revolute_eval_d
   !! with dq = 0; the rows are linear in s', so p itself does not enter): with u = A t s'
   !! and v = B t s' = perp(u) of each body,
   !!   Phi_p = u_i - u_j  (a ground point: its change itself),
   !!   nu_p - J_p q_dot = -v_i thd_i + v_j thd_j,
   !!   gamma_p - J_p q_ddot = u_i thd_i**2 - v_i thdd_i - u_j thd_j**2 + v_j thdd_j,
-  !! for n (revolute, parameter) pairs at once: pair e takes the change
-  !! tp(po(e) .. po(e) + 3, k(e)) of its revolute's parameters, bodies bi(e), bj(e) with
-  !! states bst as in revolute_second_set (the ground's 1, 0, 0, 0 gives its point's change
-  !! itself and no velocity or acceleration part).
-  pure subroutine revolute_param_set(n, nb, ldt, ntp, po, k, bi, bj, tp, bst, tphi, vp, ap)
-    integer, intent(in) :: n, nb, ldt, ntp      !! pairs, bodies, shape of tp
-    integer, intent(in) :: po(n), k(n), bi(n), bj(n)  !! offsets, parameters, bodies
+  !! each a sum over the two sides of sg (u, -perp(u) thd, u thd**2 - perp(u) thdd) with
+  !! sg = +1 on side i and -1 on side j. For n (side, parameter) entries at once, each a
+  !! side whose point the parameter moves: entry e is body b(e) (0: ground, whose state
+  !! 1, 0, 0, 0 gives the point's change itself and nothing else), the change
+  !! t(o(e)), t(o(e) + 1) of column k(e) of tp, sign sg(e).
+  pure subroutine revolute_param_sides(n, nb, ldt, ntp, o, k, b, sg, tp, bst, tphi, vp, ap)
+    integer, intent(in) :: n, nb, ldt, ntp      !! entries, bodies, shape of tp
+    integer, intent(in) :: o(n), k(n), b(n)     !! offsets, parameters, bodies
+    real(wp), intent(in) :: sg(n)               !! signs
     real(wp), intent(in) :: tp(ldt, ntp)        !! changes of the prepared pool
     real(wp), intent(in) :: bst(4, 0:nb)        !! body states
     real(wp), intent(out) :: tphi(2, n), vp(2, n), ap(2, n)
-    integer :: e, i, j, o, c
-    real(wp) :: ux, uy, w, a, w2
+    integer :: e, i, j, c
+    real(wp) :: ux, uy, w, a, w2, g
     !GCC$ novector
-    do e = 1, n                                  ! (a few pairs: no vector set-up)
-      i = bi(e); j = bj(e); o = po(e); c = k(e)
-      ux = bst(1, i) * tp(o, c) - bst(2, i) * tp(o + 1, c)
-      uy = bst(2, i) * tp(o, c) + bst(1, i) * tp(o + 1, c)
+    do e = 1, n                                  ! (a few entries: no vector set-up)
+      i = b(e); j = o(e); c = k(e); g = sg(e)
+      ux = g * (bst(1, i) * tp(j, c) - bst(2, i) * tp(j + 1, c))
+      uy = g * (bst(2, i) * tp(j, c) + bst(1, i) * tp(j + 1, c))
       w = bst(3, i); a = bst(4, i); w2 = w**2
       tphi(1, e) = ux; tphi(2, e) = uy
       vp(1, e) = uy * w; vp(2, e) = -ux * w                        ! -perp(u) thd
       ap(1, e) = ux * w2 + uy * a; ap(2, e) = uy * w2 - ux * a     ! u thd**2 - perp(u) thdd
-      ux = bst(1, j) * tp(o + 2, c) - bst(2, j) * tp(o + 3, c)
-      uy = bst(2, j) * tp(o + 2, c) + bst(1, j) * tp(o + 3, c)
-      w = bst(3, j); a = bst(4, j); w2 = w**2
-      tphi(1, e) = tphi(1, e) - ux; tphi(2, e) = tphi(2, e) - uy
-      vp(1, e) = vp(1, e) - uy * w; vp(2, e) = vp(2, e) + ux * w
-      ap(1, e) = ap(1, e) - ux * w2 - uy * a; ap(2, e) = ap(2, e) - uy * w2 + ux * a
     end do
-  end subroutine revolute_param_set
+  end subroutine revolute_param_sides
 
 end module mbd_joint_revolute

@@ -45,7 +45,7 @@ module mbd_kinematics
                       splu_solve_rows, splu_pos, LMAX
   use mbd_lapack, only: dgels, dgecon, dtrcon
   use mbd_interp, only: hermite5
-  use mbd_sensitivity, only: sens_t, sens_hessian, sens_params, sens_kin_rhs
+  use mbd_sensitivity, only: sens_t, sens_states, sens_hessian, sens_params, sens_kin_rhs
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   implicit none
   private
@@ -1571,15 +1571,15 @@ contains
     real(wp), intent(in) :: q(:), qd(:), qdd(:)  !! state and accelerations
     real(wp), intent(in) :: t                !! time
     real(wp), intent(out) :: sq(:, :), sqd(:, :), sqdd(:, :)  !! (nq, np)
-    s%cb(:) = w%asm%cb(:); s%sb(:) = w%asm%sb(:)   ! the angles' cos and sin of the assembly at q
-    call sens_hessian(m, s, q, qd, qdd, t)
-    call sens_params(m, s, q, qd, qdd, t)
+    call sens_states(m, s, w%asm%cb, w%asm%sb, qd, qdd)   ! (cos, sin of the assembly at q)
+    call sens_hessian(m, s, q, qd, qdd, t, states=.false.)
+    call sens_params(m, s, q, qd, qdd, t, states=.false.)
     if (w%spfact) then                        ! the sparse factors: straight to their solves
       call splu_solve_rows(w%sp, s%mphip, sq, w%cs, s%st)
       call sens_kin_rhs(s, 2, s%rhs)
       call splu_solve_rows(w%sp, s%rhs, sqd, w%cs, s%sdt)
       call sens_kin_rhs(s, 3, s%rhs)
-      call splu_solve_rows(w%sp, s%rhs, sqdd, w%cs, s%st)   ! (s as rows no longer needed)
+      call splu_solve_rows(w%sp, s%rhs, sqdd, w%cs)
       return
     end if
     s%rhs(:, :) = s%mphip                     ! (the dense solves overwrite their right sides)

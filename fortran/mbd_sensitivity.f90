@@ -28,12 +28,12 @@ module mbd_sensitivity
   use mbd_constraints, only: con_eval_d, con_prepare_d, con_is_count, con_name, con_linear, &
                              con_affine_r, con_exponents, &
                              CON_TRANSLATIONAL, DRV_REL_DIST, CON_REVOLUTE
-  use mbd_joint_revolute, only: revolute_second_set, revolute_param_set
+  use mbd_joint_revolute, only: revolute_second_sides, revolute_param_sides
   use mbd_forces, only: force_eval_d, force_is_count, force_exponents
   implicit none
   private
   public :: sens_t, PT_RPAR, PT_MASS, PT_GRAV, PT_FPAR
-  public :: sens_setup, sens_trig, sens_hessian, sens_params, sens_kin_rhs, block_apply, &
+  public :: sens_setup, sens_trig, sens_states, sens_hessian, sens_params, sens_kin_rhs, block_apply, &
             block_apply_t, block_apply_cols, &
             sens_klam, sens_klam_list, sens_jpt_lam, sens_force_d, sens_force_jac, sens_eval_d
 
@@ -54,8 +54,6 @@ module mbd_sensitivity
     real(wp), allocatable :: tgrav(:, :)     !! (2, np) change of gravity
     ! local blocks at the current state (sens_hessian)
     real(wp), allocatable :: hs(:, :, :, :)  !! (MAXROW, NLOC, NLOC, nc) dJ_loc / dq_slot
-    real(wp), allocatable :: hv(:, :, :)     !! (MAXROW, NLOC, nc) (J q_dot)_q
-    real(wp), allocatable :: ha(:, :, :)     !! (MAXROW, NLOC, nc) (J q_ddot - gamma)_q
     ! parameter parts at the current state (sens_params), (npad, neq): a row per parameter
     ! (the padding rows and the pairs a parameter does not change stay zero)
     real(wp), allocatable :: mphip(:, :)     !! -Phi_p (the first level's right-hand side)
@@ -67,22 +65,27 @@ module mbd_sensitivity
     real(wp), allocatable :: rhs(:, :)
     real(wp), allocatable :: st(:, :), sdt(:, :)  !! (npad, nq) s and s_dot as rows (sens_kin_rhs)
     logical :: curved = .true.               !! some constraint is not linear in q
-    !> the revolutes (closed forms): constraint, bodies, parameter offset, first row,
-    !! theta columns (0: ground), and their blocks (2, 2, nrv) at the current state
-    integer, allocatable :: rvc(:), rvbi(:), rvbj(:), rvpo(:), rvr0(:), rvci(:), rvcj(:)
-    real(wp), allocatable :: rvh(:, :, :), rvv(:, :, :), rva(:, :, :)
+    !> the revolutes' moving sides (closed forms): body, point offset in the pool, sign,
+    !! constraint, theta slot (3, 6), and their blocks (2, nside) at the current state
+    integer, allocatable :: rsb(:), rso(:), rsc(:), rss(:)
+    real(wp), allocatable :: rsg(:)
+    real(wp), allocatable :: rsh(:, :), rsv(:, :), rsa(:, :)
     integer, allocatable :: gen(:)           !! the other constraints not linear in q
-    !> the pairs (revolute, parameter) whose prepared parameters change: parameter,
-    !! bodies, parameter offset, first row, and their parts (2, npr) at the current state
-    integer, allocatable :: rpk(:), rpbi(:), rpbj(:), rppo(:), rpr0(:)
-    real(wp), allocatable :: rpphi(:, :), rpv(:, :), rpa(:, :)
+    !> the (revolute side, parameter) entries whose point the parameter moves: parameter,
+    !! body, offset in tp's column, sign, first row, first entry of its pair, and their parts
+    !! (2, n) at the current state
+    integer, allocatable :: psk(:), psb(:), pso(:), psr(:)
+    real(wp), allocatable :: psg(:)
+    logical, allocatable :: psfirst(:)
+    real(wp), allocatable :: psphi(:, :), psv(:, :), psa(:, :)
     !> the other pairs (constraint gpc(e), parameter gpk(e)), by constraint; with the
-    !! revolute pairs, the only entries of mphip, vp, ap sens_params writes
+    !! revolute entries, the only entries of mphip, vp, ap sens_params writes
     integer, allocatable :: gpc(:), gpk(:)
     real(wp), allocatable :: cb(:), sb(:)    !! (0:nb) cos and sin of the body angles (sens_trig)
     real(wp), allocatable :: bst(:, :)       !! (4, 0:nb) cos, sin, theta_dot, theta_ddot
     ! the nonzeros of Hv and Ha (sens_hessian): row, column, values
     integer :: nnz = 0
+    integer :: nrvz = 0                      !! the first nrvz: the revolutes' (fixed places)
     integer, allocatable :: nzr(:), nzc(:)
     real(wp), allocatable :: nzv(:), nza(:)
     ! the nonzeros of K_lambda (sens_klam_list): row, column, value
@@ -123,8 +126,7 @@ contains
     if (dyn) nfp = size(m%fp)
     allocate (s%ptab(2, s%np), s%pscale(s%np), s%tp(size(m%p), s%np), s%caff(m%nc, s%np), &
               s%tfp(nfp, s%np), s%faff(m%nf, s%np), s%tmass(m%nq, s%np), s%tgrav(2, s%np), &
-              s%hs(MAXROW, NLOC, NLOC, m%nc), s%hv(MAXROW, NLOC, m%nc), &
-              s%ha(MAXROW, NLOC, m%nc), s%mphip(npad, m%neq), s%vp(npad, m%neq), &
+              s%hs(MAXROW, NLOC, NLOC, m%nc), s%mphip(npad, m%neq), s%vp(npad, m%neq), &
               s%ap(npad, m%neq), s%work(m%neq), s%rhs(npad, m%neq), &
               s%st(npad, m%nq), s%sdt(npad, m%nq), &
               s%zp(maxval(m%pn)), s%zq(m%nq), &
@@ -137,7 +139,7 @@ contains
     end if
     s%ptab = ptab
     s%tp = zero; s%caff = .false.; s%tfp = zero; s%faff = .false.; s%tmass = zero
-    s%tgrav = zero; s%hs = zero; s%hv = zero; s%ha = zero; s%zp = zero
+    s%tgrav = zero; s%hs = zero; s%zp = zero
     s%cb = one; s%sb = zero; s%rhs = zero; s%pscale = one; s%zq = zero
     s%mphip = zero; s%vp = zero; s%ap = zero   ! entries of unaffected pairs stay zero
     s%st = zero; s%sdt = zero                 ! (padding rows stay zero)
@@ -271,49 +273,77 @@ contains
   end subroutine sens_setup
 
   !> cos and sin of every body angle at q, for the evaluations that follow at the same q.
-  !> The constraints not linear in q (revolutes apart) and the (constraint, parameter) pairs
-  !! a parameter changes (revolutes apart), so the per-output loops visit only those.
+  !> What the per-output loops visit: the revolutes' moving sides (and their fixed places
+  !! in the list of nonzeros), the (revolute side, parameter) entries whose point a
+  !! parameter moves, the other constraints not linear in q and the other (constraint,
+  !! parameter) pairs a parameter changes.
   pure subroutine sens_lists(m, s, st)
     type(model_t), intent(in) :: m           !! model
     type(sens_t), intent(inout) :: s         !! caff set (in); the lists (out)
     integer, intent(out) :: st               !! allocation status
-    integer :: c, k, nrv, ngen, npr, ngp
+    integer :: c, k, side, ns, ngen, nps, ngp, o
     logical :: rev(m%nc), curv(m%nc)
     do c = 1, m%nc
       rev(c) = m%kind(c) == CON_REVOLUTE
       curv(c) = .not. con_linear(m%kind(c))
     end do
-    nrv = count(rev); ngen = count(curv .and. .not. rev)
-    npr = 0; ngp = 0
-    do k = 1, s%np
-      npr = npr + count(s%caff(:, k) .and. rev); ngp = ngp + count(s%caff(:, k) .and. .not. rev)
-    end do
-    allocate (s%rvc(nrv), s%rvbi(nrv), s%rvbj(nrv), s%rvpo(nrv), s%rvr0(nrv), s%rvci(nrv), &
-              s%rvcj(nrv), s%rvh(2, 2, nrv), s%rvv(2, 2, nrv), s%rva(2, 2, nrv), s%gen(ngen), &
-              s%rpk(npr), s%rpbi(npr), s%rpbj(npr), s%rppo(npr), s%rpr0(npr), &
-              s%rpphi(2, npr), s%rpv(2, npr), s%rpa(2, npr), s%gpc(ngp), s%gpk(ngp), stat=st)
-    if (st /= 0) return
-    s%rvh = zero; s%rvv = zero; s%rva = zero
-    s%curved = any(curv)
-    nrv = 0; ngen = 0; npr = 0; ngp = 0
+    ns = 0; ngen = count(curv .and. .not. rev); nps = 0; ngp = 0
     do c = 1, m%nc
       if (rev(c)) then
-        nrv = nrv + 1
-        s%rvc(nrv) = c; s%rvbi(nrv) = m%bi(c); s%rvbj(nrv) = m%bj(c); s%rvpo(nrv) = m%po(c)
-        s%rvr0(nrv) = m%row0(c); s%rvci(nrv) = m%loc(3, c); s%rvcj(nrv) = m%loc(6, c)
-      else if (curv(c)) then
-        ngen = ngen + 1; s%gen(ngen) = c
+        ns = ns + count(m%loc([3, 6], c) > 0)
+        do k = 1, s%np
+          if (.not. s%caff(c, k)) cycle
+          do side = 0, 1
+            o = m%po(c) + 2 * side
+            if (any(abs(s%tp(o:o + 1, k)) > zero)) nps = nps + 1
+          end do
+        end do
+      else
+        ngp = ngp + count(s%caff(c, :))
       end if
-      do k = 1, s%np
-        if (.not. s%caff(c, k)) cycle
-        if (rev(c)) then
-          npr = npr + 1
-          s%rpk(npr) = k; s%rpbi(npr) = m%bi(c); s%rpbj(npr) = m%bj(c)
-          s%rppo(npr) = m%po(c); s%rpr0(npr) = m%row0(c)
-        else
-          ngp = ngp + 1; s%gpc(ngp) = c; s%gpk(ngp) = k
+    end do
+    allocate (s%rsb(ns), s%rso(ns), s%rsc(ns), s%rss(ns), s%rsg(ns), s%rsh(2, ns), &
+              s%rsv(2, ns), s%rsa(2, ns), s%gen(ngen), s%psk(nps), s%psb(nps), s%pso(nps), &
+              s%psr(nps), s%psg(nps), s%psfirst(nps), s%psphi(2, nps), s%psv(2, nps), &
+              s%psa(2, nps), s%gpc(ngp), s%gpk(ngp), stat=st)
+    if (st /= 0) return
+    s%rsh = zero; s%rsv = zero; s%rsa = zero
+    s%curved = any(curv)
+    s%nrvz = 0
+    ns = 0; ngen = 0; nps = 0; ngp = 0
+    do c = 1, m%nc
+      if (rev(c)) then
+        do side = 1, 2                           ! moving sides; two fixed list entries each
+          if (m%loc(3 * side, c) == 0) cycle
+          ns = ns + 1
+          s%rsb(ns) = merge(m%bi(c), m%bj(c), side == 1); s%rso(ns) = m%po(c) + 2 * (side - 1)
+          s%rsg(ns) = merge(-one, one, side == 1); s%rsc(ns) = c; s%rss(ns) = 3 * side
+          s%nzr(s%nrvz + 1) = m%row0(c); s%nzr(s%nrvz + 2) = m%row0(c) + 1
+          s%nzc(s%nrvz + 1:s%nrvz + 2) = m%loc(3 * side, c)
+          s%nzv(s%nrvz + 1:s%nrvz + 2) = zero; s%nza(s%nrvz + 1:s%nrvz + 2) = zero
+          s%nrvz = s%nrvz + 2
+        end do
+        do k = 1, s%np
+          if (.not. s%caff(c, k)) cycle
+          do side = 0, 1                         ! the sides whose point parameter k moves
+            o = m%po(c) + 2 * side
+            if (.not. any(abs(s%tp(o:o + 1, k)) > zero)) cycle
+            nps = nps + 1
+            s%psk(nps) = k; s%psb(nps) = merge(m%bi(c), m%bj(c), side == 0); s%pso(nps) = o
+            s%psg(nps) = merge(one, -one, side == 0); s%psr(nps) = m%row0(c)
+            s%psfirst(nps) = .true.
+            if (nps > 1) s%psfirst(nps) = s%psk(nps - 1) /= k .or. s%psr(nps - 1) /= m%row0(c)
+          end do
+        end do
+      else
+        if (curv(c)) then
+          ngen = ngen + 1; s%gen(ngen) = c
         end if
-      end do
+        do k = 1, s%np
+          if (.not. s%caff(c, k)) cycle
+          ngp = ngp + 1; s%gpc(ngp) = c; s%gpk(ngp) = k
+        end do
+      end if
     end do
   end subroutine sens_lists
 
@@ -354,21 +384,26 @@ contains
   !! d ar/dq_j = -dgamma/dq_j; then hv(:, j) = hs(:, :, j) q_dot_loc and
   !! ha(:, j) = hs(:, :, j) q_ddot_loc + d ar/dq_j (and their nonzeros in a list).
   !! sens_trig first.
-  pure subroutine sens_hessian(m, s, q, qd, qdd, t)
+  pure subroutine sens_hessian(m, s, q, qd, qdd, t, states)
     type(model_t), intent(in) :: m             !! model
     type(sens_t), intent(inout) :: s           !! blocks (out)
     real(wp), intent(in) :: q(:), qd(:), qdd(:)  !! state and accelerations
     real(wp), intent(in) :: t                  !! time
+    logical, intent(in), optional :: states    !! .false.: sens_states has set the state
     type(dloc) :: x
-    real(wp) :: qddl(NLOC), tphi(MAXROW), tnu(MAXROW), tgam(MAXROW)
+    real(wp) :: qddl(NLOC), tphi(MAXROW), tnu(MAXROW), tgam(MAXROW), hv, ha
     integer :: k, j, nr, si, sj, r, e
-    call body_states(m, s, qd, qdd)
-    s%nnz = 0
-    if (size(s%rvc) > 0) then                   ! the revolutes in closed form
-      call revolute_second_set(size(s%rvc), m%nb, s%rvpo, s%rvbi, s%rvbj, m%p, s%bst, s%rvh, &
-                               s%rvv, s%rva)
-      call revolute_push(size(s%rvc), m%nc, s%rvc, s%rvr0, s%rvci, s%rvcj, s%rvh, s%rvv, &
-                         s%rva, s%hs, s%hv, s%ha, s%nnz, s%nzr, s%nzc, s%nzv, s%nza)
+    if (.not. present(states)) then
+      call body_states(m, s, qd, qdd)
+    else if (states) then
+      call body_states(m, s, qd, qdd)
+    end if
+    s%nnz = s%nrvz                              ! the revolutes' entries first, in fixed places
+    if (size(s%rsb) > 0) then                   ! the revolutes in closed form
+      call revolute_second_sides(size(s%rsb), m%nb, s%rso, s%rsb, s%rsg, m%p, s%bst, s%rsh, &
+                                 s%rsv, s%rsa)
+      call revolute_push(size(s%rsb), m%nc, s%rsc, s%rss, s%rsh, s%rsv, s%rsa, s%hs, s%nzv, &
+                         s%nza)
     end if
     do e = 1, size(s%gen)                       ! (the linear ones' blocks stay zero)
       k = s%gen(e)
@@ -383,49 +418,35 @@ contains
                         s%zp(1:m%pn(k)), si, sj, x, t, tphi, s%hs(:, :, j, k), tnu, tgam)
         x%tq(j) = zero
         do r = 1, nr
-          s%hv(r, j, k) = dot_product(s%hs(r, :, j, k), x%x%qd)
-          s%ha(r, j, k) = dot_product(s%hs(r, :, j, k), qddl) - tgam(r)
-          if (abs(s%hv(r, j, k)) > zero .or. abs(s%ha(r, j, k)) > zero) then
+          hv = dot_product(s%hs(r, :, j, k), x%x%qd)
+          ha = dot_product(s%hs(r, :, j, k), qddl) - tgam(r)
+          if (abs(hv) > zero .or. abs(ha) > zero) then
             s%nnz = s%nnz + 1
             s%nzr(s%nnz) = m%row0(k) + r - 1; s%nzc(s%nnz) = m%loc(j, k)
-            s%nzv(s%nnz) = s%hv(r, j, k); s%nza(s%nnz) = s%ha(r, j, k)
+            s%nzv(s%nnz) = hv; s%nza(s%nnz) = ha
           end if
         end do
       end do
     end do
   end subroutine sens_hessian
 
-  !> The revolutes' blocks (revolute_second_set) into hs, hv, ha and the list of nonzeros:
-  !! only the theta slots (3, 6) of a revolute have second derivatives (the blocks' other
-  !! entries stay zero from sens_setup).
-  pure subroutine revolute_push(nrv, nc, rvc, rvr0, rvci, rvcj, h, hv, ha, hs, hvb, hab, nnz, &
-                                nzr, nzc, nzv, nza)
-    integer, intent(in) :: nrv, nc                       !! revolutes, constraints
-    integer, intent(in) :: rvc(nrv), rvr0(nrv), rvci(nrv), rvcj(nrv)
-    real(wp), intent(in) :: h(2, 2, nrv), hv(2, 2, nrv), ha(2, 2, nrv)
-    real(wp), intent(inout) :: hs(MAXROW, NLOC, NLOC, nc), hvb(MAXROW, NLOC, nc)
-    real(wp), intent(inout) :: hab(MAXROW, NLOC, nc)
-    integer, intent(inout) :: nnz                        !! nonzeros so far
-    integer, intent(inout) :: nzr(*), nzc(*)
-    real(wp), intent(inout) :: nzv(*), nza(*)
-    integer :: e, k, side, slot, col, rr
-    do e = 1, nrv
-      k = rvc(e)
-      do side = 1, 2
-        col = rvci(e)
-        if (side == 2) col = rvcj(e)
-        if (col == 0) cycle
-        slot = 3 * side
-        hs(1, slot, slot, k) = h(1, side, e); hs(2, slot, slot, k) = h(2, side, e)
-        do rr = 1, 2
-          hvb(rr, slot, k) = hv(rr, side, e); hab(rr, slot, k) = ha(rr, side, e)
-          if (abs(hv(rr, side, e)) > zero .or. abs(ha(rr, side, e)) > zero) then
-            nnz = nnz + 1
-            nzr(nnz) = rvr0(e) + rr - 1; nzc(nnz) = col
-            nzv(nnz) = hv(rr, side, e); nza(nnz) = ha(rr, side, e)
-          end if
-        end do
-      end do
+  !> The revolutes' moving sides' blocks (revolute_second_sides) into hs and their values
+  !! into the list of nonzeros (its first entries, two per side, whose rows and columns
+  !! sens_lists set, zero or not): only the theta slots (3, 6) of a revolute have second
+  !! derivatives (the blocks' other entries stay zero from sens_setup).
+  pure subroutine revolute_push(ns, nc, rsc, rss, h, hv, ha, hs, nzv, nza)
+    integer, intent(in) :: ns, nc                        !! sides, constraints
+    integer, intent(in) :: rsc(ns), rss(ns)              !! constraint and slot of each side
+    real(wp), intent(in) :: h(2, ns), hv(2, ns), ha(2, ns)
+    real(wp), intent(inout) :: hs(MAXROW, NLOC, NLOC, nc)
+    real(wp), intent(inout) :: nzv(2, *), nza(2, *)
+    integer :: e, k, j
+    !GCC$ novector
+    do e = 1, ns
+      k = rsc(e); j = rss(e)
+      hs(1, j, j, k) = h(1, e); hs(2, j, j, k) = h(2, e)
+      nzv(1, e) = hv(1, e); nzv(2, e) = hv(2, e)
+      nza(1, e) = ha(1, e); nza(2, e) = ha(2, e)
     end do
   end subroutine revolute_push
 
@@ -434,20 +455,25 @@ contains
   !! parameter) of the lists only (the other entries stay zero from sens_setup): the
   !! revolutes' in closed form, the others by the dual evaluation along the parameter's
   !! change (dq = 0).
-  pure subroutine sens_params(m, s, q, qd, qdd, t)
+  pure subroutine sens_params(m, s, q, qd, qdd, t, states)
     type(model_t), intent(in) :: m             !! model
     type(sens_t), intent(inout) :: s           !! parameter parts (out)
     real(wp), intent(in) :: q(:), qd(:), qdd(:)  !! state and accelerations
     real(wp), intent(in) :: t                  !! time
+    logical, intent(in), optional :: states    !! .false.: sens_states has set the state
     type(dloc) :: x
     real(wp) :: qddl(NLOC), tphi(MAXROW), tjl(MAXROW, NLOC), tnu(MAXROW), tgam(MAXROW)
     integer :: e, k, c, cprev, nr, si, sj, r, r0
-    call body_states(m, s, qd, qdd)
-    if (size(s%rpk) > 0) then
-      call revolute_param_set(size(s%rpk), m%nb, size(s%tp, 1), s%np, s%rppo, s%rpk, s%rpbi, &
-                              s%rpbj, s%tp, s%bst, s%rpphi, s%rpv, s%rpa)
-      call pairs_put(size(s%rpk), size(s%mphip, 1), size(s%mphip, 2), s%rpk, s%rpr0, s%rpphi, &
-                     s%rpv, s%rpa, s%mphip, s%vp, s%ap)
+    if (.not. present(states)) then
+      call body_states(m, s, qd, qdd)
+    else if (states) then
+      call body_states(m, s, qd, qdd)
+    end if
+    if (size(s%psk) > 0) then                   ! the revolutes' in closed form
+      call revolute_param_sides(size(s%psk), m%nb, size(s%tp, 1), s%np, s%pso, s%psk, s%psb, &
+                                s%psg, s%tp, s%bst, s%psphi, s%psv, s%psa)
+      call pairs_put(size(s%psk), size(s%mphip, 1), size(s%mphip, 2), s%psk, s%psr, &
+                     s%psfirst, s%psphi, s%psv, s%psa, s%mphip, s%vp, s%ap)
     end if
     cprev = 0
     do e = 1, size(s%gpc)
@@ -467,19 +493,26 @@ contains
     end do
   end subroutine sens_params
 
-  !> The two-row parts of n pairs (parameter k(e), first row r0(e)) into mphip (negated),
-  !! vp, ap.
-  pure subroutine pairs_put(n, npad, neq, k, r0, tphi, tv, ta, mphip, vp, ap)
+  !> The two-row parts of n entries (parameter k(e), first row r0(e)) into mphip (negated),
+  !! vp, ap: an entry that is the first of its pair writes, the others add.
+  pure subroutine pairs_put(n, npad, neq, k, r0, first, tphi, tv, ta, mphip, vp, ap)
     integer, intent(in) :: n, npad, neq, k(n), r0(n)
+    logical, intent(in) :: first(n)
     real(wp), intent(in) :: tphi(2, n), tv(2, n), ta(2, n)
     real(wp), intent(inout) :: mphip(npad, neq), vp(npad, neq), ap(npad, neq)
     integer :: e, i, r
     !GCC$ novector
     do e = 1, n
       i = k(e); r = r0(e)
-      mphip(i, r) = -tphi(1, e); mphip(i, r + 1) = -tphi(2, e)
-      vp(i, r) = tv(1, e); vp(i, r + 1) = tv(2, e)
-      ap(i, r) = ta(1, e); ap(i, r + 1) = ta(2, e)
+      if (first(e)) then
+        mphip(i, r) = -tphi(1, e); mphip(i, r + 1) = -tphi(2, e)
+        vp(i, r) = tv(1, e); vp(i, r + 1) = tv(2, e)
+        ap(i, r) = ta(1, e); ap(i, r + 1) = ta(2, e)
+      else
+        mphip(i, r) = mphip(i, r) - tphi(1, e); mphip(i, r + 1) = mphip(i, r + 1) - tphi(2, e)
+        vp(i, r) = vp(i, r) + tv(1, e); vp(i, r + 1) = vp(i, r + 1) + tv(2, e)
+        ap(i, r) = ap(i, r) + ta(1, e); ap(i, r + 1) = ap(i, r + 1) + ta(2, e)
+      end if
     end do
   end subroutine pairs_put
 
@@ -489,12 +522,34 @@ contains
     type(model_t), intent(in) :: m              !! model
     type(sens_t), intent(inout) :: s            !! bst (out)
     real(wp), intent(in) :: qd(:), qdd(:)       !! velocities and accelerations
-    integer :: b
-    do b = 1, m%nb
-      s%bst(1, b) = s%cb(b); s%bst(2, b) = s%sb(b)
-      s%bst(3, b) = qd(3 * b); s%bst(4, b) = qdd(3 * b)
-    end do
+    call states_kernel(m%nb, s%cb, s%sb, qd, qdd, s%bst)
   end subroutine body_states
+
+  !> The state sens_hessian and sens_params work at, from the cos and sin of the body angles
+  !! cb, sb (0:nb) at q (instead of sens_trig; they are copied only when a constraint other
+  !! than a revolute needs them); both then called with states = .false.
+  pure subroutine sens_states(m, s, cb, sb, qd, qdd)
+    type(model_t), intent(in) :: m              !! model
+    type(sens_t), intent(inout) :: s            !! bst (and cb, sb) (out)
+    real(wp), intent(in) :: cb(0:), sb(0:)      !! cos and sin of the body angles
+    real(wp), intent(in) :: qd(:), qdd(:)       !! velocities and accelerations
+    if (size(s%gen) + size(s%gpc) > 0) then
+      s%cb(:) = cb; s%sb(:) = sb
+    end if
+    call states_kernel(m%nb, cb, sb, qd, qdd, s%bst)
+  end subroutine sens_states
+
+  !> bst(:, b) = [cos, sin, theta_dot, theta_ddot] of body b = 1 .. nb.
+  pure subroutine states_kernel(nb, cb, sb, qd, qdd, bst)
+    integer, intent(in) :: nb
+    real(wp), intent(in) :: cb(0:nb), sb(0:nb), qd(3 * nb), qdd(3 * nb)
+    real(wp), intent(inout) :: bst(4, 0:nb)
+    integer :: b
+    !GCC$ novector
+    do b = 1, nb
+      bst(1, b) = cb(b); bst(2, b) = sb(b); bst(3, b) = qd(3 * b); bst(4, b) = qdd(3 * b)
+    end do
+  end subroutine states_kernel
 
   !> Changes of Phi, nu, gamma (neq) and of the local J blocks (MAXROW, NLOC, nc) along a
   !! direction (dq, dq_dot) and parameter k (k = 0: none): every constraint evaluated on
@@ -643,6 +698,10 @@ contains
     do e = 1, npad * neq
       rhs(e) = base(e)
     end do
+    if (npad == 4) then                        ! (up to four parameters: no inner loop)
+      call rhs_four(nnz, nzr, nzc, h1, h2, both, st, sdt, rhs)
+      return
+    end if
     if (.not. both) then                       ! nu_p - J_p q_dot - Hv s
       do n = 1, nnz
         e = npad * (nzr(n) - 1); c = npad * (nzc(n) - 1); v = h1(n)
@@ -665,6 +724,31 @@ contains
       end do
     end do
   end subroutine kin_rhs_kernel
+
+  !> kin_rhs_kernel's nonzeros for npad = 4.
+  pure subroutine rhs_four(nnz, nzr, nzc, h1, h2, both, st, sdt, rhs)
+    integer, intent(in) :: nnz, nzr(*), nzc(*)
+    real(wp), intent(in) :: h1(*), h2(*), st(4, *), sdt(4, *)
+    logical, intent(in) :: both
+    real(wp), intent(inout) :: rhs(4, *)
+    integer :: n, r, c
+    real(wp) :: v, a
+    if (.not. both) then
+      do n = 1, nnz
+        r = nzr(n); c = nzc(n); v = h1(n)
+        rhs(1, r) = rhs(1, r) - v * st(1, c); rhs(2, r) = rhs(2, r) - v * st(2, c)
+        rhs(3, r) = rhs(3, r) - v * st(3, c); rhs(4, r) = rhs(4, r) - v * st(4, c)
+      end do
+      return
+    end if
+    do n = 1, nnz
+      r = nzr(n); c = nzc(n); a = h1(n); v = 2 * h2(n)
+      rhs(1, r) = rhs(1, r) - a * st(1, c) - v * sdt(1, c)
+      rhs(2, r) = rhs(2, r) - a * st(2, c) - v * sdt(2, c)
+      rhs(3, r) = rhs(3, r) - a * st(3, c) - v * sdt(3, c)
+      rhs(4, r) = rhs(4, r) - a * st(4, c) - v * sdt(4, c)
+    end do
+  end subroutine rhs_four
 
   !> K_lambda = (J^T lambda)_q = sum over rows of lambda_r (Phi_r)_qq as a list of its
   !! nonzeros (row, column, value), from the local Hessian blocks (sens_hessian at the same q).

@@ -342,34 +342,37 @@ contains
 
   !> X = D A^-1 B for several right-hand sides given as rows, bt = B^T (a multiple of 4 rows,
   !! padding zero), four at a time through the factors (each column's operations those of
-  !! splu_solve, in the same order); x (n, ncol) takes the first ncol of them and xt (4 k, n)
-  !! all of them as rows.
+  !! splu_solve, in the same order); x (n, ncol) takes the first ncol of them and xt (4 k, n),
+  !! when present, all of them as rows.
   pure subroutine splu_solve_rows(sp, bt, x, cs, xt)
     type(splu_t), intent(inout) :: sp                !! factors (and the work block)
     real(wp), intent(in) :: bt(:, :)                 !! right-hand sides as rows (4 k, n)
     real(wp), intent(inout) :: x(:, :)               !! solutions (A's columns, ncol)
     real(wp), intent(in) :: cs(:)                    !! column scale
-    real(wp), intent(inout) :: xt(:, :)              !! solutions as rows (4 k, n)
+    real(wp), intent(inout), optional :: xt(:, :)    !! solutions as rows (4 k, n)
     integer :: g
     do g = 1, size(bt, 1) - 3, 4
       if (g > size(x, 2)) exit
-      call rows_kernel(sp%n, sp%lptr(sp%n + 1) - 1, sp%nu, sp%prow, sp%pcol, sp%lpos, &
-                       sp%lrow, sp%lcol, sp%bpos, sp%brow, sp%bcol, sp%rinv, sp%val, sp%y4, &
-                       size(bt, 1), bt, x, g, cs, xt)
+      call rows_kernel(sp%n, sp%lptr(sp%n + 1) - 1, sp%nu, sp%prow, sp%lpos, sp%lrow, &
+                       sp%lcol, sp%bpos, sp%brow, sp%bcol, sp%val, sp%y4, size(bt, 1), bt, g)
+      if (present(xt)) then
+        call rows_out(sp%n, sp%pcol, sp%rinv, cs, sp%y4, size(xt, 1), xt, g, x)
+      else
+        call cols_out(sp%n, sp%pcol, sp%rinv, cs, sp%y4, g, x)
+      end if
     end do
   end subroutine splu_solve_rows
 
-  !> Four right-hand sides (rows g .. g + 3 of bt) through the factors; columns g .. g + 3
-  !! of x, rows g .. g + 3 of xt.
-  pure subroutine rows_kernel(n, nl, nu, prow, pcol, lpos, lrow, lcol, bpos, brow, bcol, &
-                              rinv, val, y, ldb, bt, x, g, cs, xt)
+  !> Four right-hand sides (rows g .. g + 3 of bt) through L and U1: y (4, n) in step
+  !! order, before the pivots and the column permutation (rows_out, cols_out).
+  pure subroutine rows_kernel(n, nl, nu, prow, lpos, lrow, lcol, bpos, brow, bcol, val, y, &
+                              ldb, bt, g)
     integer, intent(in) :: n, nl, nu, g, ldb
-    integer, intent(in) :: prow(n), pcol(n), lpos(nl), lrow(nl), lcol(nl)
+    integer, intent(in) :: prow(n), lpos(nl), lrow(nl), lcol(nl)
     integer, intent(in) :: bpos(nu), brow(nu), bcol(nu)
-    real(wp), intent(in) :: rinv(n), val(*), bt(ldb, n), cs(n)
+    real(wp), intent(in) :: val(*), bt(ldb, n)
     real(wp), intent(out) :: y(4, n)
-    real(wp), intent(inout) :: x(:, :), xt(ldb, n)
-    integer :: k, p, i, a, c
+    integer :: k, p, a, c
     real(wp) :: v, t1, t2, t3, t4
     ! (the four columns written out: array sections of extent 4 cost a loop each)
     do k = 1, n                                      ! y = P b
@@ -378,7 +381,7 @@ contains
     end do
     do p = 1, nl                                     ! L z = y (unit diagonal)
       v = val(lpos(p)); a = lrow(p); c = lcol(p)
-      t1 = y(1, c); t2 = y(2, c); t3 = y(3, c); t4 = y(4, c)   ! (loaded first: pairs vectorize)
+      t1 = y(1, c); t2 = y(2, c); t3 = y(3, c); t4 = y(4, c)
       y(1, a) = y(1, a) - v * t1; y(2, a) = y(2, a) - v * t2
       y(3, a) = y(3, a) - v * t3; y(4, a) = y(4, a) - v * t4
     end do
@@ -388,12 +391,22 @@ contains
       y(1, a) = y(1, a) - v * t1; y(2, a) = y(2, a) - v * t2
       y(3, a) = y(3, a) - v * t3; y(4, a) = y(4, a) - v * t4
     end do
-    do k = 1, n                                      ! x = D Q diag(1/u_kk) v, as rows
+  end subroutine rows_kernel
+
+  !> x = D Q diag(1/u_kk) v of rows_kernel's four solutions as rows g .. g + 3 of xt and as
+  !! columns g .. of x (as many as x has).
+  pure subroutine rows_out(n, pcol, rinv, cs, y, ldt, xt, g, x)
+    integer, intent(in) :: n, pcol(n), ldt, g
+    real(wp), intent(in) :: rinv(n), cs(n), y(4, n)
+    real(wp), intent(inout) :: xt(ldt, n), x(:, :)
+    integer :: k, c, i
+    real(wp) :: v
+    do k = 1, n
       c = pcol(k); v = rinv(k) * cs(c)
-      t1 = y(1, k) * v; t2 = y(2, k) * v; t3 = y(3, k) * v; t4 = y(4, k) * v
-      xt(g, c) = t1; xt(g + 1, c) = t2; xt(g + 2, c) = t3; xt(g + 3, c) = t4
+      xt(g, c) = y(1, k) * v; xt(g + 1, c) = y(2, k) * v
+      xt(g + 2, c) = y(3, k) * v; xt(g + 3, c) = y(4, k) * v
     end do
-    if (size(x, 2) - g >= 3) then                    ! and as columns
+    if (size(x, 2) - g >= 3) then
       do c = 1, n
         x(c, g) = xt(g, c); x(c, g + 1) = xt(g + 1, c)
         x(c, g + 2) = xt(g + 2, c); x(c, g + 3) = xt(g + 3, c)
@@ -405,7 +418,30 @@ contains
         x(c, g + i - 1) = xt(g + i - 1, c)
       end do
     end do
-  end subroutine rows_kernel
+  end subroutine rows_out
+
+  !> rows_out without the rows: columns g .. of x only.
+  pure subroutine cols_out(n, pcol, rinv, cs, y, g, x)
+    integer, intent(in) :: n, pcol(n), g
+    real(wp), intent(in) :: rinv(n), cs(n), y(4, n)
+    real(wp), intent(inout) :: x(:, :)
+    integer :: k, c, i
+    real(wp) :: v
+    if (size(x, 2) - g >= 3) then
+      do k = 1, n
+        c = pcol(k); v = rinv(k) * cs(c)
+        x(c, g) = y(1, k) * v; x(c, g + 1) = y(2, k) * v
+        x(c, g + 2) = y(3, k) * v; x(c, g + 3) = y(4, k) * v
+      end do
+      return
+    end if
+    do i = 1, size(x, 2) - g + 1
+      do k = 1, n
+        c = pcol(k)
+        x(c, g + i - 1) = y(i, k) * (rinv(k) * cs(c))
+      end do
+    end do
+  end subroutine cols_out
 
   !> x1 = -A^-1 b1 (a Newton correction from Phi = b1) and x2 = A^-1 b2 in one pass over the
   !! factors (as splu_solve, each x multiplied by the column scale cs).
