@@ -279,43 +279,48 @@ contains
     integer :: bad
     iinfo = 0; rinfo = zero; qsing = zero; dep = 0; redundant = 0; tpass = zero
     qout = zero; qdout = zero; qddout = zero
-    if (present(ptab)) then
-      sq = zero; sqd = zero; sqdd = zero      ! (kin_run writes them; for the early returns)
-    end if
-    call model_build(nb, ctab, rpar, m, status, msg, bad, nondim=.true.)
-    iinfo(2) = bad
-    if (status /= MBD_OK) return
-    if (present(ptab)) then
-      if (any(shape(sq) /= [m%nq, size(ptab, 2), size(qout, 2)]) .or. &
-          any(shape(sqd) /= shape(sq)) .or. any(shape(sqdd) /= shape(sq))) then
-        status = MBD_BAD_COUNT; msg = 'sensitivity arrays do not match the model'; return
+    checks: block                             ! (a failed check leaves the outputs zero)
+      call model_build(nb, ctab, rpar, m, status, msg, bad, nondim=.true.)
+      iinfo(2) = bad
+      if (status /= MBD_OK) exit checks
+      if (present(ptab)) then
+        if (any(shape(sq) /= [m%nq, size(ptab, 2), size(qout, 2)]) .or. &
+            any(shape(sqd) /= shape(sq)) .or. any(shape(sqdd) /= shape(sq))) then
+          status = MBD_BAD_COUNT; msg = 'sensitivity arrays do not match the model'; exit checks
+        end if
+        call sens_setup(m, ctab, rpar, ptab, sens, status, msg, bad)
+        if (status /= MBD_OK) then
+          iinfo(2) = -2000000 - bad; exit checks
+        end if
       end if
-      call sens_setup(m, ctab, rpar, ptab, sens, status, msg, bad)
-      if (status /= MBD_OK) then
-        iinfo(2) = -2000000 - bad; return
+      if (.not. (finite(q0) .and. finite(t0) .and. finite(t1) .and. finite(tol) .and. &
+                 finite(tmin))) then
+        call not_finite('q0, the times and the tolerances', status, msg); exit checks
       end if
-    end if
-    if (.not. (finite(q0) .and. finite(t0) .and. finite(t1) .and. finite(tol) .and. &
-               finite(tmin))) then
-      call not_finite('q0, the times and the tolerances', status, msg); return
-    end if
-    if (.not. (finite(t1 - t0))) then
-      call not_finite('the time span', status, msg); return
-    end if
-    if (m%neq < m%nq) then
-      status = MBD_BAD_COUNT
-      write (msg, '(a,i0,a,i0,a,i0,a)') 'the model is not kinematically determined: ', m%neq, &
-        ' equations for ', m%nq, ' coordinates (', m%nq - m%neq, ' degrees of freedom left)'
+      if (.not. (finite(t1 - t0))) then
+        call not_finite('the time span', status, msg); exit checks
+      end if
+      if (m%neq < m%nq) then
+        status = MBD_BAD_COUNT
+        write (msg, '(a,i0,a,i0,a,i0,a)') 'the model is not kinematically determined: ', m%neq, &
+          ' equations for ', m%nq, ' coordinates (', m%nq - m%neq, ' degrees of freedom left)'
+        exit checks
+      end if
+      if (size(q0) /= m%nq .or. size(qsing) /= m%nq .or. size(dep) /= m%neq .or. &
+          size(redundant) /= m%neq .or. size(tpass) /= MAXPASS .or. &
+          size(qout, 1) /= m%nq .or. size(qout, 2) /= kin_out_count(nsteps, max(every, 1))) then
+        status = MBD_BAD_COUNT; msg = 'array sizes do not match the model'; exit checks
+      end if
+      if (every < 1 .or. solver < SOLVER_AUTO .or. solver > SOLVER_BANDED) then
+        status = MBD_BAD_SETTING; msg = 'every must be >= 1 and solver 0 (auto), 1 (dense) '// &
+          'or 2 (banded)'; exit checks
+      end if
+    end block checks
+    if (status /= MBD_OK) then
+      if (present(ptab)) then
+        sq = zero; sqd = zero; sqdd = zero
+      end if
       return
-    end if
-    if (size(q0) /= m%nq .or. size(qsing) /= m%nq .or. size(dep) /= m%neq .or. &
-        size(redundant) /= m%neq .or. size(tpass) /= MAXPASS .or. &
-        size(qout, 1) /= m%nq .or. size(qout, 2) /= kin_out_count(nsteps, max(every, 1))) then
-      status = MBD_BAD_COUNT; msg = 'array sizes do not match the model'; return
-    end if
-    if (every < 1 .or. solver < SOLVER_AUTO .or. solver > SOLVER_BANDED) then
-      status = MBD_BAD_SETTING; msg = 'every must be >= 1 and solver 0 (auto), 1 (dense) '// &
-        'or 2 (banded)'; return
     end if
     opts%every = every; opts%solver = solver
     if (tol > zero) opts%tol = tol
@@ -323,10 +328,11 @@ contains
     if (tmin > zero) opts%tmin = tmin
     if (present(ptab)) then
       call kin_run(m, q0 / m%cunit, t0, t1, nsteps, opts, qout, qdout, qddout, rep, status, &
-                   msg, sens, sq, sqd, sqdd, ctl=ctl)
-      call sens_units(m, sens, sq, m%cunit, .false.)
-      call sens_units(m, sens, sqd, m%cunit, .false.)
-      call sens_units(m, sens, sqdd, m%cunit, .false.)
+                   msg, sens, sq, sqd, sqdd, ctl=ctl)     ! (in model units: sens%ounit)
+      if (rep%ndone < size(sq, 3)) then        ! (the rows after a failure: zero)
+        sq(:, :, rep%ndone + 1:) = zero; sqd(:, :, rep%ndone + 1:) = zero
+        sqdd(:, :, rep%ndone + 1:) = zero
+      end if
     else
       call kin_run(m, q0 / m%cunit, t0, t1, nsteps, opts, qout, qdout, qddout, rep, status, &
                    msg, ctl=ctl)

@@ -1015,7 +1015,7 @@ contains
     integer, intent(out) :: status             !! MBD_OK or the failure
     character(len=MSG_LEN), intent(out) :: msg !! explanation
     !> design parameters (mbd_sensitivity): with them, sq, sqd, sqdd (nq, np, outputs) get
-    !! dq/dp, dq_dot/dp and dq_ddot/dp at every stored output
+    !! dq/dp, dq_dot/dp and dq_ddot/dp at every stored output (in model units, sens%ounit)
     type(sens_t), intent(inout), optional :: sens
     real(wp), intent(out), optional :: sq(:, :, :), sqd(:, :, :), sqdd(:, :, :)
     !> progress, shared with a caller in another thread: ctl(1) gets the outputs stored so
@@ -1046,7 +1046,7 @@ contains
     integer, intent(out) :: status             !! MBD_OK or the failure
     character(len=MSG_LEN), intent(out) :: msg !! explanation
     !> design parameters (mbd_sensitivity): with them, sq, sqd, sqdd (nq, np, outputs) get
-    !! dq/dp, dq_dot/dp and dq_ddot/dp at every stored output
+    !! dq/dp, dq_dot/dp and dq_ddot/dp at every stored output (in model units, sens%ounit)
     type(sens_t), intent(inout), optional :: sens
     real(wp), intent(out), optional :: sq(:, :, :), sqd(:, :, :), sqdd(:, :, :)
     !> progress (see kin_run)
@@ -1563,7 +1563,8 @@ contains
 
   !> Sensitivities at a converged state (q, q_dot, q_ddot) whose J factors are in w:
   !! J s = -Phi_p, J s_dot = nu_p - J_p q_dot - Hv s, J s_ddot = gamma_p - J_p q_ddot - Ha s
-  !! - 2 Hv s_dot (mbd_sensitivity), three solves with the same factors per parameter.
+  !! - 2 Hv s_dot (mbd_sensitivity), three solves with the same factors per parameter;
+  !! returned in model units (s%ounit: the core works in the model's length scale).
   subroutine kin_sens(m, w, s, q, qd, qdd, t, sq, sqd, sqdd)
     type(model_t), intent(in) :: m           !! model
     type(kin_work_t), intent(inout) :: w     !! work arrays with the factors of J(q)
@@ -1575,11 +1576,11 @@ contains
     call sens_hessian(m, s, q, qd, qdd, t, states=.false.)
     call sens_params(m, s, q, qd, qdd, t, states=.false.)
     if (w%spfact) then                        ! the sparse factors: straight to their solves
-      call splu_solve_rows(w%sp, s%mphip, sq, w%cs, s%st)
+      call splu_solve_rows(w%sp, s%mphip, sq, w%cs, s%ounit, s%st)
       call sens_kin_rhs(s, 2, s%rhs)
-      call splu_solve_rows(w%sp, s%rhs, sqd, w%cs, s%sdt)
+      call splu_solve_rows(w%sp, s%rhs, sqd, w%cs, s%ounit, s%sdt)
       call sens_kin_rhs(s, 3, s%rhs)
-      call splu_solve_rows(w%sp, s%rhs, sqdd, w%cs)
+      call splu_solve_rows(w%sp, s%rhs, sqdd, w%cs, s%ounit)
       return
     end if
     s%rhs(:, :) = s%mphip                     ! (the dense solves overwrite their right sides)
@@ -1588,6 +1589,7 @@ contains
     call solve_cols(w, s%rhs, sqd, s%work, s%sdt)
     call sens_kin_rhs(s, 3, s%rhs)
     call solve_cols(w, s%rhs, sqdd, s%work, s%st)
+    sq = sq * s%ounit; sqd = sqd * s%ounit; sqdd = sqdd * s%ounit   ! (in model units)
   end subroutine kin_sens
 
   !> The predictor's sum qp = q + hs q_dot + hp0 q_ddot + sum_j wt_j d_j; qn = qp (explicit

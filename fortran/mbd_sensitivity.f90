@@ -33,8 +33,8 @@ module mbd_sensitivity
   implicit none
   private
   public :: sens_t, PT_RPAR, PT_MASS, PT_GRAV, PT_FPAR
-  public :: sens_setup, sens_trig, sens_states, sens_hessian, sens_params, sens_kin_rhs, block_apply, &
-            block_apply_t, block_apply_cols, &
+  public :: sens_setup, sens_trig, sens_states, sens_hessian, sens_params, sens_kin_rhs, &
+            block_apply, block_apply_t, block_apply_cols, &
             sens_klam, sens_klam_list, sens_jpt_lam, sens_force_d, sens_force_jac, sens_eval_d
 
   integer, parameter :: PT_RPAR = 1, PT_MASS = 2, PT_GRAV = 3, PT_FPAR = 4  !! table ids
@@ -46,6 +46,9 @@ module mbd_sensitivity
     !> (np) dp'/dp: a nondimensional model (mbd_model) works with p' = p L**e; the
     !! sensitivities the core computes are with respect to p'
     real(wp), allocatable :: pscale(:)
+    !> (nq, np) ds/dp = ounit ds'/dp': a sensitivity of q in model units from the core's
+    !! (cunit of the row times pscale; kinematics writes its outputs with it)
+    real(wp), allocatable :: ounit(:, :)
     real(wp), allocatable :: tp(:, :)        !! (size(m%p), np) change of the prepared pool
     logical, allocatable :: caff(:, :)       !! (nc, np) the constraint's parameters change
     real(wp), allocatable :: tfp(:, :)       !! (size(m%fp), np) change of the force pool
@@ -305,8 +308,11 @@ contains
     allocate (s%rsb(ns), s%rso(ns), s%rsc(ns), s%rss(ns), s%rsg(ns), s%rsh(2, ns), &
               s%rsv(2, ns), s%rsa(2, ns), s%gen(ngen), s%psk(nps), s%psb(nps), s%pso(nps), &
               s%psr(nps), s%psg(nps), s%psfirst(nps), s%psphi(2, nps), s%psv(2, nps), &
-              s%psa(2, nps), s%gpc(ngp), s%gpk(ngp), stat=st)
+              s%psa(2, nps), s%gpc(ngp), s%gpk(ngp), s%ounit(m%nq, s%np), stat=st)
     if (st /= 0) return
+    do k = 1, s%np
+      s%ounit(:, k) = s%pscale(k) * m%cunit
+    end do
     s%rsh = zero; s%rsv = zero; s%rsa = zero
     s%curved = any(curv)
     s%nrvz = 0

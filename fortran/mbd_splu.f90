@@ -342,13 +342,15 @@ contains
 
   !> X = D A^-1 B for several right-hand sides given as rows, bt = B^T (a multiple of 4 rows,
   !! padding zero), four at a time through the factors (each column's operations those of
-  !! splu_solve, in the same order); x (n, ncol) takes the first ncol of them and xt (4 k, n),
-  !! when present, all of them as rows.
-  pure subroutine splu_solve_rows(sp, bt, x, cs, xt)
+  !! splu_solve, in the same order); x (n, ncol) takes the first ncol of them, each entry
+  !! multiplied by that of f (n, ncol), and xt (4 k, n), when present, all of them as rows
+  !! (without f).
+  pure subroutine splu_solve_rows(sp, bt, x, cs, f, xt)
     type(splu_t), intent(inout) :: sp                !! factors (and the work block)
     real(wp), intent(in) :: bt(:, :)                 !! right-hand sides as rows (4 k, n)
     real(wp), intent(inout) :: x(:, :)               !! solutions (A's columns, ncol)
     real(wp), intent(in) :: cs(:)                    !! column scale
+    real(wp), intent(in) :: f(:, :)                  !! output factors (n, ncol)
     real(wp), intent(inout), optional :: xt(:, :)    !! solutions as rows (4 k, n)
     integer :: g
     do g = 1, size(bt, 1) - 3, 4
@@ -356,9 +358,9 @@ contains
       call rows_kernel(sp%n, sp%lptr(sp%n + 1) - 1, sp%nu, sp%prow, sp%lpos, sp%lrow, &
                        sp%lcol, sp%bpos, sp%brow, sp%bcol, sp%val, sp%y4, size(bt, 1), bt, g)
       if (present(xt)) then
-        call rows_out(sp%n, sp%pcol, sp%rinv, cs, sp%y4, size(xt, 1), xt, g, x)
+        call rows_out(sp%n, size(x, 2), sp%pcol, sp%rinv, cs, sp%y4, size(xt, 1), xt, g, x, f)
       else
-        call cols_out(sp%n, sp%pcol, sp%rinv, cs, sp%y4, g, x)
+        call cols_out(sp%n, size(x, 2), sp%pcol, sp%rinv, cs, sp%y4, g, x, f)
       end if
     end do
   end subroutine splu_solve_rows
@@ -393,12 +395,12 @@ contains
     end do
   end subroutine rows_kernel
 
-  !> x = D Q diag(1/u_kk) v of rows_kernel's four solutions as rows g .. g + 3 of xt and as
-  !! columns g .. of x (as many as x has).
-  pure subroutine rows_out(n, pcol, rinv, cs, y, ldt, xt, g, x)
-    integer, intent(in) :: n, pcol(n), ldt, g
-    real(wp), intent(in) :: rinv(n), cs(n), y(4, n)
-    real(wp), intent(inout) :: xt(ldt, n), x(:, :)
+  !> x = D Q diag(1/u_kk) v of rows_kernel's four solutions as rows g .. g + 3 of xt and,
+  !! times f, as columns g .. of x (as many as x has).
+  pure subroutine rows_out(n, ncol, pcol, rinv, cs, y, ldt, xt, g, x, f)
+    integer, intent(in) :: n, ncol, pcol(n), ldt, g
+    real(wp), intent(in) :: rinv(n), cs(n), y(4, n), f(n, ncol)
+    real(wp), intent(inout) :: xt(ldt, n), x(n, ncol)
     integer :: k, c, i
     real(wp) :: v
     do k = 1, n
@@ -406,39 +408,39 @@ contains
       xt(g, c) = y(1, k) * v; xt(g + 1, c) = y(2, k) * v
       xt(g + 2, c) = y(3, k) * v; xt(g + 3, c) = y(4, k) * v
     end do
-    if (size(x, 2) - g >= 3) then
+    if (ncol - g >= 3) then
       do c = 1, n
-        x(c, g) = xt(g, c); x(c, g + 1) = xt(g + 1, c)
-        x(c, g + 2) = xt(g + 2, c); x(c, g + 3) = xt(g + 3, c)
+        x(c, g) = xt(g, c) * f(c, g); x(c, g + 1) = xt(g + 1, c) * f(c, g + 1)
+        x(c, g + 2) = xt(g + 2, c) * f(c, g + 2); x(c, g + 3) = xt(g + 3, c) * f(c, g + 3)
       end do
       return
     end if
-    do i = 1, size(x, 2) - g + 1
+    do i = 1, ncol - g + 1
       do c = 1, n
-        x(c, g + i - 1) = xt(g + i - 1, c)
+        x(c, g + i - 1) = xt(g + i - 1, c) * f(c, g + i - 1)
       end do
     end do
   end subroutine rows_out
 
-  !> rows_out without the rows: columns g .. of x only.
-  pure subroutine cols_out(n, pcol, rinv, cs, y, g, x)
-    integer, intent(in) :: n, pcol(n), g
-    real(wp), intent(in) :: rinv(n), cs(n), y(4, n)
-    real(wp), intent(inout) :: x(:, :)
+  !> rows_out without the rows: columns g .. of x only (times f).
+  pure subroutine cols_out(n, ncol, pcol, rinv, cs, y, g, x, f)
+    integer, intent(in) :: n, ncol, pcol(n), g
+    real(wp), intent(in) :: rinv(n), cs(n), y(4, n), f(n, ncol)
+    real(wp), intent(inout) :: x(n, ncol)
     integer :: k, c, i
     real(wp) :: v
-    if (size(x, 2) - g >= 3) then
+    if (ncol - g >= 3) then
       do k = 1, n
         c = pcol(k); v = rinv(k) * cs(c)
-        x(c, g) = y(1, k) * v; x(c, g + 1) = y(2, k) * v
-        x(c, g + 2) = y(3, k) * v; x(c, g + 3) = y(4, k) * v
+        x(c, g) = (y(1, k) * v) * f(c, g); x(c, g + 1) = (y(2, k) * v) * f(c, g + 1)
+        x(c, g + 2) = (y(3, k) * v) * f(c, g + 2); x(c, g + 3) = (y(4, k) * v) * f(c, g + 3)
       end do
       return
     end if
-    do i = 1, size(x, 2) - g + 1
+    do i = 1, ncol - g + 1
       do k = 1, n
         c = pcol(k)
-        x(c, g + i - 1) = y(i, k) * (rinv(k) * cs(c))
+        x(c, g + i - 1) = (y(i, k) * (rinv(k) * cs(c))) * f(c, g + i - 1)
       end do
     end do
   end subroutine cols_out
