@@ -11,6 +11,10 @@ Cases:
               also covers them, so the step count may differ: it is reported.
 
 Target (issue 10): sensitivities for 4 parameters cost at most 2x the analysis alone.
+Beside the wall time, each case's core call (the api_* routine, setup and output included)
+runs once more under callgrind with and without sensitivities (shorter runs: 3000 steps, the
+dopri5 case as it is): the instruction ratio, stable on a shared machine (skipped without
+valgrind or with --quick).
 
     python bench/sensitivities.py [--steps N] [--repeats R] [--quick]
 """
@@ -18,7 +22,10 @@ from __future__ import annotations
 
 import argparse
 import json
+import shutil
+import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 from typing import Any, Callable
@@ -28,6 +35,22 @@ import mbd2d
 BENCH = Path(__file__).resolve().parent
 EX = BENCH.parent / "examples"
 TARGET = 2.0
+#: per case: the model, the call (``{S}`` takes the sensitivities) and the core routine
+#: whose instructions are counted
+CALLGRIND_CASES = {
+    "kinematics four-bar, 4 parameters": (
+        "m = mbd2d.load(EX / 'fourbar_grashof.toml')",
+        "m.kinematics(3.0, 3000{S})", "__mbd_api_MOD_api_kinematics"),
+    "kinematics slider-crank, 4 parameters": (
+        "m = mbd2d.load(EX / 'slider_crank.toml')",
+        "m.kinematics(3.0, 3000{S})", "__mbd_api_MOD_api_kinematics"),
+    "inverse dynamics slider-crank, 4 parameters": (
+        "m = S.masses(mbd2d.load(EX / 'slider_crank.toml'))",
+        "m.inverse_dynamics(3.0, 3000{S})", "__mbd_api_MOD_api_inverse"),
+    "dopri5 free slider-crank, 4 parameters": (
+        "m = S.free_slider_crank()",
+        "m.dynamics(10.0, 200, rtol=1e-8, atol=1e-8{S})", "__mbd_api_MOD_api_dynamics"),
+}
 
 
 def masses(m: mbd2d.Model) -> mbd2d.Model:
@@ -42,6 +65,30 @@ def free_slider_crank() -> mbd2d.Model:
     m.add_spring(["ground", "slider"], [[0.0, 0.5], [0.0, 0.0]], stiffness=40.0, damping=3.0,
                  length0=2.0, name="s1")
     return m
+
+
+def instructions(case: str, names: list[str]) -> list[int] | None:
+    """Callgrind instructions of a case's core call without and with sensitivities of
+    names (None without valgrind)."""
+    sys.path.insert(0, str(BENCH))
+    import callgrind as cg                         # bench/callgrind.py: the dump reader
+    exe = shutil.which("valgrind")
+    if exe is None:
+        return None
+    build, call, fn = CALLGRIND_CASES[case]
+    counts = []
+    for sens in ("", f", sensitivities={names!r}"):
+        code = (f"import sys; sys.path.insert(0, {str(BENCH)!r})\nimport mbd2d\n"
+                f"import sensitivities as S\nEX = S.EX\n{build}\n{call.format(S=sens)}\n")
+        # dynamics with sensitivities runs its own routine (api_dynamics_sens)
+        f = fn + ("_sens" if sens and fn.endswith("api_dynamics") else "")
+        with tempfile.TemporaryDirectory() as tmp:
+            out = Path(tmp) / "cg.out"
+            subprocess.run([exe, "--tool=callgrind", f"--callgrind-out-file={out}",
+                            f"--toggle-collect={f}", sys.executable, "-c", code],
+                           capture_output=True, text=True, timeout=900, check=True)
+            counts.append(cg._totals(out))
+    return counts
 
 
 def timed(fn: Callable[[], Any], repeats: int) -> tuple[float, Any]:
@@ -102,8 +149,16 @@ def measure(steps: int, reps: int, quick: bool = False) -> dict[str, Any]:
                         lambda: free.dynamics(t_dyn, 200, rtol=1e-8, atol=1e-8),
                         lambda: free.dynamics(t_dyn, 200, rtol=1e-8, atol=1e-8,
                                               sensitivities=pd), reps, 200))
+    names = {rows[0]["case"]: p4, rows[1]["case"]: ps, rows[2]["case"]: pi, rows[3]["case"]: pd}
+    for r in rows if not quick else []:
+        counts = instructions(r["case"], names[r["case"]])
+        if counts and counts[0] > 0:
+            r["instructions"] = counts
+            r["instruction_ratio"] = counts[1] / counts[0]
     for r in rows:
         extra = f"  steps {r['integrator_steps']}" if "integrator_steps" in r else ""
+        if "instruction_ratio" in r:
+            extra += f"  callgrind {r['instruction_ratio']:.2f}"
         print(f"{r['case']:46s} {r['base_us_per_step']:9.2f} us  {r['sens_us_per_step']:9.2f} us"
               f"  ratio {r['ratio']:5.2f}{'' if r['meets_target'] else '  (above 2x)'}{extra}")
     return {"target_ratio": TARGET, "steps": steps, "repeats": reps, "quick": quick,
