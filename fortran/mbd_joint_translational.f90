@@ -19,6 +19,7 @@ module mbd_joint_translational
   private
   public :: translational_prepare, translational_eval, slide_distance
   public :: translational_prepare_d, translational_eval_d, slide_distance_d
+  public :: translational_second, translational_param
 
 contains
 
@@ -126,5 +127,97 @@ contains
     call put_scal(ssub(ssub(body_angle(x, sj), body_angle(x, si)), sconst(p(9), tp(9))), &
                   tphi(2), tjl(2, :), tgam(2))
   end subroutine translational_eval_d
+
+  !> Second derivatives of the first row for the sensitivity equations, in closed form.
+  !! Over the slots (r_i, theta_i, r_j, theta_j), with h = A_i n (n = perp(u'_i)), b = B_i n
+  !! = perp(h), u_i = A_i s'_i, u_j = A_j s'_j, d = r_j + u_j - r_i - u_i, the Hessian
+  !! H = Phi_1,qq is symmetric with
+  !!   H(r_i, theta_i) = -b,  H(r_j, theta_i) = b,  H(theta_i, theta_i) = -h.d - n.s'_i,
+  !!   H(theta_i, theta_j) = b.perp(u_j),  H(theta_j, theta_j) = -h.u_j,  the rest 0;
+  !! hm(a, c) = dJ_a/dq_c = H(a, c); hv = H q_dot; and as gamma_1 = -q_dot' H q_dot,
+  !! ha = H q_ddot - dgamma_1/dq = H q_ddot + g, g_c = q_dot' (dH/dq_c) q_dot:
+  !!   g(theta_i) = 2 thd_i h.(v_i - v_j) - thd_i**2 J(theta_i) - 2 thd_i thd_j h.perp(u_j)
+  !!                - thd_j**2 b.u_j,            J(theta_i) = b.d - h.perp(u_i),
+  !!   g(theta_j) = -(thd_i**2 + thd_j**2) h.perp(u_j) - 2 thd_i thd_j b.u_j,
+  !!   g(r_i) = thd_i**2 h,  g(r_j) = -thd_i**2 h        (v = r_dot of each body).
+  !! The second row (the angles) is linear. A ground body's slots come with zero state and
+  !! cos 1, sin 0; the caller keeps only the moving ones.
+  pure subroutine translational_second(p, ci, si, cj, sj, ql, qdl, qddl, hm, hv, ha)
+    real(wp), intent(in) :: p(9)            !! prepared parameters
+    real(wp), intent(in) :: ci, si, cj, sj  !! cos and sin of theta_i, theta_j
+    real(wp), intent(in) :: ql(6), qdl(6), qddl(6)  !! slot coordinates, velocities, accel.
+    real(wp), intent(out) :: hm(6, 6)       !! dJ_a/dq_c of the first row
+    real(wp), intent(out) :: hv(6), ha(6)   !! H q_dot, H q_ddot + g
+    real(wp) :: h(2), b(2), ui(2), uj(2), pui(2), puj(2), d(2), jti, hpj, buj, wi, wj, g(6)
+    h = [ci * p(7) - si * p(8), si * p(7) + ci * p(8)]
+    b = [-h(2), h(1)]
+    ui = [ci * p(1) - si * p(2), si * p(1) + ci * p(2)]
+    uj = [cj * p(3) - sj * p(4), sj * p(3) + cj * p(4)]
+    pui = [-ui(2), ui(1)]; puj = [-uj(2), uj(1)]
+    d = ql(4:5) + uj - ql(1:2) - ui
+    jti = dot_product(b, d) - dot_product(h, pui)
+    hpj = dot_product(h, puj)
+    buj = dot_product(b, uj)
+    hm = zero
+    hm(1:2, 3) = -b; hm(3, 1:2) = -b; hm(4:5, 3) = b; hm(3, 4:5) = b
+    hm(3, 3) = -dot_product(h, d) - (p(7) * p(1) + p(8) * p(2))
+    hm(3, 6) = dot_product(b, puj); hm(6, 3) = hm(3, 6)
+    hm(6, 6) = -dot_product(h, uj)
+    hv = matmul(qdl, hm)
+    wi = qdl(3); wj = qdl(6)
+    g = zero
+    g(1:2) = wi**2 * h; g(4:5) = -wi**2 * h
+    g(3) = 2 * wi * dot_product(h, qdl(1:2) - qdl(4:5)) - wi**2 * jti - 2 * wi * wj * hpj &
+           - wj**2 * buj
+    g(6) = -(wi**2 + wj**2) * hpj - 2 * wi * wj * buj
+    ha = matmul(qddl, hm) + g
+  end subroutine translational_second
+
+  !> The parameter parts for a change tp of the prepared parameters in closed form
+  !! (translational_eval_d with dq = 0): with t(.) the change of each p-dependent quantity
+  !! (t h = A_i t n, t b = perp(t h), t u_i = A_i t s'_i, t u_j = A_j t s'_j, t d =
+  !! t u_j - t u_i) and the first row's time derivatives
+  !!   Phi_1 = h.d,  dPhi_1/dt = h_dot.d + h.d_dot,
+  !!   d2Phi_1/dt2 = h_ddot.d + 2 h_dot.d_dot + h.d_ddot,
+  !!   h_dot = b thd_i, h_ddot = b thdd_i - h thd_i**2,
+  !!   d_dot = v_j + perp(u_j) thd_j - v_i - perp(u_i) thd_i,
+  !!   d_ddot = a_j + perp(u_j) thdd_j - u_j thd_j**2 - (a_i + perp(u_i) thdd_i - u_i thd_i**2),
+  !! the parts are Phi_p = t(Phi_1), nu_p - J_p q_dot = -t(dPhi_1/dt), gamma_p - J_p q_ddot
+  !! = -t(d2Phi_1/dt2) (no explicit time), and for the second row -t theta0, 0, 0.
+  pure subroutine translational_param(p, tp, ci, si, cj, sj, ql, qdl, qddl, tphi, tv, ta)
+    real(wp), intent(in) :: p(9), tp(9)     !! prepared parameters and their change
+    real(wp), intent(in) :: ci, si, cj, sj  !! cos and sin of theta_i, theta_j
+    real(wp), intent(in) :: ql(6), qdl(6), qddl(6)  !! slot coordinates, velocities, accel.
+    real(wp), intent(out) :: tphi(2), tv(2), ta(2)  !! the two rows' parts
+    real(wp) :: h(2), b(2), ui(2), uj(2), d(2), dd(2), ddd(2), hd(2), hdd(2)
+    real(wp) :: th(2), tb(2), tui(2), tuj(2), td(2), tdd(2), tddd(2), thd(2), thdd(2)
+    real(wp) :: wi, wj, ai, aj
+    wi = qdl(3); wj = qdl(6); ai = qddl(3); aj = qddl(6)
+    h = rot(ci, si, p(7:8)); b = [-h(2), h(1)]
+    ui = rot(ci, si, p(1:2)); uj = rot(cj, sj, p(3:4))
+    d = ql(4:5) + uj - ql(1:2) - ui
+    dd = qdl(4:5) + [-uj(2), uj(1)] * wj - qdl(1:2) - [-ui(2), ui(1)] * wi
+    ddd = qddl(4:5) + [-uj(2), uj(1)] * aj - uj * wj**2 &
+          - (qddl(1:2) + [-ui(2), ui(1)] * ai - ui * wi**2)
+    hd = b * wi; hdd = b * ai - h * wi**2
+    th = rot(ci, si, tp(7:8)); tb = [-th(2), th(1)]
+    tui = rot(ci, si, tp(1:2)); tuj = rot(cj, sj, tp(3:4))
+    td = tuj - tui
+    tdd = [-tuj(2), tuj(1)] * wj - [-tui(2), tui(1)] * wi
+    tddd = [-tuj(2), tuj(1)] * aj - tuj * wj**2 - ([-tui(2), tui(1)] * ai - tui * wi**2)
+    thd = tb * wi; thdd = tb * ai - th * wi**2
+    tphi(1) = dot_product(th, d) + dot_product(h, td)
+    tv(1) = -(dot_product(thd, d) + dot_product(hd, td) + dot_product(th, dd) &
+              + dot_product(h, tdd))
+    ta(1) = -(dot_product(thdd, d) + dot_product(hdd, td) + 2 * dot_product(thd, dd) &
+              + 2 * dot_product(hd, tdd) + dot_product(th, ddd) + dot_product(h, tddd))
+    tphi(2) = -tp(9); tv(2) = zero; ta(2) = zero
+  contains
+    pure function rot(c, s, v) result(w)
+      real(wp), intent(in) :: c, s, v(2)
+      real(wp) :: w(2)
+      w = [c * v(1) - s * v(2), s * v(1) + c * v(2)]
+    end function rot
+  end subroutine translational_param
 
 end module mbd_joint_translational

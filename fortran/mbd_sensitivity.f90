@@ -29,6 +29,7 @@ module mbd_sensitivity
                              con_affine_r, con_exponents, &
                              CON_TRANSLATIONAL, DRV_REL_DIST, CON_REVOLUTE
   use mbd_joint_revolute, only: revolute_second_sides, revolute_param_sides
+  use mbd_joint_translational, only: translational_second, translational_param
   use mbd_forces, only: force_eval_d, force_is_count, force_exponents
   implicit none
   private
@@ -73,6 +74,7 @@ module mbd_sensitivity
     integer, allocatable :: rsb(:), rso(:), rsc(:), rss(:)
     real(wp), allocatable :: rsg(:)
     real(wp), allocatable :: rsh(:, :), rsv(:, :), rsa(:, :)
+    integer, allocatable :: tlc(:)           !! the translationals (closed forms)
     integer, allocatable :: gen(:)           !! the other constraints not linear in q
     !> the (revolute side, parameter) entries whose point the parameter moves: parameter,
     !! body, offset in tp's column, sign, first row, first entry of its pair, and their parts
@@ -275,22 +277,22 @@ contains
     end subroutine fail
   end subroutine sens_setup
 
-  !> cos and sin of every body angle at q, for the evaluations that follow at the same q.
-  !> What the per-output loops visit: the revolutes' moving sides (and their fixed places
-  !! in the list of nonzeros), the (revolute side, parameter) entries whose point a
-  !! parameter moves, the other constraints not linear in q and the other (constraint,
-  !! parameter) pairs a parameter changes.
+  !> What the per-output loops visit: the revolutes' moving sides and the translationals
+  !! (and their fixed places in the list of nonzeros), the (revolute side, parameter) entries
+  !! whose point a parameter moves, the other constraints not linear in q and the other
+  !! (constraint, parameter) pairs a parameter changes.
   pure subroutine sens_lists(m, s, st)
     type(model_t), intent(in) :: m           !! model
     type(sens_t), intent(inout) :: s         !! caff set (in); the lists (out)
     integer, intent(out) :: st               !! allocation status
-    integer :: c, k, side, ns, ngen, nps, ngp, o
-    logical :: rev(m%nc), curv(m%nc)
+    integer :: c, k, side, ns, ngen, nps, ngp, o, ntr, j
+    logical :: rev(m%nc), curv(m%nc), tra(m%nc)
     do c = 1, m%nc
       rev(c) = m%kind(c) == CON_REVOLUTE
+      tra(c) = m%kind(c) == CON_TRANSLATIONAL
       curv(c) = .not. con_linear(m%kind(c))
     end do
-    ns = 0; ngen = count(curv .and. .not. rev); nps = 0; ngp = 0
+    ns = 0; ngen = count(curv .and. .not. (rev .or. tra)); nps = 0; ngp = 0
     do c = 1, m%nc
       if (rev(c)) then
         ns = ns + count(m%loc([3, 6], c) > 0)
@@ -308,7 +310,8 @@ contains
     allocate (s%rsb(ns), s%rso(ns), s%rsc(ns), s%rss(ns), s%rsg(ns), s%rsh(2, ns), &
               s%rsv(2, ns), s%rsa(2, ns), s%gen(ngen), s%psk(nps), s%psb(nps), s%pso(nps), &
               s%psr(nps), s%psg(nps), s%psfirst(nps), s%psphi(2, nps), s%psv(2, nps), &
-              s%psa(2, nps), s%gpc(ngp), s%gpk(ngp), s%ounit(m%nq, s%np), stat=st)
+              s%psa(2, nps), s%gpc(ngp), s%gpk(ngp), s%ounit(m%nq, s%np), &
+              s%tlc(count(tra)), stat=st)
     if (st /= 0) return
     do k = 1, s%np
       s%ounit(:, k) = s%pscale(k) * m%cunit
@@ -316,7 +319,7 @@ contains
     s%rsh = zero; s%rsv = zero; s%rsa = zero
     s%curved = any(curv)
     s%nrvz = 0
-    ns = 0; ngen = 0; nps = 0; ngp = 0
+    ns = 0; ngen = 0; nps = 0; ngp = 0; ntr = 0
     do c = 1, m%nc
       if (rev(c)) then
         do side = 1, 2                           ! moving sides; two fixed list entries each
@@ -342,7 +345,7 @@ contains
           end do
         end do
       else
-        if (curv(c)) then
+        if (curv(c) .and. .not. tra(c)) then
           ngen = ngen + 1; s%gen(ngen) = c
         end if
         do k = 1, s%np
@@ -351,8 +354,19 @@ contains
         end do
       end if
     end do
+    do c = 1, m%nc                               ! the translationals' first rows, after
+      if (.not. tra(c)) cycle                    ! the revolutes' entries
+      ntr = ntr + 1; s%tlc(ntr) = c
+      do j = 1, 6
+        if (m%loc(j, c) == 0) cycle
+        s%nrvz = s%nrvz + 1
+        s%nzr(s%nrvz) = m%row0(c); s%nzc(s%nrvz) = m%loc(j, c)
+        s%nzv(s%nrvz) = zero; s%nza(s%nrvz) = zero
+      end do
+    end do
   end subroutine sens_lists
 
+  !> cos and sin of every body angle at q, for the evaluations that follow at the same q.
   pure subroutine sens_trig(m, s, q)
     type(model_t), intent(in) :: m           !! model
     type(sens_t), intent(inout) :: s         !! cache (out)
@@ -386,10 +400,11 @@ contains
   end subroutine gather
 
   !> Local Hessian blocks at (q, q_dot, q_ddot, t): for each constraint and each of its
-  !! slots j, the dual evaluation along dq = e_j gives hs(:, :, j) = dJ_loc/dq_j and
-  !! d ar/dq_j = -dgamma/dq_j; then hv(:, j) = hs(:, :, j) q_dot_loc and
-  !! ha(:, j) = hs(:, :, j) q_ddot_loc + d ar/dq_j (and their nonzeros in a list).
-  !! sens_trig first.
+  !! slots j, hs(:, :, j) = dJ_loc/dq_j, hv(:, j) = hs(:, :, j) q_dot_loc and
+  !! ha(:, j) = hs(:, :, j) q_ddot_loc - dgamma/dq_j, in the list of nonzeros: revolutes and
+  !! translationals in closed form (revolute_second_sides, translational_second, in fixed
+  !! places of the list), the others by the dual evaluation along dq = e_j.
+  !! sens_trig first (or sens_states, with states = .false.).
   pure subroutine sens_hessian(m, s, q, qd, qdd, t, states)
     type(model_t), intent(in) :: m             !! model
     type(sens_t), intent(inout) :: s           !! blocks (out)
@@ -398,7 +413,8 @@ contains
     logical, intent(in), optional :: states    !! .false.: sens_states has set the state
     type(dloc) :: x
     real(wp) :: qddl(NLOC), tphi(MAXROW), tnu(MAXROW), tgam(MAXROW), hv, ha
-    integer :: k, j, nr, si, sj, r, e
+    real(wp) :: qloc(NLOC), qdl(NLOC), hm(6, 6), hvt(6), hat(6)
+    integer :: k, j, nr, si, sj, r, e, c, n
     if (.not. present(states)) then
       call body_states(m, s, qd, qdd)
     else if (states) then
@@ -411,6 +427,26 @@ contains
       call revolute_push(size(s%rsb), m%nc, s%rsc, s%rss, s%rsh, s%rsv, s%rsa, s%hs, s%nzv, &
                          s%nza)
     end if
+    n = 2 * size(s%rsb)                         ! the translationals' entries follow
+    do e = 1, size(s%tlc)
+      k = s%tlc(e)
+      do j = 1, 6
+        c = m%loc(j, k)
+        qloc(j) = zero; qdl(j) = zero; qddl(j) = zero
+        if (c > 0) then
+          qloc(j) = q(c); qdl(j) = qd(c); qddl(j) = qdd(c)
+        end if
+      end do
+      call translational_second(m%p(m%po(k):m%po(k) + 8), s%bst(1, m%bi(k)), &
+                                s%bst(2, m%bi(k)), s%bst(1, m%bj(k)), s%bst(2, m%bj(k)), &
+                                qloc(1:6), qdl(1:6), qddl(1:6), hm, hvt, hat)
+      do j = 1, 6
+        if (m%loc(j, k) == 0) cycle
+        s%hs(1, 1:6, j, k) = hm(:, j)
+        n = n + 1
+        s%nzv(n) = hvt(j); s%nza(n) = hat(j)
+      end do
+    end do
     do e = 1, size(s%gen)                       ! (the linear ones' blocks stay zero)
       k = s%gen(e)
       call gather(m, s, k, q, qd, qdd, x, qddl)
@@ -459,8 +495,8 @@ contains
   !> Parameter parts at (q, q_dot, q_ddot, t): Phi_p, nu_p - J_p q_dot and
   !! gamma_p - J_p q_ddot, each a row per parameter, written for the pairs (constraint,
   !! parameter) of the lists only (the other entries stay zero from sens_setup): the
-  !! revolutes' in closed form, the others by the dual evaluation along the parameter's
-  !! change (dq = 0).
+  !! revolutes' and translationals' in closed form, the others by the dual evaluation along
+  !! the parameter's change (dq = 0).
   pure subroutine sens_params(m, s, q, qd, qdd, t, states)
     type(model_t), intent(in) :: m             !! model
     type(sens_t), intent(inout) :: s           !! parameter parts (out)
@@ -469,7 +505,8 @@ contains
     logical, intent(in), optional :: states    !! .false.: sens_states has set the state
     type(dloc) :: x
     real(wp) :: qddl(NLOC), tphi(MAXROW), tjl(MAXROW, NLOC), tnu(MAXROW), tgam(MAXROW)
-    integer :: e, k, c, cprev, nr, si, sj, r, r0
+    real(wp) :: qloc(NLOC), qdl(NLOC)
+    integer :: e, k, c, cprev, nr, si, sj, r, r0, j
     if (.not. present(states)) then
       call body_states(m, s, qd, qdd)
     else if (states) then
@@ -484,6 +521,25 @@ contains
     cprev = 0
     do e = 1, size(s%gpc)
       c = s%gpc(e); k = s%gpk(e); r0 = m%row0(c) - 1
+      if (m%kind(c) == CON_TRANSLATIONAL) then  ! in closed form too
+        if (c /= cprev) then
+          do j = 1, 6
+            qloc(j) = zero; qdl(j) = zero; qddl(j) = zero
+            if (m%loc(j, c) > 0) then
+              qloc(j) = q(m%loc(j, c)); qdl(j) = qd(m%loc(j, c)); qddl(j) = qdd(m%loc(j, c))
+            end if
+          end do
+        end if
+        cprev = c
+        call translational_param(m%p(m%po(c):m%po(c) + 8), s%tp(m%po(c):m%po(c) + 8, k), &
+                                 s%bst(1, m%bi(c)), s%bst(2, m%bi(c)), s%bst(1, m%bj(c)), &
+                                 s%bst(2, m%bj(c)), qloc(1:6), qdl(1:6), qddl(1:6), &
+                                 tphi(1:2), tnu(1:2), tgam(1:2))
+        do r = 1, 2
+          s%mphip(k, r0 + r) = -tphi(r); s%vp(k, r0 + r) = tnu(r); s%ap(k, r0 + r) = tgam(r)
+        end do
+        cycle
+      end if
       if (c /= cprev) call gather(m, s, c, q, qd, qdd, x, qddl)
       cprev = c
       si = merge(1, 0, m%bi(c) > 0); sj = merge(2, 0, m%bj(c) > 0)
