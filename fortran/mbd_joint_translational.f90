@@ -148,7 +148,7 @@ contains
     real(wp), intent(in) :: ql(6), qdl(6), qddl(6)  !! slot coordinates, velocities, accel.
     real(wp), intent(out) :: hm(6, 6)       !! dJ_a/dq_c of the first row
     real(wp), intent(out) :: hv(6), ha(6)   !! H q_dot, H q_ddot + g
-    real(wp) :: h(2), b(2), ui(2), uj(2), pui(2), puj(2), d(2), jti, hpj, buj, wi, wj, g(6)
+    real(wp) :: h(2), b(2), ui(2), uj(2), pui(2), puj(2), d(2), jti, hpj, buj, wi, wj
     h = [ci * p(7) - si * p(8), si * p(7) + ci * p(8)]
     b = [-h(2), h(1)]
     ui = [ci * p(1) - si * p(2), si * p(1) + ci * p(2)]
@@ -163,14 +163,22 @@ contains
     hm(3, 3) = -dot_product(h, d) - (p(7) * p(1) + p(8) * p(2))
     hm(3, 6) = dot_product(b, puj); hm(6, 3) = hm(3, 6)
     hm(6, 6) = -dot_product(h, uj)
-    hv = matmul(qdl, hm)
     wi = qdl(3); wj = qdl(6)
-    g = zero
-    g(1:2) = wi**2 * h; g(4:5) = -wi**2 * h
-    g(3) = 2 * wi * dot_product(h, qdl(1:2) - qdl(4:5)) - wi**2 * jti - 2 * wi * wj * hpj &
-           - wj**2 * buj
-    g(6) = -(wi**2 + wj**2) * hpj - 2 * wi * wj * buj
-    ha = matmul(qddl, hm) + g
+    call hprod(qdl, hv)                                 ! H q_dot
+    call hprod(qddl, ha)                                ! H q_ddot + g
+    ha(1:2) = ha(1:2) + wi**2 * h; ha(4:5) = ha(4:5) - wi**2 * h
+    ha(3) = ha(3) + (2 * wi * dot_product(h, qdl(1:2) - qdl(4:5)) - wi**2 * jti &
+                     - 2 * wi * wj * hpj - wj**2 * buj)
+    ha(6) = ha(6) + (-(wi**2 + wj**2) * hpj - 2 * wi * wj * buj)
+  contains
+    !> y = H v from H's nonzeros (hm holds them too, for the callers that need the blocks).
+    pure subroutine hprod(v, y)
+      real(wp), intent(in) :: v(6)
+      real(wp), intent(out) :: y(6)
+      y(1:2) = -b * v(3); y(4:5) = b * v(3)
+      y(3) = dot_product(b, v(4:5) - v(1:2)) + hm(3, 3) * v(3) + hm(3, 6) * v(6)
+      y(6) = hm(3, 6) * v(3) + hm(6, 6) * v(6)
+    end subroutine hprod
   end subroutine translational_second
 
   !> The parameter parts for a change tp of the prepared parameters in closed form

@@ -75,6 +75,10 @@ module mbd_sensitivity
     real(wp), allocatable :: rsg(:)
     real(wp), allocatable :: rsh(:, :), rsv(:, :), rsa(:, :)
     integer, allocatable :: tlc(:)           !! the translationals (closed forms)
+    !> a state at rest at the origin: a constraint linear in q (con_linear) has J free of the
+    !! parameters and parameter parts that depend on t only, evaluated here
+    type(dloc) :: x0
+    logical :: gathers = .true.              !! some pair or constraint needs gather (cb, sb)
     integer, allocatable :: gen(:)           !! the other constraints not linear in q
     !> the (revolute side, parameter) entries whose point the parameter moves: parameter,
     !! body, offset in tp's column, sign, first row, first entry of its pair, and their parts
@@ -320,6 +324,7 @@ contains
     s%curved = any(curv)
     s%nrvz = 0
     ns = 0; ngen = 0; nps = 0; ngp = 0; ntr = 0
+    s%gathers = size(s%gen) > 0
     do c = 1, m%nc
       if (rev(c)) then
         do side = 1, 2                           ! moving sides; two fixed list entries each
@@ -352,6 +357,7 @@ contains
           if (.not. s%caff(c, k)) cycle
           ngp = ngp + 1; s%gpc(ngp) = c; s%gpk(ngp) = k
         end do
+        if (any(s%caff(c, :)) .and. .not. (tra(c) .or. con_linear(m%kind(c)))) s%gathers = .true.
       end if
     end do
     do c = 1, m%nc                               ! the translationals' first rows, after
@@ -540,10 +546,20 @@ contains
         end do
         cycle
       end if
-      if (c /= cprev) call gather(m, s, c, q, qd, qdd, x, qddl)
-      cprev = c
       si = merge(1, 0, m%bi(c) > 0); sj = merge(2, 0, m%bj(c) > 0)
       nr = m%nrow(c)
+      if (con_linear(m%kind(c))) then           ! J_p = 0: the parts of t alone, no state
+        call con_eval_d(m%kind(c), m%suba(c), m%subb(c), &
+                        m%p(m%po(c):m%po(c) + m%pn(c) - 1), &
+                        s%tp(m%po(c):m%po(c) + m%pn(c) - 1, k), si, sj, s%x0, t, tphi, tjl, &
+                        tnu, tgam)
+        do r = 1, nr
+          s%mphip(k, r0 + r) = -tphi(r); s%vp(k, r0 + r) = tnu(r); s%ap(k, r0 + r) = tgam(r)
+        end do
+        cycle
+      end if
+      if (c /= cprev) call gather(m, s, c, q, qd, qdd, x, qddl)
+      cprev = c
       call con_eval_d(m%kind(c), m%suba(c), m%subb(c), m%p(m%po(c):m%po(c) + m%pn(c) - 1), &
                       s%tp(m%po(c):m%po(c) + m%pn(c) - 1, k), si, sj, x, &
                       t, tphi, tjl, tnu, tgam)
@@ -588,14 +604,14 @@ contains
   end subroutine body_states
 
   !> The state sens_hessian and sens_params work at, from the cos and sin of the body angles
-  !! cb, sb (0:nb) at q (instead of sens_trig; they are copied only when a constraint other
-  !! than a revolute needs them); both then called with states = .false.
+  !! cb, sb (0:nb) at q (instead of sens_trig; they are copied only when a dual evaluation
+  !! needs the local state, s%gathers); both then called with states = .false.
   pure subroutine sens_states(m, s, cb, sb, qd, qdd)
     type(model_t), intent(in) :: m              !! model
     type(sens_t), intent(inout) :: s            !! bst (and cb, sb) (out)
     real(wp), intent(in) :: cb(0:), sb(0:)      !! cos and sin of the body angles
     real(wp), intent(in) :: qd(:), qdd(:)       !! velocities and accelerations
-    if (size(s%gen) + size(s%gpc) > 0) then
+    if (s%gathers) then
       s%cb(:) = cb; s%sb(:) = sb
     end if
     call states_kernel(m%nb, cb, sb, qd, qdd, s%bst)
