@@ -29,7 +29,8 @@ module mbd_sens_dynamics
   use mbd_sensitivity, only: sens_t, sens_trig, sens_hessian, sens_params, sens_klam, &
                              sens_klam_list, &
                              sens_jpt_lam, sens_force_d, sens_force_jac
-  use mbd_linsolve, only: lu_factor, lu_solve, lapack_status, ls_small_cols
+  use mbd_linsolve, only: lu_factor, lu_solve, lapack_status, ls_small_cols, lu_factor_small, &
+                          lu_solve_small, LS_RTOL
   use mbd_lapack, only: dgelsy
   use mbd_status, only: MBD_INTEGRATOR_FAILED, MBD_BAD_SETTING
   use mbd_dynamics, only: dyn_work_t, dyn_accel, dyn_solve, dyn_project_pos, dyn_velocity
@@ -57,53 +58,75 @@ contains
     real(wp), intent(out) :: slam(:, :)         !! (neq, np)
     integer, intent(out) :: status              !! MBD_OK or MBD_LAPACK / MBD_NO_MEMORY
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
-    real(wp), allocatable :: jt(:, :), b(:, :), y(:), jpb(:, :, :), work(:), bb(:, :)
+    real(wp), allocatable :: work(:)
     logical :: full
-    real(wp) :: wq(1)
-    integer, allocatable :: jpvt(:)
+    real(wp) :: wq(1), umin, umax
     integer :: k, nq, neq, np, rank, info, st
     status = MBD_OK; msg = ''
     nq = m%nq; neq = m%neq; np = s%np
     slam = zero
     if (np == 0) return
-    allocate (jt(nq, neq), b(max(nq, neq), np), y(nq), jpb(MAXROW, NLOC, m%nc), jpvt(neq), &
-              bb(max(nq, neq), np), stat=st)
-    if (st /= 0) then
-      status = MBD_NO_MEMORY; msg = 'out of memory for the multiplier sensitivities'; return
-    end if
-    call sens_trig(m, s, q)
-    call sens_hessian(m, s, q, qd, qdd, t)
-    call sens_klam_list(m, s, lam)
-    b = zero
-    do k = 1, np
-      call sens_force_d(m, s, k, q, qd, sq(:, k), sqd(:, k), t, y)   ! Q_q s + Q_qd s_dot + Q_p
-      b(1:nq, k) = y - s%tmass(:, k) * qdd - m%mdiag * sqdd(:, k)
-      call sens_klam(s, sq(:, k), y)
-      b(1:nq, k) = b(1:nq, k) - y
-      call sens_jpt_lam(m, s, k, q, t, lam, y, jpb)
-      b(1:nq, k) = b(1:nq, k) - y
-    end do
-    ! J^T dlambda = b: Householder least squares (independent rows, the unique solution),
-    ! or the minimum-norm one by dgelsy when J^T is rank deficient (redundant rows)
-    if (neq <= nq) then
-      jt = transpose(jac)
-      bb = b
-      call ls_small_cols(jt, bb, full)
-      if (full) then
-        slam = bb(1:neq, :); return
+    if (.not. allocated(s%mjt)) then           ! (once: the work of every later output)
+      allocate (s%mjt(nq, neq), s%mb(max(nq, neq), np), s%my(nq), s%mjpb(MAXROW, NLOC, m%nc), &
+                s%mpiv(max(nq, neq)), s%mbb(max(nq, neq), np), stat=st)
+      if (st /= 0) then
+        status = MBD_NO_MEMORY; msg = 'out of memory for the multiplier sensitivities'; return
       end if
     end if
-    jt = transpose(jac)
-    jpvt = 0
-    call dgelsy(nq, neq, np, jt, nq, b, size(b, 1), jpvt, 1.0e-10_wp, rank, wq, -1, info)
-    allocate (work(max(1, int(wq(1)))), stat=st)
-    if (st /= 0) then
-      status = MBD_NO_MEMORY; msg = 'out of memory for the multiplier sensitivities'; return
-    end if
-    call dgelsy(nq, neq, np, jt, nq, b, size(b, 1), jpvt, 1.0e-10_wp, rank, work, size(work), &
-                info)
-    call lapack_status('dgelsy', info, status, msg)
-    slam = b(1:neq, :)
+    associate (jt => s%mjt, b => s%mb, y => s%my, jpb => s%mjpb, jpvt => s%mpiv, bb => s%mbb)
+      call sens_trig(m, s, q)
+      call sens_hessian(m, s, q, qd, qdd, t)
+      call sens_klam_list(m, s, lam)
+      b = zero
+      do k = 1, np
+        call sens_force_d(m, s, k, q, qd, sq(:, k), sqd(:, k), t, y)   ! Q_q s + Q_qd s_dot + Q_p
+        b(1:nq, k) = y - s%tmass(:, k) * qdd - m%mdiag * sqdd(:, k)
+        call sens_klam(s, sq(:, k), y)
+        b(1:nq, k) = b(1:nq, k) - y
+        call sens_jpt_lam(m, s, k, q, t, lam, y, jpb)
+        b(1:nq, k) = b(1:nq, k) - y
+      end do
+      if (neq == nq) then
+        ! square J (a driven mechanism): J^T dlambda = b by an LU of J^T with partial
+        ! pivoting, trusted when its pivot ratio is above the QR's rank threshold (as
+        ! dyn_multipliers); otherwise the least squares below
+        jt = transpose(jac)
+        call lu_factor_small(jt, jpvt(1:nq), st)
+        if (st == MBD_OK) then
+          umin = huge(one); umax = zero
+          do k = 1, nq
+            umin = min(umin, abs(jt(k, k))); umax = max(umax, abs(jt(k, k)))
+          end do
+          if (umin >= LS_RTOL * umax) then
+            do k = 1, np
+              call lu_solve_small(jt, jpvt(1:nq), b(1:nq, k))
+            end do
+            slam = b(1:neq, :); return
+          end if
+        end if
+      end if
+      ! J^T dlambda = b: Householder least squares (independent rows, the unique solution),
+      ! or the minimum-norm one by dgelsy when J^T is rank deficient (redundant rows)
+      if (neq <= nq) then
+        jt = transpose(jac)
+        bb = b
+        call ls_small_cols(jt, bb, full)
+        if (full) then
+          slam = bb(1:neq, :); return
+        end if
+      end if
+      jt = transpose(jac)
+      jpvt = 0
+      call dgelsy(nq, neq, np, jt, nq, b, size(b, 1), jpvt, 1.0e-10_wp, rank, wq, -1, info)
+      allocate (work(max(1, int(wq(1)))), stat=st)
+      if (st /= 0) then
+        status = MBD_NO_MEMORY; msg = 'out of memory for the multiplier sensitivities'; return
+      end if
+      call dgelsy(nq, neq, np, jt, nq, b, size(b, 1), jpvt, 1.0e-10_wp, rank, work, &
+                  size(work), info)
+      call lapack_status('dgelsy', info, status, msg)
+      slam = b(1:neq, :)
+    end associate
   end subroutine sens_multipliers
 
   !> Changes of the reactions (mbd_dynamics dyn_reactions) of every constraint at one state

@@ -79,6 +79,9 @@ module mbd_sensitivity
     !! parameters and parameter parts that depend on t only, evaluated here
     type(dloc) :: x0
     logical :: gathers = .true.              !! some pair or constraint needs gather (cb, sb)
+    ! work of the multipliers' sensitivities (mbd_sens_dynamics, allocated at its first call)
+    real(wp), allocatable :: mjt(:, :), mb(:, :), mbb(:, :), my(:), mjpb(:, :, :)
+    integer, allocatable :: mpiv(:)
     integer, allocatable :: gen(:)           !! the other constraints not linear in q
     !> the (revolute side, parameter) entries whose point the parameter moves: parameter,
     !! body, offset in tp's column, sign, first row, first entry of its pair, and their parts
