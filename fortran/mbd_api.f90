@@ -672,10 +672,17 @@ contains
         end if
         if (present(eo) .and. m%nf > 0) call dyn_element_outputs(m, w, qout(:, k), &
                                                                  qdout(:, k), t, eo(:, :, k))
-        if (present(ptab)) call sens_multipliers(m, sens, qout(:, k), qdout(:, k), &
-                                                 qddout(:, k), t, w%jac, lamout(:, k), &
-                                                 sq(:, :, k), sqd(:, :, k), sqdd(:, :, k), &
-                                                 slam(:, :, k), st, lmsg)
+        if (present(ptab)) then
+          if (w%jt_lu) then                    ! (the LU of J^T dyn_multipliers just took)
+            call sens_multipliers(m, sens, qout(:, k), qdout(:, k), qddout(:, k), t, w%jac, &
+                                  lamout(:, k), sq(:, :, k), sqd(:, :, k), sqdd(:, :, k), &
+                                  slam(:, :, k), st, lmsg, w%acopy, w%jpvt)
+          else
+            call sens_multipliers(m, sens, qout(:, k), qdout(:, k), qddout(:, k), t, w%jac, &
+                                  lamout(:, k), sq(:, :, k), sqd(:, :, k), sqdd(:, :, k), &
+                                  slam(:, :, k), st, lmsg)
+          end if
+        end if
       end do
       if (present(evo) .and. present(nev)) call events_out(m, log, evo, nev)
     end if

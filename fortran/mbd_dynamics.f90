@@ -90,6 +90,9 @@ module mbd_dynamics
     real(wp), allocatable :: metric(:), jt(:, :), bls(:)
     real(wp), allocatable :: acopy(:, :)  !! a copy of jt (dense multipliers with friction)
     integer, allocatable :: jpvt(:)
+    !> the last dyn_multipliers solved with the LU of J^T in acopy, jpvt (a square J, no
+    !! friction): the multipliers' sensitivities reuse it
+    logical :: jt_lu = .false.
     !> pattern of K by columns (rows krow(kptr(c):kptr(c+1)-1) of column c) and the column
     !! groups of the differences (columns gcol(gptr(g):gptr(g+1)-1) of group g)
     integer, allocatable :: kptr(:), krow(:), gptr(:), gcol(:)
@@ -837,6 +840,7 @@ contains
     integer :: it, bb, k, jc, s, mode, n
     logical :: settled
     msg = ''
+    w%jt_lu = .false.
     call assemble(m, w, q, qd, t)
     call gen_forces(m, q, qd, t, w%force, v, cst=w%cst)
     if (w%solver == SOLVER_BANDED) then      ! (no joint friction here: dyn_choose)
@@ -932,6 +936,7 @@ contains
         if (st == MBD_OK) then
           if (diag_ratio(w%acopy) >= LS_RTOL) then
             call lu_solve_small(w%acopy, w%jpvt, w%bls(1:m%nq))
+            w%jt_lu = m%nfric == 0
             l = w%bls(1:m%neq); return
           end if
         end if

@@ -47,7 +47,8 @@ contains
 
   !> dlambda/dp (neq, np) at one output of an inverse dynamics run, from the kinematic
   !! sensitivities sq, sqd, sqdd (nq, np) there; jac is J at q.
-  subroutine sens_multipliers(m, s, q, qd, qdd, t, jac, lam, sq, sqd, sqdd, slam, status, msg)
+  subroutine sens_multipliers(m, s, q, qd, qdd, t, jac, lam, sq, sqd, sqdd, slam, status, msg, &
+                              jtlu, jtpiv)
     type(model_t), intent(in) :: m              !! model with dynamics data
     type(sens_t), intent(inout) :: s            !! parameters and blocks
     real(wp), intent(in) :: q(:), qd(:), qdd(:) !! state and accelerations
@@ -58,6 +59,9 @@ contains
     real(wp), intent(out) :: slam(:, :)         !! (neq, np)
     integer, intent(out) :: status              !! MBD_OK or MBD_LAPACK / MBD_NO_MEMORY
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    !> the LU of J^T with its pivots (dyn_multipliers' at the same state, when it took one)
+    real(wp), intent(in), optional :: jtlu(:, :)
+    integer, intent(in), optional :: jtpiv(:)
     real(wp), allocatable :: work(:)
     logical :: full
     real(wp) :: wq(1), umin, umax
@@ -86,6 +90,12 @@ contains
         call sens_jpt_lam(m, s, k, q, t, lam, y, jpb)
         b(1:nq, k) = b(1:nq, k) - y
       end do
+      if (present(jtlu) .and. present(jtpiv)) then   ! dyn_multipliers' LU, trusted there
+        do k = 1, np
+          call lu_solve_small(jtlu, jtpiv, b(1:nq, k))
+        end do
+        slam = b(1:neq, :); return
+      end if
       if (neq == nq) then
         ! square J (a driven mechanism): J^T dlambda = b by an LU of J^T with partial
         ! pivoting, trusted when its pivot ratio is above the QR's rank threshold (as

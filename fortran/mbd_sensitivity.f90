@@ -843,6 +843,17 @@ contains
     do k = 1, m%nc
       if (con_linear(m%kind(k))) cycle
       r0 = m%row0(k) - 1
+      if (m%kind(k) == CON_REVOLUTE) then      ! only (theta, theta) of each moving side
+        do j = 3, 6, 3
+          cj = m%loc(j, k)
+          if (cj == 0) cycle
+          acc = lam(r0 + 1) * s%hs(1, j, j, k) + lam(r0 + 2) * s%hs(2, j, j, k)
+          if (abs(acc) <= zero) cycle
+          s%kln = s%kln + 1
+          s%klr(s%kln) = cj; s%klc(s%kln) = cj; s%klv(s%kln) = acc
+        end do
+        cycle
+      end if
       do j = 1, NLOC
         cj = m%loc(j, k)
         if (cj == 0) cycle
@@ -882,13 +893,20 @@ contains
     real(wp), intent(in) :: q(:), t          !! configuration, time
     real(wp), intent(in) :: lam(:)           !! multipliers (neq)
     real(wp), intent(out) :: y(:)            !! (nq)
-    real(wp), intent(out) :: jpb(:, :, :)    !! (MAXROW, NLOC, nc)
+    real(wp), intent(out), contiguous :: jpb(:, :, :)    !! (MAXROW, NLOC, nc)
     type(dloc) :: x
     real(wp) :: qddl(NLOC), tphi(MAXROW), tnu(MAXROW), tgam(MAXROW)
-    integer :: c, si, sj, j, r
+    integer :: c, si, sj, j, r, o
     jpb = zero
     do c = 1, m%nc
       if (.not. s%caff(c, k)) cycle
+      if (m%kind(c) == CON_REVOLUTE) then      ! J = [I, B_i s'_i, -I, -B_j s'_j]: J_p has
+        o = m%po(c)                            ! B_i t s'_i, -B_j t s'_j (perp(A t s'))
+        if (m%bi(c) > 0) jpb(1:2, 3, c) = rperp(s%cb(m%bi(c)), s%sb(m%bi(c)), s%tp(o:o + 1, k))
+        if (m%bj(c) > 0) jpb(1:2, 6, c) = -rperp(s%cb(m%bj(c)), s%sb(m%bj(c)), &
+                                                 s%tp(o + 2:o + 3, k))
+        cycle
+      end if
       call gather(m, s, c, q, s%zq, s%zq, x, qddl)
       si = merge(1, 0, m%bi(c) > 0); sj = merge(2, 0, m%bj(c) > 0)
       call con_eval_d(m%kind(c), m%suba(c), m%subb(c), m%p(m%po(c):m%po(c) + m%pn(c) - 1), &
@@ -905,6 +923,13 @@ contains
         end do
       end do
     end do
+  contains
+    !> perp(A v) = B v for the angle with cos cc, sin ss.
+    pure function rperp(cc, ss, v) result(w)
+      real(wp), intent(in) :: cc, ss, v(2)
+      real(wp) :: w(2)
+      w = [-(ss * v(1) + cc * v(2)), cc * v(1) - ss * v(2)]
+    end function rperp
   end subroutine sens_jpt_lam
 
   !> Change of the applied generalized force Q along (dq, dq_dot) and parameter k
