@@ -897,7 +897,7 @@ contains
     type(dloc) :: x
     real(wp) :: qddl(NLOC), tphi(MAXROW), tnu(MAXROW), tgam(MAXROW)
     integer :: c, si, sj, j, r, o
-    jpb = zero
+    call zero_fill(size(jpb), jpb)           ! (one flat fill, not a loop of column fills)
     do c = 1, m%nc
       if (.not. s%caff(c, k)) cycle
       if (m%kind(c) == CON_REVOLUTE) then      ! J = [I, B_i s'_i, -I, -B_j s'_j]: J_p has
@@ -931,6 +931,13 @@ contains
       w = [-(ss * v(1) + cc * v(2)), cc * v(1) - ss * v(2)]
     end function rperp
   end subroutine sens_jpt_lam
+
+  !> a(1:n) = 0 for an array seen flat.
+  pure subroutine zero_fill(n, a)
+    integer, intent(in) :: n
+    real(wp), intent(out) :: a(n)
+    a = zero
+  end subroutine zero_fill
 
   !> Change of the applied generalized force Q along (dq, dq_dot) and parameter k
   !! (k = 0: no parameter change): forces by dual evaluation, gravity m g by the changes of
