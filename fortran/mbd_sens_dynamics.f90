@@ -43,7 +43,34 @@ module mbd_sens_dynamics
   private
   public :: sens_multipliers, sens_reactions, sens_statics, sens_dopri5, sens_initial
 
+  !> Work of project_sens (allocated once per run by proj_init: no step allocates).
+  type :: proj_work_t
+    real(wp), allocatable :: vv(:), met(:), aug(:, :), r(:), aug2(:, :), phi(:), nu(:), &
+                             gam(:), jac(:, :), z(:), hvs(:)
+    integer, allocatable :: piv(:), piv2(:)
+    type(asm_work_t) :: a                       !! assembly work
+  end type proj_work_t
+
 contains
+
+  !> Allocate project_sens's work for model m and the active rows of w.
+  subroutine proj_init(m, w, pw, status, msg)
+    type(model_t), intent(in) :: m              !! model
+    type(dyn_work_t), intent(in) :: w           !! dynamics work arrays (dyn_init done)
+    type(proj_work_t), intent(out) :: pw        !! the work
+    integer, intent(out) :: status              !! MBD_OK or MBD_NO_MEMORY
+    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    integer :: n, na, st
+    n = m%nq; na = w%na
+    allocate (pw%vv(n), pw%met(n), pw%aug(n + na, n + na), pw%r(n + na), &
+              pw%aug2(n + na, n + na), pw%phi(m%neq), pw%nu(m%neq), pw%gam(m%neq), &
+              pw%jac(m%neq, n), pw%z(n), pw%hvs(m%neq), pw%piv(n + na), pw%piv2(n + na), &
+              stat=st)
+    if (st /= 0) then
+      status = MBD_NO_MEMORY; msg = 'out of memory for the sensitivity projections'; return
+    end if
+    call asm_init(m, pw%a, status, msg)
+  end subroutine proj_init
 
   !> dlambda/dp (neq, np) at one output of an inverse dynamics run, from the kinematic
   !! sensitivities sq, sqd, sqdd (nq, np) there; jac is J at q.
@@ -286,6 +313,10 @@ contains
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
     real(wp), allocatable :: y(:), yn(:), k(:, :), e(:), za(:), zda(:), zdda(:), lam(:), &
                              zz(:), zzd(:), zzdd(:)
+    ! the work of rhs and project (here, so that no step allocates)
+    real(wp), allocatable :: qq(:), vv(:), aa(:), r(:), y1(:), sk(:), sdk(:), jpb(:, :, :), &
+                             v0(:)
+    type(proj_work_t) :: pw
     real(wp) :: t, h, tnew, err, fac, sc
     integer :: n, np, nz, st, kout
     logical :: fsal
@@ -298,10 +329,13 @@ contains
       return
     end if
     allocate (y(2 * nz), yn(2 * nz), k(2 * nz, 7), e(2 * nz), za(nz), zda(nz), zdda(nz), &
-              lam(m%neq), zz(nz), zzd(nz), zzdd(nz), stat=st)
+              lam(m%neq), zz(nz), zzd(nz), zzdd(nz), qq(n), vv(n), aa(n), r(n + w%na), y1(n), &
+              sk(n), sdk(n), jpb(MAXROW, NLOC, m%nc), v0(n), stat=st)
     if (st /= 0) then
       status = MBD_NO_MEMORY; msg = 'out of memory for the sensitivity integration'; return
     end if
+    call proj_init(m, w, pw, status, msg)
+    if (status /= MBD_OK) return
     y(1:n) = q; y(n + 1:nz) = reshape(sq, [n * np])
     y(nz + 1:nz + n) = qd; y(nz + n + 1:) = reshape(sqd, [n * np])
     t = t0
@@ -401,7 +435,6 @@ contains
       real(wp), intent(in) :: tt, yy(:)
       real(wp), intent(out) :: f(:)
       integer, intent(out) :: stp
-      real(wp) :: qq(n), vv(n), aa(n), r(n + w%na), y1(n), sk(n), sdk(n), jpb(MAXROW, NLOC, m%nc)
       integer :: kk, i, o
       stats(3) = stats(3) + 1
       qq = yy(1:n); vv = yy(nz + 1:nz + n)
@@ -439,14 +472,13 @@ contains
       real(wp), intent(in) :: tt
       real(wp), intent(inout) :: yy(:)
       integer, intent(out) :: stp
-      real(wp) :: qq(n), vv(n), v0(n)
       qq = yy(1:n); v0 = yy(nz + 1:nz + n)
       call dyn_project_pos(m, w, qq, tt, stp)
       if (stp /= MBD_OK) return
       call dyn_velocity(m, w, qq, tt, v0, vv, stp)
       if (stp /= MBD_OK) return
       yy(1:n) = qq; yy(nz + 1:nz + n) = vv
-      call project_sens(m, w, s, tt, yy, stp)
+      call project_sens(m, w, s, tt, yy, pw, stp)
     end subroutine project
 
     !> The stored outputs in (ta, tb] by quintic Hermite interpolation of z = (q, S).
@@ -480,57 +512,56 @@ contains
   !> Project the sensitivities in the packed state yy = (q, S, q_dot, S_dot) (q, q_dot
   !! consistent) onto the linearized constraints: S onto J S = -Phi_p by the minimum-norm
   !! change, S_dot onto J S_dot = nu_p - J_p q_dot - Hv S nearest in the kinetic metric.
-  subroutine project_sens(m, w, s, tt, yy, stp)
+  subroutine project_sens(m, w, s, tt, yy, pw, stp)
     type(model_t), intent(in) :: m              !! model with dynamics data
     type(dyn_work_t), intent(in) :: w           !! dynamics work arrays (active rows, scale)
     type(sens_t), intent(inout) :: s            !! parameters and blocks
     real(wp), intent(in) :: tt                  !! time
     real(wp), intent(inout) :: yy(:)            !! packed state
+    type(proj_work_t), intent(inout) :: pw      !! work (proj_init)
     integer, intent(out) :: stp                 !! MBD_OK or MBD_SINGULAR
-    real(wp) :: vv(m%nq), met(m%nq), aug(m%nq + w%na, m%nq + w%na), r(m%nq + w%na), &
-                aug2(m%nq + w%na, m%nq + w%na), phi(m%neq), nu(m%neq), gam(m%neq), &
-                jac(m%neq, m%nq), z(m%nq), hvs(m%neq)
-    integer :: piv(m%nq + w%na), piv2(m%nq + w%na), kk, o, i, n, nz
-    type(asm_work_t) :: a
+    integer :: kk, o, i, n, nz
     character(len=MSG_LEN) :: lmsg
     n = m%nq; nz = n * (1 + s%np)
-    vv = yy(nz + 1:nz + n)
-    z = zero
-    call asm_init(m, a, stp, lmsg)
-    if (stp /= MBD_OK) return
-    call assemble_dense(m, yy(1:n), vv, tt, phi, nu, gam, a, jac)
-    call sens_trig(m, s, yy(1:n))
-    call sens_hessian(m, s, yy(1:n), vv, z, tt)
-    call sens_params(m, s, yy(1:n), vv, z, tt)
-    met = merge(m%mdiag, w%s, m%mdiag > zero)
-    aug = zero; aug2 = zero
-    do i = 1, n
-      aug(i, i) = one; aug2(i, i) = met(i)
-    end do
-    aug(1:n, n + 1:) = transpose(jac(w%rows, :)); aug(n + 1:, 1:n) = jac(w%rows, :)
-    aug2(1:n, n + 1:) = aug(1:n, n + 1:); aug2(n + 1:, 1:n) = aug(n + 1:, 1:n)
-    call lu_factor(aug, piv, stp, lmsg)
-    if (stp == MBD_OK) call lu_factor(aug2, piv2, stp, lmsg)
-    if (stp /= MBD_OK) return
-    do kk = 1, s%np
-      o = n * kk
-      ! S <- S + dS, [I J^T; J 0][dS; mu] = [0; -(J S + Phi_p)]
-      r = zero
-      r(n + 1:) = s%mphip(kk, w%rows) - matmul(jac(w%rows, :), yy(o + 1:o + n))
-      call lu_solve(aug, piv, r, stp, lmsg)
-      if (stp /= MBD_OK) return
-      yy(o + 1:o + n) = yy(o + 1:o + n) + r(1:n)
-      ! S_dot nearest in M to its value with J S_dot = nu_p - J_p q_dot - Hv S
-      hvs = s%vp(kk, :)
-      do i = 1, s%nnz
-        hvs(s%nzr(i)) = hvs(s%nzr(i)) - s%nzv(i) * yy(o + s%nzc(i))
+    associate (vv => pw%vv, met => pw%met, aug => pw%aug, r => pw%r, aug2 => pw%aug2, &
+               phi => pw%phi, nu => pw%nu, gam => pw%gam, jac => pw%jac, z => pw%z, &
+               hvs => pw%hvs, piv => pw%piv, piv2 => pw%piv2)
+      vv = yy(nz + 1:nz + n)
+      z = zero
+      call assemble_dense(m, yy(1:n), vv, tt, phi, nu, gam, pw%a, jac)
+      call sens_trig(m, s, yy(1:n))
+      call sens_hessian(m, s, yy(1:n), vv, z, tt)
+      call sens_params(m, s, yy(1:n), vv, z, tt)
+      met = merge(m%mdiag, w%s, m%mdiag > zero)
+      aug = zero; aug2 = zero
+      do i = 1, n
+        aug(i, i) = one; aug2(i, i) = met(i)
       end do
-      r(1:n) = met * yy(nz + o + 1:nz + o + n)
-      r(n + 1:) = hvs(w%rows)
-      call lu_solve(aug2, piv2, r, stp, lmsg)
+      aug(1:n, n + 1:) = transpose(jac(w%rows, :)); aug(n + 1:, 1:n) = jac(w%rows, :)
+      aug2(1:n, n + 1:) = aug(1:n, n + 1:); aug2(n + 1:, 1:n) = aug(n + 1:, 1:n)
+      call lu_factor(aug, piv, stp, lmsg)
+      if (stp == MBD_OK) call lu_factor(aug2, piv2, stp, lmsg)
       if (stp /= MBD_OK) return
-      yy(nz + o + 1:nz + o + n) = r(1:n)
-    end do
+      do kk = 1, s%np
+        o = n * kk
+        ! S <- S + dS, [I J^T; J 0][dS; mu] = [0; -(J S + Phi_p)]
+        r = zero
+        r(n + 1:) = s%mphip(kk, w%rows) - matmul(jac(w%rows, :), yy(o + 1:o + n))
+        call lu_solve(aug, piv, r, stp, lmsg)
+        if (stp /= MBD_OK) return
+        yy(o + 1:o + n) = yy(o + 1:o + n) + r(1:n)
+        ! S_dot nearest in M to its value with J S_dot = nu_p - J_p q_dot - Hv S
+        hvs = s%vp(kk, :)
+        do i = 1, s%nnz
+          hvs(s%nzr(i)) = hvs(s%nzr(i)) - s%nzv(i) * yy(o + s%nzc(i))
+        end do
+        r(1:n) = met * yy(nz + o + 1:nz + o + n)
+        r(n + 1:) = hvs(w%rows)
+        call lu_solve(aug2, piv2, r, stp, lmsg)
+        if (stp /= MBD_OK) return
+        yy(nz + o + 1:nz + o + n) = r(1:n)
+      end do
+    end associate
   end subroutine project_sens
 
   !> Sensitivities of the consistent initial state of forward dynamics: the assembled q
@@ -546,12 +577,15 @@ contains
     integer, intent(out) :: status              !! MBD_OK or MBD_SINGULAR
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
     real(wp) :: y(2 * m%nq * (1 + s%np))
+    type(proj_work_t) :: pw
     integer :: n, nz
     n = m%nq; nz = n * (1 + s%np)
     y = zero
     y(1:n) = q; y(nz + 1:nz + n) = qd
+    call proj_init(m, w, pw, status, msg)
+    if (status /= MBD_OK) return
     msg = ''
-    call project_sens(m, w, s, t, y, status)
+    call project_sens(m, w, s, t, y, pw, status)
     if (status /= MBD_OK) msg = 'the initial sensitivities cannot be made consistent'
     sq = reshape(y(n + 1:nz), [n, s%np]); sqd = reshape(y(nz + n + 1:), [n, s%np])
   end subroutine sens_initial
