@@ -8,12 +8,8 @@ solved to machine accuracy), with Richardson extrapolation of two step sizes."""
 from __future__ import annotations
 
 import numpy as np
-import pytest
 
-import mbd2d
-from conftest import load_example
-
-STEPS, T_END = 24, 1.0
+from conftest import check_kinematic_sensitivities, load_example, model_from_toml
 
 INVERTED = """
 [model]
@@ -65,35 +61,17 @@ f = { poly = [0.0, 6.283185307179586] }
 """
 
 
-def central(model, name: str, value: float, h: float) -> np.ndarray:
-    """(3, rows, nq) central differences of q, q_dot, q_ddot along the parameter."""
-    runs = []
-    for v in (value + h, value - h):
-        res = model.with_params({name: v}).kinematics(T_END, STEPS)
-        runs.append(np.stack([res.q, res.qd, res.qdd]))
-    return (runs[0] - runs[1]) / (2 * h)
-
-
-def check(model, joint: str) -> None:
-    pars = model.parameters()
-    names = [f"joint.{joint}.{what}.{side}.{c}" for what in ("points", "axes")
-             for side in (0, 1) for c in (0, 1)]
-    res = model.kinematics(T_END, STEPS, sensitivities=names)
-    assert np.abs(res.dq_dp).max() > 0.1                    # the parameters do move things
-    for j, name in enumerate(names):
-        h = 1e-3 * max(1.0, abs(pars[name]))
-        d1, d2 = central(model, name, pars[name], h), central(model, name, pars[name], h / 2)
-        want = (4 * d2 - d1) / 3                            # Richardson: O(h**4)
-        for k, got in enumerate([res.dq_dp, res.dqd_dp, res.dqdd_dp]):
-            scale = max(1.0, float(np.abs(want[k]).max()))
-            err = float(np.abs(got[:, :, j] - want[k]).max())
-            assert err <= 1e-7 * scale, f"d{['q', 'qd', 'qdd'][k]}/d {name}: {err:.2e}"
+def names_of(joint: str) -> list[str]:
+    """Every point and axis parameter of a translational joint."""
+    return [f"joint.{joint}.{what}.{side}.{c}" for what in ("points", "axes")
+            for side in (0, 1) for c in (0, 1)]
 
 
 def test_translational_between_two_moving_bodies_against_central_differences():
-    check(mbd2d.loads(INVERTED), "slot")
+    model = model_from_toml(INVERTED)
+    assert np.abs(model.kinematics(1.0, 24, sensitivities=names_of("slot")).dq_dp).max() > 0.1
+    check_kinematic_sensitivities(model, names_of("slot"))
 
 
-@pytest.mark.parametrize("joint", ["guide"])
-def test_translational_on_the_ground_against_central_differences(joint):
-    check(load_example("slider_crank.toml"), joint)
+def test_translational_on_the_ground_against_central_differences():
+    check_kinematic_sensitivities(load_example("slider_crank.toml"), names_of("guide"))
