@@ -68,7 +68,6 @@ module mbd_sensitivity
     !! padding rows stay zero: lu_solve_rows works on 4 at a time)
     real(wp), allocatable :: rhs(:, :)
     real(wp), allocatable :: st(:, :), sdt(:, :)  !! (npad, nq) s and s_dot as rows (sens_kin_rhs)
-    logical :: curved = .true.               !! some constraint is not linear in q
     !> the revolutes' moving sides (closed forms): body, point offset in the pool, sign,
     !! constraint, theta slot (3, 6), and their blocks (2, nside) at the current state
     integer, allocatable :: rsb(:), rso(:), rsc(:), rss(:)
@@ -324,7 +323,6 @@ contains
       s%ounit(:, k) = s%pscale(k) * m%cunit
     end do
     s%rsh = zero; s%rsv = zero; s%rsa = zero
-    s%curved = any(curv)
     s%nrvz = 0
     ns = 0; ngen = 0; nps = 0; ngp = 0; ntr = 0
     s%gathers = size(s%gen) > 0
