@@ -104,6 +104,7 @@ module mbd_sensitivity
     integer, allocatable :: klr(:), klc(:)
     real(wp), allocatable :: klv(:)
     real(wp), allocatable :: zp(:)           !! zeros, the longest prepared slice
+    real(wp), allocatable :: zfp(:)          !! zeros, the force pool's length (dynamics)
     real(wp), allocatable :: zq(:)           !! zeros (nq)
   end type sens_t
 
@@ -140,7 +141,7 @@ contains
               s%hs(MAXROW, NLOC, NLOC, m%nc), s%mphip(npad, m%neq), s%vp(npad, m%neq), &
               s%ap(npad, m%neq), s%work(m%neq), s%rhs(npad, m%neq), &
               s%st(npad, m%nq), s%sdt(npad, m%nq), &
-              s%zp(maxval(m%pn)), s%zq(m%nq), &
+              s%zp(maxval(m%pn)), s%zq(m%nq), s%zfp(nfp), &
               s%cb(0:m%nb), s%sb(0:m%nb), s%bst(4, 0:m%nb), s%nzr(NLOC * m%neq), &
               s%nzc(NLOC * m%neq), &
               s%nzv(NLOC * m%neq), s%nza(NLOC * m%neq), s%klr(NLOC * NLOC * m%nc), &
@@ -150,7 +151,7 @@ contains
     end if
     s%ptab = ptab
     s%tp = zero; s%caff = .false.; s%tfp = zero; s%faff = .false.; s%tmass = zero
-    s%tgrav = zero; s%hs = zero; s%zp = zero
+    s%tgrav = zero; s%hs = zero; s%zp = zero; s%zfp = zero
     s%cb = one; s%sb = zero; s%rhs = zero; s%pscale = one; s%zq = zero
     s%mphip = zero; s%vp = zero; s%ap = zero   ! entries of unaffected pairs stay zero
     s%st = zero; s%sdt = zero                 ! (padding rows stay zero)
@@ -948,7 +949,7 @@ contains
     real(wp), intent(in) :: dq(:), dqd(:)    !! direction
     real(wp), intent(in) :: t                !! time
     real(wp), intent(out) :: y(:)            !! (nq)
-    real(wp) :: ql(NLOC), qdl(NLOC), tql(NLOC), tqdl(NLOC), fl(NLOC), tpz(size(m%fp))
+    real(wp) :: ql(NLOC), qdl(NLOC), tql(NLOC), tqdl(NLOC), fl(NLOC)
     integer :: f, j, c, si, sj, b
     y = zero
     if (k > 0) then
@@ -957,7 +958,6 @@ contains
                                  m%mdiag(3 * b - 2) * s%tgrav(:, k)
       end do
     end if
-    tpz = zero
     do f = 1, m%nf
       do j = 1, NLOC
         c = m%floc(j, f)
@@ -973,7 +973,7 @@ contains
                           tql, tqdl, t, fl)
       else
         call force_eval_d(m%fkind(f), m%fp(m%fpo(f):m%fpo(f) + m%fpn(f) - 1), &
-                          tpz(m%fpo(f):m%fpo(f) + m%fpn(f) - 1), si, sj, ql, qdl, &
+                          s%zfp(m%fpo(f):m%fpo(f) + m%fpn(f) - 1), si, sj, ql, qdl, &
                           tql, tqdl, t, fl)
       end if
       do j = 1, NLOC
