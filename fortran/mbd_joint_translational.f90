@@ -149,10 +149,8 @@ contains
     real(wp), intent(out) :: hm(6, 6)       !! dJ_a/dq_c of the first row
     real(wp), intent(out) :: hv(6), ha(6)   !! H q_dot, H q_ddot + g
     real(wp) :: h(2), b(2), ui(2), uj(2), pui(2), puj(2), d(2), jti, hpj, buj, wi, wj
-    h = [ci * p(7) - si * p(8), si * p(7) + ci * p(8)]
-    b = [-h(2), h(1)]
-    ui = [ci * p(1) - si * p(2), si * p(1) + ci * p(2)]
-    uj = [cj * p(3) - sj * p(4), sj * p(3) + cj * p(4)]
+    h = rot(ci, si, p(7:8)); b = [-h(2), h(1)]
+    ui = rot(ci, si, p(1:2)); uj = rot(cj, sj, p(3:4))
     pui = [-ui(2), ui(1)]; puj = [-uj(2), uj(1)]
     d = ql(4:5) + uj - ql(1:2) - ui
     jti = dot_product(b, d) - dot_product(h, pui)
@@ -220,12 +218,13 @@ contains
     ta(1) = -(dot_product(thdd, d) + dot_product(hdd, td) + 2 * dot_product(thd, dd) &
               + 2 * dot_product(hd, tdd) + dot_product(th, ddd) + dot_product(h, tddd))
     tphi(2) = -tp(9); tv(2) = zero; ta(2) = zero
-  contains
-    pure function rot(c, s, v) result(w)
-      real(wp), intent(in) :: c, s, v(2)
-      real(wp) :: w(2)
-      w = [c * v(1) - s * v(2), s * v(1) + c * v(2)]
-    end function rot
   end subroutine translational_param
+
+  !> A v for the angle with cos c, sin s.
+  pure function rot(c, s, v) result(w)
+    real(wp), intent(in) :: c, s, v(2)
+    real(wp) :: w(2)
+    w = [c * v(1) - s * v(2), s * v(1) + c * v(2)]
+  end function rot
 
 end module mbd_joint_translational

@@ -422,7 +422,7 @@ contains
     type(dloc) :: x
     real(wp) :: qddl(NLOC), tphi(MAXROW), tnu(MAXROW), tgam(MAXROW), hv, ha
     real(wp) :: qloc(NLOC), qdl(NLOC), hm(6, 6), hvt(6), hat(6)
-    integer :: k, j, nr, si, sj, r, e, c, n
+    integer :: k, j, nr, si, sj, r, e, n
     if (.not. present(states)) then
       call body_states(m, s, qd, qdd)
     else if (states) then
@@ -438,13 +438,7 @@ contains
     n = 2 * size(s%rsb)                         ! the translationals' entries follow
     do e = 1, size(s%tlc)
       k = s%tlc(e)
-      do j = 1, 6
-        c = m%loc(j, k)
-        qloc(j) = zero; qdl(j) = zero; qddl(j) = zero
-        if (c > 0) then
-          qloc(j) = q(c); qdl(j) = qd(c); qddl(j) = qdd(c)
-        end if
-      end do
+      call slot_values(m, k, q, qd, qdd, qloc, qdl, qddl)
       call translational_second(m%p(m%po(k):m%po(k) + 8), s%bst(1, m%bi(k)), &
                                 s%bst(2, m%bi(k)), s%bst(1, m%bj(k)), s%bst(2, m%bj(k)), &
                                 qloc(1:6), qdl(1:6), qddl(1:6), hm, hvt, hat)
@@ -514,7 +508,7 @@ contains
     type(dloc) :: x
     real(wp) :: qddl(NLOC), tphi(MAXROW), tjl(MAXROW, NLOC), tnu(MAXROW), tgam(MAXROW)
     real(wp) :: qloc(NLOC), qdl(NLOC)
-    integer :: e, k, c, cprev, nr, si, sj, r, r0, j
+    integer :: e, k, c, cprev, nr, si, sj, r, r0
     if (.not. present(states)) then
       call body_states(m, s, qd, qdd)
     else if (states) then
@@ -530,14 +524,7 @@ contains
     do e = 1, size(s%gpc)
       c = s%gpc(e); k = s%gpk(e); r0 = m%row0(c) - 1
       if (m%kind(c) == CON_TRANSLATIONAL) then  ! in closed form too
-        if (c /= cprev) then
-          do j = 1, 6
-            qloc(j) = zero; qdl(j) = zero; qddl(j) = zero
-            if (m%loc(j, c) > 0) then
-              qloc(j) = q(m%loc(j, c)); qdl(j) = qd(m%loc(j, c)); qddl(j) = qdd(m%loc(j, c))
-            end if
-          end do
-        end if
+        if (c /= cprev) call slot_values(m, c, q, qd, qdd, qloc, qdl, qddl)
         cprev = c
         call translational_param(m%p(m%po(c):m%po(c) + 8), s%tp(m%po(c):m%po(c) + 8, k), &
                                  s%bst(1, m%bi(c)), s%bst(2, m%bi(c)), s%bst(1, m%bj(c)), &
@@ -595,6 +582,22 @@ contains
       end if
     end do
   end subroutine pairs_put
+
+  !> Coordinates, velocities and accelerations of constraint k's slots (0 for a ground slot).
+  pure subroutine slot_values(m, k, q, qd, qdd, ql, qdl, qddl)
+    type(model_t), intent(in) :: m              !! model
+    integer, intent(in) :: k                    !! constraint
+    real(wp), intent(in) :: q(:), qd(:), qdd(:) !! state and accelerations
+    real(wp), intent(out) :: ql(NLOC), qdl(NLOC), qddl(NLOC)  !! by slot
+    integer :: j, c
+    do j = 1, NLOC
+      c = m%loc(j, k)
+      ql(j) = zero; qdl(j) = zero; qddl(j) = zero
+      if (c > 0) then
+        ql(j) = q(c); qdl(j) = qd(c); qddl(j) = qdd(c)
+      end if
+    end do
+  end subroutine slot_values
 
   !> Each body's [cos, sin, theta_dot, theta_ddot] in s%bst (the ground's 1, 0, 0, 0; cos and
   !! sin from sens_trig), as the revolute's closed forms take them.
