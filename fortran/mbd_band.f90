@@ -235,12 +235,14 @@ contains
     from%n = 0; from%factored = .false.
   end subroutine band_move
 
-  !> Clear the matrix before an assembly: rows kl+1..ldab of ab, the part dgbtrf reads
-  !! (it clears its fill rows 1..kl itself).
+  !> Clear the matrix before an assembly: the whole storage, the fill rows 1..kl included
+  !! (band_lu relies on them being zero), in one contiguous pass (a section of rows kl+1..ldab
+  !! is cleared column by column, a memset call per column, and band_lu cleared the fill rows
+  !! column by column again).
   pure subroutine band_zero(b)
     type(band_t), intent(inout) :: b   !! planned band matrix
     if (.not. allocated(b%ab)) return
-    b%ab(b%kl + 1:b%ldab, :) = zero
+    b%ab = zero
     b%factored = .false.
   end subroutine band_zero
 
@@ -369,10 +371,19 @@ contains
     do
       call dlacn2(n, b%work(1:n), b%work(n + 1:2 * n), b%iwork, ainvnm, kase, isave)
       if (kase == 0) exit
-      call dgbtrs(merge('N', 'T', kase == 1), n, b%kl, b%ku, 1, b%ab, b%ldab, b%ipiv, &
-                  b%work(n + 1:2 * n), n, info)
-      call lapack_status('dgbtrs', info, status, msg)
-      if (status /= MBD_OK) return
+      if (b%plain) then                       ! band_lu's factors: plain loops
+        if (kase == 1) then
+          call band_lu_solve(n, b%kl, b%ku, b%ab, b%ldab, b%ipiv, b%work(n + 1:2 * n), b%kvu)
+        else
+          call band_lu_solve_t(n, b%kl, b%ku, b%ab, b%ldab, b%ipiv, b%work(n + 1:2 * n), &
+                               b%kvu)
+        end if
+      else
+        call dgbtrs(merge('N', 'T', kase == 1), n, b%kl, b%ku, 1, b%ab, b%ldab, b%ipiv, &
+                    b%work(n + 1:2 * n), n, info)
+        call lapack_status('dgbtrs', info, status, msg)
+        if (status /= MBD_OK) return
+      end if
       if (.not. all(ieee_is_finite(b%work(n + 1:2 * n)))) return   ! overflow: rcond = 0
     end do
     if (ainvnm > zero .and. ieee_is_finite(ainvnm)) rcond = (one / ainvnm) / anorm
@@ -508,7 +519,8 @@ contains
   !! algorithm, storage and pivots (so dgbtrs and dgbcon read its factors), without its
   !! BLAS calls per column. info > 0: U(info, info) is exactly zero. kvu: the upper width
   !! of U the row interchanges actually filled (ku without any, at most kl + ku), so that
-  !! band_lu_solve reads no more of U than it holds.
+  !! band_lu_solve reads no more of U than it holds. The fill rows 1..kl of ab must be zero
+  !! on entry (band_storage and band_zero clear the whole storage; dgbtf2 clears them itself).
   pure subroutine band_lu(n, kl, ku, ab, ldab, ipiv, info, kvu)
     integer, intent(in) :: n, kl, ku, ldab    !! size, widths, leading dimension (2kl+ku+1)
     real(wp), intent(inout) :: ab(ldab, n)    !! band matrix, then its factors
@@ -521,18 +533,8 @@ contains
     kv = ku + kl
     info = 0
     kvu = ku
-    do j = ku + 2, min(kv, n)                 ! clear the fill of the first columns
-      do i = kv - j + 2, kl
-        ab(i, j) = zero
-      end do
-    end do
     ju = 1
     do j = 1, n
-      if (j + kv <= n) then
-        do i = 1, kl
-          ab(i, j + kv) = zero
-        end do
-      end if
       km = min(kl, n - j)
       jp = 0; piv = abs(ab(kv + 1, j))        ! pivot: the first largest |a_ij|, i >= j
       do i = 1, km
@@ -599,6 +601,37 @@ contains
       end do
     end do
   end subroutine band_lu_solve
+
+  !> Solve B^T x = r with the factors of band_lu in plain loops (dgbtrs 'T'): U^T forward
+  !! (upper width kvu), then L^T backward with the row interchanges in reverse; r becomes x.
+  pure subroutine band_lu_solve_t(n, kl, ku, ab, ldab, ipiv, r, kvu)
+    integer, intent(in) :: n, kl, ku, ldab    !! size, widths, leading dimension
+    real(wp), intent(in) :: ab(ldab, n)       !! factors
+    integer, intent(in) :: ipiv(n)            !! row interchanges
+    real(wp), intent(inout) :: r(n)           !! right-hand side, then solution
+    integer, intent(in) :: kvu                !! upper width of U (band_lu's)
+    integer :: kv, i, j, p
+    real(wp) :: tmp, f
+    kv = ku + kl
+    do j = 1, n                               ! U^T y = r: y_j = (r_j - sum_i u_ij y_i) / u_jj
+      f = r(j)
+      do i = max(1, j - kvu), j - 1
+        f = f - ab(kv + 1 + i - j, j) * r(i)
+      end do
+      r(j) = f / ab(kv + 1, j)
+    end do
+    do j = n - 1, 1, -1                       ! L^T x = y, then P^T: x_j -= sum_i l_ij x_i
+      f = r(j)
+      do i = 1, min(kl, n - j)
+        f = f - ab(kv + 1 + i, j) * r(j + i)
+      end do
+      r(j) = f
+      p = ipiv(j)
+      if (p /= j) then
+        tmp = r(j); r(j) = r(p); r(p) = tmp
+      end if
+    end do
+  end subroutine band_lu_solve_t
 
   ! ---------------------------------------------------------------------------------------
   ! ordering

@@ -408,7 +408,7 @@ contains
     real(wp), intent(in), optional :: e        !! constraint diagonal -e (default 0)
     logical, intent(in), optional :: check     !! index-1: nearly singular solves
     real(wp) :: ee, anorm, rc, pr
-    logical :: chk
+    logical :: chk, refused
     character(len=MSG_LEN) :: msg
     integer :: info, k
     ee = zero; if (present(e)) ee = e
@@ -416,6 +416,7 @@ contains
     sd%nfactor = sd%nfactor + 1
     sd%lsq = .false.
     sd%schur = .false.
+    refused = .false.
     if (chk .and. sd%use_schur .and. .not. present(kv) .and. .not. abs(ee) > zero) then
       ! diagonal, positive A and a well-conditioned Schur complement: its Cholesky
       call schur_factor(sd%sc, d, jb, s, sd%schur)
@@ -424,6 +425,7 @@ contains
         sd%nschur = sd%nschur + 1
         return
       end if
+      refused = .true.
     end if
     if (sd%banded) then
       call fill(ee)
@@ -433,13 +435,18 @@ contains
       end if
       ! ||A||_1 only where it is used (a small pivot ratio): the matrix is filled again and,
       ! for the condition estimate, factored again (the same factors), which keeps a pass
-      ! over the whole band out of every well-conditioned factorization
-      call band_factor(sd%b, status, msg, pivratio=pr)
+      ! over the whole band out of every well-conditioned factorization; after a refused
+      ! Schur complement (a small pivot ratio of S: the condition estimate is likely needed)
+      ! the norm is taken at once, one pass instead of a second fill and factorization
       anorm = zero
+      if (refused) anorm = band_norm1(sd%b)
+      call band_factor(sd%b, status, msg, pivratio=pr)
       if (status == MBD_OK .and. pr < 1.0e-6_wp) then
-        call fill(ee)
-        anorm = band_norm1(sd%b)
-        call band_factor(sd%b, status, msg)
+        if (.not. anorm > zero) then
+          call fill(ee)
+          anorm = band_norm1(sd%b)
+          call band_factor(sd%b, status, msg)
+        end if
         sd%lsq = status /= MBD_OK
         if (status == MBD_OK) then
           call band_rcond(sd%b, anorm, rc, info, msg)
