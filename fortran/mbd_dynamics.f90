@@ -59,7 +59,7 @@ module mbd_dynamics
             dyn_velocity, &
             dyn_project_pos, dyn_multipliers, dyn_reactions, dyn_tangent, dyn_solve, &
             dyn_jt_lam, dyn_damped, dyn_assemble, dyn_choose, dyn_jv, dyn_null_basis, &
-            SOLVER_AUTO, SOLVER_DENSE, SOLVER_BANDED, friction_forces, dyn_element_outputs, &
+            dyn_factor_projection, SOLVER_AUTO, SOLVER_DENSE, SOLVER_BANDED, friction_forces, dyn_element_outputs, &
             element_state, element_slip
   public :: MODE_STUCK
 
@@ -767,6 +767,26 @@ contains
       w%rhs(w%n + k) = f * x(w%rows(k))
     end do
   end subroutine gather_rows
+
+  !> Assemble at q and factor the matrix of a projection, s [D J^T; J 0] (active rows) with
+  !! D = I (minimum-norm changes, as dyn_project_pos) or, with kinetic, D = M (massless
+  !! coordinates: the unit metric, as dyn_velocity); dyn_solve then solves with it and
+  !! w%jv = J x comes from dyn_jv (the blocks are assembled).
+  subroutine dyn_factor_projection(m, w, q, t, kinetic, status)
+    type(model_t), intent(in) :: m           !! model
+    type(dyn_work_t), intent(inout) :: w     !! work arrays
+    real(wp), intent(in) :: q(:)             !! configuration
+    real(wp), intent(in) :: t                !! time
+    logical, intent(in) :: kinetic           !! D = M (else the identity)
+    integer, intent(out) :: status           !! MBD_OK or MBD_SINGULAR
+    if (kinetic) then
+      w%metric = merge(m%mdiag, w%s, m%mdiag > zero)
+    else
+      w%metric = w%s
+    end if
+    call assemble(m, w, q, w%qz, t)
+    call factor_aug(w, w%metric, status)
+  end subroutine dyn_factor_projection
 
   !> Velocities consistent with J q_dot = nu, nearest to v0 in kinetic energy:
   !! [M J^T; J 0][q_dot; mu] = [M v0; nu]. Massless coordinates get the unit metric.

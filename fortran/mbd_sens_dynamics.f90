@@ -33,7 +33,8 @@ module mbd_sens_dynamics
                           lu_solve_small, LS_RTOL
   use mbd_lapack, only: dgelsy
   use mbd_status, only: MBD_INTEGRATOR_FAILED, MBD_BAD_SETTING
-  use mbd_dynamics, only: dyn_work_t, dyn_accel, dyn_solve, dyn_project_pos, dyn_velocity
+  use mbd_dynamics, only: dyn_work_t, dyn_accel, dyn_solve, dyn_project_pos, dyn_velocity, &
+                          dyn_factor_projection, dyn_jv
   use mbd_integrators, only: output_rows, C2, C3, C4, C5, A21, A31, A32, A41, A42, A43, A51, &
                              A52, A53, A54, A61, A62, A63, A64, A65, A71, A73, A74, A75, A76, &
                              E1, E3, E4, E5, E6, E7
@@ -45,10 +46,7 @@ module mbd_sens_dynamics
 
   !> Work of project_sens (allocated once per run by proj_init: no step allocates).
   type :: proj_work_t
-    real(wp), allocatable :: vv(:), met(:), aug(:, :), r(:), aug2(:, :), phi(:), nu(:), &
-                             gam(:), jac(:, :), z(:), hvs(:)
-    integer, allocatable :: piv(:), piv2(:)
-    type(asm_work_t) :: a                       !! assembly work
+    real(wp), allocatable :: vv(:), r(:), z(:), hvs(:)
   end type proj_work_t
 
 contains
@@ -60,16 +58,12 @@ contains
     type(proj_work_t), intent(out) :: pw        !! the work
     integer, intent(out) :: status              !! MBD_OK or MBD_NO_MEMORY
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
-    integer :: n, na, st
-    n = m%nq; na = w%na
-    allocate (pw%vv(n), pw%met(n), pw%aug(n + na, n + na), pw%r(n + na), &
-              pw%aug2(n + na, n + na), pw%phi(m%neq), pw%nu(m%neq), pw%gam(m%neq), &
-              pw%jac(m%neq, n), pw%z(n), pw%hvs(m%neq), pw%piv(n + na), pw%piv2(n + na), &
-              stat=st)
+    integer :: st
+    status = MBD_OK; msg = ''
+    allocate (pw%vv(m%nq), pw%r(m%nq + w%na), pw%z(m%nq), pw%hvs(m%neq), stat=st)
     if (st /= 0) then
-      status = MBD_NO_MEMORY; msg = 'out of memory for the sensitivity projections'; return
+      status = MBD_NO_MEMORY; msg = 'out of memory for the sensitivity projections'
     end if
-    call asm_init(m, pw%a, status, msg)
   end subroutine proj_init
 
   !> dlambda/dp (neq, np) at one output of an inverse dynamics run, from the kinematic
@@ -511,53 +505,53 @@ contains
 
   !> Project the sensitivities in the packed state yy = (q, S, q_dot, S_dot) (q, q_dot
   !! consistent) onto the linearized constraints: S onto J S = -Phi_p by the minimum-norm
-  !! change, S_dot onto J S_dot = nu_p - J_p q_dot - Hv S nearest in the kinetic metric.
+  !! change, s [I J^T; J 0][dS; mu] = [0; -s (J S + Phi_p)], then S_dot onto
+  !! J S_dot = nu_p - J_p q_dot - Hv S nearest in the kinetic metric,
+  !! s [M J^T; J 0][S_dot; mu] = [M S_dot; s (nu_p - J_p q_dot - Hv S)], with the matrices
+  !! and solves of the state's projections (dyn_factor_projection: the Schur complement, the
+  !! band or the dense LU as the model allows; no dense J).
   subroutine project_sens(m, w, s, tt, yy, pw, stp)
     type(model_t), intent(in) :: m              !! model with dynamics data
-    type(dyn_work_t), intent(in) :: w           !! dynamics work arrays (active rows, scale)
+    type(dyn_work_t), intent(inout) :: w        !! dynamics work arrays (its matrix is used)
     type(sens_t), intent(inout) :: s            !! parameters and blocks
     real(wp), intent(in) :: tt                  !! time
     real(wp), intent(inout) :: yy(:)            !! packed state
     type(proj_work_t), intent(inout) :: pw      !! work (proj_init)
     integer, intent(out) :: stp                 !! MBD_OK or MBD_SINGULAR
     integer :: kk, o, i, n, nz
-    character(len=MSG_LEN) :: lmsg
     n = m%nq; nz = n * (1 + s%np)
-    associate (vv => pw%vv, met => pw%met, aug => pw%aug, r => pw%r, aug2 => pw%aug2, &
-               phi => pw%phi, nu => pw%nu, gam => pw%gam, jac => pw%jac, z => pw%z, &
-               hvs => pw%hvs, piv => pw%piv, piv2 => pw%piv2)
+    associate (vv => pw%vv, r => pw%r, z => pw%z, hvs => pw%hvs)
       vv = yy(nz + 1:nz + n)
       z = zero
-      call assemble_dense(m, yy(1:n), vv, tt, phi, nu, gam, pw%a, jac)
       call sens_trig(m, s, yy(1:n))
       call sens_hessian(m, s, yy(1:n), vv, z, tt)
       call sens_params(m, s, yy(1:n), vv, z, tt)
-      met = merge(m%mdiag, w%s, m%mdiag > zero)
-      aug = zero; aug2 = zero
-      do i = 1, n
-        aug(i, i) = one; aug2(i, i) = met(i)
-      end do
-      aug(1:n, n + 1:) = transpose(jac(w%rows, :)); aug(n + 1:, 1:n) = jac(w%rows, :)
-      aug2(1:n, n + 1:) = aug(1:n, n + 1:); aug2(n + 1:, 1:n) = aug(n + 1:, 1:n)
-      call lu_factor(aug, piv, stp, lmsg)
-      if (stp == MBD_OK) call lu_factor(aug2, piv2, stp, lmsg)
+      call dyn_factor_projection(m, w, yy(1:n), tt, .false., stp)
       if (stp /= MBD_OK) return
-      do kk = 1, s%np
+      do kk = 1, s%np                           ! S += dS
         o = n * kk
-        ! S <- S + dS, [I J^T; J 0][dS; mu] = [0; -(J S + Phi_p)]
-        r = zero
-        r(n + 1:) = s%mphip(kk, w%rows) - matmul(jac(w%rows, :), yy(o + 1:o + n))
-        call lu_solve(aug, piv, r, stp, lmsg)
+        call dyn_jv(m, w, yy(o + 1:o + n))
+        r(1:n) = zero
+        do i = 1, w%na
+          r(n + i) = w%s * (s%mphip(kk, w%rows(i)) - w%jv(w%rows(i)))
+        end do
+        call dyn_solve(w, r, stp)
         if (stp /= MBD_OK) return
         yy(o + 1:o + n) = yy(o + 1:o + n) + r(1:n)
-        ! S_dot nearest in M to its value with J S_dot = nu_p - J_p q_dot - Hv S
+      end do
+      call dyn_factor_projection(m, w, yy(1:n), tt, .true., stp)
+      if (stp /= MBD_OK) return
+      do kk = 1, s%np                           ! S_dot, nearest in M
+        o = n * kk
         hvs = s%vp(kk, :)
         do i = 1, s%nnz
           hvs(s%nzr(i)) = hvs(s%nzr(i)) - s%nzv(i) * yy(o + s%nzc(i))
         end do
-        r(1:n) = met * yy(nz + o + 1:nz + o + n)
-        r(n + 1:) = hvs(w%rows)
-        call lu_solve(aug2, piv2, r, stp, lmsg)
+        r(1:n) = w%metric * yy(nz + o + 1:nz + o + n)
+        do i = 1, w%na
+          r(n + i) = w%s * hvs(w%rows(i))
+        end do
+        call dyn_solve(w, r, stp)
         if (stp /= MBD_OK) return
         yy(nz + o + 1:nz + o + n) = r(1:n)
       end do
