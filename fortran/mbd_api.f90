@@ -1066,7 +1066,8 @@ contains
   !! plus sq, sqd, sqdd (nq, np, rows), the sensitivities of q, q_dot and q_ddot.
   subroutine api_dynamics_sens(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, v0, t0, t1, &
                                nsteps, rtol, atol, every, max_steps, ptab, qout, qdout, qddout, &
-                               lamout, eout, sq, sqd, sqdd, iinfo, rinfo, redundant, status, msg)
+                               lamout, eout, sq, sqd, sqdd, iinfo, rinfo, redundant, status, msg, &
+                               solver)
     integer, intent(in) :: nb, ctab(:, :), ftab(:, :), nsteps, every, max_steps
     real(wp), intent(in) :: rpar(:), bmass(:, :), grav(2), fpar(:), q0(:), v0(:), t0, t1
     real(wp), intent(in) :: rtol, atol          !! tolerances (<= 0: defaults 1e-6, 1e-8)
@@ -1080,15 +1081,14 @@ contains
     integer, intent(out) :: redundant(:)
     integer, intent(out) :: status              !! MBD_OK, < 0 input, > 0 numerical
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    integer, intent(in), optional :: solver     !! 0 auto (default), 1 dense, 2 banded
     type(model_t) :: m
     type(dyn_work_t) :: w
-    type(kin_work_t) :: kw
     type(kin_opts_t) :: kopts
-    type(kin_report_t) :: rep
     type(sens_t) :: sens
     real(wp), allocatable :: q(:), qd(:), s0(:, :), sd0(:, :)
     real(wp) :: t, r_tol, a_tol, hmm(2), tfail
-    integer :: bad, badf, k, ko, nout, st, stats(3)
+    integer :: bad, badf, k, ko, nout, st, stats(3), path, kl, ku
     character(len=MSG_LEN) :: lmsg
     iinfo = 0; rinfo = zero; redundant = 0
     qout = zero; qdout = zero; qddout = zero; lamout = zero; eout = zero
@@ -1115,25 +1115,27 @@ contains
     if (status /= MBD_OK) then
       iinfo(2) = -2000000 - bad; return
     end if
-    call dyn_memory_check(m, status, msg)
+    ! the path as for dynamics (auto: the band, Schur complement included, for a large model;
+    ! nothing of the sensitivities needs a dense J)
+    call dyn_choose(m, solver_or_auto(solver), path, kl, ku, status, msg)
     if (status /= MBD_OK) return
-    call kin_work_init(m, kw, status, msg)
+    rinfo(5) = path; rinfo(6) = kl; rinfo(7) = ku
+    if (path == SOLVER_DENSE) call dyn_memory_check(m, status, msg)
     if (status /= MBD_OK) return
-    kw%tol = kopts%tol * m%lscale
-    allocate (q(m%nq), qd(m%nq), rep%qsing(m%nq), rep%dep(m%neq), rep%redundant(m%neq), &
-              s0(m%nq, sens%np), sd0(m%nq, sens%np), stat=st)
+    allocate (q(m%nq), qd(m%nq), s0(m%nq, sens%np), sd0(m%nq, sens%np), stat=st)
     if (st /= 0) then
       call mem_fail(REAL_BYTES * (3 * real(m%nq, wp) * (1 + sens%np) + m%neq), &
                     'the state and its sensitivities', 'use fewer parameters', status, msg)
       return
     end if
     q = q0 / m%cunit
-    call kin_assemble(m, kw, q, t0, kopts, rep, status, msg)
+    call assemble_start(m, path, q, t0, kopts, status, msg)
     if (status /= MBD_OK) then
       rinfo(1) = t0; return
     end if
-    call dyn_init(m, w, q, t0, kw%tol, status, msg)
+    call dyn_init(m, w, q, t0, kopts%tol * m%lscale, status, msg, path)
     if (status /= MBD_OK) return
+    rinfo(6) = w%sd%kl; rinfo(7) = w%sd%ku
     iinfo(9) = w%na
     do k = 1, m%neq
       if (.not. any(w%rows == k)) redundant(k) = 1

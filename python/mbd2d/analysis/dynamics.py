@@ -124,7 +124,7 @@ def run_dynamics(model: ModelDescription, t_end: float, steps: int, method: str 
     if params:
         ptab = table(p, params, d)
         out = core.dynamics_sens(p, d, t0, t_end, steps, rtol_v, atol_v, every, nmax, nout,
-                                 ptab)
+                                 ptab, code)
         check_status(out.status, out.iinfo, out.msg, params)
     else:
         fixed = (t_end - t0) / h_v if h_v > 0 else 0.0
