@@ -8,11 +8,12 @@
 !! Half the physical memory is the rule the Python front end applies to its output arrays.
 !! Requests below CHECK_ABOVE are not checked (no file read in small or per-step calls).
 module mbd_memory
-  use mbd_kinds, only: wp, half
+  use mbd_kinds, only: wp, half, zero
   use mbd_status, only: MBD_OK, MBD_NO_MEMORY, MSG_LEN
   implicit none
   private
-  public :: MIB, GIB, CHECK_ABOVE, REAL_BYTES, mem_limit, mem_text, mem_check, mem_fail
+  public :: MIB, GIB, CHECK_ABOVE, REAL_BYTES, mem_limit, mem_text, mem_check, mem_fail, &
+            zero_fill
 
   real(wp), parameter :: MIB = 1048576.0_wp            !! bytes in a MiB
   real(wp), parameter :: GIB = 1073741824.0_wp         !! bytes in a GiB
@@ -91,5 +92,13 @@ contains
     msg = 'not enough memory: allocating ' // trim(mem_text(bytes)) // ' for ' // what // &
           ' failed; ' // hint
   end subroutine mem_fail
+
+  !> a(1:n) = 0 for an array seen flat: one memset (gfortran clears a 2-D or 3-D array or
+  !! section column by column, a memset call per column).
+  pure subroutine zero_fill(n, a)
+    integer, intent(in) :: n          !! number of entries
+    real(wp), intent(out) :: a(n)     !! the array, flat
+    a = zero
+  end subroutine zero_fill
 
 end module mbd_memory

@@ -30,7 +30,7 @@
 module mbd_schur
   use mbd_kinds, only: wp, zero, one
   use mbd_status, only: MBD_OK, MBD_NO_MEMORY, MSG_LEN
-  use mbd_memory, only: REAL_BYTES, mem_check, mem_fail
+  use mbd_memory, only: REAL_BYTES, mem_check, mem_fail, zero_fill
   use mbd_points, only: NLOC, MAXROW
   use mbd_model, only: model_t
   use mbd_band, only: band_graph, band_rcm
@@ -294,7 +294,7 @@ contains
     do e = 1, size(sc%esrc)
       sc%ev(e) = s * jb(sc%esrc(e))
     end do
-    sc%g = zero
+    call zero_fill(size(sc%g), sc%g)        ! (one memset, not one per column)
     do g = 1, sc%ng
       w = sc%gc(g + 1) - sc%gc(g)
       c = sc%gc(g) - 1

@@ -22,6 +22,7 @@
 module mbd_sensitivity
   use mbd_kinds, only: wp, zero, one
   use mbd_status, only: MBD_OK, MBD_BAD_PARAM, MBD_BAD_INPUT, MBD_NO_MEMORY, MSG_LEN
+  use mbd_memory, only: zero_fill
   use mbd_points, only: NLOC, MAXROW, kloc, local_state
   use mbd_dual, only: dloc
   use mbd_model, only: model_t, NCT, NFT
@@ -933,13 +934,6 @@ contains
       w = [-(ss * v(1) + cc * v(2)), cc * v(1) - ss * v(2)]
     end function rperp
   end subroutine sens_jpt_lam
-
-  !> a(1:n) = 0 for an array seen flat.
-  pure subroutine zero_fill(n, a)
-    integer, intent(in) :: n
-    real(wp), intent(out) :: a(n)
-    a = zero
-  end subroutine zero_fill
 
   !> Change of the applied generalized force Q along (dq, dq_dot) and parameter k
   !! (k = 0: no parameter change): forces by dual evaluation, gravity m g by the changes of
