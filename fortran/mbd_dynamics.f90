@@ -252,7 +252,8 @@ contains
   end subroutine dyn_init
 
   !> The pattern of K = d(J^T lambda - Q)/dq and C = -dQ/dq_dot: entry (i, c) when a
-  !! constraint or a force element holds both coordinates. The column groups: greedy
+  !! constraint or a force element holds both coordinates (a revolute joint: only its
+  !! bodies' angles, each with itself; see pair). The column groups: greedy
   !! colouring in which two columns share a group only when no row has both in its pattern
   !! (no element couples them to a common coordinate), so one residual evaluation with the
   !! whole group perturbed gives each column's entries exactly as perturbing it alone would.
@@ -283,7 +284,7 @@ contains
     do e = 1, m%nc + m%nf
       do s = 1, NLOC
         c = slot(e, s)
-        if (c > 0) cnt(c + 1) = cnt(c + 1) + count([(slot(e, i) > 0, i=1, NLOC)])
+        if (c > 0) cnt(c + 1) = cnt(c + 1) + count([(pair(e, s, i), i=1, NLOC)])
       end do
     end do
     cnt(1) = 1
@@ -296,7 +297,7 @@ contains
         c = slot(e, s)
         if (c == 0) cycle
         do i = 1, NLOC
-          if (slot(e, i) == 0) cycle
+          if (.not. pair(e, s, i)) cycle
           w%krow(nxt(c)) = slot(e, i)
           nxt(c) = nxt(c) + 1
         end do
@@ -371,6 +372,16 @@ contains
         slot = m%floc(s, e - m%nc)
       end if
     end function slot
+
+    !> Slots a and b of element e can couple in K: both present; a revolute joint only on
+    !! each body's angle (J^T lambda of a pin: lambda on x, y, lambda . B(theta) s on theta,
+    !! so d/dq is -lambda . A(theta) s on the theta diagonal and zero elsewhere).
+    pure logical function pair(e, a, b)
+      integer, intent(in) :: e, a, b
+      pair = slot(e, a) > 0 .and. slot(e, b) > 0
+      if (.not. pair .or. e > m%nc) return
+      if (m%kind(e) == CON_REVOLUTE) pair = a == b .and. (a == 3 .or. a == 6)
+    end function pair
   end subroutine tangent_pattern
 
   !> The work arrays of contacts and friction (element states, friction solve).

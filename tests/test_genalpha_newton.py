@@ -21,10 +21,12 @@ import numpy as np
 import pytest
 
 import mbd2d
-from conftest import EXAMPLES
+from conftest import EXAMPLES, model_from_toml
+from test_translational_sensitivity import INVERTED
 
 sys.path.insert(0, str(EXAMPLES))
 import free_fourbar as free_fourbar_example  # noqa: E402
+import nfourbar  # noqa: E402
 
 G = 9.81
 RHO_INF = 0.9
@@ -127,3 +129,43 @@ def test_adaptive_generalized_alpha_still_controls_its_error() -> None:
                              atol=rtol * 1e-2)
         errs.append(np.max(np.abs(np.asarray(res.q)[:, 2::3] - np.asarray(ref.q)[:, 2::3])))
     assert errs[1] < errs[0] / 10
+
+
+def geometric_stiffness(model: mbd2d.Model, q: np.ndarray, lam: np.ndarray) -> np.ndarray:
+    """d(J(q)^T lambda)/dq by central differences of model.jacobian."""
+    n = len(q)
+    k = np.zeros((n, n))
+    for c in range(n):
+        dq = np.zeros(n)
+        dq[c] = 1e-6
+        k[:, c] = (model.jacobian(q + dq).T @ lam - model.jacobian(q - dq).T @ lam) / 2e-6
+    return k
+
+
+def test_pin_joints_stiffen_only_their_angles() -> None:
+    """The pattern of generalized-alpha's tangent K: a revolute joint's J^T lambda depends
+    on q only through each body's angle (lambda . B(theta) s on theta), so its K has entries
+    on the theta diagonal alone, and the iteration matrix of a pin-jointed chain is as
+    narrow as the index-1 saddle-point matrix (band (6, 6) for the N-four-bar). Checked
+    from central differences of model.jacobian with arbitrary multipliers; a translational
+    joint couples more (off-diagonal entries), so only pins get the narrow pattern."""
+    rng = np.random.default_rng(3)
+    model = free_fourbar()
+    res = model.dynamics(0.01, 1, method="dopri5")
+    q = res.q[-1]
+    lam = rng.normal(size=model.jacobian(q).shape[0])
+    k = geometric_stiffness(model, q, lam)
+    theta = np.zeros(k.shape, dtype=bool)
+    for b in range(len(model.bodies)):
+        theta[3 * b + 2, 3 * b + 2] = True
+    assert np.abs(k[~theta]).max() < 1e-8 * np.abs(k).max()
+    assert np.abs(k[theta]).min() > 1e-3 * np.abs(k).max()
+    slider = model_from_toml(INVERTED)                # a slider between two moving bodies
+    qs = slider.kinematics(0.1, 1).q[-1]
+    ks = geometric_stiffness(slider, qs, rng.normal(size=slider.jacobian(qs).shape[0]))
+    off = ~np.eye(len(qs), dtype=bool)
+    assert np.abs(ks[off]).max() > 1e-3 * np.abs(ks).max()
+    chain = nfourbar.build(100, driven=False, omega0=1.0)
+    ga = chain.dynamics(0.002, 1, method="generalized-alpha", h=1e-3, solver="banded")
+    dp = chain.dynamics(0.002, 1, method="dopri5", solver="banded")
+    assert ga.stats["band"] == dp.stats["band"] == (6, 6)
