@@ -821,7 +821,12 @@ contains
     iinfo(6) = dst%rhs; iinfo(7) = dst%jacobians; iinfo(8) = dst%partitions
     iinfo(10) = dst%factorizations
     rinfo(2) = dst%hmin; rinfo(3) = dst%hmax
-    rinfo(4) = w%sd%nfactor; rinfo(8) = w%sd%nschur   ! index-1 factorizations, by Schur
+    ! saddle-point factorizations (index-1, and generalized-alpha's when its K is diagonal),
+    ! of them through the Schur complement
+    rinfo(4) = w%sd%nfactor; rinfo(8) = w%sd%nschur
+    if (dst%schur > 0) then
+      rinfo(4) = rinfo(4) + dst%factorizations; rinfo(8) = rinfo(8) + dst%schur
+    end if
     if (dst%rc_min < huge(one)) then          ! partitioned: J_u's worst conditioning
       rinfo(9) = dst%rc_min; rinfo(10) = dst%t_rc_min
     end if

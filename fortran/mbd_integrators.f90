@@ -77,6 +77,7 @@ module mbd_integrators
   type :: dyn_stats_t
     integer :: steps = 0, rejected = 0, newton = 0, rhs = 0, jacobians = 0, partitions = 0
     integer :: factorizations = 0     !! LU factorizations of the iteration matrix
+    integer :: schur = 0              !! of them through the Schur complement (diagonal K)
     integer :: kl = 0, ku = 0         !! band widths of the iteration matrix (band path)
     real(wp) :: hmin = huge(one), hmax = zero
     real(wp) :: t_fail = zero         !! time reached when a method failed
@@ -454,13 +455,16 @@ contains
     real(wp) :: res(m%nq + w%na), dg(m%nq), ew(m%nq)
     real(wp), allocatable :: kv(:), cv(:), kc(:)   ! K, C and K + g' C on the pattern
     type(saddle_t) :: sg                            ! the iteration matrix S
-    integer :: it, n, stt, nfix, na, attempt, nkc, k, nnz, kev, nprev
-    logical :: fixed, conv, have_kc, new_kc, finite, changed
+    integer :: it, n, stt, nfix, na, attempt, nkc, k, nnz, kev, nprev, i
+    logical :: fixed, conv, have_kc, new_kc, finite, changed, diagk
     status = MBD_OK; msg = ''
     n = m%nq; na = w%na
-    ! S = [M b' + K + g' C, b' J^T; b' J, 0] on the path of w (dense: plain-loop LU)
+    ! S = [M b' + K + g' C, b' J^T; b' J, 0] on the path of w (dense: plain-loop LU); a
+    ! diagonal K pattern (pins, no force couples two coordinates) keeps the upper-left block
+    ! diagonal, and S goes through its Schur complement like the index-1 systems (mbd_schur)
+    diagk = all([(all(w%krow(w%kptr(k):w%kptr(k + 1) - 1) == k), k=1, m%nq)])
     call saddle_plan(m, w%rows, w%solver, sg, status, msg, kptr=w%kptr, krow=w%krow, &
-                     small=.true.)
+                     small=.true., schur=diagk)
     if (status /= MBD_OK) return
     c%st%kl = sg%kl; c%st%ku = sg%ku
     nnz = w%kptr(n + 1) - 1
@@ -578,7 +582,17 @@ contains
             do k = 1, n
               dg(k) = m%mdiag(k) * bp
             end do
-            call saddle_factor(sg, dg, w%asm%jb, bp, stt, kv=kc)
+            if (diagk) then                 ! K + g' C on the diagonal: A = diag(dg)
+              do k = 1, n
+                do i = w%kptr(k), w%kptr(k + 1) - 1
+                  dg(k) = dg(k) + kc(i)
+                end do
+              end do
+              call saddle_factor(sg, dg, w%asm%jb, bp, stt, schur=.true.)
+              if (sg%schur) c%st%schur = c%st%schur + 1
+            else
+              call saddle_factor(sg, dg, w%asm%jb, bp, stt, kv=kc)
+            end if
             c%st%factorizations = c%st%factorizations + 1
             if (stt /= MBD_OK) exit
           end if

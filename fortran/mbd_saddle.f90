@@ -128,7 +128,7 @@ contains
   !! column c), for a full matrix. solver: 1 dense, 2 banded. small: the dense path factors
   !! in plain loops (a small iteration matrix, no near-singularity check). index1: allocate
   !! the workspace of nearly singular solves (saddle_factor's check). Allocates.
-  subroutine saddle_plan(m, rows, solver, sd, status, msg, kptr, krow, small, index1)
+  subroutine saddle_plan(m, rows, solver, sd, status, msg, kptr, krow, small, index1, schur)
     type(model_t), intent(in) :: m                 !! model
     integer, intent(in) :: rows(:)                 !! active rows (na), increasing
     integer, intent(in) :: solver                  !! 1 dense, 2 banded
@@ -138,6 +138,9 @@ contains
     integer, intent(in), optional :: kptr(:), krow(:)  !! tangent pattern (full)
     logical, intent(in), optional :: small         !! dense: sparse / plain LU for iterations
     logical, intent(in), optional :: index1        !! workspace of nearly singular solves
+    !> plan the Schur complement for a full matrix too (its K pattern diagonal: A stays
+    !! diagonal, K folded into d by the caller; saddle_factor's schur)
+    logical, intent(in), optional :: schur
     integer, allocatable :: arow(:), sr(:), sc(:), perm(:), cptr(:), crow(:), csrc(:)
     integer :: n, na, nt, ne, nk, c, a, i, ierr, ldab
     real(wp) :: bytes
@@ -220,7 +223,7 @@ contains
       sd%a = zero
       if (sd%plain .and. nt <= SPARSE_MAX) call sparse_plan(sd, sr, sc)
     end if
-    if (chk .and. .not. sd%full) then         ! index-1 with diagonal A: the Schur complement
+    if ((chk .and. .not. sd%full) .or. present_and(schur)) then   ! diagonal A: the Schur complement
       call schur_plan(m, rows, sd%sc, status, msg)
       if (status /= MBD_OK) return
     end if
@@ -398,7 +401,7 @@ contains
   !! the constraint diagonal) and factor it. check: index-1 (a nearly singular matrix is
   !! detected and solved as such, sd%lsq; the plan needs index1); otherwise a plain
   !! factorization (status MBD_SINGULAR on an exactly zero pivot).
-  subroutine saddle_factor(sd, d, jb, s, status, kv, e, check)
+  subroutine saddle_factor(sd, d, jb, s, status, kv, e, check, schur)
     type(saddle_t), intent(inout) :: sd        !! planned matrix; factors on return
     real(wp), intent(in) :: d(:)               !! diagonal of A (n)
     real(wp), intent(in) :: jb(:, :, :)        !! constraint blocks (MAXROW, NLOC, nc)
@@ -407,6 +410,9 @@ contains
     real(wp), intent(in), optional :: kv(:)    !! K on its pattern (full)
     real(wp), intent(in), optional :: e        !! constraint diagonal -e (default 0)
     logical, intent(in), optional :: check     !! index-1: nearly singular solves
+    !> try the Schur complement without the index-1 checks (A diagonal: an iteration matrix
+    !! whose K is diagonal, folded into d); refused, the LU of the path as without it
+    logical, intent(in), optional :: schur
     real(wp) :: ee, anorm, rc, pr
     logical :: chk, refused
     character(len=MSG_LEN) :: msg
@@ -417,7 +423,8 @@ contains
     sd%lsq = .false.
     sd%schur = .false.
     refused = .false.
-    if (chk .and. sd%use_schur .and. .not. present(kv) .and. .not. abs(ee) > zero) then
+    if ((chk .or. present_and(schur)) .and. sd%use_schur .and. .not. present(kv) .and. &
+        .not. abs(ee) > zero) then
       ! diagonal, positive A and a well-conditioned Schur complement: its Cholesky
       call schur_factor(sd%sc, d, jb, s, sd%schur)
       status = MBD_OK
@@ -626,6 +633,13 @@ contains
       f(etpos(i)) = f(etpos(i)) + v
     end do
   end subroutine put
+
+  !> An optional flag, .false. when absent.
+  pure logical function present_and(flag)
+    logical, intent(in), optional :: flag
+    present_and = .false.
+    if (present(flag)) present_and = flag
+  end function present_and
 
   !> min |u_ii| / max |u_ii| of dense LU factors.
   pure real(wp) function pivot_ratio(a) result(pr)

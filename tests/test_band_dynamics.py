@@ -130,6 +130,7 @@ def test_band_path_follows_the_reduced_solution_at_n_300() -> None:
     for h in (4e-3, 2e-3):
         res = model.dynamics(t_end, 20, method="generalized-alpha", h=h)
         assert res.stats["solver"] == "banded"
+        assert res.stats["schur"][0] == res.stats["schur"][1] >= res.stats["factorizations"]
         th = res.q[:, 2::3][:, :n + 1]
         assert np.abs(th - th[:, :1]).max() < 1e-10          # the parallelogram branch
         errs.append(np.abs(th[:, 0] - ref).max())
