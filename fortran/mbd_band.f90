@@ -372,12 +372,8 @@ contains
       call dlacn2(n, b%work(1:n), b%work(n + 1:2 * n), b%iwork, ainvnm, kase, isave)
       if (kase == 0) exit
       if (b%plain) then                       ! band_lu's factors: plain loops
-        if (kase == 1) then
-          call band_lu_solve(n, b%kl, b%ku, b%ab, b%ldab, b%ipiv, b%work(n + 1:2 * n), b%kvu)
-        else
-          call band_lu_solve_t(n, b%kl, b%ku, b%ab, b%ldab, b%ipiv, b%work(n + 1:2 * n), &
-                               b%kvu)
-        end if
+        call band_lu_solve(n, b%kl, b%ku, b%ab, b%ldab, b%ipiv, b%work(n + 1:2 * n), b%kvu, &
+                           trans=kase == 2)
       else
         call dgbtrs(merge('N', 'T', kase == 1), n, b%kl, b%ku, 1, b%ab, b%ldab, b%ipiv, &
                     b%work(n + 1:2 * n), n, info)
@@ -570,17 +566,43 @@ contains
     end do
   end subroutine band_lu
 
-  !> Solve B x = r with the factors of band_lu (or dgbtrf) in plain loops: the row
-  !! interchanges and L (forward), then U (upper width kl + ku, backward); r becomes x.
-  pure subroutine band_lu_solve(n, kl, ku, ab, ldab, ipiv, r, kvu)
+  !> Solve B x = r (or, with trans, B^T x = r: dgbtrs 'T') with the factors of band_lu (or
+  !! dgbtrf) in plain loops; r becomes x. B x = r: the row interchanges and L forward, then U
+  !! (upper width kvu) backward; B^T x = r: U^T forward, then L^T backward with the
+  !! interchanges in reverse.
+  pure subroutine band_lu_solve(n, kl, ku, ab, ldab, ipiv, r, kvu, trans)
     integer, intent(in) :: n, kl, ku, ldab    !! size, widths, leading dimension
     real(wp), intent(in) :: ab(ldab, n)       !! factors
     integer, intent(in) :: ipiv(n)            !! row interchanges
     real(wp), intent(inout) :: r(n)           !! right-hand side, then solution
     integer, intent(in) :: kvu                !! upper width of U (band_lu's)
+    logical, intent(in), optional :: trans    !! solve B^T x = r (default .false.)
     integer :: kv, i, j, p
     real(wp) :: tmp, f
     kv = ku + kl
+    if (present(trans)) then
+      if (trans) then
+        do j = 1, n                           ! U^T y = r: y_j = (r_j - sum_i u_ij y_i) / u_jj
+          f = r(j)
+          do i = max(1, j - kvu), j - 1
+            f = f - ab(kv + 1 + i - j, j) * r(i)
+          end do
+          r(j) = f / ab(kv + 1, j)
+        end do
+        do j = n - 1, 1, -1                   ! L^T x = y, then P^T: x_j -= sum_i l_ij x_i
+          f = r(j)
+          do i = 1, min(kl, n - j)
+            f = f - ab(kv + 1 + i, j) * r(j + i)
+          end do
+          r(j) = f
+          p = ipiv(j)
+          if (p /= j) then
+            tmp = r(j); r(j) = r(p); r(p) = tmp
+          end if
+        end do
+        return
+      end if
+    end if
     do j = 1, n - 1
       p = ipiv(j)
       if (p /= j) then
@@ -601,37 +623,6 @@ contains
       end do
     end do
   end subroutine band_lu_solve
-
-  !> Solve B^T x = r with the factors of band_lu in plain loops (dgbtrs 'T'): U^T forward
-  !! (upper width kvu), then L^T backward with the row interchanges in reverse; r becomes x.
-  pure subroutine band_lu_solve_t(n, kl, ku, ab, ldab, ipiv, r, kvu)
-    integer, intent(in) :: n, kl, ku, ldab    !! size, widths, leading dimension
-    real(wp), intent(in) :: ab(ldab, n)       !! factors
-    integer, intent(in) :: ipiv(n)            !! row interchanges
-    real(wp), intent(inout) :: r(n)           !! right-hand side, then solution
-    integer, intent(in) :: kvu                !! upper width of U (band_lu's)
-    integer :: kv, i, j, p
-    real(wp) :: tmp, f
-    kv = ku + kl
-    do j = 1, n                               ! U^T y = r: y_j = (r_j - sum_i u_ij y_i) / u_jj
-      f = r(j)
-      do i = max(1, j - kvu), j - 1
-        f = f - ab(kv + 1 + i - j, j) * r(i)
-      end do
-      r(j) = f / ab(kv + 1, j)
-    end do
-    do j = n - 1, 1, -1                       ! L^T x = y, then P^T: x_j -= sum_i l_ij x_i
-      f = r(j)
-      do i = 1, min(kl, n - j)
-        f = f - ab(kv + 1 + i, j) * r(j + i)
-      end do
-      r(j) = f
-      p = ipiv(j)
-      if (p /= j) then
-        tmp = r(j); r(j) = r(p); r(p) = tmp
-      end if
-    end do
-  end subroutine band_lu_solve_t
 
   ! ---------------------------------------------------------------------------------------
   ! ordering
