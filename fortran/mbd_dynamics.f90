@@ -59,8 +59,8 @@ module mbd_dynamics
             dyn_velocity, &
             dyn_project_pos, dyn_multipliers, dyn_reactions, dyn_tangent, dyn_solve, &
             dyn_jt_lam, dyn_damped, dyn_assemble, dyn_choose, dyn_jv, dyn_null_basis, &
-            dyn_factor_projection, SOLVER_AUTO, SOLVER_DENSE, SOLVER_BANDED, friction_forces, dyn_element_outputs, &
-            element_state, element_slip
+            dyn_factor_projection, SOLVER_AUTO, SOLVER_DENSE, SOLVER_BANDED, friction_forces, &
+            dyn_element_outputs, element_state, element_slip
   public :: MODE_STUCK
 
   integer, parameter :: MODE_STUCK = 2   !! friction mode of a stuck joint (w%cst(1, k))

@@ -223,7 +223,8 @@ contains
       sd%a = zero
       if (sd%plain .and. nt <= SPARSE_MAX) call sparse_plan(sd, sr, sc)
     end if
-    if ((chk .and. .not. sd%full) .or. present_and(schur)) then   ! diagonal A: the Schur complement
+    ! diagonal A (index-1, or an iteration matrix with a diagonal K): the Schur complement
+    if ((chk .and. .not. sd%full) .or. present_and(schur)) then
       call schur_plan(m, rows, sd%sc, status, msg)
       if (status /= MBD_OK) return
     end if
