@@ -243,7 +243,7 @@ class Model(ModelDescription):
             variational equations are integrated with the state, under the same error
             control, giving ``dq_dp``, ``dqd_dp``, ``dqdd_dp`` (rows, n_coordinates,
             n_params). The start's sensitivities are those of the assembled q0 (the minimum-
-            norm change) and of the projected v0.
+            norm change) and of the projected v0. They take the path ``solver`` gives.
         progress : bool, optional
             A progress bar while the core integrates, as in :meth:`kinematics`.
         solver : {"auto", "dense", "banded"}, optional
@@ -253,7 +253,10 @@ class Model(ModelDescription):
             with the rows of its constraints (no n x n matrix: cost and memory linear in the
             number of bodies of a chain-like model). "auto" picks the band for at least 60
             coordinates whose band is narrow (``res.stats["solver"]`` and
-            ``res.stats["band"]`` say which ran).
+            ``res.stats["band"]`` say which ran). Systems with a diagonal upper-left block
+            (the index-1 ones; on the band path generalized-alpha's when its K is diagonal,
+            as for pins) go through the Schur complement J A^-1 J^T where it is well
+            conditioned (``res.stats["schur"]``).
 
         Returns
         -------
