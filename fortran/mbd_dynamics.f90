@@ -41,7 +41,7 @@ module mbd_dynamics
   use mbd_memory, only: REAL_BYTES, mem_check, mem_fail
   use mbd_points, only: NLOC, rot
   use mbd_model, only: model_t, model_slots
-  use mbd_constraints, only: con_is_driver, con_name, CON_REVOLUTE
+  use mbd_constraints, only: con_is_driver, con_name, con_affine_r, CON_REVOLUTE
   use mbd_forces, only: force_eval, FRC_SPRING, FRC_ROTSPRING, FRC_FRICTION, force_is_contact
   use mbd_contact, only: NCS, NEO, MODE_UNTRACKED, joint_slip, joint_normal_load, &
                          joint_friction_force, reg_mu, contact_damped
@@ -252,8 +252,8 @@ contains
   end subroutine dyn_init
 
   !> The pattern of K = d(J^T lambda - Q)/dq and C = -dQ/dq_dot: entry (i, c) when a
-  !! constraint or a force element holds both coordinates (a revolute joint: only its
-  !! bodies' angles, each with itself; see pair). The column groups: greedy
+  !! constraint or a force element holds both coordinates (a pin, a weld, a line fixed in
+  !! ground: only its bodies' angles, each with itself; see pair). The column groups: greedy
   !! colouring in which two columns share a group only when no row has both in its pattern
   !! (no element couples them to a common coordinate), so one residual evaluation with the
   !! whole group perturbed gives each column's entries exactly as perturbing it alone would.
@@ -373,14 +373,16 @@ contains
       end if
     end function slot
 
-    !> Slots a and b of element e can couple in K: both present; a revolute joint only on
-    !! each body's angle (J^T lambda of a pin: lambda on x, y, lambda . B(theta) s on theta,
-    !! so d/dq is -lambda . A(theta) s on the theta diagonal and zero elsewhere).
+    !> Slots a and b of element e can couple in K: both present; a constraint affine in the
+    !! positions with each body's angle apart (con_affine_r: pins, welds, a line fixed in
+    !! ground, linear ones) only on each angle with itself (a pin's J^T lambda: lambda on
+    !! x, y, lambda . B(theta) s on theta, so d/dq is -lambda . A(theta) s on the theta
+    !! diagonal and zero elsewhere).
     pure logical function pair(e, a, b)
       integer, intent(in) :: e, a, b
       pair = slot(e, a) > 0 .and. slot(e, b) > 0
       if (.not. pair .or. e > m%nc) return
-      if (m%kind(e) == CON_REVOLUTE) pair = a == b .and. (a == 3 .or. a == 6)
+      if (con_affine_r(m%kind(e), m%bi(e))) pair = a == b .and. (a == 3 .or. a == 6)
     end function pair
   end subroutine tangent_pattern
 

@@ -145,10 +145,11 @@ def geometric_stiffness(model: mbd2d.Model, q: np.ndarray, lam: np.ndarray) -> n
 def test_pin_joints_stiffen_only_their_angles() -> None:
     """The pattern of generalized-alpha's tangent K: a revolute joint's J^T lambda depends
     on q only through each body's angle (lambda . B(theta) s on theta), so its K has entries
-    on the theta diagonal alone, and the iteration matrix of a pin-jointed chain is as
-    narrow as the index-1 saddle-point matrix (band (6, 6) for the N-four-bar). Checked
-    from central differences of model.jacobian with arbitrary multipliers; a translational
-    joint couples more (off-diagonal entries), so only pins get the narrow pattern."""
+    on the theta diagonal alone (so has a slider on a guide fixed in ground), and the
+    iteration matrix of a pin-jointed chain is as narrow as the index-1 saddle-point matrix
+    (band (6, 6) for the N-four-bar). Checked from central differences of model.jacobian
+    with arbitrary multipliers; a translational joint between two moving bodies couples
+    more (off-diagonal entries), so it keeps the full pattern."""
     rng = np.random.default_rng(3)
     model = free_fourbar()
     res = model.dynamics(0.01, 1, method="dopri5")
@@ -160,6 +161,13 @@ def test_pin_joints_stiffen_only_their_angles() -> None:
         theta[3 * b + 2, 3 * b + 2] = True
     assert np.abs(k[~theta]).max() < 1e-8 * np.abs(k).max()
     assert np.abs(k[theta]).min() > 1e-3 * np.abs(k).max()
+    guided = mbd2d.load(EXAMPLES / "slider_crank.toml")      # pins and a guide in ground
+    qg = guided.kinematics(0.1, 1).q[-1]
+    kg = geometric_stiffness(guided, qg, rng.normal(size=guided.jacobian(qg).shape[0]))
+    diag = np.zeros(kg.shape, dtype=bool)
+    for b in range(len(guided.bodies)):
+        diag[3 * b + 2, 3 * b + 2] = True
+    assert np.abs(kg[~diag]).max() < 1e-8 * np.abs(kg).max()
     slider = model_from_toml(INVERTED)                # a slider between two moving bodies
     qs = slider.kinematics(0.1, 1).q[-1]
     ks = geometric_stiffness(slider, qs, rng.normal(size=slider.jacobian(qs).shape[0]))
