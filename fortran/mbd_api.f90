@@ -821,7 +821,7 @@ contains
     iinfo(6) = dst%rhs; iinfo(7) = dst%jacobians; iinfo(8) = dst%partitions
     iinfo(10) = dst%factorizations
     rinfo(2) = dst%hmin; rinfo(3) = dst%hmax
-    ! saddle-point factorizations (index-1, and generalized-alpha's when its K is diagonal),
+    ! saddle-point factorizations (index-1, and generalized-alpha's when they go through S),
     ! of them through the Schur complement
     rinfo(4) = w%sd%nfactor; rinfo(8) = w%sd%nschur
     if (dst%schur > 0) then

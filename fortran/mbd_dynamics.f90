@@ -785,19 +785,24 @@ contains
   !! D = I (minimum-norm changes, as dyn_project_pos) or, with kinetic, D = M (massless
   !! coordinates: the unit metric, as dyn_velocity); dyn_solve then solves with it and
   !! w%jv = J x comes from dyn_jv (the blocks are assembled).
-  subroutine dyn_factor_projection(m, w, q, t, kinetic, status)
+  subroutine dyn_factor_projection(m, w, q, t, kinetic, status, assembled)
     type(model_t), intent(in) :: m           !! model
     type(dyn_work_t), intent(inout) :: w     !! work arrays
     real(wp), intent(in) :: q(:)             !! configuration
     real(wp), intent(in) :: t                !! time
     logical, intent(in) :: kinetic           !! D = M (else the identity)
     integer, intent(out) :: status           !! MBD_OK or MBD_SINGULAR
+    logical, intent(in), optional :: assembled  !! the blocks are already those at (q, t)
     if (kinetic) then
       w%metric = merge(m%mdiag, w%s, m%mdiag > zero)
     else
       w%metric = w%s
     end if
-    call assemble(m, w, q, w%qz, t)
+    if (.not. present(assembled)) then
+      call assemble(m, w, q, w%qz, t)
+    else if (.not. assembled) then
+      call assemble(m, w, q, w%qz, t)
+    end if
     call factor_aug(w, w%metric, status)
   end subroutine dyn_factor_projection
 

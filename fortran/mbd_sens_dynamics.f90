@@ -539,7 +539,7 @@ contains
         if (stp /= MBD_OK) return
         yy(o + 1:o + n) = yy(o + 1:o + n) + r(1:n)
       end do
-      call dyn_factor_projection(m, w, yy(1:n), tt, .true., stp)
+      call dyn_factor_projection(m, w, yy(1:n), tt, .true., stp, assembled=.true.)
       if (stp /= MBD_OK) return
       do kk = 1, s%np                           ! S_dot, nearest in M
         o = n * kk
