@@ -387,15 +387,22 @@ def test_dopri5_sensitivities_against_scipy_reference():
     assert errs[0] > 30 * errs[1] > 30 * 30 * errs[2] or errs[2] < 1e-10
 
 
-def test_dopri5_sensitivities_against_central_differences():
-    """A free slider-crank under gravity with a spring: parameters that leave the assembled
-    start alone, central differences of runs at rtol = atol = 1e-12."""
+def free_slider_crank() -> mbd2d.Model:
+    """The slider-crank example without its driver, with masses and a spring from ground to
+    the slider (stiffness 40, damping 3, free length 2), under gravity."""
     m = load_example("slider_crank.toml")
     m.drivers.clear()
     for b, (ms, J) in zip(m.bodies, [(2.0, 0.3), (1.5, 1.1), (0.8, 0.05)]):
         b.mass, b.inertia = ms, J
     m.add_spring(["ground", "slider"], [[0.0, 0.5], [0.0, 0.0]], stiffness=40.0, damping=3.0,
                  length0=2.0, name="s1")
+    return m
+
+
+def test_dopri5_sensitivities_against_central_differences():
+    """A free slider-crank under gravity with a spring: parameters that leave the assembled
+    start alone, central differences of runs at rtol = atol = 1e-12."""
+    m = free_slider_crank()
     names = ["force.s1.stiffness", "body.rod.mass", "body.crank.inertia", "model.gravity.1"]
     res = m.dynamics(1.0, 10, rtol=1e-11, atol=1e-11, sensitivities=names)
     h = 1e-5
@@ -415,12 +422,7 @@ def test_dopri5_sensitivities_of_pin_coordinates():
     assembly and projection take those same changes to first order, so central differences
     of plain runs (Richardson, h and h/2) are an independent reference. Measured 1.8e-10 to
     1.3e-9; the projection's Phi_p term with its sign flipped fails it (relative error 2)."""
-    m = load_example("slider_crank.toml")
-    m.drivers.clear()
-    for b, (ms, J) in zip(m.bodies, [(2.0, 0.3), (1.5, 1.1), (0.8, 0.05)]):
-        b.mass, b.inertia = ms, J
-    m.add_spring(["ground", "slider"], [[0.0, 0.5], [0.0, 0.0]], stiffness=40.0, damping=3.0,
-                 length0=2.0, name="s1")
+    m = free_slider_crank()
     start = m.dynamics(1.0, 10, rtol=1e-12, atol=1e-12)
     for k, b in enumerate(m.bodies):
         b.q0 = [float(x) for x in start.q[0, 3 * k:3 * k + 3]]
