@@ -46,7 +46,7 @@ module mbd_sens_dynamics
 
   !> Work of project_sens (allocated once per run by proj_init: no step allocates).
   type :: proj_work_t
-    real(wp), allocatable :: vv(:), r(:), z(:), hvs(:)
+    real(wp), allocatable :: r(:), hvs(:)   !! a saddle right-hand side (nq + na), Hv S rows
   end type proj_work_t
 
 contains
@@ -60,7 +60,7 @@ contains
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
     integer :: st
     status = MBD_OK; msg = ''
-    allocate (pw%vv(m%nq), pw%r(m%nq + w%na), pw%z(m%nq), pw%hvs(m%neq), stat=st)
+    allocate (pw%r(m%nq + w%na), pw%hvs(m%neq), stat=st)
     if (st /= 0) then
       status = MBD_NO_MEMORY; msg = 'out of memory for the sensitivity projections'
     end if
@@ -520,12 +520,10 @@ contains
     integer, intent(out) :: stp                 !! MBD_OK or MBD_SINGULAR
     integer :: kk, o, i, n, nz
     n = m%nq; nz = n * (1 + s%np)
-    associate (vv => pw%vv, r => pw%r, z => pw%z, hvs => pw%hvs)
-      vv = yy(nz + 1:nz + n)
-      z = zero
+    associate (r => pw%r, hvs => pw%hvs, z => w%qz)   ! (w%qz: dynamics' zero vector)
       call sens_trig(m, s, yy(1:n))
-      call sens_hessian(m, s, yy(1:n), vv, z, tt)
-      call sens_params(m, s, yy(1:n), vv, z, tt)
+      call sens_hessian(m, s, yy(1:n), yy(nz + 1:nz + n), z, tt)
+      call sens_params(m, s, yy(1:n), yy(nz + 1:nz + n), z, tt)
       call dyn_factor_projection(m, w, yy(1:n), tt, .false., stp)
       if (stp /= MBD_OK) return
       do kk = 1, s%np                           ! S += dS
