@@ -477,10 +477,16 @@ contains
     call fill(ee)
     if (sd%plain) then
       sd%spfact = .false.
-      if (sd%sparse) call sparse_factor(sd, sd%spfact)
+      if (sd%sparse) call sparse_factor(sd, sd%spfact, pr)
       status = MBD_OK
-      if (.not. sd%spfact) call lu_factor_small(sd%a, sd%ipiv, status)
-      return
+      if (chk .and. sd%spfact) sd%spfact = pr >= 1.0e-6_wp
+      if (sd%spfact) return
+      ! no sparse factors: the plain-loop LU, or, index-1 (a small pivot ratio: nearly
+      ! singular?), the LU with the condition estimate below (fill left sd%a as it was)
+      if (.not. (chk .and. allocated(sd%acopy))) then
+        call lu_factor_small(sd%a, sd%ipiv, status)
+        return
+      end if
     end if
     if (.not. (chk .and. allocated(sd%acopy))) then
       call lu_factor(sd%a, sd%ipiv, status, msg)
@@ -554,15 +560,16 @@ contains
   !! a new plan (on these values) when there is none, an entry outside the planned pattern
   !! is non-zero, a pivot is zero or a multiplier exceeds LMAX. ok false: a plan failed
   !! too (the caller factors densely).
-  subroutine sparse_factor(sd, ok)
+  subroutine sparse_factor(sd, ok, ratio)
     type(saddle_t), intent(inout) :: sd
     logical, intent(out) :: ok
-    real(wp) :: lmax, ratio
+    real(wp), intent(out) :: ratio               ! min |u_kk| / max |u_kk|
+    real(wp) :: lmax
     integer :: st, sgn
     logical :: off
     character(len=MSG_LEN) :: msg
     ok = .false.
-    st = MBD_SINGULAR; lmax = zero
+    st = MBD_SINGULAR; lmax = zero; ratio = zero
     if (sd%sp%planned) then
       call gather(sd%a, sd%uflat, sd%upos, sd%sp%val, off)
       if (.not. off) call splu_factor(sd%sp, st, lmax, sgn, ratio)
@@ -700,7 +707,7 @@ contains
       sd%nrank = sd%nrank + 1
       return
     end if
-    if (sd%plain) then
+    if (sd%plain .and. .not. sd%lsq) then   ! (lu_solve_small: dgetrf's factors too)
       if (sd%spfact) then
         call splu_solve(sd%sp, rhs, sd%xs, sd%ones)
         rhs = sd%xs

@@ -1,10 +1,13 @@
 """A failure mode found by the benchmarks: dopri5 at tight tolerances across the N-four-bar's
 singular passage. Near the passage J loses rank, the projected index-1 solution carries
-errors of order cond(J) * eps, and dopri5's error estimate reads them as truncation error: its
-steps and its accuracy then depend erratically on the last digit of atol, and a step can
-underflow at a passage. The partitioned method (independent coordinate away from the singular
-direction) stays accurate for the same settings. Oracle: the reduced one-degree-of-freedom
-solution of the parallelogram branch."""
+errors of order cond(J) * eps (through the Schur complement cond(J)^2 eps), and dopri5's
+error estimate reads them as truncation error: its steps and its accuracy then depend
+erratically on the last digit of atol, and a step can underflow at a passage. That is what
+the band path (Schur complement, band LU) still does. The dense path's sparse LU of the
+saddle matrix, replayed in one pivot order, has rounding errors that vary smoothly with q:
+the error estimate does not see them and every run is accurate. The partitioned method
+(independent coordinate away from the singular direction) stays accurate for the same
+settings. Oracle: the reduced one-degree-of-freedom solution of the parallelogram branch."""
 from __future__ import annotations
 
 import math
@@ -30,16 +33,20 @@ def crank_error(res: mbd2d.DynamicsResult, ref: np.ndarray) -> float:
     return float(np.abs(th - ref[: th.shape[1], 0]).max())
 
 
+ATOL_SWEEP = np.linspace(0.6e-14, 1.6e-14, 11)
+
+
 def test_dopri5_at_rtol_1e12_underflows_at_a_singular_passage_for_some_atol(reference):
-    """rtol 1e-12 and eleven atol from 0.6e-14 to 1.6e-14: some runs end in a step-size
-    underflow at a passage (3 of 11 measured with the index-1 systems through the Schur
-    complement, 7 of 11 with the saddle-point LU before), the others are accurate."""
+    """Band path, rtol 1e-12 and eleven atol from 0.6e-14 to 1.6e-14: some runs end in a
+    step-size underflow at a passage (5 of 11 measured; 3 of 11 on the dense path when it
+    went through the Schur complement, 7 of 11 with the saddle-point LU before), the others
+    are accurate."""
     model = free_nfourbar(1)
     failures = []
-    for atol in np.linspace(0.6e-14, 1.6e-14, 11):
+    for atol in ATOL_SWEEP:
         try:
             res = model.dynamics(t_end=T_END, steps=STEPS, method="dopri5", rtol=1e-12,
-                                 atol=atol)
+                                 atol=atol, solver="banded")
             assert crank_error(res, reference) < 1e-6
         except mbd2d.IntegrationError as exc:
             assert "step size underflow" in str(exc)
@@ -49,6 +56,19 @@ def test_dopri5_at_rtol_1e12_underflows_at_a_singular_passage_for_some_atol(refe
         # at a passage: the cranks horizontal on the reduced solution, sin(theta) ~ 0
         th = reduced_nfourbar(1, np.array([0.0, tf]), substeps=4000)[-1, 0]
         assert abs(math.sin(th)) < 0.05, f"underflow at t = {tf}, theta = {th}"
+
+
+def test_dopri5_on_the_dense_path_passes_for_every_atol(reference):
+    """The same eleven settings on the dense path (the sparse LU of the saddle matrix): every
+    run passes, accurate to 1e-9 (measured 5.6e-11 to 6.4e-11), with 4 to 39 rejected steps
+    of about 2900 and no step below 3.7e-8 s (the band path: up to 351 rejected, steps down
+    to 3e-14 s)."""
+    model = free_nfourbar(1)
+    for atol in ATOL_SWEEP:
+        res = model.dynamics(t_end=T_END, steps=STEPS, method="dopri5", rtol=1e-12, atol=atol)
+        assert res.stats["solver"] == "dense" and res.stats["schur"][0] == 0
+        assert crank_error(res, reference) < 1e-9
+        assert res.stats["rejected_steps"] <= 50 and res.stats["h_min"] > 1e-8
 
 
 def test_partitioned_stays_accurate_for_the_same_tolerances(reference):
