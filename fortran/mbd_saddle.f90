@@ -64,8 +64,12 @@ module mbd_saddle
   !> bands up to this kl + ku are factored in plain loops (band_lu), wider ones by dgbtrf
   integer, parameter :: PLAIN_MAX = 64
   !> small dense iteration matrices up to this order take the sparse LU (mbd_splu: its plan
-  !! keeps several arrays of nt^2 entries)
-  integer, parameter :: SPARSE_MAX = 64
+  !! keeps several arrays of nt^2 entries), index-1 ones up to SPARSE_INDEX1_MAX: beyond, the
+  !! Schur complement costs less (dopri5 on the free N-four-bar, callgrind: N = 5, 65 rows,
+  !! 33.0M through S against 49.3M; N = 8, 113 rows, 54.2M against 144.0M), while for
+  !! generalized-alpha the sparse LU still beats the plain-loop LU (N = 5: 135.7M against
+  !! 338.1M; N = 8: 247.8M against 713.5M)
+  integer, parameter :: SPARSE_MAX = 128, SPARSE_INDEX1_MAX = 64
   character(len=*), parameter :: HINT = 'use a model with fewer coordinates'
 
   !> A planned saddle-point matrix: the map from the constraint blocks, the storage and
@@ -221,7 +225,8 @@ contains
         call mem_fail(bytes, 'the dense saddle-point matrix', HINT, status, msg); return
       end if
       sd%a = zero
-      if (sd%plain .and. nt <= SPARSE_MAX) call sparse_plan(sd, sr, sc)
+      if (sd%plain .and. nt <= merge(SPARSE_INDEX1_MAX, SPARSE_MAX, chk)) &
+        call sparse_plan(sd, sr, sc)
     end if
     ! diagonal A (index-1, or an iteration matrix with a diagonal K): the Schur complement
     if ((chk .and. .not. sd%full) .or. present_and(schur)) then

@@ -68,7 +68,7 @@ def run(model: mbd2d.Model, method: str, solver: str) -> mbd2d.DynamicsResult:
 
 
 @pytest.mark.parametrize("method", list(METHODS))
-@pytest.mark.parametrize("case", ["chain-3", "chain-40", "loaded-12"])
+@pytest.mark.parametrize("case", ["chain-3", "chain-8", "chain-40", "loaded-12"])
 def test_band_path_gives_the_dense_results(case: str, method: str) -> None:
     kind, n = case.split("-")
     model = (build(int(n), driven=False, omega0=-1.0) if kind == "chain" else loaded(int(n)))
