@@ -640,7 +640,11 @@ contains
     real(wp) :: v
     integer :: n, k
     n = m%nq
-    call assemble(m, w, q, qd, t)
+    if (m%nfric > 0) then
+      call assemble(m, w, q, qd, t)       ! (friction's least squares takes the dense J)
+    else                                  ! the blocks are all the factorization takes
+      call assemble_blocks(m, q, qd, t, w%phi, w%nu, w%gam, w%asm)
+    end if
     call gen_forces(m, q, qd, t, w%force, v, cst=w%cst)
     call factor_aug(w, m%mdiag, status)
     if (status /= MBD_OK) return
