@@ -44,7 +44,7 @@ module mbd_saddle
   use mbd_points, only: NLOC, MAXROW
   use mbd_model, only: model_t
   use mbd_band, only: band_t, band_plan_perm, band_graph, band_rcm, band_zero, band_norm1, &
-                      band_factor, band_rcond, band_solve, band_matvec
+                      band_factor, band_rcond, band_solve
   use mbd_schur, only: schur_t, schur_plan, schur_factor, schur_solve, rows_rcm, &
                        rows_by_coordinate
   use mbd_splu, only: splu_t, splu_init, splu_plan, splu_factor, splu_solve, splu_pos, LMAX
@@ -104,7 +104,11 @@ module mbd_saddle
     logical :: spfact = .false.          !! the last factorization is the sparse one
     integer, allocatable :: uflat(:), urow(:), ucol(:), upos(:)  !! structural entries
     real(wp), allocatable :: ones(:), xs(:)  !! unit column scale, solution of the sparse solves
-    real(wp), allocatable :: bcopy(:, :) !! the unregularized matrix of a nearly singular one
+    !> the unregularized matrix of a nearly singular band one, as its pieces (the refinement's
+    !! products): the diagonal of A, -e, s J_a's values lval in esrc's order, at (n + erow, ecol)
+    real(wp), allocatable :: ld(:), lval(:)
+    real(wp) :: le = zero
+    integer, allocatable :: erow(:), ecol(:)
     real(wp), allocatable :: r(:), x(:), xw(:)  !! refinement workspace (nt)
   end type saddle_t
 
@@ -119,8 +123,8 @@ contains
     logical, intent(in) :: check       !! index-1 (nearly singular solves possible)
     real(wp) :: t
     t = real(nt, wp)
-    if (banded) then
-      bytes = REAL_BYTES * t * (merge(2, 1, check) * (2 * kl + ku + 1) + 12)
+    if (banded) then      ! (check: the pieces, at most NLOC entries of J_a a row)
+      bytes = REAL_BYTES * t * ((2 * kl + ku + 1) + 12 + merge(2 * NLOC + 1, 0, check))
     else
       bytes = REAL_BYTES * (t * t * merge(2, 1, check) + 8 * t)
     end if
@@ -209,7 +213,14 @@ contains
       call mem_check(bytes, 'the band saddle-point matrix', HINT, status, msg)
       if (status /= MBD_OK) return
       allocate (sd%r(nt), sd%x(nt), sd%xw(nt), stat=ierr)
-      if (ierr == 0 .and. chk) allocate (sd%bcopy(ldab, nt), stat=ierr)
+      if (ierr == 0 .and. chk) allocate (sd%ld(n), sd%lval(ne), sd%erow(ne), sd%ecol(ne), &
+                                         stat=ierr)
+      if (ierr == 0 .and. chk) then
+        do c = 1, n
+          sd%ecol(cptr(c):cptr(c + 1) - 1) = c
+        end do
+        sd%erow = crow
+      end if
       if (ierr /= 0) then
         call mem_fail(bytes, 'the band saddle-point workspace', HINT, status, msg); return
       end if
@@ -468,12 +479,15 @@ contains
       else
         sd%lsq = status /= MBD_OK
       end if
-      if (.not. allocated(sd%bcopy)) sd%lsq = .false.
+      if (.not. allocated(sd%lval) .or. present(kv)) sd%lsq = .false.
       if (sd%lsq) then
-        ! keep the matrix, then factor it with the constraint block regularized
-        call fill(ee)
-        if (anorm <= zero) anorm = band_norm1(sd%b)
-        sd%bcopy = sd%b%ab
+        ! keep the matrix as its pieces, then factor it with the constraint block regularized
+        if (anorm <= zero) then
+          call fill(ee)
+          anorm = band_norm1(sd%b)
+        end if
+        sd%ld = d; sd%le = ee
+        call keep_values(sd%lval, sd%esrc, jb, size(jb), s)
         call fill(ee + AUG_RCOND * anorm)
         call band_factor(sd%b, status, msg)
       end if
@@ -647,6 +661,39 @@ contains
     end do
   end subroutine put
 
+  !> y = A x of the unregularized matrix kept as its pieces (saddle_factor, nearly singular
+  !! band): [diag(d), s J_a^T; s J_a, -e I] x, no pass over the band storage.
+  pure subroutine pieces_matvec(sd, x, y)
+    type(saddle_t), intent(in) :: sd
+    real(wp), intent(in) :: x(:)
+    real(wp), intent(out) :: y(:)
+    integer :: i, c, r, n
+    real(wp) :: v
+    n = sd%n
+    do c = 1, n
+      y(c) = sd%ld(c) * x(c)
+    end do
+    do r = n + 1, sd%nt
+      y(r) = -sd%le * x(r)
+    end do
+    do i = 1, size(sd%lval)
+      v = sd%lval(i); c = sd%ecol(i); r = n + sd%erow(i)
+      y(c) = y(c) + v * x(r)
+      y(r) = y(r) + v * x(c)
+    end do
+  end subroutine pieces_matvec
+
+  !> lval = s jb(esrc) over a flat view of the blocks.
+  pure subroutine keep_values(lval, esrc, jb, nj, s)
+    integer, intent(in) :: nj, esrc(:)
+    real(wp), intent(out) :: lval(:)
+    real(wp), intent(in) :: jb(nj), s
+    integer :: i
+    do i = 1, size(esrc)
+      lval(i) = s * jb(esrc(i))
+    end do
+  end subroutine keep_values
+
   !> An optional flag, .false. when absent.
   pure logical function present_and(flag)
     logical, intent(in), optional :: flag
@@ -704,7 +751,7 @@ contains
       call band_solve(sd%b, rhs, status, msg)
       do it = 1, 2
         if (status /= MBD_OK) return
-        call band_matvec(sd%b, sd%bcopy, rhs, sd%x, sd%xw)
+        call pieces_matvec(sd, rhs, sd%x)
         sd%x = sd%r - sd%x
         call band_solve(sd%b, sd%x, status, msg)
         rhs = rhs + sd%x
