@@ -115,7 +115,8 @@ module mbd_saddle
 contains
 
   !> Bytes of a saddle-point matrix of nt = n + na: dense nt^2 (with the copy for the
-  !! rank-revealing solve when check), band nt (2 kl + ku + 1) plus its copy and vectors.
+  !! rank-revealing solve when check), band nt (2 kl + ku + 1), vectors and (check) the
+  !! pieces of J_a.
   pure real(wp) function saddle_bytes(nt, banded, kl, ku, check) result(bytes)
     integer, intent(in) :: nt          !! n + na
     logical, intent(in) :: banded      !! band path
