@@ -341,7 +341,8 @@ contains
   end subroutine add
 
   !> S = L L^T in place (lower band, right-looking: column j scaled, then the trailing
-  !! triangle S(k:, k) -= L(k:, j) L(k, j), contiguous in the storage). ok: every pivot
+  !! triangle S(k:, k) -= L(k:, j) L(k, j), contiguous in the storage); the diagonal keeps
+  !! 1 / l_jj (the solves multiply: no division on their dependency chain). ok: every pivot
   !! S_jj > 0 and min / max of them >= SCHUR_PIVOT.
   pure subroutine cholesky(na, kd, g, ok)
     integer, intent(in) :: na, kd
@@ -357,7 +358,7 @@ contains
       dmin = min(dmin, dj); dmax = max(dmax, dj)
       dj = sqrt(dj)
       rj = one / dj
-      g(1, j) = dj
+      g(1, j) = rj
       l = min(kd, na - j)
       !GCC$ novector
       do t = 2, l + 1
@@ -483,7 +484,7 @@ contains
   end subroutine jtv_sub
 
 
-  !> L L^T z = z in place (lower band factor).
+  !> L L^T z = z in place (lower band factor, its diagonal held as 1 / l_jj).
   pure subroutine chol_solve(na, kd, g, z)
     integer, intent(in) :: na, kd
     real(wp), intent(in) :: g(kd + 1, *)
@@ -491,7 +492,7 @@ contains
     integer :: j, l, t
     real(wp) :: v
     do j = 1, na                              ! L v = z
-      v = z(j) / g(1, j)
+      v = z(j) * g(1, j)
       z(j) = v
       l = min(kd, na - j)
       !GCC$ novector
@@ -506,7 +507,7 @@ contains
       do t = 1, l
         v = v - g(t + 1, j) * z(j + t)
       end do
-      z(j) = v / g(1, j)
+      z(j) = v * g(1, j)
     end do
   end subroutine chol_solve
 
