@@ -26,7 +26,7 @@ module mbd_forces
                         vdot, ssqrt, ssub
   use mbd_functions, only: fun_eval, fun_length, fun_check, fun_exponents, fun_eval_d, &
                            fun_is_count
-  use mbd_dual, only: dloc, dvec, dscal, dual_state, body_point, body_angle, vsub, vdot, ssqrt, &
+  use mbd_dual, only: dloc, dvec, dscal, dual_state, point_terms_d, body_point, body_angle, &
                       ssub
   use mbd_contact, only: NCS, NEO, contact_raw_length, contact_prepare, contact_exponents, &
                          contact_eval, friction_raw_length, friction_exponents
@@ -263,24 +263,15 @@ contains
     real(wp), intent(in) :: t               !! time
     real(wp), intent(out) :: tforce(NLOC)   !! change of the generalized force
     type(dloc) :: x
-    type(dvec) :: d, pt
-    type(dscal) :: l, a
-    real(wp) :: f, f1, f2, tf, tf1, tf2, fy, tfy, tension, ttension, tau, ttau
+    type(dvec) :: pt
+    type(dscal) :: a
+    real(wp) :: f, f1, f2, tf, tf1, tf2, fy, tfy, tau, ttau
     integer :: nf
     tforce = zero
     x = dual_state(local_state(ql, qdl), tq, tqd)
     select case (kind)
     case (FRC_SPRING)
-      d = vsub(body_point(x, sj, p(3:4), tp(3:4)), body_point(x, si, p(1:2), tp(1:2)))
-      call fun_eval(p(8:), t, f, f1, f2)
-      call fun_eval_d(p(8:), tp(8:), t, tf, tf1, tf2)
-      if (dot_product(d%a%v, d%a%v) > zero) then
-        l = ssqrt(vdot(d, d))
-        tension = p(5) * (l%a%v - p(7)) + p(6) * l%a%vd - f
-        ttension = tp(5) * (l%a%v - p(7)) + p(5) * (l%t%v - tp(7)) + tp(6) * l%a%vd + &
-                   p(6) * l%t%vd - tf
-        tforce = -ttension * l%a%d - tension * l%t%d
-      end if
+      call spring_d(x, p, tp, si, sj, t, tforce)
     case (FRC_TORQUE)
       call fun_eval_d(p, tp, t, tf, tf1, tf2)
       if (si > 0) tforce(3) = tf
@@ -302,5 +293,65 @@ contains
       tforce = ttau * a%a%d + tau * a%t%d
     end select
   end subroutine force_eval_d
+
+  !> force_eval_d of a spring-damper-actuator in closed form (the dual types carry the
+  !! point Jacobians' tangents through every operation: ~4x the work). d = P_j - P_i,
+  !! l = |d|, u = d / l, T = k (l - l0) + c l_dot - f(t), Q = -T grad l with grad l =
+  !! (-u, -u . B_i s_i; u, u . B_j s_j); along (dq, dq_dot, dp):
+  !!   dl = u . dd,  du = (dd - u dl) / l,  dl_dot = du . d_dot + u . dd_dot,
+  !!   dT = dk (l - l0) + k (dl - dl0) + dc l_dot + c dl_dot - df,
+  !!   dQ = -dT grad l - T d(grad l),  d(u . B s) = du . B s + u . d(B s).
+  pure subroutine spring_d(x, p, tp, si, sj, t, tforce)
+    type(dloc), intent(in) :: x             !! local state and direction
+    real(wp), intent(in) :: p(:), tp(:)     !! prepared parameters and their change
+    integer, intent(in) :: si, sj           !! slot ids of the bodies (0 = ground)
+    real(wp), intent(in) :: t               !! time
+    real(wp), intent(out) :: tforce(NLOC)   !! change of the generalized force
+    real(wp) :: pi(2), bi(2), ari(2), tpi(2), tbi(2), tari(2), vi(2), tvi(2)
+    real(wp) :: pj(2), bj(2), arj(2), tpj(2), tbj(2), tarj(2), vj(2), tvj(2)
+    real(wp) :: d(2), dd(2), tdd(2), td(2), u(2), tu(2), l, ldot, tl, tldot
+    real(wp) :: f, f1, f2, tf, tf1, tf2, tension, ttension
+    tforce = zero
+    call point_terms_d(x, si, p(1:2), tp(1:2), pi, bi, ari, tpi, tbi, tari)
+    call point_terms_d(x, sj, p(3:4), tp(3:4), pj, bj, arj, tpj, tbj, tarj)
+    call point_rates(si, bi, tbi, vi, tvi)
+    call point_rates(sj, bj, tbj, vj, tvj)
+    d = pj - pi
+    l = dot_product(d, d)
+    if (.not. l > zero) return
+    l = sqrt(l); u = d / l
+    dd = vj - vi; tdd = tvj - tvi; td = tpj - tpi
+    ldot = dot_product(u, dd)
+    tl = dot_product(u, td)
+    tu = (td - u * tl) / l
+    tldot = dot_product(tu, dd) + dot_product(u, tdd)
+    call fun_eval(p(8:), t, f, f1, f2)
+    call fun_eval_d(p(8:), tp(8:), t, tf, tf1, tf2)
+    tension = p(5) * (l - p(7)) + p(6) * ldot - f
+    ttension = tp(5) * (l - p(7)) + p(5) * (tl - tp(7)) + tp(6) * ldot + p(6) * tldot - tf
+    if (si > 0) then
+      tforce(1:2) = ttension * u + tension * tu
+      tforce(3) = ttension * dot_product(u, bi) + &
+                  tension * (dot_product(tu, bi) + dot_product(u, tbi))
+    end if
+    if (sj > 0) then
+      tforce(4:5) = -ttension * u - tension * tu
+      tforce(6) = -ttension * dot_product(u, bj) - &
+                  tension * (dot_product(tu, bj) + dot_product(u, tbj))
+    end if
+  contains
+    !> Velocity r_dot + B s theta_dot of a slot's point and its change (ground: zero).
+    pure subroutine point_rates(slot, bs, tbs, v, tv)
+      integer, intent(in) :: slot
+      real(wp), intent(in) :: bs(2), tbs(2)
+      real(wp), intent(out) :: v(2), tv(2)
+      integer :: c
+      v = zero; tv = zero
+      if (slot == 0) return
+      c = 3 * (slot - 1)
+      v = x%x%qd(c + 1:c + 2) + bs * x%x%qd(c + 3)
+      tv = x%tqd(c + 1:c + 2) + tbs * x%x%qd(c + 3) + bs * x%tqd(c + 3)
+    end subroutine point_rates
+  end subroutine spring_d
 
 end module mbd_forces
