@@ -103,6 +103,8 @@ module mbd_saddle
     logical :: sparse = .false.          !! the sparse LU is planned for
     logical :: spfact = .false.          !! the last factorization is the sparse one
     integer, allocatable :: uflat(:), urow(:), ucol(:), upos(:)  !! structural entries
+    !> the pieces' places in the plan's storage (dpos, epos, etpos, kpos there; 0: not held)
+    integer, allocatable :: sdp(:), sep(:), setp(:), skp(:)
     real(wp), allocatable :: ones(:), xs(:)  !! unit column scale, solution of the sparse solves
     !> the unregularized matrix of a nearly singular band one, as its pieces (the refinement's
     !! products): the diagonal of A, -e, s J_a's values lval in esrc's order, at (n + erow, ecol)
@@ -494,6 +496,14 @@ contains
       end if
       return
     end if
+    if (sd%plain .and. sd%sparse) then
+      ! the pieces straight into the planned storage (no dense matrix) while the plan holds
+      ! them and its pivots stay good; else the dense fill below and a new plan
+      call direct_factor(sd%spfact, pr)
+      if (chk .and. sd%spfact) sd%spfact = pr >= 1.0e-6_wp
+      status = MBD_OK
+      if (sd%spfact) return
+    end if
     call fill(ee)
     if (sd%plain) then
       sd%spfact = .false.
@@ -528,6 +538,23 @@ contains
     if (sd%lsq) call fill(ee)                  ! the matrix itself, for dgelsy
     status = MBD_OK
   contains
+    !> The sparse LU of the pieces put into the plan's storage: ok when the plan holds every
+    !! non-zero piece, no pivot vanishes and no multiplier exceeds LMAX.
+    subroutine direct_factor(ok, ratio)
+      logical, intent(out) :: ok
+      real(wp), intent(out) :: ratio
+      real(wp) :: lmax
+      integer :: st, sgn
+      logical :: off
+      ok = .false.; ratio = zero
+      if (.not. sd%sp%planned) return
+      call put_sparse(sd%sp%val, sd%upos, sd%n, sd%nt, sd%sdp, sd%skp, sd%esrc, sd%sep, &
+                      sd%setp, d, jb, size(jb), s, ee, off, kv)
+      if (off) return
+      call splu_factor(sd%sp, st, lmax, sgn, ratio)
+      ok = st == MBD_OK .and. lmax <= LMAX
+    end subroutine direct_factor
+
     !> The matrix into the storage of the path: zero, then the pieces (put).
     subroutine fill(ediag)
       real(wp), intent(in) :: ediag
@@ -565,7 +592,8 @@ contains
       tr(nu) = sr(i); tc(nu) = sc(i)
     end do
     allocate (sd%urow(nu), sd%ucol(nu), sd%uflat(nu), sd%upos(nu), sd%ones(nt), sd%xs(nt), &
-              stat=ierr)
+              sd%sdp(nt), sd%sep(size(sd%epos)), sd%setp(size(sd%epos)), &
+              sd%skp(size(sd%kpos)), stat=ierr)
     if (ierr /= 0) return
     sd%urow = tr(1:nu); sd%ucol = tc(1:nu)
     sd%uflat = sd%urow + nt * (sd%ucol - 1)
@@ -604,13 +632,23 @@ contains
     end if
     ok = .true.
   contains
-    !> The places of the structural entries in the new plan.
+    !> The places of the structural entries and of the pieces in the new plan.
     subroutine positions()
       integer :: i
       do i = 1, size(sd%upos)
         sd%upos(i) = splu_pos(sd%sp, sd%urow(i), sd%ucol(i))
       end do
+      sd%sdp = held(sd%dpos); sd%sep = held(sd%epos); sd%setp = held(sd%etpos)
+      sd%skp = held(sd%kpos)
     end subroutine positions
+    !> Plan positions of dense flat positions f (column-major, nt rows).
+    pure function held(f) result(pos)
+      integer, intent(in) :: f(:)
+      integer :: pos(size(f)), i
+      do i = 1, size(f)
+        pos(i) = splu_pos(sd%sp, mod(f(i) - 1, sd%nt) + 1, (f(i) - 1) / sd%nt + 1)
+      end do
+    end function held
   end subroutine sparse_factor
 
   !> The structural entries of the dense matrix a (flat positions uflat) into the sparse
@@ -694,6 +732,56 @@ contains
       lval(i) = s * jb(esrc(i))
     end do
   end subroutine keep_values
+
+  !> put into a sparse plan's storage val: the held structural entries zeroed, then the
+  !! pieces in put's order at their plan positions (so the sums are put's); off: a non-zero
+  !! piece the plan does not hold.
+  pure subroutine put_sparse(val, upos, n, nt, sdp, skp, esrc, sep, setp, d, jb, nj, s, e, &
+                             off, kv)
+    real(wp), intent(inout) :: val(:)
+    integer, intent(in) :: upos(:), n, nt, nj
+    integer, intent(in) :: sdp(:), skp(:), esrc(:), sep(:), setp(:)
+    real(wp), intent(in) :: d(:), jb(nj), s, e
+    logical, intent(out) :: off
+    real(wp), intent(in), optional :: kv(:)
+    integer :: i
+    real(wp) :: v
+    off = .false.
+    do i = 1, size(upos)
+      if (upos(i) > 0) val(upos(i)) = zero
+    end do
+    if (present(kv)) then
+      do i = 1, size(skp)
+        call put_add(val, off, skp(i), kv(i))
+      end do
+    end if
+    do i = 1, n
+      call put_add(val, off, sdp(i), d(i))
+    end do
+    if (abs(e) > zero) then
+      do i = n + 1, nt
+        call put_add(val, off, sdp(i), -e)
+      end do
+    end if
+    do i = 1, size(esrc)
+      v = s * jb(esrc(i))
+      call put_add(val, off, sep(i), v)
+      call put_add(val, off, setp(i), v)
+    end do
+  end subroutine put_sparse
+
+  !> val(p) += x at a held position p; off when x /= 0 has no place (p = 0).
+  pure subroutine put_add(val, off, p, x)
+    real(wp), intent(inout) :: val(:)
+    logical, intent(inout) :: off
+    integer, intent(in) :: p
+    real(wp), intent(in) :: x
+    if (p > 0) then
+      val(p) = val(p) + x
+    else if (abs(x) > zero) then
+      off = .true.
+    end if
+  end subroutine put_add
 
   !> An optional flag, .false. when absent.
   pure logical function present_and(flag)
