@@ -414,6 +414,19 @@ def test_dopri5_sensitivities_against_central_differences():
         rel_close(res.dq_dp[:, :, j], fd, rtol=2e-6, what=f"free slider-crank dq / d {name}")
 
 
+def richardson_dq_dp(m: mbd2d.Model, name: str, h: float = 1e-4) -> np.ndarray:
+    """dq/dp of a 1 s dopri5 run (10 outputs) from plain runs at rtol = atol = 1e-12: central
+    differences at h and 2h, Richardson-extrapolated (4 D(h) - D(2h)) / 3."""
+    v = m.parameters()[name]
+
+    def central(hh: float) -> np.ndarray:
+        up = m.with_params({name: v + hh}).dynamics(1.0, 10, rtol=1e-12, atol=1e-12)
+        dn = m.with_params({name: v - hh}).dynamics(1.0, 10, rtol=1e-12, atol=1e-12)
+        return (up.q - dn.q) / (2 * hh)
+
+    return (4 * central(h) - central(2 * h)) / 3
+
+
 def test_dopri5_sensitivities_of_pin_coordinates():
     """Geometric parameters enter Phi: their forward-dynamics sensitivities start from the
     minimum-norm change of the assembled q (J S = -Phi_p) and the kinetic-energy-nearest one
@@ -430,14 +443,7 @@ def test_dopri5_sensitivities_of_pin_coordinates():
     names = ["joint.O.points.0.0", "joint.A.points.0.1", "joint.B.points.1.0"]
     res = m.dynamics(1.0, 10, rtol=1e-11, atol=1e-11, sensitivities=names)
     for j, name in enumerate(names):
-        v = m.parameters()[name]
-
-        def central(h: float, name: str = name, v: float = v) -> np.ndarray:
-            up = m.with_params({name: v + h}).dynamics(1.0, 10, rtol=1e-12, atol=1e-12)
-            dn = m.with_params({name: v - h}).dynamics(1.0, 10, rtol=1e-12, atol=1e-12)
-            return (up.q - dn.q) / (2 * h)
-
-        ref = (4 * central(1e-4) - central(2e-4)) / 3
+        ref = richardson_dq_dp(m, name)
         rel_close(res.dq_dp[:, :, j], ref, rtol=1e-8, what=f"free slider-crank dq / d {name}")
 
 
@@ -460,14 +466,7 @@ def test_dopri5_sensitivities_of_force_parameters():
              "force.p1.fy.poly.1"]
     res = m.dynamics(1.0, 10, rtol=1e-11, atol=1e-11, sensitivities=names)
     for j, name in enumerate(names):
-        v = m.parameters()[name]
-
-        def central(h: float, name: str = name, v: float = v) -> np.ndarray:
-            up = m.with_params({name: v + h}).dynamics(1.0, 10, rtol=1e-12, atol=1e-12)
-            dn = m.with_params({name: v - h}).dynamics(1.0, 10, rtol=1e-12, atol=1e-12)
-            return (up.q - dn.q) / (2 * h)
-
-        ref = (4 * central(1e-4) - central(2e-4)) / 3
+        ref = richardson_dq_dp(m, name)
         assert np.abs(ref).max() > 1e-3, name          # each parameter moves the motion
         rel_close(res.dq_dp[:, :, j], ref, rtol=2e-7, what=f"free slider-crank dq / d {name}")
 
