@@ -102,7 +102,7 @@ module mbd_saddle
     type(splu_t) :: sp
     logical :: sparse = .false.          !! the sparse LU is planned for
     logical :: spfact = .false.          !! the last factorization is the sparse one
-    integer, allocatable :: uflat(:), urow(:), ucol(:), upos(:)  !! structural entries
+    integer, allocatable :: urow(:), ucol(:), upos(:)  !! structural entries
     !> the pieces' places in the plan's storage (dpos, epos, etpos, kpos there; 0: not held)
     integer, allocatable :: sdp(:), sep(:), setp(:), skp(:)
     real(wp), allocatable :: ones(:), xs(:)  !! unit column scale, solution of the sparse solves
@@ -496,18 +496,17 @@ contains
       end if
       return
     end if
+    sd%spfact = .false.
     if (sd%plain .and. sd%sparse) then
       ! the pieces straight into the planned storage (no dense matrix) while the plan holds
-      ! them and its pivots stay good; else the dense fill below and a new plan
+      ! them and its pivots stay good; else the dense fill below and a new plan on it
       call direct_factor(sd%spfact, pr)
-      if (chk .and. sd%spfact) sd%spfact = pr >= 1.0e-6_wp
       status = MBD_OK
-      if (sd%spfact) return
+      if (sd%spfact .and. (pr >= 1.0e-6_wp .or. .not. chk)) return
     end if
     call fill(ee)
     if (sd%plain) then
-      sd%spfact = .false.
-      if (sd%sparse) call sparse_factor(sd, sd%spfact, pr)
+      if (sd%sparse .and. .not. sd%spfact) call sparse_factor(sd, sd%spfact, pr)
       status = MBD_OK
       if (chk .and. sd%spfact) sd%spfact = pr >= 1.0e-6_wp
       if (sd%spfact) return
@@ -591,12 +590,11 @@ contains
       nu = nu + 1
       tr(nu) = sr(i); tc(nu) = sc(i)
     end do
-    allocate (sd%urow(nu), sd%ucol(nu), sd%uflat(nu), sd%upos(nu), sd%ones(nt), sd%xs(nt), &
+    allocate (sd%urow(nu), sd%ucol(nu), sd%upos(nu), sd%ones(nt), sd%xs(nt), &
               sd%sdp(nt), sd%sep(size(sd%epos)), sd%setp(size(sd%epos)), &
               sd%skp(size(sd%kpos)), stat=ierr)
     if (ierr /= 0) return
     sd%urow = tr(1:nu); sd%ucol = tc(1:nu)
-    sd%uflat = sd%urow + nt * (sd%ucol - 1)
     sd%upos = 0
     sd%ones = one
     msg = ''
@@ -604,33 +602,25 @@ contains
     sd%sparse = st == MBD_OK
   end subroutine sparse_plan
 
-  !> Factor the filled dense matrix sd%a by the sparse LU: its values in the planned order,
-  !! a new plan (on these values) when there is none, an entry outside the planned pattern
-  !! is non-zero, a pivot is zero or a multiplier exceeds LMAX. ok false: a plan failed
-  !! too (the caller factors densely).
+  !> A new plan of the sparse LU on the filled dense matrix sd%a (there is none yet, or the
+  !! last one no longer held a non-zero piece, met a zero pivot or a multiplier past LMAX:
+  !! direct_factor), the pieces' places in it, and its factorization of sd%a. ok false: the
+  !! plan or its factorization failed (the caller factors densely).
   subroutine sparse_factor(sd, ok, ratio)
     type(saddle_t), intent(inout) :: sd
     logical, intent(out) :: ok
     real(wp), intent(out) :: ratio               ! min |u_kk| / max |u_kk|
     real(wp) :: lmax
     integer :: st, sgn
-    logical :: off
     character(len=MSG_LEN) :: msg
     ok = .false.
-    st = MBD_SINGULAR; lmax = zero; ratio = zero
-    if (sd%sp%planned) then
-      call gather(sd%a, sd%uflat, sd%upos, sd%sp%val, off)
-      if (.not. off) call splu_factor(sd%sp, st, lmax, sgn, ratio)
-    end if
-    if (st /= MBD_OK .or. .not. lmax <= LMAX) then
-      msg = ''
-      call splu_plan(sd%sp, sd%a, st, msg)
-      if (st /= MBD_OK) return
-      call positions()
-      call splu_factor(sd%sp, st, lmax, sgn, ratio)
-      if (st /= MBD_OK .or. .not. lmax <= LMAX) return
-    end if
-    ok = .true.
+    lmax = zero; ratio = zero
+    msg = ''
+    call splu_plan(sd%sp, sd%a, st, msg)        ! (the plan loads sd%a's values)
+    if (st /= MBD_OK) return
+    call positions()
+    call splu_factor(sd%sp, st, lmax, sgn, ratio)
+    ok = st == MBD_OK .and. lmax <= LMAX
   contains
     !> The places of the structural entries and of the pieces in the new plan.
     subroutine positions()
@@ -650,24 +640,6 @@ contains
       end do
     end function held
   end subroutine sparse_factor
-
-  !> The structural entries of the dense matrix a (flat positions uflat) into the sparse
-  !! plan's storage val (positions upos); off: a non-zero entry the plan does not hold.
-  pure subroutine gather(a, uflat, upos, val, off)
-    real(wp), intent(in) :: a(*)
-    integer, intent(in) :: uflat(:), upos(:)
-    real(wp), intent(inout) :: val(:)
-    logical, intent(out) :: off
-    integer :: i
-    off = .false.
-    do i = 1, size(upos)
-      if (upos(i) > 0) then
-        val(upos(i)) = a(uflat(i))
-      else if (abs(a(uflat(i))) > zero) then
-        off = .true.
-      end if
-    end do
-  end subroutine gather
 
   !> Place the pieces into flat storage: K on its pattern, += d on the diagonal of A, -e on
   !! the constraint diagonal, s J_a and s J_a^T (the order of the dense matrices before, so
