@@ -253,10 +253,12 @@ class Model(ModelDescription):
             with the rows of its constraints (no n x n matrix: cost and memory linear in the
             number of bodies of a chain-like model). "auto" picks the band for at least 60
             coordinates whose band is narrow (``res.stats["solver"]`` and
-            ``res.stats["band"]`` say which ran). Systems with a diagonal upper-left block
-            (the index-1 ones; on the band path generalized-alpha's when its K is diagonal,
-            as for pins) go through the Schur complement J A^-1 J^T where it is well
-            conditioned (``res.stats["schur"]``).
+            ``res.stats["band"]`` say which ran). On the dense path a small saddle matrix
+            (at most 64 rows; generalized-alpha's up to 128) takes a sparse LU replayed in
+            a fixed pivot order. Systems with a diagonal upper-left block (the index-1 ones
+            beyond that size and on the band path; on the band path generalized-alpha's when
+            its K is diagonal, as for pins) go through the Schur complement J A^-1 J^T where
+            it is well conditioned (``res.stats["schur"]``).
 
         Returns
         -------
