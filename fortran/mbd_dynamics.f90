@@ -831,9 +831,7 @@ contains
     integer, intent(out) :: status           !! MBD_OK or MBD_SINGULAR
     integer :: n
     n = m%nq
-    w%metric = merge(m%mdiag, w%s, m%mdiag > zero)
-    call assemble(m, w, q, w%qz, t)
-    call factor_aug(w, w%metric, status)
+    call dyn_factor_projection(m, w, q, t, .true., status)
     if (status /= MBD_OK) return
     w%rhs(1:n) = w%metric * v0
     call gather_rows(w, w%nu, w%s)
@@ -852,12 +850,11 @@ contains
     integer, intent(out) :: status           !! MBD_OK, MBD_NO_CONVERGENCE or MBD_SINGULAR
     integer :: it, n
     n = m%nq
-    w%metric = w%s
     do it = 1, 20
       call assemble(m, w, q, w%qz, t)
       status = MBD_OK
       if (maxval(abs(w%phi)) <= w%tol) return
-      call factor_aug(w, w%metric, status)
+      call dyn_factor_projection(m, w, q, t, .false., status, assembled=.true.)
       if (status /= MBD_OK) return
       w%rhs(1:n) = zero
       call gather_rows(w, w%phi, -w%s)

@@ -459,9 +459,9 @@ contains
     logical :: fixed, conv, have_kc, new_kc, finite, changed, diagk
     status = MBD_OK; msg = ''
     n = m%nq; na = w%na
-    ! S = [M b' + K + g' C, b' J^T; b' J, 0] on the path of w (dense: plain-loop LU); on the
-    ! band path a diagonal K pattern (pins, no force couples two coordinates) keeps the
-    ! upper-left block diagonal, and S goes through its Schur complement like the index-1
+    ! S = [M b' + K + g' C, b' J^T; b' J, 0] on the path of w (dense: the sparse LU up to 128
+    ! rows, the plain-loop LU beyond); on the band path a diagonal K pattern (pins, no force
+    ! couples two coordinates) keeps the upper-left block diagonal, and S goes through its Schur complement like the index-1
     ! systems (mbd_schur; on the dense path the sparse LU costs less: the free four-bar's step
     ! 17.9k instructions against 20.0k through S)
     diagk = w%solver /= SOLVER_DENSE .and. &
