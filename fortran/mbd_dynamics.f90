@@ -52,12 +52,14 @@ module mbd_dynamics
                           lu_solve_small, LS_RTOL
   use mbd_lapack, only: dgelsy
   use mbd_saddle, only: saddle_t, saddle_plan, saddle_factor, saddle_solve, saddle_row_rank, &
+                        saddle_solve_rows, &
                         SADDLE_BAND_MIN_N, SADDLE_BAND_RATIO
   implicit none
   private
   public :: dyn_work_t, dyn_init, dyn_memory_check, gen_forces, kinetic_energy, dyn_accel, &
             dyn_velocity, &
             dyn_project_pos, dyn_multipliers, dyn_reactions, dyn_tangent, dyn_solve, &
+            dyn_solve_rows, &
             dyn_jt_lam, dyn_damped, dyn_assemble, dyn_choose, dyn_jv, dyn_null_basis, &
             dyn_factor_projection, SOLVER_AUTO, SOLVER_DENSE, SOLVER_BANDED, friction_forces, &
             dyn_element_outputs, element_state, element_slip
@@ -604,6 +606,18 @@ contains
     call saddle_solve(w%sd, rhs, status)
     if (w%sd%lsq) w%nrank = w%nrank + 1
   end subroutine dyn_solve
+
+  !> Several right-hand sides with the last augmented matrix: the rows of bt (4 k, nt) into
+  !! the columns of x (nt, ncol) (saddle_solve_rows; f: ones of x's shape).
+  subroutine dyn_solve_rows(w, bt, x, f, status)
+    type(dyn_work_t), intent(inout) :: w     !! work arrays with the last augmented matrix
+    real(wp), intent(in) :: bt(:, :)         !! right-hand sides as rows
+    real(wp), intent(inout) :: x(:, :)       !! solutions as columns
+    real(wp), intent(in) :: f(:, :)          !! ones (nt, ncol)
+    integer, intent(out) :: status           !! MBD_OK or MBD_LAPACK
+    call saddle_solve_rows(w%sd, bt, x, f, status)
+    if (w%sd%lsq) w%nrank = w%nrank + size(x, 2)
+  end subroutine dyn_solve_rows
 
   !> Phi, nu, gamma and the constraint blocks at (q, q_dot, t); the dense J too on the
   !! dense path.

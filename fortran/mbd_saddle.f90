@@ -47,12 +47,14 @@ module mbd_saddle
                       band_factor, band_rcond, band_solve
   use mbd_schur, only: schur_t, schur_plan, schur_factor, schur_solve, rows_rcm, &
                        rows_by_coordinate
-  use mbd_splu, only: splu_t, splu_init, splu_plan, splu_factor, splu_solve, splu_pos, LMAX
+  use mbd_splu, only: splu_t, splu_init, splu_plan, splu_factor, splu_solve, splu_solve_rows, &
+                      splu_pos, LMAX
   use mbd_linsolve, only: lu_factor, lu_solve, lu_factor_small, lu_solve_small, lapack_status
   use mbd_lapack, only: dgecon, dgelsy
   implicit none
   private
-  public :: saddle_t, saddle_plan, saddle_factor, saddle_solve, saddle_bytes, AUG_RCOND
+  public :: saddle_t, saddle_plan, saddle_factor, saddle_solve, saddle_solve_rows, &
+            saddle_bytes, AUG_RCOND
   public :: saddle_row_rank
   public :: SADDLE_BAND_MIN_N, SADDLE_BAND_RATIO
 
@@ -102,7 +104,6 @@ module mbd_saddle
     type(splu_t) :: sp
     logical :: sparse = .false.          !! the sparse LU is planned for
     logical :: spfact = .false.          !! the last factorization is the sparse one
-    integer, allocatable :: urow(:), ucol(:), upos(:)  !! structural entries
     !> the pieces' places in the plan's storage (dpos, epos, etpos, kpos there; 0: not held)
     integer, allocatable :: sdp(:), sep(:), setp(:), skp(:)
     real(wp), allocatable :: ones(:), xs(:)  !! unit column scale, solution of the sparse solves
@@ -547,7 +548,7 @@ contains
       logical :: off
       ok = .false.; ratio = zero
       if (.not. sd%sp%planned) return
-      call put_sparse(sd%sp%val, sd%upos, sd%n, sd%nt, sd%sdp, sd%skp, sd%esrc, sd%sep, &
+      call put_sparse(sd%sp%val, sd%sp%nnz, sd%n, sd%nt, sd%sdp, sd%skp, sd%esrc, sd%sep, &
                       sd%setp, d, jb, size(jb), s, ee, off, kv)
       if (off) return
       call splu_factor(sd%sp, st, lmax, sgn, ratio)
@@ -590,15 +591,13 @@ contains
       nu = nu + 1
       tr(nu) = sr(i); tc(nu) = sc(i)
     end do
-    allocate (sd%urow(nu), sd%ucol(nu), sd%upos(nu), sd%ones(nt), sd%xs(nt), &
+    allocate (sd%ones(nt), sd%xs(nt), &
               sd%sdp(nt), sd%sep(size(sd%epos)), sd%setp(size(sd%epos)), &
               sd%skp(size(sd%kpos)), stat=ierr)
     if (ierr /= 0) return
-    sd%urow = tr(1:nu); sd%ucol = tc(1:nu)
-    sd%upos = 0
     sd%ones = one
     msg = ''
-    call splu_init(nt, sd%urow, sd%ucol, sd%sp, st, msg)
+    call splu_init(nt, tr(1:nu), tc(1:nu), sd%sp, st, msg)
     sd%sparse = st == MBD_OK
   end subroutine sparse_plan
 
@@ -622,12 +621,8 @@ contains
     call splu_factor(sd%sp, st, lmax, sgn, ratio)
     ok = st == MBD_OK .and. lmax <= LMAX
   contains
-    !> The places of the structural entries and of the pieces in the new plan.
+    !> The places of the pieces in the new plan.
     subroutine positions()
-      integer :: i
-      do i = 1, size(sd%upos)
-        sd%upos(i) = splu_pos(sd%sp, sd%urow(i), sd%ucol(i))
-      end do
       sd%sdp = held(sd%dpos); sd%sep = held(sd%epos); sd%setp = held(sd%etpos)
       sd%skp = held(sd%kpos)
     end subroutine positions
@@ -705,13 +700,14 @@ contains
     end do
   end subroutine keep_values
 
-  !> put into a sparse plan's storage val: the held structural entries zeroed, then the
-  !! pieces in put's order at their plan positions (so the sums are put's); off: a non-zero
-  !! piece the plan does not hold.
-  pure subroutine put_sparse(val, upos, n, nt, sdp, skp, esrc, sep, setp, d, jb, nj, s, e, &
+  !> put into a sparse plan's storage val: its nnz entries zeroed (one flat fill; the fill
+  !! entries among them are zeroed by the factorization anyway), then the pieces in put's
+  !! order at their plan positions (so the sums are put's); off: a non-zero piece the plan
+  !! does not hold.
+  pure subroutine put_sparse(val, nnz, n, nt, sdp, skp, esrc, sep, setp, d, jb, nj, s, e, &
                              off, kv)
     real(wp), intent(inout) :: val(:)
-    integer, intent(in) :: upos(:), n, nt, nj
+    integer, intent(in) :: nnz, n, nt, nj
     integer, intent(in) :: sdp(:), skp(:), esrc(:), sep(:), setp(:)
     real(wp), intent(in) :: d(:), jb(nj), s, e
     logical, intent(out) :: off
@@ -719,9 +715,7 @@ contains
     integer :: i
     real(wp) :: v
     off = .false.
-    do i = 1, size(upos)
-      if (upos(i) > 0) val(upos(i)) = zero
-    end do
+    val(1:nnz) = zero
     if (present(kv)) then
       do i = 1, size(skp)
         call put_add(val, off, skp(i), kv(i))
@@ -841,6 +835,30 @@ contains
     call lapack_status('dgelsy', info, status, msg)
     sd%nrank = sd%nrank + 1
   end subroutine saddle_solve
+
+  !> Several right-hand sides, given as the rows of bt (4 k, nt; the rows past size(x, 2)
+  !! zero), solved into the columns of x (nt, ncol): on the sparse LU four at a time through
+  !! its factors (splu_solve_rows: each column's operations and results those of
+  !! saddle_solve), else column by column by saddle_solve. f (nt, ncol) holds ones (the
+  !! rows solve's output factors).
+  subroutine saddle_solve_rows(sd, bt, x, f, status)
+    type(saddle_t), intent(inout) :: sd      !! factored matrix
+    real(wp), intent(in) :: bt(:, :)         !! right-hand sides as rows (4 k, nt)
+    real(wp), intent(inout) :: x(:, :)       !! solutions (nt, ncol)
+    real(wp), intent(in) :: f(:, :)          !! ones (nt, ncol)
+    integer, intent(out) :: status           !! MBD_OK, MBD_SINGULAR or MBD_LAPACK
+    integer :: k
+    status = MBD_OK
+    if (sd%plain .and. sd%spfact .and. .not. (sd%schur .or. sd%banded .or. sd%lsq)) then
+      call splu_solve_rows(sd%sp, bt, x, sd%ones, f)
+      return
+    end if
+    do k = 1, size(x, 2)
+      x(:, k) = bt(k, :)
+      call saddle_solve(sd, x(:, k), status)
+      if (status /= MBD_OK) return
+    end do
+  end subroutine saddle_solve_rows
 
   !> Redundant rows of J without a dense matrix: a Cholesky factorization of the Gram matrix
   !! G = D J J^T D of the rows scaled to unit length (D), in band storage after a reverse

@@ -34,7 +34,7 @@ module mbd_sens_dynamics
   use mbd_lapack, only: dgelsy
   use mbd_status, only: MBD_INTEGRATOR_FAILED, MBD_BAD_SETTING
   use mbd_dynamics, only: dyn_work_t, dyn_accel, dyn_solve, dyn_project_pos, dyn_velocity, &
-                          dyn_factor_projection, dyn_jv
+                          dyn_factor_projection, dyn_jv, dyn_solve_rows
   use mbd_integrators, only: output_rows, C2, C3, C4, C5, A21, A31, A32, A41, A42, A43, A51, &
                              A52, A53, A54, A61, A62, A63, A64, A65, A71, A73, A74, A75, A76, &
                              E1, E3, E4, E5, E6, E7
@@ -308,8 +308,11 @@ contains
     real(wp), allocatable :: y(:), yn(:), k(:, :), e(:), za(:), zda(:), zdda(:), lam(:), &
                              zz(:), zzd(:), zzdd(:)
     ! the work of rhs and project (here, so that no step allocates)
-    real(wp), allocatable :: qq(:), vv(:), aa(:), r(:), y1(:), sk(:), sdk(:), jpb(:, :, :), &
-                             v0(:)
+    real(wp), allocatable :: qq(:), vv(:), aa(:), y1(:), y2(:), y3(:), jpb(:, :, :), v0(:)
+    !> the sensitivities' right-hand sides as rows (4 k, n + na; the rows past np stay zero),
+    !! their solutions (n + na, np) and ones of that shape (dyn_solve_rows)
+    real(wp), allocatable :: rt(:, :), xr(:, :), fones(:, :)
+    real(wp), allocatable :: wk(:, :)   ! (np, neq) the constraint rows, parameter by row
     type(proj_work_t) :: pw
     real(wp) :: t, h, tnew, err, fac, sc
     integer :: n, np, nz, st, kout
@@ -323,13 +326,15 @@ contains
       return
     end if
     allocate (y(2 * nz), yn(2 * nz), k(2 * nz, 7), e(2 * nz), za(nz), zda(nz), zdda(nz), &
-              lam(m%neq), zz(nz), zzd(nz), zzdd(nz), qq(n), vv(n), aa(n), r(n + w%na), y1(n), &
-              sk(n), sdk(n), jpb(MAXROW, NLOC, m%nc), v0(n), stat=st)
+              lam(m%neq), zz(nz), zzd(nz), zzdd(nz), qq(n), vv(n), aa(n), y1(n), y2(n), y3(n), &
+              jpb(MAXROW, NLOC, m%nc), v0(n), rt(4 * ((np + 3) / 4), n + w%na), &
+              xr(n + w%na, np), fones(n + w%na, np), wk(np, m%neq), stat=st)
     if (st /= 0) then
       status = MBD_NO_MEMORY; msg = 'out of memory for the sensitivity integration'; return
     end if
     call proj_init(m, w, pw, status, msg)
     if (status /= MBD_OK) return
+    rt = zero; fones = one
     y(1:n) = q; y(n + 1:nz) = reshape(sq, [n * np])
     y(nz + 1:nz + n) = qd; y(nz + n + 1:) = reshape(sqd, [n * np])
     t = t0
@@ -429,35 +434,34 @@ contains
       real(wp), intent(in) :: tt, yy(:)
       real(wp), intent(out) :: f(:)
       integer, intent(out) :: stp
-      integer :: kk, i, o
+      integer :: kk, o
       stats(3) = stats(3) + 1
       qq = yy(1:n); vv = yy(nz + 1:nz + n)
       call dyn_accel(m, w, qq, vv, tt, aa, lam, stp)
       if (stp /= MBD_OK) return
       f(1:nz) = yy(nz + 1:)
       f(nz + 1:nz + n) = aa
-      call sens_trig(m, s, qq)
+      ! cos and sin of the angles at qq: the assembly's (sens_trig's values, not computed again)
+      s%cb(1:m%nb) = w%asm%cb(1:m%nb); s%sb(1:m%nb) = w%asm%sb(1:m%nb)
       call sens_hessian(m, s, qq, vv, aa, tt)
       call sens_params(m, s, qq, vv, aa, tt)
       call sens_klam_list(m, s, lam)
+      ! the right-hand side of each parameter as a row of rt, then one solve for all
       do kk = 1, np
         o = n * kk
-        sk = yy(o + 1:o + n); sdk = yy(nz + o + 1:nz + o + n)
-        call sens_force_d(m, s, kk, qq, vv, sk, sdk, tt, y1)
-        r(1:n) = y1 - s%tmass(:, kk) * aa
-        call sens_klam(s, sk, y1)
-        r(1:n) = r(1:n) - y1
-        call sens_jpt_lam(m, s, kk, qq, tt, lam, y1, jpb)
-        r(1:n) = r(1:n) - y1
-        s%work = s%ap(kk, :)
-        do i = 1, s%nnz
-          s%work(s%nzr(i)) = s%work(s%nzr(i)) - s%nza(i) * sk(s%nzc(i)) - &
-                             2 * s%nzv(i) * sdk(s%nzc(i))
-        end do
-        r(n + 1:) = w%s * s%work(w%rows)
-        call dyn_solve(w, r, stp)
-        if (stp /= MBD_OK) return
-        f(nz + o + 1:nz + o + n) = r(1:n)
+        call sens_force_d(m, s, kk, qq, vv, yy(o + 1:o + n), yy(nz + o + 1:nz + o + n), tt, y1)
+        call sens_klam(s, yy(o + 1:o + n), y2)
+        call sens_jpt_lam(m, s, kk, qq, tt, lam, y3, jpb)
+        call force_row(n, size(rt, 1), kk, y1, s%tmass(:, kk), aa, y2, y3, rt)
+      end do
+      call constraint_rows(n, np, m%neq, w%na, s%nnz, size(rt, 1), s%nzr, s%nzc, s%nza, &
+                           s%nzv, size(s%ap, 1), s%ap, w%rows, w%s, yy(n + 1:nz), &
+                           yy(nz + n + 1:), wk, rt)
+      call dyn_solve_rows(w, rt, xr, fones, stp)
+      if (stp /= MBD_OK) return
+      do kk = 1, np
+        o = n * kk
+        f(nz + o + 1:nz + o + n) = xr(1:n, kk)
       end do
     end subroutine rhs
 
@@ -502,6 +506,46 @@ contains
       sddo(:, :, row) = reshape(z3(n + 1:), [n, np])
     end subroutine put
   end subroutine sens_dopri5
+
+  !> Row k of the sensitivities' right-hand sides, its first n entries (the dynamic
+  !! equations): Q_p + K S_k + C S_dot_k (y1) - M_p q_ddot - K_lambda S_k (y2) - J_p^T lambda
+  !! (y3).
+  pure subroutine force_row(n, npad, k, y1, tm, aa, y2, y3, rt)
+    integer, intent(in) :: n, npad, k
+    real(wp), intent(in) :: y1(n), tm(n), aa(n), y2(n), y3(n)
+    real(wp), intent(inout) :: rt(npad, *)
+    integer :: i
+    do i = 1, n
+      rt(k, i) = ((y1(i) - tm(i) * aa(i)) - y2(i)) - y3(i)
+    end do
+  end subroutine force_row
+
+  !> The constraint rows of the sensitivities' right-hand sides, every parameter at once (each
+  !! entry's indices and values read once): rt(k, n + i) = s w(k, rows(i)),
+  !! w(k, :) = gamma_p - J_p q_ddot (ap's row k) - Hq S_k - 2 Hv S_dot_k (the entries nzr,
+  !! nzc, nza, nzv; S and S_dot (n, np) the packed state's).
+  pure subroutine constraint_rows(n, np, neq, na, nnz, npad, nzr, nzc, nza, nzv, ldap, ap, &
+                                  rows, sc, sq, sqd, wk, rt)
+    integer, intent(in) :: n, np, neq, na, nnz, npad, ldap
+    integer, intent(in) :: nzr(*), nzc(*), rows(na)
+    real(wp), intent(in) :: nza(*), nzv(*), ap(ldap, neq), sc, sq(n, np), sqd(n, np)
+    real(wp), intent(out) :: wk(np, neq)
+    real(wp), intent(inout) :: rt(npad, *)
+    integer :: i, k, ir, ic
+    real(wp) :: a1, a2
+    wk = ap(1:np, :)
+    do i = 1, nnz
+      ir = nzr(i); ic = nzc(i); a1 = nza(i); a2 = 2 * nzv(i)
+      do k = 1, np
+        wk(k, ir) = wk(k, ir) - a1 * sq(ic, k) - a2 * sqd(ic, k)
+      end do
+    end do
+    do i = 1, na
+      do k = 1, np
+        rt(k, n + i) = sc * wk(k, rows(i))
+      end do
+    end do
+  end subroutine constraint_rows
 
   !> Project the sensitivities in the packed state yy = (q, S, q_dot, S_dot) (q, q_dot
   !! consistent) onto the linearized constraints: S onto J S = -Phi_p by the minimum-norm
