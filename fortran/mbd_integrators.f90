@@ -53,8 +53,7 @@ module mbd_integrators
   public :: dyn_opts_t, dyn_stats_t, METH_GENALPHA, METH_DOPRI5, METH_RK4, METH_PARTITIONED
   public :: integrate, output_rows, output_index, MAX_STEPS_DEFAULT
   ! the Dormand-Prince 5(4) tableau, also used by the sensitivity integrator (mbd_sens_dynamics)
-  public :: C2, C3, C4, C5, A21, A31, A32, A41, A42, A43, A51, A52, A53, A54, A61, A62, A63, &
-            A64, A65, A71, A73, A74, A75, A76, E1, E3, E4, E5, E6, E7
+  public :: dopri5_state, dopri5_error, DOPRI_C
 
   integer, parameter :: METH_GENALPHA = 1, METH_DOPRI5 = 2, METH_RK4 = 3, METH_PARTITIONED = 4
   !> Default step limit: it ends a run whose steps collapse without underflowing, after
@@ -132,6 +131,8 @@ module mbd_integrators
   real(wp), parameter :: A75 = -2187.0_wp / 6784, A76 = 11.0_wp / 84
   real(wp), parameter :: E1 = 71.0_wp / 57600, E3 = -71.0_wp / 16695, E4 = 71.0_wp / 1920
   real(wp), parameter :: E5 = -17253.0_wp / 339200, E6 = 22.0_wp / 525, E7 = -1.0_wp / 40
+  !> the nodes of stages 2 .. 6 (c_6 = 1)
+  real(wp), parameter :: DOPRI_C(2:6) = [C2, C3, C4, C5, 1.0_wp]
 
 contains
 
@@ -1460,6 +1461,42 @@ contains
 
   !> One Dormand-Prince 5(4) step; e is the embedded error estimate. k(:, 1) is reused from
   !! the last stage of the previous step when fsal is true (first same as last).
+  !> The state of Dormand-Prince stage j = 2 .. 7 from y and the rates k(:, 1:j-1) of the
+  !! stages before: ys = y + h sum_i a_ji k_i (j = 7: the new state, the fifth-order
+  !! solution; y and ys of equal length).
+  pure subroutine dopri5_state(j, y, h, k, ys)
+    integer, intent(in) :: j                  !! stage
+    real(wp), intent(in) :: y(:), h           !! state at the step's start, step
+    real(wp), intent(in) :: k(:, :)           !! rates of the stages (at least j - 1)
+    real(wp), intent(out) :: ys(:)            !! the stage's state
+    select case (j)
+    case (2)
+      ys = y + h * A21 * k(:, 1)
+    case (3)
+      ys = y + h * (A31 * k(:, 1) + A32 * k(:, 2))
+    case (4)
+      ys = y + h * (A41 * k(:, 1) + A42 * k(:, 2) + A43 * k(:, 3))
+    case (5)
+      ys = y + h * (A51 * k(:, 1) + A52 * k(:, 2) + A53 * k(:, 3) + A54 * k(:, 4))
+    case (6)
+      ys = y + h * (A61 * k(:, 1) + A62 * k(:, 2) + A63 * k(:, 3) + A64 * k(:, 4) + &
+                    A65 * k(:, 5))
+    case default
+      ys = y + h * (A71 * k(:, 1) + A73 * k(:, 3) + A74 * k(:, 4) + A75 * k(:, 5) + &
+                    A76 * k(:, 6))
+    end select
+  end subroutine dopri5_state
+
+  !> The embedded error estimate of a Dormand-Prince step: e = h sum_i e_i k_i (fifth minus
+  !! fourth order, the seven stages' rates in k).
+  pure subroutine dopri5_error(h, k, e)
+    real(wp), intent(in) :: h                 !! step
+    real(wp), intent(in) :: k(:, :)           !! rates of the seven stages
+    real(wp), intent(out) :: e(:)             !! estimate
+    e = h * (E1 * k(:, 1) + E3 * k(:, 3) + E4 * k(:, 4) + E5 * k(:, 5) + E6 * k(:, 6) + &
+             E7 * k(:, 7))
+  end subroutine dopri5_error
+
   subroutine dopri5_step(m, w, c, t, y, h, yn, k, e, ys, fsal, stf)
     type(model_t), intent(in) :: m
     type(dyn_work_t), intent(inout) :: w
@@ -1470,32 +1507,22 @@ contains
     real(wp), intent(inout) :: ys(:)          !! a stage's state (workspace)
     logical, intent(inout) :: fsal
     integer, intent(out) :: stf
+    integer :: j
     stf = MBD_OK
     if (.not. fsal) then
       call rhs(m, w, c, t, y, k(:, 1), stf)
       if (stf /= MBD_OK) return
     end if
     ! the stages' states in ys (expressions as arguments would be heap temporaries)
-    ys = y + h * A21 * k(:, 1)
-    call rhs(m, w, c, t + C2 * h, ys, k(:, 2), stf)
-    if (stf /= MBD_OK) return
-    ys = y + h * (A31 * k(:, 1) + A32 * k(:, 2))
-    call rhs(m, w, c, t + C3 * h, ys, k(:, 3), stf)
-    if (stf /= MBD_OK) return
-    ys = y + h * (A41 * k(:, 1) + A42 * k(:, 2) + A43 * k(:, 3))
-    call rhs(m, w, c, t + C4 * h, ys, k(:, 4), stf)
-    if (stf /= MBD_OK) return
-    ys = y + h * (A51 * k(:, 1) + A52 * k(:, 2) + A53 * k(:, 3) + A54 * k(:, 4))
-    call rhs(m, w, c, t + C5 * h, ys, k(:, 5), stf)
-    if (stf /= MBD_OK) return
-    ys = y + h * (A61 * k(:, 1) + A62 * k(:, 2) + A63 * k(:, 3) + A64 * k(:, 4) + A65 * k(:, 5))
-    call rhs(m, w, c, t + h, ys, k(:, 6), stf)
-    if (stf /= MBD_OK) return
-    yn = y + h * (A71 * k(:, 1) + A73 * k(:, 3) + A74 * k(:, 4) + A75 * k(:, 5) + A76 * k(:, 6))
+    do j = 2, 6
+      call dopri5_state(j, y, h, k, ys)
+      call rhs(m, w, c, t + DOPRI_C(j) * h, ys, k(:, j), stf)
+      if (stf /= MBD_OK) return
+    end do
+    call dopri5_state(7, y, h, k, yn)
     call rhs(m, w, c, t + h, yn, k(:, 7), stf)
     if (stf /= MBD_OK) return
-    e = h * (E1 * k(:, 1) + E3 * k(:, 3) + E4 * k(:, 4) + E5 * k(:, 5) + E6 * k(:, 6) + &
-             E7 * k(:, 7))
+    call dopri5_error(h, k, e)
     k(:, 1) = k(:, 7)
     fsal = .true.
   end subroutine dopri5_step

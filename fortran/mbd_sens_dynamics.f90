@@ -33,37 +33,44 @@ module mbd_sens_dynamics
                           lu_solve_small, LS_RTOL
   use mbd_lapack, only: dgelsy
   use mbd_status, only: MBD_INTEGRATOR_FAILED, MBD_BAD_SETTING
-  use mbd_dynamics, only: dyn_work_t, dyn_accel, dyn_solve, dyn_project_pos, dyn_velocity, &
+  use mbd_dynamics, only: dyn_work_t, dyn_accel, dyn_project_pos, dyn_velocity, &
                           dyn_factor_projection, dyn_jv, dyn_solve_rows
-  use mbd_integrators, only: output_rows, C2, C3, C4, C5, A21, A31, A32, A41, A42, A43, A51, &
-                             A52, A53, A54, A61, A62, A63, A64, A65, A71, A73, A74, A75, A76, &
-                             E1, E3, E4, E5, E6, E7
+  use mbd_integrators, only: output_rows, dopri5_state, dopri5_error, DOPRI_C
   use mbd_interp, only: hermite5
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   implicit none
   private
   public :: sens_multipliers, sens_reactions, sens_statics, sens_dopri5, sens_initial
 
-  !> Work of project_sens (allocated once per run by proj_init: no step allocates).
+  !> Work of project_sens and of the dopri5 right-hand sides (allocated once per run by
+  !! proj_init: no step allocates).
   type :: proj_work_t
-    real(wp), allocatable :: r(:), hvs(:)   !! a saddle right-hand side (nq + na), Hv S rows
+    real(wp), allocatable :: hvs(:)         !! Hv S rows (neq)
+    !> one saddle right-hand side per parameter as the rows of rt (4 k, nq + na; the rows past
+    !! np stay zero), their solutions xr (nq + na, np), ones of that shape (dyn_solve_rows)
+    real(wp), allocatable :: rt(:, :), xr(:, :), fones(:, :)
   end type proj_work_t
 
 contains
 
-  !> Allocate project_sens's work for model m and the active rows of w.
-  subroutine proj_init(m, w, pw, status, msg)
+  !> Allocate project_sens's work for model m, the active rows of w and np parameters.
+  subroutine proj_init(m, w, np, pw, status, msg)
     type(model_t), intent(in) :: m              !! model
     type(dyn_work_t), intent(in) :: w           !! dynamics work arrays (dyn_init done)
+    integer, intent(in) :: np                   !! parameters
     type(proj_work_t), intent(out) :: pw        !! the work
     integer, intent(out) :: status              !! MBD_OK or MBD_NO_MEMORY
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
-    integer :: st
+    integer :: st, nt
     status = MBD_OK; msg = ''
-    allocate (pw%r(m%nq + w%na), pw%hvs(m%neq), stat=st)
+    nt = m%nq + w%na
+    allocate (pw%hvs(m%neq), pw%rt(4 * ((np + 3) / 4), nt), pw%xr(nt, np), pw%fones(nt, np), &
+              stat=st)
     if (st /= 0) then
       status = MBD_NO_MEMORY; msg = 'out of memory for the sensitivity projections'
+      return
     end if
+    pw%rt = zero; pw%fones = one
   end subroutine proj_init
 
   !> dlambda/dp (neq, np) at one output of an inverse dynamics run, from the kinematic
@@ -305,13 +312,10 @@ contains
     real(wp), intent(out) :: t_fail             !! time reached at a failure
     integer, intent(out) :: status              !! MBD_OK or a failure
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
-    real(wp), allocatable :: y(:), yn(:), k(:, :), e(:), za(:), zda(:), zdda(:), lam(:), &
+    real(wp), allocatable :: y(:), yn(:), ys(:), k(:, :), e(:), za(:), zda(:), zdda(:), lam(:), &
                              zz(:), zzd(:), zzdd(:)
     ! the work of rhs and project (here, so that no step allocates)
     real(wp), allocatable :: qq(:), vv(:), aa(:), y1(:), y2(:), y3(:), jpb(:, :, :), v0(:)
-    !> the sensitivities' right-hand sides as rows (4 k, n + na; the rows past np stay zero),
-    !! their solutions (n + na, np) and ones of that shape (dyn_solve_rows)
-    real(wp), allocatable :: rt(:, :), xr(:, :), fones(:, :)
     real(wp), allocatable :: wk(:, :)   ! (np, neq) the constraint rows, parameter by row
     type(proj_work_t) :: pw
     real(wp) :: t, h, tnew, err, fac, sc
@@ -325,16 +329,14 @@ contains
       status = MBD_BAD_SETTING; msg = 'rtol, atol > 0, every >= 1 and outputs sized for it'
       return
     end if
-    allocate (y(2 * nz), yn(2 * nz), k(2 * nz, 7), e(2 * nz), za(nz), zda(nz), zdda(nz), &
+    allocate (y(2 * nz), yn(2 * nz), ys(2 * nz), k(2 * nz, 7), e(2 * nz), za(nz), zda(nz), zdda(nz), &
               lam(m%neq), zz(nz), zzd(nz), zzdd(nz), qq(n), vv(n), aa(n), y1(n), y2(n), y3(n), &
-              jpb(MAXROW, NLOC, m%nc), v0(n), rt(4 * ((np + 3) / 4), n + w%na), &
-              xr(n + w%na, np), fones(n + w%na, np), wk(np, m%neq), stat=st)
+              jpb(MAXROW, NLOC, m%nc), v0(n), wk(np, m%neq), stat=st)
     if (st /= 0) then
       status = MBD_NO_MEMORY; msg = 'out of memory for the sensitivity integration'; return
     end if
-    call proj_init(m, w, pw, status, msg)
+    call proj_init(m, w, s%np, pw, status, msg)
     if (status /= MBD_OK) return
-    rt = zero; fones = one
     y(1:n) = q; y(n + 1:nz) = reshape(sq, [n * np])
     y(nz + 1:nz + n) = qd; y(nz + n + 1:) = reshape(sqd, [n * np])
     t = t0
@@ -404,28 +406,21 @@ contains
     !> One Dormand-Prince step from (t, y) with k(:, 1) = f(t, y) known: yn, e.
     subroutine step(stp)
       integer, intent(out) :: stp
+      integer :: j
       if (.not. fsal) then
         call rhs(t, y, k(:, 1), stp)
         if (stp /= MBD_OK) return
       end if
-      call rhs(t + C2 * h, y + h * A21 * k(:, 1), k(:, 2), stp)
-      if (stp /= MBD_OK) return
-      call rhs(t + C3 * h, y + h * (A31 * k(:, 1) + A32 * k(:, 2)), k(:, 3), stp)
-      if (stp /= MBD_OK) return
-      call rhs(t + C4 * h, y + h * (A41 * k(:, 1) + A42 * k(:, 2) + A43 * k(:, 3)), k(:, 4), stp)
-      if (stp /= MBD_OK) return
-      call rhs(t + C5 * h, y + h * (A51 * k(:, 1) + A52 * k(:, 2) + A53 * k(:, 3) + &
-               A54 * k(:, 4)), k(:, 5), stp)
-      if (stp /= MBD_OK) return
-      call rhs(t + h, y + h * (A61 * k(:, 1) + A62 * k(:, 2) + A63 * k(:, 3) + A64 * k(:, 4) + &
-               A65 * k(:, 5)), k(:, 6), stp)
-      if (stp /= MBD_OK) return
-      yn = y + h * (A71 * k(:, 1) + A73 * k(:, 3) + A74 * k(:, 4) + A75 * k(:, 5) + &
-                    A76 * k(:, 6))
+      ! the stages' states in ys (expressions as arguments would be heap temporaries)
+      do j = 2, 6
+        call dopri5_state(j, y, h, k, ys)
+        call rhs(t + DOPRI_C(j) * h, ys, k(:, j), stp)
+        if (stp /= MBD_OK) return
+      end do
+      call dopri5_state(7, y, h, k, yn)
       call rhs(t + h, yn, k(:, 7), stp)
       if (stp /= MBD_OK) return
-      e = h * (E1 * k(:, 1) + E3 * k(:, 3) + E4 * k(:, 4) + E5 * k(:, 5) + E6 * k(:, 6) + &
-               E7 * k(:, 7))
+      call dopri5_error(h, k, e)
     end subroutine step
 
     !> f(t, y): (z_dot, z_ddot), z = (q, S): q_ddot from the index-1 system, each S_ddot from
@@ -452,16 +447,16 @@ contains
         call sens_force_d(m, s, kk, qq, vv, yy(o + 1:o + n), yy(nz + o + 1:nz + o + n), tt, y1)
         call sens_klam(s, yy(o + 1:o + n), y2)
         call sens_jpt_lam(m, s, kk, qq, tt, lam, y3, jpb)
-        call force_row(n, size(rt, 1), kk, y1, s%tmass(:, kk), aa, y2, y3, rt)
+        call force_row(n, size(pw%rt, 1), kk, y1, s%tmass(:, kk), aa, y2, y3, pw%rt)
       end do
-      call constraint_rows(n, np, m%neq, w%na, s%nnz, size(rt, 1), s%nzr, s%nzc, s%nza, &
+      call constraint_rows(n, np, m%neq, w%na, s%nnz, size(pw%rt, 1), s%nzr, s%nzc, s%nza, &
                            s%nzv, size(s%ap, 1), s%ap, w%rows, w%s, yy(n + 1:nz), &
-                           yy(nz + n + 1:), wk, rt)
-      call dyn_solve_rows(w, rt, xr, fones, stp)
+                           yy(nz + n + 1:), wk, pw%rt)
+      call dyn_solve_rows(w, pw%rt, pw%xr, pw%fones, stp)
       if (stp /= MBD_OK) return
       do kk = 1, np
         o = n * kk
-        f(nz + o + 1:nz + o + n) = xr(1:n, kk)
+        f(nz + o + 1:nz + o + n) = pw%xr(1:n, kk)
       end do
     end subroutine rhs
 
@@ -564,22 +559,25 @@ contains
     integer, intent(out) :: stp                 !! MBD_OK or MBD_SINGULAR
     integer :: kk, o, i, n, nz
     n = m%nq; nz = n * (1 + s%np)
-    associate (r => pw%r, hvs => pw%hvs, z => w%qz)   ! (w%qz: dynamics' zero vector)
+    associate (rt => pw%rt, xr => pw%xr, hvs => pw%hvs, z => w%qz)  ! (w%qz: a zero vector)
       call sens_trig(m, s, yy(1:n))
       call sens_hessian(m, s, yy(1:n), yy(nz + 1:nz + n), z, tt)
       call sens_params(m, s, yy(1:n), yy(nz + 1:nz + n), z, tt)
       call dyn_factor_projection(m, w, yy(1:n), tt, .false., stp)
       if (stp /= MBD_OK) return
-      do kk = 1, s%np                           ! S += dS
+      do kk = 1, s%np                           ! S += dS (one solve for all parameters)
         o = n * kk
         call dyn_jv(m, w, yy(o + 1:o + n))
-        r(1:n) = zero
+        rt(kk, 1:n) = zero
         do i = 1, w%na
-          r(n + i) = w%s * (s%mphip(kk, w%rows(i)) - w%jv(w%rows(i)))
+          rt(kk, n + i) = w%s * (s%mphip(kk, w%rows(i)) - w%jv(w%rows(i)))
         end do
-        call dyn_solve(w, r, stp)
-        if (stp /= MBD_OK) return
-        yy(o + 1:o + n) = yy(o + 1:o + n) + r(1:n)
+      end do
+      call dyn_solve_rows(w, rt, xr, pw%fones, stp)
+      if (stp /= MBD_OK) return
+      do kk = 1, s%np
+        o = n * kk
+        yy(o + 1:o + n) = yy(o + 1:o + n) + xr(1:n, kk)
       end do
       call dyn_factor_projection(m, w, yy(1:n), tt, .true., stp, assembled=.true.)
       if (stp /= MBD_OK) return
@@ -589,13 +587,18 @@ contains
         do i = 1, s%nnz
           hvs(s%nzr(i)) = hvs(s%nzr(i)) - s%nzv(i) * yy(o + s%nzc(i))
         end do
-        r(1:n) = w%metric * yy(nz + o + 1:nz + o + n)
-        do i = 1, w%na
-          r(n + i) = w%s * hvs(w%rows(i))
+        do i = 1, n
+          rt(kk, i) = w%metric(i) * yy(nz + o + i)
         end do
-        call dyn_solve(w, r, stp)
-        if (stp /= MBD_OK) return
-        yy(nz + o + 1:nz + o + n) = r(1:n)
+        do i = 1, w%na
+          rt(kk, n + i) = w%s * hvs(w%rows(i))
+        end do
+      end do
+      call dyn_solve_rows(w, rt, xr, pw%fones, stp)
+      if (stp /= MBD_OK) return
+      do kk = 1, s%np
+        o = n * kk
+        yy(nz + o + 1:nz + o + n) = xr(1:n, kk)
       end do
     end associate
   end subroutine project_sens
@@ -618,7 +621,7 @@ contains
     n = m%nq; nz = n * (1 + s%np)
     y = zero
     y(1:n) = q; y(nz + 1:nz + n) = qd
-    call proj_init(m, w, pw, status, msg)
+    call proj_init(m, w, s%np, pw, status, msg)
     if (status /= MBD_OK) return
     msg = ''
     call project_sens(m, w, s, t, y, pw, status)
