@@ -24,7 +24,7 @@ module mbd_dual
                         sscale, ssqrt, sconst, put_vec, put_scal
   implicit none
   private
-  public :: dloc, dvec, dscal, dual_state, point_terms_d
+  public :: dloc, dvec, dscal, dual_state, point_terms_d, point_values, point_changes
   public :: curve_vector, curve_point, body_point, body_vector, body_angle, slot_value, &
             const_vec, vsub, vadd, vscale, vdot, vcross, ssub, sadd, sscale, ssqrt, sconst, &
             put_vec, put_scal
@@ -234,24 +234,54 @@ contains
     real(wp), intent(in) :: s(2), ts(2)  !! point in the body frame and its change
     real(wp), intent(out) :: p(2), bs(2), ar(2)      !! P, B s', -A s' thd**2
     real(wp), intent(out) :: tp(2), tbs(2), tar(2)   !! their changes
-    real(wp) :: cs, sn, thd, dth, dthd, au(2), e(2)
+    real(wp) :: au(2)
+    call point_values(x%x, slot, s, p, bs, ar, au)
+    call point_changes(x, slot, ts, au, bs, tp, tbs, tar)
+  end subroutine point_terms_d
+
+  !> The values of point_terms_d: P = r + A s', B s', -A s' thd**2 and A s' (au).
+  pure subroutine point_values(x, slot, s, p, bs, ar, au)
+    type(kloc), intent(in) :: x          !! local state
+    integer, intent(in) :: slot          !! 0 ground (s global), 1 or 2
+    real(wp), intent(in) :: s(2)         !! point in the body frame
+    real(wp), intent(out) :: p(2), bs(2), ar(2), au(2)
+    real(wp) :: cs, sn, thd
     integer :: c
     if (slot == 0) then
-      p = s; tp = ts; bs = zero; ar = zero; tbs = zero; tar = zero
+      p = s; bs = zero; ar = zero; au = zero
+      return
+    end if
+    c = 3 * (slot - 1)
+    cs = x%c(slot); sn = x%s(slot)
+    thd = x%qd(c + 3)
+    au = [cs * s(1) - sn * s(2), sn * s(1) + cs * s(2)]
+    bs = [-au(2), au(1)]
+    p = x%q(c + 1:c + 2) + au
+    ar = -au * thd**2
+  end subroutine point_values
+
+  !> The changes of point_terms_d along x's direction and the change ts of s', from the
+  !! values au = A s' and bs = B s' (point_values).
+  pure subroutine point_changes(x, slot, ts, au, bs, tp, tbs, tar)
+    type(dloc), intent(in) :: x          !! local state and direction
+    integer, intent(in) :: slot          !! 0 ground (s global), 1 or 2
+    real(wp), intent(in) :: ts(2)        !! change of the point
+    real(wp), intent(in) :: au(2), bs(2) !! A s', B s'
+    real(wp), intent(out) :: tp(2), tbs(2), tar(2)
+    real(wp) :: cs, sn, thd, dth, dthd, e(2)
+    integer :: c
+    if (slot == 0) then
+      tp = ts; tbs = zero; tar = zero
       return
     end if
     c = 3 * (slot - 1)
     cs = x%x%c(slot); sn = x%x%s(slot)
     thd = x%x%qd(c + 3); dth = x%tq(c + 3); dthd = x%tqd(c + 3)
-    au = [cs * s(1) - sn * s(2), sn * s(1) + cs * s(2)]
-    bs = [-au(2), au(1)]
     e = [cs * ts(1) - sn * ts(2), sn * ts(1) + cs * ts(2)]
-    p = x%x%q(c + 1:c + 2) + au
-    ar = -au * thd**2
     tp = x%tq(c + 1:c + 2) + bs * dth + e
     tbs = [-e(2), e(1)] - au * dth
     tar = -(bs * dth + e) * thd**2 - two * au * thd * dthd
-  end subroutine point_terms_d
+  end subroutine point_changes
 
   !> Body-fixed direction A u' whose u' changes by tu (body_point_d without r).
   pure function body_vector_d(x, slot, u, tu) result(a)

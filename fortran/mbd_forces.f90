@@ -26,8 +26,8 @@ module mbd_forces
                         vdot, ssqrt, ssub
   use mbd_functions, only: fun_eval, fun_length, fun_check, fun_exponents, fun_eval_d, &
                            fun_is_count
-  use mbd_dual, only: dloc, dvec, dscal, dual_state, point_terms_d, body_point, body_angle, &
-                      ssub
+  use mbd_dual, only: dloc, dvec, dscal, dual_state, point_values, point_changes, body_point, &
+                      body_angle, ssub
   use mbd_contact, only: NCS, NEO, contact_raw_length, contact_prepare, contact_exponents, &
                          contact_eval, friction_raw_length, friction_exponents
   implicit none
@@ -35,12 +35,20 @@ module mbd_forces
   public :: FRC_SPRING, FRC_TORQUE, FRC_POINT, FRC_ROTSPRING, FRC_CONTACT0, FRC_CONTACT1
   public :: FRC_FRICTION
   public :: force_known, force_raw_length, force_prepare, force_eval, force_exponents
-  public :: force_is_contact, force_is_count, force_eval_d
+  public :: force_is_contact, force_is_count, force_eval_d, force_eval_dm
 
   integer, parameter :: FRC_SPRING = 1, FRC_TORQUE = 2, FRC_POINT = 3, FRC_ROTSPRING = 4
   !> contacts: kind FRC_CONTACT0 + geometry - 1 (mbd_contact GEO_*), up to FRC_CONTACT1
   integer, parameter :: FRC_CONTACT0 = 5, FRC_CONTACT1 = 8
   integer, parameter :: FRC_FRICTION = 9   !! friction of a joint (force table row 6)
+
+
+  !> The values of a spring-damper-actuator its changes are taken at (spring_values).
+  type :: spring_v
+    real(wp) :: aui(2) = zero, bi(2) = zero, auj(2) = zero, bj(2) = zero  !! A s', B s'
+    real(wp) :: u(2) = zero, dd(2) = zero    !! direction j - i, relative velocity
+    real(wp) :: l = zero, ldot = zero, tension = zero
+  end type spring_v
 
 contains
 
@@ -307,51 +315,124 @@ contains
     integer, intent(in) :: si, sj           !! slot ids of the bodies (0 = ground)
     real(wp), intent(in) :: t               !! time
     real(wp), intent(out) :: tforce(NLOC)   !! change of the generalized force
-    real(wp) :: pi(2), bi(2), ari(2), tpi(2), tbi(2), tari(2), vi(2), tvi(2)
-    real(wp) :: pj(2), bj(2), arj(2), tpj(2), tbj(2), tarj(2), vj(2), tvj(2)
-    real(wp) :: d(2), dd(2), tdd(2), td(2), u(2), tu(2), l, ldot, tl, tldot
-    real(wp) :: f, f1, f2, tf, tf1, tf2, tension, ttension
+    type(spring_v) :: v
     tforce = zero
-    call point_terms_d(x, si, p(1:2), tp(1:2), pi, bi, ari, tpi, tbi, tari)
-    call point_terms_d(x, sj, p(3:4), tp(3:4), pj, bj, arj, tpj, tbj, tarj)
-    call point_rates(si, bi, tbi, vi, tvi)
-    call point_rates(sj, bj, tbj, vj, tvj)
+    call spring_values(x%x, p, si, sj, t, v)
+    if (v%l > zero) call spring_change(x, v, p, tp, si, sj, t, tforce)
+  end subroutine spring_d
+
+  !> The values spring_d's changes are taken at: B s' and A s' of both points, u, l, the
+  !! relative velocity dd = d_dot, l_dot and the tension T (l = 0: a spring of zero length,
+  !! no direction; the rest is then not set).
+  pure subroutine spring_values(x, p, si, sj, t, v)
+    type(kloc), intent(in) :: x             !! local state
+    real(wp), intent(in) :: p(:)            !! prepared parameters
+    integer, intent(in) :: si, sj           !! slot ids of the bodies (0 = ground)
+    real(wp), intent(in) :: t               !! time
+    type(spring_v), intent(out) :: v        !! the values
+    real(wp) :: pi(2), ari(2), pj(2), arj(2), vi(2), vj(2), d(2), l, f, f1, f2
+    call point_values(x, si, p(1:2), pi, v%bi, ari, v%aui)
+    call point_values(x, sj, p(3:4), pj, v%bj, arj, v%auj)
+    vi = point_rate(x, si, v%bi); vj = point_rate(x, sj, v%bj)
     d = pj - pi
     l = dot_product(d, d)
+    v%l = zero
     if (.not. l > zero) return
-    l = sqrt(l); u = d / l
-    dd = vj - vi; tdd = tvj - tvi; td = tpj - tpi
-    ldot = dot_product(u, dd)
-    tl = dot_product(u, td)
-    tu = (td - u * tl) / l
-    tldot = dot_product(tu, dd) + dot_product(u, tdd)
+    v%l = sqrt(l); v%u = d / v%l
+    v%dd = vj - vi
+    v%ldot = dot_product(v%u, v%dd)
     call fun_eval(p(8:), t, f, f1, f2)
+    v%tension = p(5) * (v%l - p(7)) + p(6) * v%ldot - f
+  end subroutine spring_values
+
+  !> spring_d's change of the generalized force along x's direction and tp from the values
+  !! v (spring_values, l > 0).
+  pure subroutine spring_change(x, v, p, tp, si, sj, t, tforce)
+    type(dloc), intent(in) :: x             !! local state and direction
+    type(spring_v), intent(in) :: v         !! the values at x
+    real(wp), intent(in) :: p(:), tp(:)     !! prepared parameters and their change
+    integer, intent(in) :: si, sj           !! slot ids of the bodies (0 = ground)
+    real(wp), intent(in) :: t               !! time
+    real(wp), intent(out) :: tforce(NLOC)   !! change of the generalized force
+    real(wp) :: tpi(2), tbi(2), tari(2), tvi(2), tpj(2), tbj(2), tarj(2), tvj(2)
+    real(wp) :: tdd(2), td(2), tu(2), tl, tldot, tf, tf1, tf2, ttension
+    tforce = zero
+    call point_changes(x, si, tp(1:2), v%aui, v%bi, tpi, tbi, tari)
+    call point_changes(x, sj, tp(3:4), v%auj, v%bj, tpj, tbj, tarj)
+    tvi = rate_change(si, v%bi, tbi); tvj = rate_change(sj, v%bj, tbj)
+    tdd = tvj - tvi; td = tpj - tpi
+    tl = dot_product(v%u, td)
+    tu = (td - v%u * tl) / v%l
+    tldot = dot_product(tu, v%dd) + dot_product(v%u, tdd)
     call fun_eval_d(p(8:), tp(8:), t, tf, tf1, tf2)
-    tension = p(5) * (l - p(7)) + p(6) * ldot - f
-    ttension = tp(5) * (l - p(7)) + p(5) * (tl - tp(7)) + tp(6) * ldot + p(6) * tldot - tf
+    ttension = tp(5) * (v%l - p(7)) + p(5) * (tl - tp(7)) + tp(6) * v%ldot + p(6) * tldot - tf
     if (si > 0) then
-      tforce(1:2) = ttension * u + tension * tu
-      tforce(3) = ttension * dot_product(u, bi) + &
-                  tension * (dot_product(tu, bi) + dot_product(u, tbi))
+      tforce(1:2) = ttension * v%u + v%tension * tu
+      tforce(3) = ttension * dot_product(v%u, v%bi) + &
+                  v%tension * (dot_product(tu, v%bi) + dot_product(v%u, tbi))
     end if
     if (sj > 0) then
-      tforce(4:5) = -ttension * u - tension * tu
-      tforce(6) = -ttension * dot_product(u, bj) - &
-                  tension * (dot_product(tu, bj) + dot_product(u, tbj))
+      tforce(4:5) = -ttension * v%u - v%tension * tu
+      tforce(6) = -ttension * dot_product(v%u, v%bj) - &
+                  v%tension * (dot_product(tu, v%bj) + dot_product(v%u, tbj))
     end if
   contains
-    !> Velocity r_dot + B s theta_dot of a slot's point and its change (ground: zero).
-    pure subroutine point_rates(slot, bs, tbs, v, tv)
+    !> Change of a slot's point velocity r_dot + B s theta_dot (ground: zero).
+    pure function rate_change(slot, bs, tbs) result(tv)
       integer, intent(in) :: slot
       real(wp), intent(in) :: bs(2), tbs(2)
-      real(wp), intent(out) :: v(2), tv(2)
+      real(wp) :: tv(2)
       integer :: c
-      v = zero; tv = zero
+      tv = zero
       if (slot == 0) return
       c = 3 * (slot - 1)
-      v = x%x%qd(c + 1:c + 2) + bs * x%x%qd(c + 3)
       tv = x%tqd(c + 1:c + 2) + tbs * x%x%qd(c + 3) + bs * x%tqd(c + 3)
-    end subroutine point_rates
-  end subroutine spring_d
+    end function rate_change
+  end subroutine spring_change
+
+  !> Velocity r_dot + B s theta_dot of a slot's point (ground: zero).
+  pure function point_rate(x, slot, bs) result(v)
+    type(kloc), intent(in) :: x
+    integer, intent(in) :: slot
+    real(wp), intent(in) :: bs(2)
+    real(wp) :: v(2)
+    integer :: c
+    v = zero
+    if (slot == 0) return
+    c = 3 * (slot - 1)
+    v = x%qd(c + 1:c + 2) + bs * x%qd(c + 3)
+  end function point_rate
+
+  !> force_eval_d along several directions (columns of tq, tqd, tp) at one state: a
+  !! spring's values once (spring_values) and its change per direction, the other kinds
+  !! direction by direction.
+  pure subroutine force_eval_dm(kind, p, tp, si, sj, ql, qdl, tq, tqd, t, tforce)
+    integer, intent(in) :: kind             !! force kind
+    real(wp), intent(in) :: p(:)            !! prepared parameters
+    real(wp), intent(in) :: tp(:, :)        !! their changes (size(p), nk)
+    integer, intent(in) :: si, sj           !! slot ids of the bodies (0 = ground)
+    real(wp), intent(in) :: ql(NLOC), qdl(NLOC)  !! local coordinates and velocities
+    real(wp), intent(in) :: tq(:, :), tqd(:, :)  !! directions (NLOC, nk)
+    real(wp), intent(in) :: t               !! time
+    real(wp), intent(out) :: tforce(:, :)   !! changes of the generalized force (NLOC, nk)
+    type(kloc) :: xs
+    type(spring_v) :: v
+    integer :: k
+    if (kind /= FRC_SPRING) then
+      do k = 1, size(tforce, 2)
+        call force_eval_d(kind, p, tp(:, k), si, sj, ql, qdl, tq(:, k), tqd(:, k), t, &
+                          tforce(:, k))
+      end do
+      return
+    end if
+    tforce = zero
+    xs = local_state(ql, qdl)
+    call spring_values(xs, p, si, sj, t, v)
+    if (.not. v%l > zero) return
+    do k = 1, size(tforce, 2)
+      call spring_change(dual_state(xs, tq(:, k), tqd(:, k)), v, p, tp(:, k), si, sj, t, &
+                         tforce(:, k))
+    end do
+  end subroutine force_eval_dm
 
 end module mbd_forces

@@ -28,7 +28,7 @@ module mbd_sens_dynamics
   use mbd_assemble, only: asm_work_t, asm_init, assemble_blocks, assemble_dense
   use mbd_sensitivity, only: sens_t, sens_trig, sens_hessian, sens_params, sens_klam, &
                              sens_klam_list, &
-                             sens_jpt_lam, sens_force_d, sens_force_jac
+                             sens_jpt_lam, sens_force_d, sens_force_dm, sens_force_jac
   use mbd_linsolve, only: lu_factor, lu_solve, lapack_status, ls_small_cols, lu_factor_small, &
                           lu_solve_small, LS_RTOL
   use mbd_lapack, only: dgelsy
@@ -315,7 +315,8 @@ contains
     real(wp), allocatable :: y(:), yn(:), ys(:), k(:, :), e(:), za(:), zda(:), zdda(:), lam(:), &
                              zz(:), zzd(:), zzdd(:)
     ! the work of rhs and project (here, so that no step allocates)
-    real(wp), allocatable :: qq(:), vv(:), aa(:), y1(:), y2(:), y3(:), jpb(:, :, :), v0(:)
+    real(wp), allocatable :: qq(:), vv(:), aa(:), y2(:), y3(:), jpb(:, :, :), v0(:)
+    real(wp), allocatable :: yf(:, :)   ! (n, np) the forces' changes along S, S_dot and p
     real(wp), allocatable :: wk(:, :)   ! (np, neq) the constraint rows, parameter by row
     type(proj_work_t) :: pw
     real(wp) :: t, h, tnew, err, fac, sc
@@ -330,8 +331,8 @@ contains
       return
     end if
     allocate (y(2 * nz), yn(2 * nz), ys(2 * nz), k(2 * nz, 7), e(2 * nz), za(nz), zda(nz), zdda(nz), &
-              lam(m%neq), zz(nz), zzd(nz), zzdd(nz), qq(n), vv(n), aa(n), y1(n), y2(n), y3(n), &
-              jpb(MAXROW, NLOC, m%nc), v0(n), wk(np, m%neq), stat=st)
+              lam(m%neq), zz(nz), zzd(nz), zzdd(nz), qq(n), vv(n), aa(n), y2(n), y3(n), &
+              jpb(MAXROW, NLOC, m%nc), v0(n), wk(np, m%neq), yf(n, np), stat=st)
     if (st /= 0) then
       status = MBD_NO_MEMORY; msg = 'out of memory for the sensitivity integration'; return
     end if
@@ -442,12 +443,12 @@ contains
       call sens_params(m, s, qq, vv, aa, tt)
       call sens_klam_list(m, s, lam)
       ! the right-hand side of each parameter as a row of rt, then one solve for all
+      call sens_force_dm(m, s, 1, np, qq, vv, n, yy(n + 1:nz), yy(nz + n + 1:), tt, yf)
       do kk = 1, np
         o = n * kk
-        call sens_force_d(m, s, kk, qq, vv, yy(o + 1:o + n), yy(nz + o + 1:nz + o + n), tt, y1)
         call sens_klam(s, yy(o + 1:o + n), y2)
         call sens_jpt_lam(m, s, kk, qq, tt, lam, y3, jpb)
-        call force_row(n, size(pw%rt, 1), kk, y1, s%tmass(:, kk), aa, y2, y3, pw%rt)
+        call force_row(n, size(pw%rt, 1), kk, yf(:, kk), s%tmass(:, kk), aa, y2, y3, pw%rt)
       end do
       call constraint_rows(n, np, m%neq, w%na, s%nnz, size(pw%rt, 1), s%nzr, s%nzc, s%nza, &
                            s%nzv, size(s%ap, 1), s%ap, w%rows, w%s, yy(n + 1:nz), &

@@ -31,13 +31,14 @@ module mbd_sensitivity
                              CON_TRANSLATIONAL, DRV_REL_DIST, CON_REVOLUTE
   use mbd_joint_revolute, only: revolute_second_sides, revolute_param_sides
   use mbd_joint_translational, only: translational_second, translational_param
-  use mbd_forces, only: force_eval_d, force_is_count, force_exponents
+  use mbd_forces, only: force_eval_d, force_eval_dm, force_is_count, force_exponents
   implicit none
   private
   public :: sens_t, PT_RPAR, PT_MASS, PT_GRAV, PT_FPAR
   public :: sens_setup, sens_trig, sens_states, sens_hessian, sens_params, sens_kin_rhs, &
             block_apply, block_apply_t, block_apply_cols, &
-            sens_klam, sens_klam_list, sens_jpt_lam, sens_force_d, sens_force_jac, sens_eval_d
+            sens_klam, sens_klam_list, sens_jpt_lam, sens_force_d, sens_force_dm, sens_force_jac, &
+            sens_eval_d
 
   integer, parameter :: PT_RPAR = 1, PT_MASS = 2, PT_GRAV = 3, PT_FPAR = 4  !! table ids
 
@@ -105,7 +106,7 @@ module mbd_sensitivity
     integer, allocatable :: klr(:), klc(:)
     real(wp), allocatable :: klv(:)
     real(wp), allocatable :: zp(:)           !! zeros, the longest prepared slice
-    real(wp), allocatable :: zfp(:)          !! zeros, the force pool's length (dynamics)
+    real(wp), allocatable :: zfp(:, :)       !! (size(m%fp), 1) zeros: no parameter's change
     real(wp), allocatable :: zq(:)           !! zeros (nq)
   end type sens_t
 
@@ -142,7 +143,7 @@ contains
               s%hs(MAXROW, NLOC, NLOC, m%nc), s%mphip(npad, m%neq), s%vp(npad, m%neq), &
               s%ap(npad, m%neq), s%work(m%neq), s%rhs(npad, m%neq), &
               s%st(npad, m%nq), s%sdt(npad, m%nq), &
-              s%zp(maxval(m%pn)), s%zq(m%nq), s%zfp(nfp), &
+              s%zp(maxval(m%pn)), s%zq(m%nq), s%zfp(nfp, 1), &
               s%cb(0:m%nb), s%sb(0:m%nb), s%bst(4, 0:m%nb), s%nzr(NLOC * m%neq), &
               s%nzc(NLOC * m%neq), &
               s%nzv(NLOC * m%neq), s%nza(NLOC * m%neq), s%klr(NLOC * NLOC * m%nc), &
@@ -946,39 +947,69 @@ contains
     real(wp), intent(in) :: dq(:), dqd(:)    !! direction
     real(wp), intent(in) :: t                !! time
     real(wp), intent(out) :: y(:)            !! (nq)
-    real(wp) :: ql(NLOC), qdl(NLOC), tql(NLOC), tqdl(NLOC), fl(NLOC)
-    integer :: f, j, c, si, sj, b
+    call sens_force_dm(m, s, k, 1, q, qd, m%nq, dq, dqd, t, y)
+  end subroutine sens_force_d
+
+  !> sens_force_d along nk directions at one state, column j of dq, dqd with the parameter
+  !! k0 + j - 1 (k0 = 0: no parameter, nk = 1): each force's state gathered once and a
+  !! spring's values computed once for up to four directions (force_eval_dm).
+  pure subroutine sens_force_dm(m, s, k0, nk, q, qd, nq, dq, dqd, t, y)
+    type(model_t), intent(in) :: m           !! model with dynamics data
+    type(sens_t), intent(in) :: s            !! parameters
+    integer, intent(in) :: k0, nk            !! first parameter (or 0), directions
+    real(wp), intent(in) :: q(:), qd(:)      !! state
+    integer, intent(in) :: nq                !! coordinates
+    real(wp), intent(in) :: dq(nq, nk), dqd(nq, nk)  !! directions
+    real(wp), intent(in) :: t                !! time
+    real(wp), intent(out) :: y(nq, nk)       !! changes of Q
+    integer, parameter :: KB = 4             ! directions per force evaluation
+    real(wp) :: ql(NLOC), qdl(NLOC), tql(NLOC, KB), tqdl(NLOC, KB), fl(NLOC, KB)
+    integer :: f, j, c, si, sj, b, k, n0, n1, g, ng
     y = zero
-    if (k > 0) then
+    do k = 1, nk
+      if (k0 < 1) exit
       do b = 1, m%nb
-        y(3 * b - 2:3 * b - 1) = s%tmass(3 * b - 2, k) * m%grav + &
-                                 m%mdiag(3 * b - 2) * s%tgrav(:, k)
-      end do
-    end if
-    do f = 1, m%nf
-      do j = 1, NLOC
-        c = m%floc(j, f)
-        ql(j) = zero; qdl(j) = zero; tql(j) = zero; tqdl(j) = zero
-        if (c > 0) then
-          ql(j) = q(c); qdl(j) = qd(c); tql(j) = dq(c); tqdl(j) = dqd(c)
-        end if
-      end do
-      si = merge(1, 0, m%fbi(f) > 0); sj = merge(2, 0, m%fbj(f) > 0)
-      if (k > 0) then
-        call force_eval_d(m%fkind(f), m%fp(m%fpo(f):m%fpo(f) + m%fpn(f) - 1), &
-                          s%tfp(m%fpo(f):m%fpo(f) + m%fpn(f) - 1, k), si, sj, ql, qdl, &
-                          tql, tqdl, t, fl)
-      else
-        call force_eval_d(m%fkind(f), m%fp(m%fpo(f):m%fpo(f) + m%fpn(f) - 1), &
-                          s%zfp(m%fpo(f):m%fpo(f) + m%fpn(f) - 1), si, sj, ql, qdl, &
-                          tql, tqdl, t, fl)
-      end if
-      do j = 1, NLOC
-        c = m%floc(j, f)
-        if (c > 0) y(c) = y(c) + fl(j)
+        y(3 * b - 2:3 * b - 1, k) = s%tmass(3 * b - 2, k0 + k - 1) * m%grav + &
+                                    m%mdiag(3 * b - 2) * s%tgrav(:, k0 + k - 1)
       end do
     end do
-  end subroutine sens_force_d
+    do f = 1, m%nf
+      n0 = m%fpo(f); n1 = n0 + m%fpn(f) - 1
+      si = merge(1, 0, m%fbi(f) > 0); sj = merge(2, 0, m%fbj(f) > 0)
+      do j = 1, NLOC
+        c = m%floc(j, f)
+        ql(j) = zero; qdl(j) = zero
+        if (c > 0) then
+          ql(j) = q(c); qdl(j) = qd(c)
+        end if
+      end do
+      do g = 1, nk, KB
+        ng = min(KB, nk - g + 1)
+        do k = 1, ng
+          do j = 1, NLOC
+            c = m%floc(j, f)
+            tql(j, k) = zero; tqdl(j, k) = zero
+            if (c > 0) then
+              tql(j, k) = dq(c, g + k - 1); tqdl(j, k) = dqd(c, g + k - 1)
+            end if
+          end do
+        end do
+        if (k0 > 0) then
+          call force_eval_dm(m%fkind(f), m%fp(n0:n1), s%tfp(n0:n1, k0 + g - 1:k0 + g + ng - 2), &
+                             si, sj, ql, qdl, tql(:, 1:ng), tqdl(:, 1:ng), t, fl(:, 1:ng))
+        else
+          call force_eval_dm(m%fkind(f), m%fp(n0:n1), s%zfp(n0:n1, 1:ng), si, sj, ql, qdl, &
+                             tql(:, 1:ng), tqdl(:, 1:ng), t, fl(:, 1:ng))
+        end if
+        do k = 1, ng
+          do j = 1, NLOC
+            c = m%floc(j, f)
+            if (c > 0) y(c, g + k - 1) = y(c, g + k - 1) + fl(j, k)
+          end do
+        end do
+      end do
+    end do
+  end subroutine sens_force_dm
 
   !> Dense Jacobians of the applied forces, kq = dQ/dq and (optionally) kv = dQ/dq_dot,
   !! from the dual evaluation of each force along its slots (nq x nq each).
