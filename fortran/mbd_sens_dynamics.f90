@@ -315,7 +315,7 @@ contains
     real(wp), allocatable :: y(:), yn(:), ys(:), k(:, :), e(:), za(:), zda(:), zdda(:), lam(:), &
                              zz(:), zzd(:), zzdd(:)
     ! the work of rhs and project (here, so that no step allocates)
-    real(wp), allocatable :: qq(:), vv(:), aa(:), y2(:), y3(:), jpb(:, :, :), v0(:)
+    real(wp), allocatable :: qq(:), vv(:), aa(:), y2(:), y3(:), v0(:)
     real(wp), allocatable :: yf(:, :)   ! (n, np) the forces' changes along S, S_dot and p
     real(wp), allocatable :: wk(:, :)   ! (np, neq) the constraint rows, parameter by row
     type(proj_work_t) :: pw
@@ -332,7 +332,7 @@ contains
     end if
     allocate (y(2 * nz), yn(2 * nz), ys(2 * nz), k(2 * nz, 7), e(2 * nz), za(nz), zda(nz), zdda(nz), &
               lam(m%neq), zz(nz), zzd(nz), zzdd(nz), qq(n), vv(n), aa(n), y2(n), y3(n), &
-              jpb(MAXROW, NLOC, m%nc), v0(n), wk(np, m%neq), yf(n, np), stat=st)
+              v0(n), wk(np, m%neq), yf(n, np), stat=st)
     if (st /= 0) then
       status = MBD_NO_MEMORY; msg = 'out of memory for the sensitivity integration'; return
     end if
@@ -447,7 +447,7 @@ contains
       do kk = 1, np
         o = n * kk
         call sens_klam(s, yy(o + 1:o + n), y2)
-        call sens_jpt_lam(m, s, kk, qq, tt, lam, y3, jpb)
+        call sens_jpt_lam(m, s, kk, qq, tt, lam, y3)
         call force_row(n, size(pw%rt, 1), kk, yf(:, kk), s%tmass(:, kk), aa, y2, y3, pw%rt)
       end do
       call constraint_rows(n, np, m%neq, w%na, s%nnz, size(pw%rt, 1), s%nzr, s%nzc, s%nza, &

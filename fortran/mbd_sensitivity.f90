@@ -888,8 +888,8 @@ contains
     end do
   end subroutine sens_klam
 
-  !> y = J_p^T lambda for parameter k at (q, t), and jpb, the change of the local J blocks
-  !! (MAXROW, NLOC, nc) along the parameter (zero for unaffected constraints).
+  !> y = J_p^T lambda for parameter k at (q, t), and (optionally) jpb, the change of the local
+  !! J blocks (MAXROW, NLOC, nc) along the parameter (zero for unaffected constraints).
   pure subroutine sens_jpt_lam(m, s, k, q, t, lam, y, jpb)
     type(model_t), intent(in) :: m           !! model
     type(sens_t), intent(in) :: s            !! parameters
@@ -897,35 +897,34 @@ contains
     real(wp), intent(in) :: q(:), t          !! configuration, time
     real(wp), intent(in) :: lam(:)           !! multipliers (neq)
     real(wp), intent(out) :: y(:)            !! (nq)
-    real(wp), intent(out), contiguous :: jpb(:, :, :)    !! (MAXROW, NLOC, nc)
+    real(wp), intent(out), contiguous, optional :: jpb(:, :, :)    !! (MAXROW, NLOC, nc)
     type(dloc) :: x
-    real(wp) :: qddl(NLOC), tphi(MAXROW), tnu(MAXROW), tgam(MAXROW)
+    real(wp) :: qddl(NLOC), tphi(MAXROW), tnu(MAXROW), tgam(MAXROW), jl(MAXROW, NLOC)
     integer :: c, si, sj, j, r, o
-    call zero_fill(size(jpb), jpb)           ! (one flat fill, not a loop of column fills)
-    do c = 1, m%nc
-      if (.not. s%caff(c, k)) cycle
-      if (m%kind(c) == CON_REVOLUTE) then      ! J = [I, B_i s'_i, -I, -B_j s'_j]: J_p has
-        o = m%po(c)                            ! B_i t s'_i, -B_j t s'_j (perp(A t s'))
-        if (m%bi(c) > 0) jpb(1:2, 3, c) = rperp(s%cb(m%bi(c)), s%sb(m%bi(c)), s%tp(o:o + 1, k))
-        if (m%bj(c) > 0) jpb(1:2, 6, c) = -rperp(s%cb(m%bj(c)), s%sb(m%bj(c)), &
-                                                 s%tp(o + 2:o + 3, k))
-        cycle
-      end if
-      call gather(m, s, c, q, s%zq, s%zq, x, qddl)
-      si = merge(1, 0, m%bi(c) > 0); sj = merge(2, 0, m%bj(c) > 0)
-      call con_eval_d(m%kind(c), m%suba(c), m%subb(c), m%p(m%po(c):m%po(c) + m%pn(c) - 1), &
-                      s%tp(m%po(c):m%po(c) + m%pn(c) - 1, k), si, sj, x, t, &
-                      tphi, jpb(:, :, c), tnu, tgam)
-    end do
+    if (present(jpb)) call zero_fill(size(jpb), jpb)   ! (one flat fill, not column fills)
     y = zero
     do c = 1, m%nc
       if (.not. s%caff(c, k)) cycle
+      jl = zero
+      if (m%kind(c) == CON_REVOLUTE) then      ! J = [I, B_i s'_i, -I, -B_j s'_j]: J_p has
+        o = m%po(c)                            ! B_i t s'_i, -B_j t s'_j (perp(A t s'))
+        if (m%bi(c) > 0) jl(1:2, 3) = rperp(s%cb(m%bi(c)), s%sb(m%bi(c)), s%tp(o:o + 1, k))
+        if (m%bj(c) > 0) jl(1:2, 6) = -rperp(s%cb(m%bj(c)), s%sb(m%bj(c)), &
+                                             s%tp(o + 2:o + 3, k))
+      else
+        call gather(m, s, c, q, s%zq, s%zq, x, qddl)
+        si = merge(1, 0, m%bi(c) > 0); sj = merge(2, 0, m%bj(c) > 0)
+        call con_eval_d(m%kind(c), m%suba(c), m%subb(c), m%p(m%po(c):m%po(c) + m%pn(c) - 1), &
+                        s%tp(m%po(c):m%po(c) + m%pn(c) - 1, k), si, sj, x, t, &
+                        tphi, jl, tnu, tgam)
+      end if
       do j = 1, NLOC
         if (m%loc(j, c) == 0) cycle
         do r = 1, m%nrow(c)
-          y(m%loc(j, c)) = y(m%loc(j, c)) + jpb(r, j, c) * lam(m%row0(c) + r - 1)
+          y(m%loc(j, c)) = y(m%loc(j, c)) + jl(r, j) * lam(m%row0(c) + r - 1)
         end do
       end do
+      if (present(jpb)) jpb(:, :, c) = jl
     end do
   contains
     !> perp(A v) = B v for the angle with cos cc, sin ss.
