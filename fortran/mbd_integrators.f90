@@ -462,9 +462,9 @@ contains
     n = m%nq; na = w%na
     ! S = [M b' + K + g' C, b' J^T; b' J, 0] on the path of w (dense: the sparse LU up to 128
     ! rows, the plain-loop LU beyond); on the band path a diagonal K pattern (pins, no force
-    ! couples two coordinates) keeps the upper-left block diagonal, and S goes through its Schur complement like the index-1
-    ! systems (mbd_schur; on the dense path the sparse LU costs less: the free four-bar's step
-    ! 17.9k instructions against 20.0k through S)
+    ! couples two coordinates) keeps the upper-left block diagonal, and S goes through its
+    ! Schur complement like the index-1 systems (mbd_schur; on the dense path the sparse LU
+    ! costs less: the free four-bar's step 17.9k instructions against 20.0k through S)
     diagk = w%solver /= SOLVER_DENSE .and. &
             all([(all(w%krow(w%kptr(k):w%kptr(k + 1) - 1) == k), k=1, m%nq)])
     call saddle_plan(m, w%rows, w%solver, sg, status, msg, kptr=w%kptr, krow=w%krow, &

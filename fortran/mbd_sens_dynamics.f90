@@ -99,23 +99,23 @@ contains
     slam = zero
     if (np == 0) return
     if (.not. allocated(s%mjt)) then           ! (once: the work of every later output)
-      allocate (s%mjt(nq, neq), s%mb(max(nq, neq), np), s%my(nq), s%mjpb(MAXROW, NLOC, m%nc), &
+      allocate (s%mjt(nq, neq), s%mb(max(nq, neq), np), s%my(nq), s%myf(nq, np), &
                 s%mpiv(max(nq, neq)), s%mbb(max(nq, neq), np), stat=st)
       if (st /= 0) then
         status = MBD_NO_MEMORY; msg = 'out of memory for the multiplier sensitivities'; return
       end if
     end if
-    associate (jt => s%mjt, b => s%mb, y => s%my, jpb => s%mjpb, jpvt => s%mpiv, bb => s%mbb)
+    associate (jt => s%mjt, b => s%mb, y => s%my, yf => s%myf, jpvt => s%mpiv, bb => s%mbb)
       call sens_trig(m, s, q)
       call sens_hessian(m, s, q, qd, qdd, t)
       call sens_klam_list(m, s, lam)
       b = zero
+      call sens_force_dm(m, s, 1, np, q, qd, nq, sq, sqd, t, yf)   ! Q_q s + Q_qd s_dot + Q_p
       do k = 1, np
-        call sens_force_d(m, s, k, q, qd, sq(:, k), sqd(:, k), t, y)   ! Q_q s + Q_qd s_dot + Q_p
-        b(1:nq, k) = y - s%tmass(:, k) * qdd - m%mdiag * sqdd(:, k)
+        b(1:nq, k) = yf(:, k) - s%tmass(:, k) * qdd - m%mdiag * sqdd(:, k)
         call sens_klam(s, sq(:, k), y)
         b(1:nq, k) = b(1:nq, k) - y
-        call sens_jpt_lam(m, s, k, q, t, lam, y, jpb)
+        call sens_jpt_lam(m, s, k, q, t, lam, y)
         b(1:nq, k) = b(1:nq, k) - y
       end do
       if (present(jtlu) .and. present(jtpiv)) then   ! dyn_multipliers' LU, trusted there
@@ -237,7 +237,7 @@ contains
     integer, intent(out) :: status              !! MBD_OK or MBD_SINGULAR
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
     type(asm_work_t) :: a
-    real(wp), allocatable :: kk(:, :), kq(:, :), aug(:, :), rhs(:), y(:), e(:), jpb(:, :, :), &
+    real(wp), allocatable :: kk(:, :), kq(:, :), aug(:, :), rhs(:), y(:), e(:), &
                              phi(:), nu(:), gam(:), jac(:, :), z(:)
     integer, allocatable :: ipiv(:)
     integer :: n, na, i, k, st
@@ -245,7 +245,7 @@ contains
     n = m%nq; na = size(rows)
     sq = zero; slam = zero
     allocate (kk(n, n), kq(n, n), aug(n + na, n + na), rhs(n + na), y(n), e(n), &
-              jpb(MAXROW, NLOC, m%nc), phi(m%neq), nu(m%neq), gam(m%neq), jac(m%neq, n), &
+              phi(m%neq), nu(m%neq), gam(m%neq), jac(m%neq, n), &
               z(n), ipiv(n + na), stat=st)
     if (st /= 0) then
       status = MBD_NO_MEMORY; msg = 'out of memory for the statics sensitivities'; return
@@ -278,7 +278,7 @@ contains
     do k = 1, s%np
       call sens_force_d(m, s, k, q, z, z, z, t, y)          ! Q_p
       rhs(1:n) = y
-      call sens_jpt_lam(m, s, k, q, t, lam, y, jpb)
+      call sens_jpt_lam(m, s, k, q, t, lam, y)
       rhs(1:n) = rhs(1:n) - y
       rhs(n + 1:) = s%mphip(k, rows)
       call lu_solve(aug, ipiv, rhs, status, msg)

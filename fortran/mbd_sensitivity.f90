@@ -81,7 +81,7 @@ module mbd_sensitivity
     type(dloc) :: x0
     logical :: gathers = .true.              !! some pair or constraint needs gather (cb, sb)
     ! work of the multipliers' sensitivities (mbd_sens_dynamics, allocated at its first call)
-    real(wp), allocatable :: mjt(:, :), mb(:, :), mbb(:, :), my(:), mjpb(:, :, :)
+    real(wp), allocatable :: mjt(:, :), mb(:, :), mbb(:, :), my(:), myf(:, :)
     integer, allocatable :: mpiv(:)
     integer, allocatable :: gen(:)           !! the other constraints not linear in q
     !> the (revolute side, parameter) entries whose point the parameter moves: parameter,
