@@ -200,29 +200,20 @@ contains
     integer, intent(in) :: slot          !! 0 ground (s global), 1 or 2
     real(wp), intent(in) :: s(2), ts(2)  !! point in the body frame and its change
     type(dvec) :: a
-    real(wp) :: cs, sn, thd, dth, dthd, au(2), bu(2), e(2), pe(2), tdt(2)
+    real(wp) :: au(2), bu(2), tdt(2)
     integer :: c
     if (slot == 0) then
       a%a%v = s; a%t%v = ts
       return
     end if
     c = 3 * (slot - 1)
-    cs = x%x%c(slot); sn = x%x%s(slot)
-    thd = x%x%qd(c + 3); dth = x%tq(c + 3); dthd = x%tqd(c + 3)
-    au = [cs * s(1) - sn * s(2), sn * s(1) + cs * s(2)]
-    bu = [-au(2), au(1)]
-    e = [cs * ts(1) - sn * ts(2), sn * ts(1) + cs * ts(2)]
-    pe = [-e(2), e(1)]
-    a%a%v = x%x%q(c + 1:c + 2) + au
+    call point_values(x%x, slot, s, a%a%v, bu, a%a%ar, au)
+    call point_changes(x, slot, ts, au, bu, a%t%v, tdt, a%t%ar)
     a%a%d(1, c + 1) = one; a%a%d(2, c + 2) = one
     a%a%d(:, c + 3) = bu
-    a%a%vd = x%x%qd(c + 1:c + 2) + bu * thd
-    a%a%ar = -au * thd**2
-    tdt = pe - au * dth
-    a%t%v = x%tq(c + 1:c + 2) + bu * dth + e
+    a%a%vd = x%x%qd(c + 1:c + 2) + bu * x%x%qd(c + 3)
     a%t%d(:, c + 3) = tdt
-    a%t%vd = x%tqd(c + 1:c + 2) + tdt * thd + bu * dthd
-    a%t%ar = -(bu * dth + e) * thd**2 - two * au * thd * dthd
+    a%t%vd = x%tqd(c + 1:c + 2) + tdt * x%x%qd(c + 3) + bu * x%tqd(c + 3)
   end function body_point_d
 
   !> The fields of body_point_d without the product-rule types (the joints that only compare
