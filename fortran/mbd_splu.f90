@@ -54,6 +54,9 @@ module mbd_splu
     integer :: nu = 0                     !! entries of U above the diagonal
     !> U1 entries by columns, last column first: position, step row, step column
     integer, allocatable :: bpos(:), brow(:), bcol(:)
+    !> L by rows (entries lrptr(a):lrptr(a+1)-1 of step row a, step columns c < a ascending)
+    !! and U1 by rows (urptr, step columns c > a descending): position and step column
+    integer, allocatable :: lrptr(:), lrpos(:), lrcol(:), urptr(:), urpos(:), urcol(:)
     integer, allocatable :: optr(:), otgt(:), ol(:), ou(:)  !! updates of step k: tgt -= l u
     integer, allocatable :: fill(:)       !! positions of the fill entries
     real(wp), allocatable :: a(:, :)      !! (n, n) work of the plan
@@ -79,7 +82,8 @@ contains
               sp%y(n), sp%y2(n), sp%prow(n), sp%pcol(n), sp%diag(n), sp%lptr(n + 1), sp%lpos(nn), &
               sp%lrow(nn), sp%uptr(n + 1), sp%upos(nn), sp%urow(nn), sp%optr(n + 1), &
               sp%fill(nn), sp%a(n, n), sp%s(n, n), sp%lcol(nn), sp%bpos(nn), sp%brow(nn), &
-              sp%bcol(nn), sp%y4(4, n), stat=ierr)
+              sp%bcol(nn), sp%y4(4, n), sp%lrptr(n + 1), sp%lrpos(nn), sp%lrcol(nn), &
+              sp%urptr(n + 1), sp%urpos(nn), sp%urcol(nn), stat=ierr)
     if (ierr /= 0) then
       call mem_fail(REAL_BYTES * 4 * real(nn, wp), 'the sparse LU of J', &
                     'use a smaller model', status, msg)
@@ -213,6 +217,9 @@ contains
         sp%bpos(sp%nu) = sp%upos(p); sp%brow(sp%nu) = sp%urow(p); sp%bcol(sp%nu) = c
       end do
     end do
+    call by_rows(n, sp%lptr(n + 1) - 1, sp%lrow, sp%lcol, sp%lpos, sp%lrptr, sp%lrcol, &
+                 sp%lrpos)
+    call by_rows(n, sp%nu, sp%brow, sp%bcol, sp%bpos, sp%urptr, sp%urcol, sp%urpos)
     ! the updates of step k: a(r, c) -= l(r, k) u(k, c) for r, c > k in the pattern
     if (allocated(sp%otgt)) deallocate (sp%otgt, sp%ol, sp%ou)
     allocate (otgt(max(nops, 1)), ol(max(nops, 1)), ou(max(nops, 1)), stat=ierr)
@@ -246,6 +253,30 @@ contains
     end do
     sp%planned = .true.
   end subroutine splu_plan
+
+  !> The entries (row(e), col(e), pos(e)), e = 1 .. ne, grouped by row (a counting sort that
+  !! keeps their order within a row): row a's are rptr(a) .. rptr(a + 1) - 1 of rcol, rpos.
+  pure subroutine by_rows(n, ne, row, col, pos, rptr, rcol, rpos)
+    integer, intent(in) :: n, ne
+    integer, intent(in) :: row(:), col(:), pos(:)
+    integer, intent(out) :: rptr(n + 1)
+    integer, intent(inout) :: rcol(:), rpos(:)
+    integer :: e, a, nxt(n)
+    rptr = 0
+    do e = 1, ne
+      rptr(row(e) + 1) = rptr(row(e) + 1) + 1
+    end do
+    rptr(1) = 1
+    do a = 1, n
+      rptr(a + 1) = rptr(a + 1) + rptr(a)
+    end do
+    nxt = rptr(1:n)
+    do e = 1, ne
+      a = row(e)
+      rcol(nxt(a)) = col(e); rpos(nxt(a)) = pos(e)
+      nxt(a) = nxt(a) + 1
+    end do
+  end subroutine by_rows
 
   !> Factor the values in sp%val (A's entries at sp%at, written by the caller) in place.
   !! status MBD_SINGULAR on an exactly zero pivot. lmax: largest |l_ik|; detsign: sign of
@@ -355,8 +386,8 @@ contains
     integer :: g
     do g = 1, size(bt, 1) - 3, 4
       if (g > size(x, 2)) exit
-      call rows_kernel(sp%n, sp%lptr(sp%n + 1) - 1, sp%nu, sp%prow, sp%lpos, sp%lrow, &
-                       sp%lcol, sp%bpos, sp%brow, sp%bcol, sp%val, sp%y4, size(bt, 1), bt, g)
+      call rows_kernel(sp%n, sp%lptr(sp%n + 1) - 1, sp%nu, sp%prow, sp%lrptr, sp%lrpos, &
+                       sp%lrcol, sp%urptr, sp%urpos, sp%urcol, sp%val, sp%y4, size(bt, 1), bt, g)
       if (present(xt)) then
         call rows_out(sp%n, size(x, 2), sp%pcol, sp%rinv, cs, sp%y4, size(xt, 1), xt, g, x, f)
       else
@@ -367,31 +398,34 @@ contains
 
   !> Four right-hand sides (rows g .. g + 3 of bt) through L and U1: y (4, n) in step
   !! order, before the pivots and the column permutation (rows_out, cols_out).
-  pure subroutine rows_kernel(n, nl, nu, prow, lpos, lrow, lcol, bpos, brow, bcol, val, y, &
-                              ldb, bt, g)
+  pure subroutine rows_kernel(n, nl, nu, prow, lrptr, lrpos, lrcol, urptr, urpos, urcol, &
+                              val, y, ldb, bt, g)
     integer, intent(in) :: n, nl, nu, g, ldb
-    integer, intent(in) :: prow(n), lpos(nl), lrow(nl), lcol(nl)
-    integer, intent(in) :: bpos(nu), brow(nu), bcol(nu)
+    integer, intent(in) :: prow(n), lrptr(n + 1), lrpos(nl), lrcol(nl)
+    integer, intent(in) :: urptr(n + 1), urpos(nu), urcol(nu)
     real(wp), intent(in) :: val(*), bt(ldb, n)
     real(wp), intent(out) :: y(4, n)
-    integer :: k, p, a, c
+    integer :: a, p, c
     real(wp) :: v, t1, t2, t3, t4
     ! (the four columns written out: array sections of extent 4 cost a loop each)
-    do k = 1, n                                      ! y = P b
-      c = prow(k)
-      y(1, k) = bt(g, c); y(2, k) = bt(g + 1, c); y(3, k) = bt(g + 2, c); y(4, k) = bt(g + 3, c)
+    do a = 1, n                                      ! L z = P b (unit diagonal), by rows
+      c = prow(a)
+      t1 = bt(g, c); t2 = bt(g + 1, c); t3 = bt(g + 2, c); t4 = bt(g + 3, c)
+      do p = lrptr(a), lrptr(a + 1) - 1
+        v = val(lrpos(p)); c = lrcol(p)
+        t1 = t1 - v * y(1, c); t2 = t2 - v * y(2, c)
+        t3 = t3 - v * y(3, c); t4 = t4 - v * y(4, c)
+      end do
+      y(1, a) = t1; y(2, a) = t2; y(3, a) = t3; y(4, a) = t4
     end do
-    do p = 1, nl                                     ! L z = y (unit diagonal)
-      v = val(lpos(p)); a = lrow(p); c = lcol(p)
-      t1 = y(1, c); t2 = y(2, c); t3 = y(3, c); t4 = y(4, c)
-      y(1, a) = y(1, a) - v * t1; y(2, a) = y(2, a) - v * t2
-      y(3, a) = y(3, a) - v * t3; y(4, a) = y(4, a) - v * t4
-    end do
-    do p = 1, nu                                     ! U1 v = z
-      v = val(bpos(p)); a = brow(p); c = bcol(p)
-      t1 = y(1, c); t2 = y(2, c); t3 = y(3, c); t4 = y(4, c)
-      y(1, a) = y(1, a) - v * t1; y(2, a) = y(2, a) - v * t2
-      y(3, a) = y(3, a) - v * t3; y(4, a) = y(4, a) - v * t4
+    do a = n, 1, -1                                  ! U1 v = z, by rows
+      t1 = y(1, a); t2 = y(2, a); t3 = y(3, a); t4 = y(4, a)
+      do p = urptr(a), urptr(a + 1) - 1
+        v = val(urpos(p)); c = urcol(p)
+        t1 = t1 - v * y(1, c); t2 = t2 - v * y(2, c)
+        t3 = t3 - v * y(3, c); t4 = t4 - v * y(4, c)
+      end do
+      y(1, a) = t1; y(2, a) = t2; y(3, a) = t3; y(4, a) = t4
     end do
   end subroutine rows_kernel
 
