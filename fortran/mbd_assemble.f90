@@ -271,21 +271,30 @@ contains
     type(asm_work_t), intent(in) :: a     !! work arrays with the blocks
     real(wp), intent(in) :: x(:)          !! vector (nq)
     real(wp), intent(out) :: y(:)         !! J x (neq)
+    call jv_kernel(m%nc, m%loc, m%row0, m%nrow, a%jb, x, y)
+  end subroutine blocks_jv
+
+  !> blocks_jv on explicit shapes (no descriptor in the loops).
+  pure subroutine jv_kernel(nc, loc, row0, nrow, jb, x, y)
+    integer, intent(in) :: nc
+    integer, intent(in) :: loc(NLOC, nc), row0(nc), nrow(nc)
+    real(wp), intent(in) :: jb(MAXROW, NLOC, nc), x(*)
+    real(wp), intent(inout) :: y(*)
     integer :: k, s, c, r0, i
-    do k = 1, m%nc
-      r0 = m%row0(k) - 1
-      do i = 1, m%nrow(k)
+    do k = 1, nc
+      r0 = row0(k) - 1
+      do i = 1, nrow(k)
         y(r0 + i) = zero
       end do
       do s = 1, NLOC
-        c = m%loc(s, k)
+        c = loc(s, k)
         if (c == 0) cycle
-        do i = 1, m%nrow(k)
-          y(r0 + i) = y(r0 + i) + a%jb(i, s, k) * x(c)
+        do i = 1, nrow(k)
+          y(r0 + i) = y(r0 + i) + jb(i, s, k) * x(c)
         end do
       end do
     end do
-  end subroutine blocks_jv
+  end subroutine jv_kernel
 
   !> x = J^T y from the local blocks of the last assembly (no dense J).
   pure subroutine blocks_jtv(m, a, y, x)
