@@ -52,7 +52,8 @@ module mbd_integrators
   private
   public :: dyn_opts_t, dyn_stats_t, METH_GENALPHA, METH_DOPRI5, METH_RK4, METH_PARTITIONED
   public :: integrate, output_rows, output_index, MAX_STEPS_DEFAULT
-  ! the Dormand-Prince 5(4) tableau, also used by the sensitivity integrator (mbd_sens_dynamics)
+  ! the Dormand-Prince 5(4) stages and error estimate, also used by the sensitivity integrator
+  ! (mbd_sens_dynamics)
   public :: dopri5_state, dopri5_error, DOPRI_C
 
   integer, parameter :: METH_GENALPHA = 1, METH_DOPRI5 = 2, METH_RK4 = 3, METH_PARTITIONED = 4
@@ -1459,8 +1460,6 @@ contains
     yn = y + h / 6 * (k(:, 1) + 2 * k(:, 2) + 2 * k(:, 3) + k(:, 4))
   end subroutine rk4_step
 
-  !> One Dormand-Prince 5(4) step; e is the embedded error estimate. k(:, 1) is reused from
-  !! the last stage of the previous step when fsal is true (first same as last).
   !> The state of Dormand-Prince stage j = 2 .. 7 from y and the rates k(:, 1:j-1) of the
   !! stages before: ys = y + h sum_i a_ji k_i (j = 7: the new state, the fifth-order
   !! solution; y and ys of equal length).
@@ -1497,6 +1496,8 @@ contains
              E7 * k(:, 7))
   end subroutine dopri5_error
 
+  !> One Dormand-Prince 5(4) step; e is the embedded error estimate. k(:, 1) is reused from
+  !! the last stage of the previous step when fsal is true (first same as last).
   subroutine dopri5_step(m, w, c, t, y, h, yn, k, e, ys, fsal, stf)
     type(model_t), intent(in) :: m
     type(dyn_work_t), intent(inout) :: w
