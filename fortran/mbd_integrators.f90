@@ -805,6 +805,10 @@ contains
           tnew
         return
       end if
+      if (c%opts%method == METH_DOPRI5) then
+        ! y' at the projected state (finish_step's, in e) is the next step's first stage
+        k(:, 1) = e; fsal = .true.
+      end if
       if (c%baumgarte) then
         ! an unstable run shows first as growing constraint violation
         if (maxval(abs(w%phi)) > 1.0e-3_wp * m%lscale) then
