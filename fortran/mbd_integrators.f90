@@ -749,7 +749,7 @@ contains
         h = tnew - t
       end if
       if (fixed) then
-        call rk4_step(m, w, c, t, y, h, ynew, k, ys, stt)
+        call rk4_step(m, w, c, t, y, h, ynew, k, ys, fsal, stt)
         err = zero
       else
         call dopri5_step(m, w, c, t, y, h, ynew, k, e, ys, fsal, stt)
@@ -805,8 +805,9 @@ contains
           tnew
         return
       end if
-      if (c%opts%method == METH_DOPRI5) then
-        ! y' at the projected state (finish_step's, in e) is the next step's first stage
+      if (c%opts%method == METH_DOPRI5 .or. c%opts%method == METH_RK4) then
+        ! y' at the new (dopri5: projected) state, finish_step's in e, is the next step's
+        ! first stage
         k(:, 1) = e; fsal = .true.
       end if
       if (c%baumgarte) then
@@ -1440,7 +1441,7 @@ contains
   end function needs_partition
 
   !> One classical Runge-Kutta step.
-  subroutine rk4_step(m, w, c, t, y, h, yn, k, ys, stf)
+  subroutine rk4_step(m, w, c, t, y, h, yn, k, ys, first, stf)
     type(model_t), intent(in) :: m
     type(dyn_work_t), intent(inout) :: w
     type(itg_t), intent(inout) :: c
@@ -1449,8 +1450,10 @@ contains
     real(wp), intent(inout) :: k(:, :)
     real(wp), intent(inout) :: ys(:)          !! a stage's state (workspace: expressions as
                                               !! arguments would be heap temporaries)
+    logical, intent(in) :: first              !! k(:, 1) = f(t, y) is known
     integer, intent(out) :: stf
-    call rhs(m, w, c, t, y, k(:, 1), stf)
+    stf = MBD_OK
+    if (.not. first) call rhs(m, w, c, t, y, k(:, 1), stf)
     if (stf /= MBD_OK) return
     ys = y + half * h * k(:, 1)
     call rhs(m, w, c, t + half * h, ys, k(:, 2), stf)
