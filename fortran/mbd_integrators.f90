@@ -805,7 +805,7 @@ contains
           tnew
         return
       end if
-      if (c%opts%method == METH_DOPRI5 .or. c%opts%method == METH_RK4) then
+      if (c%opts%method == METH_DOPRI5 .or. c%opts%method == METH_RK4 .or. partitioned) then
         ! y' at the new (dopri5: projected) state, finish_step's in e, is the next step's
         ! first stage
         k(:, 1) = e; fsal = .true.
@@ -908,11 +908,15 @@ contains
     real(wp), intent(in) :: tn
     real(wp), intent(inout) :: yn(:)
     logical, intent(inout) :: fsal
-    real(wp), intent(out) :: f(:)                 !! workspace (size(yn)): y'
+    real(wp), intent(inout) :: f(:)               !! y' at (tn, yn) (partitioned without
+                                                  !! events: already, from the step's check)
     real(wp), intent(inout) :: ys(:)              !! workspace (size(yn))
     integer, intent(out) :: stf
     if (partitioned) then
-      call rhs(m, w, c, tn, yn, f, stf)          ! solves u, u_dot and the accelerations
+      ! solves u, u_dot and the accelerations; without events the step's check of the
+      ! dependent coordinates has just done so at this state (f and c%qf, c%vf, c%af hold it)
+      stf = MBD_OK
+      if (c%events) call rhs(m, w, c, tn, yn, f, stf)
       return
     end if
     c%qf = yn(1:m%nq); c%vf = yn(m%nq + 1:)
