@@ -52,10 +52,12 @@ import mbd2d
 from mbd2d import _core
 from mbd2d.binding.pack import pack
 path, h, n1, n2 = sys.argv[1], float(sys.argv[2]), int(sys.argv[3]), int(sys.argv[4])
+pos = int(sys.argv[5]) if len(sys.argv) > 5 else 0     # 1: positions only
 p = pack(mbd2d.load(path))
 for n in (n1, n2):
     out = _core.core_kinematics(p.nb, p.ctab, p.rpar, p.neq, p.q0, 0.0, n * h, n, 0.0, 0,
-                                0.0, 1, 0, n + 1, np.zeros(2, dtype=np.int32))
+                                0.0, 1, 0, n + 1, pos, 0 if pos else n + 1,
+                                np.zeros(2, dtype=np.int32))
     assert out[-2] == 0, out[-1]
     print("COUNTS", n, int(out[3][5]), int(out[3][6]), flush=True)
 """

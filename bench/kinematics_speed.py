@@ -52,7 +52,7 @@ def core_us_per_step(model: mbd2d.Model, t_end: float, steps: int, repeats: int)
     for _ in range(repeats):
         t0 = time.perf_counter()
         out = _core.core_kinematics(p.nb, p.ctab, p.rpar, p.neq, p.q0, 0.0, t_end, steps,
-                                    0.0, 0, 0.0, 1, 0, steps + 1, new_ctl())
+                                    0.0, 0, 0.0, 1, 0, steps + 1, 0, steps + 1, new_ctl())
         best = min(best, time.perf_counter() - t0)
         status, msg = out[-2], out[-1]
         assert status == 0, msg

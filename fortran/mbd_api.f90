@@ -243,7 +243,7 @@ contains
   !> Kinematic analysis: the whole time loop in one call.
   subroutine api_kinematics(nb, ctab, rpar, q0, t0, t1, nsteps, tol, maxit, tmin, every, &
                             solver, qout, qdout, qddout, iinfo, rinfo, qsing, dep, redundant, &
-                            tpass, status, msg, ptab, sq, sqd, sqdd, ctl)
+                            tpass, status, msg, ptab, sq, sqd, sqdd, ctl, positions)
     integer, intent(in) :: nb                   !! moving bodies
     integer, intent(in) :: ctab(:, :)           !! constraint table
     real(wp), intent(in) :: rpar(:)             !! raw parameters
@@ -255,7 +255,7 @@ contains
     real(wp), intent(in) :: tmin                !! singular-time resolution (<= 0: default)
     integer, intent(in) :: every                !! store every k-th output (and the last)
     integer, intent(in) :: solver               !! 0 auto, 1 dense, 2 banded LU
-    !> outputs (nq, kin_out_count(nsteps, every))
+    !> outputs (nq, kin_out_count(nsteps, every); q_dot and q_ddot (nq, 0) with positions)
     real(wp), intent(out) :: qout(:, :), qdout(:, :), qddout(:, :)
     integer, intent(out) :: iinfo(NINFO)        !! integer report
     real(wp), intent(out) :: rinfo(NINFO)       !! real report
@@ -272,6 +272,8 @@ contains
     !> progress, shared with a caller in another thread (2): ctl(1) the outputs stored so
     !! far, ctl(2) /= 0 asks the run to stop (MBD_USER_ABORT, the outputs so far kept)
     integer, intent(inout), optional, volatile :: ctl(:)
+    !> 1: positions only (chord steps where J is well conditioned; q_dot, q_ddot not returned)
+    integer, intent(in), optional :: positions
     type(model_t) :: m
     type(kin_opts_t) :: opts
     type(kin_report_t) :: rep
@@ -326,6 +328,7 @@ contains
     if (tol > zero) opts%tol = tol
     if (maxit > 0) opts%maxit = maxit
     if (tmin > zero) opts%tmin = tmin
+    if (present(positions)) opts%positions = positions == 1
     if (present(ptab)) then
       call kin_run(m, q0 / m%cunit, t0, t1, nsteps, opts, qout, qdout, qddout, rep, status, &
                    msg, sens, sq, sqd, sqdd, ctl=ctl)     ! (in model units: sens%ounit)

@@ -12,12 +12,14 @@ module mbd_assemble
   use mbd_points, only: NLOC, MAXROW, kloc
   use mbd_model, only: model_t, model_slots
   use mbd_constraints, only: con_eval, con_init_extra, CON_REVOLUTE
-  use mbd_joint_revolute, only: revolute_rows, revolute_gamma
+  use mbd_joint_revolute, only: revolute_rows, revolute_gamma, revolute_phi_all
   use mbd_drivers, only: DRV_ABS, driver_abs_row
+  use mbd_functions, only: fun_eval
   implicit none
   private
   public :: asm_work_t, asm_init, assemble_blocks, scatter_dense, assemble_dense, init_extras, &
-            gather_local, blocks_jv, blocks_jtv, scatter_values, asm_turn, assemble_gamma
+            gather_local, blocks_jv, blocks_jtv, scatter_values, asm_turn, assemble_gamma, &
+            assemble_phi
 
   !> Work arrays of the assembly, allocated once per analysis.
   type :: asm_work_t
@@ -25,6 +27,10 @@ module mbd_assemble
     real(wp), allocatable :: cb(:), sb(:)  !! cos and sin of each body's angle (0:nb; 0 ground)
     real(wp), allocatable :: qx(:), qdx(:) !! q and q_dot with a zero in front (0:nq): slot
                                            !! loc = 0 reads the zero
+    real(wp), allocatable :: fv(:)         !! absolute drivers' f(t) of assemble_phi (nc)
+    !> assemble_phi's lists: the revolutes (parameter offset, bodies, first row) and the
+    !! other constraints
+    integer, allocatable :: rtab(:, :), oth(:)
     !> the nonzeros of the blocks: jb(src(i)) goes to J(dst(i)) and column col(i) (flat
     !! column-major indices into jb and the dense neq x nq J; dst = 0 when J has more than
     !! huge(1) entries)
@@ -48,8 +54,10 @@ contains
       n = n + m%nrow(k) * count(m%loc(:, k) > 0)
     end do
     allocate (a%jb(MAXROW, NLOC, m%nc), a%cb(0:m%nb), a%sb(0:m%nb), a%qx(0:m%nq), &
-              a%qdx(0:m%nq), stat=ierr)
+              a%qdx(0:m%nq), a%fv(m%nc), stat=ierr)
     if (ierr == 0) allocate (a%src(n), a%dst(n), a%col(n), stat=ierr)
+    if (ierr == 0) allocate (a%rtab(4, count(m%kind(1:m%nc) == CON_REVOLUTE)), &
+                             a%oth(count(m%kind(1:m%nc) /= CON_REVOLUTE)), stat=ierr)
     if (ierr /= 0) then
       call mem_fail(REAL_BYTES * (MAXROW * NLOC * real(m%nc, wp) + 2 * real(m%nb, wp)) + &
                     12 * real(n, wp), 'the constraint blocks', 'use a smaller model', &
@@ -57,7 +65,15 @@ contains
       return
     end if
     a%jb = zero
-    a%cb = one; a%sb = zero; a%qx = zero; a%qdx = zero
+    a%cb = one; a%sb = zero; a%qx = zero; a%qdx = zero; a%fv = zero
+    r = 0; s = 0
+    do k = 1, m%nc
+      if (m%kind(k) == CON_REVOLUTE) then
+        r = r + 1; a%rtab(:, r) = [m%po(k), m%bi(k), m%bj(k), m%row0(k)]
+      else
+        s = s + 1; a%oth(s) = k
+      end if
+    end do
     dense_map = real(m%neq, wp) * real(m%nq, wp) < real(huge(n), wp)
     n = 0
     do k = 1, m%nc
@@ -192,6 +208,45 @@ contains
       end do
     end do
   end subroutine assemble_gamma
+
+  !> Phi alone at q (the chord steps of positions-only kinematics). fresh: a new q and t,
+  !! the bodies' cos and sin from q and the absolute drivers' f(t) evaluated (kept in a);
+  !! otherwise a correction of the last q at the same t, with the cos and sin in a (turned by
+  !! asm_turn) and the kept f(t). The revolutes' Phi rows alone (revolute_phi_all), an absolute
+  !! driver's Phi = q_c - f(t); every other constraint evaluated whole (its block of J
+  !! rewritten, its nu and gamma rows dropped).
+  pure subroutine assemble_phi(m, q, t, fresh, phi, a)
+    type(model_t), intent(in) :: m            !! model
+    real(wp), intent(in) :: q(:)              !! coordinates (nq)
+    real(wp), intent(in) :: t                 !! time
+    logical, intent(in) :: fresh              !! a new q and t (else a correction at the same t)
+    real(wp), intent(out) :: phi(:)           !! Phi (neq)
+    type(asm_work_t), intent(inout) :: a      !! work: blocks, body cos, sin, drivers' f(t)
+    real(wp) :: ph(MAXROW), nv(MAXROW), ga(MAXROW), f1, f2
+    integer :: j, k, r0, b, i
+    if (fresh) then
+      do b = 1, m%nb
+        a%cb(b) = cos(q(3 * b)); a%sb(b) = sin(q(3 * b))
+      end do
+    end if
+    do i = 1, m%nq
+      a%qx(i) = q(i)
+    end do
+    call revolute_phi_all(size(a%rtab, 2), a%rtab, m%p, a%qx, a%cb, a%sb, phi)
+    do j = 1, size(a%oth)
+      k = a%oth(j)
+      r0 = m%row0(k)
+      if (m%kind(k) == DRV_ABS) then
+        if (fresh) call fun_eval(m%p(m%po(k):m%po(k) + m%pn(k) - 1), t, a%fv(k), f1, f2)
+        phi(r0) = a%qx(m%loc(m%suba(k), k)) - a%fv(k)       ! (as driver_abs_row)
+        cycle
+      end if
+      call eval_one(m, k, t, a, ph, nv, ga)
+      do i = 1, m%nrow(k)
+        phi(r0 + i - 1) = ph(i)
+      end do
+    end do
+  end subroutine assemble_phi
 
   !> Place the local blocks into a dense J (neq x nq), or J D (D = diag(cs)) with a column
   !! scale, through the map of asm_init.

@@ -31,18 +31,20 @@ subroutine core_eval(nb, nc, ctab, np, rpar, nq, neq, q, qd, t, phi, jac, nu, ga
 end subroutine core_eval
 
 subroutine core_kinematics(nb, nc, ctab, np, rpar, nq, neq, q0, t0, t1, nsteps, tol, &
-                           maxit, tmin, every, solver, nout, ctl, qout, qdout, qddout, iinfo, &
-                           rinfo, qsing, dep, redundant, tpass, status, msg)
+                           maxit, tmin, every, solver, nout, positions, nd, ctl, qout, qdout, &
+                           qddout, iinfo, rinfo, qsing, dep, redundant, tpass, status, msg)
   use iso_c_binding, only: c_double, c_int
   use mbd_api, only: api_kinematics
   implicit none
   integer(c_int), intent(in) :: nb, nc, np, nq, neq, nsteps, maxit, every, solver, nout
+  !> 1: positions only, with nd = 0 (q_dot and q_ddot not returned); 0: nd = nout
+  integer(c_int), intent(in) :: positions, nd
   integer(c_int), intent(in) :: ctab(8, nc)
   !> progress: ctl(1) outputs stored so far, ctl(2) /= 0 stops the run (read and written
   !! while the call runs, from another thread)
   integer(c_int), intent(inout) :: ctl(2)
   real(c_double), intent(in) :: rpar(np), q0(nq), t0, t1, tol, tmin
-  real(c_double), intent(out) :: qout(nq, nout), qdout(nq, nout), qddout(nq, nout)
+  real(c_double), intent(out) :: qout(nq, nout), qdout(nq, nd), qddout(nq, nd)
   integer(c_int), intent(out) :: iinfo(10)
   real(c_double), intent(out) :: rinfo(10)
   real(c_double), intent(out) :: qsing(nq)
@@ -54,7 +56,7 @@ subroutine core_kinematics(nb, nc, ctab, np, rpar, nq, neq, q0, t0, t1, nsteps, 
   !f2py threadsafe
   call api_kinematics(nb, ctab, rpar, q0, t0, t1, nsteps, tol, maxit, tmin, every, solver, &
                       qout, qdout, qddout, iinfo, rinfo, qsing, dep, redundant, tpass, &
-                      status, msg, ctl=ctl)
+                      status, msg, ctl=ctl, positions=positions)
 end subroutine core_kinematics
 
 subroutine core_kin_step(nb, nc, ctab, np, rpar, nq, q, qd, qdd, t_prev, t, tol, maxit, &

@@ -12,7 +12,7 @@ module mbd_joint_revolute
   implicit none
   private
   public :: revolute_prepare, revolute_eval, revolute_eval_d, revolute_rows, &
-            revolute_gamma, revolute_second_sides, revolute_param_sides
+            revolute_gamma, revolute_phi_all, revolute_second_sides, revolute_param_sides
 
 contains
 
@@ -75,6 +75,38 @@ contains
     call revolute_kernel(p, bi > 0, bj > 0, q(i3 - 2:i3 - 1), c(bi), s(bi), qd(i3), &
                          q(j3 - 2:j3 - 1), c(bj), s(bj), qd(j3), phi, jl, gam)
   end subroutine revolute_rows
+
+  !> The Phi rows of revolute_kernel alone (the same operations) for n revolutes at once,
+  !! for the chord steps of positions-only kinematics: Phi = r_i + A_i s'_i - r_j - A_j s'_j.
+  !! Revolute e has its [s'_i, s'_j] at p(tab(1, e)), bodies tab(2, e), tab(3, e) (0 ground)
+  !! and its rows from tab(4, e).
+  pure subroutine revolute_phi_all(n, tab, p, q, c, s, phi)
+    integer, intent(in) :: n                !! revolutes
+    integer, intent(in) :: tab(4, n)        !! parameter offset, bodies, first row
+    real(wp), intent(in) :: p(*)            !! prepared parameter pool
+    real(wp), intent(in) :: q(0:*)          !! coordinates (q(0) unused)
+    real(wp), intent(in) :: c(0:*), s(0:*)  !! cos and sin of the bodies' angles
+    real(wp), intent(inout) :: phi(*)       !! Phi (their rows written)
+    real(wp) :: p1, p2
+    integer :: e, o, b, r
+    do e = 1, n
+      o = tab(1, e); b = tab(2, e); r = tab(4, e)
+      if (b > 0) then
+        p1 = q(3 * b - 2) + (c(b) * p(o) - s(b) * p(o + 1))
+        p2 = q(3 * b - 1) + (s(b) * p(o) + c(b) * p(o + 1))
+      else
+        p1 = p(o); p2 = p(o + 1)
+      end if
+      b = tab(3, e)
+      if (b > 0) then
+        p1 = p1 - (q(3 * b - 2) + (c(b) * p(o + 2) - s(b) * p(o + 3)))
+        p2 = p2 - (q(3 * b - 1) + (s(b) * p(o + 2) + c(b) * p(o + 3)))
+      else
+        p1 = p1 - p(o + 2); p2 = p2 - p(o + 3)
+      end if
+      phi(r) = p1; phi(r + 1) = p2
+    end do
+  end subroutine revolute_phi_all
 
   !> The gamma rows of revolute_kernel alone, for the second pass of a kinematic step (new
   !! velocities at the same q): gamma = A_i s'_i thd_i**2 - A_j s'_j thd_j**2.

@@ -36,7 +36,7 @@ module mbd_kinematics
   use mbd_constraints, only: con_is_driver, con_name
   use mbd_assemble, only: asm_work_t, asm_init, assemble_blocks, assemble_gamma, assemble_dense, &
                           scatter_dense, init_extras, blocks_jv, blocks_jtv, scatter_values, &
-                          asm_turn
+                          asm_turn, assemble_phi
   use mbd_band, only: band_t, band_plan, band_move, band_zero, band_norm1, band_factor, &
                       band_rcond, band_solve
   use mbd_linsolve, only: lu_factor, lu_solve, lu_det_sign, svd_null, row_rank, qr_factor, &
@@ -80,6 +80,17 @@ module mbd_kinematics
   integer, parameter :: SPARSE_MAX_N = 60
   !> divided differences of the accelerations in the predictor (its error O(h**(order + 3)))
   integer, parameter :: PRED_ORDER = 5
+  !> positions-only runs (kin_opts_t%positions): chord steps (simplified Newton on the last
+  !! factorization) while its pivot ratio is at least FAST_PIV and the coordinates have moved
+  !! less than FAST_DRIFT times it (lengths in units of the length scale, angles in rad)
+  !! since; at most CHORD_MAXIT corrections, each at most CHORD_RATE of the one before
+  real(wp), parameter :: FAST_PIV = COND_CHECK, FAST_DRIFT = 0.1_wp, CHORD_RATE = 0.1_wp
+  integer, parameter :: CHORD_MAXIT = 6
+  !> accepted full steps (with q_dot, q_ddot) before chord steps again, after leaving them
+  integer, parameter :: FAST_REENTER = 8
+  !> a chord correction of the angles up to this is turned into the bodies' cos and sin
+  !! (asm_turn: first order, exact to rounding); a larger one takes cos and sin anew
+  real(wp), parameter :: TURN_MAX = 1.0e-9_wp
   !> largest dense Levenberg-Marquardt assembly (J and [J; mu I]) allowed in band mode (bytes):
   !! n up to about 1670; larger banded models assemble by damped Newton on the band
   real(wp), parameter :: DENSE_FALLBACK = 64.0_wp * 1048576
@@ -99,6 +110,9 @@ module mbd_kinematics
     integer :: assembly_maxit = 400 !! damped iterations for the initial assembly
     integer :: solver = SOLVER_AUTO !! SOLVER_AUTO, SOLVER_DENSE or SOLVER_BANDED
     integer :: every = 1            !! store every k-th output (and the last)
+    !> positions only: q_dot and q_ddot are not returned (qdout and qddout are work space)
+    !! and, where J is well conditioned, the steps are chord steps without them
+    logical :: positions = .false.
   end type kin_opts_t
 
   !> Work arrays, allocated once per analysis.
@@ -1009,8 +1023,8 @@ contains
     integer, intent(in) :: nsteps              !! output intervals
     type(kin_opts_t), intent(in) :: opts       !! settings
     real(wp), intent(out) :: qout(:, :)        !! coordinates (nq, kin_out_count)
-    real(wp), intent(out) :: qdout(:, :)       !! velocities
-    real(wp), intent(out) :: qddout(:, :)      !! accelerations
+    !> velocities and accelerations (as qout; (nq, 0) with opts%positions: not returned)
+    real(wp), intent(out) :: qdout(:, :), qddout(:, :)
     type(kin_report_t), intent(out) :: rep     !! what happened
     integer, intent(out) :: status             !! MBD_OK or the failure
     character(len=MSG_LEN), intent(out) :: msg !! explanation
@@ -1040,8 +1054,8 @@ contains
     integer, intent(in) :: nsteps              !! output intervals
     type(kin_opts_t), intent(in) :: opts       !! settings
     real(wp), intent(out) :: qout(:, :)        !! coordinates (nq, kin_out_count)
-    real(wp), intent(out) :: qdout(:, :)       !! velocities
-    real(wp), intent(out) :: qddout(:, :)      !! accelerations
+    !> velocities and accelerations (as qout; (nq, 0) with opts%positions: not returned)
+    real(wp), intent(out) :: qdout(:, :), qddout(:, :)
     type(kin_report_t), intent(out) :: rep     !! what happened
     integer, intent(out) :: status             !! MBD_OK or the failure
     character(len=MSG_LEN), intent(out) :: msg !! explanation
@@ -1066,6 +1080,13 @@ contains
     integer :: nhist
     integer :: k, j, c, st, detprev, mobility, lev, nsub, nderiv, ierr
     logical :: last, ok
+    ! positions only: chord steps (fast), the positions' divided differences pd (as dd) at
+    ! the times ptau back, the coordinates qf and pivot ratio pivf of the factorization in
+    ! use, full steps since the chord steps were left
+    logical :: fast
+    real(wp), allocatable :: pd(:, :), qf(:)
+    real(wp) :: ptau(0:PRED_ORDER), pivf
+    integer :: npd, nfull
 
     status = MBD_OK; msg = ''
     if (present(sens)) then
@@ -1089,6 +1110,16 @@ contains
     end if
     if (nsteps > 0 .and. .not. (t1 > t0)) then
       status = MBD_BAD_SETTING; msg = 't_end must be greater than the start time'; return
+    end if
+    if (opts%positions .and. present(sens)) then
+      status = MBD_BAD_SETTING; msg = 'sensitivities need the velocities and accelerations: '// &
+        'do not ask for positions only'
+      return
+    end if
+    if (size(qdout, 2) /= size(qout, 2) .and. .not. (opts%positions .and. size(qdout, 2) == 0) &
+        .or. size(qddout, 2) /= size(qdout, 2)) then
+      status = MBD_BAD_SETTING; msg = 'the derivatives'' output arrays do not match the outputs'
+      return
     end if
     if (opts%every < 1 .or. size(qout, 2) /= kin_out_count(nsteps, opts%every)) then
       status = MBD_BAD_SETTING; msg = 'every must be >= 1 (and the output arrays sized for it)'
@@ -1126,8 +1157,9 @@ contains
     if (ierr == 0) allocate (dd(PRED_ORDER, m%nq), qddn(m%nq), qdn(m%nq), stat=ierr)
     if (ierr == 0) allocate (qa(m%nq), qda(m%nq), qdda(m%nq), qb(m%nq), stat=ierr)
     if (ierr == 0) allocate (qdb(m%nq), qddb(m%nq), stat=ierr)
+    if (ierr == 0 .and. opts%positions) allocate (pd(PRED_ORDER, m%nq), qf(m%nq), stat=ierr)
     if (ierr /= 0) then
-      call mem_fail(17 * REAL_BYTES * m%nq, 'the kinematic state vectors', &
+      call mem_fail(23 * REAL_BYTES * m%nq, 'the kinematic state vectors', &
                     'use a smaller model', status, msg)
       return
     end if
@@ -1189,7 +1221,9 @@ contains
       msg = 'velocities or accelerations overflow at the start: a driver is far too fast'
       call count_work(); return
     end if
-    qout(:, 1) = q; qdout(:, 1) = qd; qddout(:, 1) = qdd
+    call put_out(1)
+    fast = .false.; nfull = FAST_REENTER
+    if (opts%positions) call reenter(w%pivratio)
     if (present(sens)) call kin_sens(m, w, sens, q, qd, qdd, t0, sq(:, :, 1), sqd(:, :, 1), &
                                      sqdd(:, :, 1))
     rep%ndone = 1
@@ -1218,6 +1252,17 @@ contains
       last = hcur >= (target - t) * (one - 1.0e-9_wp)
       hh = merge(target - t, hcur, last)
       tt = merge(target, t + hh, last)
+      if (fast) then
+        call fast_step(hh, ok)
+        if (ok) then
+          call accept_fast()
+          if (last) call store(k)
+          if (stop_asked()) return
+          hcur = min(2 * hh, h)
+          cycle
+        end if
+        call leave_fast()
+      end if
       call predict(hh)
       call kin_newton(m, w, qn, tt, opts%maxit, st)
       ok = st == MBD_OK .and. on_branch(JUMP_RATIO) .and. w%pivratio >= NEAR_SING
@@ -1234,16 +1279,9 @@ contains
         pcur = w%pivratio
         call accept()
         if (last) call store(k)
-        if (present(ctl)) then
-          ctl(1) = rep%ndone
-          if (ctl(2) /= 0) then
-            status = MBD_USER_ABORT; rep%t_fail = tt
-            write (msg, '(a,es12.5,a)') 'stopped on request at t = ', tt, &
-              ' (the outputs so far are kept)'
-            call count_work(); return
-          end if
-        end if
+        if (stop_asked()) return
         call quiet_passage()
+        if (opts%positions) call reenter(pcur)
         hcur = min(2 * hh, h)
         cycle
       end if
@@ -1296,8 +1334,7 @@ contains
         if (out_time(j) > ta .and. out_time(j) <= ts + d) then
           c = column(j)
           if (c > 0) then
-            call hermite5(ta, qa, qda, qdda, ts + d, qn, qdn, qddn, out_time(j), qout(:, c), &
-                          qdout(:, c), qddout(:, c))
+            call interp_out(ta, ts + d, out_time(j), c)
             rep%ndone = max(rep%ndone, c)
             if (present(sens)) post(c) = .true.
           end if
@@ -1418,6 +1455,133 @@ contains
       anchor = anchor .and. st2 == MBD_OK
     end function anchor
 
+    !> Progress to ctl(1); true (status MBD_USER_ABORT, the outputs so far kept) when ctl(2)
+    !! asks the run to stop.
+    logical function stop_asked()
+      stop_asked = .false.
+      if (.not. present(ctl)) return
+      ctl(1) = rep%ndone
+      if (ctl(2) == 0) return
+      stop_asked = .true.
+      status = MBD_USER_ABORT; rep%t_fail = tt
+      write (msg, '(a,es12.5,a)') 'stopped on request at t = ', tt, ' (the outputs so far are kept)'
+      call count_work()
+    end function stop_asked
+
+    !> Positions only: chord steps again from the accepted state (q, q_dot, q_ddot) once
+    !! FAST_REENTER full steps in a row were well conditioned (square J). The positions'
+    !! Newton polynomial starts as the Taylor polynomial q + q_dot s + q_ddot s**2 / 2 (nodes
+    !! t, t, t), and the first chord step factors J anew (the factors in w may be another
+    !! time's, from the passage search or an output's refinement).
+    subroutine reenter(piv)
+      real(wp), intent(in) :: piv     ! pivot ratio of the accepted state's factorization
+      nfull = nfull + 1
+      if (w%lsq .or. piv < FAST_PIV .or. nfull < FAST_REENTER) return
+      fast = .true.
+      qf = q
+      pd = zero; pd(1, :) = qd; pd(2, :) = half * qdd
+      ptau = zero; npd = 2
+      pivf = -one       ! (a factorization first)
+    end subroutine reenter
+
+    !> Positions only: the full steps from the accepted q, whose q_dot and q_ddot the chord
+    !! steps did not compute: Newton from q (converged: one factorization), J q_dot = nu,
+    !! J q_ddot = gamma, and the accelerations' history anew.
+    subroutine leave_fast()
+      integer :: st2
+      fast = .false.; nfull = 0
+      qn = q
+      call kin_newton(m, w, qn, t, opts%maxit, st2)
+      if (st2 == MBD_OK) call kin_vel_acc(m, w, qn, t, qd, qdd, st2)
+      if (st2 == MBD_OK) then
+        detprev = w%detsign
+      else
+        qd = zero; qdd = zero    ! (the full steps start from q alone)
+      end if
+      call forget_derivatives()
+    end subroutine leave_fast
+
+    !> Positions only: a step to tt without q_dot and q_ddot. The positions' Newton polynomial
+    !! predicts, chord corrections J(qf) dq = -Phi(q, tt) correct (simplified Newton: each
+    !! contracts the error by about |J(qf)^-1 (J(q) - J(qf))|). J is factored anew at the
+    !! prediction when q has moved more than FAST_DRIFT pivf from qf or the chord does not
+    !! converge. ok: a correction below resolution (as kin_newton's test of a start), on the
+    !! predicted branch, with det J of unchanged sign and a pivot ratio >= FAST_PIV at any
+    !! new factorization.
+    subroutine fast_step(hs, ok)
+      real(wp), intent(in) :: hs
+      logical, intent(out) :: ok
+      logical :: fresh
+      integer :: st2
+      real(wp) :: motion, corr
+      ok = .false.
+      call pos_predict(size(q), hs, ptau, q, pd, qp, qn, motion)
+      fresh = .not. (scaled_drift(size(q), m%nb, lscale, qn, qf) <= FAST_DRIFT * pivf)
+      if (.not. fresh) then
+        call chord(.true., ok, corr)
+        if (.not. ok) qn = qp
+        fresh = .not. ok
+      end if
+      if (fresh) then
+        call assemble_j(m, w, qn, w%qz, tt)
+        call factor(w, st2)
+        if (st2 /= MBD_OK .or. w%lsq) return
+        if (w%pivratio < FAST_PIV .or. w%detsign /= detprev) return
+        qf = qn; pivf = w%pivratio
+        call chord(.false., ok, corr)
+        if (.not. ok) return
+      end if
+      ok = corr <= max(JUMP_RATIO * motion, 1.0e3_wp * w%tol)     ! (as on_branch)
+    end subroutine fast_step
+
+    !> Chord corrections of qn at tt with the factors in w, from Phi(qn) (evaluated when
+    !! need, else assemble_j's) until one is below resolution with ||Phi|| <= tol (conv);
+    !! false after CHORD_MAXIT, on a correction larger than CHORD_RATE times the one before,
+    !! or on a non-finite Phi. corr: the sum of the corrections' max norms (>= max |qn - qp|).
+    subroutine chord(need, conv, corr)
+      logical, intent(in) :: need
+      logical, intent(out) :: conv
+      real(wp), intent(out) :: corr
+      real(wp) :: dmax, dprev
+      logical :: fresh, kept
+      integer :: it
+      conv = .false.; fresh = .true.; dprev = huge(one); corr = zero
+      kept = .false.          ! assemble_phi's drivers' f(tt) are known
+      do it = 1, CHORD_MAXIT
+        if (need .or. it > 1) then
+          call assemble_phi(m, qn, tt, fresh .or. .not. kept, w%phi, w%asm)
+          kept = .true.
+        end if
+        call solve(w, w%phi, w%dq)                   ! J(qf)^-1 Phi: the correction's negative
+        call chord_update(size(q), m%nb, lscale, w%tol, w%phi, w%dq, qn, conv, dmax)
+        w%newton_its = w%newton_its + 1
+        corr = corr + dmax
+        if (conv) return
+        if (.not. (dmax <= CHORD_RATE * dprev)) return      ! (NaN too)
+        fresh = dmax > TURN_MAX
+        if (.not. fresh) call asm_turn(m, w%asm, w%dq)
+        dprev = dmax
+      end do
+    end subroutine chord
+
+    !> Take the chord step to (tt, qn): the positions' divided differences with the new q
+    !! (as accept does with the accelerations).
+    subroutine accept_fast()
+      real(wp) :: rden(PRED_ORDER), hs
+      integer :: jj
+      hs = tt - t
+      do jj = 1, PRED_ORDER
+        rden(jj) = zero
+        if (jj <= npd + 1) rden(jj) = one / (hs + ptau(jj - 1))
+      end do
+      call newton_update(size(q), rden, qn, q, pd)
+      do jj = PRED_ORDER, 1, -1
+        ptau(jj) = hs + ptau(jj - 1)
+      end do
+      npd = min(npd + 1, PRED_ORDER)
+      t = tt
+    end subroutine accept_fast
+
     subroutine forget_derivatives()
       dd = zero; tau = zero; nderiv = 0; wt_h = -one
       nhist = 0
@@ -1491,8 +1655,11 @@ contains
       integer :: cc
       nsub = 0
       cc = column(kk)
-      if (cc > 0) then
-        call copy3(size(q), q, qd, qdd, qout(:, cc), qdout(:, cc), qddout(:, cc))
+      if (cc > 0 .and. fast) then
+        call copy1(size(q), q, qout(:, cc))   ! (a chord step: no q_dot, q_ddot, J(q) unfactored)
+        rep%ndone = cc
+      else if (cc > 0) then
+        call put_out(cc)
         if (present(sens)) call kin_sens(m, w, sens, q, qd, qdd, t, sq(:, :, cc), &
                                          sqd(:, :, cc), sqdd(:, :, cc))
         if (w%pivratio < ANCHOR_PIV) call refine_output(cc)
@@ -1500,6 +1667,31 @@ contains
       end if
       kk = kk + 1
     end subroutine store
+
+    !> The accepted state (q, q_dot, q_ddot) to output column cc (q alone when the
+    !! derivatives' outputs have no columns: positions only).
+    subroutine put_out(cc)
+      integer, intent(in) :: cc
+      if (size(qdout, 2) == 0) then
+        call copy1(size(q), q, qout(:, cc))
+      else
+        call copy3(size(q), q, qd, qdd, qout(:, cc), qdout(:, cc), qddout(:, cc))
+      end if
+    end subroutine put_out
+
+    !> Output column cc at time tx by quintic Hermite interpolation between the anchors
+    !! (ta; qa, qda, qdda) and (tb; qn, qdn, qddn) (its q alone when the derivatives'
+    !! outputs have no columns; qdb, qddb are free then).
+    subroutine interp_out(ta2, tb2, tx, cc)
+      real(wp), intent(in) :: ta2, tb2, tx
+      integer, intent(in) :: cc
+      if (size(qdout, 2) == 0) then
+        call hermite5(ta2, qa, qda, qdda, tb2, qn, qdn, qddn, tx, qout(:, cc), qdb, qddb)
+      else
+        call hermite5(ta2, qa, qda, qdda, tb2, qn, qdn, qddn, tx, qout(:, cc), qdout(:, cc), &
+                      qddout(:, cc))
+      end if
+    end subroutine interp_out
 
     !> Output column cc sits where J is poorly conditioned (near a singular point): its q_ddot (error
     !! ~ cond**3 tol) is replaced by quintic Hermite interpolation between regular anchors at
@@ -1520,8 +1712,7 @@ contains
         if (dd >= 64 * h) return
         dd = 2 * dd
       end do
-      call hermite5(t - dd, qa, qda, qdda, t + dd, qn, qdn, qddn, t, qout(:, cc), &
-                    qdout(:, cc), qddout(:, cc))
+      call interp_out(t - dd, t + dd, t, cc)
       if (present(sens)) post(cc) = .true.
     end subroutine refine_output
 
@@ -1615,17 +1806,75 @@ contains
     integer, intent(in) :: n
     real(wp), intent(in) :: rden(PRED_ORDER), qn(n), qdn(n), qddn(n)
     real(wp), intent(inout) :: q(n), qd(n), qdd(n), dd(PRED_ORDER, n)
+    integer :: i
+    call newton_update(n, rden, qddn, qdd, dd)
+    do i = 1, n
+      q(i) = qn(i); qd(i) = qdn(i)
+    end do
+  end subroutine accept_state
+
+  !> A new value xn at a new node enters the divided differences of x:
+  !! d_j <- (d_(j-1)new - d_(j-1)old) rden_j (d_0 = the value; rden_j = 1 / (t_new - t_(j-1)),
+  !! zero while d_j is not yet known), and x <- xn.
+  pure subroutine newton_update(n, rden, xn, x, dd)
+    integer, intent(in) :: n
+    real(wp), intent(in) :: rden(PRED_ORDER), xn(n)
+    real(wp), intent(inout) :: x(n), dd(PRED_ORDER, n)
     real(wp) :: dn, dnew, dold
     integer :: i, j
     do i = 1, n
-      dnew = qddn(i); dold = qdd(i)
+      dnew = xn(i); dold = x(i)
       do j = 1, PRED_ORDER
         dn = (dnew - dold) * rden(j)
         dold = dd(j, i); dd(j, i) = dn; dnew = dn
       end do
-      q(i) = qn(i); qd(i) = qdn(i); qdd(i) = qddn(i)
+      x(i) = xn(i)
     end do
-  end subroutine accept_state
+  end subroutine newton_update
+
+  !> The positions' Newton polynomial at hs after its last node (positions-only steps):
+  !! qp = q + sum_j w_j d_j, w_1 = hs, w_j = w_(j-1) (hs + tau_(j-1)) (d_j = q[t, ..., t_j]
+  !! at the nodes tau_j back); qn = qp; motion = max |qp - q|. Error O(hs**(PRED_ORDER + 1)) once the divided
+  !! differences are known.
+  pure subroutine pos_predict(n, hs, tau, q, dd, qp, qn, motion)
+    integer, intent(in) :: n
+    real(wp), intent(in) :: hs, tau(0:PRED_ORDER), q(n), dd(PRED_ORDER, n)
+    real(wp), intent(out) :: qp(n), qn(n)
+    real(wp), intent(out) :: motion           !! max |qp - q|
+    real(wp) :: wt(PRED_ORDER), x
+    integer :: i, j
+    wt(1) = hs
+    do j = 2, PRED_ORDER
+      wt(j) = wt(j - 1) * (hs + tau(j - 1))
+    end do
+    motion = zero
+    do i = 1, n
+      x = zero
+      do j = PRED_ORDER, 1, -1          ! (the smallest terms first)
+        x = x + wt(j) * dd(j, i)
+      end do
+      qp(i) = q(i) + x; qn(i) = qp(i)
+      if (abs(x) > motion) motion = abs(x)
+    end do
+  end subroutine pos_predict
+
+  !> How far q has moved from qf: max of |dx|, |dy| / L and |d theta| over the bodies and
+  !! |dq| of the extra coordinates (L: the model's length scale).
+  pure real(wp) function scaled_drift(n, nb, lscale, q, qf) result(d)
+    integer, intent(in) :: n, nb
+    real(wp), intent(in) :: lscale, q(n), qf(n)
+    real(wp) :: r
+    integer :: b, i
+    r = one / lscale
+    d = zero
+    do b = 1, nb
+      i = 3 * b
+      d = max(d, r * abs(q(i - 2) - qf(i - 2)), r * abs(q(i - 1) - qf(i - 1)), abs(q(i) - qf(i)))
+    end do
+    do i = 3 * nb + 1, n
+      d = max(d, abs(q(i) - qf(i)))
+    end do
+  end function scaled_drift
 
   !> corr = max |qn - qp| (the Newton correction), motion = max |qp - q| (the predicted one).
   pure subroutine max_diffs(n, qn, qp, q, corr, motion)
@@ -1680,6 +1929,52 @@ contains
     end do
     below = .true.
   end function below_resolution
+
+  !> One chord correction of q: dq = -x (x = J^-1 Phi, overwritten with dq), q <- q + dq.
+  !! conv: ||Phi||_inf <= tol and dq below resolution at the q before (below_resolution's
+  !! test: |dq_i| <= RES_ULPS eps max(|q_i|, ref)); dmax = max |dq| (NaN when dq is not
+  !! finite).
+  pure subroutine chord_update(n, nb, lscale, tol, phi, x, q, conv, dmax)
+    integer, intent(in) :: n, nb
+    real(wp), intent(in) :: lscale, tol, phi(n)
+    real(wp), intent(inout) :: x(n), q(n)
+    logical, intent(out) :: conv
+    real(wp), intent(out) :: dmax
+    real(wp), parameter :: ULP = RES_ULPS * epsilon(one)
+    real(wp) :: ref, res, d, a, fin
+    integer :: i
+    ref = zero
+    do i = 1, nb
+      a = abs(q(3 * i))
+      if (a > ref) ref = a
+    end do
+    ref = ULP * max(one, lscale * ref)
+    conv = .true.
+    res = zero; dmax = zero; fin = zero
+    do i = 1, n                  ! (comparisons, not max: NaN goes to fin)
+      a = abs(phi(i))
+      if (a > res) res = a
+      d = -x(i); x(i) = d
+      a = abs(d)
+      if (a > dmax) dmax = a
+      if (a > ULP * abs(q(i)) .and. a > ref) conv = .false.   ! |dq_i| > ULP max(|q_i|, ref)
+      fin = fin + (d - d)                                  ! 0, or NaN if not finite
+      q(i) = q(i) + d
+    end do
+    dmax = dmax + fin
+    conv = conv .and. res <= tol .and. fin == zero
+  end subroutine chord_update
+
+  !> x = a.
+  pure subroutine copy1(n, a, x)
+    integer, intent(in) :: n
+    real(wp), intent(in) :: a(n)
+    real(wp), intent(out) :: x(n)
+    integer :: i
+    do i = 1, n
+      x(i) = a(i)
+    end do
+  end subroutine copy1
 
   !> x = a, y = b, z = c.
   pure subroutine copy3(n, a, b, c, x, y, z)

@@ -67,14 +67,16 @@ def new_ctl() -> np.ndarray:
 
 def kinematics(p: Packed, t0: float, t1: float, steps: int, tol: float, maxit: int,
                tmin: float, every: int, solver: int, nout: int,
-               ctl: np.ndarray | None = None) -> SimpleNamespace:
-    """The whole kinematic run: ``q``, ``qd``, ``qdd`` (nq, nout), ``iinfo``, ``rinfo``,
-    ``qsing``, ``dep``, ``red``, ``tpass``, ``status``, ``msg``. ``ctl``: see
-    :func:`new_ctl` (the core releases the GIL while it runs)."""
+               ctl: np.ndarray | None = None, positions: bool = False) -> SimpleNamespace:
+    """The whole kinematic run: ``q``, ``qd``, ``qdd`` (nq, nout; (nq, 0) with
+    ``positions``), ``iinfo``, ``rinfo``, ``qsing``, ``dep``, ``red``, ``tpass``,
+    ``status``, ``msg``. ``ctl``: see :func:`new_ctl` (the core releases the GIL while it
+    runs)."""
+    nd = 0 if positions else nout
     return _named("q qd qdd iinfo rinfo qsing dep red tpass status msg", _core.core_kinematics,
                   p.nb, p.ctab, p.rpar, p.neq, p.q0, t0, t1, steps, tol, maxit, tmin, every,
-                  solver, nout, new_ctl() if ctl is None else ctl,
-                  numbers=3 * p.nq * nout + p.nq + 2 * p.neq)
+                  solver, nout, int(positions), nd, new_ctl() if ctl is None else ctl,
+                  numbers=p.nq * (nout + 2 * nd) + p.nq + 2 * p.neq)
 
 
 def kin_step(p: Packed, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, t_prev: float,
