@@ -28,13 +28,15 @@ module mbd_batch
   !> analyses
   integer, parameter :: BATCH_KINEMATICS = 1, BATCH_INVERSE = 2, BATCH_STATICS = 3, &
                         BATCH_DYNAMICS = 4
-  !> settings: iset = [nsteps, maxit, every, solver, method, max_steps, 0, 0];
+  !> settings: iset = [nsteps, maxit, every, solver, method, max_steps, positions, 0]
+  !! (positions: 1 = kinematics of the positions alone, qdout and qddout (nq, 0, ncase));
   !! rset = [t0, t1, tol, tmin, rtol, atol, h, rho_inf, alpha, beta, t (statics), 0]
   integer, parameter :: NISET = 8, NRSET = 12
 
 contains
 
-  !> Run the analysis for every case. Output shapes: qout, qdout, qddout (nq, rows, ncase),
+  !> Run the analysis for every case. Output shapes: qout, qdout, qddout (nq, rows, ncase;
+  !! qdout, qddout (nq, 0, ncase) for positions-only kinematics),
   !! lamout (neq or 0, rows, ncase), eout (4 or 0, rows, ncase); iinfo, rinfo (NINFO, ncase)
   !! as the analysis reports them (statics: rinfo(1) residual, rinfo(2) stability code);
   !! qsing (nq, ncase), dep and redundant (neq, ncase). Statics writes row 1.
@@ -106,7 +108,7 @@ contains
         call api_kinematics(nb, ctab, r, q0, rset(1), rset(2), iset(1), rset(3), iset(2), &
                             rset(4), iset(3), iset(4), qout(:, :, c), qdout(:, :, c), &
                             qddout(:, :, c), iinfo(:, c), rinfo(:, c), qsing(:, c), dep(:, c), &
-                            redundant(:, c), tpass, status(c), msg(c))
+                            redundant(:, c), tpass, status(c), msg(c), positions=iset(7))
       case (BATCH_INVERSE)
         call api_inverse(nb, ctab, r, bm, g, ftab, fp, q0, rset(1), rset(2), iset(1), rset(3), &
                          iset(3), iset(4), qout(:, :, c), qdout(:, :, c), qddout(:, :, c), &
@@ -132,7 +134,9 @@ contains
       integer, intent(out) :: st
       character(len=MSG_LEN), intent(out) :: text
       integer :: j, n(4), nrow
+      logical :: positions
       st = MBD_BAD_INPUT; text = ''
+      positions = analysis == BATCH_KINEMATICS .and. iset(7) == 1
       n = [size(rpar), size(bmass), 2, size(fpar)]
       nrow = size(qout, 2)
       if (analysis < BATCH_KINEMATICS .or. analysis > BATCH_DYNAMICS) then
@@ -153,8 +157,9 @@ contains
           any(opens(2, :) < 1) .or. any(opens(2, :) > neq)) then
         text = 'batch: an open phase is out of range'; return
       end if
-      if (size(v0) /= nq .or. any(shape(qdout) /= shape(qout)) .or. &
-          any(shape(qddout) /= shape(qout)) .or. size(qout, 1) /= nq .or. &
+      if (size(v0) /= nq .or. any(shape(qddout) /= shape(qdout)) .or. &
+          size(qdout, 1) /= nq .or. size(qdout, 3) /= ncase .or. &
+          size(qdout, 2) /= merge(0, nrow, positions) .or. size(qout, 1) /= nq .or. &
           size(qout, 3) /= ncase .or. size(lamout, 2) /= nrow .or. &
           size(lamout, 3) /= ncase .or. size(eout, 2) /= nrow .or. size(eout, 3) /= ncase .or. &
           size(iinfo, 1) /= NINFO .or. size(iinfo, 2) /= ncase .or. &

@@ -385,19 +385,21 @@ end subroutine core_dynamics_sens
 ! to set again from q0 (index in rpar, row of Phi); settings in iset, rset (mbd_batch). nlam
 ! is neq (0 for kinematics), ne 4 (0 for kinematics); nrow the output rows per case.
 subroutine core_batch(analysis, nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp, fpar, nq, &
-                      q0, v0, nv, vtab, ncase, vals, no, opens, iset, rset, neq, nrow, nlam, ne, &
+                      q0, v0, nv, vtab, ncase, vals, no, opens, iset, rset, neq, nrow, nd, &
+                      nlam, ne, &
                       qout, qdout, qddout, lamout, eout, iinfo, rinfo, qsing, dep, redundant, &
                       status, msg)
   use iso_c_binding, only: c_double, c_int
   use mbd_batch, only: batch_run
   implicit none
   integer(c_int), intent(in) :: analysis, nb, nc, np, nf, nfp, nq, nv, ncase, no, neq, nrow
-  integer(c_int), intent(in) :: nlam, ne
+  !> nd: rows of qdout and qddout (nrow; 0 for positions-only kinematics, iset(7) = 1)
+  integer(c_int), intent(in) :: nlam, ne, nd
   integer(c_int), intent(in) :: ctab(8, nc), ftab(6, nf), vtab(2, nv), opens(2, no), iset(8)
   real(c_double), intent(in) :: rpar(np), bmass(2, nb), grav(2), fpar(nfp), q0(nq), v0(nq)
   real(c_double), intent(in) :: vals(nv, ncase), rset(12)
-  real(c_double), intent(out) :: qout(nq, nrow, ncase), qdout(nq, nrow, ncase)
-  real(c_double), intent(out) :: qddout(nq, nrow, ncase), lamout(nlam, nrow, ncase)
+  real(c_double), intent(out) :: qout(nq, nrow, ncase), qdout(nq, nd, ncase)
+  real(c_double), intent(out) :: qddout(nq, nd, ncase), lamout(nlam, nrow, ncase)
   real(c_double), intent(out) :: eout(ne, nrow, ncase)
   integer(c_int), intent(out) :: iinfo(10, ncase), dep(neq, ncase), redundant(neq, ncase)
   real(c_double), intent(out) :: rinfo(10, ncase), qsing(nq, ncase)

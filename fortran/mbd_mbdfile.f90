@@ -7,6 +7,7 @@
 !!   analysis kinematics | inverse-dynamics | dynamics | statics
 !!   t0 <time>   t_end <time>   steps <n>   every <k>                  (one per line)
 !!   tol <x>   maxit <n>   tmin <x>   solver auto|dense|banded           (kinematic runs)
+!!   positions_only 0|1                       (kinematics: 1 = positions alone, optional)
 !!   method generalized-alpha|dopri5|baumgarte-rk4|partitioned   rtol <x>   atol <x>   h <x>
 !!   rho_inf <x>   alpha <x>   beta <x>   max_steps <n>                  (dynamics)
 !!   t <time>                                                           (statics)
@@ -86,6 +87,7 @@ module mbd_mbdfile
     real(wp) :: grav(2) = zero            !! gravity
     !> optional output columns
     logical :: out_energy = .false., out_lam = .false., out_reac = .false., out_eff = .false.
+    logical :: positions_only = .false.   !! kinematics: positions alone
     ! masses, forces and row labels (dynamic analyses)
     logical :: have_masses = .false.      !! body lines carry mass, inertia and v0
     real(wp), allocatable :: bmass(:, :)  !! (2, nb) mass, inertia
@@ -197,6 +199,13 @@ contains
         case ('beta'); spec%beta = x
         case default; spec%tstat = x
         end select
+      case ('positions_only')
+        if (.not. one_int(big)) exit
+        if (big < 0 .or. big > 1) then
+          call fail_int('positions_only must be 0 or ', 1_int64, '', big)
+          exit
+        end if
+        spec%positions_only = big == 1
       case ('every')
         if (.not. one_int(big)) exit
         if (big < 1 .or. big > MAX_STEPS) then

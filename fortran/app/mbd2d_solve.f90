@@ -82,6 +82,8 @@ program mbd2d_solve
                            spec%out_eff)) &
     call die(2, trim(model_path) // ': the outputs energy, multipliers, reactions and '// &
              'efforts need inverse-dynamics, dynamics or statics')
+  if (spec%positions_only .and. spec%analysis /= 'kinematics') call die(2, &
+    trim(model_path) // ': positions_only is a setting of kinematics')
   if (spec%nlabels >= 0 .and. spec%nlabels /= neq) call die(2, trim(model_path) // &
     ': ' // trim(itoa(spec%nlabels)) // ' labels for ' // trim(itoa(neq)) // ' rows of Phi')
   if (spec%analysis == 'statics' .and. spec%out_energy) call die(2, trim(model_path) // &
@@ -122,7 +124,8 @@ program mbd2d_solve
   case ('kinematics')
     call api_kinematics(spec%nb, spec%ctab, spec%rpar, q0, spec%t0, spec%t_end, spec%steps, &
                         spec%tol, spec%maxit, spec%tmin, spec%every, spec%solver, qout, qdout, &
-                        qddout, iinfo, rinfo, qsing, dep, redundant, tpass, status, msg)
+                        qddout, iinfo, rinfo, qsing, dep, redundant, tpass, status, msg, &
+                        positions=merge(1, 0, spec%positions_only))
     nout = iinfo(1)
   case ('inverse-dynamics')
     call api_inverse(spec%nb, spec%ctab, spec%rpar, spec%bmass, spec%grav, ftab, fpar, q0, &
@@ -297,7 +300,8 @@ contains
     logical :: st
     character(len=32) :: word
     integer :: nw
-    st = spec%analysis == 'statics'
+    ! statics and positions-only kinematics: x, y, theta per body
+    st = spec%analysis == 'statics' .or. spec%positions_only
     ncols = 1 + merge(5, 9, st) * spec%nb + 5 + neq + 6 * spec%nc + spec%nc + 4 * spec%nf
     allocate (v(ncols), stat=ierr)
     if (ierr /= 0) call die(2, 'not enough memory to write ' // path)
@@ -310,7 +314,7 @@ contains
         call put(u, ios, ',' // trim(spec%body_names(b)) // trim(sfx(i)))
       end do
     end do
-    if (st) call put(u, ios, ',stable,residual')
+    if (spec%analysis == 'statics') call put(u, ios, ',stable,residual')
     if (spec%out_energy) then
       do i = 1, 5
         call put(u, ios, ',' // trim(ew(i)))
@@ -385,7 +389,7 @@ contains
     n = 1
     v(1) = tout(k)
     do b = 1, spec%nb
-      if (spec%analysis == 'statics') then
+      if (spec%analysis == 'statics' .or. spec%positions_only) then
         v(n + 1:n + 3) = qout(3 * b - 2:3 * b, k); n = n + 3
       else
         v(n + 1:n + 3) = qout(3 * b - 2:3 * b, k)

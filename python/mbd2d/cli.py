@@ -1,13 +1,14 @@
 """The ``mbd2d`` command line.
 
-    mbd2d kinematics MODEL.toml --t-end T --steps N --out OUT.csv|OUT.npz [--every K --solver S]
+    mbd2d kinematics MODEL.toml --t-end T --steps N --out OUT.csv|OUT.npz [--every K --solver S
+                     --positions-only]
     mbd2d inverse-dynamics MODEL.toml --t-end T --steps N --out OUT.csv [--every K --solver S]
     mbd2d dynamics MODEL.toml --t-end T --steps N --out OUT.csv [--method M --rtol R --atol A --h H
                    --max-steps S --solver S]
     mbd2d statics MODEL.toml [--t T --solver S] [--out OUT.csv]
     mbd2d sweep MODEL.toml --param NAME=START:STOP:NUM ... [--grid] --t-end T --steps N
                 --out sweep.nc|sweep.csv [--analysis A --t0 T0 --every K --workers W
-                --scheduler ADDRESS]
+                --scheduler ADDRESS --positions-only]
     mbd2d synthesize TASK.toml --out BEST.toml [--starts K --seed S --workers N]
     mbd2d check MODEL.toml
     mbd2d export MODEL.toml OUT.mbd [--analysis A] --t-end T --steps N [settings of A]
@@ -112,6 +113,8 @@ def _parser() -> argparse.ArgumentParser:
     k.add_argument("--every", type=int, default=1, help="write every k-th row (and the last)")
     k.add_argument("--solver", default="auto", choices=["auto", "dense", "banded"],
                    help="linear solver (default auto: banded LU for large chains)")
+    k.add_argument("--positions-only", action="store_true",
+                   help="positions alone, no velocities or accelerations (faster: chord steps)")
     _columns(k)
     i = sub.add_parser("inverse-dynamics", help="kinematics of a driven model with masses, "
                        "with driver efforts, multipliers and reactions")
@@ -154,6 +157,8 @@ def _parser() -> argparse.ArgumentParser:
     w.add_argument("--t0", type=float, default=0.0, help="start time (statics: its time)")
     w.add_argument("--every", type=int, default=1, help="keep every k-th row (and the last)")
     w.add_argument("--method", default=None, help="dynamics: the integrator")
+    w.add_argument("--positions-only", action="store_true",
+                   help="kinematics: positions alone (no velocities or accelerations)")
     w.add_argument("--out", required=True, help="output file, .nc (netCDF) or .csv")
     w.add_argument("--workers", type=int, default=None,
                    help="local worker processes (default: every core)")
@@ -176,6 +181,8 @@ def _parser() -> argparse.ArgumentParser:
     e.add_argument("--solver", default="auto", choices=["auto", "dense", "banded"],
                    help="linear solver of kinematic runs (default auto)")
     e.add_argument("--t", type=float, default=0.0, help="statics: time of loads and drivers")
+    e.add_argument("--positions-only", action="store_true",
+                   help="kinematics: positions alone (no velocities or accelerations)")
     _dynamics_settings(e)
     _columns(e)
     p = sub.add_parser("plot", help="run an analysis and draw it (PNG, SVG or PDF)")
@@ -296,7 +303,8 @@ def _run(model: Model, args: argparse.Namespace, analysis: str) -> Any:
                                       solver=getattr(args, "solver", "auto"))
     return model.kinematics(**span, tol=getattr(args, "tol", None),
                             every=getattr(args, "every", 1),
-                            solver=getattr(args, "solver", "auto"))
+                            solver=getattr(args, "solver", "auto"),
+                            positions_only=getattr(args, "positions_only", False))
 
 
 def _picture(res: Any, args: argparse.Namespace) -> str:
@@ -376,6 +384,8 @@ def _sweep(model: Model, args: argparse.Namespace) -> int:
         kw = {"t_end": args.t_end, "steps": args.steps, "t0": args.t0, "every": args.every}
         if args.method is not None:
             kw["method"] = args.method
+        if args.positions_only:
+            kw["positions_only"] = True
     client = connect(args.scheduler) if args.scheduler else None
     try:
         ds = sweep(model, cases, args.analysis, client, workers=args.workers, **kw)
@@ -413,7 +423,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             extra = _dynamics_kwargs(args) if args.analysis == "dynamics" else {}
             model.export(args.out, t_end=args.t_end, steps=args.steps, t0=args.t0, tol=args.tol,
                          analysis=args.analysis, every=args.every, solver=args.solver, t=args.t,
-                         outputs=list(_outputs(args)), **extra)
+                         outputs=list(_outputs(args)), positions_only=args.positions_only,
+                         **extra)
             print(f"wrote {args.out} ({args.analysis}; run it with mbd2d-solve "
                   f"{args.out} OUT.csv)")
             return EXIT_OK

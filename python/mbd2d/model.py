@@ -80,7 +80,8 @@ class Model(ModelDescription):
     # ------------------------------------------------------------------ analyses
     def kinematics(self, t_end: float, steps: int, t0: float = 0.0, tol: float | None = None,
                    maxit: int | None = None, every: int = 1, solver: str = "auto",
-                   sensitivities: Any = None, progress: bool | None = None) -> KinematicsResult:
+                   sensitivities: Any = None, progress: bool | None = None,
+                   positions_only: bool = False) -> KinematicsResult:
         """Kinematic analysis at steps + 1 uniform times from t0 to t_end.
 
         The whole time loop runs in the Fortran core. Assembly refines the q0 estimates at t0.
@@ -117,12 +118,21 @@ class Model(ModelDescription):
             lasts more than about 2 s on a terminal or in a notebook, True always, False
             never. The results are the same bit for bit (one core call either way); Ctrl-C
             stops the run at its next step.
+        positions_only : bool, optional
+            Compute the positions alone (coupler curves, sweeps of paths): ``res.qd`` and
+            ``res.qdd`` are None. Where J is well conditioned the core then steps by chord
+            corrections on a kept factorization of J from a polynomial prediction of the
+            positions, each step ending as a full step's Newton correction does (below
+            resolution); near singular configurations it takes full steps. The positions
+            agree with a full run's to round-off (docs/kinematics.md). Not with
+            ``sensitivities``; no inverse dynamics.
 
         Returns
         -------
         KinematicsResult
-            When every body has a mass and an inertia (and ``maxit`` is not given), a
-            DynamicsResult with the inverse dynamics too (see :meth:`inverse_dynamics`).
+            When every body has a mass and an inertia (and ``maxit`` is not given, and not
+            ``positions_only``), a DynamicsResult with the inverse dynamics too (see
+            :meth:`inverse_dynamics`).
 
         Raises
         ------
@@ -140,12 +150,12 @@ class Model(ModelDescription):
         >>> res.q.shape[0]
         11
         """
-        if self.has_masses() and maxit is None:
+        if self.has_masses() and maxit is None and positions_only is False:
             return run_inverse(self, t_end=t_end, steps=steps, t0=t0, tol=tol, every=every,
                                solver=solver, sensitivities=sensitivities, progress=progress)
         return run_kinematics(self, t_end=t_end, steps=steps, t0=t0, tol=tol, maxit=maxit,
                               every=every, solver=solver, sensitivities=sensitivities,
-                              progress=progress)
+                              progress=progress, positions_only=positions_only)
 
     def analyze_dof(self, t: float = 0.0, tol: float | None = None) -> DofReport:
         """Degrees of freedom and redundant constraints at the configuration assembled from
@@ -361,7 +371,7 @@ class Model(ModelDescription):
                atol: float | None = None, h: float | None = None,
                rho_inf: float | None = None, alpha: float | None = None,
                beta: float | None = None, max_steps: int | None = None, t: float = 0.0,
-               outputs: Sequence[str] | None = None) -> None:
+               outputs: Sequence[str] | None = None, positions_only: bool = False) -> None:
         """Write a plain-text model file that the standalone ``mbd2d-solve`` runs without
         Python (format: docs/mbd-format.md), with the analysis and its settings.
 
@@ -382,6 +392,9 @@ class Model(ModelDescription):
         outputs : list of str, optional
             Optional CSV columns: "energy", "multipliers", "reactions", "efforts" (not for
             kinematics; no energy for statics), as ``res.to_csv(path, energy=True, ...)``.
+        positions_only : bool, optional
+            Kinematics: positions alone, as :meth:`kinematics` (the CSV has t and NAME.x,
+            NAME.y, NAME.theta per body).
 
         Raises
         ------
@@ -398,7 +411,7 @@ class Model(ModelDescription):
         export_mbd(self, path, t_end=t_end, steps=steps, t0=t0, tol=tol, maxit=maxit,
                    analysis=analysis, every=every, solver=solver, method=method, rtol=rtol,
                    atol=atol, h=h, rho_inf=rho_inf, alpha=alpha, beta=beta,
-                   max_steps=max_steps, t=t, outputs=outputs)
+                   max_steps=max_steps, t=t, outputs=outputs, positions_only=positions_only)
 
 
 def load(path: str | Path) -> Model:

@@ -95,6 +95,13 @@ def whole(x: Any, what: str, entry: str, lo: int, hi: int) -> int:
     return int(x)
 
 
+def flag(x: Any, what: str, entry: str) -> bool:
+    """True or False (a NumPy bool too)."""
+    if not isinstance(x, (bool, np.bool_)):
+        raise ModelError(f"{what} must be True or False, got {x!r}", entry)
+    return bool(x)
+
+
 def table(x: Any, what: str, entry: str) -> Mapping[str, Any]:
     """A TOML table (mapping)."""
     if not isinstance(x, Mapping):

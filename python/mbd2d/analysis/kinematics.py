@@ -12,8 +12,9 @@ from ..binding.pack import pack
 from ..binding.status import NO_CONVERGENCE, OK, SINGULAR_CONFIG, error_for
 from ..binding.tables import Packed
 from ..description.builder import ModelDescription
-from ..errors import MbdError, RedundantConstraintWarning, SingularPassageWarning
+from ..errors import MbdError, ModelError, RedundantConstraintWarning, SingularPassageWarning
 from ..results.kinematics import KinematicsResult
+from ..validate import flag
 from .failures import kinematic_failure, row_names
 from .outputs import finite_part, rows
 from .progress import run_core
@@ -25,17 +26,22 @@ from .settings import (check_memory, check_solver, check_span, output_rows, outp
 def run_kinematics(model: ModelDescription, t_end: float, steps: int, t0: float = 0.0,
                    tol: float | None = None, maxit: int | None = None,
                    tmin: float | None = None, every: Any = 1, solver: str = "auto",
-                   sensitivities: Any = None, progress: bool | None = None) -> KinematicsResult:
+                   sensitivities: Any = None, progress: bool | None = None,
+                   positions_only: bool = False) -> KinematicsResult:
     """Run a kinematic analysis in one core call; see :meth:`mbd2d.Model.kinematics`."""
     t0, t_end, steps = check_span(t0, t_end, steps)
     tol_v, maxit_v = check_solver(tol, maxit)
     nout = output_rows(steps, every)
     code = solver_code(solver)
     params = requested(model, sensitivities)
+    pos = flag(positions_only, "positions_only", "kinematics")
+    if pos and params:
+        raise ModelError("sensitivities need the velocities and accelerations of every "
+                         "step: drop positions_only=True to ask for them", "positions_only")
     p = pack(model)
     require_determined(p, model)
     npar = len(params) if params else 0
-    check_memory(nout, 3 * p.nq * (1 + npar), "kinematics")
+    check_memory(nout, (1 if pos else 3) * p.nq * (1 + npar), "kinematics")
     idx = output_steps(steps, every)
     if params:
         ptab = table(p, params)
@@ -45,15 +51,15 @@ def run_kinematics(model: ModelDescription, t_end: float, steps: int, t0: float 
     else:
         out = run_core(lambda ctl: core.kinematics(p, t0, t_end, steps, tol_v, maxit_v,
                                                    float(tmin or 0.0), int(every), code, nout,
-                                                   ctl),
+                                                   ctl, pos),
                        nout, "kinematics", progress, float(steps) * (p.nq + p.neq))
     iinfo, rinfo, tpass, status = out.iinfo, out.rinfo, out.tpass, out.status
     n = int(iinfo[0])
     t = time_grid(t0, t_end, steps, idx)
     npass = int(iinfo[9])
     red_cons, red_rows = row_names(p, model, out.red)
-    res = KinematicsResult(t=t[:n], q=rows(out.q, n), qd=rows(out.qd, n),
-                           qdd=rows(out.qdd, n), body_names=p.body_names,
+    res = KinematicsResult(t=t[:n], q=rows(out.q, n), qd=None if pos else rows(out.qd, n),
+                           qdd=None if pos else rows(out.qdd, n), body_names=p.body_names,
                            coordinate_names=p.coordinate_names,
                            stats={"newton_corrections": int(iinfo[5]),
                                   "factorizations": int(iinfo[6]),

@@ -23,7 +23,7 @@ from ..description.joints import (Absolute, Cam, Distance, Gear, PinInSlot, Poin
                                   Weld)
 from ..errors import ModelError
 from ..results.files import OUTPUTS, write_text
-from ..validate import number
+from ..validate import flag, number
 from .dynamics import dynamics_settings
 from .settings import (SOLVERS, check_solver, check_span, output_rows, require_determined,
                        solver_code)
@@ -83,6 +83,7 @@ def header() -> str:
         "every k-th kept",
         "#   tol, maxit, tmin, solver     Newton tolerance, iterations, singular-time "
         "resolution (0 = default); auto | dense | banded",
+        "#   positions_only 0|1           kinematics: 1 = positions alone (optional)",
         "#   method, rtol, atol, h, rho_inf, alpha, beta, max_steps   dynamics (0, or -1 for "
         "rho_inf, alpha, beta: default)",
         "#   t                            statics: the time of loads and drivers",
@@ -147,7 +148,7 @@ def export(model: ModelDescription, path: str | Path, t_end: float | None = None
            solver: str = "auto", method: str | None = None, rtol: Any = None,
            atol: Any = None, h: Any = None, rho_inf: Any = None, alpha: Any = None,
            beta: Any = None, max_steps: Any = None, t: float = 0.0,
-           outputs: Sequence[str] | None = None) -> None:
+           outputs: Sequence[str] | None = None, positions_only: Any = False) -> None:
     """Write a model file for ``mbd2d-solve``; see :meth:`mbd2d.Model.export`.
 
     Raises
@@ -159,6 +160,10 @@ def export(model: ModelDescription, path: str | Path, t_end: float | None = None
         raise ModelError(f"unknown analysis {analysis!r}; use one of {', '.join(ANALYSES)}",
                          "export")
     words = _outputs(outputs, analysis)
+    pos = flag(positions_only, "positions_only", "export")
+    if pos and analysis != "kinematics":
+        raise ModelError(f"positions_only is a setting of kinematics, not of {analysis}",
+                         "export")
     p = pack(model)
     lines = [header(), f"mbd2d {FORMAT}",
              f"name {model.name.replace(' ', '_') or 'model'}", f"analysis {analysis}"]
@@ -176,6 +181,8 @@ def export(model: ModelDescription, path: str | Path, t_end: float | None = None
         lines += [f"tol {_r(tol_v)}", f"solver {solver}"]
         if analysis == "kinematics":
             lines += [f"maxit {maxit_v}", f"tmin {_r(0.0)}"]
+            if pos:
+                lines.append("positions_only 1")
     elif analysis == "dynamics":
         st = dynamics_settings(method, rtol, atol, h, rho_inf, alpha, beta, max_steps)
         lines += [f"method {st.method}", f"rtol {_r(st.rtol)}", f"atol {_r(st.atol)}",

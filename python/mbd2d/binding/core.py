@@ -247,7 +247,8 @@ def reactions_dp(p: Packed, ptab: np.ndarray, q: np.ndarray, t: np.ndarray, lam:
 def batch(b: BatchTables, vals: np.ndarray) -> dict[str, Any]:
     """One analysis for every case (column) of vals (nv, ncase), in one core call
     (``fortran/mbd_batch.f90``). Returns the core's arrays by name, the case last: ``q``,
-    ``qd``, ``qdd`` (nq, nrow, ncase), ``lam`` (nlam, nrow, ncase), ``e`` (ne, nrow, ncase),
+    ``qd``, ``qdd`` (nq, nrow, ncase; (nq, 0, ncase) for positions only), ``lam`` (nlam, nrow,
+    ncase), ``e`` (ne, nrow, ncase),
     ``iinfo``, ``rinfo`` (10, ncase), ``qsing`` (nq, ncase), ``dep``, ``red`` (neq, ncase),
     ``status`` (ncase) and ``msg`` (ncase, text). A module-level function of plain arrays, so
     that worker processes and Dask workers can run it."""
@@ -257,6 +258,7 @@ def batch(b: BatchTables, vals: np.ndarray) -> dict[str, Any]:
                  analysis=b.analysis, nb=b.nb, ctab=b.ctab, rpar=b.rpar, bmass=b.bmass,
                  grav=b.grav, ftab=b.ftab, fpar=b.fpar, q0=b.q0, v0=b.v0, vtab=b.vtab,
                  vals=vals, opens=b.opens, iset=b.iset, rset=b.rset, neq=b.neq, nrow=b.nrow,
-                 nlam=b.nlam, ne=b.ne,
-                 numbers=ncase * ((3 * b.nq + b.nlam + b.ne) * b.nrow + 2 * b.neq + b.nq + 20))
+                 nd=b.nd, nlam=b.nlam, ne=b.ne,
+                 numbers=ncase * ((b.nq + b.nlam + b.ne) * b.nrow + 2 * b.nq * b.nd
+                                  + 2 * b.neq + b.nq + 20))
     return vars(out)

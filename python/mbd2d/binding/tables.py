@@ -79,3 +79,8 @@ class BatchTables:
     @property
     def nq(self) -> int:
         return len(self.q0)
+
+    @property
+    def nd(self) -> int:
+        """Rows of the velocities and accelerations: 0 for positions-only kinematics."""
+        return 0 if self.analysis == 1 and int(self.iset[6]) == 1 else self.nrow

@@ -96,11 +96,12 @@ def _name(result: Motion) -> str:
 def _motion(result: Motion, bodies: Sequence[str] | None, lu: str) -> "Figure":
     names = list(result.body_names if bodies is None else bodies)
     hist = [result.body(b) for b in names]  # KeyError on an unknown name
-    fig = new_figure((11.0, 8.0))
-    axes = fig.subplots(3, 3, sharex=True, squeeze=False)
+    levels = 1 if getattr(result, "qd", None) is None else 3    # (positions only: 1)
+    fig = new_figure((11.0, 8.0 if levels == 3 else 3.6))
+    axes = fig.subplots(levels, 3, sharex=True, squeeze=False)
     marks = ["", "\u0307", "\u0308"]  # combining dot / two dots
     per = ["", "/s", "/s²"]
-    suffixes = ["", "_dot", "_ddot"]
+    suffixes = ["", "_dot", "_ddot"][:levels]
     for i, suffix in enumerate(suffixes):
         row_data = [np.asarray(getattr(h, c + suffix)) for h in hist for c in ("x", "y", "theta")]
         ref = max([1.0] + [float(np.abs(d).max()) for d in row_data if d.size])
@@ -121,12 +122,13 @@ def _motion(result: Motion, bodies: Sequence[str] | None, lu: str) -> "Figure":
             a.set_ylabel(f"{sym}{marks[i]} [{unit}{per[i]}]" if unit else f"{sym}{marks[i]}")
             a.grid(True, lw=0.4, alpha=0.5)
             mark_times(a, result, labels=(i, c) == (0, 0))
-            if i == 2:
+            if i == levels - 1:
                 a.set_xlabel("t [s]")
     for c, sym in enumerate(("x", "y", "θ")):
         axes[0][c].set_title(sym)
     axes[0][0].legend(fontsize=8, loc="best")
-    fig.suptitle(f"{_name(result)}: positions, velocities, accelerations"
+    fig.suptitle(f"{_name(result)}: positions"
+                 + (", velocities, accelerations" if levels == 3 else "")
                  + ("" if result.complete else " (incomplete run)"))
     return fig
 

@@ -31,18 +31,19 @@ SUFFIXES = ("x", "y", "theta", "x_dot", "y_dot", "theta_dot", "x_ddot", "y_ddot"
 
 @dataclass
 class BodyResult:
-    """Time histories of one body (arrays over the output times)."""
+    """Time histories of one body (arrays over the output times; the velocities and
+    accelerations None after a ``positions_only`` run)."""
 
     name: str
     x: np.ndarray
     y: np.ndarray
     theta: np.ndarray
-    x_dot: np.ndarray
-    y_dot: np.ndarray
-    theta_dot: np.ndarray
-    x_ddot: np.ndarray
-    y_ddot: np.ndarray
-    theta_ddot: np.ndarray
+    x_dot: np.ndarray | None
+    y_dot: np.ndarray | None
+    theta_dot: np.ndarray | None
+    x_ddot: np.ndarray | None
+    y_ddot: np.ndarray | None
+    theta_ddot: np.ndarray | None
 
 
 @dataclass
@@ -56,6 +57,7 @@ class KinematicsResult:
     q, qd, qdd : numpy.ndarray
         Coordinates, velocities, accelerations (n, nq); rows are times. Columns are
         ``coordinate_names``: x, y, theta of each body, then extra coordinates (cam alpha).
+        ``qd`` and ``qdd`` are None after a ``positions_only`` run.
     body_names, coordinate_names : list of str
     stats : dict
         Newton corrections, LU factorizations, rejected steps, tolerance used.
@@ -70,8 +72,8 @@ class KinematicsResult:
 
     t: np.ndarray
     q: np.ndarray
-    qd: np.ndarray
-    qdd: np.ndarray
+    qd: np.ndarray | None
+    qdd: np.ndarray | None
     body_names: list[str]
     coordinate_names: list[str]
     stats: dict[str, Any] = field(default_factory=dict)
@@ -95,7 +97,11 @@ class KinematicsResult:
         except ValueError:
             raise KeyError(f"no body {name!r}; bodies: {', '.join(self.body_names)}") from None
         c = slice(3 * i, 3 * i + 3)
-        q, qd, qdd = self.q[:, c], self.qd[:, c], self.qdd[:, c]
+        q = self.q[:, c]
+        if self.qd is None or self.qdd is None:
+            return BodyResult(name, q[:, 0], q[:, 1], q[:, 2], None, None, None, None, None,
+                              None)
+        qd, qdd = self.qd[:, c], self.qdd[:, c]
         return BodyResult(name, q[:, 0], q[:, 1], q[:, 2], qd[:, 0], qd[:, 1], qd[:, 2],
                           qdd[:, 0], qdd[:, 1], qdd[:, 2])
 
@@ -137,7 +143,8 @@ class KinematicsResult:
         -------
         PointResult
             ``.r``, ``.v``, ``.a`` (n, 2) global position, velocity, acceleration (also
-            ``.x``, ``.y``, ``.x_dot``, ..., ``.speed``); indexing it indexes ``.r``.
+            ``.x``, ``.y``, ``.x_dot``, ..., ``.speed``); indexing it indexes ``.r``. After a
+            ``positions_only`` run ``.v`` and ``.a`` are None.
 
         Raises
         ------
@@ -157,6 +164,8 @@ class KinematicsResult:
         sx, sy = vector(s, 2, "s", "point")
         b = self.body(name)
         q = np.column_stack([b.x, b.y, b.theta])
+        if self.qd is None:
+            return PointResult.of(name, (sx, sy), q, None, None)
         qd = np.column_stack([b.x_dot, b.y_dot, b.theta_dot])
         qdd = np.column_stack([b.x_ddot, b.y_ddot, b.theta_ddot])
         return PointResult.of(name, (sx, sy), q, qd, qdd)
@@ -305,7 +314,8 @@ class KinematicsResult:
         return repr_png(self)
 
     def table(self, **outputs: bool) -> tuple[list[str], np.ndarray]:
-        """Header and rows of the CSV: t, then NAME.x ... NAME.theta_ddot per body.
+        """Header and rows of the CSV: t, then NAME.x ... NAME.theta_ddot per body (NAME.x,
+        NAME.y, NAME.theta after a ``positions_only`` run).
 
         A kinematic result has no optional columns (``energy``, ``multipliers``,
         ``reactions``, ``efforts`` need a DynamicsResult): asking for one is a ModelError.
@@ -314,12 +324,14 @@ class KinematicsResult:
         return self._motion_table()
 
     def _motion_table(self) -> tuple[list[str], np.ndarray]:
-        header = ["t"] + [f"{b}.{s}" for b in self.body_names for s in SUFFIXES]
+        levels = [a for a in (self.q, self.qd, self.qdd) if a is not None]
+        suffixes = SUFFIXES[:3 * len(levels)]
+        header = ["t"] + [f"{b}.{s}" for b in self.body_names for s in suffixes]
         nb = len(self.body_names)
         blocks = [self.t[:, None]]
         for i in range(nb):
             c = slice(3 * i, 3 * i + 3)
-            blocks += [self.q[:, c], self.qd[:, c], self.qdd[:, c]]
+            blocks += [a[:, c] for a in levels]
         return header, np.hstack(blocks)
 
     def to_csv(self, path: str | Path, **outputs: bool) -> None:
@@ -329,11 +341,13 @@ class KinematicsResult:
         write_csv(path, header, rows, "to_csv")
 
     def to_npz(self, path: str | Path, **outputs: bool) -> None:
-        """Write t, q, qd, qdd and the names to a NumPy .npz archive."""
+        """Write t, q, qd, qdd (q alone after a ``positions_only`` run) and the names to a
+        NumPy .npz archive."""
         check_outputs(outputs, (), "to_npz")
+        motion = {k: v for k, v in (("q", self.q), ("qd", self.qd), ("qdd", self.qdd))
+                  if v is not None}
         with writing(path, "to_npz") as p:
-            np.savez(p, t=self.t, q=self.q, qd=self.qd, qdd=self.qdd,
-                     coordinate_names=np.array(self.coordinate_names),
+            np.savez(p, t=self.t, **motion, coordinate_names=np.array(self.coordinate_names),
                      body_names=np.array(self.body_names))
 
     def save(self, path: str | Path, **outputs: bool) -> None:

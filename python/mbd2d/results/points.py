@@ -14,6 +14,8 @@ from typing import Any
 
 import numpy as np
 
+from ..errors import ModelError
+
 
 @dataclass
 class PointResult:
@@ -26,7 +28,8 @@ class PointResult:
     s : tuple of float
         The point in the body's frame.
     r, v, a : numpy.ndarray
-        Global position, velocity and acceleration, each (n, 2): columns x and y.
+        Global position, velocity and acceleration, each (n, 2): columns x and y (``v`` and
+        ``a`` None after a ``positions_only`` run; their components raise ModelError).
 
     Indexing the result indexes the positions, so ``res.point("rod", s)[:, 0]`` is the
     x path, as before the velocities were added.
@@ -35,21 +38,34 @@ class PointResult:
     body: str
     s: tuple[float, float]
     r: np.ndarray
-    v: np.ndarray
-    a: np.ndarray
+    v: np.ndarray | None
+    a: np.ndarray | None
 
     @classmethod
-    def of(cls, body: str, s: tuple[float, float], q: np.ndarray, qd: np.ndarray,
-           qdd: np.ndarray) -> "PointResult":
-        """The point s of a body from its (n, 3) coordinates, velocities, accelerations."""
-        th, w, al = q[:, 2], qd[:, 2], qdd[:, 2]
+    def of(cls, body: str, s: tuple[float, float], q: np.ndarray, qd: np.ndarray | None,
+           qdd: np.ndarray | None) -> "PointResult":
+        """The point s of a body from its (n, 3) coordinates, velocities, accelerations
+        (None: positions only)."""
+        th = q[:, 2]
         c, sn = np.cos(th), np.sin(th)
         as_ = np.column_stack([c * s[0] - sn * s[1], sn * s[0] + c * s[1]])   # A s'
-        bs = np.column_stack([-as_[:, 1], as_[:, 0]])                       # B s'
         r = q[:, :2] + as_
+        if qd is None or qdd is None:
+            return cls(body, s, r, None, None)
+        w, al = qd[:, 2], qdd[:, 2]
+        bs = np.column_stack([-as_[:, 1], as_[:, 0]])                       # B s'
         v = qd[:, :2] + w[:, None] * bs
         a = qdd[:, :2] + al[:, None] * bs - (w**2)[:, None] * as_
         return cls(body, s, r, v, a)
+
+    def _rates(self, which: str) -> np.ndarray:
+        """v or a, or a ModelError after a positions-only run."""
+        x = self.v if which == "v" else self.a
+        if x is None:
+            raise ModelError("the run computed positions only (positions_only=True): run "
+                             "the kinematics without it for velocities and accelerations",
+                             "positions_only")
+        return x
 
     @property
     def x(self) -> np.ndarray:
@@ -64,27 +80,28 @@ class PointResult:
     @property
     def x_dot(self) -> np.ndarray:
         """Velocity, x component."""
-        return self.v[:, 0]
+        return self._rates("v")[:, 0]
 
     @property
     def y_dot(self) -> np.ndarray:
         """Velocity, y component."""
-        return self.v[:, 1]
+        return self._rates("v")[:, 1]
 
     @property
     def x_ddot(self) -> np.ndarray:
         """Acceleration, x component."""
-        return self.a[:, 0]
+        return self._rates("a")[:, 0]
 
     @property
     def y_ddot(self) -> np.ndarray:
         """Acceleration, y component."""
-        return self.a[:, 1]
+        return self._rates("a")[:, 1]
 
     @property
     def speed(self) -> np.ndarray:
         """|v|."""
-        return np.hypot(self.v[:, 0], self.v[:, 1])
+        v = self._rates("v")
+        return np.hypot(v[:, 0], v[:, 1])
 
     # the positions as an (n, 2) array
     @property

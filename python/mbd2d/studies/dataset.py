@@ -53,7 +53,7 @@ def _finite_rows(pl: Plan, out: Outputs) -> np.ndarray:
     a = out.arrays
     fin = np.ones(a["q"].shape[1:], dtype=bool)
     for k in ("q", "qd", "qdd", "lam", "e"):
-        if a[k].shape[0]:
+        if a[k].shape[0] and a[k].shape[1]:       # (none: no multipliers, positions only)
             fin &= np.isfinite(a[k]).all(axis=0)
     return fin
 
@@ -105,8 +105,11 @@ def _failure(pl: Plan, model: ModelDescription, c: SimpleNamespace, n: int,
         if pl.analysis == "statics":
             return statics_error(model, own() if c.status == INCONSISTENT else p, c, pl.t0)
         if pl.analysis == "kinematics":
-            res: Any = KinematicsResult(t=t[:n], q=c.q.T[:n].copy(), qd=c.qd.T[:n].copy(),
-                                        qdd=c.qdd.T[:n].copy(), body_names=p.body_names,
+            pos = pl.tables.nd == 0
+            res: Any = KinematicsResult(t=t[:n], q=c.q.T[:n].copy(),
+                                        qd=None if pos else c.qd.T[:n].copy(),
+                                        qdd=None if pos else c.qdd.T[:n].copy(),
+                                        body_names=p.body_names,
                                         coordinate_names=p.coordinate_names, complete=False,
                                         model=model)
             res, bad = finite_part(res)
@@ -137,8 +140,9 @@ def to_dataset(pl: Plan, analysis: str, model: ModelDescription, out: Outputs,
 
     a = out.arrays
     cube = ("case", "time", "coordinate")
-    data: dict[str, Any] = {"q": (cube, per_case(a["q"])), "qd": (cube, per_case(a["qd"])),
-                            "qdd": (cube, per_case(a["qdd"]))}
+    data: dict[str, Any] = {"q": (cube, per_case(a["q"]))}
+    if b.nd:                                                   # (not positions only)
+        data.update(qd=(cube, per_case(a["qd"])), qdd=(cube, per_case(a["qdd"])))
     coords: dict[str, Any] = {"case": np.arange(len(status)), "time": pl.times,
                               "coordinate": list(p.coordinate_names)}
     if b.nlam:

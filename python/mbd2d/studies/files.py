@@ -33,8 +33,8 @@ def write_sweep(ds: Any, path: str | Path) -> None:
     and message).
 
     CSV columns: ``case``, the parameters, ``t``, ``status``, ``message``, then per
-    coordinate NAME (q), NAME_dot (qd), NAME_ddot (qdd), and with multipliers the efforts
-    ``effort.DRIVER``.
+    coordinate NAME (q), NAME_dot (qd), NAME_ddot (qdd) (NAME alone for a positions-only
+    sweep), and with multipliers the efforts ``effort.DRIVER``.
 
     Raises
     ------
@@ -63,11 +63,12 @@ def _params(ds: Any) -> list[str]:
 def _csv(ds: Any, path: Path) -> None:
     params = _params(ds)
     coords = [str(c) for c in ds.coordinate.values]
-    header = ["case", *params, "t", "status", "message", *coords,
-              *(f"{c}_dot" for c in coords), *(f"{c}_ddot" for c in coords)]
+    levels = [ds[k].values for k in ("q", "qd", "qdd") if k in ds]   # (q alone: positions only)
+    header = ["case", *params, "t", "status", "message",
+              *(f"{c}{s}" for s in ("", "_dot", "_ddot")[:len(levels)] for c in coords)]
     drivers = [str(d) for d in ds.driver.values] if "effort" in ds else []
     header += [f"effort.{d}" for d in drivers]
-    q, qd, qdd = ds.q.values, ds.qd.values, ds.qdd.values
+    q = levels[0]
     eff = ds.effort.values if drivers else None
     t = ds.time.values
     with open(path, "w", newline="", encoding="utf-8") as f:
@@ -81,8 +82,7 @@ def _csv(ds: Any, path: Path) -> None:
                 w.writerow(head + ["", st, msg])
                 continue
             for k in rows:
-                line = head + [_g(t[k]), st, msg] + [_g(v) for v in q[c, k]] \
-                    + [_g(v) for v in qd[c, k]] + [_g(v) for v in qdd[c, k]]
+                line = head + [_g(t[k]), st, msg] + [_g(v) for x in levels for v in x[c, k]]
                 if eff is not None:
                     line += [_g(v) for v in eff[c, k]]
                 w.writerow(line)

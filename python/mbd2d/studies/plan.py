@@ -20,7 +20,7 @@ from ..binding.tables import NFT, BatchTables, DynamicTables, Packed
 from ..description.builder import ModelDescription
 from ..description.parameters import Parameter, find
 from ..errors import ModelError
-from ..validate import number
+from ..validate import flag, number
 
 #: the analyses a sweep runs, by the Model method's name, and the core's batch code
 ANALYSES = {"kinematics": 1, "inverse_dynamics": 2, "statics": 3, "dynamics": 4}
@@ -151,7 +151,8 @@ def _bind(fn: Callable[..., Any], kw: Mapping[str, Any], analysis: str) -> dict[
 
 
 def _kinematics_settings(t_end: Any, steps: Any, t0: Any = 0.0, tol: Any = None,
-                         maxit: Any = None, every: Any = 1, solver: Any = "auto") -> None:
+                         maxit: Any = None, every: Any = 1, solver: Any = "auto",
+                         positions_only: Any = False) -> None:
     """Settings of a kinematic sweep (as :meth:`mbd2d.Model.kinematics`)."""
 
 
@@ -202,8 +203,9 @@ def plan(model: ModelDescription, names: Sequence[str], analysis: Any,
     params = find(model, list(names), "sweep")
     if analysis == "kinematics":
         a = _bind(_kinematics_settings, kw, analysis)
-        if model.has_masses() and a["maxit"] is None:      # as Model.kinematics
-            a.pop("maxit")
+        if model.has_masses() and a["maxit"] is None and a["positions_only"] is False:
+            a.pop("maxit")                                 # as Model.kinematics
+            a.pop("positions_only")
             return _inverse(model, params, a)
         return _kinematics(model, params, a)
     if analysis == "inverse_dynamics":
@@ -223,9 +225,10 @@ def _kinematics(model: ModelDescription, params: list[Parameter], a: dict[str, A
     t0, t_end, steps, nrow, times = _span(a)
     tol, maxit = check_solver(a["tol"], a["maxit"])
     code = solver_code(a["solver"])
+    pos = flag(a["positions_only"], "positions_only", "sweep")
     p = pack(model)
     require_determined(p, model)
-    b = _tables(1, p, None, [steps, maxit, int(a["every"]), code],
+    b = _tables(1, p, None, [steps, maxit, int(a["every"]), code, 0, 0, int(pos)],
                 [t0, t_end, tol, 0.0], nrow, 0, 0)
     return Plan("kinematics", b, p, params, times, a, t0=t0)
 
@@ -271,7 +274,7 @@ def with_cases(pl: Plan, model: ModelDescription, values: np.ndarray) -> np.ndar
     ct = case_tables(model, pl.packed, d, pl.params, values)
     pl.tables.vtab, pl.tables.opens = ct.vtab, ct.opens
     b = pl.tables
-    check_memory(b.nrow * values.shape[1], 3 * b.nq + b.nlam + b.ne, "sweep")
+    check_memory(b.nrow * values.shape[1], b.nq * (3 if b.nd else 1) + b.nlam + b.ne, "sweep")
     return ct.vals
 
 

@@ -50,7 +50,7 @@ class Outputs:
 
     def __init__(self, b: BatchTables, ncase: int) -> None:
         nq, nr = b.nq, b.nrow
-        shapes = {"q": (nq, nr), "qd": (nq, nr), "qdd": (nq, nr), "lam": (b.nlam, nr),
+        shapes = {"q": (nq, nr), "qd": (nq, b.nd), "qdd": (nq, b.nd), "lam": (b.nlam, nr),
                   "e": (b.ne, nr), "iinfo": (10,), "rinfo": (10,), "qsing": (nq,),
                   "dep": (b.neq,), "red": (b.neq,)}
         ints = ("iinfo", "dep", "red")
