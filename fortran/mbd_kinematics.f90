@@ -86,8 +86,10 @@ module mbd_kinematics
   !! since; at most CHORD_MAXIT corrections, each at most CHORD_RATE of the one before
   real(wp), parameter :: FAST_PIV = COND_CHECK, FAST_DRIFT = 0.1_wp, CHORD_RATE = 0.1_wp
   integer, parameter :: CHORD_MAXIT = 6
-  !> accepted full steps (with q_dot, q_ddot) before chord steps again, after leaving them
-  integer, parameter :: FAST_REENTER = 8
+  !> accepted full steps in a row with a pivot ratio >= FAST_PIV before chord steps again,
+  !! after leaving them; doubled (up to FAST_REENTER_MAX) each time they are left before one
+  !! chord step was taken
+  integer, parameter :: FAST_REENTER = 8, FAST_REENTER_MAX = 1024
   !> a chord correction of the angles up to this is turned into the bodies' cos and sin
   !! (asm_turn: first order, exact to rounding); a larger one takes cos and sin anew
   real(wp), parameter :: TURN_MAX = 1.0e-9_wp
@@ -1075,7 +1077,7 @@ contains
     ! the predictor's weights and the step and tau they were computed for
     real(wp) :: wt(PRED_ORDER), wt_h, wt_tau(0:PRED_ORDER)
     real(wp), allocatable :: qa(:), qda(:), qdda(:), qb(:), qdb(:), qddb(:)
-    real(wp) :: t, h, hcur, hh, tt, target, lscale, ts, ta, d
+    real(wp) :: t, h, hcur, hh, tt, target, lscale, ts, ta, d, corr, motion
     real(wp) :: pcur, phist(2), thist(2)   ! pivot ratios and times of the last accepted states
     integer :: nhist
     integer :: k, j, c, st, detprev, mobility, lev, nsub, nderiv, ierr
@@ -1086,7 +1088,7 @@ contains
     logical :: fast
     real(wp), allocatable :: pd(:, :), qf(:)
     real(wp) :: ptau(0:PRED_ORDER), pivf
-    integer :: npd, nfull
+    integer :: npd, nfull, nreq, nchord
 
     status = MBD_OK; msg = ''
     if (present(sens)) then
@@ -1221,8 +1223,12 @@ contains
       msg = 'velocities or accelerations overflow at the start: a driver is far too fast'
       call count_work(); return
     end if
-    call put_out(1)
-    fast = .false.; nfull = FAST_REENTER
+    if (size(qdout, 2) == 0) then
+      call copy1(size(q), q, qout(:, 1))
+    else
+      call copy3(size(q), q, qd, qdd, qout(:, 1), qdout(:, 1), qddout(:, 1))
+    end if
+    fast = .false.; nfull = FAST_REENTER; nreq = FAST_REENTER
     if (opts%positions) call reenter(w%pivratio)
     if (present(sens)) call kin_sens(m, w, sens, q, qd, qdd, t0, sq(:, :, 1), sqd(:, :, 1), &
                                      sqdd(:, :, 1))
@@ -1257,7 +1263,12 @@ contains
         if (ok) then
           call accept_fast()
           if (last) call store(k)
-          if (stop_asked()) return
+          if (present(ctl)) then
+            ctl(1) = rep%ndone
+            if (ctl(2) /= 0) then
+              call stopped(); return
+            end if
+          end if
           hcur = min(2 * hh, h)
           cycle
         end if
@@ -1265,7 +1276,9 @@ contains
       end if
       call predict(hh)
       call kin_newton(m, w, qn, tt, opts%maxit, st)
-      ok = st == MBD_OK .and. on_branch(JUMP_RATIO) .and. w%pivratio >= NEAR_SING
+      call max_diffs(size(q), qn, qp, q, corr, motion)
+      ok = st == MBD_OK .and. same_branch(corr, motion, JUMP_RATIO, w%tol) .and. &
+           w%pivratio >= NEAR_SING
       if (ok .and. .not. w%lsq) ok = w%detsign == detprev
       if (ok .and. w%pivratio < ANCHOR_PIV) call polish(tt)
       if (ok) then
@@ -1279,7 +1292,12 @@ contains
         pcur = w%pivratio
         call accept()
         if (last) call store(k)
-        if (stop_asked()) return
+        if (present(ctl)) then
+          ctl(1) = rep%ndone
+          if (ctl(2) /= 0) then
+            call stopped(); return
+          end if
+        end if
         call quiet_passage()
         if (opts%positions) call reenter(pcur)
         hcur = min(2 * hh, h)
@@ -1366,14 +1384,6 @@ contains
       if (kk == nsteps) out_time = t1
     end function out_time
 
-    !> The Newton correction is small against the predicted motion: same branch.
-    logical function on_branch(ratio)
-      real(wp), intent(in) :: ratio
-      real(wp) :: corr, motion
-      call max_diffs(size(q), qn, qp, q, corr, motion)
-      on_branch = corr <= max(ratio * motion, 1.0e3_wp * w%tol)
-    end function on_branch
-
     !> The predictor qp at t + hs: the acceleration extrapolated by its Newton polynomial
     !! through the last PRED_ORDER + 1 accelerations, a(s) = a + sum_j d_j w_j(s) with
     !! w_j(s) = s (s + tau_1) ... (s + tau_(j-1)), integrated twice:
@@ -1446,7 +1456,8 @@ contains
       qp = q + hj * qd
       qn = qp
       call kin_newton(m, w, qn, ta2, opts%maxit, st2)
-      anchor = st2 == MBD_OK .and. on_branch(0.25_wp)
+      call max_diffs(size(q), qn, qp, q, corr, motion)
+      anchor = st2 == MBD_OK .and. same_branch(corr, motion, 0.25_wp, w%tol)
       if (.not. anchor) return
       ! one more correction: errors grow like cond, cond**2, cond**3 in q, q_dot, q_ddot
       call polish(ta2)
@@ -1455,29 +1466,24 @@ contains
       anchor = anchor .and. st2 == MBD_OK
     end function anchor
 
-    !> Progress to ctl(1); true (status MBD_USER_ABORT, the outputs so far kept) when ctl(2)
-    !! asks the run to stop.
-    logical function stop_asked()
-      stop_asked = .false.
-      if (.not. present(ctl)) return
-      ctl(1) = rep%ndone
-      if (ctl(2) == 0) return
-      stop_asked = .true.
+    !> ctl(2) asked the run to stop: MBD_USER_ABORT, the outputs so far kept.
+    subroutine stopped()
       status = MBD_USER_ABORT; rep%t_fail = tt
       write (msg, '(a,es12.5,a)') 'stopped on request at t = ', tt, ' (the outputs so far are kept)'
       call count_work()
-    end function stop_asked
+    end subroutine stopped
 
     !> Positions only: chord steps again from the accepted state (q, q_dot, q_ddot) once
-    !! FAST_REENTER full steps in a row were well conditioned (square J). The positions'
+    !! nreq full steps in a row were well conditioned (square J). The positions'
     !! Newton polynomial starts as the Taylor polynomial q + q_dot s + q_ddot s**2 / 2 (nodes
     !! t, t, t), and the first chord step factors J anew (the factors in w may be another
     !! time's, from the passage search or an output's refinement).
     subroutine reenter(piv)
       real(wp), intent(in) :: piv     ! pivot ratio of the accepted state's factorization
       nfull = nfull + 1
-      if (w%lsq .or. piv < FAST_PIV .or. nfull < FAST_REENTER) return
-      fast = .true.
+      if (piv < FAST_PIV) nfull = 0
+      if (w%lsq .or. nfull < nreq) return
+      fast = .true.; nchord = 0
       qf = q
       pd = zero; pd(1, :) = qd; pd(2, :) = half * qdd
       ptau = zero; npd = 2
@@ -1486,10 +1492,13 @@ contains
 
     !> Positions only: the full steps from the accepted q, whose q_dot and q_ddot the chord
     !! steps did not compute: Newton from q (converged: one factorization), J q_dot = nu,
-    !! J q_ddot = gamma, and the accelerations' history anew.
+    !! J q_ddot = gamma, and the accelerations' history anew. Left before a chord step was
+    !! taken, the full step's state at q still holds.
     subroutine leave_fast()
       integer :: st2
       fast = .false.; nfull = 0
+      nreq = merge(min(2 * nreq, FAST_REENTER_MAX), FAST_REENTER, nchord == 0)
+      if (nchord == 0) return
       qn = q
       call kin_newton(m, w, qn, t, opts%maxit, st2)
       if (st2 == MBD_OK) call kin_vel_acc(m, w, qn, t, qd, qdd, st2)
@@ -1531,7 +1540,7 @@ contains
         call chord(.false., ok, corr)
         if (.not. ok) return
       end if
-      ok = corr <= max(JUMP_RATIO * motion, 1.0e3_wp * w%tol)     ! (as on_branch)
+      ok = same_branch(corr, motion, JUMP_RATIO, w%tol)
     end subroutine fast_step
 
     !> Chord corrections of qn at tt with the factors in w, from Phi(qn) (evaluated when
@@ -1579,6 +1588,7 @@ contains
         ptau(jj) = hs + ptau(jj - 1)
       end do
       npd = min(npd + 1, PRED_ORDER)
+      nchord = nchord + 1
       t = tt
     end subroutine accept_fast
 
@@ -1655,11 +1665,12 @@ contains
       integer :: cc
       nsub = 0
       cc = column(kk)
-      if (cc > 0 .and. fast) then
-        call copy1(size(q), q, qout(:, cc))   ! (a chord step: no q_dot, q_ddot, J(q) unfactored)
+      if (cc > 0 .and. (fast .or. size(qdout, 2) == 0)) then
+        ! q alone: a chord step (no q_dot, q_ddot, J(q) unfactored), or no columns for them
+        call copy1(size(q), q, qout(:, cc))
         rep%ndone = cc
       else if (cc > 0) then
-        call put_out(cc)
+        call copy3(size(q), q, qd, qdd, qout(:, cc), qdout(:, cc), qddout(:, cc))
         if (present(sens)) call kin_sens(m, w, sens, q, qd, qdd, t, sq(:, :, cc), &
                                          sqd(:, :, cc), sqdd(:, :, cc))
         if (w%pivratio < ANCHOR_PIV) call refine_output(cc)
@@ -1667,17 +1678,6 @@ contains
       end if
       kk = kk + 1
     end subroutine store
-
-    !> The accepted state (q, q_dot, q_ddot) to output column cc (q alone when the
-    !! derivatives' outputs have no columns: positions only).
-    subroutine put_out(cc)
-      integer, intent(in) :: cc
-      if (size(qdout, 2) == 0) then
-        call copy1(size(q), q, qout(:, cc))
-      else
-        call copy3(size(q), q, qd, qdd, qout(:, cc), qdout(:, cc), qddout(:, cc))
-      end if
-    end subroutine put_out
 
     !> Output column cc at time tx by quintic Hermite interpolation between the anchors
     !! (ta; qa, qda, qdda) and (tb; qn, qdn, qddn) (its q alone when the derivatives'
@@ -1793,7 +1793,8 @@ contains
     integer :: i, j
     do i = 1, n
       x = hs * qd(i) + hp0 * qdd(i)
-      do j = 1, PRED_ORDER
+      !GCC$ unroll 8
+      do j = 1, PRED_ORDER                     ! (all of it: a short loop in a hot one)
         x = x + wt(j) * dd(j, i)
       end do
       qp(i) = q(i) + x; qn(i) = qp(i)
@@ -1824,6 +1825,7 @@ contains
     integer :: i, j
     do i = 1, n
       dnew = xn(i); dold = x(i)
+      !GCC$ unroll 8
       do j = 1, PRED_ORDER
         dn = (dnew - dold) * rden(j)
         dold = dd(j, i); dd(j, i) = dn; dnew = dn
@@ -1850,6 +1852,7 @@ contains
     motion = zero
     do i = 1, n
       x = zero
+      !GCC$ unroll 8
       do j = PRED_ORDER, 1, -1          ! (the smallest terms first)
         x = x + wt(j) * dd(j, i)
       end do
@@ -1875,6 +1878,12 @@ contains
       d = max(d, abs(q(i) - qf(i)))
     end do
   end function scaled_drift
+
+  !> The Newton correction corr is small against the predicted motion: the same branch.
+  pure logical function same_branch(corr, motion, ratio, tol)
+    real(wp), intent(in) :: corr, motion, ratio, tol
+    same_branch = corr <= max(ratio * motion, 1.0e3_wp * tol)
+  end function same_branch
 
   !> corr = max |qn - qp| (the Newton correction), motion = max |qp - q| (the predicted one).
   pure subroutine max_diffs(n, qn, qp, q, corr, motion)
