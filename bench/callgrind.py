@@ -117,7 +117,7 @@ def _parts(d1: dict[str, int], d2: dict[str, int], steps: int, total: float) -> 
 
 
 def measure(stem: str = "fourbar_grashof", h: float = 1e-3, steps: tuple[int, int] = STEPS,
-            parts: bool = True) -> dict[str, Any]:
+            parts: bool = True, positions_only: bool = False) -> dict[str, Any]:
     """Instructions per step of the kinematic loop at step size h (see the module docstring).
 
     Parameters
@@ -130,12 +130,15 @@ def measure(stem: str = "fourbar_grashof", h: float = 1e-3, steps: tuple[int, in
         The two run lengths n1 < n2.
     parts : bool
         Also split a step into assembly, LU, solves and the rest (needs callgrind_annotate).
+    positions_only : bool
+        The positions-only kinematics (chord steps) instead of the full step.
 
     Returns
     -------
     dict
-        {"h", "steps", "instructions_per_step", "newton_corrections_per_step",
-        "lu_per_step", "parts" (instructions per step of each part)}.
+        {"h", "positions_only", "steps", "instructions_per_step",
+        "newton_corrections_per_step", "lu_per_step", "parts" (instructions per step of each
+        part)}.
     """
     n1, n2 = steps
     with tempfile.TemporaryDirectory() as tmp:
@@ -143,7 +146,7 @@ def measure(stem: str = "fourbar_grashof", h: float = 1e-3, steps: tuple[int, in
         cmd = ["valgrind", "--tool=callgrind", f"--callgrind-out-file={out}",
                f"--toggle-collect={LOOP_FN}", f"--dump-after={LOOP_FN}",
                sys.executable, "-c", WORKER, str(EX / f"{stem}.toml"), repr(h), str(n1),
-               str(n2)]
+               str(n2), str(int(positions_only))]
         env = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1")
         r = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=1800)
         if r.returncode != 0:
@@ -155,7 +158,8 @@ def measure(stem: str = "fourbar_grashof", h: float = 1e-3, steps: tuple[int, in
             raise RuntimeError(f"expected two callgrind dumps, found {len(dumps)}")
         d1, d2 = dumps[-2], dumps[-1]
         per_step = (_totals(d2) - _totals(d1)) / (n2 - n1)
-        res: dict[str, Any] = {"model": f"examples/{stem}.toml", "h": h, "steps": [n1, n2],
+        res: dict[str, Any] = {"model": f"examples/{stem}.toml", "h": h,
+                               "positions_only": positions_only, "steps": [n1, n2],
                                "instructions_per_step": per_step}
         if len(counts) == 2:
             (_, c1, l1), (_, c2, l2) = counts
@@ -167,21 +171,23 @@ def measure(stem: str = "fourbar_grashof", h: float = 1e-3, steps: tuple[int, in
 
 
 def callgrind(h_values: tuple[float, ...] = H_VALUES, stem: str = "fourbar_grashof",
-              log: bool = True) -> dict[str, Any]:
-    """measure() at each step size, or the reason it was skipped."""
+              log: bool = True, positions: bool = True) -> dict[str, Any]:
+    """measure() at each step size (the full step, then with positions the positions-only
+    step), or the reason it was skipped."""
     ok, info = available()
     if not ok:
         if log:
             print(f" callgrind skipped: {info}", flush=True)
         return {"available": False, "reason": info}
     rows = []
-    for h in h_values:
-        r = measure(stem, h)
+    for pos, h in [(False, h) for h in h_values] + [(True, h) for h in h_values if positions]:
+        r = measure(stem, h, positions_only=pos)
         rows.append(r)
         if log:
             parts = r.get("parts", {})
             txt = ", ".join(f"{k} {v:.0f}" for k, v in parts.items())
-            print(f"  h = {h:g}: {r['instructions_per_step']:.0f} instructions/step "
+            print(f"  h = {h:g}{' positions only' if pos else ''}: "
+                  f"{r['instructions_per_step']:.0f} instructions/step "
                   f"({r.get('newton_corrections_per_step', 0):.2f} Newton corrections, "
                   f"{r.get('lu_per_step', 0):.2f} LU per step; {txt})", flush=True)
     return {"available": True, "valgrind": info, "rows": rows}

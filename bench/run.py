@@ -142,7 +142,7 @@ def section_peers(quick: bool) -> dict:
 
 def section_kinematics(quick: bool) -> dict:
     """The three ways of running kinematics, at h = 1 ms, with the ratios, and the four-bar's
-    instructions per step (callgrind) at h = 1 ms and 0.1 ms."""
+    instructions per step (callgrind) at h = 1 ms and 0.1 ms, full and positions only."""
     rows = kinematics_speed.compare(kinematics_speed.H, repeats=5, quick=quick)
     try:
         cg = callgrind.callgrind(callgrind.H_VALUES[:1] if quick else callgrind.H_VALUES)

@@ -280,7 +280,6 @@ contains
     type(sens_t) :: sens
     integer :: bad
     iinfo = 0; rinfo = zero; qsing = zero; dep = 0; redundant = 0; tpass = zero
-    qout = zero; qdout = zero; qddout = zero
     checks: block                             ! (a failed check leaves the outputs zero)
       call model_build(nb, ctab, rpar, m, status, msg, bad, nondim=.true.)
       iinfo(2) = bad
@@ -319,11 +318,13 @@ contains
       end if
     end block checks
     if (status /= MBD_OK) then
+      qout = zero; qdout = zero; qddout = zero
       if (present(ptab)) then
         sq = zero; sqd = zero; sqdd = zero
       end if
       return
     end if
+    ! (kin_run fills the outputs: those it does not reach with zeros)
     opts%every = every; opts%solver = solver
     if (tol > zero) opts%tol = tol
     if (maxit > 0) opts%maxit = maxit
