@@ -1576,17 +1576,9 @@ contains
     !> Take the chord step to (tt, qn): the positions' divided differences with the new q
     !! (as accept does with the accelerations).
     subroutine accept_fast()
-      real(wp) :: rden(PRED_ORDER), hs
-      integer :: jj
-      hs = tt - t
-      do jj = 1, PRED_ORDER
-        rden(jj) = zero
-        if (jj <= npd + 1) rden(jj) = one / (hs + ptau(jj - 1))
-      end do
+      real(wp) :: rden(PRED_ORDER)
+      call new_node(tt - t, npd, ptau, rden)
       call newton_update(size(q), rden, qn, q, pd)
-      do jj = PRED_ORDER, 1, -1
-        ptau(jj) = hs + ptau(jj - 1)
-      end do
       npd = min(npd + 1, PRED_ORDER)
       nchord = nchord + 1
       t = tt
@@ -1645,17 +1637,9 @@ contains
     !! the new one, d_j <- (d_(j-1)new - d_(j-1)old) / (t_(k+1) - t_(k+1-j)) (d_0 = q_ddot),
     !! each once j + 1 accelerations are known; tau_j <- hs + tau_(j-1).
     subroutine accept()
-      real(wp) :: rden(PRED_ORDER), hs
-      integer :: jj
-      hs = tt - t
-      do jj = 1, PRED_ORDER           ! d_j stays zero until j + 1 accelerations are known
-        rden(jj) = zero
-        if (jj <= nderiv + 1) rden(jj) = one / (hs + tau(jj - 1))
-      end do
+      real(wp) :: rden(PRED_ORDER)
+      call new_node(tt - t, nderiv, tau, rden)
       call accept_state(size(q), rden, qn, qdn, qddn, q, qd, qdd, dd)
-      do jj = PRED_ORDER, 1, -1
-        tau(jj) = hs + tau(jj - 1)
-      end do
       nderiv = nderiv + 1
       t = tt
     end subroutine accept
@@ -1813,6 +1797,24 @@ contains
       q(i) = qn(i); qd(i) = qdn(i)
     end do
   end subroutine accept_state
+
+  !> A new node hs after the last (known: divided differences known so far): the
+  !! reciprocals rden_j = 1 / (hs + tau_(j-1)) of the new differences (zero while d_j stays
+  !! unknown: until j + 1 values are known), then tau_j <- hs + tau_(j-1).
+  pure subroutine new_node(hs, known, tau, rden)
+    real(wp), intent(in) :: hs
+    integer, intent(in) :: known
+    real(wp), intent(inout) :: tau(0:PRED_ORDER)
+    real(wp), intent(out) :: rden(PRED_ORDER)
+    integer :: j
+    do j = 1, PRED_ORDER
+      rden(j) = zero
+      if (j <= known + 1) rden(j) = one / (hs + tau(j - 1))
+    end do
+    do j = PRED_ORDER, 1, -1
+      tau(j) = hs + tau(j - 1)
+    end do
+  end subroutine new_node
 
   !> A new value xn at a new node enters the divided differences of x:
   !! d_j <- (d_(j-1)new - d_(j-1)old) rden_j (d_0 = the value; rden_j = 1 / (t_new - t_(j-1)),
