@@ -672,8 +672,9 @@ def _analysis_error(err: mbd2d.AnalysisError, what: str) -> None:
     assert str(err).strip(), f"{type(err).__name__} with an empty message in {what}"
     res = err.results
     if res is not None:
+        # (a positions-only run has no velocities, accelerations)
         _finite(f"the partial results of {type(err).__name__} from {what} ({str(err)[:200]})",
-                res.t, res.q, res.qd, res.qdd)
+                res.t, res.q, *(x for x in (res.qd, res.qdd) if x is not None))
 
 
 def _memory_error(err: mbd2d.InsufficientMemoryError, what: str) -> None:
@@ -913,7 +914,8 @@ def check_analysis_call(base: str, method: str, kw: dict[str, Any]) -> tuple[str
             result = "InsufficientMemoryError"
         else:
             if method == "kinematics":
-                _finite("kinematics results", value.t, value.q, value.qd, value.qdd)
+                _finite("kinematics results", value.t, value.q,
+                        *(x for x in (value.qd, value.qdd) if x is not None))
             elif method == "analyze_dof":
                 _finite("the DOF report's configuration", value.q)
             else:
@@ -1786,6 +1788,9 @@ def analysis_call(draw: Any) -> tuple[str, str, dict[str, Any]]:
             kw["tol"] = draw(TOL_ARG)
         if draw(st.booleans()):
             kw["maxit"] = draw(MAXIT_ARG)
+        if draw(st.booleans()):
+            kw["positions_only"] = draw(st.sampled_from([True, False, np.bool_(True), 1,
+                                                        "yes", None, float("nan")]))
     elif method == "analyze_dof":
         kw["t"] = draw(TIME_ARG)
         kw["tol"] = draw(TOL_ARG)

@@ -277,3 +277,26 @@ def test_sweep_of_positions() -> None:
         one = m.with_params({"joint.A.points.1.0": float(v)}).kinematics(1.0, 50,
                                                                           positions_only=True)
         assert np.array_equal(ds.q.values[c], one.q)
+
+
+def test_sweep_of_positions_keeps_failures_as_the_variants_alone() -> None:
+    """Coupler lengths from dead centres through Grashof to no assembly: each case's status,
+    message and rows are those of the variant run alone with positions_only."""
+    pytest.importorskip("xarray")
+    m = load_example("fourbar_grashof.toml")
+    cases = {"joint.B.points.0.0": np.array([-0.6, 1.2, 1.75, 4.05])}
+    ds = mbd2d.sweep(m, cases, t_end=1.0, steps=40, positions_only=True, workers=1)
+    assert set(ds.status.values) >= {0, 3}
+    for j, v in enumerate(cases["joint.B.points.0.0"]):
+        variant = m.with_params({"joint.B.points.0.0": float(v)})
+        st, msg = int(ds.status.values[j]), str(ds.message.values[j])
+        try:
+            res = variant.kinematics(1.0, 40, positions_only=True)
+        except mbd2d.AnalysisError as exc:
+            assert (st, msg) == (exc.status, str(exc))
+            n = len(exc.results.t) if exc.results is not None else 0
+            assert exc.results is None or exc.results.qd is None
+            assert np.array_equal(ds.q.values[j, :n], exc.results.q if n else ds.q.values[j, :0])
+            assert np.isnan(ds.q.values[j, n:]).all()
+            continue
+        assert (st, msg) == (0, "") and np.array_equal(ds.q.values[j], res.q)
