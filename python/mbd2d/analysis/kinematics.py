@@ -34,10 +34,10 @@ def run_kinematics(model: ModelDescription, t_end: float, steps: int, t0: float 
     nout = output_rows(steps, every)
     code = solver_code(solver)
     params = requested(model, sensitivities)
-    pos = flag(positions_only, "positions_only", "kinematics")
+    pos = flag(positions_only, "positions_only", "analysis")
     if pos and params:
         raise ModelError("sensitivities need the velocities and accelerations of every "
-                         "step: drop positions_only=True to ask for them", "positions_only")
+                         "step: drop positions_only=True to ask for them", "analysis")
     p = pack(model)
     require_determined(p, model)
     npar = len(params) if params else 0
