@@ -1035,7 +1035,8 @@ contains
     type(sens_t), intent(inout), optional :: sens
     real(wp), intent(out), optional :: sq(:, :, :), sqd(:, :, :), sqdd(:, :, :)
     !> progress, shared with a caller in another thread: ctl(1) gets the outputs stored so
-    !! far, ctl(2) /= 0 asks the run to stop (MBD_USER_ABORT, the outputs so far kept)
+    !! far, ctl(2) /= 0 asks the run to stop (MBD_USER_ABORT, the outputs so far kept; seen at
+    !! the next output time)
     integer, intent(inout), optional, volatile :: ctl(:)
     integer :: c0
     call kin_loop(m, q0, t0, t1, nsteps, opts, qout, qdout, qddout, rep, status, msg, &
@@ -1082,6 +1083,7 @@ contains
     integer :: nhist
     integer :: k, j, c, st, detprev, mobility, lev, nsub, nderiv, ierr
     logical :: last, ok
+    logical :: halt        ! ctl(2) asked the run to stop (store saw it)
     ! positions only: chord steps (fast), the positions' divided differences pd (as dd) at
     ! the times ptau back, the coordinates qf and pivot ratio pivf of the factorization in
     ! use, full steps since the chord steps were left
@@ -1228,7 +1230,7 @@ contains
     else
       call copy3(size(q), q, qd, qdd, qout(:, 1), qdout(:, 1), qddout(:, 1))
     end if
-    fast = .false.; nfull = FAST_REENTER; nreq = FAST_REENTER
+    fast = .false.; nfull = FAST_REENTER; nreq = FAST_REENTER; halt = .false.
     if (opts%positions) call reenter(w%pivratio)
     if (present(sens)) call kin_sens(m, w, sens, q, qd, qdd, t0, sq(:, :, 1), sqd(:, :, 1), &
                                      sqdd(:, :, 1))
@@ -1263,12 +1265,7 @@ contains
         if (ok) then
           call accept_fast()
           if (last) call store(k)
-          if (present(ctl)) then
-            ctl(1) = rep%ndone
-            if (ctl(2) /= 0) then
-              call stopped(); return
-            end if
-          end if
+          if (halt) return
           hcur = min(2 * hh, h)
           cycle
         end if
@@ -1292,12 +1289,7 @@ contains
         pcur = w%pivratio
         call accept()
         if (last) call store(k)
-        if (present(ctl)) then
-          ctl(1) = rep%ndone
-          if (ctl(2) /= 0) then
-            call stopped(); return
-          end if
-        end if
+        if (halt) return
         call quiet_passage()
         if (opts%positions) call reenter(pcur)
         hcur = min(2 * hh, h)
@@ -1466,12 +1458,16 @@ contains
       anchor = anchor .and. st2 == MBD_OK
     end function anchor
 
-    !> ctl(2) asked the run to stop: MBD_USER_ABORT, the outputs so far kept.
-    subroutine stopped()
+    !> The outputs stored so far to ctl(1); when ctl(2) asks the run to stop, halt, with
+    !! MBD_USER_ABORT (the outputs so far kept).
+    subroutine report_progress()
+      ctl(1) = rep%ndone
+      if (ctl(2) == 0) return
+      halt = .true.
       status = MBD_USER_ABORT; rep%t_fail = tt
       write (msg, '(a,es12.5,a)') 'stopped on request at t = ', tt, ' (the outputs so far are kept)'
       call count_work()
-    end subroutine stopped
+    end subroutine report_progress
 
     !> Positions only: chord steps again from the accepted state (q, q_dot, q_ddot) once
     !! nreq full steps in a row were well conditioned (square J). The positions'
@@ -1644,6 +1640,8 @@ contains
       t = tt
     end subroutine accept
 
+    !> Output time kk reached with the accepted state: its column (if kept) gets it, the
+    !! progress goes to ctl (a stop asked there halts the run), kk moves on.
     subroutine store(kk)
       integer, intent(inout) :: kk
       integer :: cc
@@ -1661,6 +1659,7 @@ contains
         rep%ndone = cc
       end if
       kk = kk + 1
+      if (present(ctl)) call report_progress()
     end subroutine store
 
     !> Output column cc at time tx by quintic Hermite interpolation between the anchors
