@@ -30,6 +30,7 @@ from .description.builder import ModelDescription
 from .errors import MbdError
 from .description.parameters import parameter_list
 from .results import DofReport, DynamicsResult, KinematicsResult, StaticsResult
+from .validate import flag
 
 
 class Model(ModelDescription):
@@ -124,7 +125,7 @@ class Model(ModelDescription):
             corrections on a kept factorization of J from a polynomial prediction of the
             positions, each step ending as a full step's Newton correction does (below
             resolution); near singular configurations it takes full steps. The positions
-            agree with a full run's to round-off (docs/kinematics.md). Not with
+            are as close to the exact ones as a full run's (docs/kinematics.md). Not with
             ``sensitivities``; no inverse dynamics.
 
         Returns
@@ -150,7 +151,8 @@ class Model(ModelDescription):
         >>> res.q.shape[0]
         11
         """
-        if self.has_masses() and maxit is None and positions_only is False:
+        positions_only = flag(positions_only, "positions_only", "analysis")
+        if self.has_masses() and maxit is None and not positions_only:
             return run_inverse(self, t_end=t_end, steps=steps, t0=t0, tol=tol, every=every,
                                solver=solver, sensitivities=sensitivities, progress=progress)
         return run_kinematics(self, t_end=t_end, steps=steps, t0=t0, tol=tol, maxit=maxit,

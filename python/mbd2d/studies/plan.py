@@ -203,7 +203,8 @@ def plan(model: ModelDescription, names: Sequence[str], analysis: Any,
     params = find(model, list(names), "sweep")
     if analysis == "kinematics":
         a = _bind(_kinematics_settings, kw, analysis)
-        if model.has_masses() and a["maxit"] is None and a["positions_only"] is False:
+        a["positions_only"] = flag(a["positions_only"], "positions_only", "sweep")
+        if model.has_masses() and a["maxit"] is None and not a["positions_only"]:
             a.pop("maxit")                                 # as Model.kinematics
             a.pop("positions_only")
             return _inverse(model, params, a)
@@ -225,7 +226,7 @@ def _kinematics(model: ModelDescription, params: list[Parameter], a: dict[str, A
     t0, t_end, steps, nrow, times = _span(a)
     tol, maxit = check_solver(a["tol"], a["maxit"])
     code = solver_code(a["solver"])
-    pos = flag(a["positions_only"], "positions_only", "sweep")
+    pos = a["positions_only"]
     p = pack(model)
     require_determined(p, model)
     b = _tables(1, p, None, [steps, maxit, int(a["every"]), code, 0, 0, int(pos)],
