@@ -12,7 +12,7 @@ module mbd_assemble
   use mbd_points, only: NLOC, MAXROW, kloc
   use mbd_model, only: model_t, model_slots
   use mbd_constraints, only: con_eval, con_init_extra, CON_REVOLUTE
-  use mbd_joint_revolute, only: revolute_rows, revolute_gamma, revolute_phi_all
+  use mbd_joint_revolute, only: revolute_rows, revolute_gamma_all, revolute_phi_all
   use mbd_drivers, only: DRV_ABS, driver_abs_row
   use mbd_functions, only: fun_eval
   implicit none
@@ -28,8 +28,8 @@ module mbd_assemble
     real(wp), allocatable :: qx(:), qdx(:) !! q and q_dot with a zero in front (0:nq): slot
                                            !! loc = 0 reads the zero
     real(wp), allocatable :: fv(:)         !! absolute drivers' f(t) of assemble_phi (nc)
-    !> assemble_phi's lists: the revolutes (parameter offset, bodies, first row) and the
-    !! other constraints
+    !> assemble_phi's and assemble_gamma's lists: the revolutes (parameter offset, bodies,
+    !! first row) and the other constraints
     integer, allocatable :: rtab(:, :), oth(:)
     !> the nonzeros of the blocks: jb(src(i)) goes to J(dst(i)) and column col(i) (flat
     !! column-major indices into jb and the dense neq x nq J; dst = 0 when J has more than
@@ -176,7 +176,7 @@ contains
   end subroutine eval_one
 
   !> gamma alone at new velocities q_dot and the q of the last assembly (its cos and sin):
-  !! J q_ddot = gamma after J q_dot = nu. The revolutes' gamma rows alone (revolute_gamma);
+  !! J q_ddot = gamma after J q_dot = nu. The revolutes' gamma rows alone (revolute_gamma_all);
   !! every other constraint evaluated whole (its block of J rewritten with the same values).
   pure subroutine assemble_gamma(m, q, qd, t, gam, a)
     type(model_t), intent(in) :: m            !! model
@@ -186,17 +186,15 @@ contains
     real(wp), intent(out) :: gam(:)           !! gamma (neq)
     type(asm_work_t), intent(inout) :: a      !! work: blocks and body cos, sin
     real(wp) :: ph(MAXROW), nv(MAXROW), ga(MAXROW)
-    integer :: k, r0, i
+    integer :: j, k, r0, i
     do i = 1, m%nq
       a%qx(i) = q(i); a%qdx(i) = qd(i)
     end do
-    do k = 1, m%nc
+    call revolute_gamma_all(size(a%rtab, 2), a%rtab, m%p, a%qdx, a%cb, a%sb, gam)
+    do j = 1, size(a%oth)
+      k = a%oth(j)
       r0 = m%row0(k)
-      if (m%kind(k) == CON_REVOLUTE) then
-        call revolute_gamma(m%p(m%po(k)), m%bi(k), m%bj(k), a%qdx, a%cb, a%sb, ga)
-        gam(r0) = ga(1); gam(r0 + 1) = ga(2)
-        cycle
-      else if (m%kind(k) == DRV_ABS) then
+      if (m%kind(k) == DRV_ABS) then
         call driver_abs_row(m%suba(k), m%p(m%po(k):m%po(k) + m%pn(k) - 1), &
                             a%qx(m%loc(m%suba(k), k)), t, ph(1), a%jb(1, 1, k), nv(1), &
                             gam(r0))

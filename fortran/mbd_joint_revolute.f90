@@ -12,7 +12,7 @@ module mbd_joint_revolute
   implicit none
   private
   public :: revolute_prepare, revolute_eval, revolute_eval_d, revolute_rows, &
-            revolute_gamma, revolute_phi_all, revolute_second_sides, revolute_param_sides
+            revolute_gamma_all, revolute_phi_all, revolute_second_sides, revolute_param_sides
 
 contains
 
@@ -108,26 +108,34 @@ contains
     end do
   end subroutine revolute_phi_all
 
-  !> The gamma rows of revolute_kernel alone, for the second pass of a kinematic step (new
-  !! velocities at the same q): gamma = A_i s'_i thd_i**2 - A_j s'_j thd_j**2.
-  pure subroutine revolute_gamma(p, bi, bj, qd, c, s, gam)
-    real(wp), intent(in) :: p(4)            !! [s'_i, s'_j]
-    integer, intent(in) :: bi, bj           !! bodies (0 ground)
+  !> The gamma rows of revolute_kernel alone for n revolutes at once (tab as
+  !! revolute_phi_all), for the second pass of a kinematic step (new velocities at the same
+  !! q): gamma = A_i s'_i thd_i**2 - A_j s'_j thd_j**2.
+  pure subroutine revolute_gamma_all(n, tab, p, qd, c, s, gam)
+    integer, intent(in) :: n                !! revolutes
+    integer, intent(in) :: tab(4, n)        !! parameter offset, bodies, first row
+    real(wp), intent(in) :: p(*)            !! prepared parameter pool
     real(wp), intent(in) :: qd(0:*)         !! velocities
     real(wp), intent(in) :: c(0:*), s(0:*)  !! cos and sin of the bodies' angles
-    real(wp), intent(out) :: gam(2)         !! rows of gamma
-    real(wp) :: w2
-    gam(1) = zero; gam(2) = zero
-    if (bi > 0) then
-      w2 = qd(3 * bi)**2
-      gam(1) = (c(bi) * p(1) - s(bi) * p(2)) * w2; gam(2) = (s(bi) * p(1) + c(bi) * p(2)) * w2
-    end if
-    if (bj > 0) then
-      w2 = qd(3 * bj)**2
-      gam(1) = gam(1) - (c(bj) * p(3) - s(bj) * p(4)) * w2
-      gam(2) = gam(2) - (s(bj) * p(3) + c(bj) * p(4)) * w2
-    end if
-  end subroutine revolute_gamma
+    real(wp), intent(inout) :: gam(*)       !! gamma (their rows written)
+    real(wp) :: w2, g1, g2
+    integer :: e, o, b, r
+    do e = 1, n
+      o = tab(1, e); b = tab(2, e); r = tab(4, e)
+      g1 = zero; g2 = zero
+      if (b > 0) then
+        w2 = qd(3 * b)**2
+        g1 = (c(b) * p(o) - s(b) * p(o + 1)) * w2; g2 = (s(b) * p(o) + c(b) * p(o + 1)) * w2
+      end if
+      b = tab(3, e)
+      if (b > 0) then
+        w2 = qd(3 * b)**2
+        g1 = g1 - (c(b) * p(o + 2) - s(b) * p(o + 3)) * w2
+        g2 = g2 - (s(b) * p(o + 2) + c(b) * p(o + 3)) * w2
+      end if
+      gam(r) = g1; gam(r + 1) = g2
+    end do
+  end subroutine revolute_gamma_all
 
   !> The revolute's rows from each body's position r, cos, sin and angular velocity w (g:
   !! the body moves; a ground point p(1:2) or p(3:4) is global):
