@@ -29,8 +29,8 @@ module mbd_assemble
                                            !! loc = 0 reads the zero
     real(wp), allocatable :: fv(:)         !! absolute drivers' f(t) of assemble_phi (nc)
     !> assemble_phi's and assemble_gamma's lists: the revolutes (parameter offset, bodies,
-    !! first row) and the other constraints
-    integer, allocatable :: rtab(:, :), oth(:)
+    !! first row), the absolute drivers and the other constraints
+    integer, allocatable :: rtab(:, :), drv(:), gen(:)
     !> the nonzeros of the blocks: jb(src(i)) goes to J(dst(i)) and column col(i) (flat
     !! column-major indices into jb and the dense neq x nq J; dst = 0 when J has more than
     !! huge(1) entries)
@@ -57,7 +57,9 @@ contains
               a%qdx(0:m%nq), a%fv(m%nc), stat=ierr)
     if (ierr == 0) allocate (a%src(n), a%dst(n), a%col(n), stat=ierr)
     if (ierr == 0) allocate (a%rtab(4, count(m%kind(1:m%nc) == CON_REVOLUTE)), &
-                             a%oth(count(m%kind(1:m%nc) /= CON_REVOLUTE)), stat=ierr)
+                             a%drv(count(m%kind(1:m%nc) == DRV_ABS)), &
+                             a%gen(count(m%kind(1:m%nc) /= CON_REVOLUTE .and. &
+                                         m%kind(1:m%nc) /= DRV_ABS)), stat=ierr)
     if (ierr /= 0) then
       call mem_fail(REAL_BYTES * (MAXROW * NLOC * real(m%nc, wp) + 2 * real(m%nb, wp)) + &
                     12 * real(n, wp), 'the constraint blocks', 'use a smaller model', &
@@ -66,12 +68,14 @@ contains
     end if
     a%jb = zero
     a%cb = one; a%sb = zero; a%qx = zero; a%qdx = zero; a%fv = zero
-    r = 0; s = 0
+    r = 0; s = 0; n = 0
     do k = 1, m%nc
       if (m%kind(k) == CON_REVOLUTE) then
         r = r + 1; a%rtab(:, r) = [m%po(k), m%bi(k), m%bj(k), m%row0(k)]
+      else if (m%kind(k) == DRV_ABS) then
+        s = s + 1; a%drv(s) = k
       else
-        s = s + 1; a%oth(s) = k
+        n = n + 1; a%gen(n) = k
       end if
     end do
     dense_map = real(m%neq, wp) * real(m%nq, wp) < real(huge(n), wp)
@@ -185,27 +189,39 @@ contains
     real(wp), intent(in) :: t                 !! time
     real(wp), intent(out) :: gam(:)           !! gamma (neq)
     type(asm_work_t), intent(inout) :: a      !! work: blocks and body cos, sin
-    real(wp) :: ph(MAXROW), nv(MAXROW), ga(MAXROW)
-    integer :: j, k, r0, i
+    real(wp) :: ph, nv
+    integer :: j, k, i
     do i = 1, m%nq
       a%qx(i) = q(i); a%qdx(i) = qd(i)
     end do
     call revolute_gamma_all(size(a%rtab, 2), a%rtab, m%p, a%qdx, a%cb, a%sb, gam)
-    do j = 1, size(a%oth)
-      k = a%oth(j)
-      r0 = m%row0(k)
-      if (m%kind(k) == DRV_ABS) then
-        call driver_abs_row(m%suba(k), m%p(m%po(k):m%po(k) + m%pn(k) - 1), &
-                            a%qx(m%loc(m%suba(k), k)), t, ph(1), a%jb(1, 1, k), nv(1), &
-                            gam(r0))
-        cycle
-      end if
-      call eval_one(m, k, t, a, ph, nv, ga)
+    do j = 1, size(a%drv)
+      k = a%drv(j)
+      call driver_abs_row(m%suba(k), m%p(m%po(k):m%po(k) + m%pn(k) - 1), &
+                          a%qx(m%loc(m%suba(k), k)), t, ph, a%jb(1, 1, k), nv, gam(m%row0(k)))
+    end do
+    if (size(a%gen) > 0) call general_rows(m, a%gen, t, 3, gam, a)
+  end subroutine assemble_gamma
+
+  !> The rows of Phi (lev 1) or gamma (lev 3) of the constraints in list, each evaluated
+  !! whole (eval_one: its block of J rewritten, its other rows dropped).
+  pure subroutine general_rows(m, list, t, lev, x, a)
+    type(model_t), intent(in) :: m            !! model
+    integer, intent(in) :: list(:)            !! constraints
+    real(wp), intent(in) :: t                 !! time
+    integer, intent(in) :: lev                !! 1 Phi, 3 gamma
+    real(wp), intent(inout) :: x(:)           !! Phi or gamma (their rows written)
+    type(asm_work_t), intent(inout) :: a      !! work: state in, blocks out
+    real(wp) :: r(MAXROW, 3)                  ! rows of Phi, nu, gamma
+    integer :: j, k, i
+    do j = 1, size(list)
+      k = list(j)
+      call eval_one(m, k, t, a, r(:, 1), r(:, 2), r(:, 3))
       do i = 1, m%nrow(k)
-        gam(r0 + i - 1) = ga(i)
+        x(m%row0(k) + i - 1) = r(i, lev)
       end do
     end do
-  end subroutine assemble_gamma
+  end subroutine general_rows
 
   !> Phi alone at q (the chord steps of positions-only kinematics). fresh: a new q and t,
   !! the bodies' cos and sin from q and the absolute drivers' f(t) evaluated (kept in a);
@@ -220,8 +236,8 @@ contains
     logical, intent(in) :: fresh              !! a new q and t (else a correction at the same t)
     real(wp), intent(out) :: phi(:)           !! Phi (neq)
     type(asm_work_t), intent(inout) :: a      !! work: blocks, body cos, sin, drivers' f(t)
-    real(wp) :: ph(MAXROW), nv(MAXROW), ga(MAXROW), f1, f2
-    integer :: j, k, r0, b, i
+    real(wp) :: f1, f2
+    integer :: j, k, b, i
     if (fresh) then
       do b = 1, m%nb
         a%cb(b) = cos(q(3 * b)); a%sb(b) = sin(q(3 * b))
@@ -231,19 +247,12 @@ contains
       a%qx(i) = q(i)
     end do
     call revolute_phi_all(size(a%rtab, 2), a%rtab, m%p, a%qx, a%cb, a%sb, phi)
-    do j = 1, size(a%oth)
-      k = a%oth(j)
-      r0 = m%row0(k)
-      if (m%kind(k) == DRV_ABS) then
-        if (fresh) call fun_eval(m%p(m%po(k):m%po(k) + m%pn(k) - 1), t, a%fv(k), f1, f2)
-        phi(r0) = a%qx(m%loc(m%suba(k), k)) - a%fv(k)       ! (as driver_abs_row)
-        cycle
-      end if
-      call eval_one(m, k, t, a, ph, nv, ga)
-      do i = 1, m%nrow(k)
-        phi(r0 + i - 1) = ph(i)
-      end do
+    do j = 1, size(a%drv)
+      k = a%drv(j)
+      if (fresh) call fun_eval(m%p(m%po(k):m%po(k) + m%pn(k) - 1), t, a%fv(k), f1, f2)
+      phi(m%row0(k)) = a%qx(m%loc(m%suba(k), k)) - a%fv(k)       ! (as driver_abs_row)
     end do
+    if (size(a%gen) > 0) call general_rows(m, a%gen, t, 1, phi, a)
   end subroutine assemble_phi
 
   !> Place the local blocks into a dense J (neq x nq), or J D (D = diag(cs)) with a column
