@@ -122,18 +122,16 @@ contains
     real(wp), intent(out) :: gam(:)           !! gamma (neq)
     type(asm_work_t), intent(inout) :: a      !! work: blocks (out) and body cos, sin
     real(wp) :: ph(MAXROW), nv(MAXROW), ga(MAXROW)
-    integer :: k, r0, nr, b, i
+    integer :: k, r0, nr, b
     do b = 1, m%nb
       a%cb(b) = cos(q(3 * b)); a%sb(b) = sin(q(3 * b))
     end do
-    do i = 1, m%nq
-      a%qx(i) = q(i); a%qdx(i) = qd(i)
-    end do
+    if (size(a%gen) > 0) call copy_state(m%nq, q, qd, a%qx, a%qdx)     ! (for eval_one)
     do k = 1, m%nc
       r0 = m%row0(k)
       if (m%kind(k) == CON_REVOLUTE) then
         ! the commonest joint from the bodies' states directly (the rows of revolute_eval)
-        call revolute_rows(m%p(m%po(k)), m%bi(k), m%bj(k), a%qx, a%qdx, a%cb, a%sb, ph, &
+        call revolute_rows(m%p(m%po(k)), m%bi(k), m%bj(k), q, qd, a%cb, a%sb, ph, &
                            a%jb(1, 1, k), ga)
         phi(r0) = ph(1); phi(r0 + 1) = ph(2); gam(r0) = ga(1); gam(r0 + 1) = ga(2)
         nu(r0) = zero; nu(r0 + 1) = zero
@@ -141,7 +139,7 @@ contains
       else if (m%kind(k) == DRV_ABS) then
         ! the commonest driver from its coordinate (the row of driver_eval)
         call driver_abs_row(m%suba(k), m%p(m%po(k):m%po(k) + m%pn(k) - 1), &
-                            a%qx(m%loc(m%suba(k), k)), t, phi(r0), a%jb(1, 1, k), nu(r0), &
+                            q(m%loc(m%suba(k), k)), t, phi(r0), a%jb(1, 1, k), nu(r0), &
                             gam(r0))
         cycle
       end if
@@ -157,6 +155,17 @@ contains
       end if
     end do
   end subroutine assemble_blocks
+
+  !> a%qx = q, a%qdx = q_dot (the state eval_one gathers from: with a zero in front).
+  pure subroutine copy_state(n, q, qd, qx, qdx)
+    integer, intent(in) :: n
+    real(wp), intent(in) :: q(n), qd(n)
+    real(wp), intent(inout) :: qx(0:n), qdx(0:n)
+    integer :: i
+    do i = 1, n
+      qx(i) = q(i); qdx(i) = qd(i)
+    end do
+  end subroutine copy_state
 
   !> Constraint k through con_eval, its local state gathered from the work arrays (q and
   !! q_dot with a zero in front, the bodies' cos and sin): its rows of Phi, nu, gamma and its
@@ -190,17 +199,17 @@ contains
     real(wp), intent(out) :: gam(:)           !! gamma (neq)
     type(asm_work_t), intent(inout) :: a      !! work: blocks and body cos, sin
     real(wp) :: ph, nv
-    integer :: j, k, i
-    do i = 1, m%nq
-      a%qx(i) = q(i); a%qdx(i) = qd(i)
-    end do
-    call revolute_gamma_all(size(a%rtab, 2), a%rtab, m%p, a%qdx, a%cb, a%sb, gam)
+    integer :: j, k
+    call revolute_gamma_all(size(a%rtab, 2), a%rtab, m%p, qd, a%cb, a%sb, gam)
     do j = 1, size(a%drv)
       k = a%drv(j)
       call driver_abs_row(m%suba(k), m%p(m%po(k):m%po(k) + m%pn(k) - 1), &
-                          a%qx(m%loc(m%suba(k), k)), t, ph, a%jb(1, 1, k), nv, gam(m%row0(k)))
+                          q(m%loc(m%suba(k), k)), t, ph, a%jb(1, 1, k), nv, gam(m%row0(k)))
     end do
-    if (size(a%gen) > 0) call general_rows(m, a%gen, t, 3, gam, a)
+    if (size(a%gen) > 0) then
+      call copy_state(m%nq, q, qd, a%qx, a%qdx)
+      call general_rows(m, a%gen, t, 3, gam, a)
+    end if
   end subroutine assemble_gamma
 
   !> The rows of Phi (lev 1) or gamma (lev 3) of the constraints in list, each evaluated
@@ -237,22 +246,22 @@ contains
     real(wp), intent(out) :: phi(:)           !! Phi (neq)
     type(asm_work_t), intent(inout) :: a      !! work: blocks, body cos, sin, drivers' f(t)
     real(wp) :: f1, f2
-    integer :: j, k, b, i
+    integer :: j, k, b
     if (fresh) then
       do b = 1, m%nb
         a%cb(b) = cos(q(3 * b)); a%sb(b) = sin(q(3 * b))
       end do
     end if
-    do i = 1, m%nq
-      a%qx(i) = q(i)
-    end do
-    call revolute_phi_all(size(a%rtab, 2), a%rtab, m%p, a%qx, a%cb, a%sb, phi)
+    call revolute_phi_all(size(a%rtab, 2), a%rtab, m%p, q, a%cb, a%sb, phi)
     do j = 1, size(a%drv)
       k = a%drv(j)
       if (fresh) call fun_eval(m%p(m%po(k):m%po(k) + m%pn(k) - 1), t, a%fv(k), f1, f2)
-      phi(m%row0(k)) = a%qx(m%loc(m%suba(k), k)) - a%fv(k)       ! (as driver_abs_row)
+      phi(m%row0(k)) = q(m%loc(m%suba(k), k)) - a%fv(k)       ! (as driver_abs_row)
     end do
-    if (size(a%gen) > 0) call general_rows(m, a%gen, t, 1, phi, a)
+    if (size(a%gen) > 0) then
+      a%qx(1:m%nq) = q          ! (for eval_one; its q_dot not used)
+      call general_rows(m, a%gen, t, 1, phi, a)
+    end if
   end subroutine assemble_phi
 
   !> Place the local blocks into a dense J (neq x nq), or J D (D = diag(cs)) with a column

@@ -65,7 +65,7 @@ contains
   pure subroutine revolute_rows(p, bi, bj, q, qd, c, s, phi, jl, gam)
     real(wp), intent(in) :: p(4)            !! [s'_i, s'_j]
     integer, intent(in) :: bi, bj           !! bodies (0 ground)
-    real(wp), intent(in) :: q(0:*), qd(0:*) !! coordinates and velocities (q(0) unused)
+    real(wp), intent(in) :: q(*), qd(*)     !! coordinates and velocities
     real(wp), intent(in) :: c(0:*), s(0:*)  !! cos and sin of the bodies' angles
     real(wp), intent(out) :: phi(2)         !! rows of Phi
     real(wp), intent(inout) :: jl(MAXROW, NLOC)  !! local block of J (rows 1 and 2 written)
@@ -84,7 +84,7 @@ contains
     integer, intent(in) :: n                !! revolutes
     integer, intent(in) :: tab(4, n)        !! parameter offset, bodies, first row
     real(wp), intent(in) :: p(*)            !! prepared parameter pool
-    real(wp), intent(in) :: q(0:*)          !! coordinates (q(0) unused)
+    real(wp), intent(in) :: q(*)            !! coordinates
     real(wp), intent(in) :: c(0:*), s(0:*)  !! cos and sin of the bodies' angles
     real(wp), intent(inout) :: phi(*)       !! Phi (their rows written)
     real(wp) :: p1, p2
@@ -115,7 +115,7 @@ contains
     integer, intent(in) :: n                !! revolutes
     integer, intent(in) :: tab(4, n)        !! parameter offset, bodies, first row
     real(wp), intent(in) :: p(*)            !! prepared parameter pool
-    real(wp), intent(in) :: qd(0:*)         !! velocities
+    real(wp), intent(in) :: qd(*)           !! velocities
     real(wp), intent(in) :: c(0:*), s(0:*)  !! cos and sin of the bodies' angles
     real(wp), intent(inout) :: gam(*)       !! gamma (their rows written)
     real(wp) :: w2, g1, g2
