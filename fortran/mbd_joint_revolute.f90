@@ -12,7 +12,8 @@ module mbd_joint_revolute
   implicit none
   private
   public :: revolute_prepare, revolute_eval, revolute_eval_d, revolute_rows, &
-            revolute_gamma_all, revolute_phi_all, revolute_second_sides, revolute_param_sides
+            revolute_gamma_all, revolute_phi_all, revolute_curvature_all, &
+            revolute_second_sides, revolute_param_sides
 
 contains
 
@@ -107,6 +108,31 @@ contains
       phi(r) = p1; phi(r + 1) = p2
     end do
   end subroutine revolute_phi_all
+
+  !> u = d/d theta_b of J's column theta_b for n revolutes (tab as revolute_phi_all) at body
+  !! b's angle (c = cos, s = sin): that column holds B_b s'_i on the side i of each revolute
+  !! on b and -B_b s'_j on its side j, and dB/dtheta = -A, so u = -A_b s'_i there and
+  !! +A_b s'_j; the revolutes' other columns are constant. u's other rows are left as given.
+  pure subroutine revolute_curvature_all(n, tab, p, b, c, s, u)
+    integer, intent(in) :: n                !! revolutes
+    integer, intent(in) :: tab(4, n)        !! parameter offset, bodies, first row
+    real(wp), intent(in) :: p(*)            !! prepared parameter pool
+    integer, intent(in) :: b                !! body
+    real(wp), intent(in) :: c, s            !! cos and sin of its angle
+    real(wp), intent(inout) :: u(*)         !! rows of the revolutes on b written
+    integer :: e, o, r
+    do e = 1, n
+      o = tab(1, e); r = tab(4, e)
+      if (tab(2, e) == b) then
+        u(r) = u(r) - (c * p(o) - s * p(o + 1))
+        u(r + 1) = u(r + 1) - (s * p(o) + c * p(o + 1))
+      end if
+      if (tab(3, e) == b) then
+        u(r) = u(r) + (c * p(o + 2) - s * p(o + 3))
+        u(r + 1) = u(r + 1) + (s * p(o + 2) + c * p(o + 3))
+      end if
+    end do
+  end subroutine revolute_curvature_all
 
   !> The gamma rows of revolute_kernel alone for n revolutes at once (tab as
   !! revolute_phi_all), for the second pass of a kinematic step (new velocities at the same

@@ -37,6 +37,7 @@ module mbd_kinematics
   use mbd_assemble, only: asm_work_t, asm_init, assemble_blocks, assemble_gamma, assemble_dense, &
                           scatter_dense, init_extras, blocks_jv, blocks_jtv, scatter_values, &
                           asm_turn, assemble_phi
+  use mbd_joint_revolute, only: revolute_curvature_all
   use mbd_band, only: band_t, band_plan, band_move, band_zero, band_norm1, band_factor, &
                       band_rcond, band_solve
   use mbd_linsolve, only: lu_factor, lu_solve, lu_det_sign, svd_null, row_rank, qr_factor, &
@@ -93,6 +94,14 @@ module mbd_kinematics
   !> a chord correction of the angles up to this is turned into the bodies' cos and sin
   !! (asm_turn: first order, exact to rounding); a larger one takes cos and sin anew
   real(wp), parameter :: TURN_MAX = 1.0e-9_wp
+  !> chord steps of a model of revolutes and absolute drivers alone (J's columns other than
+  !! the angles' constant), dense or sparse LU, at most LIN_MAXB bodies: after a chord
+  !! correction dq, the rest of the Newton step from J(q) - J(qf) in closed form
+  !! (lin_correction), taken as the step's end when c = |J(qf)^-1 (J(qf) - J(q))| <= LIN_CMAX
+  !! and LIN_SAFETY times the bound of its error, (sum_b 1 + |g_b|) |dq|**2 (1 + c) /
+  !! (1 - c)**3, is below half the resolution
+  integer, parameter :: LIN_MAXB = 4
+  real(wp), parameter :: LIN_SAFETY = 2.0_wp, LIN_CMAX = 0.9_wp
   !> largest dense Levenberg-Marquardt assembly (J and [J; mu I]) allowed in band mode (bytes):
   !! n up to about 1670; larger banded models assemble by damped Newton on the band
   real(wp), parameter :: DENSE_FALLBACK = 64.0_wp * 1048576
@@ -1091,6 +1100,11 @@ contains
     real(wp), allocatable :: pd(:, :), qf(:)
     real(wp) :: ptau(0:PRED_ORDER), pivf
     integer :: npd, nfull, nreq, nchord
+    ! models of revolutes and absolute drivers (lin): g_b = J(qf)^-1 u_b (nq, nb), u_b the
+    ! change of J's column theta_b with theta_b at qf (lin_prepare), |g_b| (max norm), work
+    logical :: lin
+    real(wp), allocatable :: gb(:, :), gn(:), ub(:), xl(:)
+    real(wp) :: gk(LIN_MAXB, LIN_MAXB)      ! gk(a, b) = g_b(theta_a)
 
     status = MBD_OK; msg = ''
     if (present(sens)) then
@@ -1162,6 +1176,11 @@ contains
     if (ierr == 0) allocate (qa(m%nq), qda(m%nq), qdda(m%nq), qb(m%nq), stat=ierr)
     if (ierr == 0) allocate (qdb(m%nq), qddb(m%nq), stat=ierr)
     if (ierr == 0 .and. opts%positions) allocate (pd(PRED_ORDER, m%nq), qf(m%nq), stat=ierr)
+    lin = opts%positions .and. .not. w%banded .and. size(w%asm%gen) == 0 .and. &
+          m%nb <= LIN_MAXB .and. m%neq == m%nq .and. m%nq >= 3 * m%nb
+    if (ierr == 0 .and. lin) allocate (gb(m%nq, LIN_MAXB), gn(m%nb), ub(m%neq), xl(m%nq), &
+                                       stat=ierr)
+    if (ierr == 0 .and. lin) gb = zero
     if (ierr /= 0) then
       call mem_fail(23 * REAL_BYTES * m%nq, 'the kinematic state vectors', &
                     'use a smaller model', status, msg)
@@ -1533,6 +1552,7 @@ contains
         if (st2 /= MBD_OK .or. w%lsq) return
         if (w%pivratio < FAST_PIV .or. w%detsign /= detprev) return
         qf = qn; pivf = w%pivratio
+        if (lin) call lin_prepare()
         call chord(.false., ok, corr)
         if (.not. ok) return
       end if
@@ -1547,8 +1567,8 @@ contains
       logical, intent(in) :: need
       logical, intent(out) :: conv
       real(wp), intent(out) :: corr
-      real(wp) :: dmax, dprev
-      logical :: fresh, kept
+      real(wp) :: dmax, dprev, ref, xmax
+      logical :: fresh, kept, sound
       integer :: it
       conv = .false.; fresh = .true.; dprev = huge(one); corr = zero
       kept = .false.          ! assemble_phi's drivers' f(tt) are known
@@ -1558,16 +1578,43 @@ contains
           kept = .true.
         end if
         call solve(w, w%phi, w%dq)                   ! J(qf)^-1 Phi: the correction's negative
-        call chord_update(size(q), m%nb, lscale, w%tol, w%phi, w%dq, qn, conv, dmax)
+        call chord_update(size(q), m%nb, lscale, w%tol, w%phi, w%dq, qn, conv, dmax, sound, &
+                          ref)
         w%newton_its = w%newton_its + 1
         corr = corr + dmax
         if (conv) return
+        if (lin .and. sound) then
+          call lin_correction(size(q), m%nb, qn, qf, w%dq, gb, gk, gn, dmax, ref, xl, conv, &
+                              xmax)
+          if (conv) then
+            corr = corr + xmax; return
+          end if
+        end if
         if (.not. (dmax <= CHORD_RATE * dprev)) return      ! (NaN too)
         fresh = dmax > TURN_MAX
         if (.not. fresh) call asm_turn(m, w%asm, w%dq)
         dprev = dmax
       end do
     end subroutine chord
+
+    !> g_b = J(qf)^-1 u_b for every body b (the factors of J(qf) in w), u_b = dJ/dtheta_b's
+    !! column theta_b at qf (revolute_curvature_all), and their max norms.
+    subroutine lin_prepare()
+      integer :: a, b
+      do b = 1, m%nb
+        ub = zero
+        call revolute_curvature_all(size(w%asm%rtab, 2), w%asm%rtab, m%p, b, cos(qf(3 * b)), &
+                                    sin(qf(3 * b)), ub)
+        call solve(w, ub, gb(:, b))
+        gn(b) = maxval(abs(gb(:, b)))
+      end do
+      gk = zero
+      do b = 1, m%nb
+        do a = 1, m%nb
+          gk(a, b) = gb(3 * a, b)
+        end do
+      end do
+    end subroutine lin_prepare
 
     !> Take the chord step to (tt, qn): the positions' divided differences with the new q
     !! (as accept does with the accelerations).
@@ -1944,14 +1991,14 @@ contains
   !! conv: ||Phi||_inf <= tol and dq below resolution at the q before (below_resolution's
   !! test: |dq_i| <= RES_ULPS eps max(|q_i|, ref)); dmax = max |dq| (NaN when dq is not
   !! finite).
-  pure subroutine chord_update(n, nb, lscale, tol, phi, x, q, conv, dmax)
+  pure subroutine chord_update(n, nb, lscale, tol, phi, x, q, conv, dmax, sound, ref)
     integer, intent(in) :: n, nb
     real(wp), intent(in) :: lscale, tol, phi(n)
     real(wp), intent(inout) :: x(n), q(n)
-    logical, intent(out) :: conv
-    real(wp), intent(out) :: dmax
+    logical, intent(out) :: conv, sound
+    real(wp), intent(out) :: dmax, ref
     real(wp), parameter :: ULP = RES_ULPS * epsilon(one)
-    real(wp) :: ref, res, d, a, fin
+    real(wp) :: res, d, a, fin
     integer :: i
     ref = zero
     do i = 1, nb
@@ -1972,8 +2019,94 @@ contains
       q(i) = q(i) + d
     end do
     dmax = dmax + fin
-    conv = conv .and. res <= tol .and. fin == zero
+    sound = res <= tol .and. fin == zero
+    conv = conv .and. sound
   end subroutine chord_update
+
+  !> The rest of a Newton step after a chord correction dq (q = q_0 + dq, J(qf) dq =
+  !! -Phi(q_0)) for a model whose J changes only in the angles' columns (revolutes and
+  !! absolute drivers). Column theta_b of J(q) - J(qf) is (cos d_b - 1) J(qf)_b + sin d_b u_b
+  !! (d_b = theta_b - thetaf_b; B(thetaf + d) = cos d B - sin d A), so
+  !! C = J(qf)^-1 (J(qf) - J(q)) = sum_b c_b e_b^T, c_b = -((cos d_b - 1) e_b + sin d_b g_b).
+  !! The chord leaves the error e = q - q* = -(I - C)^-1 C dq (to second order), so
+  !! x = (I - C)^-1 C dq: x = sum_b c_b z_b with (I - K) z = dq_theta, K_ab = c_b(theta_a)
+  !! (nb x nb, by rows diagonally dominant when c < 1). With the chord's C0 (the secant's J
+  !! between q* and q - dq), q + x - q* = (I - C)^-1 (C - C0) (I - C0)^-1 dq, and column b of
+  !! C - C0 is at most (|e0| + |e|) (1 + |g_b|) (to first order), |e0| <= |dq| / (1 - c),
+  !! |e| <= c |dq| / (1 - c): the rest is at most (sum_b 1 + |g_b|) |dq|**2 (1 + c) /
+  !! (1 - c)**3 (max norms; c = sum_b |cos d_b - 1| + |sin d_b| |g_b| >= |C|). conv: q + x
+  !! taken (q updated, xmax = |x|) when c <= LIN_CMAX and LIN_SAFETY times that rest is
+  !! below ref / 2; else q unchanged.
+  pure subroutine lin_correction(n, nb, q, qf, dq, g, gk, gn, dmax, ref, x, conv, xmax)
+    integer, intent(in) :: n, nb
+    real(wp), intent(inout) :: q(n)
+    !> g_b (n, LIN_MAXB; zero past nb), its angle rows gk(a, b) = g_b(theta_a), |g_b|
+    real(wp), intent(in) :: qf(n), dq(n), g(n, LIN_MAXB), gk(LIN_MAXB, LIN_MAXB), gn(nb)
+    real(wp), intent(in) :: dmax, ref
+    real(wp), intent(out) :: x(n)
+    logical, intent(out) :: conv
+    real(wp), intent(out) :: xmax
+    real(wp), parameter :: S3 = one / 6, S5 = one / 20, C4 = one / 12, C6 = one / 30
+    real(wp) :: cm(LIN_MAXB), sn(LIN_MAXB), z(LIN_MAXB), k(LIN_MAXB, LIN_MAXB)
+    real(wp) :: d, d2, c, s2, f
+    integer :: a, b, i, j
+    conv = .false.; xmax = zero
+    c = zero; s2 = zero
+    cm = zero; sn = zero; z = zero
+    do b = 1, nb
+      d = q(3 * b) - qf(3 * b); d2 = d * d
+      sn(b) = d * (one - d2 * S3 * (one - d2 * S5))               ! sin d
+      cm(b) = -half * d2 * (one - d2 * C4 * (one - d2 * C6))      ! cos d - 1
+      c = c + abs(cm(b)) + abs(sn(b)) * gn(b)
+      s2 = s2 + one + gn(b)
+      z(b) = dq(3 * b)
+    end do
+    if (.not. c <= LIN_CMAX) return                                      ! (NaN too)
+    if (.not. LIN_SAFETY * s2 * dmax * dmax * (one + c) <= half * ref * (one - c)**3) return
+    ! (I - K) z = dq_theta, K_ab = -(cm_b delta_ab + sn_b g_b(theta_a)); no pivoting (the
+    ! bodies past nb: a unit row and column, z_b = 0)
+    do b = 1, LIN_MAXB
+      do a = 1, LIN_MAXB
+        k(a, b) = sn(b) * gk(a, b)
+      end do
+      k(b, b) = k(b, b) + (one + cm(b))
+    end do
+    do a = 1, LIN_MAXB - 1
+      f = one / k(a, a)
+      do i = a + 1, LIN_MAXB
+        d = k(i, a) * f
+        do j = a + 1, LIN_MAXB
+          k(i, j) = k(i, j) - d * k(a, j)
+        end do
+        z(i) = z(i) - d * z(a)
+      end do
+    end do
+    do a = LIN_MAXB, 1, -1
+      d = z(a)
+      do j = a + 1, LIN_MAXB
+        d = d - k(a, j) * z(j)
+      end do
+      z(a) = d / k(a, a)
+    end do
+    do b = 1, LIN_MAXB                        ! the weights z_b sn_b and z_b cm_b
+      sn(b) = z(b) * sn(b); cm(b) = z(b) * cm(b)
+    end do
+    do i = 1, n                               ! x = -sum_b z_b (cm_b e_b + sn_b g_b)
+      d = zero
+      do b = 1, LIN_MAXB
+        d = d - sn(b) * g(i, b)
+      end do
+      x(i) = d
+    end do
+    do b = 1, nb
+      x(3 * b) = x(3 * b) - cm(b)
+    end do
+    do i = 1, n
+      xmax = max(xmax, abs(x(i)))
+      q(i) = q(i) + x(i)
+    end do
+    conv = .true.
+  end subroutine lin_correction
 
   !> x = a.
   pure subroutine copy1(n, a, x)

@@ -26,7 +26,7 @@ from numpy.testing import assert_allclose
 import mbd2d
 import test_closed_forms as cf
 import test_toggle as tg
-from conftest import EXAMPLES, load_example, wrap_angle
+from conftest import EXAMPLES, example_path, load_example, model_from_toml, wrap_angle
 from mbd2d.binding import core
 from mbd2d.binding.pack import pack
 from mbd2d.binding.status import USER_ABORT
@@ -108,6 +108,65 @@ def test_cam_lift_against_its_closed_form(kind: str) -> None:
     at_least_as_close(f"cam ({kind}) follower y", pos.body("follower").y,
                       full.body("follower").y, y)
     assert_allclose(pos.q, full.q, rtol=0, atol=1e-12)
+
+
+# ------------------------------------------------------------------ one correction per step
+FLAG = 0.8          # distance from a flag's pin (the coupler's centre) to its centre
+
+
+def flagged_fourbar(flags: int) -> mbd2d.Model:
+    """The Grashof four-bar with flags: bodies pinned at the coupler's centre, each at its
+    point (-0.8, 0), their angles driven (0.3 k + (1 + k) t). Closed form: a flag's centre is
+    the coupler's plus 0.8 (cos, sin) of its angle."""
+    text = example_path("fourbar_grashof.toml").read_text()
+    for k in range(flags):
+        text += f"""
+[[body]]
+name = "flag{k}"
+q0 = [2.25, 1.2, {0.3 * k}]
+
+[[joint]]
+name = "F{k}"
+type = "revolute"
+bodies = ["coupler", "flag{k}"]
+points = [[0.0, 0.0], [{-FLAG}, 0.0]]
+
+[[driver]]
+name = "swing{k}"
+type = "absolute"
+body = "flag{k}"
+coordinate = "theta"
+f = {{ poly = [{0.3 * k}, {1.0 + k}] }}
+"""
+    return model_from_toml(text)
+
+
+@pytest.mark.parametrize("flags", [0, 1, 2])
+@pytest.mark.parametrize("h", [1e-2, 1e-3, 1e-4])
+def test_the_rest_of_the_newton_step_in_closed_form(flags: int, h: float) -> None:
+    """Revolutes and absolute drivers alone (only J's angle columns change, at most 4 bodies):
+    after one chord correction the rest of the Newton step is computed from J(q) - J(qf) in
+    closed form and ends the step when its error bound is below half the resolution, so at
+    h = 0.1 ms each step takes one correction. With 5 bodies (2 flags) the chord steps go on
+    as before (about two corrections). Every position within the rounding floor of the
+    closed form at every step size."""
+    steps = int(round(1.0 / h))
+    pos, full = both(flagged_fourbar(flags), 1.0, steps)
+    ref = cf.fourbar_closed_form(pos.t)
+    for body, th in (("coupler", "th3"), ("rocker", "th4")):
+        at_least_as_close(f"{flags} flags h={h:g} {body} theta", pos.body(body).theta,
+                          full.body(body).theta, ref[th], angle=True)
+    for k in range(flags):
+        ang = 0.3 * k + (1.0 + k) * pos.t
+        centre = ref["coupler"] + FLAG * np.column_stack([np.cos(ang), np.sin(ang)])
+        b, bf = pos.body(f"flag{k}"), full.body(f"flag{k}")
+        at_least_as_close(f"{flags} flags h={h:g} flag{k} centre", np.column_stack([b.x, b.y]),
+                          np.column_stack([bf.x, bf.y]), centre)
+    per_step = pos.stats["newton_corrections"] / steps
+    if h == 1e-4:
+        assert per_step < 1.05 if flags < 2 else per_step > 1.5
+    if h == 1e-2:
+        assert per_step > 1.5       # corrections too large for the bound: the chord goes on
 
 
 # ------------------------------------------------------------------ where a method breaks
