@@ -2030,13 +2030,14 @@ contains
   !! C = J(qf)^-1 (J(qf) - J(q)) = sum_b c_b e_b^T, c_b = -((cos d_b - 1) e_b + sin d_b g_b).
   !! The chord leaves the error e = q - q* = -(I - C)^-1 C dq (to second order), so
   !! x = (I - C)^-1 C dq: x = sum_b c_b z_b with (I - K) z = dq_theta, K_ab = c_b(theta_a)
-  !! (nb x nb, by rows diagonally dominant when c < 1). With the chord's C0 (the secant's J
+  !! (nb x nb, |K| <= c < 1: a Neumann sum of three terms). With the chord's C0 (the secant's J
   !! between q* and q - dq), q + x - q* = (I - C)^-1 (C - C0) (I - C0)^-1 dq, and column b of
   !! C - C0 is at most (|e0| + |e|) (1 + |g_b|) (to first order), |e0| <= |dq| / (1 - c),
   !! |e| <= c |dq| / (1 - c): the rest is at most (sum_b 1 + |g_b|) |dq|**2 (1 + c) /
-  !! (1 - c)**3 (max norms; c = sum_b |cos d_b - 1| + |sin d_b| |g_b| >= |C|). conv: q + x
-  !! taken (q updated, xmax = |x|) when c <= LIN_CMAX and LIN_SAFETY times that rest is
-  !! below ref / 2; else q unchanged.
+  !! (1 - c)**3 (max norms; c = sum_b |cos d_b - 1| + |sin d_b| |g_b| >= |C|), and the
+  !! Neumann sum's terms left out add c**4 |dq| / (1 - c). conv: q + x taken (q updated,
+  !! xmax = |x|) when c <= LIN_CMAX and LIN_SAFETY times those is below ref / 2; else q
+  !! unchanged.
   pure subroutine lin_correction(n, nb, q, qf, dq, g, gk, gn, dmax, ref, x, conv, xmax)
     integer, intent(in) :: n, nb
     real(wp), intent(inout) :: q(n)
@@ -2047,9 +2048,9 @@ contains
     logical, intent(out) :: conv
     real(wp), intent(out) :: xmax
     real(wp), parameter :: S3 = one / 6, S5 = one / 20, C4 = one / 12, C6 = one / 30
-    real(wp) :: cm(LIN_MAXB), sn(LIN_MAXB), z(LIN_MAXB), k(LIN_MAXB, LIN_MAXB)
-    real(wp) :: d, d2, c, s2, f
-    integer :: a, b, i, j
+    real(wp) :: cm(LIN_MAXB), sn(LIN_MAXB), z(LIN_MAXB), v(LIN_MAXB), y(LIN_MAXB)
+    real(wp) :: d, d2, c, s2
+    integer :: a, b, i
     conv = .false.; xmax = zero
     c = zero; s2 = zero
     cm = zero; sn = zero; z = zero
@@ -2062,31 +2063,21 @@ contains
       z(b) = dq(3 * b)
     end do
     if (.not. c <= LIN_CMAX) return                                      ! (NaN too)
-    if (.not. LIN_SAFETY * s2 * dmax * dmax * (one + c) <= half * ref * (one - c)**3) return
-    ! (I - K) z = dq_theta, K_ab = -(cm_b delta_ab + sn_b g_b(theta_a)); no pivoting (the
-    ! bodies past nb: a unit row and column, z_b = 0)
-    do b = 1, LIN_MAXB
+    if (.not. LIN_SAFETY * (s2 * dmax * (one + c) + c**4 * (one - c)**2) * dmax <= &
+        half * ref * (one - c)**3) return
+    ! (I - K) z = dq_theta, K_ab = -(cm_b delta_ab + sn_b g_b(theta_a)), by the Neumann sum
+    ! z = (I + K + K**2) dq_theta (the bodies past nb: zero): |K| <= c, so x's error from
+    ! the terms left out is at most c**4 |dq| / (1 - c), within the bound above
+    v = z
+    do i = 1, 2
       do a = 1, LIN_MAXB
-        k(a, b) = sn(b) * gk(a, b)
-      end do
-      k(b, b) = k(b, b) + (one + cm(b))
-    end do
-    do a = 1, LIN_MAXB - 1
-      f = one / k(a, a)
-      do i = a + 1, LIN_MAXB
-        d = k(i, a) * f
-        do j = a + 1, LIN_MAXB
-          k(i, j) = k(i, j) - d * k(a, j)
+        d = v(a) - cm(a) * z(a)
+        do b = 1, LIN_MAXB
+          d = d - sn(b) * gk(a, b) * z(b)
         end do
-        z(i) = z(i) - d * z(a)
+        y(a) = d
       end do
-    end do
-    do a = LIN_MAXB, 1, -1
-      d = z(a)
-      do j = a + 1, LIN_MAXB
-        d = d - k(a, j) * z(j)
-      end do
-      z(a) = d / k(a, a)
+      z = y
     end do
     do b = 1, LIN_MAXB                        ! the weights z_b sn_b and z_b cm_b
       sn(b) = z(b) * sn(b); cm(b) = z(b) * cm(b)
