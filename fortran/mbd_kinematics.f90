@@ -102,6 +102,11 @@ module mbd_kinematics
   !! (1 - c)**3, is below half the resolution
   integer, parameter :: LIN_MAXB = 4
   real(wp), parameter :: LIN_SAFETY = 2.0_wp, LIN_CMAX = 0.9_wp
+  !> those steps' predictor order (the positions' divided differences used, from PRED_ORDER
+  !! down to POS_ORDER_MIN): one lower after a step whose prediction's last term was below
+  !! its error (the first correction: the term no longer helps), one higher after a step
+  !! whose first correction was too large for the closed-form rest
+  integer, parameter :: POS_ORDER_MIN = PRED_ORDER - 2
   !> largest dense Levenberg-Marquardt assembly (J and [J; mu I]) allowed in band mode (bytes):
   !! n up to about 1670; larger banded models assemble by damped Newton on the band
   real(wp), parameter :: DENSE_FALLBACK = 64.0_wp * 1048576
@@ -1104,6 +1109,11 @@ contains
     ! change of J's column theta_b with theta_b at qf (lin_prepare), |g_b| (max norm), work
     logical :: lin
     real(wp), allocatable :: gb(:, :), gn(:), ub(:), xl(:)
+    ! the positions predictor's order (pmax), the first correction's size, the number of
+    ! corrections of the last chord step and its last c (lin_correction) (dfirst, ncorr,
+    ! clast)
+    integer :: pmax, ncorr
+    real(wp) :: dfirst, clast
     real(wp) :: gk(LIN_MAXB, LIN_MAXB)      ! gk(a, b) = g_b(theta_a)
 
     status = MBD_OK; msg = ''
@@ -1250,6 +1260,7 @@ contains
       call copy3(size(q), q, qd, qdd, qout(:, 1), qdout(:, 1), qddout(:, 1))
     end if
     fast = .false.; nfull = FAST_REENTER; nreq = FAST_REENTER; halt = .false.
+    pmax = PRED_ORDER; ncorr = 0; dfirst = zero; clast = zero
     if (opts%positions) call reenter(w%pivratio)
     if (present(sens)) call kin_sens(m, w, sens, q, qd, qdd, t0, sq(:, :, 1), sqd(:, :, 1), &
                                      sqdd(:, :, 1))
@@ -1501,7 +1512,7 @@ contains
       fast = .true.; nchord = 0
       qf = q
       pd = zero; pd(1, :) = qd; pd(2, :) = half * qdd
-      ptau = zero; npd = 2
+      ptau = zero; npd = 2; pmax = PRED_ORDER
       pivf = -one       ! (a factorization first)
     end subroutine reenter
 
@@ -1537,9 +1548,9 @@ contains
       logical, intent(out) :: ok
       logical :: fresh
       integer :: st2
-      real(wp) :: motion, corr
+      real(wp) :: motion, corr, mtop
       ok = .false.
-      call pos_predict(size(q), hs, ptau, q, pd, qp, qn, motion)
+      call pos_predict(size(q), pmax, hs, ptau, q, pd, qp, qn, motion, mtop)
       fresh = .not. (scaled_drift(size(q), m%nb, lscale, qn, qf) <= FAST_DRIFT * pivf)
       if (.not. fresh) then
         call chord(.true., ok, corr)
@@ -1557,7 +1568,19 @@ contains
         if (.not. ok) return
       end if
       ok = same_branch(corr, motion, JUMP_RATIO, w%tol)
+      if (ok .and. lin) call adapt_order(mtop)
     end subroutine fast_step
+
+    !> Positions only (lin): the predictor's order for the next step from this one's chord
+    !! step (ncorr, dfirst) and its prediction's last term (mtop).
+    subroutine adapt_order(mtop)
+      real(wp), intent(in) :: mtop
+      if (ncorr > 1) then
+        if (clast <= LIN_CMAX .and. pmax < PRED_ORDER) pmax = pmax + 1
+      else if (npd >= pmax .and. pmax > POS_ORDER_MIN .and. mtop <= dfirst) then
+        pmax = pmax - 1; npd = min(npd, pmax)
+      end if
+    end subroutine adapt_order
 
     !> Chord corrections of qn at tt with the factors in w, from Phi(qn) (evaluated when
     !! need, else assemble_j's) until one is below resolution with ||Phi|| <= tol (conv);
@@ -1570,7 +1593,7 @@ contains
       real(wp) :: dmax, dprev, ref, xmax
       logical :: fresh, kept, sound
       integer :: it
-      conv = .false.; fresh = .true.; dprev = huge(one); corr = zero
+      conv = .false.; fresh = .true.; dprev = huge(one); corr = zero; clast = zero
       kept = .false.          ! assemble_phi's drivers' f(tt) are known
       do it = 1, CHORD_MAXIT
         if (need .or. it > 1) then
@@ -1582,10 +1605,12 @@ contains
                           ref)
         w%newton_its = w%newton_its + 1
         corr = corr + dmax
+        ncorr = it
+        if (it == 1) dfirst = dmax
         if (conv) return
         if (lin .and. sound) then
           call lin_correction(size(q), m%nb, qn, qf, w%dq, gb, gk, gn, dmax, ref, xl, conv, &
-                              xmax)
+                              xmax, clast)
           if (conv) then
             corr = corr + xmax; return
           end if
@@ -1620,9 +1645,9 @@ contains
     !! (as accept does with the accelerations).
     subroutine accept_fast()
       real(wp) :: rden(PRED_ORDER)
-      call new_node(tt - t, npd, ptau, rden)
-      call newton_update(size(q), rden, qn, q, pd)
-      npd = min(npd + 1, PRED_ORDER)
+      call new_node(tt - t, npd, pmax, ptau, rden)
+      call newton_update(size(q), pmax, rden, qn, q, pd)
+      npd = min(npd + 1, pmax)
       nchord = nchord + 1
       t = tt
     end subroutine accept_fast
@@ -1681,7 +1706,7 @@ contains
     !! each once j + 1 accelerations are known; tau_j <- hs + tau_(j-1).
     subroutine accept()
       real(wp) :: rden(PRED_ORDER)
-      call new_node(tt - t, nderiv, tau, rden)
+      call new_node(tt - t, nderiv, PRED_ORDER, tau, rden)
       call accept_state(size(q), rden, qn, qdn, qddn, q, qd, qdd, dd)
       nderiv = nderiv + 1
       t = tt
@@ -1838,7 +1863,7 @@ contains
     real(wp), intent(in) :: rden(PRED_ORDER), qn(n), qdn(n), qddn(n)
     real(wp), intent(inout) :: q(n), qd(n), qdd(n), dd(PRED_ORDER, n)
     integer :: i
-    call newton_update(n, rden, qddn, qdd, dd)
+    call newton_update(n, PRED_ORDER, rden, qddn, qdd, dd)
     do i = 1, n
       q(i) = qn(i); qd(i) = qdn(i)
     end do
@@ -1847,15 +1872,15 @@ contains
   !> A new node hs after the last (known: divided differences known so far): the
   !! reciprocals rden_j = 1 / (hs + tau_(j-1)) of the new differences (zero while d_j stays
   !! unknown: until j + 1 values are known), then tau_j <- hs + tau_(j-1).
-  pure subroutine new_node(hs, known, tau, rden)
+  pure subroutine new_node(hs, known, nlev, tau, rden)
     real(wp), intent(in) :: hs
-    integer, intent(in) :: known
+    integer, intent(in) :: known, nlev
     real(wp), intent(inout) :: tau(0:PRED_ORDER)
     real(wp), intent(out) :: rden(PRED_ORDER)
     integer :: j
     do j = 1, PRED_ORDER
       rden(j) = zero
-      if (j <= known + 1) rden(j) = one / (hs + tau(j - 1))
+      if (j <= known + 1 .and. j <= nlev) rden(j) = one / (hs + tau(j - 1))
     end do
     do j = PRED_ORDER, 1, -1
       tau(j) = hs + tau(j - 1)
@@ -1865,8 +1890,8 @@ contains
   !> A new value xn at a new node enters the divided differences of x:
   !! d_j <- (d_(j-1)new - d_(j-1)old) rden_j (d_0 = the value; rden_j = 1 / (t_new - t_(j-1)),
   !! zero while d_j is not yet known), and x <- xn.
-  pure subroutine newton_update(n, rden, xn, x, dd)
-    integer, intent(in) :: n
+  pure subroutine newton_update(n, nlev, rden, xn, x, dd)
+    integer, intent(in) :: n, nlev
     real(wp), intent(in) :: rden(PRED_ORDER), xn(n)
     real(wp), intent(inout) :: x(n), dd(PRED_ORDER, n)
     real(wp) :: dn, dnew, dold
@@ -1874,7 +1899,7 @@ contains
     do i = 1, n
       dnew = xn(i); dold = x(i)
       !GCC$ unroll 8
-      do j = 1, PRED_ORDER
+      do j = 1, nlev
         dn = (dnew - dold) * rden(j)
         dold = dd(j, i); dd(j, i) = dn; dnew = dn
       end do
@@ -1884,26 +1909,40 @@ contains
 
   !> The positions' Newton polynomial at hs after its last node (positions-only steps):
   !! qp = q + sum_j w_j d_j, w_1 = hs, w_j = w_(j-1) (hs + tau_(j-1)) (d_j = q[t, ..., t_j]
-  !! at the nodes tau_j back); qn = qp; motion = max |qp - q|. Error O(hs**(PRED_ORDER + 1)) once the divided
-  !! differences are known.
-  pure subroutine pos_predict(n, hs, tau, q, dd, qp, qn, motion)
-    integer, intent(in) :: n
+  !! at the nodes tau_j back, j <= nlev); qn = qp; motion = max |qp - q|. Error
+  !! O(hs**(nlev + 1)) once the divided differences are known, about the size of the next
+  !! term; mtop, the last term's, is the error of the order below.
+  pure subroutine pos_predict(n, nlev, hs, tau, q, dd, qp, qn, motion, mtop)
+    integer, intent(in) :: n, nlev
     real(wp), intent(in) :: hs, tau(0:PRED_ORDER), q(n), dd(PRED_ORDER, n)
     real(wp), intent(out) :: qp(n), qn(n)
     real(wp), intent(out) :: motion           !! max |qp - q|
+    real(wp), intent(out) :: mtop             !! max |w_nlev d_nlev|: the last term's size
     real(wp) :: wt(PRED_ORDER), x
     integer :: i, j
     wt(1) = hs
-    do j = 2, PRED_ORDER
+    do j = 2, nlev
       wt(j) = wt(j - 1) * (hs + tau(j - 1))
     end do
-    motion = zero
+    motion = zero; mtop = zero
     do i = 1, n
-      x = zero
-      !GCC$ unroll 8
-      do j = PRED_ORDER, 1, -1          ! (the smallest terms first)
-        x = x + wt(j) * dd(j, i)
-      end do
+      x = wt(nlev) * dd(nlev, i)
+      if (abs(x) > mtop) mtop = abs(x)
+      ! the smallest terms first; the cases written out, so that each order's loop is
+      ! unrolled (the orders used: PRED_ORDER - 2 .. PRED_ORDER = 5)
+      select case (nlev)
+      case (3)
+        x = x + wt(2) * dd(2, i)
+      case (4)
+        x = x + wt(3) * dd(3, i); x = x + wt(2) * dd(2, i)
+      case (5)
+        x = x + wt(4) * dd(4, i); x = x + wt(3) * dd(3, i); x = x + wt(2) * dd(2, i)
+      case default
+        do j = nlev - 1, 2, -1
+          x = x + wt(j) * dd(j, i)
+        end do
+      end select
+      if (nlev > 1) x = x + wt(1) * dd(1, i)
       qp(i) = q(i) + x; qn(i) = qp(i)
       if (abs(x) > motion) motion = abs(x)
     end do
@@ -2038,7 +2077,7 @@ contains
   !! Neumann sum's terms left out add c**4 |dq| / (1 - c). conv: q + x taken (q updated,
   !! xmax = |x|) when c <= LIN_CMAX and LIN_SAFETY times those is below ref / 2; else q
   !! unchanged.
-  pure subroutine lin_correction(n, nb, q, qf, dq, g, gk, gn, dmax, ref, x, conv, xmax)
+  pure subroutine lin_correction(n, nb, q, qf, dq, g, gk, gn, dmax, ref, x, conv, xmax, c)
     integer, intent(in) :: n, nb
     real(wp), intent(inout) :: q(n)
     !> g_b (n, LIN_MAXB; zero past nb), its angle rows gk(a, b) = g_b(theta_a), |g_b|
@@ -2047,9 +2086,10 @@ contains
     real(wp), intent(out) :: x(n)
     logical, intent(out) :: conv
     real(wp), intent(out) :: xmax
+    real(wp), intent(out) :: c                !! the bound of |C| (below)
     real(wp), parameter :: S3 = one / 6, S5 = one / 20, C4 = one / 12, C6 = one / 30
     real(wp) :: cm(LIN_MAXB), sn(LIN_MAXB), z(LIN_MAXB), v(LIN_MAXB), y(LIN_MAXB)
-    real(wp) :: d, d2, c, s2
+    real(wp) :: d, d2, s2
     integer :: a, b, i
     conv = .false.; xmax = zero
     c = zero; s2 = zero

@@ -147,7 +147,7 @@ def test_the_rest_of_the_newton_step_in_closed_form(flags: int, h: float) -> Non
     """Revolutes and absolute drivers alone (only J's angle columns change, at most 4 bodies):
     after one chord correction the rest of the Newton step is computed from J(q) - J(qf) in
     closed form and ends the step when its error bound is below half the resolution, so at
-    h = 0.1 ms each step takes one correction. With 5 bodies (2 flags) the chord steps go on
+    h = 0.1 ms each step takes one correction (at 1 ms most do). With 5 bodies (2 flags) the chord steps go on
     as before (about two corrections). Every position within the rounding floor of the
     closed form at every step size."""
     steps = int(round(1.0 / h))
@@ -163,8 +163,10 @@ def test_the_rest_of_the_newton_step_in_closed_form(flags: int, h: float) -> Non
         at_least_as_close(f"{flags} flags h={h:g} flag{k} centre", np.column_stack([b.x, b.y]),
                           np.column_stack([bf.x, bf.y]), centre)
     per_step = pos.stats["newton_corrections"] / steps
-    if h == 1e-4:
+    if h == 1e-4:     # (the predictor's order drops while its last term is below its error)
         assert per_step < 1.05 if flags < 2 else per_step > 1.5
+    if h == 1e-3 and flags < 2:       # (and rises again when the rest cannot be taken)
+        assert per_step < 1.5
     if h == 1e-2:
         assert per_step > 1.5       # corrections too large for the bound: the chord goes on
 
