@@ -27,10 +27,12 @@ module mbd_assemble
     real(wp), allocatable :: cb(:), sb(:)  !! cos and sin of each body's angle (0:nb; 0 ground)
     real(wp), allocatable :: qx(:), qdx(:) !! q and q_dot with a zero in front (0:nq): slot
                                            !! loc = 0 reads the zero
-    real(wp), allocatable :: fv(:)         !! absolute drivers' f(t) of assemble_phi (nc)
+    real(wp), allocatable :: fv(:)         !! absolute drivers' f(t) of assemble_phi (drv)
     !> assemble_phi's and assemble_gamma's lists: the revolutes (parameter offset, bodies,
     !! first row), the absolute drivers and the other constraints
     integer, allocatable :: rtab(:, :), drv(:), gen(:)
+    !> the absolute drivers' row, driven coordinate, parameter offset and count (4, drv)
+    integer, allocatable :: dtab(:, :)
     !> the nonzeros of the blocks: jb(src(i)) goes to J(dst(i)) and column col(i) (flat
     !! column-major indices into jb and the dense neq x nq J; dst = 0 when J has more than
     !! huge(1) entries)
@@ -54,10 +56,12 @@ contains
       n = n + m%nrow(k) * count(m%loc(:, k) > 0)
     end do
     allocate (a%jb(MAXROW, NLOC, m%nc), a%cb(0:m%nb), a%sb(0:m%nb), a%qx(0:m%nq), &
-              a%qdx(0:m%nq), a%fv(m%nc), stat=ierr)
+              a%qdx(0:m%nq), stat=ierr)
     if (ierr == 0) allocate (a%src(n), a%dst(n), a%col(n), stat=ierr)
     if (ierr == 0) allocate (a%rtab(4, count(m%kind(1:m%nc) == CON_REVOLUTE)), &
                              a%drv(count(m%kind(1:m%nc) == DRV_ABS)), &
+                             a%dtab(4, count(m%kind(1:m%nc) == DRV_ABS)), &
+                             a%fv(count(m%kind(1:m%nc) == DRV_ABS)), &
                              a%gen(count(m%kind(1:m%nc) /= CON_REVOLUTE .and. &
                                          m%kind(1:m%nc) /= DRV_ABS)), stat=ierr)
     if (ierr /= 0) then
@@ -74,6 +78,7 @@ contains
         r = r + 1; a%rtab(:, r) = [m%po(k), m%bi(k), m%bj(k), m%row0(k)]
       else if (m%kind(k) == DRV_ABS) then
         s = s + 1; a%drv(s) = k
+        a%dtab(:, s) = [m%row0(k), m%loc(m%suba(k), k), m%po(k), m%pn(k)]
       else
         n = n + 1; a%gen(n) = k
       end if
@@ -254,9 +259,11 @@ contains
     end if
     call revolute_phi_all(size(a%rtab, 2), a%rtab, m%p, q, a%cb, a%sb, phi)
     do j = 1, size(a%drv)
-      k = a%drv(j)
-      if (fresh) call fun_eval(m%p(m%po(k):m%po(k) + m%pn(k) - 1), t, a%fv(k), f1, f2)
-      phi(m%row0(k)) = q(m%loc(m%suba(k), k)) - a%fv(k)       ! (as driver_abs_row)
+      if (fresh) then
+        k = a%dtab(3, j)
+        call fun_eval(m%p(k:k + a%dtab(4, j) - 1), t, a%fv(j), f1, f2)
+      end if
+      phi(a%dtab(1, j)) = q(a%dtab(2, j)) - a%fv(j)            ! (as driver_abs_row)
     end do
     if (size(a%gen) > 0) then
       a%qx(1:m%nq) = q          ! (for eval_one; its q_dot not used)

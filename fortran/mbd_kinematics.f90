@@ -1103,6 +1103,7 @@ contains
     ! use, full steps since the chord steps were left
     logical :: fast
     real(wp), allocatable :: pd(:, :), qf(:)
+    real(wp), allocatable :: wd(:)    ! the drift's weights: 1 / L for x and y, 1 otherwise
     real(wp) :: ptau(0:PRED_ORDER), pivf
     integer :: npd, nfull, nreq, nchord
     ! models of revolutes and absolute drivers (lin): g_b = J(qf)^-1 u_b (nq, nb), u_b the
@@ -1185,7 +1186,14 @@ contains
     if (ierr == 0) allocate (dd(PRED_ORDER, m%nq), qddn(m%nq), qdn(m%nq), stat=ierr)
     if (ierr == 0) allocate (qa(m%nq), qda(m%nq), qdda(m%nq), qb(m%nq), stat=ierr)
     if (ierr == 0) allocate (qdb(m%nq), qddb(m%nq), stat=ierr)
-    if (ierr == 0 .and. opts%positions) allocate (pd(PRED_ORDER, m%nq), qf(m%nq), stat=ierr)
+    if (ierr == 0 .and. opts%positions) allocate (pd(PRED_ORDER, m%nq), qf(m%nq), wd(m%nq), &
+                                                  stat=ierr)
+    if (ierr == 0 .and. opts%positions) then
+      wd = one
+      do j = 1, m%nb
+        wd(3 * j - 2:3 * j - 1) = one / m%lscale
+      end do
+    end if
     lin = opts%positions .and. .not. w%banded .and. size(w%asm%gen) == 0 .and. &
           m%nb <= LIN_MAXB .and. m%neq == m%nq .and. m%nq >= 3 * m%nb
     if (ierr == 0 .and. lin) allocate (gb(m%nq, LIN_MAXB), gn(m%nb), ub(m%neq), xl(m%nq), &
@@ -1548,10 +1556,10 @@ contains
       logical, intent(out) :: ok
       logical :: fresh
       integer :: st2
-      real(wp) :: motion, corr, mtop
+      real(wp) :: motion, corr, mtop, drift
       ok = .false.
-      call pos_predict(size(q), pmax, hs, ptau, q, pd, qp, qn, motion, mtop)
-      fresh = .not. (scaled_drift(size(q), m%nb, lscale, qn, qf) <= FAST_DRIFT * pivf)
+      call pos_predict(size(q), pmax, hs, ptau, q, pd, qf, wd, qp, qn, motion, mtop, drift)
+      fresh = .not. (drift <= FAST_DRIFT * pivf)
       if (.not. fresh) then
         call chord(.true., ok, corr)
         if (.not. ok) qn = qp
@@ -1912,19 +1920,22 @@ contains
   !! at the nodes tau_j back, j <= nlev); qn = qp; motion = max |qp - q|. Error
   !! O(hs**(nlev + 1)) once the divided differences are known, about the size of the next
   !! term; mtop, the last term's, is the error of the order below.
-  pure subroutine pos_predict(n, nlev, hs, tau, q, dd, qp, qn, motion, mtop)
+  pure subroutine pos_predict(n, nlev, hs, tau, q, dd, qf, wd, qp, qn, motion, mtop, drift)
     integer, intent(in) :: n, nlev
     real(wp), intent(in) :: hs, tau(0:PRED_ORDER), q(n), dd(PRED_ORDER, n)
+    real(wp), intent(in) :: qf(n), wd(n)      !! the factorization's q, the drift's weights
     real(wp), intent(out) :: qp(n), qn(n)
     real(wp), intent(out) :: motion           !! max |qp - q|
     real(wp), intent(out) :: mtop             !! max |w_nlev d_nlev|: the last term's size
+    !> max wd_i |qp_i - qf_i|: how far qp is from qf (lengths in units of the length scale)
+    real(wp), intent(out) :: drift
     real(wp) :: wt(PRED_ORDER), x
     integer :: i, j
     wt(1) = hs
     do j = 2, nlev
       wt(j) = wt(j - 1) * (hs + tau(j - 1))
     end do
-    motion = zero; mtop = zero
+    motion = zero; mtop = zero; drift = zero
     do i = 1, n
       x = wt(nlev) * dd(nlev, i)
       if (abs(x) > mtop) mtop = abs(x)
@@ -1945,26 +1956,10 @@ contains
       if (nlev > 1) x = x + wt(1) * dd(1, i)
       qp(i) = q(i) + x; qn(i) = qp(i)
       if (abs(x) > motion) motion = abs(x)
+      x = wd(i) * abs(qp(i) - qf(i))
+      if (x > drift) drift = x
     end do
   end subroutine pos_predict
-
-  !> How far q has moved from qf: max of |dx|, |dy| / L and |d theta| over the bodies and
-  !! |dq| of the extra coordinates (L: the model's length scale).
-  pure real(wp) function scaled_drift(n, nb, lscale, q, qf) result(d)
-    integer, intent(in) :: n, nb
-    real(wp), intent(in) :: lscale, q(n), qf(n)
-    real(wp) :: r
-    integer :: b, i
-    r = one / lscale
-    d = zero
-    do b = 1, nb
-      i = 3 * b
-      d = max(d, r * abs(q(i - 2) - qf(i - 2)), r * abs(q(i - 1) - qf(i - 1)), abs(q(i) - qf(i)))
-    end do
-    do i = 3 * nb + 1, n
-      d = max(d, abs(q(i) - qf(i)))
-    end do
-  end function scaled_drift
 
   !> The Newton correction corr is small against the predicted motion: the same branch.
   pure logical function same_branch(corr, motion, ratio, tol)
