@@ -6,7 +6,7 @@
 !! into jb(:, :, k); scatter_dense then places the blocks in a dense J through a map built
 !! once (asm_init). No allocation here.
 module mbd_assemble
-  use mbd_kinds, only: wp, zero, one
+  use mbd_kinds, only: wp, zero, one, half
   use mbd_status, only: MBD_OK, MSG_LEN
   use mbd_memory, only: REAL_BYTES, mem_fail
   use mbd_points, only: NLOC, MAXROW, kloc
@@ -25,6 +25,9 @@ module mbd_assemble
   type :: asm_work_t
     real(wp), allocatable :: jb(:, :, :)   !! local Jacobian blocks (MAXROW, NLOC, nc)
     real(wp), allocatable :: cb(:), sb(:)  !! cos and sin of each body's angle (0:nb; 0 ground)
+    !> assemble_phi's anchors: an angle of each body and its cos and sin from the library
+    !! (0:nb), from which nearby angles' cos and sin are turned (trig_near)
+    real(wp), allocatable :: ta(:), ca(:), sa(:)
     real(wp), allocatable :: qx(:), qdx(:) !! q and q_dot with a zero in front (0:nq): slot
                                            !! loc = 0 reads the zero
     real(wp), allocatable :: fv(:)         !! absolute drivers' f(t) of assemble_phi (drv)
@@ -56,7 +59,7 @@ contains
       n = n + m%nrow(k) * count(m%loc(:, k) > 0)
     end do
     allocate (a%jb(MAXROW, NLOC, m%nc), a%cb(0:m%nb), a%sb(0:m%nb), a%qx(0:m%nq), &
-              a%qdx(0:m%nq), stat=ierr)
+              a%qdx(0:m%nq), a%ta(0:m%nb), a%ca(0:m%nb), a%sa(0:m%nb), stat=ierr)
     if (ierr == 0) allocate (a%src(n), a%dst(n), a%col(n), stat=ierr)
     if (ierr == 0) allocate (a%rtab(4, count(m%kind(1:m%nc) == CON_REVOLUTE)), &
                              a%drv(count(m%kind(1:m%nc) == DRV_ABS)), &
@@ -72,6 +75,7 @@ contains
     end if
     a%jb = zero
     a%cb = one; a%sb = zero; a%qx = zero; a%qdx = zero; a%fv = zero
+    a%ta = huge(one); a%ca = one; a%sa = zero
     r = 0; s = 0; n = 0
     do k = 1, m%nc
       if (m%kind(k) == CON_REVOLUTE) then
@@ -238,7 +242,8 @@ contains
   end subroutine general_rows
 
   !> Phi alone at q (the chord steps of positions-only kinematics). fresh: a new q and t,
-  !! the bodies' cos and sin from q and the absolute drivers' f(t) evaluated (kept in a);
+  !! the bodies' cos and sin from q (trig_near) and the absolute drivers' f(t) evaluated (kept
+  !! in a);
   !! otherwise a correction of the last q at the same t, with the cos and sin in a (turned by
   !! asm_turn) and the kept f(t). The revolutes' Phi rows alone (revolute_phi_all), an absolute
   !! driver's Phi = q_c - f(t); every other constraint evaluated whole (its block of J
@@ -254,7 +259,7 @@ contains
     integer :: j, k, b
     if (fresh) then
       do b = 1, m%nb
-        a%cb(b) = cos(q(3 * b)); a%sb(b) = sin(q(3 * b))
+        call trig_near(q(3 * b), a%ta(b), a%ca(b), a%sa(b), a%cb(b), a%sb(b))
       end do
     end if
     call revolute_phi_all(size(a%rtab, 2), a%rtab, m%p, q, a%cb, a%sb, phi)
@@ -397,6 +402,33 @@ contains
   !> The bodies' cos and sin after their angles changed by dq(3 b), a change within a few units
   !! in the last place: cos(th + d) = c - s d, sin(th + d) = s + c d (the d**2 terms are below
   !! rounding).
+  !> c, s = cos th, sin th from an anchor angle ta whose ca, sa came from the library, by the
+  !! angle addition c = ca + (ca (cos d - 1) - sa sin d), s = sa + (sa (cos d - 1) + ca sin d),
+  !! d = th - ta (exact where th and ta are within a factor 2), with sin d and cos d - 1 by
+  !! their series to d**7 and d**8 (the next terms below 6e-18 for |d| <= NEAR_MAX): c and s
+  !! carry the anchor's rounding plus at most half a unit in the last place. Farther than
+  !! NEAR_MAX from it (or a NaN), cos and sin anew, and th the new anchor.
+  pure subroutine trig_near(th, ta, ca, sa, c, s)
+    real(wp), intent(in) :: th                !! angle
+    real(wp), intent(inout) :: ta, ca, sa     !! anchor: angle, cos, sin
+    real(wp), intent(out) :: c, s             !! cos th, sin th
+    real(wp), parameter :: NEAR_MAX = 0.05_wp
+    real(wp), parameter :: S3 = one / 6, S5 = one / 20, S7 = one / 42
+    real(wp), parameter :: C4 = one / 12, C6 = one / 30, C8 = one / 56
+    real(wp) :: d, d2, sn, cm
+    d = th - ta
+    if (abs(d) <= NEAR_MAX) then
+      d2 = d * d
+      sn = d * (one - d2 * S3 * (one - d2 * S5 * (one - d2 * S7)))
+      cm = -half * d2 * (one - d2 * C4 * (one - d2 * C6 * (one - d2 * C8)))
+      c = ca + (ca * cm - sa * sn)
+      s = sa + (sa * cm + ca * sn)
+    else
+      c = cos(th); s = sin(th)
+      ta = th; ca = c; sa = s
+    end if
+  end subroutine trig_near
+
   pure subroutine asm_turn(m, a, dq)
     type(model_t), intent(in) :: m            !! model
     type(asm_work_t), intent(inout) :: a      !! cos and sin of the angles
