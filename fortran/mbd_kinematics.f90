@@ -1195,7 +1195,7 @@ contains
       end do
     end if
     lin = opts%positions .and. .not. w%banded .and. size(w%asm%gen) == 0 .and. &
-          m%nb <= LIN_MAXB .and. m%neq == m%nq .and. m%nq >= 3 * m%nb
+          m%nb <= LIN_MAXB .and. m%neq == m%nq
     if (ierr == 0 .and. lin) allocate (gb(m%nq, LIN_MAXB), gn(m%nb), ub(m%neq), xl(m%nq), &
                                        stat=ierr)
     if (ierr == 0 .and. lin) gb = zero
