@@ -18,8 +18,8 @@ module mbd_assemble
   implicit none
   private
   public :: asm_work_t, asm_init, assemble_blocks, scatter_dense, assemble_dense, init_extras, &
-            gather_local, blocks_jv, blocks_jtv, scatter_values, asm_turn, assemble_gamma, &
-            assemble_phi
+            gather_local, blocks_jv, blocks_jv_rows, blocks_jtv, scatter_values, asm_turn, &
+            assemble_gamma, assemble_phi
 
   !> Work arrays of the assembly, allocated once per analysis.
   type :: asm_work_t
@@ -378,6 +378,45 @@ contains
       end do
     end do
   end subroutine jv_kernel
+
+  !> Y = J X for several vectors held as rows (xt (npad, nq) -> yt (npad, neq), npad a
+  !! multiple of 4), from the local blocks of the last assembly: each block entry read once.
+  pure subroutine blocks_jv_rows(m, a, npad, xt, yt)
+    type(model_t), intent(in) :: m        !! model
+    type(asm_work_t), intent(in) :: a     !! work arrays with the blocks
+    integer, intent(in) :: npad           !! rows of xt and yt
+    real(wp), intent(in) :: xt(*)         !! vectors as rows (npad, nq)
+    real(wp), intent(inout) :: yt(*)      !! J x as rows (npad, neq)
+    call jv_rows_kernel(m%nc, m%loc, m%row0, m%nrow, a%jb, npad, xt, yt)
+  end subroutine blocks_jv_rows
+
+  !> blocks_jv_rows on explicit shapes.
+  pure subroutine jv_rows_kernel(nc, loc, row0, nrow, jb, npad, xt, yt)
+    integer, intent(in) :: nc, npad
+    integer, intent(in) :: loc(NLOC, nc), row0(nc), nrow(nc)
+    real(wp), intent(in) :: jb(MAXROW, NLOC, nc), xt(npad, *)
+    real(wp), intent(inout) :: yt(npad, *)
+    integer :: k, s, c, r, i, g
+    real(wp) :: v
+    do k = 1, nc
+      do i = 0, nrow(k) - 1
+        yt(:, row0(k) + i) = zero
+      end do
+      do s = 1, NLOC
+        c = loc(s, k)
+        if (c == 0) cycle
+        do i = 1, nrow(k)
+          r = row0(k) + i - 1; v = jb(i, s, k)
+          do g = 0, npad - 4, 4
+            yt(g + 1, r) = yt(g + 1, r) + v * xt(g + 1, c)
+            yt(g + 2, r) = yt(g + 2, r) + v * xt(g + 2, c)
+            yt(g + 3, r) = yt(g + 3, r) + v * xt(g + 3, c)
+            yt(g + 4, r) = yt(g + 4, r) + v * xt(g + 4, c)
+          end do
+        end do
+      end do
+    end do
+  end subroutine jv_rows_kernel
 
   !> x = J^T y from the local blocks of the last assembly (no dense J).
   pure subroutine blocks_jtv(m, a, y, x)

@@ -35,7 +35,7 @@ module mbd_forces
   public :: FRC_SPRING, FRC_TORQUE, FRC_POINT, FRC_ROTSPRING, FRC_CONTACT0, FRC_CONTACT1
   public :: FRC_FRICTION
   public :: force_known, force_raw_length, force_prepare, force_eval, force_exponents
-  public :: force_is_contact, force_is_count, force_eval_d, force_eval_dm
+  public :: force_is_contact, force_is_count, force_eval_d, force_eval_dm, force_rows_d
 
   integer, parameter :: FRC_SPRING = 1, FRC_TORQUE = 2, FRC_POINT = 3, FRC_ROTSPRING = 4
   !> contacts: kind FRC_CONTACT0 + geometry - 1 (mbd_contact GEO_*), up to FRC_CONTACT1
@@ -406,10 +406,11 @@ contains
   !> force_eval_d along several directions (columns of tq, tqd, tp) at one state: a
   !! spring's values once (spring_values) and its change per direction, the other kinds
   !! direction by direction.
-  pure subroutine force_eval_dm(kind, p, tp, si, sj, ql, qdl, tq, tqd, t, tforce)
+  pure subroutine force_eval_dm(kind, p, tp, aff, si, sj, ql, qdl, tq, tqd, t, tforce)
     integer, intent(in) :: kind             !! force kind
     real(wp), intent(in) :: p(:)            !! prepared parameters
     real(wp), intent(in) :: tp(:, :)        !! their changes (size(p), nk)
+    logical, intent(in) :: aff(:)           !! (nk) tp(:, k) is not zero
     integer, intent(in) :: si, sj           !! slot ids of the bodies (0 = ground)
     real(wp), intent(in) :: ql(NLOC), qdl(NLOC)  !! local coordinates and velocities
     real(wp), intent(in) :: tq(:, :), tqd(:, :)  !! directions (NLOC, nk)
@@ -430,9 +431,167 @@ contains
     call spring_values(xs, p, si, sj, t, v)
     if (.not. v%l > zero) return
     do k = 1, size(tforce, 2)
-      call spring_change(dual_state(xs, tq(:, k), tqd(:, k)), v, p, tp(:, k), si, sj, t, &
-                         tforce(:, k))
+      if (.not. aff(k)) then
+        call spring_state_change(v, p, si, sj, qdl, tq(:, k), tqd(:, k), tforce(:, k))
+      else if (all(tp(1:4, k) == zero)) then   ! the points stay: the tension's change only
+        call spring_state_change(v, p, si, sj, qdl, tq(:, k), tqd(:, k), tforce(:, k))
+        call spring_tension_change(v, p, tp(:, k), si, sj, t, tforce(:, k))
+      else
+        call spring_change(dual_state(xs, tq(:, k), tqd(:, k)), v, p, tp(:, k), si, sj, t, &
+                           tforce(:, k))
+      end if
     end do
   end subroutine force_eval_dm
+
+  !> force_eval_d along up to four directions given as rows (the local slots' tqr, tqdr
+  !! (4, NLOC), the rows past np zero) with the parameters' changes tp (size(p), np;
+  !! aff(k): column k is not zero), the changes as rows tfr (4, NLOC). A spring's state
+  !! part (spring_rows) takes the four rows at once, its parameters' part is added for the
+  !! affected ones; the other kinds go direction by direction.
+  pure subroutine force_rows_d(kind, p, tp, aff, si, sj, ql, qdl, np, tqr, tqdr, t, tfr)
+    integer, intent(in) :: kind             !! force kind
+    real(wp), intent(in) :: p(:)            !! prepared parameters
+    real(wp), intent(in) :: tp(:, :)        !! their changes (size(p), np)
+    logical, intent(in) :: aff(:)           !! (np) tp(:, k) is not zero
+    integer, intent(in) :: si, sj           !! slot ids of the bodies (0 = ground)
+    real(wp), intent(in) :: ql(NLOC), qdl(NLOC)  !! local coordinates and velocities
+    integer, intent(in) :: np               !! directions (at most 4)
+    real(wp), intent(in) :: tqr(4, NLOC), tqdr(4, NLOC)  !! directions as rows
+    real(wp), intent(in) :: t               !! time
+    real(wp), intent(out) :: tfr(4, NLOC)   !! changes as rows
+    type(kloc) :: xs
+    type(spring_v) :: v
+    real(wp) :: tf(NLOC)
+    real(wp), parameter :: z(NLOC) = zero
+    integer :: k
+    tfr = zero
+    if (kind /= FRC_SPRING) then
+      do k = 1, np
+        call force_eval_d(kind, p, tp(:, k), si, sj, ql, qdl, tqr(k, :), tqdr(k, :), t, tf)
+        tfr(k, :) = tf
+      end do
+      return
+    end if
+    xs = local_state(ql, qdl)
+    call spring_values(xs, p, si, sj, t, v)
+    if (.not. v%l > zero) return
+    call spring_rows(v, p, qdl, tqr, tqdr, tfr)
+    do k = 1, np                            ! the parameters' own changes
+      if (.not. aff(k)) cycle
+      tf = zero
+      if (all(tp(1:4, k) == zero)) then     ! the points stay: the tension's change only
+        call spring_tension_change(v, p, tp(:, k), si, sj, t, tf)
+      else
+        call spring_change(dual_state(xs, z, z), v, p, tp(:, k), si, sj, t, tf)
+      end if
+      tfr(k, :) = tfr(k, :) + tf
+    end do
+  end subroutine force_rows_d
+
+  !> A spring-damper-actuator's change of Q = -T grad l along four state directions at
+  !! once (rows of tqr, tqdr (4, NLOC); a ground slot's entries zero, as its B s' and A s'
+  !! in v). With D = dd/dq_loc = [-I, -B_i s'_i, I, B_j s'_j] (2 x 6), grad l = g = D^T u,
+  !! l_dot = g . q_dot and H = dg/dq = D^T (I - u u^T) D / l + diag(0, 0, u . A_i s'_i, 0, 0,
+  !! -u . A_j s'_j) (symmetric), along (dq, dq_dot):
+  !!   dl = g . dq,  dl_dot = g . dq_dot + (H q_dot) . dq,  dT = k dl + c dl_dot,
+  !!   dQ = -g dT - T H dq,  H dq = D^T ((I - u u^T) D dq) / l + diag dq;
+  !! H q_dot = D^T ((I - u u^T) d_dot) / l + diag q_dot (d_dot = D q_dot, the points'
+  !! relative velocity).
+  pure subroutine spring_rows(v, p, qdl, tqr, tqdr, tfr)
+    type(spring_v), intent(in) :: v         !! the values (spring_values, l > 0)
+    real(wp), intent(in) :: p(:)            !! prepared parameters
+    real(wp), intent(in) :: qdl(NLOC)       !! local velocities
+    real(wp), intent(in) :: tqr(4, NLOC), tqdr(4, NLOC)  !! directions as rows
+    real(wp), intent(inout) :: tfr(4, NLOC) !! changes as rows (added)
+    real(wp) :: g(6), w(6), e(2), rl, ci, cj, dx, dy, dl, ex, ey, dt, th
+    integer :: k
+    rl = one / v%l
+    ci = dot_product(v%u, v%aui); cj = dot_product(v%u, v%auj)
+    g = [-v%u(1), -v%u(2), -dot_product(v%u, v%bi), v%u(1), v%u(2), dot_product(v%u, v%bj)]
+    e = (v%dd - v%u * dot_product(v%u, v%dd)) * rl   ! (I - u u^T) d_dot / l
+    w = [-e(1), -e(2), -dot_product(v%bi, e) + ci * qdl(3), e(1), e(2), &
+         dot_product(v%bj, e) - cj * qdl(6)]
+    th = v%tension
+    do k = 1, 4
+      ! D dq, dl = u . D dq, (I - u u^T) D dq / l
+      dx = tqr(k, 4) - tqr(k, 1) - v%bi(1) * tqr(k, 3) + v%bj(1) * tqr(k, 6)
+      dy = tqr(k, 5) - tqr(k, 2) - v%bi(2) * tqr(k, 3) + v%bj(2) * tqr(k, 6)
+      dl = v%u(1) * dx + v%u(2) * dy
+      ex = (dx - v%u(1) * dl) * rl; ey = (dy - v%u(2) * dl) * rl
+      dt = p(5) * dl + p(6) * (g(1) * tqdr(k, 1) + g(2) * tqdr(k, 2) + g(3) * tqdr(k, 3) + &
+                               g(4) * tqdr(k, 4) + g(5) * tqdr(k, 5) + g(6) * tqdr(k, 6) + &
+                               w(1) * tqr(k, 1) + w(2) * tqr(k, 2) + w(3) * tqr(k, 3) + &
+                               w(4) * tqr(k, 4) + w(5) * tqr(k, 5) + w(6) * tqr(k, 6))
+      tfr(k, 1) = tfr(k, 1) - g(1) * dt + th * ex
+      tfr(k, 2) = tfr(k, 2) - g(2) * dt + th * ey
+      tfr(k, 3) = tfr(k, 3) - g(3) * dt - th * (ci * tqr(k, 3) - (v%bi(1) * ex + v%bi(2) * ey))
+      tfr(k, 4) = tfr(k, 4) - g(4) * dt - th * ex
+      tfr(k, 5) = tfr(k, 5) - g(5) * dt - th * ey
+      tfr(k, 6) = tfr(k, 6) - g(6) * dt - th * (v%bj(1) * ex + v%bj(2) * ey - cj * tqr(k, 6))
+    end do
+  end subroutine spring_rows
+
+  !> Add to tforce the change of a spring's generalized force by a change tp of its
+  !! parameters that leaves its points alone: dT = dk (l - l0) - k dl0 + dc l_dot - df,
+  !! dQ = -dT grad l.
+  pure subroutine spring_tension_change(v, p, tp, si, sj, t, tforce)
+    type(spring_v), intent(in) :: v         !! the values (spring_values, l > 0)
+    real(wp), intent(in) :: p(:), tp(:)     !! prepared parameters and their change
+    integer, intent(in) :: si, sj           !! slot ids of the bodies (0 = ground)
+    real(wp), intent(in) :: t               !! time
+    real(wp), intent(inout) :: tforce(NLOC) !! change of the generalized force
+    real(wp) :: tf, tf1, tf2, tt
+    tf = zero
+    if (any(tp(8:) /= zero)) call fun_eval_d(p(8:), tp(8:), t, tf, tf1, tf2)
+    tt = tp(5) * (v%l - p(7)) - p(5) * tp(7) + tp(6) * v%ldot - tf
+    if (si > 0) then
+      tforce(1:2) = tforce(1:2) + tt * v%u
+      tforce(3) = tforce(3) + tt * dot_product(v%u, v%bi)
+    end if
+    if (sj > 0) then
+      tforce(4:5) = tforce(4:5) - tt * v%u
+      tforce(6) = tforce(6) - tt * dot_product(v%u, v%bj)
+    end if
+  end subroutine spring_tension_change
+
+  !> spring_change along a direction of the state alone (no parameter change: the terms of
+  !! tp vanish): a point changes by dr + B s' dtheta, B s' by -A s' dtheta, the point's
+  !! velocity by dr_dot + d(B s') theta_dot + B s' dtheta_dot; then as spring_change with
+  !! dT = k dl + c dl_dot.
+  pure subroutine spring_state_change(v, p, si, sj, qdl, tq, tqd, tforce)
+    type(spring_v), intent(in) :: v         !! the values (spring_values, l > 0)
+    real(wp), intent(in) :: p(:)            !! prepared parameters
+    integer, intent(in) :: si, sj           !! slot ids of the bodies (0 = ground)
+    real(wp), intent(in) :: qdl(NLOC)       !! local velocities
+    real(wp), intent(in) :: tq(NLOC), tqd(NLOC)  !! direction
+    real(wp), intent(out) :: tforce(NLOC)   !! change of the generalized force
+    real(wp) :: td(2), tdd(2), tbi(2), tbj(2), tl, tu(2), tldot, tt
+    td = zero; tdd = zero; tbi = zero; tbj = zero
+    if (sj > 0) then                        ! d = P_j - P_i
+      tbj = -v%auj * tq(6)
+      td = tq(4:5) + v%bj * tq(6)
+      tdd = tqd(4:5) + tbj * qdl(6) + v%bj * tqd(6)
+    end if
+    if (si > 0) then
+      tbi = -v%aui * tq(3)
+      td = td - (tq(1:2) + v%bi * tq(3))
+      tdd = tdd - (tqd(1:2) + tbi * qdl(3) + v%bi * tqd(3))
+    end if
+    tl = dot_product(v%u, td)
+    tu = (td - v%u * tl) / v%l
+    tldot = dot_product(tu, v%dd) + dot_product(v%u, tdd)
+    tt = p(5) * tl + p(6) * tldot
+    tforce = zero
+    if (si > 0) then
+      tforce(1:2) = tt * v%u + v%tension * tu
+      tforce(3) = tt * dot_product(v%u, v%bi) + &
+                  v%tension * (dot_product(tu, v%bi) + dot_product(v%u, tbi))
+    end if
+    if (sj > 0) then
+      tforce(4:5) = -tt * v%u - v%tension * tu
+      tforce(6) = -tt * dot_product(v%u, v%bj) - &
+                  v%tension * (dot_product(tu, v%bj) + dot_product(v%u, tbj))
+    end if
+  end subroutine spring_state_change
 
 end module mbd_forces

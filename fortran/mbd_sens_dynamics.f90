@@ -16,25 +16,29 @@
 !! sensitivities (S, S_dot) of every parameter are integrated, S_ddot from
 !!   [M J^T; J 0] [S_ddot; dlambda] = [dQ - M_p q_ddot - K_lam S - J_p^T lambda;
 !!                                     gamma_p - J_p q_ddot - Ha S - 2 Hv S_dot]
-!! (dQ = Q_q S + Q_q_dot S_dot + Q_p) with the factors of the step's augmented matrix, and the
-!! error control covers them (Dormand-Prince 5(4) on all components). After each step S is
-!! projected like q: onto J S = -Phi_p (minimum norm) and S_dot onto J S_dot = nu_p - J_p q_dot
-!! - Hv S (kinetic-energy metric), the linearized projections of q and q_dot.
+!! (dQ = Q_q S + Q_q_dot S_dot + Q_p) with the factors of the step's augmented matrix, every
+!! parameter at once (S, S_dot held as rows; a spring's dQ from its closed-form derivative,
+!! mbd_forces spring_rows), and the error control covers them (Dormand-Prince 5(4), RMS over
+!! all components). After each step S is projected onto J S = -Phi_p and S_dot onto
+!! J S_dot = nu_p - J_p q_dot - Hv S, both nearest in the kinetic-energy metric with the
+!! factors of q_dot's projection (the linearized projection of q_dot; the initial S takes the
+!! minimum-norm change, as the assembly of q0).
 module mbd_sens_dynamics
   use mbd_kinds, only: wp, zero, one
   use mbd_status, only: MBD_OK, MBD_SINGULAR, MBD_NO_MEMORY, MSG_LEN
   use mbd_points, only: NLOC, MAXROW, rot, drot
   use mbd_model, only: model_t
-  use mbd_assemble, only: asm_work_t, asm_init, assemble_blocks, assemble_dense
+  use mbd_assemble, only: asm_work_t, asm_init, assemble_blocks, assemble_dense, blocks_jv_rows
   use mbd_sensitivity, only: sens_t, sens_trig, sens_hessian, sens_params, sens_klam, &
-                             sens_klam_list, &
-                             sens_jpt_lam, sens_force_d, sens_force_dm, sens_force_jac
+                             sens_klam_list, sens_kin_rhs, &
+                             sens_jpt_lam, sens_force_d, sens_force_dm, sens_force_jac, &
+                             sens_force_rows
   use mbd_linsolve, only: lu_factor, lu_solve, lapack_status, ls_small_cols, lu_factor_small, &
                           lu_solve_small, LS_RTOL
   use mbd_lapack, only: dgelsy
   use mbd_status, only: MBD_INTEGRATOR_FAILED, MBD_BAD_SETTING
   use mbd_dynamics, only: dyn_work_t, dyn_accel, dyn_project_pos, dyn_velocity, &
-                          dyn_factor_projection, dyn_jv, dyn_solve_rows
+                          dyn_factor_projection, dyn_solve_rows
   use mbd_integrators, only: output_rows, dopri5_state, dopri5_error, DOPRI_C
   use mbd_interp, only: hermite5
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
@@ -49,6 +53,7 @@ module mbd_sens_dynamics
     !> one saddle right-hand side per parameter as the rows of rt (4 k, nq + na; the rows past
     !! np stay zero), their solutions xr (nq + na, np), ones of that shape (dyn_solve_rows)
     real(wp), allocatable :: rt(:, :), xr(:, :), fones(:, :)
+    real(wp), allocatable :: jst(:, :)      !! J S as rows (4 k, neq)
   end type proj_work_t
 
 contains
@@ -65,7 +70,7 @@ contains
     status = MBD_OK; msg = ''
     nt = m%nq + w%na
     allocate (pw%hvs(m%neq), pw%rt(4 * ((np + 3) / 4), nt), pw%xr(nt, np), pw%fones(nt, np), &
-              stat=st)
+              pw%jst(4 * ((np + 3) / 4), m%neq), stat=st)
     if (st /= 0) then
       status = MBD_NO_MEMORY; msg = 'out of memory for the sensitivity projections'
       return
@@ -315,31 +320,35 @@ contains
     real(wp), allocatable :: y(:), yn(:), ys(:), k(:, :), e(:), za(:), zda(:), zdda(:), lam(:), &
                              zz(:), zzd(:), zzdd(:)
     ! the work of rhs and project (here, so that no step allocates)
-    real(wp), allocatable :: qq(:), vv(:), aa(:), y2(:), y3(:), v0(:)
-    real(wp), allocatable :: yf(:, :)   ! (n, np) the forces' changes along S, S_dot and p
-    real(wp), allocatable :: wk(:, :)   ! (np, neq) the constraint rows, parameter by row
+    real(wp), allocatable :: qq(:), vv(:), aa(:), y3(:), v0(:)
     type(proj_work_t) :: pw
     real(wp) :: t, h, tnew, err, fac, sc
-    integer :: n, np, nz, st, kout
-    logical :: fsal
+    integer :: n, np, npd, nz, st, kout, nreal
+    logical :: fsal, pcon
     status = MBD_OK; msg = ''; nout = 0; stats = 0; hmm = [huge(one), zero]; t_fail = t0
     qo = zero; vo = zero; ao = zero; so = zero; sdo = zero; sddo = zero
-    n = m%nq; np = s%np; nz = n * (1 + np)
+    ! the packed state (q, S, q_dot, S_dot) holds S and S_dot as rows (npd, n), npd = np
+    ! rounded up to a multiple of 4 (the padding rows stay zero: no rate, no error)
+    n = m%nq; np = s%np; npd = 4 * ((np + 3) / 4); nz = n * (1 + npd)
+    nreal = 2 * n * (1 + np)
+    pcon = any(s%kcon)
     if (.not. (rtol > zero .and. atol > zero) .or. every < 1 .or. &
         size(qo, 2) /= output_rows(nsteps, every)) then
       status = MBD_BAD_SETTING; msg = 'rtol, atol > 0, every >= 1 and outputs sized for it'
       return
     end if
     allocate (y(2 * nz), yn(2 * nz), ys(2 * nz), k(2 * nz, 7), e(2 * nz), za(nz), zda(nz), &
-              zdda(nz), lam(m%neq), zz(nz), zzd(nz), zzdd(nz), qq(n), vv(n), aa(n), y2(n), y3(n), &
-              v0(n), wk(np, m%neq), yf(n, np), stat=st)
+              zdda(nz), lam(m%neq), zz(nz), zzd(nz), zzdd(nz), qq(n), vv(n), aa(n), y3(n), &
+              v0(n), stat=st)
     if (st /= 0) then
       status = MBD_NO_MEMORY; msg = 'out of memory for the sensitivity integration'; return
     end if
     call proj_init(m, w, s%np, pw, status, msg)
     if (status /= MBD_OK) return
-    y(1:n) = q; y(n + 1:nz) = reshape(sq, [n * np])
-    y(nz + 1:nz + n) = qd; y(nz + n + 1:) = reshape(sqd, [n * np])
+    y = zero
+    y(1:n) = q; y(nz + 1:nz + n) = qd
+    call cols_to_rows(n, np, npd, n, sq, y(n + 1:nz))
+    call cols_to_rows(n, np, npd, n, sqd, y(nz + n + 1:))
     t = t0
     call rhs(t, y, k(:, 1), st)
     if (st /= MBD_OK) then
@@ -366,7 +375,7 @@ contains
       tnew = t + h
       call step(st)
       if (st == MBD_OK .and. all(ieee_is_finite(yn))) then
-        err = sqrt(sum((e / (atol + rtol * max(abs(y), abs(yn))))**2) / size(e))
+        err = sqrt(sum((e / (atol + rtol * max(abs(y), abs(yn))))**2) / nreal)
       else
         err = 10.0_wp
       end if
@@ -401,7 +410,8 @@ contains
       h = h * fac
     end do
     q = y(1:n); qd = y(nz + 1:nz + n)
-    sq = reshape(y(n + 1:nz), [n, np]); sqd = reshape(y(nz + n + 1:), [n, np])
+    call rows_to_cols(n, np, npd, y(n + 1:nz), sq)
+    call rows_to_cols(n, np, npd, y(nz + n + 1:), sqd)
   contains
 
     !> One Dormand-Prince step from (t, y) with k(:, 1) = f(t, y) known: yn, e.
@@ -425,12 +435,13 @@ contains
     end subroutine step
 
     !> f(t, y): (z_dot, z_ddot), z = (q, S): q_ddot from the index-1 system, each S_ddot from
-    !! its differentiation with the same factors.
+    !! its differentiation with the same factors (S, S_dot and S_ddot as rows).
     subroutine rhs(tt, yy, f, stp)
-      real(wp), intent(in) :: tt, yy(:)
-      real(wp), intent(out) :: f(:)
+      real(wp), intent(in) :: tt
+      real(wp), intent(in), contiguous :: yy(:)
+      real(wp), intent(out), contiguous :: f(:)
       integer, intent(out) :: stp
-      integer :: kk, o
+      integer :: kk
       stats(3) = stats(3) + 1
       qq = yy(1:n); vv = yy(nz + 1:nz + n)
       call dyn_accel(m, w, qq, vv, tt, aa, lam, stp)
@@ -440,25 +451,24 @@ contains
       ! cos and sin of the angles at qq: the assembly's (sens_trig's values, not computed again)
       s%cb(1:m%nb) = w%asm%cb(1:m%nb); s%sb(1:m%nb) = w%asm%sb(1:m%nb)
       call sens_hessian(m, s, qq, vv, aa, tt)
-      call sens_params(m, s, qq, vv, aa, tt)
+      ! (the parameter parts: only parameters that change a constraint have any)
+      if (pcon) call sens_params(m, s, qq, vv, aa, tt, states=.false.)
       call sens_klam_list(m, s, lam)
-      ! the right-hand side of each parameter as a row of rt, then one solve for all
-      call sens_force_dm(m, s, 1, np, qq, vv, n, yy(n + 1:nz), yy(nz + n + 1:), tt, yf)
+      ! the right-hand sides as the rows of rt, every parameter at once, then one solve
+      call accel_rows(n, np, npd, s%tmass, aa, s%kln, s%klr, s%klc, s%klv, yy(n + 1:nz), &
+                      pw%rt)
+      call sens_force_rows(m, s, qq, vv, tt, npd, yy(n + 1:nz), yy(nz + n + 1:), pw%rt)
       do kk = 1, np
-        o = n * kk
-        call sens_klam(s, yy(o + 1:o + n), y2)
+        if (.not. s%kcon(kk)) cycle             ! (J_p = 0 otherwise)
         call sens_jpt_lam(m, s, kk, qq, tt, lam, y3)
-        call force_row(n, size(pw%rt, 1), kk, yf(:, kk), s%tmass(:, kk), aa, y2, y3, pw%rt)
+        pw%rt(kk, 1:n) = pw%rt(kk, 1:n) - y3
       end do
-      call constraint_rows(n, np, m%neq, w%na, s%nnz, size(pw%rt, 1), s%nzr, s%nzc, s%nza, &
-                           s%nzv, size(s%ap, 1), s%ap, w%rows, w%s, yy(n + 1:nz), &
-                           yy(nz + n + 1:), wk, pw%rt)
+      ! gamma_p - J_p q_ddot - Ha S - 2 Hv S_dot
+      call sens_kin_rhs(s, 3, s%rhs, yy(n + 1:nz), yy(nz + n + 1:))
+      call constraint_rows(n, w%na, npd, m%neq, w%rows, w%s, s%rhs, pw%rt)
       call dyn_solve_rows(w, pw%rt, pw%xr, pw%fones, stp)
       if (stp /= MBD_OK) return
-      do kk = 1, np
-        o = n * kk
-        f(nz + o + 1:nz + o + n) = pw%xr(1:n, kk)
-      end do
+      call cols_to_rows(n, np, npd, size(pw%xr, 1), pw%xr, f(nz + n + 1:))
     end subroutine rhs
 
     !> Project q, q_dot (mbd_dynamics) and then S, S_dot (project_sens).
@@ -472,7 +482,7 @@ contains
       call dyn_velocity(m, w, qq, tt, v0, vv, stp)
       if (stp /= MBD_OK) return
       yy(1:n) = qq; yy(nz + 1:nz + n) = vv
-      call project_sens(m, w, s, tt, yy, pw, stp)
+      call project_sens(m, w, s, tt, yy, pw, .true., stp)
     end subroutine project
 
     !> The stored outputs in (ta, tb] by quintic Hermite interpolation of z = (q, S).
@@ -497,112 +507,179 @@ contains
       integer, intent(in) :: row
       real(wp), intent(in) :: z1(:), z2(:), z3(:)
       qo(:, row) = z1(1:n); vo(:, row) = z2(1:n); ao(:, row) = z3(1:n)
-      so(:, :, row) = reshape(z1(n + 1:), [n, np])
-      sdo(:, :, row) = reshape(z2(n + 1:), [n, np])
-      sddo(:, :, row) = reshape(z3(n + 1:), [n, np])
+      call rows_to_cols(n, np, npd, z1(n + 1:), so(:, :, row))
+      call rows_to_cols(n, np, npd, z2(n + 1:), sdo(:, :, row))
+      call rows_to_cols(n, np, npd, z3(n + 1:), sddo(:, :, row))
     end subroutine put
   end subroutine sens_dopri5
 
-  !> Row k of the sensitivities' right-hand sides, its first n entries (the dynamic
-  !! equations): Q_p + K S_k + C S_dot_k (y1) - M_p q_ddot - K_lambda S_k (y2) - J_p^T lambda
-  !! (y3).
-  pure subroutine force_row(n, npad, k, y1, tm, aa, y2, y3, rt)
-    integer, intent(in) :: n, npad, k
-    real(wp), intent(in) :: y1(n), tm(n), aa(n), y2(n), y3(n)
-    real(wp), intent(inout) :: rt(npad, *)
-    integer :: i
+  !> Columns c (n of each of np; leading dimension ldc) as rows r (npd, n) (the padding rows
+  !! zero). (The loops over parameters go by fours, written out, and a remainder: loops of
+  !! a variable count this short cost several times their work.)
+  pure subroutine cols_to_rows(n, np, npd, ldc, c, r)
+    integer, intent(in) :: n, np, npd, ldc
+    real(wp), intent(in) :: c(ldc, np)
+    real(wp), intent(out) :: r(npd, n)
+    integer :: i, k, g
     do i = 1, n
-      rt(k, i) = ((y1(i) - tm(i) * aa(i)) - y2(i)) - y3(i)
-    end do
-  end subroutine force_row
-
-  !> The constraint rows of the sensitivities' right-hand sides, every parameter at once (each
-  !! entry's indices and values read once): rt(k, n + i) = s w(k, rows(i)),
-  !! w(k, :) = gamma_p - J_p q_ddot (ap's row k) - Hq S_k - 2 Hv S_dot_k (the entries nzr,
-  !! nzc, nza, nzv; S and S_dot (n, np) the packed state's).
-  pure subroutine constraint_rows(n, np, neq, na, nnz, npad, nzr, nzc, nza, nzv, ldap, ap, &
-                                  rows, sc, sq, sqd, wk, rt)
-    integer, intent(in) :: n, np, neq, na, nnz, npad, ldap
-    integer, intent(in) :: nzr(*), nzc(*), rows(na)
-    real(wp), intent(in) :: nza(*), nzv(*), ap(ldap, neq), sc, sq(n, np), sqd(n, np)
-    real(wp), intent(out) :: wk(np, neq)
-    real(wp), intent(inout) :: rt(npad, *)
-    integer :: i, k, ir, ic
-    real(wp) :: a1, a2
-    wk = ap(1:np, :)
-    do i = 1, nnz
-      ir = nzr(i); ic = nzc(i); a1 = nza(i); a2 = 2 * nzv(i)
-      do k = 1, np
-        wk(k, ir) = wk(k, ir) - a1 * sq(ic, k) - a2 * sqd(ic, k)
+      do g = 0, np - 4, 4
+        r(g + 1, i) = c(i, g + 1); r(g + 2, i) = c(i, g + 2)
+        r(g + 3, i) = c(i, g + 3); r(g + 4, i) = c(i, g + 4)
+      end do
+      do k = 4 * (np / 4) + 1, npd
+        r(k, i) = zero
+        if (k <= np) r(k, i) = c(i, k)
       end do
     end do
+  end subroutine cols_to_rows
+
+  !> Rows r (npd, n) as columns c (n, np).
+  pure subroutine rows_to_cols(n, np, npd, r, c)
+    integer, intent(in) :: n, np, npd
+    real(wp), intent(in) :: r(npd, n)
+    real(wp), intent(out) :: c(n, np)
+    integer :: i, k
+    do k = 1, np
+      do i = 1, n
+        c(i, k) = r(k, i)
+      end do
+    end do
+  end subroutine rows_to_cols
+
+  !> The first n entries (the dynamic equations) of the sensitivities' right-hand sides as
+  !! rows, but for the forces' changes (sens_force_rows adds them) and J_p^T lambda:
+  !! rt(k, :) = - M_p q_ddot - K_lambda S_k (the list klr, klc, klv; S as rows st).
+  pure subroutine accel_rows(n, np, npd, tm, aa, kln, klr, klc, klv, st, rt)
+    integer, intent(in) :: n, np, npd, kln
+    integer, intent(in) :: klr(*), klc(*)
+    real(wp), intent(in) :: tm(n, np), aa(n), klv(*), st(npd, n)
+    real(wp), intent(inout) :: rt(npd, *)
+    integer :: i, k, e, r, c, g
+    real(wp) :: v, a
+    do i = 1, n
+      a = aa(i)
+      do g = 0, np - 4, 4
+        rt(g + 1, i) = -tm(i, g + 1) * a; rt(g + 2, i) = -tm(i, g + 2) * a
+        rt(g + 3, i) = -tm(i, g + 3) * a; rt(g + 4, i) = -tm(i, g + 4) * a
+      end do
+      do k = 4 * (np / 4) + 1, np
+        rt(k, i) = -tm(i, k) * a
+      end do
+    end do
+    do e = 1, kln                               ! (the padding rows stay zero: st's are)
+      r = klr(e); c = klc(e); v = klv(e)
+      do g = 0, npd - 4, 4
+        rt(g + 1, r) = rt(g + 1, r) - v * st(g + 1, c)
+        rt(g + 2, r) = rt(g + 2, r) - v * st(g + 2, c)
+        rt(g + 3, r) = rt(g + 3, r) - v * st(g + 3, c)
+        rt(g + 4, r) = rt(g + 4, r) - v * st(g + 4, c)
+      end do
+    end do
+  end subroutine accel_rows
+
+  !> The constraint rows of the sensitivities' right-hand sides: rt(:, n + i) = sc
+  !! w(:, rows(i)), w = gamma_p - J_p q_ddot - Ha S - 2 Hv S_dot as rows (sens_kin_rhs).
+  pure subroutine constraint_rows(n, na, npad, neq, rows, sc, wk, rt)
+    integer, intent(in) :: n, na, npad, neq, rows(na)
+    real(wp), intent(in) :: sc, wk(npad, neq)
+    real(wp), intent(inout) :: rt(npad, *)
+    integer :: i, g, r
     do i = 1, na
-      do k = 1, np
-        rt(k, n + i) = sc * wk(k, rows(i))
+      r = rows(i)
+      do g = 0, npad - 4, 4
+        rt(g + 1, n + i) = sc * wk(g + 1, r); rt(g + 2, n + i) = sc * wk(g + 2, r)
+        rt(g + 3, n + i) = sc * wk(g + 3, r); rt(g + 4, n + i) = sc * wk(g + 4, r)
       end do
     end do
   end subroutine constraint_rows
 
   !> Project the sensitivities in the packed state yy = (q, S, q_dot, S_dot) (q, q_dot
-  !! consistent) onto the linearized constraints: S onto J S = -Phi_p by the minimum-norm
-  !! change, s [I J^T; J 0][dS; mu] = [0; -s (J S + Phi_p)], then S_dot onto
+  !! consistent; S and S_dot as rows (npd, n), sens_dopri5) onto the linearized
+  !! constraints: S onto J S = -Phi_p by the change nearest in the metric D,
+  !! s [D J^T; J 0][dS; mu] = [0; -s (J S + Phi_p)], then S_dot onto
   !! J S_dot = nu_p - J_p q_dot - Hv S nearest in the kinetic metric,
-  !! s [M J^T; J 0][S_dot; mu] = [M S_dot; s (nu_p - J_p q_dot - Hv S)], with the matrices
-  !! and solves of the state's projections (dyn_factor_projection: the Schur complement, the
-  !! band or the dense LU as the model allows; no dense J).
-  subroutine project_sens(m, w, s, tt, yy, pw, stp)
+  !! s [M J^T; J 0][S_dot; mu] = [M S_dot; s (nu_p - J_p q_dot - Hv S)], every parameter at
+  !! once, with the matrices and solves of the state's projections (dyn_factor_projection:
+  !! the Schur complement, the band or the dense LU as the model allows; no dense J).
+  !! reuse: the factors of the kinetic matrix at yy's q are in w (dyn_velocity's, after a
+  !! step): both projections take them (D = M); otherwise (the start) D = I, the
+  !! minimum-norm change, as the assembly of q0 makes, and the kinetic matrix is factored
+  !! after.
+  subroutine project_sens(m, w, s, tt, yy, pw, reuse, stp)
     type(model_t), intent(in) :: m              !! model with dynamics data
     type(dyn_work_t), intent(inout) :: w        !! dynamics work arrays (its matrix is used)
     type(sens_t), intent(inout) :: s            !! parameters and blocks
     real(wp), intent(in) :: tt                  !! time
-    real(wp), intent(inout) :: yy(:)            !! packed state
+    real(wp), intent(inout), contiguous :: yy(:)  !! packed state
     type(proj_work_t), intent(inout) :: pw      !! work (proj_init)
+    logical, intent(in) :: reuse                !! w holds the kinetic matrix's factors at q
     integer, intent(out) :: stp                 !! MBD_OK or MBD_SINGULAR
-    integer :: kk, o, i, n, nz
-    n = m%nq; nz = n * (1 + s%np)
-    associate (rt => pw%rt, xr => pw%xr, hvs => pw%hvs, z => w%qz)  ! (w%qz: a zero vector)
-      call sens_trig(m, s, yy(1:n))
+    integer :: kk, i, n, nz, npd, np
+    n = m%nq; np = s%np; npd = size(pw%rt, 1); nz = n * (1 + npd)
+    associate (rt => pw%rt, xr => pw%xr, z => w%qz)  ! (w%qz: a zero vector)
+      if (reuse) then                           ! (the assembly's cos and sin at q)
+        s%cb(1:m%nb) = w%asm%cb(1:m%nb); s%sb(1:m%nb) = w%asm%sb(1:m%nb)
+      else
+        call sens_trig(m, s, yy(1:n))
+      end if
       call sens_hessian(m, s, yy(1:n), yy(nz + 1:nz + n), z, tt)
-      call sens_params(m, s, yy(1:n), yy(nz + 1:nz + n), z, tt)
-      call dyn_factor_projection(m, w, yy(1:n), tt, .false., stp)
-      if (stp /= MBD_OK) return
-      do kk = 1, s%np                           ! S += dS (one solve for all parameters)
-        o = n * kk
-        call dyn_jv(m, w, yy(o + 1:o + n))
-        rt(kk, 1:n) = zero
-        do i = 1, w%na
-          rt(kk, n + i) = w%s * (s%mphip(kk, w%rows(i)) - w%jv(w%rows(i)))
+      if (any(s%kcon)) call sens_params(m, s, yy(1:n), yy(nz + 1:nz + n), z, tt, states=.false.)
+      if (.not. reuse) then
+        call dyn_factor_projection(m, w, yy(1:n), tt, .false., stp)
+        if (stp /= MBD_OK) return
+      end if
+      call blocks_jv_rows(m, w%asm, npd, yy(n + 1:nz), pw%jst)   ! J S, every parameter
+      do i = 1, n
+        rt(:, i) = zero
+      end do
+      do i = 1, w%na                            ! S += dS (one solve for all parameters)
+        do kk = 1, npd
+          rt(kk, n + i) = w%s * (s%mphip(kk, w%rows(i)) - pw%jst(kk, w%rows(i)))
         end do
       end do
       call dyn_solve_rows(w, rt, xr, pw%fones, stp)
       if (stp /= MBD_OK) return
-      do kk = 1, s%np
-        o = n * kk
-        yy(o + 1:o + n) = yy(o + 1:o + n) + xr(1:n, kk)
-      end do
-      call dyn_factor_projection(m, w, yy(1:n), tt, .true., stp, assembled=.true.)
-      if (stp /= MBD_OK) return
-      do kk = 1, s%np                           ! S_dot, nearest in M
-        o = n * kk
-        hvs = s%vp(kk, :)
-        do i = 1, s%nnz
-          hvs(s%nzr(i)) = hvs(s%nzr(i)) - s%nzv(i) * yy(o + s%nzc(i))
-        end do
-        do i = 1, n
-          rt(kk, i) = w%metric(i) * yy(nz + o + i)
-        end do
-        do i = 1, w%na
-          rt(kk, n + i) = w%s * hvs(w%rows(i))
-        end do
-      end do
+      call add_rows(n, np, npd, size(xr, 1), xr, yy(n + 1:nz))
+      if (.not. reuse) then
+        call dyn_factor_projection(m, w, yy(1:n), tt, .true., stp, assembled=.true.)
+        if (stp /= MBD_OK) return
+      end if
+      ! S_dot, nearest in M: [M S_dot; s (nu_p - J_p q_dot - Hv S)]
+      call sens_kin_rhs(s, 2, s%rhs, yy(n + 1:nz), yy(nz + n + 1:))
+      call metric_rows(n, npd, w%metric, yy(nz + n + 1:), rt)
+      call constraint_rows(n, w%na, npd, m%neq, w%rows, w%s, s%rhs, rt)
       call dyn_solve_rows(w, rt, xr, pw%fones, stp)
       if (stp /= MBD_OK) return
-      do kk = 1, s%np
-        o = n * kk
-        yy(nz + o + 1:nz + o + n) = xr(1:n, kk)
-      end do
+      call cols_to_rows(n, np, npd, size(xr, 1), xr, yy(nz + n + 1:))
     end associate
   end subroutine project_sens
+
+  !> r(:, i) += c(i, :) for the np columns of c (leading dimension ldc), r (npd, n).
+  pure subroutine add_rows(n, np, npd, ldc, c, r)
+    integer, intent(in) :: n, np, npd, ldc
+    real(wp), intent(in) :: c(ldc, np)
+    real(wp), intent(inout) :: r(npd, n)
+    integer :: i, k
+    do i = 1, n
+      do k = 1, np
+        r(k, i) = r(k, i) + c(i, k)
+      end do
+    end do
+  end subroutine add_rows
+
+  !> rt(:, i) = metric(i) sd(:, i), i = 1 .. n (sd as rows (npd, n)).
+  pure subroutine metric_rows(n, npd, metric, sd, rt)
+    integer, intent(in) :: n, npd
+    real(wp), intent(in) :: metric(n), sd(npd, n)
+    real(wp), intent(inout) :: rt(npd, *)
+    integer :: i, g
+    do i = 1, n
+      do g = 0, npd - 4, 4
+        rt(g + 1, i) = metric(i) * sd(g + 1, i); rt(g + 2, i) = metric(i) * sd(g + 2, i)
+        rt(g + 3, i) = metric(i) * sd(g + 3, i); rt(g + 4, i) = metric(i) * sd(g + 4, i)
+      end do
+    end do
+  end subroutine metric_rows
 
   !> Sensitivities of the consistent initial state of forward dynamics: the assembled q
   !! changes by the minimum-norm solution of J S = -Phi_p, the projected q_dot by the
@@ -616,18 +693,19 @@ contains
     real(wp), intent(out) :: sq(:, :), sqd(:, :)  !! (nq, np)
     integer, intent(out) :: status              !! MBD_OK or MBD_SINGULAR
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
-    real(wp) :: y(2 * m%nq * (1 + s%np))
+    real(wp) :: y(2 * m%nq * (1 + 4 * ((s%np + 3) / 4)))
     type(proj_work_t) :: pw
-    integer :: n, nz
-    n = m%nq; nz = n * (1 + s%np)
+    integer :: n, nz, npd
+    n = m%nq; npd = 4 * ((s%np + 3) / 4); nz = n * (1 + npd)
     y = zero
     y(1:n) = q; y(nz + 1:nz + n) = qd
     call proj_init(m, w, s%np, pw, status, msg)
     if (status /= MBD_OK) return
     msg = ''
-    call project_sens(m, w, s, t, y, pw, status)
+    call project_sens(m, w, s, t, y, pw, .false., status)
     if (status /= MBD_OK) msg = 'the initial sensitivities cannot be made consistent'
-    sq = reshape(y(n + 1:nz), [n, s%np]); sqd = reshape(y(nz + n + 1:), [n, s%np])
+    call rows_to_cols(n, s%np, npd, y(n + 1:nz), sq)
+    call rows_to_cols(n, s%np, npd, y(nz + n + 1:), sqd)
   end subroutine sens_initial
 
 end module mbd_sens_dynamics

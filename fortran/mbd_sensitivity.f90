@@ -31,13 +31,15 @@ module mbd_sensitivity
                              CON_TRANSLATIONAL, DRV_REL_DIST, CON_REVOLUTE
   use mbd_joint_revolute, only: revolute_second_sides, revolute_param_sides
   use mbd_joint_translational, only: translational_second, translational_param
-  use mbd_forces, only: force_eval_d, force_eval_dm, force_is_count, force_exponents
+  use mbd_forces, only: force_eval_d, force_eval_dm, force_is_count, force_exponents, &
+                        force_rows_d
   implicit none
   private
   public :: sens_t, PT_RPAR, PT_MASS, PT_GRAV, PT_FPAR
   public :: sens_setup, sens_trig, sens_states, sens_hessian, sens_params, sens_kin_rhs, &
             block_apply, block_apply_t, block_apply_cols, &
             sens_klam, sens_klam_list, sens_jpt_lam, sens_force_d, sens_force_dm, sens_force_jac, &
+            sens_force_rows, &
             sens_eval_d
 
   integer, parameter :: PT_RPAR = 1, PT_MASS = 2, PT_GRAV = 3, PT_FPAR = 4  !! table ids
@@ -56,6 +58,10 @@ module mbd_sensitivity
     logical, allocatable :: caff(:, :)       !! (nc, np) the constraint's parameters change
     real(wp), allocatable :: tfp(:, :)       !! (size(m%fp), np) change of the force pool
     logical, allocatable :: faff(:, :)       !! (nf, np) the force's parameters change
+    logical, allocatable :: kgrav(:)         !! (np) the parameter changes a mass or gravity
+    logical, allocatable :: kcon(:)          !! (np) the parameter changes a constraint
+    !> (nq, np) the change of the gravity loads m g (with the masses and g: constant)
+    real(wp), allocatable :: qg(:, :)
     real(wp), allocatable :: tmass(:, :)     !! (nq, np) change of the mass matrix diagonal
     real(wp), allocatable :: tgrav(:, :)     !! (2, np) change of gravity
     ! local blocks at the current state (sens_hessian)
@@ -233,6 +239,22 @@ contains
       end select
     end do
     bad = 0
+    allocate (s%kgrav(s%np), s%kcon(s%np), s%qg(m%nq, s%np), stat=st)
+    if (st /= 0) then
+      status = MBD_NO_MEMORY; msg = 'out of memory for the sensitivity arrays'; return
+    end if
+    s%qg = zero
+    do k = 1, s%np
+      s%kgrav(k) = any(abs(s%tmass(:, k)) > zero) .or. any(abs(s%tgrav(:, k)) > zero)
+      s%kcon(k) = any(s%caff(:, k))
+      if (.not. (dyn .and. s%kgrav(k))) cycle
+      do i = 1, m%nb                              ! d(m g) = dm g + m dg
+        s%qg(3 * i - 2, k) = s%tmass(3 * i - 2, k) * m%grav(1) + m%mdiag(3 * i - 2) * &
+                             s%tgrav(1, k)
+        s%qg(3 * i - 1, k) = s%tmass(3 * i - 2, k) * m%grav(2) + m%mdiag(3 * i - 2) * &
+                             s%tgrav(2, k)
+      end do
+    end do
     call sens_lists(m, s, st)
     if (st /= 0) then
       status = MBD_NO_MEMORY; msg = 'out of memory for the sensitivity arrays'; return
@@ -752,10 +774,22 @@ contains
   !! (npad, nq; the solves write them, padding rows zero): level 2 nu_p - J_p q_dot - Hv s;
   !! 3 gamma_p - J_p q_ddot - Ha s - 2 Hv s_dot (level 1's, -Phi_p, is s%mphip itself).
   !! sens_hessian and sens_params first.
-  pure subroutine sens_kin_rhs(s, level, rhs)
+  pure subroutine sens_kin_rhs(s, level, rhs, st, sdt)
     type(sens_t), intent(in) :: s            !! blocks, parameter parts, s and s_dot as rows
     integer, intent(in) :: level             !! 2 velocity, 3 acceleration
     real(wp), intent(inout) :: rhs(:, :)     !! (npad, neq)
+    !> s and s_dot as rows (npad, nq) in place of s%st, s%sdt
+    real(wp), intent(in), optional :: st(:), sdt(:)
+    if (present(st) .and. present(sdt)) then
+      if (level == 2) then
+        call kin_rhs_kernel(size(rhs, 1), size(rhs, 2), size(s%st, 2), s%nnz, s%nzr, s%nzc, &
+                            s%nzv, s%nzv, .false., s%vp, st, sdt, rhs)
+      else
+        call kin_rhs_kernel(size(rhs, 1), size(rhs, 2), size(s%st, 2), s%nnz, s%nzr, s%nzc, &
+                            s%nza, s%nzv, .true., s%ap, st, sdt, rhs)
+      end if
+      return
+    end if
     if (level == 2) then
       call kin_rhs_kernel(size(rhs, 1), size(rhs, 2), size(s%st, 2), s%nnz, s%nzr, s%nzc, &
                           s%nzv, s%nzv, .false., s%vp, s%st, s%sdt, rhs)
@@ -841,7 +875,7 @@ contains
     type(model_t), intent(in) :: m           !! model
     type(sens_t), intent(inout) :: s         !! Hessian blocks; the list (out)
     real(wp), intent(in) :: lam(:)           !! multipliers (neq)
-    integer :: k, i, j, r, r0, ci, cj
+    integer :: k, i, j, r, r0, ci, cj, nr
     real(wp) :: acc
     s%kln = 0
     do k = 1, m%nc
@@ -858,14 +892,16 @@ contains
         end do
         cycle
       end if
+      nr = m%nrow(k)
+      if (m%kind(k) == CON_TRANSLATIONAL) nr = 1   ! (its second row is linear in q)
       do j = 1, NLOC
         cj = m%loc(j, k)
         if (cj == 0) cycle
         do i = 1, NLOC
           ci = m%loc(i, k)
           if (ci == 0) cycle
-          acc = zero
-          do r = 1, m%nrow(k)
+          acc = lam(r0 + 1) * s%hs(1, i, j, k)
+          do r = 2, nr
             acc = acc + lam(r0 + r) * s%hs(r, i, j, k)
           end do
           if (abs(acc) <= zero) cycle
@@ -963,15 +999,13 @@ contains
     real(wp), intent(out) :: y(nq, nk)       !! changes of Q
     integer, parameter :: KB = 4             ! directions per force evaluation
     real(wp) :: ql(NLOC), qdl(NLOC), tql(NLOC, KB), tqdl(NLOC, KB), fl(NLOC, KB)
-    integer :: f, j, c, si, sj, b, k, n0, n1, g, ng
-    y = zero
-    do k = 1, nk
-      if (k0 < 1) exit
-      do b = 1, m%nb
-        y(3 * b - 2:3 * b - 1, k) = s%tmass(3 * b - 2, k0 + k - 1) * m%grav + &
-                                    m%mdiag(3 * b - 2) * s%tgrav(:, k0 + k - 1)
-      end do
-    end do
+    logical, parameter :: none(KB) = .false.
+    integer :: f, j, c, si, sj, k, n0, n1, g, ng
+    if (k0 > 0) then                           ! m g changes with the masses and g (qg)
+      y = s%qg(:, k0:k0 + nk - 1)
+    else
+      y = zero
+    end if
     do f = 1, m%nf
       n0 = m%fpo(f); n1 = n0 + m%fpn(f) - 1
       si = merge(1, 0, m%fbi(f) > 0); sj = merge(2, 0, m%fbj(f) > 0)
@@ -984,31 +1018,82 @@ contains
       end do
       do g = 1, nk, KB
         ng = min(KB, nk - g + 1)
-        do k = 1, ng
-          do j = 1, NLOC
-            c = m%floc(j, f)
-            tql(j, k) = zero; tqdl(j, k) = zero
-            if (c > 0) then
-              tql(j, k) = dq(c, g + k - 1); tqdl(j, k) = dqd(c, g + k - 1)
-            end if
+        tql = zero; tqdl = zero
+        do j = 1, NLOC
+          c = m%floc(j, f)
+          if (c == 0) cycle
+          do k = 1, ng
+            tql(j, k) = dq(c, g + k - 1); tqdl(j, k) = dqd(c, g + k - 1)
           end do
         end do
         if (k0 > 0) then
           call force_eval_dm(m%fkind(f), m%fp(n0:n1), s%tfp(n0:n1, k0 + g - 1:k0 + g + ng - 2), &
-                             si, sj, ql, qdl, tql(:, 1:ng), tqdl(:, 1:ng), t, fl(:, 1:ng))
-        else
-          call force_eval_dm(m%fkind(f), m%fp(n0:n1), s%zfp(n0:n1, 1:ng), si, sj, ql, qdl, &
+                             s%faff(f, k0 + g - 1:k0 + g + ng - 2), si, sj, ql, qdl, &
                              tql(:, 1:ng), tqdl(:, 1:ng), t, fl(:, 1:ng))
+        else
+          call force_eval_dm(m%fkind(f), m%fp(n0:n1), s%zfp(n0:n1, 1:ng), none(1:ng), si, sj, &
+                             ql, qdl, tql(:, 1:ng), tqdl(:, 1:ng), t, fl(:, 1:ng))
         end if
-        do k = 1, ng
-          do j = 1, NLOC
-            c = m%floc(j, f)
-            if (c > 0) y(c, g + k - 1) = y(c, g + k - 1) + fl(j, k)
+        do j = 1, NLOC
+          c = m%floc(j, f)
+          if (c == 0) cycle
+          do k = 1, ng
+            y(c, g + k - 1) = y(c, g + k - 1) + fl(j, k)
           end do
         end do
       end do
     end do
   end subroutine sens_force_dm
+
+  !> The changes of the applied generalized forces along every parameter's sensitivity,
+  !! added to rt(:, 1:nq) (a row per parameter, npad rows, a multiple of 4; the rows past
+  !! np stay as they are): along (S, S_dot) given as rows st, sdt (npad, nq) and by the
+  !! parameters' own changes (force_rows_d, four parameters at a time), and the change of
+  !! m g (qg).
+  pure subroutine sens_force_rows(m, s, q, qd, t, npad, st, sdt, rt)
+    type(model_t), intent(in) :: m           !! model with dynamics data
+    type(sens_t), intent(in) :: s            !! parameters
+    real(wp), intent(in) :: q(:), qd(:)      !! state
+    real(wp), intent(in) :: t                !! time
+    integer, intent(in) :: npad              !! rows
+    real(wp), intent(in) :: st(npad, *), sdt(npad, *)  !! S, S_dot as rows
+    real(wp), intent(inout) :: rt(npad, *)   !! right-hand sides as rows
+    real(wp) :: ql(NLOC), qdl(NLOC), tqr(4, NLOC), tqdr(4, NLOC), tfr(4, NLOC)
+    integer :: f, j, c, si, sj, k, n0, n1, g, ng
+    do k = 1, s%np                             ! d(m g): the masses' and g's changes
+      if (.not. s%kgrav(k)) cycle
+      do j = 1, m%nq
+        rt(k, j) = rt(k, j) + s%qg(j, k)
+      end do
+    end do
+    do f = 1, m%nf
+      n0 = m%fpo(f); n1 = n0 + m%fpn(f) - 1
+      si = merge(1, 0, m%fbi(f) > 0); sj = merge(2, 0, m%fbj(f) > 0)
+      do j = 1, NLOC
+        c = m%floc(j, f)
+        ql(j) = zero; qdl(j) = zero
+        if (c > 0) then
+          ql(j) = q(c); qdl(j) = qd(c)
+        end if
+      end do
+      do g = 0, npad - 4, 4
+        ng = min(4, s%np - g)
+        tqr = zero; tqdr = zero
+        do j = 1, NLOC
+          c = m%floc(j, f)
+          if (c == 0) cycle
+          tqr(:, j) = st(g + 1:g + 4, c); tqdr(:, j) = sdt(g + 1:g + 4, c)
+        end do
+        call force_rows_d(m%fkind(f), m%fp(n0:n1), s%tfp(n0:n1, g + 1:g + ng), &
+                          s%faff(f, g + 1:g + ng), si, sj, ql, qdl, ng, tqr, tqdr, t, tfr)
+        do j = 1, NLOC
+          c = m%floc(j, f)
+          if (c == 0) cycle
+          rt(g + 1:g + 4, c) = rt(g + 1:g + 4, c) + tfr(:, j)
+        end do
+      end do
+    end do
+  end subroutine sens_force_rows
 
   !> Dense Jacobians of the applied forces, kq = dQ/dq and (optionally) kv = dQ/dq_dot,
   !! from the dual evaluation of each force along its slots (nq x nq each).
