@@ -38,7 +38,8 @@ module mbd_api
                             SOLVER_BANDED, kin_newton, kin_vel_acc
   use mbd_status, only: MBD_BAD_SETTING, MBD_USER_ABORT
   use mbd_profiles, only: profile_raw_length, profile_prepare, profile_eval
-  use mbd_sensitivity, only: sens_t, sens_setup, sens_eval_d, sens_trig
+  use mbd_sensitivity, only: sens_t, sens_setup, sens_eval_d, sens_trig, sens_force_dm, &
+                             sens_force_rows
   use mbd_assemble, only: scatter_dense
   use mbd_sens_dynamics, only: sens_multipliers, sens_reactions, sens_statics, sens_dopri5, &
                                sens_initial
@@ -46,7 +47,7 @@ module mbd_api
   private
   public :: NINFO, api_sizes, api_eval, api_kinematics, api_profile, api_analyze, api_kin_step
   public :: api_inverse, api_dynamics, api_statics, api_reactions, api_cam_forces
-  public :: api_eval_d, api_reactions_dp, api_dynamics_sens
+  public :: api_eval_d, api_reactions_dp, api_dynamics_sens, api_forces_d
 
   integer, parameter :: NINFO = 10   !! length of the report arrays
 
@@ -1033,6 +1034,62 @@ contains
     call sens_eval_d(m, sens, k, q, qd, dq, dqd, t, tphi, tnu, tgam, aw%jb)
     call scatter_dense(aw, tjac)
   end subroutine api_eval_d
+
+  !> The applied generalized forces Q(q, q_dot, t) and their changes along nk directions
+  !! (columns of dq, dqd), direction k together with design parameter k (column k of ptab),
+  !! by both of the core's paths: dcol as inverse dynamics and statics take them
+  !! (sens_force_dm, direction by direction), drow as the dopri5 sensitivities (sens_force_rows,
+  !! the directions as rows). The model in its own units (no length scale).
+  subroutine api_forces_d(nb, ctab, rpar, bmass, grav, ftab, fpar, q, qd, t, dq, dqd, ptab, &
+                          qf, dcol, drow, status, msg, bad)
+    integer, intent(in) :: nb, ctab(:, :), ftab(:, :)  !! bodies, constraint and force tables
+    real(wp), intent(in) :: rpar(:), bmass(:, :), grav(2), fpar(:)
+    real(wp), intent(in) :: q(:), qd(:), t      !! state (nq), time
+    real(wp), intent(in) :: dq(:, :), dqd(:, :) !! directions (nq, nk)
+    integer, intent(in) :: ptab(:, :)           !! (2, nk) the parameters
+    real(wp), intent(out) :: qf(:)              !! Q (nq)
+    real(wp), intent(out) :: dcol(:, :), drow(:, :)  !! changes of Q (nq, nk)
+    integer, intent(out) :: status              !! MBD_OK or < 0
+    character(len=MSG_LEN), intent(out) :: msg  !! what is wrong
+    integer, intent(out) :: bad                 !! offending entry, or 0
+    type(model_t) :: m
+    type(sens_t) :: sens
+    real(wp), allocatable :: st(:, :), sdt(:, :), rt(:, :)
+    real(wp) :: v
+    integer :: badf, nk, npd, k, ist
+    qf = zero; dcol = zero; drow = zero; bad = 0
+    call model_build(nb, ctab, rpar, m, status, msg, bad, lforce=model_force_size(ftab, fpar))
+    if (status /= MBD_OK) return
+    call model_add_dynamics(m, bmass, grav, ftab, fpar, status, msg, badf)
+    if (status /= MBD_OK) then
+      bad = -badf; return
+    end if
+    if (.not. (finite(q) .and. finite(qd) .and. finite(t) .and. finite(dq) .and. &
+               finite(dqd))) then
+      call not_finite('the state and the directions', status, msg); return
+    end if
+    nk = size(ptab, 2)
+    if (size(q) /= m%nq .or. size(qd) /= m%nq .or. any(shape(dq) /= [m%nq, nk]) .or. &
+        any(shape(dqd) /= [m%nq, nk]) .or. size(qf) /= m%nq .or. &
+        any(shape(dcol) /= [m%nq, nk]) .or. any(shape(drow) /= [m%nq, nk]) .or. nk < 1) then
+      status = MBD_BAD_COUNT; msg = 'array sizes do not match the model'; return
+    end if
+    call sens_setup(m, ctab, rpar, ptab, sens, status, msg, bad, ftab, fpar)
+    if (status /= MBD_OK) return
+    call gen_forces(m, q, qd, t, qf, v)
+    call sens_force_dm(m, sens, 1, nk, q, qd, m%nq, dq, dqd, t, dcol)
+    npd = 4 * ((nk + 3) / 4)
+    allocate (st(npd, m%nq), sdt(npd, m%nq), rt(npd, m%nq), stat=ist)
+    if (ist /= 0) then
+      status = MBD_NO_MEMORY; msg = 'out of memory'; return
+    end if
+    st = zero; sdt = zero; rt = zero
+    st(1:nk, :) = transpose(dq); sdt(1:nk, :) = transpose(dqd)
+    call sens_force_rows(m, sens, q, qd, t, npd, st, sdt, rt)
+    do k = 1, nk
+      drow(:, k) = rt(k, :)
+    end do
+  end subroutine api_forces_d
 
   !> Changes of the reactions (as api_reactions) along design parameters at many states:
   !! dreac, drloc (6, nc, np, nt), from dq/dp (nq, np, nt) and dlambda/dp (neq, np, nt).

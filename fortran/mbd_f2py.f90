@@ -270,6 +270,23 @@ subroutine core_eval_d(nb, nc, ctab, np, rpar, nq, neq, q, qd, t, dq, dqd, npar,
                   bad)
 end subroutine core_eval_d
 
+subroutine core_forces_d(nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp, fpar, nq, q, qd, &
+                         t, nk, dq, dqd, ptab, qf, dcol, drow, status, msg, bad)
+  use iso_c_binding, only: c_double, c_int
+  use mbd_api, only: api_forces_d
+  implicit none
+  integer(c_int), intent(in) :: nb, nc, np, nf, nfp, nq, nk
+  integer(c_int), intent(in) :: ctab(8, nc), ftab(6, nf), ptab(2, nk)
+  real(c_double), intent(in) :: rpar(np), bmass(2, nb), grav(2), fpar(nfp), q(nq), qd(nq), t
+  real(c_double), intent(in) :: dq(nq, nk), dqd(nq, nk)
+  real(c_double), intent(out) :: qf(nq), dcol(nq, nk), drow(nq, nk)
+  integer(c_int), intent(out) :: status, bad
+  character(len=512), intent(out) :: msg
+  !f2py intent(hide) :: nc, np, nf, nfp, nq, nk
+  call api_forces_d(nb, ctab, rpar, bmass, grav, ftab, fpar, q, qd, t, dq, dqd, ptab, qf, dcol, &
+                    drow, status, msg, bad)
+end subroutine core_forces_d
+
 subroutine core_kinematics_sens(nb, nc, ctab, np, rpar, nq, neq, q0, t0, t1, nsteps, tol, &
                                 maxit, tmin, every, solver, nout, npar, ptab, qout, qdout, &
                                 qddout, sq, sqd, sqdd, iinfo, rinfo, qsing, dep, redundant, &

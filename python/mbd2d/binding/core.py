@@ -189,6 +189,19 @@ def eval_d(p: Packed, rpar: np.ndarray, q: np.ndarray, qd: np.ndarray, t: float,
                   p.neq, q, qd, float(t), dq, dqd, ptab)
 
 
+def forces_d(p: Packed, d: DynamicTables, rpar: np.ndarray, bmass: np.ndarray,
+             grav: np.ndarray, fpar: np.ndarray, q: np.ndarray, qd: np.ndarray, t: float,
+             dq: np.ndarray, dqd: np.ndarray, ptab: np.ndarray) -> SimpleNamespace:
+    """The applied generalized forces ``qf`` at (q, qd, t) and their changes along the
+    columns of dq, dqd, each with the design parameter of the same column of ptab, by the
+    core's two paths: ``dcol`` (inverse dynamics, statics) and ``drow`` (dopri5
+    sensitivities); ``status``, ``msg``, ``bad``. The parameter arrays are given (a test
+    changes them by differences); the tables' shapes come from p and d."""
+    return _named("qf dcol drow status msg bad", _core.core_forces_d, ctab=p.ctab, rpar=rpar,
+                  bmass=bmass, grav=grav, ftab=d.ftab, fpar=fpar, q=q, qd=qd, t=float(t),
+                  dq=np.asfortranarray(dq), dqd=np.asfortranarray(dqd), ptab=ptab)
+
+
 def kinematics_sens(p: Packed, t0: float, t1: float, steps: int, tol: float, maxit: int,
                     tmin: float, every: int, solver: int, nout: int,
                     ptab: np.ndarray) -> SimpleNamespace:
