@@ -1153,6 +1153,7 @@ contains
     type(kin_opts_t) :: kopts
     type(sens_t) :: sens
     real(wp), allocatable :: q(:), qd(:), s0(:, :), sd0(:, :)
+    logical, allocatable :: lok(:)
     real(wp) :: t, r_tol, a_tol, hmm(2), tfail
     integer :: bad, badf, k, ko, nout, st, stats(3), path, kl, ku
     character(len=MSG_LEN) :: lmsg
@@ -1217,9 +1218,13 @@ contains
     r_tol = 1.0e-6_wp; a_tol = 1.0e-8_wp
     if (rtol > zero) r_tol = rtol
     if (atol > zero) a_tol = atol
+    allocate (lok(size(qout, 2)), stat=st)
+    if (st /= 0) then
+      status = MBD_NO_MEMORY; msg = 'out of memory for the outputs'; return
+    end if
     call sens_dopri5(m, w, sens, q, qd, s0, sd0, t0, t1, nsteps, every, r_tol, a_tol, &
-                     max_steps, qout, qdout, qddout, sq, sqd, sqdd, nout, stats, hmm, tfail, &
-                     status, msg)
+                     max_steps, qout, qdout, qddout, sq, sqd, sqdd, lamout, lok, nout, stats, &
+                     hmm, tfail, status, msg)
     iinfo(1) = nout; iinfo(3) = stats(1); iinfo(4) = stats(2); iinfo(6) = stats(3)
     rinfo(2) = hmm(1); rinfo(3) = hmm(2)
     if (status /= MBD_OK) rinfo(1) = tfail
@@ -1227,7 +1232,9 @@ contains
       ko = output_index(nsteps, every, k)
       t = t0 + (t1 - t0) * (real(ko, wp) / max(nsteps, 1))
       if (ko == nsteps) t = t1
-      call dyn_multipliers(m, w, qout(:, k), qdout(:, k), qddout(:, k), t, lamout(:, k), st, lmsg)
+      ! (independent rows: the index-1 solve's lambda at the output, as in api_dynamics)
+      if (.not. lok(k)) call dyn_multipliers(m, w, qout(:, k), qdout(:, k), qddout(:, k), t, &
+                                             lamout(:, k), st, lmsg)
       call state_measures(m, w, qout(:, k), qdout(:, k), t, eout(:, k))
     end do
     call units(m, qout, m%cunit, .false.); call units(m, qdout, m%cunit, .false.)

@@ -298,8 +298,8 @@ contains
   !! so, sdo, sddo (nq, np, rows) the sensitivities of q, q_dot, q_ddot.
   !! stats: 1 steps, 2 rejected, 3 right-hand sides; hmm(1:2) smallest and largest step.
   subroutine sens_dopri5(m, w, s, q, qd, sq, sqd, t0, t1, nsteps, every, rtol, atol, &
-                         max_steps, qo, vo, ao, so, sdo, sddo, nout, stats, hmm, t_fail, &
-                         status, msg)
+                         max_steps, qo, vo, ao, so, sdo, sddo, lo, lok, nout, stats, hmm, &
+                         t_fail, status, msg)
     type(model_t), intent(in) :: m              !! model with dynamics data
     type(dyn_work_t), intent(inout) :: w        !! dynamics work arrays (dyn_init done)
     type(sens_t), intent(inout) :: s            !! parameters and blocks
@@ -311,6 +311,10 @@ contains
     integer, intent(in) :: max_steps            !! step limit
     real(wp), intent(out) :: qo(:, :), vo(:, :), ao(:, :)       !! (nq, rows)
     real(wp), intent(out) :: so(:, :, :), sdo(:, :, :), sddo(:, :, :)  !! (nq, np, rows)
+    !> multipliers at the outputs (neq, rows), those of the index-1 solve at the output's
+    !! state where lok (independent rows, a regular solve); elsewhere the caller finds them
+    real(wp), intent(out) :: lo(:, :)
+    logical, intent(out) :: lok(:)
     integer, intent(out) :: nout                !! rows written
     integer, intent(out) :: stats(3)            !! steps, rejected, right-hand sides
     real(wp), intent(out) :: hmm(2)             !! smallest, largest step
@@ -320,13 +324,14 @@ contains
     real(wp), allocatable :: y(:), yn(:), ys(:), k(:, :), e(:), za(:), zda(:), zdda(:), lam(:), &
                              zz(:), zzd(:), zzdd(:)
     ! the work of rhs and project (here, so that no step allocates)
-    real(wp), allocatable :: qq(:), vv(:), aa(:), y3(:), v0(:)
+    real(wp), allocatable :: qq(:), vv(:), aa(:), y3(:), v0(:), fo(:)
     type(proj_work_t) :: pw
     real(wp) :: t, h, tnew, err, fac, sc
     integer :: n, np, npd, nz, st, kout, nreal
     logical :: fsal, pcon
     status = MBD_OK; msg = ''; nout = 0; stats = 0; hmm = [huge(one), zero]; t_fail = t0
-    qo = zero; vo = zero; ao = zero; so = zero; sdo = zero; sddo = zero
+    qo = zero; vo = zero; ao = zero; so = zero; sdo = zero; sddo = zero; lo = zero
+    lok = .false.
     ! the packed state (q, S, q_dot, S_dot) holds S and S_dot as rows (npd, n), npd = np
     ! rounded up to a multiple of 4 (the padding rows stay zero: no rate, no error)
     n = m%nq; np = s%np; npd = 4 * ((np + 3) / 4); nz = n * (1 + npd)
@@ -339,7 +344,7 @@ contains
     end if
     allocate (y(2 * nz), yn(2 * nz), ys(2 * nz), k(2 * nz, 7), e(2 * nz), za(nz), zda(nz), &
               zdda(nz), lam(m%neq), zz(nz), zzd(nz), zzdd(nz), qq(n), vv(n), aa(n), y3(n), &
-              v0(n), stat=st)
+              v0(n), fo(2 * nz), stat=st)
     if (st /= 0) then
       status = MBD_NO_MEMORY; msg = 'out of memory for the sensitivity integration'; return
     end if
@@ -356,6 +361,7 @@ contains
       return
     end if
     za = y(1:nz); zda = y(nz + 1:); zdda = k(nz + 1:, 1)
+    lo(:, 1) = lam; lok(1) = w%na == m%neq .and. .not. w%lsq
     call put(1, za, zda, zdda)
     nout = 1; kout = 1
     fsal = .true.
@@ -497,11 +503,28 @@ contains
           call hermite5(ta, za, zda, zdda, tb, yn(1:nz), yn(nz + 1:), k(nz + 1:, 1), tk, zz, &
                         zzd, zzdd)
           nout = nout + 1
+          call at_state(nout, tk)
           call put(nout, zz, zzd, zzdd)
         end if
         kout = kout + 1
       end do
     end subroutine emit
+
+    !> The accelerations (q_ddot and S_ddot) and multipliers of an output from the index-1
+    !! equations at its interpolated state (zz, zzd), as mbd_integrators' finish_outputs
+    !! for the state alone (an interpolant of the accelerations errs about 100x more); the
+    !! interpolant's zzdd stays where the solve fails there.
+    subroutine at_state(row, tk)
+      integer, intent(in) :: row
+      real(wp), intent(in) :: tk
+      integer :: stp
+      ys(1:nz) = zz; ys(nz + 1:) = zzd
+      call rhs(tk, ys, fo, stp)
+      stats(3) = stats(3) - 1                   ! (an output's, not the integration's)
+      if (stp /= MBD_OK) return
+      zzdd = fo(nz + 1:)
+      lo(:, row) = lam; lok(row) = w%na == m%neq .and. .not. w%lsq
+    end subroutine at_state
 
     subroutine put(row, z1, z2, z3)
       integer, intent(in) :: row
