@@ -1085,6 +1085,7 @@ contains
     end if
     st = zero; sdt = zero; rt = zero
     st(1:nk, :) = transpose(dq); sdt(1:nk, :) = transpose(dqd)
+    call sens_trig(m, sens, q)                   ! (the bodies' cos and sin it takes)
     call sens_force_rows(m, sens, q, qd, t, npd, st, sdt, rt)
     do k = 1, nk
       drow(:, k) = rt(k, :)

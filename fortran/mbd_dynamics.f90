@@ -608,14 +608,13 @@ contains
   end subroutine dyn_solve
 
   !> Several right-hand sides with the last augmented matrix: the rows of bt (4 k, nt) into
-  !! the columns of x (nt, ncol) (saddle_solve_rows; f: ones of x's shape).
-  subroutine dyn_solve_rows(w, bt, x, f, status)
+  !! the columns of x (nt, ncol) (saddle_solve_rows).
+  subroutine dyn_solve_rows(w, bt, x, status)
     type(dyn_work_t), intent(inout) :: w     !! work arrays with the last augmented matrix
     real(wp), intent(in) :: bt(:, :)         !! right-hand sides as rows
     real(wp), intent(inout) :: x(:, :)       !! solutions as columns
-    real(wp), intent(in) :: f(:, :)          !! ones (nt, ncol)
     integer, intent(out) :: status           !! MBD_OK or MBD_LAPACK
-    call saddle_solve_rows(w%sd, bt, x, f, status)
+    call saddle_solve_rows(w%sd, bt, x, status)
     if (w%sd%lsq) w%nrank = w%nrank + size(x, 2)
   end subroutine dyn_solve_rows
 

@@ -448,7 +448,7 @@ contains
   !! aff(k): column k is not zero), the changes as rows tfr (4, NLOC). A spring's state
   !! part (spring_rows) takes the four rows at once, its parameters' part is added for the
   !! affected ones; the other kinds go direction by direction.
-  pure subroutine force_rows_d(kind, p, tp, aff, si, sj, ql, qdl, np, tqr, tqdr, t, tfr)
+  pure subroutine force_rows_d(kind, p, tp, aff, si, sj, ql, qdl, np, tqr, tqdr, t, tfr, cs, sn)
     integer, intent(in) :: kind             !! force kind
     real(wp), intent(in) :: p(:)            !! prepared parameters
     real(wp), intent(in) :: tp(:, :)        !! their changes (size(p), np)
@@ -459,6 +459,8 @@ contains
     real(wp), intent(in) :: tqr(4, NLOC), tqdr(4, NLOC)  !! directions as rows
     real(wp), intent(in) :: t               !! time
     real(wp), intent(out) :: tfr(4, NLOC)   !! changes as rows
+    !> cos and sin of the two slots' angles (1, 0 for ground), when the caller has them
+    real(wp), intent(in), optional :: cs(2), sn(2)
     type(kloc) :: xs
     type(spring_v) :: v
     real(wp) :: tf(NLOC)
@@ -472,7 +474,11 @@ contains
       end do
       return
     end if
-    xs = local_state(ql, qdl)
+    if (present(cs) .and. present(sn)) then
+      xs%q = ql; xs%qd = qdl; xs%c = cs; xs%s = sn
+    else
+      xs = local_state(ql, qdl)
+    end if
     call spring_values(xs, p, si, sj, t, v)
     if (.not. v%l > zero) return
     call spring_rows(v, p, qdl, tqr, tqdr, tfr)

@@ -841,16 +841,15 @@ contains
   !! its factors (splu_solve_rows: each column's operations and results those of
   !! saddle_solve), else column by column by saddle_solve. f (nt, ncol) holds ones (the
   !! rows solve's output factors).
-  subroutine saddle_solve_rows(sd, bt, x, f, status)
+  subroutine saddle_solve_rows(sd, bt, x, status)
     type(saddle_t), intent(inout) :: sd      !! factored matrix
     real(wp), intent(in) :: bt(:, :)         !! right-hand sides as rows (4 k, nt)
     real(wp), intent(inout) :: x(:, :)       !! solutions (nt, ncol)
-    real(wp), intent(in) :: f(:, :)          !! ones (nt, ncol)
     integer, intent(out) :: status           !! MBD_OK, MBD_SINGULAR or MBD_LAPACK
     integer :: k
     status = MBD_OK
     if (sd%plain .and. sd%spfact .and. .not. (sd%schur .or. sd%banded .or. sd%lsq)) then
-      call splu_solve_rows(sd%sp, bt, x, sd%ones, f)
+      call splu_solve_rows(sd%sp, bt, x)      ! (the plain matrix: no column scale)
       return
     end if
     do k = 1, size(x, 2)

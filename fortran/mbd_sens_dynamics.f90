@@ -49,10 +49,9 @@ module mbd_sens_dynamics
   !> Work of project_sens and of the dopri5 right-hand sides (allocated once per run by
   !! proj_init: no step allocates).
   type :: proj_work_t
-    real(wp), allocatable :: hvs(:)         !! Hv S rows (neq)
     !> one saddle right-hand side per parameter as the rows of rt (4 k, nq + na; the rows past
-    !! np stay zero), their solutions xr (nq + na, np), ones of that shape (dyn_solve_rows)
-    real(wp), allocatable :: rt(:, :), xr(:, :), fones(:, :)
+    !! np stay zero), their solutions xr (nq + na, np) (dyn_solve_rows)
+    real(wp), allocatable :: rt(:, :), xr(:, :)
     real(wp), allocatable :: jst(:, :)      !! J S as rows (4 k, neq)
   end type proj_work_t
 
@@ -69,13 +68,13 @@ contains
     integer :: st, nt
     status = MBD_OK; msg = ''
     nt = m%nq + w%na
-    allocate (pw%hvs(m%neq), pw%rt(4 * ((np + 3) / 4), nt), pw%xr(nt, np), pw%fones(nt, np), &
-              pw%jst(4 * ((np + 3) / 4), m%neq), stat=st)
+    allocate (pw%rt(4 * ((np + 3) / 4), nt), pw%xr(nt, np), pw%jst(4 * ((np + 3) / 4), m%neq), &
+              stat=st)
     if (st /= 0) then
       status = MBD_NO_MEMORY; msg = 'out of memory for the sensitivity projections'
       return
     end if
-    pw%rt = zero; pw%fones = one
+    pw%rt = zero
   end subroutine proj_init
 
   !> dlambda/dp (neq, np) at one output of an inverse dynamics run, from the kinematic
@@ -449,7 +448,7 @@ contains
       integer, intent(out) :: stp
       integer :: kk
       stats(3) = stats(3) + 1
-      qq = yy(1:n); vv = yy(nz + 1:nz + n)
+      associate (qq => yy(1:n), vv => yy(nz + 1:nz + n))
       call dyn_accel(m, w, qq, vv, tt, aa, lam, stp)
       if (stp /= MBD_OK) return
       f(1:nz) = yy(nz + 1:)
@@ -461,8 +460,8 @@ contains
       if (pcon) call sens_params(m, s, qq, vv, aa, tt, states=.false.)
       call sens_klam_list(m, s, lam)
       ! the right-hand sides as the rows of rt, every parameter at once, then one solve
-      call accel_rows(n, np, npd, s%tmass, aa, s%kln, s%klr, s%klc, s%klv, yy(n + 1:nz), &
-                      pw%rt)
+      call accel_rows(n, npd, s%nmz, s%mzc, s%mzk, s%mzv, aa, s%kln, s%klr, s%klc, s%klv, &
+                      yy(n + 1:nz), pw%rt)
       call sens_force_rows(m, s, qq, vv, tt, npd, yy(n + 1:nz), yy(nz + n + 1:), pw%rt)
       do kk = 1, np
         if (.not. s%kcon(kk)) cycle             ! (J_p = 0 otherwise)
@@ -472,9 +471,10 @@ contains
       ! gamma_p - J_p q_ddot - Ha S - 2 Hv S_dot
       call sens_kin_rhs(s, 3, s%rhs, yy(n + 1:nz), yy(nz + n + 1:))
       call constraint_rows(n, w%na, npd, m%neq, w%rows, w%s, s%rhs, pw%rt)
-      call dyn_solve_rows(w, pw%rt, pw%xr, pw%fones, stp)
+      call dyn_solve_rows(w, pw%rt, pw%xr, stp)
       if (stp /= MBD_OK) return
       call cols_to_rows(n, np, npd, size(pw%xr, 1), pw%xr, f(nz + n + 1:))
+      end associate
     end subroutine rhs
 
     !> Project q, q_dot (mbd_dynamics) and then S, S_dot (project_sens).
@@ -544,6 +544,12 @@ contains
     real(wp), intent(in) :: c(ldc, np)
     real(wp), intent(out) :: r(npd, n)
     integer :: i, k, g
+    if (np == 4) then                          ! (the common case, no remainder)
+      do i = 1, n
+        r(1, i) = c(i, 1); r(2, i) = c(i, 2); r(3, i) = c(i, 3); r(4, i) = c(i, 4)
+      end do
+      return
+    end if
     do i = 1, n
       do g = 0, np - 4, 4
         r(g + 1, i) = c(i, g + 1); r(g + 2, i) = c(i, g + 2)
@@ -571,23 +577,22 @@ contains
 
   !> The first n entries (the dynamic equations) of the sensitivities' right-hand sides as
   !! rows, but for the forces' changes (sens_force_rows adds them) and J_p^T lambda:
-  !! rt(k, :) = - M_p q_ddot - K_lambda S_k (the list klr, klc, klv; S as rows st).
-  pure subroutine accel_rows(n, np, npd, tm, aa, kln, klr, klc, klv, st, rt)
-    integer, intent(in) :: n, np, npd, kln
-    integer, intent(in) :: klr(*), klc(*)
-    real(wp), intent(in) :: tm(n, np), aa(n), klv(*), st(npd, n)
+  !! rt(k, :) = - M_p q_ddot - K_lambda S_k (M_p: the list mzc, mzk, mzv of the mass
+  !! matrix's changes; K_lambda: klr, klc, klv; S as rows st).
+  pure subroutine accel_rows(n, npd, nmz, mzc, mzk, mzv, aa, kln, klr, klc, klv, st, rt)
+    integer, intent(in) :: n, npd, nmz, kln
+    integer, intent(in) :: mzc(*), mzk(*), klr(*), klc(*)
+    real(wp), intent(in) :: mzv(*), aa(n), klv(*), st(npd, n)
     real(wp), intent(inout) :: rt(npd, *)
-    integer :: i, k, e, r, c, g
-    real(wp) :: v, a
+    integer :: i, e, r, c, g
+    real(wp) :: v
     do i = 1, n
-      a = aa(i)
-      do g = 0, np - 4, 4
-        rt(g + 1, i) = -tm(i, g + 1) * a; rt(g + 2, i) = -tm(i, g + 2) * a
-        rt(g + 3, i) = -tm(i, g + 3) * a; rt(g + 4, i) = -tm(i, g + 4) * a
+      do g = 1, npd
+        rt(g, i) = zero
       end do
-      do k = 4 * (np / 4) + 1, np
-        rt(k, i) = -tm(i, k) * a
-      end do
+    end do
+    do e = 1, nmz
+      rt(mzk(e), mzc(e)) = -mzv(e) * aa(mzc(e))
     end do
     do e = 1, kln                               ! (the padding rows stay zero: st's are)
       r = klr(e); c = klc(e); v = klv(e)
@@ -660,7 +665,7 @@ contains
           rt(kk, n + i) = w%s * (s%mphip(kk, w%rows(i)) - pw%jst(kk, w%rows(i)))
         end do
       end do
-      call dyn_solve_rows(w, rt, xr, pw%fones, stp)
+      call dyn_solve_rows(w, rt, xr, stp)
       if (stp /= MBD_OK) return
       call add_rows(n, np, npd, size(xr, 1), xr, yy(n + 1:nz))
       if (.not. reuse) then
@@ -671,7 +676,7 @@ contains
       call sens_kin_rhs(s, 2, s%rhs, yy(n + 1:nz), yy(nz + n + 1:))
       call metric_rows(n, npd, w%metric, yy(nz + n + 1:), rt)
       call constraint_rows(n, w%na, npd, m%neq, w%rows, w%s, s%rhs, rt)
-      call dyn_solve_rows(w, rt, xr, pw%fones, stp)
+      call dyn_solve_rows(w, rt, xr, stp)
       if (stp /= MBD_OK) return
       call cols_to_rows(n, np, npd, size(xr, 1), xr, yy(nz + n + 1:))
     end associate

@@ -60,8 +60,14 @@ module mbd_sensitivity
     logical, allocatable :: faff(:, :)       !! (nf, np) the force's parameters change
     logical, allocatable :: kgrav(:)         !! (np) the parameter changes a mass or gravity
     logical, allocatable :: kcon(:)          !! (np) the parameter changes a constraint
-    !> (nq, np) the change of the gravity loads m g (with the masses and g: constant)
-    real(wp), allocatable :: qg(:, :)
+    !> (nq, np) the change of the gravity loads m g (with the masses and g: constant), and
+    !! as rows (npad, nq)
+    real(wp), allocatable :: qg(:, :), qgr(:, :)
+    logical :: anyg = .false.                !! some parameter changes m g
+    !> the mass matrix's changes as a list: coordinate, parameter, value (tmass's nonzeros)
+    integer :: nmz = 0
+    integer, allocatable :: mzc(:), mzk(:)
+    real(wp), allocatable :: mzv(:)
     real(wp), allocatable :: tmass(:, :)     !! (nq, np) change of the mass matrix diagonal
     real(wp), allocatable :: tgrav(:, :)     !! (2, np) change of gravity
     ! local blocks at the current state (sens_hessian)
@@ -239,11 +245,20 @@ contains
       end select
     end do
     bad = 0
-    allocate (s%kgrav(s%np), s%kcon(s%np), s%qg(m%nq, s%np), stat=st)
+    allocate (s%kgrav(s%np), s%kcon(s%np), s%qg(m%nq, s%np), s%qgr(npad, m%nq), &
+              s%mzc(count(s%tmass /= zero)), s%mzk(count(s%tmass /= zero)), &
+              s%mzv(count(s%tmass /= zero)), stat=st)
     if (st /= 0) then
       status = MBD_NO_MEMORY; msg = 'out of memory for the sensitivity arrays'; return
     end if
-    s%qg = zero
+    s%qg = zero; s%qgr = zero; s%nmz = 0
+    do k = 1, s%np
+      do i = 1, m%nq
+        if (s%tmass(i, k) == zero) cycle
+        s%nmz = s%nmz + 1
+        s%mzc(s%nmz) = i; s%mzk(s%nmz) = k; s%mzv(s%nmz) = s%tmass(i, k)
+      end do
+    end do
     do k = 1, s%np
       s%kgrav(k) = any(abs(s%tmass(:, k)) > zero) .or. any(abs(s%tgrav(:, k)) > zero)
       s%kcon(k) = any(s%caff(:, k))
@@ -254,7 +269,9 @@ contains
         s%qg(3 * i - 1, k) = s%tmass(3 * i - 2, k) * m%grav(2) + m%mdiag(3 * i - 2) * &
                              s%tgrav(2, k)
       end do
+      s%qgr(k, :) = s%qg(:, k)
     end do
+    s%anyg = any(s%kgrav) .and. dyn
     call sens_lists(m, s, st)
     if (st /= 0) then
       status = MBD_NO_MEMORY; msg = 'out of memory for the sensitivity arrays'; return
@@ -870,47 +887,59 @@ contains
   end subroutine rhs_four
 
   !> K_lambda = (J^T lambda)_q = sum over rows of lambda_r (Phi_r)_qq as a list of its
-  !! nonzeros (row, column, value), from the local Hessian blocks (sens_hessian at the same q).
+  !! nonzeros (row, column, value), from the local Hessian blocks (sens_hessian at the same q):
+  !! each revolute side's (theta, theta) entry from its closed form (rsh), a translational's
+  !! first row (its second is linear in q), the other constraints not linear in q in full.
   pure subroutine sens_klam_list(m, s, lam)
     type(model_t), intent(in) :: m           !! model
     type(sens_t), intent(inout) :: s         !! Hessian blocks; the list (out)
     real(wp), intent(in) :: lam(:)           !! multipliers (neq)
-    integer :: k, i, j, r, r0, ci, cj, nr
+    integer :: k, e, r0
     real(wp) :: acc
     s%kln = 0
-    do k = 1, m%nc
-      if (con_linear(m%kind(k))) cycle
-      r0 = m%row0(k) - 1
-      if (m%kind(k) == CON_REVOLUTE) then      ! only (theta, theta) of each moving side
-        do j = 3, 6, 3
-          cj = m%loc(j, k)
-          if (cj == 0) cycle
-          acc = lam(r0 + 1) * s%hs(1, j, j, k) + lam(r0 + 2) * s%hs(2, j, j, k)
-          if (abs(acc) <= zero) cycle
-          s%kln = s%kln + 1
-          s%klr(s%kln) = cj; s%klc(s%kln) = cj; s%klv(s%kln) = acc
-        end do
-        cycle
-      end if
-      nr = m%nrow(k)
-      if (m%kind(k) == CON_TRANSLATIONAL) nr = 1   ! (its second row is linear in q)
-      do j = 1, NLOC
-        cj = m%loc(j, k)
-        if (cj == 0) cycle
-        do i = 1, NLOC
-          ci = m%loc(i, k)
-          if (ci == 0) cycle
-          acc = lam(r0 + 1) * s%hs(1, i, j, k)
-          do r = 2, nr
-            acc = acc + lam(r0 + r) * s%hs(r, i, j, k)
-          end do
-          if (abs(acc) <= zero) cycle
-          s%kln = s%kln + 1
-          s%klr(s%kln) = ci; s%klc(s%kln) = cj; s%klv(s%kln) = acc
-        end do
-      end do
+    do e = 1, size(s%rsc)                      ! the revolutes' moving sides
+      k = s%rsc(e); r0 = m%row0(k) - 1
+      acc = lam(r0 + 1) * s%rsh(1, e) + lam(r0 + 2) * s%rsh(2, e)
+      if (abs(acc) <= zero) cycle
+      s%kln = s%kln + 1
+      s%klr(s%kln) = m%loc(s%rss(e), k); s%klc(s%kln) = s%klr(s%kln); s%klv(s%kln) = acc
+    end do
+    do e = 1, size(s%tlc)
+      call block_entries(m, s, lam, s%tlc(e), 1)
+    end do
+    do e = 1, size(s%gen)
+      call block_entries(m, s, lam, s%gen(e), m%nrow(s%gen(e)))
     end do
   end subroutine sens_klam_list
+
+  !> sens_klam_list's entries of constraint kk's block from its first nr rows.
+  pure subroutine block_entries(m, s, lam, kk, nr)
+    type(model_t), intent(in) :: m           !! model
+    type(sens_t), intent(inout) :: s         !! Hessian blocks; the list (added)
+    real(wp), intent(in) :: lam(:)           !! multipliers (neq)
+    integer, intent(in) :: kk, nr            !! constraint, rows
+    integer :: i, j, r, ci, cj, q0, na, ia, ja, act(NLOC)
+    real(wp) :: a
+    q0 = m%row0(kk) - 1
+    na = 0
+    do j = 1, NLOC                             ! the slots with a coordinate
+      if (m%loc(j, kk) == 0) cycle
+      na = na + 1; act(na) = j
+    end do
+    do ja = 1, na
+      j = act(ja); cj = m%loc(j, kk)
+      do ia = 1, na
+        i = act(ia); ci = m%loc(i, kk)
+        a = lam(q0 + 1) * s%hs(1, i, j, kk)
+        do r = 2, nr
+          a = a + lam(q0 + r) * s%hs(r, i, j, kk)
+        end do
+        if (abs(a) <= zero) cycle
+        s%kln = s%kln + 1
+        s%klr(s%kln) = ci; s%klc(s%kln) = cj; s%klv(s%kln) = a
+      end do
+    end do
+  end subroutine block_entries
 
   !> y = K_lambda x from the list of sens_klam_list.
   pure subroutine sens_klam(s, x, y)
@@ -1049,7 +1078,7 @@ contains
   !! added to rt(:, 1:nq) (a row per parameter, npad rows, a multiple of 4; the rows past
   !! np stay as they are): along (S, S_dot) given as rows st, sdt (npad, nq) and by the
   !! parameters' own changes (force_rows_d, four parameters at a time), and the change of
-  !! m g (qg).
+  !! m g (qg). The bodies' cos and sin at q from s%cb, s%sb (sens_trig or the assembly's).
   pure subroutine sens_force_rows(m, s, q, qd, t, npad, st, sdt, rt)
     type(model_t), intent(in) :: m           !! model with dynamics data
     type(sens_t), intent(in) :: s            !! parameters
@@ -1059,13 +1088,8 @@ contains
     real(wp), intent(in) :: st(npad, *), sdt(npad, *)  !! S, S_dot as rows
     real(wp), intent(inout) :: rt(npad, *)   !! right-hand sides as rows
     real(wp) :: ql(NLOC), qdl(NLOC), tqr(4, NLOC), tqdr(4, NLOC), tfr(4, NLOC)
-    integer :: f, j, c, si, sj, k, n0, n1, g, ng
-    do k = 1, s%np                             ! d(m g): the masses' and g's changes
-      if (.not. s%kgrav(k)) cycle
-      do j = 1, m%nq
-        rt(k, j) = rt(k, j) + s%qg(j, k)
-      end do
-    end do
+    integer :: f, j, c, si, sj, n0, n1, g, ng
+    if (s%anyg) call add_flat(npad * m%nq, s%qgr, rt)   ! d(m g): the masses' and g's changes
     do f = 1, m%nf
       n0 = m%fpo(f); n1 = n0 + m%fpn(f) - 1
       si = merge(1, 0, m%fbi(f) > 0); sj = merge(2, 0, m%fbj(f) > 0)
@@ -1082,18 +1106,34 @@ contains
         do j = 1, NLOC
           c = m%floc(j, f)
           if (c == 0) cycle
-          tqr(:, j) = st(g + 1:g + 4, c); tqdr(:, j) = sdt(g + 1:g + 4, c)
+          tqr(1, j) = st(g + 1, c); tqr(2, j) = st(g + 2, c)
+          tqr(3, j) = st(g + 3, c); tqr(4, j) = st(g + 4, c)
+          tqdr(1, j) = sdt(g + 1, c); tqdr(2, j) = sdt(g + 2, c)
+          tqdr(3, j) = sdt(g + 3, c); tqdr(4, j) = sdt(g + 4, c)
         end do
         call force_rows_d(m%fkind(f), m%fp(n0:n1), s%tfp(n0:n1, g + 1:g + ng), &
-                          s%faff(f, g + 1:g + ng), si, sj, ql, qdl, ng, tqr, tqdr, t, tfr)
+                          s%faff(f, g + 1:g + ng), si, sj, ql, qdl, ng, tqr, tqdr, t, tfr, &
+                          [s%cb(m%fbi(f)), s%cb(m%fbj(f))], [s%sb(m%fbi(f)), s%sb(m%fbj(f))])
         do j = 1, NLOC
           c = m%floc(j, f)
           if (c == 0) cycle
-          rt(g + 1:g + 4, c) = rt(g + 1:g + 4, c) + tfr(:, j)
+          rt(g + 1, c) = rt(g + 1, c) + tfr(1, j); rt(g + 2, c) = rt(g + 2, c) + tfr(2, j)
+          rt(g + 3, c) = rt(g + 3, c) + tfr(3, j); rt(g + 4, c) = rt(g + 4, c) + tfr(4, j)
         end do
       end do
     end do
   end subroutine sens_force_rows
+
+  !> b(1:n) += a(1:n), flat.
+  pure subroutine add_flat(n, a, b)
+    integer, intent(in) :: n
+    real(wp), intent(in) :: a(n)
+    real(wp), intent(inout) :: b(n)
+    integer :: i
+    do i = 1, n
+      b(i) = b(i) + a(i)
+    end do
+  end subroutine add_flat
 
   !> Dense Jacobians of the applied forces, kq = dQ/dq and (optionally) kv = dQ/dq_dot,
   !! from the dual evaluation of each force along its slots (nq x nq each).

@@ -380,15 +380,17 @@ contains
     type(splu_t), intent(inout) :: sp                !! factors (and the work block)
     real(wp), intent(in) :: bt(:, :)                 !! right-hand sides as rows (4 k, n)
     real(wp), intent(inout) :: x(:, :)               !! solutions (A's columns, ncol)
-    real(wp), intent(in) :: cs(:)                    !! column scale
-    real(wp), intent(in) :: f(:, :)                  !! output factors (n, ncol)
+    !> column scale and output factors (n, ncol); both absent: ones
+    real(wp), intent(in), optional :: cs(:), f(:, :)
     real(wp), intent(inout), optional :: xt(:, :)    !! solutions as rows (4 k, n)
     integer :: g
     do g = 1, size(bt, 1) - 3, 4
       if (g > size(x, 2)) exit
       call rows_kernel(sp%n, sp%lptr(sp%n + 1) - 1, sp%nu, sp%prow, sp%lrptr, sp%lrpos, &
                        sp%lrcol, sp%urptr, sp%urpos, sp%urcol, sp%val, sp%y4, size(bt, 1), bt, g)
-      if (present(xt)) then
+      if (.not. (present(cs) .and. present(f))) then
+        call plain_out(sp%n, size(x, 2), sp%pcol, sp%rinv, sp%y4, g, x)
+      else if (present(xt)) then
         call rows_out(sp%n, size(x, 2), sp%pcol, sp%rinv, cs, sp%y4, size(xt, 1), xt, g, x, f)
       else
         call cols_out(sp%n, size(x, 2), sp%pcol, sp%rinv, cs, sp%y4, g, x, f)
@@ -455,6 +457,28 @@ contains
       end do
     end do
   end subroutine rows_out
+
+  !> cols_out with no column scale or factors (ones): x(pcol(k), g + i) = y(i, k) / u_kk.
+  pure subroutine plain_out(n, ncol, pcol, rinv, y, g, x)
+    integer, intent(in) :: n, ncol, pcol(n), g
+    real(wp), intent(in) :: rinv(n), y(4, n)
+    real(wp), intent(inout) :: x(n, ncol)
+    integer :: k, c, i
+    real(wp) :: v
+    if (ncol - g >= 3) then
+      do k = 1, n
+        c = pcol(k); v = rinv(k)
+        x(c, g) = y(1, k) * v; x(c, g + 1) = y(2, k) * v
+        x(c, g + 2) = y(3, k) * v; x(c, g + 3) = y(4, k) * v
+      end do
+      return
+    end if
+    do i = 1, ncol - g + 1
+      do k = 1, n
+        x(pcol(k), g + i - 1) = y(i, k) * rinv(k)
+      end do
+    end do
+  end subroutine plain_out
 
   !> rows_out without the rows: columns g .. of x only (times f).
   pure subroutine cols_out(n, ncol, pcol, rinv, cs, y, g, x, f)
