@@ -400,13 +400,20 @@ contains
     real(wp) :: v
     do k = 1, nc
       do i = 0, nrow(k) - 1
-        yt(:, row0(k) + i) = zero
+        do g = 1, npad
+          yt(g, row0(k) + i) = zero
+        end do
       end do
       do s = 1, NLOC
         c = loc(s, k)
         if (c == 0) cycle
         do i = 1, nrow(k)
           r = row0(k) + i - 1; v = jb(i, s, k)
+          if (npad == 4) then                  ! (up to four vectors: no inner loop)
+            yt(1, r) = yt(1, r) + v * xt(1, c); yt(2, r) = yt(2, r) + v * xt(2, c)
+            yt(3, r) = yt(3, r) + v * xt(3, c); yt(4, r) = yt(4, r) + v * xt(4, c)
+            cycle
+          end if
           do g = 0, npad - 4, 4
             yt(g + 1, r) = yt(g + 1, r) + v * xt(g + 1, c)
             yt(g + 2, r) = yt(g + 2, r) + v * xt(g + 2, c)

@@ -460,9 +460,10 @@ contains
       if (pcon) call sens_params(m, s, qq, vv, aa, tt, states=.false.)
       call sens_klam_list(m, s, lam)
       ! the right-hand sides as the rows of rt, every parameter at once, then one solve
-      call accel_rows(n, npd, s%nmz, s%mzc, s%mzk, s%mzv, aa, s%kln, s%klr, s%klc, s%klv, &
-                      yy(n + 1:nz), pw%rt)
-      call sens_force_rows(m, s, qq, vv, tt, npd, yy(n + 1:nz), yy(nz + n + 1:), pw%rt)
+      call accel_rows(n, npd, s%anyg, s%qgr, s%nmz, s%mzc, s%mzk, s%mzv, aa, s%kln, s%klr, &
+                      s%klc, s%klv, yy(n + 1:nz), pw%rt)
+      call sens_force_rows(m, s, qq, vv, tt, npd, yy(n + 1:nz), yy(nz + n + 1:), pw%rt, &
+                           grav=.false.)
       do kk = 1, np
         if (.not. s%kcon(kk)) cycle             ! (J_p = 0 otherwise)
         call sens_jpt_lam(m, s, kk, qq, tt, lam, y3)
@@ -579,20 +580,18 @@ contains
   !! rows, but for the forces' changes (sens_force_rows adds them) and J_p^T lambda:
   !! rt(k, :) = - M_p q_ddot - K_lambda S_k (M_p: the list mzc, mzk, mzv of the mass
   !! matrix's changes; K_lambda: klr, klc, klv; S as rows st).
-  pure subroutine accel_rows(n, npd, nmz, mzc, mzk, mzv, aa, kln, klr, klc, klv, st, rt)
+  pure subroutine accel_rows(n, npd, anyg, qgr, nmz, mzc, mzk, mzv, aa, kln, klr, klc, klv, &
+                             st, rt)
     integer, intent(in) :: n, npd, nmz, kln
+    logical, intent(in) :: anyg                 !! m g changes: start from qgr
     integer, intent(in) :: mzc(*), mzk(*), klr(*), klc(*)
-    real(wp), intent(in) :: mzv(*), aa(n), klv(*), st(npd, n)
+    real(wp), intent(in) :: qgr(npd * n), mzv(*), aa(n), klv(*), st(npd, n)
     real(wp), intent(inout) :: rt(npd, *)
-    integer :: i, e, r, c, g
+    integer :: e, r, c, g
     real(wp) :: v
-    do i = 1, n
-      do g = 1, npd
-        rt(g, i) = zero
-      end do
-    end do
+    call start_rows(npd * n, anyg, qgr, rt)    ! d(m g), or zero
     do e = 1, nmz
-      rt(mzk(e), mzc(e)) = -mzv(e) * aa(mzc(e))
+      rt(mzk(e), mzc(e)) = rt(mzk(e), mzc(e)) - mzv(e) * aa(mzc(e))
     end do
     do e = 1, kln                               ! (the padding rows stay zero: st's are)
       r = klr(e); c = klc(e); v = klv(e)
@@ -605,6 +604,24 @@ contains
     end do
   end subroutine accel_rows
 
+  !> r(1:nn) = a (when use) or zero, flat.
+  pure subroutine start_rows(nn, use, a, r)
+    integer, intent(in) :: nn
+    logical, intent(in) :: use
+    real(wp), intent(in) :: a(nn)
+    real(wp), intent(out) :: r(nn)
+    integer :: e
+    if (use) then
+      do e = 1, nn
+        r(e) = a(e)
+      end do
+    else
+      do e = 1, nn
+        r(e) = zero
+      end do
+    end if
+  end subroutine start_rows
+
   !> The constraint rows of the sensitivities' right-hand sides: rt(:, n + i) = sc
   !! w(:, rows(i)), w = gamma_p - J_p q_ddot - Ha S - 2 Hv S_dot as rows (sens_kin_rhs).
   pure subroutine constraint_rows(n, na, npad, neq, rows, sc, wk, rt)
@@ -612,6 +629,14 @@ contains
     real(wp), intent(in) :: sc, wk(npad, neq)
     real(wp), intent(inout) :: rt(npad, *)
     integer :: i, g, r
+    if (npad == 4) then                        ! (up to four parameters: no inner loop)
+      do i = 1, na
+        r = rows(i)
+        rt(1, n + i) = sc * wk(1, r); rt(2, n + i) = sc * wk(2, r)
+        rt(3, n + i) = sc * wk(3, r); rt(4, n + i) = sc * wk(4, r)
+      end do
+      return
+    end if
     do i = 1, na
       r = rows(i)
       do g = 0, npad - 4, 4

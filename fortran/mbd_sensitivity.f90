@@ -1079,7 +1079,7 @@ contains
   !! np stay as they are): along (S, S_dot) given as rows st, sdt (npad, nq) and by the
   !! parameters' own changes (force_rows_d, four parameters at a time), and the change of
   !! m g (qg). The bodies' cos and sin at q from s%cb, s%sb (sens_trig or the assembly's).
-  pure subroutine sens_force_rows(m, s, q, qd, t, npad, st, sdt, rt)
+  pure subroutine sens_force_rows(m, s, q, qd, t, npad, st, sdt, rt, grav)
     type(model_t), intent(in) :: m           !! model with dynamics data
     type(sens_t), intent(in) :: s            !! parameters
     real(wp), intent(in) :: q(:), qd(:)      !! state
@@ -1087,12 +1087,18 @@ contains
     integer, intent(in) :: npad              !! rows
     real(wp), intent(in) :: st(npad, *), sdt(npad, *)  !! S, S_dot as rows
     real(wp), intent(inout) :: rt(npad, *)   !! right-hand sides as rows
-    real(wp) :: ql(NLOC), qdl(NLOC), tqr(4, NLOC), tqdr(4, NLOC), tfr(4, NLOC)
+    logical, intent(in), optional :: grav    !! .false.: leave d(m g) out (the caller has it)
+    real(wp) :: ql(NLOC), qdl(NLOC), tqr(4, NLOC), tqdr(4, NLOC), tfr(4, NLOC), cs(2), sn(2)
     integer :: f, j, c, si, sj, n0, n1, g, ng
-    if (s%anyg) call add_flat(npad * m%nq, s%qgr, rt)   ! d(m g): the masses' and g's changes
+    logical :: addg
+    addg = s%anyg
+    if (present(grav)) addg = addg .and. grav
+    if (addg) call add_flat(npad * m%nq, s%qgr, rt)   ! d(m g): the masses' and g's changes
     do f = 1, m%nf
       n0 = m%fpo(f); n1 = n0 + m%fpn(f) - 1
       si = merge(1, 0, m%fbi(f) > 0); sj = merge(2, 0, m%fbj(f) > 0)
+      cs(1) = s%cb(m%fbi(f)); cs(2) = s%cb(m%fbj(f))
+      sn(1) = s%sb(m%fbi(f)); sn(2) = s%sb(m%fbj(f))
       do j = 1, NLOC
         c = m%floc(j, f)
         ql(j) = zero; qdl(j) = zero
@@ -1113,7 +1119,7 @@ contains
         end do
         call force_rows_d(m%fkind(f), m%fp(n0:n1), s%tfp(n0:n1, g + 1:g + ng), &
                           s%faff(f, g + 1:g + ng), si, sj, ql, qdl, ng, tqr, tqdr, t, tfr, &
-                          [s%cb(m%fbi(f)), s%cb(m%fbj(f))], [s%sb(m%fbi(f)), s%sb(m%fbj(f))])
+                          cs, sn)
         do j = 1, NLOC
           c = m%floc(j, f)
           if (c == 0) cycle
