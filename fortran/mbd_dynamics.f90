@@ -607,15 +607,18 @@ contains
     if (w%sd%lsq) w%nrank = w%nrank + 1
   end subroutine dyn_solve
 
-  !> Several right-hand sides with the last augmented matrix: the rows of bt (4 k, nt) into
-  !! the columns of x (nt, ncol) (saddle_solve_rows).
-  subroutine dyn_solve_rows(w, bt, x, status)
+  !> Several right-hand sides (ncol of them) with the last augmented matrix, as the rows of
+  !! bt (4 k, nt): the first nkeep entries of each solution as a row of xt (ldt, nkeep),
+  !! written or (add) added (saddle_solve_rows; w%rhs its work).
+  subroutine dyn_solve_rows(w, bt, ncol, nkeep, ldt, xt, add, status)
     type(dyn_work_t), intent(inout) :: w     !! work arrays with the last augmented matrix
     real(wp), intent(in) :: bt(:, :)         !! right-hand sides as rows
-    real(wp), intent(inout) :: x(:, :)       !! solutions as columns
+    integer, intent(in) :: ncol, nkeep, ldt  !! right-hand sides, entries kept, xt's rows
+    real(wp), intent(inout) :: xt(ldt, *)    !! solutions as rows
+    logical, intent(in) :: add               !! add to xt (else overwrite)
     integer, intent(out) :: status           !! MBD_OK or MBD_LAPACK
-    call saddle_solve_rows(w%sd, bt, x, status)
-    if (w%sd%lsq) w%nrank = w%nrank + size(x, 2)
+    call saddle_solve_rows(w%sd, bt, ncol, nkeep, ldt, xt, add, w%rhs, status)
+    if (w%sd%lsq) w%nrank = w%nrank + ncol
   end subroutine dyn_solve_rows
 
   !> Phi, nu, gamma and the constraint blocks at (q, q_dot, t); the dense J too on the

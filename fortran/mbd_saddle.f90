@@ -47,7 +47,7 @@ module mbd_saddle
                       band_factor, band_rcond, band_solve
   use mbd_schur, only: schur_t, schur_plan, schur_factor, schur_solve, rows_rcm, &
                        rows_by_coordinate
-  use mbd_splu, only: splu_t, splu_init, splu_plan, splu_factor, splu_solve, splu_solve_rows, &
+  use mbd_splu, only: splu_solve_rows_t, splu_t, splu_init, splu_plan, splu_factor, splu_solve, splu_solve_rows, &
                       splu_pos, LMAX
   use mbd_linsolve, only: lu_factor, lu_solve, lu_factor_small, lu_solve_small, lapack_status
   use mbd_lapack, only: dgecon, dgelsy
@@ -836,26 +836,36 @@ contains
     sd%nrank = sd%nrank + 1
   end subroutine saddle_solve
 
-  !> Several right-hand sides, given as the rows of bt (4 k, nt; the rows past size(x, 2)
-  !! zero), solved into the columns of x (nt, ncol): on the sparse LU four at a time through
-  !! its factors (splu_solve_rows: each column's operations and results those of
-  !! saddle_solve), else column by column by saddle_solve. f (nt, ncol) holds ones (the
-  !! rows solve's output factors).
-  subroutine saddle_solve_rows(sd, bt, x, status)
+  !> Several right-hand sides as the rows of bt (4 k, nt), ncol of them: the first nkeep
+  !! entries of each solution as a row of xt (ldt, nkeep), written or (add) added. The
+  !! plain sparse LU solves four at a time; the other paths column by column.
+  subroutine saddle_solve_rows(sd, bt, ncol, nkeep, ldt, xt, add, x, status)
     type(saddle_t), intent(inout) :: sd      !! factored matrix
     real(wp), intent(in) :: bt(:, :)         !! right-hand sides as rows (4 k, nt)
-    real(wp), intent(inout) :: x(:, :)       !! solutions (nt, ncol)
+    integer, intent(in) :: ncol, nkeep, ldt  !! right-hand sides, entries kept, xt's rows
+    real(wp), intent(inout) :: xt(ldt, *)    !! solutions as rows
+    logical, intent(in) :: add               !! add to xt (else overwrite)
+    real(wp), intent(inout) :: x(:)          !! work (nt)
     integer, intent(out) :: status           !! MBD_OK, MBD_SINGULAR or MBD_LAPACK
     integer :: k
     status = MBD_OK
     if (sd%plain .and. sd%spfact .and. .not. (sd%schur .or. sd%banded .or. sd%lsq)) then
-      call splu_solve_rows(sd%sp, bt, x)      ! (the plain matrix: no column scale)
+      call splu_solve_rows_t(sd%sp, bt, nkeep, ldt, xt, add)   ! (plain: no column scale)
       return
     end if
-    do k = 1, size(x, 2)
-      x(:, k) = bt(k, :)
-      call saddle_solve(sd, x(:, k), status)
+    do k = 1, ncol
+      x = bt(k, :)
+      call saddle_solve(sd, x, status)
       if (status /= MBD_OK) return
+      if (add) then
+        xt(k, 1:nkeep) = xt(k, 1:nkeep) + x(1:nkeep)
+      else
+        xt(k, 1:nkeep) = x(1:nkeep)
+      end if
+    end do
+    if (add) return
+    do k = ncol + 1, ldt                     ! (the padding rows' solutions: zero)
+      xt(k, 1:nkeep) = zero
     end do
   end subroutine saddle_solve_rows
 

@@ -50,8 +50,8 @@ module mbd_sens_dynamics
   !! proj_init: no step allocates).
   type :: proj_work_t
     !> one saddle right-hand side per parameter as the rows of rt (4 k, nq + na; the rows past
-    !! np stay zero), their solutions xr (nq + na, np) (dyn_solve_rows)
-    real(wp), allocatable :: rt(:, :), xr(:, :)
+    !! np stay zero; dyn_solve_rows)
+    real(wp), allocatable :: rt(:, :)
     real(wp), allocatable :: jst(:, :)      !! J S as rows (4 k, neq)
   end type proj_work_t
 
@@ -68,8 +68,7 @@ contains
     integer :: st, nt
     status = MBD_OK; msg = ''
     nt = m%nq + w%na
-    allocate (pw%rt(4 * ((np + 3) / 4), nt), pw%xr(nt, np), pw%jst(4 * ((np + 3) / 4), m%neq), &
-              stat=st)
+    allocate (pw%rt(4 * ((np + 3) / 4), nt), pw%jst(4 * ((np + 3) / 4), m%neq), stat=st)
     if (st /= 0) then
       status = MBD_NO_MEMORY; msg = 'out of memory for the sensitivity projections'
       return
@@ -472,9 +471,7 @@ contains
       ! gamma_p - J_p q_ddot - Ha S - 2 Hv S_dot
       call sens_kin_rhs(s, 3, s%rhs, yy(n + 1:nz), yy(nz + n + 1:))
       call constraint_rows(n, w%na, npd, m%neq, w%rows, w%s, s%rhs, pw%rt)
-      call dyn_solve_rows(w, pw%rt, pw%xr, stp)
-      if (stp /= MBD_OK) return
-      call cols_to_rows(n, np, npd, size(pw%xr, 1), pw%xr, f(nz + n + 1:))
+      call dyn_solve_rows(w, pw%rt, np, n, npd, f(nz + n + 1:), .false., stp)   ! S_ddot rows
       end associate
     end subroutine rhs
 
@@ -669,7 +666,7 @@ contains
     integer, intent(out) :: stp                 !! MBD_OK or MBD_SINGULAR
     integer :: kk, i, n, nz, npd, np
     n = m%nq; np = s%np; npd = size(pw%rt, 1); nz = n * (1 + npd)
-    associate (rt => pw%rt, xr => pw%xr, z => w%qz)  ! (w%qz: a zero vector)
+    associate (rt => pw%rt, z => w%qz)  ! (w%qz: a zero vector)
       if (reuse) then                           ! (the assembly's cos and sin at q)
         s%cb(1:m%nb) = w%asm%cb(1:m%nb); s%sb(1:m%nb) = w%asm%sb(1:m%nb)
       else
@@ -690,9 +687,8 @@ contains
           rt(kk, n + i) = w%s * (s%mphip(kk, w%rows(i)) - pw%jst(kk, w%rows(i)))
         end do
       end do
-      call dyn_solve_rows(w, rt, xr, stp)
+      call dyn_solve_rows(w, rt, np, n, npd, yy(n + 1:nz), .true., stp)   ! S += dS
       if (stp /= MBD_OK) return
-      call add_rows(n, np, npd, size(xr, 1), xr, yy(n + 1:nz))
       if (.not. reuse) then
         call dyn_factor_projection(m, w, yy(1:n), tt, .true., stp, assembled=.true.)
         if (stp /= MBD_OK) return
@@ -701,24 +697,9 @@ contains
       call sens_kin_rhs(s, 2, s%rhs, yy(n + 1:nz), yy(nz + n + 1:))
       call metric_rows(n, npd, w%metric, yy(nz + n + 1:), rt)
       call constraint_rows(n, w%na, npd, m%neq, w%rows, w%s, s%rhs, rt)
-      call dyn_solve_rows(w, rt, xr, stp)
-      if (stp /= MBD_OK) return
-      call cols_to_rows(n, np, npd, size(xr, 1), xr, yy(nz + n + 1:))
+      call dyn_solve_rows(w, rt, np, n, npd, yy(nz + n + 1:), .false., stp)   ! S_dot
     end associate
   end subroutine project_sens
-
-  !> r(:, i) += c(i, :) for the np columns of c (leading dimension ldc), r (npd, n).
-  pure subroutine add_rows(n, np, npd, ldc, c, r)
-    integer, intent(in) :: n, np, npd, ldc
-    real(wp), intent(in) :: c(ldc, np)
-    real(wp), intent(inout) :: r(npd, n)
-    integer :: i, k
-    do i = 1, n
-      do k = 1, np
-        r(k, i) = r(k, i) + c(i, k)
-      end do
-    end do
-  end subroutine add_rows
 
   !> rt(:, i) = metric(i) sd(:, i), i = 1 .. n (sd as rows (npd, n)).
   pure subroutine metric_rows(n, npd, metric, sd, rt)

@@ -26,7 +26,7 @@ module mbd_splu
   implicit none
   private
   public :: splu_t, splu_init, splu_plan, splu_factor, splu_solve, splu_solve2, splu_solve_rows, &
-            splu_pos, LMAX, TAU
+            splu_solve_rows_t, splu_pos, LMAX, TAU
 
   real(wp), parameter :: TAU = 0.5_wp   !! pivot threshold of a plan (|l_ik| <= 1/TAU = 2)
   real(wp), parameter :: LMAX = 4.0_wp  !! largest multiplier a replayed factorization keeps
@@ -380,17 +380,15 @@ contains
     type(splu_t), intent(inout) :: sp                !! factors (and the work block)
     real(wp), intent(in) :: bt(:, :)                 !! right-hand sides as rows (4 k, n)
     real(wp), intent(inout) :: x(:, :)               !! solutions (A's columns, ncol)
-    !> column scale and output factors (n, ncol); both absent: ones
-    real(wp), intent(in), optional :: cs(:), f(:, :)
+    real(wp), intent(in) :: cs(:)                    !! column scale
+    real(wp), intent(in) :: f(:, :)                  !! output factors (n, ncol)
     real(wp), intent(inout), optional :: xt(:, :)    !! solutions as rows (4 k, n)
     integer :: g
     do g = 1, size(bt, 1) - 3, 4
       if (g > size(x, 2)) exit
       call rows_kernel(sp%n, sp%lptr(sp%n + 1) - 1, sp%nu, sp%prow, sp%lrptr, sp%lrpos, &
                        sp%lrcol, sp%urptr, sp%urpos, sp%urcol, sp%val, sp%y4, size(bt, 1), bt, g)
-      if (.not. (present(cs) .and. present(f))) then
-        call plain_out(sp%n, size(x, 2), sp%pcol, sp%rinv, sp%y4, g, x)
-      else if (present(xt)) then
+      if (present(xt)) then
         call rows_out(sp%n, size(x, 2), sp%pcol, sp%rinv, cs, sp%y4, size(xt, 1), xt, g, x, f)
       else
         call cols_out(sp%n, size(x, 2), sp%pcol, sp%rinv, cs, sp%y4, g, x, f)
@@ -458,27 +456,49 @@ contains
     end do
   end subroutine rows_out
 
-  !> cols_out with no column scale or factors (ones): x(pcol(k), g + i) = y(i, k) / u_kk.
-  pure subroutine plain_out(n, ncol, pcol, rinv, y, g, x)
-    integer, intent(in) :: n, ncol, pcol(n), g
+  !> Several right-hand sides as the rows of bt (4 k, n) with no column scale: the first
+  !! nkeep entries of each solution as a row of xt (ldt, nkeep), written or (add) added.
+  pure subroutine splu_solve_rows_t(sp, bt, nkeep, ldt, xt, add)
+    type(splu_t), intent(inout) :: sp                !! factors (and the work block)
+    real(wp), intent(in) :: bt(:, :)                 !! right-hand sides as rows (4 k, n)
+    integer, intent(in) :: nkeep, ldt                !! entries kept, xt's leading dimension
+    real(wp), intent(inout) :: xt(ldt, *)            !! solutions as rows
+    logical, intent(in) :: add                       !! add to xt (else overwrite)
+    integer :: g
+    do g = 1, size(bt, 1) - 3, 4
+      call rows_kernel(sp%n, sp%lptr(sp%n + 1) - 1, sp%nu, sp%prow, sp%lrptr, sp%lrpos, &
+                       sp%lrcol, sp%urptr, sp%urpos, sp%urcol, sp%val, sp%y4, size(bt, 1), bt, g)
+      call rows_t_out(sp%n, nkeep, sp%pcol, sp%rinv, sp%y4, ldt, xt, g, add)
+    end do
+  end subroutine splu_solve_rows_t
+
+  !> splu_solve_rows_t's output of rows_kernel's four solutions: x = Q diag(1/u_kk) v, its
+  !! entries c <= nkeep into rows g .. g + 3 of xt.
+  pure subroutine rows_t_out(n, nkeep, pcol, rinv, y, ldt, xt, g, add)
+    integer, intent(in) :: n, nkeep, pcol(n), ldt, g
     real(wp), intent(in) :: rinv(n), y(4, n)
-    real(wp), intent(inout) :: x(n, ncol)
-    integer :: k, c, i
+    real(wp), intent(inout) :: xt(ldt, *)
+    logical, intent(in) :: add
+    integer :: k, c
     real(wp) :: v
-    if (ncol - g >= 3) then
+    if (add) then
       do k = 1, n
-        c = pcol(k); v = rinv(k)
-        x(c, g) = y(1, k) * v; x(c, g + 1) = y(2, k) * v
-        x(c, g + 2) = y(3, k) * v; x(c, g + 3) = y(4, k) * v
+        c = pcol(k)
+        if (c > nkeep) cycle
+        v = rinv(k)
+        xt(g, c) = xt(g, c) + y(1, k) * v; xt(g + 1, c) = xt(g + 1, c) + y(2, k) * v
+        xt(g + 2, c) = xt(g + 2, c) + y(3, k) * v; xt(g + 3, c) = xt(g + 3, c) + y(4, k) * v
       end do
       return
     end if
-    do i = 1, ncol - g + 1
-      do k = 1, n
-        x(pcol(k), g + i - 1) = y(i, k) * rinv(k)
-      end do
+    do k = 1, n
+      c = pcol(k)
+      if (c > nkeep) cycle
+      v = rinv(k)
+      xt(g, c) = y(1, k) * v; xt(g + 1, c) = y(2, k) * v
+      xt(g + 2, c) = y(3, k) * v; xt(g + 3, c) = y(4, k) * v
     end do
-  end subroutine plain_out
+  end subroutine rows_t_out
 
   !> rows_out without the rows: columns g .. of x only (times f).
   pure subroutine cols_out(n, ncol, pcol, rinv, cs, y, g, x, f)
