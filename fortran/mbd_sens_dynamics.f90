@@ -30,7 +30,8 @@ module mbd_sens_dynamics
   use mbd_model, only: model_t
   use mbd_assemble, only: asm_work_t, asm_init, assemble_blocks, assemble_dense, blocks_jv_rows
   use mbd_sensitivity, only: sens_t, sens_trig, sens_hessian, sens_params, sens_klam, &
-                             sens_klam_list, sens_kin_rhs, &
+                             sens_klam_list, sens_kin_rhs, sens_rows_rhs, sens_revolute_rows, &
+                             sens_translational_rows, &
                              sens_jpt_lam, sens_force_d, sens_force_dm, sens_force_jac, &
                              sens_force_rows
   use mbd_linsolve, only: lu_factor, lu_solve, lapack_status, ls_small_cols, lu_factor_small, &
@@ -454,10 +455,11 @@ contains
       f(nz + 1:nz + n) = aa
       ! cos and sin of the angles at qq: the assembly's (sens_trig's values, not computed again)
       s%cb(1:m%nb) = w%asm%cb(1:m%nb); s%sb(1:m%nb) = w%asm%sb(1:m%nb)
-      call sens_hessian(m, s, qq, vv, aa, tt)
+      ! (the revolutes' and translationals' second derivatives: their *_rows below)
+      call sens_hessian(m, s, qq, vv, aa, tt, closed=.false.)
       ! (the parameter parts: only parameters that change a constraint have any)
       if (pcon) call sens_params(m, s, qq, vv, aa, tt, states=.false.)
-      call sens_klam_list(m, s, lam)
+      call sens_klam_list(m, s, lam, closed=.false.)
       ! the right-hand sides as the rows of rt, every parameter at once, then one solve
       call accel_rows(n, npd, s%anyg, s%qgr, s%nmz, s%mzc, s%mzk, s%mzv, aa, s%kln, s%klr, &
                       s%klc, s%klv, yy(n + 1:nz), pw%rt)
@@ -468,8 +470,11 @@ contains
         call sens_jpt_lam(m, s, kk, qq, tt, lam, y3)
         pw%rt(kk, 1:n) = pw%rt(kk, 1:n) - y3
       end do
-      ! gamma_p - J_p q_ddot - Ha S - 2 Hv S_dot
-      call sens_kin_rhs(s, 3, s%rhs, yy(n + 1:nz), yy(nz + n + 1:))
+      ! gamma_p - J_p q_ddot - Ha S - 2 Hv S_dot; the revolutes' Ha, Hv and K_lambda
+      call sens_rows_rhs(s, .true., s%nrvz + 1, npd, n, yy(n + 1:nz), yy(nz + n + 1:), s%rhs)
+      call sens_revolute_rows(m, s, lam, npd, yy(n + 1:nz), yy(nz + n + 1:), pw%rt, s%rhs)
+      call sens_translational_rows(m, s, qq, vv, aa, lam, npd, yy(n + 1:nz), yy(nz + n + 1:), &
+                                   pw%rt, s%rhs)
       call constraint_rows(n, w%na, npd, m%neq, w%rows, w%s, s%rhs, pw%rt)
       call dyn_solve_rows(w, pw%rt, np, n, npd, f(nz + n + 1:), .false., stp)   ! S_ddot rows
       end associate

@@ -39,7 +39,7 @@ module mbd_sensitivity
   public :: sens_setup, sens_trig, sens_states, sens_hessian, sens_params, sens_kin_rhs, &
             block_apply, block_apply_t, block_apply_cols, &
             sens_klam, sens_klam_list, sens_jpt_lam, sens_force_d, sens_force_dm, sens_force_jac, &
-            sens_force_rows, &
+            sens_force_rows, sens_revolute_rows, sens_translational_rows, sens_rows_rhs, &
             sens_eval_d
 
   integer, parameter :: PT_RPAR = 1, PT_MASS = 2, PT_GRAV = 3, PT_FPAR = 4  !! table ids
@@ -85,6 +85,7 @@ module mbd_sensitivity
     !> the revolutes' moving sides (closed forms): body, point offset in the pool, sign,
     !! constraint, theta slot (3, 6), and their blocks (2, nside) at the current state
     integer, allocatable :: rsb(:), rso(:), rsc(:), rss(:)
+    integer, allocatable :: rsq(:), rsr(:)   !! each side's angle coordinate and first row
     real(wp), allocatable :: rsg(:)
     real(wp), allocatable :: rsh(:, :), rsv(:, :), rsa(:, :)
     integer, allocatable :: tlc(:)           !! the translationals (closed forms)
@@ -355,7 +356,8 @@ contains
         ngp = ngp + count(s%caff(c, :))
       end if
     end do
-    allocate (s%rsb(ns), s%rso(ns), s%rsc(ns), s%rss(ns), s%rsg(ns), s%rsh(2, ns), &
+    allocate (s%rsb(ns), s%rso(ns), s%rsc(ns), s%rss(ns), s%rsq(ns), s%rsr(ns), s%rsg(ns), &
+              s%rsh(2, ns), &
               s%rsv(2, ns), s%rsa(2, ns), s%gen(ngen), s%psk(nps), s%psb(nps), s%pso(nps), &
               s%psr(nps), s%psg(nps), s%psfirst(nps), s%psphi(2, nps), s%psv(2, nps), &
               s%psa(2, nps), s%gpc(ngp), s%gpk(ngp), s%ounit(m%nq, s%np), &
@@ -375,6 +377,7 @@ contains
           ns = ns + 1
           s%rsb(ns) = merge(m%bi(c), m%bj(c), side == 1); s%rso(ns) = m%po(c) + 2 * (side - 1)
           s%rsg(ns) = merge(-one, one, side == 1); s%rsc(ns) = c; s%rss(ns) = 3 * side
+          s%rsq(ns) = m%loc(3 * side, c); s%rsr(ns) = m%row0(c)
           s%nzr(s%nrvz + 1) = m%row0(c); s%nzr(s%nrvz + 2) = m%row0(c) + 1
           s%nzc(s%nrvz + 1:s%nrvz + 2) = m%loc(3 * side, c)
           s%nzv(s%nrvz + 1:s%nrvz + 2) = zero; s%nza(s%nrvz + 1:s%nrvz + 2) = zero
@@ -454,30 +457,36 @@ contains
   !! translationals in closed form (revolute_second_sides, translational_second, in fixed
   !! places of the list), the others by the dual evaluation along dq = e_j.
   !! sens_trig first (or sens_states, with states = .false.).
-  pure subroutine sens_hessian(m, s, q, qd, qdd, t, states)
+  pure subroutine sens_hessian(m, s, q, qd, qdd, t, states, closed)
     type(model_t), intent(in) :: m             !! model
     type(sens_t), intent(inout) :: s           !! blocks (out)
     real(wp), intent(in) :: q(:), qd(:), qdd(:)  !! state and accelerations
     real(wp), intent(in) :: t                  !! time
     logical, intent(in), optional :: states    !! .false.: sens_states has set the state
+    !> .false.: leave the revolutes and translationals out (their blocks, entries and closed
+    !! forms stale; sens_revolute_rows and sens_translational_rows take them)
+    logical, intent(in), optional :: closed
     type(dloc) :: x
     real(wp) :: qddl(NLOC), tphi(MAXROW), tnu(MAXROW), tgam(MAXROW), hv, ha
     real(wp) :: qloc(NLOC), qdl(NLOC), hm(6, 6), hvt(6), hat(6)
     integer :: k, j, nr, si, sj, r, e, n
+    logical :: revs
     if (.not. present(states)) then
       call body_states(m, s, qd, qdd)
     else if (states) then
       call body_states(m, s, qd, qdd)
     end if
     s%nnz = s%nrvz                              ! the revolutes' entries first, in fixed places
-    if (size(s%rsb) > 0) then                   ! the revolutes in closed form
+    revs = .true.
+    if (present(closed)) revs = closed
+    if (size(s%rsb) > 0 .and. revs) then        ! the revolutes in closed form
       call revolute_second_sides(size(s%rsb), m%nb, s%rso, s%rsb, s%rsg, m%p, s%bst, s%rsh, &
                                  s%rsv, s%rsa)
       call revolute_push(size(s%rsb), m%nc, s%rsc, s%rss, s%rsh, s%rsv, s%rsa, s%hs, s%nzv, &
                          s%nza)
     end if
     n = 2 * size(s%rsb)                         ! the translationals' entries follow
-    do e = 1, size(s%tlc)
+    do e = 1, merge(size(s%tlc), 0, revs)
       k = s%tlc(e)
       call slot_values(m, k, q, qd, qdd, qloc, qdl, qddl)
       call translational_second(m%p(m%po(k):m%po(k) + 8), s%bst(1, m%bi(k)), &
@@ -886,25 +895,149 @@ contains
     end do
   end subroutine rhs_four
 
+  !> rhs = base - sum over the nonzeros n >= first of h1 S (- 2 h2 S_dot when both), a
+  !! row per parameter (npd, neq; S, S_dot as rows st, sdt (npd, nq)): sens_kin_rhs on
+  !! explicit arrays, from entry first (first = 2 ns + 1 leaves the ns revolute sides'
+  !! entries, the first ones, to sens_revolute_rows).
+  pure subroutine sens_rows_rhs(s, both, first, npd, nq, st, sdt, rhs)
+    type(sens_t), intent(in) :: s            !! the nonzeros, the parameter parts
+    logical, intent(in) :: both              !! level 3 (else 2: nu_p - J_p q_dot - Hv S)
+    integer, intent(in) :: first, npd, nq    !! first entry, rows, coordinates
+    real(wp), intent(in) :: st(npd * nq), sdt(npd * nq)  !! S, S_dot as rows
+    real(wp), intent(inout) :: rhs(npd, *)   !! (npd, neq)
+    integer :: n0
+    n0 = first - 1
+    if (both) then
+      call kin_rhs_kernel(npd, size(s%ap, 2), nq, s%nnz - n0, s%nzr(first:), s%nzc(first:), &
+                          s%nza(first:), s%nzv(first:), .true., s%ap, st, sdt, rhs)
+    else
+      call kin_rhs_kernel(npd, size(s%vp, 2), nq, s%nnz - n0, s%nzr(first:), s%nzc(first:), &
+                          s%nzv(first:), s%nzv(first:), .false., s%vp, st, sdt, rhs)
+    end if
+  end subroutine sens_rows_rhs
+
+  !> The revolutes' share of the dopri5 sensitivities' right-hand sides, every moving side
+  !! at once from its closed form (revolute_second_sides' values, here from the body states
+  !! s%bst of sens_hessian): with h = d(theta column)/dtheta, hv, ha of side e (body b,
+  !! angle coordinate c, rows r0, r0 + 1),
+  !!   rt(:, c) -= (lambda_r0 h_1 + lambda_r0+1 h_2) S(c, :)        (K_lambda S)
+  !!   wk(:, r0 + i) -= ha_i S(c, :) + 2 hv_i S_dot(c, :),  i = 0, 1   (Ha S + 2 Hv S_dot)
+  !! (S, S_dot as rows st, sdt (npd, nq); rt (npd, nq + ...), wk (npd, neq)).
+  pure subroutine sens_revolute_rows(m, s, lam, npd, st, sdt, rt, wk)
+    type(model_t), intent(in) :: m           !! model
+    type(sens_t), intent(in) :: s            !! the sides, the body states
+    real(wp), intent(in) :: lam(:)           !! multipliers (neq)
+    integer, intent(in) :: npd               !! rows (a multiple of 4)
+    real(wp), intent(in) :: st(npd, *), sdt(npd, *)  !! S, S_dot as rows
+    real(wp), intent(inout) :: rt(npd, *), wk(npd, *)
+    call revolute_rows_kernel(size(s%rsb), m%nb, npd, s%rso, s%rsb, s%rsg, s%rsq, s%rsr, m%p, &
+                              s%bst, lam, st, sdt, rt, wk)
+  end subroutine sens_revolute_rows
+
+  !> The translationals' share of the dopri5 sensitivities' right-hand sides, from their
+  !! closed forms (translational_second at the state: the first row's Hessian hm over the
+  !! slots, hv = hm q_dot, ha = hm q_ddot - dgamma/dq; the second row is linear): with
+  !! lambda the first row's multiplier and r that row,
+  !!   rt(:, c_i) -= lambda hm(i, j) S(c_j, :)                 (K_lambda S)
+  !!   wk(:, r) -= ha_j S(c_j, :) + 2 hv_j S_dot(c_j, :)         (Ha S + 2 Hv S_dot)
+  !! over the slots i, j with a coordinate (S, S_dot as rows st, sdt (npd, nq)).
+  pure subroutine sens_translational_rows(m, s, q, qd, qdd, lam, npd, st, sdt, rt, wk)
+    type(model_t), intent(in) :: m           !! model
+    type(sens_t), intent(in) :: s            !! the translationals, the body states
+    real(wp), intent(in) :: q(:), qd(:), qdd(:)  !! state and accelerations
+    real(wp), intent(in) :: lam(:)           !! multipliers (neq)
+    integer, intent(in) :: npd               !! rows (a multiple of 4)
+    real(wp), intent(in) :: st(npd, *), sdt(npd, *)  !! S, S_dot as rows
+    real(wp), intent(inout) :: rt(npd, *), wk(npd, *)
+    real(wp) :: qloc(NLOC), qdl(NLOC), qddl(NLOC), hm(6, 6), hvt(6), hat(6), la, kl, a1, v1
+    integer :: e, k, r, i, j, ci, cj, g
+    do e = 1, size(s%tlc)
+      k = s%tlc(e); r = m%row0(k)
+      call slot_values(m, k, q, qd, qdd, qloc, qdl, qddl)
+      call translational_second(m%p(m%po(k):m%po(k) + 8), s%bst(1, m%bi(k)), &
+                                s%bst(2, m%bi(k)), s%bst(1, m%bj(k)), s%bst(2, m%bj(k)), &
+                                qloc(1:6), qdl(1:6), qddl(1:6), hm, hvt, hat)
+      la = lam(r)
+      do j = 1, 6
+        cj = m%loc(j, k)
+        if (cj == 0) cycle
+        a1 = hat(j); v1 = 2 * hvt(j)
+        do g = 0, npd - 4, 4
+          call row4(a1, v1, st(g + 1, cj), sdt(g + 1, cj), wk(g + 1, r))
+        end do
+        do i = 1, 6
+          ci = m%loc(i, k)
+          if (ci == 0) cycle
+          kl = la * hm(i, j)
+          if (abs(kl) <= zero) cycle
+          do g = 0, npd - 4, 4
+            call row4(kl, zero, st(g + 1, cj), sdt(g + 1, cj), rt(g + 1, ci))
+          end do
+        end do
+      end do
+    end do
+  end subroutine sens_translational_rows
+
+  !> sens_revolute_rows on explicit shapes: u = A s' of the side's body, w, a its theta_dot
+  !! and theta_ddot, g the side's sign: h = g u, hv = g u w, ha = g (u a - perp(u) w**2).
+  pure subroutine revolute_rows_kernel(ns, nb, npd, o, b, sg, cq, r0, p, bst, lam, st, sdt, &
+                                       rt, wk)
+    integer, intent(in) :: ns, nb, npd
+    integer, intent(in) :: o(ns), b(ns), cq(ns), r0(ns)
+    real(wp), intent(in) :: sg(ns), p(*), bst(4, 0:nb), lam(*), st(npd, *), sdt(npd, *)
+    real(wp), intent(inout) :: rt(npd, *), wk(npd, *)
+    integer :: e, i, k, c, r, j
+    real(wp) :: ux, uy, w, a, w2, g, kl, a1, a2, v1, v2
+    do e = 1, ns
+      i = b(e); k = o(e); g = sg(e); c = cq(e); r = r0(e)
+      ux = bst(1, i) * p(k) - bst(2, i) * p(k + 1); uy = bst(2, i) * p(k) + bst(1, i) * p(k + 1)
+      w = bst(3, i); a = bst(4, i); w2 = w**2
+      kl = lam(r) * (g * ux) + lam(r + 1) * (g * uy)
+      a1 = g * (ux * a - uy * w2); a2 = g * (uy * a + ux * w2)
+      v1 = 2 * (g * (ux * w)); v2 = 2 * (g * (uy * w))
+      do j = 0, npd - 4, 4                       ! (four rows at a time, written out)
+        call row4(kl, zero, st(j + 1, c), sdt(j + 1, c), rt(j + 1, c))
+        call row4(a1, v1, st(j + 1, c), sdt(j + 1, c), wk(j + 1, r))
+        call row4(a2, v2, st(j + 1, c), sdt(j + 1, c), wk(j + 1, r + 1))
+      end do
+    end do
+  end subroutine revolute_rows_kernel
+
+  !> y(1:4) -= a x(1:4) + b z(1:4).
+  pure subroutine row4(a, b, x, z, y)
+    real(wp), intent(in) :: a, b, x(4), z(4)
+    real(wp), intent(inout) :: y(4)
+    y(1) = y(1) - a * x(1) - b * z(1); y(2) = y(2) - a * x(2) - b * z(2)
+    y(3) = y(3) - a * x(3) - b * z(3); y(4) = y(4) - a * x(4) - b * z(4)
+  end subroutine row4
+
   !> K_lambda = (J^T lambda)_q = sum over rows of lambda_r (Phi_r)_qq as a list of its
   !! nonzeros (row, column, value), from the local Hessian blocks (sens_hessian at the same q):
   !! each revolute side's (theta, theta) entry from its closed form (rsh), a translational's
   !! first row (its second is linear in q), the other constraints not linear in q in full.
-  pure subroutine sens_klam_list(m, s, lam)
+  pure subroutine sens_klam_list(m, s, lam, closed)
     type(model_t), intent(in) :: m           !! model
     type(sens_t), intent(inout) :: s         !! Hessian blocks; the list (out)
     real(wp), intent(in) :: lam(:)           !! multipliers (neq)
-    integer :: k, e, r0
+    !> .false.: leave the revolutes and translationals out (sens_hessian's closed = .false.)
+    logical, intent(in), optional :: closed
+    integer :: k, e, r0, ns, nt
     real(wp) :: acc
     s%kln = 0
-    do e = 1, size(s%rsc)                      ! the revolutes' moving sides
+    ns = size(s%rsc); nt = size(s%tlc)
+    if (present(closed)) then
+      if (.not. closed) then
+        ns = 0; nt = 0
+      end if
+    end if
+    do e = 1, ns                               ! the revolutes' moving sides
       k = s%rsc(e); r0 = m%row0(k) - 1
       acc = lam(r0 + 1) * s%rsh(1, e) + lam(r0 + 2) * s%rsh(2, e)
       if (abs(acc) <= zero) cycle
       s%kln = s%kln + 1
       s%klr(s%kln) = m%loc(s%rss(e), k); s%klc(s%kln) = s%klr(s%kln); s%klv(s%kln) = acc
     end do
-    do e = 1, size(s%tlc)
+    do e = 1, nt
       call block_entries(m, s, lam, s%tlc(e), 1)
     end do
     do e = 1, size(s%gen)
