@@ -445,14 +445,15 @@ contains
 
   !> force_eval_d along up to four directions given as rows (the local slots' tqr, tqdr
   !! (4, NLOC), the rows past np zero) with the parameters' changes tp (size(p), np;
-  !! aff(k): column k is not zero), the changes as rows tfr (4, NLOC). A spring's state
-  !! part (spring_rows) takes the four rows at once, its parameters' part is added for the
-  !! affected ones; the other kinds go direction by direction.
+  !! aff(k): 0 column k is zero, 1 a spring's points stay, 2 otherwise), the changes as rows
+  !! tfr (4, NLOC). A spring's state part (spring_rows) takes the four rows at once, its
+  !! parameters' part is added for the affected ones; the other kinds go direction by
+  !! direction.
   pure subroutine force_rows_d(kind, p, tp, aff, si, sj, ql, qdl, np, tqr, tqdr, t, tfr, cs, sn)
     integer, intent(in) :: kind             !! force kind
     real(wp), intent(in) :: p(:)            !! prepared parameters
     real(wp), intent(in) :: tp(:, :)        !! their changes (size(p), np)
-    logical, intent(in) :: aff(:)           !! (np) tp(:, k) is not zero
+    integer, intent(in) :: aff(:)           !! (np) how tp(:, k) changes the force
     integer, intent(in) :: si, sj           !! slot ids of the bodies (0 = ground)
     real(wp), intent(in) :: ql(NLOC), qdl(NLOC)  !! local coordinates and velocities
     integer, intent(in) :: np               !! directions (at most 4)
@@ -483,9 +484,9 @@ contains
     if (.not. v%l > zero) return
     call spring_rows(v, p, qdl, tqr, tqdr, tfr)
     do k = 1, np                            ! the parameters' own changes
-      if (.not. aff(k)) cycle
+      if (aff(k) == 0) cycle
       tf = zero
-      if (all(tp(1:4, k) == zero)) then     ! the points stay: the tension's change only
+      if (aff(k) == 1) then                 ! the points stay: the tension's change only
         call spring_tension_change(v, p, tp(:, k), si, sj, t, tf)
       else
         call spring_change(dual_state(xs, z, z), v, p, tp(:, k), si, sj, t, tf)

@@ -32,7 +32,7 @@ module mbd_sensitivity
   use mbd_joint_revolute, only: revolute_second_sides, revolute_param_sides
   use mbd_joint_translational, only: translational_second, translational_param
   use mbd_forces, only: force_eval_d, force_eval_dm, force_is_count, force_exponents, &
-                        force_rows_d
+                        force_rows_d, FRC_SPRING
   implicit none
   private
   public :: sens_t, PT_RPAR, PT_MASS, PT_GRAV, PT_FPAR
@@ -60,6 +60,9 @@ module mbd_sensitivity
     logical, allocatable :: faff(:, :)       !! (nf, np) the force's parameters change
     logical, allocatable :: kgrav(:)         !! (np) the parameter changes a mass or gravity
     logical, allocatable :: kcon(:)          !! (np) the parameter changes a constraint
+    !> (np, nf) how parameter k changes force f: 0 not, 1 a spring's tension only (not its
+    !! points), 2 otherwise (force_rows_d)
+    integer, allocatable :: fcode(:, :)
     !> (nq, np) the change of the gravity loads m g (with the masses and g: constant), and
     !! as rows (npad, nq)
     real(wp), allocatable :: qg(:, :), qgr(:, :)
@@ -247,12 +250,23 @@ contains
     end do
     bad = 0
     allocate (s%kgrav(s%np), s%kcon(s%np), s%qg(m%nq, s%np), s%qgr(npad, m%nq), &
+              s%fcode(s%np, m%nf), &
               s%mzc(count(s%tmass /= zero)), s%mzk(count(s%tmass /= zero)), &
               s%mzv(count(s%tmass /= zero)), stat=st)
     if (st /= 0) then
       status = MBD_NO_MEMORY; msg = 'out of memory for the sensitivity arrays'; return
     end if
     s%qg = zero; s%qgr = zero; s%nmz = 0
+    s%fcode = 0
+    do c = 1, m%nf
+      do k = 1, s%np
+        if (.not. s%faff(c, k)) cycle
+        s%fcode(k, c) = 2
+        if (m%fkind(c) == FRC_SPRING) then
+          if (all(s%tfp(m%fpo(c):m%fpo(c) + 3, k) == zero)) s%fcode(k, c) = 1
+        end if
+      end do
+    end do
     do k = 1, s%np
       do i = 1, m%nq
         if (s%tmass(i, k) == zero) cycle
@@ -1239,9 +1253,9 @@ contains
           ql(j) = q(c); qdl(j) = qd(c)
         end if
       end do
+      tqr = zero; tqdr = zero                  ! (the slots without a coordinate stay zero)
       do g = 0, npad - 4, 4
         ng = min(4, s%np - g)
-        tqr = zero; tqdr = zero
         do j = 1, NLOC
           c = m%floc(j, f)
           if (c == 0) cycle
@@ -1251,7 +1265,7 @@ contains
           tqdr(3, j) = sdt(g + 3, c); tqdr(4, j) = sdt(g + 4, c)
         end do
         call force_rows_d(m%fkind(f), m%fp(n0:n1), s%tfp(n0:n1, g + 1:g + ng), &
-                          s%faff(f, g + 1:g + ng), si, sj, ql, qdl, ng, tqr, tqdr, t, tfr, &
+                          s%fcode(g + 1:g + ng, f), si, sj, ql, qdl, ng, tqr, tqdr, t, tfr, &
                           cs, sn)
         do j = 1, NLOC
           c = m%floc(j, f)
