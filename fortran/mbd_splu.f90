@@ -466,39 +466,56 @@ contains
     logical, intent(in) :: add                       !! add to xt (else overwrite)
     integer :: g
     do g = 1, size(bt, 1) - 3, 4
-      call rows_kernel(sp%n, sp%lptr(sp%n + 1) - 1, sp%nu, sp%prow, sp%lrptr, sp%lrpos, &
-                       sp%lrcol, sp%urptr, sp%urpos, sp%urcol, sp%val, sp%y4, size(bt, 1), bt, g)
-      call rows_t_out(sp%n, nkeep, sp%pcol, sp%rinv, sp%y4, ldt, xt, g, add)
+      call rows_kernel_t(sp%n, sp%lptr(sp%n + 1) - 1, sp%nu, sp%prow, sp%lrptr, sp%lrpos, &
+                         sp%lrcol, sp%urptr, sp%urpos, sp%urcol, sp%val, sp%y4, size(bt, 1), &
+                         bt, g, nkeep, sp%pcol, sp%rinv, ldt, xt, add)
     end do
   end subroutine splu_solve_rows_t
 
-  !> splu_solve_rows_t's output of rows_kernel's four solutions: x = Q diag(1/u_kk) v, its
-  !! entries c <= nkeep into rows g .. g + 3 of xt.
-  pure subroutine rows_t_out(n, nkeep, pcol, rinv, y, ldt, xt, g, add)
-    integer, intent(in) :: n, nkeep, pcol(n), ldt, g
-    real(wp), intent(in) :: rinv(n), y(4, n)
+  !> rows_kernel with the output of splu_solve_rows_t taken in its U pass: each row's four
+  !! values, final there, go out (x = Q diag(1/u_kk) v, the entries c <= nkeep) as they are
+  !! found. (A kernel of its own: rows_kernel, called only by splu_solve_rows, stays inlined
+  !! there.)
+  pure subroutine rows_kernel_t(n, nl, nu, prow, lrptr, lrpos, lrcol, urptr, urpos, urcol, &
+                                val, y, ldb, bt, g, nkeep, pcol, rinv, ldt, xt, add)
+    integer, intent(in) :: n, nl, nu, g, ldb, nkeep, ldt
+    integer, intent(in) :: prow(n), lrptr(n + 1), lrpos(nl), lrcol(nl)
+    integer, intent(in) :: urptr(n + 1), urpos(nu), urcol(nu), pcol(n)
+    real(wp), intent(in) :: val(*), bt(ldb, n), rinv(n)
+    real(wp), intent(out) :: y(4, n)
     real(wp), intent(inout) :: xt(ldt, *)
     logical, intent(in) :: add
-    integer :: k, c
-    real(wp) :: v
-    if (add) then
-      do k = 1, n
-        c = pcol(k)
-        if (c > nkeep) cycle
-        v = rinv(k)
-        xt(g, c) = xt(g, c) + y(1, k) * v; xt(g + 1, c) = xt(g + 1, c) + y(2, k) * v
-        xt(g + 2, c) = xt(g + 2, c) + y(3, k) * v; xt(g + 3, c) = xt(g + 3, c) + y(4, k) * v
+    integer :: a, p, c
+    real(wp) :: v, t1, t2, t3, t4
+    do a = 1, n                                      ! L z = P b (unit diagonal), by rows
+      c = prow(a)
+      t1 = bt(g, c); t2 = bt(g + 1, c); t3 = bt(g + 2, c); t4 = bt(g + 3, c)
+      do p = lrptr(a), lrptr(a + 1) - 1
+        v = val(lrpos(p)); c = lrcol(p)
+        t1 = t1 - v * y(1, c); t2 = t2 - v * y(2, c)
+        t3 = t3 - v * y(3, c); t4 = t4 - v * y(4, c)
       end do
-      return
-    end if
-    do k = 1, n
-      c = pcol(k)
-      if (c > nkeep) cycle
-      v = rinv(k)
-      xt(g, c) = y(1, k) * v; xt(g + 1, c) = y(2, k) * v
-      xt(g + 2, c) = y(3, k) * v; xt(g + 3, c) = y(4, k) * v
+      y(1, a) = t1; y(2, a) = t2; y(3, a) = t3; y(4, a) = t4
     end do
-  end subroutine rows_t_out
+    do a = n, 1, -1                                  ! U1 v = z, by rows, and out
+      t1 = y(1, a); t2 = y(2, a); t3 = y(3, a); t4 = y(4, a)
+      do p = urptr(a), urptr(a + 1) - 1
+        v = val(urpos(p)); c = urcol(p)
+        t1 = t1 - v * y(1, c); t2 = t2 - v * y(2, c)
+        t3 = t3 - v * y(3, c); t4 = t4 - v * y(4, c)
+      end do
+      y(1, a) = t1; y(2, a) = t2; y(3, a) = t3; y(4, a) = t4
+      c = pcol(a)
+      if (c > nkeep) cycle
+      v = rinv(a)
+      if (add) then
+        xt(g, c) = xt(g, c) + t1 * v; xt(g + 1, c) = xt(g + 1, c) + t2 * v
+        xt(g + 2, c) = xt(g + 2, c) + t3 * v; xt(g + 3, c) = xt(g + 3, c) + t4 * v
+      else
+        xt(g, c) = t1 * v; xt(g + 1, c) = t2 * v; xt(g + 2, c) = t3 * v; xt(g + 3, c) = t4 * v
+      end if
+    end do
+  end subroutine rows_kernel_t
 
   !> rows_out without the rows: columns g .. of x only (times f).
   pure subroutine cols_out(n, ncol, pcol, rinv, cs, y, g, x, f)
