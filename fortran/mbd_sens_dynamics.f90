@@ -455,7 +455,7 @@ contains
       f(1:nz) = yy(nz + 1:)
       f(nz + 1:nz + n) = aa
       ! cos and sin of the angles at qq: the assembly's (sens_trig's values, not computed again)
-      s%cb(1:m%nb) = w%asm%cb(1:m%nb); s%sb(1:m%nb) = w%asm%sb(1:m%nb)
+      call copy_trig(m%nb, w%asm%cb, w%asm%sb, s%cb, s%sb)
       ! (the revolutes' and translationals' second derivatives: their *_rows below)
       call sens_hessian(m, s, qq, vv, aa, tt, closed=.false.)
       ! (the parameter parts: only parameters that change a constraint have any)
@@ -472,7 +472,12 @@ contains
         pw%rt(kk, 1:n) = pw%rt(kk, 1:n) - y3
       end do
       ! gamma_p - J_p q_ddot - Ha S - 2 Hv S_dot; the revolutes' Ha, Hv and K_lambda
-      call sens_rows_rhs(s, .true., s%nrvz + 1, npd, n, yy(n + 1:nz), yy(nz + n + 1:), s%rhs)
+      if (pcon .or. s%nnz > s%nrvz) then
+        call sens_rows_rhs(s, .true., s%nrvz + 1, npd, n, yy(n + 1:nz), yy(nz + n + 1:), &
+                           s%rhs)
+      else                                      ! (no parameter part, no other nonzero)
+        call zero_rows(npd * m%neq, s%rhs)
+      end if
       call sens_revolute_rows(m, s, lam, npd, yy(n + 1:nz), yy(nz + n + 1:), pw%rt, s%rhs)
       call sens_translational_rows(m, s, qq, vv, aa, lam, npd, yy(n + 1:nz), yy(nz + n + 1:), &
                                    pw%rt, s%rhs)
@@ -606,6 +611,27 @@ contains
       end do
     end do
   end subroutine accel_rows
+
+  !> cb(1:nb), sb(1:nb) = ca(1:nb), sa(1:nb) (the bodies' cos and sin; index 0, ground, kept).
+  pure subroutine copy_trig(nb, ca, sa, cb, sb)
+    integer, intent(in) :: nb
+    real(wp), intent(in) :: ca(0:nb), sa(0:nb)
+    real(wp), intent(inout) :: cb(0:nb), sb(0:nb)
+    integer :: b
+    do b = 1, nb
+      cb(b) = ca(b); sb(b) = sa(b)
+    end do
+  end subroutine copy_trig
+
+  !> r(1:nn) = 0, flat.
+  pure subroutine zero_rows(nn, r)
+    integer, intent(in) :: nn
+    real(wp), intent(out) :: r(nn)
+    integer :: e
+    do e = 1, nn
+      r(e) = zero
+    end do
+  end subroutine zero_rows
 
   !> r(1:nn) = a (when use) or zero, flat.
   pure subroutine start_rows(nn, use, a, r)
