@@ -1240,9 +1240,7 @@ contains
     end do
     call units(m, qout, m%cunit, .false.); call units(m, qdout, m%cunit, .false.)
     call units(m, qddout, m%cunit, .false.); call units(m, lamout, m%rowunit, .true.)
-    call sens_units(m, sens, sq, m%cunit, .false.)
-    call sens_units(m, sens, sqd, m%cunit, .false.)
-    call sens_units(m, sens, sqdd, m%cunit, .false.)
+    ! (sq, sqd, sqdd: sens_dopri5 wrote them in model units)
   end subroutine api_dynamics_sens
 
   !> Normal force of each cam joint on its follower at many states: fn(nc, nt), positive

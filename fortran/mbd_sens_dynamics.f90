@@ -294,7 +294,8 @@ contains
 
   !> Forward dynamics with sensitivities by dopri5 from the consistent state (q, qd) at t0 and
   !! its sensitivities (sq, sqd) (nq, np); outputs as mbd_integrators' integrate, with
-  !! so, sdo, sddo (nq, np, rows) the sensitivities of q, q_dot, q_ddot.
+  !! so, sdo, sddo (nq, np, rows) the sensitivities of q, q_dot, q_ddot (in model units,
+  !! s%ounit; the state's outputs in the core's).
   !! stats: 1 steps, 2 rejected, 3 right-hand sides; hmm(1:2) smallest and largest step.
   subroutine sens_dopri5(m, w, s, q, qd, sq, sqd, t0, t1, nsteps, every, rtol, atol, &
                          max_steps, qo, vo, ao, so, sdo, sddo, lo, lok, nout, stats, hmm, &
@@ -308,11 +309,13 @@ contains
     integer, intent(in) :: nsteps, every        !! output intervals, decimation
     real(wp), intent(in) :: rtol, atol          !! tolerances (all components)
     integer, intent(in) :: max_steps            !! step limit
-    real(wp), intent(out) :: qo(:, :), vo(:, :), ao(:, :)       !! (nq, rows)
-    real(wp), intent(out) :: so(:, :, :), sdo(:, :, :), sddo(:, :, :)  !! (nq, np, rows)
+    !> the outputs (rows 1 .. nout written; the others left as the caller set them, its
+    !! zeros: the output arrays are the run's largest, not filled twice)
+    real(wp), intent(inout) :: qo(:, :), vo(:, :), ao(:, :)       !! (nq, rows)
+    real(wp), intent(inout) :: so(:, :, :), sdo(:, :, :), sddo(:, :, :)  !! (nq, np, rows)
     !> multipliers at the outputs (neq, rows), those of the index-1 solve at the output's
     !! state where lok (independent rows, a regular solve); elsewhere the caller finds them
-    real(wp), intent(out) :: lo(:, :)
+    real(wp), intent(inout) :: lo(:, :)
     logical, intent(out) :: lok(:)
     integer, intent(out) :: nout                !! rows written
     integer, intent(out) :: stats(3)            !! steps, rejected, right-hand sides
@@ -329,7 +332,6 @@ contains
     integer :: n, np, npd, nz, st, kout, nreal
     logical :: fsal, pcon
     status = MBD_OK; msg = ''; nout = 0; stats = 0; hmm = [huge(one), zero]; t_fail = t0
-    qo = zero; vo = zero; ao = zero; so = zero; sdo = zero; sddo = zero; lo = zero
     lok = .false.
     ! the packed state (q, S, q_dot, S_dot) holds S and S_dot as rows (npd, n), npd = np
     ! rounded up to a multiple of 4 (the padding rows stay zero: no rate, no error)
@@ -539,9 +541,10 @@ contains
       integer, intent(in) :: row
       real(wp), intent(in) :: z1(:), z2(:), z3(:)
       qo(:, row) = z1(1:n); vo(:, row) = z2(1:n); ao(:, row) = z3(1:n)
-      call rows_to_cols(n, np, npd, z1(n + 1:), so(:, :, row))
-      call rows_to_cols(n, np, npd, z2(n + 1:), sdo(:, :, row))
-      call rows_to_cols(n, np, npd, z3(n + 1:), sddo(:, :, row))
+      ! (the sensitivities in model units: ounit, exact powers of 2)
+      call rows_to_cols(n, np, npd, z1(n + 1:), so(:, :, row), s%ounit)
+      call rows_to_cols(n, np, npd, z2(n + 1:), sdo(:, :, row), s%ounit)
+      call rows_to_cols(n, np, npd, z3(n + 1:), sddo(:, :, row), s%ounit)
     end subroutine put
   end subroutine sens_dopri5
 
@@ -571,12 +574,21 @@ contains
     end do
   end subroutine cols_to_rows
 
-  !> Rows r (npd, n) as columns c (n, np).
-  pure subroutine rows_to_cols(n, np, npd, r, c)
+  !> Rows r (npd, n) as columns c (n, np), each entry times u's when given.
+  pure subroutine rows_to_cols(n, np, npd, r, c, u)
     integer, intent(in) :: n, np, npd
     real(wp), intent(in) :: r(npd, n)
     real(wp), intent(out) :: c(n, np)
+    real(wp), intent(in), optional :: u(n, np)
     integer :: i, k
+    if (present(u)) then
+      do k = 1, np
+        do i = 1, n
+          c(i, k) = r(k, i) * u(i, k)
+        end do
+      end do
+      return
+    end if
     do k = 1, np
       do i = 1, n
         c(i, k) = r(k, i)
