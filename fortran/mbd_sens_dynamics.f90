@@ -323,7 +323,7 @@ contains
     real(wp), intent(out) :: t_fail             !! time reached at a failure
     integer, intent(out) :: status              !! MBD_OK or a failure
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
-    real(wp), allocatable :: y(:), yn(:), ys(:), k(:, :), e(:), za(:), zda(:), zdda(:), lam(:), &
+    real(wp), allocatable :: y(:), yn(:), ys(:), k(:, :), e(:), zdda(:), lam(:), yt(:), &
                              zz(:), zzd(:), zzdd(:)
     ! the work of rhs and project (here, so that no step allocates)
     real(wp), allocatable :: qq(:), vv(:), aa(:), y3(:), v0(:), fo(:)
@@ -343,7 +343,7 @@ contains
       status = MBD_BAD_SETTING; msg = 'rtol, atol > 0, every >= 1 and outputs sized for it'
       return
     end if
-    allocate (y(2 * nz), yn(2 * nz), ys(2 * nz), k(2 * nz, 7), e(2 * nz), za(nz), zda(nz), &
+    allocate (y(2 * nz), yn(2 * nz), ys(2 * nz), k(2 * nz, 7), e(2 * nz), &
               zdda(nz), lam(m%neq), zz(nz), zzd(nz), zzdd(nz), qq(n), vv(n), aa(n), y3(n), &
               v0(n), fo(2 * nz), stat=st)
     if (st /= 0) then
@@ -361,13 +361,13 @@ contains
       status = st; msg = 'the mass matrix and constraints give a singular system at the start'
       return
     end if
-    za = y(1:nz); zda = y(nz + 1:); zdda = k(nz + 1:, 1)
+    zdda = k(nz + 1:, 1)
     lo(:, 1) = lam; lok(1) = w%na == m%neq .and. .not. w%lsq
-    call put(1, za, zda, zdda)
+    call put(1, y(1:nz), y(nz + 1:), zdda)
     nout = 1; kout = 1
     fsal = .true.
     if (nsteps == 0) return
-    sc = maxval(abs(zdda) / (atol + rtol * abs(za)))
+    sc = maxval(abs(zdda) / (atol + rtol * abs(y(1:nz))))
     h = (t1 - t0) / nsteps
     if (sc > zero) h = min(h, 0.1_wp * sqrt(one / sc))
     h = max(h, 1.0e-10_wp * abs(t1 - t0))
@@ -409,11 +409,11 @@ contains
       end if
       fsal = .true.
       call emit(t, tnew)
-      za = yn(1:nz); zda = yn(nz + 1:); zdda = k(nz + 1:, 1)
+      zdda = k(nz + 1:, 1)
       stats(1) = stats(1) + 1
       hmm = [min(hmm(1), h), max(hmm(2), h)]
       t = tnew
-      y = yn
+      call move_alloc(y, yt); call move_alloc(yn, y); call move_alloc(yt, yn)   ! y = yn
       fac = min(5.0_wp, max(0.2_wp, 0.9_wp * max(err, 1.0e-10_wp)**(-0.2_wp)))
       h = h * fac
     end do
@@ -502,7 +502,8 @@ contains
       call project_sens(m, w, s, tt, yy, pw, .true., stp)
     end subroutine project
 
-    !> The stored outputs in (ta, tb] by quintic Hermite interpolation of z = (q, S).
+    !> The stored outputs in (ta, tb] by quintic Hermite interpolation of z = (q, S) between
+    !! the step's start (y, zdda) and end (yn, k(:, 1)).
     subroutine emit(ta, tb)
       real(wp), intent(in) :: ta, tb
       real(wp) :: tk
@@ -511,8 +512,8 @@ contains
         if (kout == nsteps) tk = t1
         if (tk > tb + 1.0e-12_wp * abs(t1 - t0)) exit
         if (mod(kout, every) == 0 .or. kout == nsteps) then
-          call hermite5(ta, za, zda, zdda, tb, yn(1:nz), yn(nz + 1:), k(nz + 1:, 1), tk, zz, &
-                        zzd, zzdd)
+          call hermite5(ta, y(1:nz), y(nz + 1:), zdda, tb, yn(1:nz), yn(nz + 1:), k(nz + 1:, 1), &
+                        tk, zz, zzd, zzdd)
           nout = nout + 1
           call at_state(nout, tk)
           call put(nout, zz, zzd, zzdd)
