@@ -366,16 +366,7 @@ contains
     tldot = dot_product(tu, v%dd) + dot_product(v%u, tdd)
     call fun_eval_d(p(8:), tp(8:), t, tf, tf1, tf2)
     ttension = tp(5) * (v%l - p(7)) + p(5) * (tl - tp(7)) + tp(6) * v%ldot + p(6) * tldot - tf
-    if (si > 0) then
-      tforce(1:2) = ttension * v%u + v%tension * tu
-      tforce(3) = ttension * dot_product(v%u, v%bi) + &
-                  v%tension * (dot_product(tu, v%bi) + dot_product(v%u, tbi))
-    end if
-    if (sj > 0) then
-      tforce(4:5) = -ttension * v%u - v%tension * tu
-      tforce(6) = -ttension * dot_product(v%u, v%bj) - &
-                  v%tension * (dot_product(tu, v%bj) + dot_product(v%u, tbj))
-    end if
+    call spring_q_change(v, si, sj, ttension, tu, tbi, tbj, tforce)
   contains
     !> Change of a slot's point velocity r_dot + B s theta_dot (ground: zero).
     pure function rate_change(slot, bs, tbs) result(tv)
@@ -589,6 +580,17 @@ contains
     tldot = dot_product(tu, v%dd) + dot_product(v%u, tdd)
     tt = p(5) * tl + p(6) * tldot
     tforce = zero
+    call spring_q_change(v, si, sj, tt, tu, tbi, tbj, tforce)
+  end subroutine spring_state_change
+
+  !> The change of a spring's Q = -T grad l from those of its tension (tt), direction (tu)
+  !! and points' B s' (tbi, tbj): on body i (tt u + T tu, tt u . B_i s' + T (tu . B_i s' +
+  !! u . d(B_i s'))), on body j the same negated with B_j s'; a ground slot's entries left.
+  pure subroutine spring_q_change(v, si, sj, tt, tu, tbi, tbj, tforce)
+    type(spring_v), intent(in) :: v         !! the values (spring_values)
+    integer, intent(in) :: si, sj           !! slot ids of the bodies (0 = ground)
+    real(wp), intent(in) :: tt, tu(2), tbi(2), tbj(2)  !! the changes
+    real(wp), intent(inout) :: tforce(NLOC) !! change of the generalized force
     if (si > 0) then
       tforce(1:2) = tt * v%u + v%tension * tu
       tforce(3) = tt * dot_product(v%u, v%bi) + &
@@ -599,6 +601,6 @@ contains
       tforce(6) = -tt * dot_product(v%u, v%bj) - &
                   v%tension * (dot_product(tu, v%bj) + dot_product(v%u, tbj))
     end if
-  end subroutine spring_state_change
+  end subroutine spring_q_change
 
 end module mbd_forces

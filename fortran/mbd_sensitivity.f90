@@ -1185,13 +1185,7 @@ contains
     do f = 1, m%nf
       n0 = m%fpo(f); n1 = n0 + m%fpn(f) - 1
       si = merge(1, 0, m%fbi(f) > 0); sj = merge(2, 0, m%fbj(f) > 0)
-      do j = 1, NLOC
-        c = m%floc(j, f)
-        ql(j) = zero; qdl(j) = zero
-        if (c > 0) then
-          ql(j) = q(c); qdl(j) = qd(c)
-        end if
-      end do
+      call force_slots(m, f, q, qd, ql, qdl)
       do g = 1, nk, KB
         ng = min(KB, nk - g + 1)
         tql = zero; tqdl = zero
@@ -1246,13 +1240,7 @@ contains
       si = merge(1, 0, m%fbi(f) > 0); sj = merge(2, 0, m%fbj(f) > 0)
       cs(1) = s%cb(m%fbi(f)); cs(2) = s%cb(m%fbj(f))
       sn(1) = s%sb(m%fbi(f)); sn(2) = s%sb(m%fbj(f))
-      do j = 1, NLOC
-        c = m%floc(j, f)
-        ql(j) = zero; qdl(j) = zero
-        if (c > 0) then
-          ql(j) = q(c); qdl(j) = qd(c)
-        end if
-      end do
+      call force_slots(m, f, q, qd, ql, qdl)
       tqr = zero; tqdr = zero                  ! (the slots without a coordinate stay zero)
       do g = 0, npad - 4, 4
         ng = min(4, s%np - g)
@@ -1276,6 +1264,22 @@ contains
       end do
     end do
   end subroutine sens_force_rows
+
+  !> Force f's local coordinates and velocities (zero in the slots without a coordinate).
+  pure subroutine force_slots(m, f, q, qd, ql, qdl)
+    type(model_t), intent(in) :: m           !! model with dynamics data
+    integer, intent(in) :: f                 !! force
+    real(wp), intent(in) :: q(:), qd(:)      !! state
+    real(wp), intent(out) :: ql(NLOC), qdl(NLOC)
+    integer :: j, c
+    do j = 1, NLOC
+      c = m%floc(j, f)
+      ql(j) = zero; qdl(j) = zero
+      if (c > 0) then
+        ql(j) = q(c); qdl(j) = qd(c)
+      end if
+    end do
+  end subroutine force_slots
 
   !> b(1:n) += a(1:n), flat.
   pure subroutine add_flat(n, a, b)

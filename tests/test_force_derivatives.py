@@ -26,14 +26,10 @@ H = 1e-6
 
 
 def loaded_model() -> mbd2d.Model:
-    """The slider-crank without its driver, with masses and every kind of force."""
-    from conftest import load_example
-    m = load_example("slider_crank.toml")
-    m.drivers.clear()
-    for b, (ms, j) in zip(m.bodies, [(2.0, 0.3), (1.5, 1.1), (0.8, 0.05)]):
-        b.mass, b.inertia = ms, j
-    m.add_spring(["ground", "slider"], [[0.0, 0.5], [0.0, 0.0]], stiffness=40.0, damping=3.0,
-                 length0=2.0, name="s1")
+    """The free slider-crank of test_sensitivities (masses, a spring s1 to ground) with every
+    other kind of force."""
+    from test_sensitivities import free_slider_crank
+    m = free_slider_crank()
     m.add_spring(["crank", "rod"], [[0.3, 0.1], [-0.2, 0.15]], stiffness=25.0, damping=1.5,
                  length0=0.5, f={"poly": [1.0, 0.5]}, name="s2")
     m.add_torque("crank", {"poly": [0.3, -0.2]}, name="t1")
