@@ -1307,13 +1307,7 @@ contains
     if (present(kv)) kv = zero
     tpz = zero
     do f = 1, m%nf
-      do j = 1, NLOC
-        c = m%floc(j, f)
-        ql(j) = zero; qdl(j) = zero
-        if (c > 0) then
-          ql(j) = q(c); qdl(j) = qd(c)
-        end if
-      end do
+      call force_slots(m, f, q, qd, ql, qdl)
       si = merge(1, 0, m%fbi(f) > 0); sj = merge(2, 0, m%fbj(f) > 0)
       do j = 1, NLOC
         c = m%floc(j, f)

@@ -28,13 +28,8 @@ H = 1e-6
 def loaded_model() -> mbd2d.Model:
     """The free slider-crank of test_sensitivities (masses, a spring s1 to ground) with every
     other kind of force."""
-    from test_sensitivities import free_slider_crank
-    m = free_slider_crank()
-    m.add_spring(["crank", "rod"], [[0.3, 0.1], [-0.2, 0.15]], stiffness=25.0, damping=1.5,
-                 length0=0.5, f={"poly": [1.0, 0.5]}, name="s2")
-    m.add_torque("crank", {"poly": [0.3, -0.2]}, name="t1")
-    m.add_point_force("rod", [0.4, 0.05], fx={"poly": [0.5]}, fy={"poly": [0.0, 1.0]},
-                      name="p1")
+    from test_sensitivities import add_force_kinds, free_slider_crank
+    m = add_force_kinds(free_slider_crank())
     m.add_rotational_spring(["crank", "rod"], stiffness=7.0, damping=0.4, angle0=0.3,
                             f={"poly": [0.2, 0.1]}, name="r1")
     return m

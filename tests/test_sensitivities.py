@@ -443,6 +443,17 @@ def free_slider_crank() -> mbd2d.Model:
     return m
 
 
+def add_force_kinds(m: mbd2d.Model) -> mbd2d.Model:
+    """m with a spring-damper-actuator between the crank and the rod (s2), a torque on the
+    crank (t1) and a point force on the rod (p1)."""
+    m.add_spring(["crank", "rod"], [[0.3, 0.1], [-0.2, 0.15]], stiffness=25.0, damping=1.5,
+                 length0=0.5, f={"poly": [1.0, 0.5]}, name="s2")
+    m.add_torque("crank", {"poly": [0.3, -0.2]}, name="t1")
+    m.add_point_force("rod", [0.4, 0.05], fx={"poly": [0.5]}, fy={"poly": [0.0, 1.0]},
+                      name="p1")
+    return m
+
+
 def test_dopri5_sensitivities_against_central_differences():
     """A free slider-crank under gravity with a spring: parameters that leave the assembled
     start alone, central differences of runs at rtol = atol = 1e-12."""
@@ -499,12 +510,7 @@ def test_dopri5_sensitivities_of_force_parameters():
     central differences of plain runs at rtol 1e-12 (h = 1e-4, 2e-4). Measured 4.3e-11 to
     3.8e-8 relative to each sensitivity's largest entry (the larger ones where the
     sensitivity is small, about 3e-3: the differences' own noise)."""
-    m = free_slider_crank()
-    m.add_spring(["crank", "rod"], [[0.3, 0.1], [-0.2, 0.15]], stiffness=25.0, damping=1.5,
-                 length0=0.5, f={"poly": [1.0, 0.5]}, name="s2")
-    m.add_torque("crank", {"poly": [0.3, -0.2]}, name="t1")
-    m.add_point_force("rod", [0.4, 0.05], fx={"poly": [0.5]}, fy={"poly": [0.0, 1.0]},
-                      name="p1")
+    m = add_force_kinds(free_slider_crank())
     names = ["force.s2.points.0.0", "force.s2.points.1.1", "force.s2.damping",
              "force.s2.length0", "force.s2.f.poly.1", "force.t1.f.poly.0", "force.p1.point.0",
              "force.p1.fy.poly.1"]
