@@ -424,7 +424,7 @@ contains
     do k = 1, size(tforce, 2)
       if (.not. aff(k)) then
         call spring_state_change(v, p, si, sj, qdl, tq(:, k), tqd(:, k), tforce(:, k))
-      else if (all(tp(1:4, k) == zero)) then   ! the points stay: the tension's change only
+      else if (.not. any(abs(tp(1:4, k)) > zero)) then   ! (the points stay: the tension's)
         call spring_state_change(v, p, si, sj, qdl, tq(:, k), tqd(:, k), tforce(:, k))
         call spring_tension_change(v, p, tp(:, k), si, sj, t, tforce(:, k))
       else
@@ -540,7 +540,7 @@ contains
     real(wp), intent(inout) :: tforce(NLOC) !! change of the generalized force
     real(wp) :: tf, tf1, tf2, tt
     tf = zero
-    if (any(tp(8:) /= zero)) call fun_eval_d(p(8:), tp(8:), t, tf, tf1, tf2)
+    if (any(abs(tp(8:)) > zero)) call fun_eval_d(p(8:), tp(8:), t, tf, tf1, tf2)
     tt = tp(5) * (v%l - p(7)) - p(5) * tp(7) + tp(6) * v%ldot - tf
     if (si > 0) then
       tforce(1:2) = tforce(1:2) + tt * v%u

@@ -251,8 +251,8 @@ contains
     bad = 0
     allocate (s%kgrav(s%np), s%kcon(s%np), s%qg(m%nq, s%np), s%qgr(npad, m%nq), &
               s%fcode(s%np, m%nf), &
-              s%mzc(count(s%tmass /= zero)), s%mzk(count(s%tmass /= zero)), &
-              s%mzv(count(s%tmass /= zero)), stat=st)
+              s%mzc(count(abs(s%tmass) > zero)), s%mzk(count(abs(s%tmass) > zero)), &
+              s%mzv(count(abs(s%tmass) > zero)), stat=st)
     if (st /= 0) then
       status = MBD_NO_MEMORY; msg = 'out of memory for the sensitivity arrays'; return
     end if
@@ -263,13 +263,13 @@ contains
         if (.not. s%faff(c, k)) cycle
         s%fcode(k, c) = 2
         if (m%fkind(c) == FRC_SPRING) then
-          if (all(s%tfp(m%fpo(c):m%fpo(c) + 3, k) == zero)) s%fcode(k, c) = 1
+          if (.not. any(abs(s%tfp(m%fpo(c):m%fpo(c) + 3, k)) > zero)) s%fcode(k, c) = 1
         end if
       end do
     end do
     do k = 1, s%np
       do i = 1, m%nq
-        if (s%tmass(i, k) == zero) cycle
+        if (.not. abs(s%tmass(i, k)) > zero) cycle
         s%nmz = s%nmz + 1
         s%mzc(s%nmz) = i; s%mzk(s%nmz) = k; s%mzv(s%nmz) = s%tmass(i, k)
       end do
