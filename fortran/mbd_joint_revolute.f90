@@ -13,7 +13,7 @@ module mbd_joint_revolute
   private
   public :: revolute_prepare, revolute_eval, revolute_eval_d, revolute_rows, &
             revolute_gamma_all, revolute_phi_all, revolute_curvature_all, &
-            revolute_second_sides, revolute_param_sides
+            revolute_second_sides, revolute_second_rows, revolute_param_sides
 
 contains
 
@@ -216,17 +216,59 @@ contains
     real(wp), intent(out) :: hcol(2, n)         !! d(theta column of J)/dtheta
     real(wp), intent(out) :: hv(2, n), ha(2, n)
     integer :: e, i, k
-    real(wp) :: ux, uy, w, a, w2, g
     !GCC$ novector
     do e = 1, n                                  ! (a few sides: no vector set-up)
-      i = b(e); k = o(e); g = sg(e)
-      ux = bst(1, i) * p(k) - bst(2, i) * p(k + 1); uy = bst(2, i) * p(k) + bst(1, i) * p(k + 1)
-      w = bst(3, i); a = bst(4, i); w2 = w**2
-      hcol(1, e) = g * ux; hcol(2, e) = g * uy
-      hv(1, e) = g * (ux * w); hv(2, e) = g * (uy * w)
-      ha(1, e) = g * (ux * a - uy * w2); ha(2, e) = g * (uy * a + ux * w2)
+      i = b(e); k = o(e)
+      call revolute_second_side(bst(:, i), p(k), p(k + 1), sg(e), hcol(:, e), hv(:, e), ha(:, e))
     end do
   end subroutine revolute_second_sides
+
+  !> revolute_second_sides for one side: body state st = [cos, sin, theta_dot, theta_ddot],
+  !! point s' = (px, py), sign g.
+  pure subroutine revolute_second_side(st, px, py, g, hcol, hv, ha)
+    real(wp), intent(in) :: st(4), px, py, g
+    real(wp), intent(out) :: hcol(2), hv(2), ha(2)
+    real(wp) :: ux, uy, w, a, w2
+    ux = st(1) * px - st(2) * py; uy = st(2) * px + st(1) * py
+    w = st(3); a = st(4); w2 = w**2
+    hcol(1) = g * ux; hcol(2) = g * uy
+    hv(1) = g * (ux * w); hv(2) = g * (uy * w)
+    ha(1) = g * (ux * a - uy * w2); ha(2) = g * (uy * a + ux * w2)
+  end subroutine revolute_second_side
+
+  !> revolute_second_sides' values applied to the dopri5 sensitivities' right-hand sides as
+  !! rows (mbd_sensitivity sens_revolute_rows), side e with angle coordinate cq(e) and rows
+  !! r0(e), r0(e) + 1: rt(:, c) -= (lambda_r0 h_1 + lambda_r0+1 h_2) S(c, :) (K_lambda S),
+  !! wk(:, r0 + i) -= ha_i S(c, :) + 2 hv_i S_dot(c, :) (Ha S + 2 Hv S_dot); S, S_dot as rows
+  !! st, sdt (npd, nq), npd a multiple of 4.
+  pure subroutine revolute_second_rows(n, nb, npd, o, b, sg, cq, r0, p, bst, lam, st, sdt, &
+                                       rt, wk)
+    integer, intent(in) :: n, nb, npd           !! sides, bodies, rows
+    integer, intent(in) :: o(n), b(n), cq(n), r0(n)  !! offsets, bodies, coordinates, rows
+    real(wp), intent(in) :: sg(n), p(*), bst(4, 0:nb)  !! signs, pool, body states
+    real(wp), intent(in) :: lam(*), st(npd, *), sdt(npd, *)  !! multipliers, S, S_dot
+    real(wp), intent(inout) :: rt(npd, *), wk(npd, *)        !! the rows
+    integer :: e, c, r, j
+    real(wp) :: h(2), hv(2), ha(2), kl
+    do e = 1, n
+      c = cq(e); r = r0(e)
+      call revolute_second_side(bst(:, b(e)), p(o(e)), p(o(e) + 1), sg(e), h, hv, ha)
+      kl = lam(r) * h(1) + lam(r + 1) * h(2)
+      do j = 0, npd - 4, 4                       ! (four rows at a time, written out)
+        call row4(kl, zero, st(j + 1, c), sdt(j + 1, c), rt(j + 1, c))
+        call row4(ha(1), 2 * hv(1), st(j + 1, c), sdt(j + 1, c), wk(j + 1, r))
+        call row4(ha(2), 2 * hv(2), st(j + 1, c), sdt(j + 1, c), wk(j + 1, r + 1))
+      end do
+    end do
+  contains
+    !> y(1:4) -= a x(1:4) + bb z(1:4).
+    pure subroutine row4(a, bb, x, z, y)
+      real(wp), intent(in) :: a, bb, x(4), z(4)
+      real(wp), intent(inout) :: y(4)
+      y(1) = y(1) - a * x(1) - bb * z(1); y(2) = y(2) - a * x(2) - bb * z(2)
+      y(3) = y(3) - a * x(3) - bb * z(3); y(4) = y(4) - a * x(4) - bb * z(4)
+    end subroutine row4
+  end subroutine revolute_second_rows
 
   !> The parameter parts for a change t of [s'_i, s'_j] in closed form (revolute_eval_d
   !! with dq = 0; the rows are linear in s', so p itself does not enter): with u = A t s'

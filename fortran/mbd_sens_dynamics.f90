@@ -30,7 +30,7 @@ module mbd_sens_dynamics
   use mbd_model, only: model_t
   use mbd_assemble, only: asm_work_t, asm_init, assemble_blocks, assemble_dense, blocks_jv_rows
   use mbd_sensitivity, only: sens_t, sens_trig, sens_hessian, sens_params, sens_klam, &
-                             sens_klam_list, sens_kin_rhs, sens_rows_rhs, sens_revolute_rows, &
+                             sens_klam_list, sens_rows_rhs, sens_revolute_rows, &
                              sens_translational_rows, &
                              sens_jpt_lam, sens_force_d, sens_force_dm, sens_force_jac, &
                              sens_force_rows
@@ -451,26 +451,26 @@ contains
       integer, intent(out) :: stp
       integer :: kk
       stats(3) = stats(3) + 1
-      associate (qq => yy(1:n), vv => yy(nz + 1:nz + n))
-      call dyn_accel(m, w, qq, vv, tt, aa, lam, stp)
+      associate (qs => yy(1:n), vs => yy(nz + 1:nz + n))
+      call dyn_accel(m, w, qs, vs, tt, aa, lam, stp)
       if (stp /= MBD_OK) return
       f(1:nz) = yy(nz + 1:)
       f(nz + 1:nz + n) = aa
-      ! cos and sin of the angles at qq: the assembly's (sens_trig's values, not computed again)
+      ! cos and sin of the angles at qs: the assembly's (sens_trig's values, not computed again)
       call copy_trig(m%nb, w%asm%cb, w%asm%sb, s%cb, s%sb)
       ! (the revolutes' and translationals' second derivatives: their *_rows below)
-      call sens_hessian(m, s, qq, vv, aa, tt, closed=.false.)
+      call sens_hessian(m, s, qs, vs, aa, tt, closed=.false.)
       ! (the parameter parts: only parameters that change a constraint have any)
-      if (pcon) call sens_params(m, s, qq, vv, aa, tt, states=.false.)
+      if (pcon) call sens_params(m, s, qs, vs, aa, tt, states=.false.)
       call sens_klam_list(m, s, lam, closed=.false.)
       ! the right-hand sides as the rows of rt, every parameter at once, then one solve
       call accel_rows(n, npd, s%anyg, s%qgr, s%nmz, s%mzc, s%mzk, s%mzv, aa, s%kln, s%klr, &
                       s%klc, s%klv, yy(n + 1:nz), pw%rt)
-      call sens_force_rows(m, s, qq, vv, tt, npd, yy(n + 1:nz), yy(nz + n + 1:), pw%rt, &
+      call sens_force_rows(m, s, qs, vs, tt, npd, yy(n + 1:nz), yy(nz + n + 1:), pw%rt, &
                            grav=.false.)
       do kk = 1, np
         if (.not. s%kcon(kk)) cycle             ! (J_p = 0 otherwise)
-        call sens_jpt_lam(m, s, kk, qq, tt, lam, y3)
+        call sens_jpt_lam(m, s, kk, qs, tt, lam, y3)
         pw%rt(kk, 1:n) = pw%rt(kk, 1:n) - y3
       end do
       ! gamma_p - J_p q_ddot - Ha S - 2 Hv S_dot; the revolutes' Ha, Hv and K_lambda
@@ -481,7 +481,7 @@ contains
         call zero_rows(npd * m%neq, s%rhs)
       end if
       call sens_revolute_rows(m, s, lam, npd, yy(n + 1:nz), yy(nz + n + 1:), pw%rt, s%rhs)
-      call sens_translational_rows(m, s, qq, vv, aa, lam, npd, yy(n + 1:nz), yy(nz + n + 1:), &
+      call sens_translational_rows(m, s, qs, vs, aa, lam, npd, yy(n + 1:nz), yy(nz + n + 1:), &
                                    pw%rt, s%rhs)
       call constraint_rows(n, w%na, npd, m%neq, w%rows, w%s, s%rhs, pw%rt)
       call dyn_solve_rows(w, pw%rt, np, n, npd, f(nz + n + 1:), .false., stp)   ! S_ddot rows
@@ -739,7 +739,7 @@ contains
         if (stp /= MBD_OK) return
       end if
       ! S_dot, nearest in M: [M S_dot; s (nu_p - J_p q_dot - Hv S)]
-      call sens_kin_rhs(s, 2, s%rhs, yy(n + 1:nz), yy(nz + n + 1:))
+      call sens_rows_rhs(s, .false., 1, npd, n, yy(n + 1:nz), yy(nz + n + 1:), s%rhs)
       call metric_rows(n, npd, w%metric, yy(nz + n + 1:), rt)
       call constraint_rows(n, w%na, npd, m%neq, w%rows, w%s, s%rhs, rt)
       call dyn_solve_rows(w, rt, np, n, npd, yy(nz + n + 1:), .false., stp)   ! S_dot

@@ -29,7 +29,7 @@ module mbd_sensitivity
   use mbd_constraints, only: con_eval_d, con_prepare_d, con_is_count, con_name, con_linear, &
                              con_affine_r, con_exponents, &
                              CON_TRANSLATIONAL, DRV_REL_DIST, CON_REVOLUTE
-  use mbd_joint_revolute, only: revolute_second_sides, revolute_param_sides
+  use mbd_joint_revolute, only: revolute_second_sides, revolute_second_rows, revolute_param_sides
   use mbd_joint_translational, only: translational_second, translational_param
   use mbd_forces, only: force_eval_d, force_eval_dm, force_is_count, force_exponents, &
                         force_rows_d, FRC_SPRING
@@ -814,22 +814,10 @@ contains
   !! (npad, nq; the solves write them, padding rows zero): level 2 nu_p - J_p q_dot - Hv s;
   !! 3 gamma_p - J_p q_ddot - Ha s - 2 Hv s_dot (level 1's, -Phi_p, is s%mphip itself).
   !! sens_hessian and sens_params first.
-  pure subroutine sens_kin_rhs(s, level, rhs, st, sdt)
+  pure subroutine sens_kin_rhs(s, level, rhs)
     type(sens_t), intent(in) :: s            !! blocks, parameter parts, s and s_dot as rows
     integer, intent(in) :: level             !! 2 velocity, 3 acceleration
     real(wp), intent(inout) :: rhs(:, :)     !! (npad, neq)
-    !> s and s_dot as rows (npad, nq) in place of s%st, s%sdt
-    real(wp), intent(in), optional :: st(:), sdt(:)
-    if (present(st) .and. present(sdt)) then
-      if (level == 2) then
-        call kin_rhs_kernel(size(rhs, 1), size(rhs, 2), size(s%st, 2), s%nnz, s%nzr, s%nzc, &
-                            s%nzv, s%nzv, .false., s%vp, st, sdt, rhs)
-      else
-        call kin_rhs_kernel(size(rhs, 1), size(rhs, 2), size(s%st, 2), s%nnz, s%nzr, s%nzc, &
-                            s%nza, s%nzv, .true., s%ap, st, sdt, rhs)
-      end if
-      return
-    end if
     if (level == 2) then
       call kin_rhs_kernel(size(rhs, 1), size(rhs, 2), size(s%st, 2), s%nnz, s%nzr, s%nzc, &
                           s%nzv, s%nzv, .false., s%vp, s%st, s%sdt, rhs)
@@ -931,9 +919,9 @@ contains
   end subroutine sens_rows_rhs
 
   !> The revolutes' share of the dopri5 sensitivities' right-hand sides, every moving side
-  !! at once from its closed form (revolute_second_sides' values, here from the body states
-  !! s%bst of sens_hessian): with h = d(theta column)/dtheta, hv, ha of side e (body b,
-  !! angle coordinate c, rows r0, r0 + 1),
+  !! at once from its closed form (revolute_second_side: h = d(theta column)/dtheta, hv, ha
+  !! from the body states s%bst of sens_hessian): for side e (angle coordinate c, rows r0,
+  !! r0 + 1),
   !!   rt(:, c) -= (lambda_r0 h_1 + lambda_r0+1 h_2) S(c, :)        (K_lambda S)
   !!   wk(:, r0 + i) -= ha_i S(c, :) + 2 hv_i S_dot(c, :),  i = 0, 1   (Ha S + 2 Hv S_dot)
   !! (S, S_dot as rows st, sdt (npd, nq); rt (npd, nq + ...), wk (npd, neq)).
@@ -944,7 +932,7 @@ contains
     integer, intent(in) :: npd               !! rows (a multiple of 4)
     real(wp), intent(in) :: st(npd, *), sdt(npd, *)  !! S, S_dot as rows
     real(wp), intent(inout) :: rt(npd, *), wk(npd, *)
-    call revolute_rows_kernel(size(s%rsb), m%nb, npd, s%rso, s%rsb, s%rsg, s%rsq, s%rsr, m%p, &
+    call revolute_second_rows(size(s%rsb), m%nb, npd, s%rso, s%rsb, s%rsg, s%rsq, s%rsr, m%p, &
                               s%bst, lam, st, sdt, rt, wk)
   end subroutine sens_revolute_rows
 
@@ -991,31 +979,6 @@ contains
       end do
     end do
   end subroutine sens_translational_rows
-
-  !> sens_revolute_rows on explicit shapes: u = A s' of the side's body, w, a its theta_dot
-  !! and theta_ddot, g the side's sign: h = g u, hv = g u w, ha = g (u a - perp(u) w**2).
-  pure subroutine revolute_rows_kernel(ns, nb, npd, o, b, sg, cq, r0, p, bst, lam, st, sdt, &
-                                       rt, wk)
-    integer, intent(in) :: ns, nb, npd
-    integer, intent(in) :: o(ns), b(ns), cq(ns), r0(ns)
-    real(wp), intent(in) :: sg(ns), p(*), bst(4, 0:nb), lam(*), st(npd, *), sdt(npd, *)
-    real(wp), intent(inout) :: rt(npd, *), wk(npd, *)
-    integer :: e, i, k, c, r, j
-    real(wp) :: ux, uy, w, a, w2, g, kl, a1, a2, v1, v2
-    do e = 1, ns
-      i = b(e); k = o(e); g = sg(e); c = cq(e); r = r0(e)
-      ux = bst(1, i) * p(k) - bst(2, i) * p(k + 1); uy = bst(2, i) * p(k) + bst(1, i) * p(k + 1)
-      w = bst(3, i); a = bst(4, i); w2 = w**2
-      kl = lam(r) * (g * ux) + lam(r + 1) * (g * uy)
-      a1 = g * (ux * a - uy * w2); a2 = g * (uy * a + ux * w2)
-      v1 = 2 * (g * (ux * w)); v2 = 2 * (g * (uy * w))
-      do j = 0, npd - 4, 4                       ! (four rows at a time, written out)
-        call row4(kl, zero, st(j + 1, c), sdt(j + 1, c), rt(j + 1, c))
-        call row4(a1, v1, st(j + 1, c), sdt(j + 1, c), wk(j + 1, r))
-        call row4(a2, v2, st(j + 1, c), sdt(j + 1, c), wk(j + 1, r + 1))
-      end do
-    end do
-  end subroutine revolute_rows_kernel
 
   !> y(1:4) -= a x(1:4) + b z(1:4).
   pure subroutine row4(a, b, x, z, y)
