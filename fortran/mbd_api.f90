@@ -269,7 +269,7 @@ contains
     !> design parameters (mbd_sensitivity; (2, np)) and, with them, dq/dp, dq_dot/dp,
     !! dq_ddot/dp at the outputs, each (nq, np, kin_out_count(nsteps, every))
     integer, intent(in), optional :: ptab(:, :)
-    real(wp), intent(out), optional :: sq(:, :, :), sqd(:, :, :), sqdd(:, :, :)
+    real(wp), intent(out), optional, contiguous :: sq(:, :, :), sqd(:, :, :), sqdd(:, :, :)
     !> progress, shared with a caller in another thread (2): ctl(1) the outputs stored so
     !! far, ctl(2) /= 0 asks the run to stop (MBD_USER_ABORT, the outputs so far kept)
     integer, intent(inout), optional, volatile :: ctl(:)
@@ -577,7 +577,8 @@ contains
     !> design parameters (2, np) and, with them, dq/dp, dq_dot/dp, dq_ddot/dp (nq, np, rows)
     !! and dlambda/dp (neq, np, rows) at the outputs
     integer, intent(in), optional :: ptab(:, :)
-    real(wp), intent(out), optional :: sq(:, :, :), sqd(:, :, :), sqdd(:, :, :), slam(:, :, :)
+    real(wp), intent(out), optional, contiguous :: sq(:, :, :), sqd(:, :, :), sqdd(:, :, :), &
+                                                    slam(:, :, :)
     !> contacts and friction: the element outputs (NEO, nf, rows) and the contact events found
     !! at the outputs (4, capacity), their number
     real(wp), intent(out), optional :: eo(:, :, :), evo(:, :)

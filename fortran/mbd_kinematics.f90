@@ -1047,7 +1047,7 @@ contains
     !> design parameters (mbd_sensitivity): with them, sq, sqd, sqdd (nq, np, outputs) get
     !! dq/dp, dq_dot/dp and dq_ddot/dp at every stored output (in model units, sens%ounit)
     type(sens_t), intent(inout), optional :: sens
-    real(wp), intent(out), optional :: sq(:, :, :), sqd(:, :, :), sqdd(:, :, :)
+    real(wp), intent(out), optional, contiguous :: sq(:, :, :), sqd(:, :, :), sqdd(:, :, :)
     !> progress, shared with a caller in another thread: ctl(1) gets the outputs stored so
     !! far, ctl(2) /= 0 asks the run to stop (MBD_USER_ABORT, the outputs so far kept; seen at
     !! the next output time)
@@ -1079,7 +1079,7 @@ contains
     !> design parameters (mbd_sensitivity): with them, sq, sqd, sqdd (nq, np, outputs) get
     !! dq/dp, dq_dot/dp and dq_ddot/dp at every stored output (in model units, sens%ounit)
     type(sens_t), intent(inout), optional :: sens
-    real(wp), intent(out), optional :: sq(:, :, :), sqd(:, :, :), sqdd(:, :, :)
+    real(wp), intent(out), optional, contiguous :: sq(:, :, :), sqd(:, :, :), sqdd(:, :, :)
     !> progress (see kin_run)
     integer, intent(inout), optional, volatile :: ctl(:)
     type(kin_work_t) :: w
@@ -1825,7 +1825,9 @@ contains
     type(sens_t), intent(inout) :: s         !! parameters and blocks
     real(wp), intent(in) :: q(:), qd(:), qdd(:)  !! state and accelerations
     real(wp), intent(in) :: t                !! time
-    real(wp), intent(out) :: sq(:, :), sqd(:, :), sqdd(:, :)  !! (nq, np)
+    !> (nq, np); contiguous down from the f2py layer's arrays: their sections reach the
+    !! solves' explicit shapes with no run-time contiguity checks (~390 instructions a step)
+    real(wp), intent(out), contiguous :: sq(:, :), sqd(:, :), sqdd(:, :)
     call sens_states(m, s, w%asm%cb, w%asm%sb, qd, qdd)   ! (cos, sin of the assembly at q)
     call sens_hessian(m, s, q, qd, qdd, t, states=.false.)
     call sens_params(m, s, q, qd, qdd, t, states=.false.)

@@ -817,13 +817,13 @@ contains
   pure subroutine sens_kin_rhs(s, level, rhs)
     type(sens_t), intent(in) :: s            !! blocks, parameter parts, s and s_dot as rows
     integer, intent(in) :: level             !! 2 velocity, 3 acceleration
-    real(wp), intent(inout) :: rhs(:, :)     !! (npad, neq)
+    real(wp), intent(inout), contiguous :: rhs(:, :)  !! (npad, neq)
     if (level == 2) then
-      call kin_rhs_kernel(size(rhs, 1), size(rhs, 2), size(s%st, 2), s%nnz, s%nzr, s%nzc, &
-                          s%nzv, s%nzv, .false., s%vp, s%st, s%sdt, rhs)
+      call kin_rhs_kernel(size(rhs, 1), size(rhs, 2), size(s%st, 2), s%nnz, size(s%rsb), &
+                          s%nzr, s%nzc, s%nzv, s%nzv, .false., s%vp, s%st, s%sdt, rhs)
     else
-      call kin_rhs_kernel(size(rhs, 1), size(rhs, 2), size(s%st, 2), s%nnz, s%nzr, s%nzc, &
-                          s%nza, s%nzv, .true., s%ap, s%st, s%sdt, rhs)
+      call kin_rhs_kernel(size(rhs, 1), size(rhs, 2), size(s%st, 2), s%nnz, size(s%rsb), &
+                          s%nzr, s%nzc, s%nza, s%nzv, .true., s%ap, s%st, s%sdt, rhs)
     end if
   end subroutine sens_kin_rhs
 
@@ -831,10 +831,11 @@ contains
   !! (- 2 H2 s_dot when both). The parameter parts and rhs share the padded layout
   !! (npad, neq), seen here flat, so the first term is one copy; s and s_dot come as rows
   !! (st, sdt: (npad, nq)), so each nonzero updates a row of rhs from a row of them, four
-  !! parameters at a time.
-  pure subroutine kin_rhs_kernel(npad, neq, nq, nnz, nzr, nzc, h1, h2, both, base, st, sdt, &
-                                 rhs)
-    integer, intent(in) :: npad, neq, nq, nnz
+  !! parameters at a time. The first npair pairs of entries are the revolutes' sides (rows
+  !! r, r + 1 of one column: one row of s read for both).
+  pure subroutine kin_rhs_kernel(npad, neq, nq, nnz, npair, nzr, nzc, h1, h2, both, base, st, &
+                                 sdt, rhs)
+    integer, intent(in) :: npad, neq, nq, nnz, npair
     integer, intent(in) :: nzr(*), nzc(*)
     real(wp), intent(in) :: h1(*), h2(*)       !! values of the nonzeros (Hv or Ha, Hv)
     logical, intent(in) :: both                !! the s_dot term too
@@ -846,7 +847,9 @@ contains
       rhs(e) = base(e)
     end do
     if (npad == 4) then                        ! (up to four parameters: no inner loop)
-      call rhs_four(nnz, nzr, nzc, h1, h2, both, st, sdt, rhs)
+      call rhs_pairs(npair, nzr, nzc, h1, h2, both, st, sdt, rhs)
+      n = 2 * npair + 1
+      call rhs_four(nnz - 2 * npair, nzr(n), nzc(n), h1(n), h2(n), both, st, sdt, rhs)
       return
     end if
     if (.not. both) then                       ! nu_p - J_p q_dot - Hv s
@@ -871,6 +874,40 @@ contains
       end do
     end do
   end subroutine kin_rhs_kernel
+
+  !> kin_rhs_kernel's leading pairs for npad = 4: entries 2 e - 1, 2 e in rows r, r + 1 of
+  !! one column c (a revolute's side).
+  pure subroutine rhs_pairs(npair, nzr, nzc, h1, h2, both, st, sdt, rhs)
+    integer, intent(in) :: npair, nzr(2, *), nzc(2, *)
+    real(wp), intent(in) :: h1(2, *), h2(2, *), st(4, *), sdt(4, *)
+    logical, intent(in) :: both
+    real(wp), intent(inout) :: rhs(4, *)
+    integer :: e, r, c
+    real(wp) :: v1, v2, a1, a2, s1, s2, s3, s4, d1, d2, d3, d4
+    if (.not. both) then                       ! rhs(:, r + i) -= hv_i s(:, c)
+      do e = 1, npair
+        r = nzr(1, e); c = nzc(1, e); v1 = h1(1, e); v2 = h1(2, e)
+        s1 = st(1, c); s2 = st(2, c); s3 = st(3, c); s4 = st(4, c)
+        rhs(1, r) = rhs(1, r) - v1 * s1; rhs(2, r) = rhs(2, r) - v1 * s2
+        rhs(3, r) = rhs(3, r) - v1 * s3; rhs(4, r) = rhs(4, r) - v1 * s4
+        rhs(1, r + 1) = rhs(1, r + 1) - v2 * s1; rhs(2, r + 1) = rhs(2, r + 1) - v2 * s2
+        rhs(3, r + 1) = rhs(3, r + 1) - v2 * s3; rhs(4, r + 1) = rhs(4, r + 1) - v2 * s4
+      end do
+      return
+    end if
+    do e = 1, npair                            ! rhs(:, r + i) -= ha_i s(:, c) + 2 hv_i s_dot(:, c)
+      r = nzr(1, e); c = nzc(1, e)
+      a1 = h1(1, e); a2 = h1(2, e); v1 = 2 * h2(1, e); v2 = 2 * h2(2, e)
+      s1 = st(1, c); s2 = st(2, c); s3 = st(3, c); s4 = st(4, c)
+      d1 = sdt(1, c); d2 = sdt(2, c); d3 = sdt(3, c); d4 = sdt(4, c)
+      rhs(1, r) = rhs(1, r) - a1 * s1 - v1 * d1; rhs(2, r) = rhs(2, r) - a1 * s2 - v1 * d2
+      rhs(3, r) = rhs(3, r) - a1 * s3 - v1 * d3; rhs(4, r) = rhs(4, r) - a1 * s4 - v1 * d4
+      rhs(1, r + 1) = rhs(1, r + 1) - a2 * s1 - v2 * d1
+      rhs(2, r + 1) = rhs(2, r + 1) - a2 * s2 - v2 * d2
+      rhs(3, r + 1) = rhs(3, r + 1) - a2 * s3 - v2 * d3
+      rhs(4, r + 1) = rhs(4, r + 1) - a2 * s4 - v2 * d4
+    end do
+  end subroutine rhs_pairs
 
   !> kin_rhs_kernel's nonzeros for npad = 4.
   pure subroutine rhs_four(nnz, nzr, nzc, h1, h2, both, st, sdt, rhs)
@@ -910,11 +947,12 @@ contains
     integer :: n0
     n0 = first - 1
     if (both) then
-      call kin_rhs_kernel(npd, size(s%ap, 2), nq, s%nnz - n0, s%nzr(first:), s%nzc(first:), &
-                          s%nza(first:), s%nzv(first:), .true., s%ap, st, sdt, rhs)
+      call kin_rhs_kernel(npd, size(s%ap, 2), nq, s%nnz - n0, 0, s%nzr(first:), &
+                          s%nzc(first:), s%nza(first:), s%nzv(first:), .true., s%ap, st, sdt, rhs)
     else
-      call kin_rhs_kernel(npd, size(s%vp, 2), nq, s%nnz - n0, s%nzr(first:), s%nzc(first:), &
-                          s%nzv(first:), s%nzv(first:), .false., s%vp, st, sdt, rhs)
+      call kin_rhs_kernel(npd, size(s%vp, 2), nq, s%nnz - n0, 0, s%nzr(first:), &
+                          s%nzc(first:), s%nzv(first:), s%nzv(first:), .false., s%vp, st, sdt, &
+                          rhs)
     end if
   end subroutine sens_rows_rhs
 

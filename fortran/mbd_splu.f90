@@ -378,11 +378,12 @@ contains
   !! (without f).
   pure subroutine splu_solve_rows(sp, bt, x, cs, f, xt)
     type(splu_t), intent(inout) :: sp                !! factors (and the work block)
-    real(wp), intent(in) :: bt(:, :)                 !! right-hand sides as rows (4 k, n)
-    real(wp), intent(inout) :: x(:, :)               !! solutions (A's columns, ncol)
-    real(wp), intent(in) :: cs(:)                    !! column scale
-    real(wp), intent(in) :: f(:, :)                  !! output factors (n, ncol)
-    real(wp), intent(inout), optional :: xt(:, :)    !! solutions as rows (4 k, n)
+    real(wp), intent(in), contiguous :: bt(:, :)     !! right-hand sides as rows (4 k, n)
+    real(wp), intent(inout), contiguous :: x(:, :)   !! solutions (A's columns, ncol)
+    real(wp), intent(in), contiguous :: cs(:)        !! column scale
+    real(wp), intent(in), contiguous :: f(:, :)      !! output factors (n, ncol)
+    !> solutions as rows (4 k, n)
+    real(wp), intent(inout), contiguous, optional :: xt(:, :)
     integer :: g
     do g = 1, size(bt, 1) - 3, 4
       if (g > size(x, 2)) exit
@@ -436,19 +437,22 @@ contains
     real(wp), intent(in) :: rinv(n), cs(n), y(4, n), f(n, ncol)
     real(wp), intent(inout) :: xt(ldt, n), x(n, ncol)
     integer :: k, c, i
-    real(wp) :: v
+    real(wp) :: v, z1, z2, z3, z4
+    if (ncol - g >= 3) then
+      do k = 1, n
+        c = pcol(k); v = rinv(k) * cs(c)
+        z1 = y(1, k) * v; z2 = y(2, k) * v; z3 = y(3, k) * v; z4 = y(4, k) * v
+        xt(g, c) = z1; xt(g + 1, c) = z2; xt(g + 2, c) = z3; xt(g + 3, c) = z4
+        x(c, g) = z1 * f(c, g); x(c, g + 1) = z2 * f(c, g + 1)
+        x(c, g + 2) = z3 * f(c, g + 2); x(c, g + 3) = z4 * f(c, g + 3)
+      end do
+      return
+    end if
     do k = 1, n
       c = pcol(k); v = rinv(k) * cs(c)
       xt(g, c) = y(1, k) * v; xt(g + 1, c) = y(2, k) * v
       xt(g + 2, c) = y(3, k) * v; xt(g + 3, c) = y(4, k) * v
     end do
-    if (ncol - g >= 3) then
-      do c = 1, n
-        x(c, g) = xt(g, c) * f(c, g); x(c, g + 1) = xt(g + 1, c) * f(c, g + 1)
-        x(c, g + 2) = xt(g + 2, c) * f(c, g + 2); x(c, g + 3) = xt(g + 3, c) * f(c, g + 3)
-      end do
-      return
-    end if
     do i = 1, ncol - g + 1
       do c = 1, n
         x(c, g + i - 1) = xt(g + i - 1, c) * f(c, g + i - 1)
