@@ -53,6 +53,8 @@ subroutine core_kinematics(nb, nc, ctab, np, rpar, nq, neq, q0, t0, t1, nsteps, 
   integer(c_int), intent(out) :: status
   character(len=512), intent(out) :: msg
   !f2py intent(hide) :: nc, np, nq
+  !f2py intent(out, cache) :: qout, qdout, qddout
+  ! (out, cache: f2py leaves the arrays unset, not zeroed: the core writes every entry)
   !f2py threadsafe
   call api_kinematics(nb, ctab, rpar, q0, t0, t1, nsteps, tol, maxit, tmin, every, solver, &
                       qout, qdout, qddout, iinfo, rinfo, qsing, dep, redundant, tpass, &
@@ -307,6 +309,8 @@ subroutine core_kinematics_sens(nb, nc, ctab, np, rpar, nq, neq, q0, t0, t1, nst
   integer(c_int), intent(out) :: status
   character(len=512), intent(out) :: msg
   !f2py intent(hide) :: nc, np, nq, npar
+  !f2py intent(out, cache) :: qout, qdout, qddout, sq, sqd, sqdd
+  ! (out, cache: f2py leaves the arrays unset, not zeroed: the core writes every entry)
   !f2py threadsafe
   call api_kinematics(nb, ctab, rpar, q0, t0, t1, nsteps, tol, maxit, tmin, every, solver, &
                       qout, qdout, qddout, iinfo, rinfo, qsing, dep, redundant, tpass, &

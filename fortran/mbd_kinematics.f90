@@ -1807,8 +1807,12 @@ contains
         if (cc == size(qout, 2)) tt = t1
         call assemble_j(m, w, qout(:, cc), w%qz, tt)
         call factor(w, st3)
-        if (st3 == MBD_OK) call kin_sens(m, w, sens, qout(:, cc), qdout(:, cc), qddout(:, cc), &
-                                         tt, sq(:, :, cc), sqd(:, :, cc), sqdd(:, :, cc))
+        if (st3 == MBD_OK) then
+          call kin_sens(m, w, sens, qout(:, cc), qdout(:, cc), qddout(:, cc), tt, sq(:, :, cc), &
+                        sqd(:, :, cc), sqdd(:, :, cc))
+        else                                  ! (every output is written: the arrays come
+          sq(:, :, cc) = zero; sqd(:, :, cc) = zero; sqdd(:, :, cc) = zero   ! unset)
+        end if
       end do
       post = .false.
     end subroutine count_work
