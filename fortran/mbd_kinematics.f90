@@ -1827,7 +1827,7 @@ contains
     type(model_t), intent(in) :: m           !! model
     type(kin_work_t), intent(inout) :: w     !! work arrays with the factors of J(q)
     type(sens_t), intent(inout) :: s         !! parameters and blocks
-    real(wp), intent(in) :: q(:), qd(:), qdd(:)  !! state and accelerations
+    real(wp), intent(in), contiguous :: q(:), qd(:), qdd(:)  !! state and accelerations
     real(wp), intent(in) :: t                !! time
     !> (nq, np); contiguous down from the f2py layer's arrays: their sections reach the
     !! solves' explicit shapes with no run-time contiguity checks (~390 instructions a step)

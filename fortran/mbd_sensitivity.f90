@@ -474,7 +474,7 @@ contains
   pure subroutine sens_hessian(m, s, q, qd, qdd, t, states, closed)
     type(model_t), intent(in) :: m             !! model
     type(sens_t), intent(inout) :: s           !! blocks (out)
-    real(wp), intent(in) :: q(:), qd(:), qdd(:)  !! state and accelerations
+    real(wp), intent(in) :: q(m%nq), qd(m%nq), qdd(m%nq)  !! state, accelerations
     real(wp), intent(in) :: t                  !! time
     logical, intent(in), optional :: states    !! .false.: sens_states has set the state
     !> .false.: leave the revolutes and translationals out (their blocks, entries and closed
@@ -566,7 +566,7 @@ contains
   pure subroutine sens_params(m, s, q, qd, qdd, t, states)
     type(model_t), intent(in) :: m             !! model
     type(sens_t), intent(inout) :: s           !! parameter parts (out)
-    real(wp), intent(in) :: q(:), qd(:), qdd(:)  !! state and accelerations
+    real(wp), intent(in) :: q(m%nq), qd(m%nq), qdd(m%nq)  !! state, accelerations
     real(wp), intent(in) :: t                  !! time
     logical, intent(in), optional :: states    !! .false.: sens_states has set the state
     type(dloc) :: x
@@ -678,8 +678,8 @@ contains
   pure subroutine sens_states(m, s, cb, sb, qd, qdd)
     type(model_t), intent(in) :: m              !! model
     type(sens_t), intent(inout) :: s            !! bst (and cb, sb) (out)
-    real(wp), intent(in) :: cb(0:), sb(0:)      !! cos and sin of the body angles
-    real(wp), intent(in) :: qd(:), qdd(:)       !! velocities and accelerations
+    real(wp), intent(in) :: cb(0:m%nb), sb(0:m%nb)  !! cos and sin of the body angles
+    real(wp), intent(in) :: qd(m%nq), qdd(m%nq)  !! velocities, accelerations
     if (s%gathers) then
       s%cb(:) = cb; s%sb(:) = sb
     end if
