@@ -206,11 +206,13 @@ def kinematics_sens(p: Packed, t0: float, t1: float, steps: int, tol: float, max
                     tmin: float, every: int, solver: int, nout: int,
                     ptab: np.ndarray) -> SimpleNamespace:
     """A kinematic run with sensitivities: as :func:`kinematics` plus ``sq``, ``sqd``,
-    ``sqdd`` (nq, np, nout)."""
-    return _named("q qd qdd sq sqd sqdd iinfo rinfo qsing dep red tpass status msg",
-                  _core.core_kinematics_sens, p.nb, p.ctab, p.rpar, p.neq, p.q0, t0, t1, steps,
-                  tol, maxit, tmin, every, solver, nout, ptab,
-                  numbers=3 * p.nq * nout * (1 + ptab.shape[1]))
+    ``sqdd`` (nq, np, nout), views of the core's one block (nq, np, nout, 3)."""
+    out = _named("q qd qdd s3 iinfo rinfo qsing dep red tpass status msg",
+                 _core.core_kinematics_sens, p.nb, p.ctab, p.rpar, p.neq, p.q0, t0, t1, steps,
+                 tol, maxit, tmin, every, solver, nout, ptab,
+                 numbers=3 * p.nq * nout * (1 + ptab.shape[1]))
+    out.sq, out.sqd, out.sqdd = out.s3[..., 0], out.s3[..., 1], out.s3[..., 2]
+    return out
 
 
 def inverse_sens(p: Packed, d: DynamicTables, t0: float, t1: float, steps: int, tol: float,
