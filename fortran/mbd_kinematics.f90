@@ -1833,7 +1833,7 @@ contains
     !! solves' explicit shapes with no run-time contiguity checks (~390 instructions a step)
     real(wp), intent(out), contiguous :: sq(:, :), sqd(:, :), sqdd(:, :)
     call sens_states(m, s, w%asm%cb, w%asm%sb, qd, qdd)   ! (cos, sin of the assembly at q)
-    call sens_hessian(m, s, q, qd, qdd, t, states=.false.)
+    call sens_hessian(m, s, q, qd, qdd, t, states=.false., push=.false.)
     call sens_params(m, s, q, qd, qdd, t, states=.false.)
     if (w%spfact) then                        ! the sparse factors: straight to their solves
       call splu_solve_rows(w%sp, s%mphip, sq, w%cs, s%ounit, s%st)

@@ -471,7 +471,7 @@ contains
   !! translationals in closed form (revolute_second_sides, translational_second, in fixed
   !! places of the list), the others by the dual evaluation along dq = e_j.
   !! sens_trig first (or sens_states, with states = .false.).
-  pure subroutine sens_hessian(m, s, q, qd, qdd, t, states, closed)
+  pure subroutine sens_hessian(m, s, q, qd, qdd, t, states, closed, push)
     type(model_t), intent(in) :: m             !! model
     type(sens_t), intent(inout) :: s           !! blocks (out)
     real(wp), intent(in) :: q(m%nq), qd(m%nq), qdd(m%nq)  !! state, accelerations
@@ -480,6 +480,9 @@ contains
     !> .false.: leave the revolutes and translationals out (their blocks, entries and closed
     !! forms stale; sens_revolute_rows and sens_translational_rows take them)
     logical, intent(in), optional :: closed
+    !> .false.: the revolutes' closed forms only in s%rsh, rsv, rsa (their blocks and list
+    !! entries stale: the kinematic right-hand sides, sens_kin_rhs, read them there)
+    logical, intent(in), optional :: push
     type(dloc) :: x
     real(wp) :: qddl(NLOC), tphi(MAXROW), tnu(MAXROW), tgam(MAXROW), hv, ha
     real(wp) :: qloc(NLOC), qdl(NLOC), hm(6, 6), hvt(6), hat(6)
@@ -496,8 +499,13 @@ contains
     if (size(s%rsb) > 0 .and. revs) then        ! the revolutes in closed form
       call revolute_second_sides(size(s%rsb), m%nb, s%rso, s%rsb, s%rsg, m%p, s%bst, s%rsh, &
                                  s%rsv, s%rsa)
-      call revolute_push(size(s%rsb), m%nc, s%rsc, s%rss, s%rsh, s%rsv, s%rsa, s%hs, s%nzv, &
-                         s%nza)
+      if (.not. present(push)) then
+        call revolute_push(size(s%rsb), m%nc, s%rsc, s%rss, s%rsh, s%rsv, s%rsa, s%hs, s%nzv, &
+                           s%nza)
+      else if (push) then
+        call revolute_push(size(s%rsb), m%nc, s%rsc, s%rss, s%rsh, s%rsv, s%rsa, s%hs, s%nzv, &
+                           s%nza)
+      end if
     end if
     n = 2 * size(s%rsb)                         ! the translationals' entries follow
     do e = 1, merge(size(s%tlc), 0, revs)
@@ -820,10 +828,12 @@ contains
     real(wp), intent(inout), contiguous :: rhs(:, :)  !! (npad, neq)
     if (level == 2) then
       call kin_rhs_kernel(size(rhs, 1), size(rhs, 2), size(s%st, 2), s%nnz, size(s%rsb), &
-                          s%nzr, s%nzc, s%nzv, s%nzv, .false., s%vp, s%st, s%sdt, rhs)
+                          s%rsr, s%rsq, s%rsv, s%rsv, s%nzr, s%nzc, s%nzv, s%nzv, .false., &
+                          s%vp, s%st, s%sdt, rhs)
     else
       call kin_rhs_kernel(size(rhs, 1), size(rhs, 2), size(s%st, 2), s%nnz, size(s%rsb), &
-                          s%nzr, s%nzc, s%nza, s%nzv, .true., s%ap, s%st, s%sdt, rhs)
+                          s%rsr, s%rsq, s%rsa, s%rsv, s%nzr, s%nzc, s%nza, s%nzv, .true., &
+                          s%ap, s%st, s%sdt, rhs)
     end if
   end subroutine sens_kin_rhs
 
@@ -831,12 +841,14 @@ contains
   !! (- 2 H2 s_dot when both). The parameter parts and rhs share the padded layout
   !! (npad, neq), seen here flat, so the first term is one copy; s and s_dot come as rows
   !! (st, sdt: (npad, nq)), so each nonzero updates a row of rhs from a row of them, four
-  !! parameters at a time. The first npair pairs of entries are the revolutes' sides (rows
-  !! r, r + 1 of one column: one row of s read for both).
-  pure subroutine kin_rhs_kernel(npad, neq, nq, nnz, npair, nzr, nzc, h1, h2, both, base, st, &
-                                 sdt, rhs)
+  !! parameters at a time. The list's first 2 npair entries are the revolutes' sides, taken
+  !! from their closed forms instead (side e: rows pr(e), pr(e) + 1, angle column pc(e),
+  !! values p1(:, e), p2(:, e) as h1, h2; one row of s read for both rows).
+  pure subroutine kin_rhs_kernel(npad, neq, nq, nnz, npair, pr, pc, p1, p2, nzr, nzc, h1, h2, &
+                                 both, base, st, sdt, rhs)
     integer, intent(in) :: npad, neq, nq, nnz, npair
-    integer, intent(in) :: nzr(*), nzc(*)
+    integer, intent(in) :: pr(npair), pc(npair), nzr(*), nzc(*)
+    real(wp), intent(in) :: p1(2, npair), p2(2, npair)  !! the sides' values
     real(wp), intent(in) :: h1(*), h2(*)       !! values of the nonzeros (Hv or Ha, Hv)
     logical, intent(in) :: both                !! the s_dot term too
     real(wp), intent(in) :: base(npad * neq), st(npad * nq), sdt(npad * nq)
@@ -847,13 +859,15 @@ contains
       rhs(e) = base(e)
     end do
     if (npad == 4) then                        ! (up to four parameters: no inner loop)
-      call rhs_pairs(npair, nzr, nzc, h1, h2, both, st, sdt, rhs)
+      call rhs_pairs(npair, pr, pc, p1, p2, both, st, sdt, rhs)
       n = 2 * npair + 1
       call rhs_four(nnz - 2 * npair, nzr(n), nzc(n), h1(n), h2(n), both, st, sdt, rhs)
       return
     end if
+    call rhs_general(npad, npair, pr, pc, p1, p2, both, st, sdt, rhs)
+    n = 2 * npair + 1
     if (.not. both) then                       ! nu_p - J_p q_dot - Hv s
-      do n = 1, nnz
+      do n = n, nnz
         e = npad * (nzr(n) - 1); c = npad * (nzc(n) - 1); v = h1(n)
         do g = 0, npad - 4, 4
           rhs(e + g + 1) = rhs(e + g + 1) - v * st(c + g + 1)
@@ -864,7 +878,7 @@ contains
       end do
       return
     end if
-    do n = 1, nnz                              ! gamma_p - J_p q_ddot - Ha s - 2 Hv s_dot
+    do n = n, nnz                              ! gamma_p - J_p q_ddot - Ha s - 2 Hv s_dot
       e = npad * (nzr(n) - 1); c = npad * (nzc(n) - 1); a = h1(n); v = 2 * h2(n)
       do g = 0, npad - 4, 4
         rhs(e + g + 1) = rhs(e + g + 1) - a * st(c + g + 1) - v * sdt(c + g + 1)
@@ -875,18 +889,18 @@ contains
     end do
   end subroutine kin_rhs_kernel
 
-  !> kin_rhs_kernel's leading pairs for npad = 4: entries 2 e - 1, 2 e in rows r, r + 1 of
-  !! one column c (a revolute's side).
-  pure subroutine rhs_pairs(npair, nzr, nzc, h1, h2, both, st, sdt, rhs)
-    integer, intent(in) :: npair, nzr(2, *), nzc(2, *)
-    real(wp), intent(in) :: h1(2, *), h2(2, *), st(4, *), sdt(4, *)
+  !> kin_rhs_kernel's revolute sides for npad = 4: side e in rows pr(e), pr(e) + 1 of
+  !! column pc(e), values h1(:, e) (and h2(:, e)).
+  pure subroutine rhs_pairs(npair, pr, pc, h1, h2, both, st, sdt, rhs)
+    integer, intent(in) :: npair, pr(npair), pc(npair)
+    real(wp), intent(in) :: h1(2, npair), h2(2, npair), st(4, *), sdt(4, *)
     logical, intent(in) :: both
     real(wp), intent(inout) :: rhs(4, *)
     integer :: e, r, c
     real(wp) :: v1, v2, a1, a2, s1, s2, s3, s4, d1, d2, d3, d4
     if (.not. both) then                       ! rhs(:, r + i) -= hv_i s(:, c)
       do e = 1, npair
-        r = nzr(1, e); c = nzc(1, e); v1 = h1(1, e); v2 = h1(2, e)
+        r = pr(e); c = pc(e); v1 = h1(1, e); v2 = h1(2, e)
         s1 = st(1, c); s2 = st(2, c); s3 = st(3, c); s4 = st(4, c)
         rhs(1, r) = rhs(1, r) - v1 * s1; rhs(2, r) = rhs(2, r) - v1 * s2
         rhs(3, r) = rhs(3, r) - v1 * s3; rhs(4, r) = rhs(4, r) - v1 * s4
@@ -896,7 +910,7 @@ contains
       return
     end if
     do e = 1, npair                            ! rhs(:, r + i) -= ha_i s(:, c) + 2 hv_i s_dot(:, c)
-      r = nzr(1, e); c = nzc(1, e)
+      r = pr(e); c = pc(e)
       a1 = h1(1, e); a2 = h1(2, e); v1 = 2 * h2(1, e); v2 = 2 * h2(2, e)
       s1 = st(1, c); s2 = st(2, c); s3 = st(3, c); s4 = st(4, c)
       d1 = sdt(1, c); d2 = sdt(2, c); d3 = sdt(3, c); d4 = sdt(4, c)
@@ -908,6 +922,28 @@ contains
       rhs(4, r + 1) = rhs(4, r + 1) - a2 * s4 - v2 * d4
     end do
   end subroutine rhs_pairs
+
+  !> kin_rhs_kernel's revolute sides for npad > 4 (a multiple of 4; rhs_pairs' forms).
+  pure subroutine rhs_general(npad, npair, pr, pc, h1, h2, both, st, sdt, rhs)
+    integer, intent(in) :: npad, npair, pr(npair), pc(npair)
+    real(wp), intent(in) :: h1(2, npair), h2(2, npair), st(npad, *), sdt(npad, *)
+    logical, intent(in) :: both
+    real(wp), intent(inout) :: rhs(npad, *)
+    integer :: e, r, c, g
+    real(wp) :: v1, v2, a1, a2
+    do e = 1, npair
+      r = pr(e); c = pc(e)
+      if (both) then
+        a1 = h1(1, e); a2 = h1(2, e); v1 = 2 * h2(1, e); v2 = 2 * h2(2, e)
+      else
+        a1 = h1(1, e); a2 = h1(2, e); v1 = zero; v2 = zero
+      end if
+      do g = 1, npad
+        rhs(g, r) = rhs(g, r) - a1 * st(g, c) - v1 * sdt(g, c)
+        rhs(g, r + 1) = rhs(g, r + 1) - a2 * st(g, c) - v2 * sdt(g, c)
+      end do
+    end do
+  end subroutine rhs_general
 
   !> kin_rhs_kernel's nonzeros for npad = 4.
   pure subroutine rhs_four(nnz, nzr, nzc, h1, h2, both, st, sdt, rhs)
@@ -947,12 +983,13 @@ contains
     integer :: n0
     n0 = first - 1
     if (both) then
-      call kin_rhs_kernel(npd, size(s%ap, 2), nq, s%nnz - n0, 0, s%nzr(first:), &
-                          s%nzc(first:), s%nza(first:), s%nzv(first:), .true., s%ap, st, sdt, rhs)
+      call kin_rhs_kernel(npd, size(s%ap, 2), nq, s%nnz - n0, 0, s%rsr, s%rsq, s%rsa, s%rsv, &
+                          s%nzr(first:), s%nzc(first:), s%nza(first:), s%nzv(first:), .true., &
+                          s%ap, st, sdt, rhs)
     else
-      call kin_rhs_kernel(npd, size(s%vp, 2), nq, s%nnz - n0, 0, s%nzr(first:), &
-                          s%nzc(first:), s%nzv(first:), s%nzv(first:), .false., s%vp, st, sdt, &
-                          rhs)
+      call kin_rhs_kernel(npd, size(s%vp, 2), nq, s%nnz - n0, 0, s%rsr, s%rsq, s%rsv, s%rsv, &
+                          s%nzr(first:), s%nzc(first:), s%nzv(first:), s%nzv(first:), .false., &
+                          s%vp, st, sdt, rhs)
     end if
   end subroutine sens_rows_rhs
 
