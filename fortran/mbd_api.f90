@@ -244,7 +244,7 @@ contains
   !> Kinematic analysis: the whole time loop in one call.
   subroutine api_kinematics(nb, ctab, rpar, q0, t0, t1, nsteps, tol, maxit, tmin, every, &
                             solver, qout, qdout, qddout, iinfo, rinfo, qsing, dep, redundant, &
-                            tpass, status, msg, ptab, sq, sqd, sqdd, ctl, positions)
+                            tpass, status, msg, ptab, sq, sqd, sqdd, ctl, positions, ssum)
     integer, intent(in) :: nb                   !! moving bodies
     integer, intent(in) :: ctab(:, :)           !! constraint table
     real(wp), intent(in) :: rpar(:)             !! raw parameters
@@ -275,6 +275,10 @@ contains
     integer, intent(inout), optional, volatile :: ctl(:)
     !> 1: positions only (chord steps where J is well conditioned; q_dot, q_ddot not returned)
     integer, intent(in), optional :: positions
+    !> with ptab: each output's sum of its sensitivities, finite exactly when they all are
+    !! (barring an overflow of the sum), for the caller's check (kin_out_count(nsteps, every))
+    real(wp), intent(out), optional :: ssum(:)
+    real(wp), allocatable :: ss(:)
     type(model_t) :: m
     type(kin_opts_t) :: opts
     type(kin_report_t) :: rep
@@ -323,6 +327,7 @@ contains
       if (present(ptab)) then
         sq = zero; sqd = zero; sqdd = zero
       end if
+      if (present(ssum)) ssum = zero
       return
     end if
     ! (kin_run fills the outputs: those it does not reach with zeros)
@@ -332,8 +337,20 @@ contains
     if (tmin > zero) opts%tmin = tmin
     if (present(positions)) opts%positions = positions == 1
     if (present(ptab)) then
-      call kin_run(m, q0 / m%cunit, t0, t1, nsteps, opts, qout, qdout, qddout, rep, status, &
-                   msg, sens, sq, sqd, sqdd, ctl=ctl)     ! (in model units: sens%ounit)
+      if (present(ssum)) then                  ! (in model units: sens%ounit)
+        call kin_run(m, q0 / m%cunit, t0, t1, nsteps, opts, qout, qdout, qddout, rep, status, &
+                     msg, sens, sq, sqd, sqdd, ssum, ctl=ctl)
+      else
+        allocate (ss(size(qout, 2)), stat=bad)
+        if (bad /= 0) then
+          call mem_fail(REAL_BYTES * size(qout, 2), 'the sensitivity sums', &
+                        'fewer outputs (every) or steps', status, msg)
+          qout = zero; qdout = zero; qddout = zero; sq = zero; sqd = zero; sqdd = zero
+          return
+        end if
+        call kin_run(m, q0 / m%cunit, t0, t1, nsteps, opts, qout, qdout, qddout, rep, status, &
+                     msg, sens, sq, sqd, sqdd, ss, ctl=ctl)
+      end if
       if (rep%ndone < size(sq, 3)) then        ! (the rows after a failure: zero)
         sq(:, :, rep%ndone + 1:) = zero; sqd(:, :, rep%ndone + 1:) = zero
         sqdd(:, :, rep%ndone + 1:) = zero

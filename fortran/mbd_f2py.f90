@@ -291,8 +291,8 @@ end subroutine core_forces_d
 
 subroutine core_kinematics_sens(nb, nc, ctab, np, rpar, nq, neq, q0, t0, t1, nsteps, tol, &
                                 maxit, tmin, every, solver, nout, npar, ptab, qout, qdout, &
-                                qddout, s3, iinfo, rinfo, qsing, dep, redundant, tpass, &
-                                status, msg)
+                                qddout, s3, ssum, iinfo, rinfo, qsing, dep, redundant, &
+                                tpass, status, msg)
   use iso_c_binding, only: c_double, c_int
   use mbd_api, only: api_kinematics
   implicit none
@@ -303,6 +303,9 @@ subroutine core_kinematics_sens(nb, nc, ctab, np, rpar, nq, neq, q0, t0, t1, nst
   !> dq/dp, dq_dot/dp and dq_ddot/dp in one block (one allocation: repeated runs reuse it
   !! rather than map and fault in three)
   real(c_double), intent(out) :: s3(nq, npar, nout, 3)
+  !> each output's sum of its sensitivities: finite exactly when they all are (barring an
+  !! overflow of the sum), so the caller need not read the block to check it
+  real(c_double), intent(out) :: ssum(nout)
   integer(c_int), intent(out) :: iinfo(10)
   real(c_double), intent(out) :: rinfo(10)
   real(c_double), intent(out) :: qsing(nq)
@@ -311,12 +314,13 @@ subroutine core_kinematics_sens(nb, nc, ctab, np, rpar, nq, neq, q0, t0, t1, nst
   integer(c_int), intent(out) :: status
   character(len=512), intent(out) :: msg
   !f2py intent(hide) :: nc, np, nq, npar
-  !f2py intent(out, cache) :: qout, qdout, qddout, s3
+  !f2py intent(out, cache) :: qout, qdout, qddout, s3, ssum
   ! (out, cache: f2py leaves the arrays unset, not zeroed: the core writes every entry)
   !f2py threadsafe
   call api_kinematics(nb, ctab, rpar, q0, t0, t1, nsteps, tol, maxit, tmin, every, solver, &
                       qout, qdout, qddout, iinfo, rinfo, qsing, dep, redundant, tpass, &
-                      status, msg, ptab, s3(:, :, :, 1), s3(:, :, :, 2), s3(:, :, :, 3))
+                      status, msg, ptab, s3(:, :, :, 1), s3(:, :, :, 2), s3(:, :, :, 3), &
+                      ssum=ssum)
 end subroutine core_kinematics_sens
 
 subroutine core_inverse_sens(nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp, fpar, nq, neq, &

@@ -1032,7 +1032,7 @@ contains
   !! On a singular configuration the outputs up to it are filled (rep%ndone columns) and
   !! status is MBD_SINGULAR_CONFIG with rep describing the configuration.
   subroutine kin_run(m, q0, t0, t1, nsteps, opts, qout, qdout, qddout, rep, status, msg, &
-                     sens, sq, sqd, sqdd, ctl)
+                     sens, sq, sqd, sqdd, ssum, ctl)
     type(model_t), intent(in) :: m             !! model
     real(wp), intent(in) :: q0(:)              !! estimates (nq)
     real(wp), intent(in) :: t0, t1             !! time span
@@ -1048,23 +1048,26 @@ contains
     !! dq/dp, dq_dot/dp and dq_ddot/dp at every stored output (in model units, sens%ounit)
     type(sens_t), intent(inout), optional :: sens
     real(wp), intent(out), optional, contiguous :: sq(:, :, :), sqd(:, :, :), sqdd(:, :, :)
+    !> with them, each output's sum of its sensitivities (kin_sens; (outputs))
+    real(wp), intent(out), optional :: ssum(:)
     !> progress, shared with a caller in another thread: ctl(1) gets the outputs stored so
     !! far, ctl(2) /= 0 asks the run to stop (MBD_USER_ABORT, the outputs so far kept; seen at
     !! the next output time)
     integer, intent(inout), optional, volatile :: ctl(:)
     integer :: c0
     call kin_loop(m, q0, t0, t1, nsteps, opts, qout, qdout, qddout, rep, status, msg, &
-                  sens, sq, sqd, sqdd, ctl)
+                  sens, sq, sqd, sqdd, ssum, ctl)
     ! the outputs not computed are zero (set here, not before the loop: no pass over them)
     c0 = max(rep%ndone, 0)
     if (c0 < size(qout, 2)) then
       qout(:, c0 + 1:) = zero; qdout(:, c0 + 1:) = zero; qddout(:, c0 + 1:) = zero
+      if (present(ssum)) ssum(c0 + 1:) = zero
     end if
   end subroutine kin_run
 
   !> kin_run's work (the outputs beyond rep%ndone are left as they are).
   subroutine kin_loop(m, q0, t0, t1, nsteps, opts, qout, qdout, qddout, rep, status, msg, &
-                     sens, sq, sqd, sqdd, ctl)
+                     sens, sq, sqd, sqdd, ssum, ctl)
     type(model_t), intent(in) :: m             !! model
     real(wp), intent(in) :: q0(:)              !! estimates (nq)
     real(wp), intent(in) :: t0, t1             !! time span
@@ -1080,6 +1083,8 @@ contains
     !! dq/dp, dq_dot/dp and dq_ddot/dp at every stored output (in model units, sens%ounit)
     type(sens_t), intent(inout), optional :: sens
     real(wp), intent(out), optional, contiguous :: sq(:, :, :), sqd(:, :, :), sqdd(:, :, :)
+    !> with them, each output's sum of its sensitivities (kin_sens; (outputs))
+    real(wp), intent(out), optional :: ssum(:)
     !> progress (see kin_run)
     integer, intent(inout), optional, volatile :: ctl(:)
     type(kin_work_t) :: w
@@ -1271,7 +1276,7 @@ contains
     pmax = PRED_ORDER; ncorr = 0; dfirst = zero; clast = zero
     if (opts%positions) call reenter(w%pivratio)
     if (present(sens)) call kin_sens(m, w, sens, q, qd, qdd, t0, sq(:, :, 1), sqd(:, :, 1), &
-                                     sqdd(:, :, 1))
+                                     sqdd(:, :, 1), ssum(1))
     rep%ndone = 1
     detprev = w%detsign
     call forget_derivatives()
@@ -1734,7 +1739,7 @@ contains
       else if (cc > 0) then
         call copy3(size(q), q, qd, qdd, qout(:, cc), qdout(:, cc), qddout(:, cc))
         if (present(sens)) call kin_sens(m, w, sens, q, qd, qdd, t, sq(:, :, cc), &
-                                         sqd(:, :, cc), sqdd(:, :, cc))
+                                         sqd(:, :, cc), sqdd(:, :, cc), ssum(cc))
         if (w%pivratio < ANCHOR_PIV) call refine_output(cc)
         rep%ndone = cc
       end if
@@ -1809,9 +1814,10 @@ contains
         call factor(w, st3)
         if (st3 == MBD_OK) then
           call kin_sens(m, w, sens, qout(:, cc), qdout(:, cc), qddout(:, cc), tt, sq(:, :, cc), &
-                        sqd(:, :, cc), sqdd(:, :, cc))
+                        sqd(:, :, cc), sqdd(:, :, cc), ssum(cc))
         else                                  ! (every output is written: the arrays come
           sq(:, :, cc) = zero; sqd(:, :, cc) = zero; sqdd(:, :, cc) = zero   ! unset)
+          ssum(cc) = zero
         end if
       end do
       post = .false.
@@ -1823,7 +1829,7 @@ contains
   !! J s = -Phi_p, J s_dot = nu_p - J_p q_dot - Hv s, J s_ddot = gamma_p - J_p q_ddot - Ha s
   !! - 2 Hv s_dot (mbd_sensitivity), three solves with the same factors per parameter;
   !! returned in model units (s%ounit: the core works in the model's length scale).
-  subroutine kin_sens(m, w, s, q, qd, qdd, t, sq, sqd, sqdd)
+  subroutine kin_sens(m, w, s, q, qd, qdd, t, sq, sqd, sqdd, ssum)
     type(model_t), intent(in) :: m           !! model
     type(kin_work_t), intent(inout) :: w     !! work arrays with the factors of J(q)
     type(sens_t), intent(inout) :: s         !! parameters and blocks
@@ -1832,15 +1838,19 @@ contains
     !> (nq, np); contiguous down from the f2py layer's arrays: their sections reach the
     !! solves' explicit shapes with no run-time contiguity checks (~390 instructions a step)
     real(wp), intent(out), contiguous :: sq(:, :), sqd(:, :), sqdd(:, :)
+    !> the sum of all three's entries: finite exactly when every entry is, barring an
+    !! overflow of the sum itself (the caller's check of the outputs, taken here for free)
+    real(wp), intent(out) :: ssum
     call sens_states(m, s, w%asm%cb, w%asm%sb, qd, qdd)   ! (cos, sin of the assembly at q)
     call sens_hessian(m, s, q, qd, qdd, t, states=.false., push=.false.)
     call sens_params(m, s, q, qd, qdd, t, states=.false.)
+    ssum = zero
     if (w%spfact) then                        ! the sparse factors: straight to their solves
-      call splu_solve_rows(w%sp, s%mphip, sq, w%cs, s%ounit, s%st)
+      call splu_solve_rows(w%sp, s%mphip, sq, w%cs, s%ounit, ssum, s%st)
       call sens_kin_rhs(s, 2, s%rhs)
-      call splu_solve_rows(w%sp, s%rhs, sqd, w%cs, s%ounit, s%sdt)
+      call splu_solve_rows(w%sp, s%rhs, sqd, w%cs, s%ounit, ssum, s%sdt)
       call sens_kin_rhs(s, 3, s%rhs)
-      call splu_solve_rows(w%sp, s%rhs, sqdd, w%cs, s%ounit)
+      call splu_solve_rows(w%sp, s%rhs, sqdd, w%cs, s%ounit, ssum)
       return
     end if
     s%rhs(:, :) = s%mphip                     ! (the dense solves overwrite their right sides)
@@ -1850,6 +1860,7 @@ contains
     call sens_kin_rhs(s, 3, s%rhs)
     call solve_cols(w, s%rhs, sqdd, s%work, s%st)
     sq = sq * s%ounit; sqd = sqd * s%ounit; sqdd = sqdd * s%ounit   ! (in model units)
+    ssum = sum(sq) + sum(sqd) + sum(sqdd)
   end subroutine kin_sens
 
   !> The predictor's sum qp = q + hs q_dot + hp0 q_ddot + sum_j wt_j d_j; qn = qp (explicit

@@ -375,13 +375,15 @@ contains
   !! padding zero), four at a time through the factors (each column's operations those of
   !! splu_solve, in the same order); x (n, ncol) takes the first ncol of them, each entry
   !! multiplied by that of f (n, ncol), and xt (4 k, n), when present, all of them as rows
-  !! (without f).
-  pure subroutine splu_solve_rows(sp, bt, x, cs, f, xt)
+  !! (without f). acc gets the sum of x's entries added (a check of their finiteness taken
+  !! while they are in registers).
+  pure subroutine splu_solve_rows(sp, bt, x, cs, f, acc, xt)
     type(splu_t), intent(inout) :: sp                !! factors (and the work block)
     real(wp), intent(in), contiguous :: bt(:, :)     !! right-hand sides as rows (4 k, n)
     real(wp), intent(inout), contiguous :: x(:, :)   !! solutions (A's columns, ncol)
     real(wp), intent(in), contiguous :: cs(:)        !! column scale
     real(wp), intent(in), contiguous :: f(:, :)      !! output factors (n, ncol)
+    real(wp), intent(inout) :: acc                   !! sum of the outputs (added to)
     !> solutions as rows (4 k, n)
     real(wp), intent(inout), contiguous, optional :: xt(:, :)
     integer :: g
@@ -390,9 +392,10 @@ contains
       call rows_kernel(sp%n, sp%lptr(sp%n + 1) - 1, sp%nu, sp%prow, sp%lrptr, sp%lrpos, &
                        sp%lrcol, sp%urptr, sp%urpos, sp%urcol, sp%val, sp%y4, size(bt, 1), bt, g)
       if (present(xt)) then
-        call rows_out(sp%n, size(x, 2), sp%pcol, sp%rinv, cs, sp%y4, size(xt, 1), xt, g, x, f)
+        call rows_out(sp%n, size(x, 2), sp%pcol, sp%rinv, cs, sp%y4, size(xt, 1), xt, g, x, f, &
+                      acc)
       else
-        call cols_out(sp%n, size(x, 2), sp%pcol, sp%rinv, cs, sp%y4, g, x, f)
+        call cols_out(sp%n, size(x, 2), sp%pcol, sp%rinv, cs, sp%y4, g, x, f, acc)
       end if
     end do
   end subroutine splu_solve_rows
@@ -432,10 +435,10 @@ contains
 
   !> x = D Q diag(1/u_kk) v of rows_kernel's four solutions as rows g .. g + 3 of xt and,
   !! times f, as columns g .. of x (as many as x has).
-  pure subroutine rows_out(n, ncol, pcol, rinv, cs, y, ldt, xt, g, x, f)
+  pure subroutine rows_out(n, ncol, pcol, rinv, cs, y, ldt, xt, g, x, f, acc)
     integer, intent(in) :: n, ncol, pcol(n), ldt, g
     real(wp), intent(in) :: rinv(n), cs(n), y(4, n), f(n, ncol)
-    real(wp), intent(inout) :: xt(ldt, n), x(n, ncol)
+    real(wp), intent(inout) :: xt(ldt, n), x(n, ncol), acc
     integer :: k, c, i
     real(wp) :: v, z1, z2, z3, z4
     if (ncol - g >= 3) then
@@ -443,8 +446,9 @@ contains
         c = pcol(k); v = rinv(k) * cs(c)
         z1 = y(1, k) * v; z2 = y(2, k) * v; z3 = y(3, k) * v; z4 = y(4, k) * v
         xt(g, c) = z1; xt(g + 1, c) = z2; xt(g + 2, c) = z3; xt(g + 3, c) = z4
-        x(c, g) = z1 * f(c, g); x(c, g + 1) = z2 * f(c, g + 1)
-        x(c, g + 2) = z3 * f(c, g + 2); x(c, g + 3) = z4 * f(c, g + 3)
+        z1 = z1 * f(c, g); z2 = z2 * f(c, g + 1); z3 = z3 * f(c, g + 2); z4 = z4 * f(c, g + 3)
+        x(c, g) = z1; x(c, g + 1) = z2; x(c, g + 2) = z3; x(c, g + 3) = z4
+        acc = acc + ((z1 + z2) + (z3 + z4))
       end do
       return
     end if
@@ -456,6 +460,7 @@ contains
     do i = 1, ncol - g + 1
       do c = 1, n
         x(c, g + i - 1) = xt(g + i - 1, c) * f(c, g + i - 1)
+        acc = acc + x(c, g + i - 1)
       end do
     end do
   end subroutine rows_out
@@ -522,17 +527,19 @@ contains
   end subroutine rows_kernel_t
 
   !> rows_out without the rows: columns g .. of x only (times f).
-  pure subroutine cols_out(n, ncol, pcol, rinv, cs, y, g, x, f)
+  pure subroutine cols_out(n, ncol, pcol, rinv, cs, y, g, x, f, acc)
     integer, intent(in) :: n, ncol, pcol(n), g
     real(wp), intent(in) :: rinv(n), cs(n), y(4, n), f(n, ncol)
-    real(wp), intent(inout) :: x(n, ncol)
+    real(wp), intent(inout) :: x(n, ncol), acc
     integer :: k, c, i
-    real(wp) :: v
+    real(wp) :: v, z1, z2, z3, z4
     if (ncol - g >= 3) then
       do k = 1, n
         c = pcol(k); v = rinv(k) * cs(c)
-        x(c, g) = (y(1, k) * v) * f(c, g); x(c, g + 1) = (y(2, k) * v) * f(c, g + 1)
-        x(c, g + 2) = (y(3, k) * v) * f(c, g + 2); x(c, g + 3) = (y(4, k) * v) * f(c, g + 3)
+        z1 = (y(1, k) * v) * f(c, g); z2 = (y(2, k) * v) * f(c, g + 1)
+        z3 = (y(3, k) * v) * f(c, g + 2); z4 = (y(4, k) * v) * f(c, g + 3)
+        x(c, g) = z1; x(c, g + 1) = z2; x(c, g + 2) = z3; x(c, g + 3) = z4
+        acc = acc + ((z1 + z2) + (z3 + z4))
       end do
       return
     end if
@@ -540,6 +547,7 @@ contains
       do k = 1, n
         c = pcol(k)
         x(c, g + i - 1) = (y(i, k) * (rinv(k) * cs(c))) * f(c, g + i - 1)
+        acc = acc + x(c, g + i - 1)
       end do
     end do
   end subroutine cols_out

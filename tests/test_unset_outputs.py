@@ -31,8 +31,9 @@ def poison(sizes: list[int], copies: int = 6) -> None:
 
 
 def sizes(nq: int, rows: int, npar: int) -> list[int]:
-    """The float counts of a run's arrays: q, q_dot, q_ddot each, the sensitivities' block."""
-    return [nq * rows, 3 * nq * rows * max(npar, 1)]
+    """The float counts of a run's arrays: q, q_dot, q_ddot each, the sensitivities' block
+    and their sums."""
+    return [nq * rows, 3 * nq * rows * max(npar, 1), rows]
 
 
 def test_poisoned_memory_reaches_new_arrays() -> None:

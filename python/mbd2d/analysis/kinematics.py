@@ -73,7 +73,9 @@ def run_kinematics(model: ModelDescription, t_end: float, steps: int, t0: float 
                            complete=status == OK, model=model)
     if params:
         attach(res, out, params, n, ptab)
-    res, bad = finite_part(res)
+        res, bad = finite_part(res, out.ssum[:n], ("dq_dp", "dqd_dp", "dqdd_dp"))
+    else:
+        res, bad = finite_part(res)
     if red_rows and status in (OK, SINGULAR_CONFIG, NO_CONVERGENCE):
         warnings.warn(f"redundant constraints: {', '.join(red_rows)} repeat what the other "
                       "constraints impose (rank of J is "

@@ -69,10 +69,24 @@ def first_nonfinite_row(*arrays: np.ndarray) -> int | None:
     return bad
 
 
-def finite_part(res: R) -> tuple[R, int | None]:
+def finite_part(res: R, sums: np.ndarray | None = None,
+                covered: tuple[str, ...] = ()) -> tuple[R, int | None]:
     """The result cut before its first row with a non-finite number (marked incomplete),
-    and that row's index; the result itself and None when every number is finite."""
+    and that row's index; the result itself and None when every number is finite.
+
+    Parameters
+    ----------
+    res : the result
+    sums : per row, the core's sum of the fields in ``covered`` (finite exactly when they
+        all are, unless the sum overflowed): when every one is finite, those fields need not
+        be read again; otherwise they are checked entry by entry like the others
+    covered : the fields ``sums`` vouches for
+    """
     names = [f for f in ROW_FIELDS if getattr(res, f, None) is not None]
+    if sums is not None:
+        with np.errstate(over="ignore", invalid="ignore"):
+            if np.isfinite(sums).all():
+                names = [f for f in names if f not in covered]
     k = first_nonfinite_row(*(getattr(res, f) for f in names))
     if k is None:
         return res, None

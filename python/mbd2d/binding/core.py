@@ -206,8 +206,9 @@ def kinematics_sens(p: Packed, t0: float, t1: float, steps: int, tol: float, max
                     tmin: float, every: int, solver: int, nout: int,
                     ptab: np.ndarray) -> SimpleNamespace:
     """A kinematic run with sensitivities: as :func:`kinematics` plus ``sq``, ``sqd``,
-    ``sqdd`` (nq, np, nout), views of the core's one block (nq, np, nout, 3)."""
-    out = _named("q qd qdd s3 iinfo rinfo qsing dep red tpass status msg",
+    ``sqdd`` (nq, np, nout), views of the core's one block (nq, np, nout, 3), and ``ssum``
+    (nout), each output's sum of them (finite exactly when they all are, barring overflow)."""
+    out = _named("q qd qdd s3 ssum iinfo rinfo qsing dep red tpass status msg",
                  _core.core_kinematics_sens, p.nb, p.ctab, p.rpar, p.neq, p.q0, t0, t1, steps,
                  tol, maxit, tmin, every, solver, nout, ptab,
                  numbers=3 * p.nq * nout * (1 + ptab.shape[1]))
