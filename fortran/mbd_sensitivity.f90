@@ -89,6 +89,10 @@ module mbd_sensitivity
     !! constraint, theta slot (3, 6), and their blocks (2, nside) at the current state
     integer, allocatable :: rsb(:), rso(:), rsc(:), rss(:)
     integer, allocatable :: rsq(:), rsr(:)   !! each side's angle coordinate and first row
+    !> the sides' entries by row (sens_kin_rhs): row r's are rwe(rwp(r) .. rwp(r + 1) - 1),
+    !! each a place in rsv, rsa (seen flat: 2 (e - 1) + i for row rsr(e) + i - 1), in the
+    !! order of the sides, with its angle column rwc
+    integer, allocatable :: rwp(:), rwe(:), rwc(:)
     real(wp), allocatable :: rsg(:)
     real(wp), allocatable :: rsh(:, :), rsv(:, :), rsa(:, :)
     integer, allocatable :: tlc(:)           !! the translationals (closed forms)
@@ -375,7 +379,7 @@ contains
               s%rsv(2, ns), s%rsa(2, ns), s%gen(ngen), s%psk(nps), s%psb(nps), s%pso(nps), &
               s%psr(nps), s%psg(nps), s%psfirst(nps), s%psphi(2, nps), s%psv(2, nps), &
               s%psa(2, nps), s%gpc(ngp), s%gpk(ngp), s%ounit(m%nq, s%np), &
-              s%tlc(count(tra)), stat=st)
+              s%tlc(count(tra)), s%rwp(m%neq + 1), s%rwe(2 * ns), s%rwc(2 * ns), stat=st)
     if (st /= 0) return
     do k = 1, s%np
       s%ounit(:, k) = s%pscale(k) * m%cunit
@@ -420,6 +424,7 @@ contains
         if (any(s%caff(c, :)) .and. .not. (tra(c) .or. con_linear(m%kind(c)))) s%gathers = .true.
       end if
     end do
+    call side_rows(m%neq, ns, s%rsr, s%rsq, s%rwp, s%rwe, s%rwc)
     do c = 1, m%nc                               ! the translationals' first rows, after
       if (.not. tra(c)) cycle                    ! the revolutes' entries
       ntr = ntr + 1; s%tlc(ntr) = c
@@ -431,6 +436,31 @@ contains
       end do
     end do
   end subroutine sens_lists
+
+  !> The revolute sides' entries gathered by row (counting sort, stable: within a row in
+  !! the order of the sides): side e has row r0(e) (value 2 e - 1) and r0(e) + 1 (2 e), both
+  !! in column cq(e).
+  pure subroutine side_rows(neq, ns, r0, cq, rwp, rwe, rwc)
+    integer, intent(in) :: neq, ns, r0(ns), cq(ns)
+    integer, intent(out) :: rwp(neq + 1), rwe(2 * ns), rwc(2 * ns)
+    integer :: e, i, r, nxt(neq)
+    rwp = 0
+    do e = 1, ns
+      rwp(r0(e)) = rwp(r0(e)) + 1; rwp(r0(e) + 1) = rwp(r0(e) + 1) + 1
+    end do
+    nxt(1) = 1
+    do r = 2, neq
+      nxt(r) = nxt(r - 1) + rwp(r - 1)
+    end do
+    rwp(1:neq) = nxt; rwp(neq + 1) = 2 * ns + 1
+    do e = 1, ns
+      do i = 0, 1
+        r = r0(e) + i
+        rwe(nxt(r)) = 2 * e - 1 + i; rwc(nxt(r)) = cq(e)
+        nxt(r) = nxt(r) + 1
+      end do
+    end do
+  end subroutine side_rows
 
   !> cos and sin of every body angle at q, for the evaluations that follow at the same q.
   pure subroutine sens_trig(m, s, q)
@@ -828,44 +858,62 @@ contains
     real(wp), intent(inout), contiguous :: rhs(:, :)  !! (npad, neq)
     if (level == 2) then
       call kin_rhs_kernel(size(rhs, 1), size(rhs, 2), size(s%st, 2), s%nnz, size(s%rsb), &
-                          s%rsr, s%rsq, s%rsv, s%rsv, s%nzr, s%nzc, s%nzv, s%nzv, .false., &
-                          s%vp, s%st, s%sdt, rhs)
+                          s%rwp, s%rwe, s%rwc, s%rsv, s%rsv, s%nzr, s%nzc, s%nzv, s%nzv, &
+                          .false., s%vp, s%st, s%sdt, rhs)
     else
       call kin_rhs_kernel(size(rhs, 1), size(rhs, 2), size(s%st, 2), s%nnz, size(s%rsb), &
-                          s%rsr, s%rsq, s%rsa, s%rsv, s%nzr, s%nzc, s%nza, s%nzv, .true., &
-                          s%ap, s%st, s%sdt, rhs)
+                          s%rwp, s%rwe, s%rwc, s%rsa, s%rsv, s%nzr, s%nzc, s%nza, s%nzv, &
+                          .true., s%ap, s%st, s%sdt, rhs)
     end if
   end subroutine sens_kin_rhs
 
   !> sens_kin_rhs on explicit shapes (the loops see plain arrays): rhs = base - H1 s
   !! (- 2 H2 s_dot when both). The parameter parts and rhs share the padded layout
-  !! (npad, neq), seen here flat, so the first term is one copy; s and s_dot come as rows
-  !! (st, sdt: (npad, nq)), so each nonzero updates a row of rhs from a row of them, four
-  !! parameters at a time. The list's first 2 npair entries are the revolutes' sides, taken
-  !! from their closed forms instead (side e: rows pr(e), pr(e) + 1, angle column pc(e),
-  !! values p1(:, e), p2(:, e) as h1, h2; one row of s read for both rows).
-  pure subroutine kin_rhs_kernel(npad, neq, nq, nnz, npair, pr, pc, p1, p2, nzr, nzc, h1, h2, &
-                                 both, base, st, sdt, rhs)
+  !! (npad, neq), seen here flat; s and s_dot come as rows (st, sdt: (npad, nq)), so each
+  !! nonzero updates a row of rhs from a row of them, four parameters at a time. The
+  !! revolutes' sides (npair of them, the list's first 2 npair entries) come from their
+  !! closed forms' values p1, p2 (2, npair) by row (rwp, rwe, rwc: side_rows): with four
+  !! parameters each row of rhs is then written once, its sums kept in registers.
+  pure subroutine kin_rhs_kernel(npad, neq, nq, nnz, npair, rwp, rwe, rwc, p1, p2, nzr, nzc, &
+                                 h1, h2, both, base, st, sdt, rhs)
     integer, intent(in) :: npad, neq, nq, nnz, npair
-    integer, intent(in) :: pr(npair), pc(npair), nzr(*), nzc(*)
-    real(wp), intent(in) :: p1(2, npair), p2(2, npair)  !! the sides' values
+    integer, intent(in) :: rwp(neq + 1), rwe(*), rwc(*), nzr(*), nzc(*)
+    real(wp), intent(in) :: p1(*), p2(*)       !! the sides' values (2 npair, flat)
     real(wp), intent(in) :: h1(*), h2(*)       !! values of the nonzeros (Hv or Ha, Hv)
     logical, intent(in) :: both                !! the s_dot term too
     real(wp), intent(in) :: base(npad * neq), st(npad * nq), sdt(npad * nq)
     real(wp), intent(inout) :: rhs(npad * neq)
-    integer :: g, n, e, c
+    integer :: g, n, e, c, r, p, j
     real(wp) :: v, a
-    do e = 1, npad * neq
-      rhs(e) = base(e)
-    end do
-    if (npad == 4) then                        ! (up to four parameters: no inner loop)
-      call rhs_pairs(npair, pr, pc, p1, p2, both, st, sdt, rhs)
-      n = 2 * npair + 1
+    n = 2 * npair + 1                          ! (the list's entries after the sides')
+    if (npad == 4 .and. npair > 0) then        ! (up to four parameters: no inner loop)
+      call rhs_rows(neq, rwp, rwe, rwc, p1, p2, both, base, st, sdt, rhs)
       call rhs_four(nnz - 2 * npair, nzr(n), nzc(n), h1(n), h2(n), both, st, sdt, rhs)
       return
     end if
-    call rhs_general(npad, npair, pr, pc, p1, p2, both, st, sdt, rhs)
-    n = 2 * npair + 1
+    do e = 1, npad * neq
+      rhs(e) = base(e)
+    end do
+    if (npad == 4) then
+      call rhs_four(nnz, nzr, nzc, h1, h2, both, st, sdt, rhs)
+      return
+    end if
+    do r = 1, merge(neq, 0, npair > 0)         ! the sides, by row
+      e = npad * (r - 1)
+      do p = rwp(r), rwp(r + 1) - 1
+        j = rwe(p); c = npad * (rwc(p) - 1); a = p1(j)
+        if (both) then
+          v = 2 * p2(j)
+          do g = 1, npad
+            rhs(e + g) = rhs(e + g) - a * st(c + g) - v * sdt(c + g)
+          end do
+        else
+          do g = 1, npad
+            rhs(e + g) = rhs(e + g) - a * st(c + g)
+          end do
+        end if
+      end do
+    end do
     if (.not. both) then                       ! nu_p - J_p q_dot - Hv s
       do n = n, nnz
         e = npad * (nzr(n) - 1); c = npad * (nzc(n) - 1); v = h1(n)
@@ -889,61 +937,37 @@ contains
     end do
   end subroutine kin_rhs_kernel
 
-  !> kin_rhs_kernel's revolute sides for npad = 4: side e in rows pr(e), pr(e) + 1 of
-  !! column pc(e), values h1(:, e) (and h2(:, e)).
-  pure subroutine rhs_pairs(npair, pr, pc, h1, h2, both, st, sdt, rhs)
-    integer, intent(in) :: npair, pr(npair), pc(npair)
-    real(wp), intent(in) :: h1(2, npair), h2(2, npair), st(4, *), sdt(4, *)
+  !> kin_rhs_kernel's sides for npad = 4, row by row: rhs(:, r) = base(:, r) - the sum over
+  !! the row's entries of h1 s(:, c) (+ 2 h2 s_dot(:, c) when both), kept in registers.
+  pure subroutine rhs_rows(neq, rwp, rwe, rwc, h1, h2, both, base, st, sdt, rhs)
+    integer, intent(in) :: neq, rwp(neq + 1), rwe(*), rwc(*)
+    real(wp), intent(in) :: h1(*), h2(*), base(4, neq), st(4, *), sdt(4, *)
     logical, intent(in) :: both
-    real(wp), intent(inout) :: rhs(4, *)
-    integer :: e, r, c
-    real(wp) :: v1, v2, a1, a2, s1, s2, s3, s4, d1, d2, d3, d4
-    if (.not. both) then                       ! rhs(:, r + i) -= hv_i s(:, c)
-      do e = 1, npair
-        r = pr(e); c = pc(e); v1 = h1(1, e); v2 = h1(2, e)
-        s1 = st(1, c); s2 = st(2, c); s3 = st(3, c); s4 = st(4, c)
-        rhs(1, r) = rhs(1, r) - v1 * s1; rhs(2, r) = rhs(2, r) - v1 * s2
-        rhs(3, r) = rhs(3, r) - v1 * s3; rhs(4, r) = rhs(4, r) - v1 * s4
-        rhs(1, r + 1) = rhs(1, r + 1) - v2 * s1; rhs(2, r + 1) = rhs(2, r + 1) - v2 * s2
-        rhs(3, r + 1) = rhs(3, r + 1) - v2 * s3; rhs(4, r + 1) = rhs(4, r + 1) - v2 * s4
+    real(wp), intent(out) :: rhs(4, neq)
+    integer :: r, p, j, c
+    real(wp) :: a, v, t1, t2, t3, t4
+    if (.not. both) then                       ! nu_p - J_p q_dot - Hv s
+      do r = 1, neq
+        t1 = base(1, r); t2 = base(2, r); t3 = base(3, r); t4 = base(4, r)
+        do p = rwp(r), rwp(r + 1) - 1
+          j = rwe(p); c = rwc(p); a = h1(j)
+          t1 = t1 - a * st(1, c); t2 = t2 - a * st(2, c)
+          t3 = t3 - a * st(3, c); t4 = t4 - a * st(4, c)
+        end do
+        rhs(1, r) = t1; rhs(2, r) = t2; rhs(3, r) = t3; rhs(4, r) = t4
       end do
       return
     end if
-    do e = 1, npair                            ! rhs(:, r + i) -= ha_i s(:, c) + 2 hv_i s_dot(:, c)
-      r = pr(e); c = pc(e)
-      a1 = h1(1, e); a2 = h1(2, e); v1 = 2 * h2(1, e); v2 = 2 * h2(2, e)
-      s1 = st(1, c); s2 = st(2, c); s3 = st(3, c); s4 = st(4, c)
-      d1 = sdt(1, c); d2 = sdt(2, c); d3 = sdt(3, c); d4 = sdt(4, c)
-      rhs(1, r) = rhs(1, r) - a1 * s1 - v1 * d1; rhs(2, r) = rhs(2, r) - a1 * s2 - v1 * d2
-      rhs(3, r) = rhs(3, r) - a1 * s3 - v1 * d3; rhs(4, r) = rhs(4, r) - a1 * s4 - v1 * d4
-      rhs(1, r + 1) = rhs(1, r + 1) - a2 * s1 - v2 * d1
-      rhs(2, r + 1) = rhs(2, r + 1) - a2 * s2 - v2 * d2
-      rhs(3, r + 1) = rhs(3, r + 1) - a2 * s3 - v2 * d3
-      rhs(4, r + 1) = rhs(4, r + 1) - a2 * s4 - v2 * d4
-    end do
-  end subroutine rhs_pairs
-
-  !> kin_rhs_kernel's revolute sides for npad > 4 (a multiple of 4; rhs_pairs' forms).
-  pure subroutine rhs_general(npad, npair, pr, pc, h1, h2, both, st, sdt, rhs)
-    integer, intent(in) :: npad, npair, pr(npair), pc(npair)
-    real(wp), intent(in) :: h1(2, npair), h2(2, npair), st(npad, *), sdt(npad, *)
-    logical, intent(in) :: both
-    real(wp), intent(inout) :: rhs(npad, *)
-    integer :: e, r, c, g
-    real(wp) :: v1, v2, a1, a2
-    do e = 1, npair
-      r = pr(e); c = pc(e)
-      if (both) then
-        a1 = h1(1, e); a2 = h1(2, e); v1 = 2 * h2(1, e); v2 = 2 * h2(2, e)
-      else
-        a1 = h1(1, e); a2 = h1(2, e); v1 = zero; v2 = zero
-      end if
-      do g = 1, npad
-        rhs(g, r) = rhs(g, r) - a1 * st(g, c) - v1 * sdt(g, c)
-        rhs(g, r + 1) = rhs(g, r + 1) - a2 * st(g, c) - v2 * sdt(g, c)
+    do r = 1, neq                              ! gamma_p - J_p q_ddot - Ha s - 2 Hv s_dot
+      t1 = base(1, r); t2 = base(2, r); t3 = base(3, r); t4 = base(4, r)
+      do p = rwp(r), rwp(r + 1) - 1
+        j = rwe(p); c = rwc(p); a = h1(j); v = 2 * h2(j)
+        t1 = t1 - a * st(1, c) - v * sdt(1, c); t2 = t2 - a * st(2, c) - v * sdt(2, c)
+        t3 = t3 - a * st(3, c) - v * sdt(3, c); t4 = t4 - a * st(4, c) - v * sdt(4, c)
       end do
+      rhs(1, r) = t1; rhs(2, r) = t2; rhs(3, r) = t3; rhs(4, r) = t4
     end do
-  end subroutine rhs_general
+  end subroutine rhs_rows
 
   !> kin_rhs_kernel's nonzeros for npad = 4.
   pure subroutine rhs_four(nnz, nzr, nzc, h1, h2, both, st, sdt, rhs)
@@ -983,13 +1007,13 @@ contains
     integer :: n0
     n0 = first - 1
     if (both) then
-      call kin_rhs_kernel(npd, size(s%ap, 2), nq, s%nnz - n0, 0, s%rsr, s%rsq, s%rsa, s%rsv, &
-                          s%nzr(first:), s%nzc(first:), s%nza(first:), s%nzv(first:), .true., &
-                          s%ap, st, sdt, rhs)
+      call kin_rhs_kernel(npd, size(s%ap, 2), nq, s%nnz - n0, 0, s%rwp, s%rwe, s%rwc, s%rsa, &
+                          s%rsv, s%nzr(first:), s%nzc(first:), s%nza(first:), s%nzv(first:), &
+                          .true., s%ap, st, sdt, rhs)
     else
-      call kin_rhs_kernel(npd, size(s%vp, 2), nq, s%nnz - n0, 0, s%rsr, s%rsq, s%rsv, s%rsv, &
-                          s%nzr(first:), s%nzc(first:), s%nzv(first:), s%nzv(first:), .false., &
-                          s%vp, st, sdt, rhs)
+      call kin_rhs_kernel(npd, size(s%vp, 2), nq, s%nnz - n0, 0, s%rwp, s%rwe, s%rwc, s%rsv, &
+                          s%rsv, s%nzr(first:), s%nzc(first:), s%nzv(first:), s%nzv(first:), &
+                          .false., s%vp, st, sdt, rhs)
     end if
   end subroutine sens_rows_rhs
 
