@@ -43,7 +43,7 @@ module mbd_kinematics
   use mbd_linsolve, only: lu_factor, lu_solve, lu_det_sign, svd_null, row_rank, qr_factor, &
                           qr_solve, qr_lwork, lu_solve_rows, lu_factor_small, lu_solve_small
   use mbd_splu, only: splu_t, splu_init, splu_plan, splu_factor, splu_solve, splu_solve2, &
-                      splu_solve_rows, splu_pos, LMAX
+                      splu_solve_rows, splu_solve_rows_h, splu_pos, LMAX
   use mbd_lapack, only: dgels, dgecon, dtrcon
   use mbd_interp, only: hermite5
   use mbd_sensitivity, only: sens_t, sens_states, sens_hessian, sens_params, sens_kin_rhs
@@ -1845,6 +1845,16 @@ contains
     call sens_hessian(m, s, q, qd, qdd, t, states=.false., push=.false.)
     call sens_params(m, s, q, qd, qdd, t, states=.false.)
     ssum = zero
+    if (w%spfact .and. size(s%rhs, 1) == 4 .and. s%nnz == 2 * size(s%rsb)) then
+      ! four parameters, second derivatives from revolutes alone: each solve forms its
+      ! right-hand side's rows as it goes (nu_p - Hv s, gamma_p - Ha s - 2 Hv s_dot)
+      call splu_solve_rows(w%sp, s%mphip, sq, w%cs, s%ounit, ssum, s%st)
+      call splu_solve_rows_h(w%sp, s%vp, s%rwp, s%rwe, s%rwc, s%rsv, s%rsv, .false., s%st, &
+                             s%st, sqd, w%cs, s%ounit, ssum, s%sdt)
+      call splu_solve_rows_h(w%sp, s%ap, s%rwp, s%rwe, s%rwc, s%rsa, s%rsv, .true., s%st, &
+                             s%sdt, sqdd, w%cs, s%ounit, ssum)
+      return
+    end if
     if (w%spfact) then                        ! the sparse factors: straight to their solves
       call splu_solve_rows(w%sp, s%mphip, sq, w%cs, s%ounit, ssum, s%st)
       call sens_kin_rhs(s, 2, s%rhs)

@@ -26,6 +26,7 @@ module mbd_splu
   implicit none
   private
   public :: splu_t, splu_init, splu_plan, splu_factor, splu_solve, splu_solve2, splu_solve_rows, &
+            splu_solve_rows_h, &
             splu_solve_rows_t, splu_pos, LMAX, TAU
 
   real(wp), parameter :: TAU = 0.5_wp   !! pivot threshold of a plan (|l_ik| <= 1/TAU = 2)
@@ -399,6 +400,78 @@ contains
       end if
     end do
   end subroutine splu_solve_rows
+
+  !> splu_solve_rows for four right-hand sides B - H1 S (- 2 H2 S2 when both), B's rows in
+  !! bt (4, n), S and S2 as rows st, sdt (4, *), H1 and H2 sparse by rows: row r's entries
+  !! he(hp(r) .. hp(r + 1) - 1), values h1(he), h2(he), columns hc. Each row of the
+  !! right-hand side is formed, in registers, as the forward pass reaches it (the same
+  !! operations, in the same order, as forming it first).
+  pure subroutine splu_solve_rows_h(sp, bt, hp, he, hc, h1, h2, both, st, sdt, x, cs, f, acc, &
+                                    xt)
+    type(splu_t), intent(inout) :: sp                !! factors (and the work block)
+    real(wp), intent(in), contiguous :: bt(:, :)     !! B as rows (4, n)
+    integer, intent(in), contiguous :: hp(:), he(:), hc(:)  !! H by rows
+    real(wp), intent(in) :: h1(*), h2(*)             !! H's values (by he)
+    logical, intent(in) :: both                      !! the H2 S2 term too
+    real(wp), intent(in), contiguous :: st(:, :), sdt(:, :)  !! S, S2 as rows (4, *)
+    real(wp), intent(inout), contiguous :: x(:, :)   !! solutions (A's columns, ncol <= 4)
+    real(wp), intent(in), contiguous :: cs(:)        !! column scale
+    real(wp), intent(in), contiguous :: f(:, :)      !! output factors (n, ncol)
+    real(wp), intent(inout) :: acc                   !! sum of the outputs (added to)
+    real(wp), intent(inout), contiguous, optional :: xt(:, :)  !! solutions as rows (4, n)
+    call rows_kernel_h(sp%n, sp%lptr(sp%n + 1) - 1, sp%nu, sp%prow, sp%lrptr, sp%lrpos, &
+                       sp%lrcol, sp%urptr, sp%urpos, sp%urcol, sp%val, sp%y4, bt, hp, he, hc, &
+                       h1, h2, both, st, sdt)
+    if (present(xt)) then
+      call rows_out(sp%n, size(x, 2), sp%pcol, sp%rinv, cs, sp%y4, 4, xt, 1, x, f, acc)
+    else
+      call cols_out(sp%n, size(x, 2), sp%pcol, sp%rinv, cs, sp%y4, 1, x, f, acc)
+    end if
+  end subroutine splu_solve_rows_h
+
+  !> rows_kernel with each row of the right-hand side formed where the forward pass takes
+  !! it: b(:, r) - sum of h1 st(:, c) (+ 2 h2 sdt(:, c)) over H's row r (splu_solve_rows_h).
+  pure subroutine rows_kernel_h(n, nl, nu, prow, lrptr, lrpos, lrcol, urptr, urpos, urcol, &
+                                val, y, bt, hp, he, hc, h1, h2, both, st, sdt)
+    integer, intent(in) :: n, nl, nu
+    integer, intent(in) :: prow(n), lrptr(n + 1), lrpos(nl), lrcol(nl)
+    integer, intent(in) :: urptr(n + 1), urpos(nu), urcol(nu), hp(n + 1), he(*), hc(*)
+    real(wp), intent(in) :: val(*), bt(4, n), h1(*), h2(*), st(4, *), sdt(4, *)
+    logical, intent(in) :: both
+    real(wp), intent(out) :: y(4, n)
+    integer :: a, p, c, j, k
+    real(wp) :: v, w, t1, t2, t3, t4
+    do a = 1, n                                      ! L z = P (b - H s), by rows
+      c = prow(a)
+      t1 = bt(1, c); t2 = bt(2, c); t3 = bt(3, c); t4 = bt(4, c)
+      do p = hp(c), hp(c + 1) - 1
+        j = he(p); k = hc(p); v = h1(j)
+        if (both) then
+          w = 2 * h2(j)
+          t1 = t1 - v * st(1, k) - w * sdt(1, k); t2 = t2 - v * st(2, k) - w * sdt(2, k)
+          t3 = t3 - v * st(3, k) - w * sdt(3, k); t4 = t4 - v * st(4, k) - w * sdt(4, k)
+        else
+          t1 = t1 - v * st(1, k); t2 = t2 - v * st(2, k)
+          t3 = t3 - v * st(3, k); t4 = t4 - v * st(4, k)
+        end if
+      end do
+      do p = lrptr(a), lrptr(a + 1) - 1
+        v = val(lrpos(p)); c = lrcol(p)
+        t1 = t1 - v * y(1, c); t2 = t2 - v * y(2, c)
+        t3 = t3 - v * y(3, c); t4 = t4 - v * y(4, c)
+      end do
+      y(1, a) = t1; y(2, a) = t2; y(3, a) = t3; y(4, a) = t4
+    end do
+    do a = n, 1, -1                                  ! U1 v = z, by rows
+      t1 = y(1, a); t2 = y(2, a); t3 = y(3, a); t4 = y(4, a)
+      do p = urptr(a), urptr(a + 1) - 1
+        v = val(urpos(p)); c = urcol(p)
+        t1 = t1 - v * y(1, c); t2 = t2 - v * y(2, c)
+        t3 = t3 - v * y(3, c); t4 = t4 - v * y(4, c)
+      end do
+      y(1, a) = t1; y(2, a) = t2; y(3, a) = t3; y(4, a) = t4
+    end do
+  end subroutine rows_kernel_h
 
   !> Four right-hand sides (rows g .. g + 3 of bt) through L and U1: y (4, n) in step
   !! order, before the pivots and the column permutation (rows_out, cols_out).
