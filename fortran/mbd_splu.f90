@@ -512,19 +512,29 @@ contains
     integer, intent(in) :: n, ncol, pcol(n), ldt, g
     real(wp), intent(in) :: rinv(n), cs(n), y(4, n), f(n, ncol)
     real(wp), intent(inout) :: xt(ldt, n), x(n, ncol), acc
-    integer :: k, c, i
+    integer :: k, c
     real(wp) :: v, z1, z2, z3, z4
-    if (ncol - g >= 3) then
-      do k = 1, n
-        c = pcol(k); v = rinv(k) * cs(c)
-        z1 = y(1, k) * v; z2 = y(2, k) * v; z3 = y(3, k) * v; z4 = y(4, k) * v
-        xt(g, c) = z1; xt(g + 1, c) = z2; xt(g + 2, c) = z3; xt(g + 3, c) = z4
-        z1 = z1 * f(c, g); z2 = z2 * f(c, g + 1); z3 = z3 * f(c, g + 2); z4 = z4 * f(c, g + 3)
-        x(c, g) = z1; x(c, g + 1) = z2; x(c, g + 2) = z3; x(c, g + 3) = z4
-        acc = acc + ((z1 + z2) + (z3 + z4))
-      end do
+    if (ncol - g < 3) then
+      call rows_out_part(n, ncol, pcol, rinv, cs, y, ldt, xt, g, x, f, acc)
       return
     end if
+    do k = 1, n
+      c = pcol(k); v = rinv(k) * cs(c)
+      z1 = y(1, k) * v; z2 = y(2, k) * v; z3 = y(3, k) * v; z4 = y(4, k) * v
+      xt(g, c) = z1; xt(g + 1, c) = z2; xt(g + 2, c) = z3; xt(g + 3, c) = z4
+      z1 = z1 * f(c, g); z2 = z2 * f(c, g + 1); z3 = z3 * f(c, g + 2); z4 = z4 * f(c, g + 3)
+      x(c, g) = z1; x(c, g + 1) = z2; x(c, g + 2) = z3; x(c, g + 3) = z4
+      acc = acc + ((z1 + z2) + (z3 + z4))
+    end do
+  end subroutine rows_out
+
+  !> rows_out for a last group of fewer than four columns.
+  pure subroutine rows_out_part(n, ncol, pcol, rinv, cs, y, ldt, xt, g, x, f, acc)
+    integer, intent(in) :: n, ncol, pcol(n), ldt, g
+    real(wp), intent(in) :: rinv(n), cs(n), y(4, n), f(n, ncol)
+    real(wp), intent(inout) :: xt(ldt, n), x(n, ncol), acc
+    integer :: k, c, i
+    real(wp) :: v
     do k = 1, n
       c = pcol(k); v = rinv(k) * cs(c)
       xt(g, c) = y(1, k) * v; xt(g + 1, c) = y(2, k) * v
@@ -536,7 +546,7 @@ contains
         acc = acc + x(c, g + i - 1)
       end do
     end do
-  end subroutine rows_out
+  end subroutine rows_out_part
 
   !> Several right-hand sides as the rows of bt (4 k, n) with no column scale: the first
   !! nkeep entries of each solution as a row of xt (ldt, nkeep), written or (add) added.
@@ -604,18 +614,27 @@ contains
     integer, intent(in) :: n, ncol, pcol(n), g
     real(wp), intent(in) :: rinv(n), cs(n), y(4, n), f(n, ncol)
     real(wp), intent(inout) :: x(n, ncol), acc
-    integer :: k, c, i
+    integer :: k, c
     real(wp) :: v, z1, z2, z3, z4
-    if (ncol - g >= 3) then
-      do k = 1, n
-        c = pcol(k); v = rinv(k) * cs(c)
-        z1 = (y(1, k) * v) * f(c, g); z2 = (y(2, k) * v) * f(c, g + 1)
-        z3 = (y(3, k) * v) * f(c, g + 2); z4 = (y(4, k) * v) * f(c, g + 3)
-        x(c, g) = z1; x(c, g + 1) = z2; x(c, g + 2) = z3; x(c, g + 3) = z4
-        acc = acc + ((z1 + z2) + (z3 + z4))
-      end do
+    if (ncol - g < 3) then
+      call cols_out_part(n, ncol, pcol, rinv, cs, y, g, x, f, acc)
       return
     end if
+    do k = 1, n
+      c = pcol(k); v = rinv(k) * cs(c)
+      z1 = (y(1, k) * v) * f(c, g); z2 = (y(2, k) * v) * f(c, g + 1)
+      z3 = (y(3, k) * v) * f(c, g + 2); z4 = (y(4, k) * v) * f(c, g + 3)
+      x(c, g) = z1; x(c, g + 1) = z2; x(c, g + 2) = z3; x(c, g + 3) = z4
+      acc = acc + ((z1 + z2) + (z3 + z4))
+    end do
+  end subroutine cols_out
+
+  !> cols_out for a last group of fewer than four columns.
+  pure subroutine cols_out_part(n, ncol, pcol, rinv, cs, y, g, x, f, acc)
+    integer, intent(in) :: n, ncol, pcol(n), g
+    real(wp), intent(in) :: rinv(n), cs(n), y(4, n), f(n, ncol)
+    real(wp), intent(inout) :: x(n, ncol), acc
+    integer :: k, c, i
     do i = 1, ncol - g + 1
       do k = 1, n
         c = pcol(k)
@@ -623,7 +642,7 @@ contains
         acc = acc + x(c, g + i - 1)
       end do
     end do
-  end subroutine cols_out
+  end subroutine cols_out_part
 
   !> x1 = -A^-1 b1 (a Newton correction from Phi = b1) and x2 = A^-1 b2 in one pass over the
   !! factors (as splu_solve, each x multiplied by the column scale cs).
