@@ -26,6 +26,9 @@
 !!                              contacts and joint frictions too: <joint> is a friction's joint)
 !!   fparams <np>
 !!   <np reals>
+!!   sensitivities <npar>                     (optional: design parameters)
+!!   <name> <table> <index>                   (npar lines; table 1 params, 2 masses,
+!!                              3 gravity, 4 fparams; index 1-based in that list)
 !!   end
 !! The constraint and force columns are the flat tables of mbd_model; tol, maxit, tmin, rtol,
 !! atol, h and max_steps = 0 and rho_inf, alpha, beta = -1 mean the core's defaults.
@@ -45,9 +48,10 @@ module mbd_mbdfile
   use, intrinsic :: iso_fortran_env, only: int64
   implicit none
   private
-  public :: NAME_LEN, MAX_STEPS, mbd_spec_t, mbd_read, ANALYSES
+  public :: NAME_LEN, PNAME_LEN, MAX_STEPS, mbd_spec_t, mbd_read, ANALYSES
 
   integer, parameter :: NAME_LEN = 64             !! longest body or constraint name
+  integer, parameter :: PNAME_LEN = 256           !! longest design parameter name
   integer, parameter :: LINE_LEN = 4096           !! longest line
   integer, parameter :: MAX_STEPS = 1000000000    !! output intervals (as the Python front end)
   integer, parameter :: MAX_ITER = 1000000        !! Newton iterations (as the Python front end)
@@ -98,6 +102,12 @@ module mbd_mbdfile
     real(wp), allocatable :: fpar(:)
     integer :: nlabels = -1               !! row labels given (-1: none)
     character(len=NAME_LEN), allocatable :: labels(:)
+    ! design parameters (sensitivities)
+    integer :: npar = 0
+    character(len=PNAME_LEN), allocatable :: par_names(:)
+    integer, allocatable :: ptab(:, :)    !! (2, npar) table and index (mbd_sensitivity)
+    integer, allocatable :: par_line(:)   !! line of each design parameter
+    integer :: sens_line = 0              !! line of "sensitivities" (0: not given)
   end type mbd_spec_t
 
 contains
@@ -113,7 +123,7 @@ contains
     character(len=LINE_LEN) :: line
     character(len=NAME_LEN) :: key
     character(len=LINE_LEN) :: tok
-    logical :: have_header, done, seen_b, seen_c, seen_p, seen_f, seen_fp, seen_l
+    logical :: have_header, done, seen_b, seen_c, seen_p, seen_f, seen_fp, seen_l, seen_s
     real(wp) :: x
     status = MBD_OK; msg = ''
     ! first pass: the data lines (not blank, not comments) and their characters
@@ -140,11 +150,12 @@ contains
     rewind (u)
     lineno = 0; nread = 0
     have_header = .false.; done = .false.; seen_b = .false.; seen_c = .false.
-    seen_p = .false.; seen_f = .false.; seen_fp = .false.; seen_l = .false.
+    seen_p = .false.; seen_f = .false.; seen_fp = .false.; seen_l = .false.; seen_s = .false.
     allocate (spec%body_names(0), spec%con_names(0), spec%q0(3, 0), stat=ierr)
     if (ierr == 0) allocate (spec%ctab(NCT, 0), spec%con_line(0), spec%rpar(0), stat=ierr)
     if (ierr == 0) allocate (spec%bmass(2, 0), spec%v0(3, 0), spec%force_names(0), &
                              spec%ftab(NFT, 0), spec%fpar(0), spec%labels(0), stat=ierr)
+    if (ierr == 0) allocate (spec%par_names(0), spec%ptab(2, 0), spec%par_line(0), stat=ierr)
     if (ierr /= 0) then
       call mem_fail(zero, 'the model file', 'free some memory', status, msg); close (u); return
     end if
@@ -513,6 +524,12 @@ contains
           end do
           if (status /= MBD_OK) exit
         end do
+      case ('sensitivities')
+        if (seen_s) then
+          call fail('"sensitivities" is given twice'); exit
+        end if
+        seen_s = .true.
+        if (.not. read_sensitivities()) exit
       case ('end')
         if (ntok /= 1) then
           call fail('"end" stands alone'); exit
@@ -662,6 +679,54 @@ contains
       end select
       setting_real = .true.
     end function setting_real
+
+    !> The "sensitivities" block: a count, then NAME TABLE INDEX per design parameter.
+    logical function read_sensitivities()
+      integer :: j, it
+      integer(int64) :: v
+      read_sensitivities = .false.
+      if (.not. count_ok(n, 'sensitivity', 1)) return
+      call mem_check(real(n, wp) * (PNAME_LEN + 12), 'the design parameters', &
+                     'give fewer sensitivities', status, msg)
+      if (status /= MBD_OK) then
+        call where_prefix(); return
+      end if
+      deallocate (spec%par_names, spec%ptab, spec%par_line)
+      allocate (spec%par_names(n), spec%ptab(2, n), spec%par_line(n), stat=ierr)
+      if (ierr /= 0) then
+        call mem_fail(real(n, wp) * (PNAME_LEN + 12), 'the design parameters', &
+                      'give fewer sensitivities', status, msg)
+        call where_prefix(); return
+      end if
+      spec%npar = n; spec%sens_line = lineno; spec%ptab = 0
+      do j = 1, n
+        call next_line(ios)
+        if (ios /= 0) return
+        spec%par_line(j) = lineno
+        if (count_tokens(line) /= 3) then
+          call fail('bad sensitivity line: NAME TABLE INDEX expected'); return
+        end if
+        pos = 1
+        call next_token(line, pos, tok)
+        if (len_trim(tok) > PNAME_LEN) then
+          call fail('a design parameter name is longer than 256 characters'); return
+        end if
+        spec%par_names(j) = tok(1:PNAME_LEN)
+        do it = 1, 2
+          call next_token(line, pos, tok)
+          if (.not. read_int(tok, v)) v = -1
+          if (it == 1 .and. (v < 1 .or. v > 4)) then
+            call fail('"' // trim(tok(1:40)) // '": TABLE is 1 (params), 2 (masses), '// &
+                      '3 (gravity) or 4 (fparams)'); return
+          end if
+          if (it == 2 .and. (v < 1 .or. v > huge(1))) then
+            call fail('"' // trim(tok(1:40)) // '": INDEX is a whole number from 1'); return
+          end if
+          spec%ptab(it, j) = int(v)
+        end do
+      end do
+      read_sensitivities = .true.
+    end function read_sensitivities
 
     !> The numbers of a block (any number per line) into x, exactly size(x) of them.
     logical function read_reals(xs)

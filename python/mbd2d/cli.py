@@ -1,7 +1,7 @@
 """The ``mbd2d`` command line.
 
     mbd2d kinematics MODEL.toml --t-end T --steps N --out OUT.csv|OUT.npz [--every K --solver S
-                     --positions-only]
+                     --positions-only --sensitivities NAME,...]
     mbd2d inverse-dynamics MODEL.toml --t-end T --steps N --out OUT.csv [--every K --solver S]
     mbd2d dynamics MODEL.toml --t-end T --steps N --out OUT.csv [--method M --rtol R --atol A --h H
                    --max-steps S --solver S]
@@ -11,6 +11,7 @@
                 --scheduler ADDRESS --positions-only]
     mbd2d synthesize TASK.toml --out BEST.toml [--starts K --seed S --workers N]
     mbd2d check MODEL.toml
+    mbd2d parameters MODEL.toml [--match TEXT]
     mbd2d export MODEL.toml OUT.mbd [--analysis A] --t-end T --steps N [settings of A]
     mbd2d plot MODEL.toml --t-end T --steps N --out FIG.png
                [--what mechanism|paths|time-series|forces|energy] [--analysis A] [--trace B:X,Y]
@@ -20,6 +21,11 @@ The result commands take optional columns: ``--energy`` (kinetic, potential, tot
 drift), ``--multipliers``, ``--reactions`` and ``--efforts`` (need multipliers: inverse
 dynamics, dynamics, statics, or kinematics of a model with masses; inverse-dynamics writes
 the efforts unless ``--no-efforts``). ``export`` writes them into the file for mbd2d-solve.
+
+``--sensitivities NAME,...`` (kinematics, inverse-dynamics, statics, dynamics by dopri5,
+export) computes the design sensitivities with respect to the named parameters (``mbd2d
+parameters MODEL`` lists them) and adds the columns ``d(COLUMN)/d(NAME)`` to the CSV
+(``dq_dp``, ``dqd_dp``, ``dqdd_dp`` arrays to an .npz).
 
 ``plot`` and ``animate`` run the analysis ``--analysis`` (default ``auto``: kinematics of a
 driven model, with the inverse dynamics when every body has a mass; dynamics otherwise) and
@@ -90,6 +96,32 @@ def _outputs(args: argparse.Namespace) -> dict[str, bool]:
     return {k: bool(getattr(args, k, False)) for k in OUTPUTS if getattr(args, k, False)}
 
 
+def _sensitivities(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--sensitivities", action="append", default=None, metavar="NAME,...",
+                   help="design parameters (`mbd2d parameters MODEL` lists them): adds the "
+                   "columns d(COLUMN)/d(NAME) for each (comma-separated, repeatable)")
+
+
+def _sens_names(args: argparse.Namespace) -> list[str] | None:
+    """The parameter names of --sensitivities (None without it)."""
+    items = getattr(args, "sensitivities", None)
+    if not items:
+        return None
+    names = [n.strip() for item in items for n in item.split(",") if n.strip()]
+    if not names:
+        raise ModelError("--sensitivities names no parameter; give NAME,NAME,... (`mbd2d "
+                         "parameters MODEL` lists them)", "command line")
+    return names
+
+
+def _file_outputs(args: argparse.Namespace) -> dict[str, bool]:
+    """The optional columns of a result file: --energy ... and the sensitivities'."""
+    out = _outputs(args)
+    if _sens_names(args):
+        out["sensitivities"] = True
+    return out
+
+
 def _picture_settings(p: argparse.ArgumentParser) -> None:
     p.add_argument("--analysis", default="auto", choices=ANALYSES,
                    help="auto (default): kinematics of a driven model (with the inverse "
@@ -113,6 +145,7 @@ def _parser() -> argparse.ArgumentParser:
     k.add_argument("--every", type=int, default=1, help="write every k-th row (and the last)")
     k.add_argument("--solver", default="auto", choices=["auto", "dense", "banded"],
                    help="linear solver (default auto: banded LU for large chains)")
+    _sensitivities(k)
     k.add_argument("--positions-only", action="store_true",
                    help="positions alone, no velocities or accelerations (faster: chord steps)")
     _columns(k)
@@ -122,6 +155,7 @@ def _parser() -> argparse.ArgumentParser:
     i.add_argument("--out", required=True, help="output file, .csv or .npz")
     i.add_argument("--tol", type=float, default=None, help="Newton tolerance (default 1e-12)")
     i.add_argument("--every", type=int, default=1, help="write every k-th row (and the last)")
+    _sensitivities(i)
     i.add_argument("--solver", default="auto", choices=["auto", "dense", "banded"],
                    help="linear solver (default auto: banded LU for large chains)")
     _columns(i, efforts=True)
@@ -130,6 +164,7 @@ def _parser() -> argparse.ArgumentParser:
     d.add_argument("--out", required=True, help="output file, .csv or .npz")
     _dynamics_settings(d)
     d.add_argument("--every", type=int, default=1, help="write every k-th row (and the last)")
+    _sensitivities(d)
     d.add_argument("--solver", default="auto", choices=["auto", "dense", "banded"],
                    help="linear algebra (default auto: band LU for large chains)")
     _columns(d)
@@ -140,6 +175,7 @@ def _parser() -> argparse.ArgumentParser:
     s.add_argument("--solver", default="auto", choices=["auto", "dense", "banded"],
                    help="linear algebra (default auto: band LU for large chains)")
     s.add_argument("--out", default=None, help="also write the equilibrium as CSV")
+    _sensitivities(s)
     _columns(s, energy=False)
     w = sub.add_parser("sweep", help="one analysis of many variants (design parameters "
                        "swept): netCDF or CSV")
@@ -164,6 +200,10 @@ def _parser() -> argparse.ArgumentParser:
                    help="local worker processes (default: every core)")
     w.add_argument("--scheduler", default=None, metavar="ADDRESS",
                    help="run on the Dask cluster of this scheduler (tcp://host:8786)")
+    r = sub.add_parser("parameters", help="the design parameters of a model: name = value")
+    r.add_argument("model", help="model file (.toml)")
+    r.add_argument("--match", default=None, metavar="TEXT",
+                   help="only the names that contain TEXT")
     c = sub.add_parser("check", help="degrees of freedom and redundant constraints")
     c.add_argument("model", help="model file (.toml)")
     c.add_argument("--t", type=float, default=0.0, help="time of the check (default 0)")
@@ -181,6 +221,7 @@ def _parser() -> argparse.ArgumentParser:
     e.add_argument("--solver", default="auto", choices=["auto", "dense", "banded"],
                    help="linear solver of kinematic runs (default auto)")
     e.add_argument("--t", type=float, default=0.0, help="statics: time of loads and drivers")
+    _sensitivities(e)
     e.add_argument("--positions-only", action="store_true",
                    help="kinematics: positions alone (no velocities or accelerations)")
     _dynamics_settings(e)
@@ -261,6 +302,24 @@ def _statics_report(model: Model, st: StaticsResult) -> str:
             if b != "ground":
                 lines.append(f"  {c.name:12s} on {b:12s} Fx = {fx[0]: .6g}  Fy = {fy[0]: .6g}  "
                              f"Mz = {mz[0]: .6g}")
+    if st.parameter_names:
+        lines.append("sensitivities of the equilibrium (change per unit of each parameter):")
+    for prm in st.parameter_names:
+        for name in st.body_names:
+            dx, dy, dth = st.sensitivity(name, prm)
+            lines.append(f"  d/d({prm}) {name:16s} x: {dx: .9g}  y: {dy: .9g}  "
+                         f"theta: {dth: .9g}")
+    return "\n".join(lines)
+
+
+def _parameters_report(model: Model, match: str | None) -> str:
+    """The design parameters, one "name = value" line each (those containing match)."""
+    params = model.parameters()
+    lines = [f"{n} = {'(from the q0 estimates)' if v is None else f'{v:.17g}'}"
+             for n, v in params.items() if match is None or match in n]
+    if not lines:
+        raise ModelError(f"no design parameter name contains {match!r}; "
+                         f"{len(params)} parameters in all", "command line")
     return "\n".join(lines)
 
 
@@ -294,17 +353,20 @@ def _run(model: Model, args: argparse.Namespace, analysis: str) -> Any:
     if analysis == "auto":
         neq, nq = model.counts()
         analysis = "kinematics" if neq >= nq else "dynamics"
+    sens = _sens_names(args)
     if analysis == "dynamics":
         return model.dynamics(**span, every=getattr(args, "every", 1), **_dynamics_kwargs(args),
-                              solver=getattr(args, "solver", "auto"))
+                              solver=getattr(args, "solver", "auto"), sensitivities=sens)
     if analysis == "inverse-dynamics":
         return model.inverse_dynamics(**span, tol=getattr(args, "tol", None),
                                       every=getattr(args, "every", 1),
-                                      solver=getattr(args, "solver", "auto"))
+                                      solver=getattr(args, "solver", "auto"),
+                                      sensitivities=sens)
     return model.kinematics(**span, tol=getattr(args, "tol", None),
                             every=getattr(args, "every", 1),
                             solver=getattr(args, "solver", "auto"),
-                            positions_only=getattr(args, "positions_only", False))
+                            positions_only=getattr(args, "positions_only", False),
+                            sensitivities=sens)
 
 
 def _picture(res: Any, args: argparse.Namespace) -> str:
@@ -342,7 +404,7 @@ def _write(res: Any, args: argparse.Namespace) -> str:
     """Write a (possibly partial) result where the command puts it."""
     if args.command in ("plot", "animate"):
         return _picture(res, args)
-    res.save(args.out, **_outputs(args))
+    res.save(args.out, **_file_outputs(args))
     return args.out
 def _param_values(spec: str) -> tuple[str, np.ndarray]:
     """NAME=START:STOP:NUM as the name and NUM values from START to STOP."""
@@ -410,13 +472,16 @@ def main(argv: Sequence[str] | None = None) -> int:
         if args.command == "check":
             print(model.analyze_dof(t=args.t))
             return EXIT_OK
+        if args.command == "parameters":
+            print(_parameters_report(model, args.match))
+            return EXIT_OK
         if args.command == "statics":
-            st = model.statics(t=args.t, solver=args.solver)
+            if args.out is not None and not str(args.out).endswith(".csv"):
+                raise ModelError(f"--out must end in .csv, got {args.out!r}", "command line")
+            st = model.statics(t=args.t, solver=args.solver, sensitivities=_sens_names(args))
             print(_statics_report(model, st))
             if args.out is not None:
-                if not str(args.out).endswith(".csv"):
-                    raise ModelError(f"--out must end in .csv, got {args.out!r}", "command line")
-                st.to_csv(args.out, **_outputs(args))
+                st.to_csv(args.out, **_file_outputs(args))
                 print(f"wrote the equilibrium to {args.out}")
             return EXIT_OK
         if args.command == "export":
@@ -424,7 +489,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             model.export(args.out, t_end=args.t_end, steps=args.steps, t0=args.t0, tol=args.tol,
                          analysis=args.analysis, every=args.every, solver=args.solver, t=args.t,
                          outputs=list(_outputs(args)), positions_only=args.positions_only,
-                         **extra)
+                         sensitivities=_sens_names(args), **extra)
             print(f"wrote {args.out} ({args.analysis}; run it with mbd2d-solve "
                   f"{args.out} OUT.csv)")
             return EXIT_OK

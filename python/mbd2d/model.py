@@ -373,7 +373,8 @@ class Model(ModelDescription):
                atol: float | None = None, h: float | None = None,
                rho_inf: float | None = None, alpha: float | None = None,
                beta: float | None = None, max_steps: int | None = None, t: float = 0.0,
-               outputs: Sequence[str] | None = None, positions_only: bool = False) -> None:
+               outputs: Sequence[str] | None = None, positions_only: bool = False,
+               sensitivities: Sequence[str] | None = None) -> None:
         """Write a plain-text model file that the standalone ``mbd2d-solve`` runs without
         Python (format: docs/mbd-format.md), with the analysis and its settings.
 
@@ -397,6 +398,11 @@ class Model(ModelDescription):
         positions_only : bool, optional
             Kinematics: positions alone, as :meth:`kinematics` (the CSV has t and NAME.x,
             NAME.y, NAME.theta per body).
+        sensitivities : list of str, optional
+            Design parameters (names as :meth:`parameters`): ``mbd2d-solve`` computes the
+            sensitivities as the analysis does with ``sensitivities=[...]`` and writes their
+            columns ``d(COLUMN)/d(NAME)``, as ``res.to_csv(path, sensitivities=True)``
+            (kinematics, inverse dynamics, statics, and dynamics by dopri5).
 
         Raises
         ------
@@ -413,7 +419,8 @@ class Model(ModelDescription):
         export_mbd(self, path, t_end=t_end, steps=steps, t0=t0, tol=tol, maxit=maxit,
                    analysis=analysis, every=every, solver=solver, method=method, rtol=rtol,
                    atol=atol, h=h, rho_inf=rho_inf, alpha=alpha, beta=beta,
-                   max_steps=max_steps, t=t, outputs=outputs, positions_only=positions_only)
+                   max_steps=max_steps, t=t, outputs=outputs, positions_only=positions_only,
+                   sensitivities=sensitivities)
 
 
 def load(path: str | Path) -> Model:

@@ -21,7 +21,7 @@ from .contacts import MAX_EVENTS, check_method, has_events, report_pulls
 from .failures import assembly_failed, bad_entry, inconsistent_at, row_names
 from .outputs import dynamics_result, finite_part
 from .progress import run_core
-from .sensitivities import attach, check_status, requested, table
+from .sensitivities import attach, check_dopri5, check_status, requested, table
 from .settings import (check_memory, check_span, output_rows, output_steps, solver_code,
                        time_grid)
 
@@ -111,10 +111,7 @@ def run_dynamics(model: ModelDescription, t_end: float, steps: int, method: str 
                                                    st.alpha, st.beta)
     check_method(model, method)
     params = requested(model, sensitivities)
-    if params and method != "dopri5":
-        raise ModelError(f"sensitivities are integrated with dopri5 (the variational "
-                         f"equations with the state); method {method!r} has none",
-                         "dynamics")
+    check_dopri5(params, method, "dynamics")
     p = pack(model)
     d = pack_dynamics(model, p)
     npar = len(params) if params else 0

@@ -18,7 +18,7 @@ from ..validate import flag
 from .failures import kinematic_failure, row_names
 from .outputs import finite_part, rows
 from .progress import run_core
-from .sensitivities import attach, check_status, requested, table
+from .sensitivities import attach, check_positions_only, check_status, requested, table
 from .settings import (check_memory, check_solver, check_span, output_rows, output_steps,
                        require_determined, solver_code, time_grid)
 
@@ -35,9 +35,7 @@ def run_kinematics(model: ModelDescription, t_end: float, steps: int, t0: float 
     code = solver_code(solver)
     params = requested(model, sensitivities)
     pos = flag(positions_only, "positions_only", "analysis")
-    if pos and params:
-        raise ModelError("sensitivities need the velocities and accelerations of every "
-                         "step: drop positions_only=True to ask for them", "analysis")
+    check_positions_only(params, pos)
     p = pack(model)
     require_determined(p, model)
     npar = len(params) if params else 0

@@ -25,6 +25,7 @@ from ..errors import ModelError
 from ..results.files import OUTPUTS, write_text
 from ..validate import flag, number
 from .dynamics import dynamics_settings
+from .sensitivities import check_dopri5, check_positions_only, requested, table
 from .settings import (SOLVERS, check_solver, check_span, output_rows, require_determined,
                        solver_code)
 
@@ -112,7 +113,11 @@ def header() -> str:
     ]
     for k, t, d in FORCE_KINDS + ELEMENT_KINDS:
         lines.append(f"#        {k:3d} {t:24s} {d}")
-    lines.append("#   end")
+    lines += [
+        "#   sensitivities NP, then NP lines   NAME TABLE INDEX (optional): design parameters",
+        "#        and their d(COLUMN)/d(NAME) columns; TABLE 1 params, 2 masses (mass, inertia",
+        "#        per body), 3 gravity, 4 fparams; INDEX 1-based in that list",
+        "#   end"]
     return "\n".join(lines)
 
 
@@ -148,7 +153,8 @@ def export(model: ModelDescription, path: str | Path, t_end: float | None = None
            solver: str = "auto", method: str | None = None, rtol: Any = None,
            atol: Any = None, h: Any = None, rho_inf: Any = None, alpha: Any = None,
            beta: Any = None, max_steps: Any = None, t: float = 0.0,
-           outputs: Sequence[str] | None = None, positions_only: Any = False) -> None:
+           outputs: Sequence[str] | None = None, positions_only: Any = False,
+           sensitivities: Sequence[str] | None = None) -> None:
     """Write a model file for ``mbd2d-solve``; see :meth:`mbd2d.Model.export`.
 
     Raises
@@ -164,6 +170,8 @@ def export(model: ModelDescription, path: str | Path, t_end: float | None = None
     if pos and analysis != "kinematics":
         raise ModelError(f"positions_only is a setting of kinematics, not of {analysis}",
                          "export")
+    params = requested(model, sensitivities)
+    check_positions_only(params, pos)
     p = pack(model)
     lines = [header(), f"mbd2d {FORMAT}",
              f"name {model.name.replace(' ', '_') or 'model'}", f"analysis {analysis}"]
@@ -185,6 +193,7 @@ def export(model: ModelDescription, path: str | Path, t_end: float | None = None
                 lines.append("positions_only 1")
     elif analysis == "dynamics":
         st = dynamics_settings(method, rtol, atol, h, rho_inf, alpha, beta, max_steps)
+        check_dopri5(params, st.method, "export")
         lines += [f"method {st.method}", f"rtol {_r(st.rtol)}", f"atol {_r(st.atol)}",
                   f"h {_r(st.h)}", f"rho_inf {_r(st.rho_inf)}", f"alpha {_r(st.alpha)}",
                   f"beta {_r(st.beta)}", f"max_steps {st.max_steps}"]
@@ -214,6 +223,10 @@ def export(model: ModelDescription, path: str | Path, t_end: float | None = None
             col = dyn.ftab[:, k] if dyn.ftab[NFT - 1, k] else dyn.ftab[:NFT - 1, k]
             lines.append(f"{name} " + " ".join(str(int(v)) for v in col))
         lines += _reals("fparams", dyn.fpar)
+    if params:
+        ptab = table(p, params, dyn)
+        lines.append(f"sensitivities {len(params)}")
+        lines += [f"{prm.name} {ptab[0, k]} {ptab[1, k]}" for k, prm in enumerate(params)]
     lines.append("end")
     write_text(path, "\n".join(lines) + "\n", "export")
 

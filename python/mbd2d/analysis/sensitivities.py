@@ -38,6 +38,20 @@ def requested(model: Any, names: Sequence[str] | None) -> list[Parameter] | None
     return params
 
 
+def check_positions_only(params: list[Parameter] | None, positions_only: bool) -> None:
+    """Kinematic sensitivities need every step's velocities and accelerations."""
+    if positions_only and params:
+        raise ModelError("sensitivities need the velocities and accelerations of every "
+                         "step: drop positions_only=True to ask for them", "analysis")
+
+
+def check_dopri5(params: list[Parameter] | None, method: str, what: str) -> None:
+    """Forward dynamics integrates the sensitivities with dopri5 alone."""
+    if params and method != "dopri5":
+        raise ModelError(f"sensitivities are integrated with dopri5 (the variational "
+                         f"equations with the state); method {method!r} has none", what)
+
+
 def table(p: Packed, params: list[Parameter], d: DynamicTables | None = None) -> np.ndarray:
     """The core's parameter table."""
     return parameter_table(p, params, d)

@@ -10,6 +10,7 @@ import numpy as np
 
 from .contacts import (ContactEvent, ContactHistory, FrictionEvent, FrictionHistory, LiftOff,
                        history)
+from .columns import REACTION_WORDS, constraint_columns, derivative_names
 from .files import check_outputs, writing
 from .kinematics import KinematicsResult
 from .reactions import Reaction, reaction_arrays, reaction_of
@@ -18,8 +19,6 @@ from .sensitivities import parameter_index, reaction_dp_arrays, reaction_dp_of
 
 #: columns of ``energy=True`` in a table
 ENERGY_COLUMNS = ("kinetic", "potential", "energy", "drift_position", "drift_velocity")
-#: the reaction columns of a constraint, NAME.WORD (the Reaction attributes)
-REACTION_WORDS = ("fx", "fy", "mz", "fx_j", "fy_j", "mz_j")
 
 
 @dataclass(repr=False)
@@ -125,10 +124,14 @@ class DynamicsResult(KinematicsResult):
         if self.dlam_dp is None or self.dq_dp is None:
             raise KeyError("this result has no reaction sensitivities: run inverse dynamics "
                            "with sensitivities=[names]")
+        return reaction_dp_of(self.packed, self.model, name, *self._reaction_dp_arrays())
+
+    def _reaction_dp_arrays(self) -> tuple[np.ndarray, np.ndarray]:
+        """The reactions' sensitivities (n, nc, 6, n_params), global and local (cached)."""
         if self._reac_dp is None:
             self._reac_dp = reaction_dp_arrays(self.packed, self.ptab, self.q, self.t,
                                                self.lam, self.dq_dp, self.dlam_dp)
-        return reaction_dp_of(self.packed, self.model, name, *self._reac_dp)
+        return self._reac_dp
 
     def multiplier_dp(self, row: str, name: str) -> np.ndarray:
         """d lambda / d p of a row (by its label) for one parameter, over time."""
@@ -172,7 +175,8 @@ class DynamicsResult(KinematicsResult):
         return history(self.elements, self.element_names, name, "friction")
 
     def table(self, energy: bool = False, multipliers: bool = False, reactions: bool = False,
-              efforts: bool = False, **unknown: bool) -> tuple[list[str], np.ndarray]:
+              efforts: bool = False, sensitivities: bool = False, **unknown: bool
+              ) -> tuple[list[str], np.ndarray]:
         """Header and rows of the CSV: the motion columns of
         :meth:`KinematicsResult.table`, then the optional columns asked for, in this order:
 
@@ -188,6 +192,11 @@ class DynamicsResult(KinematicsResult):
         NAME.penetration, NAME.sliding_speed, and for each joint with friction
         NAME.normal_load, NAME.friction_force, NAME.sliding_speed.
 
+        With ``sensitivities=True`` (a run with ``sensitivities=[names]``) then, for each
+        parameter P in turn, ``d(COLUMN)/d(P)`` of the motion columns and, when the run has
+        the multipliers' sensitivities (inverse dynamics), of the multiplier, reaction and
+        effort columns asked for.
+
         ``mbd2d-solve`` writes the same columns for an exported file (``outputs``).
         """
         check_outputs(unknown, (), "table")
@@ -197,20 +206,11 @@ class DynamicsResult(KinematicsResult):
             header += list(ENERGY_COLUMNS)
             blocks.append(np.column_stack([self.kinetic, self.potential, self.energy,
                                            self.drift_position, self.drift_velocity]))
-        if multipliers:
-            header += [f"lambda.{r}" for r in self.row_labels]
-            blocks.append(self.lam)
-        if reactions:
-            g, _ = self._reactions()
-            for k, name in enumerate(self.packed.constraint_names):
-                header += [f"{name}.{w}" for w in REACTION_WORDS]
-                blocks.append(g[:, k, :])
-        if efforts:
-            names = self.packed.constraint_names
-            for k, name in enumerate(names):
-                if self.packed.driver_flags[k]:
-                    header.append(f"{name}.effort")
-                    blocks.append(self.effort(name)[:, None])
+        names, cols = self._constraint_columns(self.lam,
+                                               self._reactions()[0] if reactions else None,
+                                               multipliers, efforts)
+        header += names
+        blocks += cols
         for k, (name, what) in enumerate(self.element_names):
             if what == "contact":
                 words, idx = ("normal_force", "friction_force", "penetration",
@@ -221,16 +221,50 @@ class DynamicsResult(KinematicsResult):
                 continue
             header += [f"{name}.{w}" for w in words]
             blocks.append(np.column_stack([self.elements[:, k, i] for i in idx]))
+        if sensitivities:
+            names, cols = self._derivative_columns(multipliers, reactions, efforts)
+            header += names
+            blocks += cols
         return header, np.hstack(blocks)
 
+    def _constraint_columns(self, lam: np.ndarray, reac: np.ndarray | None, multipliers: bool,
+                            efforts: bool) -> tuple[list[str], list[np.ndarray]]:
+        p = self.packed
+        return constraint_columns(p.constraint_names, p.driver_flags, p.row_owner,
+                                  self.row_labels, lam, reac, multipliers, efforts)
+
+    def _derivative_columns(self, multipliers: bool, reactions: bool, efforts: bool
+                            ) -> tuple[list[str], list[np.ndarray]]:
+        """The sensitivity columns, parameter after parameter: the motion's, then (with
+        the multipliers' sensitivities) those of the multiplier, reaction and effort
+        columns asked for."""
+        lam_columns = self.dlam_dp is not None and (multipliers or reactions or efforts)
+        if not lam_columns:
+            return self._motion_derivatives("table")
+        dreac = self._reaction_dp_arrays()[0] if reactions else None
+        names: list[str] = []
+        blocks: list[np.ndarray] = []
+        for k, prm in enumerate(self.parameter_names):
+            mn, mb = self._motion_derivative(k, "table")
+            cn, cb = self._constraint_columns(self.dlam_dp[:, :, k],
+                                              None if dreac is None else dreac[..., k],
+                                              multipliers, efforts)
+            names += mn + derivative_names(cn, prm)
+            blocks += [mb] + cb
+        return names, blocks
+
     def to_npz(self, path: str | Path, reactions: bool = False, efforts: bool = False,
-               **always: bool) -> None:
+               sensitivities: bool = False, **always: bool) -> None:
         """t, q, qd, qdd, the multipliers and energies, the force elements' outputs, and
         the names; with
         ``reactions=True`` also ``reactions`` (n, nc, 6: as the table's reaction columns)
-        and with ``efforts=True`` ``efforts`` (n, n_drivers)."""
+        and with ``efforts=True`` ``efforts`` (n, n_drivers); after a run with
+        ``sensitivities=[names]`` also ``dq_dp``, ``dqd_dp``, ``dqdd_dp``,
+        ``parameter_names`` and (inverse dynamics) ``dlam_dp`` (n, neq, n_params)."""
         check_outputs(always, ("energy", "multipliers"), "to_npz")
-        extra: dict[str, np.ndarray] = {}
+        extra = self._sensitivity_arrays(sensitivities, "to_npz")
+        if self.dlam_dp is not None:
+            extra["dlam_dp"] = self.dlam_dp
         if reactions:
             extra["reactions"] = self._reactions()[0]
         if efforts:

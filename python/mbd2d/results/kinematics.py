@@ -12,6 +12,7 @@ from .. import plots
 from ..errors import MbdError
 from ..validate import vector
 from . import measures
+from .columns import SUFFIXES, derivative_names, motion_columns, require_sensitivities
 from .files import check_outputs, write_csv, writing
 from .points import PointResult
 from .sensitivities import LEVELS, body_columns, parameter_index
@@ -24,9 +25,6 @@ def repr_png(obj: Any) -> bytes | None:
         return plots.png_bytes(obj)
     except (ImportError, MbdError, ValueError):
         return None
-
-
-SUFFIXES = ("x", "y", "theta", "x_dot", "y_dot", "theta_dot", "x_ddot", "y_ddot", "theta_ddot")
 
 
 @dataclass
@@ -313,26 +311,58 @@ class KinematicsResult:
         """The mechanism picture, for Jupyter (None when it cannot be drawn)."""
         return repr_png(self)
 
-    def table(self, **outputs: bool) -> tuple[list[str], np.ndarray]:
+    def table(self, sensitivities: bool = False, **outputs: bool
+              ) -> tuple[list[str], np.ndarray]:
         """Header and rows of the CSV: t, then NAME.x ... NAME.theta_ddot per body (NAME.x,
-        NAME.y, NAME.theta after a ``positions_only`` run).
+        NAME.y, NAME.theta after a ``positions_only`` run); with ``sensitivities=True`` (a
+        run with ``sensitivities=[names]``), then for each parameter P in turn the
+        derivatives of those columns, ``d(NAME.x)/d(P)`` ... ``d(NAME.theta_ddot)/d(P)``.
 
         A kinematic result has no optional columns (``energy``, ``multipliers``,
         ``reactions``, ``efforts`` need a DynamicsResult): asking for one is a ModelError.
         """
         check_outputs(outputs, (), "table")
-        return self._motion_table()
+        header, rows = self._motion_table()
+        if not sensitivities:
+            return header, rows
+        names, blocks = self._motion_derivatives("table")
+        return header + names, np.hstack([rows] + blocks)
+
+    def _levels(self) -> list[np.ndarray]:
+        return [a for a in (self.q, self.qd, self.qdd) if a is not None]
 
     def _motion_table(self) -> tuple[list[str], np.ndarray]:
-        levels = [a for a in (self.q, self.qd, self.qdd) if a is not None]
-        suffixes = SUFFIXES[:3 * len(levels)]
-        header = ["t"] + [f"{b}.{s}" for b in self.body_names for s in suffixes]
-        nb = len(self.body_names)
-        blocks = [self.t[:, None]]
-        for i in range(nb):
-            c = slice(3 * i, 3 * i + 3)
-            blocks += [a[:, c] for a in levels]
-        return header, np.hstack(blocks)
+        names, cols = motion_columns(self.body_names, self._levels())
+        return ["t"] + names, np.hstack([self.t[:, None], cols])
+
+    def _motion_derivative(self, k: int, what: str) -> tuple[list[str], np.ndarray]:
+        """The sensitivity columns of the motion for parameter k: d(NAME.x)/d(P) ..."""
+        require_sensitivities(self.dq_dp is not None, what)
+        levels = [a[:, :, k] for a in (self.dq_dp, self.dqd_dp, self.dqdd_dp) if a is not None]
+        cols, block = motion_columns(self.body_names, levels)
+        return derivative_names(cols, self.parameter_names[k]), block
+
+    def _motion_derivatives(self, what: str) -> tuple[list[str], list[np.ndarray]]:
+        """The sensitivity columns of the motion, parameter after parameter."""
+        require_sensitivities(self.dq_dp is not None, what)
+        names: list[str] = []
+        blocks: list[np.ndarray] = []
+        for k in range(len(self.parameter_names)):
+            n, b = self._motion_derivative(k, what)
+            names += n
+            blocks.append(b)
+        return names, blocks
+
+    def _sensitivity_arrays(self, sensitivities: bool, what: str) -> dict[str, np.ndarray]:
+        """The sensitivities for an .npz (always when the run has them)."""
+        if sensitivities:
+            require_sensitivities(self.dq_dp is not None, what)
+        if self.dq_dp is None:
+            return {}
+        out = {k: v for k, v in (("dq_dp", self.dq_dp), ("dqd_dp", self.dqd_dp),
+                                 ("dqdd_dp", self.dqdd_dp)) if v is not None}
+        out["parameter_names"] = np.array(self.parameter_names)
+        return out
 
     def to_csv(self, path: str | Path, **outputs: bool) -> None:
         """Write the CSV (the columns of :meth:`table`; every number with 17 significant
@@ -340,15 +370,17 @@ class KinematicsResult:
         header, rows = self.table(**outputs)
         write_csv(path, header, rows, "to_csv")
 
-    def to_npz(self, path: str | Path, **outputs: bool) -> None:
+    def to_npz(self, path: str | Path, sensitivities: bool = False, **outputs: bool) -> None:
         """Write t, q, qd, qdd (q alone after a ``positions_only`` run) and the names to a
-        NumPy .npz archive."""
+        NumPy .npz archive; after a run with ``sensitivities=[names]`` also ``dq_dp``,
+        ``dqd_dp``, ``dqdd_dp`` (n, n_coordinates, n_params) and ``parameter_names``."""
         check_outputs(outputs, (), "to_npz")
         motion = {k: v for k, v in (("q", self.q), ("qd", self.qd), ("qdd", self.qdd))
                   if v is not None}
+        sens = self._sensitivity_arrays(sensitivities, "to_npz")
         with writing(path, "to_npz") as p:
             np.savez(p, t=self.t, **motion, coordinate_names=np.array(self.coordinate_names),
-                     body_names=np.array(self.body_names))
+                     body_names=np.array(self.body_names), **sens)
 
     def save(self, path: str | Path, **outputs: bool) -> None:
         """Write .csv or .npz by the file suffix (optional columns as :meth:`table`)."""

@@ -7,7 +7,7 @@ from typing import Any
 import numpy as np
 
 from .. import plots
-from .dynamics import REACTION_WORDS
+from .columns import constraint_columns, derivative_names, require_sensitivities
 from .files import check_outputs, write_csv
 from .kinematics import repr_png
 from .reactions import Reaction, reaction_arrays, reaction_of
@@ -79,39 +79,68 @@ class StaticsResult:
         if self.dq_dp is None or self.dlam_dp is None:
             raise KeyError("this result has no sensitivities: run statics with "
                            "sensitivities=[names]")
-        g, loc = reaction_dp_arrays(self.packed, self.ptab, self.q[None, :],
-                                    np.array([self.t]), self.lam[None, :], self.dq_dp[None],
-                                    self.dlam_dp[None])
-        return reaction_dp_of(self.packed, self.model, name, g, loc)
+        return reaction_dp_of(self.packed, self.model, name, *self._reaction_dp_arrays())
+
+    def _reaction_dp_arrays(self) -> tuple[np.ndarray, np.ndarray]:
+        """The reactions' sensitivities (1, nc, 6, n_params), global and local."""
+        assert self.dq_dp is not None and self.dlam_dp is not None
+        return reaction_dp_arrays(self.packed, self.ptab, self.q[None, :], np.array([self.t]),
+                                  self.lam[None, :], self.dq_dp[None], self.dlam_dp[None])
 
     def table(self, multipliers: bool = False, reactions: bool = False, efforts: bool = False,
-              **unknown: bool) -> tuple[list[str], np.ndarray]:
+              sensitivities: bool = False, **unknown: bool) -> tuple[list[str], np.ndarray]:
         """Header and the one row of the CSV: t, NAME.x, NAME.y, NAME.theta per body,
         ``stable`` (1 stable, 0 unstable, -1 neutral, 2 fully constrained), ``residual``,
         then optional columns as :meth:`DynamicsResult.table` (``multipliers``,
-        ``reactions``, ``efforts``; ``mbd2d-solve`` writes the same)."""
+        ``reactions``, ``efforts``; ``mbd2d-solve`` writes the same); with
+        ``sensitivities=True`` (statics with ``sensitivities=[names]``) then, for each
+        parameter P in turn, ``d(COLUMN)/d(P)`` of the body columns and of the optional
+        columns asked for."""
         check_outputs(unknown, (), "table")
         nb = len(self.body_names)
-        header = ["t"] + [f"{b}.{s}" for b in self.body_names for s in ("x", "y", "theta")]
+        header = ["t"] + self._body_columns()
         header += ["stable", "residual"]
-        row = [self.t, *self.q[:3 * nb], STABILITY_CODES.get(self.stability, 0), self.residual]
-        if multipliers:
-            header += [f"lambda.{r}" for r in self.row_labels]
-            row += list(self.lam)
-        if reactions or efforts:
-            g, _ = reaction_arrays(self.packed, self.q[None, :], np.array([self.t]),
-                                   self.lam[None, :])
-        names = self.packed.constraint_names
+        row = [np.array([self.t, *self.q[:3 * nb], STABILITY_CODES.get(self.stability, 0),
+                         self.residual])]
+        reac = None
         if reactions:
-            for k, name in enumerate(names):
-                header += [f"{name}.{w}" for w in REACTION_WORDS]
-                row += list(g[0, k, :])
-        if efforts:
-            for k, name in enumerate(names):
-                if self.packed.driver_flags[k]:
-                    header.append(f"{name}.effort")
-                    row.append(-self.lam[self.packed.row_owner.index(k)])
-        return header, np.array([row], dtype=float)
+            reac, _ = reaction_arrays(self.packed, self.q[None, :], np.array([self.t]),
+                                      self.lam[None, :])
+        names, blocks = self._constraint_columns(self.lam, reac, multipliers, efforts)
+        header += names
+        row += [b[0] for b in blocks]
+        if sensitivities:
+            names, values = self._derivative_columns(multipliers, reactions, efforts)
+            header += names
+            row += values
+        return header, np.concatenate(row)[None, :].astype(float)
+
+    def _body_columns(self) -> list[str]:
+        return [f"{b}.{s}" for b in self.body_names for s in ("x", "y", "theta")]
+
+    def _constraint_columns(self, lam: np.ndarray, reac: np.ndarray | None, multipliers: bool,
+                            efforts: bool) -> tuple[list[str], list[np.ndarray]]:
+        p = self.packed
+        return constraint_columns(p.constraint_names, p.driver_flags, p.row_owner,
+                                  self.row_labels, lam[None, :], reac, multipliers, efforts)
+
+    def _derivative_columns(self, multipliers: bool, reactions: bool, efforts: bool
+                            ) -> tuple[list[str], list[np.ndarray]]:
+        """d(COLUMN)/d(P) of the body columns and the optional columns, parameter after
+        parameter (names, and one row of values per parameter)."""
+        require_sensitivities(self.dq_dp is not None and self.dlam_dp is not None, "table")
+        assert self.dq_dp is not None and self.dlam_dp is not None
+        dreac = self._reaction_dp_arrays()[0] if reactions else None
+        nb = len(self.body_names)
+        names: list[str] = []
+        values: list[np.ndarray] = []
+        for k, prm in enumerate(self.parameter_names):
+            cn, cb = self._constraint_columns(self.dlam_dp[:, k],
+                                              None if dreac is None else dreac[..., k],
+                                              multipliers, efforts)
+            names += derivative_names(self._body_columns() + cn, prm)
+            values += [self.dq_dp[:3 * nb, k]] + [b[0] for b in cb]
+        return names, values
 
     def to_csv(self, path: Any, **outputs: bool) -> None:
         """Write the table (:meth:`table`) as CSV, numbers as every mbd2d CSV."""
