@@ -9,6 +9,9 @@
     mbd2d sweep MODEL.toml --param NAME=START:STOP:NUM ... [--grid] --t-end T --steps N
                 --out sweep.nc|sweep.csv [--analysis A --t0 T0 --every K --workers W
                 --scheduler ADDRESS --positions-only]
+    mbd2d tolerance MODEL.toml --sigma NAME=STD ... --t-end T --steps N --out tol.csv|tol.nc
+                    [--samples N --seed S --analysis A --point BODY:X,Y --workers W
+                    --scheduler ADDRESS]
     mbd2d synthesize TASK.toml --out BEST.toml [--starts K --seed S --workers N]
     mbd2d check MODEL.toml
     mbd2d parameters MODEL.toml [--match TEXT]
@@ -204,6 +207,7 @@ def _parser() -> argparse.ArgumentParser:
     r.add_argument("model", help="model file (.toml)")
     r.add_argument("--match", default=None, metavar="TEXT",
                    help="only the names that contain TEXT")
+    _tolerance_parser(sub)
     c = sub.add_parser("check", help="degrees of freedom and redundant constraints")
     c.add_argument("model", help="model file (.toml)")
     c.add_argument("--t", type=float, default=0.0, help="time of the check (default 0)")
@@ -309,6 +313,98 @@ def _statics_report(model: Model, st: StaticsResult) -> str:
             dx, dy, dth = st.sensitivity(name, prm)
             lines.append(f"  d/d({prm}) {name:16s} x: {dx: .9g}  y: {dy: .9g}  "
                          f"theta: {dth: .9g}")
+    return "\n".join(lines)
+
+
+def _tolerance_parser(sub: Any) -> None:
+    t = sub.add_parser("tolerance", help="scatter of every output under parameter "
+                       "tolerances: first order (exact sensitivities) beside Monte Carlo")
+    t.add_argument("model", help="model file (.toml)")
+    t.add_argument("--sigma", action="append", required=True, metavar="NAME=STD",
+                   help="a design parameter and its standard deviation (repeatable)")
+    t.add_argument("--samples", type=int, default=200,
+                   help="Monte Carlo variants (default 200; 0: first order alone)")
+    t.add_argument("--seed", type=int, default=0, help="seed of the draws (default 0)")
+    t.add_argument("--analysis", default="kinematics",
+                   choices=["kinematics", "inverse_dynamics", "statics", "dynamics"],
+                   help="the analysis (default kinematics; dynamics by dopri5)")
+    t.add_argument("--t-end", type=float, default=None, help="final time")
+    t.add_argument("--steps", type=int, default=None, help="output intervals")
+    t.add_argument("--t0", type=float, default=0.0, help="start time (statics: its time)")
+    t.add_argument("--every", type=int, default=1, help="keep every k-th row (and the last)")
+    t.add_argument("--point", action="append", default=None, metavar="BODY:X,Y",
+                   help="also the scatter of the point (X, Y) of BODY (repeatable)")
+    t.add_argument("--out", required=True, help="output file, .csv (one row per time) or "
+                   ".nc (netCDF)")
+    t.add_argument("--workers", type=int, default=None,
+                   help="local processes for the Monte Carlo sweep (default: all cores)")
+    t.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                   help="run the Monte Carlo sweep on the Dask scheduler at ADDRESS")
+
+
+def _sigma(spec: str) -> tuple[str, float]:
+    """NAME=STD as the name and the standard deviation."""
+    name, eq, value = spec.partition("=")
+    try:
+        if not eq or not name.strip():
+            raise ValueError
+        std = float(value)
+    except ValueError:
+        raise ModelError(f"--sigma {spec!r}: write NAME=STD, for example "
+                         "joint.B.points.0.0=1e-4", "command line") from None
+    return name.strip(), std
+
+
+def _tolerance(model: Model, args: argparse.Namespace) -> int:
+    """The tolerance command: run, write, summarize."""
+    from .studies import connect, tolerance, write_tolerance
+    if not str(args.out).endswith((".nc", ".csv")):
+        raise ModelError(f"--out must end in .nc or .csv, got {args.out!r}", "command line")
+    sigma = dict(_sigma(s) for s in args.sigma)
+    points = _trace(args.point) or []
+    if args.analysis == "statics":
+        kw: dict = {"t": args.t0}
+    else:
+        if args.t_end is None or args.steps is None:
+            raise ModelError(f"{args.analysis} needs --t-end and --steps", "command line")
+        kw = {"t_end": args.t_end, "steps": args.steps, "t0": args.t0, "every": args.every}
+    client = connect(args.scheduler) if args.scheduler else None
+    try:
+        tol = tolerance(model, sigma, args.analysis, samples=args.samples, client=client,
+                        seed=args.seed, workers=args.workers, **kw)
+    finally:
+        if client is not None:
+            client.close()
+    pts = [(f"{b}({x:g};{y:g})", tol.point(b, (x, y))) for b, (x, y) in points]
+    write_tolerance(tol.dataset, args.out, pts)
+    print(_tolerance_report(tol, pts))
+    print(f"wrote {args.out}")
+    return EXIT_OK
+
+
+def _tolerance_report(tol: Any, points: list[tuple[str, Any]]) -> str:
+    """The largest first-order standard deviations of the positions (and points), with the
+    Monte Carlo estimate beside them."""
+    ds = tol.dataset
+    a = ds.attrs
+    lines = [f"tolerance of '{a['model']}' ({a['run']}; {a['samples']} samples, {a['failed']} "
+             f"failed): {a['sigma']}",
+             "largest first-order standard deviation over the run (Monte Carlo at the same "
+             "time):"]
+    rows = []
+    for j, name in enumerate(str(c) for c in ds.coordinate.values):
+        rows.append((name, ds.q_std_linear.values[:, j],
+                     ds.q_std_mc.values[:, j] if "q_std_mc" in ds else None))
+    for label, pt in points:
+        for v in ("x", "y"):
+            rows.append((f"{label}.{v}", pt[f"{v}_std_linear"].values,
+                         pt[f"{v}_std_mc"].values))
+    rows.sort(key=lambda r: -float(np.nanmax(r[1])))
+    t = np.atleast_1d(ds.time.values)
+    for name, lin, mc in rows[:8]:
+        k = int(np.nanargmax(lin))
+        beside = "" if mc is None else f"  (Monte Carlo {mc[k]:.3g})"
+        lines.append(f"  {name:24s} {lin[k]:.3g} at t = {t[k]:.6g}{beside}")
     return "\n".join(lines)
 
 
@@ -495,6 +591,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             return EXIT_OK
         if args.command == "sweep":
             return _sweep(model, args)
+        if args.command == "tolerance":
+            return _tolerance(model, args)
         _check_out(args)
         _trace(getattr(args, "trace", None))       # a malformed --trace fails before the run
         res = _run(model, args, getattr(args, "analysis", args.command))

@@ -7,11 +7,11 @@ they are imported here only, when a study runs.
 """
 from __future__ import annotations
 
-from .files import write_sweep
+from .files import tolerance_table, write_sweep, write_tolerance
 from .plan import ANALYSES, grid
 from .runner import connect
 from .sweep import sweep
 from .tolerance import ToleranceResult, tolerance
 
-__all__ = ["sweep", "grid", "tolerance", "ToleranceResult", "write_sweep", "connect",
-           "ANALYSES"]
+__all__ = ["sweep", "grid", "tolerance", "ToleranceResult", "write_sweep", "write_tolerance",
+           "tolerance_table", "connect", "ANALYSES"]

@@ -1,14 +1,16 @@
-"""Sweep files: netCDF (through xarray) or CSV, one row per case and time."""
+"""Study files: a sweep as netCDF (through xarray) or CSV, one row per case and time; a
+tolerance analysis as netCDF or CSV, one row per time."""
 from __future__ import annotations
 
 import csv
 import math
 from pathlib import Path
-from typing import Any
+from typing import Any, Sequence
 
 import numpy as np
 
 from ..errors import ModelError
+from ..results.files import write_csv
 from .dataset import EXTRA
 
 SUFFIXES = (".nc", ".csv")
@@ -94,4 +96,68 @@ def _g(v: Any) -> str:
     return "" if math.isnan(x) else format(x, ".17g")
 
 
-__all__ = ["write_sweep"]
+#: the column names of a tolerance output's entries, from its coordinate's labels
+_ENTRY = {"q": "{}", "qd": "{}_dot", "qdd": "{}_ddot", "lam": "lambda.{}", "effort": "{}.effort"}
+#: the statistics of a tolerance output, as column suffixes
+_STATS = (("", ""), ("_std_linear", ".std_linear"), ("_std_mc", ".std_mc"),
+          ("_mean_mc", ".mean_mc"))
+
+
+def tolerance_table(ds: Any, points: Sequence[tuple[str, Any]] = ()
+                    ) -> tuple[list[str], np.ndarray]:
+    """A tolerance analysis (:attr:`ToleranceResult.dataset`) and point scatters
+    (``(label, ToleranceResult.point(...))``) as one row per output time: ``t``, then for
+    each output (q, qd, qdd, lam, effort) and entry its nominal value ``NAME``, first-order
+    standard deviation ``NAME.std_linear`` and, with Monte Carlo samples, ``NAME.std_mc``
+    and ``NAME.mean_mc`` (NAME: ``crank.x``, ``crank.x_dot``, ``crank.x_ddot``,
+    ``lambda.LABEL``, ``DRIVER.effort``); then per point ``LABEL.x``, ``LABEL.y`` with
+    their ``.std_linear`` and ``.std_mc``."""
+    header = ["t"]
+    blocks = [np.atleast_1d(ds.time.values)[:, None]]
+    for out, fmt in _ENTRY.items():
+        if out not in ds:
+            continue
+        labels = [str(v) for v in ds[ds[out].dims[1]].values]
+        for suffix, word in _STATS:
+            if f"{out}{suffix}" in ds:
+                header += [fmt.format(lb) + word for lb in labels]
+                blocks.append(np.asarray(ds[f"{out}{suffix}"].values))
+    for label, pt in points:
+        for v in ("x", "y", "x_std_linear", "y_std_linear", "x_std_mc", "y_std_mc"):
+            header.append(f"{label}.{v.replace('_std', '.std')}")
+            blocks.append(np.asarray(pt[v].values)[:, None])
+    return header, np.hstack(blocks)
+
+
+def write_tolerance(ds: Any, path: str | Path, points: Sequence[tuple[str, Any]] = ()
+                    ) -> None:
+    """Write a tolerance analysis: ``.csv`` as :func:`tolerance_table` (numbers as every
+    mbd2d CSV, ``%.16e``), ``.nc`` as netCDF-4 with the point scatters as variables
+    ``point1_x``, ``point1_x_std_linear``, ... (attributes ``point1`` ... name them).
+
+    Raises
+    ------
+    ModelError
+        For another suffix or a file that cannot be written.
+    """
+    p = Path(path)
+    if p.suffix not in SUFFIXES:
+        raise ModelError(f"a tolerance analysis is written as .nc (netCDF) or .csv, got "
+                         f"{str(path)!r}", "write_tolerance")
+    if p.suffix == ".csv":
+        header, rows = tolerance_table(ds, points)
+        write_csv(p, header, rows, "write_tolerance")
+        return
+    out = ds.copy()
+    for k, (label, pt) in enumerate(points, start=1):
+        for v in pt.data_vars:
+            out[f"point{k}_{v}"] = pt[v]
+        out.attrs[f"point{k}"] = label
+    try:
+        out.to_netcdf(p, engine=_netcdf_engine())
+    except OSError as exc:
+        raise ModelError(f"cannot write {str(path)!r}: {exc.strerror or exc}",
+                         "write_tolerance") from None
+
+
+__all__ = ["write_sweep", "write_tolerance", "tolerance_table"]

@@ -1,0 +1,128 @@
+"""`mbd2d tolerance`: the tolerance analysis from the command line, one row per time in a CSV
+(or a netCDF file), a summary on the terminal.
+
+Oracle of the first-order columns: |dq/dp| sigma with dq/dp from central differences of
+runs of ``model.with_params`` (no sensitivity code); of a point's: the same for the point
+P = r + A(theta) s' computed here from those runs. The Monte Carlo columns are the API's
+sweep (same seed), already checked against the first order in tests/test_tolerance.py.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import mbd2d
+from mbd2d.cli import main
+from mbd2d.results import read_csv
+
+pytest.importorskip("xarray")
+
+ROOT = Path(__file__).resolve().parents[1]
+EX = ROOT / "examples"
+FOURBAR = str(EX / "fourbar_grashof.toml")
+PRM, SIG = "joint.B.points.0.0", 2e-3
+
+
+def _fd_q(model: mbd2d.Model, prm: str, **kw) -> tuple[np.ndarray, np.ndarray]:
+    """q and dq/dp by central differences (at the tightest Newton tolerance)."""
+    v = model.parameters()[prm]
+    dp = 1e-5 * max(1.0, abs(v))
+    run = lambda m: m.kinematics(tol=1e-15, **kw).q  # noqa: E731
+    return run(model), (run(model.with_params({prm: v + dp}))
+                        - run(model.with_params({prm: v - dp}))) / (2 * dp)
+
+
+def test_csv_first_order_columns_are_differences_times_sigma(tmp_path: Path, capsys) -> None:
+    out = tmp_path / "tol.csv"
+    assert main(["tolerance", FOURBAR, "--sigma", f"{PRM}={SIG}", "--samples", "40",
+                 "--workers", "1", "--t-end", "1", "--steps", "20", "--point", "coupler:0,1",
+                 "--out", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert "largest first-order standard deviation" in text and f"wrote {out}" in text
+    header, rows = read_csv(out)
+    model = mbd2d.load(FOURBAR)
+    _, dq = _fd_q(model, PRM, t_end=1.0, steps=20)
+    q = model.kinematics(1.0, 20).q                   # the nominal run, as the command's
+    names = [str(c) for c in model.kinematics(1.0, 1).coordinate_names]
+    np.testing.assert_allclose(rows[:, 0], np.linspace(0, 1, 21), rtol=0, atol=1e-15)
+    for j, c in enumerate(names):
+        np.testing.assert_array_equal(rows[:, header.index(c)], q[:, j])
+        lin = rows[:, header.index(f"{c}.std_linear")]
+        np.testing.assert_allclose(lin, np.abs(dq[:, j]) * SIG, rtol=1e-6,
+                                   atol=1e-9 * SIG, err_msg=c)
+    # the point (0, 1) of the coupler: P = r + A(theta) s'
+    i = 3 * [n.split(".")[0] for n in names[::3]].index("coupler")
+
+    def point(qq: np.ndarray) -> np.ndarray:
+        th = qq[:, i + 2]
+        return np.column_stack([qq[:, i] - np.sin(th), qq[:, i + 1] + np.cos(th)])
+    v = model.parameters()[PRM]
+    dp = 1e-5 * max(1.0, abs(v))
+    runs = [model.with_params({PRM: v + s * dp}).kinematics(1.0, 20, tol=1e-15).q
+            for s in (1, -1)]
+    dpt = (point(runs[0]) - point(runs[1])) / (2 * dp)
+    for k, xy in enumerate("xy"):
+        np.testing.assert_allclose(rows[:, header.index(f"coupler(0;1).{xy}.std_linear")],
+                                   np.abs(dpt[:, k]) * SIG, rtol=1e-6, atol=1e-9 * SIG)
+    # the Monte Carlo columns are the API's (same seed, same draws)
+    tol = mbd2d.tolerance(model, {PRM: SIG}, samples=40, workers=1, t_end=1.0, steps=20)
+    for j, c in enumerate(names):
+        np.testing.assert_array_equal(rows[:, header.index(f"{c}.std_mc")],
+                                      tol.dataset.q_std_mc.values[:, j])
+        np.testing.assert_array_equal(rows[:, header.index(f"{c}_ddot.mean_mc")],
+                                      tol.dataset.qdd_mean_mc.values[:, j])
+
+
+def test_netcdf_and_statics(tmp_path: Path, capsys) -> None:
+    """A .nc file holds the dataset and the points (point1_x ...); statics gives one row."""
+    xr = pytest.importorskip("xarray")
+    pytest.importorskip("h5netcdf")
+    out = tmp_path / "tol.nc"
+    assert main(["tolerance", FOURBAR, "--sigma", f"{PRM}={SIG}", "--samples", "0",
+                 "--t-end", "1", "--steps", "10", "--point", "coupler:0,1",
+                 "--out", str(out)]) == 0
+    capsys.readouterr()
+    ds = xr.open_dataset(out)
+    tol = mbd2d.tolerance(mbd2d.load(FOURBAR), {PRM: SIG}, samples=0, t_end=1.0, steps=10)
+    np.testing.assert_array_equal(ds.q_std_linear.values, tol.dataset.q_std_linear.values)
+    np.testing.assert_array_equal(ds.point1_y_std_linear.values,
+                                  tol.point("coupler", (0, 1)).y_std_linear.values)
+    assert ds.attrs["point1"] == "coupler(0;1)" and "q_std_mc" not in ds
+    ds.close()
+    spring = str(EX / "pendulum_spring.toml")
+    csv = tmp_path / "st.csv"
+    assert main(["tolerance", spring, "--analysis", "statics", "--sigma", "body.bar.mass=0.01",
+                 "--samples", "0", "--out", str(csv)]) == 0
+    header, rows = read_csv(csv)
+    st = mbd2d.load(spring).statics(sensitivities=["body.bar.mass"])
+    assert rows.shape == (1, len(header))
+    np.testing.assert_allclose(rows[0, header.index("bar.theta.std_linear")],
+                               abs(st.dq_dp[2, 0]) * 0.01, rtol=1e-14)
+    assert "lambda.pivot.x.std_linear" in header
+
+
+@pytest.mark.parametrize("argv, needle", [
+    (["--sigma", "joint.B.points.0.0"], "write NAME=STD"),
+    (["--sigma", "joint.B.points.0.0=abc"], "write NAME=STD"),
+    (["--sigma", "joint.B.point.0.0=1e-3"], "did you mean joint.B.points.0.0"),
+    (["--sigma", "joint.B.points.0.0=-1e-3"], "must be >= 0"),
+    (["--sigma", "joint.B.points.0.0=1e-3", "--samples", "1"], "at least 2"),
+    (["--sigma", "joint.B.points.0.0=1e-3", "--point", "coupler:0"], "BODY:X,Y"),
+])
+def test_bad_input_is_refused(tmp_path: Path, capsys, argv: list[str], needle: str) -> None:
+    out = tmp_path / "t.csv"
+    assert main(["tolerance", FOURBAR, *argv, "--t-end", "1", "--steps", "4",
+                 "--out", str(out)]) == 2
+    assert needle in " ".join(capsys.readouterr().err.split())
+    assert not out.exists()
+
+
+def test_needs_a_span_and_a_known_suffix(tmp_path: Path, capsys) -> None:
+    assert main(["tolerance", FOURBAR, "--sigma", f"{PRM}=1e-3", "--out",
+                 str(tmp_path / "t.csv")]) == 2
+    assert "needs --t-end and --steps" in capsys.readouterr().err
+    assert main(["tolerance", FOURBAR, "--sigma", f"{PRM}=1e-3", "--t-end", "1", "--steps",
+                 "4", "--out", str(tmp_path / "t.txt")]) == 2
+    assert "must end in .nc or .csv" in capsys.readouterr().err
