@@ -29,6 +29,13 @@
 !!   sensitivities <npar>                     (optional: design parameters)
 !!   <name> <table> <index>                   (npar lines; table 1 params, 2 masses,
 !!                              3 gravity, 4 fparams; index 1-based in that list)
+!!   cases <np> <nv> <ncase>                  (optional: a sweep, `mbd2d.export_sweep`)
+!!   <name>                                   (np lines: the swept parameters)
+!!   <table> <index>                          (nv lines: the entries each case sets)
+!!   <(np + nv) * ncase reals>                (per case: the parameters' values, then the
+!!                              entries'; any number per line)
+!!   opens <no>                               (with cases: phases set again from q0)
+!!   <rpar index> <row of Phi>                (no lines)
 !!   end
 !! The constraint and force columns are the flat tables of mbd_model; tol, maxit, tmin, rtol,
 !! atol, h and max_steps = 0 and rho_inf, alpha, beta = -1 mean the core's defaults.
@@ -108,6 +115,13 @@ module mbd_mbdfile
     integer, allocatable :: ptab(:, :)    !! (2, npar) table and index (mbd_sensitivity)
     integer, allocatable :: par_line(:)   !! line of each design parameter
     integer :: sens_line = 0              !! line of "sensitivities" (0: not given)
+    ! a sweep (mbd_batch): its parameters, the entries each case sets, their values
+    integer :: ncase = 0, ncp = 0, nv = 0
+    integer :: cases_line = 0             !! line of "cases" (0: not given)
+    character(len=PNAME_LEN), allocatable :: case_names(:)  !! (ncp) the swept parameters
+    integer, allocatable :: vtab(:, :)    !! (2, nv) table and index of each set entry
+    real(wp), allocatable :: cvals(:, :)  !! (ncp + nv, ncase) values per case
+    integer, allocatable :: opens(:, :)   !! (2, no) open phases: rpar index, row of Phi
   end type mbd_spec_t
 
 contains
@@ -124,6 +138,7 @@ contains
     character(len=NAME_LEN) :: key
     character(len=LINE_LEN) :: tok
     logical :: have_header, done, seen_b, seen_c, seen_p, seen_f, seen_fp, seen_l, seen_s
+    logical :: seen_k, seen_o
     real(wp) :: x
     status = MBD_OK; msg = ''
     ! first pass: the data lines (not blank, not comments) and their characters
@@ -151,11 +166,14 @@ contains
     lineno = 0; nread = 0
     have_header = .false.; done = .false.; seen_b = .false.; seen_c = .false.
     seen_p = .false.; seen_f = .false.; seen_fp = .false.; seen_l = .false.; seen_s = .false.
+    seen_k = .false.; seen_o = .false.
     allocate (spec%body_names(0), spec%con_names(0), spec%q0(3, 0), stat=ierr)
     if (ierr == 0) allocate (spec%ctab(NCT, 0), spec%con_line(0), spec%rpar(0), stat=ierr)
     if (ierr == 0) allocate (spec%bmass(2, 0), spec%v0(3, 0), spec%force_names(0), &
                              spec%ftab(NFT, 0), spec%fpar(0), spec%labels(0), stat=ierr)
     if (ierr == 0) allocate (spec%par_names(0), spec%ptab(2, 0), spec%par_line(0), stat=ierr)
+    if (ierr == 0) allocate (spec%case_names(0), spec%vtab(2, 0), spec%cvals(0, 0), &
+                             spec%opens(2, 0), stat=ierr)
     if (ierr /= 0) then
       call mem_fail(zero, 'the model file', 'free some memory', status, msg); close (u); return
     end if
@@ -530,6 +548,18 @@ contains
         end if
         seen_s = .true.
         if (.not. read_sensitivities()) exit
+      case ('cases')
+        if (seen_k) then
+          call fail('"cases" is given twice'); exit
+        end if
+        seen_k = .true.
+        if (.not. read_cases()) exit
+      case ('opens')
+        if (seen_o) then
+          call fail('"opens" is given twice'); exit
+        end if
+        seen_o = .true.
+        if (.not. read_opens()) exit
       case ('end')
         if (ntok /= 1) then
           call fail('"end" stands alone'); exit
@@ -727,6 +757,124 @@ contains
       end do
       read_sensitivities = .true.
     end function read_sensitivities
+
+    !> The "cases" block: "cases NP NV NCASE", NP parameter names, NV lines TABLE INDEX,
+    !! then (NP + NV) * NCASE reals.
+    logical function read_cases()
+      integer(int64) :: c(3), room
+      integer :: j, it
+      integer(int64) :: v
+      read_cases = .false.
+      if (ntok /= 4) then
+        call fail('"cases" takes three whole numbers: NP NV NCASE'); return
+      end if
+      do j = 1, 3
+        call next_token(line, pos, tok)
+        if (.not. read_int(tok, c(j))) then
+          call fail('"cases": "' // trim(tok(1:40)) // '" is not a whole number'); return
+        end if
+      end do
+      if (c(1) < 1 .or. c(2) < 0 .or. c(3) < 1) then
+        call fail('"cases NP NV NCASE": NP and NCASE must be at least 1, NV at least 0')
+        return
+      end if
+      room = ndata - nread
+      if (c(1) + c(2) > room .or. (c(1) + c(2)) * c(3) > (chars_left + 1) / 2) then
+        call fail('more cases than the rest of the file can hold: the counts do not match '// &
+                  'the file (truncated or edited?)'); return
+      end if
+      call mem_check(real(c(1), wp) * PNAME_LEN + 8 * real(c(2), wp) + &
+                     REAL_BYTES * real(c(1) + c(2), wp) * real(c(3), wp), 'the cases', &
+                     'give fewer cases', status, msg)
+      if (status /= MBD_OK) then
+        call where_prefix(); return
+      end if
+      spec%ncp = int(c(1)); spec%nv = int(c(2)); spec%ncase = int(c(3))
+      spec%cases_line = lineno
+      deallocate (spec%case_names, spec%vtab, spec%cvals)
+      allocate (spec%case_names(spec%ncp), spec%vtab(2, spec%nv), &
+                spec%cvals(spec%ncp + spec%nv, spec%ncase), stat=ierr)
+      if (ierr /= 0) then
+        call mem_fail(REAL_BYTES * real(c(1) + c(2), wp) * real(c(3), wp), 'the cases', &
+                      'give fewer cases', status, msg)
+        call where_prefix(); return
+      end if
+      spec%vtab = 0
+      do j = 1, spec%ncp
+        call next_line(ios)
+        if (ios /= 0) return
+        if (count_tokens(line) /= 1) then
+          call fail('bad case parameter line: one NAME expected'); return
+        end if
+        pos = 1
+        call next_token(line, pos, tok)
+        if (len_trim(tok) > PNAME_LEN) then
+          call fail('a parameter name is longer than 256 characters'); return
+        end if
+        spec%case_names(j) = tok(1:PNAME_LEN)
+      end do
+      do j = 1, spec%nv
+        call next_line(ios)
+        if (ios /= 0) return
+        if (count_tokens(line) /= 2) then
+          call fail('bad case entry line: TABLE INDEX expected'); return
+        end if
+        pos = 1
+        do it = 1, 2
+          call next_token(line, pos, tok)
+          if (.not. read_int(tok, v)) v = -1
+          if (it == 1 .and. (v < 1 .or. v > 4)) then
+            call fail('"' // trim(tok(1:40)) // '": TABLE is 1 (params), 2 (masses), '// &
+                      '3 (gravity) or 4 (fparams)'); return
+          end if
+          if (it == 2 .and. (v < 1 .or. v > huge(1))) then
+            call fail('"' // trim(tok(1:40)) // '": INDEX is a whole number from 1'); return
+          end if
+          spec%vtab(it, j) = int(v)
+        end do
+      end do
+      read_cases = read_reals_2d(spec%cvals)
+    end function read_cases
+
+    !> The "opens" block: a count, then RPAR_INDEX ROW per open phase.
+    logical function read_opens()
+      integer :: j, it
+      integer(int64) :: v
+      read_opens = .false.
+      if (.not. count_ok(n, 'open phase', 0)) return
+      deallocate (spec%opens)
+      allocate (spec%opens(2, n), stat=ierr)
+      if (ierr /= 0) then
+        call mem_fail(real(n, wp) * 8, 'the open phases', 'give fewer joints', status, msg)
+        call where_prefix(); return
+      end if
+      do j = 1, n
+        call next_line(ios)
+        if (ios /= 0) return
+        if (count_tokens(line) /= 2) then
+          call fail('bad open phase line: RPAR_INDEX ROW expected'); return
+        end if
+        pos = 1
+        do it = 1, 2
+          call next_token(line, pos, tok)
+          if (.not. read_int(tok, v)) v = -1
+          if (v < 1 .or. v > huge(1)) then
+            call fail('"' // trim(tok(1:40)) // '": an open phase entry is a whole number '// &
+                      'from 1'); return
+          end if
+          spec%opens(it, j) = int(v)
+        end do
+      end do
+      read_opens = .true.
+    end function read_opens
+
+    !> The numbers of a block into a 2-D array, column by column (any number per line).
+    logical function read_reals_2d(xs)
+      real(wp), intent(out), contiguous, target :: xs(:, :)
+      real(wp), pointer :: flat(:)
+      flat(1:size(xs)) => xs
+      read_reals_2d = read_reals(flat)
+    end function read_reals_2d
 
     !> The numbers of a block (any number per line) into x, exactly size(x) of them.
     logical function read_reals(xs)

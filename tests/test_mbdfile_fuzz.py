@@ -35,7 +35,7 @@ CODES = {0, 2, 3, 4}
 EXAMPLES = ["fourbar_grashof", "fourbar_seed", "fourbar_redundant", "slider_crank",
             "cam_follower", "door_two_hinges", "parallelogram_extra_link"]
 COUNT_KEYS = ("bodies", "constraints", "params", "steps", "maxit", "every", "labels", "forces",
-              "fparams", "max_steps", "sensitivities")
+              "fparams", "max_steps", "sensitivities", "opens")
 # (no counts that are valid and merely large: 1e9 steps need 216 GB of outputs and more)
 HUGE = [-1, -7, -2**31, -2**31 - 1, 2**31 - 1, 2**31, 2**32 + 1, 10**9, 10**9 + 1, 10**10,
         10**12, 2**63 - 1, 2**63, 10**19, 10**30]
@@ -80,6 +80,16 @@ def bases(tmp_path_factory: pytest.TempPathFactory) -> list[bytes]:
                      "sensitivities": ["body.bar.mass", "force.torsion.angle0"]})]):
         f = d / f"dyn{k}.mbd"
         model.export(f, **kw)
+        out.append(f.read_bytes())
+    # sweeps: the cases and opens blocks (a kinematic grid, an inverse dynamics sweep)
+    for k, (model, cases, analysis, kw) in enumerate([
+            (mbd2d.load(EX / "fourbar_grashof.toml"),
+             mbd2d.grid({"joint.B.points.0.0": [1.6, 1.8], "joint.O4.points.1.0": [2.9, 3.1]}),
+             "kinematics", {"t_end": 1.0, "steps": 20}),
+            (heavy, {"body.coupler.mass": [1.0, 2.0, 3.0]}, "inverse_dynamics",
+             {"t_end": 0.5, "steps": 10})]):
+        f = d / f"sweep{k}.mbd"
+        mbd2d.export_sweep(model, f, cases, analysis, **kw)
         out.append(f.read_bytes())
     return out
 

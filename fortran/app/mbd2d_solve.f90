@@ -8,7 +8,11 @@
 !! contact's and joint friction's columns (dynamic runs), then with a "sensitivities" block,
 !! for each design parameter P in turn, d(COLUMN)/d(P) of the motion columns and (inverse
 !! dynamics, statics) of the multiplier, reaction and effort columns asked for; every number
-!! as Python's "%.16e" (docs/mbd-format.md).
+!! as Python's "%.16e" (docs/mbd-format.md). A file with a "cases" block (mbd2d.export_sweep)
+!! runs the analysis for every case in one batch call (mbd_batch) and writes the CSV of
+!! mbd2d.write_sweep: case, the parameters, t, status, message, then q, q_dot, q_ddot per
+!! coordinate and the drivers' efforts, one row per case and output time (numbers as "%.17g");
+!! a failing case keeps its rows and says why, and the exit code is 0.
 !! Exit codes: 0 ok, 2 bad input (a malformed file, or counts too large for the memory),
 !! 3 singular configuration (partial output written), 4 other numerical failure (partial
 !! output written when there is any). Messages go to standard error, each starting
@@ -25,6 +29,9 @@ program mbd2d_solve
   use mbd_constraints, only: con_nrow, con_is_driver
   use mbd_api, only: NINFO, api_sizes, api_kinematics, api_inverse, api_dynamics, api_statics, &
                      api_reactions, api_dynamics_sens, api_reactions_dp
+  use mbd_batch, only: batch_run, NISET, NRSET
+  use mbd_status, only: MBD_NO_CONVERGENCE, MBD_INTEGRATOR_FAILED, MBD_INCONSISTENT
+  use mbd_constraints, only: con_nextra
   use mbd_kinematics, only: MAXPASS, kin_out_count
   use mbd_integrators, only: output_index
   use mbd_contact, only: NEO
@@ -40,6 +47,14 @@ program mbd2d_solve
       integer(c_int), value :: len
       integer(c_int) :: n
     end function format_e16
+    !> x as "%.17g" into buf(len); the length written (number_format.c)
+    function format_g17(x, buf, len) result(n) bind(C, name='mbd_format_g17')
+      import :: c_char, c_double, c_int
+      real(c_double), value :: x
+      character(kind=c_char), intent(out) :: buf(*)
+      integer(c_int), value :: len
+      integer(c_int) :: n
+    end function format_g17
   end interface
   type(mbd_spec_t) :: spec
   character(len=1024) :: model_path, out_path
@@ -54,6 +69,13 @@ program mbd2d_solve
   integer :: nev
   integer, allocatable :: dep(:), redundant(:), ftab(:, :)
   logical :: dynamic, elements, sens, lam_sens
+  ! a sweep (run_sweep): the batch call's outputs per case and each case's outcome
+  real(wp), allocatable :: bq(:, :, :), bqd(:, :, :), bqdd(:, :, :), blam(:, :, :), &
+                           be(:, :, :), brinfo(:, :), bqsing(:, :)
+  integer, allocatable :: biinfo(:, :), bdep(:, :), bred(:, :), bstat(:), nkeep(:), cstat(:)
+  character(len=MSG_LEN), allocatable :: bmsg(:)
+  character(len=4 * MSG_LEN), allocatable :: cmsg(:)
+  integer :: code = 0, nrow = 0, nd = 0, nlam = 0   !! batch analysis, rows, rows of q_dot, lambda
   !> the run's status when sensitivities turn non-finite (rows cut there, exit code 4)
   integer, parameter :: NONFINITE = 100
   integer :: nsr
@@ -95,6 +117,10 @@ program mbd2d_solve
   if (spec%analysis == 'statics' .and. spec%out_energy) call die(2, trim(model_path) // &
     ': statics has no energy output')
   call check_sensitivities()
+  if (spec%ncase > 0) then
+    call run_sweep()
+    stop 0, quiet=.true.
+  end if
 
   ! the states (q, q_dot, q_ddot), multipliers, energies and reactions of every output are
   ! held in memory until the CSV is written
@@ -223,7 +249,7 @@ contains
     if (spec%analysis == 'statics') then
       tout = spec%tstat; return
     end if
-    do k = 1, nrows
+    do k = 1, size(tout)
       ko = output_index(spec%steps, spec%every, k)
       tout(k) = spec%t0 + (spec%t_end - spec%t0) * (real(ko, wp) / spec%steps)
       if (ko == spec%steps) tout(k) = spec%t_end
@@ -345,30 +371,45 @@ contains
   !> One paragraph: when, which driver, which constraints, what to do.
   function singular_message() result(s)
     character(len=4 * MSG_LEN) :: s
+    s = trim(singular_text(rinfo(1), iinfo(3), dep)) // ' ' // trim(rows_written()) // '.'
+  end function singular_message
+
+  !> " NAME NAME ...": the constraints that own a row flagged in dp (neq).
+  function dep_names(dp) result(names)
+    integer, intent(in) :: dp(:)
     character(len=2 * MSG_LEN) :: names
-    character(len=32) :: ts
     integer :: c, r0, nr
     names = ''
     r0 = 1
     do c = 1, spec%nc
       nr = con_nrow(spec%ctab(1, c))
-      if (any(dep(r0:r0 + nr - 1) == 1)) names = trim(names) // ' ' // trim(spec%con_names(c))
+      if (any(dp(r0:r0 + nr - 1) == 1)) names = trim(names) // ' ' // trim(spec%con_names(c))
       r0 = r0 + nr
     end do
-    write (ts, '(f0.10)') rinfo(1)
+  end function dep_names
+
+  !> The dead centre at time ts of driver drv (0: none named) with the dependent rows dp.
+  function singular_text(tsing, drv, dp) result(s)
+    real(wp), intent(in) :: tsing
+    integer, intent(in) :: drv, dp(:)
+    character(len=4 * MSG_LEN) :: s
+    character(len=2 * MSG_LEN) :: names
+    character(len=32) :: ts
+    names = dep_names(dp)
+    write (ts, '(f0.10)') tsing
     if (ts(1:1) == '.') ts = '0' // trim(ts)
     if (ts(1:2) == '-.') ts = '-0' // ts(2:)
     s = 'Singular configuration (dead centre) at t = ' // trim(ts) // ' s: '
-    if (iinfo(3) > 0 .and. iinfo(3) <= spec%nc) then
-      s = trim(s) // ' driver "' // trim(spec%con_names(iinfo(3))) // &
+    if (drv > 0 .and. drv <= spec%nc) then
+      s = trim(s) // ' driver "' // trim(spec%con_names(drv)) // &
           '" can no longer be met, because the constraints' // trim(names) // &
           ' became dependent (J lost rank).'
     else
       s = trim(s) // ' the constraints' // trim(names) // ' became dependent (J lost rank).'
     end if
     s = trim(s) // ' The mechanism cannot move further as driven; change the driver range or ' // &
-        'the link lengths. ' // trim(rows_written()) // '.'
-  end function singular_message
+        'the link lengths.'
+  end function singular_text
 
   !> A number as Python's "%.16e": 17 significant digits, a lower-case e and an exponent of
   !! at least two digits (-1.2345678901234567e-05, 0.0000000000000000e+00, 1.0e+100 style);
@@ -612,6 +653,294 @@ contains
       end do
     end if
   end subroutine lam_values
+
+  !> A sweep: every case of the "cases" block in one batch call (as mbd2d.sweep makes it),
+  !! written as mbd2d.write_sweep writes a sweep's CSV.
+  subroutine run_sweep()
+    integer :: iset(NISET), c, nfail, ne
+    real(wp) :: rset(NRSET), bytes
+    real(wp), allocatable :: bm(:, :), bv0(:), bfp(:)
+    integer, allocatable :: bft(:, :)
+    if (sens) call die(2, trim(model_path) // ':' // trim(itoa(spec%cases_line)) // &
+      ': sweeps compute no sensitivities: run the cases one by one, or mbd2d.tolerance')
+    if (spec%out_energy .or. spec%out_lam .or. spec%out_reac .or. spec%out_eff) &
+      call die(2, trim(model_path) // ': a sweep writes its own columns (q, q_dot, q_ddot, '// &
+               'efforts): give no "outputs" line with "cases"')
+    call check_case_entries()
+    iset = 0; rset = 0.0_wp
+    select case (spec%analysis)
+    case ('kinematics')
+      code = 1
+      iset(1:7) = [spec%steps, spec%maxit, spec%every, spec%solver, 0, 0, &
+                   merge(1, 0, spec%positions_only)]
+      rset(1:4) = [spec%t0, spec%t_end, spec%tol, spec%tmin]
+    case ('inverse-dynamics')
+      code = 2
+      iset(1:4) = [spec%steps, 0, spec%every, spec%solver]
+      rset(1:3) = [spec%t0, spec%t_end, spec%tol]
+    case ('statics')
+      code = 3
+      rset(11) = spec%tstat
+    case default
+      code = 4
+      iset(1:6) = [spec%steps, 0, spec%every, 0, spec%method, spec%max_steps]
+      rset(1:10) = [spec%t0, spec%t_end, 0.0_wp, 0.0_wp, spec%rtol, spec%atol, spec%h, &
+                    spec%rho_inf, spec%alpha, spec%beta]
+    end select
+    nrow = 1
+    if (code /= 3) nrow = kin_out_count(spec%steps, spec%every)
+    nd = merge(0, nrow, code == 1 .and. spec%positions_only)
+    nlam = merge(0, neq, code == 1); ne = merge(0, 4, code == 1)
+    bytes = REAL_BYTES * real(spec%ncase, wp) * (real(nrow, wp) * (nq + nlam + ne) + &
+            2.0_wp * nq * nd + 2 * NINFO + nq) + 4.0_wp * spec%ncase * (2 * neq + NINFO + 3)
+    call mem_check(bytes, 'the outputs of ' // trim(itoa(spec%ncase)) // ' cases', &
+                   'give fewer cases or steps', status, msg)
+    if (status /= MBD_OK) call die(2, trim(model_path) // ':' // trim(itoa(spec%cases_line)) &
+                                   // ': ' // trim(msg))
+    allocate (bq(nq, nrow, spec%ncase), bqd(nq, nd, spec%ncase), bqdd(nq, nd, spec%ncase), &
+              blam(nlam, nrow, spec%ncase), be(ne, nrow, spec%ncase), &
+              brinfo(NINFO, spec%ncase), bqsing(nq, spec%ncase), biinfo(NINFO, spec%ncase), &
+              bdep(neq, spec%ncase), bred(neq, spec%ncase), bstat(spec%ncase), &
+              bmsg(spec%ncase), nkeep(spec%ncase), cstat(spec%ncase), cmsg(spec%ncase), &
+              tout(nrow), q0(nq), stat=ierr)
+    ! the dynamic tables (a kinematic sweep takes none: zeros, as the Python sweep passes)
+    if (ierr == 0) allocate (bm(2, spec%nb), bv0(nq), bft(NFT, merge(0, spec%nf, code == 1)), &
+                             bfp(max(1, size(spec%fpar))), stat=ierr)
+    if (ierr /= 0) call die(2, 'not enough memory for the outputs of ' // &
+                            trim(itoa(spec%ncase)) // ' cases; give fewer cases or steps')
+    q0 = 0.0_wp; bv0 = 0.0_wp; bm = 0.0_wp; bfp = 0.0_wp
+    q0(1:3 * spec%nb) = reshape(spec%q0, [3 * spec%nb])
+    if (code /= 1) then
+      bm = spec%bmass; bft = spec%ftab; bfp(1:size(spec%fpar)) = spec%fpar
+      bv0(1:3 * spec%nb) = reshape(spec%v0, [3 * spec%nb])
+    end if
+    call batch_run(code, spec%nb, spec%ctab, spec%rpar, bm, merge(spec%grav, 0.0_wp, code /= 1), &
+                   bft, bfp, q0, bv0, spec%vtab, spec%cvals(spec%ncp + 1:, :), spec%opens, &
+                   iset, rset, bq, bqd, bqdd, blam, be, biinfo, brinfo, bqsing, bdep, bred, &
+                   bstat, bmsg)
+    call times()
+    nfail = 0
+    do c = 1, spec%ncase
+      call case_outcome(c)
+      if (cstat(c) /= 0) then
+        nfail = nfail + 1
+        if (nfail <= 5) write (error_unit, '(a,i0,a,a)') 'mbd2d-solve: case ', c - 1, ': ', &
+          trim(cmsg(c))
+      end if
+    end do
+    call write_sweep_csv(trim(out_path))
+  end subroutine run_sweep
+
+  !> The entries the cases set and the open phases lie in the model's tables (a kinematic
+  !! run takes the constraints' parameters alone).
+  subroutine check_case_entries()
+    integer :: j, n(4)
+    n = [size(spec%rpar), 2 * spec%nb, 2, size(spec%fpar)]
+    if (spec%analysis == 'kinematics') n(2:4) = 0
+    do j = 1, spec%nv
+      if (spec%vtab(2, j) > n(spec%vtab(1, j))) call die(2, trim(model_path) // ':' // &
+        trim(itoa(spec%cases_line + spec%ncp + j)) // ': the case entry "' // &
+        trim(itoa(spec%vtab(1, j))) // ' ' // trim(itoa(spec%vtab(2, j))) // &
+        '" lies outside its table (' // trim(itoa(n(spec%vtab(1, j)))) // ' entries' // &
+        trim(merge(' in kinematics', '              ', n(spec%vtab(1, j)) == 0)) // ')')
+    end do
+    do j = 1, size(spec%opens, 2)
+      if (spec%opens(1, j) > size(spec%rpar) .or. spec%opens(2, j) > neq) call die(2, &
+        trim(model_path) // ': open phase ' // trim(itoa(j)) // ' lies outside the '// &
+        'parameters (' // trim(itoa(size(spec%rpar))) // ') or the rows of Phi (' // &
+        trim(itoa(neq)) // ')')
+    end do
+  end subroutine check_case_entries
+
+  !> Rows kept, status and message of case c, as the Python sweep decides them: a case
+  !! that completed keeps its rows; any other keeps the rows before its failure (or before
+  !! its first non-finite row) and has the status of the failure.
+  subroutine case_outcome(c)
+    integer, intent(in) :: c
+    integer :: n, k
+    logical :: clean
+    if (code == 3) then
+      n = merge(1, 0, bstat(c) == MBD_OK)
+    else
+      n = max(0, min(biinfo(1, c), nrow))
+    end if
+    k = first_bad(c, n)
+    clean = bstat(c) == MBD_OK .and. k > n
+    if (code == 3) clean = clean .and. ieee_is_finite(brinfo(1, c))
+    cstat(c) = 0; cmsg(c) = ''; nkeep(c) = n
+    if (clean) return
+    nkeep(c) = min(n, k - 1)
+    cstat(c) = bstat(c)
+    if (bstat(c) < 0 .or. code == 3) nkeep(c) = 0
+    if (bstat(c) == MBD_OK) then
+      cstat(c) = merge(MBD_INTEGRATOR_FAILED, MBD_NO_CONVERGENCE, code == 4)
+      write (cmsg(c), '(a,es14.6,a)') 'the run gave non-finite values at t =', &
+        tout(max(1, min(k, nrow))), ' s'
+    else if (bstat(c) == MBD_SINGULAR_CONFIG) then
+      cmsg(c) = singular_text(brinfo(1, c), biinfo(3, c), bdep(:, c))
+    else if (bstat(c) == MBD_INCONSISTENT .and. any(bdep(:, c) == 1)) then
+      cmsg(c) = trim(bmsg(c)) // ': the constraints' // trim(dep_names(bdep(:, c))) // &
+                ' cannot all hold; check their points and dimensions'
+    else
+      cmsg(c) = bmsg(c)
+      if (code /= 4 .and. biinfo(4, c) > 0 .and. biinfo(4, c) <= spec%nc) cmsg(c) = &
+        trim(bmsg(c)) // ' ("' // trim(spec%con_names(biinfo(4, c))) // '")'
+    end if
+  end subroutine case_outcome
+
+  !> The first of the rows 1..n of case c with a non-finite number (n + 1: none).
+  integer function first_bad(c, n) result(k)
+    integer, intent(in) :: c, n
+    do k = 1, n
+      if (.not. all(ieee_is_finite(bq(:, k, c)))) return
+      if (nd > 0) then
+        if (.not. (all(ieee_is_finite(bqd(:, k, c))) .and. &
+                   all(ieee_is_finite(bqdd(:, k, c))))) return
+      end if
+      if (.not. (all(ieee_is_finite(blam(:, k, c))) .and. all(ieee_is_finite(be(:, k, c))))) &
+        return
+    end do
+    k = n + 1
+  end function first_bad
+
+  !> The CSV of mbd2d.write_sweep (Python's csv module: fields quoted when they hold a
+  !! comma, a quote or a line break; lines end in CR LF).
+  subroutine write_sweep_csv(path)
+    character(len=*), intent(in) :: path
+    character(len=*), parameter :: crlf = achar(13) // achar(10)
+    character(len=*), parameter :: lev(3) = [character(len=6) :: '', '_dot', '_ddot']
+    integer :: u, ios, j, k, l, r0, nlev, c
+    nlev = merge(3, 1, nd > 0)
+    open (newunit=u, file=path, status='replace', action='write', access='stream', &
+          form='unformatted', iostat=ios)
+    if (ios /= 0) call die(2, 'cannot write ' // path)
+    call sput(u, ios, 'case')
+    do j = 1, spec%ncp
+      call sput(u, ios, ',' // trim(spec%case_names(j)))
+    end do
+    call sput(u, ios, ',t,status,message')
+    do l = 1, nlev
+      call coordinate_header(u, ios, trim(lev(l)))
+    end do
+    if (nlam > 0) then
+      do j = 1, spec%nc
+        if (con_is_driver(spec%ctab(1, j))) &
+          call sput(u, ios, ',effort.' // trim(spec%con_names(j)))
+      end do
+    end if
+    call sput(u, ios, crlf)
+    do c = 1, spec%ncase
+      if (nkeep(c) == 0) then
+        call case_head(u, ios, c)
+        call sput(u, ios, ',,' // trim(itoa(cstat(c))) // ',' // quoted(trim(cmsg(c))) // crlf)
+        cycle
+      end if
+      do k = 1, nkeep(c)
+        call case_head(u, ios, c)
+        call gput(u, ios, tout(k))
+        call sput(u, ios, ',' // trim(itoa(cstat(c))) // ',' // quoted(trim(cmsg(c))))
+        do j = 1, nq
+          call gput(u, ios, bq(j, k, c))
+        end do
+        if (nd > 0) then
+          do j = 1, nq
+            call gput(u, ios, bqd(j, k, c))
+          end do
+          do j = 1, nq
+            call gput(u, ios, bqdd(j, k, c))
+          end do
+        end if
+        if (nlam > 0) then
+          r0 = 1
+          do j = 1, spec%nc
+            if (con_is_driver(spec%ctab(1, j))) call gput(u, ios, -blam(r0, k, c))
+            r0 = r0 + con_nrow(spec%ctab(1, j))
+          end do
+        end if
+        call sput(u, ios, crlf)
+      end do
+    end do
+    close (u)
+    if (ios /= 0) call die(2, 'cannot write ' // path // ' (disk full?)')
+  end subroutine write_sweep_csv
+
+  !> "c,v1,...,vnp" of case c (0-based, as the Python sweep numbers cases).
+  subroutine case_head(u, ios, c)
+    integer, intent(in) :: u, c
+    integer, intent(inout) :: ios
+    integer :: j
+    call sput(u, ios, trim(itoa(c - 1)))
+    do j = 1, spec%ncp
+      call gput(u, ios, spec%cvals(j, c))
+    end do
+  end subroutine case_head
+
+  !> The coordinates' names NAME.x, NAME.y, NAME.theta per body, then NAME.alpha per extra
+  !! coordinate of a cam or curve joint, each with the suffix sfx.
+  subroutine coordinate_header(u, ios, sfx)
+    integer, intent(in) :: u
+    integer, intent(inout) :: ios
+    character(len=*), intent(in) :: sfx
+    character(len=*), parameter :: w(3) = [character(len=6) :: '.x', '.y', '.theta']
+    integer :: b, i, j
+    do b = 1, spec%nb
+      do i = 1, 3
+        call sput(u, ios, ',' // trim(spec%body_names(b)) // trim(w(i)) // sfx)
+      end do
+    end do
+    do j = 1, spec%nc
+      do i = 1, con_nextra(spec%ctab(1, j))
+        call sput(u, ios, ',' // trim(spec%con_names(j)) // '.alpha' // sfx)
+      end do
+    end do
+  end subroutine coordinate_header
+
+  !> Write bytes to a stream unit (nothing once a write has failed).
+  subroutine sput(u, ios, text)
+    integer, intent(in) :: u
+    integer, intent(inout) :: ios
+    character(len=*), intent(in) :: text
+    if (ios == 0) write (u, iostat=ios) text
+  end subroutine sput
+
+  !> ",x" with x as Python's format(x, ".17g") (NaN: an empty field).
+  subroutine gput(u, ios, x)
+    integer, intent(in) :: u
+    integer, intent(inout) :: ios
+    real(wp), intent(in) :: x
+    character(kind=c_char) :: buf(40)
+    character(len=40) :: s
+    integer :: i, n
+    if (ieee_is_nan(x)) then
+      call sput(u, ios, ','); return
+    end if
+    n = max(0, min(int(format_g17(real(x, c_double), buf, 40_c_int)), 39))
+    s = ''
+    do i = 1, n
+      s(i:i) = buf(i)
+    end do
+    call sput(u, ios, ',' // s(1:n))
+  end subroutine gput
+
+  !> A CSV field as Python's csv module writes it: in quotes (inner quotes doubled) when it
+  !! holds a comma, a quote or a line break.
+  function quoted(text) result(s)
+    character(len=*), intent(in) :: text
+    character(len=:), allocatable :: s
+    integer :: i
+    if (scan(text, ',"' // achar(10) // achar(13)) == 0) then
+      s = text; return
+    end if
+    s = '"'
+    do i = 1, len(text)
+      if (text(i:i) == '"') then
+        s = s // '""'
+      else
+        s = s // text(i:i)
+      end if
+    end do
+    s = s // '"'
+  end function quoted
 
   subroutine die(code, text)
     integer, intent(in) :: code

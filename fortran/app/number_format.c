@@ -7,3 +7,9 @@ int mbd_format_e16(double x, char *buf, int len)
 {
     return snprintf(buf, (size_t) len, "%.16e", x);
 }
+
+/* x as C's and Python's "%.17g" (the sweep CSV: mbd2d.write_sweep writes format(x, ".17g")). */
+int mbd_format_g17(double x, char *buf, int len)
+{
+    return snprintf(buf, (size_t) len, "%.17g", x);
+}

@@ -16,6 +16,7 @@
     mbd2d check MODEL.toml
     mbd2d parameters MODEL.toml [--match TEXT]
     mbd2d export MODEL.toml OUT.mbd [--analysis A] --t-end T --steps N [settings of A]
+                 [--param NAME=START:STOP:NUM ... --grid]   (a sweep for mbd2d-solve)
     mbd2d plot MODEL.toml --t-end T --steps N --out FIG.png
                [--what mechanism|paths|time-series|forces|energy] [--analysis A] [--trace B:X,Y]
     mbd2d animate MODEL.toml --t-end T --steps N --out MOTION.gif|MOTION.mp4 [--fps F --speed S]
@@ -228,6 +229,10 @@ def _parser() -> argparse.ArgumentParser:
     _sensitivities(e)
     e.add_argument("--positions-only", action="store_true",
                    help="kinematics: positions alone (no velocities or accelerations)")
+    e.add_argument("--param", action="append", default=None, metavar="NAME=START:STOP:NUM",
+                   help="a sweep: mbd2d-solve runs every case and writes the sweep's CSV "
+                   "(as `mbd2d sweep`; repeatable)")
+    e.add_argument("--grid", action="store_true", help="with --param: every combination")
     _dynamics_settings(e)
     _columns(e)
     p = sub.add_parser("plot", help="run an analysis and draw it (PNG, SVG or PDF)")
@@ -519,21 +524,50 @@ def _param_values(spec: str) -> tuple[str, np.ndarray]:
     return name.strip(), np.linspace(start, stop, num)
 
 
-def _sweep(model: Model, args: argparse.Namespace) -> int:
-    """The sweep command: run, write, summarize."""
-    from .studies import connect, grid, sweep, write_sweep
-    if not str(args.out).endswith((".nc", ".csv")):
-        raise ModelError(f"--out must end in .nc or .csv, got {args.out!r}", "command line")
+def _cases(args: argparse.Namespace) -> dict[str, np.ndarray]:
+    """The case table of --param (and --grid)."""
+    from .studies import grid
     values = dict(_param_values(p) for p in args.param)
     if args.grid:
-        cases = grid(values)
-    else:
-        counts = {len(v) for v in values.values()}
-        if len(counts) != 1:
-            raise ModelError("without --grid every --param needs the same NUM (the i-th "
-                             "values form case i); use --grid for every combination",
-                             "command line")
-        cases = values
+        return grid(values)
+    counts = {len(v) for v in values.values()}
+    if len(counts) != 1:
+        raise ModelError("without --grid every --param needs the same NUM (the i-th "
+                         "values form case i); use --grid for every combination",
+                         "command line")
+    return values
+
+
+def _export_sweep(model: Model, args: argparse.Namespace) -> int:
+    """export --param: a sweep file for mbd2d-solve (the settings of the analysis alone)."""
+    from .studies import export_sweep
+    if _outputs(args) or _sens_names(args):
+        raise ModelError("a sweep file writes the sweep's columns: no --energy, "
+                         "--multipliers, --reactions, --efforts or --sensitivities with "
+                         "--param", "command line")
+    span = {"t_end": args.t_end, "steps": args.steps, "t0": args.t0, "every": args.every}
+    kw: dict[str, Any] = {
+        "kinematics": dict(span, tol=args.tol, solver=args.solver,
+                           positions_only=args.positions_only),
+        "inverse-dynamics": dict(span, tol=args.tol, solver=args.solver),
+        "statics": {"t": args.t},
+        "dynamics": dict(span, **_dynamics_kwargs(args))}[args.analysis]
+    if args.analysis != "statics" and (args.t_end is None or args.steps is None):
+        raise ModelError(f"{args.analysis} needs --t-end and --steps", "command line")
+    cases = _cases(args)
+    export_sweep(model, args.out, cases, args.analysis.replace("-", "_"), **kw)
+    n = len(next(iter(cases.values())))
+    print(f"wrote {args.out} ({args.analysis} of {n} cases; run it with mbd2d-solve "
+          f"{args.out} OUT.csv)")
+    return EXIT_OK
+
+
+def _sweep(model: Model, args: argparse.Namespace) -> int:
+    """The sweep command: run, write, summarize."""
+    from .studies import connect, sweep, write_sweep
+    if not str(args.out).endswith((".nc", ".csv")):
+        raise ModelError(f"--out must end in .nc or .csv, got {args.out!r}", "command line")
+    cases = _cases(args)
     if args.analysis == "statics":
         kw: dict = {"t": args.t0}
     else:
@@ -580,6 +614,8 @@ def main(argv: Sequence[str] | None = None) -> int:
                 st.to_csv(args.out, **_file_outputs(args))
                 print(f"wrote the equilibrium to {args.out}")
             return EXIT_OK
+        if args.command == "export" and args.param:
+            return _export_sweep(model, args)
         if args.command == "export":
             extra = _dynamics_kwargs(args) if args.analysis == "dynamics" else {}
             model.export(args.out, t_end=args.t_end, steps=args.steps, t0=args.t0, tol=args.tol,

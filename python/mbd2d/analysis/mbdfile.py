@@ -117,6 +117,10 @@ def header() -> str:
         "#   sensitivities NP, then NP lines   NAME TABLE INDEX (optional): design parameters",
         "#        and their d(COLUMN)/d(NAME) columns; TABLE 1 params, 2 masses (mass, inertia",
         "#        per body), 3 gravity, 4 fparams; INDEX 1-based in that list",
+        "#   cases NP NV NCASE, then NP lines NAME, NV lines TABLE INDEX, then per case NP + NV",
+        "#        reals (optional: a sweep, mbd2d.export_sweep): the swept parameters, the",
+        "#        entries each case sets (TABLE as for sensitivities) and their values",
+        "#   opens NO, then NO lines      RPAR_INDEX ROW: phases set again from q0 per case",
         "#   end"]
     return "\n".join(lines)
 
@@ -147,15 +151,29 @@ def _outputs(outputs: Any, analysis: str) -> list[str]:
     return [w for w in OUTPUTS if w in words]
 
 
-def export(model: ModelDescription, path: str | Path, t_end: float | None = None,
-           steps: int | None = None, t0: float = 0.0, tol: float | None = None,
-           maxit: int | None = None, analysis: str = "kinematics", every: Any = 1,
-           solver: str = "auto", method: str | None = None, rtol: Any = None,
-           atol: Any = None, h: Any = None, rho_inf: Any = None, alpha: Any = None,
-           beta: Any = None, max_steps: Any = None, t: float = 0.0,
-           outputs: Sequence[str] | None = None, positions_only: Any = False,
-           sensitivities: Sequence[str] | None = None) -> None:
-    """Write a model file for ``mbd2d-solve``; see :meth:`mbd2d.Model.export`.
+def export(model: ModelDescription, path: str | Path, **settings: Any) -> None:
+    """Write a model file for ``mbd2d-solve``; see :meth:`mbd2d.Model.export` (the settings
+    as :func:`file_lines` takes them).
+
+    Raises
+    ------
+    ModelError
+        If the model or the settings are invalid (checked as for a Python run).
+    """
+    lines = file_lines(model, **settings)
+    write_text(path, "\n".join(lines + ["end"]) + "\n", "export")
+
+
+def file_lines(model: ModelDescription, t_end: float | None = None, steps: int | None = None,
+               t0: float = 0.0, tol: float | None = None, maxit: int | None = None,
+               analysis: str = "kinematics", every: Any = 1, solver: str = "auto",
+               method: str | None = None, rtol: Any = None, atol: Any = None, h: Any = None,
+               rho_inf: Any = None, alpha: Any = None, beta: Any = None,
+               max_steps: Any = None, t: float = 0.0, outputs: Sequence[str] | None = None,
+               positions_only: Any = False,
+               sensitivities: Sequence[str] | None = None) -> list[str]:
+    """The lines of a model file up to its ``end`` line (the header, the model, the analysis
+    and its settings, the optional blocks).
 
     Raises
     ------
@@ -227,8 +245,7 @@ def export(model: ModelDescription, path: str | Path, t_end: float | None = None
         ptab = table(p, params, dyn)
         lines.append(f"sensitivities {len(params)}")
         lines += [f"{prm.name} {ptab[0, k]} {ptab[1, k]}" for k, prm in enumerate(params)]
-    lines.append("end")
-    write_text(path, "\n".join(lines) + "\n", "export")
+    return lines
 
 
 def _reals(key: str, values: Any) -> list[str]:
@@ -239,4 +256,4 @@ def _reals(key: str, values: Any) -> list[str]:
     return out
 
 
-__all__ = ["export", "header", "ANALYSES", "FORMAT", "SOLVERS"]
+__all__ = ["export", "file_lines", "header", "ANALYSES", "FORMAT", "SOLVERS"]

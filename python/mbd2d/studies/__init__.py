@@ -7,6 +7,7 @@ they are imported here only, when a study runs.
 """
 from __future__ import annotations
 
+from .export import export_sweep
 from .files import tolerance_table, write_sweep, write_tolerance
 from .plan import ANALYSES, grid
 from .runner import connect
@@ -14,4 +15,4 @@ from .sweep import sweep
 from .tolerance import ToleranceResult, tolerance
 
 __all__ = ["sweep", "grid", "tolerance", "ToleranceResult", "write_sweep", "write_tolerance",
-           "tolerance_table", "connect", "ANALYSES"]
+           "tolerance_table", "export_sweep", "connect", "ANALYSES"]

@@ -1,0 +1,233 @@
+"""Sweeps in the standalone mbd2d-solve: a file written by ``mbd2d.export_sweep`` (or
+``mbd2d export ... --param``) runs every case in one batch call and writes the CSV that
+``mbd2d.write_sweep`` writes for the Python sweep.
+
+References: the Python sweep's CSV (its numbers are those of ``with_params`` runs, bit for
+bit: tests/test_sweep.py), and here again single runs of ``model.with_params(case)``, read
+back from mbd2d-solve's file. The failed cases' messages are mbd2d-solve's own words (the
+numbers, statuses and rows kept are the Python sweep's).
+"""
+from __future__ import annotations
+
+import csv
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import mbd2d
+from mbd2d.cli import main
+
+from test_standalone import find_solver
+from test_sweep import gear_pair, model_from_toml
+
+pytest.importorskip("xarray")
+
+ROOT = Path(__file__).resolve().parents[1]
+EX = ROOT / "examples"
+
+RACK = """
+[[body]]
+name = "pinion"
+q0 = [0, 0, 0.2]
+[[body]]
+name = "rack"
+q0 = [0.1, -0.3, 0]
+[[joint]]
+type = "revolute"
+bodies = ["ground", "pinion"]
+points = [[0, 0], [0, 0]]
+[[joint]]
+type = "translational"
+bodies = ["ground", "rack"]
+points = [[0, -0.3], [0, 0]]
+axes = [[1, 0], [1, 0]]
+[[joint]]
+name = "rp"
+type = "rack-pinion"
+bodies = ["pinion", "rack"]
+center = [0, 0]
+point = [0, 0]
+axis = [1, 0]
+radius = 0.3
+[[driver]]
+type = "absolute"
+body = "pinion"
+coordinate = "theta"
+f = { poly = [0.2, 6.283185307179586] }
+"""
+
+
+def _rows(path: Path) -> list[list[str]]:
+    with open(path, newline="") as f:
+        return list(csv.reader(f))
+
+
+def solve_sweep(tmp_path: Path, model: mbd2d.Model, cases: dict, analysis: str,
+                **kw) -> tuple[list[list[str]], list[list[str]], subprocess.CompletedProcess]:
+    """mbd2d-solve's rows and the Python sweep's rows of the same sweep."""
+    mbd = tmp_path / "s.mbd"
+    mbd2d.export_sweep(model, mbd, cases, analysis, **kw)
+    out = tmp_path / "solve.csv"
+    r = subprocess.run([find_solver(), str(mbd), str(out)], capture_output=True, text=True,
+                       timeout=300)
+    py = tmp_path / "python.csv"
+    mbd2d.write_sweep(mbd2d.sweep(model, cases, analysis, workers=1, **kw), py)
+    return _rows(out), _rows(py), r
+
+
+def same_but_messages(solve: list[list[str]], py: list[list[str]]) -> None:
+    """Every field equal (numbers as text), except the message of a failed case, which
+    must be there in both."""
+    assert len(solve) == len(py) and solve[0] == py[0]
+    m = solve[0].index("message")
+    for a, b in zip(solve[1:], py[1:]):
+        assert a[:m] + a[m + 1:] == b[:m] + b[m + 1:]
+        assert bool(a[m]) == bool(b[m])
+
+
+CASES = {
+    "kinematics": (lambda: mbd2d.load(EX / "fourbar_grashof.toml"),
+                   mbd2d.grid({"joint.B.points.0.0": [1.6, 1.75, 1.9],
+                               "joint.O4.points.1.0": [2.9, 3.1]}), "kinematics",
+                   dict(t_end=1.0, steps=30, every=4)),
+    "positions": (lambda: mbd2d.load(EX / "cam_follower.toml"),
+                  {"joint.pivot.points.0.0": [0.0, 0.01, -0.02]}, "kinematics",
+                  dict(t_end=1.0, steps=20, positions_only=True)),
+    "rack_open_phase": (lambda: model_from_toml(RACK),
+                        {"joint.rp.radius": [0.3, 0.35, 0.25],
+                         "joint.rp.point.0": [0.0, 0.05, -0.1]}, "kinematics",
+                        dict(t_end=0.5, steps=10)),
+    "gear_inverse": (gear_pair, {"joint.mesh.radii.0": [0.5, 0.6, 0.45],
+                                 "joint.mesh.radii.1": [1.5, 1.4, 1.55],
+                                 "joint.O2.points.0.0": [2.0, 2.0, 2.1],
+                                 "body.wheel.mass": [3.0, 2.5, 4.0],
+                                 "model.gravity.1": [-9.81, -1.6, 0.0]},
+                     "inverse_dynamics", dict(t_end=0.5, steps=10)),
+    "statics": (lambda: mbd2d.load(EX / "pendulum_spring.toml"),
+                {"body.bar.mass": [0.5, 1.0, 2.0], "force.torsion.angle0": [0.0, 0.1, 0.2]},
+                "statics", dict(t=0.0)),
+    "dynamics": (lambda: mbd2d.load(EX / "fourbar_masses.toml"),
+                 {"body.coupler.mass": [1.0, 2.0], "body.rocker.inertia": [0.05, 0.2]},
+                 "dynamics", dict(t_end=0.3, steps=6, method="generalized-alpha", h=1e-3)),
+}
+
+
+@pytest.mark.parametrize("case", list(CASES))
+def test_mbd2d_solve_writes_the_python_sweep(tmp_path: Path, case: str) -> None:
+    """Byte for byte when every case completes."""
+    build, cases, analysis, kw = CASES[case]
+    model = build()
+    solve, py, r = solve_sweep(tmp_path, model, cases, analysis, **kw)
+    assert r.returncode == 0 and r.stderr == "", r.stderr
+    assert (tmp_path / "solve.csv").read_bytes() == (tmp_path / "python.csv").read_bytes()
+    # one case against a run of its own model (no batch code)
+    names = list(cases)
+    j = len(next(iter(cases.values()))) - 1
+    own = model.with_params({n: float(cases[n][j]) for n in names})
+    t0 = {"kinematics": lambda: own.kinematics(**kw),
+          "inverse_dynamics": lambda: own.inverse_dynamics(**kw),
+          "statics": lambda: own.statics(**kw),
+          "dynamics": lambda: own.dynamics(**kw)}[analysis]()
+    head = solve[0]
+    mine = [row for row in solve[1:] if row[0] == str(j)]
+    q = np.atleast_2d(t0.q)
+    assert len(mine) == q.shape[0]
+    coords = [str(c) for c in (t0.coordinate_names)]
+    got = np.array([[float(row[head.index(c)]) for c in coords] for row in mine])
+    np.testing.assert_array_equal(got, q)
+
+
+def test_failed_cases_keep_their_rows_and_say_why(tmp_path: Path) -> None:
+    """The seed four-bar's coupler lengths reach the dead centre at different times, and a
+    far-off pivot does not assemble: rows, statuses and numbers as the Python sweep, the
+    messages mbd2d-solve's, exit code 0 with the first failures on standard error."""
+    model = mbd2d.load(EX / "fourbar_seed.toml")
+    cases = {"joint.B.points.0.0": [1.0, 2.0, 3.0, 40.0]}
+    solve, py, r = solve_sweep(tmp_path, model, cases, "kinematics", t_end=1.0, steps=50)
+    assert r.returncode == 0
+    same_but_messages(solve, py)
+    m, s = solve[0].index("message"), solve[0].index("status")
+    status = {row[0]: row[s] for row in solve[1:]}
+    assert status == {"0": "3", "1": "3", "2": "0", "3": "6"}
+    last = {row[0]: row[m] for row in solve[1:]}
+    assert "dead centre" in last["0"] and '"motor"' in last["0"] and last["2"] == ""
+    assert "contradict" in last["3"] and "O2 A B O4 motor cannot all hold" in last["3"]
+    assert r.stderr.count("mbd2d-solve: case ") == 3
+    assert [row for row in solve[1:] if row[0] == "3"][0][solve[0].index("t")] == ""
+
+
+def test_cli_export_param_gives_the_sweep_file(tmp_path: Path, capsys) -> None:
+    """`mbd2d export --param ... --grid` writes export_sweep's file; mbd2d-solve then writes
+    `mbd2d sweep --out .csv`'s file."""
+    toml = str(EX / "fourbar_grashof.toml")
+    args = ["--param", "joint.B.points.0.0=1.5:2.0:3", "--param", "joint.O4.points.1.0=2.9:3.1:2",
+            "--grid", "--t-end", "1", "--steps", "20"]
+    cli = tmp_path / "cli.mbd"
+    assert main(["export", toml, str(cli), *args]) == 0
+    assert "of 6 cases" in capsys.readouterr().out
+    api = tmp_path / "api.mbd"
+    mbd2d.export_sweep(mbd2d.load(toml), api, mbd2d.grid(
+        {"joint.B.points.0.0": np.linspace(1.5, 2.0, 3),
+         "joint.O4.points.1.0": np.linspace(2.9, 3.1, 2)}), t_end=1.0, steps=20)
+    assert cli.read_text() == api.read_text()
+    out = tmp_path / "solve.csv"
+    assert subprocess.run([find_solver(), str(cli), str(out)], timeout=120).returncode == 0
+    py = tmp_path / "sweep.csv"
+    assert main(["sweep", toml, *args, "--workers", "1", "--out", str(py)]) == 0
+    assert out.read_bytes() == py.read_bytes()
+    assert main(["export", toml, str(cli), *args, "--energy"]) == 2
+    assert "writes the sweep's columns" in " ".join(capsys.readouterr().err.split())
+
+
+def _sweep_lines(tmp_path: Path) -> list[str]:
+    mbd = tmp_path / "m.mbd"
+    mbd2d.export_sweep(mbd2d.load(EX / "fourbar_grashof.toml"), mbd,
+                       {"joint.B.points.0.0": [1.7, 1.8]}, t_end=1.0, steps=5)
+    return mbd.read_text().splitlines()
+
+
+@pytest.mark.parametrize("edit, needle", [
+    (("cases 1 1 2", "cases 1 1"), "three whole numbers"),
+    (("cases 1 1 2", "cases 0 1 2"), "NP and NCASE must be at least 1"),
+    (("cases 1 1 2", "cases 1 1 999999"), "more cases than the rest of the file"),
+    (("cases 1 1 2", "cases 1 1 x"), "is not a whole number"),
+    (("1 9", "7 9"), "TABLE is 1 (params)"),
+    (("1 9", "1 0"), "INDEX is a whole number"),
+    (("1 9", "1 9 3"), "TABLE INDEX expected"),
+    (("1 9", "1 999"), "lies outside its table (20 entries)"),
+    (("1 9", "2 1"), "lies outside its table (0 entries in kinematics)"),
+    (("opens 0", "opens 1\n3 99"), "open phase 1 lies outside"),
+    (("1.80000000000000004e+00 1.80000000000000004e+00", "1.8 nan"), "is not a number"),
+    (("opens 0", "opens 1\n0 3"), "from 1"),
+    (("opens 0", "opens 0\ncases 1 0 1\nx\n1"), '"cases" is given twice'),
+    (("opens 0", "opens 0\noutputs energy"), "outputs"),
+    (("opens 0", "opens 0\nsensitivities 1\njoint.B.points.0.0 1 9"),
+     "sweeps compute no sensitivities"),
+])
+def test_bad_cases_blocks_name_their_line(tmp_path: Path, edit: tuple[str, str],
+                                          needle: str) -> None:
+    lines = _sweep_lines(tmp_path)
+    i = lines.index(edit[0])
+    lines[i] = edit[1]
+    bad = tmp_path / "bad.mbd"
+    bad.write_text("\n".join(lines) + "\n")
+    r = subprocess.run([find_solver(), str(bad), str(tmp_path / "o.csv")], capture_output=True,
+                       text=True, timeout=60)
+    assert r.returncode == 2, r.stderr
+    assert needle in r.stderr and r.stderr.startswith("mbd2d-solve: "), r.stderr
+
+
+def test_a_sweep_file_takes_no_output_columns(tmp_path: Path) -> None:
+    """An inverse-dynamics sweep with an "outputs" line: refused (the sweep's CSV has its
+    own columns), as the command line refuses --energy with --param."""
+    mbd = tmp_path / "g.mbd"
+    mbd2d.export_sweep(gear_pair(), mbd, {"body.wheel.mass": [3.0, 4.0]}, "inverse_dynamics",
+                       t_end=0.2, steps=4)
+    text = mbd.read_text().replace("\nend\n", "\noutputs efforts\nend\n")
+    mbd.write_text(text)
+    r = subprocess.run([find_solver(), str(mbd), str(tmp_path / "o.csv")], capture_output=True,
+                       text=True, timeout=60)
+    assert r.returncode == 2 and "a sweep writes its own columns" in r.stderr, r.stderr
+    assert not (tmp_path / "o.csv").exists()
