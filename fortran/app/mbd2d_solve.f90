@@ -804,13 +804,21 @@ contains
   end function first_bad
 
   !> The CSV of mbd2d.write_sweep (Python's csv module: fields quoted when they hold a
-  !! comma, a quote or a line break; lines end in CR LF).
+  !! comma, a quote or a line break; lines end in CR LF). Each row is built in one buffer and
+  !! written at once; a case's leading fields (case, parameters) and its status and message
+  !! are formatted once per case.
   subroutine write_sweep_csv(path)
     character(len=*), intent(in) :: path
     character(len=*), parameter :: crlf = achar(13) // achar(10)
     character(len=*), parameter :: lev(3) = [character(len=6) :: '', '_dot', '_ddot']
-    integer :: u, ios, j, k, l, r0, nlev, c
+    character(len=:), allocatable :: line, head, tail
+    integer :: u, ios, j, k, l, r0, nlev, c, lp, nh, nt, width
     nlev = merge(3, 1, nd > 0)
+    ! at most 26 characters a number ("%.17g": -1.2345678901234567e-308) with its comma
+    width = 26 * (spec%ncp + 2 + 3 * nq + spec%nc) + 32
+    allocate (character(len=width) :: head, line, stat=ierr)
+    if (ierr == 0) allocate (character(len=2 * len(cmsg) + 40) :: tail, stat=ierr)
+    if (ierr /= 0) call die(2, 'not enough memory to write ' // path)
     open (newunit=u, file=path, status='replace', action='write', access='stream', &
           form='unformatted', iostat=ios)
     if (ios /= 0) call die(2, 'cannot write ' // path)
@@ -830,50 +838,47 @@ contains
     end if
     call sput(u, ios, crlf)
     do c = 1, spec%ncase
+      nh = 0
+      call bput(head, nh, trim(itoa(c - 1)))
+      do j = 1, spec%ncp
+        call bnum(head, nh, spec%cvals(j, c))
+      end do
+      nt = 0
+      call bput(tail, nt, ',' // trim(itoa(cstat(c))) // ',' // quoted(trim(cmsg(c))))
       if (nkeep(c) == 0) then
-        call case_head(u, ios, c)
-        call sput(u, ios, ',,' // trim(itoa(cstat(c))) // ',' // quoted(trim(cmsg(c))) // crlf)
+        call sput(u, ios, head(1:nh) // ',' // tail(1:nt) // crlf)
         cycle
       end if
       do k = 1, nkeep(c)
-        call case_head(u, ios, c)
-        call gput(u, ios, tout(k))
-        call sput(u, ios, ',' // trim(itoa(cstat(c))) // ',' // quoted(trim(cmsg(c))))
+        lp = 0
+        call bput(line, lp, head(1:nh))
+        call bnum(line, lp, tout(k))
+        call bput(line, lp, tail(1:nt))
         do j = 1, nq
-          call gput(u, ios, bq(j, k, c))
+          call bnum(line, lp, bq(j, k, c))
         end do
         if (nd > 0) then
           do j = 1, nq
-            call gput(u, ios, bqd(j, k, c))
+            call bnum(line, lp, bqd(j, k, c))
           end do
           do j = 1, nq
-            call gput(u, ios, bqdd(j, k, c))
+            call bnum(line, lp, bqdd(j, k, c))
           end do
         end if
         if (nlam > 0) then
           r0 = 1
           do j = 1, spec%nc
-            if (con_is_driver(spec%ctab(1, j))) call gput(u, ios, -blam(r0, k, c))
+            if (con_is_driver(spec%ctab(1, j))) call bnum(line, lp, -blam(r0, k, c))
             r0 = r0 + con_nrow(spec%ctab(1, j))
           end do
         end if
-        call sput(u, ios, crlf)
+        call bput(line, lp, crlf)
+        call sput(u, ios, line(1:lp))
       end do
     end do
     close (u)
     if (ios /= 0) call die(2, 'cannot write ' // path // ' (disk full?)')
   end subroutine write_sweep_csv
-
-  !> "c,v1,...,vnp" of case c (0-based, as the Python sweep numbers cases).
-  subroutine case_head(u, ios, c)
-    integer, intent(in) :: u, c
-    integer, intent(inout) :: ios
-    integer :: j
-    call sput(u, ios, trim(itoa(c - 1)))
-    do j = 1, spec%ncp
-      call gput(u, ios, spec%cvals(j, c))
-    end do
-  end subroutine case_head
 
   !> The coordinates' names NAME.x, NAME.y, NAME.theta per body, then NAME.alpha per extra
   !! coordinate of a cam or curve joint, each with the suffix sfx.
@@ -903,24 +908,31 @@ contains
     if (ios == 0) write (u, iostat=ios) text
   end subroutine sput
 
-  !> ",x" with x as Python's format(x, ".17g") (NaN: an empty field).
-  subroutine gput(u, ios, x)
-    integer, intent(in) :: u
-    integer, intent(inout) :: ios
+  !> Append text to buf(1:n).
+  subroutine bput(buf, n, text)
+    character(len=*), intent(inout) :: buf
+    integer, intent(inout) :: n
+    character(len=*), intent(in) :: text
+    buf(n + 1:n + len(text)) = text
+    n = n + len(text)
+  end subroutine bput
+
+  !> Append ",x" to buf(1:n), x as Python's format(x, ".17g") (NaN: an empty field).
+  subroutine bnum(buf, n, x)
+    character(len=*), intent(inout) :: buf
+    integer, intent(inout) :: n
     real(wp), intent(in) :: x
-    character(kind=c_char) :: buf(40)
-    character(len=40) :: s
-    integer :: i, n
-    if (ieee_is_nan(x)) then
-      call sput(u, ios, ','); return
-    end if
-    n = max(0, min(int(format_g17(real(x, c_double), buf, 40_c_int)), 39))
-    s = ''
-    do i = 1, n
-      s(i:i) = buf(i)
+    character(kind=c_char) :: cb(40)
+    integer :: i, m
+    n = n + 1
+    buf(n:n) = ','
+    if (ieee_is_nan(x)) return
+    m = max(0, min(int(format_g17(real(x, c_double), cb, 40_c_int)), 39))
+    do i = 1, m
+      buf(n + i:n + i) = cb(i)
     end do
-    call sput(u, ios, ',' // s(1:n))
-  end subroutine gput
+    n = n + m
+  end subroutine bnum
 
   !> A CSV field as Python's csv module writes it: in quotes (inner quotes doubled) when it
   !! holds a comma, a quote or a line break.
