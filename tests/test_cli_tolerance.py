@@ -110,6 +110,10 @@ def test_netcdf_and_statics(tmp_path: Path, capsys) -> None:
     (["--sigma", "joint.B.points.0.0=-1e-3"], "must be >= 0"),
     (["--sigma", "joint.B.points.0.0=1e-3", "--samples", "1"], "at least 2"),
     (["--sigma", "joint.B.points.0.0=1e-3", "--point", "coupler:0"], "BODY:X,Y"),
+    (["--sigma", "joint.B.points.0.0=1e-3", "--point", "ground:0,0"], "no moving body 'ground'"),
+    (["--sigma", "joint.B.points.0.0=nan"], "must be finite"),
+    (["--sigma", "joint.B.points.0.0=1.7e308", "--samples", "0"],
+     "exceeds the floating-point range"),
 ])
 def test_bad_input_is_refused(tmp_path: Path, capsys, argv: list[str], needle: str) -> None:
     out = tmp_path / "t.csv"

@@ -367,6 +367,11 @@ def _tolerance(model: Model, args: argparse.Namespace) -> int:
         raise ModelError(f"--out must end in .nc or .csv, got {args.out!r}", "command line")
     sigma = dict(_sigma(s) for s in args.sigma)
     points = _trace(args.point) or []
+    bodies = [b.name for b in model.bodies]
+    for body, _ in points:
+        if body not in bodies:
+            raise ModelError(f"--point {body}:...: no moving body {body!r}; bodies: "
+                             f"{', '.join(bodies)}", "command line")
     if args.analysis == "statics":
         kw: dict = {"t": args.t0}
     else:
@@ -408,7 +413,8 @@ def _tolerance_report(tol: Any, points: list[tuple[str, Any]]) -> str:
     t = np.atleast_1d(ds.time.values)
     for name, lin, mc in rows[:8]:
         k = int(np.nanargmax(lin))
-        beside = "" if mc is None else f"  (Monte Carlo {mc[k]:.3g})"
+        beside = "" if mc is None else f"  (Monte Carlo {mc[k]:.3g})" if np.isfinite(mc[k]) \
+            else "  (Monte Carlo: fewer than 2 samples completed)"
         lines.append(f"  {name:24s} {lin[k]:.3g} at t = {t[k]:.6g}{beside}")
     return "\n".join(lines)
 

@@ -112,8 +112,23 @@ def _rows(res: Any, a: np.ndarray) -> np.ndarray:
 
 
 def _std_linear(s: np.ndarray, sigma: np.ndarray) -> np.ndarray:
-    """sqrt of the diagonal of S diag(sigma**2) S^T: sqrt(sum_k (S_k sigma_k)**2)."""
-    return np.sqrt(np.sum((s * sigma) ** 2, axis=-1))
+    """sqrt of the diagonal of S diag(sigma**2) S^T: sqrt(sum_k (S_k sigma_k)**2), scaled by
+    the largest term so that the squares do not overflow.
+
+    Raises
+    ------
+    ModelError
+        When a standard deviation itself exceeds the floating-point range.
+    """
+    with np.errstate(over="ignore", invalid="ignore"):
+        a = np.abs(s * sigma)
+        m = a.max(axis=-1, keepdims=True) if a.shape[-1] else np.zeros(a.shape[:-1] + (1,))
+        safe = np.where(m > 0, m, 1.0)
+        out = (m * np.sqrt(np.sum((a / safe) ** 2, axis=-1, keepdims=True)))[..., 0]
+    if not np.isfinite(out).all():
+        raise ModelError("the first-order standard deviation exceeds the floating-point range: "
+                         "give smaller sigma", "tolerance")
+    return out
 
 
 def _std(x: np.ndarray) -> np.ndarray:
