@@ -4,13 +4,13 @@
 !! the kinematics-only subset, is read too):
 !!   mbd2d 2
 !!   name <model name>
-!!   analysis kinematics | inverse-dynamics | dynamics | statics
+!!   analysis kinematics | inverse-dynamics | dynamics | statics | check
 !!   t0 <time>   t_end <time>   steps <n>   every <k>                  (one per line)
 !!   tol <x>   maxit <n>   tmin <x>   solver auto|dense|banded           (kinematic runs)
 !!   positions_only 0|1                       (kinematics: 1 = positions alone, optional)
 !!   method generalized-alpha|dopri5|baumgarte-rk4|partitioned   rtol <x>   atol <x>   h <x>
 !!   rho_inf <x>   alpha <x>   beta <x>   max_steps <n>                  (dynamics)
-!!   t <time>                                                           (statics)
+!!   t <time>                                                           (statics, check)
 !!   outputs <energy | multipliers | reactions | efforts ...>           (optional columns)
 !!   gravity <gx> <gy>
 !!   bodies <nb>
@@ -65,8 +65,8 @@ module mbd_mbdfile
   real(wp), parameter :: MIN_TOL = 1.0e-15_wp     !! smallest tolerance (as the Python front end)
   integer, parameter :: INT32_MAX = huge(1)       !! largest step limit
   !> the analyses a file can hold
-  character(len=16), parameter :: ANALYSES(4) = [character(len=16) :: 'kinematics', &
-    'inverse-dynamics', 'dynamics', 'statics']
+  character(len=16), parameter :: ANALYSES(5) = [character(len=16) :: 'kinematics', &
+    'inverse-dynamics', 'dynamics', 'statics', 'check']
   !> linear solvers (codes 0, 1, 2) and dynamics methods (codes 1 .. 4) by name
   character(len=8), parameter :: SOLVER_WORDS(0:2) = [character(len=8) :: 'auto', 'dense', &
     'banded']
@@ -210,7 +210,7 @@ contains
         if (key == 'analysis') then
           if (.not. any(ANALYSES == tok(1:16)) .or. len_trim(tok) > 16) then
             call fail('unknown analysis "' // trim(tok(1:40)) // '"; one of kinematics, '// &
-                      'inverse-dynamics, dynamics, statics')
+                      'inverse-dynamics, dynamics, statics, check')
             exit
           end if
           spec%analysis = tok(1:NAME_LEN)

@@ -24,11 +24,11 @@ program mbd2d_solve
   use mbd_kinds, only: wp
   use mbd_status, only: MBD_OK, MBD_SINGULAR_CONFIG, MBD_NO_MEMORY, MSG_LEN
   use mbd_memory, only: REAL_BYTES, mem_check
-  use mbd_mbdfile, only: mbd_spec_t, mbd_read
+  use mbd_mbdfile, only: mbd_spec_t, mbd_read, NAME_LEN
   use mbd_model, only: NFT
   use mbd_constraints, only: con_nrow, con_is_driver
   use mbd_api, only: NINFO, api_sizes, api_kinematics, api_inverse, api_dynamics, api_statics, &
-                     api_reactions, api_dynamics_sens, api_reactions_dp
+                     api_reactions, api_dynamics_sens, api_reactions_dp, api_analyze
   use mbd_batch, only: batch_run, NISET, NRSET
   use mbd_status, only: MBD_NO_CONVERGENCE, MBD_INTEGRATOR_FAILED, MBD_INCONSISTENT
   use mbd_constraints, only: con_nextra
@@ -47,6 +47,14 @@ program mbd2d_solve
       integer(c_int), value :: len
       integer(c_int) :: n
     end function format_e16
+    !> x as "%g" into buf(len); the length written (number_format.c)
+    function format_g6(x, buf, len) result(n) bind(C, name='mbd_format_g6')
+      import :: c_char, c_double, c_int
+      real(c_double), value :: x
+      character(kind=c_char), intent(out) :: buf(*)
+      integer(c_int), value :: len
+      integer(c_int) :: n
+    end function format_g6
     !> x as "%.17g" into buf(len); the length written (number_format.c)
     function format_g17(x, buf, len) result(n) bind(C, name='mbd_format_g17')
       import :: c_char, c_double, c_int
@@ -100,6 +108,10 @@ program mbd2d_solve
   if (status /= MBD_OK) call die(2, trim(msg))
   call api_sizes(spec%nb, spec%ctab, spec%rpar, nq, neq, status, msg, bad)
   if (status /= MBD_OK) call die(2, where(bad, msg))
+  if (spec%analysis == 'check') then
+    call run_check()
+    stop 0, quiet=.true.
+  end if
   dynamic = spec%analysis /= 'kinematics'
   if (spec%analysis /= 'statics' .and. spec%steps_line == 0) &
     call die(2, trim(model_path) // ': the file gives no "steps" line')
@@ -653,6 +665,92 @@ contains
       end do
     end if
   end subroutine lam_values
+
+  !> Degrees of freedom and redundancy at the configuration assembled from q0 at time t:
+  !! the report `mbd2d check` prints (on standard output) and DofReport.to_csv's CSV.
+  subroutine run_check()
+    integer :: rank, mobility, worst, r, nw, u, ios, j
+    real(wp) :: resid, counts(5)
+    real(wp), allocatable :: qa(:)
+    integer, allocatable :: red(:), dp(:)
+    character(len=32) :: word, ts
+    character(kind=c_char) :: cb(32)
+    if (spec%nlabels >= 0 .and. spec%nlabels /= neq) call die(2, trim(model_path) // &
+      ': ' // trim(itoa(spec%nlabels)) // ' labels for ' // trim(itoa(neq)) // ' rows of Phi')
+    if (spec%out_energy .or. spec%out_lam .or. spec%out_reac .or. spec%out_eff .or. &
+        spec%npar > 0 .or. spec%ncase > 0 .or. spec%positions_only) call die(2, &
+      trim(model_path) // ': check takes no outputs, sensitivities, cases or positions_only')
+    allocate (q0(nq), qa(nq), red(neq), dp(neq), stat=ierr)
+    if (ierr /= 0) call die(2, 'not enough memory for the model')
+    q0 = 0.0_wp
+    q0(1:3 * spec%nb) = reshape(spec%q0, [3 * spec%nb])
+    call api_analyze(spec%nb, spec%ctab, spec%rpar, q0, spec%tstat, spec%tol, qa, rank, &
+                     mobility, red, dp, resid, worst, status, msg)
+    if (status < 0) call die(2, where(worst, msg))
+    if (status == MBD_INCONSISTENT) call die(4, trim(msg) // ': the constraints' // &
+      trim(dep_names(dp)) // ' cannot all hold; check their points and dimensions')
+    if (status /= MBD_OK) then
+      if (worst > 0 .and. worst <= spec%nc) call die(4, trim(msg) // ' ("' // &
+        trim(spec%con_names(worst)) // '")')
+      call die(4, trim(msg))
+    end if
+    ! the report, as str(DofReport)
+    nw = max(0, min(int(format_g6(real(spec%tstat, c_double), cb, 32_c_int)), 31))
+    ts = ''
+    do j = 1, nw
+      ts(j:j) = cb(j)
+    end do
+    write (*, '(a)') "model '" // trim(spec%name) // "' at t = " // trim(ts)
+    write (*, '(a,i0)') '  coordinates        ', nq
+    write (*, '(a,i0)') '  equations          ', neq
+    write (*, '(a,i0)') '  rank of J          ', rank
+    write (*, '(a,i0,a)') '  degrees of freedom ', nq - rank, '   (coordinates - rank)'
+    write (*, '(a,i0,a)') '  mobility           ', mobility, '   (joints alone, without drivers)'
+    write (*, '(a,i0,a)') '  redundant          ', count(red /= 0), ' equation(s)'
+    do r = 1, neq
+      if (red(r) /= 0) write (*, '(a)') '    ' // trim(row_label(r))
+    end do
+    if (any(red /= 0)) write (*, '(a)') '  redundant equations repeat what the others impose: '// &
+      'kinematics solves them in least squares; reactions are statically indeterminate'
+    ! the CSV, as DofReport.to_csv (numpy.savetxt: "%.16e", lines ending in LF)
+    open (newunit=u, file=trim(out_path), status='replace', action='write', access='stream', &
+          form='unformatted', iostat=ios)
+    if (ios /= 0) call die(2, 'cannot write ' // trim(out_path))
+    call sput(u, ios, 't')
+    call coordinate_header(u, ios, '')
+    call sput(u, ios, ',coordinates,equations,rank,dof,mobility')
+    do r = 1, neq
+      call sput(u, ios, ',redundant.' // trim(row_label(r)))
+    end do
+    call sput(u, ios, achar(10))
+    call num(spec%tstat, word, nw)
+    call sput(u, ios, word(1:nw))
+    counts = real([nq, neq, rank, nq - rank, mobility], wp)
+    do j = 1, nq + 5 + neq
+      if (j <= nq) then
+        call num(qa(j), word, nw)
+      else if (j <= nq + 5) then
+        call num(counts(j - nq), word, nw)
+      else
+        call num(merge(1.0_wp, 0.0_wp, red(j - nq - 5) /= 0), word, nw)
+      end if
+      call sput(u, ios, ',' // word(1:nw))
+    end do
+    call sput(u, ios, achar(10))
+    close (u)
+    if (ios /= 0) call die(2, 'cannot write ' // trim(out_path) // ' (disk full?)')
+  end subroutine run_check
+
+  !> The label of row r of Phi (lambda's column name): the file's labels, else rowR.
+  function row_label(r) result(s)
+    integer, intent(in) :: r
+    character(len=NAME_LEN + 8) :: s
+    if (spec%nlabels == neq) then
+      s = spec%labels(r)
+    else
+      s = 'row' // trim(itoa(r))
+    end if
+  end function row_label
 
   !> A sweep: every case of the "cases" block in one batch call (as mbd2d.sweep makes it),
   !! written as mbd2d.write_sweep writes a sweep's CSV.

@@ -13,3 +13,9 @@ int mbd_format_g17(double x, char *buf, int len)
 {
     return snprintf(buf, (size_t) len, "%.17g", x);
 }
+
+/* x as C's and Python's "%g" (six significant digits; the check report's time). */
+int mbd_format_g6(double x, char *buf, int len)
+{
+    return snprintf(buf, (size_t) len, "%g", x);
+}

@@ -13,7 +13,7 @@
                     [--samples N --seed S --analysis A --point BODY:X,Y --workers W
                     --scheduler ADDRESS]
     mbd2d synthesize TASK.toml --out BEST.toml [--starts K --seed S --workers N]
-    mbd2d check MODEL.toml
+    mbd2d check MODEL.toml [--t T --tol TOL --out REPORT.csv]
     mbd2d parameters MODEL.toml [--match TEXT]
     mbd2d export MODEL.toml OUT.mbd [--analysis A] --t-end T --steps N [settings of A]
                  [--param NAME=START:STOP:NUM ... --grid]   (a sweep for mbd2d-solve)
@@ -212,11 +212,15 @@ def _parser() -> argparse.ArgumentParser:
     c = sub.add_parser("check", help="degrees of freedom and redundant constraints")
     c.add_argument("model", help="model file (.toml)")
     c.add_argument("--t", type=float, default=0.0, help="time of the check (default 0)")
+    c.add_argument("--tol", type=float, default=None, help="assembly tolerance (default 1e-12)")
+    c.add_argument("--out", default=None, help="also write the report as CSV (the assembled "
+                   "configuration, the counts, a 0/1 column per row of Phi: redundant)")
     e = sub.add_parser("export", help="write a model file with its analysis for the standalone "
                        "mbd2d-solve")
     e.add_argument("model", help="model file (.toml)")
     e.add_argument("out", help="output model file (.mbd)")
-    e.add_argument("--analysis", default="kinematics", choices=ANALYSES[1:] + ("statics",),
+    e.add_argument("--analysis", default="kinematics",
+                   choices=ANALYSES[1:] + ("statics", "check"),
                    help="the analysis mbd2d-solve runs (default kinematics)")
     e.add_argument("--t-end", type=float, default=None, help="final time (not for statics)")
     e.add_argument("--steps", type=int, default=None, help="output intervals")
@@ -606,7 +610,12 @@ def main(argv: Sequence[str] | None = None) -> int:
             return _synthesize(args)
         model = load(args.model)
         if args.command == "check":
-            print(model.analyze_dof(t=args.t))
+            if args.out is not None and not str(args.out).endswith(".csv"):
+                raise ModelError(f"--out must end in .csv, got {args.out!r}", "command line")
+            report = model.analyze_dof(t=args.t, tol=args.tol)
+            print(report)
+            if args.out is not None:
+                report.to_csv(args.out)
             return EXIT_OK
         if args.command == "parameters":
             print(_parameters_report(model, args.match))

@@ -38,4 +38,5 @@ def analyze_dof(model: ModelDescription, t: float = 0.0, tol: float | None = Non
         raise error_for("dof", status, out.msg, t=t)
     cons, rows = row_names(p, model, out.red)
     return DofReport(model.name, t, p.nq, p.neq, int(out.rank), p.nq - int(out.rank),
-                     int(out.mobility), rows, cons, out.q)
+                     int(out.mobility), rows, cons, out.q, list(p.coordinate_names),
+                     list(p.row_labels))

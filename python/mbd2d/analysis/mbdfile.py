@@ -30,8 +30,8 @@ from .settings import (SOLVERS, check_solver, check_span, output_rows, require_d
                        solver_code)
 
 FORMAT = 2
-#: the analyses a file can hold
-ANALYSES = ("kinematics", "inverse-dynamics", "dynamics", "statics")
+#: the analyses a file can hold (check: degrees of freedom and redundancy, as `mbd2d check`)
+ANALYSES = ("kinematics", "inverse-dynamics", "dynamics", "statics", "check")
 #: every kind code the format holds: (code, type, parameters in the params list)
 JOINT_KINDS = [(c.kind, c.type, d) for c, d in [
     (Revolute, "s_i(2) s_j(2)"),
@@ -79,7 +79,7 @@ def header() -> str:
         "# Plain text, whitespace separated. Lines starting with '#' are comments.",
         "#   mbd2d 2                      format and version",
         "#   name NAME                    model name",
-        "#   analysis A                   kinematics | inverse-dynamics | dynamics | statics",
+        "#   analysis A                   kinematics | inverse-dynamics | dynamics | statics | check",
         "#   t0, t_end, steps, every      outputs t0 + k (t_end - t0) / steps, k = 0..steps, "
         "every k-th kept",
         "#   tol, maxit, tmin, solver     Newton tolerance, iterations, singular-time "
@@ -87,7 +87,7 @@ def header() -> str:
         "#   positions_only 0|1           kinematics: 1 = positions alone (optional)",
         "#   method, rtol, atol, h, rho_inf, alpha, beta, max_steps   dynamics (0, or -1 for "
         "rho_inf, alpha, beta: default)",
-        "#   t                            statics: the time of loads and drivers",
+        "#   t                            statics: the time of loads and drivers; check: its time",
         "#   outputs W ...                optional CSV columns: energy multipliers reactions "
         "efforts",
         "#   gravity GX GY",
@@ -143,7 +143,7 @@ def _outputs(outputs: Any, analysis: str) -> list[str]:
         if w not in OUTPUTS:
             raise ModelError(f"unknown output {w!r}; the optional columns are "
                              f"{', '.join(OUTPUTS)}", "export")
-    if words and analysis == "kinematics":
+    if words and analysis in ("kinematics", "check"):
         raise ModelError(f"{', '.join(words)} need multipliers: export inverse-dynamics, "
                          "dynamics or statics", "export")
     if "energy" in words and analysis == "statics":
@@ -190,10 +190,12 @@ def file_lines(model: ModelDescription, t_end: float | None = None, steps: int |
                          "export")
     params = requested(model, sensitivities)
     check_positions_only(params, pos)
+    if params and analysis == "check":
+        raise ModelError("check computes no sensitivities", "export")
     p = pack(model)
     lines = [header(), f"mbd2d {FORMAT}",
              f"name {model.name.replace(' ', '_') or 'model'}", f"analysis {analysis}"]
-    if analysis != "statics":
+    if analysis not in ("statics", "check"):
         if t_end is None or steps is None:
             raise ModelError(f"{analysis} needs t_end and steps", "export")
         t0, t_end, steps = check_span(t0, t_end, steps)
@@ -215,11 +217,14 @@ def file_lines(model: ModelDescription, t_end: float | None = None, steps: int |
         lines += [f"method {st.method}", f"rtol {_r(st.rtol)}", f"atol {_r(st.atol)}",
                   f"h {_r(st.h)}", f"rho_inf {_r(st.rho_inf)}", f"alpha {_r(st.alpha)}",
                   f"beta {_r(st.beta)}", f"max_steps {st.max_steps}"]
+    elif analysis == "check":
+        tol_v, _ = check_solver(tol, None)
+        lines += [f"tol {_r(tol_v)}", f"t {_r(number(t, 't', 'export'))}"]
     else:
         lines.append(f"t {_r(number(t, 't', 'export'))}")
     if words:
         lines.append("outputs " + " ".join(words))
-    dyn = pack_dynamics(model, p) if analysis != "kinematics" else None
+    dyn = pack_dynamics(model, p) if analysis not in ("kinematics", "check") else None
     if dyn is not None:
         lines.append(f"gravity {_r(dyn.grav[0])} {_r(dyn.grav[1])}")
     lines.append(f"bodies {p.nb}")

@@ -2,8 +2,11 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
+
+from .files import write_csv
 
 
 @dataclass
@@ -28,6 +31,8 @@ class DofReport:
         The joints or drivers those rows belong to.
     q : numpy.ndarray
         The assembled configuration.
+    coordinate_names, row_labels : list of str
+        The names of the entries of q and of the rows of Phi.
     """
 
     model_name: str
@@ -40,6 +45,25 @@ class DofReport:
     redundant_rows: list[str] = field(default_factory=list)
     redundant_constraints: list[str] = field(default_factory=list)
     q: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    coordinate_names: list[str] = field(default_factory=list)
+    row_labels: list[str] = field(default_factory=list)
+
+    def table(self) -> tuple[list[str], np.ndarray]:
+        """Header and the one row of the CSV: ``t``, the assembled configuration (a column
+        per coordinate), ``coordinates``, ``equations``, ``rank``, ``dof``, ``mobility``, then
+        ``redundant.LABEL`` per row of Phi (1 redundant, 0 not); ``mbd2d-solve`` writes the
+        same for an exported ``check``."""
+        header = ["t", *self.coordinate_names, "coordinates", "equations", "rank", "dof",
+                  "mobility", *(f"redundant.{r}" for r in self.row_labels)]
+        red = set(self.redundant_rows)
+        row = [self.t, *self.q, self.coordinates, self.equations, self.rank, self.dof,
+               self.mobility, *(1.0 if r in red else 0.0 for r in self.row_labels)]
+        return header, np.array([row], dtype=float)
+
+    def to_csv(self, path: Any) -> None:
+        """Write :meth:`table` as CSV (numbers as every mbd2d CSV, ``%.16e``)."""
+        header, rows = self.table()
+        write_csv(path, header, rows, "to_csv")
 
     def __str__(self) -> str:
         lines = [f"model '{self.model_name}' at t = {self.t:g}",
