@@ -240,6 +240,20 @@ subroutine core_influence(nb, nc, ctab, np, rpar, nq, nt, q, t, row, u, ok, stat
   call api_influence(nb, ctab, rpar, q, t, row, u, ok, status, msg)
 end subroutine core_influence
 
+subroutine core_link_angle(nq, nt, q, kind, b, s, mu, status, msg)
+  use iso_c_binding, only: c_double, c_int
+  use mbd_measures, only: api_link_angle
+  implicit none
+  integer(c_int), intent(in) :: nq, nt, kind
+  integer(c_int), intent(in) :: b(3)
+  real(c_double), intent(in) :: q(nq, nt), s(2, 3)
+  real(c_double), intent(out) :: mu(nt)
+  integer(c_int), intent(out) :: status
+  character(len=512), intent(out) :: msg
+  !f2py intent(hide) :: nq, nt
+  call api_link_angle(q, kind, b, s, mu, status, msg)
+end subroutine core_link_angle
+
 subroutine core_fun_values(np, p, nt, t, f, f1, f2, status, msg)
   use iso_c_binding, only: c_double, c_int
   use mbd_measures, only: api_fun_values

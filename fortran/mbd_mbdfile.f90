@@ -29,6 +29,10 @@
 !!   sensitivities <npar>                     (optional: design parameters)
 !!   <name> <table> <index>                   (npar lines; table 1 params, 2 masses,
 !!                              3 gravity, 4 fparams; index 1-based in that list)
+!!   measures <nm>                            (optional: measure columns)
+!!   <spec> angle <kind> <b1> <x> <y> <b2> <x> <y> <b3> <x> <y>   (transmission angle)
+!!   <spec> ratio|advantage <ref> <xkind> <xindex> <ykind> <yindex>  (influence ratios)
+!!   <spec> conditioning                      (distance to a dead centre)
 !!   cases <np> <nv> <ncase>                  (optional: a sweep, `mbd2d.export_sweep`)
 !!   <name>                                   (np lines: the swept parameters)
 !!   <table> <index>                          (nv lines: the entries each case sets)
@@ -56,9 +60,13 @@ module mbd_mbdfile
   implicit none
   private
   public :: NAME_LEN, PNAME_LEN, MAX_STEPS, mbd_spec_t, mbd_read, ANALYSES
+  public :: MEAS_ANGLE, MEAS_RATIO, MEAS_ADVANTAGE, MEAS_CONDITIONING
 
   integer, parameter :: NAME_LEN = 64             !! longest body or constraint name
   integer, parameter :: PNAME_LEN = 256           !! longest design parameter name
+  !> measure kinds (the "measures" block)
+  integer, parameter :: MEAS_ANGLE = 1, MEAS_RATIO = 2, MEAS_ADVANTAGE = 3, &
+                        MEAS_CONDITIONING = 4
   integer, parameter :: LINE_LEN = 4096           !! longest line
   integer, parameter :: MAX_STEPS = 1000000000    !! output intervals (as the Python front end)
   integer, parameter :: MAX_ITER = 1000000        !! Newton iterations (as the Python front end)
@@ -115,6 +123,15 @@ module mbd_mbdfile
     integer, allocatable :: ptab(:, :)    !! (2, npar) table and index (mbd_sensitivity)
     integer, allocatable :: par_line(:)   !! line of each design parameter
     integer :: sens_line = 0              !! line of "sensitivities" (0: not given)
+    ! measure columns: spec (the column's name), kind, integers and reals of the recipe
+    integer :: nmeas = 0
+    character(len=PNAME_LEN), allocatable :: meas_names(:)
+    integer, allocatable :: meas_kind(:)      !! MEAS_ANGLE ... MEAS_CONDITIONING
+    !> angle: kind (1 turning, 2 sliding), bodies b1, b2, b3; ratio, advantage: the
+    !! reference row, kind (1 coordinate, 2 driver) and index of X, then of Y
+    integer, allocatable :: meas_int(:, :)    !! (5, nmeas)
+    real(wp), allocatable :: meas_pts(:, :, :)  !! (2, 3, nmeas) an angle's points
+    integer, allocatable :: meas_line(:)
     ! a sweep (mbd_batch): its parameters, the entries each case sets, their values
     integer :: ncase = 0, ncp = 0, nv = 0
     integer :: cases_line = 0             !! line of "cases" (0: not given)
@@ -138,7 +155,7 @@ contains
     character(len=NAME_LEN) :: key
     character(len=LINE_LEN) :: tok
     logical :: have_header, done, seen_b, seen_c, seen_p, seen_f, seen_fp, seen_l, seen_s
-    logical :: seen_k, seen_o
+    logical :: seen_k, seen_o, seen_m
     real(wp) :: x
     status = MBD_OK; msg = ''
     ! first pass: the data lines (not blank, not comments) and their characters
@@ -166,7 +183,7 @@ contains
     lineno = 0; nread = 0
     have_header = .false.; done = .false.; seen_b = .false.; seen_c = .false.
     seen_p = .false.; seen_f = .false.; seen_fp = .false.; seen_l = .false.; seen_s = .false.
-    seen_k = .false.; seen_o = .false.
+    seen_k = .false.; seen_o = .false.; seen_m = .false.
     allocate (spec%body_names(0), spec%con_names(0), spec%q0(3, 0), stat=ierr)
     if (ierr == 0) allocate (spec%ctab(NCT, 0), spec%con_line(0), spec%rpar(0), stat=ierr)
     if (ierr == 0) allocate (spec%bmass(2, 0), spec%v0(3, 0), spec%force_names(0), &
@@ -174,6 +191,8 @@ contains
     if (ierr == 0) allocate (spec%par_names(0), spec%ptab(2, 0), spec%par_line(0), stat=ierr)
     if (ierr == 0) allocate (spec%case_names(0), spec%vtab(2, 0), spec%cvals(0, 0), &
                              spec%opens(2, 0), stat=ierr)
+    if (ierr == 0) allocate (spec%meas_names(0), spec%meas_kind(0), spec%meas_int(5, 0), &
+                             spec%meas_pts(2, 3, 0), spec%meas_line(0), stat=ierr)
     if (ierr /= 0) then
       call mem_fail(zero, 'the model file', 'free some memory', status, msg); close (u); return
     end if
@@ -548,6 +567,12 @@ contains
         end if
         seen_s = .true.
         if (.not. read_sensitivities()) exit
+      case ('measures')
+        if (seen_m) then
+          call fail('"measures" is given twice'); exit
+        end if
+        seen_m = .true.
+        if (.not. read_measures()) exit
       case ('cases')
         if (seen_k) then
           call fail('"cases" is given twice'); exit
@@ -835,6 +860,89 @@ contains
       end do
       read_cases = read_reals_2d(spec%cvals)
     end function read_cases
+
+    !> The "measures" block: a count, then a recipe line per measure column.
+    logical function read_measures()
+      integer :: j, it, nt
+      integer(int64) :: v
+      character(len=16) :: word
+      read_measures = .false.
+      if (.not. count_ok(n, 'measure', 1)) return
+      deallocate (spec%meas_names, spec%meas_kind, spec%meas_int, spec%meas_pts, spec%meas_line)
+      allocate (spec%meas_names(n), spec%meas_kind(n), spec%meas_int(5, n), &
+                spec%meas_pts(2, 3, n), spec%meas_line(n), stat=ierr)
+      if (ierr /= 0) then
+        call mem_fail(real(n, wp) * (PNAME_LEN + 100), 'the measures', 'give fewer measures', &
+                      status, msg)
+        call where_prefix(); return
+      end if
+      spec%nmeas = n; spec%meas_int = 0; spec%meas_pts = zero
+      do j = 1, n
+        call next_line(ios)
+        if (ios /= 0) return
+        spec%meas_line(j) = lineno
+        nt = count_tokens(line)
+        pos = 1
+        call next_token(line, pos, tok)
+        if (len_trim(tok) > PNAME_LEN) then
+          call fail('a measure name is longer than 256 characters'); return
+        end if
+        spec%meas_names(j) = tok(1:PNAME_LEN)
+        call next_token(line, pos, tok)
+        word = tok(1:16)
+        select case (word)
+        case ('angle')
+          if (nt /= 12) then
+            call fail('bad measure line: SPEC angle KIND B1 X Y B2 X Y B3 X Y expected'); return
+          end if
+          spec%meas_kind(j) = MEAS_ANGLE
+          call next_token(line, pos, tok)
+          if (.not. read_int(tok, v)) v = -1
+          if (v < 1 .or. v > 2) then
+            call fail('"' // trim(tok(1:40)) // '": an angle KIND is 1 (turning) or 2 '// &
+                      '(sliding)'); return
+          end if
+          spec%meas_int(1, j) = int(v)
+          do it = 1, 3
+            call next_token(line, pos, tok)
+            if (.not. read_int(tok, v)) v = -1
+            if (v < 0 .or. v > huge(1)) then
+              call fail('"' // trim(tok(1:40)) // '": a body number is a whole number '// &
+                        'from 0 (ground)'); return
+            end if
+            spec%meas_int(1 + it, j) = int(v)
+            call next_token(line, pos, tok)
+            if (.not. real_ok(tok, spec%meas_pts(1, it, j))) return
+            call next_token(line, pos, tok)
+            if (.not. real_ok(tok, spec%meas_pts(2, it, j))) return
+          end do
+        case ('ratio', 'advantage')
+          if (nt /= 7) then
+            call fail('bad measure line: SPEC ' // trim(word) // ' REF XKIND XINDEX YKIND '// &
+                      'YINDEX expected'); return
+          end if
+          spec%meas_kind(j) = merge(MEAS_RATIO, MEAS_ADVANTAGE, word == 'ratio')
+          do it = 1, 5
+            call next_token(line, pos, tok)
+            if (.not. read_int(tok, v)) v = -1
+            if (v < 1 .or. v > huge(1) .or. ((it == 2 .or. it == 4) .and. v > 2)) then
+              call fail('"' // trim(tok(1:40)) // '": REF and the indices are whole numbers '// &
+                        'from 1, the kinds 1 (coordinate) or 2 (driver)'); return
+            end if
+            spec%meas_int(it, j) = int(v)
+          end do
+        case ('conditioning')
+          if (nt /= 2) then
+            call fail('bad measure line: SPEC conditioning expected'); return
+          end if
+          spec%meas_kind(j) = MEAS_CONDITIONING
+        case default
+          call fail('unknown measure "' // trim(tok(1:40)) // '"; angle, ratio, advantage '// &
+                    'or conditioning'); return
+        end select
+      end do
+      read_measures = .true.
+    end function read_measures
 
     !> The "opens" block: a count, then RPAR_INDEX ROW per open phase.
     logical function read_opens()

@@ -14,6 +14,11 @@
 !!                 constraints): least squares by pivoted QR, exact while they agree.
 !!   fun_values    f(t), f'(t), f''(t) of an encoded function of time at many times (the
 !!                 applied loads drawn as arrows).
+!!   link_angle    the transmission angle (Norton, Design of Machinery, ch. 4) from points and
+!!                 an axis fixed in bodies: e = (A - B)/|A - B| along the coupler from the
+!!                 joint B to its other joint A; an output turning about P: p = (P - B)/|P - B|,
+!!                 mu = acos(e . p); an output sliding along the axis u: mu = asin(|e . u|).
+!!                 The front end finds the joints; mbd2d-solve reads the same recipe.
 !!
 !! Work arrays are allocated once per call (with stat=), none in the loop over states.
 module mbd_measures
@@ -28,7 +33,9 @@ module mbd_measures
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   implicit none
   private
-  public :: api_conditioning, api_influence, api_fun_values
+  public :: api_conditioning, api_influence, api_fun_values, api_link_angle
+  !> link_angle recipes: an output link turning about a second pivot, or sliding
+  integer, parameter, public :: ANGLE_TURN = 1, ANGLE_SLIDE = 2
 
 contains
 
@@ -167,6 +174,70 @@ contains
       call fun_eval(p, t(k), f(k), f1(k), f2(k))
     end do
   end subroutine api_fun_values
+
+  !> The transmission angle at every state q(:, k) (nq, nt): points s(:, 1) of body b(1) (B,
+  !! the joint), s(:, 2) of body b(2) (A, the coupler's other joint) and, for ANGLE_TURN,
+  !! s(:, 3) of body b(3) (P, the output's other pivot); for ANGLE_SLIDE, s(:, 3) the slide's
+  !! axis in body b(3). Body 0 is ground (s global). Radians: [0, pi] turning, [0, pi/2]
+  !! sliding (pi/2 - the acute angle between the coupler and the slide).
+  subroutine api_link_angle(q, kind, b, s, mu, status, msg)
+    real(wp), intent(in) :: q(:, :)             !! states (nq, nt)
+    integer, intent(in) :: kind                 !! ANGLE_TURN or ANGLE_SLIDE
+    integer, intent(in) :: b(3)                 !! bodies (0 ground)
+    real(wp), intent(in) :: s(2, 3)             !! points (and the axis) in their bodies
+    real(wp), intent(out) :: mu(:)              !! the angle at each state (nt)
+    integer, intent(out) :: status              !! MBD_OK or < 0
+    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    real(wp) :: pb(2), pa(2), e(2), v(2), d
+    integer :: k
+    mu = zero; status = MBD_OK; msg = ''
+    if (size(mu) /= size(q, 2)) then
+      status = MBD_BAD_COUNT; msg = 'array sizes do not match the states'; return
+    end if
+    if ((kind /= ANGLE_TURN .and. kind /= ANGLE_SLIDE) .or. any(b < 0) .or. &
+        any(3 * b > size(q, 1))) then
+      status = MBD_BAD_PARAM; msg = 'link angle: unknown kind or body out of range'; return
+    end if
+    if (.not. (all(ieee_is_finite(q)) .and. all(ieee_is_finite(s)))) then
+      status = MBD_BAD_PARAM; msg = 'the states and points must be finite'; return
+    end if
+    do k = 1, size(q, 2)
+      pb = point(b(1), s(:, 1), q(:, k))
+      pa = point(b(2), s(:, 2), q(:, k))
+      e = (pa - pb) / hypot(pa(1) - pb(1), pa(2) - pb(2))
+      if (kind == ANGLE_TURN) then
+        v = point(b(3), s(:, 3), q(:, k)) - pb
+      else
+        v = turned(b(3), s(:, 3), q(:, k))
+      end if
+      v = v / hypot(v(1), v(2))
+      d = e(1) * v(1) + e(2) * v(2)
+      if (kind == ANGLE_TURN) then
+        mu(k) = acos(max(-one, min(one, d)))
+      else
+        mu(k) = asin(max(zero, min(one, abs(d))))
+      end if
+    end do
+  contains
+    !> r_i + A(theta_i) s' (ground: s').
+    pure function point(bi, sl, qk) result(r)
+      integer, intent(in) :: bi
+      real(wp), intent(in) :: sl(2), qk(:)
+      real(wp) :: r(2)
+      r = sl
+      if (bi > 0) r = qk(3 * bi - 2:3 * bi - 1) + turned(bi, sl, qk)
+    end function point
+    !> A(theta_i) v' (ground: v').
+    pure function turned(bi, vl, qk) result(r)
+      integer, intent(in) :: bi
+      real(wp), intent(in) :: vl(2), qk(:)
+      real(wp) :: r(2), c, sn
+      r = vl
+      if (bi == 0) return
+      c = cos(qk(3 * bi)); sn = sin(qk(3 * bi))
+      r = [c * vl(1) - sn * vl(2), sn * vl(1) + c * vl(2)]
+    end function turned
+  end subroutine api_link_angle
 
   !> States and times finite and sized for the model.
   logical function check_states(m, q, t, nt, status, msg) result(good)

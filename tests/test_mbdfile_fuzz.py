@@ -35,7 +35,7 @@ CODES = {0, 2, 3, 4}
 EXAMPLES = ["fourbar_grashof", "fourbar_seed", "fourbar_redundant", "slider_crank",
             "cam_follower", "door_two_hinges", "parallelogram_extra_link"]
 COUNT_KEYS = ("bodies", "constraints", "params", "steps", "maxit", "every", "labels", "forces",
-              "fparams", "max_steps", "sensitivities", "opens")
+              "fparams", "max_steps", "sensitivities", "opens", "measures")
 # (no counts that are valid and merely large: 1e9 steps need 216 GB of outputs and more)
 HUGE = [-1, -7, -2**31, -2**31 - 1, 2**31 - 1, 2**31, 2**32 + 1, 10**9, 10**9 + 1, 10**10,
         10**12, 2**63 - 1, 2**63, 10**19, 10**30]
@@ -77,7 +77,12 @@ def bases(tmp_path_factory: pytest.TempPathFactory) -> list[bytes]:
             (heavy, {"analysis": "dynamics", "t_end": 0.2, "steps": 10,
                      "sensitivities": ["body.crank.inertia"]}),
             (swing, {"analysis": "statics", "outputs": ["reactions", "efforts"],
-                     "sensitivities": ["body.bar.mass", "force.torsion.angle0"]})]):
+                     "sensitivities": ["body.bar.mass", "force.torsion.angle0"]}),
+            # measure columns: every recipe kind
+            (heavy, {"analysis": "inverse-dynamics", "t_end": 1.0, "steps": 20,
+                     "measures": ["transmission_angle:B", "velocity_ratio:motor:rocker.theta",
+                                  "mechanical_advantage:motor:rocker.theta",
+                                  "dead_centre_distance"]})]):
         f = d / f"dyn{k}.mbd"
         model.export(f, **kw)
         out.append(f.read_bytes())

@@ -20,11 +20,14 @@
 !! outputs, held in memory, are checked against it (mem_check).
 program mbd2d_solve
   use, intrinsic :: iso_fortran_env, only: error_unit
-  use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan
+  use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan, ieee_value, &
+                                          ieee_positive_inf, ieee_copy_sign
   use mbd_kinds, only: wp
   use mbd_status, only: MBD_OK, MBD_SINGULAR_CONFIG, MBD_NO_MEMORY, MSG_LEN
   use mbd_memory, only: REAL_BYTES, mem_check
-  use mbd_mbdfile, only: mbd_spec_t, mbd_read, NAME_LEN
+  use mbd_mbdfile, only: mbd_spec_t, mbd_read, NAME_LEN, MEAS_ANGLE, MEAS_RATIO, &
+                         MEAS_ADVANTAGE, MEAS_CONDITIONING
+  use mbd_measures, only: api_conditioning, api_influence, api_link_angle
   use mbd_model, only: NFT
   use mbd_constraints, only: con_nrow, con_is_driver
   use mbd_api, only: NINFO, api_sizes, api_kinematics, api_inverse, api_dynamics, api_statics, &
@@ -84,6 +87,7 @@ program mbd2d_solve
   character(len=MSG_LEN), allocatable :: bmsg(:)
   character(len=4 * MSG_LEN), allocatable :: cmsg(:)
   integer :: code = 0, nrow = 0, nd = 0, nlam = 0   !! batch analysis, rows, rows of q_dot, lambda
+  real(wp), allocatable :: mvals(:, :)                !! the measures (nmeas, rows written)
   !> the run's status when sensitivities turn non-finite (rows cut there, exit code 4)
   integer, parameter :: NONFINITE = 100
   integer :: nsr
@@ -129,6 +133,7 @@ program mbd2d_solve
   if (spec%analysis == 'statics' .and. spec%out_energy) call die(2, trim(model_path) // &
     ': statics has no energy output')
   call check_sensitivities()
+  call check_measures()
   if (spec%ncase > 0) then
     call run_sweep()
     stop 0, quiet=.true.
@@ -244,6 +249,7 @@ program mbd2d_solve
   call times()
   if (sens) call finite_rows()
   if (spec%out_reac .and. nout > 0) call reactions()
+  call eval_measures()
   call write_csv(trim(out_path))
   if (status == MBD_SINGULAR_CONFIG) then
     call die(3, trim(singular_message()))
@@ -307,6 +313,100 @@ contains
                  'in the parameters')
     end do
   end subroutine check_sensitivities
+
+  !> The measures' recipes lie in the model (bodies, rows of Phi, coordinates) and the
+  !! analysis has rows over time.
+  subroutine check_measures()
+    integer :: j, k, lim
+    do j = 1, spec%nmeas
+      if (spec%analysis == 'statics') call die(2, trim(model_path) // ':' // &
+        trim(itoa(spec%meas_line(j))) // ': measures are columns of a run over time, not of '// &
+        'statics')
+      select case (spec%meas_kind(j))
+      case (MEAS_ANGLE)
+        if (any(spec%meas_int(2:4, j) > spec%nb)) call die(2, trim(model_path) // ':' // &
+          trim(itoa(spec%meas_line(j))) // ': measure "' // trim(spec%meas_names(j)) // &
+          '": a body number beyond the ' // trim(itoa(spec%nb)) // ' bodies')
+      case (MEAS_RATIO, MEAS_ADVANTAGE)
+        if (spec%meas_int(1, j) > neq) call bad_measure(j)
+        do k = 2, 4, 2                   ! X, then Y: a coordinate (1) or a driver's row (2)
+          lim = merge(nq, neq, spec%meas_int(k, j) == 1)
+          if (spec%meas_int(k + 1, j) > lim) call bad_measure(j)
+        end do
+      end select
+    end do
+  end subroutine check_measures
+
+  subroutine bad_measure(j)
+    integer, intent(in) :: j
+    call die(2, trim(model_path) // ':' // trim(itoa(spec%meas_line(j))) // ': measure "' // &
+             trim(spec%meas_names(j)) // '": a row or coordinate beyond the model (' // &
+             trim(itoa(neq)) // ' rows of Phi, ' // trim(itoa(nq)) // ' coordinates)')
+  end subroutine bad_measure
+
+  !> The measures at the rows written (the core, as the Python path's table): the
+  !! conditioning of J, the transmission angle, and the ratios of influence coefficients.
+  subroutine eval_measures()
+    integer :: j, k, st
+    real(wp) :: scale, num, den, sing
+    real(wp), allocatable :: u(:, :), col(:), dx(:), dy(:)
+    integer, allocatable :: okf(:)
+    if (spec%nmeas == 0 .or. nout == 0) return
+    allocate (mvals(spec%nmeas, nout), u(nq, nout), col(nout), dx(nout), dy(nout), &
+              okf(nout), stat=ierr)
+    if (ierr /= 0) call die(2, 'not enough memory for the measures; give fewer steps')
+    do j = 1, spec%nmeas
+      select case (spec%meas_kind(j))
+      case (MEAS_CONDITIONING)
+        call api_conditioning(spec%nb, spec%ctab, spec%rpar, qout(:, 1:nout), tout(1:nout), &
+                              col, st, msg)
+      case (MEAS_ANGLE)
+        call api_link_angle(qout(:, 1:nout), spec%meas_int(1, j), spec%meas_int(2:4, j), &
+                            spec%meas_pts(:, :, j), col, st, msg)
+      case default
+        call api_influence(spec%nb, spec%ctab, spec%rpar, qout(:, 1:nout), tout(1:nout), &
+                           spec%meas_int(1, j), u, okf, st, msg)
+        if (st == MBD_OK) then
+          scale = maxval(abs(u))
+          call measure_rate(j, 2, u, scale, dx)
+          call measure_rate(j, 4, u, scale, dy)
+          ! Python's velocity_ratio dY/dX (singular: inf), mechanical_advantage dX/dY (0)
+          sing = merge(ieee_value(0.0_wp, ieee_positive_inf), 0.0_wp, &
+                       spec%meas_kind(j) == MEAS_RATIO)
+          do k = 1, nout
+            num = merge(dy(k), dx(k), spec%meas_kind(j) == MEAS_RATIO)
+            den = merge(dx(k), dy(k), spec%meas_kind(j) == MEAS_RATIO)
+            if (okf(k) /= 1 .or. (den == 0.0_wp .and. num == 0.0_wp)) then
+              col(k) = sing
+            else if (den == 0.0_wp) then
+              col(k) = ieee_copy_sign(ieee_value(0.0_wp, ieee_positive_inf), num)
+            else
+              col(k) = num / den
+            end if
+          end do
+        end if
+      end select
+      if (st /= MBD_OK) call die(4, 'measure "' // trim(spec%meas_names(j)) // &
+                                 '" could not be computed: ' // trim(msg))
+      mvals(j, :) = col
+    end do
+  end subroutine eval_measures
+
+  !> dX/ds of the quantity at meas_int(i:i+1, j) from the influence coefficients u (nq,
+  !! rows): a coordinate's, 1 for the reference driver itself, 0 for another (held) driver.
+  subroutine measure_rate(j, i, u, scale, d)
+    integer, intent(in) :: j, i
+    real(wp), intent(in) :: u(:, :), scale
+    real(wp), intent(out) :: d(:)
+    if (spec%meas_int(i, j) == 1) then
+      d = u(spec%meas_int(i + 1, j), :)
+      if (.not. maxval(abs(d)) > 1.0e-12_wp * scale) call die(2, 'measure "' // &
+        trim(spec%meas_names(j)) // '": a quantity does not move with the driver (its '// &
+        'influence coefficient is zero throughout): no ratio to it')
+    else
+      d = merge(1.0_wp, 0.0_wp, spec%meas_int(i + 1, j) == spec%meas_int(1, j))
+    end if
+  end subroutine measure_rate
 
   !> Keep the rows before the first one with a non-finite sensitivity (as the Python path:
   !! no result leaves with a non-finite number); status NONFINITE when rows are cut.
@@ -459,7 +559,7 @@ contains
     real(wp), allocatable :: v(:)
     character(len=32) :: word
     integer :: nw
-    ncols = 1 + 9 * spec%nb + 5 + neq + 6 * spec%nc + spec%nc + 4 * spec%nf + &
+    ncols = 1 + 9 * spec%nb + 5 + neq + 6 * spec%nc + spec%nc + 4 * spec%nf + spec%nmeas + &
             spec%npar * (9 * spec%nb + neq + 6 * spec%nc + spec%nc)
     allocate (v(ncols), stat=ierr)
     if (ierr /= 0) call die(2, 'not enough memory to write ' // path)
@@ -488,6 +588,9 @@ contains
         end if
       end do
     end if
+    do j = 1, spec%nmeas
+      call put(u, ios, ',' // trim(spec%meas_names(j)))
+    end do
     do j = 1, spec%npar
       call motion_header(u, ios, j)
       if (lam_sens) call lam_header(u, ios, j)
@@ -613,6 +716,9 @@ contains
         end if
       end do
     end if
+    if (spec%nmeas > 0) then
+      v(n + 1:n + spec%nmeas) = mvals(:, k); n = n + spec%nmeas
+    end if
     do j = 1, spec%npar
       call motion_values(sq(:, j, k), sqd(:, j, k), sqdd(:, j, k), v, n)
       if (.not. lam_sens) cycle
@@ -678,7 +784,8 @@ contains
     if (spec%nlabels >= 0 .and. spec%nlabels /= neq) call die(2, trim(model_path) // &
       ': ' // trim(itoa(spec%nlabels)) // ' labels for ' // trim(itoa(neq)) // ' rows of Phi')
     if (spec%out_energy .or. spec%out_lam .or. spec%out_reac .or. spec%out_eff .or. &
-        spec%npar > 0 .or. spec%ncase > 0 .or. spec%positions_only) call die(2, &
+        spec%npar > 0 .or. spec%ncase > 0 .or. spec%positions_only .or. spec%nmeas > 0) &
+      call die(2, &
       trim(model_path) // ': check takes no outputs, sensitivities, cases or positions_only')
     allocate (q0(nq), qa(nq), red(neq), dp(neq), stat=ierr)
     if (ierr /= 0) call die(2, 'not enough memory for the model')
@@ -761,9 +868,10 @@ contains
     integer, allocatable :: bft(:, :)
     if (sens) call die(2, trim(model_path) // ':' // trim(itoa(spec%cases_line)) // &
       ': sweeps compute no sensitivities: run the cases one by one, or mbd2d.tolerance')
-    if (spec%out_energy .or. spec%out_lam .or. spec%out_reac .or. spec%out_eff) &
+    if (spec%out_energy .or. spec%out_lam .or. spec%out_reac .or. spec%out_eff .or. &
+        spec%nmeas > 0) &
       call die(2, trim(model_path) // ': a sweep writes its own columns (q, q_dot, q_ddot, '// &
-               'efforts): give no "outputs" line with "cases"')
+               'efforts): give no "outputs" or "measures" line with "cases"')
     call check_case_entries()
     iset = 0; rset = 0.0_wp
     select case (spec%analysis)

@@ -26,6 +26,10 @@ drift), ``--multipliers``, ``--reactions`` and ``--efforts`` (need multipliers: 
 dynamics, dynamics, statics, or kinematics of a model with masses; inverse-dynamics writes
 the efforts unless ``--no-efforts``). ``export`` writes them into the file for mbd2d-solve.
 
+``--measure SPEC`` (repeatable; kinematics, inverse-dynamics, dynamics, export) adds a column
+per measure: ``transmission_angle:JOINT[:OUTPUT]``, ``velocity_ratio:INPUT:OUTPUT[:VIA]``,
+``mechanical_advantage:INPUT:OUTPUT[:VIA]`` or ``dead_centre_distance``.
+
 ``--sensitivities NAME,...`` (kinematics, inverse-dynamics, statics, dynamics by dopri5,
 export) computes the design sensitivities with respect to the named parameters (``mbd2d
 parameters MODEL`` lists them) and adds the columns ``d(COLUMN)/d(NAME)`` to the CSV
@@ -100,6 +104,13 @@ def _outputs(args: argparse.Namespace) -> dict[str, bool]:
     return {k: bool(getattr(args, k, False)) for k in OUTPUTS if getattr(args, k, False)}
 
 
+def _measures(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--measure", action="append", default=None, metavar="SPEC",
+                   help="a measure column (repeatable): transmission_angle:JOINT[:OUTPUT], "
+                   "velocity_ratio:INPUT:OUTPUT[:VIA], mechanical_advantage:INPUT:OUTPUT[:VIA] "
+                   "or dead_centre_distance")
+
+
 def _sensitivities(p: argparse.ArgumentParser) -> None:
     p.add_argument("--sensitivities", action="append", default=None, metavar="NAME,...",
                    help="design parameters (`mbd2d parameters MODEL` lists them): adds the "
@@ -118,11 +129,13 @@ def _sens_names(args: argparse.Namespace) -> list[str] | None:
     return names
 
 
-def _file_outputs(args: argparse.Namespace) -> dict[str, bool]:
+def _file_outputs(args: argparse.Namespace) -> dict[str, Any]:
     """The optional columns of a result file: --energy ... and the sensitivities'."""
-    out = _outputs(args)
+    out: dict[str, Any] = dict(_outputs(args))
     if _sens_names(args):
         out["sensitivities"] = True
+    if getattr(args, "measure", None):
+        out["measures"] = list(args.measure)
     return out
 
 
@@ -150,6 +163,7 @@ def _parser() -> argparse.ArgumentParser:
     k.add_argument("--solver", default="auto", choices=["auto", "dense", "banded"],
                    help="linear solver (default auto: banded LU for large chains)")
     _sensitivities(k)
+    _measures(k)
     k.add_argument("--positions-only", action="store_true",
                    help="positions alone, no velocities or accelerations (faster: chord steps)")
     _columns(k)
@@ -160,6 +174,7 @@ def _parser() -> argparse.ArgumentParser:
     i.add_argument("--tol", type=float, default=None, help="Newton tolerance (default 1e-12)")
     i.add_argument("--every", type=int, default=1, help="write every k-th row (and the last)")
     _sensitivities(i)
+    _measures(i)
     i.add_argument("--solver", default="auto", choices=["auto", "dense", "banded"],
                    help="linear solver (default auto: banded LU for large chains)")
     _columns(i, efforts=True)
@@ -169,6 +184,7 @@ def _parser() -> argparse.ArgumentParser:
     _dynamics_settings(d)
     d.add_argument("--every", type=int, default=1, help="write every k-th row (and the last)")
     _sensitivities(d)
+    _measures(d)
     d.add_argument("--solver", default="auto", choices=["auto", "dense", "banded"],
                    help="linear algebra (default auto: band LU for large chains)")
     _columns(d)
@@ -231,6 +247,7 @@ def _parser() -> argparse.ArgumentParser:
                    help="linear solver of kinematic runs (default auto)")
     e.add_argument("--t", type=float, default=0.0, help="statics: time of loads and drivers")
     _sensitivities(e)
+    _measures(e)
     e.add_argument("--positions-only", action="store_true",
                    help="kinematics: positions alone (no velocities or accelerations)")
     e.add_argument("--param", action="append", default=None, metavar="NAME=START:STOP:NUM",
@@ -551,10 +568,10 @@ def _cases(args: argparse.Namespace) -> dict[str, np.ndarray]:
 def _export_sweep(model: Model, args: argparse.Namespace) -> int:
     """export --param: a sweep file for mbd2d-solve (the settings of the analysis alone)."""
     from .studies import export_sweep
-    if _outputs(args) or _sens_names(args):
+    if _outputs(args) or _sens_names(args) or args.measure:
         raise ModelError("a sweep file writes the sweep's columns: no --energy, "
-                         "--multipliers, --reactions, --efforts or --sensitivities with "
-                         "--param", "command line")
+                         "--multipliers, --reactions, --efforts, --sensitivities or "
+                         "--measure with --param", "command line")
     span = {"t_end": args.t_end, "steps": args.steps, "t0": args.t0, "every": args.every}
     kw: dict[str, Any] = {
         "kinematics": dict(span, tol=args.tol, solver=args.solver,
@@ -636,7 +653,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             model.export(args.out, t_end=args.t_end, steps=args.steps, t0=args.t0, tol=args.tol,
                          analysis=args.analysis, every=args.every, solver=args.solver, t=args.t,
                          outputs=list(_outputs(args)), positions_only=args.positions_only,
-                         sensitivities=_sens_names(args), **extra)
+                         sensitivities=_sens_names(args), measures=args.measure, **extra)
             print(f"wrote {args.out} ({args.analysis}; run it with mbd2d-solve "
                   f"{args.out} OUT.csv)")
             return EXIT_OK

@@ -374,7 +374,8 @@ class Model(ModelDescription):
                rho_inf: float | None = None, alpha: float | None = None,
                beta: float | None = None, max_steps: int | None = None, t: float = 0.0,
                outputs: Sequence[str] | None = None, positions_only: bool = False,
-               sensitivities: Sequence[str] | None = None) -> None:
+               sensitivities: Sequence[str] | None = None,
+               measures: Sequence[str] | None = None) -> None:
         """Write a plain-text model file that the standalone ``mbd2d-solve`` runs without
         Python (format: docs/mbd-format.md), with the analysis and its settings.
 
@@ -403,6 +404,11 @@ class Model(ModelDescription):
             sensitivities as the analysis does with ``sensitivities=[...]`` and writes their
             columns ``d(COLUMN)/d(NAME)``, as ``res.to_csv(path, sensitivities=True)``
             (kinematics, inverse dynamics, statics, and dynamics by dopri5).
+        measures : list of str, optional
+            Measure columns, as ``res.to_csv(path, measures=[...])``:
+            ``transmission_angle:JOINT[:OUTPUT]``, ``velocity_ratio:INPUT:OUTPUT[:VIA]``,
+            ``mechanical_advantage:INPUT:OUTPUT[:VIA]``, ``dead_centre_distance`` (not for
+            statics).
 
         Raises
         ------
@@ -420,7 +426,7 @@ class Model(ModelDescription):
                    analysis=analysis, every=every, solver=solver, method=method, rtol=rtol,
                    atol=atol, h=h, rho_inf=rho_inf, alpha=alpha, beta=beta,
                    max_steps=max_steps, t=t, outputs=outputs, positions_only=positions_only,
-                   sensitivities=sensitivities)
+                   sensitivities=sensitivities, measures=measures)
 
 
 def load(path: str | Path) -> Model:

@@ -23,6 +23,7 @@ from ..description.joints import (Absolute, Cam, Distance, Gear, PinInSlot, Poin
                                   Weld)
 from ..errors import ModelError
 from ..results.files import OUTPUTS, write_text
+from ..results.measures import angle_recipe, parse_measure, ratio_recipe
 from ..validate import flag, number
 from .dynamics import dynamics_settings
 from .sensitivities import check_dopri5, check_positions_only, requested, table
@@ -117,6 +118,9 @@ def header() -> str:
         "#   sensitivities NP, then NP lines   NAME TABLE INDEX (optional): design parameters",
         "#        and their d(COLUMN)/d(NAME) columns; TABLE 1 params, 2 masses (mass, inertia",
         "#        per body), 3 gravity, 4 fparams; INDEX 1-based in that list",
+        "#   measures NM, then NM lines   SPEC angle KIND B1 X Y B2 X Y B3 X Y | SPEC ratio|advantage",
+        "#        REF XKIND XINDEX YKIND YINDEX | SPEC conditioning (optional columns: the",
+        "#        transmission angle, velocity ratio, mechanical advantage, dead-centre distance)",
         "#   cases NP NV NCASE, then NP lines NAME, NV lines TABLE INDEX, then per case NP + NV",
         "#        reals (optional: a sweep, mbd2d.export_sweep): the swept parameters, the",
         "#        entries each case sets (TABLE as for sensitivities) and their values",
@@ -171,7 +175,8 @@ def file_lines(model: ModelDescription, t_end: float | None = None, steps: int |
                rho_inf: Any = None, alpha: Any = None, beta: Any = None,
                max_steps: Any = None, t: float = 0.0, outputs: Sequence[str] | None = None,
                positions_only: Any = False,
-               sensitivities: Sequence[str] | None = None) -> list[str]:
+               sensitivities: Sequence[str] | None = None,
+               measures: Sequence[str] | None = None) -> list[str]:
     """The lines of a model file up to its ``end`` line (the header, the model, the analysis
     and its settings, the optional blocks).
 
@@ -246,10 +251,38 @@ def file_lines(model: ModelDescription, t_end: float | None = None, steps: int |
             col = dyn.ftab[:, k] if dyn.ftab[NFT - 1, k] else dyn.ftab[:NFT - 1, k]
             lines.append(f"{name} " + " ".join(str(int(v)) for v in col))
         lines += _reals("fparams", dyn.fpar)
+    lines += _measure_lines(model, p, measures, analysis)
     if params:
         ptab = table(p, params, dyn)
         lines.append(f"sensitivities {len(params)}")
         lines += [f"{prm.name} {ptab[0, k]} {ptab[1, k]}" for k, prm in enumerate(params)]
+    return lines
+
+
+def _measure_lines(model: ModelDescription, p: Any, specs: Any, analysis: str) -> list[str]:
+    """The measures block: each spec with the recipe mbd2d-solve evaluates (an angle's
+    bodies and points, a ratio's reference row and quantities, 1-based)."""
+    if specs is None or (not isinstance(specs, str) and not len(specs)):
+        return []
+    specs = [specs] if isinstance(specs, str) else list(specs)
+    if analysis in ("statics", "check"):
+        raise ModelError(f"measures are columns of a run over time, not of {analysis}",
+                         "export")
+    lines = [f"measures {len(specs)}"]
+    for spec in specs:
+        name, args = parse_measure(spec)
+        if name == "transmission_angle":
+            kind, bodies, pts = angle_recipe(model, *args)
+            lines.append(f"{spec} angle {kind} " + " ".join(
+                f"{int(bodies[k])} {_r(pts[0, k])} {_r(pts[1, k])}" for k in range(3)))
+        elif name == "dead_centre_distance":
+            lines.append(f"{spec} conditioning")
+        else:
+            ref, qx, qy = ratio_recipe(model, p, *args)
+            word = "ratio" if name == "velocity_ratio" else "advantage"
+            kinds = {"coordinate": 1, "driver": 2}
+            lines.append(f"{spec} {word} {ref + 1} {kinds[qx[0]]} {qx[1] + 1} "
+                         f"{kinds[qy[0]]} {qy[1] + 1}")
     return lines
 
 

@@ -173,6 +173,16 @@ def influence(p: Packed, q: np.ndarray, t: np.ndarray, row: int) -> SimpleNamesp
                   int(row), numbers=np.size(q) + np.size(t))
 
 
+def link_angle(q: np.ndarray, kind: int, bodies: np.ndarray, points: np.ndarray
+               ) -> SimpleNamespace:
+    """The transmission angle at states q (nq, nt) from the recipe of
+    :func:`mbd2d.results.measures.angle_recipe` (kind 1 turning, 2 sliding; bodies (3),
+    1-based, 0 ground; points (2, 3)): ``mu`` (nt), ``status``, ``msg``."""
+    return _named("mu status msg", _core.core_link_angle, q, int(kind),
+                  np.asarray(bodies, dtype=np.int32), np.asfortranarray(points, dtype=float),
+                  numbers=q.shape[1])
+
+
 def fun_values(p: np.ndarray, t: np.ndarray) -> SimpleNamespace:
     """f(t), f'(t), f''(t) of an encoded function of time (``TimeFunction.encode()``) at the
     times t: ``f``, ``f1``, ``f2``, ``status``, ``msg``."""

@@ -12,7 +12,8 @@ from .contacts import (ContactEvent, ContactHistory, FrictionEvent, FrictionHist
                        history)
 from .columns import REACTION_WORDS, constraint_columns, derivative_names
 from .files import check_outputs, writing
-from .kinematics import KinematicsResult
+from .kinematics import KinematicsResult, measures_arg
+from .measures import measure_columns
 from .reactions import Reaction, reaction_arrays, reaction_of
 from .sensitivities import parameter_index, reaction_dp_arrays, reaction_dp_of
 
@@ -175,8 +176,8 @@ class DynamicsResult(KinematicsResult):
         return history(self.elements, self.element_names, name, "friction")
 
     def table(self, energy: bool = False, multipliers: bool = False, reactions: bool = False,
-              efforts: bool = False, sensitivities: bool = False, **unknown: bool
-              ) -> tuple[list[str], np.ndarray]:
+              efforts: bool = False, sensitivities: bool = False, measures: Any = None,
+              **unknown: bool) -> tuple[list[str], np.ndarray]:
         """Header and rows of the CSV: the motion columns of
         :meth:`KinematicsResult.table`, then the optional columns asked for, in this order:
 
@@ -192,6 +193,7 @@ class DynamicsResult(KinematicsResult):
         NAME.penetration, NAME.sliding_speed, and for each joint with friction
         NAME.normal_load, NAME.friction_force, NAME.sliding_speed.
 
+        Then a column per measure of ``measures`` (as :meth:`KinematicsResult.table`).
         With ``sensitivities=True`` (a run with ``sensitivities=[names]``) then, for each
         parameter P in turn, ``d(COLUMN)/d(P)`` of the motion columns and, when the run has
         the multipliers' sensitivities (inverse dynamics), of the multiplier, reaction and
@@ -221,6 +223,9 @@ class DynamicsResult(KinematicsResult):
                 continue
             header += [f"{name}.{w}" for w in words]
             blocks.append(np.column_stack([self.elements[:, k, i] for i in idx]))
+        names, cols = measure_columns(self, measures_arg(measures))
+        header += names
+        blocks += cols
         if sensitivities:
             names, cols = self._derivative_columns(multipliers, reactions, efforts)
             header += names
@@ -254,7 +259,7 @@ class DynamicsResult(KinematicsResult):
         return names, blocks
 
     def to_npz(self, path: str | Path, reactions: bool = False, efforts: bool = False,
-               sensitivities: bool = False, **always: bool) -> None:
+               sensitivities: bool = False, measures: Any = None, **always: bool) -> None:
         """t, q, qd, qdd, the multipliers and energies, the force elements' outputs, and
         the names; with
         ``reactions=True`` also ``reactions`` (n, nc, 6: as the table's reaction columns)
@@ -263,6 +268,7 @@ class DynamicsResult(KinematicsResult):
         ``parameter_names`` and (inverse dynamics) ``dlam_dp`` (n, neq, n_params)."""
         check_outputs(always, ("energy", "multipliers"), "to_npz")
         extra = self._sensitivity_arrays(sensitivities, "to_npz")
+        extra.update(self._measure_arrays(measures))
         if self.dlam_dp is not None:
             extra["dlam_dp"] = self.dlam_dp
         if reactions:

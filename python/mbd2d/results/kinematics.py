@@ -14,8 +14,14 @@ from ..validate import vector
 from . import measures
 from .columns import SUFFIXES, derivative_names, motion_columns, require_sensitivities
 from .files import check_outputs, write_csv, writing
+from .measures import measure_columns
 from .points import PointResult
 from .sensitivities import LEVELS, body_columns, parameter_index
+
+
+def measures_arg(specs: Any) -> Any:
+    """The ``measures=`` of a table (None, one spec or a list of specs)."""
+    return None if specs is None or (not isinstance(specs, str) and not len(specs)) else specs
 
 
 def repr_png(obj: Any) -> bytes | None:
@@ -311,21 +317,25 @@ class KinematicsResult:
         """The mechanism picture, for Jupyter (None when it cannot be drawn)."""
         return repr_png(self)
 
-    def table(self, sensitivities: bool = False, **outputs: bool
+    def table(self, sensitivities: bool = False, measures: Any = None, **outputs: bool
               ) -> tuple[list[str], np.ndarray]:
         """Header and rows of the CSV: t, then NAME.x ... NAME.theta_ddot per body (NAME.x,
-        NAME.y, NAME.theta after a ``positions_only`` run); with ``sensitivities=True`` (a
+        NAME.y, NAME.theta after a ``positions_only`` run); then a column per measure of
+        ``measures`` (specs ``transmission_angle:JOINT[:OUTPUT]``,
+        ``velocity_ratio:INPUT:OUTPUT[:VIA]``, ``mechanical_advantage:INPUT:OUTPUT[:VIA]``,
+        ``dead_centre_distance``, each named by its spec); with ``sensitivities=True`` (a
         run with ``sensitivities=[names]``), then for each parameter P in turn the
-        derivatives of those columns, ``d(NAME.x)/d(P)`` ... ``d(NAME.theta_ddot)/d(P)``.
+        derivatives of the motion columns, ``d(NAME.x)/d(P)`` ... ``d(NAME.theta_ddot)/d(P)``.
 
         A kinematic result has no optional columns (``energy``, ``multipliers``,
         ``reactions``, ``efforts`` need a DynamicsResult): asking for one is a ModelError.
         """
         check_outputs(outputs, (), "table")
         header, rows = self._motion_table()
-        if not sensitivities:
-            return header, rows
-        names, blocks = self._motion_derivatives("table")
+        names, blocks = measure_columns(self, measures_arg(measures))
+        if sensitivities:
+            dn, db = self._motion_derivatives("table")
+            names, blocks = names + dn, blocks + db
         return header + names, np.hstack([rows] + blocks)
 
     def _levels(self) -> list[np.ndarray]:
@@ -364,20 +374,31 @@ class KinematicsResult:
         out["parameter_names"] = np.array(self.parameter_names)
         return out
 
+    def _measure_arrays(self, specs: Any) -> dict[str, np.ndarray]:
+        """The measures for an .npz: ``measures`` (n, k) and ``measure_names``."""
+        names, cols = measure_columns(self, measures_arg(specs))
+        if not names:
+            return {}
+        return {"measures": np.hstack(cols), "measure_names": np.array(names)}
+
     def to_csv(self, path: str | Path, **outputs: bool) -> None:
         """Write the CSV (the columns of :meth:`table`; every number with 17 significant
         digits, ``%.16e``, as ``mbd2d-solve`` writes them)."""
         header, rows = self.table(**outputs)
         write_csv(path, header, rows, "to_csv")
 
-    def to_npz(self, path: str | Path, sensitivities: bool = False, **outputs: bool) -> None:
+    def to_npz(self, path: str | Path, sensitivities: bool = False, measures: Any = None,
+               **outputs: bool) -> None:
         """Write t, q, qd, qdd (q alone after a ``positions_only`` run) and the names to a
         NumPy .npz archive; after a run with ``sensitivities=[names]`` also ``dq_dp``,
-        ``dqd_dp``, ``dqdd_dp`` (n, n_coordinates, n_params) and ``parameter_names``."""
+        ``dqd_dp``, ``dqdd_dp`` (n, n_coordinates, n_params) and ``parameter_names``; with
+        ``measures=[specs]`` (as :meth:`table`) ``measures`` (n, n_measures) and
+        ``measure_names``."""
         check_outputs(outputs, (), "to_npz")
         motion = {k: v for k, v in (("q", self.q), ("qd", self.qd), ("qdd", self.qdd))
                   if v is not None}
         sens = self._sensitivity_arrays(sensitivities, "to_npz")
+        sens.update(self._measure_arrays(measures))
         with writing(path, "to_npz") as p:
             np.savez(p, t=self.t, **motion, coordinate_names=np.array(self.coordinate_names),
                      body_names=np.array(self.body_names), **sens)

@@ -65,49 +65,62 @@ def dead_centre_distance(res: Any) -> np.ndarray:
 
 
 # ----------------------------------------------------------------------------- ratios
-def _driver(res: Any, name: str) -> tuple[int, Any] | None:
-    """(first row, driver) of the driver called name; None if name is no driver."""
-    p = packed_of(res)
+def _driver(model: Any, p: Packed, name: str) -> int | None:
+    """First row of Phi (0-based) of the driver called name; None if name is no driver."""
     names = p.constraint_names
     if name in names and p.driver_flags[names.index(name)]:
-        k = names.index(name)
-        return p.row_owner.index(k), res.model.constraints[k]
+        return p.row_owner.index(names.index(name))
     return None
 
 
-def _quantity(res: Any, name: Any, what: str) -> tuple[str, int]:
-    """('driver', row) or ('coordinate', column) of a quantity's name."""
+def _quantity(model: Any, p: Packed, name: Any, what: str) -> tuple[str, int]:
+    """('driver', row) or ('coordinate', column) of a quantity's name (0-based)."""
     if not isinstance(name, str):
         raise ModelError(f"{what} must be a driver name or a coordinate name, got {name!r}",
                          what)
-    d = _driver(res, name)
-    if d is not None:
-        return "driver", d[0]
-    if name in res.coordinate_names:
-        return "coordinate", res.coordinate_names.index(name)
-    drivers = [c.name for c in res.model.constraints if c.is_driver]
+    row = _driver(model, p, name)
+    if row is not None:
+        return "driver", row
+    if name in p.coordinate_names:
+        return "coordinate", p.coordinate_names.index(name)
+    drivers = [c.name for c in model.constraints if c.is_driver]
     raise ModelError(f"no driver or coordinate {name!r}; drivers: {', '.join(drivers)}; "
-                     f"coordinates: {', '.join(res.coordinate_names)}", what)
+                     f"coordinates: {', '.join(p.coordinate_names)}", what)
 
 
-def _reference(res: Any, x: tuple[str, int], y: tuple[str, int], via: Any) -> int:
+def _reference(model: Any, p: Packed, x: tuple[str, int], y: tuple[str, int],
+               via: Any) -> int:
     """Row of the driver whose motion relates X and Y."""
     if via is not None:
-        kind, row = _quantity(res, via, "via")
+        kind, row = _quantity(model, p, via, "via")
         if kind != "driver":
             raise ModelError(f"via must name a driver, got the coordinate {via!r}", "via")
         return row
     for kind, row in (x, y):
         if kind == "driver":
             return row
-    drivers = [c.name for c in res.model.constraints if c.is_driver]
+    drivers = [c.name for c in model.constraints if c.is_driver]
     if len(drivers) != 1:
         raise ModelError("neither quantity is a driver and the model has "
                          f"{len(drivers)} drivers ({', '.join(drivers)}): name the one that "
                          "moves them with via=", "via")
-    row = _driver(res, drivers[0])
+    row = _driver(model, p, drivers[0])
     assert row is not None
-    return row[0]
+    return row
+
+
+def ratio_recipe(model: Any, p: Packed, x: Any, y: Any, via: Any = None
+                 ) -> tuple[int, tuple[str, int], tuple[str, int]]:
+    """The reference driver's row and the two quantities of a ratio (0-based); what
+    ``mbd2d-solve`` takes for a velocity ratio or a mechanical advantage.
+
+    Raises
+    ------
+    ModelError
+        If a name is neither a driver nor a coordinate, or no driver relates them.
+    """
+    qx, qy = _quantity(model, p, x, "input"), _quantity(model, p, y, "output")
+    return _reference(model, p, qx, qy, via), qx, qy
 
 
 def influence(res: Any, row: int) -> tuple[np.ndarray, np.ndarray]:
@@ -138,8 +151,8 @@ def rates(res: Any, x: Any, y: Any, via: Any = None) -> tuple[np.ndarray, np.nda
         If a name is neither a driver nor a coordinate, no driver relates them, or a
         quantity does not move with the driver at all.
     """
-    qx, qy = _quantity(res, x, "input"), _quantity(res, y, "output")
-    ref = _reference(res, qx, qy, via)
+    p = packed_of(res)
+    ref, qx, qy = ratio_recipe(res.model, p, x, y, via)
     u, ok = influence(res, ref)
     dx, dy = _rate(u, qx, ref), _rate(u, qy, ref)
     scale = float(np.abs(u).max()) if u.size else 0.0
@@ -147,7 +160,7 @@ def rates(res: Any, x: Any, y: Any, via: Any = None) -> tuple[np.ndarray, np.nda
         # a driver other than the reference is held: 0 by definition (independent drivers)
         if q[0] == "coordinate" and not float(np.abs(d).max()) > 1e-12 * scale:
             raise ModelError(f"{name!r} does not move with the driver "
-                             f"'{res.model.constraints[packed_of(res).row_owner[ref]].name}' "
+                             f"'{res.model.constraints[p.row_owner[ref]].name}' "
                              "(its influence coefficient is zero throughout): no ratio to it",
                              "velocity_ratio")
     return dx, dy, ok
@@ -163,40 +176,39 @@ def ratio(num: np.ndarray, den: np.ndarray, ok: np.ndarray, singular: float) -> 
 
 
 # ----------------------------------------------------------------------------- transmission
-def _joint(res: Any, name: Any) -> Any:
-    for c in res.model.joints:
+def _joint(model: Any, name: Any) -> Any:
+    for c in model.joints:
         if c.name == name:
             return c
-    names = [c.name for c in res.model.joints]
+    names = [c.name for c in model.joints]
     raise ModelError(f"no joint {name!r}; joints: {', '.join(names)}", "transmission_angle")
 
 
-def _other_revolute(res: Any, body: str, joint: Any) -> Any:
-    for c in res.model.joints:
+def _other_revolute(model: Any, body: str, joint: Any) -> Any:
+    for c in model.joints:
         if c is not joint and isinstance(c, Revolute) and body in c.bodies:
             return c
     return None
 
 
-def _global(res: Any, body: str, s: Any) -> np.ndarray:
-    if body == GROUND:
-        return np.broadcast_to(np.asarray(s, dtype=float), (len(res.t), 2))
-    return res.point(body, s).r
-
-
-def _direction(res: Any, body: str, v: Any) -> np.ndarray:
-    if body == GROUND:
-        d = np.broadcast_to(np.asarray(v, dtype=float), (len(res.t), 2))
-    else:
-        th = res.body(body).theta
-        c, sn = np.cos(th), np.sin(th)
-        d = np.column_stack([c * v[0] - sn * v[1], sn * v[0] + c * v[1]])
-    return d / np.hypot(d[:, 0], d[:, 1])[:, None]
-
-
 def transmission_angle(res: Any, joint: Any, output: Any = None) -> np.ndarray:
     """The transmission angle at a revolute joint between a coupler and an output link
-    (radians, one value per output row); see the module banner.
+    (radians, one value per output row), by the core from :func:`angle_recipe`."""
+    kind, bodies, points = angle_recipe(res.model, joint, output)
+    q, _ = _states(res)
+    out = core.link_angle(q, kind, bodies, points)
+    if out.status != OK:
+        raise error_for("measures", out.status, out.msg, entry="transmission_angle")
+    return np.asarray(out.mu, dtype=float).copy()
+
+
+def angle_recipe(model: Any, joint: Any, output: Any = None
+                 ) -> tuple[int, np.ndarray, np.ndarray]:
+    """Where the transmission angle at ``joint`` is measured (see the module banner): kind
+    1 (the output turns about a second revolute joint) or 2 (it slides), the bodies (3,)
+    (1-based, 0 ground) and points (2, 3) in them: the joint B on the output link, the
+    coupler's other joint A, and the output's other pivot P (kind 1) or its slide's axis
+    (kind 2, in the body that carries the axis). ``mbd2d-solve`` takes the same recipe.
 
     Raises
     ------
@@ -205,7 +217,9 @@ def transmission_angle(res: Any, joint: Any, output: Any = None) -> np.ndarray:
         one of its bodies, the coupler has no second revolute joint, or the output link
         neither turns about a second revolute joint nor slides in a translational joint.
     """
-    j = _joint(res, joint)
+    index = {b.name: k + 1 for k, b in enumerate(model.bodies)}
+    index[GROUND] = 0
+    j = _joint(model, joint)
     entry = "transmission_angle"
     if not isinstance(j, Revolute):
         raise ModelError(f"joint {joint!r} is a {j.type} joint; the transmission angle is "
@@ -220,26 +234,75 @@ def transmission_angle(res: Any, joint: Any, output: Any = None) -> np.ndarray:
     if cpl == GROUND:
         raise ModelError(f"joint {joint!r} joins {out!r} to ground: there is no coupler",
                          entry)
-    b = _global(res, out, j.points[j.bodies.index(out)])
-    ja = _other_revolute(res, cpl, j)
+    ja = _other_revolute(model, cpl, j)
     if ja is None:
         raise ModelError(f"the coupler {cpl!r} has no second revolute joint: its force line "
                          "runs between its two joints", entry)
-    a = _global(res, cpl, ja.points[ja.bodies.index(cpl)])
-    e = a - b
-    e = e / np.hypot(e[:, 0], e[:, 1])[:, None]
-    jp = _other_revolute(res, out, j)
+    first = [(index[out], j.points[j.bodies.index(out)]),
+             (index[cpl], ja.points[ja.bodies.index(cpl)])]
+    jp = _other_revolute(model, out, j)
     if jp is not None:
         pb = jp.bodies.index(out)
-        pv = _global(res, jp.bodies[1 - pb], jp.points[1 - pb]) - b
-        pv = pv / np.hypot(pv[:, 0], pv[:, 1])[:, None]
-        return np.arccos(np.clip(np.einsum("ij,ij->i", e, pv), -1.0, 1.0))
-    for c in res.model.joints:
+        return 1, *_recipe(first + [(index[jp.bodies[1 - pb]], jp.points[1 - pb])])
+    for c in model.joints:
         if isinstance(c, (Translational, PointOnLine)) and out in c.bodies:
             k = 0 if isinstance(c, PointOnLine) else c.bodies.index(out)
             axis = c.axis if isinstance(c, PointOnLine) else c.axes[k]
             owner = c.bodies[0] if isinstance(c, PointOnLine) else c.bodies[k]
-            u = _direction(res, owner, axis)
-            return np.arcsin(np.clip(np.abs(np.einsum("ij,ij->i", e, u)), 0.0, 1.0))
+            return 2, *_recipe(first + [(index[owner], axis)])
     raise ModelError(f"the output link {out!r} neither turns about a second revolute joint "
                      "nor slides in a translational joint", entry)
+
+
+def _recipe(items: list[tuple[int, Any]]) -> tuple[np.ndarray, np.ndarray]:
+    bodies = np.array([b for b, _ in items], dtype=np.int32)
+    points = np.asfortranarray(np.array([[float(v) for v in s] for _, s in items]).T)
+    return bodies, points
+
+
+# ----------------------------------------------------------------------------- by name
+#: the measures a table takes by name, with their argument counts (least, most)
+MEASURES = {"transmission_angle": (1, 2), "velocity_ratio": (2, 3),
+            "mechanical_advantage": (2, 3), "dead_centre_distance": (0, 0)}
+FORMS = ("transmission_angle:JOINT[:OUTPUT], velocity_ratio:INPUT:OUTPUT[:VIA], "
+         "mechanical_advantage:INPUT:OUTPUT[:VIA] or dead_centre_distance")
+
+
+def parse_measure(spec: Any) -> tuple[str, list[str]]:
+    """A measure's name and arguments from its spec "NAME:ARG:...".
+
+    Raises
+    ------
+    ModelError
+        For an unknown measure or a wrong number of arguments.
+    """
+    if not isinstance(spec, str):
+        raise ModelError(f"a measure is a text {FORMS}, got {spec!r}", "measures")
+    name, *args = spec.split(":")
+    if name not in MEASURES or not MEASURES[name][0] <= len(args) <= MEASURES[name][1] \
+            or not all(args):
+        raise ModelError(f"unknown measure {spec!r}; write {FORMS}", "measures")
+    return name, args
+
+
+def measure(res: Any, spec: str) -> np.ndarray:
+    """The values of the measure spec (see :func:`parse_measure`) at every output row."""
+    name, args = parse_measure(spec)
+    if name == "transmission_angle":
+        return transmission_angle(res, *args)
+    if name == "dead_centre_distance":
+        return dead_centre_distance(res)
+    dx, dy, ok = rates(res, *args)
+    if name == "velocity_ratio":
+        return ratio(dy, dx, ok, np.inf)
+    return ratio(dx, dy, ok, 0.0)
+
+
+def measure_columns(res: Any, specs: Any) -> tuple[list[str], list[np.ndarray]]:
+    """The table columns of the measures asked for: named by their specs."""
+    if specs is None:
+        return [], []
+    if isinstance(specs, str):
+        specs = [specs]
+    specs = list(specs)
+    return specs, [measure(res, s)[:, None] for s in specs]
