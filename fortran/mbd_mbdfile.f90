@@ -329,10 +329,7 @@ contains
         end if
         spec%maxit = int(big)
       case ('bodies')
-        if (seen_b) then
-          call fail('"bodies" is given twice'); exit
-        end if
-        seen_b = .true.
+        if (.not. first_time(seen_b)) exit
         if (.not. count_ok(n, 'body', 1)) exit
         spec%nb = n; spec%bodies_line = lineno
         call mem_check(real(n, wp) * (NAME_LEN + 3 * REAL_BYTES), 'the bodies', &
@@ -387,10 +384,7 @@ contains
           if (status /= MBD_OK) exit
         end do
       case ('constraints')
-        if (seen_c) then
-          call fail('"constraints" is given twice'); exit
-        end if
-        seen_c = .true.
+        if (.not. first_time(seen_c)) exit
         if (.not. count_ok(n, 'constraint', 0)) exit
         spec%nc = n
         call mem_check(real(n, wp) * (NAME_LEN + 4 * NCT + 4), 'the constraints', &
@@ -433,10 +427,7 @@ contains
           if (status /= MBD_OK) exit
         end do
       case ('params')
-        if (seen_p) then
-          call fail('"params" is given twice'); exit
-        end if
-        seen_p = .true.
+        if (.not. first_time(seen_p)) exit
         if (.not. count_ok(n, 'parameter', 0)) exit
         call mem_check(REAL_BYTES * n, 'the parameters', 'give fewer parameters', status, msg)
         if (status /= MBD_OK) then
@@ -465,10 +456,7 @@ contains
           if (status /= MBD_OK) exit
         end do
       case ('fparams')
-        if (seen_fp) then
-          call fail('"fparams" is given twice'); exit
-        end if
-        seen_fp = .true.
+        if (.not. first_time(seen_fp)) exit
         if (.not. count_ok(n, 'force parameter', 0)) exit
         call mem_check(REAL_BYTES * n, 'the force parameters', 'give fewer forces', status, msg)
         if (status /= MBD_OK) then
@@ -482,10 +470,7 @@ contains
         end if
         if (.not. read_reals(spec%fpar)) exit
       case ('labels')
-        if (seen_l) then
-          call fail('"labels" is given twice'); exit
-        end if
-        seen_l = .true.
+        if (.not. first_time(seen_l)) exit
         if (.not. count_ok(n, 'label', 0)) exit
         call mem_check(real(n, wp) * NAME_LEN, 'the row labels', 'give fewer constraints', &
                        status, msg)
@@ -517,10 +502,7 @@ contains
           if (status /= MBD_OK) exit
         end do
       case ('forces')
-        if (seen_f) then
-          call fail('"forces" is given twice'); exit
-        end if
-        seen_f = .true.
+        if (.not. first_time(seen_f)) exit
         if (.not. count_ok(n, 'force', 0)) exit
         spec%nf = n
         call mem_check(real(n, wp) * (NAME_LEN + 4 * NFT), 'the forces', 'give fewer forces', &
@@ -562,28 +544,16 @@ contains
           if (status /= MBD_OK) exit
         end do
       case ('sensitivities')
-        if (seen_s) then
-          call fail('"sensitivities" is given twice'); exit
-        end if
-        seen_s = .true.
+        if (.not. first_time(seen_s)) exit
         if (.not. read_sensitivities()) exit
       case ('measures')
-        if (seen_m) then
-          call fail('"measures" is given twice'); exit
-        end if
-        seen_m = .true.
+        if (.not. first_time(seen_m)) exit
         if (.not. read_measures()) exit
       case ('cases')
-        if (seen_k) then
-          call fail('"cases" is given twice'); exit
-        end if
-        seen_k = .true.
+        if (.not. first_time(seen_k)) exit
         if (.not. read_cases()) exit
       case ('opens')
-        if (seen_o) then
-          call fail('"opens" is given twice'); exit
-        end if
-        seen_o = .true.
+        if (.not. first_time(seen_o)) exit
         if (.not. read_opens()) exit
       case ('end')
         if (ntok /= 1) then
@@ -735,10 +705,17 @@ contains
       setting_real = .true.
     end function setting_real
 
+    !> True the first time a block's keyword comes (marking it seen); a failure after.
+    logical function first_time(seen)
+      logical, intent(inout) :: seen
+      first_time = .not. seen
+      if (seen) call fail('"' // trim(key) // '" is given twice')
+      seen = .true.
+    end function first_time
+
     !> The "sensitivities" block: a count, then NAME TABLE INDEX per design parameter.
     logical function read_sensitivities()
-      integer :: j, it
-      integer(int64) :: v
+      integer :: j
       read_sensitivities = .false.
       if (.not. count_ok(n, 'sensitivity', 1)) return
       call mem_check(real(n, wp) * (PNAME_LEN + 12), 'the design parameters', &
@@ -767,18 +744,7 @@ contains
           call fail('a design parameter name is longer than 256 characters'); return
         end if
         spec%par_names(j) = tok(1:PNAME_LEN)
-        do it = 1, 2
-          call next_token(line, pos, tok)
-          if (.not. read_int(tok, v)) v = -1
-          if (it == 1 .and. (v < 1 .or. v > 4)) then
-            call fail('"' // trim(tok(1:40)) // '": TABLE is 1 (params), 2 (masses), '// &
-                      '3 (gravity) or 4 (fparams)'); return
-          end if
-          if (it == 2 .and. (v < 1 .or. v > huge(1))) then
-            call fail('"' // trim(tok(1:40)) // '": INDEX is a whole number from 1'); return
-          end if
-          spec%ptab(it, j) = int(v)
-        end do
+        if (.not. table_entry(spec%ptab(:, j))) return
       end do
       read_sensitivities = .true.
     end function read_sensitivities
@@ -787,8 +753,7 @@ contains
     !! then (NP + NV) * NCASE reals.
     logical function read_cases()
       integer(int64) :: c(3), room
-      integer :: j, it
-      integer(int64) :: v
+      integer :: j
       read_cases = .false.
       if (ntok /= 4) then
         call fail('"cases" takes three whole numbers: NP NV NCASE'); return
@@ -845,21 +810,32 @@ contains
           call fail('bad case entry line: TABLE INDEX expected'); return
         end if
         pos = 1
-        do it = 1, 2
-          call next_token(line, pos, tok)
-          if (.not. read_int(tok, v)) v = -1
-          if (it == 1 .and. (v < 1 .or. v > 4)) then
-            call fail('"' // trim(tok(1:40)) // '": TABLE is 1 (params), 2 (masses), '// &
-                      '3 (gravity) or 4 (fparams)'); return
-          end if
-          if (it == 2 .and. (v < 1 .or. v > huge(1))) then
-            call fail('"' // trim(tok(1:40)) // '": INDEX is a whole number from 1'); return
-          end if
-          spec%vtab(it, j) = int(v)
-        end do
+        if (.not. table_entry(spec%vtab(:, j))) return
       end do
       read_cases = read_reals_2d(spec%cvals)
     end function read_cases
+
+    !> The next two tokens as an entry of the core's tables: TABLE (1 params, 2 masses,
+    !! 3 gravity, 4 fparams) and a 1-based INDEX.
+    logical function table_entry(e)
+      integer, intent(out) :: e(2)
+      integer :: it
+      integer(int64) :: v
+      table_entry = .false.; e = 0
+      do it = 1, 2
+        call next_token(line, pos, tok)
+        if (.not. read_int(tok, v)) v = -1
+        if (it == 1 .and. (v < 1 .or. v > 4)) then
+          call fail('"' // trim(tok(1:40)) // '": TABLE is 1 (params), 2 (masses), '// &
+                    '3 (gravity) or 4 (fparams)'); return
+        end if
+        if (it == 2 .and. (v < 1 .or. v > huge(1))) then
+          call fail('"' // trim(tok(1:40)) // '": INDEX is a whole number from 1'); return
+        end if
+        e(it) = int(v)
+      end do
+      table_entry = .true.
+    end function table_entry
 
     !> The "measures" block: a count, then a recipe line per measure column.
     logical function read_measures()

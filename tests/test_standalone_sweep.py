@@ -20,43 +20,12 @@ import mbd2d
 from mbd2d.cli import main
 
 from test_standalone import find_solver
-from test_sweep import gear_pair, model_from_toml
+from test_sweep import RACK, gear_pair, model_from_toml
 
 pytest.importorskip("xarray")
 
 ROOT = Path(__file__).resolve().parents[1]
 EX = ROOT / "examples"
-
-RACK = """
-[[body]]
-name = "pinion"
-q0 = [0, 0, 0.2]
-[[body]]
-name = "rack"
-q0 = [0.1, -0.3, 0]
-[[joint]]
-type = "revolute"
-bodies = ["ground", "pinion"]
-points = [[0, 0], [0, 0]]
-[[joint]]
-type = "translational"
-bodies = ["ground", "rack"]
-points = [[0, -0.3], [0, 0]]
-axes = [[1, 0], [1, 0]]
-[[joint]]
-name = "rp"
-type = "rack-pinion"
-bodies = ["pinion", "rack"]
-center = [0, 0]
-point = [0, 0]
-axis = [1, 0]
-radius = 0.3
-[[driver]]
-type = "absolute"
-body = "pinion"
-coordinate = "theta"
-f = { poly = [0.2, 6.283185307179586] }
-"""
 
 
 def _rows(path: Path) -> list[list[str]]:

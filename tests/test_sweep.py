@@ -174,9 +174,7 @@ def test_gear_pair_inverse_dynamics() -> None:
         analysis="kinematics", settings=ds2.attrs["settings"]))
 
 
-def test_rack_pinion_open_phase() -> None:
-    """A rack-pinion whose phase is left open: the core sets it again per case from q0."""
-    m = model_from_toml("""
+RACK = """
 [[body]]
 name = "pinion"
 q0 = [0, 0, 0.2]
@@ -205,7 +203,12 @@ type = "absolute"
 body = "pinion"
 coordinate = "theta"
 f = { poly = [0.2, 6.283185307179586] }
-""")
+"""
+
+
+def test_rack_pinion_open_phase() -> None:
+    """A rack-pinion whose phase is left open: the core sets it again per case from q0."""
+    m = model_from_toml(RACK)
     ds = check_all(m, {"joint.rp.radius": [0.3, 0.35, 0.25],
                        "joint.rp.point.0": [0.0, 0.05, -0.1]}, t_end=0.5, steps=10)
     x = ds.q.sel(coordinate="rack.x").values

@@ -42,31 +42,18 @@ program mbd2d_solve
   use iso_c_binding, only: c_char, c_double, c_int
   implicit none
   interface
-    !> x as "%.16e" into buf(len); the length written (number_format.c)
-    function format_e16(x, buf, len) result(n) bind(C, name='mbd_format_e16')
+    !> x into buf(len) as "%.16e" (kind 1), "%.17g" (2) or "%g" (3); the length written
+    !! (number_format.c)
+    function format_num(x, kind, buf, len) result(n) bind(C, name='mbd_format')
       import :: c_char, c_double, c_int
       real(c_double), value :: x
+      integer(c_int), value :: kind
       character(kind=c_char), intent(out) :: buf(*)
       integer(c_int), value :: len
       integer(c_int) :: n
-    end function format_e16
-    !> x as "%g" into buf(len); the length written (number_format.c)
-    function format_g6(x, buf, len) result(n) bind(C, name='mbd_format_g6')
-      import :: c_char, c_double, c_int
-      real(c_double), value :: x
-      character(kind=c_char), intent(out) :: buf(*)
-      integer(c_int), value :: len
-      integer(c_int) :: n
-    end function format_g6
-    !> x as "%.17g" into buf(len); the length written (number_format.c)
-    function format_g17(x, buf, len) result(n) bind(C, name='mbd_format_g17')
-      import :: c_char, c_double, c_int
-      real(c_double), value :: x
-      character(kind=c_char), intent(out) :: buf(*)
-      integer(c_int), value :: len
-      integer(c_int) :: n
-    end function format_g17
+    end function format_num
   end interface
+  integer(c_int), parameter :: FMT_E16 = 1, FMT_G17 = 2, FMT_G6 = 3
   type(mbd_spec_t) :: spec
   character(len=1024) :: model_path, out_path
   character(len=MSG_LEN) :: msg
@@ -539,7 +526,7 @@ contains
     else if (.not. ieee_is_finite(x)) then
       s = merge('inf ', '-inf', x > 0.0_wp); n = merge(3, 4, x > 0.0_wp); return
     end if
-    n = max(0, min(int(format_e16(real(x, c_double), buf, 32_c_int)), 31))
+    n = max(0, min(int(format_num(real(x, c_double), FMT_E16, buf, 32_c_int)), 31))
     s = ''
     do i = 1, n
       s(i:i) = buf(i)
@@ -802,7 +789,7 @@ contains
       call die(4, trim(msg))
     end if
     ! the report, as str(DofReport)
-    nw = max(0, min(int(format_g6(real(spec%tstat, c_double), cb, 32_c_int)), 31))
+    nw = max(0, min(int(format_num(real(spec%tstat, c_double), FMT_G6, cb, 32_c_int)), 31))
     ts = ''
     do j = 1, nw
       ts(j:j) = cb(j)
@@ -1133,7 +1120,7 @@ contains
     n = n + 1
     buf(n:n) = ','
     if (ieee_is_nan(x)) return
-    m = max(0, min(int(format_g17(real(x, c_double), cb, 40_c_int)), 39))
+    m = max(0, min(int(format_num(real(x, c_double), FMT_G17, cb, 40_c_int)), 39))
     do i = 1, m
       buf(n + i:n + i) = cb(i)
     end do

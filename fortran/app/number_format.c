@@ -1,21 +1,12 @@
-/* mbd2d-solve's number format without Fortran internal I/O (which allocates per statement
- * in libgfortran): x as C's and Python's "%.16e" (17 significant digits, correctly rounded,
- * lower-case e, an exponent of at least two digits) into buf; returns the length. */
+/* mbd2d-solve's number formats without Fortran internal I/O (which allocates per statement
+ * in libgfortran), as C and Python write them: kind 1 "%.16e" (17 significant digits,
+ * correctly rounded, lower-case e, an exponent of at least two digits: every mbd2d CSV),
+ * 2 "%.17g" (the sweep CSV: Python's format(x, ".17g")), 3 "%g" (six significant digits:
+ * the check report's time). x into buf; returns the length. */
 #include <stdio.h>
 
-int mbd_format_e16(double x, char *buf, int len)
+int mbd_format(double x, int kind, char *buf, int len)
 {
-    return snprintf(buf, (size_t) len, "%.16e", x);
-}
-
-/* x as C's and Python's "%.17g" (the sweep CSV: mbd2d.write_sweep writes format(x, ".17g")). */
-int mbd_format_g17(double x, char *buf, int len)
-{
-    return snprintf(buf, (size_t) len, "%.17g", x);
-}
-
-/* x as C's and Python's "%g" (six significant digits; the check report's time). */
-int mbd_format_g6(double x, char *buf, int len)
-{
-    return snprintf(buf, (size_t) len, "%g", x);
+    const char *fmt = kind == 1 ? "%.16e" : kind == 2 ? "%.17g" : "%g";
+    return snprintf(buf, (size_t) len, fmt, x);
 }

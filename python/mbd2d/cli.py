@@ -205,13 +205,7 @@ def _parser() -> argparse.ArgumentParser:
                    "START to STOP; repeat for more parameters")
     w.add_argument("--grid", action="store_true", help="every combination of the values "
                    "(default: the i-th value of every parameter together; equal NUM)")
-    w.add_argument("--analysis", default="kinematics",
-                   choices=["kinematics", "inverse_dynamics", "statics", "dynamics"],
-                   help="the analysis (default kinematics)")
-    w.add_argument("--t-end", type=float, default=None, help="final time")
-    w.add_argument("--steps", type=int, default=None, help="output intervals")
-    w.add_argument("--t0", type=float, default=0.0, help="start time (statics: its time)")
-    w.add_argument("--every", type=int, default=1, help="keep every k-th row (and the last)")
+    _study_settings(w, "the analysis (default kinematics)")
     w.add_argument("--method", default=None, help="dynamics: the integrator")
     w.add_argument("--positions-only", action="store_true",
                    help="kinematics: positions alone (no velocities or accelerations)")
@@ -342,6 +336,26 @@ def _statics_report(model: Model, st: StaticsResult) -> str:
     return "\n".join(lines)
 
 
+def _study_settings(p: argparse.ArgumentParser, analysis_help: str) -> None:
+    """The analysis and output times of a study (sweep, tolerance)."""
+    p.add_argument("--analysis", default="kinematics",
+                   choices=["kinematics", "inverse_dynamics", "statics", "dynamics"],
+                   help=analysis_help)
+    p.add_argument("--t-end", type=float, default=None, help="final time")
+    p.add_argument("--steps", type=int, default=None, help="output intervals")
+    p.add_argument("--t0", type=float, default=0.0, help="start time (statics: its time)")
+    p.add_argument("--every", type=int, default=1, help="keep every k-th row (and the last)")
+
+
+def _study_span(args: argparse.Namespace) -> dict[str, Any]:
+    """The settings of a study's analysis from --t0, --t-end, --steps, --every (statics: t)."""
+    if args.analysis == "statics":
+        return {"t": args.t0}
+    if args.t_end is None or args.steps is None:
+        raise ModelError(f"{args.analysis} needs --t-end and --steps", "command line")
+    return {"t_end": args.t_end, "steps": args.steps, "t0": args.t0, "every": args.every}
+
+
 def _tolerance_parser(sub: Any) -> None:
     t = sub.add_parser("tolerance", help="scatter of every output under parameter "
                        "tolerances: first order (exact sensitivities) beside Monte Carlo")
@@ -351,13 +365,7 @@ def _tolerance_parser(sub: Any) -> None:
     t.add_argument("--samples", type=int, default=200,
                    help="Monte Carlo variants (default 200; 0: first order alone)")
     t.add_argument("--seed", type=int, default=0, help="seed of the draws (default 0)")
-    t.add_argument("--analysis", default="kinematics",
-                   choices=["kinematics", "inverse_dynamics", "statics", "dynamics"],
-                   help="the analysis (default kinematics; dynamics by dopri5)")
-    t.add_argument("--t-end", type=float, default=None, help="final time")
-    t.add_argument("--steps", type=int, default=None, help="output intervals")
-    t.add_argument("--t0", type=float, default=0.0, help="start time (statics: its time)")
-    t.add_argument("--every", type=int, default=1, help="keep every k-th row (and the last)")
+    _study_settings(t, "the analysis (default kinematics; dynamics by dopri5)")
     t.add_argument("--point", action="append", default=None, metavar="BODY:X,Y",
                    help="also the scatter of the point (X, Y) of BODY (repeatable)")
     t.add_argument("--out", required=True, help="output file, .csv (one row per time) or "
@@ -393,12 +401,7 @@ def _tolerance(model: Model, args: argparse.Namespace) -> int:
         if body not in bodies:
             raise ModelError(f"--point {body}:...: no moving body {body!r}; bodies: "
                              f"{', '.join(bodies)}", "command line")
-    if args.analysis == "statics":
-        kw: dict = {"t": args.t0}
-    else:
-        if args.t_end is None or args.steps is None:
-            raise ModelError(f"{args.analysis} needs --t-end and --steps", "command line")
-        kw = {"t_end": args.t_end, "steps": args.steps, "t0": args.t0, "every": args.every}
+    kw = _study_span(args)
     client = connect(args.scheduler) if args.scheduler else None
     try:
         tol = tolerance(model, sigma, args.analysis, samples=args.samples, client=client,
@@ -595,12 +598,8 @@ def _sweep(model: Model, args: argparse.Namespace) -> int:
     if not str(args.out).endswith((".nc", ".csv")):
         raise ModelError(f"--out must end in .nc or .csv, got {args.out!r}", "command line")
     cases = _cases(args)
-    if args.analysis == "statics":
-        kw: dict = {"t": args.t0}
-    else:
-        if args.t_end is None or args.steps is None:
-            raise ModelError(f"{args.analysis} needs --t-end and --steps", "command line")
-        kw = {"t_end": args.t_end, "steps": args.steps, "t0": args.t0, "every": args.every}
+    kw = _study_span(args)
+    if args.analysis != "statics":
         if args.method is not None:
             kw["method"] = args.method
         if args.positions_only:
