@@ -6,9 +6,10 @@ Usage::
 
 Writes ``NAME_mechanism.png`` and ``NAME_timeseries.png`` for each example to DIR (default
 ``examples/output/`` next to this script), animations ``fourbar_grashof.gif`` (with its
-coupler curve) and ``slider_crank.gif``, the cam lift-off pictures, and the design study's
+coupler curve) and ``slider_crank.gif``, the cam lift-off pictures, the design study's
 three pictures (examples/design_study.py: a sweep of the crank-rocker's coupler length, the
-sensitivities of the rocker angle, the tolerance of a coupler point). The seed four-bar is
+sensitivities of the rocker angle, the tolerance of a coupler point), and the same sweep
+and a sensitivity run in the standalone mbd2d-solve (examples/standalone_sweep.py). The seed four-bar is
 non-Grashof: driven past its
 toggle it raises :class:`mbd2d.SingularConfigurationError`, which is the expected outcome;
 its partial results are drawn with the toggle configuration marked.
@@ -152,6 +153,18 @@ def main(argv: list[str] | None = None) -> int:
         traceback.print_exc()
         problems.append(f"design_study: {type(exc).__name__}: {exc}")
         print(f"design_study: FAILED ({type(exc).__name__})")
+
+    total += 1
+    print("\nstandalone_sweep (the design study's sweep and a sensitivity run in mbd2d-solve):")
+    try:
+        sys.path.insert(0, str(HERE))
+        import standalone_sweep
+        if standalone_sweep.main(["--out", str(out)]) != 0:
+            problems.append("standalone_sweep: mbd2d-solve's files differ from the Python "
+                            "path's")
+    except Exception as exc:  # report every example, then fail
+        traceback.print_exc()
+        problems.append(f"standalone_sweep: {type(exc).__name__}: {exc}")
 
     if not args.no_synthesis:
         print("\nsynthesis_straight_line (linkage synthesis, issue 14):")
