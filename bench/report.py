@@ -583,6 +583,18 @@ def sweep_section(results: dict) -> str:
         parts.append(f"Dask unavailable: {tp['dask_unavailable']}.\n")
     parts.append(table(("runner", "variants / s", "s", "identical to the serial Dataset"),
                        rows))
+    alone = [r for r in sw.get("standalone") or [] if "solve_s" in r]
+    if alone:
+        parts.append("Without Python: the same sweeps exported once (`mbd2d.export_sweep`) and "
+                     "run from the file to a CSV by `mbd2d-solve` (process start, reading, the "
+                     "batch call, writing), against `mbd2d.sweep(..., workers=1)` + "
+                     "`mbd2d.write_sweep` (interleaved, best of the repeats).\n")
+        parts.append(table(("variants x steps (rows kept)", "mbd2d-solve s", "Python s",
+                            "Python / mbd2d-solve", "the same CSV bytes"),
+                           [(f"{r['cases']} x {r['steps']} (every {r['every']})",
+                             fmt(r.get("solve_s"), ".3f"), fmt(r.get("python_s"), ".3f"),
+                             fmt(r.get("ratio"), ".1f") + "x",
+                             "yes" if r.get("same_csv") else "**no**") for r in alone]))
     return "\n".join(parts)
 
 

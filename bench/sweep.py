@@ -20,13 +20,21 @@ moving the outputs); variants per second, cluster start excluded, the first swee
 cluster discarded (the workers import mbd2d). For reference the same sweep in this process
 (workers=1) and in the local process pool (every core).
 
+Without Python: the same sweeps exported once (``mbd2d.export_sweep``) and run from the file
+to a CSV by the standalone ``mbd2d-solve`` (process start, reading the file, the batch call,
+writing the CSV), against ``mbd2d.sweep(..., workers=1)`` + ``mbd2d.write_sweep`` in this
+process, interleaved best of R; the two CSV files are compared byte for byte.
+
     python bench/sweep.py [--quick] [--out FILE]
 """
 from __future__ import annotations
 
 import argparse
 import json
+import shutil
+import subprocess
 import sys
+import tempfile
 import time
 import warnings
 from pathlib import Path
@@ -123,6 +131,41 @@ def throughput(m_cases: int, steps: int, every: int, repeats: int) -> dict[str, 
             "rows": rows}
 
 
+def standalone(m_cases: int, steps: int, every: int, repeats: int) -> dict[str, Any]:
+    """Seconds from one exported file to a CSV: mbd2d-solve against the Python sweep and
+    write_sweep, interleaved best-of-repeats, and whether the files are the same bytes."""
+    here = Path(sys.executable).parent / "mbd2d-solve"
+    solver = str(here) if here.exists() else shutil.which("mbd2d-solve")
+    if not solver:
+        return {"unavailable": "mbd2d-solve not found next to this Python or on PATH"}
+    m = mbd2d.load(EX / "fourbar_grashof.toml")
+    cases = {NAME: np.linspace(1.6, 1.9, m_cases)}
+    kw = {"t_end": 1.0, "steps": steps, "every": every}
+    with tempfile.TemporaryDirectory() as tmp:
+        d = Path(tmp)
+        mbd2d.export_sweep(m, d / "s.mbd", cases, **kw)
+
+        def solve() -> None:
+            subprocess.run([solver, str(d / "s.mbd"), str(d / "solve.csv")], check=True,
+                           timeout=600)
+
+        def python() -> None:
+            mbd2d.write_sweep(mbd2d.sweep(m, cases, workers=1, progress=False, **kw),
+                              d / "python.csv")
+
+        ts, tp = float("inf"), float("inf")
+        for _ in range(repeats):
+            ts, tp = min(ts, best(solve, 1)), min(tp, best(python, 1))
+        same = (d / "solve.csv").read_bytes() == (d / "python.csv").read_bytes()
+        size = (d / "solve.csv").stat().st_size
+    print(f" file to CSV, {m_cases} variants x {steps} steps (every {every}): mbd2d-solve "
+          f"{ts:.3f} s, Python sweep + write_sweep {tp:.3f} s ({tp / ts:.1f}x); same bytes: "
+          f"{same}", flush=True)
+    return {"cases": m_cases, "steps": steps, "every": every, "repeats": repeats,
+            "solve_s": ts, "python_s": tp, "ratio": tp / ts, "same_csv": same,
+            "csv_bytes": size}
+
+
 def measure(quick: bool = False) -> dict[str, Any]:
     """The whole section: per-variant cost and throughput."""
     pv = per_variant(n=100 if quick else 400, repeats=2 if quick else 5)
@@ -134,8 +177,10 @@ def measure(quick: bool = False) -> dict[str, Any]:
               f"{r['ratio_loop_over_batched']:.1f}x (target {TARGET:.0f}x)", flush=True)
     tp = throughput(m_cases=200 if quick else 1000, steps=1000, every=50,
                     repeats=1 if quick else 3)
+    alone = [standalone(100 if quick else 400, 10, 1, 2 if quick else 5),
+             standalone(200 if quick else 1000, 1000, 50, 1 if quick else 3)]
     return {"per_variant": pv, "per_variant_short_steps": short, "throughput": tp,
-            "quick": quick}
+            "standalone": alone, "quick": quick}
 
 
 def main(argv: list[str] | None = None) -> int:

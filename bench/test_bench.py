@@ -101,7 +101,10 @@ def synthetic_results(stepper: bool = True, exudyn: bool = True) -> dict:
                                                          "core": 65.0}},
                       "throughput": {"cases": 10, "steps": 200, "rows": [
                           {"runner": "Dask LocalCluster, 2 worker(s)", "seconds": 1.0,
-                           "variants_per_s": 10.0, "identical_to_serial": True}]}},
+                           "variants_per_s": 10.0, "identical_to_serial": True}]},
+                      "standalone": [{"cases": 10, "steps": 10, "every": 1, "solve_s": 0.1,
+                                      "python_s": 0.25, "ratio": 2.5, "same_csv": True},
+                                     {"unavailable": "mbd2d-solve not found"}]},
             "sensitivities": {"steps": 100, "repeats": 1, "rows": [
                 {"case": "kinematics four-bar, 4 parameters", "base_us_per_step": 1.0,
                  "sens_us_per_step": 2.5, "ratio": 2.5, "instruction_ratio": 2.1}]},
@@ -168,6 +171,7 @@ def test_report_renders_failures_and_missing_stepper(tmp_path: Path) -> None:
     assert "not available (no KinematicStepper)" in md
     assert "Section **work_precision failed**" in md
     assert "## Design sweeps" in md and "Loop / batched: **12.0x**" in md
+    assert "| 10 x 10 (every 1) | 0.100 | 0.250 | 2.5x | yes |" in md
     assert "## Sensitivity cost" in md
     head = report.headline_markdown(res, {}, tmp_path)
     assert head.startswith("## Performance") and "| target |" in head

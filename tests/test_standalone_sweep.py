@@ -200,3 +200,23 @@ def test_a_sweep_file_takes_no_output_columns(tmp_path: Path) -> None:
                        text=True, timeout=60)
     assert r.returncode == 2 and "a sweep writes its own columns" in r.stderr, r.stderr
     assert not (tmp_path / "o.csv").exists()
+
+
+def test_the_threads_do_not_change_a_byte(tmp_path: Path) -> None:
+    """mbd2d-solve runs the cases in parallel chunks (OpenMP): 1 and 2 threads write the
+    same file, failed cases included (the seed four-bar's dead centres, a contradiction)."""
+    import os
+    mbd = tmp_path / "s.mbd"
+    mbd2d.export_sweep(mbd2d.load(EX / "fourbar_seed.toml"), mbd,
+                       {"joint.B.points.0.0": np.linspace(0.5, 4.0, 150).tolist() + [40.0]},
+                       t_end=1.0, steps=40)
+    outs = []
+    for threads in ("1", "2"):
+        out = tmp_path / f"t{threads}.csv"
+        r = subprocess.run([find_solver(), str(mbd), str(out)], capture_output=True,
+                           text=True, timeout=120, env={**os.environ, "OMP_NUM_THREADS": threads})
+        assert r.returncode == 0, r.stderr
+        outs.append(out.read_bytes())
+    assert outs[0] == outs[1]
+    statuses = {row[3] for row in _rows(tmp_path / "t1.csv")[1:]}
+    assert {"0", "3", "6"} <= statuses

@@ -19,7 +19,7 @@
 !! "mbd2d-solve: ". Nothing is allocated before the counts are checked (mbd_read) and the
 !! outputs, held in memory, are checked against it (mem_check).
 program mbd2d_solve
-  use, intrinsic :: iso_fortran_env, only: error_unit
+  use, intrinsic :: iso_fortran_env, only: error_unit, int64
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan, ieee_value, &
                                           ieee_positive_inf, ieee_copy_sign
   use mbd_kinds, only: wp
@@ -849,7 +849,7 @@ contains
   !> A sweep: every case of the "cases" block in one batch call (as mbd2d.sweep makes it),
   !! written as mbd2d.write_sweep writes a sweep's CSV.
   subroutine run_sweep()
-    integer :: iset(NISET), c, nfail, ne
+    integer :: iset(NISET), c, nfail, ne, nchunk, ic, c0, c1
     real(wp) :: rset(NRSET), bytes
     real(wp), allocatable :: bm(:, :), bv0(:), bfp(:)
     integer, allocatable :: bft(:, :)
@@ -907,10 +907,22 @@ contains
       bm = spec%bmass; bft = spec%ftab; bfp(1:size(spec%fpar)) = spec%fpar
       bv0(1:3 * spec%nb) = reshape(spec%v0, [3 * spec%nb])
     end if
-    call batch_run(code, spec%nb, spec%ctab, spec%rpar, bm, merge(spec%grav, 0.0_wp, code /= 1), &
-                   bft, bfp, q0, bv0, spec%vtab, spec%cvals(spec%ncp + 1:, :), spec%opens, &
-                   iset, rset, bq, bqd, bqdd, blam, be, biinfo, brinfo, bqsing, bdep, bred, &
-                   bstat, bmsg)
+    ! the cases in chunks, run in parallel (OpenMP) where the build has it: each case's
+    ! numbers depend on its own values alone, so any split gives the same bytes
+    nchunk = min(spec%ncase, 64)
+    !$omp parallel do schedule(dynamic, 1) private(c0, c1)
+    do ic = 1, nchunk
+      c0 = int((int(ic - 1, int64) * spec%ncase) / nchunk) + 1
+      c1 = int((int(ic, int64) * spec%ncase) / nchunk)
+      call batch_run(code, spec%nb, spec%ctab, spec%rpar, bm, &
+                     merge(spec%grav, 0.0_wp, code /= 1), bft, bfp, q0, bv0, spec%vtab, &
+                     spec%cvals(spec%ncp + 1:, c0:c1), spec%opens, iset, rset, &
+                     bq(:, :, c0:c1), bqd(:, :, c0:c1), bqdd(:, :, c0:c1), &
+                     blam(:, :, c0:c1), be(:, :, c0:c1), biinfo(:, c0:c1), brinfo(:, c0:c1), &
+                     bqsing(:, c0:c1), bdep(:, c0:c1), bred(:, c0:c1), bstat(c0:c1), &
+                     bmsg(c0:c1))
+    end do
+    !$omp end parallel do
     call times()
     nfail = 0
     do c = 1, spec%ncase
