@@ -175,10 +175,11 @@ def measure(quick: bool = False) -> dict[str, Any]:
         print(f" per variant (10 steps, {label}): loop {us['loop']:.0f} us, batched "
               f"{us['batched']:.1f} us, core alone {us['core']:.1f} us; loop / batched = "
               f"{r['ratio_loop_over_batched']:.1f}x (target {TARGET:.0f}x)", flush=True)
-    tp = throughput(m_cases=200 if quick else 1000, steps=1000, every=50,
-                    repeats=1 if quick else 3)
+    # before the Dask clusters: their worker processes may linger a moment after closing
     alone = [standalone(100 if quick else 400, 10, 1, 2 if quick else 5),
              standalone(200 if quick else 1000, 1000, 50, 1 if quick else 3)]
+    tp = throughput(m_cases=200 if quick else 1000, steps=1000, every=50,
+                    repeats=1 if quick else 3)
     return {"per_variant": pv, "per_variant_short_steps": short, "throughput": tp,
             "standalone": alone, "quick": quick}
 
