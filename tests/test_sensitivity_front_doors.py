@@ -187,7 +187,7 @@ def test_cli_statics_and_parameters(tmp_path: Path, capsys) -> None:
     text = capsys.readouterr().out
     st = model.statics(sensitivities=["body.bar.mass"])
     dx = st.sensitivity("bar", "body.bar.mass")[0]
-    assert f"d/d(body.bar.mass) bar" in text and f"{dx: .9g}" in text
+    assert "d/d(body.bar.mass) bar" in text and f"{dx: .9g}" in text
     header, rows = read_csv(out)
     assert header[-3:] == [f"d(bar.{c})/d(body.bar.mass)" for c in ("x", "y", "theta")]
     np.testing.assert_array_equal(rows[0, -3:], st.dq_dp[:3, 0])

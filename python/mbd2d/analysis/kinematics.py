@@ -12,7 +12,7 @@ from ..binding.pack import pack
 from ..binding.status import NO_CONVERGENCE, OK, SINGULAR_CONFIG, error_for
 from ..binding.tables import Packed
 from ..description.builder import ModelDescription
-from ..errors import MbdError, ModelError, RedundantConstraintWarning, SingularPassageWarning
+from ..errors import MbdError, RedundantConstraintWarning, SingularPassageWarning
 from ..results.kinematics import KinematicsResult
 from ..validate import flag
 from .failures import kinematic_failure, row_names

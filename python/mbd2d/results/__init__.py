@@ -11,7 +11,8 @@ from .contacts import ContactEvent, ContactHistory, FrictionEvent, FrictionHisto
 from .dof import DofReport
 from .dynamics import DynamicsResult
 from .files import read_csv
-from .kinematics import SUFFIXES, BodyResult, KinematicsResult
+from .columns import SUFFIXES
+from .kinematics import BodyResult, KinematicsResult
 from .points import PointResult
 from .reactions import Reaction
 from .statics import StaticsResult

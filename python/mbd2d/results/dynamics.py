@@ -10,7 +10,7 @@ import numpy as np
 
 from .contacts import (ContactEvent, ContactHistory, FrictionEvent, FrictionHistory, LiftOff,
                        history)
-from .columns import REACTION_WORDS, constraint_columns, derivative_names
+from .columns import constraint_columns, derivative_names
 from .files import check_outputs, writing
 from .kinematics import KinematicsResult, measures_arg
 from .measures import measure_columns

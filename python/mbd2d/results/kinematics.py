@@ -12,7 +12,7 @@ from .. import plots
 from ..errors import MbdError
 from ..validate import vector
 from . import measures
-from .columns import SUFFIXES, derivative_names, motion_columns, require_sensitivities
+from .columns import derivative_names, motion_columns, require_sensitivities
 from .files import check_outputs, write_csv, writing
 from .measures import measure_columns
 from .points import PointResult
