@@ -18,8 +18,6 @@ import math
 import time
 from typing import Any
 
-import numpy as np
-
 import mbd2d
 
 L1, L2 = 0.05, 0.12

@@ -2,7 +2,6 @@
 computations (closed-form kinematics and the power balance)."""
 from __future__ import annotations
 
-import math
 
 import numpy as np
 import pytest

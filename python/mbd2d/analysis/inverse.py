@@ -15,7 +15,7 @@ from ..description.builder import ModelDescription
 from ..errors import MbdError, RedundantConstraintWarning
 from ..results.dynamics import DynamicsResult
 from .contacts import MAX_EVENTS, report_pulls
-from .failures import BAD_FORCE, bad_entry, kinematic_failure, row_names
+from .failures import bad_entry, kinematic_failure, row_names
 from .outputs import dynamics_result, finite_part
 from .progress import run_core
 from .sensitivities import attach, check_status, requested, table

@@ -7,7 +7,6 @@ client's ``map``/``gather``).
 from __future__ import annotations
 
 import math
-import os
 import time
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
