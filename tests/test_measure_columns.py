@@ -193,3 +193,31 @@ def test_bad_measure_lines_name_their_line(tmp_path: Path, edit: tuple[str, str]
     r = _solve(tmp_path, mbd)
     assert r.returncode == 2, r.stderr
     assert needle in r.stderr and r.stderr.startswith(f"mbd2d-solve: {mbd}:"), r.stderr
+
+
+@pytest.mark.parametrize("analysis", ["inverse-dynamics", "dynamics"])
+def test_every_column_group_together(tmp_path: Path, analysis: str) -> None:
+    """Energy, multipliers, reactions, efforts, measures and sensitivities in one file, in
+    the Python table's order: mbd2d-solve writes the same text."""
+    outputs = ["energy", "multipliers", "reactions", "efforts"]
+    specs = ["transmission_angle:B", "velocity_ratio:motor:rocker.theta", "dead_centre_distance"]
+    if analysis == "inverse-dynamics":
+        model, names = mbd2d.load(EX / "fourbar_masses.toml"), ["joint.B.points.0.0",
+                                                                "body.coupler.mass"]
+        res = model.inverse_dynamics(1.0, 20, every=3, sensitivities=names)
+        kw = dict(t_end=1.0, steps=20, every=3)
+    else:
+        import sys
+        sys.path.insert(0, str(EX))
+        import free_fourbar
+        model, names, specs = free_fourbar.build(), ["body.coupler.mass"], [specs[0], specs[2]]
+        res = model.dynamics(0.5, 10, method="dopri5", sensitivities=names)
+        kw = dict(t_end=0.5, steps=10, method="dopri5")
+    mbd = tmp_path / "all.mbd"
+    model.export(mbd, analysis=analysis, outputs=outputs, measures=specs, sensitivities=names,
+                 **kw)
+    r = _solve(tmp_path, mbd)
+    assert r.returncode == 0, r.stderr
+    py = tmp_path / "py.csv"
+    res.to_csv(py, sensitivities=True, measures=specs, **{k: True for k in outputs})
+    assert (tmp_path / "solve.csv").read_text() == py.read_text()
