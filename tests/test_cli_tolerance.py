@@ -130,3 +130,38 @@ def test_needs_a_span_and_a_known_suffix(tmp_path: Path, capsys) -> None:
     assert main(["tolerance", FOURBAR, "--sigma", f"{PRM}=1e-3", "--t-end", "1", "--steps",
                  "4", "--out", str(tmp_path / "t.txt")]) == 2
     assert "must end in .nc or .csv" in capsys.readouterr().err
+
+
+def test_monte_carlo_draws_run_in_mbd2d_solve(tmp_path: Path, capsys) -> None:
+    """--export-samples writes the Monte Carlo draws as a sweep file; mbd2d-solve's CSV is
+    the tolerance analysis's own sample sweep (the same draws, byte for byte), and the sample
+    standard deviation taken from it is the analysis's q_std_mc."""
+    import csv
+    import subprocess
+    from test_standalone import find_solver
+    mbd = tmp_path / "mc.mbd"
+    sig = {PRM: SIG, "joint.O4.points.1.0": 1e-3}
+    argv = ["tolerance", FOURBAR, "--t-end", "1", "--steps", "10", "--samples", "60",
+            "--seed", "3", "--export-samples", str(mbd)]
+    for k, v in sig.items():
+        argv += ["--sigma", f"{k}={v}"]
+    assert main(argv) == 0
+    assert "60 Monte Carlo variants" in capsys.readouterr().out
+    out = tmp_path / "solve.csv"
+    r = subprocess.run([find_solver(), str(mbd), str(out)], capture_output=True, text=True,
+                       timeout=120)
+    assert r.returncode == 0, r.stderr
+    model = mbd2d.load(FOURBAR)
+    tol = mbd2d.tolerance(model, sig, samples=60, seed=3, workers=1, t_end=1.0, steps=10)
+    py = tmp_path / "py.csv"
+    mbd2d.write_sweep(tol.samples, py)
+    assert out.read_bytes() == py.read_bytes()
+    with open(out, newline="") as f:
+        rows = list(csv.reader(f))
+    col = rows[0].index("rocker.theta")
+    x = np.array([[float(r[col]) for r in rows[1:] if r[0] == str(c)] for c in range(60)])
+    np.testing.assert_allclose(x.std(axis=0, ddof=1),
+                               tol.dataset.q_std_mc.sel(coordinate="rocker.theta").values,
+                               rtol=1e-12, atol=0)
+    assert np.array_equal(mbd2d.tolerance_samples(model, sig, 60, 3)[PRM],
+                          tol.samples[PRM].values)

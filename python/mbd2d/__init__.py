@@ -21,7 +21,8 @@ from .model import Model, load, loads
 from .plots import animate, plot_mechanism, plot_paths, plot_timeseries
 from .results import (BodyResult, DofReport, DynamicsResult, KinematicsResult, PointResult,
                       Reaction, StaticsResult)
-from .studies import ToleranceResult, export_sweep, grid, sweep, tolerance, write_sweep
+from .studies import (ToleranceResult, export_sweep, grid, sweep, tolerance,
+                      tolerance_samples, write_sweep)
 from .synthesis import SynthesisResult, synthesize
 
 __version__ = "0.1.0"
@@ -35,4 +36,4 @@ __all__ = ["load", "loads", "Model", "TimeFunction", "Harmonic", "KinematicsResu
            "InsufficientMemoryError", "MbdWarning", "RedundantConstraintWarning",
            "SingularPassageWarning", "LiftOffWarning", "plot_mechanism", "plot_paths",
            "plot_timeseries", "animate", "sweep", "grid", "tolerance", "ToleranceResult",
-           "write_sweep", "export_sweep", "synthesize", "SynthesisResult", "__version__"]
+           "write_sweep", "export_sweep", "tolerance_samples", "synthesize", "SynthesisResult", "__version__"]

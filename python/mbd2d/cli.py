@@ -368,8 +368,11 @@ def _tolerance_parser(sub: Any) -> None:
     _study_settings(t, "the analysis (default kinematics; dynamics by dopri5)")
     t.add_argument("--point", action="append", default=None, metavar="BODY:X,Y",
                    help="also the scatter of the point (X, Y) of BODY (repeatable)")
-    t.add_argument("--out", required=True, help="output file, .csv (one row per time) or "
+    t.add_argument("--out", default=None, help="output file, .csv (one row per time) or "
                    ".nc (netCDF)")
+    t.add_argument("--export-samples", default=None, metavar="FILE.mbd",
+                   help="instead of running: write the Monte Carlo draws (--samples, --seed) "
+                   "as a sweep file for mbd2d-solve")
     t.add_argument("--workers", type=int, default=None,
                    help="local processes for the Monte Carlo sweep (default: all cores)")
     t.add_argument("--scheduler", default=None, metavar="ADDRESS",
@@ -391,10 +394,16 @@ def _sigma(spec: str) -> tuple[str, float]:
 
 def _tolerance(model: Model, args: argparse.Namespace) -> int:
     """The tolerance command: run, write, summarize."""
-    from .studies import connect, tolerance, write_tolerance
-    if not str(args.out).endswith((".nc", ".csv")):
-        raise ModelError(f"--out must end in .nc or .csv, got {args.out!r}", "command line")
+    from .studies import connect, export_sweep, tolerance, tolerance_samples, write_tolerance
     sigma = dict(_sigma(s) for s in args.sigma)
+    if args.export_samples is not None:
+        cases = tolerance_samples(model, sigma, args.samples, args.seed)
+        export_sweep(model, args.export_samples, cases, args.analysis, **_study_span(args))
+        print(f"wrote {args.export_samples} ({args.samples} Monte Carlo variants, seed "
+              f"{args.seed}; run it with mbd2d-solve {args.export_samples} OUT.csv)")
+        return EXIT_OK
+    if args.out is None or not str(args.out).endswith((".nc", ".csv")):
+        raise ModelError(f"--out must end in .nc or .csv, got {args.out!r}", "command line")
     points = _trace(args.point) or []
     bodies = [b.name for b in model.bodies]
     for body, _ in points:

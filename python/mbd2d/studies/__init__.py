@@ -12,7 +12,7 @@ from .files import tolerance_table, write_sweep, write_tolerance
 from .plan import ANALYSES, grid
 from .runner import connect
 from .sweep import sweep
-from .tolerance import ToleranceResult, tolerance
+from .tolerance import ToleranceResult, tolerance, tolerance_samples
 
-__all__ = ["sweep", "grid", "tolerance", "ToleranceResult", "write_sweep", "write_tolerance",
+__all__ = ["sweep", "grid", "tolerance", "tolerance_samples", "ToleranceResult", "write_sweep", "write_tolerance",
            "tolerance_table", "export_sweep", "connect", "ANALYSES"]

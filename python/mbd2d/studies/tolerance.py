@@ -186,6 +186,44 @@ def _linear_outputs(res: Any, ran: str) -> dict[str, tuple[tuple[str, ...], np.n
     return out
 
 
+def draws(model: ModelDescription, params: Any, sig: np.ndarray, n: int,
+          seed: int | None) -> dict[str, np.ndarray]:
+    """The Monte Carlo case table: n variants with p ~ Normal(p0, sigma), drawn by numpy's
+    default generator from seed (the parameters in turn, one row of n each)."""
+    p0 = nominal_values(model, params)
+    rng = np.random.default_rng(seed)
+    values = p0[:, None] + sig[:, None] * rng.standard_normal((len(params), n))
+    return dict(zip([prm.name for prm in params], values))
+
+
+def tolerance_samples(model: ModelDescription, sigma: Mapping[str, Any], samples: int = 200,
+                      seed: int | None = 0) -> dict[str, np.ndarray]:
+    """The case table of :func:`tolerance`'s Monte Carlo estimate (the same draws for the
+    same sigma, samples and seed): for :func:`mbd2d.sweep` or :func:`mbd2d.export_sweep`
+    (mbd2d-solve then runs them without Python).
+
+    Raises
+    ------
+    ModelError
+        As :func:`tolerance` for sigma and samples.
+    """
+    params, sig = _sigma(model, sigma)
+    n = whole(samples, "samples", "tolerance", 1, 10**8)
+    return draws(model, params, sig, n, seed)
+
+
+def _sigma(model: ModelDescription, sigma: Any) -> tuple[list[Any], np.ndarray]:
+    """The parameters and standard deviations of sigma, checked."""
+    if not isinstance(sigma, Mapping) or not sigma:
+        raise ModelError("sigma must be a dict {parameter name: standard deviation}",
+                         "tolerance")
+    params = find(model, list(sigma), "tolerance")
+    sig = np.array([number(sigma[n], f"sigma of {n}", "tolerance") for n in sigma])
+    if (sig < 0).any():
+        raise ModelError("a standard deviation must be >= 0", "tolerance")
+    return params, sig
+
+
 def tolerance(model: ModelDescription, sigma: Mapping[str, Any], analysis: str = "kinematics",
               samples: int = 200, client: Any = None, *, seed: int | None = 0,
               workers: int | None = None, progress: bool | None = None,
@@ -236,30 +274,21 @@ def tolerance(model: ModelDescription, sigma: Mapping[str, Any], analysis: str =
     (21, 9)
     """
     xr = xarray()
-    if not isinstance(sigma, Mapping) or not sigma:
-        raise ModelError("sigma must be a dict {parameter name: standard deviation}",
-                         "tolerance")
+    params, sig = _sigma(model, sigma)
     if not isinstance(analysis, str) or analysis not in ANALYSES:
         raise ModelError(f"unknown analysis {analysis!r}; use one of {', '.join(ANALYSES)}",
                          "tolerance")
     names = [str(n) for n in sigma]
-    params = find(model, list(sigma), "tolerance")
-    sig = np.array([number(sigma[n], f"sigma of {n}", "tolerance") for n in sigma])
-    if (sig < 0).any():
-        raise ModelError("a standard deviation must be >= 0", "tolerance")
     n = whole(samples, "samples", "tolerance", 0, 10**8)
     if n == 1:
         raise ModelError("samples must be 0 (no Monte Carlo estimate) or at least 2",
                          "tolerance")
     res, ran = _nominal(model, names, analysis, analysis_kwargs)
     outs = _linear_outputs(res, ran)
-    p0 = nominal_values(model, params)
     mc = None
     if n:
-        rng = np.random.default_rng(seed)
-        draws = p0[:, None] + sig[:, None] * rng.standard_normal((len(names), n))
-        mc = sweep(model, dict(zip(names, draws)), analysis, client, workers=workers,
-                   progress=progress, **analysis_kwargs)
+        mc = sweep(model, draws(model, params, sig, n, seed), analysis, client,
+                   workers=workers, progress=progress, **analysis_kwargs)
     ok = mc.status.values == 0 if mc is not None else np.zeros(0, dtype=bool)
     times = np.array([res.t]) if ran == "statics" else np.asarray(res.t)
     data: dict[str, Any] = {}
@@ -284,4 +313,4 @@ def tolerance(model: ModelDescription, sigma: Mapping[str, Any], analysis: str =
     return ToleranceResult(ds, mc, res, dict(zip(names, sig.tolist())))
 
 
-__all__ = ["tolerance", "ToleranceResult"]
+__all__ = ["tolerance", "tolerance_samples", "ToleranceResult"]
