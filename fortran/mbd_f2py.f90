@@ -240,6 +240,21 @@ subroutine core_influence(nb, nc, ctab, np, rpar, nq, nt, q, t, row, u, ok, stat
   call api_influence(nb, ctab, rpar, q, t, row, u, ok, status, msg)
 end subroutine core_influence
 
+subroutine core_ratio(nb, nc, ctab, np, rpar, nq, nt, q, t, kind, ref, x, y, ratio, bad, &
+                      status, msg)
+  use iso_c_binding, only: c_double, c_int
+  use mbd_measures, only: api_ratio
+  implicit none
+  integer(c_int), intent(in) :: nb, nc, np, nq, nt, kind, ref
+  integer(c_int), intent(in) :: ctab(8, nc), x(2), y(2)
+  real(c_double), intent(in) :: rpar(np), q(nq, nt), t(nt)
+  real(c_double), intent(out) :: ratio(nt)
+  integer(c_int), intent(out) :: bad, status
+  character(len=512), intent(out) :: msg
+  !f2py intent(hide) :: nc, np, nq, nt
+  call api_ratio(nb, ctab, rpar, q, t, kind, ref, x, y, ratio, bad, status, msg)
+end subroutine core_ratio
+
 subroutine core_link_angle(nq, nt, q, kind, b, s, mu, status, msg)
   use iso_c_binding, only: c_double, c_int
   use mbd_measures, only: api_link_angle

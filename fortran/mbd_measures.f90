@@ -14,6 +14,10 @@
 !!                 constraints): least squares by pivoted QR, exact while they agree.
 !!   fun_values    f(t), f'(t), f''(t) of an encoded function of time at many times (the
 !!                 applied loads drawn as arrows).
+!!   ratio         the velocity ratio dY/dX or the mechanical advantage dX/dY of two
+!!                 quantities (coordinates, or the quantity a driver prescribes) from the
+!!                 influence coefficients of one driver's row: dX/ds = u_X for a coordinate,
+!!                 1 for that driver, 0 for another (held) one.
 !!   link_angle    the transmission angle (Norton, Design of Machinery, ch. 4) from points and
 !!                 an axis fixed in bodies: e = (A - B)/|A - B| along the coupler from the
 !!                 joint B to its other joint A; an output turning about P: p = (P - B)/|P - B|,
@@ -30,10 +34,15 @@ module mbd_measures
   use mbd_linsolve, only: lapack_status, lu_factor, lu_solve, qr_factor, qr_solve, qr_lwork
   use mbd_lapack, only: dgesvd
   use mbd_functions, only: fun_check, fun_eval, fun_length
-  use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+  use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_value, ieee_positive_inf, &
+                                          ieee_copy_sign
   implicit none
   private
-  public :: api_conditioning, api_influence, api_fun_values, api_link_angle
+  public :: api_conditioning, api_influence, api_fun_values, api_link_angle, api_ratio
+  !> ratio kinds: the velocity ratio dY/dX, the mechanical advantage dX/dY
+  integer, parameter, public :: RATIO_VELOCITY = 1, RATIO_ADVANTAGE = 2
+  !> quantity kinds: a coordinate (its column), a driver (its row of Phi)
+  integer, parameter, public :: QTY_COORDINATE = 1, QTY_DRIVER = 2
   !> link_angle recipes: an output link turning about a second pivot, or sliding
   integer, parameter, public :: ANGLE_TURN = 1, ANGLE_SLIDE = 2
 
@@ -150,6 +159,84 @@ contains
       end if
     end do
   end subroutine api_influence
+
+  !> The velocity ratio dY/dX (RATIO_VELOCITY; inf where J is singular for the driver) or
+  !! the mechanical advantage dX/dY (RATIO_ADVANTAGE; 0 there) at each state, by the
+  !! influence coefficients u of row ref (api_influence): dX/ds = u(X's column) for a
+  !! coordinate, 1 for the driver of row ref itself, 0 for another driver (held); where only
+  !! the denominator vanishes, +-inf with the numerator's sign; where both do, the singular
+  !! value. A coordinate that does not move with the driver (|u_X| <= 1e-12 max |u|
+  !! throughout) has no ratio: MBD_BAD_PARAM with bad = 1 (X) or 2 (Y).
+  subroutine api_ratio(nb, ctab, rpar, q, t, kind, ref, x, y, ratio, bad, status, msg)
+    integer, intent(in) :: nb                   !! moving bodies
+    integer, intent(in) :: ctab(:, :)           !! constraint table
+    real(wp), intent(in) :: rpar(:)             !! raw parameters
+    real(wp), intent(in) :: q(:, :)             !! states (nq, nt), model units
+    real(wp), intent(in) :: t(:)                !! times (nt)
+    integer, intent(in) :: kind                 !! RATIO_VELOCITY or RATIO_ADVANTAGE
+    integer, intent(in) :: ref                  !! the driver's row of Phi (1-based)
+    integer, intent(in) :: x(2), y(2)           !! QTY_COORDINATE or QTY_DRIVER, 1-based index
+    real(wp), intent(out) :: ratio(:)           !! at each state (nt)
+    integer, intent(out) :: bad                 !! 1 or 2: the quantity that does not move
+    integer, intent(out) :: status              !! MBD_OK, < 0 input, > 0 numerical
+    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    real(wp), allocatable :: u(:, :), dx(:), dy(:)
+    integer, allocatable :: ok(:)
+    real(wp) :: scale, num, den, sing
+    integer :: k, ist
+    ratio = zero; bad = 0
+    if ((kind /= RATIO_VELOCITY .and. kind /= RATIO_ADVANTAGE) .or. &
+        any([x(1), y(1)] < QTY_COORDINATE) .or. any([x(1), y(1)] > QTY_DRIVER) .or. &
+        size(ratio) /= size(t) .or. any([x(2), y(2)] < 1)) then
+      status = MBD_BAD_PARAM; msg = 'ratio: unknown kind or quantity'; return
+    end if
+    if ((x(1) == QTY_COORDINATE .and. x(2) > size(q, 1)) .or. &
+        (y(1) == QTY_COORDINATE .and. y(2) > size(q, 1))) then
+      status = MBD_BAD_COUNT; msg = 'ratio: a coordinate beyond the model'; return
+    end if
+    allocate (u(size(q, 1), size(t)), ok(size(t)), dx(size(t)), dy(size(t)), stat=ist)
+    if (ist /= 0) then
+      call mem_fail(REAL_BYTES * (real(size(q, 1), wp) + 3) * size(t), 'the influence '// &
+                    'coefficients', 'keep fewer rows', status, msg)
+      return
+    end if
+    call api_influence(nb, ctab, rpar, q, t, ref, u, ok, status, msg)
+    if (status /= MBD_OK) return
+    scale = zero
+    if (size(u) > 0) scale = maxval(abs(u))
+    call rate(x, dx, 1)
+    if (bad == 0) call rate(y, dy, 2)
+    if (bad /= 0) then
+      status = MBD_BAD_PARAM
+      msg = 'the quantity does not move with the driver (its influence coefficient is zero '// &
+            'throughout): no ratio to it'
+      return
+    end if
+    sing = merge(ieee_value(zero, ieee_positive_inf), zero, kind == RATIO_VELOCITY)
+    do k = 1, size(t)
+      num = merge(dy(k), dx(k), kind == RATIO_VELOCITY)
+      den = merge(dx(k), dy(k), kind == RATIO_VELOCITY)
+      if (ok(k) /= 1 .or. (den == zero .and. num == zero)) then
+        ratio(k) = sing
+      else if (den == zero) then
+        ratio(k) = ieee_copy_sign(ieee_value(zero, ieee_positive_inf), num)
+      else
+        ratio(k) = num / den
+      end if
+    end do
+  contains
+    !> dQ/ds of quantity qq; bad = which when a coordinate does not move at all.
+    subroutine rate(qq, d, which)
+      integer, intent(in) :: qq(2), which
+      real(wp), intent(out) :: d(:)
+      if (qq(1) == QTY_COORDINATE) then
+        d = u(qq(2), :)
+        if (.not. (size(d) > 0 .and. maxval(abs(d)) > 1.0e-12_wp * scale)) bad = which
+      else
+        d = merge(one, zero, qq(2) == ref)
+      end if
+    end subroutine rate
+  end subroutine api_ratio
 
   !> f(t), f'(t), f''(t) of the encoded function p at the times t.
   subroutine api_fun_values(p, t, f, f1, f2, status, msg)

@@ -20,14 +20,14 @@
 !! outputs, held in memory, are checked against it (mem_check).
 program mbd2d_solve
   use, intrinsic :: iso_fortran_env, only: error_unit, int64
-  use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan, ieee_value, &
-                                          ieee_positive_inf, ieee_copy_sign
+  use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan
   use mbd_kinds, only: wp
   use mbd_status, only: MBD_OK, MBD_SINGULAR_CONFIG, MBD_NO_MEMORY, MSG_LEN
   use mbd_memory, only: REAL_BYTES, mem_check
   use mbd_mbdfile, only: mbd_spec_t, mbd_read, NAME_LEN, MEAS_ANGLE, MEAS_RATIO, &
                          MEAS_ADVANTAGE, MEAS_CONDITIONING
-  use mbd_measures, only: api_conditioning, api_influence, api_link_angle
+  use mbd_measures, only: api_conditioning, api_link_angle, api_ratio, RATIO_VELOCITY, &
+                          RATIO_ADVANTAGE
   use mbd_model, only: NFT
   use mbd_constraints, only: con_nrow, con_is_driver
   use mbd_api, only: NINFO, api_sizes, api_kinematics, api_inverse, api_dynamics, api_statics, &
@@ -334,13 +334,10 @@ contains
   !> The measures at the rows written (the core, as the Python path's table): the
   !! conditioning of J, the transmission angle, and the ratios of influence coefficients.
   subroutine eval_measures()
-    integer :: j, k, st
-    real(wp) :: scale, num, den, sing
-    real(wp), allocatable :: u(:, :), col(:), dx(:), dy(:)
-    integer, allocatable :: okf(:)
+    integer :: j, st, bad
+    real(wp), allocatable :: col(:)
     if (spec%nmeas == 0 .or. nout == 0) return
-    allocate (mvals(spec%nmeas, nout), u(nq, nout), col(nout), dx(nout), dy(nout), &
-              okf(nout), stat=ierr)
+    allocate (mvals(spec%nmeas, nout), col(nout), stat=ierr)
     if (ierr /= 0) call die(2, 'not enough memory for the measures; give fewer steps')
     do j = 1, spec%nmeas
       select case (spec%meas_kind(j))
@@ -351,49 +348,18 @@ contains
         call api_link_angle(qout(:, 1:nout), spec%meas_int(1, j), spec%meas_int(2:4, j), &
                             spec%meas_pts(:, :, j), col, st, msg)
       case default
-        call api_influence(spec%nb, spec%ctab, spec%rpar, qout(:, 1:nout), tout(1:nout), &
-                           spec%meas_int(1, j), u, okf, st, msg)
-        if (st == MBD_OK) then
-          scale = maxval(abs(u))
-          call measure_rate(j, 2, u, scale, dx)
-          call measure_rate(j, 4, u, scale, dy)
-          ! Python's velocity_ratio dY/dX (singular: inf), mechanical_advantage dX/dY (0)
-          sing = merge(ieee_value(0.0_wp, ieee_positive_inf), 0.0_wp, &
-                       spec%meas_kind(j) == MEAS_RATIO)
-          do k = 1, nout
-            num = merge(dy(k), dx(k), spec%meas_kind(j) == MEAS_RATIO)
-            den = merge(dx(k), dy(k), spec%meas_kind(j) == MEAS_RATIO)
-            if (okf(k) /= 1 .or. (den == 0.0_wp .and. num == 0.0_wp)) then
-              col(k) = sing
-            else if (den == 0.0_wp) then
-              col(k) = ieee_copy_sign(ieee_value(0.0_wp, ieee_positive_inf), num)
-            else
-              col(k) = num / den
-            end if
-          end do
-        end if
+        call api_ratio(spec%nb, spec%ctab, spec%rpar, qout(:, 1:nout), tout(1:nout), &
+                       merge(RATIO_VELOCITY, RATIO_ADVANTAGE, &
+                             spec%meas_kind(j) == MEAS_RATIO), spec%meas_int(1, j), &
+                       spec%meas_int(2:3, j), spec%meas_int(4:5, j), col, bad, st, msg)
+        if (bad /= 0) call die(2, 'measure "' // trim(spec%meas_names(j)) // '": ' // &
+                               trim(msg))
       end select
       if (st /= MBD_OK) call die(4, 'measure "' // trim(spec%meas_names(j)) // &
                                  '" could not be computed: ' // trim(msg))
       mvals(j, :) = col
     end do
   end subroutine eval_measures
-
-  !> dX/ds of the quantity at meas_int(i:i+1, j) from the influence coefficients u (nq,
-  !! rows): a coordinate's, 1 for the reference driver itself, 0 for another (held) driver.
-  subroutine measure_rate(j, i, u, scale, d)
-    integer, intent(in) :: j, i
-    real(wp), intent(in) :: u(:, :), scale
-    real(wp), intent(out) :: d(:)
-    if (spec%meas_int(i, j) == 1) then
-      d = u(spec%meas_int(i + 1, j), :)
-      if (.not. maxval(abs(d)) > 1.0e-12_wp * scale) call die(2, 'measure "' // &
-        trim(spec%meas_names(j)) // '": a quantity does not move with the driver (its '// &
-        'influence coefficient is zero throughout): no ratio to it')
-    else
-      d = merge(1.0_wp, 0.0_wp, spec%meas_int(i + 1, j) == spec%meas_int(1, j))
-    end if
-  end subroutine measure_rate
 
   !> Keep the rows before the first one with a non-finite sensitivity (as the Python path:
   !! no result leaves with a non-finite number); status NONFINITE when rows are cut.

@@ -173,6 +173,17 @@ def influence(p: Packed, q: np.ndarray, t: np.ndarray, row: int) -> SimpleNamesp
                   int(row), numbers=np.size(q) + np.size(t))
 
 
+def ratio(p: Packed, q: np.ndarray, t: np.ndarray, kind: int, ref: int, x: tuple[int, int],
+          y: tuple[int, int]) -> SimpleNamespace:
+    """The velocity ratio (kind 1) or mechanical advantage (kind 2) of quantities x and y
+    (kind 1 coordinate / 2 driver row, 1-based index) by the influence coefficients of row
+    ``ref`` (1-based) at states q (nq, nt): ``ratio`` (nt), ``bad`` (1 or 2: the quantity
+    that does not move), ``status``, ``msg``."""
+    return _named("ratio bad status msg", _core.core_ratio, p.nb, p.ctab, p.rpar, q, t,
+                  int(kind), int(ref), np.asarray(x, dtype=np.int32),
+                  np.asarray(y, dtype=np.int32), numbers=np.size(q) + 4 * np.size(t))
+
+
 def link_angle(q: np.ndarray, kind: int, bodies: np.ndarray, points: np.ndarray
                ) -> SimpleNamespace:
     """The transmission angle at states q (nq, nt) from the recipe of

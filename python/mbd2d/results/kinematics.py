@@ -233,8 +233,7 @@ class KinematicsResult:
             If a name is neither a driver nor a coordinate, or a quantity does not move with
             the driver at all.
         """
-        dx, dy, ok = measures.rates(self, input, output, via)
-        return measures.ratio(dy, dx, ok, np.inf)
+        return measures.ratio_values(self, "velocity_ratio", input, output, via)
 
     def mechanical_advantage(self, input: str, output: str,
                              via: str | None = None) -> np.ndarray:
@@ -263,8 +262,7 @@ class KinematicsResult:
         >>> ma.shape
         (5,)
         """
-        dx, dy, ok = measures.rates(self, input, output, via)
-        return measures.ratio(dx, dy, ok, 0.0)
+        return measures.ratio_values(self, "mechanical_advantage", input, output, via)
 
     def dead_centre_distance(self) -> np.ndarray:
         """Distance to a dead centre at every output: sigma_min / sigma_max of the

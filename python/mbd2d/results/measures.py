@@ -65,7 +65,7 @@ def dead_centre_distance(res: Any) -> np.ndarray:
 
 
 # ----------------------------------------------------------------------------- ratios
-def _driver(model: Any, p: Packed, name: str) -> int | None:
+def _driver(p: Packed, name: str) -> int | None:
     """First row of Phi (0-based) of the driver called name; None if name is no driver."""
     names = p.constraint_names
     if name in names and p.driver_flags[names.index(name)]:
@@ -78,7 +78,7 @@ def _quantity(model: Any, p: Packed, name: Any, what: str) -> tuple[str, int]:
     if not isinstance(name, str):
         raise ModelError(f"{what} must be a driver name or a coordinate name, got {name!r}",
                          what)
-    row = _driver(model, p, name)
+    row = _driver(p, name)
     if row is not None:
         return "driver", row
     if name in p.coordinate_names:
@@ -104,7 +104,7 @@ def _reference(model: Any, p: Packed, x: tuple[str, int], y: tuple[str, int],
         raise ModelError("neither quantity is a driver and the model has "
                          f"{len(drivers)} drivers ({', '.join(drivers)}): name the one that "
                          "moves them with via=", "via")
-    row = _driver(model, p, drivers[0])
+    row = _driver(p, drivers[0])
     assert row is not None
     return row
 
@@ -123,27 +123,14 @@ def ratio_recipe(model: Any, p: Packed, x: Any, y: Any, via: Any = None
     return _reference(model, p, qx, qy, via), qx, qy
 
 
-def influence(res: Any, row: int) -> tuple[np.ndarray, np.ndarray]:
-    """(n, nq) dq/ds of the quantity driven by Phi's row ``row`` (0-based), and (n,) flags:
-    False where J is singular there."""
-    p = packed_of(res)
-    q, t = _states(res)
-    out = core.influence(p, q, t, row + 1)
-    if out.status != OK:
-        raise error_for("measures", out.status, out.msg, entry="velocity_ratio")
-    return np.asarray(out.u).T.copy(), np.asarray(out.ok) == 1
+#: the core's ratio kinds and quantity kinds (fortran/mbd_measures.f90)
+RATIO_KINDS = {"velocity_ratio": 1, "mechanical_advantage": 2}
+QUANTITY_KINDS = {"coordinate": 1, "driver": 2}
 
 
-def _rate(u: np.ndarray, q: tuple[str, int], ref: int) -> np.ndarray:
-    kind, i = q
-    if kind == "coordinate":
-        return u[:, i]
-    return np.full(len(u), 1.0 if i == ref else 0.0)
-
-
-def rates(res: Any, x: Any, y: Any, via: Any = None) -> tuple[np.ndarray, np.ndarray,
-                                                              np.ndarray]:
-    """dX/ds, dY/ds and the regular-row flags for the reference driver s.
+def ratio_values(res: Any, kind: str, x: Any, y: Any, via: Any = None) -> np.ndarray:
+    """The velocity ratio dY/dX or the mechanical advantage dX/dY at every output row, by
+    the core (the influence coefficients of the reference driver's row).
 
     Raises
     ------
@@ -153,26 +140,17 @@ def rates(res: Any, x: Any, y: Any, via: Any = None) -> tuple[np.ndarray, np.nda
     """
     p = packed_of(res)
     ref, qx, qy = ratio_recipe(res.model, p, x, y, via)
-    u, ok = influence(res, ref)
-    dx, dy = _rate(u, qx, ref), _rate(u, qy, ref)
-    scale = float(np.abs(u).max()) if u.size else 0.0
-    for name, q, d in ((x, qx, dx), (y, qy, dy)):
-        # a driver other than the reference is held: 0 by definition (independent drivers)
-        if q[0] == "coordinate" and not float(np.abs(d).max()) > 1e-12 * scale:
+    q, t = _states(res)
+    out = core.ratio(p, q, t, RATIO_KINDS[kind], ref + 1,
+                     (QUANTITY_KINDS[qx[0]], qx[1] + 1), (QUANTITY_KINDS[qy[0]], qy[1] + 1))
+    if out.status != OK:
+        if int(out.bad) in (1, 2):
+            name = (x, y)[int(out.bad) - 1]
             raise ModelError(f"{name!r} does not move with the driver "
-                             f"'{res.model.constraints[p.row_owner[ref]].name}' "
-                             "(its influence coefficient is zero throughout): no ratio to it",
-                             "velocity_ratio")
-    return dx, dy, ok
-
-
-def ratio(num: np.ndarray, den: np.ndarray, ok: np.ndarray, singular: float) -> np.ndarray:
-    """num / den, +-inf where only den vanishes; ``singular`` where J was singular."""
-    with np.errstate(divide="ignore", invalid="ignore"):
-        r = num / den
-    r = np.where(den == 0.0, np.copysign(np.inf, num), r)
-    r = np.where((den == 0.0) & (num == 0.0), singular, r)
-    return np.where(ok, r, singular)
+                             f"'{res.model.constraints[p.row_owner[ref]].name}' (its influence "
+                             "coefficient is zero throughout): no ratio to it", "velocity_ratio")
+        raise error_for("measures", out.status, out.msg, entry=kind)
+    return np.asarray(out.ratio, dtype=float).copy()
 
 
 # ----------------------------------------------------------------------------- transmission
@@ -292,10 +270,7 @@ def measure(res: Any, spec: str) -> np.ndarray:
         return transmission_angle(res, *args)
     if name == "dead_centre_distance":
         return dead_centre_distance(res)
-    dx, dy, ok = rates(res, *args)
-    if name == "velocity_ratio":
-        return ratio(dy, dx, ok, np.inf)
-    return ratio(dx, dy, ok, 0.0)
+    return ratio_values(res, name, *args)
 
 
 def measure_columns(res: Any, specs: Any) -> tuple[list[str], list[np.ndarray]]:
