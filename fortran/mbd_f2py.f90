@@ -226,20 +226,6 @@ subroutine core_conditioning(nb, nc, ctab, np, rpar, nq, nt, q, t, cond, status,
   call api_conditioning(nb, ctab, rpar, q, t, cond, status, msg)
 end subroutine core_conditioning
 
-subroutine core_influence(nb, nc, ctab, np, rpar, nq, nt, q, t, row, u, ok, status, msg)
-  use iso_c_binding, only: c_double, c_int
-  use mbd_measures, only: api_influence
-  implicit none
-  integer(c_int), intent(in) :: nb, nc, np, nq, nt, row
-  integer(c_int), intent(in) :: ctab(8, nc)
-  real(c_double), intent(in) :: rpar(np), q(nq, nt), t(nt)
-  real(c_double), intent(out) :: u(nq, nt)
-  integer(c_int), intent(out) :: ok(nt), status
-  character(len=512), intent(out) :: msg
-  !f2py intent(hide) :: nc, np, nq, nt
-  call api_influence(nb, ctab, rpar, q, t, row, u, ok, status, msg)
-end subroutine core_influence
-
 subroutine core_ratio(nb, nc, ctab, np, rpar, nq, nt, q, t, kind, ref, x, y, ratio, bad, &
                       status, msg)
   use iso_c_binding, only: c_double, c_int

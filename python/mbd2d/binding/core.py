@@ -165,14 +165,6 @@ def conditioning(p: Packed, q: np.ndarray, t: np.ndarray) -> SimpleNamespace:
                   numbers=np.size(t))
 
 
-def influence(p: Packed, q: np.ndarray, t: np.ndarray, row: int) -> SimpleNamespace:
-    """Influence coefficients dq/ds of the quantity driven by row ``row`` (1-based) at states
-    q (nq, nt) and times t (nt): ``u`` (nq, nt), ``ok`` (nt; 0 where J is singular),
-    ``status``, ``msg``."""
-    return _named("u ok status msg", _core.core_influence, p.nb, p.ctab, p.rpar, q, t,
-                  int(row), numbers=np.size(q) + np.size(t))
-
-
 def ratio(p: Packed, q: np.ndarray, t: np.ndarray, kind: int, ref: int, x: tuple[int, int],
           y: tuple[int, int]) -> SimpleNamespace:
     """The velocity ratio (kind 1) or mechanical advantage (kind 2) of quantities x and y
