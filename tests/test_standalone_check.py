@@ -90,3 +90,11 @@ def test_export_check_refuses_what_it_cannot_hold(tmp_path: Path) -> None:
         m.export(tmp_path / "x.mbd", analysis="check", outputs=["reactions"])
     with pytest.raises(mbd2d.ModelError, match="check computes no sensitivities"):
         m.export(tmp_path / "x.mbd", analysis="check", sensitivities=["body.crank.mass"])
+
+
+def test_check_output_that_cannot_be_written(tmp_path: Path) -> None:
+    mbd = tmp_path / "c.mbd"
+    mbd2d.load(EX / "fourbar_grashof.toml").export(mbd, analysis="check")
+    r = subprocess.run([find_solver(), str(mbd), str(tmp_path / "no" / "dir" / "o.csv")],
+                       capture_output=True, text=True, timeout=60)
+    assert r.returncode == 2 and "cannot write" in r.stderr, r.stderr

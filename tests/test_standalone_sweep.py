@@ -220,3 +220,21 @@ def test_the_threads_do_not_change_a_byte(tmp_path: Path) -> None:
     assert outs[0] == outs[1]
     statuses = {row[3] for row in _rows(tmp_path / "t1.csv")[1:]}
     assert {"0", "3", "6"} <= statuses
+
+
+def test_a_sweep_too_large_or_unwritable_is_refused(tmp_path: Path) -> None:
+    """Outputs beyond the memory are refused before anything is allocated, and an output
+    path that cannot be written is named: exit code 2 both."""
+    lines = _sweep_lines(tmp_path)
+    i = next(k for k, ln in enumerate(lines) if ln.startswith("steps "))
+    lines[i] = "steps 900000000"
+    big = tmp_path / "big.mbd"
+    big.write_text("\n".join(lines) + "\n")
+    r = subprocess.run([find_solver(), str(big), str(tmp_path / "o.csv")], capture_output=True,
+                       text=True, timeout=60)
+    assert r.returncode == 2 and "give fewer cases or steps" in r.stderr, r.stderr
+    ok = tmp_path / "ok.mbd"
+    ok.write_text("\n".join(_sweep_lines(tmp_path)) + "\n")
+    r = subprocess.run([find_solver(), str(ok), str(tmp_path / "no" / "dir" / "o.csv")],
+                       capture_output=True, text=True, timeout=60)
+    assert r.returncode == 2 and "cannot write" in r.stderr, r.stderr
