@@ -610,11 +610,7 @@ contains
     integer :: r, c, i
     if (spec%out_lam) then
       do r = 1, neq
-        if (spec%nlabels == neq) then
-          call put_col(u, ios, 'lambda.' // trim(spec%labels(r)), j)
-        else
-          call put_col(u, ios, 'lambda.row' // trim(itoa(r)), j)
-        end if
+        call put_col(u, ios, 'lambda.' // trim(row_label(r)), j)
       end do
     end if
     if (spec%out_reac) then
