@@ -20,7 +20,7 @@
 !! outputs, held in memory, are checked against it (mem_check).
 program mbd2d_solve
   use, intrinsic :: iso_fortran_env, only: error_unit, int64
-  use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan
+  use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use mbd_kinds, only: wp
   use mbd_status, only: MBD_OK, MBD_SINGULAR_CONFIG, MBD_NO_MEMORY, MSG_LEN
   use mbd_memory, only: REAL_BYTES, mem_check
