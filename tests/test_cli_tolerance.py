@@ -165,3 +165,18 @@ def test_monte_carlo_draws_run_in_mbd2d_solve(tmp_path: Path, capsys) -> None:
                                rtol=1e-12, atol=0)
     assert np.array_equal(mbd2d.tolerance_samples(model, sig, 60, 3)[PRM],
                           tol.samples[PRM].values)
+
+
+def test_study_files_refuse_bad_paths(tmp_path: Path) -> None:
+    """A sweep or a tolerance analysis goes to .nc or .csv; a path that cannot be written
+    is a ModelError naming it (the command line's exit code 2)."""
+    model = mbd2d.load(FOURBAR)
+    ds = mbd2d.sweep(model, {PRM: [1.7, 1.8]}, t_end=1.0, steps=4, workers=1)
+    tol = mbd2d.tolerance(model, {PRM: SIG}, samples=0, t_end=1.0, steps=4)
+    for write, what in ((mbd2d.write_sweep, "a sweep"),
+                        (mbd2d.studies.write_tolerance, "a tolerance analysis")):
+        data = ds if write is mbd2d.write_sweep else tol.dataset
+        with pytest.raises(mbd2d.ModelError, match=f"{what} is written as .nc"):
+            write(data, tmp_path / "x.txt")
+        with pytest.raises(mbd2d.ModelError, match="cannot write"):
+            write(data, tmp_path / "no" / "dir" / "x.csv")

@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import csv
 import math
+from contextlib import contextmanager
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any, Iterator, Sequence
 
 import numpy as np
 
@@ -43,18 +44,30 @@ def write_sweep(ds: Any, path: str | Path) -> None:
     ModelError
         For another suffix or a file that cannot be written.
     """
-    p = Path(path)
-    if p.suffix not in SUFFIXES:
-        raise ModelError(f"a sweep is written as .nc (netCDF) or .csv, got {str(path)!r}",
-                         "write_sweep")
-    try:
+    p = _study_path(path, "a sweep", "write_sweep")
+    with _writing(path, "write_sweep"):
         if p.suffix == ".nc":
             ds.to_netcdf(p, engine=_netcdf_engine())
         else:
             _csv(ds, p)
+
+
+def _study_path(path: Any, what: str, where: str) -> Path:
+    """The path of a study's file, .nc or .csv (else a ModelError)."""
+    p = Path(path)
+    if p.suffix not in SUFFIXES:
+        raise ModelError(f"{what} is written as .nc (netCDF) or .csv, got {str(path)!r}",
+                         where)
+    return p
+
+
+@contextmanager
+def _writing(path: Any, where: str) -> Iterator[None]:
+    """An OSError while writing a study's file becomes a ModelError naming it."""
+    try:
+        yield
     except OSError as exc:
-        raise ModelError(f"cannot write {str(path)!r}: {exc.strerror or exc}",
-                         "write_sweep") from None
+        raise ModelError(f"cannot write {str(path)!r}: {exc.strerror or exc}", where) from None
 
 
 def _params(ds: Any) -> list[str]:
@@ -140,10 +153,7 @@ def write_tolerance(ds: Any, path: str | Path, points: Sequence[tuple[str, Any]]
     ModelError
         For another suffix or a file that cannot be written.
     """
-    p = Path(path)
-    if p.suffix not in SUFFIXES:
-        raise ModelError(f"a tolerance analysis is written as .nc (netCDF) or .csv, got "
-                         f"{str(path)!r}", "write_tolerance")
+    p = _study_path(path, "a tolerance analysis", "write_tolerance")
     if p.suffix == ".csv":
         header, rows = tolerance_table(ds, points)
         write_csv(p, header, rows, "write_tolerance")
@@ -153,11 +163,8 @@ def write_tolerance(ds: Any, path: str | Path, points: Sequence[tuple[str, Any]]
         for v in pt.data_vars:
             out[f"point{k}_{v}"] = pt[v]
         out.attrs[f"point{k}"] = label
-    try:
+    with _writing(path, "write_tolerance"):
         out.to_netcdf(p, engine=_netcdf_engine())
-    except OSError as exc:
-        raise ModelError(f"cannot write {str(path)!r}: {exc.strerror or exc}",
-                         "write_tolerance") from None
 
 
 __all__ = ["write_sweep", "write_tolerance", "tolerance_table"]
