@@ -221,3 +221,15 @@ def test_every_column_group_together(tmp_path: Path, analysis: str) -> None:
     py = tmp_path / "py.csv"
     res.to_csv(py, sensitivities=True, measures=specs, **{k: True for k in outputs})
     assert (tmp_path / "solve.csv").read_text() == py.read_text()
+
+
+@pytest.mark.parametrize("bad", [5, 3.0, object()])
+def test_measures_that_are_not_a_list_are_model_errors(tmp_path: Path, bad) -> None:
+    model = mbd2d.load(EX / "fourbar_grashof.toml")
+    res = model.kinematics(1.0, 4)
+    for call in (lambda: res.to_csv(tmp_path / "m.csv", measures=bad),
+                 lambda: res.to_npz(tmp_path / "m.npz", measures=bad),
+                 lambda: model.export(tmp_path / "m.mbd", t_end=1.0, steps=4, measures=bad)):
+        with pytest.raises(mbd2d.ModelError, match="measures must be a list of specs"):
+            call()
+    assert not list(tmp_path.iterdir())

@@ -23,7 +23,7 @@ from ..description.joints import (Absolute, Cam, Distance, Gear, PinInSlot, Poin
                                   Weld)
 from ..errors import ModelError
 from ..results.files import OUTPUTS, write_text
-from ..results.measures import angle_recipe, parse_measure, ratio_recipe
+from ..results.measures import angle_recipe, measure_list, parse_measure, ratio_recipe
 from ..validate import flag, number
 from .dynamics import dynamics_settings
 from .sensitivities import check_dopri5, check_positions_only, requested, table
@@ -262,9 +262,9 @@ def file_lines(model: ModelDescription, t_end: float | None = None, steps: int |
 def _measure_lines(model: ModelDescription, p: Any, specs: Any, analysis: str) -> list[str]:
     """The measures block: each spec with the recipe mbd2d-solve evaluates (an angle's
     bodies and points, a ratio's reference row and quantities, 1-based)."""
-    if specs is None or (not isinstance(specs, str) and not len(specs)):
+    specs = measure_list(specs)
+    if not specs:
         return []
-    specs = [specs] if isinstance(specs, str) else list(specs)
     if analysis in ("statics", "check"):
         raise ModelError(f"measures are columns of a run over time, not of {analysis}",
                          "export")

@@ -12,7 +12,7 @@ from .contacts import (ContactEvent, ContactHistory, FrictionEvent, FrictionHist
                        history)
 from .columns import constraint_columns, derivative_names
 from .files import check_outputs, writing
-from .kinematics import KinematicsResult, measures_arg
+from .kinematics import KinematicsResult
 from .measures import measure_columns
 from .reactions import Reaction, reaction_arrays, reaction_of
 from .sensitivities import parameter_index, reaction_dp_arrays, reaction_dp_of
@@ -223,7 +223,7 @@ class DynamicsResult(KinematicsResult):
                 continue
             header += [f"{name}.{w}" for w in words]
             blocks.append(np.column_stack([self.elements[:, k, i] for i in idx]))
-        names, cols = measure_columns(self, measures_arg(measures))
+        names, cols = measure_columns(self, measures)
         header += names
         blocks += cols
         if sensitivities:

@@ -19,11 +19,6 @@ from .points import PointResult
 from .sensitivities import LEVELS, body_columns, parameter_index
 
 
-def measures_arg(specs: Any) -> Any:
-    """The ``measures=`` of a table (None, one spec or a list of specs)."""
-    return None if specs is None or (not isinstance(specs, str) and not len(specs)) else specs
-
-
 def repr_png(obj: Any) -> bytes | None:
     """PNG of a result's mechanism picture for notebooks; None (plain text shown instead)
     when matplotlib is missing or the picture cannot be drawn."""
@@ -330,7 +325,7 @@ class KinematicsResult:
         """
         check_outputs(outputs, (), "table")
         header, rows = self._motion_table()
-        names, blocks = measure_columns(self, measures_arg(measures))
+        names, blocks = measure_columns(self, measures)
         if sensitivities:
             dn, db = self._motion_derivatives("table")
             names, blocks = names + dn, blocks + db
@@ -374,7 +369,7 @@ class KinematicsResult:
 
     def _measure_arrays(self, specs: Any) -> dict[str, np.ndarray]:
         """The measures for an .npz: ``measures`` (n, k) and ``measure_names``."""
-        names, cols = measure_columns(self, measures_arg(specs))
+        names, cols = measure_columns(self, specs)
         if not names:
             return {}
         return {"measures": np.hstack(cols), "measure_names": np.array(names)}

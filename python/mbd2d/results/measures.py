@@ -273,11 +273,27 @@ def measure(res: Any, spec: str) -> np.ndarray:
     return ratio_values(res, name, *args)
 
 
-def measure_columns(res: Any, specs: Any) -> tuple[list[str], list[np.ndarray]]:
-    """The table columns of the measures asked for: named by their specs."""
+def measure_list(specs: Any) -> list[Any]:
+    """The measures asked for as a list: None (none), one spec, or a list of specs.
+
+    Raises
+    ------
+    ModelError
+        For anything else.
+    """
     if specs is None:
-        return [], []
+        return []
     if isinstance(specs, str):
-        specs = [specs]
-    specs = list(specs)
+        return [specs]
+    try:
+        return list(specs)
+    except TypeError:
+        raise ModelError(f"measures must be a list of specs ({FORMS}), got {specs!r}",
+                         "measures") from None
+
+
+def measure_columns(res: Any, specs: Any) -> tuple[list[str], list[np.ndarray]]:
+    """The table columns of the measures asked for (see :func:`measure_list`): named by
+    their specs."""
+    specs = measure_list(specs)
     return specs, [measure(res, s)[:, None] for s in specs]
