@@ -238,3 +238,15 @@ def test_a_sweep_too_large_or_unwritable_is_refused(tmp_path: Path) -> None:
     r = subprocess.run([find_solver(), str(ok), str(tmp_path / "no" / "dir" / "o.csv")],
                        capture_output=True, text=True, timeout=60)
     assert r.returncode == 2 and "cannot write" in r.stderr, r.stderr
+
+
+@pytest.mark.parametrize("command", ["sweep", "export"])
+def test_param_counts_beyond_a_sweep_are_refused(tmp_path: Path, capsys, command: str) -> None:
+    """NUM beyond the largest sweep (10^8 cases) is refused before any array is made."""
+    toml = str(EX / "fourbar_grashof.toml")
+    argv = [command, toml] + ([str(tmp_path / "s.mbd")] if command == "export" else []) + [
+        "--param", "joint.B.points.0.0=1.5:2.0:1000000000", "--t-end", "1", "--steps", "4"]
+    if command == "sweep":
+        argv += ["--out", str(tmp_path / "s.csv")]
+    assert main(argv) == 2
+    assert "NUM must be from 1 to 100000000" in " ".join(capsys.readouterr().err.split())

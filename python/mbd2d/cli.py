@@ -59,6 +59,7 @@ from .description import toml_io
 from .results import StaticsResult
 from .results.files import OUTPUTS
 from .synthesis import SynthesisResult, load_task, synthesize
+from .studies.plan import MAX_CASES
 
 EXIT_OK, EXIT_INPUT, EXIT_SINGULAR, EXIT_NUMERICAL = 0, 2, 3, 4
 ANALYSES = ("auto", "kinematics", "inverse-dynamics", "dynamics")
@@ -557,9 +558,9 @@ def _param_values(spec: str) -> tuple[str, np.ndarray]:
     except ValueError:
         raise ModelError(f"--param {spec!r}: write NAME=START:STOP:NUM, for example "
                          "joint.B.points.0.0=1.5:2.0:11", "command line") from None
-    if num < 1 or not (np.isfinite(start) and np.isfinite(stop)):
-        raise ModelError(f"--param {spec!r}: NUM must be >= 1 and START, STOP finite",
-                         "command line")
+    if not 1 <= num <= MAX_CASES or not (np.isfinite(start) and np.isfinite(stop)):
+        raise ModelError(f"--param {spec!r}: NUM must be from 1 to {MAX_CASES} and START, "
+                         "STOP finite", "command line")
     return name.strip(), np.linspace(start, stop, num)
 
 
