@@ -180,3 +180,13 @@ def test_study_files_refuse_bad_paths(tmp_path: Path) -> None:
             write(data, tmp_path / "x.txt")
         with pytest.raises(mbd2d.ModelError, match="cannot write"):
             write(data, tmp_path / "no" / "dir" / "x.csv")
+
+
+def test_draws_beyond_the_memory_are_refused(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The Monte Carlo draws are checked against the memory before numpy makes them (here a
+    machine of 1 MiB): an InsufficientMemoryError naming the size, not a MemoryError."""
+    from mbd2d.analysis import settings
+    monkeypatch.setattr(settings, "physical_memory", lambda: 2.0**20)
+    model = mbd2d.load(FOURBAR)
+    with pytest.raises(mbd2d.InsufficientMemoryError, match="tolerance: the run would need"):
+        mbd2d.tolerance_samples(model, {PRM: SIG}, samples=100000)

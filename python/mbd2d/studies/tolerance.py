@@ -24,6 +24,7 @@ from ..analysis.dynamics import run_dynamics
 from ..analysis.inverse import run_inverse
 from ..analysis.kinematics import run_kinematics
 from ..analysis.statics import run_statics
+from ..analysis.settings import check_memory
 from ..description.builder import ModelDescription
 from ..description.parameters import find
 from ..errors import ModelError
@@ -190,6 +191,7 @@ def draws(model: ModelDescription, params: Any, sig: np.ndarray, n: int,
           seed: int | None) -> dict[str, np.ndarray]:
     """The Monte Carlo case table: n variants with p ~ Normal(p0, sigma), drawn by numpy's
     default generator from seed (the parameters in turn, one row of n each)."""
+    check_memory(n, len(params), "tolerance")      # the draws (the sweep checks its outputs)
     p0 = nominal_values(model, params)
     rng = np.random.default_rng(seed)
     values = p0[:, None] + sig[:, None] * rng.standard_normal((len(params), n))
