@@ -68,6 +68,12 @@ def test_contradicting_constraints_fail_alike(tmp_path: Path, capsys) -> None:
                        text=True, timeout=60)
     assert r.returncode == 4 and "contradict" in r.stderr and "cannot all hold" in r.stderr
     assert not (tmp_path / "o.csv").exists()
+    # the kinematics of the same file names them too (and writes the rows it has: none)
+    kin = tmp_path / "k.mbd"
+    model.export(kin, t_end=1.0, steps=4)
+    r = subprocess.run([find_solver(), str(kin), str(tmp_path / "k.csv")], capture_output=True,
+                       text=True, timeout=60)
+    assert r.returncode == 4 and "O2 A B O4 motor cannot all hold" in r.stderr, r.stderr
 
 
 @pytest.mark.parametrize("extra, needle", [

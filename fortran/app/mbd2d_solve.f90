@@ -234,6 +234,9 @@ program mbd2d_solve
     call die(3, trim(singular_message()))
   else if (status == NONFINITE) then
     call die(4, trim(msg) // ' ' // trim(rows_written()))
+  else if (status == MBD_INCONSISTENT .and. any(dep == 1)) then
+    call die(4, trim(msg) // ': the constraints' // trim(dep_names(dep)) // ' cannot all '// &
+             'hold; check their points and dimensions. ' // trim(rows_written()))
   else if (status /= MBD_OK) then
     call die(4, trim(msg) // trim(worst()) // '. ' // trim(rows_written()))
   end if
