@@ -298,3 +298,33 @@ def test_gallery_is_regenerated_for_every_joint_type(tmp_path):
     for name in readme:
         assert f"(docs/img/gallery/{name})" in text, name
     assert (ROOT / "docs" / "gallery.md").read_text() == gallery.markdown(list(gallery.MODELS))
+
+
+def test_measures_against_time(tmp_path: Path, capsys) -> None:
+    """kind="measures": one axis per measure; the transmission angle in degrees (the
+    seed four-bar's reaches 180 deg at its toggle, where coupler and rocker line up), a
+    ratio's infinite values left as gaps, the dead centre marked; the command line draws it."""
+    from mbd2d.cli import main
+    toml = Path(__file__).resolve().parents[1] / "examples" / "fourbar_seed.toml"
+    with pytest.raises(mbd2d.SingularConfigurationError) as info:
+        mbd2d.load(toml).kinematics(1.0, 200)
+    res = info.value.results
+    specs = ["transmission_angle:B", "mechanical_advantage:motor:rocker.theta"]
+    fig = plot_timeseries(res, kind="measures", measures=specs)
+    axes = fig.axes
+    assert len(axes) == 2 and [a.get_title() for a in axes] == specs
+    def data(a):
+        return [ln for ln in a.lines if len(ln.get_ydata()) == len(res.t)][0].get_ydata()
+    mu = data(axes[0])
+    assert_allclose(mu, np.degrees(res.transmission_angle("B")), rtol=0, atol=1e-12)
+    assert 170.0 < mu[-1] <= 180.0            # the toggle: coupler and rocker in line
+    ma = res.mechanical_advantage("motor", "rocker.theta")
+    drawn = data(axes[1])
+    assert np.array_equal(np.isnan(drawn), ~np.isfinite(ma))
+    assert any(ln.get_color() == STOP_COLOUR for ln in axes[0].lines)
+    with pytest.raises(ModelError, match="needs measures"):
+        plot_timeseries(res, kind="measures")
+    out = tmp_path / "m.png"
+    assert main(["plot", str(toml), "--t-end", "1", "--steps", "100", "--what", "measures",
+                 "--measure", specs[0], "--out", str(out)]) == 3      # drawn up to the toggle
+    assert out.stat().st_size > 0

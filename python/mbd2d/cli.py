@@ -63,7 +63,7 @@ from .studies.plan import MAX_CASES
 
 EXIT_OK, EXIT_INPUT, EXIT_SINGULAR, EXIT_NUMERICAL = 0, 2, 3, 4
 ANALYSES = ("auto", "kinematics", "inverse-dynamics", "dynamics")
-PICTURES = ("mechanism", "paths", "time-series", "forces", "energy")
+PICTURES = ("mechanism", "paths", "time-series", "forces", "energy", "measures")
 
 
 def _span(p: argparse.ArgumentParser) -> None:
@@ -257,7 +257,9 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--what", default="mechanism", choices=PICTURES,
                    help="mechanism (default): snapshots; paths: point paths; time-series: "
                    "positions, velocities, accelerations; forces: driver efforts and joint "
-                   "reactions; energy: energies and constraint drift")
+                   "reactions; energy: energies and constraint drift; measures: the --measure "
+                   "columns against time")
+    _measures(p)
     _picture_settings(p)
     a = sub.add_parser("animate", help="run an analysis and animate it (GIF or MP4)")
     _span(a)
@@ -525,7 +527,8 @@ def _picture(res: Any, args: argparse.Namespace) -> str:
         fig = plots.plot_paths(res, trace, length_unit=args.length_unit)
     else:
         kind = {"time-series": "motion"}.get(args.what, args.what)
-        fig = plots.plot_timeseries(res, kind=kind, length_unit=args.length_unit)
+        fig = plots.plot_timeseries(res, kind=kind, length_unit=args.length_unit,
+                                    measures=getattr(args, "measure", None))
     return plots.save_figure(fig, args.out, **extra)
 
 

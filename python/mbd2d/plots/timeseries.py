@@ -1,6 +1,7 @@
 """Time series: x, y, theta of bodies and their derivatives; driver efforts and joint
-reactions; energies and constraint drift. Dead centres and singular passages are marked on
-every time axis."""
+reactions; energies and constraint drift; mechanism measures (transmission angle, velocity
+ratio, mechanical advantage, dead-centre distance). Dead centres and singular passages are
+marked on every time axis."""
 from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any, Sequence
@@ -16,7 +17,9 @@ if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
-KINDS = ("motion", "forces", "energy")
+KINDS = ("motion", "forces", "energy", "measures")
+#: the transmission angle designers keep: pi/2 +- 50 deg (Norton, ch. 4) [deg]
+MU_WINDOW = (40.0, 140.0)
 
 
 def mark_times(ax: "Axes", result: Motion, labels: bool = True) -> None:
@@ -37,7 +40,7 @@ def mark_times(ax: "Axes", result: Motion, labels: bool = True) -> None:
 
 def plot_timeseries(result: Motion, bodies: Sequence[str] | None = None,
                     kind: str = "motion", length_unit: str = "m",
-                    force_unit: str = "N") -> "Figure":
+                    force_unit: str = "N", measures: Sequence[str] | None = None) -> "Figure":
     """Plot a result against time.
 
     Parameters
@@ -52,9 +55,14 @@ def plot_timeseries(result: Motion, bodies: Sequence[str] | None = None,
         columns, one line per body). "forces": what each driver supplies (torque or force)
         and the magnitude of each joint's reaction on its moving body; needs multipliers
         (inverse dynamics or dynamics). "energy": kinetic, potential and total energy and
-        the constraint drift ||Phi||, ||J q_dot - nu||; needs a DynamicsResult.
+        the constraint drift ||Phi||, ||J q_dot - nu||; needs a DynamicsResult. "measures":
+        one axis per measure of ``measures`` (specs as ``res.table(measures=...)``: the
+        transmission angle in degrees with the 40-140 deg window designers keep, ratios,
+        the dead-centre distance).
     length_unit, force_unit : str
         Units for the axis labels (default "m" and "N"; any consistent set).
+    measures : sequence of str, optional
+        The measures of kind "measures".
 
     Returns
     -------
@@ -77,6 +85,8 @@ def plot_timeseries(result: Motion, bodies: Sequence[str] | None = None,
     if kind not in KINDS:
         raise ModelError(f"unknown kind {kind!r}; use one of {', '.join(KINDS)}",
                          "plot_timeseries")
+    if kind == "measures":
+        return _measures(result, measures)
     if kind != "motion" and not hasattr(result, "lam"):
         raise ModelError(f"kind={kind!r} needs a result with multipliers and energies "
                          "(inverse dynamics, dynamics, or kinematics of a model with masses)",
@@ -129,6 +139,39 @@ def _motion(result: Motion, bodies: Sequence[str] | None, lu: str) -> "Figure":
     axes[0][0].legend(fontsize=8, loc="best")
     fig.suptitle(f"{_name(result)}: positions"
                  + (", velocities, accelerations" if levels == 3 else "")
+                 + ("" if result.complete else " (incomplete run)"))
+    return fig
+
+
+def _measures(result: Any, specs: Sequence[str] | None) -> "Figure":
+    if not specs or isinstance(specs, str):
+        specs = [specs] if isinstance(specs, str) else []
+    if not specs:
+        raise ModelError('kind="measures" needs measures=[specs] (for example '
+                         '"transmission_angle:B")', "plot_timeseries")
+    header, rows = result.table(measures=list(specs))      # the measures are its last columns
+    values = rows[:, len(header) - len(specs):]
+    fig = new_figure((10.0, 1.2 + 2.3 * len(specs)))
+    axes = fig.subplots(len(specs), 1, sharex=True, squeeze=False)
+    for i, spec in enumerate(specs):
+        a = axes[i][0]
+        y = np.asarray(values[:, i], dtype=float)
+        angle = spec.startswith("transmission_angle")
+        if angle:
+            y = np.degrees(y)
+            for bound in MU_WINDOW:
+                a.axhline(bound, color="0.6", ls=":", lw=1.0)
+        # infinite ratios (a limit position of the input or output) leave a gap
+        a.plot(result.t, np.where(np.isfinite(y), y, np.nan), lw=1.5,
+               color=PALETTE[i % len(PALETTE)])
+        a.set_ylabel("deg" if angle else "")
+        a.set_title(spec, fontsize=9)
+        a.grid(True, lw=0.4, alpha=0.5)
+        mark_times(a, result, labels=i == 0)
+    axes[-1][0].set_xlabel("t [s]")
+    if result.stats.get("singular_passages") or not result.complete:
+        axes[0][0].legend(fontsize=8, loc="best")
+    fig.suptitle(f"{_name(result)}: mechanism measures"
                  + ("" if result.complete else " (incomplete run)"))
     return fig
 
