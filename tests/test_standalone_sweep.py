@@ -250,3 +250,11 @@ def test_param_counts_beyond_a_sweep_are_refused(tmp_path: Path, capsys, command
         argv += ["--out", str(tmp_path / "s.csv")]
     assert main(argv) == 2
     assert "NUM must be from 1 to 100000000" in " ".join(capsys.readouterr().err.split())
+
+
+def test_a_check_is_no_sweep(tmp_path: Path, capsys) -> None:
+    """export --analysis check --param: a ModelError (exit 2), not a KeyError (found by
+    tests/test_cli_fuzz.py)."""
+    assert main(["export", str(EX / "fourbar_grashof.toml"), str(tmp_path / "c.mbd"),
+                 "--analysis", "check", "--param", "joint.B.points.0.0=1.5:2.0:3"]) == 2
+    assert "not check" in capsys.readouterr().err

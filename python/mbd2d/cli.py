@@ -588,6 +588,9 @@ def _export_sweep(model: Model, args: argparse.Namespace) -> int:
         raise ModelError("a sweep file writes the sweep's columns: no --energy, "
                          "--multipliers, --reactions, --efforts, --sensitivities or "
                          "--measure with --param", "command line")
+    if args.analysis == "check":
+        raise ModelError("a sweep runs kinematics, inverse-dynamics, dynamics or statics, not "
+                         "check", "command line")
     span = {"t_end": args.t_end, "steps": args.steps, "t0": args.t0, "every": args.every}
     kw: dict[str, Any] = {
         "kinematics": dict(span, tol=args.tol, solver=args.solver,
