@@ -190,3 +190,24 @@ def test_draws_beyond_the_memory_are_refused(monkeypatch: pytest.MonkeyPatch) ->
     model = mbd2d.load(FOURBAR)
     with pytest.raises(mbd2d.InsufficientMemoryError, match="tolerance: the run would need"):
         mbd2d.tolerance_samples(model, {PRM: SIG}, samples=100000)
+
+
+def test_kinematics_of_a_model_with_masses_is_inverse_dynamics(tmp_path: Path, capsys) -> None:
+    """As Model.kinematics and the sweep: a model with masses runs inverse dynamics, so the
+    tolerance has the efforts too (it raised a TypeError; found by tests/test_cli_fuzz.py).
+    Reference: the motor torque is linear in the coupler's mass, so its first-order standard
+    deviation is |central difference of inverse-dynamics runs| x sigma."""
+    heavy = EX / "fourbar_masses.toml"
+    out = tmp_path / "t.csv"
+    sig = 0.01
+    assert main(["tolerance", str(heavy), "--sigma", f"body.coupler.mass={sig}", "--samples",
+                 "0", "--t-end", "1", "--steps", "8", "--out", str(out)]) == 0
+    header, rows = read_csv(out)
+    model = mbd2d.load(heavy)
+    m0 = model.parameters()["body.coupler.mass"]
+    dm = 1e-3 * m0
+    tau = [model.with_params({"body.coupler.mass": m0 + s * dm}).inverse_dynamics(1.0, 8)
+           .effort("motor") for s in (1, -1)]
+    np.testing.assert_allclose(rows[:, header.index("motor.effort.std_linear")],
+                               np.abs(tau[0] - tau[1]) / (2 * dm) * sig, rtol=1e-7,
+                               atol=1e-12)

@@ -149,8 +149,9 @@ def _nominal(model: ModelDescription, names: list[str], analysis: str,
     analysis ran."""
     if analysis == "kinematics":
         a = _bind(_kinematics_settings, kw, analysis)
-        if model.has_masses() and a["maxit"] is None:
-            a.pop("maxit")
+        if model.has_masses() and a["maxit"] is None and not a["positions_only"]:
+            a.pop("maxit")                      # as the sweep (plan) and Model.kinematics
+            a.pop("positions_only")
             return run_inverse(model, sensitivities=names, **a), "inverse"
         return run_kinematics(model, sensitivities=names, **a), "kinematics"
     if analysis == "inverse_dynamics":
