@@ -258,3 +258,19 @@ def test_a_check_is_no_sweep(tmp_path: Path, capsys) -> None:
     assert main(["export", str(EX / "fourbar_grashof.toml"), str(tmp_path / "c.mbd"),
                  "--analysis", "check", "--param", "joint.B.points.0.0=1.5:2.0:3"]) == 2
     assert "not check" in capsys.readouterr().err
+
+
+def test_a_parameter_a_kinematic_run_does_not_take(tmp_path: Path) -> None:
+    """Gravity swept in kinematics enters no table of the run (it raised a ValueError when no
+    entry was left to set; found by a random sweep export): every case is the base model's
+    run, in the Python sweep and in mbd2d-solve alike."""
+    model = mbd2d.load(EX / "fourbar_grashof.toml")
+    cases = {"model.gravity.1": [-9.81, -1.0, 0.0]}
+    solve, py, r = solve_sweep(tmp_path, model, cases, "kinematics", t_end=1.0, steps=6)
+    assert r.returncode == 0 and solve == py
+    base = model.kinematics(1.0, 6).q
+    head = solve[0]
+    cols = [head.index(c) for c in model.kinematics(1.0, 1).coordinate_names]
+    for c in range(3):
+        got = np.array([[float(row[k]) for k in cols] for row in solve[1:] if row[0] == str(c)])
+        np.testing.assert_array_equal(got, base)

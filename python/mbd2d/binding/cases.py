@@ -71,8 +71,13 @@ def case_tables(model: ModelDescription, p: Packed, d: DynamicTables | None,
             off, n = int(p.ctab[5, k]), int(p.ctab[6, k])
             cols += [np.array([1, off + i], dtype=np.int32) for i in range(n)]
         rows += list(raw.T)
+    if not cols:
+        # no swept number enters this analysis (gravity in kinematics): every case is the base
+        # model; f2py takes no zero-length table, so the first raw parameter is set to itself
+        cols = [np.array([1, 1], dtype=np.int32)]
+        rows = [np.full(values.shape[1], p.rpar[0])]
     vtab = np.asfortranarray(np.array(cols, dtype=np.int32).reshape(-1, 2).T)
-    vals = np.asfortranarray(np.array(rows, dtype=np.float64).reshape(len(cols), -1))
+    vals = np.asfortranarray(np.array(rows, dtype=np.float64).reshape(len(cols), values.shape[1]))
     return CaseTables(vtab, vals, open_phases(model, p, params))
 
 
