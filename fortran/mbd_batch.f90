@@ -12,7 +12,9 @@
 !! bit for bit.
 !!
 !! Outputs are per case (last dimension); a failing case keeps its status, message and the
-!! rows it computed, and the next case runs.
+!! rows it computed, and the next case runs. With a list of mechanism measures (mbd_measures:
+!! transmission angles, ratios, the distance to a dead centre) each case also gets them at
+!! its rows, from its own tables (an angle's points may be entries the case sets).
 module mbd_batch
   use mbd_kinds, only: wp, zero
   use mbd_status, only: MBD_OK, MBD_BAD_INPUT, MBD_BAD_SETTING, MSG_LEN
@@ -20,6 +22,8 @@ module mbd_batch
   use mbd_api, only: NINFO, api_kinematics, api_inverse, api_statics, api_dynamics, api_eval
   use mbd_kinematics, only: MAXPASS
   use mbd_contact, only: NEO
+  use mbd_measures, only: api_measures
+  use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   implicit none
   private
   public :: batch_run, NISET, NRSET
@@ -40,9 +44,16 @@ contains
   !! lamout (neq or 0, rows, ncase), eout (4 or 0, rows, ncase); iinfo, rinfo (NINFO, ncase)
   !! as the analysis reports them (statics: rinfo(1) residual, rinfo(2) stability code);
   !! qsing (nq, ncase), dep and redundant (neq, ncase). Statics writes row 1.
+  !! Measures (all or none of the optional arguments; none given or an empty list: no
+  !! measures; not with statics): mkind, mint, mpts,
+  !! mref as api_measures takes them, times (rows) the output times; mout (nm, rows, ncase)
+  !! gets them at the rows up to the first that is not finite, and mbad (3, ncase) the
+  !! status, measure and quantity of a case whose measures failed (its message too, when
+  !! its analysis succeeded).
   subroutine batch_run(analysis, nb, ctab, rpar, bmass, grav, ftab, fpar, q0, v0, vtab, vals, &
                        opens, iset, rset, qout, qdout, qddout, lamout, eout, iinfo, rinfo, &
-                       qsing, dep, redundant, status, msg)
+                       qsing, dep, redundant, status, msg, times, mkind, mint, mpts, mref, &
+                       mout, mbad)
     integer, intent(in) :: analysis             !! BATCH_KINEMATICS ... BATCH_DYNAMICS
     integer, intent(in) :: nb                   !! moving bodies
     integer, intent(in) :: ctab(:, :), ftab(:, :)  !! constraint and force tables
@@ -62,15 +73,27 @@ contains
     integer, intent(out) :: dep(:, :), redundant(:, :)  !! (neq, ncase)
     integer, intent(out) :: status(:)           !! (ncase) each case's status
     character(len=MSG_LEN), intent(out) :: msg(:)  !! (ncase) and message
+    real(wp), intent(in), optional :: times(:)  !! (rows) output times
+    integer, intent(in), optional :: mkind(:), mint(:, :), mref(:, :, :)  !! measures
+    real(wp), intent(in), optional :: mpts(:, :, :)  !! an angle's points
+    real(wp), intent(out), optional :: mout(:, :, :)  !! (nm, rows, ncase)
+    integer, intent(out), optional :: mbad(:, :)  !! (3, ncase)
     real(wp), allocatable :: r(:), bm(:, :), fp(:), phi(:), jac(:, :), nu(:), gam(:), zq(:)
     real(wp), allocatable :: eo(:, :, :)      ! element outputs of a dynamics case (not kept)
     real(wp) :: g(2), tpass(MAXPASS), resid, evo(4, 1)
-    integer :: c, k, nq, neq, ncase, st, bad, stable, ierr, nev
+    integer :: c, k, nq, neq, ncase, st, bad, stable, ierr, nev, nr, mb(2)
+    logical :: meas
     character(len=MSG_LEN) :: lmsg
     qout = zero; qdout = zero; qddout = zero; lamout = zero; eout = zero
     iinfo = 0; rinfo = zero; qsing = zero; dep = 0; redundant = 0
     ncase = size(vals, 2); nq = size(q0); neq = size(dep, 1)
     status = MBD_OK; msg = ''
+    meas = present(times) .and. present(mkind) .and. present(mint) .and. present(mpts) .and. &
+           present(mref) .and. present(mout) .and. present(mbad)
+    if (meas) then
+      mout = zero; mbad = 0
+      meas = size(mkind) > 0
+    end if
     call check(st, lmsg)
     if (st /= MBD_OK) then
       status = st; msg = lmsg; return
@@ -125,6 +148,19 @@ contains
                           lamout(:, :, c), eout(:, :, c), iinfo(:, c), rinfo(:, c), &
                           redundant(:, c), status(c), msg(c), iset(6), eo, evo, nev)
       end select
+      if (meas .and. iinfo(1, c) > 0) then   ! the rows up to the first that is not finite
+        nr = 0
+        do while (nr < min(iinfo(1, c), size(qout, 2)))
+          if (.not. all(ieee_is_finite(qout(:, nr + 1, c)))) exit
+          nr = nr + 1
+        end do
+        call api_measures(nb, ctab, r, qout(:, 1:nr, c), times(1:nr), mkind, mint, mpts, &
+                          mref, mout(:, 1:nr, c), mb, st, lmsg)
+        if (st /= MBD_OK) then
+          mbad(:, c) = [st, mb]
+          if (status(c) == MBD_OK) msg(c) = lmsg
+        end if
+      end if
     end do
 
   contains
@@ -175,6 +211,13 @@ contains
       end if
       if (analysis == BATCH_STATICS .and. nrow /= 1) then
         text = 'batch: statics has one output row'; return
+      end if
+      if (meas) then
+        if (analysis == BATCH_STATICS .or. size(times) /= nrow .or. &
+            size(mout, 1) /= size(mkind) .or. size(mout, 2) /= nrow .or. &
+            size(mout, 3) /= ncase .or. size(mbad, 1) /= 3 .or. size(mbad, 2) /= ncase) then
+          text = 'batch: measure arrays do not match'; return
+        end if
       end if
       st = MBD_OK
     end subroutine check

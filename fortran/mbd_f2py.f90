@@ -425,33 +425,46 @@ end subroutine core_dynamics_sens
 ! sets: vtab (2, nv) names the entries each case sets (table 1 rpar, 2 bmass flattened, 3
 ! grav, 4 fpar; 1-based index), vals (nv, ncase) their values, opens (2, no) the open phases
 ! to set again from q0 (index in rpar, row of Phi); settings in iset, rset (mbd_batch). nlam
-! is neq (0 for kinematics), ne 4 (0 for kinematics); nrow the output rows per case.
+! is neq (0 for kinematics), ne 4 (0 for kinematics); nrow the output rows per case. With
+! nm > 0 measures (mbd_measures: mkind, mint, mpts, mref, at the output times) go to mout
+! (nm, nrow, ncase), their failures to mbad (3, ncase); the measure tables have nmp =
+! max(nm, 1) columns (f2py takes no zero-length table).
 subroutine core_batch(analysis, nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp, fpar, nq, &
                       q0, v0, nv, vtab, ncase, vals, no, opens, iset, rset, neq, nrow, nd, &
-                      nlam, ne, &
+                      nlam, ne, times, nm, nmp, mkind, mint, mpts, mref, &
                       qout, qdout, qddout, lamout, eout, iinfo, rinfo, qsing, dep, redundant, &
-                      status, msg)
+                      mout, mbad, status, msg)
   use iso_c_binding, only: c_double, c_int
   use mbd_batch, only: batch_run
   implicit none
   integer(c_int), intent(in) :: analysis, nb, nc, np, nf, nfp, nq, nv, ncase, no, neq, nrow
   !> nd: rows of qdout and qddout (nrow; 0 for positions-only kinematics, iset(7) = 1)
-  integer(c_int), intent(in) :: nlam, ne, nd
+  integer(c_int), intent(in) :: nlam, ne, nd, nm, nmp
   integer(c_int), intent(in) :: ctab(8, nc), ftab(6, nf), vtab(2, nv), opens(2, no), iset(8)
   real(c_double), intent(in) :: rpar(np), bmass(2, nb), grav(2), fpar(nfp), q0(nq), v0(nq)
-  real(c_double), intent(in) :: vals(nv, ncase), rset(12)
+  real(c_double), intent(in) :: vals(nv, ncase), rset(12), times(nrow), mpts(2, 3, nmp)
+  integer(c_int), intent(in) :: mkind(nmp), mint(5, nmp), mref(2, 3, nmp)
   real(c_double), intent(out) :: qout(nq, nrow, ncase), qdout(nq, nd, ncase)
   real(c_double), intent(out) :: qddout(nq, nd, ncase), lamout(nlam, nrow, ncase)
-  real(c_double), intent(out) :: eout(ne, nrow, ncase)
+  real(c_double), intent(out) :: eout(ne, nrow, ncase), mout(nm, nrow, ncase)
   integer(c_int), intent(out) :: iinfo(10, ncase), dep(neq, ncase), redundant(neq, ncase)
+  integer(c_int), intent(out) :: mbad(3, ncase)
   real(c_double), intent(out) :: rinfo(10, ncase), qsing(nq, ncase)
   integer(c_int), intent(out) :: status(ncase)
   character(len=512), intent(out) :: msg(ncase)
-  !f2py intent(hide) :: nc, np, nf, nfp, nq, nv, ncase, no
+  !f2py intent(hide) :: nc, np, nf, nfp, nq, nv, ncase, no, nmp
   !f2py threadsafe
-  call batch_run(analysis, nb, ctab, rpar, bmass, grav, ftab, fpar, q0, v0, vtab, vals, opens, &
-                 iset, rset, qout, qdout, qddout, lamout, eout, iinfo, rinfo, qsing, dep, &
-                 redundant, status, msg)
+  if (nm > 0 .and. nm <= nmp) then
+    call batch_run(analysis, nb, ctab, rpar, bmass, grav, ftab, fpar, q0, v0, vtab, vals, &
+                   opens, iset, rset, qout, qdout, qddout, lamout, eout, iinfo, rinfo, qsing, &
+                   dep, redundant, status, msg, times, mkind(1:nm), mint(:, 1:nm), &
+                   mpts(:, :, 1:nm), mref(:, :, 1:nm), mout, mbad)
+  else
+    mbad = 0
+    call batch_run(analysis, nb, ctab, rpar, bmass, grav, ftab, fpar, q0, v0, vtab, vals, &
+                   opens, iset, rset, qout, qdout, qddout, lamout, eout, iinfo, rinfo, qsing, &
+                   dep, redundant, status, msg)
+  end if
 end subroutine core_batch
 ! Normal force of each cam joint on its follower at states q (nq, nt), times t and
 ! multipliers lam: fn(nc, nt), negative where the joint must pull the follower onto its profile.

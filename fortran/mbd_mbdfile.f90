@@ -30,7 +30,9 @@
 !!   <name> <table> <index>                   (npar lines; table 1 params, 2 masses,
 !!                              3 gravity, 4 fparams; index 1-based in that list)
 !!   measures <nm>                            (optional: measure columns)
-!!   <spec> angle <kind> <b1> <x> <y> <b2> <x> <y> <b3> <x> <y>   (transmission angle)
+!!   <spec> angle <kind> <b1> <x> <y> <b2> <x> <y> <b3> <x> <y> [<ix1> <iy1> ... <iy3>]
+!!                              (transmission angle; the optional indices: the params
+!!                              entries of the points, 0 the number given)
 !!   <spec> ratio|advantage <ref> <xkind> <xindex> <ykind> <yindex>  (influence ratios)
 !!   <spec> conditioning                      (distance to a dead centre)
 !!   cases <np> <nv> <ncase>                  (optional: a sweep, `mbd2d.export_sweep`)
@@ -55,6 +57,7 @@ module mbd_mbdfile
   use mbd_status, only: MBD_OK, MBD_BAD_INPUT, MBD_NO_MEMORY, MSG_LEN
   use mbd_model, only: NCT, NFT
   use mbd_memory, only: REAL_BYTES, mem_check, mem_fail
+  use mbd_measures, only: MEAS_ANGLE, MEAS_RATIO, MEAS_ADVANTAGE, MEAS_CONDITIONING
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use, intrinsic :: iso_fortran_env, only: int64
   implicit none
@@ -64,9 +67,6 @@ module mbd_mbdfile
 
   integer, parameter :: NAME_LEN = 64             !! longest body or constraint name
   integer, parameter :: PNAME_LEN = 256           !! longest design parameter name
-  !> measure kinds (the "measures" block)
-  integer, parameter :: MEAS_ANGLE = 1, MEAS_RATIO = 2, MEAS_ADVANTAGE = 3, &
-                        MEAS_CONDITIONING = 4
   integer, parameter :: LINE_LEN = 4096           !! longest line
   integer, parameter :: MAX_STEPS = 1000000000    !! output intervals (as the Python front end)
   integer, parameter :: MAX_ITER = 1000000        !! Newton iterations (as the Python front end)
@@ -131,6 +131,9 @@ module mbd_mbdfile
     !! reference row, kind (1 coordinate, 2 driver) and index of X, then of Y
     integer, allocatable :: meas_int(:, :)    !! (5, nmeas)
     real(wp), allocatable :: meas_pts(:, :, :)  !! (2, 3, nmeas) an angle's points
+    !> (2, 3, nmeas) the params entries of an angle's points (0: the number given), for a
+    !! sweep that moves them
+    integer, allocatable :: meas_ref(:, :, :)
     integer, allocatable :: meas_line(:)
     ! a sweep (mbd_batch): its parameters, the entries each case sets, their values
     integer :: ncase = 0, ncp = 0, nv = 0
@@ -192,7 +195,8 @@ contains
     if (ierr == 0) allocate (spec%case_names(0), spec%vtab(2, 0), spec%cvals(0, 0), &
                              spec%opens(2, 0), stat=ierr)
     if (ierr == 0) allocate (spec%meas_names(0), spec%meas_kind(0), spec%meas_int(5, 0), &
-                             spec%meas_pts(2, 3, 0), spec%meas_line(0), stat=ierr)
+                             spec%meas_pts(2, 3, 0), spec%meas_ref(2, 3, 0), &
+                             spec%meas_line(0), stat=ierr)
     if (ierr /= 0) then
       call mem_fail(zero, 'the model file', 'free some memory', status, msg); close (u); return
     end if
@@ -844,15 +848,16 @@ contains
       character(len=16) :: word
       read_measures = .false.
       if (.not. count_ok(n, 'measure', 1)) return
-      deallocate (spec%meas_names, spec%meas_kind, spec%meas_int, spec%meas_pts, spec%meas_line)
+      deallocate (spec%meas_names, spec%meas_kind, spec%meas_int, spec%meas_pts, &
+                  spec%meas_ref, spec%meas_line)
       allocate (spec%meas_names(n), spec%meas_kind(n), spec%meas_int(5, n), &
-                spec%meas_pts(2, 3, n), spec%meas_line(n), stat=ierr)
+                spec%meas_pts(2, 3, n), spec%meas_ref(2, 3, n), spec%meas_line(n), stat=ierr)
       if (ierr /= 0) then
         call mem_fail(real(n, wp) * (PNAME_LEN + 100), 'the measures', 'give fewer measures', &
                       status, msg)
         call where_prefix(); return
       end if
-      spec%nmeas = n; spec%meas_int = 0; spec%meas_pts = zero
+      spec%nmeas = n; spec%meas_int = 0; spec%meas_pts = zero; spec%meas_ref = 0
       do j = 1, n
         call next_line(ios)
         if (ios /= 0) return
@@ -868,8 +873,9 @@ contains
         word = tok(1:16)
         select case (word)
         case ('angle')
-          if (nt /= 12) then
-            call fail('bad measure line: SPEC angle KIND B1 X Y B2 X Y B3 X Y expected'); return
+          if (nt /= 12 .and. nt /= 18) then
+            call fail('bad measure line: SPEC angle KIND B1 X Y B2 X Y B3 X Y [IX1 IY1 IX2 '// &
+                      'IY2 IX3 IY3] expected'); return
           end if
           spec%meas_kind(j) = MEAS_ANGLE
           call next_token(line, pos, tok)
@@ -891,6 +897,15 @@ contains
             if (.not. real_ok(tok, spec%meas_pts(1, it, j))) return
             call next_token(line, pos, tok)
             if (.not. real_ok(tok, spec%meas_pts(2, it, j))) return
+          end do
+          do it = 1, merge(6, 0, nt == 18)    ! the points' params entries (0: as given)
+            call next_token(line, pos, tok)
+            if (.not. read_int(tok, v)) v = -1
+            if (v < 0 .or. v > huge(1)) then
+              call fail('"' // trim(tok(1:40)) // '": a point''s entry is a whole number '// &
+                        'from 0 (the number given)'); return
+            end if
+            spec%meas_ref(2 - mod(it, 2), (it + 1) / 2, j) = int(v)
           end do
         case ('ratio', 'advantage')
           if (nt /= 7) then

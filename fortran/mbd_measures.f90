@@ -23,6 +23,9 @@
 !!                 joint B to its other joint A; an output turning about P: p = (P - B)/|P - B|,
 !!                 mu = acos(e . p); an output sliding along the axis u: mu = asin(|e . u|).
 !!                 The front end finds the joints; mbd2d-solve reads the same recipe.
+!!   measures      a list of the three above (kind, integers, points) at every state in one
+!!                 call: a table's columns and a sweep case's (mbd_batch), where the points
+!!                 of an angle may come from the raw parameters a case sets.
 !!
 !! Work arrays are allocated once per call (with stat=), none in the loop over states.
 module mbd_measures
@@ -38,13 +41,17 @@ module mbd_measures
                                           ieee_copy_sign
   implicit none
   private
-  public :: api_conditioning, api_influence, api_fun_values, api_link_angle, api_ratio
+  public :: api_conditioning, api_influence, api_fun_values, api_link_angle, api_ratio, &
+            api_measures
   !> ratio kinds: the velocity ratio dY/dX, the mechanical advantage dX/dY
   integer, parameter, public :: RATIO_VELOCITY = 1, RATIO_ADVANTAGE = 2
   !> quantity kinds: a coordinate (its column), a driver (its row of Phi)
   integer, parameter, public :: QTY_COORDINATE = 1, QTY_DRIVER = 2
   !> link_angle recipes: an output link turning about a second pivot, or sliding
   integer, parameter, public :: ANGLE_TURN = 1, ANGLE_SLIDE = 2
+  !> measure kinds of a list (api_measures; the .mbd file's "measures" block)
+  integer, parameter, public :: MEAS_ANGLE = 1, MEAS_RATIO = 2, MEAS_ADVANTAGE = 3, &
+                                MEAS_CONDITIONING = 4
 
 contains
 
@@ -325,6 +332,75 @@ contains
       r = [c * vl(1) - sn * vl(2), sn * vl(1) + c * vl(2)]
     end function turned
   end subroutine api_link_angle
+
+  !> Every measure of a list at each state: vals(j, k) is measure j at state k. Measure j
+  !! is kind(j) with the integers mint(:, j): MEAS_ANGLE its angle kind and three bodies
+  !! (api_link_angle) with the points spts(:, :, j), an entry of which is rpar(pref(i, l, j))
+  !! instead where pref(i, l, j) > 0 (a joint's point that a sweep case sets);
+  !! MEAS_RATIO, MEAS_ADVANTAGE the driver's row, X's kind and index, Y's kind and index
+  !! (api_ratio); MEAS_CONDITIONING none (api_conditioning). On a failure the rest of vals
+  !! is zero, bad(1) names the measure and bad(2) a ratio's quantity that does not move
+  !! (1 X, 2 Y; else 0).
+  subroutine api_measures(nb, ctab, rpar, q, t, kind, mint, spts, pref, vals, bad, status, msg)
+    integer, intent(in) :: nb                   !! moving bodies
+    integer, intent(in) :: ctab(:, :)           !! constraint table
+    real(wp), intent(in) :: rpar(:)             !! raw parameters
+    real(wp), intent(in) :: q(:, :)             !! states (nq, nt), model units
+    real(wp), intent(in) :: t(:)                !! times (nt)
+    integer, intent(in) :: kind(:)              !! (nm) MEAS_ANGLE ... MEAS_CONDITIONING
+    integer, intent(in) :: mint(:, :)           !! (5, nm) each measure's integers
+    real(wp), intent(in) :: spts(:, :, :)       !! (2, 3, nm) an angle's points
+    integer, intent(in) :: pref(:, :, :)        !! (2, 3, nm) rpar entries of them, or 0
+    real(wp), intent(out) :: vals(:, :)         !! (nm, nt)
+    integer, intent(out) :: bad(2)              !! the failing measure, a ratio's quantity
+    integer, intent(out) :: status              !! MBD_OK, < 0 input, > 0 numerical
+    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    real(wp), allocatable :: col(:)
+    real(wp) :: s(2, 3)
+    integer :: j, ist, i, l
+    vals = zero; bad = 0; status = MBD_OK; msg = ''
+    if (size(mint, 1) /= 5 .or. size(mint, 2) /= size(kind) .or. &
+        any(shape(spts) /= [2, 3, size(kind)]) .or. any(shape(pref) /= shape(spts)) .or. &
+        size(vals, 1) /= size(kind) .or. size(vals, 2) /= size(t)) then
+      status = MBD_BAD_COUNT; msg = 'measures: array sizes do not match'; return
+    end if
+    if (any(pref < 0) .or. any(pref > size(rpar))) then
+      status = MBD_BAD_PARAM; msg = 'measures: a point''s entry is beyond the parameters'
+      return
+    end if
+    allocate (col(size(t)), stat=ist)
+    if (ist /= 0) then
+      call mem_fail(REAL_BYTES * size(t), 'a measure''s column', 'keep fewer rows', status, &
+                    msg)
+      return
+    end if
+    do j = 1, size(kind)
+      bad(1) = j
+      select case (kind(j))
+      case (MEAS_CONDITIONING)
+        call api_conditioning(nb, ctab, rpar, q, t, col, status, msg)
+      case (MEAS_ANGLE)
+        s = spts(:, :, j)
+        do l = 1, 3
+          do i = 1, 2
+            if (pref(i, l, j) > 0) s(i, l) = rpar(pref(i, l, j))
+          end do
+        end do
+        call api_link_angle(q, mint(1, j), mint(2:4, j), s, col, status, msg)
+      case (MEAS_RATIO, MEAS_ADVANTAGE)
+        call api_ratio(nb, ctab, rpar, q, t, merge(RATIO_VELOCITY, RATIO_ADVANTAGE, &
+                       kind(j) == MEAS_RATIO), mint(1, j), mint(2:3, j), mint(4:5, j), col, &
+                       bad(2), status, msg)
+      case default
+        status = MBD_BAD_PARAM; msg = 'measures: unknown kind'
+      end select
+      if (status /= MBD_OK) then
+        vals = zero; return
+      end if
+      vals(j, :) = col
+    end do
+    bad = 0
+  end subroutine api_measures
 
   !> States and times finite and sized for the model.
   logical function check_states(m, q, t, nt, status, msg) result(good)

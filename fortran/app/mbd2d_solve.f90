@@ -20,14 +20,13 @@
 !! outputs, held in memory, are checked against it (mem_check).
 program mbd2d_solve
   use, intrinsic :: iso_fortran_env, only: error_unit, int64
-  use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+  use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_value, ieee_quiet_nan
   use mbd_kinds, only: wp
   use mbd_status, only: MBD_OK, MBD_SINGULAR_CONFIG, MBD_NO_MEMORY, MSG_LEN
   use mbd_memory, only: REAL_BYTES, mem_check
   use mbd_mbdfile, only: mbd_spec_t, mbd_read, NAME_LEN, MEAS_ANGLE, MEAS_RATIO, &
                          MEAS_ADVANTAGE, MEAS_CONDITIONING
-  use mbd_measures, only: api_conditioning, api_link_angle, api_ratio, RATIO_VELOCITY, &
-                          RATIO_ADVANTAGE
+  use mbd_measures, only: api_measures
   use mbd_model, only: NFT
   use mbd_constraints, only: con_nrow, con_is_driver
   use mbd_api, only: NINFO, api_sizes, api_kinematics, api_inverse, api_dynamics, api_statics, &
@@ -57,8 +56,9 @@ program mbd2d_solve
   logical :: dynamic, elements, sens, lam_sens
   ! a sweep (run_sweep): the batch call's outputs per case and each case's outcome
   real(wp), allocatable :: bq(:, :, :), bqd(:, :, :), bqdd(:, :, :), blam(:, :, :), &
-                           be(:, :, :), brinfo(:, :), bqsing(:, :)
+                           be(:, :, :), brinfo(:, :), bqsing(:, :), bmv(:, :, :)
   integer, allocatable :: biinfo(:, :), bdep(:, :), bred(:, :), bstat(:), nkeep(:), cstat(:)
+  integer, allocatable :: bmbad(:, :)                 !! a case's failed measure (mbd_batch)
   character(len=MSG_LEN), allocatable :: bmsg(:)
   character(len=4 * MSG_LEN), allocatable :: cmsg(:)
   integer :: code = 0, nrow = 0, nd = 0, nlam = 0   !! batch analysis, rows, rows of q_dot, lambda
@@ -309,6 +309,9 @@ contains
         if (any(spec%meas_int(2:4, j) > spec%nb)) call die(2, trim(model_path) // ':' // &
           trim(itoa(spec%meas_line(j))) // ': measure "' // trim(spec%meas_names(j)) // &
           '": a body number beyond the ' // trim(itoa(spec%nb)) // ' bodies')
+        if (any(spec%meas_ref(:, :, j) > size(spec%rpar))) call die(2, trim(model_path) // &
+          ':' // trim(itoa(spec%meas_line(j))) // ': measure "' // trim(spec%meas_names(j)) // &
+          '": a point''s entry beyond the ' // trim(itoa(size(spec%rpar))) // ' params')
       case (MEAS_RATIO, MEAS_ADVANTAGE)
         if (spec%meas_int(1, j) > neq) call bad_measure(j)
         do k = 2, 4, 2                   ! X, then Y: a coordinate (1) or a driver's row (2)
@@ -329,31 +332,18 @@ contains
   !> The measures at the rows written (the core, as the Python path's table): the
   !! conditioning of J, the transmission angle, and the ratios of influence coefficients.
   subroutine eval_measures()
-    integer :: j, st, bad
-    real(wp), allocatable :: col(:)
+    integer :: st, bad(2)
     if (spec%nmeas == 0 .or. nout == 0) return
-    allocate (mvals(spec%nmeas, nout), col(nout), stat=ierr)
+    allocate (mvals(spec%nmeas, nout), stat=ierr)
     if (ierr /= 0) call die(2, 'not enough memory for the measures; give fewer steps')
-    do j = 1, spec%nmeas
-      select case (spec%meas_kind(j))
-      case (MEAS_CONDITIONING)
-        call api_conditioning(spec%nb, spec%ctab, spec%rpar, qout(:, 1:nout), tout(1:nout), &
-                              col, st, msg)
-      case (MEAS_ANGLE)
-        call api_link_angle(qout(:, 1:nout), spec%meas_int(1, j), spec%meas_int(2:4, j), &
-                            spec%meas_pts(:, :, j), col, st, msg)
-      case default
-        call api_ratio(spec%nb, spec%ctab, spec%rpar, qout(:, 1:nout), tout(1:nout), &
-                       merge(RATIO_VELOCITY, RATIO_ADVANTAGE, &
-                             spec%meas_kind(j) == MEAS_RATIO), spec%meas_int(1, j), &
-                       spec%meas_int(2:3, j), spec%meas_int(4:5, j), col, bad, st, msg)
-        if (bad /= 0) call die(2, 'measure "' // trim(spec%meas_names(j)) // '": ' // &
-                               trim(msg))
-      end select
-      if (st /= MBD_OK) call die(4, 'measure "' // trim(spec%meas_names(j)) // &
-                                 '" could not be computed: ' // trim(msg))
-      mvals(j, :) = col
-    end do
+    call api_measures(spec%nb, spec%ctab, spec%rpar, qout(:, 1:nout), tout(1:nout), &
+                      spec%meas_kind, spec%meas_int, spec%meas_pts, spec%meas_ref, mvals, bad, &
+                      st, msg)
+    if (st == MBD_OK) return
+    if (bad(2) /= 0) call die(2, 'measure "' // trim(spec%meas_names(bad(1))) // '": ' // &
+                              trim(msg))
+    call die(4, 'measure "' // trim(spec%meas_names(max(1, bad(1)))) // &
+             '" could not be computed: ' // trim(msg))
   end subroutine eval_measures
 
   !> Keep the rows before the first one with a non-finite sensitivity (as the Python path:
@@ -789,10 +779,9 @@ contains
     integer, allocatable :: bft(:, :)
     if (sens) call die(2, trim(model_path) // ':' // trim(itoa(spec%cases_line)) // &
       ': sweeps compute no sensitivities: run the cases one by one, or mbd2d.tolerance')
-    if (spec%out_energy .or. spec%out_lam .or. spec%out_reac .or. spec%out_eff .or. &
-        spec%nmeas > 0) &
+    if (spec%out_energy .or. spec%out_lam .or. spec%out_reac .or. spec%out_eff) &
       call die(2, trim(model_path) // ': a sweep writes its own columns (q, q_dot, q_ddot, '// &
-               'efforts): give no "outputs" or "measures" line with "cases"')
+               'efforts, measures): give no "outputs" line with "cases"')
     call check_case_entries()
     iset = 0; rset = 0.0_wp
     select case (spec%analysis)
@@ -818,7 +807,8 @@ contains
     if (code /= 3) nrow = kin_out_count(spec%steps, spec%every)
     nd = merge(0, nrow, code == 1 .and. spec%positions_only)
     nlam = merge(0, neq, code == 1); ne = merge(0, 4, code == 1)
-    bytes = REAL_BYTES * real(spec%ncase, wp) * (real(nrow, wp) * (nq + nlam + ne) + &
+    bytes = REAL_BYTES * real(spec%ncase, wp) * (real(nrow, wp) * (nq + nlam + ne + &
+            spec%nmeas) + &
             2.0_wp * nq * nd + 2 * NINFO + nq) + 4.0_wp * spec%ncase * (2 * neq + NINFO + 3)
     call mem_check(bytes, 'the outputs of ' // trim(itoa(spec%ncase)) // ' cases', &
                    'give fewer cases or steps', status, msg)
@@ -829,7 +819,8 @@ contains
               brinfo(NINFO, spec%ncase), bqsing(nq, spec%ncase), biinfo(NINFO, spec%ncase), &
               bdep(neq, spec%ncase), bred(neq, spec%ncase), bstat(spec%ncase), &
               bmsg(spec%ncase), nkeep(spec%ncase), cstat(spec%ncase), cmsg(spec%ncase), &
-              tout(nrow), q0(nq), stat=ierr)
+              tout(nrow), q0(nq), bmv(spec%nmeas, nrow, spec%ncase), &
+              bmbad(3, spec%ncase), stat=ierr)
     ! the dynamic tables (a kinematic sweep takes none: zeros, as the Python sweep passes)
     if (ierr == 0) allocate (bm(2, spec%nb), bv0(nq), bft(NFT, merge(0, spec%nf, code == 1)), &
                              bfp(max(1, size(spec%fpar))), stat=ierr)
@@ -841,6 +832,7 @@ contains
       bm = spec%bmass; bft = spec%ftab; bfp(1:size(spec%fpar)) = spec%fpar
       bv0(1:3 * spec%nb) = reshape(spec%v0, [3 * spec%nb])
     end if
+    call times()
     ! the cases in chunks, run in parallel (OpenMP) where the build has it: each case's
     ! numbers depend on its own values alone, so any split gives the same bytes
     nchunk = min(spec%ncase, 64)
@@ -854,10 +846,10 @@ contains
                      bq(:, :, c0:c1), bqd(:, :, c0:c1), bqdd(:, :, c0:c1), &
                      blam(:, :, c0:c1), be(:, :, c0:c1), biinfo(:, c0:c1), brinfo(:, c0:c1), &
                      bqsing(:, c0:c1), bdep(:, c0:c1), bred(:, c0:c1), bstat(c0:c1), &
-                     bmsg(c0:c1))
+                     bmsg(c0:c1), tout, spec%meas_kind, spec%meas_int, spec%meas_pts, &
+                     spec%meas_ref, bmv(:, :, c0:c1), bmbad(:, c0:c1))
     end do
     !$omp end parallel do
-    call times()
     nfail = 0
     do c = 1, spec%ncase
       call case_outcome(c)
@@ -907,6 +899,11 @@ contains
     clean = bstat(c) == MBD_OK .and. k > n
     if (code == 3) clean = clean .and. ieee_is_finite(brinfo(1, c))
     cstat(c) = 0; cmsg(c) = ''; nkeep(c) = n
+    if (clean .and. bmbad(1, c) /= MBD_OK) then   ! its rows, without its measures
+      cstat(c) = bmbad(1, c)
+      cmsg(c) = 'measure "' // trim(spec%meas_names(bmbad(2, c))) // '": ' // trim(bmsg(c))
+      bmv(:, :, c) = ieee_value(0.0_wp, ieee_quiet_nan)
+    end if
     if (clean) return
     nkeep(c) = min(n, k - 1)
     cstat(c) = bstat(c)
@@ -954,7 +951,7 @@ contains
     integer :: u, ios, j, k, l, r0, nlev, c, lp, nh, nt, width
     nlev = merge(3, 1, nd > 0)
     ! at most 26 characters a number ("%.17g": -1.2345678901234567e-308) with its comma
-    width = 26 * (spec%ncp + 2 + 3 * nq + spec%nc) + 32
+    width = 26 * (spec%ncp + 2 + 3 * nq + spec%nc + spec%nmeas) + 32
     allocate (character(len=width) :: head, line, stat=ierr)
     if (ierr == 0) allocate (character(len=2 * len(cmsg) + 40) :: tail, stat=ierr)
     if (ierr /= 0) call die(2, 'not enough memory to write ' // path)
@@ -975,6 +972,9 @@ contains
           call sput(u, ios, ',effort.' // trim(spec%con_names(j)))
       end do
     end if
+    do j = 1, spec%nmeas
+      call sput(u, ios, ',' // quoted(trim(spec%meas_names(j))))
+    end do
     call sput(u, ios, crlf)
     do c = 1, spec%ncase
       nh = 0
@@ -1011,6 +1011,9 @@ contains
             r0 = r0 + con_nrow(spec%ctab(1, j))
           end do
         end if
+        do j = 1, spec%nmeas
+          call bnum(line, lp, bmv(j, k, c))
+        end do
         call bput(line, lp, crlf)
         call sput(u, ios, line(1:lp))
       end do

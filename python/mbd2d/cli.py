@@ -26,9 +26,10 @@ drift), ``--multipliers``, ``--reactions`` and ``--efforts`` (need multipliers: 
 dynamics, dynamics, statics, or kinematics of a model with masses; inverse-dynamics writes
 the efforts unless ``--no-efforts``). ``export`` writes them into the file for mbd2d-solve.
 
-``--measure SPEC`` (repeatable; kinematics, inverse-dynamics, dynamics, export) adds a column
-per measure: ``transmission_angle:JOINT[:OUTPUT]``, ``velocity_ratio:INPUT:OUTPUT[:VIA]``,
-``mechanical_advantage:INPUT:OUTPUT[:VIA]`` or ``dead_centre_distance``.
+``--measure SPEC`` (repeatable; kinematics, inverse-dynamics, dynamics, sweep, export) adds a
+column per measure: ``transmission_angle:JOINT[:OUTPUT]``,
+``velocity_ratio:INPUT:OUTPUT[:VIA]``, ``mechanical_advantage:INPUT:OUTPUT[:VIA]`` or
+``dead_centre_distance`` (a sweep: each case's, from its own dimensions).
 
 ``--sensitivities NAME,...`` (kinematics, inverse-dynamics, statics, dynamics by dopri5,
 export) computes the design sensitivities with respect to the named parameters (``mbd2d
@@ -215,6 +216,7 @@ def _parser() -> argparse.ArgumentParser:
                    help="local worker processes (default: every core)")
     w.add_argument("--scheduler", default=None, metavar="ADDRESS",
                    help="run on the Dask cluster of this scheduler (tcp://host:8786)")
+    _measures(w)
     r = sub.add_parser("parameters", help="the design parameters of a model: name = value")
     r.add_argument("model", help="model file (.toml)")
     r.add_argument("--match", default=None, metavar="TEXT",
@@ -584,10 +586,10 @@ def _cases(args: argparse.Namespace) -> dict[str, np.ndarray]:
 def _export_sweep(model: Model, args: argparse.Namespace) -> int:
     """export --param: a sweep file for mbd2d-solve (the settings of the analysis alone)."""
     from .studies import export_sweep
-    if _outputs(args) or _sens_names(args) or args.measure:
-        raise ModelError("a sweep file writes the sweep's columns: no --energy, "
-                         "--multipliers, --reactions, --efforts, --sensitivities or "
-                         "--measure with --param", "command line")
+    if _outputs(args) or _sens_names(args):
+        raise ModelError("a sweep file writes the sweep's columns (and --measure): no "
+                         "--energy, --multipliers, --reactions, --efforts or --sensitivities "
+                         "with --param", "command line")
     if args.analysis == "check":
         raise ModelError("a sweep runs kinematics, inverse-dynamics, dynamics or statics, not "
                          "check", "command line")
@@ -601,7 +603,8 @@ def _export_sweep(model: Model, args: argparse.Namespace) -> int:
     if args.analysis != "statics" and (args.t_end is None or args.steps is None):
         raise ModelError(f"{args.analysis} needs --t-end and --steps", "command line")
     cases = _cases(args)
-    export_sweep(model, args.out, cases, args.analysis.replace("-", "_"), **kw)
+    export_sweep(model, args.out, cases, args.analysis.replace("-", "_"),
+                 measures=args.measure, **kw)
     n = len(next(iter(cases.values())))
     print(f"wrote {args.out} ({args.analysis} of {n} cases; run it with mbd2d-solve "
           f"{args.out} OUT.csv)")
@@ -622,7 +625,8 @@ def _sweep(model: Model, args: argparse.Namespace) -> int:
             kw["positions_only"] = True
     client = connect(args.scheduler) if args.scheduler else None
     try:
-        ds = sweep(model, cases, args.analysis, client, workers=args.workers, **kw)
+        ds = sweep(model, cases, args.analysis, client, workers=args.workers,
+                   measures=args.measure, **kw)
     finally:
         if client is not None:
             client.close()
@@ -631,7 +635,26 @@ def _sweep(model: Model, args: argparse.Namespace) -> int:
     print(f"wrote {ds.sizes['case']} cases ({failed} failed) to {args.out}")
     for j in np.flatnonzero(ds.status.values != 0)[:5]:
         _say(f"  case {int(j)}: {ds.message.values[j]}")
+    for line in _measure_ranges(ds):
+        print(line)
     return EXIT_OK
+
+
+def _measure_ranges(ds: Any) -> list[str]:
+    """Each measure's least and greatest value over the cases' rows, and where."""
+    if "measure" not in ds.coords:
+        return []
+    out = []
+    for k, spec in enumerate(ds["measure"].values):
+        v = np.asarray(ds["measures"].values[:, :, k], dtype=float)
+        if not np.isfinite(v).any():
+            out.append(f"  {spec}: no value")
+            continue
+        lo, hi = np.nanargmin(v), np.nanargmax(v)
+        cl, ch = np.unravel_index(lo, v.shape)[0], np.unravel_index(hi, v.shape)[0]
+        out.append(f"  {spec}: from {v.flat[lo]:.6g} (case {int(cl)}) to {v.flat[hi]:.6g} "
+                   f"(case {int(ch)})")
+    return out
 
 
 def main(argv: Sequence[str] | None = None) -> int:

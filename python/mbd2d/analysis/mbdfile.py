@@ -23,7 +23,7 @@ from ..description.joints import (Absolute, Cam, Distance, Gear, PinInSlot, Poin
                                   Weld)
 from ..errors import ModelError
 from ..results.files import OUTPUTS, write_text
-from ..results.measures import angle_recipe, measure_list, parse_measure, ratio_recipe
+from ..results.measures import measure_tables
 from ..validate import flag, number
 from .dynamics import dynamics_settings
 from .sensitivities import check_dopri5, check_positions_only, requested, table
@@ -176,9 +176,11 @@ def file_lines(model: ModelDescription, t_end: float | None = None, steps: int |
                max_steps: Any = None, t: float = 0.0, outputs: Sequence[str] | None = None,
                positions_only: Any = False,
                sensitivities: Sequence[str] | None = None,
-               measures: Sequence[str] | None = None) -> list[str]:
+               measures: Sequence[str] | None = None,
+               measure_refs: bool = False) -> list[str]:
     """The lines of a model file up to its ``end`` line (the header, the model, the analysis
-    and its settings, the optional blocks).
+    and its settings, the optional blocks; with measure_refs an angle's points name the
+    params entries they come from, for a sweep's cases).
 
     Raises
     ------
@@ -251,7 +253,7 @@ def file_lines(model: ModelDescription, t_end: float | None = None, steps: int |
             col = dyn.ftab[:, k] if dyn.ftab[NFT - 1, k] else dyn.ftab[:NFT - 1, k]
             lines.append(f"{name} " + " ".join(str(int(v)) for v in col))
         lines += _reals("fparams", dyn.fpar)
-    lines += _measure_lines(model, p, measures, analysis)
+    lines += _measure_lines(model, p, measures, analysis, measure_refs)
     if params:
         ptab = table(p, params, dyn)
         lines.append(f"sensitivities {len(params)}")
@@ -259,30 +261,31 @@ def file_lines(model: ModelDescription, t_end: float | None = None, steps: int |
     return lines
 
 
-def _measure_lines(model: ModelDescription, p: Any, specs: Any, analysis: str) -> list[str]:
+def _measure_lines(model: ModelDescription, p: Any, specs: Any, analysis: str,
+                   moved: bool = False) -> list[str]:
     """The measures block: each spec with the recipe mbd2d-solve evaluates (an angle's
-    bodies and points, a ratio's reference row and quantities, 1-based)."""
-    specs = measure_list(specs)
-    if not specs:
+    bodies and points, with moved also the params entries of the points; a ratio's
+    reference row and quantities; 1-based)."""
+    t = measure_tables(model, p, specs, moved)
+    if not t.specs:
         return []
     if analysis in ("statics", "check"):
         raise ModelError(f"measures are columns of a run over time, not of {analysis}",
                          "export")
-    lines = [f"measures {len(specs)}"]
-    for spec in specs:
-        name, args = parse_measure(spec)
-        if name == "transmission_angle":
-            kind, bodies, pts = angle_recipe(model, *args)
-            lines.append(f"{spec} angle {kind} " + " ".join(
-                f"{int(bodies[k])} {_r(pts[0, k])} {_r(pts[1, k])}" for k in range(3)))
-        elif name == "dead_centre_distance":
+    words = {2: "ratio", 3: "advantage"}
+    lines = [f"measures {len(t.specs)}"]
+    for j, spec in enumerate(t.specs):
+        if t.kind[j] == 1:
+            refs = " " + " ".join(str(int(v)) for v in t.mref[:, :, j].T.ravel()) \
+                if moved else ""
+            lines.append(f"{spec} angle {t.mint[0, j]} " + " ".join(
+                f"{t.mint[1 + k, j]} {_r(t.mpts[0, k, j])} {_r(t.mpts[1, k, j])}"
+                for k in range(3)) + refs)
+        elif t.kind[j] == 4:
             lines.append(f"{spec} conditioning")
         else:
-            ref, qx, qy = ratio_recipe(model, p, *args)
-            word = "ratio" if name == "velocity_ratio" else "advantage"
-            kinds = {"coordinate": 1, "driver": 2}
-            lines.append(f"{spec} {word} {ref + 1} {kinds[qx[0]]} {qx[1] + 1} "
-                         f"{kinds[qy[0]]} {qy[1] + 1}")
+            lines.append(f"{spec} {words[int(t.kind[j])]} "
+                         + " ".join(str(int(v)) for v in t.mint[:, j]))
     return lines
 
 

@@ -16,7 +16,7 @@ import numpy as np
 from .. import _core
 from ..errors import InsufficientMemoryError
 from .status import MEMORY_ADVICE
-from .tables import BatchTables, DynamicTables, Packed, decode
+from .tables import BatchTables, DynamicTables, MeasureTables, Packed, decode
 
 
 def _named(names: str, fn: Callable[..., tuple[Any, ...]], *args: Any, numbers: float = 0,
@@ -273,21 +273,33 @@ def reactions_dp(p: Packed, ptab: np.ndarray, q: np.ndarray, t: np.ndarray, lam:
 
 # ------------------------------------------------------------------ design sweeps
 
+#: the measure tables passed without measures (one unused column)
+_ONE_MEASURE = MeasureTables(["-"], np.ones(1, dtype=np.int32),
+                             np.zeros((5, 1), dtype=np.int32, order="F"),
+                             np.zeros((2, 3, 1), order="F"),
+                             np.zeros((2, 3, 1), dtype=np.int32, order="F"))
+
+
 def batch(b: BatchTables, vals: np.ndarray) -> dict[str, Any]:
     """One analysis for every case (column) of vals (nv, ncase), in one core call
     (``fortran/mbd_batch.f90``). Returns the core's arrays by name, the case last: ``q``,
     ``qd``, ``qdd`` (nq, nrow, ncase; (nq, 0, ncase) for positions only), ``lam`` (nlam, nrow,
     ncase), ``e`` (ne, nrow, ncase),
     ``iinfo``, ``rinfo`` (10, ncase), ``qsing`` (nq, ncase), ``dep``, ``red`` (neq, ncase),
-    ``status`` (ncase) and ``msg`` (ncase, text). A module-level function of plain arrays, so
+    the measures ``m`` (nm, nrow, ncase) with ``mbad`` (3, ncase: status, measure, quantity of
+    a case whose measures failed), ``status`` (ncase) and ``msg`` (ncase, text). A module-level function of plain arrays, so
     that worker processes and Dask workers can run it."""
     vals = np.asfortranarray(vals, dtype=np.float64)
     ncase = vals.shape[1]
-    out = _named("q qd qdd lam e iinfo rinfo qsing dep red status msg", _core.core_batch,
+    m = b.measures if len(b.measures.specs) else _ONE_MEASURE    # (f2py: no zero-length table)
+    times = b.times if len(b.measures.specs) else np.zeros(b.nrow)
+    out = _named("q qd qdd lam e iinfo rinfo qsing dep red m mbad status msg", _core.core_batch,
                  analysis=b.analysis, nb=b.nb, ctab=b.ctab, rpar=b.rpar, bmass=b.bmass,
                  grav=b.grav, ftab=b.ftab, fpar=b.fpar, q0=b.q0, v0=b.v0, vtab=b.vtab,
                  vals=vals, opens=b.opens, iset=b.iset, rset=b.rset, neq=b.neq, nrow=b.nrow,
-                 nd=b.nd, nlam=b.nlam, ne=b.ne,
-                 numbers=ncase * ((b.nq + b.nlam + b.ne) * b.nrow + 2 * b.nq * b.nd
-                                  + 2 * b.neq + b.nq + 20))
+                 nd=b.nd, nlam=b.nlam, ne=b.ne, times=times, nm=len(b.measures.specs),
+                 mkind=m.kind, mint=m.mint,
+                 mpts=m.mpts, mref=m.mref,
+                 numbers=ncase * ((b.nq + b.nlam + b.ne + len(b.measures.specs)) * b.nrow
+                                  + 2 * b.nq * b.nd + 2 * b.neq + b.nq + 23))
     return vars(out)

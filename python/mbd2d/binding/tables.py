@@ -51,6 +51,29 @@ def decode(raw: bytes | str) -> str:
 
 
 @dataclass
+class MeasureTables:
+    """A list of mechanism measures as the core takes them (``api_measures`` in
+    ``fortran/mbd_measures.f90``): per measure its kind (1 transmission angle, 2 velocity
+    ratio, 3 mechanical advantage, 4 distance to a dead centre), its integers (an angle: its
+    kind and three bodies; a ratio: the driver's row, X's kind and index, Y's kind and index;
+    1-based), an angle's points and the raw-parameter entries they come from (1-based; 0
+    the number given)."""
+
+    specs: list[str]
+    kind: np.ndarray            # int32 (nm,)
+    mint: np.ndarray            # int32 (5, nm)
+    mpts: np.ndarray            # float64 (2, 3, nm)
+    mref: np.ndarray            # int32 (2, 3, nm)
+
+    @classmethod
+    def empty(cls) -> "MeasureTables":
+        """No measure."""
+        return cls([], np.zeros(0, dtype=np.int32), np.zeros((5, 0), dtype=np.int32, order="F"),
+                   np.zeros((2, 3, 0), order="F"),
+                   np.zeros((2, 3, 0), dtype=np.int32, order="F"))
+
+
+@dataclass
 class BatchTables:
     """Everything one batch call of the core needs besides the case values (see
     ``fortran/mbd_batch.f90``): the model's tables once, the entries each case sets, the
@@ -75,6 +98,8 @@ class BatchTables:
     nrow: int                   # output rows per case
     nlam: int                   # neq for the analyses with multipliers, else 0
     ne: int                     # 4 for the analyses with energies, else 0
+    times: np.ndarray = field(default_factory=lambda: np.zeros(0))   # (nrow,) output times
+    measures: MeasureTables = field(default_factory=MeasureTables.empty)
 
     @property
     def nq(self) -> int:

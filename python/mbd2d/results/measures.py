@@ -24,10 +24,12 @@ import numpy as np
 
 from ..binding import core
 from ..binding.pack import pack
+from ..binding.params import parameter_table
 from ..binding.status import OK, error_for
-from ..binding.tables import Packed
+from ..binding.tables import MeasureTables, Packed
 from ..description.joints import PointOnLine, Revolute, Translational
-from ..errors import ModelError
+from ..description.parameters import find
+from ..errors import MbdError, ModelError
 from ..validate import GROUND
 
 
@@ -144,13 +146,31 @@ def ratio_values(res: Any, kind: str, x: Any, y: Any, via: Any = None) -> np.nda
     out = core.ratio(p, q, t, RATIO_KINDS[kind], ref + 1,
                      (QUANTITY_KINDS[qx[0]], qx[1] + 1), (QUANTITY_KINDS[qy[0]], qy[1] + 1))
     if out.status != OK:
-        if int(out.bad) in (1, 2):
-            name = (x, y)[int(out.bad) - 1]
-            raise ModelError(f"{name!r} does not move with the driver "
-                             f"'{res.model.constraints[p.row_owner[ref]].name}' (its influence "
-                             "coefficient is zero throughout): no ratio to it", "velocity_ratio")
-        raise error_for("measures", out.status, out.msg, entry=kind)
+        raise _ratio_failure(res.model, p, kind, ref, (x, y), int(out.status), out.msg,
+                             int(out.bad))
     return np.asarray(out.ratio, dtype=float).copy()
+
+
+def _ratio_failure(model: Any, p: Packed, kind: str, ref: int, names: tuple[Any, Any],
+                   status: int, msg: str, bad: int) -> MbdError:
+    """The error of a ratio the core could not compute: bad 1 or 2 names the quantity (X or
+    Y) that does not move with the reference driver (row ref, 0-based)."""
+    if bad in (1, 2):
+        return ModelError(f"{names[bad - 1]!r} does not move with the driver "
+                          f"'{model.constraints[p.row_owner[ref]].name}' (its influence "
+                          "coefficient is zero throughout): no ratio to it", "velocity_ratio")
+    return error_for("measures", status, msg, entry=kind)
+
+
+def measure_failure(model: Any, p: Packed, spec: str, status: int, msg: str,
+                    bad: int) -> MbdError:
+    """The error the measure spec raises where the core failed to compute it (status, its
+    message, and for a ratio the quantity that does not move: bad 1 X, 2 Y)."""
+    name, args = parse_measure(spec)
+    if name in RATIO_KINDS:
+        ref, _, _ = ratio_recipe(model, p, *args)
+        return _ratio_failure(model, p, name, ref, (args[0], args[1]), status, msg, bad)
+    return error_for("measures", status, msg, entry=name)
 
 
 # ----------------------------------------------------------------------------- transmission
@@ -195,6 +215,14 @@ def angle_recipe(model: Any, joint: Any, output: Any = None
         one of its bodies, the coupler has no second revolute joint, or the output link
         neither turns about a second revolute joint nor slides in a translational joint.
     """
+    kind, items = _angle_items(model, joint, output)
+    return kind, *_recipe([(b, pt) for b, pt, _ in items])
+
+
+def _angle_items(model: Any, joint: Any, output: Any = None
+                 ) -> tuple[int, list[tuple[int, Any, str]]]:
+    """angle_recipe's kind and its three (body, point, parameter name prefix of the point:
+    NAME.0 is its x, NAME.1 its y)."""
     index = {b.name: k + 1 for k, b in enumerate(model.bodies)}
     index[GROUND] = 0
     j = _joint(model, joint)
@@ -216,18 +244,22 @@ def angle_recipe(model: Any, joint: Any, output: Any = None
     if ja is None:
         raise ModelError(f"the coupler {cpl!r} has no second revolute joint: its force line "
                          "runs between its two joints", entry)
-    first = [(index[out], j.points[j.bodies.index(out)]),
-             (index[cpl], ja.points[ja.bodies.index(cpl)])]
+    kb, ka = j.bodies.index(out), ja.bodies.index(cpl)
+    first = [(index[out], j.points[kb], f"joint.{j.name}.points.{kb}"),
+             (index[cpl], ja.points[ka], f"joint.{ja.name}.points.{ka}")]
     jp = _other_revolute(model, out, j)
     if jp is not None:
-        pb = jp.bodies.index(out)
-        return 1, *_recipe(first + [(index[jp.bodies[1 - pb]], jp.points[1 - pb])])
+        pb = 1 - jp.bodies.index(out)
+        return 1, first + [(index[jp.bodies[pb]], jp.points[pb],
+                            f"joint.{jp.name}.points.{pb}")]
     for c in model.joints:
         if isinstance(c, (Translational, PointOnLine)) and out in c.bodies:
-            k = 0 if isinstance(c, PointOnLine) else c.bodies.index(out)
-            axis = c.axis if isinstance(c, PointOnLine) else c.axes[k]
-            owner = c.bodies[0] if isinstance(c, PointOnLine) else c.bodies[k]
-            return 2, *_recipe(first + [(index[owner], axis)])
+            if isinstance(c, PointOnLine):
+                axis, owner, name = c.axis, c.bodies[0], f"joint.{c.name}.axis"
+            else:
+                k = c.bodies.index(out)
+                axis, owner, name = c.axes[k], c.bodies[k], f"joint.{c.name}.axes.{k}"
+            return 2, first + [(index[owner], axis, name)]
     raise ModelError(f"the output link {out!r} neither turns about a second revolute joint "
                      "nor slides in a translational joint", entry)
 
@@ -290,6 +322,46 @@ def measure_list(specs: Any) -> list[Any]:
     except TypeError:
         raise ModelError(f"measures must be a list of specs ({FORMS}), got {specs!r}",
                          "measures") from None
+
+
+#: the core's measure kinds (fortran/mbd_measures.f90, MEAS_*)
+MEASURE_KINDS = {"transmission_angle": 1, "velocity_ratio": 2, "mechanical_advantage": 3,
+                 "dead_centre_distance": 4}
+
+
+def measure_tables(model: Any, p: Packed, specs: Any, moved: bool = False) -> MeasureTables:
+    """The measures asked for (see :func:`measure_list`) as the core's tables; with moved,
+    the raw-parameter entries an angle's points come from (a sweep's case may set them).
+
+    Raises
+    ------
+    ModelError
+        For a spec the model does not have (as the measure's own function raises it).
+    """
+    specs = measure_list(specs)
+    nm = len(specs)
+    t = MeasureTables(list(specs), np.zeros(nm, dtype=np.int32),
+                      np.zeros((5, nm), dtype=np.int32, order="F"),
+                      np.zeros((2, 3, nm), order="F"),
+                      np.zeros((2, 3, nm), dtype=np.int32, order="F"))
+    for j, spec in enumerate(specs):
+        name, args = parse_measure(spec)
+        t.kind[j] = MEASURE_KINDS[name]
+        if name == "transmission_angle":
+            kind, items = _angle_items(model, *args)
+            t.mint[0, j] = kind
+            for k, (b, pt, _) in enumerate(items):
+                t.mint[1 + k, j] = b
+                t.mpts[:, k, j] = [float(v) for v in pt]
+            if moved:
+                params = find(model, [f"{n}.{i}" for _, _, n in items for i in (0, 1)],
+                              "measures")
+                t.mref[:, :, j] = parameter_table(p, params)[1].reshape(3, 2).T
+        elif name != "dead_centre_distance":
+            ref, qx, qy = ratio_recipe(model, p, *args)
+            t.mint[:, j] = [ref + 1, QUANTITY_KINDS[qx[0]], qx[1] + 1, QUANTITY_KINDS[qy[0]],
+                            qy[1] + 1]
+    return t
 
 
 def measure_columns(res: Any, specs: Any) -> tuple[list[str], list[np.ndarray]]:

@@ -17,6 +17,7 @@ from ..binding.status import INCONSISTENT, OK
 from ..description.builder import ModelDescription
 from ..errors import MbdError
 from ..results.kinematics import KinematicsResult
+from ..results.measures import measure_failure
 from .plan import Plan
 from .runner import Outputs
 
@@ -81,6 +82,12 @@ def outcomes(pl: Plan, model: ModelDescription, out: Outputs, names: Sequence[st
     rows = np.where(clean, n, 0)
     status = np.zeros(ncase, dtype=np.int32)
     messages = [""] * ncase
+    for j in np.flatnonzero(clean & (a["mbad"][0] != OK)):    # its rows, not its measures
+        bad = a["mbad"][:, j]
+        exc = measure_failure(model, pl.packed, pl.tables.measures.specs[int(bad[1]) - 1],
+                              int(bad[0]), out.msg[j], int(bad[2]))
+        status[j] = int(getattr(exc, "status", 0) or bad[0])
+        messages[j] = str(exc)
     for j in np.flatnonzero(~clean):
         exc = _failure(pl, model, _case(out, int(j)), int(n[j]), names, values[:, j])
         if exc is None:          # pragma: no cover - the same test as the front door's
@@ -145,6 +152,11 @@ def to_dataset(pl: Plan, analysis: str, model: ModelDescription, out: Outputs,
         data.update(qd=(cube, per_case(a["qd"])), qdd=(cube, per_case(a["qdd"])))
     coords: dict[str, Any] = {"case": np.arange(len(status)), "time": pl.times,
                               "coordinate": list(p.coordinate_names)}
+    if b.measures.specs:
+        m = per_case(a["m"])
+        m[a["mbad"][0] != OK] = np.nan
+        data["measures"] = (("case", "time", "measure"), m)
+        coords["measure"] = list(b.measures.specs)
     if b.nlam:
         lam = per_case(a["lam"])
         data["lam"] = (("case", "time", "equation"), lam)

@@ -37,7 +37,7 @@ def write_sweep(ds: Any, path: str | Path) -> None:
 
     CSV columns: ``case``, the parameters, ``t``, ``status``, ``message``, then per
     coordinate NAME (q), NAME_dot (qd), NAME_ddot (qdd) (NAME alone for a positions-only
-    sweep), and with multipliers the efforts ``effort.DRIVER``.
+    sweep), with multipliers the efforts ``effort.DRIVER``, then the measures by their specs.
 
     Raises
     ------
@@ -83,8 +83,11 @@ def _csv(ds: Any, path: Path) -> None:
               *(f"{c}{s}" for s in ("", "_dot", "_ddot")[:len(levels)] for c in coords)]
     drivers = [str(d) for d in ds.driver.values] if "effort" in ds else []
     header += [f"effort.{d}" for d in drivers]
+    specs = [str(m) for m in ds["measure"].values] if "measure" in ds.coords else []
+    header += specs
     q = levels[0]
     eff = ds.effort.values if drivers else None
+    meas = ds["measures"].values if specs else None
     t = ds.time.values
     with open(path, "w", newline="", encoding="utf-8") as f:
         w = csv.writer(f)
@@ -100,6 +103,8 @@ def _csv(ds: Any, path: Path) -> None:
                 line = head + [_g(t[k]), st, msg] + [_g(v) for x in levels for v in x[c, k]]
                 if eff is not None:
                     line += [_g(v) for v in eff[c, k]]
+                if meas is not None:
+                    line += [_g(v) for v in meas[c, k]]
                 w.writerow(line)
 
 

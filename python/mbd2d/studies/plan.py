@@ -20,6 +20,7 @@ from ..binding.tables import NFT, BatchTables, DynamicTables, Packed
 from ..description.builder import ModelDescription
 from ..description.parameters import Parameter, find
 from ..errors import ModelError
+from ..results.measures import measure_tables
 from ..validate import flag, number
 
 #: the analyses a sweep runs, by the Model method's name, and the core's batch code
@@ -275,8 +276,25 @@ def with_cases(pl: Plan, model: ModelDescription, values: np.ndarray) -> np.ndar
     ct = case_tables(model, pl.packed, d, pl.params, values)
     pl.tables.vtab, pl.tables.opens = ct.vtab, ct.opens
     b = pl.tables
-    check_memory(b.nrow * values.shape[1], b.nq * (3 if b.nd else 1) + b.nlam + b.ne, "sweep")
+    check_memory(b.nrow * values.shape[1],
+                 b.nq * (3 if b.nd else 1) + b.nlam + b.ne + len(b.measures.specs), "sweep")
     return ct.vals
+
+
+def with_measures(pl: Plan, model: ModelDescription, specs: Any) -> None:
+    """Add the measures asked for (specs as ``measures=`` of a table) to the plan's batch:
+    each case gets them at its rows from its own tables.
+
+    Raises
+    ------
+    ModelError
+        For a spec the model does not have, or measures of a statics sweep.
+    """
+    t = measure_tables(model, pl.packed, specs, moved=True)
+    if t.specs and pl.analysis == "statics":
+        raise ModelError("measures are columns of a run over time, not of statics", "sweep")
+    pl.tables.measures = t
+    pl.tables.times = np.ascontiguousarray(pl.times, dtype=np.float64)
 
 
 def nominal_values(model: ModelDescription, params: Sequence[Parameter]) -> np.ndarray:
@@ -286,4 +304,5 @@ def nominal_values(model: ModelDescription, params: Sequence[Parameter]) -> np.n
                     dtype=np.float64)
 
 
-__all__ = ["ANALYSES", "Plan", "case_values", "grid", "plan", "with_cases", "nominal_values"]
+__all__ = ["ANALYSES", "Plan", "case_values", "grid", "plan", "with_cases", "with_measures",
+           "nominal_values"]

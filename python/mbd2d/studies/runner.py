@@ -34,7 +34,8 @@ CHUNKS_PER_WORKER = 4
 SERIAL_CHUNK_SECONDS = 0.25
 
 #: arrays of the core's batch output with the case along the last axis
-CASE_ARRAYS = ("q", "qd", "qdd", "lam", "e", "iinfo", "rinfo", "qsing", "dep", "red")
+CASE_ARRAYS = ("q", "qd", "qdd", "lam", "e", "iinfo", "rinfo", "qsing", "dep", "red", "m",
+               "mbad")
 
 
 def cores() -> int:
@@ -52,8 +53,9 @@ class Outputs:
         nq, nr = b.nq, b.nrow
         shapes = {"q": (nq, nr), "qd": (nq, b.nd), "qdd": (nq, b.nd), "lam": (b.nlam, nr),
                   "e": (b.ne, nr), "iinfo": (10,), "rinfo": (10,), "qsing": (nq,),
-                  "dep": (b.neq,), "red": (b.neq,)}
-        ints = ("iinfo", "dep", "red")
+                  "dep": (b.neq,), "red": (b.neq,), "m": (len(b.measures.specs), nr),
+                  "mbad": (3,)}
+        ints = ("iinfo", "dep", "red", "mbad")
         self.arrays = {k: np.zeros(s + (ncase,), order="F",
                                    dtype=np.int32 if k in ints else np.float64)
                        for k, s in shapes.items()}

@@ -6,13 +6,13 @@ from typing import Any
 from ..description.builder import ModelDescription
 from ..errors import ModelError
 from .dataset import to_dataset, xarray
-from .plan import case_values, plan, with_cases
+from .plan import case_values, plan, with_cases, with_measures
 from .runner import run
 
 
 def sweep(model: ModelDescription, cases: Any, analysis: str = "kinematics", client: Any = None,
           *, workers: int | None = None, progress: bool | None = None,
-          **analysis_kwargs: Any) -> Any:
+          measures: Any = None, **analysis_kwargs: Any) -> Any:
     """Run one analysis for many variants of a model: one case per set of parameter values.
 
     The model is packed once; the core takes the cases in batches (one call per chunk of
@@ -41,6 +41,11 @@ def sweep(model: ModelDescription, cases: Any, analysis: str = "kinematics", cli
     progress : bool, optional
         A tqdm progress bar of cases done: by default one appears when the sweep takes more
         than 2 s; True always, False never.
+    measures : str or list of str, optional
+        Mechanism measures of every case at its rows, as a table's ``measures=``:
+        ``transmission_angle:JOINT[:OUTPUT]``, ``velocity_ratio:IN:OUT[:VIA]``,
+        ``mechanical_advantage:IN:OUT[:VIA]``, ``dead_centre_distance`` (not for statics).
+        Each case's come from its own dimensions (a swept pivot moves its angle's points).
     **analysis_kwargs
         The analysis's settings, as for the Model method (``t_end``, ``steps``, ``t0``,
         ``every``, ``tol``, ``solver``; ``method``, ``rtol``, ``atol``, ``h`` ... for
@@ -52,11 +57,15 @@ def sweep(model: ModelDescription, cases: Any, analysis: str = "kinematics", cli
         ``q``, ``qd``, ``qdd`` over ("case", "time", "coordinate"); with multipliers
         (inverse dynamics, dynamics, statics) also ``lam`` over ("case", "time",
         "equation"), ``effort`` over ("case", "time", "driver"), and the energies
-        ``kinetic``, ``potential`` (statics: ``stability`` and ``residual`` per case). The
+        ``kinetic``, ``potential`` (statics: ``stability`` and ``residual`` per case); with
+        measures ``measures`` over ("case", "time", "measure"), the "measure" coordinate
+        naming them by their specs. The
         parameters are coordinates of "case"; ``status`` (0 ok, else the status of the
         exception the variant raises alone, ``err.status``, or the core's status for bad
         input) and ``message`` (that exception's text) per case. A failing case keeps its
-        rows up to the failure; the rows after it are NaN. ``ds.attrs["failed"]`` counts
+        rows up to the failure; the rows after it are NaN. A case whose measure fails (a
+        quantity that does not move with the driver) keeps its rows, its measures are NaN
+        and its status and message are those of the measure's error. ``ds.attrs["failed"]`` counts
         the failed cases.
 
     Raises
@@ -82,6 +91,7 @@ def sweep(model: ModelDescription, cases: Any, analysis: str = "kinematics", cli
                          f"{type(model).__name__}", "sweep")
     names, values = case_values(cases)
     pl = plan(model, names, analysis, analysis_kwargs)
+    with_measures(pl, model, measures)
     vals = with_cases(pl, model, values)
     out = run(pl.tables, vals, client=client, workers=workers, progress=progress)
     return to_dataset(pl, analysis, model, out, names, values)
