@@ -1,5 +1,6 @@
 """The command line's new doors against seeded random arguments: whatever the flags hold
-(--sensitivities, --measure, --param, --sigma, --point, --export-samples, --analysis check),
+(--sensitivities, --measure, --param, --sigma, --point, --export-samples, --analysis check,
+sweep),
 `mbd2d` ends with a documented exit code (0 ok, 2 bad input, 3 singular configuration, 4
 other numerical failure) and, for a failure, its own message: never an exception out of
 main(), never a traceback. ``MBD2D_CLI_FUZZ`` sets the number of command lines (default 60).
@@ -24,6 +25,8 @@ NAMES = ["joint.B.points.0.0", "joint.A.points.1.0", "body.coupler.mass", "model
 MEASURES = ["transmission_angle:B", "transmission_angle:O2", "velocity_ratio:motor:rocker.theta",
             "mechanical_advantage:motor:slider.x", "dead_centre_distance", "speed", ":",
             "velocity_ratio:motor", "transmission_angle:B:coupler", "velocity_ratio:a:b:c:d"]
+RANGES = ["joint.B.points.0.0=1.5:2.0:3", "joint.O4.points.1.0=2.0:6.0:3",
+          "joint.A.points.0.0=-0.5:0.5:2", "body.bar.mass=0.5:2:2", "body.coupler.mass=1:2:2"]
 NUMBERS = ["1", "0", "-1", "1e-3", "nan", "inf", "1e300", "abc", "", "2:3", "1.5:2.0:3",
            "1.5:2.0:0", "1.5:2.0:1000000000", "0,1", "coupler:0,1", "ground:0,0", "x:y"]
 
@@ -31,11 +34,12 @@ NUMBERS = ["1", "0", "-1", "1e-3", "nan", "inf", "1e300", "abc", "", "2:3", "1.5
 def _command(rng: random.Random, tmp: Path) -> list[str]:
     model = str(EX / rng.choice(MODELS))
     cmd = rng.choice(["kinematics", "inverse-dynamics", "dynamics", "statics", "export",
-                      "tolerance", "parameters", "check", "plot"])
+                      "tolerance", "parameters", "check", "plot", "sweep"])
     argv = [cmd, model]
     if cmd == "export":
         argv.append(str(tmp / "f.mbd"))
-    if cmd in ("kinematics", "inverse-dynamics", "dynamics", "export", "tolerance", "plot"):
+    if cmd in ("kinematics", "inverse-dynamics", "dynamics", "export", "tolerance", "plot",
+               "sweep"):
         argv += ["--t-end", rng.choice(["0.2", "1", "1", "0.5", "-1", "nan"]),
                  "--steps", rng.choice(["4", "4", "3", "0"])]
     if cmd in ("kinematics", "inverse-dynamics", "dynamics", "plot"):
@@ -58,12 +62,19 @@ def _command(rng: random.Random, tmp: Path) -> list[str]:
     if cmd in ("kinematics", "inverse-dynamics", "dynamics", "statics", "export") and \
             rng.random() < 0.5:
         argv += ["--sensitivities", rng.choice(NAMES)]
-    if cmd in ("kinematics", "inverse-dynamics", "dynamics", "export", "plot") and \
+    if cmd == "sweep":
+        argv += ["--workers", "1", "--out", str(tmp / rng.choice(["w.csv", "w.csv", "w.nc", "w.txt"]))]
+        if rng.random() < 0.3:
+            argv += ["--analysis", rng.choice(["statics", "inverse_dynamics", "dynamics"])]
+    if cmd in ("kinematics", "inverse-dynamics", "dynamics", "export", "plot", "sweep") and \
             rng.random() < 0.5:
-        argv += ["--measure", rng.choice(MEASURES)]
+        for _ in range(rng.randint(1, 2)):
+            argv += ["--measure", rng.choice(MEASURES)]
     if cmd == "plot" and rng.random() < 0.5:
         argv += ["--what", "measures"]
-    if cmd == "export" and rng.random() < 0.4:
+    if cmd == "sweep" and rng.random() < 0.7:          # mostly a sweep that runs
+        argv += ["--param", rng.choice(RANGES)]
+    elif cmd == "sweep" or (cmd == "export" and rng.random() < 0.4):
         argv += ["--param", f"{rng.choice(NAMES)}={rng.choice(NUMBERS)}"]
         if rng.random() < 0.5:
             argv.append("--grid")
