@@ -19,10 +19,12 @@ module mbd_batch
   use mbd_kinds, only: wp, zero
   use mbd_status, only: MBD_OK, MBD_BAD_INPUT, MBD_BAD_SETTING, MSG_LEN
   use mbd_memory, only: REAL_BYTES, mem_fail
-  use mbd_api, only: NINFO, api_kinematics, api_inverse, api_statics, api_dynamics, api_eval
+  use mbd_api, only: NINFO, api_kinematics, api_inverse, api_statics, api_dynamics, api_eval, &
+                     api_dynamics_sens
   use mbd_kinematics, only: MAXPASS
   use mbd_contact, only: NEO
   use mbd_measures, only: api_measures
+  use mbd_integrators, only: METH_DOPRI5
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   implicit none
   private
@@ -50,10 +52,13 @@ contains
   !! gets them at the rows up to the first that is not finite, and mbad (3, ncase) the
   !! status, measure and quantity of a case whose measures failed (its message too, when
   !! its analysis succeeded).
+  !! Design sensitivities (ptab (2, np) as mbd_sensitivity takes it, with sq, sqd, sqdd
+  !! (nq, np, rows, ncase) and slam (neq or 0, np, rows, ncase); not with positions-only
+  !! kinematics; dynamics by dopri5): each case's, as a single run of its tables gives them.
   subroutine batch_run(analysis, nb, ctab, rpar, bmass, grav, ftab, fpar, q0, v0, vtab, vals, &
                        opens, iset, rset, qout, qdout, qddout, lamout, eout, iinfo, rinfo, &
                        qsing, dep, redundant, status, msg, times, mkind, mint, mpts, mref, &
-                       mout, mbad)
+                       mout, mbad, ptab, sq, sqd, sqdd, slam)
     integer, intent(in) :: analysis             !! BATCH_KINEMATICS ... BATCH_DYNAMICS
     integer, intent(in) :: nb                   !! moving bodies
     integer, intent(in) :: ctab(:, :), ftab(:, :)  !! constraint and force tables
@@ -78,11 +83,16 @@ contains
     real(wp), intent(in), optional :: mpts(:, :, :)  !! an angle's points
     real(wp), intent(out), optional :: mout(:, :, :)  !! (nm, rows, ncase)
     integer, intent(out), optional :: mbad(:, :)  !! (3, ncase)
+    integer, intent(in), optional :: ptab(:, :)   !! (2, np) design parameters
+    !> (nq, np, rows, ncase) dq/dp, dq_dot/dp, dq_ddot/dp; (neq or 0, np, rows, ncase)
+    !! dlambda/dp (inverse dynamics, statics)
+    real(wp), intent(out), optional, contiguous :: sq(:, :, :, :), sqd(:, :, :, :), &
+                                                   sqdd(:, :, :, :), slam(:, :, :, :)
     real(wp), allocatable :: r(:), bm(:, :), fp(:), phi(:), jac(:, :), nu(:), gam(:), zq(:)
     real(wp), allocatable :: eo(:, :, :)      ! element outputs of a dynamics case (not kept)
     real(wp) :: g(2), tpass(MAXPASS), resid, evo(4, 1)
     integer :: c, k, nq, neq, ncase, st, bad, stable, ierr, nev, nr, mb(2)
-    logical :: meas
+    logical :: meas, sens
     character(len=MSG_LEN) :: lmsg
     qout = zero; qdout = zero; qddout = zero; lamout = zero; eout = zero
     iinfo = 0; rinfo = zero; qsing = zero; dep = 0; redundant = 0
@@ -93,6 +103,12 @@ contains
     if (meas) then
       mout = zero; mbad = 0
       meas = size(mkind) > 0
+    end if
+    sens = present(ptab) .and. present(sq) .and. present(sqd) .and. present(sqdd) .and. &
+           present(slam)
+    if (sens) then
+      sq = zero; sqd = zero; sqdd = zero; slam = zero
+      sens = size(ptab, 2) > 0
     end if
     call check(st, lmsg)
     if (st /= MBD_OK) then
@@ -126,6 +142,31 @@ contains
         call api_eval(nb, ctab, r, q0, zq, zero, phi, jac, nu, gam, st, lmsg, bad)
         r(opens(1, :)) = phi(opens(2, :))
       end if
+      if (sens) then
+        call run_sens(c)
+      else
+        call run_plain(c)
+      end if
+      if (meas .and. iinfo(1, c) > 0) then   ! the rows up to the first that is not finite
+        nr = 0
+        do while (nr < min(iinfo(1, c), size(qout, 2)))
+          if (.not. all(ieee_is_finite(qout(:, nr + 1, c)))) exit
+          nr = nr + 1
+        end do
+        call api_measures(nb, ctab, r, qout(:, 1:nr, c), times(1:nr), mkind, mint, mpts, &
+                          mref, mout(:, 1:nr, c), mb, st, lmsg)
+        if (st /= MBD_OK) then
+          mbad(:, c) = [st, mb]
+          if (status(c) == MBD_OK) msg(c) = lmsg
+        end if
+      end if
+    end do
+
+  contains
+
+    !> Case c's analysis, as a single run of its tables.
+    subroutine run_plain(c)
+      integer, intent(in) :: c
       select case (analysis)
       case (BATCH_KINEMATICS)
         call api_kinematics(nb, ctab, r, q0, rset(1), rset(2), iset(1), rset(3), iset(2), &
@@ -148,22 +189,38 @@ contains
                           lamout(:, :, c), eout(:, :, c), iinfo(:, c), rinfo(:, c), &
                           redundant(:, c), status(c), msg(c), iset(6), eo, evo, nev)
       end select
-      if (meas .and. iinfo(1, c) > 0) then   ! the rows up to the first that is not finite
-        nr = 0
-        do while (nr < min(iinfo(1, c), size(qout, 2)))
-          if (.not. all(ieee_is_finite(qout(:, nr + 1, c)))) exit
-          nr = nr + 1
-        end do
-        call api_measures(nb, ctab, r, qout(:, 1:nr, c), times(1:nr), mkind, mint, mpts, &
-                          mref, mout(:, 1:nr, c), mb, st, lmsg)
-        if (st /= MBD_OK) then
-          mbad(:, c) = [st, mb]
-          if (status(c) == MBD_OK) msg(c) = lmsg
-        end if
-      end if
-    end do
+    end subroutine run_plain
 
-  contains
+    !> Case c's analysis with the sensitivities, as a single run of its tables with them.
+    subroutine run_sens(c)
+      integer, intent(in) :: c
+      select case (analysis)
+      case (BATCH_KINEMATICS)
+        call api_kinematics(nb, ctab, r, q0, rset(1), rset(2), iset(1), rset(3), iset(2), &
+                            rset(4), iset(3), iset(4), qout(:, :, c), qdout(:, :, c), &
+                            qddout(:, :, c), iinfo(:, c), rinfo(:, c), qsing(:, c), dep(:, c), &
+                            redundant(:, c), tpass, status(c), msg(c), ptab, sq(:, :, :, c), &
+                            sqd(:, :, :, c), sqdd(:, :, :, c))
+      case (BATCH_INVERSE)
+        call api_inverse(nb, ctab, r, bm, g, ftab, fp, q0, rset(1), rset(2), iset(1), rset(3), &
+                         iset(3), iset(4), qout(:, :, c), qdout(:, :, c), qddout(:, :, c), &
+                         lamout(:, :, c), eout(:, :, c), iinfo(:, c), rinfo(:, c), qsing(:, c), &
+                         dep(:, c), redundant(:, c), tpass, status(c), msg(c), ptab, &
+                         sq(:, :, :, c), sqd(:, :, :, c), sqdd(:, :, :, c), slam(:, :, :, c))
+      case (BATCH_STATICS)
+        call api_statics(nb, ctab, r, bm, g, ftab, fp, q0, rset(11), qout(:, 1, c), &
+                         lamout(:, 1, c), stable, resid, iinfo(:, c), status(c), msg(c), &
+                         ptab, sq(:, :, 1, c), slam(:, :, 1, c))
+        rinfo(1, c) = resid; rinfo(2, c) = real(stable, wp)
+      case default                     ! dopri5 with the variational equations
+        call api_dynamics_sens(nb, ctab, r, bm, g, ftab, fp, q0, v0, rset(1), rset(2), &
+                               iset(1), rset(5), rset(6), iset(3), iset(6), ptab, &
+                               qout(:, :, c), qdout(:, :, c), qddout(:, :, c), &
+                               lamout(:, :, c), eout(:, :, c), sq(:, :, :, c), &
+                               sqd(:, :, :, c), sqdd(:, :, :, c), iinfo(:, c), rinfo(:, c), &
+                               redundant(:, c), status(c), msg(c))
+      end select
+    end subroutine run_sens
 
     !> The tables and output shapes agree with each other (a wrong call is refused whole).
     subroutine check(st, text)
@@ -211,6 +268,16 @@ contains
       end if
       if (analysis == BATCH_STATICS .and. nrow /= 1) then
         text = 'batch: statics has one output row'; return
+      end if
+      if (sens) then
+        if (any(shape(sq) /= [nq, size(ptab, 2), nrow, ncase]) .or. size(ptab, 1) /= 2 .or. &
+            any(shape(sqd) /= shape(sq)) .or. any(shape(sqdd) /= shape(sq)) .or. positions &
+            .or. size(slam, 1) /= merge(0, neq, analysis == BATCH_KINEMATICS .or. &
+                                               analysis == BATCH_DYNAMICS) .or. &
+            size(slam, 2) /= size(ptab, 2) .or. size(slam, 3) /= nrow .or. &
+            size(slam, 4) /= ncase .or. (analysis == BATCH_DYNAMICS .and. iset(5) /= METH_DOPRI5)) then
+          text = 'batch: sensitivity arrays do not match'; return
+        end if
       end if
       if (meas) then
         if (analysis == BATCH_STATICS .or. size(times) /= nrow .or. &

@@ -427,44 +427,50 @@ end subroutine core_dynamics_sens
 ! to set again from q0 (index in rpar, row of Phi); settings in iset, rset (mbd_batch). nlam
 ! is neq (0 for kinematics), ne 4 (0 for kinematics); nrow the output rows per case. With
 ! nm > 0 measures (mbd_measures: mkind, mint, mpts, mref, at the output times) go to mout
-! (nm, nrow, ncase), their failures to mbad (3, ncase); the measure tables have nmp =
-! max(nm, 1) columns (f2py takes no zero-length table).
+! (nm, nrow, ncase), their failures to mbad (3, ncase); with npar > 0 design parameters
+! (ptab) their sensitivities to sq, sqd, sqdd (nq, npar, nrow, ncase) and slam (nsl = neq for
+! inverse dynamics and statics, else 0). The tables have nmp = max(nm, 1) and npp =
+! max(npar, 1) columns (f2py takes no zero-length table).
 subroutine core_batch(analysis, nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp, fpar, nq, &
                       q0, v0, nv, vtab, ncase, vals, no, opens, iset, rset, neq, nrow, nd, &
-                      nlam, ne, times, nm, nmp, mkind, mint, mpts, mref, &
+                      nlam, ne, times, nm, nmp, mkind, mint, mpts, mref, npar, npp, ptab, nsl, &
                       qout, qdout, qddout, lamout, eout, iinfo, rinfo, qsing, dep, redundant, &
-                      mout, mbad, status, msg)
+                      mout, mbad, sq, sqd, sqdd, slam, status, msg)
   use iso_c_binding, only: c_double, c_int
   use mbd_batch, only: batch_run
+  use mbd_status, only: MBD_BAD_INPUT
   implicit none
   integer(c_int), intent(in) :: analysis, nb, nc, np, nf, nfp, nq, nv, ncase, no, neq, nrow
   !> nd: rows of qdout and qddout (nrow; 0 for positions-only kinematics, iset(7) = 1)
-  integer(c_int), intent(in) :: nlam, ne, nd, nm, nmp
+  integer(c_int), intent(in) :: nlam, ne, nd, nm, nmp, npar, npp, nsl
   integer(c_int), intent(in) :: ctab(8, nc), ftab(6, nf), vtab(2, nv), opens(2, no), iset(8)
   real(c_double), intent(in) :: rpar(np), bmass(2, nb), grav(2), fpar(nfp), q0(nq), v0(nq)
   real(c_double), intent(in) :: vals(nv, ncase), rset(12), times(nrow), mpts(2, 3, nmp)
-  integer(c_int), intent(in) :: mkind(nmp), mint(5, nmp), mref(2, 3, nmp)
+  integer(c_int), intent(in) :: mkind(nmp), mint(5, nmp), mref(2, 3, nmp), ptab(2, npp)
   real(c_double), intent(out) :: qout(nq, nrow, ncase), qdout(nq, nd, ncase)
   real(c_double), intent(out) :: qddout(nq, nd, ncase), lamout(nlam, nrow, ncase)
   real(c_double), intent(out) :: eout(ne, nrow, ncase), mout(nm, nrow, ncase)
+  real(c_double), intent(out) :: sq(nq, npar, nrow, ncase), sqd(nq, npar, nrow, ncase)
+  real(c_double), intent(out) :: sqdd(nq, npar, nrow, ncase), slam(nsl, npar, nrow, ncase)
   integer(c_int), intent(out) :: iinfo(10, ncase), dep(neq, ncase), redundant(neq, ncase)
   integer(c_int), intent(out) :: mbad(3, ncase)
   real(c_double), intent(out) :: rinfo(10, ncase), qsing(nq, ncase)
   integer(c_int), intent(out) :: status(ncase)
   character(len=512), intent(out) :: msg(ncase)
-  !f2py intent(hide) :: nc, np, nf, nfp, nq, nv, ncase, no, nmp
+  !f2py intent(hide) :: nc, np, nf, nfp, nq, nv, ncase, no, nmp, npp
   !f2py threadsafe
-  if (nm > 0 .and. nm <= nmp) then
-    call batch_run(analysis, nb, ctab, rpar, bmass, grav, ftab, fpar, q0, v0, vtab, vals, &
-                   opens, iset, rset, qout, qdout, qddout, lamout, eout, iinfo, rinfo, qsing, &
-                   dep, redundant, status, msg, times, mkind(1:nm), mint(:, 1:nm), &
-                   mpts(:, :, 1:nm), mref(:, :, 1:nm), mout, mbad)
-  else
-    mbad = 0
-    call batch_run(analysis, nb, ctab, rpar, bmass, grav, ftab, fpar, q0, v0, vtab, vals, &
-                   opens, iset, rset, qout, qdout, qddout, lamout, eout, iinfo, rinfo, qsing, &
-                   dep, redundant, status, msg)
+  if (nm > nmp .or. npar > npp) then
+    qout = 0; qdout = 0; qddout = 0; lamout = 0; eout = 0; mout = 0; sq = 0; sqd = 0
+    sqdd = 0; slam = 0; iinfo = 0; dep = 0; redundant = 0; mbad = 0; rinfo = 0; qsing = 0
+    status = MBD_BAD_INPUT; msg = 'batch: more measures or parameters than their tables hold'
+    return
   end if
+  ! (an empty list of measures or parameters: the batch runs without them)
+  call batch_run(analysis, nb, ctab, rpar, bmass, grav, ftab, fpar, q0, v0, vtab, vals, &
+                 opens, iset, rset, qout, qdout, qddout, lamout, eout, iinfo, rinfo, qsing, &
+                 dep, redundant, status, msg, times, mkind(1:nm), mint(:, 1:nm), &
+                 mpts(:, :, 1:nm), mref(:, :, 1:nm), mout, mbad, ptab(:, 1:npar), sq, sqd, &
+                 sqdd, slam)
 end subroutine core_batch
 ! Normal force of each cam joint on its follower at states q (nq, nt), times t and
 ! multipliers lam: fn(nc, nt), negative where the joint must pull the follower onto its profile.

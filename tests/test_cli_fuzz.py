@@ -59,7 +59,7 @@ def _command(rng: random.Random, tmp: Path) -> list[str]:
             argv += ["--export-samples", str(tmp / "mc.mbd")]
         if rng.random() < 0.3:
             argv += ["--analysis", rng.choice(["statics", "inverse_dynamics", "dynamics"])]
-    if cmd in ("kinematics", "inverse-dynamics", "dynamics", "statics", "export") and \
+    if cmd in ("kinematics", "inverse-dynamics", "dynamics", "statics", "export", "sweep") and \
             rng.random() < 0.5:
         argv += ["--sensitivities", rng.choice(NAMES)]
     if cmd == "sweep":

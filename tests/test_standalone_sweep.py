@@ -172,8 +172,8 @@ def _sweep_lines(tmp_path: Path) -> list[str]:
     (("opens 0", "opens 1\n0 3"), "from 1"),
     (("opens 0", "opens 0\ncases 1 0 1\nx\n1"), '"cases" is given twice'),
     (("opens 0", "opens 0\noutputs energy"), "outputs"),
-    (("opens 0", "opens 0\nsensitivities 1\njoint.B.points.0.0 1 9"),
-     "sweeps compute no sensitivities"),
+    (("opens 0", "opens 0\nsensitivities 1\njoint.B.points.0.0 1 99"),
+     'sensitivity "joint.B.points.0.0"'),
 ])
 def test_bad_cases_blocks_name_their_line(tmp_path: Path, edit: tuple[str, str],
                                           needle: str) -> None:

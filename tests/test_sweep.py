@@ -267,7 +267,7 @@ def test_bad_case_tables(cases: Any, match: str) -> None:
     ("kinematic", {"t_end": 1.0, "steps": 4}, "unknown analysis"),
     ("kinematics", {"t_end": 1.0}, "steps"),
     ("kinematics", {"t_end": 1.0, "steps": 4, "rtol": 1e-6}, "the settings are"),
-    ("kinematics", {"t_end": 1.0, "steps": 4, "sensitivities": ["x"]}, "no sensitivities"),
+    ("kinematics", {"t_end": 1.0, "steps": 4, "sensitivities": ["x"]}, "unknown parameter"),
     ("kinematics", {"t_end": -1.0, "steps": 4}, "greater than t0"),
     ("kinematics", {"t_end": 1.0, "steps": 4, "solver": "lu"}, "unknown solver"),
     ("dynamics", {"t_end": 1.0, "steps": 4}, "mass"),

@@ -57,6 +57,9 @@ program mbd2d_solve
   ! a sweep (run_sweep): the batch call's outputs per case and each case's outcome
   real(wp), allocatable :: bq(:, :, :), bqd(:, :, :), bqdd(:, :, :), blam(:, :, :), &
                            be(:, :, :), brinfo(:, :), bqsing(:, :), bmv(:, :, :)
+  !> a sweep's sensitivities (nq, npar, rows, cases) and the multipliers' (nsl, ...)
+  real(wp), allocatable :: bsq(:, :, :, :), bsqd(:, :, :, :), bsqdd(:, :, :, :), &
+                           bslam(:, :, :, :)
   integer, allocatable :: biinfo(:, :), bdep(:, :), bred(:, :), bstat(:), nkeep(:), cstat(:)
   integer, allocatable :: bmbad(:, :)                 !! a case's failed measure (mbd_batch)
   character(len=MSG_LEN), allocatable :: bmsg(:)
@@ -735,7 +738,7 @@ contains
           form='unformatted', iostat=ios)
     if (ios /= 0) call die(2, 'cannot write ' // trim(out_path))
     call sput(u, ios, 't')
-    call coordinate_header(u, ios, '')
+    call coordinate_header(u, ios, '', 0)
     call sput(u, ios, ',coordinates,equations,rank,dof,mobility')
     do r = 1, neq
       call sput(u, ios, ',redundant.' // trim(row_label(r)))
@@ -773,12 +776,10 @@ contains
   !> A sweep: every case of the "cases" block in one batch call (as mbd2d.sweep makes it),
   !! written as mbd2d.write_sweep writes a sweep's CSV.
   subroutine run_sweep()
-    integer :: iset(NISET), c, nfail, ne, nchunk, ic, c0, c1
+    integer :: iset(NISET), c, nfail, ne, nchunk, ic, c0, c1, nsl
     real(wp) :: rset(NRSET), bytes
     real(wp), allocatable :: bm(:, :), bv0(:), bfp(:)
     integer, allocatable :: bft(:, :)
-    if (sens) call die(2, trim(model_path) // ':' // trim(itoa(spec%cases_line)) // &
-      ': sweeps compute no sensitivities: run the cases one by one, or mbd2d.tolerance')
     if (spec%out_energy .or. spec%out_lam .or. spec%out_reac .or. spec%out_eff) &
       call die(2, trim(model_path) // ': a sweep writes its own columns (q, q_dot, q_ddot, '// &
                'efforts, measures): give no "outputs" line with "cases"')
@@ -807,8 +808,9 @@ contains
     if (code /= 3) nrow = kin_out_count(spec%steps, spec%every)
     nd = merge(0, nrow, code == 1 .and. spec%positions_only)
     nlam = merge(0, neq, code == 1); ne = merge(0, 4, code == 1)
+    nsl = merge(neq, 0, lam_sens)
     bytes = REAL_BYTES * real(spec%ncase, wp) * (real(nrow, wp) * (nq + nlam + ne + &
-            spec%nmeas) + &
+            spec%nmeas + real(spec%npar, wp) * (3 * nq + nsl)) + &
             2.0_wp * nq * nd + 2 * NINFO + nq) + 4.0_wp * spec%ncase * (2 * neq + NINFO + 3)
     call mem_check(bytes, 'the outputs of ' // trim(itoa(spec%ncase)) // ' cases', &
                    'give fewer cases or steps', status, msg)
@@ -820,7 +822,9 @@ contains
               bdep(neq, spec%ncase), bred(neq, spec%ncase), bstat(spec%ncase), &
               bmsg(spec%ncase), nkeep(spec%ncase), cstat(spec%ncase), cmsg(spec%ncase), &
               tout(nrow), q0(nq), bmv(spec%nmeas, nrow, spec%ncase), &
-              bmbad(3, spec%ncase), stat=ierr)
+              bmbad(3, spec%ncase), bsq(nq, spec%npar, nrow, spec%ncase), &
+              bsqd(nq, spec%npar, nrow, spec%ncase), bsqdd(nq, spec%npar, nrow, spec%ncase), &
+              bslam(nsl, spec%npar, nrow, spec%ncase), stat=ierr)
     ! the dynamic tables (a kinematic sweep takes none: zeros, as the Python sweep passes)
     if (ierr == 0) allocate (bm(2, spec%nb), bv0(nq), bft(NFT, merge(0, spec%nf, code == 1)), &
                              bfp(max(1, size(spec%fpar))), stat=ierr)
@@ -847,9 +851,15 @@ contains
                      blam(:, :, c0:c1), be(:, :, c0:c1), biinfo(:, c0:c1), brinfo(:, c0:c1), &
                      bqsing(:, c0:c1), bdep(:, c0:c1), bred(:, c0:c1), bstat(c0:c1), &
                      bmsg(c0:c1), tout, spec%meas_kind, spec%meas_int, spec%meas_pts, &
-                     spec%meas_ref, bmv(:, :, c0:c1), bmbad(:, c0:c1))
+                     spec%meas_ref, bmv(:, :, c0:c1), bmbad(:, c0:c1), spec%ptab, &
+                     bsq(:, :, :, c0:c1), bsqd(:, :, :, c0:c1), bsqdd(:, :, :, c0:c1), &
+                     bslam(:, :, :, c0:c1))
     end do
     !$omp end parallel do
+    do c = 1, spec%ncase             ! a design parameter the core refused: the file's fault
+      if (bstat(c) < 0 .and. biinfo(2, c) <= -2000000) &
+        call die(2, param_where(-2000000 - biinfo(2, c), bmsg(c)))
+    end do
     nfail = 0
     do c = 1, spec%ncase
       call case_outcome(c)
@@ -935,6 +945,10 @@ contains
       end if
       if (.not. (all(ieee_is_finite(blam(:, k, c))) .and. all(ieee_is_finite(be(:, k, c))))) &
         return
+      if (.not. (all(ieee_is_finite(bsq(:, :, k, c))) .and. &
+                 all(ieee_is_finite(bsqd(:, :, k, c))) .and. &
+                 all(ieee_is_finite(bsqdd(:, :, k, c))) .and. &
+                 all(ieee_is_finite(bslam(:, :, k, c))))) return
     end do
     k = n + 1
   end function first_bad
@@ -948,10 +962,12 @@ contains
     character(len=*), parameter :: crlf = achar(13) // achar(10)
     character(len=*), parameter :: lev(3) = [character(len=6) :: '', '_dot', '_ddot']
     character(len=:), allocatable :: line, head, tail
-    integer :: u, ios, j, k, l, r0, nlev, c, lp, nh, nt, width
+    integer :: u, ios, j, k, l, r0, nlev, c, lp, nh, nt, width, p, nsl
     nlev = merge(3, 1, nd > 0)
+    nsl = size(bslam, 1)
     ! at most 26 characters a number ("%.17g": -1.2345678901234567e-308) with its comma
-    width = 26 * (spec%ncp + 2 + 3 * nq + spec%nc + spec%nmeas) + 32
+    width = 26 * (spec%ncp + 2 + 3 * nq + spec%nc + spec%nmeas + &
+                  spec%npar * (3 * nq + spec%nc)) + 32
     allocate (character(len=width) :: head, line, stat=ierr)
     if (ierr == 0) allocate (character(len=2 * len(cmsg) + 40) :: tail, stat=ierr)
     if (ierr /= 0) call die(2, 'not enough memory to write ' // path)
@@ -964,7 +980,7 @@ contains
     end do
     call sput(u, ios, ',t,status,message')
     do l = 1, nlev
-      call coordinate_header(u, ios, trim(lev(l)))
+      call coordinate_header(u, ios, trim(lev(l)), 0)
     end do
     if (nlam > 0) then
       do j = 1, spec%nc
@@ -974,6 +990,17 @@ contains
     end if
     do j = 1, spec%nmeas
       call sput(u, ios, ',' // quoted(trim(spec%meas_names(j))))
+    end do
+    do p = 1, spec%npar                ! d(COLUMN)/d(P): the motion, then the efforts
+      do l = 1, nlev
+        call coordinate_header(u, ios, trim(lev(l)), p)
+      end do
+      if (nsl > 0) then
+        do j = 1, spec%nc
+          if (con_is_driver(spec%ctab(1, j))) call sput(u, ios, ',d(effort.' // &
+            trim(spec%con_names(j)) // ')/d(' // trim(spec%par_names(p)) // ')')
+        end do
+      end if
     end do
     call sput(u, ios, crlf)
     do c = 1, spec%ncase
@@ -1014,6 +1041,9 @@ contains
         do j = 1, spec%nmeas
           call bnum(line, lp, bmv(j, k, c))
         end do
+        do p = 1, spec%npar
+          call sens_fields(line, lp, k, c, p, nlev, nsl)
+        end do
         call bput(line, lp, crlf)
         call sput(u, ios, line(1:lp))
       end do
@@ -1022,25 +1052,64 @@ contains
     if (ios /= 0) call die(2, 'cannot write ' // path // ' (disk full?)')
   end subroutine write_sweep_csv
 
+  !> Row k of case c's derivatives along parameter p: the motion's, then the efforts'
+  !! (-dlambda/dp of the driver rows).
+  subroutine sens_fields(buf, n, k, c, p, nlev, nsl)
+    character(len=*), intent(inout) :: buf
+    integer, intent(inout) :: n
+    integer, intent(in) :: k, c, p, nlev, nsl
+    integer :: j, r
+    do j = 1, nq
+      call bnum(buf, n, bsq(j, p, k, c))
+    end do
+    if (nlev > 1) then
+      do j = 1, nq
+        call bnum(buf, n, bsqd(j, p, k, c))
+      end do
+      do j = 1, nq
+        call bnum(buf, n, bsqdd(j, p, k, c))
+      end do
+    end if
+    if (nsl == 0) return
+    r = 1
+    do j = 1, spec%nc
+      if (con_is_driver(spec%ctab(1, j))) call bnum(buf, n, -bslam(r, p, k, c))
+      r = r + con_nrow(spec%ctab(1, j))
+    end do
+  end subroutine sens_fields
+
   !> The coordinates' names NAME.x, NAME.y, NAME.theta per body, then NAME.alpha per extra
   !! coordinate of a cam or curve joint, each with the suffix sfx.
-  subroutine coordinate_header(u, ios, sfx)
+  subroutine coordinate_header(u, ios, sfx, p)
     integer, intent(in) :: u
     integer, intent(inout) :: ios
     character(len=*), intent(in) :: sfx
+    integer, intent(in) :: p           !! 0, or d(NAME)/d(P) of design parameter p
     character(len=*), parameter :: w(3) = [character(len=6) :: '.x', '.y', '.theta']
     integer :: b, i, j
     do b = 1, spec%nb
       do i = 1, 3
-        call sput(u, ios, ',' // trim(spec%body_names(b)) // trim(w(i)) // sfx)
+        call sweep_col(u, ios, trim(spec%body_names(b)) // trim(w(i)) // sfx, p)
       end do
     end do
     do j = 1, spec%nc
       do i = 1, con_nextra(spec%ctab(1, j))
-        call sput(u, ios, ',' // trim(spec%con_names(j)) // '.alpha' // sfx)
+        call sweep_col(u, ios, trim(spec%con_names(j)) // '.alpha' // sfx, p)
       end do
     end do
   end subroutine coordinate_header
+
+  !> A sweep column's name: ",NAME" (p = 0), or ",d(NAME)/d(P)" of design parameter p.
+  subroutine sweep_col(u, ios, name, p)
+    integer, intent(in) :: u, p
+    integer, intent(inout) :: ios
+    character(len=*), intent(in) :: name
+    if (p > 0) then
+      call sput(u, ios, ',d(' // name // ')/d(' // trim(spec%par_names(p)) // ')')
+    else
+      call sput(u, ios, ',' // name)
+    end if
+  end subroutine sweep_col
 
   subroutine die(code, text)
     integer, intent(in) :: code

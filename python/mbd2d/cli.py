@@ -32,7 +32,7 @@ column per measure: ``transmission_angle:JOINT[:OUTPUT]``,
 ``dead_centre_distance`` (a sweep: each case's, from its own dimensions).
 
 ``--sensitivities NAME,...`` (kinematics, inverse-dynamics, statics, dynamics by dopri5,
-export) computes the design sensitivities with respect to the named parameters (``mbd2d
+sweep, export) computes the design sensitivities with respect to the named parameters (``mbd2d
 parameters MODEL`` lists them) and adds the columns ``d(COLUMN)/d(NAME)`` to the CSV
 (``dq_dp``, ``dqd_dp``, ``dqdd_dp`` arrays to an .npz).
 
@@ -46,6 +46,7 @@ Exit codes: 0 ok, 2 bad input, 3 singular configuration (partial output written)
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import textwrap
 from typing import Any, Sequence
@@ -217,6 +218,7 @@ def _parser() -> argparse.ArgumentParser:
     w.add_argument("--scheduler", default=None, metavar="ADDRESS",
                    help="run on the Dask cluster of this scheduler (tcp://host:8786)")
     _measures(w)
+    _sensitivities(w)
     r = sub.add_parser("parameters", help="the design parameters of a model: name = value")
     r.add_argument("model", help="model file (.toml)")
     r.add_argument("--match", default=None, metavar="TEXT",
@@ -586,10 +588,10 @@ def _cases(args: argparse.Namespace) -> dict[str, np.ndarray]:
 def _export_sweep(model: Model, args: argparse.Namespace) -> int:
     """export --param: a sweep file for mbd2d-solve (the settings of the analysis alone)."""
     from .studies import export_sweep
-    if _outputs(args) or _sens_names(args):
-        raise ModelError("a sweep file writes the sweep's columns (and --measure): no "
-                         "--energy, --multipliers, --reactions, --efforts or --sensitivities "
-                         "with --param", "command line")
+    if _outputs(args):
+        raise ModelError("a sweep file writes the sweep's columns (and --measure, "
+                         "--sensitivities): no --energy, --multipliers, --reactions or "
+                         "--efforts with --param", "command line")
     if args.analysis == "check":
         raise ModelError("a sweep runs kinematics, inverse-dynamics, dynamics or statics, not "
                          "check", "command line")
@@ -604,7 +606,7 @@ def _export_sweep(model: Model, args: argparse.Namespace) -> int:
         raise ModelError(f"{args.analysis} needs --t-end and --steps", "command line")
     cases = _cases(args)
     export_sweep(model, args.out, cases, args.analysis.replace("-", "_"),
-                 measures=args.measure, **kw)
+                 measures=args.measure, sensitivities=_sens_names(args), **kw)
     n = len(next(iter(cases.values())))
     print(f"wrote {args.out} ({args.analysis} of {n} cases; run it with mbd2d-solve "
           f"{args.out} OUT.csv)")
@@ -626,7 +628,7 @@ def _sweep(model: Model, args: argparse.Namespace) -> int:
     client = connect(args.scheduler) if args.scheduler else None
     try:
         ds = sweep(model, cases, args.analysis, client, workers=args.workers,
-                   measures=args.measure, **kw)
+                   measures=args.measure, sensitivities=_sens_names(args), **kw)
     finally:
         if client is not None:
             client.close()
@@ -732,6 +734,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     except ImportError as exc:                  # an optional package (the sweep extra)
         _say(f"mbd2d: {exc}")
         return EXIT_INPUT
+    except BrokenPipeError:                     # the reader left (mbd2d ... | head): stop
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())   # (Python's own flush at exit would fail)
+        return EXIT_OK
 
 
 if __name__ == "__main__":  # pragma: no cover

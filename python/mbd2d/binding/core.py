@@ -287,19 +287,24 @@ def batch(b: BatchTables, vals: np.ndarray) -> dict[str, Any]:
     ncase), ``e`` (ne, nrow, ncase),
     ``iinfo``, ``rinfo`` (10, ncase), ``qsing`` (nq, ncase), ``dep``, ``red`` (neq, ncase),
     the measures ``m`` (nm, nrow, ncase) with ``mbad`` (3, ncase: status, measure, quantity of
-    a case whose measures failed), ``status`` (ncase) and ``msg`` (ncase, text). A module-level function of plain arrays, so
+    a case whose measures failed), the sensitivities ``sq``, ``sqd``, ``sqdd`` (nq, npar, nrow,
+    ncase) and ``slam`` (nsl, npar, nrow, ncase), ``status`` (ncase) and ``msg`` (ncase,
+    text). A module-level function of plain arrays, so
     that worker processes and Dask workers can run it."""
     vals = np.asfortranarray(vals, dtype=np.float64)
     ncase = vals.shape[1]
     m = b.measures if len(b.measures.specs) else _ONE_MEASURE    # (f2py: no zero-length table)
     times = b.times if len(b.measures.specs) else np.zeros(b.nrow)
-    out = _named("q qd qdd lam e iinfo rinfo qsing dep red m mbad status msg", _core.core_batch,
+    ptab = b.ptab if b.npar else np.ones((2, 1), dtype=np.int32, order="F")
+    out = _named("q qd qdd lam e iinfo rinfo qsing dep red m mbad sq sqd sqdd slam status msg",
+                 _core.core_batch,
                  analysis=b.analysis, nb=b.nb, ctab=b.ctab, rpar=b.rpar, bmass=b.bmass,
                  grav=b.grav, ftab=b.ftab, fpar=b.fpar, q0=b.q0, v0=b.v0, vtab=b.vtab,
                  vals=vals, opens=b.opens, iset=b.iset, rset=b.rset, neq=b.neq, nrow=b.nrow,
                  nd=b.nd, nlam=b.nlam, ne=b.ne, times=times, nm=len(b.measures.specs),
                  mkind=m.kind, mint=m.mint,
-                 mpts=m.mpts, mref=m.mref,
-                 numbers=ncase * ((b.nq + b.nlam + b.ne + len(b.measures.specs)) * b.nrow
+                 mpts=m.mpts, mref=m.mref, npar=b.npar, ptab=ptab, nsl=b.nsl,
+                 numbers=ncase * ((b.nq + b.nlam + b.ne + len(b.measures.specs)
+                                   + b.npar * (3 * b.nq + b.nsl)) * b.nrow
                                   + 2 * b.nq * b.nd + 2 * b.neq + b.nq + 23))
     return vars(out)

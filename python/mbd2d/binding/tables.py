@@ -100,6 +100,9 @@ class BatchTables:
     ne: int                     # 4 for the analyses with energies, else 0
     times: np.ndarray = field(default_factory=lambda: np.zeros(0))   # (nrow,) output times
     measures: MeasureTables = field(default_factory=MeasureTables.empty)
+    #: design parameters of the sensitivities (int32 (2, npar)) and their names
+    ptab: np.ndarray = field(default_factory=lambda: np.zeros((2, 0), dtype=np.int32))
+    sensitivities: list[str] = field(default_factory=list)
 
     @property
     def nq(self) -> int:
@@ -109,3 +112,13 @@ class BatchTables:
     def nd(self) -> int:
         """Rows of the velocities and accelerations: 0 for positions-only kinematics."""
         return 0 if self.analysis == 1 and int(self.iset[6]) == 1 else self.nrow
+
+    @property
+    def npar(self) -> int:
+        """Design parameters of the sensitivities."""
+        return self.ptab.shape[1]
+
+    @property
+    def nsl(self) -> int:
+        """Rows of the multipliers' sensitivities: inverse dynamics and statics have them."""
+        return self.neq if self.npar and self.analysis in (2, 3) else 0

@@ -11,10 +11,12 @@ from ..analysis.dynamics import dynamics_error
 from ..analysis.inverse import inverse_error
 from ..analysis.kinematics import kinematics_error
 from ..analysis.outputs import dynamics_result, finite_part
+from ..analysis.sensitivities import attach, check_status
 from ..analysis.statics import STABILITY, statics_error
 from ..binding.pack import pack
 from ..binding.status import INCONSISTENT, OK
 from ..description.builder import ModelDescription
+from ..description.parameters import find
 from ..errors import MbdError
 from ..results.kinematics import KinematicsResult
 from ..results.measures import measure_failure
@@ -56,7 +58,23 @@ def _finite_rows(pl: Plan, out: Outputs) -> np.ndarray:
     for k in ("q", "qd", "qdd", "lam", "e"):
         if a[k].shape[0] and a[k].shape[1]:       # (none: no multipliers, positions only)
             fin &= np.isfinite(a[k]).all(axis=0)
+    for k in ("sq", "sqd", "sqdd", "slam"):      # (nq or nsl, npar, nrow, ncase)
+        if a[k].shape[0] and a[k].shape[1]:
+            fin &= np.isfinite(a[k]).all(axis=(0, 1))
     return fin
+
+
+def _with_sensitivities(pl: Plan, model: ModelDescription, res: Any, c: SimpleNamespace,
+                        n: int) -> Any:
+    """The case's result with its sensitivities (the first n rows), as a run with them."""
+    if not pl.tables.npar:
+        return res
+    names = pl.tables.sensitivities
+    arrays = {k: getattr(c, k) for k in ("sq", "sqd", "sqdd")}
+    if pl.tables.nsl:
+        arrays["slam"] = c.slam
+    attach(res, SimpleNamespace(**arrays), find(model, names, "sweep"), n, pl.tables.ptab)
+    return res
 
 
 def outcomes(pl: Plan, model: ModelDescription, out: Outputs, names: Sequence[str],
@@ -109,6 +127,8 @@ def _failure(pl: Plan, model: ModelDescription, c: SimpleNamespace, n: int,
         return pack(model.with_params(dict(zip(names, values.tolist()))))
 
     try:
+        if pl.tables.npar:            # a design parameter the core refused
+            check_status(c.status, c.iinfo, c.msg, find(model, pl.tables.sensitivities))
         if pl.analysis == "statics":
             return statics_error(model, own() if c.status == INCONSISTENT else p, c, pl.t0)
         if pl.analysis == "kinematics":
@@ -119,10 +139,10 @@ def _failure(pl: Plan, model: ModelDescription, c: SimpleNamespace, n: int,
                                         body_names=p.body_names,
                                         coordinate_names=p.coordinate_names, complete=False,
                                         model=model)
-            res, bad = finite_part(res)
+            res, bad = finite_part(_with_sensitivities(pl, model, res, c, n))
             return kinematics_error(model, p, c, res, t, bad)
         res = dynamics_result(model, p, t, n, c, {}, False)
-        res, bad = finite_part(res)
+        res, bad = finite_part(_with_sensitivities(pl, model, res, c, n))
         if pl.analysis == "inverse":
             return inverse_error(model, p, c, res, t, bad)
         if c.status == INCONSISTENT and not len(res.t):
@@ -130,6 +150,30 @@ def _failure(pl: Plan, model: ModelDescription, c: SimpleNamespace, n: int,
         return dynamics_error(model, p, c, res, t, bad, pl.method, pl.t0)
     except MbdError as exc:       # the variant's own tables are bad
         return exc
+
+
+def _sensitivity_data(pl: Plan, a: dict[str, np.ndarray], keep: np.ndarray
+                      ) -> dict[str, Any]:
+    """The sensitivities as Dataset variables (case, time, entry, parameter), NaN after each
+    case's kept rows; with multipliers the efforts' too (-dlambda/dp of the driver rows)."""
+    def per_case(x: np.ndarray) -> np.ndarray:        # (k, npar, nrow, ncase) -> (ncase, ...)
+        v = np.ascontiguousarray(np.transpose(x, (3, 2, 0, 1)))
+        v[~keep] = np.nan
+        return v
+
+    cube = ("case", "time", "coordinate", "parameter")
+    data: dict[str, Any] = {"dq_dp": (cube, per_case(a["sq"])),
+                            "dqd_dp": (cube, per_case(a["sqd"])),
+                            "dqdd_dp": (cube, per_case(a["sqdd"]))}
+    if pl.tables.nsl:
+        p = pl.packed
+        dlam = per_case(a["slam"])
+        data["dlam_dp"] = (("case", "time", "equation", "parameter"), dlam)
+        drivers = [k for k, f in enumerate(p.driver_flags) if f]
+        if drivers:
+            data["deffort_dp"] = (("case", "time", "driver", "parameter"),
+                                  -dlam[:, :, [p.row_owner.index(k) for k in drivers]])
+    return data
 
 
 def to_dataset(pl: Plan, analysis: str, model: ModelDescription, out: Outputs,
@@ -152,6 +196,9 @@ def to_dataset(pl: Plan, analysis: str, model: ModelDescription, out: Outputs,
         data.update(qd=(cube, per_case(a["qd"])), qdd=(cube, per_case(a["qdd"])))
     coords: dict[str, Any] = {"case": np.arange(len(status)), "time": pl.times,
                               "coordinate": list(p.coordinate_names)}
+    if b.npar:
+        data.update(_sensitivity_data(pl, a, keep))
+        coords["parameter"] = list(b.sensitivities)
     if b.measures.specs:
         m = per_case(a["m"])
         m[a["mbad"][0] != OK] = np.nan

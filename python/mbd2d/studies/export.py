@@ -10,7 +10,7 @@ from typing import Any
 
 from ..analysis.mbdfile import file_lines
 from ..results.files import write_text
-from .plan import case_values, plan, with_cases, with_measures
+from .plan import case_values, plan, with_cases, with_measures, with_sensitivities
 
 #: the file's analysis for the sweep's plan (kinematics of a model with masses runs as
 #: inverse dynamics, as in the sweep)
@@ -19,7 +19,8 @@ FILE_ANALYSIS = {"kinematics": "kinematics", "inverse": "inverse-dynamics",
 
 
 def export_sweep(model: Any, path: str | Path, cases: Any, analysis: str = "kinematics",
-                 measures: Any = None, **analysis_kwargs: Any) -> None:
+                 measures: Any = None, sensitivities: Any = None,
+                 **analysis_kwargs: Any) -> None:
     """Write a sweep for ``mbd2d-solve``: the cases of :func:`mbd2d.sweep` with the same
     analysis and settings, run there in one batch call without Python.
 
@@ -36,6 +37,8 @@ def export_sweep(model: Any, path: str | Path, cases: Any, analysis: str = "kine
     measures : str or list of str, optional
         As :func:`mbd2d.sweep`: columns of every case (an angle's points given with the
         params entries a case may set).
+    sensitivities : list of str, optional
+        As :func:`mbd2d.sweep`: every case's design sensitivities to these parameters.
     **analysis_kwargs
         The analysis's settings, as :func:`mbd2d.sweep` takes them.
 
@@ -55,9 +58,10 @@ def export_sweep(model: Any, path: str | Path, cases: Any, analysis: str = "kine
     names, values = case_values(cases, "export_sweep")
     pl = plan(model, names, analysis, analysis_kwargs)
     with_measures(pl, model, measures)
+    with_sensitivities(pl, model, sensitivities)
     vals = with_cases(pl, model, values)
     lines = file_lines(model, analysis=FILE_ANALYSIS[pl.analysis], measures=measures,
-                       measure_refs=True, **pl.settings)
+                       measure_refs=True, sensitivities=sensitivities, **pl.settings)
     b = pl.tables
     lines.append(f"cases {len(names)} {b.vtab.shape[1]} {values.shape[1]}")
     lines += list(names)

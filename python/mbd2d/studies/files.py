@@ -37,7 +37,9 @@ def write_sweep(ds: Any, path: str | Path) -> None:
 
     CSV columns: ``case``, the parameters, ``t``, ``status``, ``message``, then per
     coordinate NAME (q), NAME_dot (qd), NAME_ddot (qdd) (NAME alone for a positions-only
-    sweep), with multipliers the efforts ``effort.DRIVER``, then the measures by their specs.
+    sweep), with multipliers the efforts ``effort.DRIVER``, then the measures by their specs,
+    then for each design parameter P of a sweep with sensitivities ``d(COLUMN)/d(P)`` of
+    the motion columns and the efforts.
 
     Raises
     ------
@@ -85,6 +87,10 @@ def _csv(ds: Any, path: Path) -> None:
     header += [f"effort.{d}" for d in drivers]
     specs = [str(m) for m in ds["measure"].values] if "measure" in ds.coords else []
     header += specs
+    motion = header[4 + len(params):4 + len(params) + len(levels) * len(coords)]
+    sens, sens_names = _sensitivity_columns(ds)
+    derived = motion + ([f"effort.{d}" for d in drivers] if "deffort_dp" in ds else [])
+    header += [f"d({v})/d({p})" for p in sens_names for v in derived]
     q = levels[0]
     eff = ds.effort.values if drivers else None
     meas = ds["measures"].values if specs else None
@@ -105,7 +111,20 @@ def _csv(ds: Any, path: Path) -> None:
                     line += [_g(v) for v in eff[c, k]]
                 if meas is not None:
                     line += [_g(v) for v in meas[c, k]]
+                line += [_g(v) for v in sens[c, k]]
                 w.writerow(line)
+
+
+def _sensitivity_columns(ds: Any) -> tuple[np.ndarray, list[str]]:
+    """The sensitivities as (case, time, columns), parameter by parameter: for each, the
+    derivatives of the motion columns (q, qd, qdd) and, with multipliers' sensitivities, of
+    the efforts; and the parameters' names. (case, time, 0) without sensitivities."""
+    if "dq_dp" not in ds:
+        return np.zeros(ds.q.shape[:2] + (0,)), []
+    parts = [ds[k].values for k in ("dq_dp", "dqd_dp", "dqdd_dp", "deffort_dp") if k in ds]
+    block = np.concatenate(parts, axis=2)          # (case, time, columns, parameter)
+    return (np.ascontiguousarray(np.moveaxis(block, 3, 2)).reshape(
+        block.shape[0], block.shape[1], -1), [str(p) for p in ds.parameter.values])
 
 
 def _g(v: Any) -> str:

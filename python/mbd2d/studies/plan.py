@@ -20,6 +20,7 @@ from ..binding.tables import NFT, BatchTables, DynamicTables, Packed
 from ..description.builder import ModelDescription
 from ..description.parameters import Parameter, find
 from ..errors import ModelError
+from ..analysis.sensitivities import check_dopri5, check_positions_only, requested, table
 from ..results.measures import measure_tables
 from ..validate import flag, number
 
@@ -139,8 +140,8 @@ def _bind(fn: Callable[..., Any], kw: Mapping[str, Any], analysis: str) -> dict[
     """The settings kw checked against the front door's signature (a ModelError naming the
     settings it takes otherwise)."""
     if "sensitivities" in kw:
-        raise ModelError("sweeps compute no sensitivities: use mbd2d.tolerance(), or one run "
-                         "with sensitivities=[...]", "sweep")
+        raise ModelError("sensitivities= is a keyword of mbd2d.sweep and mbd2d.export_sweep "
+                         "(mbd2d.tolerance computes its own)", "sweep")
     sig = inspect.signature(fn)
     try:
         bound = sig.bind(**kw)
@@ -277,7 +278,8 @@ def with_cases(pl: Plan, model: ModelDescription, values: np.ndarray) -> np.ndar
     pl.tables.vtab, pl.tables.opens = ct.vtab, ct.opens
     b = pl.tables
     check_memory(b.nrow * values.shape[1],
-                 b.nq * (3 if b.nd else 1) + b.nlam + b.ne + len(b.measures.specs), "sweep")
+                 b.nq * (3 if b.nd else 1) + b.nlam + b.ne + len(b.measures.specs)
+                 + b.npar * (3 * b.nq + b.nsl), "sweep")
     return ct.vals
 
 
@@ -297,6 +299,27 @@ def with_measures(pl: Plan, model: ModelDescription, specs: Any) -> None:
     pl.tables.times = np.ascontiguousarray(pl.times, dtype=np.float64)
 
 
+def with_sensitivities(pl: Plan, model: ModelDescription, names: Any) -> None:
+    """Add design sensitivities (names as ``sensitivities=`` of a run) to the plan's batch:
+    each case gets them at its rows, as a run of its own model with them.
+
+    Raises
+    ------
+    ModelError
+        For an unknown or repeated name, or an analysis that has none (positions-only
+        kinematics, dynamics other than dopri5, a model with contacts or joint friction).
+    """
+    params = requested(model, names)
+    if not params:
+        return
+    b = pl.tables
+    check_positions_only(params, b.nd == 0 and pl.analysis == "kinematics")
+    check_dopri5(params, pl.method or "dopri5", "sweep")
+    d = None if b.analysis == 1 else DynamicTables(b.bmass, b.grav, b.ftab, b.fpar, b.v0)
+    b.ptab = table(pl.packed, params, d)
+    b.sensitivities = [prm.name for prm in params]
+
+
 def nominal_values(model: ModelDescription, params: Sequence[Parameter]) -> np.ndarray:
     """The parameters' values in the model (an open phase: the value taken from q0)."""
     opened = open_values(pack(model), params) if any(p.value is None for p in params) else {}
@@ -305,4 +328,4 @@ def nominal_values(model: ModelDescription, params: Sequence[Parameter]) -> np.n
 
 
 __all__ = ["ANALYSES", "Plan", "case_values", "grid", "plan", "with_cases", "with_measures",
-           "nominal_values"]
+           "with_sensitivities", "nominal_values"]

@@ -6,13 +6,13 @@ from typing import Any
 from ..description.builder import ModelDescription
 from ..errors import ModelError
 from .dataset import to_dataset, xarray
-from .plan import case_values, plan, with_cases, with_measures
+from .plan import case_values, plan, with_cases, with_measures, with_sensitivities
 from .runner import run
 
 
 def sweep(model: ModelDescription, cases: Any, analysis: str = "kinematics", client: Any = None,
           *, workers: int | None = None, progress: bool | None = None,
-          measures: Any = None, **analysis_kwargs: Any) -> Any:
+          measures: Any = None, sensitivities: Any = None, **analysis_kwargs: Any) -> Any:
     """Run one analysis for many variants of a model: one case per set of parameter values.
 
     The model is packed once; the core takes the cases in batches (one call per chunk of
@@ -46,10 +46,14 @@ def sweep(model: ModelDescription, cases: Any, analysis: str = "kinematics", cli
         ``transmission_angle:JOINT[:OUTPUT]``, ``velocity_ratio:IN:OUT[:VIA]``,
         ``mechanical_advantage:IN:OUT[:VIA]``, ``dead_centre_distance`` (not for statics).
         Each case's come from its own dimensions (a swept pivot moves its angle's points).
+    sensitivities : list of str, optional
+        Design parameters (``model.parameters()`` names): every case's exact sensitivities
+        to them at its own values, as ``sensitivities=`` of the Model method computes them
+        (not for positions-only kinematics; dynamics by dopri5).
     **analysis_kwargs
         The analysis's settings, as for the Model method (``t_end``, ``steps``, ``t0``,
         ``every``, ``tol``, ``solver``; ``method``, ``rtol``, ``atol``, ``h`` ... for
-        dynamics; ``t`` for statics). No ``sensitivities`` (see :func:`mbd2d.tolerance`).
+        dynamics; ``t`` for statics).
 
     Returns
     -------
@@ -59,7 +63,9 @@ def sweep(model: ModelDescription, cases: Any, analysis: str = "kinematics", cli
         "equation"), ``effort`` over ("case", "time", "driver"), and the energies
         ``kinetic``, ``potential`` (statics: ``stability`` and ``residual`` per case); with
         measures ``measures`` over ("case", "time", "measure"), the "measure" coordinate
-        naming them by their specs. The
+        naming them by their specs; with sensitivities ``dq_dp``, ``dqd_dp``, ``dqdd_dp``
+        over ("case", "time", "coordinate", "parameter") and, with multipliers (inverse
+        dynamics, statics), ``dlam_dp`` and ``deffort_dp``. The
         parameters are coordinates of "case"; ``status`` (0 ok, else the status of the
         exception the variant raises alone, ``err.status``, or the core's status for bad
         input) and ``message`` (that exception's text) per case. A failing case keeps its
@@ -92,6 +98,7 @@ def sweep(model: ModelDescription, cases: Any, analysis: str = "kinematics", cli
     names, values = case_values(cases)
     pl = plan(model, names, analysis, analysis_kwargs)
     with_measures(pl, model, measures)
+    with_sensitivities(pl, model, sensitivities)
     vals = with_cases(pl, model, values)
     out = run(pl.tables, vals, client=client, workers=workers, progress=progress)
     return to_dataset(pl, analysis, model, out, names, values)
