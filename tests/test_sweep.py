@@ -331,13 +331,18 @@ def fourbar_cases(n: int) -> dict[str, np.ndarray]:
             "joint.A.points.0.0": np.linspace(0.45, 0.55, n)}
 
 
+#: the cases' measures and sensitivities travel with them
+EXTRAS = dict(measures=["transmission_angle:B", "dead_centre_distance"],
+              sensitivities=["joint.O4.points.1.0"])
+
+
 def test_process_pool_gives_the_serial_result(monkeypatch: pytest.MonkeyPatch) -> None:
     m = load_example("fourbar_grashof.toml")
     cases = fourbar_cases(23)
-    serial = mbd2d.sweep(m, cases, t_end=1.0, steps=30, workers=1)
+    serial = mbd2d.sweep(m, cases, t_end=1.0, steps=30, workers=1, **EXTRAS)
     monkeypatch.setattr(runner, "POOL_MIN_SECONDS", 0.0)
     monkeypatch.setattr(runner, "PROBE_SECONDS", 0.0)
-    pooled = mbd2d.sweep(m, cases, t_end=1.0, steps=30, workers=2)
+    pooled = mbd2d.sweep(m, cases, t_end=1.0, steps=30, workers=2, **EXTRAS)
     assert serial.identical(pooled)
     assert (serial.status.values != 0).any() and (serial.status.values == 0).any()
 
@@ -346,11 +351,11 @@ def test_dask_local_cluster_gives_the_serial_result() -> None:
     distributed = pytest.importorskip("distributed")
     m = load_example("fourbar_grashof.toml")
     cases = fourbar_cases(17)
-    serial = mbd2d.sweep(m, cases, t_end=1.0, steps=30, workers=1)
+    serial = mbd2d.sweep(m, cases, t_end=1.0, steps=30, workers=1, **EXTRAS)
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
                                   dashboard_address=":0") as cluster, \
             distributed.Client(cluster) as client:
-        remote = mbd2d.sweep(m, cases, client=client, t_end=1.0, steps=30)
+        remote = mbd2d.sweep(m, cases, client=client, t_end=1.0, steps=30, **EXTRAS)
         tol = mbd2d.tolerance(m, {"joint.B.points.0.0": 1e-3}, client=client, samples=20,
                               t_end=1.0, steps=30)
         local = mbd2d.tolerance(m, {"joint.B.points.0.0": 1e-3}, samples=20, workers=1,
