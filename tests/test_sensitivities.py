@@ -571,6 +571,9 @@ def test_unknown_names_are_model_errors_with_suggestions():
         m.kinematics(1.0, 4, sensitivities=[])
     with pytest.raises(ModelError, match="list of names"):
         m.kinematics(1.0, 4, sensitivities="joint.B.points.0.0")
+    for bad in (5, 2.5):                       # (a raw TypeError before)
+        with pytest.raises(ModelError, match="list of names, got"):
+            m.kinematics(1.0, 4, sensitivities=bad)
     res = m.kinematics(1.0, 4, sensitivities=["joint.B.points.0.0"])
     with pytest.raises(KeyError, match="no sensitivity with respect to 'joint.A.points.0.0'"):
         res.sensitivity("coupler", "joint.A.points.0.0")

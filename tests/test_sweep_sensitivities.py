@@ -159,9 +159,11 @@ def test_analyses_without_sensitivities_are_model_errors(analysis, kw, match):
                     sensitivities=[ROCKER], **kw)
 
 
-def test_unknown_parameter_is_a_model_error(fourbar):
-    with pytest.raises(mbd2d.ModelError, match="unknown parameter"):
-        mbd2d.sweep(fourbar, {GROUND: [3.0]}, t_end=0.1, steps=2, sensitivities=["joint.Z.x"])
+@pytest.mark.parametrize("names, match", [(["joint.Z.x"], "unknown parameter"),
+                                          (5, "list of names"), ([ROCKER, ROCKER], "twice")])
+def test_bad_parameter_lists_are_model_errors(fourbar, names, match):
+    with pytest.raises(mbd2d.ModelError, match=match):
+        mbd2d.sweep(fourbar, {GROUND: [3.0]}, t_end=0.1, steps=2, sensitivities=names)
 
 
 def _rows(path: Path) -> list[list[str]]:

@@ -185,11 +185,17 @@ def test_no_monte_carlo_and_bad_inputs() -> None:
                            ({}, {}, "dict"),
                            ({"joint.B.points.0.0": 1e-3}, {"samples": 1}, "at least 2"),
                            ({"joint.B.points.0.0": 1e-3}, {"samples": -3}, "samples"),
-                           ({"joint.B.points.0.0": 1e-3}, {"rtol": 1.0}, "the settings are")):
+                           ({"joint.B.points.0.0": 1e-3}, {"rtol": 1.0}, "the settings are"),
+                           # (raw ValueError / TypeError from numpy before)
+                           ({"joint.B.points.0.0": 1e-3}, {"seed": -1}, "seed"),
+                           ({"joint.B.points.0.0": 1e-3}, {"seed": 2.5}, "seed"),
+                           ({"joint.B.points.0.0": 1e-3}, {"seed": "x"}, "seed")):
         with pytest.raises(mbd2d.ModelError, match=match):
             mbd2d.tolerance(m, sig, t_end=1.0, steps=4, **kw)
     with pytest.raises(mbd2d.ModelError, match="unknown analysis"):
         mbd2d.tolerance(m, {"joint.B.points.0.0": 1e-3}, "kin", t_end=1.0, steps=4)
+    with pytest.raises(mbd2d.ModelError, match="seed"):
+        mbd2d.tolerance_samples(m, {"joint.B.points.0.0": 1e-3}, 4, seed=[1, 2])
     with pytest.raises(KeyError, match="no body"):
         tol.point("crank2", (0, 0))
     with pytest.raises(mbd2d.ModelError, match="dopri5"):

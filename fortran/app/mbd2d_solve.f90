@@ -11,8 +11,10 @@
 !! as Python's "%.16e" (docs/mbd-format.md). A file with a "cases" block (mbd2d.export_sweep)
 !! runs the analysis for every case in one batch call (mbd_batch) and writes the CSV of
 !! mbd2d.write_sweep: case, the parameters, t, status, message, then q, q_dot, q_ddot per
-!! coordinate and the drivers' efforts, one row per case and output time (numbers as "%.17g");
-!! a failing case keeps its rows and says why, and the exit code is 0.
+!! coordinate, the drivers' efforts, the file's measures and, for each design parameter P,
+!! d(COLUMN)/d(P) of the motion and (inverse dynamics, statics) of the efforts, one row per
+!! case and output time (numbers as "%.17g"); a failing case keeps its rows and says why, and
+!! the exit code is 0.
 !! Exit codes: 0 ok, 2 bad input (a malformed file, or counts too large for the memory),
 !! 3 singular configuration (partial output written), 4 other numerical failure (partial
 !! output written when there is any). Messages go to standard error, each starting

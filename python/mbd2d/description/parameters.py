@@ -250,6 +250,11 @@ def find(model: Any, names: Iterable[str], where: str = "parameters") -> list[Pa
     """
     if isinstance(names, str):
         raise ModelError("parameter names must be a list of names, not one string", where)
+    try:
+        names = list(names)
+    except TypeError:
+        raise ModelError(f"parameter names must be a list of names, got {names!r}",
+                         where) from None
     table = {p.name: p for p in parameter_list(model)}
     out = []
     for name in names:

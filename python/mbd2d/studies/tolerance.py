@@ -188,13 +188,18 @@ def _linear_outputs(res: Any, ran: str) -> dict[str, tuple[tuple[str, ...], np.n
     return out
 
 
+def _seed(seed: Any) -> int | None:
+    """None, or the seed as a whole number >= 0 (else a ModelError)."""
+    return None if seed is None else whole(seed, "seed", "tolerance", 0, 2**63 - 1)
+
+
 def draws(model: ModelDescription, params: Any, sig: np.ndarray, n: int,
           seed: int | None) -> dict[str, np.ndarray]:
     """The Monte Carlo case table: n variants with p ~ Normal(p0, sigma), drawn by numpy's
     default generator from seed (the parameters in turn, one row of n each)."""
     check_memory(n, len(params), "tolerance")      # the draws (the sweep checks its outputs)
     p0 = nominal_values(model, params)
-    rng = np.random.default_rng(seed)
+    rng = np.random.default_rng(_seed(seed))
     values = p0[:, None] + sig[:, None] * rng.standard_normal((len(params), n))
     return dict(zip([prm.name for prm in params], values))
 
@@ -283,6 +288,7 @@ def tolerance(model: ModelDescription, sigma: Mapping[str, Any], analysis: str =
                          "tolerance")
     names = [str(n) for n in sigma]
     n = whole(samples, "samples", "tolerance", 0, 10**8)
+    seed = _seed(seed)
     if n == 1:
         raise ModelError("samples must be 0 (no Monte Carlo estimate) or at least 2",
                          "tolerance")
