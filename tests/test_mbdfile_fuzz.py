@@ -92,7 +92,13 @@ def bases(tmp_path_factory: pytest.TempPathFactory) -> list[bytes]:
              mbd2d.grid({"joint.B.points.0.0": [1.6, 1.8], "joint.O4.points.1.0": [2.9, 3.1]}),
              "kinematics", {"t_end": 1.0, "steps": 20}),
             (heavy, {"body.coupler.mass": [1.0, 2.0, 3.0]}, "inverse_dynamics",
-             {"t_end": 0.5, "steps": 10})]):
+             {"t_end": 0.5, "steps": 10}),
+            # a sweep with measures (angle lines naming their points' entries) and
+            # design sensitivities
+            (heavy, {"joint.B.points.1.0": [-1.3, -1.2]}, "inverse_dynamics",
+             {"t_end": 0.5, "steps": 10, "measures": ["transmission_angle:B",
+                                                      "velocity_ratio:motor:rocker.theta"],
+              "sensitivities": ["body.rocker.mass", "joint.O4.points.1.0"]})]):
         f = d / f"sweep{k}.mbd"
         mbd2d.export_sweep(model, f, cases, analysis, **kw)
         out.append(f.read_bytes())
