@@ -7,7 +7,7 @@ Usage::
 
 writes ``DIR/<name>.png`` (default ``docs/img/gallery``), the README's pictures of the
 plotting calls (``plot_mechanism.png``, ``plot_paths.png``, ``plot_timeseries.png``,
-``animate.gif``) and, with the default directory, ``docs/gallery.md``.
+``animate.gif``, ``plot_sweep.png``) and, with the default directory, ``docs/gallery.md``.
 tests/test_pictures.py runs it into a temporary directory and checks that
 every joint type has its picture and that the committed gallery lists the same files.
 """
@@ -435,7 +435,7 @@ def picture(name: str, path: Path, dpi: int = 60) -> str:
 
 
 #: the pictures of the README's plotting section: name -> what draws it
-README_PICTURES = ("plot_mechanism", "plot_paths", "plot_timeseries", "animate")
+README_PICTURES = ("plot_mechanism", "plot_paths", "plot_timeseries", "animate", "plot_sweep")
 
 
 def readme_pictures(out: Path) -> list[str]:
@@ -454,6 +454,12 @@ def readme_pictures(out: Path) -> list[str]:
                         dpi=60)]
     done.append(res.animate(out / "animate.gif", fps=12, trace=trace, size=(4.8, 3.8),
                             dpi=60))
+    import numpy as np
+
+    grashof = mbd2d.load(ROOT / "examples" / "fourbar_grashof.toml")
+    ds = mbd2d.sweep(grashof, {"joint.O4.points.1.0": np.linspace(2.0, 6.0, 41)}, t_end=1.0,
+                     steps=180, measures=["transmission_angle:B"], workers=1)
+    done.append(save_figure(mbd2d.plot_sweep(ds), out / "plot_sweep.png", dpi=60))
     return done
 
 

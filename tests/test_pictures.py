@@ -287,7 +287,8 @@ def test_gallery_is_regenerated_for_every_joint_type(tmp_path):
     assert {v[0] for v in gallery.MODELS.values()} == set(J.joint_keys()) | {"forces"}
     assert gallery.main(["--out", str(tmp_path)]) == 0
     made = sorted(p.name for p in tmp_path.iterdir())
-    readme = {"plot_mechanism.png", "plot_paths.png", "plot_timeseries.png", "animate.gif"}
+    readme = {"plot_mechanism.png", "plot_paths.png", "plot_timeseries.png", "animate.gif",
+              "plot_sweep.png"}
     assert set(made) == {f"{n}.png" for n in gallery.MODELS} | readme
     for n in gallery.MODELS:
         assert image(tmp_path / f"{n}.png")[1] == (300, 240)

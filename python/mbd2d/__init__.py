@@ -18,7 +18,7 @@ from .errors import (AnalysisError, AssemblyError, ConvergenceError, CoreError,
                      SingularConfigurationError, SingularJacobianError, SingularPassageWarning,
                      ToggleError)
 from .model import Model, load, loads
-from .plots import animate, plot_mechanism, plot_paths, plot_timeseries
+from .plots import animate, plot_mechanism, plot_paths, plot_sweep, plot_timeseries
 from .results import (BodyResult, DofReport, DynamicsResult, KinematicsResult, PointResult,
                       Reaction, StaticsResult)
 from .studies import (ToleranceResult, export_sweep, grid, sweep, tolerance,
@@ -35,5 +35,5 @@ __all__ = ["load", "loads", "Model", "TimeFunction", "Harmonic", "KinematicsResu
            "SingularJacobianError", "SingularConfigurationError", "ToggleError", "CoreError",
            "InsufficientMemoryError", "MbdWarning", "RedundantConstraintWarning",
            "SingularPassageWarning", "LiftOffWarning", "plot_mechanism", "plot_paths",
-           "plot_timeseries", "animate", "sweep", "grid", "tolerance", "ToleranceResult",
+           "plot_timeseries", "plot_sweep", "animate", "sweep", "grid", "tolerance", "ToleranceResult",
            "write_sweep", "export_sweep", "tolerance_samples", "synthesize", "SynthesisResult", "__version__"]

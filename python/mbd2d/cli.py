@@ -219,6 +219,10 @@ def _parser() -> argparse.ArgumentParser:
                    help="run on the Dask cluster of this scheduler (tcp://host:8786)")
     _measures(w)
     _sensitivities(w)
+    w.add_argument("--plot", default=None, metavar="FIG.png",
+                   help="also draw the measures of every case (needs --measure): over time "
+                   "coloured by the first parameter, and each case's worst transmission "
+                   "angle or range against it")
     r = sub.add_parser("parameters", help="the design parameters of a model: name = value")
     r.add_argument("model", help="model file (.toml)")
     r.add_argument("--match", default=None, metavar="TEXT",
@@ -618,6 +622,9 @@ def _sweep(model: Model, args: argparse.Namespace) -> int:
     from .studies import connect, sweep, write_sweep
     if not str(args.out).endswith((".nc", ".csv")):
         raise ModelError(f"--out must end in .nc or .csv, got {args.out!r}", "command line")
+    if args.plot is not None and not args.measure:
+        raise ModelError("--plot draws the sweep's measures: give --measure SPEC",
+                         "command line")
     cases = _cases(args)
     kw = _study_span(args)
     if args.analysis != "statics":
@@ -639,6 +646,10 @@ def _sweep(model: Model, args: argparse.Namespace) -> int:
         _say(f"  case {int(j)}: {ds.message.values[j]}")
     for line in _measure_ranges(ds):
         print(line)
+    if args.plot is not None:
+        from .plots import plot_sweep, save_figure
+        save_figure(plot_sweep(ds), args.plot)
+        print(f"wrote {args.plot}")
     return EXIT_OK
 
 

@@ -1,4 +1,5 @@
-"""Layer 4, the pictures: the mechanism at snapshots, paths, time series, animations.
+"""Layer 4, the pictures: the mechanism at snapshots, paths, time series, animations, and a
+sweep's family of variants.
 
 matplotlib is imported only when a function here is called, so ``import mbd2d`` does not
 need it. Figures are drawn on the non-interactive Agg canvas and are not registered with
@@ -25,8 +26,10 @@ from .canvas import STOP_COLOUR
 from .files import png_bytes, save_figure, save_figures
 from .geometry import Configuration, Motion, TracePoint
 from .mechanism import default_points, plot_mechanism, plot_paths
+from .sweep import plot_sweep
 from .timeseries import plot_timeseries
 
-__all__ = ["plot_mechanism", "plot_paths", "plot_timeseries", "animate", "save_figures",
+__all__ = ["plot_mechanism", "plot_paths", "plot_timeseries", "plot_sweep", "animate",
+           "save_figures",
            "save_figure", "png_bytes", "InlineAnimation", "ffmpeg_available", "Configuration",
            "default_points", "STOP_COLOUR", "Motion", "TracePoint"]
