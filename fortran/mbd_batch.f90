@@ -143,9 +143,10 @@ contains
         r(opens(1, :)) = phi(opens(2, :))
       end if
       if (sens) then
-        call run_sens(c)
+        call run_case(c, ptab, sq(:, :, :, c), sqd(:, :, :, c), sqdd(:, :, :, c), &
+                      slam(:, :, :, c))
       else
-        call run_plain(c)
+        call run_case(c)
       end if
       if (meas .and. iinfo(1, c) > 0) then   ! the rows up to the first that is not finite
         nr = 0
@@ -164,63 +165,54 @@ contains
 
   contains
 
-    !> Case c's analysis, as a single run of its tables.
-    subroutine run_plain(c)
+    !> Case c's analysis, as a single run of its tables; with the parameter table pt, also
+    !! its sensitivities s1, s2, s3 (q, q_dot, q_ddot; (nq, np, rows)) and sl (the
+    !! multipliers'), as that run gives them (dynamics: dopri5 with the variational
+    !! equations).
+    subroutine run_case(c, pt, s1, s2, s3, sl)
       integer, intent(in) :: c
+      integer, intent(in), optional :: pt(:, :)
+      real(wp), intent(out), optional, contiguous :: s1(:, :, :), s2(:, :, :), s3(:, :, :), &
+                                                     sl(:, :, :)
       select case (analysis)
       case (BATCH_KINEMATICS)
         call api_kinematics(nb, ctab, r, q0, rset(1), rset(2), iset(1), rset(3), iset(2), &
                             rset(4), iset(3), iset(4), qout(:, :, c), qdout(:, :, c), &
                             qddout(:, :, c), iinfo(:, c), rinfo(:, c), qsing(:, c), dep(:, c), &
-                            redundant(:, c), tpass, status(c), msg(c), positions=iset(7))
+                            redundant(:, c), tpass, status(c), msg(c), pt, s1, s2, s3, &
+                            positions=iset(7))
       case (BATCH_INVERSE)
         call api_inverse(nb, ctab, r, bm, g, ftab, fp, q0, rset(1), rset(2), iset(1), rset(3), &
                          iset(3), iset(4), qout(:, :, c), qdout(:, :, c), qddout(:, :, c), &
                          lamout(:, :, c), eout(:, :, c), iinfo(:, c), rinfo(:, c), qsing(:, c), &
-                         dep(:, c), redundant(:, c), tpass, status(c), msg(c))
+                         dep(:, c), redundant(:, c), tpass, status(c), msg(c), pt, s1, s2, s3, &
+                         sl)
       case (BATCH_STATICS)
-        call api_statics(nb, ctab, r, bm, g, ftab, fp, q0, rset(11), qout(:, 1, c), &
-                         lamout(:, 1, c), stable, resid, iinfo(:, c), status(c), msg(c))
+        if (present(pt)) then          ! (one output row: the sensitivities' first)
+          call api_statics(nb, ctab, r, bm, g, ftab, fp, q0, rset(11), qout(:, 1, c), &
+                           lamout(:, 1, c), stable, resid, iinfo(:, c), status(c), msg(c), &
+                           pt, s1(:, :, 1), sl(:, :, 1))
+        else
+          call api_statics(nb, ctab, r, bm, g, ftab, fp, q0, rset(11), qout(:, 1, c), &
+                           lamout(:, 1, c), stable, resid, iinfo(:, c), status(c), msg(c))
+        end if
         rinfo(1, c) = resid; rinfo(2, c) = real(stable, wp)
       case default
-        call api_dynamics(nb, ctab, r, bm, g, ftab, fp, q0, v0, rset(1), rset(2), iset(1), &
-                          iset(5), rset(5), rset(6), rset(7), rset(8), rset(9), rset(10), &
-                          iset(3), qout(:, :, c), qdout(:, :, c), qddout(:, :, c), &
-                          lamout(:, :, c), eout(:, :, c), iinfo(:, c), rinfo(:, c), &
-                          redundant(:, c), status(c), msg(c), iset(6), eo, evo, nev)
+        if (present(pt)) then
+          call api_dynamics_sens(nb, ctab, r, bm, g, ftab, fp, q0, v0, rset(1), rset(2), &
+                                 iset(1), rset(5), rset(6), iset(3), iset(6), pt, &
+                                 qout(:, :, c), qdout(:, :, c), qddout(:, :, c), &
+                                 lamout(:, :, c), eout(:, :, c), s1, s2, s3, iinfo(:, c), &
+                                 rinfo(:, c), redundant(:, c), status(c), msg(c))
+        else
+          call api_dynamics(nb, ctab, r, bm, g, ftab, fp, q0, v0, rset(1), rset(2), iset(1), &
+                            iset(5), rset(5), rset(6), rset(7), rset(8), rset(9), rset(10), &
+                            iset(3), qout(:, :, c), qdout(:, :, c), qddout(:, :, c), &
+                            lamout(:, :, c), eout(:, :, c), iinfo(:, c), rinfo(:, c), &
+                            redundant(:, c), status(c), msg(c), iset(6), eo, evo, nev)
+        end if
       end select
-    end subroutine run_plain
-
-    !> Case c's analysis with the sensitivities, as a single run of its tables with them.
-    subroutine run_sens(c)
-      integer, intent(in) :: c
-      select case (analysis)
-      case (BATCH_KINEMATICS)
-        call api_kinematics(nb, ctab, r, q0, rset(1), rset(2), iset(1), rset(3), iset(2), &
-                            rset(4), iset(3), iset(4), qout(:, :, c), qdout(:, :, c), &
-                            qddout(:, :, c), iinfo(:, c), rinfo(:, c), qsing(:, c), dep(:, c), &
-                            redundant(:, c), tpass, status(c), msg(c), ptab, sq(:, :, :, c), &
-                            sqd(:, :, :, c), sqdd(:, :, :, c))
-      case (BATCH_INVERSE)
-        call api_inverse(nb, ctab, r, bm, g, ftab, fp, q0, rset(1), rset(2), iset(1), rset(3), &
-                         iset(3), iset(4), qout(:, :, c), qdout(:, :, c), qddout(:, :, c), &
-                         lamout(:, :, c), eout(:, :, c), iinfo(:, c), rinfo(:, c), qsing(:, c), &
-                         dep(:, c), redundant(:, c), tpass, status(c), msg(c), ptab, &
-                         sq(:, :, :, c), sqd(:, :, :, c), sqdd(:, :, :, c), slam(:, :, :, c))
-      case (BATCH_STATICS)
-        call api_statics(nb, ctab, r, bm, g, ftab, fp, q0, rset(11), qout(:, 1, c), &
-                         lamout(:, 1, c), stable, resid, iinfo(:, c), status(c), msg(c), &
-                         ptab, sq(:, :, 1, c), slam(:, :, 1, c))
-        rinfo(1, c) = resid; rinfo(2, c) = real(stable, wp)
-      case default                     ! dopri5 with the variational equations
-        call api_dynamics_sens(nb, ctab, r, bm, g, ftab, fp, q0, v0, rset(1), rset(2), &
-                               iset(1), rset(5), rset(6), iset(3), iset(6), ptab, &
-                               qout(:, :, c), qdout(:, :, c), qddout(:, :, c), &
-                               lamout(:, :, c), eout(:, :, c), sq(:, :, :, c), &
-                               sqd(:, :, :, c), sqdd(:, :, :, c), iinfo(:, c), rinfo(:, c), &
-                               redundant(:, c), status(c), msg(c))
-      end select
-    end subroutine run_sens
+    end subroutine run_case
 
     !> The tables and output shapes agree with each other (a wrong call is refused whole).
     subroutine check(st, text)

@@ -27,7 +27,7 @@ program mbd2d_solve
   use mbd_status, only: MBD_OK, MBD_SINGULAR_CONFIG, MBD_NO_MEMORY, MSG_LEN
   use mbd_memory, only: REAL_BYTES, mem_check
   use mbd_mbdfile, only: mbd_spec_t, mbd_read, NAME_LEN, MEAS_ANGLE, MEAS_RATIO, &
-                         MEAS_ADVANTAGE, MEAS_CONDITIONING
+                         MEAS_ADVANTAGE
   use mbd_measures, only: api_measures
   use mbd_model, only: NFT
   use mbd_constraints, only: con_nrow, con_is_driver
