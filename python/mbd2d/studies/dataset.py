@@ -152,14 +152,20 @@ def _failure(pl: Plan, model: ModelDescription, c: SimpleNamespace, n: int,
         return exc
 
 
+def _per_case(x: np.ndarray, keep: np.ndarray) -> np.ndarray:
+    """A core array with rows and cases last, (k, [npar,] nrow, ncase), as (ncase, nrow, k
+    [, npar]), NaN outside each case's kept rows (keep: (ncase, nrow))."""
+    v = np.ascontiguousarray(np.moveaxis(x, (-1, -2), (0, 1)))
+    v[~keep] = np.nan
+    return v
+
+
 def _sensitivity_data(pl: Plan, a: dict[str, np.ndarray], keep: np.ndarray
                       ) -> dict[str, Any]:
     """The sensitivities as Dataset variables (case, time, entry, parameter), NaN after each
     case's kept rows; with multipliers the efforts' too (-dlambda/dp of the driver rows)."""
-    def per_case(x: np.ndarray) -> np.ndarray:        # (k, npar, nrow, ncase) -> (ncase, ...)
-        v = np.ascontiguousarray(np.transpose(x, (3, 2, 0, 1)))
-        v[~keep] = np.nan
-        return v
+    def per_case(x: np.ndarray) -> np.ndarray:
+        return _per_case(x, keep)
 
     cube = ("case", "time", "coordinate", "parameter")
     data: dict[str, Any] = {"dq_dp": (cube, per_case(a["sq"])),
@@ -185,9 +191,7 @@ def to_dataset(pl: Plan, analysis: str, model: ModelDescription, out: Outputs,
     keep = np.arange(b.nrow)[None, :] < rows[:, None]          # (ncase, nrow)
 
     def per_case(x: np.ndarray) -> np.ndarray:
-        v = np.ascontiguousarray(np.transpose(x, (2, 1, 0)))   # (ncase, nrow, k)
-        v[~keep] = np.nan
-        return v
+        return _per_case(x, keep)
 
     a = out.arrays
     cube = ("case", "time", "coordinate")
