@@ -911,10 +911,12 @@ contains
     clean = bstat(c) == MBD_OK .and. k > n
     if (code == 3) clean = clean .and. ieee_is_finite(brinfo(1, c))
     cstat(c) = 0; cmsg(c) = ''; nkeep(c) = n
-    if (clean .and. bmbad(1, c) /= MBD_OK) then   ! its rows, without its measures
-      cstat(c) = bmbad(1, c)
-      cmsg(c) = 'measure "' // trim(spec%meas_names(bmbad(2, c))) // '": ' // trim(bmsg(c))
+    if (bmbad(1, c) /= MBD_OK) then               ! its rows, without its measures
       bmv(:, :, c) = ieee_value(0.0_wp, ieee_quiet_nan)
+      if (clean) then
+        cstat(c) = bmbad(1, c)
+        cmsg(c) = 'measure "' // trim(spec%meas_names(bmbad(2, c))) // '": ' // trim(bmsg(c))
+      end if
     end if
     if (clean) return
     nkeep(c) = min(n, k - 1)

@@ -175,11 +175,16 @@ def _sensitivity_data(pl: Plan, a: dict[str, np.ndarray], keep: np.ndarray
         p = pl.packed
         dlam = per_case(a["slam"])
         data["dlam_dp"] = (("case", "time", "equation", "parameter"), dlam)
-        drivers = [k for k, f in enumerate(p.driver_flags) if f]
+        rows_d, drivers = _driver_rows(p)
         if drivers:
-            data["deffort_dp"] = (("case", "time", "driver", "parameter"),
-                                  -dlam[:, :, [p.row_owner.index(k) for k in drivers]])
+            data["deffort_dp"] = (("case", "time", "driver", "parameter"), -dlam[:, :, rows_d])
     return data
+
+
+def _driver_rows(p: Any) -> tuple[list[int], list[str]]:
+    """The rows of Phi of the drivers (an effort is -lambda there) and their names."""
+    drivers = [k for k, f in enumerate(p.driver_flags) if f]
+    return [p.row_owner.index(k) for k in drivers], [p.constraint_names[k] for k in drivers]
 
 
 def to_dataset(pl: Plan, analysis: str, model: ModelDescription, out: Outputs,
@@ -212,11 +217,10 @@ def to_dataset(pl: Plan, analysis: str, model: ModelDescription, out: Outputs,
         lam = per_case(a["lam"])
         data["lam"] = (("case", "time", "equation"), lam)
         coords["equation"] = list(p.row_labels)
-        drivers = [k for k, f in enumerate(p.driver_flags) if f]
+        rows_d, drivers = _driver_rows(p)
         if drivers:
-            data["effort"] = (("case", "time", "driver"),
-                              -lam[:, :, [p.row_owner.index(k) for k in drivers]])
-            coords["driver"] = [p.constraint_names[k] for k in drivers]
+            data["effort"] = (("case", "time", "driver"), -lam[:, :, rows_d])
+            coords["driver"] = drivers
         e = per_case(a["e"])
         if pl.analysis != "statics":
             data["kinetic"] = (("case", "time"), e[:, :, 0])

@@ -11,6 +11,7 @@ from typing import Any, Callable, Mapping, Sequence
 import numpy as np
 
 from ..analysis.dynamics import dynamics_settings
+from ..analysis.sensitivities import check_dopri5, check_positions_only, requested, table
 from ..analysis.settings import (check_memory, check_solver, check_span, output_rows,
                                  output_steps, require_determined, solver_code, time_grid)
 from ..binding.cases import case_tables
@@ -20,7 +21,6 @@ from ..binding.tables import NFT, BatchTables, DynamicTables, Packed
 from ..description.builder import ModelDescription
 from ..description.parameters import Parameter, find
 from ..errors import ModelError
-from ..analysis.sensitivities import check_dopri5, check_positions_only, requested, table
 from ..results.measures import measure_tables
 from ..validate import flag, number
 
@@ -272,15 +272,18 @@ def _dynamics(model: ModelDescription, params: list[Parameter], a: dict[str, Any
 def with_cases(pl: Plan, model: ModelDescription, values: np.ndarray) -> np.ndarray:
     """Fill the plan's value table and open phases for these cases (n_params, ncase); the
     values of every case, as the core takes them (nv, ncase), and checks the memory."""
-    d = None if pl.tables.analysis == 1 else DynamicTables(
-        pl.tables.bmass, pl.tables.grav, pl.tables.ftab, pl.tables.fpar, pl.tables.v0)
-    ct = case_tables(model, pl.packed, d, pl.params, values)
+    ct = case_tables(model, pl.packed, _dynamic(pl.tables), pl.params, values)
     pl.tables.vtab, pl.tables.opens = ct.vtab, ct.opens
     b = pl.tables
     check_memory(b.nrow * values.shape[1],
                  b.nq * (3 if b.nd else 1) + b.nlam + b.ne + len(b.measures.specs)
                  + b.npar * (3 * b.nq + b.nsl), "sweep")
     return ct.vals
+
+
+def _dynamic(b: BatchTables) -> DynamicTables | None:
+    """The batch's dynamic tables (None for kinematics, which takes none)."""
+    return None if b.analysis == 1 else DynamicTables(b.bmass, b.grav, b.ftab, b.fpar, b.v0)
 
 
 def with_measures(pl: Plan, model: ModelDescription, specs: Any) -> None:
@@ -315,8 +318,7 @@ def with_sensitivities(pl: Plan, model: ModelDescription, names: Any) -> None:
     b = pl.tables
     check_positions_only(params, b.nd == 0 and pl.analysis == "kinematics")
     check_dopri5(params, pl.method or "dopri5", "sweep")
-    d = None if b.analysis == 1 else DynamicTables(b.bmass, b.grav, b.ftab, b.fpar, b.v0)
-    b.ptab = table(pl.packed, params, d)
+    b.ptab = table(pl.packed, params, _dynamic(b))
     b.sensitivities = [prm.name for prm in params]
 
 
