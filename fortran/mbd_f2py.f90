@@ -255,6 +255,23 @@ subroutine core_link_angle(nq, nt, q, kind, b, s, mu, status, msg)
   call api_link_angle(q, kind, b, s, mu, status, msg)
 end subroutine core_link_angle
 
+! The transmission angle's design derivatives dmu (npar, nt) from the states q, their
+! sensitivities sq (nq, npar, nt), the recipe (kind, b, s) and the rpar entries of its points
+! (pref, 0 none) against the parameter table ptab (2, npar).
+subroutine core_link_angle_dp(nq, nt, npar, q, sq, kind, b, s, pref, ptab, dmu, status, msg)
+  use iso_c_binding, only: c_double, c_int
+  use mbd_measures, only: api_link_angle_dp
+  implicit none
+  integer(c_int), intent(in) :: nq, nt, npar, kind
+  integer(c_int), intent(in) :: b(3), pref(2, 3), ptab(2, npar)
+  real(c_double), intent(in) :: q(nq, nt), sq(nq, npar, nt), s(2, 3)
+  real(c_double), intent(out) :: dmu(npar, nt)
+  integer(c_int), intent(out) :: status
+  character(len=512), intent(out) :: msg
+  !f2py intent(hide) :: nq, nt, npar
+  call api_link_angle_dp(q, sq, kind, b, s, pref, ptab, dmu, status, msg)
+end subroutine core_link_angle_dp
+
 subroutine core_fun_values(np, p, nt, t, f, f1, f2, status, msg)
   use iso_c_binding, only: c_double, c_int
   use mbd_measures, only: api_fun_values

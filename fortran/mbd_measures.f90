@@ -23,6 +23,12 @@
 !!                 joint B to its other joint A; an output turning about P: p = (P - B)/|P - B|,
 !!                 mu = acos(e . p); an output sliding along the axis u: mu = asin(|e . u|).
 !!                 The front end finds the joints; mbd2d-solve reads the same recipe.
+!!   link_angle_dp its design derivative along the motion's sensitivities s = dq/dp and the
+!!                 recipe's own points where a parameter is one: with a = A - B, w = P - B
+!!                 (or the axis u), e = a/|a|, v = w/|w|, c = e . v:
+!!                 de = (da - e (e . da))/|a|, dv likewise, dmu = -(de . v + e . dv)/sin(mu)
+!!                 turning; dmu = sign(c) (de . v + e . dv)/cos(mu) sliding; a point's
+!!                 change d(r + A s') = dr + B s' dtheta + A ds'.
 !!   measures      a list of the three above (kind, integers, points) at every state in one
 !!                 call: a table's columns and a sweep case's (mbd_batch), where the points
 !!                 of an angle may come from the raw parameters a case sets.
@@ -42,7 +48,7 @@ module mbd_measures
   implicit none
   private
   public :: api_conditioning, api_influence, api_fun_values, api_link_angle, api_ratio, &
-            api_measures
+            api_measures, api_link_angle_dp
   !> ratio kinds: the velocity ratio dY/dX, the mechanical advantage dX/dY
   integer, parameter, public :: RATIO_VELOCITY = 1, RATIO_ADVANTAGE = 2
   !> quantity kinds: a coordinate (its column), a driver (its row of Phi)
@@ -401,6 +407,116 @@ contains
     end do
     bad = 0
   end subroutine api_measures
+
+  !> The transmission angle's derivatives dmu(k, j) along design parameter k at state j:
+  !! the recipe of api_link_angle, the sensitivities sq (nq, np, nt) of the states (model
+  !! units), and the recipe's points' own entries: where pref(i, l) > 0 and parameter k is
+  !! rpar entry pref(i, l) (ptab(:, k) = (1, pref(i, l))), entry i of point l moves with it.
+  !! Where sin(mu) (turning) or cos(mu) (sliding) is zero the angle has no derivative:
+  !! +-inf with the sign of the numerator (0 where that is zero too).
+  subroutine api_link_angle_dp(q, sq, kind, b, s, pref, ptab, dmu, status, msg)
+    real(wp), intent(in) :: q(:, :)             !! states (nq, nt)
+    real(wp), intent(in) :: sq(:, :, :)         !! dq/dp (nq, np, nt)
+    integer, intent(in) :: kind                 !! ANGLE_TURN or ANGLE_SLIDE
+    integer, intent(in) :: b(3)                 !! bodies (0 ground)
+    real(wp), intent(in) :: s(2, 3)             !! points (and the axis) in their bodies
+    integer, intent(in) :: pref(2, 3)           !! rpar entries of the points (0: none)
+    integer, intent(in) :: ptab(:, :)           !! (2, np) design parameters
+    real(wp), intent(out) :: dmu(:, :)          !! (np, nt)
+    integer, intent(out) :: status              !! MBD_OK or < 0
+    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    real(wp) :: mu(1), pb(2), a(2), w(2), e(2), v(2), da(2), dw(2), de(2), dv(2), c, den, num
+    real(wp) :: ds(2, 3), na, nw
+    integer :: j, k, i, l, np
+    dmu = zero; np = size(ptab, 2)
+    if (size(sq, 1) /= size(q, 1) .or. size(sq, 2) /= np .or. size(sq, 3) /= size(q, 2) .or. &
+        size(ptab, 1) /= 2 .or. size(dmu, 1) /= np .or. size(dmu, 2) /= size(q, 2)) then
+      status = MBD_BAD_COUNT; msg = 'link angle derivative: array sizes do not match'; return
+    end if
+    if (.not. all(ieee_is_finite(sq))) then
+      status = MBD_BAD_PARAM; msg = 'the sensitivities must be finite'; return
+    end if
+    do j = 1, size(q, 2)
+      call api_link_angle(q(:, j:j), kind, b, s, mu, status, msg)
+      if (status /= MBD_OK) return
+      pb = point(b(1), s(:, 1), q(:, j))
+      a = point(b(2), s(:, 2), q(:, j)) - pb
+      if (kind == ANGLE_TURN) then
+        w = point(b(3), s(:, 3), q(:, j)) - pb
+      else
+        w = turned(b(3), s(:, 3), q(:, j))
+      end if
+      na = hypot(a(1), a(2)); nw = hypot(w(1), w(2))
+      e = a / na; v = w / nw; c = e(1) * v(1) + e(2) * v(2)
+      do k = 1, np
+        ds = zero                       ! the recipe's own points that are parameter k
+        do l = 1, 3
+          do i = 1, 2
+            if (pref(i, l) > 0 .and. ptab(1, k) == 1 .and. ptab(2, k) == pref(i, l)) &
+              ds(i, l) = one
+          end do
+        end do
+        da = dpoint(b(2), s(:, 2), ds(:, 2)) - dpoint(b(1), s(:, 1), ds(:, 1))
+        if (kind == ANGLE_TURN) then
+          dw = dpoint(b(3), s(:, 3), ds(:, 3)) - dpoint(b(1), s(:, 1), ds(:, 1))
+        else
+          dw = dturned(b(3), s(:, 3), ds(:, 3))
+        end if
+        de = (da - e * (e(1) * da(1) + e(2) * da(2))) / na     ! d(a/|a|)
+        dv = (dw - v * (v(1) * dw(1) + v(2) * dw(2))) / nw
+        num = de(1) * v(1) + de(2) * v(2) + e(1) * dv(1) + e(2) * dv(2)   ! dc
+        if (kind == ANGLE_TURN) then
+          num = -num; den = sin(mu(1))                          ! mu = acos(c)
+        else
+          num = sign(one, c) * num; den = cos(mu(1))            ! mu = asin(|c|)
+        end if
+        if (den /= zero) then
+          dmu(k, j) = num / den
+        else if (num /= zero) then
+          dmu(k, j) = ieee_copy_sign(ieee_value(zero, ieee_positive_inf), num)
+        end if
+      end do
+    end do
+  contains
+    !> r_i + A(theta_i) s' (ground: s').
+    pure function point(bi, sl, qk) result(r)
+      integer, intent(in) :: bi
+      real(wp), intent(in) :: sl(2), qk(:)
+      real(wp) :: r(2)
+      r = sl
+      if (bi > 0) r = qk(3 * bi - 2:3 * bi - 1) + turned(bi, sl, qk)
+    end function point
+    !> A(theta_i) v' (ground: v').
+    pure function turned(bi, vl, qk) result(r)
+      integer, intent(in) :: bi
+      real(wp), intent(in) :: vl(2), qk(:)
+      real(wp) :: r(2), cc, sn
+      r = vl
+      if (bi == 0) return
+      cc = cos(qk(3 * bi)); sn = sin(qk(3 * bi))
+      r = [cc * vl(1) - sn * vl(2), sn * vl(1) + cc * vl(2)]
+    end function turned
+    !> d(r + A s') = dr + B s' dtheta + A ds' along parameter k at state j (ground: ds').
+    function dpoint(bi, sl, dsl) result(r)
+      integer, intent(in) :: bi
+      real(wp), intent(in) :: sl(2), dsl(2)
+      real(wp) :: r(2)
+      r = dsl
+      if (bi == 0) return
+      r = sq(3 * bi - 2:3 * bi - 1, k, j) + dturned(bi, sl, dsl)
+    end function dpoint
+    !> d(A v') = B v' dtheta + A dv' (ground: dv').
+    function dturned(bi, vl, dvl) result(r)
+      integer, intent(in) :: bi
+      real(wp), intent(in) :: vl(2), dvl(2)
+      real(wp) :: r(2), cc, sn, dth
+      r = dvl
+      if (bi == 0) return
+      cc = cos(q(3 * bi, j)); sn = sin(q(3 * bi, j)); dth = sq(3 * bi, k, j)
+      r = [cc * dvl(1) - sn * dvl(2), sn * dvl(1) + cc * dvl(2)] + &
+          dth * [-sn * vl(1) - cc * vl(2), cc * vl(1) - sn * vl(2)]
+    end function dturned
+  end subroutine api_link_angle_dp
 
   !> States and times finite and sized for the model.
   logical function check_states(m, q, t, nt, status, msg) result(good)

@@ -388,6 +388,7 @@ def _tolerance_parser(sub: Any) -> None:
                    help="local processes for the Monte Carlo sweep (default: all cores)")
     t.add_argument("--scheduler", default=None, metavar="ADDRESS",
                    help="run the Monte Carlo sweep on the Dask scheduler at ADDRESS")
+    _measures(t)
 
 
 def _sigma(spec: str) -> tuple[str, float]:
@@ -409,7 +410,8 @@ def _tolerance(model: Model, args: argparse.Namespace) -> int:
     sigma = dict(_sigma(s) for s in args.sigma)
     if args.export_samples is not None:
         cases = tolerance_samples(model, sigma, args.samples, args.seed)
-        export_sweep(model, args.export_samples, cases, args.analysis, **_study_span(args))
+        export_sweep(model, args.export_samples, cases, args.analysis, measures=args.measure,
+                     **_study_span(args))
         print(f"wrote {args.export_samples} ({args.samples} Monte Carlo variants, seed "
               f"{args.seed}; run it with mbd2d-solve {args.export_samples} OUT.csv)")
         return EXIT_OK
@@ -425,7 +427,7 @@ def _tolerance(model: Model, args: argparse.Namespace) -> int:
     client = connect(args.scheduler) if args.scheduler else None
     try:
         tol = tolerance(model, sigma, args.analysis, samples=args.samples, client=client,
-                        seed=args.seed, workers=args.workers, **kw)
+                        seed=args.seed, workers=args.workers, measures=args.measure, **kw)
     finally:
         if client is not None:
             client.close()
@@ -460,6 +462,14 @@ def _tolerance_report(tol: Any, points: list[tuple[str, Any]]) -> str:
         beside = "" if mc is None else f"  (Monte Carlo {mc[k]:.3g})" if np.isfinite(mc[k]) \
             else "  (Monte Carlo: fewer than 2 samples completed)"
         lines.append(f"  {name:24s} {lin[k]:.3g} at t = {t[k]:.6g}{beside}")
+    if "measures" in ds:
+        lines.append("transmission angles, largest first-order standard deviation [deg]:")
+        for j, spec in enumerate(str(m) for m in ds["measure"].values):
+            lin = np.degrees(ds.measures_std_linear.values[:, j])
+            k = int(np.nanargmax(lin))
+            mc = (f"  (Monte Carlo {np.degrees(ds.measures_std_mc.values[k, j]):.3g})"
+                  if "measures_std_mc" in ds else "")
+            lines.append(f"  {spec:24s} {lin[k]:.3g} at t = {t[k]:.6g}{mc}")
     return "\n".join(lines)
 
 

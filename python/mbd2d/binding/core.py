@@ -186,6 +186,19 @@ def link_angle(q: np.ndarray, kind: int, bodies: np.ndarray, points: np.ndarray
                   numbers=q.shape[1])
 
 
+def link_angle_dp(q: np.ndarray, sq: np.ndarray, kind: int, bodies: np.ndarray,
+                  points: np.ndarray, pref: np.ndarray, ptab: np.ndarray) -> SimpleNamespace:
+    """The transmission angle's design derivatives at states q (nq, nt) with their
+    sensitivities sq (nq, np, nt), the recipe of :func:`link_angle`, the rpar entries of its
+    points pref (2, 3; 0 none) and the parameter table ptab (2, np): ``dmu`` (np, nt),
+    ``status``, ``msg``."""
+    return _named("dmu status msg", _core.core_link_angle_dp, q,
+                  np.asfortranarray(sq, dtype=float), int(kind),
+                  np.asarray(bodies, dtype=np.int32), np.asfortranarray(points, dtype=float),
+                  np.asfortranarray(pref, dtype=np.int32),
+                  np.asfortranarray(ptab, dtype=np.int32), numbers=sq.shape[1] * q.shape[1])
+
+
 def fun_values(p: np.ndarray, t: np.ndarray) -> SimpleNamespace:
     """f(t), f'(t), f''(t) of an encoded function of time (``TimeFunction.encode()``) at the
     times t: ``f``, ``f1``, ``f2``, ``status``, ``msg``."""

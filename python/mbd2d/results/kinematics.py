@@ -206,6 +206,28 @@ class KinematicsResult:
         """
         return measures.transmission_angle(self, joint, output)
 
+    def transmission_angle_dp(self, joint: str, output: str | None = None) -> np.ndarray:
+        """The transmission angle's exact derivatives along the design parameters of a run
+        with ``sensitivities=[...]``: d(mu)/d(p) (rows, n_params), rad per unit of each
+        parameter, in ``parameter_names`` order. The core differentiates the angle along
+        the motion's sensitivities and, where a parameter is one of the angle's own points
+        (the pivot of the output link, the coupler's joints), along that point too.
+
+        Raises
+        ------
+        ModelError
+            Without sensitivities, or as :meth:`transmission_angle`.
+
+        Examples
+        --------
+        >>> import mbd2d
+        >>> m = mbd2d.load("examples/fourbar_grashof.toml")
+        >>> res = m.kinematics(1.0, 4, sensitivities=["joint.O4.points.1.0"])
+        >>> res.transmission_angle_dp("B").shape
+        (5, 1)
+        """
+        return measures.transmission_angle_dp(self, joint, output)
+
     def velocity_ratio(self, input: str, output: str, via: str | None = None) -> np.ndarray:
         """d(output)/d(input) along the motion: the kinematic influence coefficients.
 

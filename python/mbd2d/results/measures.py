@@ -31,6 +31,7 @@ from ..description.joints import PointOnLine, Revolute, Translational
 from ..description.parameters import find
 from ..errors import MbdError, ModelError
 from ..validate import GROUND
+from .columns import require_sensitivities
 
 
 def packed_of(res: Any) -> Packed:
@@ -198,6 +199,30 @@ def transmission_angle(res: Any, joint: Any, output: Any = None) -> np.ndarray:
     if out.status != OK:
         raise error_for("measures", out.status, out.msg, entry="transmission_angle")
     return np.asarray(out.mu, dtype=float).copy()
+
+
+def transmission_angle_dp(res: Any, joint: Any, output: Any = None) -> np.ndarray:
+    """The transmission angle's exact design derivatives (rows, n_params) [rad per unit of
+    each parameter] from the result's sensitivities: along the motion (dq/dp) and, where a
+    parameter is a point of the angle's own recipe, along that point (the core).
+
+    Raises
+    ------
+    ModelError
+        If the result has no sensitivities, or as :func:`transmission_angle`.
+    """
+    require_sensitivities(getattr(res, "dq_dp", None) is not None, "transmission_angle")
+    kind, items = _angle_items(res.model, joint, output)
+    bodies, points = _recipe([(b, pt) for b, pt, _ in items])
+    p = packed_of(res)
+    params = find(res.model, [f"{n}.{i}" for _, _, n in items for i in (0, 1)], "measures")
+    pref = np.asfortranarray(parameter_table(p, params)[1].reshape(3, 2).T)
+    q, _ = _states(res)
+    sq = np.asfortranarray(np.transpose(res.dq_dp, (1, 2, 0)))
+    out = core.link_angle_dp(q, sq, kind, bodies, points, pref, res.ptab)
+    if out.status != OK:
+        raise error_for("measures", out.status, out.msg, entry="transmission_angle")
+    return np.asarray(out.dmu, dtype=float).T.copy()
 
 
 def angle_recipe(model: Any, joint: Any, output: Any = None

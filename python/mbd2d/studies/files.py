@@ -134,7 +134,8 @@ def _g(v: Any) -> str:
 
 
 #: the column names of a tolerance output's entries, from its coordinate's labels
-_ENTRY = {"q": "{}", "qd": "{}_dot", "qdd": "{}_ddot", "lam": "lambda.{}", "effort": "{}.effort"}
+_ENTRY = {"q": "{}", "qd": "{}_dot", "qdd": "{}_ddot", "lam": "lambda.{}", "effort": "{}.effort",
+          "measures": "{}"}
 #: the statistics of a tolerance output, as column suffixes
 _STATS = (("", ""), ("_std_linear", ".std_linear"), ("_std_mc", ".std_mc"),
           ("_mean_mc", ".mean_mc"))
@@ -144,7 +145,8 @@ def tolerance_table(ds: Any, points: Sequence[tuple[str, Any]] = ()
                     ) -> tuple[list[str], np.ndarray]:
     """A tolerance analysis (:attr:`ToleranceResult.dataset`) and point scatters
     (``(label, ToleranceResult.point(...))``) as one row per output time: ``t``, then for
-    each output (q, qd, qdd, lam, effort) and entry its nominal value ``NAME``, first-order
+    each output (q, qd, qdd, lam, effort, the measures by their specs) and entry its nominal
+    value ``NAME``, first-order
     standard deviation ``NAME.std_linear`` and, with Monte Carlo samples, ``NAME.std_mc``
     and ``NAME.mean_mc`` (NAME: ``crank.x``, ``crank.x_dot``, ``crank.x_ddot``,
     ``lambda.LABEL``, ``DRIVER.effort``); then per point ``LABEL.x``, ``LABEL.y`` with

@@ -28,6 +28,7 @@ from ..analysis.settings import check_memory
 from ..description.builder import ModelDescription
 from ..description.parameters import find
 from ..errors import ModelError
+from ..results.measures import measure_list, parse_measure
 from ..validate import number, vector, whole
 from .dataset import xarray
 from .plan import (ANALYSES, _bind, _dynamics_settings, _inverse_settings,
@@ -188,6 +189,37 @@ def _linear_outputs(res: Any, ran: str) -> dict[str, tuple[tuple[str, ...], np.n
     return out
 
 
+def _angle_specs(measures: Any, analysis: str) -> list[str]:
+    """The transmission angles asked for (the measures with exact design derivatives).
+
+    Raises
+    ------
+    ModelError
+        For another measure, a malformed spec, or measures of statics.
+    """
+    specs = measure_list(measures)
+    for spec in specs:
+        name, _ = parse_measure(spec)
+        if name != "transmission_angle":
+            raise ModelError(f"the tolerance of {spec!r}: only transmission angles have exact "
+                             "design derivatives (the ratios and the dead-centre distance have "
+                             "none); run their Monte Carlo estimate as mbd2d.sweep(..., "
+                             "measures=[...]) of mbd2d.tolerance_samples(...)", "tolerance")
+    if specs and analysis == "statics":
+        raise ModelError("measures are columns of a run over time, not of statics",
+                         "tolerance")
+    return list(specs)
+
+
+def _angle_outputs(res: Any, specs: list[str]) -> tuple[tuple[str, ...], np.ndarray,
+                                                        np.ndarray]:
+    """The transmission angles' nominal values (time, k) and derivatives (time, k,
+    n_params), as _linear_outputs gives the other outputs."""
+    args = [parse_measure(s)[1] for s in specs]
+    return (("time", "measure"), np.column_stack([res.transmission_angle(*a) for a in args]),
+            np.stack([res.transmission_angle_dp(*a) for a in args], axis=1))
+
+
 def _seed(seed: Any) -> int | None:
     """None, or the seed as a whole number >= 0 (else a ModelError)."""
     return None if seed is None else whole(seed, "seed", "tolerance", 0, 2**63 - 1)
@@ -235,7 +267,7 @@ def _sigma(model: ModelDescription, sigma: Any) -> tuple[list[Any], np.ndarray]:
 def tolerance(model: ModelDescription, sigma: Mapping[str, Any], analysis: str = "kinematics",
               samples: int = 200, client: Any = None, *, seed: int | None = 0,
               workers: int | None = None, progress: bool | None = None,
-              **analysis_kwargs: Any) -> ToleranceResult:
+              measures: Any = None, **analysis_kwargs: Any) -> ToleranceResult:
     """Standard deviation of every output of an analysis under independent parameter scatter,
     by first-order propagation of the exact sensitivities (S Sigma S^T) beside a Monte Carlo
     estimate.
@@ -257,6 +289,11 @@ def tolerance(model: ModelDescription, sigma: Mapping[str, Any], analysis: str =
         Seed of the random draws (default 0: reproducible; None: fresh entropy).
     workers, progress
         As :func:`mbd2d.sweep`.
+    measures : str or list of str, optional
+        Transmission angles (``transmission_angle:JOINT[:OUTPUT]``) to spread the scatter
+        into too: ``measures`` over ("time", "measure") with its statistics, first order
+        from the angle's exact derivatives (:meth:`KinematicsResult.transmission_angle_dp`),
+        Monte Carlo from the samples' own angles (not for statics).
     **analysis_kwargs
         The analysis's settings (``t_end``, ``steps``, ...).
 
@@ -292,12 +329,16 @@ def tolerance(model: ModelDescription, sigma: Mapping[str, Any], analysis: str =
     if n == 1:
         raise ModelError("samples must be 0 (no Monte Carlo estimate) or at least 2",
                          "tolerance")
+    specs = _angle_specs(measures, analysis)
     res, ran = _nominal(model, names, analysis, analysis_kwargs)
     outs = _linear_outputs(res, ran)
+    if specs:
+        outs["measures"] = _angle_outputs(res, specs)
     mc = None
     if n:
         mc = sweep(model, draws(model, params, sig, n, seed), analysis, client,
-                   workers=workers, progress=progress, **analysis_kwargs)
+                   workers=workers, progress=progress, measures=specs or None,
+                   **analysis_kwargs)
     ok = mc.status.values == 0 if mc is not None else np.zeros(0, dtype=bool)
     times = np.array([res.t]) if ran == "statics" else np.asarray(res.t)
     data: dict[str, Any] = {}
@@ -310,6 +351,8 @@ def tolerance(model: ModelDescription, sigma: Mapping[str, Any], analysis: str =
             data[f"{name}_mean_mc"] = (dims, vals.mean(axis=0) if len(vals) else
                                        np.full(nom.shape, np.nan))
     coords: dict[str, Any] = {"time": times, "coordinate": list(res.coordinate_names)}
+    if specs:
+        coords["measure"] = specs
     if "lam" in outs:
         coords["equation"] = list(res.row_labels)
     if "effort" in outs:
