@@ -66,8 +66,8 @@ def _command(rng: random.Random, tmp: Path) -> list[str]:
         argv += ["--workers", "1", "--out", str(tmp / rng.choice(["w.csv", "w.csv", "w.nc", "w.txt"]))]
         if rng.random() < 0.3:
             argv += ["--analysis", rng.choice(["statics", "inverse_dynamics", "dynamics"])]
-    if cmd in ("kinematics", "inverse-dynamics", "dynamics", "export", "plot", "sweep") and \
-            rng.random() < 0.5:
+    if cmd in ("kinematics", "inverse-dynamics", "dynamics", "export", "plot", "sweep",
+               "tolerance") and rng.random() < 0.5:
         for _ in range(rng.randint(1, 2)):
             argv += ["--measure", rng.choice(MEASURES)]
     if cmd == "plot" and rng.random() < 0.5:
