@@ -318,25 +318,6 @@ contains
         mu(k) = asin(max(zero, min(one, abs(d))))
       end if
     end do
-  contains
-    !> r_i + A(theta_i) s' (ground: s').
-    pure function point(bi, sl, qk) result(r)
-      integer, intent(in) :: bi
-      real(wp), intent(in) :: sl(2), qk(:)
-      real(wp) :: r(2)
-      r = sl
-      if (bi > 0) r = qk(3 * bi - 2:3 * bi - 1) + turned(bi, sl, qk)
-    end function point
-    !> A(theta_i) v' (ground: v').
-    pure function turned(bi, vl, qk) result(r)
-      integer, intent(in) :: bi
-      real(wp), intent(in) :: vl(2), qk(:)
-      real(wp) :: r(2), c, sn
-      r = vl
-      if (bi == 0) return
-      c = cos(qk(3 * bi)); sn = sin(qk(3 * bi))
-      r = [c * vl(1) - sn * vl(2), sn * vl(1) + c * vl(2)]
-    end function turned
   end subroutine api_link_angle
 
   !> Every measure of a list at each state: vals(j, k) is measure j at state k. Measure j
@@ -478,24 +459,6 @@ contains
       end do
     end do
   contains
-    !> r_i + A(theta_i) s' (ground: s').
-    pure function point(bi, sl, qk) result(r)
-      integer, intent(in) :: bi
-      real(wp), intent(in) :: sl(2), qk(:)
-      real(wp) :: r(2)
-      r = sl
-      if (bi > 0) r = qk(3 * bi - 2:3 * bi - 1) + turned(bi, sl, qk)
-    end function point
-    !> A(theta_i) v' (ground: v').
-    pure function turned(bi, vl, qk) result(r)
-      integer, intent(in) :: bi
-      real(wp), intent(in) :: vl(2), qk(:)
-      real(wp) :: r(2), cc, sn
-      r = vl
-      if (bi == 0) return
-      cc = cos(qk(3 * bi)); sn = sin(qk(3 * bi))
-      r = [cc * vl(1) - sn * vl(2), sn * vl(1) + cc * vl(2)]
-    end function turned
     !> d(r + A s') = dr + B s' dtheta + A ds' along parameter k at state j (ground: ds').
     function dpoint(bi, sl, dsl) result(r)
       integer, intent(in) :: bi
@@ -517,6 +480,26 @@ contains
           dth * [-sn * vl(1) - cc * vl(2), cc * vl(1) - sn * vl(2)]
     end function dturned
   end subroutine api_link_angle_dp
+
+  !> A point fixed in body bi at state qk: r_i + A(theta_i) s' (ground: s').
+  pure function point(bi, sl, qk) result(r)
+    integer, intent(in) :: bi
+    real(wp), intent(in) :: sl(2), qk(:)
+    real(wp) :: r(2)
+    r = sl
+    if (bi > 0) r = qk(3 * bi - 2:3 * bi - 1) + turned(bi, sl, qk)
+  end function point
+
+  !> A vector fixed in body bi at state qk: A(theta_i) v' (ground: v').
+  pure function turned(bi, vl, qk) result(r)
+    integer, intent(in) :: bi
+    real(wp), intent(in) :: vl(2), qk(:)
+    real(wp) :: r(2), c, sn
+    r = vl
+    if (bi == 0) return
+    c = cos(qk(3 * bi)); sn = sin(qk(3 * bi))
+    r = [c * vl(1) - sn * vl(2), sn * vl(1) + c * vl(2)]
+  end function turned
 
   !> States and times finite and sized for the model.
   logical function check_states(m, q, t, nt, status, msg) result(good)
