@@ -253,7 +253,8 @@ def file_lines(model: ModelDescription, t_end: float | None = None, steps: int |
             col = dyn.ftab[:, k] if dyn.ftab[NFT - 1, k] else dyn.ftab[:NFT - 1, k]
             lines.append(f"{name} " + " ".join(str(int(v)) for v in col))
         lines += _reals("fparams", dyn.fpar)
-    lines += _measure_lines(model, p, measures, analysis, measure_refs)
+    # (the angles' derivatives need the params entries of their points: with sensitivities)
+    lines += _measure_lines(model, p, measures, analysis, measure_refs or bool(params))
     if params:
         ptab = table(p, params, dyn)
         lines.append(f"sensitivities {len(params)}")

@@ -14,7 +14,7 @@ from ..validate import vector
 from . import measures
 from .columns import derivative_names, motion_columns, require_sensitivities
 from .files import check_outputs, write_csv, writing
-from .measures import measure_columns
+from .measures import angle_derivative_columns, measure_columns
 from .points import PointResult
 from .sensitivities import LEVELS, body_columns, parameter_index
 
@@ -340,7 +340,9 @@ class KinematicsResult:
         ``velocity_ratio:INPUT:OUTPUT[:VIA]``, ``mechanical_advantage:INPUT:OUTPUT[:VIA]``,
         ``dead_centre_distance``, each named by its spec); with ``sensitivities=True`` (a
         run with ``sensitivities=[names]``), then for each parameter P in turn the
-        derivatives of the motion columns, ``d(NAME.x)/d(P)`` ... ``d(NAME.theta_ddot)/d(P)``.
+        derivatives of the motion columns, ``d(NAME.x)/d(P)`` ... ``d(NAME.theta_ddot)/d(P)``,
+        and of the transmission angles among the measures, ``d(transmission_angle:B)/d(P)``
+        (the other measures have no derivatives).
 
         A kinematic result has no optional columns (``energy``, ``multipliers``,
         ``reactions``, ``efforts`` need a DynamicsResult): asking for one is a ModelError.
@@ -349,7 +351,7 @@ class KinematicsResult:
         header, rows = self._motion_table()
         names, blocks = measure_columns(self, measures)
         if sensitivities:
-            dn, db = self._motion_derivatives("table")
+            dn, db = self._motion_derivatives("table", measures)
             names, blocks = names + dn, blocks + db
         return header + names, np.hstack([rows] + blocks)
 
@@ -367,15 +369,18 @@ class KinematicsResult:
         cols, block = motion_columns(self.body_names, levels)
         return derivative_names(cols, self.parameter_names[k]), block
 
-    def _motion_derivatives(self, what: str) -> tuple[list[str], list[np.ndarray]]:
-        """The sensitivity columns of the motion, parameter after parameter."""
+    def _motion_derivatives(self, what: str, measures: Any = None
+                            ) -> tuple[list[str], list[np.ndarray]]:
+        """The sensitivity columns of the motion, parameter after parameter, each followed
+        by those of the transmission angles among the measures."""
         require_sensitivities(self.dq_dp is not None, what)
+        angles = angle_derivative_columns(self, measures)
         names: list[str] = []
         blocks: list[np.ndarray] = []
         for k in range(len(self.parameter_names)):
             n, b = self._motion_derivative(k, what)
-            names += n
-            blocks.append(b)
+            names += n + derivative_names(angles[0], self.parameter_names[k])
+            blocks += [b, angles[1][:, :, k]]
         return names, blocks
 
     def _sensitivity_arrays(self, sensitivities: bool, what: str) -> dict[str, np.ndarray]:

@@ -389,6 +389,20 @@ def measure_tables(model: Any, p: Packed, specs: Any, moved: bool = False) -> Me
     return t
 
 
+def angle_derivative_columns(res: Any, specs: Any) -> tuple[list[str], np.ndarray]:
+    """The measures asked for that have design derivatives (the transmission angles) and
+    their derivatives (rows, k, n_params); none when the result has no sensitivities or no
+    such measure."""
+    if getattr(res, "dq_dp", None) is None:
+        return [], np.zeros((len(res.t), 0, 0))
+    angles = [(s, parse_measure(s)[1]) for s in measure_list(specs)
+              if parse_measure(s)[0] == "transmission_angle"]
+    if not angles:
+        return [], np.zeros((len(res.t), 0, res.dq_dp.shape[2]))
+    return ([s for s, _ in angles],
+            np.stack([transmission_angle_dp(res, *a) for _, a in angles], axis=1))
+
+
 def measure_columns(res: Any, specs: Any) -> tuple[list[str], list[np.ndarray]]:
     """The table columns of the measures asked for (see :func:`measure_list`): named by
     their specs."""
