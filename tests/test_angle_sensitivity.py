@@ -159,3 +159,16 @@ def test_table_columns_and_mbd2d_solve(tmp_path, model, cmd, extra):
     for name in names:
         got = rows[:, header.index(f"d(transmission_angle:B)/d({name})")]
         assert_allclose(got, central(mu_fourbar, FOURBAR[name], t, 1e-4), atol=1e-8)
+
+
+def test_npz_carries_the_derivatives(tmp_path):
+    m = mbd2d.load(EX / "fourbar_grashof.toml")
+    names = ["joint.O4.points.1.0", "joint.B.points.1.0"]
+    res = m.kinematics(1.0, 24, sensitivities=names, tol=1e-14)
+    res.to_npz(tmp_path / "r.npz", measures=["transmission_angle:B", "dead_centre_distance"])
+    with np.load(tmp_path / "r.npz") as z:
+        assert list(z["dmeasure_names"]) == ["transmission_angle:B"]
+        assert z["dmeasures_dp"].shape == (25, 1, 2)
+        for k, name in enumerate(names):
+            assert_allclose(z["dmeasures_dp"][:, 0, k],
+                            central(mu_fourbar, FOURBAR[name], res.t, 1e-4), atol=1e-8)

@@ -395,11 +395,17 @@ class KinematicsResult:
         return out
 
     def _measure_arrays(self, specs: Any) -> dict[str, np.ndarray]:
-        """The measures for an .npz: ``measures`` (n, k) and ``measure_names``."""
+        """The measures for an .npz: ``measures`` (n, k) and ``measure_names``; after a run
+        with sensitivities also the transmission angles' derivatives ``dmeasures_dp`` (n,
+        k_angles, n_params) and their ``dmeasure_names``."""
         names, cols = measure_columns(self, specs)
         if not names:
             return {}
-        return {"measures": np.hstack(cols), "measure_names": np.array(names)}
+        out = {"measures": np.hstack(cols), "measure_names": np.array(names)}
+        angles, d = angle_derivative_columns(self, specs)
+        if angles:
+            out.update(dmeasures_dp=d, dmeasure_names=np.array(angles))
+        return out
 
     def to_csv(self, path: str | Path, **outputs: bool) -> None:
         """Write the CSV (the columns of :meth:`table`; every number with 17 significant
@@ -413,7 +419,8 @@ class KinematicsResult:
         NumPy .npz archive; after a run with ``sensitivities=[names]`` also ``dq_dp``,
         ``dqd_dp``, ``dqdd_dp`` (n, n_coordinates, n_params) and ``parameter_names``; with
         ``measures=[specs]`` (as :meth:`table`) ``measures`` (n, n_measures) and
-        ``measure_names``."""
+        ``measure_names`` (and with sensitivities the transmission angles' ``dmeasures_dp``
+        (n, n_angles, n_params) with ``dmeasure_names``)."""
         check_outputs(outputs, (), "to_npz")
         motion = {k: v for k, v in (("q", self.q), ("qd", self.qd), ("qdd", self.qdd))
                   if v is not None}
