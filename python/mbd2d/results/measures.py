@@ -214,9 +214,7 @@ def transmission_angle_dp(res: Any, joint: Any, output: Any = None) -> np.ndarra
     require_sensitivities(getattr(res, "dq_dp", None) is not None, "transmission_angle")
     kind, items = _angle_items(res.model, joint, output)
     bodies, points = _recipe([(b, pt) for b, pt, _ in items])
-    p = packed_of(res)
-    params = find(res.model, [f"{n}.{i}" for _, _, n in items for i in (0, 1)], "measures")
-    pref = np.asfortranarray(parameter_table(p, params)[1].reshape(3, 2).T)
+    pref = np.asfortranarray(_angle_refs(res.model, packed_of(res), items))
     q, _ = _states(res)
     sq = np.asfortranarray(np.transpose(res.dq_dp, (1, 2, 0)))
     out = core.link_angle_dp(q, sq, kind, bodies, points, pref, res.ptab)
@@ -287,6 +285,13 @@ def _angle_items(model: Any, joint: Any, output: Any = None
             return 2, first + [(index[owner], axis, name)]
     raise ModelError(f"the output link {out!r} neither turns about a second revolute joint "
                      "nor slides in a translational joint", entry)
+
+
+def _angle_refs(model: Any, p: Packed, items: list[tuple[int, Any, str]]) -> np.ndarray:
+    """The raw-parameter entries (2, 3; 1-based) of the x and y of an angle's three points
+    (_angle_items)."""
+    params = find(model, [f"{n}.{i}" for _, _, n in items for i in (0, 1)], "measures")
+    return parameter_table(p, params)[1].reshape(3, 2).T
 
 
 def _recipe(items: list[tuple[int, Any]]) -> tuple[np.ndarray, np.ndarray]:
@@ -379,9 +384,7 @@ def measure_tables(model: Any, p: Packed, specs: Any, moved: bool = False) -> Me
                 t.mint[1 + k, j] = b
                 t.mpts[:, k, j] = [float(v) for v in pt]
             if moved:
-                params = find(model, [f"{n}.{i}" for _, _, n in items for i in (0, 1)],
-                              "measures")
-                t.mref[:, :, j] = parameter_table(p, params)[1].reshape(3, 2).T
+                t.mref[:, :, j] = _angle_refs(model, p, items)
         elif name != "dead_centre_distance":
             ref, qx, qy = ratio_recipe(model, p, *args)
             t.mint[:, j] = [ref + 1, QUANTITY_KINDS[qx[0]], qx[1] + 1, QUANTITY_KINDS[qy[0]],
@@ -395,8 +398,8 @@ def angle_derivative_columns(res: Any, specs: Any) -> tuple[list[str], np.ndarra
     such measure."""
     if getattr(res, "dq_dp", None) is None:
         return [], np.zeros((len(res.t), 0, 0))
-    angles = [(s, parse_measure(s)[1]) for s in measure_list(specs)
-              if parse_measure(s)[0] == "transmission_angle"]
+    parsed = [(s, *parse_measure(s)) for s in measure_list(specs)]
+    angles = [(s, args) for s, name, args in parsed if name == "transmission_angle"]
     if not angles:
         return [], np.zeros((len(res.t), 0, res.dq_dp.shape[2]))
     return ([s for s, _ in angles],

@@ -28,7 +28,7 @@ from ..analysis.settings import check_memory
 from ..description.builder import ModelDescription
 from ..description.parameters import find
 from ..errors import ModelError
-from ..results.measures import measure_list, parse_measure
+from ..results.measures import angle_derivative_columns, measure_list, parse_measure
 from ..validate import number, vector, whole
 from .dataset import xarray
 from .plan import (ANALYSES, _bind, _dynamics_settings, _inverse_settings,
@@ -217,7 +217,7 @@ def _angle_outputs(res: Any, specs: list[str]) -> tuple[tuple[str, ...], np.ndar
     n_params), as _linear_outputs gives the other outputs."""
     args = [parse_measure(s)[1] for s in specs]
     return (("time", "measure"), np.column_stack([res.transmission_angle(*a) for a in args]),
-            np.stack([res.transmission_angle_dp(*a) for a in args], axis=1))
+            angle_derivative_columns(res, specs)[1])
 
 
 def _seed(seed: Any) -> int | None:
