@@ -255,22 +255,26 @@ subroutine core_link_angle(nq, nt, q, kind, b, s, mu, status, msg)
   call api_link_angle(q, kind, b, s, mu, status, msg)
 end subroutine core_link_angle
 
-! The transmission angle's design derivatives dmu (npar, nt) from the states q, their
-! sensitivities sq (nq, npar, nt), the recipe (kind, b, s) and the rpar entries of its points
-! (pref, 0 none) against the parameter table ptab (2, npar).
-subroutine core_link_angle_dp(nq, nt, npar, q, sq, kind, b, s, pref, ptab, dmu, status, msg)
+! Every measure of a list (kind, mint, spts, pref as api_measures takes them) and its design
+! derivatives at the states q (nq, nt) with their sensitivities sq (nq, npar, nt) against the
+! parameter table ptab (2, npar): vals (nm, nt), dvals (nm, npar, nt), bad (measure,
+! quantity).
+subroutine core_measures_dp(nb, nc, ctab, np, rpar, nq, nt, q, sq, t, nm, kind, mint, spts, &
+                            pref, npar, ptab, vals, dvals, bad, status, msg)
   use iso_c_binding, only: c_double, c_int
-  use mbd_measures, only: api_link_angle_dp
+  use mbd_measures, only: api_measures
   implicit none
-  integer(c_int), intent(in) :: nq, nt, npar, kind
-  integer(c_int), intent(in) :: b(3), pref(2, 3), ptab(2, npar)
-  real(c_double), intent(in) :: q(nq, nt), sq(nq, npar, nt), s(2, 3)
-  real(c_double), intent(out) :: dmu(npar, nt)
-  integer(c_int), intent(out) :: status
+  integer(c_int), intent(in) :: nb, nc, np, nq, nt, nm, npar
+  integer(c_int), intent(in) :: ctab(8, nc), kind(nm), mint(5, nm), pref(2, 3, nm)
+  integer(c_int), intent(in) :: ptab(2, npar)
+  real(c_double), intent(in) :: rpar(np), q(nq, nt), sq(nq, npar, nt), t(nt), spts(2, 3, nm)
+  real(c_double), intent(out) :: vals(nm, nt), dvals(nm, npar, nt)
+  integer(c_int), intent(out) :: bad(2), status
   character(len=512), intent(out) :: msg
-  !f2py intent(hide) :: nq, nt, npar
-  call api_link_angle_dp(q, sq, kind, b, s, pref, ptab, dmu, status, msg)
-end subroutine core_link_angle_dp
+  !f2py intent(hide) :: nc, np, nq, nt, nm, npar
+  call api_measures(nb, ctab, rpar, q, t, kind, mint, spts, pref, vals, bad, status, msg, &
+                    ptab, sq, dvals)
+end subroutine core_measures_dp
 
 subroutine core_fun_values(np, p, nt, t, f, f1, f2, status, msg)
   use iso_c_binding, only: c_double, c_int

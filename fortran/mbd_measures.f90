@@ -38,7 +38,8 @@ module mbd_measures
   use mbd_kinds, only: wp, zero, one
   use mbd_status, only: MBD_OK, MBD_BAD_COUNT, MBD_BAD_PARAM, MSG_LEN
   use mbd_model, only: model_t, model_build
-  use mbd_assemble, only: asm_work_t, asm_init, assemble_dense
+  use mbd_assemble, only: asm_work_t, asm_init, assemble_dense, scatter_dense
+  use mbd_sensitivity, only: sens_t, sens_setup, sens_trig, sens_eval_d, block_apply
   use mbd_memory, only: mem_fail, REAL_BYTES
   use mbd_linsolve, only: lapack_status, lu_factor, lu_solve, qr_factor, qr_solve, qr_lwork
   use mbd_lapack, only: dgesvd
@@ -61,8 +62,10 @@ module mbd_measures
 
 contains
 
-  !> sigma_min / sigma_max of the column-scaled J (core units) at each state.
-  subroutine api_conditioning(nb, ctab, rpar, q, t, cond, status, msg)
+  !> sigma_min / sigma_max of the column-scaled J (core units) at each state; with the
+  !! parameter table ptab (2, np) and the states' sensitivities sq (nq, np, nt; model units),
+  !! also its design derivatives dcond (np, nt) (see the banner: conditioning_dp).
+  subroutine api_conditioning(nb, ctab, rpar, q, t, cond, status, msg, ptab, sq, dcond)
     integer, intent(in) :: nb                   !! moving bodies
     integer, intent(in) :: ctab(:, :)           !! constraint table
     real(wp), intent(in) :: rpar(:)             !! raw parameters
@@ -71,26 +74,53 @@ contains
     real(wp), intent(out) :: cond(:)            !! sigma_min / sigma_max (nt)
     integer, intent(out) :: status              !! MBD_OK, < 0 input, > 0 numerical
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    integer, intent(in), optional :: ptab(:, :)       !! (2, np) design parameters
+    real(wp), intent(in), optional :: sq(:, :, :)     !! dq/dp (nq, np, nt)
+    real(wp), intent(out), optional :: dcond(:, :)    !! dc/dp (np, nt)
     type(model_t) :: m
     type(asm_work_t) :: aw
+    type(sens_t) :: sens
     real(wp), allocatable :: phi(:), nu(:), gam(:), jac(:, :), qz(:), qc(:), sv(:), work(:)
-    real(wp) :: wq(1), du(1, 1), dvt(1, 1), cn
-    integer :: bad, k, c, info, lwork, ist, ns
+    real(wp), allocatable :: jt(:, :), us(:, :), vt(:, :), cns(:), dj(:, :), dq(:), &
+                             tphi(:), tnu(:), tgam(:)
+    real(wp) :: wq(1), cn, ds1, dsn
+    integer :: bad, k, c, info, lwork, ist, ns, kp, ldu, ldv
+    logical :: deriv
     cond = zero
+    deriv = present(ptab) .and. present(sq) .and. present(dcond)
+    if (deriv) dcond = zero
     call model_build(nb, ctab, rpar, m, status, msg, bad, nondim=.true.)
     if (status /= MBD_OK) return
     if (.not. check_states(m, q, t, size(cond), status, msg)) return
+    if (deriv) then
+      if (.not. check_sens(m, ctab, rpar, ptab, sq, size(t), size(dcond, 1) == size(ptab, 2) &
+                           .and. size(dcond, 2) == size(t), sens, status, msg)) return
+    end if
     ns = min(m%neq, m%nq)
+    if (ns == 0) return                         ! no constraint: nothing to be singular
+    ldu = 1; ldv = 1
+    if (deriv) then
+      ldu = m%neq; ldv = max(ns, 1)
+    end if
     allocate (phi(m%neq), nu(m%neq), gam(m%neq), jac(m%neq, m%nq), qz(m%nq), qc(m%nq), &
-              sv(max(ns, 1)), stat=ist)
+              sv(max(ns, 1)), cns(m%nq), us(ldu, max(ns, 1)), vt(ldv, m%nq), stat=ist)
+    if (ist == 0 .and. deriv) &
+      allocate (jt(m%neq, m%nq), dj(m%neq, m%nq), dq(m%nq), tphi(m%neq), tnu(m%neq), &
+                tgam(m%neq), stat=ist)
     if (ist /= 0) then
       call no_memory(m, status, msg); return
     end if
     call asm_init(m, aw, status, msg)
     if (status /= MBD_OK) return
     qz = zero
-    call dgesvd('N', 'N', m%neq, m%nq, jac, m%neq, sv, du, 1, dvt, 1, wq, -1, info)
+    ! the values by singular values alone, with or without derivatives (the same numbers);
+    ! the derivatives with the vectors, from a copy
+    call dgesvd('N', 'N', m%neq, m%nq, jac, m%neq, sv, us, 1, vt, 1, wq, -1, info)
     lwork = max(1, int(wq(1)))
+    if (deriv) then
+      call dgesvd('S', 'S', m%neq, m%nq, jac, m%neq, sv, us, ldu, vt, ldv, wq, -1, info)
+      lwork = max(lwork, int(wq(1)))
+    end if
     allocate (work(lwork), stat=ist)
     if (ist /= 0) then
       call no_memory(m, status, msg); return
@@ -101,19 +131,46 @@ contains
       ! columns to unit length: J D, D = diag(1/|J_k|)
       do c = 1, m%nq
         cn = norm2(jac(:, c))
-        if (cn > zero) jac(:, c) = jac(:, c) / cn
+        cns(c) = zero
+        if (cn > zero) then
+          jac(:, c) = jac(:, c) / cn; cns(c) = cn
+        end if
       end do
-      call dgesvd('N', 'N', m%neq, m%nq, jac, m%neq, sv, du, 1, dvt, 1, work, lwork, info)
+      if (deriv) jt = jac
+      call dgesvd('N', 'N', m%neq, m%nq, jac, m%neq, sv, us, 1, vt, 1, work, lwork, info)
       call lapack_status('dgesvd', info, status, msg)
       if (status /= MBD_OK) return
-      if (sv(1) > zero) cond(k) = sv(ns) / sv(1)
+      if (.not. sv(1) > zero) cycle
+      cond(k) = sv(ns) / sv(1)
+      if (.not. deriv) cycle
+      jac = jt
+      call dgesvd('S', 'S', m%neq, m%nq, jac, m%neq, sv, us, ldu, vt, ldv, work, lwork, info)
+      call lapack_status('dgesvd', info, status, msg)
+      if (status /= MBD_OK) return
+      call sens_trig(m, sens, qc)
+      do kp = 1, size(ptab, 2)
+        ! dJ along q' and p' (per unit p' = p dp'/dp), then d(J D) column by column
+        dq = sq(:, kp, k) / (m%cunit * sens%pscale(kp))
+        call sens_eval_d(m, sens, kp, qc, qz, dq, qz, t(k), tphi, tnu, tgam, aw%jb)
+        call scatter_dense(aw, dj)
+        do c = 1, m%nq
+          if (cns(c) > zero) dj(:, c) = (dj(:, c) - jt(:, c) * dot_product(jt(:, c), &
+                                         dj(:, c))) / cns(c)
+        end do
+        ds1 = bilinear(us(:, 1), dj, vt(1, :))          ! dsigma_i = u_i^T d(J D) v_i
+        dsn = bilinear(us(:, ns), dj, vt(ns, :))
+        dcond(kp, k) = (dsn * sv(1) - sv(ns) * ds1) / sv(1)**2 * sens%pscale(kp)
+      end do
     end do
   end subroutine api_conditioning
 
   !> Influence coefficients u = dq/ds of the quantity driven by row r at each state:
   !! J u = e_r (model units: u(i) per unit of row r's quantity). ok(k) = 0 where J is
-  !! singular (the quantity cannot be changed there: a dead centre of that driver).
-  subroutine api_influence(nb, ctab, rpar, q, t, r, u, ok, status, msg)
+  !! singular (the quantity cannot be changed there: a dead centre of that driver). With the
+  !! parameter table ptab (2, np) and the states' sensitivities sq (nq, np, nt), also their
+  !! design derivatives du (nq, np, nt): J du = -(dJ) u, dJ = J_q dq/dp + J_p on dual
+  !! numbers (sens_eval_d), J's factors reused.
+  subroutine api_influence(nb, ctab, rpar, q, t, r, u, ok, status, msg, ptab, sq, du)
     integer, intent(in) :: nb                   !! moving bodies
     integer, intent(in) :: ctab(:, :)           !! constraint table
     real(wp), intent(in) :: rpar(:)             !! raw parameters
@@ -124,14 +181,22 @@ contains
     integer, intent(out) :: ok(:)               !! 1 solved, 0 singular J (nt)
     integer, intent(out) :: status              !! MBD_OK, < 0 input, > 0 numerical
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    integer, intent(in), optional :: ptab(:, :)       !! (2, np) design parameters
+    real(wp), intent(in), optional :: sq(:, :, :)     !! dq/dp (nq, np, nt)
+    real(wp), intent(out), optional :: du(:, :, :)    !! du/dp (nq, np, nt)
     type(model_t) :: m
     type(asm_work_t) :: aw
-    real(wp), allocatable :: phi(:), nu(:), gam(:), jac(:, :), qz(:), b(:), tau(:), work(:)
+    type(sens_t) :: sens
+    real(wp), allocatable :: phi(:), nu(:), gam(:), jac(:, :), qz(:), b(:), tau(:), work(:), &
+                             dq(:), w(:), tphi(:), tnu(:), tgam(:)
     integer, allocatable :: ipiv(:), jpvt(:)
     real(wp) :: resid
-    integer :: bad, k, ist, st
+    integer :: bad, k, ist, st, kp
+    logical :: deriv
     character(len=MSG_LEN) :: lmsg
     u = zero; ok = 0
+    deriv = present(ptab) .and. present(sq) .and. present(du)
+    if (deriv) du = zero
     call model_build(nb, ctab, rpar, m, status, msg, bad)
     if (status /= MBD_OK) return
     if (.not. check_states(m, q, t, size(ok), status, msg)) return
@@ -146,8 +211,14 @@ contains
       msg = 'fewer equations than coordinates: the motion is not determined by the drivers'
       return
     end if
+    if (deriv) then
+      if (.not. check_sens(m, ctab, rpar, ptab, sq, size(t), size(du, 1) == m%nq .and. &
+                           size(du, 2) == size(ptab, 2) .and. size(du, 3) == size(t), &
+                           sens, status, msg)) return
+    end if
     allocate (phi(m%neq), nu(m%neq), gam(m%neq), jac(m%neq, m%nq), qz(m%nq), b(m%neq), &
-              ipiv(m%nq), jpvt(m%nq), tau(m%nq), work(qr_lwork(m%neq, m%nq)), stat=ist)
+              ipiv(m%nq), jpvt(m%nq), tau(m%nq), work(qr_lwork(m%neq, m%nq)), dq(m%nq), &
+              w(m%neq), tphi(m%neq), tnu(m%neq), tgam(m%neq), stat=ist)
     if (ist /= 0) then
       call no_memory(m, status, msg); return
     end if
@@ -157,20 +228,40 @@ contains
     do k = 1, size(t)
       call assemble_dense(m, q(:, k), qz, t(k), phi, nu, gam, aw, jac)
       b = zero; b(r) = one                      ! J u = e_r
-      if (m%neq == m%nq) then
-        call lu_factor(jac, ipiv, st, lmsg)
-        if (st == MBD_OK) call lu_solve(jac, ipiv, b, st, lmsg)
-        if (st == MBD_OK) u(:, k) = b(1:m%nq)
-      else
-        call qr_factor(jac, jpvt, tau, work, st, lmsg)
-        if (st == MBD_OK) call qr_solve(jac, jpvt, tau, b, u(:, k), resid, work)
-      end if
+      call solve(u(:, k), .true.)
       if (st == MBD_OK .and. all(ieee_is_finite(u(:, k)))) then
         ok(k) = 1
       else
-        u(:, k) = zero
+        u(:, k) = zero; cycle
       end if
+      if (.not. deriv) cycle
+      call sens_trig(m, sens, q(:, k))
+      do kp = 1, size(ptab, 2)                  ! J du = -(J_q dq + J_p) u
+        dq = sq(:, kp, k) / (m%cunit * sens%pscale(kp))
+        call sens_eval_d(m, sens, kp, q(:, k), qz, dq, qz, t(k), tphi, tnu, tgam, aw%jb)
+        call block_apply(m, aw%jb, u(:, k), w)
+        b = -w
+        call solve(du(:, kp, k), .false.)
+        du(:, kp, k) = du(:, kp, k) * sens%pscale(kp)
+        if (st /= MBD_OK) du(:, kp, k) = zero
+      end do
     end do
+  contains
+    !> x from J x = b: factor J first (first) or reuse its factors.
+    subroutine solve(x, first)
+      real(wp), intent(out) :: x(:)
+      logical, intent(in) :: first
+      if (m%neq == m%nq) then
+        st = MBD_OK
+        if (first) call lu_factor(jac, ipiv, st, lmsg)
+        if (st == MBD_OK) call lu_solve(jac, ipiv, b, st, lmsg)
+        x = b(1:m%nq)
+      else
+        st = MBD_OK; x = zero
+        if (first) call qr_factor(jac, jpvt, tau, work, st, lmsg)
+        if (st == MBD_OK) call qr_solve(jac, jpvt, tau, b, x, resid, work)
+      end if
+    end subroutine solve
   end subroutine api_influence
 
   !> The velocity ratio dY/dX (RATIO_VELOCITY; inf where J is singular for the driver) or
@@ -179,8 +270,13 @@ contains
   !! coordinate, 1 for the driver of row ref itself, 0 for another driver (held); where only
   !! the denominator vanishes, +-inf with the numerator's sign; where both do, the singular
   !! value. A coordinate that does not move with the driver (|u_X| <= 1e-12 max |u|
-  !! throughout) has no ratio: MBD_BAD_PARAM with bad = 1 (X) or 2 (Y).
-  subroutine api_ratio(nb, ctab, rpar, q, t, kind, ref, x, y, ratio, bad, status, msg)
+  !! throughout) has no ratio: MBD_BAD_PARAM with bad = 1 (X) or 2 (Y). With the parameter
+  !! table ptab (2, np) and the states' sensitivities sq (nq, np, nt), also the design
+  !! derivatives dratio (np, nt) by the quotient rule on du/dp (api_influence): where the
+  !! denominator vanishes, +-inf with the sign of the numerator's (0 where that is zero too);
+  !! where J is singular, +inf (no derivative).
+  subroutine api_ratio(nb, ctab, rpar, q, t, kind, ref, x, y, ratio, bad, status, msg, ptab, &
+                       sq, dratio)
     integer, intent(in) :: nb                   !! moving bodies
     integer, intent(in) :: ctab(:, :)           !! constraint table
     real(wp), intent(in) :: rpar(:)             !! raw parameters
@@ -193,11 +289,20 @@ contains
     integer, intent(out) :: bad                 !! 1 or 2: the quantity that does not move
     integer, intent(out) :: status              !! MBD_OK, < 0 input, > 0 numerical
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
-    real(wp), allocatable :: u(:, :), dx(:), dy(:)
+    integer, intent(in), optional :: ptab(:, :)       !! (2, np) design parameters
+    real(wp), intent(in), optional :: sq(:, :, :)     !! dq/dp (nq, np, nt)
+    real(wp), intent(out), optional :: dratio(:, :)   !! (np, nt)
+    real(wp), allocatable :: u(:, :), dx(:), dy(:), du(:, :, :), ddx(:, :), ddy(:, :)
     integer, allocatable :: ok(:)
-    real(wp) :: scale, num, den, sing
-    integer :: k, ist
+    real(wp) :: scale, num, den, sing, dnum, dden, top
+    integer :: k, ist, np, kp
+    logical :: deriv
     ratio = zero; bad = 0
+    deriv = present(ptab) .and. present(sq) .and. present(dratio)
+    np = 0
+    if (deriv) then
+      dratio = zero; np = size(ptab, 2)
+    end if
     if ((kind /= RATIO_VELOCITY .and. kind /= RATIO_ADVANTAGE) .or. &
         any([x(1), y(1)] < QTY_COORDINATE) .or. any([x(1), y(1)] > QTY_DRIVER) .or. &
         size(ratio) /= size(t) .or. any([x(2), y(2)] < 1)) then
@@ -207,18 +312,28 @@ contains
         (y(1) == QTY_COORDINATE .and. y(2) > size(q, 1))) then
       status = MBD_BAD_COUNT; msg = 'ratio: a coordinate beyond the model'; return
     end if
-    allocate (u(size(q, 1), size(t)), ok(size(t)), dx(size(t)), dy(size(t)), stat=ist)
+    if (deriv) then
+      if (size(dratio, 1) /= np .or. size(dratio, 2) /= size(t)) then
+        status = MBD_BAD_COUNT; msg = 'ratio: array sizes do not match'; return
+      end if
+    end if
+    allocate (u(size(q, 1), size(t)), ok(size(t)), dx(size(t)), dy(size(t)), &
+              du(size(q, 1), np, size(t)), ddx(np, size(t)), ddy(np, size(t)), stat=ist)
     if (ist /= 0) then
-      call mem_fail(REAL_BYTES * (real(size(q, 1), wp) + 3) * size(t), 'the influence '// &
-                    'coefficients', 'keep fewer rows', status, msg)
+      call mem_fail(REAL_BYTES * (real(size(q, 1), wp) + 3) * (np + 1) * size(t), &
+                    'the influence coefficients', 'keep fewer rows', status, msg)
       return
     end if
-    call api_influence(nb, ctab, rpar, q, t, ref, u, ok, status, msg)
+    if (deriv) then
+      call api_influence(nb, ctab, rpar, q, t, ref, u, ok, status, msg, ptab, sq, du)
+    else
+      call api_influence(nb, ctab, rpar, q, t, ref, u, ok, status, msg)
+    end if
     if (status /= MBD_OK) return
     scale = zero
     if (size(u) > 0) scale = maxval(abs(u))
-    call rate(x, dx, 1)
-    if (bad == 0) call rate(y, dy, 2)
+    call rate(x, dx, ddx, 1)
+    if (bad == 0) call rate(y, dy, ddy, 2)
     if (bad /= 0) then
       status = MBD_BAD_PARAM
       msg = 'the quantity does not move with the driver (its influence coefficient is zero '// &
@@ -231,19 +346,34 @@ contains
       den = merge(dx(k), dy(k), kind == RATIO_VELOCITY)
       if (ok(k) /= 1 .or. (den == zero .and. num == zero)) then
         ratio(k) = sing
+        if (deriv) dratio(:, k) = ieee_value(zero, ieee_positive_inf)
+        cycle
       else if (den == zero) then
         ratio(k) = ieee_copy_sign(ieee_value(zero, ieee_positive_inf), num)
       else
         ratio(k) = num / den
       end if
+      do kp = 1, np                             ! d(n/d) = (dn d - n dd) / d**2
+        dnum = merge(ddy(kp, k), ddx(kp, k), kind == RATIO_VELOCITY)
+        dden = merge(ddx(kp, k), ddy(kp, k), kind == RATIO_VELOCITY)
+        top = dnum * den - num * dden
+        if (den /= zero) then
+          dratio(kp, k) = top / den**2
+        else if (top /= zero) then
+          dratio(kp, k) = ieee_copy_sign(ieee_value(zero, ieee_positive_inf), top)
+        end if
+      end do
     end do
   contains
-    !> dQ/ds of quantity qq; bad = which when a coordinate does not move at all.
-    subroutine rate(qq, d, which)
+    !> dQ/ds of quantity qq and its design derivatives; bad = which when a coordinate does
+    !! not move at all.
+    subroutine rate(qq, d, dd, which)
       integer, intent(in) :: qq(2), which
-      real(wp), intent(out) :: d(:)
+      real(wp), intent(out) :: d(:), dd(:, :)
+      dd = zero
       if (qq(1) == QTY_COORDINATE) then
         d = u(qq(2), :)
+        if (deriv) dd = du(qq(2), :, :)
         if (.not. (size(d) > 0 .and. maxval(abs(d)) > 1.0e-12_wp * scale)) bad = which
       else
         d = merge(one, zero, qq(2) == ref)
@@ -327,8 +457,12 @@ contains
   !! MEAS_RATIO, MEAS_ADVANTAGE the driver's row, X's kind and index, Y's kind and index
   !! (api_ratio); MEAS_CONDITIONING none (api_conditioning). On a failure the rest of vals
   !! is zero, bad(1) names the measure and bad(2) a ratio's quantity that does not move
-  !! (1 X, 2 Y; else 0).
-  subroutine api_measures(nb, ctab, rpar, q, t, kind, mint, spts, pref, vals, bad, status, msg)
+  !! (1 X, 2 Y; else 0). With the parameter table ptab (2, np) and the states'
+  !! sensitivities sq (nq, np, nt; model units), also every measure's design derivatives
+  !! dvals(j, :, k) (np) at state k (an angle's points move with the parameters that are
+  !! their entries pref).
+  subroutine api_measures(nb, ctab, rpar, q, t, kind, mint, spts, pref, vals, bad, status, &
+                          msg, ptab, sq, dvals)
     integer, intent(in) :: nb                   !! moving bodies
     integer, intent(in) :: ctab(:, :)           !! constraint table
     real(wp), intent(in) :: rpar(:)             !! raw parameters
@@ -342,30 +476,48 @@ contains
     integer, intent(out) :: bad(2)              !! the failing measure, a ratio's quantity
     integer, intent(out) :: status              !! MBD_OK, < 0 input, > 0 numerical
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
-    real(wp), allocatable :: col(:)
+    integer, intent(in), optional :: ptab(:, :)       !! (2, np) design parameters
+    real(wp), intent(in), optional :: sq(:, :, :)     !! dq/dp (nq, np, nt)
+    real(wp), intent(out), optional :: dvals(:, :, :) !! (nm, np, nt)
+    real(wp), allocatable :: col(:), dcol(:, :)
     real(wp) :: s(2, 3)
-    integer :: j, ist, i, l
+    integer :: j, ist, i, l, np
+    logical :: deriv
     vals = zero; bad = 0; status = MBD_OK; msg = ''
+    deriv = present(ptab) .and. present(sq) .and. present(dvals)
+    np = 0
+    if (deriv) then
+      dvals = zero; np = size(ptab, 2)
+    end if
     if (size(mint, 1) /= 5 .or. size(mint, 2) /= size(kind) .or. &
         any(shape(spts) /= [2, 3, size(kind)]) .or. any(shape(pref) /= shape(spts)) .or. &
         size(vals, 1) /= size(kind) .or. size(vals, 2) /= size(t)) then
       status = MBD_BAD_COUNT; msg = 'measures: array sizes do not match'; return
     end if
+    if (deriv) then
+      if (any(shape(dvals) /= [size(kind), np, size(t)])) then
+        status = MBD_BAD_COUNT; msg = 'measures: array sizes do not match'; return
+      end if
+    end if
     if (any(pref < 0) .or. any(pref > size(rpar))) then
       status = MBD_BAD_PARAM; msg = 'measures: a point''s entry is beyond the parameters'
       return
     end if
-    allocate (col(size(t)), stat=ist)
+    allocate (col(size(t)), dcol(np, size(t)), stat=ist)
     if (ist /= 0) then
-      call mem_fail(REAL_BYTES * size(t), 'a measure''s column', 'keep fewer rows', status, &
-                    msg)
+      call mem_fail(REAL_BYTES * size(t) * (np + 1), 'a measure''s column', 'keep fewer rows', &
+                    status, msg)
       return
     end if
     do j = 1, size(kind)
       bad(1) = j
       select case (kind(j))
       case (MEAS_CONDITIONING)
-        call api_conditioning(nb, ctab, rpar, q, t, col, status, msg)
+        if (deriv) then
+          call api_conditioning(nb, ctab, rpar, q, t, col, status, msg, ptab, sq, dcol)
+        else
+          call api_conditioning(nb, ctab, rpar, q, t, col, status, msg)
+        end if
       case (MEAS_ANGLE)
         s = spts(:, :, j)
         do l = 1, 3
@@ -374,17 +526,29 @@ contains
           end do
         end do
         call api_link_angle(q, mint(1, j), mint(2:4, j), s, col, status, msg)
+        if (deriv .and. status == MBD_OK) &
+          call api_link_angle_dp(q, sq, mint(1, j), mint(2:4, j), s, pref(:, :, j), ptab, &
+                                 dcol, status, msg)
       case (MEAS_RATIO, MEAS_ADVANTAGE)
-        call api_ratio(nb, ctab, rpar, q, t, merge(RATIO_VELOCITY, RATIO_ADVANTAGE, &
-                       kind(j) == MEAS_RATIO), mint(1, j), mint(2:3, j), mint(4:5, j), col, &
-                       bad(2), status, msg)
+        if (deriv) then
+          call api_ratio(nb, ctab, rpar, q, t, merge(RATIO_VELOCITY, RATIO_ADVANTAGE, &
+                         kind(j) == MEAS_RATIO), mint(1, j), mint(2:3, j), mint(4:5, j), col, &
+                         bad(2), status, msg, ptab, sq, dcol)
+        else
+          call api_ratio(nb, ctab, rpar, q, t, merge(RATIO_VELOCITY, RATIO_ADVANTAGE, &
+                         kind(j) == MEAS_RATIO), mint(1, j), mint(2:3, j), mint(4:5, j), col, &
+                         bad(2), status, msg)
+        end if
       case default
         status = MBD_BAD_PARAM; msg = 'measures: unknown kind'
       end select
       if (status /= MBD_OK) then
-        vals = zero; return
+        vals = zero
+        if (deriv) dvals = zero
+        return
       end if
       vals(j, :) = col
+      if (deriv) dvals(j, :, :) = dcol
     end do
     bad = 0
   end subroutine api_measures
@@ -500,6 +664,45 @@ contains
     c = cos(qk(3 * bi)); sn = sin(qk(3 * bi))
     r = [c * vl(1) - sn * vl(2), sn * vl(1) + c * vl(2)]
   end function turned
+
+  !> x^T A y.
+  pure real(wp) function bilinear(x, a, y) result(r)
+    real(wp), intent(in) :: x(:), a(:, :), y(:)   !! (m), (m, n), (n)
+    integer :: i, j
+    r = zero
+    do j = 1, size(a, 2)
+      do i = 1, size(a, 1)
+        r = r + x(i) * a(i, j) * y(j)
+      end do
+    end do
+  end function bilinear
+
+  !> A measure's derivative inputs fit the model (ptab (2, np), sq (nq, np, nt) finite, and
+  !! its output: fits) and the sensitivity tables are set up (sens_setup).
+  logical function check_sens(m, ctab, rpar, ptab, sq, nt, fits, sens, status, msg) &
+      result(good)
+    type(model_t), intent(in) :: m              !! model
+    integer, intent(in) :: ctab(:, :)           !! constraint table
+    real(wp), intent(in) :: rpar(:)             !! raw parameters
+    integer, intent(in) :: ptab(:, :)           !! (2, np) design parameters
+    real(wp), intent(in) :: sq(:, :, :)         !! dq/dp (nq, np, nt)
+    integer, intent(in) :: nt                   !! states
+    logical, intent(in) :: fits                 !! the output's shape is right
+    type(sens_t), intent(out) :: sens           !! the parameters' tables
+    integer, intent(out) :: status              !! MBD_OK or < 0
+    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    integer :: bad
+    good = .false.
+    if (.not. fits .or. size(ptab, 1) /= 2 .or. size(sq, 1) /= m%nq .or. &
+        size(sq, 2) /= size(ptab, 2) .or. size(sq, 3) /= nt) then
+      status = MBD_BAD_COUNT; msg = 'measure derivatives: array sizes do not match'; return
+    end if
+    if (.not. all(ieee_is_finite(sq))) then
+      status = MBD_BAD_PARAM; msg = 'the sensitivities must be finite'; return
+    end if
+    call sens_setup(m, ctab, rpar, ptab, sens, status, msg, bad)
+    good = status == MBD_OK
+  end function check_sens
 
   !> States and times finite and sized for the model.
   logical function check_states(m, q, t, nt, status, msg) result(good)

@@ -28,7 +28,7 @@ program mbd2d_solve
   use mbd_memory, only: REAL_BYTES, mem_check
   use mbd_mbdfile, only: mbd_spec_t, mbd_read, NAME_LEN, MEAS_ANGLE, MEAS_RATIO, &
                          MEAS_ADVANTAGE
-  use mbd_measures, only: api_measures, api_link_angle_dp
+  use mbd_measures, only: api_measures
   use mbd_model, only: NFT
   use mbd_constraints, only: con_nrow, con_is_driver
   use mbd_api, only: NINFO, api_sizes, api_kinematics, api_inverse, api_dynamics, api_statics, &
@@ -68,8 +68,7 @@ program mbd2d_solve
   character(len=4 * MSG_LEN), allocatable :: cmsg(:)
   integer :: code = 0, nrow = 0, nd = 0, nlam = 0   !! batch analysis, rows, rows of q_dot, lambda
   real(wp), allocatable :: mvals(:, :)                !! the measures (nmeas, rows written)
-  !> with sensitivities: the transmission angles' derivatives (nmeas, npar, rows written;
-  !! the other measures' entries unused)
+  !> with sensitivities: the measures' design derivatives (nmeas, npar, rows written)
   real(wp), allocatable :: mdp(:, :, :)
   !> the run's status when sensitivities turn non-finite (rows cut there, exit code 4)
   integer, parameter :: NONFINITE = 100
@@ -338,42 +337,28 @@ contains
   end subroutine bad_measure
 
   !> The measures at the rows written (the core, as the Python path's table): the
-  !! conditioning of J, the transmission angle, and the ratios of influence coefficients.
+  !! conditioning of J, the transmission angle, and the ratios of influence coefficients;
+  !! with sensitivities also their design derivatives (the d(SPEC)/d(P) columns).
   subroutine eval_measures()
     integer :: st, bad(2)
     if (spec%nmeas == 0 .or. nout == 0) return
-    allocate (mvals(spec%nmeas, nout), stat=ierr)
+    allocate (mvals(spec%nmeas, nout), mdp(spec%nmeas, spec%npar, nout), stat=ierr)
     if (ierr /= 0) call die(2, 'not enough memory for the measures; give fewer steps')
-    call api_measures(spec%nb, spec%ctab, spec%rpar, qout(:, 1:nout), tout(1:nout), &
-                      spec%meas_kind, spec%meas_int, spec%meas_pts, spec%meas_ref, mvals, bad, &
-                      st, msg)
-    if (st == MBD_OK) then
-      call angle_derivatives()
-      return
+    if (sens) then
+      call api_measures(spec%nb, spec%ctab, spec%rpar, qout(:, 1:nout), tout(1:nout), &
+                        spec%meas_kind, spec%meas_int, spec%meas_pts, spec%meas_ref, mvals, &
+                        bad, st, msg, spec%ptab, sq(:, :, 1:nout), mdp)
+    else
+      call api_measures(spec%nb, spec%ctab, spec%rpar, qout(:, 1:nout), tout(1:nout), &
+                        spec%meas_kind, spec%meas_int, spec%meas_pts, spec%meas_ref, mvals, &
+                        bad, st, msg)
     end if
+    if (st == MBD_OK) return
     if (bad(2) /= 0) call die(2, 'measure "' // trim(spec%meas_names(bad(1))) // '": ' // &
                               trim(msg))
     call die(4, 'measure "' // trim(spec%meas_names(max(1, bad(1)))) // &
              '" could not be computed: ' // trim(msg))
   end subroutine eval_measures
-
-  !> With sensitivities, the transmission angles' derivatives at the rows written (the core,
-  !! as the Python path's d(SPEC)/d(P) columns).
-  subroutine angle_derivatives()
-    integer :: j, st
-    if (.not. sens) return
-    allocate (mdp(spec%nmeas, spec%npar, nout), stat=ierr)
-    if (ierr /= 0) call die(2, 'not enough memory for the measures; give fewer steps')
-    mdp = 0.0_wp
-    do j = 1, spec%nmeas
-      if (spec%meas_kind(j) /= MEAS_ANGLE) cycle
-      call api_link_angle_dp(qout(:, 1:nout), sq(:, :, 1:nout), spec%meas_int(1, j), &
-                             spec%meas_int(2:4, j), spec%meas_pts(:, :, j), &
-                             spec%meas_ref(:, :, j), spec%ptab, mdp(j, :, :), st, msg)
-      if (st /= MBD_OK) call die(4, 'measure "' // trim(spec%meas_names(j)) // &
-                                 '": its derivatives could not be computed: ' // trim(msg))
-    end do
-  end subroutine angle_derivatives
 
   !> Keep the rows before the first one with a non-finite sensitivity (as the Python path:
   !! no result leaves with a non-finite number); status NONFINITE when rows are cut.
@@ -538,8 +523,8 @@ contains
     do j = 1, spec%npar
       call motion_header(u, ios, j)
       if (lam_sens) call lam_header(u, ios, j)
-      do c = 1, spec%nmeas               ! the transmission angles' derivatives
-        if (spec%meas_kind(c) == MEAS_ANGLE) call put_col(u, ios, trim(spec%meas_names(c)), j)
+      do c = 1, spec%nmeas               ! the measures' derivatives
+        call put_col(u, ios, trim(spec%meas_names(c)), j)
       end do
     end do
     if (ios == 0) write (u, '(a)', iostat=ios) ''
@@ -671,10 +656,9 @@ contains
           call lam_values(slam(:, j, k), none, v, n)
         end if
       end if
-      do c = 1, spec%nmeas
-        if (spec%meas_kind(c) /= MEAS_ANGLE) cycle
-        v(n + 1) = mdp(c, j, k); n = n + 1
-      end do
+      if (spec%nmeas > 0) then
+        v(n + 1:n + spec%nmeas) = mdp(:, j, k); n = n + spec%nmeas
+      end if
     end do
   end subroutine row_values
 

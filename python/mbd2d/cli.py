@@ -463,11 +463,15 @@ def _tolerance_report(tol: Any, points: list[tuple[str, Any]]) -> str:
             else "  (Monte Carlo: fewer than 2 samples completed)"
         lines.append(f"  {name:24s} {lin[k]:.3g} at t = {t[k]:.6g}{beside}")
     if "measures" in ds:
-        lines.append("transmission angles, largest first-order standard deviation [deg]:")
+        lines.append("measures, largest first-order standard deviation (angles in deg):")
         for j, spec in enumerate(str(m) for m in ds["measure"].values):
-            lin = np.degrees(ds.measures_std_linear.values[:, j])
-            k = int(np.nanargmax(lin))
-            mc = (f"  (Monte Carlo {np.degrees(ds.measures_std_mc.values[k, j]):.3g})"
+            unit = np.degrees if spec.startswith("transmission_angle") else np.asarray
+            lin = unit(ds.measures_std_linear.values[:, j])
+            if not np.any(np.isfinite(lin)):
+                lines.append(f"  {spec:24s} no finite value (a dead centre throughout)")
+                continue
+            k = int(np.nanargmax(np.where(np.isfinite(lin), lin, np.nan)))
+            mc = (f"  (Monte Carlo {unit(ds.measures_std_mc.values[k, j]):.3g})"
                   if "measures_std_mc" in ds else "")
             lines.append(f"  {spec:24s} {lin[k]:.3g} at t = {t[k]:.6g}{mc}")
     return "\n".join(lines)

@@ -186,17 +186,17 @@ def link_angle(q: np.ndarray, kind: int, bodies: np.ndarray, points: np.ndarray
                   numbers=q.shape[1])
 
 
-def link_angle_dp(q: np.ndarray, sq: np.ndarray, kind: int, bodies: np.ndarray,
-                  points: np.ndarray, pref: np.ndarray, ptab: np.ndarray) -> SimpleNamespace:
-    """The transmission angle's design derivatives at states q (nq, nt) with their
-    sensitivities sq (nq, np, nt), the recipe of :func:`link_angle`, the rpar entries of its
-    points pref (2, 3; 0 none) and the parameter table ptab (2, np): ``dmu`` (np, nt),
+def measures_dp(p: Packed, q: np.ndarray, sq: np.ndarray, t: np.ndarray, m: MeasureTables,
+                ptab: np.ndarray) -> SimpleNamespace:
+    """Every measure of the tables m (as a sweep's, the angles' points with their entries)
+    and its design derivatives at states q (nq, nt) with their sensitivities sq (nq, np, nt)
+    against the parameter table ptab (2, np): ``vals`` (nm, nt), ``dvals`` (nm, np, nt),
+    ``bad`` (the failing measure, a ratio's quantity that does not move; 1-based),
     ``status``, ``msg``."""
-    return _named("dmu status msg", _core.core_link_angle_dp, q,
-                  np.asfortranarray(sq, dtype=float), int(kind),
-                  np.asarray(bodies, dtype=np.int32), np.asfortranarray(points, dtype=float),
-                  np.asfortranarray(pref, dtype=np.int32),
-                  np.asfortranarray(ptab, dtype=np.int32), numbers=sq.shape[1] * q.shape[1])
+    return _named("vals dvals bad status msg", _core.core_measures_dp, p.nb, p.ctab, p.rpar, q,
+                  np.asfortranarray(sq, dtype=float), t, m.kind, m.mint, m.mpts, m.mref,
+                  np.asfortranarray(ptab, dtype=np.int32),
+                  numbers=len(m.kind) * (sq.shape[1] + 1) * q.shape[1])
 
 
 def fun_values(p: np.ndarray, t: np.ndarray) -> SimpleNamespace:

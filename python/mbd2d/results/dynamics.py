@@ -13,7 +13,7 @@ from .contacts import (ContactEvent, ContactHistory, FrictionEvent, FrictionHist
 from .columns import constraint_columns, derivative_names
 from .files import check_outputs, writing
 from .kinematics import KinematicsResult
-from .measures import angle_derivative_columns, measure_columns
+from .measures import measure_columns, measure_derivative_columns
 from .reactions import Reaction, reaction_arrays, reaction_of
 from .sensitivities import parameter_index, reaction_dp_arrays, reaction_dp_of
 
@@ -197,7 +197,7 @@ class DynamicsResult(KinematicsResult):
         With ``sensitivities=True`` (a run with ``sensitivities=[names]``) then, for each
         parameter P in turn, ``d(COLUMN)/d(P)`` of the motion columns and, when the run has
         the multipliers' sensitivities (inverse dynamics), of the multiplier, reaction and
-        effort columns asked for, then of the transmission angles among the measures.
+        effort columns asked for, then of the measures.
 
         ``mbd2d-solve`` writes the same columns for an exported file (``outputs``).
         """
@@ -242,12 +242,12 @@ class DynamicsResult(KinematicsResult):
                             measures: Any = None) -> tuple[list[str], list[np.ndarray]]:
         """The sensitivity columns, parameter after parameter: the motion's, then (with
         the multipliers' sensitivities) those of the multiplier, reaction and effort
-        columns asked for, then those of the transmission angles among the measures."""
+        columns asked for, then those of the measures."""
         lam_columns = self.dlam_dp is not None and (multipliers or reactions or efforts)
         if not lam_columns:
             return self._motion_derivatives("table", measures)
         dreac = self._reaction_dp_arrays()[0] if reactions else None
-        angles = angle_derivative_columns(self, measures)
+        meas = measure_derivative_columns(self, measures)
         names: list[str] = []
         blocks: list[np.ndarray] = []
         for k, prm in enumerate(self.parameter_names):
@@ -255,8 +255,8 @@ class DynamicsResult(KinematicsResult):
             cn, cb = self._constraint_columns(self.dlam_dp[:, :, k],
                                               None if dreac is None else dreac[..., k],
                                               multipliers, efforts)
-            names += mn + derivative_names(cn, prm) + derivative_names(angles[0], prm)
-            blocks += [mb] + cb + [angles[1][:, :, k]]
+            names += mn + derivative_names(cn, prm) + derivative_names(meas[0], prm)
+            blocks += [mb] + cb + [meas[1][:, :, k]]
         return names, blocks
 
     def to_npz(self, path: str | Path, reactions: bool = False, efforts: bool = False,

@@ -14,7 +14,7 @@ from ..validate import vector
 from . import measures
 from .columns import derivative_names, motion_columns, require_sensitivities
 from .files import check_outputs, write_csv, writing
-from .measures import angle_derivative_columns, measure_columns
+from .measures import measure_columns, measure_derivative_columns
 from .points import PointResult
 from .sensitivities import LEVELS, body_columns, parameter_index
 
@@ -297,6 +297,55 @@ class KinematicsResult:
         """
         return measures.dead_centre_distance(self)
 
+    def velocity_ratio_dp(self, input: str, output: str, via: str | None = None
+                          ) -> np.ndarray:
+        """The velocity ratio's exact derivatives along the design parameters of a run with
+        ``sensitivities=[...]``: (rows, n_params) in ``parameter_names`` order. The core
+        differentiates the influence coefficients, J du/dp = -(J_q dq/dp + J_p) u with J's
+        factors reused, and the ratio by the quotient rule. Quantities and ``via`` as in
+        :meth:`velocity_ratio`; +-inf where the input stands still, inf where J is singular.
+
+        Raises
+        ------
+        ModelError
+            Without sensitivities, or as :meth:`velocity_ratio`.
+
+        Examples
+        --------
+        >>> import mbd2d
+        >>> m = mbd2d.load("examples/fourbar_grashof.toml")
+        >>> res = m.kinematics(1.0, 4, sensitivities=["joint.O4.points.1.0"])
+        >>> res.velocity_ratio_dp("motor", "rocker.theta").shape
+        (5, 1)
+        """
+        return measures.measure_dp(self, measures.spec_of("velocity_ratio", input, output,
+                                                          via))
+
+    def mechanical_advantage_dp(self, input: str, output: str, via: str | None = None
+                                ) -> np.ndarray:
+        """The mechanical advantage's exact design derivatives (rows, n_params), as
+        :meth:`velocity_ratio_dp` (+-inf where the output stands still).
+
+        Raises
+        ------
+        ModelError
+            Without sensitivities, or as :meth:`mechanical_advantage`.
+        """
+        return measures.measure_dp(self, measures.spec_of("mechanical_advantage", input,
+                                                          output, via))
+
+    def dead_centre_distance_dp(self) -> np.ndarray:
+        """The dead-centre distance's exact design derivatives (rows, n_params): with the
+        column-scaled J D = U S V^T, d sigma_i = u_i^T d(J D) v_i along the motion's
+        sensitivities and the parameters (the core; an SVD with vectors per output).
+
+        Raises
+        ------
+        ModelError
+            Without sensitivities.
+        """
+        return measures.measure_dp(self, "dead_centre_distance")
+
     # ------------------------------------------------------------------ pictures
     def plot(self, times: Any = None, trace: Any = None, forces: bool = False,
              **kwargs: Any) -> Any:
@@ -341,8 +390,8 @@ class KinematicsResult:
         ``dead_centre_distance``, each named by its spec); with ``sensitivities=True`` (a
         run with ``sensitivities=[names]``), then for each parameter P in turn the
         derivatives of the motion columns, ``d(NAME.x)/d(P)`` ... ``d(NAME.theta_ddot)/d(P)``,
-        and of the transmission angles among the measures, ``d(transmission_angle:B)/d(P)``
-        (the other measures have no derivatives).
+        and of the measures, ``d(transmission_angle:B)/d(P)`` ... (their exact design
+        derivatives, :func:`mbd2d.results.measures.measure_derivatives`).
 
         A kinematic result has no optional columns (``energy``, ``multipliers``,
         ``reactions``, ``efforts`` need a DynamicsResult): asking for one is a ModelError.
@@ -372,15 +421,15 @@ class KinematicsResult:
     def _motion_derivatives(self, what: str, measures: Any = None
                             ) -> tuple[list[str], list[np.ndarray]]:
         """The sensitivity columns of the motion, parameter after parameter, each followed
-        by those of the transmission angles among the measures."""
+        by those of the measures."""
         require_sensitivities(self.dq_dp is not None, what)
-        angles = angle_derivative_columns(self, measures)
+        meas = measure_derivative_columns(self, measures)
         names: list[str] = []
         blocks: list[np.ndarray] = []
         for k in range(len(self.parameter_names)):
             n, b = self._motion_derivative(k, what)
-            names += n + derivative_names(angles[0], self.parameter_names[k])
-            blocks += [b, angles[1][:, :, k]]
+            names += n + derivative_names(meas[0], self.parameter_names[k])
+            blocks += [b, meas[1][:, :, k]]
         return names, blocks
 
     def _sensitivity_arrays(self, sensitivities: bool, what: str) -> dict[str, np.ndarray]:
@@ -396,15 +445,15 @@ class KinematicsResult:
 
     def _measure_arrays(self, specs: Any) -> dict[str, np.ndarray]:
         """The measures for an .npz: ``measures`` (n, k) and ``measure_names``; after a run
-        with sensitivities also the transmission angles' derivatives ``dmeasures_dp`` (n,
-        k_angles, n_params) and their ``dmeasure_names``."""
+        with sensitivities also their derivatives ``dmeasures_dp`` (n, k, n_params) and
+        ``dmeasure_names`` (the same names)."""
         names, cols = measure_columns(self, specs)
         if not names:
             return {}
         out = {"measures": np.hstack(cols), "measure_names": np.array(names)}
-        angles, d = angle_derivative_columns(self, specs)
-        if angles:
-            out.update(dmeasures_dp=d, dmeasure_names=np.array(angles))
+        dnames, d = measure_derivative_columns(self, specs)
+        if dnames:
+            out.update(dmeasures_dp=d, dmeasure_names=np.array(dnames))
         return out
 
     def to_csv(self, path: str | Path, **outputs: bool) -> None:
@@ -419,8 +468,8 @@ class KinematicsResult:
         NumPy .npz archive; after a run with ``sensitivities=[names]`` also ``dq_dp``,
         ``dqd_dp``, ``dqdd_dp`` (n, n_coordinates, n_params) and ``parameter_names``; with
         ``measures=[specs]`` (as :meth:`table`) ``measures`` (n, n_measures) and
-        ``measure_names`` (and with sensitivities the transmission angles' ``dmeasures_dp``
-        (n, n_angles, n_params) with ``dmeasure_names``)."""
+        ``measure_names`` (and with sensitivities their ``dmeasures_dp``
+        (n, k, n_params) with ``dmeasure_names``)."""
         check_outputs(outputs, (), "to_npz")
         motion = {k: v for k, v in (("q", self.q), ("qd", self.qd), ("qdd", self.qdd))
                   if v is not None}

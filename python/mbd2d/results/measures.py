@@ -212,15 +212,9 @@ def transmission_angle_dp(res: Any, joint: Any, output: Any = None) -> np.ndarra
         If the result has no sensitivities, or as :func:`transmission_angle`.
     """
     require_sensitivities(getattr(res, "dq_dp", None) is not None, "transmission_angle")
-    kind, items = _angle_items(res.model, joint, output)
-    bodies, points = _recipe([(b, pt) for b, pt, _ in items])
-    pref = np.asfortranarray(_angle_refs(res.model, packed_of(res), items))
-    q, _ = _states(res)
-    sq = np.asfortranarray(np.transpose(res.dq_dp, (1, 2, 0)))
-    out = core.link_angle_dp(q, sq, kind, bodies, points, pref, res.ptab)
-    if out.status != OK:
-        raise error_for("measures", out.status, out.msg, entry="transmission_angle")
-    return np.asarray(out.dmu, dtype=float).T.copy()
+    _angle_items(res.model, joint, output)          # the joint's own errors first
+    args = [joint] if output is None else [joint, output]
+    return measure_dp(res, ":".join(["transmission_angle", *args]))
 
 
 def angle_recipe(model: Any, joint: Any, output: Any = None
@@ -392,18 +386,69 @@ def measure_tables(model: Any, p: Packed, specs: Any, moved: bool = False) -> Me
     return t
 
 
-def angle_derivative_columns(res: Any, specs: Any) -> tuple[list[str], np.ndarray]:
-    """The measures asked for that have design derivatives (the transmission angles) and
-    their derivatives (rows, k, n_params); none when the result has no sensitivities or no
-    such measure."""
+def spec_of(name: str, x: Any, y: Any, via: Any = None) -> str:
+    """The spec of a ratio measure from its quantities' names (each checked to be text).
+
+    Raises
+    ------
+    ModelError
+        If a name is not text.
+    """
+    for what, v in (("input", x), ("output", y), ("via", via)):
+        if not isinstance(v, str) and not (what == "via" and v is None):
+            raise ModelError(f"{what} must be a driver name or a coordinate name, got {v!r}",
+                             what)
+    return ":".join([name, x, y] + ([] if via is None else [via]))
+
+
+def measure_dp(res: Any, spec: str) -> np.ndarray:
+    """The exact design derivatives (rows, n_params) of the measure spec (see
+    :func:`parse_measure`) from the result's sensitivities, by the core (see
+    :func:`measure_derivatives`).
+
+    Raises
+    ------
+    ModelError
+        If the result has no sensitivities, or as :func:`measure` raises for the spec.
+    """
+    return measure_derivatives(res, [spec])[:, 0, :]
+
+
+def measure_derivatives(res: Any, specs: Any) -> np.ndarray:
+    """The exact design derivatives (rows, k, n_params) of the k measures asked for (see
+    :func:`measure_list`) from the result's sensitivities dq/dp, by the core in one call
+    (``api_measures``): a transmission angle along the motion and along its own points where
+    a parameter is one; a velocity ratio or mechanical advantage by the quotient rule on
+    the influence coefficients' derivatives (J du/dp = -(J_q dq/dp + J_p) u); the dead-centre
+    distance from its singular values' (dsigma = u^T d(J D) v). Where a ratio's denominator
+    or sin(mu) vanishes: +-inf.
+
+    Raises
+    ------
+    ModelError
+        If the result has no sensitivities, or as :func:`measure` raises for a spec.
+    """
+    require_sensitivities(getattr(res, "dq_dp", None) is not None, "measures")
+    p = packed_of(res)
+    tables = measure_tables(res.model, p, specs, moved=True)
+    q, t = _states(res)
+    if not tables.specs:
+        return np.zeros((len(t), 0, res.dq_dp.shape[2]))
+    sq = np.transpose(res.dq_dp, (1, 2, 0))
+    out = core.measures_dp(p, q, sq, t, tables, res.ptab)
+    if out.status != OK:
+        raise measure_failure(res.model, p, tables.specs[max(int(out.bad[0]), 1) - 1],
+                              int(out.status), out.msg, int(out.bad[1]))
+    return np.transpose(np.asarray(out.dvals, dtype=float), (2, 0, 1)).copy()
+
+
+def measure_derivative_columns(res: Any, specs: Any) -> tuple[list[str], np.ndarray]:
+    """The measures asked for and their design derivatives (rows, k, n_params)
+    (:func:`measure_derivatives`); none when the result has no sensitivities."""
     if getattr(res, "dq_dp", None) is None:
         return [], np.zeros((len(res.t), 0, 0))
-    parsed = [(s, *parse_measure(s)) for s in measure_list(specs)]
-    angles = [(s, args) for s, name, args in parsed if name == "transmission_angle"]
-    if not angles:
-        return [], np.zeros((len(res.t), 0, res.dq_dp.shape[2]))
-    return ([s for s, _ in angles],
-            np.stack([transmission_angle_dp(res, *a) for _, a in angles], axis=1))
+    specs = measure_list(specs)
+    return list(specs), measure_derivatives(res, specs)
 
 
 def measure_columns(res: Any, specs: Any) -> tuple[list[str], list[np.ndarray]]:

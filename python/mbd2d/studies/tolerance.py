@@ -28,7 +28,7 @@ from ..analysis.settings import check_memory
 from ..description.builder import ModelDescription
 from ..description.parameters import find
 from ..errors import ModelError
-from ..results.measures import angle_derivative_columns, measure_list, parse_measure
+from ..results.measures import measure, measure_derivatives, measure_list, parse_measure
 from ..validate import number, vector, whole
 from .dataset import xarray
 from .plan import (ANALYSES, _bind, _dynamics_settings, _inverse_settings,
@@ -189,35 +189,29 @@ def _linear_outputs(res: Any, ran: str) -> dict[str, tuple[tuple[str, ...], np.n
     return out
 
 
-def _angle_specs(measures: Any, analysis: str) -> list[str]:
-    """The transmission angles asked for (the measures with exact design derivatives).
+def _measure_specs(measures: Any, analysis: str) -> list[str]:
+    """The measures asked for (each has exact design derivatives).
 
     Raises
     ------
     ModelError
-        For another measure, a malformed spec, or measures of statics.
+        For a malformed spec, or measures of statics.
     """
     specs = measure_list(measures)
     for spec in specs:
-        name, _ = parse_measure(spec)
-        if name != "transmission_angle":
-            raise ModelError(f"the tolerance of {spec!r}: only transmission angles have exact "
-                             "design derivatives (the ratios and the dead-centre distance have "
-                             "none); run their Monte Carlo estimate as mbd2d.sweep(..., "
-                             "measures=[...]) of mbd2d.tolerance_samples(...)", "tolerance")
+        parse_measure(spec)
     if specs and analysis == "statics":
         raise ModelError("measures are columns of a run over time, not of statics",
                          "tolerance")
     return list(specs)
 
 
-def _angle_outputs(res: Any, specs: list[str]) -> tuple[tuple[str, ...], np.ndarray,
-                                                        np.ndarray]:
-    """The transmission angles' nominal values (time, k) and derivatives (time, k,
-    n_params), as _linear_outputs gives the other outputs."""
-    args = [parse_measure(s)[1] for s in specs]
-    return (("time", "measure"), np.column_stack([res.transmission_angle(*a) for a in args]),
-            angle_derivative_columns(res, specs)[1])
+def _measure_outputs(res: Any, specs: list[str]) -> tuple[tuple[str, ...], np.ndarray,
+                                                          np.ndarray]:
+    """The measures' nominal values (time, k) and derivatives (time, k, n_params), as
+    _linear_outputs gives the other outputs."""
+    return (("time", "measure"), np.column_stack([measure(res, s) for s in specs]),
+            measure_derivatives(res, specs))
 
 
 def _seed(seed: Any) -> int | None:
@@ -290,10 +284,12 @@ def tolerance(model: ModelDescription, sigma: Mapping[str, Any], analysis: str =
     workers, progress
         As :func:`mbd2d.sweep`.
     measures : str or list of str, optional
-        Transmission angles (``transmission_angle:JOINT[:OUTPUT]``) to spread the scatter
-        into too: ``measures`` over ("time", "measure") with its statistics, first order
-        from the angle's exact derivatives (:meth:`KinematicsResult.transmission_angle_dp`),
-        Monte Carlo from the samples' own angles (not for statics).
+        Mechanism measures (``transmission_angle:JOINT[:OUTPUT]``,
+        ``velocity_ratio:INPUT:OUTPUT[:VIA]``, ``mechanical_advantage:INPUT:OUTPUT[:VIA]``,
+        ``dead_centre_distance``) to spread the scatter into too: ``measures`` over
+        ("time", "measure") with its statistics, first order from the measures' exact
+        design derivatives (:func:`mbd2d.results.measures.measure_derivatives`), Monte Carlo
+        from the samples' own measures (not for statics).
     **analysis_kwargs
         The analysis's settings (``t_end``, ``steps``, ...).
 
@@ -329,11 +325,11 @@ def tolerance(model: ModelDescription, sigma: Mapping[str, Any], analysis: str =
     if n == 1:
         raise ModelError("samples must be 0 (no Monte Carlo estimate) or at least 2",
                          "tolerance")
-    specs = _angle_specs(measures, analysis)
+    specs = _measure_specs(measures, analysis)
     res, ran = _nominal(model, names, analysis, analysis_kwargs)
     outs = _linear_outputs(res, ran)
     if specs:
-        outs["measures"] = _angle_outputs(res, specs)
+        outs["measures"] = _measure_outputs(res, specs)
     mc = None
     if n:
         mc = sweep(model, draws(model, params, sig, n, seed), analysis, client,
