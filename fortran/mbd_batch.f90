@@ -55,10 +55,11 @@ contains
   !! Design sensitivities (ptab (2, np) as mbd_sensitivity takes it, with sq, sqd, sqdd
   !! (nq, np, rows, ncase) and slam (neq or 0, np, rows, ncase); not with positions-only
   !! kinematics; dynamics by dopri5): each case's, as a single run of its tables gives them.
+  !! With both, mdout gets the measures' design derivatives (api_measures).
   subroutine batch_run(analysis, nb, ctab, rpar, bmass, grav, ftab, fpar, q0, v0, vtab, vals, &
                        opens, iset, rset, qout, qdout, qddout, lamout, eout, iinfo, rinfo, &
                        qsing, dep, redundant, status, msg, times, mkind, mint, mpts, mref, &
-                       mout, mbad, ptab, sq, sqd, sqdd, slam)
+                       mout, mbad, ptab, sq, sqd, sqdd, slam, mdout)
     integer, intent(in) :: analysis             !! BATCH_KINEMATICS ... BATCH_DYNAMICS
     integer, intent(in) :: nb                   !! moving bodies
     integer, intent(in) :: ctab(:, :), ftab(:, :)  !! constraint and force tables
@@ -88,11 +89,14 @@ contains
     !! dlambda/dp (inverse dynamics, statics)
     real(wp), intent(out), optional, contiguous :: sq(:, :, :, :), sqd(:, :, :, :), &
                                                    sqdd(:, :, :, :), slam(:, :, :, :)
+    !> (nm, np, rows, ncase) the measures' design derivatives (with measures and
+    !! sensitivities), at the rows whose states and sensitivities are finite
+    real(wp), intent(out), optional :: mdout(:, :, :, :)
     real(wp), allocatable :: r(:), bm(:, :), fp(:), phi(:), jac(:, :), nu(:), gam(:), zq(:)
     real(wp), allocatable :: eo(:, :, :)      ! element outputs of a dynamics case (not kept)
     real(wp) :: g(2), tpass(MAXPASS), resid, evo(4, 1)
     integer :: c, k, nq, neq, ncase, st, bad, stable, ierr, nev, nr, mb(2)
-    logical :: meas, sens
+    logical :: meas, sens, dmeas
     character(len=MSG_LEN) :: lmsg
     qout = zero; qdout = zero; qddout = zero; lamout = zero; eout = zero
     iinfo = 0; rinfo = zero; qsing = zero; dep = 0; redundant = 0
@@ -110,6 +114,8 @@ contains
       sq = zero; sqd = zero; sqdd = zero; slam = zero
       sens = size(ptab, 2) > 0
     end if
+    dmeas = meas .and. sens .and. present(mdout)
+    if (dmeas) mdout = zero
     call check(st, lmsg)
     if (st /= MBD_OK) then
       status = st; msg = lmsg; return
@@ -152,10 +158,19 @@ contains
         nr = 0
         do while (nr < min(iinfo(1, c), size(qout, 2)))
           if (.not. all(ieee_is_finite(qout(:, nr + 1, c)))) exit
+          if (dmeas) then
+            if (.not. all(ieee_is_finite(sq(:, :, nr + 1, c)))) exit
+          end if
           nr = nr + 1
         end do
-        call api_measures(nb, ctab, r, qout(:, 1:nr, c), times(1:nr), mkind, mint, mpts, &
-                          mref, mout(:, 1:nr, c), mb, st, lmsg)
+        if (dmeas) then
+          call api_measures(nb, ctab, r, qout(:, 1:nr, c), times(1:nr), mkind, mint, mpts, &
+                            mref, mout(:, 1:nr, c), mb, st, lmsg, ptab, sq(:, :, 1:nr, c), &
+                            mdout(:, :, 1:nr, c))
+        else
+          call api_measures(nb, ctab, r, qout(:, 1:nr, c), times(1:nr), mkind, mint, mpts, &
+                            mref, mout(:, 1:nr, c), mb, st, lmsg)
+        end if
         if (st /= MBD_OK) then
           mbad(:, c) = [st, mb]
           if (status(c) == MBD_OK) msg(c) = lmsg
@@ -276,6 +291,11 @@ contains
             size(mout, 1) /= size(mkind) .or. size(mout, 2) /= nrow .or. &
             size(mout, 3) /= ncase .or. size(mbad, 1) /= 3 .or. size(mbad, 2) /= ncase) then
           text = 'batch: measure arrays do not match'; return
+        end if
+      end if
+      if (dmeas) then
+        if (any(shape(mdout) /= [size(mkind), size(ptab, 2), nrow, ncase])) then
+          text = 'batch: measure derivative arrays do not match'; return
         end if
       end if
       st = MBD_OK

@@ -450,13 +450,14 @@ end subroutine core_dynamics_sens
 ! nm > 0 measures (mbd_measures: mkind, mint, mpts, mref, at the output times) go to mout
 ! (nm, nrow, ncase), their failures to mbad (3, ncase); with npar > 0 design parameters
 ! (ptab) their sensitivities to sq, sqd, sqdd (nq, npar, nrow, ncase) and slam (nsl = neq for
-! inverse dynamics and statics, else 0). The tables have nmp = max(nm, 1) and npp =
+! inverse dynamics and statics, else 0); with both, the measures' design derivatives to dmout
+! (nm, npar, nrow, ncase). The tables have nmp = max(nm, 1) and npp =
 ! max(npar, 1) columns (f2py takes no zero-length table).
 subroutine core_batch(analysis, nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp, fpar, nq, &
                       q0, v0, nv, vtab, ncase, vals, no, opens, iset, rset, neq, nrow, nd, &
                       nlam, ne, times, nm, nmp, mkind, mint, mpts, mref, npar, npp, ptab, nsl, &
                       qout, qdout, qddout, lamout, eout, iinfo, rinfo, qsing, dep, redundant, &
-                      mout, mbad, sq, sqd, sqdd, slam, status, msg)
+                      mout, mbad, sq, sqd, sqdd, slam, dmout, status, msg)
   use iso_c_binding, only: c_double, c_int
   use mbd_batch, only: batch_run
   use mbd_status, only: MBD_BAD_INPUT
@@ -473,6 +474,7 @@ subroutine core_batch(analysis, nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, n
   real(c_double), intent(out) :: eout(ne, nrow, ncase), mout(nm, nrow, ncase)
   real(c_double), intent(out) :: sq(nq, npar, nrow, ncase), sqd(nq, npar, nrow, ncase)
   real(c_double), intent(out) :: sqdd(nq, npar, nrow, ncase), slam(nsl, npar, nrow, ncase)
+  real(c_double), intent(out) :: dmout(nm, npar, nrow, ncase)
   integer(c_int), intent(out) :: iinfo(10, ncase), dep(neq, ncase), redundant(neq, ncase)
   integer(c_int), intent(out) :: mbad(3, ncase)
   real(c_double), intent(out) :: rinfo(10, ncase), qsing(nq, ncase)
@@ -483,6 +485,7 @@ subroutine core_batch(analysis, nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, n
   if (nm > nmp .or. npar > npp) then
     qout = 0; qdout = 0; qddout = 0; lamout = 0; eout = 0; mout = 0; sq = 0; sqd = 0
     sqdd = 0; slam = 0; iinfo = 0; dep = 0; redundant = 0; mbad = 0; rinfo = 0; qsing = 0
+    dmout = 0
     status = MBD_BAD_INPUT; msg = 'batch: more measures or parameters than their tables hold'
     return
   end if
@@ -491,7 +494,7 @@ subroutine core_batch(analysis, nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, n
                  opens, iset, rset, qout, qdout, qddout, lamout, eout, iinfo, rinfo, qsing, &
                  dep, redundant, status, msg, times, mkind(1:nm), mint(:, 1:nm), &
                  mpts(:, :, 1:nm), mref(:, :, 1:nm), mout, mbad, ptab(:, 1:npar), sq, sqd, &
-                 sqdd, slam)
+                 sqdd, slam, dmout)
 end subroutine core_batch
 ! Normal force of each cam joint on its follower at states q (nq, nt), times t and
 ! multipliers lam: fn(nc, nt), negative where the joint must pull the follower onto its profile.

@@ -17,6 +17,7 @@ References (no mbd2d):
 """
 from __future__ import annotations
 
+import csv
 import sys
 from pathlib import Path
 
@@ -235,3 +236,31 @@ def test_tolerance_of_the_velocity_ratio(tmp_path, capsys):
     header, rows = read_csv(out)
     lin = np.abs(central(ratio_fourbar, FOURBAR[name], rows[:, 0], 1e-4)) * sigma
     assert_allclose(rows[:, header.index(f"{RATIO}.std_linear")], lin, rtol=1e-6)
+
+
+def test_sweep_cases_carry_their_measures_derivatives(tmp_path):
+    """Each swept coupler length's ratio derivative against the loop closure at its own
+    lengths; every measure's equal to a single run of its own model; the CSV's columns."""
+    m = mbd2d.load(EX / "fourbar_grashof.toml")
+    values = np.array([-2.0, -1.75, -1.6])              # A on the coupler: b = 1.75 - x
+    names = ["joint.O4.points.1.0", "joint.B.points.1.0"]
+    specs = [RATIO, "transmission_angle:B", "dead_centre_distance", ADVANTAGE]
+    ds = mbd2d.sweep(m, {"joint.A.points.1.0": values}, t_end=1.0, steps=36, tol=1e-14,
+                     workers=1, sensitivities=names, measures=specs)
+    assert ds.dmeasures_dp.dims == ("case", "time", "measure", "parameter")
+    t = ds.time.values
+    for k, x in enumerate(values):
+        b = 1.75 - x
+        links = {names[0]: lambda e: (1.0, b, 2.5, 3.0 + e),
+                 names[1]: lambda e: (1.0, b, 2.5 - e, 3.0)}
+        for j, name in enumerate(names):
+            e3, e4 = _h2(ds.dmeasures_dp.values[k, :, 0, j], ratio_fourbar, links[name], t)
+            assert e4 < 1e-8 and e4 < e3 / 50, (k, name, e3, e4)
+        one = m.with_params({"joint.A.points.1.0": float(x)}).kinematics(
+            1.0, 36, tol=1e-14, sensitivities=names)
+        assert np.array_equal(ds.dmeasures_dp.values[k], measure_derivatives(one, specs))
+    mbd2d.write_sweep(ds, tmp_path / "s.csv")
+    with open(tmp_path / "s.csv", newline="") as f:
+        header, *rows = list(csv.reader(f))
+    col = [float(r[header.index(f"d({ADVANTAGE})/d({names[1]})")]) for r in rows]
+    assert np.array_equal(col, ds.dmeasures_dp.values[:, :, 3, 1].ravel())

@@ -189,9 +189,11 @@ def test_csv_columns_and_the_cli(fourbar, tmp_path):
 @pytest.mark.parametrize("model, cases, analysis, kw", [
     ("fourbar_grashof.toml", {"joint.A.points.1.0": [-1.9, -1.75]}, "kinematics",
      dict(t_end=1.0, steps=20, sensitivities=[GROUND, ROCKER],
-          measures=["transmission_angle:B"])),
+          measures=["transmission_angle:B", "velocity_ratio:motor:rocker.theta",
+                    "dead_centre_distance"])),
     ("fourbar_masses.toml", {"body.coupler.mass": [1.0, 2.0]}, "inverse_dynamics",
-     dict(t_end=0.5, steps=10, sensitivities=["body.rocker.mass", "joint.B.points.0.0"])),
+     dict(t_end=0.5, steps=10, sensitivities=["body.rocker.mass", "joint.B.points.0.0"],
+          measures=["mechanical_advantage:motor:rocker.theta"])),
     ("pendulum_spring.toml", {"body.bar.mass": [0.5, 1.0]}, "statics",
      dict(sensitivities=["body.bar.mass", "force.torsion.stiffness"])),
     ("fourbar_masses.toml", {"body.coupler.mass": [1.0, 2.0]}, "dynamics",

@@ -62,6 +62,8 @@ program mbd2d_solve
   !> a sweep's sensitivities (nq, npar, rows, cases) and the multipliers' (nsl, ...)
   real(wp), allocatable :: bsq(:, :, :, :), bsqd(:, :, :, :), bsqdd(:, :, :, :), &
                            bslam(:, :, :, :)
+  !> a sweep's measures' design derivatives (nmeas, npar, rows, cases)
+  real(wp), allocatable :: bdm(:, :, :, :)
   integer, allocatable :: biinfo(:, :), bdep(:, :), bred(:, :), bstat(:), nkeep(:), cstat(:)
   integer, allocatable :: bmbad(:, :)                 !! a case's failed measure (mbd_batch)
   character(len=MSG_LEN), allocatable :: bmsg(:)
@@ -828,7 +830,7 @@ contains
     nlam = merge(0, neq, code == 1); ne = merge(0, 4, code == 1)
     nsl = merge(neq, 0, lam_sens)
     bytes = REAL_BYTES * real(spec%ncase, wp) * (real(nrow, wp) * (nq + nlam + ne + &
-            spec%nmeas + real(spec%npar, wp) * (3 * nq + nsl)) + &
+            spec%nmeas + real(spec%npar, wp) * (3 * nq + nsl + spec%nmeas)) + &
             2.0_wp * nq * nd + 2 * NINFO + nq) + 4.0_wp * spec%ncase * (2 * neq + NINFO + 3)
     call mem_check(bytes, 'the outputs of ' // trim(itoa(spec%ncase)) // ' cases', &
                    'give fewer cases or steps', status, msg)
@@ -842,7 +844,8 @@ contains
               tout(nrow), q0(nq), bmv(spec%nmeas, nrow, spec%ncase), &
               bmbad(3, spec%ncase), bsq(nq, spec%npar, nrow, spec%ncase), &
               bsqd(nq, spec%npar, nrow, spec%ncase), bsqdd(nq, spec%npar, nrow, spec%ncase), &
-              bslam(nsl, spec%npar, nrow, spec%ncase), stat=ierr)
+              bslam(nsl, spec%npar, nrow, spec%ncase), &
+              bdm(spec%nmeas, spec%npar, nrow, spec%ncase), stat=ierr)
     ! the dynamic tables (a kinematic sweep takes none: zeros, as the Python sweep passes)
     if (ierr == 0) allocate (bm(2, spec%nb), bv0(nq), bft(NFT, merge(0, spec%nf, code == 1)), &
                              bfp(max(1, size(spec%fpar))), stat=ierr)
@@ -871,7 +874,7 @@ contains
                      bmsg(c0:c1), tout, spec%meas_kind, spec%meas_int, spec%meas_pts, &
                      spec%meas_ref, bmv(:, :, c0:c1), bmbad(:, c0:c1), spec%ptab, &
                      bsq(:, :, :, c0:c1), bsqd(:, :, :, c0:c1), bsqdd(:, :, :, c0:c1), &
-                     bslam(:, :, :, c0:c1))
+                     bslam(:, :, :, c0:c1), bdm(:, :, :, c0:c1))
     end do
     !$omp end parallel do
     do c = 1, spec%ncase             ! a design parameter the core refused: the file's fault
@@ -929,6 +932,7 @@ contains
     cstat(c) = 0; cmsg(c) = ''; nkeep(c) = n
     if (bmbad(1, c) /= MBD_OK) then               ! its rows, without its measures
       bmv(:, :, c) = ieee_value(0.0_wp, ieee_quiet_nan)
+      bdm(:, :, :, c) = ieee_value(0.0_wp, ieee_quiet_nan)
       if (clean) then
         cstat(c) = bmbad(1, c)
         cmsg(c) = 'measure "' // trim(spec%meas_names(bmbad(2, c))) // '": ' // trim(bmsg(c))
@@ -987,7 +991,7 @@ contains
     nsl = size(bslam, 1)
     ! at most 26 characters a number ("%.17g": -1.2345678901234567e-308) with its comma
     width = 26 * (spec%ncp + 2 + 3 * nq + spec%nc + spec%nmeas + &
-                  spec%npar * (3 * nq + spec%nc)) + 32
+                  spec%npar * (3 * nq + spec%nc + spec%nmeas)) + 32
     allocate (character(len=width) :: head, line, stat=ierr)
     if (ierr == 0) allocate (character(len=2 * len(cmsg) + 40) :: tail, stat=ierr)
     if (ierr /= 0) call die(2, 'not enough memory to write ' // path)
@@ -1011,7 +1015,7 @@ contains
     do j = 1, spec%nmeas
       call sput(u, ios, ',' // quoted(trim(spec%meas_names(j))))
     end do
-    do p = 1, spec%npar                ! d(COLUMN)/d(P): the motion, then the efforts
+    do p = 1, spec%npar        ! d(COLUMN)/d(P): the motion, the efforts, the measures
       do l = 1, nlev
         call coordinate_header(u, ios, trim(lev(l)), p)
       end do
@@ -1021,6 +1025,10 @@ contains
             trim(spec%con_names(j)) // ')/d(' // trim(spec%par_names(p)) // ')')
         end do
       end if
+      do j = 1, spec%nmeas
+        call sput(u, ios, ',' // quoted('d(' // trim(spec%meas_names(j)) // ')/d(' // &
+                                        trim(spec%par_names(p)) // ')'))
+      end do
     end do
     call sput(u, ios, crlf)
     do c = 1, spec%ncase
@@ -1072,8 +1080,8 @@ contains
     if (ios /= 0) call die(2, 'cannot write ' // path // ' (disk full?)')
   end subroutine write_sweep_csv
 
-  !> Row k of case c's derivatives along parameter p: the motion's, then the efforts'
-  !! (-dlambda/dp of the driver rows).
+  !> Row k of case c's derivatives along parameter p: the motion's, the efforts'
+  !! (-dlambda/dp of the driver rows), then the measures'.
   subroutine sens_fields(buf, n, k, c, p, nlev, nsl)
     character(len=*), intent(inout) :: buf
     integer, intent(inout) :: n
@@ -1090,11 +1098,15 @@ contains
         call bnum(buf, n, bsqdd(j, p, k, c))
       end do
     end if
-    if (nsl == 0) return
-    r = 1
-    do j = 1, spec%nc
-      if (con_is_driver(spec%ctab(1, j))) call bnum(buf, n, -bslam(r, p, k, c))
-      r = r + con_nrow(spec%ctab(1, j))
+    if (nsl > 0) then
+      r = 1
+      do j = 1, spec%nc
+        if (con_is_driver(spec%ctab(1, j))) call bnum(buf, n, -bslam(r, p, k, c))
+        r = r + con_nrow(spec%ctab(1, j))
+      end do
+    end if
+    do j = 1, spec%nmeas
+      call bnum(buf, n, bdm(j, p, k, c))
     end do
   end subroutine sens_fields
 

@@ -301,15 +301,16 @@ def batch(b: BatchTables, vals: np.ndarray) -> dict[str, Any]:
     ``iinfo``, ``rinfo`` (10, ncase), ``qsing`` (nq, ncase), ``dep``, ``red`` (neq, ncase),
     the measures ``m`` (nm, nrow, ncase) with ``mbad`` (3, ncase: status, measure, quantity of
     a case whose measures failed), the sensitivities ``sq``, ``sqd``, ``sqdd`` (nq, npar, nrow,
-    ncase) and ``slam`` (nsl, npar, nrow, ncase), ``status`` (ncase) and ``msg`` (ncase,
-    text). A module-level function of plain arrays, so
+    ncase) and ``slam`` (nsl, npar, nrow, ncase), the measures' design derivatives ``dm`` (nm,
+    npar, nrow, ncase), ``status`` (ncase) and ``msg`` (ncase, text). A module-level function of plain arrays, so
     that worker processes and Dask workers can run it."""
     vals = np.asfortranarray(vals, dtype=np.float64)
     ncase = vals.shape[1]
     m = b.measures if len(b.measures.specs) else _ONE_MEASURE    # (f2py: no zero-length table)
     times = b.times if len(b.measures.specs) else np.zeros(b.nrow)
     ptab = b.ptab if b.npar else np.ones((2, 1), dtype=np.int32, order="F")
-    out = _named("q qd qdd lam e iinfo rinfo qsing dep red m mbad sq sqd sqdd slam status msg",
+    out = _named("q qd qdd lam e iinfo rinfo qsing dep red m mbad sq sqd sqdd slam dm status "
+                 "msg",
                  _core.core_batch,
                  analysis=b.analysis, nb=b.nb, ctab=b.ctab, rpar=b.rpar, bmass=b.bmass,
                  grav=b.grav, ftab=b.ftab, fpar=b.fpar, q0=b.q0, v0=b.v0, vtab=b.vtab,
@@ -318,6 +319,7 @@ def batch(b: BatchTables, vals: np.ndarray) -> dict[str, Any]:
                  mkind=m.kind, mint=m.mint,
                  mpts=m.mpts, mref=m.mref, npar=b.npar, ptab=ptab, nsl=b.nsl,
                  numbers=ncase * ((b.nq + b.nlam + b.ne + len(b.measures.specs)
-                                   + b.npar * (3 * b.nq + b.nsl)) * b.nrow
+                                   + b.npar * (3 * b.nq + b.nsl + len(b.measures.specs)))
+                                  * b.nrow
                                   + 2 * b.nq * b.nd + 2 * b.neq + b.nq + 23))
     return vars(out)

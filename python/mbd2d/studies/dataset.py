@@ -213,6 +213,10 @@ def to_dataset(pl: Plan, analysis: str, model: ModelDescription, out: Outputs,
         m[a["mbad"][0] != OK] = np.nan
         data["measures"] = (("case", "time", "measure"), m)
         coords["measure"] = list(b.measures.specs)
+        if b.npar:
+            dm = per_case(a["dm"])
+            dm[a["mbad"][0] != OK] = np.nan
+            data["dmeasures_dp"] = (("case", "time", "measure", "parameter"), dm)
     if b.nlam:
         lam = per_case(a["lam"])
         data["lam"] = (("case", "time", "equation"), lam)

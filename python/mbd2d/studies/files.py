@@ -39,7 +39,7 @@ def write_sweep(ds: Any, path: str | Path) -> None:
     coordinate NAME (q), NAME_dot (qd), NAME_ddot (qdd) (NAME alone for a positions-only
     sweep), with multipliers the efforts ``effort.DRIVER``, then the measures by their specs,
     then for each design parameter P of a sweep with sensitivities ``d(COLUMN)/d(P)`` of
-    the motion columns and the efforts.
+    the motion columns, the efforts and the measures.
 
     Raises
     ------
@@ -89,7 +89,8 @@ def _csv(ds: Any, path: Path) -> None:
     header += specs
     motion = header[4 + len(params):4 + len(params) + len(levels) * len(coords)]
     sens, sens_names = _sensitivity_columns(ds)
-    derived = motion + ([f"effort.{d}" for d in drivers] if "deffort_dp" in ds else [])
+    derived = motion + ([f"effort.{d}" for d in drivers] if "deffort_dp" in ds else []) + \
+        (specs if "dmeasures_dp" in ds else [])
     header += [f"d({v})/d({p})" for p in sens_names for v in derived]
     q = levels[0]
     eff = ds.effort.values if drivers else None
@@ -117,11 +118,12 @@ def _csv(ds: Any, path: Path) -> None:
 
 def _sensitivity_columns(ds: Any) -> tuple[np.ndarray, list[str]]:
     """The sensitivities as (case, time, columns), parameter by parameter: for each, the
-    derivatives of the motion columns (q, qd, qdd) and, with multipliers' sensitivities, of
-    the efforts; and the parameters' names. (case, time, 0) without sensitivities."""
+    derivatives of the motion columns (q, qd, qdd), with multipliers' sensitivities of the
+    efforts, and of the measures; and the parameters' names. (case, time, 0) without sensitivities."""
     if "dq_dp" not in ds:
         return np.zeros(ds.q.shape[:2] + (0,)), []
-    parts = [ds[k].values for k in ("dq_dp", "dqd_dp", "dqdd_dp", "deffort_dp") if k in ds]
+    parts = [ds[k].values for k in ("dq_dp", "dqd_dp", "dqdd_dp", "deffort_dp", "dmeasures_dp")
+             if k in ds]
     block = np.concatenate(parts, axis=2)          # (case, time, columns, parameter)
     return (np.ascontiguousarray(np.moveaxis(block, 3, 2)).reshape(
         block.shape[0], block.shape[1], -1), [str(p) for p in ds.parameter.values])

@@ -35,7 +35,7 @@ SERIAL_CHUNK_SECONDS = 0.25
 
 #: arrays of the core's batch output with the case along the last axis
 CASE_ARRAYS = ("q", "qd", "qdd", "lam", "e", "iinfo", "rinfo", "qsing", "dep", "red", "m",
-               "mbad", "sq", "sqd", "sqdd", "slam")
+               "mbad", "sq", "sqd", "sqdd", "slam", "dm")
 
 
 def cores() -> int:
@@ -55,7 +55,8 @@ class Outputs:
                   "e": (b.ne, nr), "iinfo": (10,), "rinfo": (10,), "qsing": (nq,),
                   "dep": (b.neq,), "red": (b.neq,), "m": (len(b.measures.specs), nr),
                   "mbad": (3,), "sq": (nq, b.npar, nr), "sqd": (nq, b.npar, nr),
-                  "sqdd": (nq, b.npar, nr), "slam": (b.nsl, b.npar, nr)}
+                  "sqdd": (nq, b.npar, nr), "slam": (b.nsl, b.npar, nr),
+                  "dm": (len(b.measures.specs), b.npar, nr)}
         ints = ("iinfo", "dep", "red", "mbad")
         self.arrays = {k: np.zeros(s + (ncase,), order="F",
                                    dtype=np.int32 if k in ints else np.float64)
