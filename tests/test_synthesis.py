@@ -14,8 +14,9 @@ import pytest
 
 import mbd2d
 from mbd2d.description import toml_io
-from mbd2d.synthesis import (FunctionTask, Grashof, LinkRatio, MotionTask, PathTask,
-                             PeakEffort, Problem, TransmissionAngle, fourbar, run_all)
+from mbd2d.synthesis import (FunctionTask, Grashof, LinkRatio, MeasureBound, MotionTask,
+                             PathTask, PeakEffort, Problem, TransmissionAngle, fourbar, make_term,
+                             run_all)
 
 FINE = 2000          # closed-form samples per input range in the independent check
 
@@ -276,6 +277,79 @@ def test_penalty_terms_jacobians_by_differences():
     pen = ev.r[ev.n_task:]             # ratio, angle, effort, then Grashof's 4 rows
     assert np.all(pen[:3] > 0) and np.all(pen[4:] > 0)      # active (s + l <= p + q holds)
     assert set(ev.terms) >= {"LinkRatio", "TransmissionAngle", "PeakEffort"}
+
+
+RATIO = "velocity_ratio:motor:rocker.theta"
+
+
+def test_measure_bound_jacobians_by_differences():
+    """Bounds on the velocity ratio (max), the mechanical advantage (min), the dead-centre
+    distance (min) and the transmission angle (min), each active: their exact derivatives
+    (the core's) against central differences of the residuals. (The rocker pivot at x = 4.1:
+    at 4 the model's length scale, a power of 2, would change under the differences, and
+    with it the dead-centre distance, measured in that unit.)"""
+    m = fourbar([[0, 0], [4.1, 0.5]], crank=1, coupler=3.5, rocker=3)
+    task = PathTask("coupler", (1.0, 0.8), [[1, 2.5], [0.5, 3], [0, 3.2]],
+                    times=[0.3, 0.6, 0.9])
+    terms = [MeasureBound(RATIO, max=0.2), MeasureBound(RATIO.replace("velocity_ratio",
+                                                                      "mechanical_advantage"),
+                                                        min=5.0),
+             MeasureBound("dead_centre_distance", min=0.2),
+             MeasureBound("transmission_angle:B", min=1.1, absolute=False)]
+    p = Problem(m, FOURBAR_FREE, task, constraints=terms)
+    ev = _fd_check(p, p.x0, rel=1e-5)
+    assert np.all(ev.r[ev.n_task:] > 0)                 # each active
+
+
+def rocker_ratio(model, t, branch):
+    """d(theta4)/d(theta2) of a fourbar() model by the loop closure (independent)."""
+    o2, o4, r2, r3, r4, th0, w = geometry(model)
+    a, b, th3, _ = closed_form(model, t, branch)
+    th2 = th0 + w * np.asarray(t, float)
+    th4 = np.arctan2(b[:, 1] - o4[1], b[:, 0] - o4[0])
+    return r2 * np.sin(th2 - th3) / (r4 * np.sin(th4 - th3))
+
+
+def test_synthesis_keeps_the_velocity_ratio_bound():
+    """Function generation whose best fit swings the rocker faster than 0.15 rad per crank
+    radian somewhere in the turn; with |d(theta4)/d(theta2)| <= 0.15 as a penalty (weight
+    10) the returned design meets it to within the penalty's slack (1 %), by the
+    closed-form loop closure at fine steps, and the term reports that worst ratio."""
+    m = fourbar([[0, 0], [4, 0.5]], crank=1, coupler=3.5, rocker=3)
+    task = FunctionTask("rocker", "theta", times=[0.0, 0.8, 1.6],
+                        values=[0.0, 0.12, 0.25], span=(0, 2 * math.pi),
+                        cycle=2 * math.pi)
+    t = np.linspace(0, 2 * math.pi, FINE)
+    kw = dict(free=FOURBAR_FREE, task=task, starts=2, workers=1,
+              bounds={n: (-6.0, 6.0) for n in FOURBAR_FREE})
+
+    def worst(res):
+        return np.abs(rocker_ratio(res.model, t, branch_of(res.model))).max()
+
+    assert worst(mbd2d.synthesize(m, **kw)) > 0.16            # the bound is active
+    res = mbd2d.synthesize(m, constraints=[MeasureBound(RATIO, max=0.15, weight=10.0)], **kw)
+    assert worst(res) <= 0.15 * 1.01, worst(res)
+    assert res.terms["MeasureBound"] == pytest.approx(worst(res), rel=1e-3)
+
+
+@pytest.mark.parametrize("kw, match", [
+    (dict(measure=RATIO), "needs min or max"),
+    (dict(measure=RATIO, min=2.0, max=1.0), "min 2.0 > max"),
+    (dict(measure="velocity_ratio:motor"), "unknown measure"),
+    (dict(measure=RATIO, max="x"), "max must be a number"),
+    (dict(measure=RATIO, max=1.0, absolute="yes"), "absolute must be"),
+    (dict(measure=RATIO, max=1.0, weight=-1.0), "weight must be"),
+])
+def test_measure_bound_bad_input(kw, match):
+    with pytest.raises(mbd2d.ModelError, match=match):
+        MeasureBound(**kw)
+    with pytest.raises(mbd2d.ModelError, match=match):
+        make_term("measure", **kw)              # a task file's [[constraint]] type
+
+
+def test_measure_bound_by_task_file_name():
+    term = make_term("measure", measure=RATIO, max=0.3)
+    assert isinstance(term, MeasureBound) and term.max == 0.3 and term.absolute
 
 
 # ===================================================================== defects

@@ -337,7 +337,10 @@ class KinematicsResult:
     def dead_centre_distance_dp(self) -> np.ndarray:
         """The dead-centre distance's exact design derivatives (rows, n_params): with the
         column-scaled J D = U S V^T, d sigma_i = u_i^T d(J D) v_i along the motion's
-        sensitivities and the parameters (the core; an SVD with vectors per output).
+        sensitivities and the parameters (the core; an SVD with vectors per output). The
+        distance is measured with lengths in the model's length scale L, a power of 2 taken
+        from the model's size: it jumps where a parameter moves the model across a power of
+        2 (L changes); the derivative is the one at fixed L.
 
         Raises
         ------

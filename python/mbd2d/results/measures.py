@@ -428,18 +428,31 @@ def measure_derivatives(res: Any, specs: Any) -> np.ndarray:
     ModelError
         If the result has no sensitivities, or as :func:`measure` raises for a spec.
     """
+    return measures_and_derivatives(res, specs)[1]
+
+
+def measures_and_derivatives(res: Any, specs: Any) -> tuple[np.ndarray, np.ndarray]:
+    """The measures asked for (rows, k) and their exact design derivatives (rows, k,
+    n_params) in one core call (see :func:`measure_derivatives`).
+
+    Raises
+    ------
+    ModelError
+        If the result has no sensitivities, or as :func:`measure` raises for a spec.
+    """
     require_sensitivities(getattr(res, "dq_dp", None) is not None, "measures")
     p = packed_of(res)
     tables = measure_tables(res.model, p, specs, moved=True)
     q, t = _states(res)
     if not tables.specs:
-        return np.zeros((len(t), 0, res.dq_dp.shape[2]))
+        return np.zeros((len(t), 0)), np.zeros((len(t), 0, res.dq_dp.shape[2]))
     sq = np.transpose(res.dq_dp, (1, 2, 0))
     out = core.measures_dp(p, q, sq, t, tables, res.ptab)
     if out.status != OK:
         raise measure_failure(res.model, p, tables.specs[max(int(out.bad[0]), 1) - 1],
                               int(out.status), out.msg, int(out.bad[1]))
-    return np.transpose(np.asarray(out.dvals, dtype=float), (2, 0, 1)).copy()
+    return (np.asarray(out.vals, dtype=float).T.copy(),
+            np.transpose(np.asarray(out.dvals, dtype=float), (2, 0, 1)).copy())
 
 
 def measure_derivative_columns(res: Any, specs: Any) -> tuple[list[str], np.ndarray]:

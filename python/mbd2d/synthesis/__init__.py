@@ -6,7 +6,8 @@ with exact kinematics and exact gradients, defect-free by construction.
 
 Tasks: :class:`PathTask` (path generation, prescribed, shifted or free timing),
 :class:`FunctionTask`, :class:`MotionTask`. Constraints: :class:`Grashof`,
-:class:`LinkRatio`, :class:`TransmissionAngle`, :class:`PeakEffort`. :func:`fourbar` builds
+:class:`LinkRatio`, :class:`TransmissionAngle`, :class:`PeakEffort`, :class:`MeasureBound`.
+:func:`fourbar` builds
 the four-bar of path generation from link lengths; :func:`load_task` reads a task file.
 See docs/synthesis.md.
 """
@@ -17,10 +18,10 @@ from .problem import Evaluation, Problem
 from .search import StartRecord, SynthesisResult, latin_hypercube, run_all, synthesize
 from .taskfile import TaskFile, load_task
 from .tasks import FunctionTask, MotionTask, PathTask, Task, make_task
-from .terms import Grashof, LinkRatio, PeakEffort, TransmissionAngle, make_term
+from .terms import Grashof, LinkRatio, MeasureBound, PeakEffort, TransmissionAngle, make_term
 
 __all__ = ["synthesize", "SynthesisResult", "StartRecord", "Problem", "Evaluation", "Task",
            "PathTask", "MotionTask", "FunctionTask", "make_task", "Grashof", "LinkRatio",
-           "TransmissionAngle", "PeakEffort", "make_term", "fourbar", "fourbar_parameters",
+           "TransmissionAngle", "PeakEffort", "MeasureBound", "make_term", "fourbar", "fourbar_parameters",
            "loop_configuration", "FOURBAR_PARAMETERS", "run_all", "latin_hypercube",
            "load_task", "TaskFile"]

@@ -98,13 +98,20 @@ class _Context:
         self.problem, self.model, self.t0, self.t1 = problem, model, t0, t1
         self.pnames = problem.pnames
         self._rows: Rows | None = None
+        self._res: Any = None
         self._inv: Any = None
+
+    def range_run(self) -> Any:
+        """The kinematic run over the input range, with sensitivities to the free
+        parameters (when there are any)."""
+        if self._res is None:
+            self._res = self.problem.run(self.model, self.t0, self.t1,
+                                         self.problem.steps(self.t1 - self.t0), sens=True)
+        return self._res
 
     def range_rows(self) -> Rows:
         if self._rows is None:
-            res = self.problem.run(self.model, self.t0, self.t1, self.problem.steps(self.t1 -
-                                                                                    self.t0),
-                                   sens=True)
+            res = self.range_run()
             self._rows = Rows(res.q, res.qd, res.dq_dp if self.pnames else None,
                               res.body_names)
         return self._rows

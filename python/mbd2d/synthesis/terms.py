@@ -11,6 +11,9 @@ A term either rejects a candidate (a defect, with its reason) or adds penalty re
 - :class:`PeakEffort`: the peak |effort| of a driver over the input range from inverse
   dynamics (a penalty above ``limit``, or a term to minimise when no limit is given);
   derivatives from the effort sensitivities.
+- :class:`MeasureBound`: a mechanism measure (velocity ratio, mechanical advantage,
+  dead-centre distance, transmission angle: a table's measure spec) within [min, max] over
+  the input range (penalty on the worst excess); values and exact derivatives from the core.
 """
 from __future__ import annotations
 
@@ -20,7 +23,9 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from ..errors import ModelError
+from ..errors import MbdError, ModelError
+from ..results.measures import measure, measures_and_derivatives, parse_measure
+from ..validate import number
 from .fourbar import loop_lengths
 from .tasks import Rows, body_point
 
@@ -249,8 +254,94 @@ class PeakEffort(Term):
         return float(np.abs(ctx.inverse_run().effort(self.driver)).max())
 
 
+@dataclass
+class MeasureBound(Term):
+    """A mechanism measure within [min, max] over the input range: ``measure`` is a table's
+    measure spec (``velocity_ratio:INPUT:OUTPUT[:VIA]``,
+    ``mechanical_advantage:INPUT:OUTPUT[:VIA]``, ``dead_centre_distance``,
+    ``transmission_angle:JOINT[:OUTPUT]`` in radians), its absolute value with ``absolute``
+    (the default: a ratio's sign says only which way the output turns). Penalty weight *
+    worst excess over the input range, with the measure's exact design derivatives from the
+    core (:func:`mbd2d.results.measures.measure_derivatives`). While solving, rows where the
+    measure is infinite (a ratio at its pole) are left out of the worst excess; in the
+    screening and the final check an infinite excess rejects the candidate."""
+
+    measure: str = "dead_centre_distance"
+    min: float | None = None
+    max: float | None = None
+    absolute: bool = True
+    weight: float = 1.0
+    needs = "kinematics"
+
+    def __post_init__(self) -> None:
+        parse_measure(self.measure)
+        if self.min is None and self.max is None:
+            raise ModelError(f"the bound on {self.measure!r} needs min or max", "constraints")
+        for key in ("min", "max"):
+            v = getattr(self, key)
+            if v is not None:
+                setattr(self, key, number(v, key, "constraints"))
+        if self.min is not None and self.max is not None and self.min > self.max:
+            raise ModelError(f"the bound on {self.measure!r} has min {self.min} > max "
+                             f"{self.max}", "constraints")
+        if not isinstance(self.absolute, bool):
+            raise ModelError(f"absolute must be true or false, got {self.absolute!r}",
+                             "constraints")
+        self.weight = number(self.weight, "weight", "constraints")
+        if self.weight < 0:
+            raise ModelError(f"weight must be >= 0, got {self.weight}", "constraints")
+
+    def _excess(self, ctx: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """The excess over the bounds at each row (> 0 violated), its derivatives, the
+        (absolute) values and the times."""
+        res = ctx.range_run()
+        if ctx.pnames:
+            v, d = measures_and_derivatives(res, [self.measure])
+            v, d = v[:, 0], d[:, 0, :]
+        else:
+            v, d = measure(res, self.measure), np.zeros((len(res.t), 0))
+        if self.absolute:
+            d = np.sign(v)[:, None] * d
+            v = np.abs(v)
+        ex = np.full(len(v), -np.inf)
+        dex = np.zeros_like(d)
+        for bound, sign in ((self.min, -1.0), (self.max, 1.0)):
+            if bound is None:
+                continue
+            e = sign * (v - bound)
+            more = e > ex
+            ex = np.where(more, e, ex)
+            dex = np.where(more[:, None], sign * d, dex)
+        return ex, dex, v, np.asarray(res.t)
+
+    def defects(self, ctx: Any) -> list[str]:
+        try:
+            ex, _, _, t = self._excess(ctx)
+        except MbdError:          # the candidate's own runs report why it fails
+            return []
+        bad = np.flatnonzero(np.isinf(ex) & (ex > 0))
+        if not len(bad):
+            return []
+        return [f"{self.measure} is infinite at t = {t[bad[0]]:.6g} (bounded by max = "
+                f"{self.max:.6g})"]
+
+    def residuals(self, ctx: Any) -> tuple[np.ndarray, np.ndarray]:
+        ex, dex, _, _ = self._excess(ctx)
+        fin = np.isfinite(ex)
+        if not fin.any() or ex[fin].max() <= 0:
+            return np.zeros(1), np.zeros((1, len(ctx.pnames)))
+        k = int(np.flatnonzero(fin)[np.argmax(ex[fin])])
+        grad = np.where(np.isfinite(dex[k]), dex[k], 0.0)     # (no derivative: no slope)
+        return np.array([self.weight * ex[k]]), self.weight * grad[None, :]
+
+    def value(self, ctx: Any) -> float:
+        """The (absolute) measure where it comes nearest its bound, or beyond it."""
+        ex, _, v, _ = self._excess(ctx)
+        return float(v[int(np.argmax(np.where(np.isnan(ex), -np.inf, ex)))])
+
+
 TERMS = {"grashof": Grashof, "link-ratio": LinkRatio, "transmission-angle": TransmissionAngle,
-         "peak-effort": PeakEffort}
+         "peak-effort": PeakEffort, "measure": MeasureBound}
 
 
 def make_term(term_type: str, /, **keys: Any) -> Term:
@@ -275,5 +366,6 @@ def make_term(term_type: str, /, **keys: Any) -> Term:
         raise ModelError(f"constraint {term_type!r}: {exc}", "constraints") from None
 
 
-__all__ = ["Term", "Grashof", "LinkRatio", "TransmissionAngle", "PeakEffort", "make_term",
+__all__ = ["Term", "Grashof", "LinkRatio", "TransmissionAngle", "PeakEffort", "MeasureBound",
+           "make_term",
            "grashof_defects", "joint_position", "TERMS"]
