@@ -264,3 +264,39 @@ def test_sweep_cases_carry_their_measures_derivatives(tmp_path):
         header, *rows = list(csv.reader(f))
     col = [float(r[header.index(f"d({ADVANTAGE})/d({names[1]})")]) for r in rows]
     assert np.array_equal(col, ds.dmeasures_dp.values[:, :, 3, 1].ravel())
+
+
+def test_random_sweeps_equal_single_runs_bit_for_bit():
+    """Random sweeps (tests/test_standalone_random_sweep.py's draws with measures and
+    sensitivities; dynamics by dopri5): every completed case's dmeasures_dp equals its own
+    single run's measure_derivatives bit for bit, and a failed case fails alone too."""
+    import random
+    import warnings
+    pytest.importorskip("xarray")
+    from test_standalone_random_sweep import _draw
+    drawn = 0
+    for seed in range(400):
+        name, cases, analysis, kw = _draw(random.Random(seed))
+        if "sensitivities" not in kw or "measures" not in kw or \
+                (analysis != "kinematics" and name != "fourbar_masses.toml"):   # (no masses)
+            continue
+        kw["method"] = "dopri5" if analysis == "dynamics" else kw.get("method")
+        kw = {k: v for k, v in kw.items() if v is not None}
+        m = mbd2d.load(EX / name)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            ds = mbd2d.sweep(m, cases, analysis, workers=1, progress=False, **kw)
+            for k in range(ds.sizes["case"]):
+                one = m.with_params({n: float(ds[n].values[k]) for n in cases})
+                single = {a: v for a, v in kw.items() if a != "measures"}
+                try:
+                    d = measure_derivatives(getattr(one, analysis)(**single), kw["measures"])
+                except mbd2d.MbdError:
+                    assert ds.status.values[k] != 0
+                    continue
+                assert ds.status.values[k] == 0
+                assert np.array_equal(ds.dmeasures_dp.values[k], d), (seed, k)
+        drawn += 1
+        if drawn == 12:
+            break
+    assert drawn == 12
