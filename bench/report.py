@@ -608,13 +608,24 @@ def sensitivities_section(results: dict) -> str:
              fmt(r.get("instruction_ratio"), ".2f"),
              " / ".join(str(x) for x in r.get("integrator_steps", [])) or "–")
             for r in se.get("rows", [])]
-    return (f"Wall time per output step of the public call with and without "
+    text = (f"Wall time per output step of the public call with and without "
             f"`sensitivities=[4 names]` ({se.get('steps')} steps at h = 1 ms, best of "
             f"{se.get('repeats')}, interleaved; bench/sensitivities.py), and the ratio of "
             "callgrind instructions of the core call (3000 steps; the dopri5 case as timed), "
             "stable on a shared machine.\n\n"
             + table(("case", "us/step", "with sensitivities", "ratio", "instruction ratio",
                      "integrator steps"), rows))
+    ms = se.get("measures")
+    if ms:
+        text += (f"\nThe mechanism measures' exact derivatives (no target): the four-bar's run "
+                 f"with {ms.get('parameters')} parameters ({ms.get('rows')} rows, "
+                 f"{fmt(ms.get('run_us_per_row'), '.2f')} us per row with its sensitivities); "
+                 "per row, each measure alone and with its derivatives (one core call).\n\n"
+                 + table(("measure", "us/row", "with derivatives", "ratio"),
+                         [(r["measure"], fmt(r["value_us_per_row"], ".2f"),
+                           fmt(r["with_derivatives_us_per_row"], ".2f"),
+                           fmt(r["ratio"], ".1f") + "x") for r in ms.get("measures", [])]))
+    return text
 
 
 def dynamics_scaling_section(results: dict, charts: dict, out: Path, base: Path) -> str:

@@ -11,6 +11,8 @@ Cases:
               also covers them, so the step count may differ: it is reported.
 
 Target (issue 10): sensitivities for 4 parameters cost at most 2x the analysis alone.
+Beside them (no target): the mechanism measures' design derivatives of the four-bar's run
+with 4 parameters, per output row, against each measure alone (the same run's rows).
 Beside the wall time, each case's core call (the api_* routine, setup and output included)
 runs once more under callgrind with and without sensitivities (shorter runs: 3000 steps, the
 dopri5 case as it is): the instruction ratio, stable on a shared machine (skipped without
@@ -155,6 +157,7 @@ def measure(steps: int, reps: int, quick: bool = False) -> dict[str, Any]:
         if counts and counts[0] > 0:
             r["instructions"] = counts
             r["instruction_ratio"] = counts[1] / counts[0]
+    meas = measure_costs(fourbar, p4, 2000 if not quick else 200, reps)
     for r in rows:
         extra = f"  steps {r['integrator_steps']}" if "integrator_steps" in r else ""
         if "instruction_ratio" in r:
@@ -162,7 +165,33 @@ def measure(steps: int, reps: int, quick: bool = False) -> dict[str, Any]:
         print(f"{r['case']:46s} {r['base_us_per_step']:9.2f} us  {r['sens_us_per_step']:9.2f} us"
               f"  ratio {r['ratio']:5.2f}{'' if r['meets_target'] else '  (above 2x)'}{extra}")
     return {"target_ratio": TARGET, "steps": steps, "repeats": reps, "quick": quick,
-            "rows": rows}
+            "rows": rows, "measures": meas}
+
+
+#: the measures whose derivatives are timed (the four-bar's)
+MEASURES = ["transmission_angle:B", "velocity_ratio:motor:rocker.theta",
+            "mechanical_advantage:motor:rocker.theta", "dead_centre_distance"]
+
+
+def measure_costs(model: mbd2d.Model, names: list[str], rows: int, reps: int
+                  ) -> dict[str, Any]:
+    """us per output row of each measure alone and with its derivatives along names (one
+    core call each, interleaved best of reps), beside the run with sensitivities itself."""
+    from mbd2d.results.measures import measure, measure_derivatives
+    t_run, res = timed(lambda: model.kinematics(1.0, rows - 1, sensitivities=names), reps)
+    out = []
+    for spec in MEASURES:
+        tv = td = float("inf")
+        for _ in range(reps):
+            tv = min(tv, timed(lambda: measure(res, spec), 1)[0])
+            td = min(td, timed(lambda: measure_derivatives(res, [spec]), 1)[0])
+        out.append({"measure": spec, "value_us_per_row": 1e6 * tv / rows,
+                    "with_derivatives_us_per_row": 1e6 * td / rows, "ratio": td / tv})
+        print(f"{spec:46s} {out[-1]['value_us_per_row']:9.2f} us  "
+              f"{out[-1]['with_derivatives_us_per_row']:9.2f} us per row with "
+              f"{len(names)} derivatives")
+    return {"rows": rows, "parameters": len(names), "run_us_per_row": 1e6 * t_run / rows,
+            "measures": out}
 
 
 def main(argv: list[str] | None = None) -> int:
