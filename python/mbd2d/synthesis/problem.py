@@ -302,7 +302,7 @@ class Problem:
                         blocks_j.append(full)
                 v = term.value(ctx)
                 if v is not None:
-                    ev.terms[type(term).__name__] = v
+                    ev.terms[term.label] = v
         except _Defect as d:
             ev.defects.append(str(d))
             return ev

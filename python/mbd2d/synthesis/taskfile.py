@@ -17,6 +17,7 @@
 
     [[constraint]]
     type = "grashof"                  # grashof | link-ratio | transmission-angle | peak-effort
+                                      # | measure (measure = "SPEC", min, max)
     kind = "crank-rocker"
 
 The keys of [task] and [[constraint]] are the arguments of :class:`PathTask`,

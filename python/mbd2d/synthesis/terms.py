@@ -50,6 +50,11 @@ class Term:
         """The quantity the term watches, for the report."""
         return None
 
+    @property
+    def label(self) -> str:
+        """The term's name in the report (``SynthesisResult.terms``)."""
+        return type(self).__name__
+
 
 @dataclass
 class Grashof(Term):
@@ -333,6 +338,11 @@ class MeasureBound(Term):
         k = int(np.flatnonzero(fin)[np.argmax(ex[fin])])
         grad = np.where(np.isfinite(dex[k]), dex[k], 0.0)     # (no derivative: no slope)
         return np.array([self.weight * ex[k]]), self.weight * grad[None, :]
+
+    @property
+    def label(self) -> str:
+        """``MeasureBound:SPEC`` (a design may bound several measures)."""
+        return f"MeasureBound:{self.measure}"
 
     def value(self, ctx: Any) -> float:
         """The (absolute) measure where it comes nearest its bound, or beyond it."""
