@@ -555,3 +555,15 @@ def test_cli_task_file_with_a_measure_bound(tmp_path, capsys):
     assert "MeasureBound:dead_centre_distance:" in capsys.readouterr().out
     kin = mbd2d.load(out).kinematics(t_end=CASE2_TIMES[-1], steps=40, t0=CASE2_TIMES[0])
     assert measure(kin, "dead_centre_distance").min() > 0.05 * 0.99
+
+
+@pytest.mark.parametrize("spec, match", [
+    ("velocity_ratio:motor:rocker.thetta", "no driver or coordinate 'rocker.thetta'"),
+    ("transmission_angle:Q", "no joint 'Q'"),
+])
+def test_measure_bound_not_in_the_model_is_refused_before_any_run(spec, match):
+    m = fourbar([[0, 0], [4, 0.5]], crank=1, coupler=3.5, rocker=3)
+    task = FunctionTask("rocker", "theta", times=[0.0, 0.8], values=[0.0, 0.12])
+    with pytest.raises(mbd2d.ModelError, match=match):
+        mbd2d.synthesize(m, free=["joint.B.points.0.0"], task=task, starts=1,
+                         constraints=[MeasureBound(spec, max=0.3)])

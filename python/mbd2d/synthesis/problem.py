@@ -158,8 +158,9 @@ class Problem:
         self.constraints = list(constraints or [])
         for c in self.constraints:
             if not isinstance(c, Term):
-                raise ModelError(f"constraints must be Grashof, LinkRatio, TransmissionAngle "
-                                 f"or PeakEffort terms, got {c!r}", "synthesize")
+                raise ModelError(f"constraints must be Grashof, LinkRatio, TransmissionAngle, "
+                                 f"PeakEffort or MeasureBound terms, got {c!r}", "synthesize")
+            c.check(model)
         params = model.parameters()
         tvars = {v.name: v for v in task.variables()}
         self.pnames = [n for n in free if n in params]

@@ -24,7 +24,9 @@ from typing import Any, Sequence
 import numpy as np
 
 from ..errors import MbdError, ModelError
-from ..results.measures import measure, measures_and_derivatives, parse_measure
+from ..binding.pack import pack
+from ..results.measures import (measure, measure_tables, measures_and_derivatives,
+                                parse_measure)
 from ..validate import number
 from .fourbar import loop_lengths
 from .tasks import Rows, body_point
@@ -39,6 +41,10 @@ class Term:
     #: the term needs the input-range run with sensitivities ('kinematics'), inverse
     #: dynamics with sensitivities ('inverse'), or nothing
     needs: str | None = None
+
+    def check(self, model: Any) -> None:
+        """Refuse a term that does not fit the starting model (a ModelError), before any
+        candidate runs."""
 
     def defects(self, ctx: Any) -> list[str]:
         return []
@@ -295,6 +301,11 @@ class MeasureBound(Term):
         self.weight = number(self.weight, "weight", "constraints")
         if self.weight < 0:
             raise ModelError(f"weight must be >= 0, got {self.weight}", "constraints")
+
+    def check(self, model: Any) -> None:
+        """The measure's joints, drivers and coordinates are the model's (else the
+        ModelError its spec raises on a result of this model)."""
+        measure_tables(model, pack(model), [self.measure])
 
     def _excess(self, ctx: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """The excess over the bounds at each row (> 0 violated), its derivatives, the
