@@ -342,3 +342,20 @@ def test_every_joint_type_against_ordinary_runs(model):
                 assert err.max() < 1e-8, (name, spec, err.max())
             checked += 1
     assert checked >= 4          # (the two hinges: only the driver moves them consistently)
+
+
+def test_cli_sweep_prints_the_derivatives_ranges(tmp_path, capsys):
+    """`mbd2d sweep --measure --sensitivities`: each measure's derivative range over the
+    cases, as the written file's column has it."""
+    out = tmp_path / "w.csv"
+    assert main(["sweep", str(EX / "fourbar_grashof.toml"), "--param",
+                 "joint.B.points.0.0=1.5:2.0:3", "--t-end", "1", "--steps", "20", "--measure",
+                 RATIO, "--sensitivities", "joint.O4.points.1.0", "--workers", "1", "--out",
+                 str(out)]) == 0
+    text = capsys.readouterr().out
+    label = f"d({RATIO})/d(joint.O4.points.1.0)"
+    line = next(ln for ln in text.splitlines() if ln.strip().startswith(label + ":"))
+    with open(out, newline="") as f:
+        header, *rows = list(csv.reader(f))
+    col = np.array([float(r[header.index(label)]) for r in rows])
+    assert f"from {col.min():.6g}" in line and f"to {col.max():.6g}" in line

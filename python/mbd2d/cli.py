@@ -668,20 +668,29 @@ def _sweep(model: Model, args: argparse.Namespace) -> int:
 
 
 def _measure_ranges(ds: Any) -> list[str]:
-    """Each measure's least and greatest value over the cases' rows, and where."""
+    """Each measure's least and greatest value over the cases' rows, and where; with
+    sensitivities, those of its derivatives along each parameter too."""
     if "measure" not in ds.coords:
         return []
     out = []
     for k, spec in enumerate(ds["measure"].values):
-        v = np.asarray(ds["measures"].values[:, :, k], dtype=float)
-        if not np.isfinite(v).any():
-            out.append(f"  {spec}: no value")
-            continue
-        lo, hi = np.nanargmin(v), np.nanargmax(v)
-        cl, ch = np.unravel_index(lo, v.shape)[0], np.unravel_index(hi, v.shape)[0]
-        out.append(f"  {spec}: from {v.flat[lo]:.6g} (case {int(cl)}) to {v.flat[hi]:.6g} "
-                   f"(case {int(ch)})")
+        out.append(_range_line(str(spec), ds["measures"].values[:, :, k]))
+        if "dmeasures_dp" in ds:
+            for j, name in enumerate(ds["parameter"].values):
+                out.append(_range_line(f"d({spec})/d({name})",
+                                       ds["dmeasures_dp"].values[:, :, k, j]))
     return out
+
+
+def _range_line(label: str, values: Any) -> str:
+    """"  LABEL: from LEAST (case i) to GREATEST (case j)" over (case, time) values."""
+    v = np.asarray(values, dtype=float)
+    if not np.isfinite(v).any():
+        return f"  {label}: no value"
+    lo, hi = np.nanargmin(v), np.nanargmax(v)
+    cl, ch = np.unravel_index(lo, v.shape)[0], np.unravel_index(hi, v.shape)[0]
+    return (f"  {label}: from {v.flat[lo]:.6g} (case {int(cl)}) to {v.flat[hi]:.6g} "
+            f"(case {int(ch)})")
 
 
 def main(argv: Sequence[str] | None = None) -> int:
