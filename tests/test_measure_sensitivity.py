@@ -359,3 +359,65 @@ def test_cli_sweep_prints_the_derivatives_ranges(tmp_path, capsys):
         header, *rows = list(csv.reader(f))
     col = np.array([float(r[header.index(label)]) for r in rows])
     assert f"from {col.min():.6g}" in line and f"to {col.max():.6g}" in line
+
+
+def coupler_point(t: np.ndarray, a: float, xa: float, xb: float, c: float, d: float
+                  ) -> np.ndarray:
+    """The crank-rocker's coupler point (0, 1) (coupler frame: A at (xa, 0), B at (xb, 0))
+    by the two-circle intersection: P = A + R(th3) (-xa, 1), (n, 2)."""
+    b = xb - xa
+    th2 = W * t
+    pa = np.stack([a * np.cos(th2), a * np.sin(th2)])
+    e = np.array([d, 0.0])[:, None] - pa
+    dist = np.hypot(*e)
+    x = (b * b - c * c + dist * dist) / (2 * dist)
+    e = e / dist
+    pb = pa + x * e + np.sqrt(b * b - x * x) * np.stack([-e[1], e[0]])
+    th3 = np.arctan2(pb[1] - pa[1], pb[0] - pa[0])
+    return (pa + np.stack([np.cos(th3) * -xa - np.sin(th3), np.sin(th3) * -xa + np.cos(th3)])).T
+
+
+POINT_LINKS = {"joint.O4.points.1.0": lambda e: (1.0, -1.75, 1.75, 2.5, 3.0 + e),
+               "joint.A.points.1.0": lambda e: (1.0, -1.75 + e, 1.75, 2.5, 3.0),
+               "joint.B.points.1.0": lambda e: (1.0, -1.75, 1.75, 2.5 - e, 3.0),
+               "joint.A.points.0.0": lambda e: (1.0 + e, -1.75, 1.75, 2.5, 3.0),
+               "joint.B.points.0.0": lambda e: (1.0, -1.75, 1.75 + e, 2.5, 3.0)}
+
+
+def test_point_dp_against_the_closed_form_and_ordinary_runs():
+    """res.point_dp: the coupler point's position derivatives against the closed form
+    differentiated (the gap falls as h^2), its velocity's and acceleration's against central
+    differences of ordinary runs."""
+    m = mbd2d.load(EX / "fourbar_grashof.toml")
+    names = list(POINT_LINKS)
+    res = m.kinematics(1.0, 48, sensitivities=names, tol=1e-14)
+    assert_allclose(res.point("coupler", (0.0, 1.0)).r,
+                    coupler_point(res.t, 1.0, -1.75, 1.75, 2.5, 3.0), atol=1e-12)
+    dr = res.point_dp("coupler", (0.0, 1.0))
+    assert dr.shape == (49, 2, len(names))
+    p0 = m.parameters()
+    for k, name in enumerate(names):
+        e3, e4 = (np.abs(dr[:, :, k] - central(coupler_point, POINT_LINKS[name], res.t, h)).max()
+                  for h in (1e-3, 1e-4))
+        assert e4 < 1e-8 and e4 < e3 / 50, (name, e3, e4)
+        h = 1e-5
+        hi, lo = (m.with_params({name: p0[name] + s * h}).kinematics(1.0, 48, tol=1e-14)
+                  .point("coupler", (0.0, 1.0)) for s in (1, -1))
+        for of in ("v", "a"):
+            fd = (getattr(hi, of) - getattr(lo, of)) / (2 * h)
+            got = res.point_dp("coupler", (0.0, 1.0), of=of)[:, :, k]
+            assert np.abs(got - fd).max() < 1e-7 * max(1.0, np.abs(fd).max()), (name, of)
+
+
+def test_point_dp_refusals():
+    res = mbd2d.load(EX / "fourbar_grashof.toml").kinematics(1.0, 4)
+    with pytest.raises(mbd2d.ModelError, match="no sensitivities"):
+        res.point_dp("coupler", (0, 1))
+    res = mbd2d.load(EX / "fourbar_grashof.toml").kinematics(
+        1.0, 4, sensitivities=["joint.O4.points.1.0"])
+    with pytest.raises(KeyError):
+        res.point_dp("nobody", (0, 1))
+    with pytest.raises(KeyError):
+        res.point_dp("coupler", (0, 1), of="jerk")
+    with pytest.raises(mbd2d.ModelError):
+        res.point_dp("coupler", (0, "x"))

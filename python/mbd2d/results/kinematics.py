@@ -9,7 +9,7 @@ from typing import Any
 import numpy as np
 
 from .. import plots
-from ..errors import MbdError
+from ..errors import MbdError, ModelError
 from ..validate import vector
 from . import measures
 from .columns import derivative_names, motion_columns, require_sensitivities
@@ -168,6 +168,42 @@ class KinematicsResult:
         qd = np.column_stack([b.x_dot, b.y_dot, b.theta_dot])
         qdd = np.column_stack([b.x_ddot, b.y_ddot, b.theta_ddot])
         return PointResult.of(name, (sx, sy), q, qd, qdd)
+
+    def point_dp(self, name: str, s: Any, of: str = "r") -> np.ndarray:
+        """The exact design derivatives of a point fixed in a body (rows, 2, n_params):
+        d(x, y)/dp of its position (``of="r"``), velocity (``"v"``) or acceleration
+        (``"a"``), in ``parameter_names`` order, from the body's sensitivities (d r_P =
+        d r_i + B s' d theta, ...; see :mod:`mbd2d.results.points`): which dimension moves
+        the coupler curve, and how much.
+
+        Raises
+        ------
+        ModelError
+            Without sensitivities, or if s is not two finite numbers.
+        KeyError
+            For an unknown body or a bad ``of``.
+
+        Examples
+        --------
+        >>> import mbd2d
+        >>> m = mbd2d.load("examples/fourbar_grashof.toml")
+        >>> res = m.kinematics(1.0, 4, sensitivities=["joint.B.points.0.0"])
+        >>> res.point_dp("coupler", [0.0, 1.0]).shape
+        (5, 2, 1)
+        """
+        require_sensitivities(self.dq_dp is not None, "point_dp")
+        if of not in ("r", "v", "a"):
+            raise KeyError(f"of must be one of r, v, a, got {of!r}")
+        sx, sy = vector(s, 2, "s", "point")
+        c = body_columns(self.body_names, name)
+        levels = [x[:, c] for x in self._levels()]
+        dlevels = [x[:, c, :] for x in (self.dq_dp, self.dqd_dp, self.dqdd_dp) if x is not None]
+        k = "rva".index(of)
+        if k >= len(levels):
+            raise ModelError("the run computed positions only (positions_only=True): run "
+                             "the kinematics without it for velocities and accelerations",
+                             "positions_only")
+        return PointResult.derivatives((sx, sy), levels[:k + 1], dlevels[:k + 1])[k]
 
     # ------------------------------------------------------------------ mechanism measures
     def transmission_angle(self, joint: str, output: str | None = None) -> np.ndarray:

@@ -6,6 +6,13 @@ and B = dA/dtheta (Haug, ch. 2; Nikravesh, ch. 2)::
     r_P     = r_i + A s'
     r_P_dot = r_i_dot + theta_dot B s'                       (B s' = A s' turned by +90 deg)
     r_P_ddot = r_i_ddot + theta_ddot B s' - theta_dot**2 A s'
+
+and along a design parameter p, from the body's sensitivities (dB/dtheta = -A)::
+
+    d r_P     = d r_i + B s' d theta
+    d r_P_dot = d r_i_dot + d theta_dot B s' - theta_dot A s' d theta
+    d r_P_ddot = d r_i_ddot + d theta_ddot B s' - theta_ddot A s' d theta
+                 - 2 theta_dot d theta_dot A s' - theta_dot**2 B s' d theta
 """
 from __future__ import annotations
 
@@ -57,6 +64,27 @@ class PointResult:
         v = qd[:, :2] + w[:, None] * bs
         a = qdd[:, :2] + al[:, None] * bs - (w**2)[:, None] * as_
         return cls(body, s, r, v, a)
+
+    @staticmethod
+    def derivatives(s: tuple[float, float], levels: list[np.ndarray],
+                    dlevels: list[np.ndarray]) -> list[np.ndarray]:
+        """d r_P, d r_P_dot, d r_P_ddot (each (n, 2, n_params), as many as levels are given)
+        of the point s from the body's levels q, q_dot, q_ddot (each (n, 3)) and their
+        sensitivities (each (n, 3, n_params))."""
+        th = levels[0][:, 2]
+        c, sn = np.cos(th), np.sin(th)
+        a_s = np.column_stack([c * s[0] - sn * s[1], sn * s[0] + c * s[1]])[:, :, None]
+        b_s = np.concatenate([-a_s[:, 1:], a_s[:, :1]], axis=1)           # B s' = A s' + 90
+        dth = dlevels[0][:, None, 2, :]
+        out = [dlevels[0][:, :2, :] + b_s * dth]
+        if len(levels) > 1:
+            w, dw = levels[1][:, None, 2, None], dlevels[1][:, None, 2, :]
+            out.append(dlevels[1][:, :2, :] + b_s * dw - w * a_s * dth)
+        if len(levels) > 2:
+            al, dal = levels[2][:, None, 2, None], dlevels[2][:, None, 2, :]
+            out.append(dlevels[2][:, :2, :] + b_s * dal - al * a_s * dth
+                       - 2 * w * dw * a_s - w**2 * b_s * dth)
+        return out
 
     def _rates(self, which: str) -> np.ndarray:
         """v or a, or a ModelError after a positions-only run."""

@@ -29,6 +29,7 @@ from ..description.builder import ModelDescription
 from ..description.parameters import find
 from ..errors import ModelError
 from ..results.measures import measure, measure_derivatives, measure_list, parse_measure
+from ..results.points import PointResult
 from ..validate import number, vector, whole
 from .dataset import xarray
 from .plan import (ANALYSES, _bind, _dynamics_settings, _inverse_settings,
@@ -84,9 +85,8 @@ class ToleranceResult:
         th = q[:, i + 2]
         c, sn = np.cos(th), np.sin(th)
         x, y = q[:, i] + c * sx - sn * sy, q[:, i + 1] + sn * sx + c * sy
-        dth = dq[:, i + 2, :]
-        dx = dq[:, i, :] + (-sn * sx - c * sy)[:, None] * dth
-        dy = dq[:, i + 1, :] + (c * sx - sn * sy)[:, None] * dth
+        dr = PointResult.derivatives((sx, sy), [q[:, i:i + 3]], [dq[:, i:i + 3, :]])[0]
+        dx, dy = dr[:, 0, :], dr[:, 1, :]
         sig = np.array(list(self.sigma.values()))
         qs = np.zeros((0,) + q.shape) if self.samples is None else \
             self.samples.q.values[self.samples.status.values == 0]      # (n, time, nq)

@@ -22,6 +22,7 @@ from typing import Any, Sequence
 import numpy as np
 
 from ..errors import ModelError
+from ..results.points import PointResult
 from ..validate import number
 
 COORDINATE = {"x": 0, "y": 1, "theta": 2}
@@ -77,7 +78,8 @@ def body_point(rows: Rows, body: str, s: Sequence[float]
     p = rows.q[:, i:i + 2] + a_s
     dp = None
     if rows.dq is not None:
-        dp = rows.dq[:, i:i + 2, :] + b_s[:, :, None] * rows.dq[:, i + 2, None, :]
+        dp = PointResult.derivatives((sx, sy), [rows.q[:, i:i + 3]],
+                                     [rows.dq[:, i:i + 3, :]])[0]
     ds = np.empty((len(th), 2, 2))
     ds[:, 0, 0], ds[:, 0, 1], ds[:, 1, 0], ds[:, 1, 1] = c, -sn, sn, c
     dt = rows.qd[:, i:i + 2] + b_s * rows.qd[:, i + 2, None]
