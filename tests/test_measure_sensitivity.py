@@ -38,19 +38,26 @@ RATIO = "velocity_ratio:motor:rocker.theta"
 ADVANTAGE = "mechanical_advantage:motor:rocker.theta"
 
 
-def ratio_fourbar(t: np.ndarray, a: float, b: float, c: float, d: float) -> np.ndarray:
-    """w4 / w2 of the crank-rocker (crank pivot at the origin, rocker pivot at (d, 0); the
-    branch of examples/fourbar_grashof.toml: B to the left of A -> O4)."""
+def loop(t: np.ndarray, a: float, b: float, c: float, d: float
+         ) -> tuple[np.ndarray, np.ndarray]:
+    """Joints A and B (2, n) of the crank-rocker (crank pivot at the origin, rocker pivot at
+    (d, 0)) by the two-circle intersection, on the branch of examples/fourbar_grashof.toml
+    (B to the left of A -> O4)."""
     th2 = W * t
     pa = np.stack([a * np.cos(th2), a * np.sin(th2)])
     e = np.array([d, 0.0])[:, None] - pa
     dist = np.hypot(*e)
     x = (b * b - c * c + dist * dist) / (2 * dist)
     e = e / dist
-    pb = pa + x * e + np.sqrt(b * b - x * x) * np.stack([-e[1], e[0]])
+    return pa, pa + x * e + np.sqrt(b * b - x * x) * np.stack([-e[1], e[0]])
+
+
+def ratio_fourbar(t: np.ndarray, a: float, b: float, c: float, d: float) -> np.ndarray:
+    """w4 / w2 of the crank-rocker from the loop closure."""
+    pa, pb = loop(t, a, b, c, d)
     th3 = np.arctan2(pb[1] - pa[1], pb[0] - pa[0])
     th4 = np.arctan2(pb[1], pb[0] - d)
-    return a * np.sin(th2 - th3) / (c * np.sin(th4 - th3))
+    return a * np.sin(W * t - th3) / (c * np.sin(th4 - th3))
 
 
 def rate_slider(t: np.ndarray, r: float, l: float, e: float) -> np.ndarray:
@@ -363,16 +370,9 @@ def test_cli_sweep_prints_the_derivatives_ranges(tmp_path, capsys):
 
 def coupler_point(t: np.ndarray, a: float, xa: float, xb: float, c: float, d: float
                   ) -> np.ndarray:
-    """The crank-rocker's coupler point (0, 1) (coupler frame: A at (xa, 0), B at (xb, 0))
-    by the two-circle intersection: P = A + R(th3) (-xa, 1), (n, 2)."""
-    b = xb - xa
-    th2 = W * t
-    pa = np.stack([a * np.cos(th2), a * np.sin(th2)])
-    e = np.array([d, 0.0])[:, None] - pa
-    dist = np.hypot(*e)
-    x = (b * b - c * c + dist * dist) / (2 * dist)
-    e = e / dist
-    pb = pa + x * e + np.sqrt(b * b - x * x) * np.stack([-e[1], e[0]])
+    """The crank-rocker's coupler point (0, 1) (coupler frame: A at (xa, 0), B at (xb, 0)):
+    P = A + R(th3) (-xa, 1), (n, 2)."""
+    pa, pb = loop(t, a, xb - xa, c, d)
     th3 = np.arctan2(pb[1] - pa[1], pb[0] - pa[0])
     return (pa + np.stack([np.cos(th3) * -xa - np.sin(th3), np.sin(th3) * -xa + np.cos(th3)])).T
 
