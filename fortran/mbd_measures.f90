@@ -31,7 +31,15 @@
 !!                 change d(r + A s') = dr + B s' dtheta + A ds'.
 !!   measures      a list of the three above (kind, integers, points) at every state in one
 !!                 call: a table's columns and a sweep case's (mbd_batch), where the points
-!!                 of an angle may come from the raw parameters a case sets.
+!!                 of an angle may come from the raw parameters a case sets; with the
+!!                 states' sensitivities s = dq/dp, each measure's design derivatives too:
+!!   influence_dp  J du = -(dJ) u, dJ = J_q s + J_p (every constraint on dual numbers along
+!!                 (s, p): sens_eval_d), with J's factors reused; a ratio n/d by the
+!!                 quotient rule (dn d - n dd)/d**2;
+!!   conditioning_dp with J D = U S V^T (core units: s' = s / (cunit dp'/dp)): a simple
+!!                 singular value changes by dsigma_i = u_i^T d(J D) v_i, d(J D)_k =
+!!                 (dJ_k - (J D)_k ((J D)_k . dJ_k)) / |J_k|; dc = (dsigma_n sigma_1 - sigma_n
+!!                 dsigma_1) / sigma_1**2. The values keep their own SVD without vectors.
 !!
 !! Work arrays are allocated once per call (with stat=), none in the loop over states.
 module mbd_measures
@@ -64,7 +72,7 @@ contains
 
   !> sigma_min / sigma_max of the column-scaled J (core units) at each state; with the
   !! parameter table ptab (2, np) and the states' sensitivities sq (nq, np, nt; model units),
-  !! also its design derivatives dcond (np, nt) (see the banner: conditioning_dp).
+  !! also its design derivatives dcond (np, nt) (the banner's conditioning_dp).
   subroutine api_conditioning(nb, ctab, rpar, q, t, cond, status, msg, ptab, sq, dcond)
     integer, intent(in) :: nb                   !! moving bodies
     integer, intent(in) :: ctab(:, :)           !! constraint table
