@@ -57,7 +57,7 @@ module mbd_measures
   implicit none
   private
   public :: api_conditioning, api_influence, api_fun_values, api_link_angle, api_ratio, &
-            api_measures, api_link_angle_dp
+            api_measures
   !> ratio kinds: the velocity ratio dY/dX, the mechanical advantage dX/dY
   integer, parameter, public :: RATIO_VELOCITY = 1, RATIO_ADVANTAGE = 2
   !> quantity kinds: a coordinate (its column), a driver (its row of Phi)
