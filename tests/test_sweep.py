@@ -332,8 +332,9 @@ def fourbar_cases(n: int) -> dict[str, np.ndarray]:
 
 
 #: the cases' measures and sensitivities travel with them
-EXTRAS = dict(measures=["transmission_angle:B", "dead_centre_distance"],
-              sensitivities=["joint.O4.points.1.0"])
+EXTRAS = dict(measures=["transmission_angle:B", "dead_centre_distance",
+                        "velocity_ratio:motor:rocker.theta"],
+              sensitivities=["joint.O4.points.1.0"])         # (and so dmeasures_dp)
 
 
 def test_process_pool_gives_the_serial_result(monkeypatch: pytest.MonkeyPatch) -> None:
