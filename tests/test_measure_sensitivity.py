@@ -421,3 +421,36 @@ def test_point_dp_refusals():
         res.point_dp("coupler", (0, 1), of="jerk")
     with pytest.raises(mbd2d.ModelError):
         res.point_dp("coupler", (0, "x"))
+
+
+def test_tolerance_contributions_against_the_law_of_cosines(tmp_path, capsys):
+    """Each parameter's share of the transmission angle's first-order variance: (dmu/dp_k
+    sigma_k)**2 / sum over the parameters, with dmu/dp from the law of cosines; a point's
+    shares add to 1; the command line names the largest."""
+    from test_angle_sensitivity import mu_fourbar
+    m = mbd2d.load(EX / "fourbar_grashof.toml")
+    sigma = {"joint.O4.points.1.0": 2e-3, "joint.A.points.0.0": 1e-3,
+             "joint.B.points.1.0": 1.5e-3}
+    tol = mbd2d.tolerance(m, sigma, samples=0, t_end=1.0, steps=36,
+                          measures=["transmission_angle:B"])
+    share = tol.contributions("measures", "transmission_angle:B")
+    assert share.dims == ("time", "parameter") and list(share.parameter.values) == list(sigma)
+    t = share.time.values
+    v = np.column_stack([(central(mu_fourbar, FOURBAR[n], t, 1e-4) * s) ** 2
+                         for n, s in sigma.items()])
+    assert_allclose(share.values, v / v.sum(axis=1, keepdims=True), atol=1e-7)
+    pt = tol.point("coupler", (0.0, 1.0))
+    assert_allclose(pt.x_share.sum("parameter").values, 1.0, rtol=1e-12)
+    with pytest.raises(mbd2d.ModelError, match="no output"):
+        tol.contributions("lam", "x")
+    with pytest.raises(mbd2d.ModelError, match="no entry"):
+        tol.contributions("q", "nobody.x")
+    assert main(["tolerance", str(EX / "fourbar_grashof.toml"), "--samples", "0",
+                 "--t-end", "1", "--steps", "36", "--measure", "transmission_angle:B",
+                 "--out", str(tmp_path / "t.csv")]
+                + [a for n, s in sigma.items() for a in ("--sigma", f"{n}={s}")]) == 0
+    line = next(ln for ln in capsys.readouterr().out.splitlines()
+                if ln.strip().startswith("transmission_angle:B"))
+    k = int(np.argmax(np.sqrt(v.sum(axis=1))))
+    j = int(np.argmax(v[k]))
+    assert f"mostly {list(sigma)[j]} ({100 * v[k, j] / v[k].sum():.0f}%)" in line

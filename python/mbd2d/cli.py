@@ -450,18 +450,19 @@ def _tolerance_report(tol: Any, points: list[tuple[str, Any]]) -> str:
     rows = []
     for j, name in enumerate(str(c) for c in ds.coordinate.values):
         rows.append((name, ds.q_std_linear.values[:, j],
-                     ds.q_std_mc.values[:, j] if "q_std_mc" in ds else None))
+                     ds.q_std_mc.values[:, j] if "q_std_mc" in ds else None, "q"))
     for label, pt in points:
         for v in ("x", "y"):
             rows.append((f"{label}.{v}", pt[f"{v}_std_linear"].values,
-                         pt[f"{v}_std_mc"].values))
+                         pt[f"{v}_std_mc"].values, pt[f"{v}_share"].values))
     rows.sort(key=lambda r: -float(np.nanmax(r[1])))
     t = np.atleast_1d(ds.time.values)
-    for name, lin, mc in rows[:8]:
+    for name, lin, mc, output in rows[:8]:
         k = int(np.nanargmax(lin))
         beside = "" if mc is None else f"  (Monte Carlo {mc[k]:.3g})" if np.isfinite(mc[k]) \
             else "  (Monte Carlo: fewer than 2 samples completed)"
-        lines.append(f"  {name:24s} {lin[k]:.3g} at t = {t[k]:.6g}{beside}")
+        lines.append(f"  {name:24s} {lin[k]:.3g} at t = {t[k]:.6g}{beside}"
+                     + _main_share(tol, output, name, k))
     if "measures" in ds:
         lines.append("measures, largest first-order standard deviation (angles in deg):")
         for j, spec in enumerate(str(m) for m in ds["measure"].values):
@@ -473,8 +474,23 @@ def _tolerance_report(tol: Any, points: list[tuple[str, Any]]) -> str:
             k = int(np.nanargmax(np.where(np.isfinite(lin), lin, np.nan)))
             mc = (f"  (Monte Carlo {unit(ds.measures_std_mc.values[k, j]):.3g})"
                   if "measures_std_mc" in ds else "")
-            lines.append(f"  {spec:24s} {lin[k]:.3g} at t = {t[k]:.6g}{mc}")
+            lines.append(f"  {spec:24s} {lin[k]:.3g} at t = {t[k]:.6g}{mc}"
+                         + _main_share(tol, "measures", spec, k))
     return "\n".join(lines)
+
+
+def _main_share(tol: Any, output: Any, entry: str, k: int) -> str:
+    """", mostly P (NN %)": the parameter with the largest share of the entry's first-order
+    variance at row k (ToleranceResult.contributions; a point's shares given as output, an
+    array (time, parameter)); "" for a lone parameter."""
+    if len(tol.sigma) < 2:
+        return ""
+    share = (tol.contributions(output, entry).values if isinstance(output, str)
+             else output)[k]
+    if not share.any():
+        return ""
+    j = int(np.argmax(share))
+    return f", mostly {list(tol.sigma)[j]} ({100 * share[j]:.0f}%)"
 
 
 def _parameters_report(model: Model, match: str | None) -> str:

@@ -66,8 +66,10 @@ class ToleranceResult:
     def point(self, body: str, s: Any) -> Any:
         """Scatter of a point fixed in a body, P = r + A(theta) s': an xarray.Dataset over
         "time" with ``x``, ``y`` (nominal), ``x_std_linear``, ``y_std_linear`` (first order:
-        dP/dp = dr/dp + B(theta) s' dtheta/dp) and ``x_std_mc``, ``y_std_mc`` (the sample
-        standard deviation of P over the completed samples).
+        dP/dp = dr/dp + B(theta) s' dtheta/dp), ``x_std_mc``, ``y_std_mc`` (the sample
+        standard deviation of P over the completed samples) and ``x_share``, ``y_share``
+        over ("time", "parameter"): each parameter's share of the first-order variance (as
+        :meth:`contributions`).
 
         Raises
         ------
@@ -95,12 +97,67 @@ class ToleranceResult:
         ys = qs[:, :, i + 1] + np.sin(ths) * sx + np.cos(ths) * sy
         xr = xarray()
         t = ("time",)
+        tp = ("time", "parameter")
         return xr.Dataset({"x": (t, x), "y": (t, y),
                            "x_std_linear": (t, _std_linear(dx, sig)),
                            "y_std_linear": (t, _std_linear(dy, sig)),
-                           "x_std_mc": (t, _std(xs)), "y_std_mc": (t, _std(ys))},
-                          coords={"time": self.dataset.time.values},
+                           "x_std_mc": (t, _std(xs)), "y_std_mc": (t, _std(ys)),
+                           "x_share": (tp, _shares(dx, sig)), "y_share": (tp, _shares(dy, sig))},
+                          coords={"time": self.dataset.time.values,
+                                  "parameter": list(self.sigma)},
                           attrs={"body": body, "point": f"({sx:g}, {sy:g})"})
+
+    def contributions(self, output: str, entry: str) -> Any:
+        """Each parameter's share of the first-order variance of one entry of an output,
+        over time: (S_k sigma_k)**2 / sum_j (S_j sigma_j)**2, from the nominal run's exact
+        sensitivities (0 where the entry does not move with any parameter). The shares say
+        which tolerance to tighten first.
+
+        Parameters
+        ----------
+        output : str
+            ``"q"``, ``"qd"``, ``"qdd"``, ``"lam"``, ``"effort"`` or ``"measures"`` (as in
+            :attr:`dataset`).
+        entry : str
+            Its coordinate (``"rocker.theta"``), equation label, driver or measure spec.
+
+        Returns
+        -------
+        xarray.DataArray
+            Over ("time", "parameter"); each row sums to 1 (or 0).
+
+        Raises
+        ------
+        ModelError
+            For an output or entry the analysis does not have.
+
+        Examples
+        --------
+        >>> import mbd2d
+        >>> m = mbd2d.load("examples/fourbar_grashof.toml")
+        >>> tol = mbd2d.tolerance(m, {"joint.A.points.0.0": 1e-3, "joint.B.points.0.0": 1e-3},
+        ...                       samples=0, t_end=1.0, steps=20)
+        >>> tol.contributions("q", "rocker.theta").sum("parameter").values.max()
+        1.0
+        """
+        ds = self.dataset
+        outputs = _outputs(ds)
+        if output not in outputs:
+            raise ModelError(f"no output {output!r}; outputs: {', '.join(outputs)}",
+                             "contributions")
+        labels = [str(v) for v in ds[ds[output].dims[1]].values]
+        if entry not in labels:
+            raise ModelError(f"{output} has no entry {entry!r}; entries: {', '.join(labels)}",
+                             "contributions")
+        if output == "measures":
+            s = measure_derivatives(self.nominal, labels)
+        else:
+            s = _linear_outputs(self.nominal, ds.attrs["run"])[output][2]
+        share = _shares(s[:, labels.index(entry), :], np.array(list(self.sigma.values())))
+        return xarray().DataArray(share, dims=("time", "parameter"),
+                                  coords={"time": ds.time.values,
+                                          "parameter": list(self.sigma)},
+                                  name=f"variance share of {entry}")
 
     def __repr__(self) -> str:
         a = self.dataset.attrs
@@ -131,6 +188,18 @@ def _std_linear(s: np.ndarray, sigma: np.ndarray) -> np.ndarray:
         raise ModelError("the first-order standard deviation exceeds the floating-point range: "
                          "give smaller sigma", "tolerance")
     return out
+
+
+def _shares(s: np.ndarray, sigma: np.ndarray) -> np.ndarray:
+    """Each parameter's share of the first-order variance, (S_k sigma_k)**2 / sum_j (S_j
+    sigma_j)**2 along the last axis (scaled by the largest term: no overflow; 0 where no
+    parameter moves the entry)."""
+    a = np.abs(s * sigma)
+    with np.errstate(invalid="ignore"):
+        m = a.max(axis=-1, keepdims=True) if a.shape[-1] else np.zeros(a.shape[:-1] + (1,))
+        v = (a / np.where(m > 0, m, 1.0)) ** 2
+        tot = v.sum(axis=-1, keepdims=True)
+        return np.where(tot > 0, v / np.where(tot > 0, tot, 1.0), 0.0)
 
 
 def _std(x: np.ndarray) -> np.ndarray:
