@@ -16,7 +16,9 @@ angle to every link length, and a tolerance analysis of a coupler point.
    length) from ``res.transmission_angle_dp`` at the worst row, against the law of cosines
    differentiated.
 3. ``mbd2d.tolerance`` propagates a scatter of the link lengths (sigma = 1 mm on metres)
-   into a coupler point's position along the cycle, first-order and by Monte Carlo.
+   into a coupler point's position along the cycle, first-order and by Monte Carlo, and
+   splits the point's variance among the links (``x_share``, ``y_share``: which tolerance
+   to tighten first).
 
 Usage::
 
@@ -189,8 +191,8 @@ def draw_sensitivity(res, out: Path) -> str:
 
 def draw_tolerance(pt, tol, out: Path) -> str:
     """The coupler point's scatter along the cycle: first order against Monte Carlo."""
-    fig = figure((11.0, 4.2))
-    ax, ax2 = fig.subplots(1, 2, width_ratios=[1.4, 1.0])
+    fig = figure((15.0, 4.2))
+    ax, ax2, ax3 = fig.subplots(1, 3, width_ratios=[1.4, 1.0, 1.2])
     crank = np.degrees(2 * np.pi * pt.time.values)
     for c, colour in (("x", "#1f77b4"), ("y", "#ff7f0e")):
         ax.plot(crank, 1e3 * pt[f"{c}_std_linear"].values, color=colour,
@@ -216,6 +218,17 @@ def draw_tolerance(pt, tol, out: Path) -> str:
     ax2.set_title(f"Monte Carlo scatter, magnified {mag:g}x")
     ax2.set_xlabel("x [m]")
     ax2.set_ylabel("y [m]")
+    # which tolerance to tighten: each link's share of the point's position variance
+    vx, vy = pt.x_std_linear.values ** 2, pt.y_std_linear.values ** 2
+    share = (pt.x_share.values * vx[:, None] + pt.y_share.values * vy[:, None]) \
+        / (vx + vy)[:, None]
+    ax3.stackplot(crank, 100 * share.T, labels=list(LINKS), alpha=0.85)
+    ax3.set_xlim(0, 360)
+    ax3.set_ylim(0, 100)
+    ax3.set_xlabel("crank angle [deg]")
+    ax3.set_ylabel("share of the variance [%]")
+    ax3.set_title("which link's tolerance the scatter comes from")
+    ax3.legend(fontsize=8, loc="upper right")
     path = out / "design_study_tolerance.png"
     fig.savefig(path, dpi=110)
     return str(path)
