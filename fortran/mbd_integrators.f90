@@ -1271,7 +1271,7 @@ contains
     type(dyn_work_t), intent(in) :: w
     type(itg_t), intent(inout) :: c
     integer, intent(out) :: stf
-    integer :: ni, na, lw
+    integer :: ni, na, lw, idum(1)
     real(wp) :: wq(1), adum(1), sdum(1), udum(1), vdum(1)
     stf = MBD_OK
     if (allocated(c%iv)) return
@@ -1282,7 +1282,7 @@ contains
               c%vkeep(m%nq), stat=stf)
     if (stf == 0 .and. w%solver == SOLVER_DENSE) then
       ! J_u, the QR's copy of J and its workspace, dgecon's
-      call dgeqp3(na, m%nq, adum, max(na, 1), c%upiv, sdum, wq, -1, stf)
+      call dgeqp3(na, m%nq, adum, max(na, 1), idum, sdum, wq, -1, stf)   ! (a query)
       lw = max(1, int(wq(1)))
       allocate (c%ju(na, na), c%upiv(na), c%jp(m%nq), c%qa(na, m%nq), c%tau(min(na, m%nq)), &
                 c%qwork(lw), c%cw(4 * na), c%iw(na), stat=stf)

@@ -397,7 +397,8 @@ contains
     call lapack_status('dgeqp3', info, status, msg)
     if (status /= MBD_OK) return
     rank = 0
-    r11 = abs(at(1, 1))
+    r11 = zero
+    if (min(m, n) > 0) r11 = abs(at(1, 1))      ! (no rows: rank 0)
     do i = 1, min(m, n)
       if (abs(at(i, i)) > RANK_TOL * r11) rank = rank + 1
     end do

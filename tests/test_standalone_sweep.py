@@ -121,7 +121,9 @@ def test_failed_cases_keep_their_rows_and_say_why(tmp_path: Path) -> None:
     status = {row[0]: row[s] for row in solve[1:]}
     assert status == {"0": "3", "1": "3", "2": "0", "3": "6"}
     last = {row[0]: row[m] for row in solve[1:]}
-    assert "dead centre" in last["0"] and '"motor"' in last["0"] and last["2"] == ""
+    assert "dead centre" in last["0"] and "'motor'" in last["0"] and last["2"] == ""
+    pm = {row[0]: row[m] for row in py[1:]}
+    assert last["0"] == pm["0"] and last["1"] == pm["1"]     # a dead centre: Python's words
     assert "contradict" in last["3"] and "O2 A B O4 motor cannot all hold" in last["3"]
     assert r.stderr.count("mbd2d-solve: case ") == 3
     assert [row for row in solve[1:] if row[0] == "3"][0][solve[0].index("t")] == ""
@@ -274,3 +276,24 @@ def test_a_parameter_a_kinematic_run_does_not_take(tmp_path: Path) -> None:
     for c in range(3):
         got = np.array([[float(row[k]) for k in cols] for row in solve[1:] if row[0] == str(c)])
         np.testing.assert_array_equal(got, base)
+
+
+@pytest.mark.parametrize("model, analysis", [("fourbar_grashof.toml", "kinematics"),
+                                             ("fourbar_masses.toml", "inverse_dynamics")])
+def test_dead_centre_cases_in_the_python_words(tmp_path: Path, model: str,
+                                               analysis: str) -> None:
+    """Coupler lengths below 1.5 stop at a dead centre: mbd2d-solve writes their messages as
+    the Python sweep records them (time, driver, dependent constraints, sigma ratio, rows
+    kept), so the whole file is the Python one byte for byte."""
+    m = mbd2d.load(EX / model)
+    cases = {"joint.B.points.0.0": [-0.5, -0.4, 1.75, -0.3]}        # coupler 1.25 .. 3.5
+    kw = dict(t_end=1.0, steps=24)
+    mbd2d.export_sweep(m, tmp_path / "s.mbd", cases, analysis, **kw)
+    r = subprocess.run([find_solver(), str(tmp_path / "s.mbd"), str(tmp_path / "solve.csv")],
+                       capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    ds = mbd2d.sweep(m, cases, analysis, workers=1, **kw)
+    assert (ds.status.values == 3).sum() >= 2          # dead centres
+    mbd2d.write_sweep(ds, tmp_path / "py.csv")
+    assert (tmp_path / "solve.csv").read_bytes() == (tmp_path / "py.csv").read_bytes()
+    assert "Singular configuration (dead centre)" in r.stderr

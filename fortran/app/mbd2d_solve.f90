@@ -41,7 +41,8 @@ program mbd2d_solve
   use mbd_contact, only: NEO
   use mbd_forces, only: force_is_contact, FRC_FRICTION
   use iso_c_binding, only: c_char, c_double, c_int
-  use solve_text, only: FMT_G6, format_num, num, sput, bput, bnum, quoted
+  use solve_text, only: FMT_G6, FMT_E1, FMT_F10, format_num, num, sput, bput, bnum, quoted, &
+                        cnum
   implicit none
   type(mbd_spec_t) :: spec
   character(len=1024) :: model_path, out_path
@@ -946,6 +947,8 @@ contains
       cstat(c) = merge(MBD_INTEGRATOR_FAILED, MBD_NO_CONVERGENCE, code == 4)
       write (cmsg(c), '(a,es14.6,a)') 'the run gave non-finite values at t =', &
         tout(max(1, min(k, nrow))), ' s'
+    else if (bstat(c) == MBD_SINGULAR_CONFIG .and. code <= 2) then
+      cmsg(c) = dead_centre_text(c)
     else if (bstat(c) == MBD_SINGULAR_CONFIG) then
       cmsg(c) = singular_text(brinfo(1, c), biinfo(3, c), bdep(:, c))
     else if (bstat(c) == MBD_INCONSISTENT .and. any(bdep(:, c) == 1)) then
@@ -957,6 +960,38 @@ contains
         trim(bmsg(c)) // ' ("' // trim(spec%con_names(biinfo(4, c))) // '")'
     end if
   end subroutine case_outcome
+
+  !> A kinematic or inverse-dynamics case's dead centre in the words of the exception the
+  !! Python sweep records (mbd2d.analysis.failures.kinematic_failure), with its kept rows.
+  function dead_centre_text(c) result(s)
+    integer, intent(in) :: c
+    character(len=4 * MSG_LEN) :: s
+    character(len=2 * MSG_LEN) :: names, last
+    integer :: k, r0, nr, drv
+    real(wp) :: ratio
+    names = ''; r0 = 1
+    do k = 1, spec%nc                        ! the dependent rows' owners, ", " between
+      nr = con_nrow(spec%ctab(1, k))
+      if (any(bdep(r0:r0 + nr - 1, c) == 1)) then
+        if (len_trim(names) > 0) names = trim(names) // ','
+        names = trim(names) // ' ' // trim(spec%con_names(k))
+      end if
+      r0 = r0 + nr
+    end do
+    ratio = 0.0_wp
+    if (brinfo(3, c) > 0.0_wp) ratio = brinfo(2, c) / brinfo(3, c)
+    last = 'no output rows'
+    if (nkeep(c) > 0) last = 't = ' // cnum(tout(nkeep(c)), FMT_G6) // ' s'
+    drv = biinfo(3, c)
+    s = 'Singular configuration (dead centre) at t = ' // cnum(brinfo(1, c), FMT_F10) // ' s:'
+    if (drv > 0 .and. drv <= spec%nc) s = trim(s) // " driver '" // &
+      trim(spec%con_names(drv)) // "' can no longer be met, because"
+    s = trim(s) // ' the constraints' // trim(names) // ' became dependent (J lost rank; ' // &
+        'sigma_min/sigma_max = ' // cnum(ratio, FMT_E1) // '). The mechanism cannot move ' // &
+        'further as driven: end the run before this time, or change the driver or the link ' &
+        // 'lengths. Results up to ' // trim(last) // ' (' // trim(itoa(nkeep(c))) // &
+        " rows) are kept in the exception's .results."
+  end function dead_centre_text
 
   !> The first of the rows 1..n of case c with a non-finite number (n + 1: none).
   integer function first_bad(c, n) result(k)
@@ -989,11 +1024,14 @@ contains
     integer :: u, ios, j, k, l, r0, nlev, c, lp, nh, nt, width, p, nsl
     nlev = merge(3, 1, nd > 0)
     nsl = size(bslam, 1)
-    ! at most 26 characters a number ("%.17g": -1.2345678901234567e-308) with its comma
+    ! at most 26 characters a number ("%.17g": -1.2345678901234567e-308) with its comma; a
+    ! row also holds the case's status and message (tail: the message quoted, every quote
+    ! doubled at most)
     width = 26 * (spec%ncp + 2 + 3 * nq + spec%nc + spec%nmeas + &
                   spec%npar * (3 * nq + spec%nc + spec%nmeas)) + 32
-    allocate (character(len=width) :: head, line, stat=ierr)
+    allocate (character(len=width) :: head, stat=ierr)
     if (ierr == 0) allocate (character(len=2 * len(cmsg) + 40) :: tail, stat=ierr)
+    if (ierr == 0) allocate (character(len=width + len(tail)) :: line, stat=ierr)
     if (ierr /= 0) call die(2, 'not enough memory to write ' // path)
     open (newunit=u, file=path, status='replace', action='write', access='stream', &
           form='unformatted', iostat=ios)

@@ -8,11 +8,12 @@ module solve_text
   use mbd_kinds, only: wp
   implicit none
   private
-  public :: FMT_E16, FMT_G17, FMT_G6, format_num, num, sput, bput, bnum, quoted
+  public :: FMT_E16, FMT_G17, FMT_G6, FMT_E1, FMT_F10, format_num, num, sput, bput, bnum, &
+            quoted, cnum
 
   interface
-    !> x into buf(len) as "%.16e" (kind 1), "%.17g" (2) or "%g" (3); the length written
-    !! (number_format.c)
+    !> x into buf(len) as "%.16e" (kind 1), "%.17g" (2), "%g" (3), "%.1e" (4) or "%.10f"
+    !! (5); the length written (number_format.c)
     function format_num(x, kind, buf, len) result(n) bind(C, name='mbd_format')
       import :: c_char, c_double, c_int
       real(c_double), value :: x
@@ -23,7 +24,7 @@ module solve_text
     end function format_num
   end interface
   !> the formats of format_num
-  integer(c_int), parameter :: FMT_E16 = 1, FMT_G17 = 2, FMT_G6 = 3
+  integer(c_int), parameter :: FMT_E16 = 1, FMT_G17 = 2, FMT_G6 = 3, FMT_E1 = 4, FMT_F10 = 5
 
 contains
 
@@ -49,6 +50,21 @@ contains
       s(i:i) = buf(i)
     end do
   end subroutine num
+
+  !> x as C's printf (and Python's format) writes it in format kind (format_num), for
+  !! messages.
+  function cnum(x, kind) result(s)
+    real(wp), intent(in) :: x
+    integer(c_int), intent(in) :: kind
+    character(len=:), allocatable :: s
+    character(kind=c_char) :: cb(64)
+    integer :: i, m
+    m = max(0, min(int(format_num(real(x, c_double), kind, cb, 64_c_int)), 63))
+    allocate (character(len=m) :: s)
+    do i = 1, m
+      s(i:i) = cb(i)
+    end do
+  end function cnum
 
   !> Write bytes to a stream unit (nothing once a write has failed).
   subroutine sput(u, ios, text)
