@@ -1,8 +1,8 @@
 """The design study's sweep without Python: the crank-rocker's coupler length over 200
 values (examples/design_study.py), exported once (``mbd2d.export_sweep``) and run by the
 standalone ``mbd2d-solve``, which writes the CSV the Python sweep writes
-(``mbd2d.write_sweep``): the same rows, numbers and statuses, the dead centres' messages in
-the Python words, the variants that do not assemble in its own; then a run with design sensitivities and measure columns, byte for byte.
+(``mbd2d.write_sweep``): the same rows, numbers and statuses, the dead centres' and the
+contradictions' messages in the Python words, other failures in its own; then a run with design sensitivities and measure columns, byte for byte.
 
 Usage::
 

@@ -41,7 +41,7 @@ program mbd2d_solve
   use mbd_contact, only: NEO
   use mbd_forces, only: force_is_contact, FRC_FRICTION
   use iso_c_binding, only: c_char, c_double, c_int
-  use solve_text, only: FMT_G6, FMT_E1, FMT_F10, format_num, num, sput, bput, bnum, quoted, &
+  use solve_text, only: FMT_G6, FMT_E1, FMT_F10, FMT_G3, format_num, num, sput, bput, bnum, quoted, &
                         cnum
   implicit none
   type(mbd_spec_t) :: spec
@@ -951,6 +951,8 @@ contains
       cmsg(c) = dead_centre_text(c)
     else if (bstat(c) == MBD_SINGULAR_CONFIG) then
       cmsg(c) = singular_text(brinfo(1, c), biinfo(3, c), bdep(:, c))
+    else if (bstat(c) == MBD_INCONSISTENT .and. code <= 2) then
+      cmsg(c) = inconsistent_text(c)
     else if (bstat(c) == MBD_INCONSISTENT .and. any(bdep(:, c) == 1)) then
       cmsg(c) = trim(bmsg(c)) // ': the constraints' // trim(dep_names(bdep(:, c))) // &
                 ' cannot all hold; check their points and dimensions'
@@ -967,17 +969,9 @@ contains
     integer, intent(in) :: c
     character(len=4 * MSG_LEN) :: s
     character(len=2 * MSG_LEN) :: names, last
-    integer :: k, r0, nr, drv
+    integer :: drv
     real(wp) :: ratio
-    names = ''; r0 = 1
-    do k = 1, spec%nc                        ! the dependent rows' owners, ", " between
-      nr = con_nrow(spec%ctab(1, k))
-      if (any(bdep(r0:r0 + nr - 1, c) == 1)) then
-        if (len_trim(names) > 0) names = trim(names) // ','
-        names = trim(names) // ' ' // trim(spec%con_names(k))
-      end if
-      r0 = r0 + nr
-    end do
+    names = owner_names(bdep(:, c))
     ratio = 0.0_wp
     if (brinfo(3, c) > 0.0_wp) ratio = brinfo(2, c) / brinfo(3, c)
     last = 'no output rows'
@@ -992,6 +986,50 @@ contains
         // 'lengths. Results up to ' // trim(last) // ' (' // trim(itoa(nkeep(c))) // &
         " rows) are kept in the exception's .results."
   end function dead_centre_text
+
+  !> A kinematic or inverse-dynamics case's contradicting redundant constraints in the words
+  !! of the exception the Python sweep records (mbd2d.analysis.failures.inconsistent).
+  function inconsistent_text(c) result(s)
+    integer, intent(in) :: c
+    character(len=4 * MSG_LEN) :: s
+    character(len=*), parameter :: what(0:2) = [character(len=20) :: '||Phi||', &
+      '||J q_dot - nu||', '||J q_ddot - gamma||']
+    character(len=*), parameter :: lvl(0:2) = [character(len=24) :: '', &
+      ' at velocity level', ' at acceleration level']
+    character(len=2 * MSG_LEN) :: rows
+    integer :: r, nred, level
+    level = max(0, min(2, biinfo(5, c)))
+    rows = ''; nred = 0
+    do r = 1, neq                            ! the redundant rows' labels, ", " between
+      if (bred(r, c) /= 1) cycle
+      if (nred > 0) rows = trim(rows) // ','
+      rows = trim(rows) // ' ' // trim(row_label(r)); nred = nred + 1
+    end do
+    s = 'Redundant constraints contradict each other' // trim(lvl(level)) // ' at t = ' // &
+        cnum(brinfo(1, c), FMT_G6) // ' s:'
+    if (nred > 0 .and. biinfo(9, c) /= 0) s = trim(s) // trim(rows) // ' (' // &
+      trim(itoa(nred)) // ' redundant equation(s): ' // trim(itoa(neq)) // ' equations, ' // &
+      'rank ' // trim(itoa(biinfo(9, c))) // ') contradict(s) the other constraints;'
+    s = trim(s) // trim(owner_names(bdep(:, c))) // ' cannot all hold (smallest residual ' // &
+        trim(what(level)) // ' = ' // cnum(brinfo(4, c), FMT_G3) // '). Check their ' // &
+        'points and dimensions, or remove the one that repeats another.'
+  end function inconsistent_text
+
+  !> " A, B, ...": the constraints that own a row flagged in dp (neq), in their order.
+  function owner_names(dp) result(names)
+    integer, intent(in) :: dp(:)
+    character(len=2 * MSG_LEN) :: names
+    integer :: k, r0, nr
+    names = ''; r0 = 1
+    do k = 1, spec%nc
+      nr = con_nrow(spec%ctab(1, k))
+      if (any(dp(r0:r0 + nr - 1) == 1)) then
+        if (len_trim(names) > 0) names = trim(names) // ','
+        names = trim(names) // ' ' // trim(spec%con_names(k))
+      end if
+      r0 = r0 + nr
+    end do
+  end function owner_names
 
   !> The first of the rows 1..n of case c with a non-finite number (n + 1: none).
   integer function first_bad(c, n) result(k)

@@ -8,12 +8,12 @@ module solve_text
   use mbd_kinds, only: wp
   implicit none
   private
-  public :: FMT_E16, FMT_G17, FMT_G6, FMT_E1, FMT_F10, format_num, num, sput, bput, bnum, &
+  public :: FMT_E16, FMT_G17, FMT_G6, FMT_E1, FMT_F10, FMT_G3, format_num, num, sput, bput, bnum, &
             quoted, cnum
 
   interface
-    !> x into buf(len) as "%.16e" (kind 1), "%.17g" (2), "%g" (3), "%.1e" (4) or "%.10f"
-    !! (5); the length written (number_format.c)
+    !> x into buf(len) as "%.16e" (kind 1), "%.17g" (2), "%g" (3), "%.1e" (4), "%.10f" (5)
+    !! or "%.3g" (6); the length written (number_format.c)
     function format_num(x, kind, buf, len) result(n) bind(C, name='mbd_format')
       import :: c_char, c_double, c_int
       real(c_double), value :: x
@@ -24,7 +24,8 @@ module solve_text
     end function format_num
   end interface
   !> the formats of format_num
-  integer(c_int), parameter :: FMT_E16 = 1, FMT_G17 = 2, FMT_G6 = 3, FMT_E1 = 4, FMT_F10 = 5
+  integer(c_int), parameter :: FMT_E16 = 1, FMT_G17 = 2, FMT_G6 = 3, FMT_E1 = 4, FMT_F10 = 5, &
+                                FMT_G3 = 6
 
 contains
 
