@@ -137,6 +137,7 @@ def test_demo_script(tmp_path: Path) -> None:
     assert "hit a dead centre" in proc.stdout
     assert "summary: 7/7" in proc.stdout and "GIF animations" in proc.stdout
     # the design study's sweep and a sensitivity run through mbd2d-solve, as Python writes them
-    assert "the same rows, numbers and statuses: True" in proc.stdout
+    assert "the same file byte for byte (rows, numbers, statuses and messages): True" in \
+        proc.stdout
     assert "the same CSV: True" in proc.stdout
     assert gifs == ["cam_liftoff.gif", "fourbar_grashof.gif", "slider_crank.gif"]

@@ -297,3 +297,19 @@ def test_dead_centre_cases_in_the_python_words(tmp_path: Path, model: str,
     mbd2d.write_sweep(ds, tmp_path / "py.csv")
     assert (tmp_path / "solve.csv").read_bytes() == (tmp_path / "py.csv").read_bytes()
     assert "Singular configuration (dead centre)" in r.stderr
+
+
+def test_assembly_failures_in_the_python_words(tmp_path: Path) -> None:
+    """Coupler lengths the loop cannot close at the start (no assembly near the estimates,
+    or the driver contradicting the loop) and a far-off rocker pivot: mbd2d-solve's file is
+    the Python sweep's byte for byte, messages included."""
+    m = mbd2d.load(EX / "fourbar_grashof.toml")
+    cases = {"joint.B.points.0.0": [3.0, 1.75, 3.2], "joint.O4.points.1.0": [3.0, 9.0, 3.0]}
+    mbd2d.export_sweep(m, tmp_path / "s.mbd", cases, "kinematics", t_end=1.0, steps=12)
+    r = subprocess.run([find_solver(), str(tmp_path / "s.mbd"), str(tmp_path / "solve.csv")],
+                       capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    ds = mbd2d.sweep(m, cases, "kinematics", workers=1, t_end=1.0, steps=12)
+    assert set(ds.status.values) == {4, 6}, ds.status.values   # no assembly, contradiction
+    mbd2d.write_sweep(ds, tmp_path / "py.csv")
+    assert (tmp_path / "solve.csv").read_bytes() == (tmp_path / "py.csv").read_bytes()

@@ -34,7 +34,8 @@ program mbd2d_solve
   use mbd_api, only: NINFO, api_sizes, api_kinematics, api_inverse, api_dynamics, api_statics, &
                      api_reactions, api_dynamics_sens, api_reactions_dp, api_analyze
   use mbd_batch, only: batch_run, NISET, NRSET
-  use mbd_status, only: MBD_NO_CONVERGENCE, MBD_INTEGRATOR_FAILED, MBD_INCONSISTENT
+  use mbd_status, only: MBD_NO_CONVERGENCE, MBD_INTEGRATOR_FAILED, MBD_INCONSISTENT, &
+                        MBD_ASSEMBLY_FAILED
   use mbd_constraints, only: con_nextra
   use mbd_kinematics, only: MAXPASS, kin_out_count
   use mbd_integrators, only: output_index
@@ -960,6 +961,9 @@ contains
       cmsg(c) = bmsg(c)
       if (code /= 4 .and. biinfo(4, c) > 0 .and. biinfo(4, c) <= spec%nc) cmsg(c) = &
         trim(bmsg(c)) // ' ("' // trim(spec%con_names(biinfo(4, c))) // '")'
+      if (bstat(c) == MBD_ASSEMBLY_FAILED .and. code <= 2) then
+        if (len_trim(assembly_text(c)) > 0) cmsg(c) = assembly_text(c)
+      end if
     end if
   end subroutine case_outcome
 
@@ -1030,6 +1034,38 @@ contains
       r0 = r0 + nr
     end do
   end function owner_names
+
+  !> A kinematic or inverse-dynamics case that does not assemble, in the words of the
+  !! exception the Python sweep records (mbd2d.analysis.failures.assembly_failed); '' where
+  !! the worst constraint's name in those words is not in the file's tables (a cam or a
+  !! point-on-curve joint, a point-on-line or a revolute-translational joint: one kind each).
+  function assembly_text(c) result(s)
+    integer, intent(in) :: c
+    character(len=4 * MSG_LEN) :: s
+    character(len=*), parameter :: types(10) = [character(len=16) :: 'revolute', &
+      'translational', '', 'distance', '', 'weld', 'gear', 'rack-pinion', 'rolling-disc', &
+      'absolute']
+    character(len=2 * MSG_LEN) :: who
+    integer :: w, kind
+    s = ''
+    w = biinfo(4, c)
+    who = '?'
+    if (w >= 1 .and. w <= spec%nc) then
+      kind = spec%ctab(1, w)
+      if (con_is_driver(kind)) then
+        who = "driver '" // trim(spec%con_names(w)) // "'"
+      else if (kind >= 1 .and. kind <= size(types)) then
+        if (len_trim(types(kind)) == 0) return
+        who = "joint '" // trim(spec%con_names(w)) // "' (" // trim(types(kind)) // ')'
+      else
+        return
+      end if
+    end if
+    s = 'Assembly failed at t = ' // cnum(brinfo(1, c), FMT_G6) // ' s: no configuration ' // &
+        'satisfies the constraints near the q0 estimates (smallest residual ' // &
+        cnum(brinfo(4, c), FMT_G3) // ', largest in ' // trim(who) // '). Check the link ' // &
+        'lengths and joint points, and give q0 closer to the intended configuration.'
+  end function assembly_text
 
   !> The first of the rows 1..n of case c with a non-finite number (n + 1: none).
   integer function first_bad(c, n) result(k)
