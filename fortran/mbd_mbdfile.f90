@@ -62,7 +62,7 @@ module mbd_mbdfile
   use, intrinsic :: iso_fortran_env, only: int64
   implicit none
   private
-  public :: NAME_LEN, PNAME_LEN, MAX_STEPS, mbd_spec_t, mbd_read, ANALYSES
+  public :: NAME_LEN, PNAME_LEN, MAX_STEPS, mbd_spec_t, mbd_read, ANALYSES, METHOD_WORDS
   public :: MEAS_ANGLE, MEAS_RATIO, MEAS_ADVANTAGE, MEAS_CONDITIONING
 
   integer, parameter :: NAME_LEN = 64             !! longest body or constraint name

@@ -313,3 +313,23 @@ def test_assembly_failures_in_the_python_words(tmp_path: Path) -> None:
     assert set(ds.status.values) == {4, 6}, ds.status.values   # no assembly, contradiction
     mbd2d.write_sweep(ds, tmp_path / "py.csv")
     assert (tmp_path / "solve.csv").read_bytes() == (tmp_path / "py.csv").read_bytes()
+
+
+@pytest.mark.parametrize("method", ["dopri5", "generalized-alpha"])
+def test_dynamics_failures_in_the_python_words(tmp_path: Path, method: str) -> None:
+    """The driven four-bar with masses, coupler lengths below 1.5 run into the dead centre in
+    forward dynamics: mbd2d-solve's file is the Python sweep's byte for byte ("METHOD: what",
+    the rows kept)."""
+    m = mbd2d.load(EX / "fourbar_masses.toml")
+    cases = {"joint.B.points.0.0": [-0.5, -0.4, 1.75]}
+    kw = dict(t_end=1.0, steps=24, method=method)
+    mbd2d.export_sweep(m, tmp_path / "s.mbd", cases, "dynamics", **kw)
+    r = subprocess.run([find_solver(), str(tmp_path / "s.mbd"), str(tmp_path / "solve.csv")],
+                       capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    ds = mbd2d.sweep(m, cases, "dynamics", workers=1, **kw)
+    assert (ds.status.values != 0).sum() >= 2, ds.status.values
+    assert all(str(msg).startswith(f"{method}: ") for msg, st in
+               zip(ds.message.values, ds.status.values) if st != 0)
+    mbd2d.write_sweep(ds, tmp_path / "py.csv")
+    assert (tmp_path / "solve.csv").read_bytes() == (tmp_path / "py.csv").read_bytes()

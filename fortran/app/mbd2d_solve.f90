@@ -26,8 +26,8 @@ program mbd2d_solve
   use mbd_kinds, only: wp
   use mbd_status, only: MBD_OK, MBD_SINGULAR_CONFIG, MBD_NO_MEMORY, MSG_LEN
   use mbd_memory, only: REAL_BYTES, mem_check
-  use mbd_mbdfile, only: mbd_spec_t, mbd_read, NAME_LEN, MEAS_ANGLE, MEAS_RATIO, &
-                         MEAS_ADVANTAGE
+  use mbd_mbdfile, only: mbd_spec_t, mbd_read, NAME_LEN, METHOD_WORDS, MEAS_ANGLE, &
+                         MEAS_RATIO, MEAS_ADVANTAGE
   use mbd_measures, only: api_measures
   use mbd_model, only: NFT
   use mbd_constraints, only: con_nrow, con_is_driver
@@ -42,8 +42,8 @@ program mbd2d_solve
   use mbd_contact, only: NEO
   use mbd_forces, only: force_is_contact, FRC_FRICTION
   use iso_c_binding, only: c_char, c_double, c_int
-  use solve_text, only: FMT_G6, FMT_E1, FMT_F10, FMT_G3, format_num, num, sput, bput, bnum, quoted, &
-                        cnum
+  use solve_text, only: FMT_G6, FMT_E1, FMT_F10, FMT_G3, format_num, num, sput, bput, bnum, &
+                        quoted, cnum
   implicit none
   type(mbd_spec_t) :: spec
   character(len=1024) :: model_path, out_path
@@ -944,6 +944,11 @@ contains
     nkeep(c) = min(n, k - 1)
     cstat(c) = bstat(c)
     if (bstat(c) < 0 .or. code == 3) nkeep(c) = 0
+    if (bstat(c) == MBD_OK) cstat(c) = merge(MBD_INTEGRATOR_FAILED, MBD_NO_CONVERGENCE, code == 4)
+    if (code == 4) then                      ! dynamics: the Python words where they fit
+      cmsg(c) = dynamics_text(c, k)
+      if (len_trim(cmsg(c)) > 0) return
+    end if
     if (bstat(c) == MBD_OK) then
       cstat(c) = merge(MBD_INTEGRATOR_FAILED, MBD_NO_CONVERGENCE, code == 4)
       write (cmsg(c), '(a,es14.6,a)') 'the run gave non-finite values at t =', &
@@ -1066,6 +1071,40 @@ contains
         cnum(brinfo(4, c), FMT_G3) // ', largest in ' // trim(who) // '). Check the link ' // &
         'lengths and joint points, and give q0 closer to the intended configuration.'
   end function assembly_text
+
+  !> A dynamics case's failure in the words of the exception the Python sweep records
+  !! (mbd2d.analysis.dynamics.dynamics_error): "METHOD: what" with the rows kept where the
+  !! integrator failed or the solution became non-finite (at row k), the failed assembly at
+  !! t0; '' where that exception's text needs more than the file holds (bad input, a
+  !! contradiction before the first row).
+  function dynamics_text(c, k) result(s)
+    integer, intent(in) :: c, k
+    character(len=4 * MSG_LEN) :: s
+    character(len=2 * MSG_LEN) :: kept
+    character(len=20) :: method
+    s = ''
+    method = METHOD_WORDS(max(1, min(size(METHOD_WORDS), spec%method)))
+    kept = 'no output rows'
+    if (nkeep(c) > 0) kept = 't = ' // cnum(tout(nkeep(c)), FMT_G6) // ' s'
+    kept = 'Results up to ' // trim(kept) // " are kept in the exception's .results."
+    select case (bstat(c))
+    case (MBD_OK)
+      s = trim(method) // ': the solution became non-finite at t = ' // &
+          cnum(tout(max(1, min(k, nrow))), FMT_G6) // ' s (a blow-up: try a smaller rtol ' // &
+          'or h, or another method). ' // trim(kept)
+    case (MBD_ASSEMBLY_FAILED)
+      s = 'Assembly failed at t = ' // cnum(spec%t0, FMT_G6) // ' s: no configuration ' // &
+          'satisfies the constraints near the q0 estimates (smallest residual 0, largest ' // &
+          'in ?). Check the link lengths and joint points, and give q0 closer to the ' // &
+          'intended configuration.'
+    case (MBD_INTEGRATOR_FAILED)
+      s = trim(method) // ': ' // trim(bmsg(c)) // '. ' // trim(kept)
+    case (MBD_INCONSISTENT)
+      if (nkeep(c) > 0) s = trim(method) // ': ' // trim(bmsg(c))
+    case default
+      if (bstat(c) > 0) s = trim(method) // ': ' // trim(bmsg(c))
+    end select
+  end function dynamics_text
 
   !> The first of the rows 1..n of case c with a non-finite number (n + 1: none).
   integer function first_bad(c, n) result(k)
