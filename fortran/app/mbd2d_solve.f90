@@ -442,16 +442,23 @@ contains
     s = trim(singular_text(rinfo(1), iinfo(3), dep)) // ' ' // trim(rows_written()) // '.'
   end function singular_message
 
-  !> " NAME NAME ...": the constraints that own a row flagged in dp (neq).
-  function dep_names(dp) result(names)
+  !> " NAME NAME ...": the constraints that own a row flagged in dp (neq), in their order;
+  !! with commas, " NAME, NAME, ..." (as the Python messages join them).
+  function dep_names(dp, commas) result(names)
     integer, intent(in) :: dp(:)
+    logical, intent(in), optional :: commas
     character(len=2 * MSG_LEN) :: names
     integer :: c, r0, nr
     names = ''
     r0 = 1
     do c = 1, spec%nc
       nr = con_nrow(spec%ctab(1, c))
-      if (any(dp(r0:r0 + nr - 1) == 1)) names = trim(names) // ' ' // trim(spec%con_names(c))
+      if (any(dp(r0:r0 + nr - 1) == 1)) then
+        if (len_trim(names) > 0 .and. present(commas)) then
+          if (commas) names = trim(names) // ','
+        end if
+        names = trim(names) // ' ' // trim(spec%con_names(c))
+      end if
       r0 = r0 + nr
     end do
   end function dep_names
@@ -980,7 +987,7 @@ contains
     character(len=2 * MSG_LEN) :: names, last
     integer :: drv
     real(wp) :: ratio
-    names = owner_names(bdep(:, c))
+    names = dep_names(bdep(:, c), .true.)
     ratio = 0.0_wp
     if (brinfo(3, c) > 0.0_wp) ratio = brinfo(2, c) / brinfo(3, c)
     last = 'no output rows'
@@ -1019,26 +1026,10 @@ contains
     if (nred > 0 .and. biinfo(9, c) /= 0) s = trim(s) // trim(rows) // ' (' // &
       trim(itoa(nred)) // ' redundant equation(s): ' // trim(itoa(neq)) // ' equations, ' // &
       'rank ' // trim(itoa(biinfo(9, c))) // ') contradict(s) the other constraints;'
-    s = trim(s) // trim(owner_names(bdep(:, c))) // ' cannot all hold (smallest residual ' // &
+    s = trim(s) // trim(dep_names(bdep(:, c), .true.)) // ' cannot all hold (smallest residual ' // &
         trim(what(level)) // ' = ' // cnum(brinfo(4, c), FMT_G3) // '). Check their ' // &
         'points and dimensions, or remove the one that repeats another.'
   end function inconsistent_text
-
-  !> " A, B, ...": the constraints that own a row flagged in dp (neq), in their order.
-  function owner_names(dp) result(names)
-    integer, intent(in) :: dp(:)
-    character(len=2 * MSG_LEN) :: names
-    integer :: k, r0, nr
-    names = ''; r0 = 1
-    do k = 1, spec%nc
-      nr = con_nrow(spec%ctab(1, k))
-      if (any(dp(r0:r0 + nr - 1) == 1)) then
-        if (len_trim(names) > 0) names = trim(names) // ','
-        names = trim(names) // ' ' // trim(spec%con_names(k))
-      end if
-      r0 = r0 + nr
-    end do
-  end function owner_names
 
   !> A kinematic or inverse-dynamics case that does not assemble, in the words of the
   !! exception the Python sweep records (mbd2d.analysis.failures.assembly_failed); '' where
