@@ -89,8 +89,7 @@ contains
     type(asm_work_t) :: aw
     type(sens_t) :: sens
     real(wp), allocatable :: phi(:), nu(:), gam(:), jac(:, :), qz(:), qc(:), sv(:), work(:)
-    real(wp), allocatable :: jt(:, :), us(:, :), vt(:, :), cns(:), dj(:, :), dq(:), &
-                             tphi(:), tnu(:), tgam(:)
+    real(wp), allocatable :: jt(:, :), us(:, :), vt(:, :), cns(:), dj(:, :), dq(:), ev(:, :)
     real(wp) :: wq(1), cn, ds1, dsn
     integer :: bad, k, c, info, lwork, ist, ns, kp, ldu, ldv
     logical :: deriv
@@ -113,8 +112,7 @@ contains
     allocate (phi(m%neq), nu(m%neq), gam(m%neq), jac(m%neq, m%nq), qz(m%nq), qc(m%nq), &
               sv(max(ns, 1)), cns(m%nq), us(ldu, max(ns, 1)), vt(ldv, m%nq), stat=ist)
     if (ist == 0 .and. deriv) &
-      allocate (jt(m%neq, m%nq), dj(m%neq, m%nq), dq(m%nq), tphi(m%neq), tnu(m%neq), &
-                tgam(m%neq), stat=ist)
+      allocate (jt(m%neq, m%nq), dj(m%neq, m%nq), dq(m%nq), ev(m%neq, 3), stat=ist)
     if (ist /= 0) then
       call no_memory(m, status, msg); return
     end if
@@ -157,10 +155,8 @@ contains
       if (status /= MBD_OK) return
       call sens_trig(m, sens, qc)
       do kp = 1, size(ptab, 2)
-        ! dJ along q' and p' (per unit p' = p dp'/dp), then d(J D) column by column
-        dq = sq(:, kp, k) / (m%cunit * sens%pscale(kp))
-        call sens_eval_d(m, sens, kp, qc, qz, dq, qz, t(k), tphi, tnu, tgam, aw%jb)
-        call scatter_dense(aw, dj)
+        call jac_change(m, sens, kp, qc, sq(:, kp, k), t(k), qz, dq, ev, aw%jb)
+        call scatter_dense(aw, dj)                    ! then d(J D) column by column
         do c = 1, m%nq
           if (cns(c) > zero) dj(:, c) = (dj(:, c) - jt(:, c) * dot_product(jt(:, c), &
                                          dj(:, c))) / cns(c)
@@ -196,7 +192,7 @@ contains
     type(asm_work_t) :: aw
     type(sens_t) :: sens
     real(wp), allocatable :: phi(:), nu(:), gam(:), jac(:, :), qz(:), b(:), tau(:), work(:), &
-                             dq(:), w(:), tphi(:), tnu(:), tgam(:)
+                             dq(:), w(:), ev(:, :)
     integer, allocatable :: ipiv(:), jpvt(:)
     real(wp) :: resid
     integer :: bad, k, ist, st, kp
@@ -226,7 +222,7 @@ contains
     end if
     allocate (phi(m%neq), nu(m%neq), gam(m%neq), jac(m%neq, m%nq), qz(m%nq), b(m%neq), &
               ipiv(m%nq), jpvt(m%nq), tau(m%nq), work(qr_lwork(m%neq, m%nq)), dq(m%nq), &
-              w(m%neq), tphi(m%neq), tnu(m%neq), tgam(m%neq), stat=ist)
+              w(m%neq), ev(m%neq, 3), stat=ist)
     if (ist /= 0) then
       call no_memory(m, status, msg); return
     end if
@@ -245,8 +241,7 @@ contains
       if (.not. deriv) cycle
       call sens_trig(m, sens, q(:, k))
       do kp = 1, size(ptab, 2)                  ! J du = -(J_q dq + J_p) u
-        dq = sq(:, kp, k) / (m%cunit * sens%pscale(kp))
-        call sens_eval_d(m, sens, kp, q(:, k), qz, dq, qz, t(k), tphi, tnu, tgam, aw%jb)
+        call jac_change(m, sens, kp, q(:, k), sq(:, kp, k), t(k), qz, dq, ev, aw%jb)
         call block_apply(m, aw%jb, u(:, k), w)
         b = -w
         call solve(du(:, kp, k), .false.)
@@ -672,6 +667,23 @@ contains
     c = cos(qk(3 * bi)); sn = sin(qk(3 * bi))
     r = [c * vl(1) - sn * vl(2), sn * vl(1) + c * vl(2)]
   end function turned
+
+  !> J's local blocks changed along design parameter kp at the state q (the model's units)
+  !! with the state's sensitivity sqk (model units): every constraint on dual numbers along
+  !! (dq', e_kp), dq' = sqk / (cunit dp'/dp), the change per unit p' = p dp'/dp (times
+  !! sens%pscale(kp): per unit p). sens_trig first.
+  subroutine jac_change(m, sens, kp, q, sqk, t, qz, dq, ev, jb)
+    type(model_t), intent(in) :: m              !! model
+    type(sens_t), intent(in) :: sens            !! the parameters' tables
+    integer, intent(in) :: kp                   !! the parameter
+    real(wp), intent(in) :: q(:), sqk(:), t     !! state, its sensitivity (nq), time
+    real(wp), intent(in) :: qz(:)               !! zeros (nq)
+    real(wp), intent(out) :: dq(:)              !! work (nq)
+    real(wp), intent(out) :: ev(:, :)           !! work (neq, 3): Phi's, nu's, gamma's changes
+    real(wp), intent(out) :: jb(:, :, :)        !! the blocks' changes (MAXROW, NLOC, nc)
+    dq = sqk / (m%cunit * sens%pscale(kp))
+    call sens_eval_d(m, sens, kp, q, qz, dq, qz, t, ev(:, 1), ev(:, 2), ev(:, 3), jb)
+  end subroutine jac_change
 
   !> x^T A y.
   pure real(wp) function bilinear(x, a, y) result(r)

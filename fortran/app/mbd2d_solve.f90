@@ -984,14 +984,12 @@ contains
   function dead_centre_text(c) result(s)
     integer, intent(in) :: c
     character(len=4 * MSG_LEN) :: s
-    character(len=2 * MSG_LEN) :: names, last
+    character(len=2 * MSG_LEN) :: names
     integer :: drv
     real(wp) :: ratio
     names = dep_names(bdep(:, c), .true.)
     ratio = 0.0_wp
     if (brinfo(3, c) > 0.0_wp) ratio = brinfo(2, c) / brinfo(3, c)
-    last = 'no output rows'
-    if (nkeep(c) > 0) last = 't = ' // cnum(tout(nkeep(c)), FMT_G6) // ' s'
     drv = biinfo(3, c)
     s = 'Singular configuration (dead centre) at t = ' // cnum(brinfo(1, c), FMT_F10) // ' s:'
     if (drv > 0 .and. drv <= spec%nc) s = trim(s) // " driver '" // &
@@ -999,7 +997,7 @@ contains
     s = trim(s) // ' the constraints' // trim(names) // ' became dependent (J lost rank; ' // &
         'sigma_min/sigma_max = ' // cnum(ratio, FMT_E1) // '). The mechanism cannot move ' // &
         'further as driven: end the run before this time, or change the driver or the link ' &
-        // 'lengths. Results up to ' // trim(last) // ' (' // trim(itoa(nkeep(c))) // &
+        // 'lengths. Results up to ' // trim(kept_until(c)) // ' (' // trim(itoa(nkeep(c))) // &
         " rows) are kept in the exception's .results."
   end function dead_centre_text
 
@@ -1026,9 +1024,10 @@ contains
     if (nred > 0 .and. biinfo(9, c) /= 0) s = trim(s) // trim(rows) // ' (' // &
       trim(itoa(nred)) // ' redundant equation(s): ' // trim(itoa(neq)) // ' equations, ' // &
       'rank ' // trim(itoa(biinfo(9, c))) // ') contradict(s) the other constraints;'
-    s = trim(s) // trim(dep_names(bdep(:, c), .true.)) // ' cannot all hold (smallest residual ' // &
-        trim(what(level)) // ' = ' // cnum(brinfo(4, c), FMT_G3) // '). Check their ' // &
-        'points and dimensions, or remove the one that repeats another.'
+    s = trim(s) // trim(dep_names(bdep(:, c), .true.)) // &
+        ' cannot all hold (smallest residual ' // trim(what(level)) // ' = ' // &
+        cnum(brinfo(4, c), FMT_G3) // '). Check their points and dimensions, or remove the ' // &
+        'one that repeats another.'
   end function inconsistent_text
 
   !> A kinematic or inverse-dynamics case that does not assemble, in the words of the
@@ -1057,11 +1056,27 @@ contains
         return
       end if
     end if
-    s = 'Assembly failed at t = ' // cnum(brinfo(1, c), FMT_G6) // ' s: no configuration ' // &
-        'satisfies the constraints near the q0 estimates (smallest residual ' // &
-        cnum(brinfo(4, c), FMT_G3) // ', largest in ' // trim(who) // '). Check the link ' // &
-        'lengths and joint points, and give q0 closer to the intended configuration.'
+    s = assembly_words(brinfo(1, c), brinfo(4, c), who)
   end function assembly_text
+
+  !> Python's words for a failed assembly at t: the smallest residual and where it is largest.
+  function assembly_words(t, resid, who) result(s)
+    real(wp), intent(in) :: t, resid
+    character(len=*), intent(in) :: who
+    character(len=4 * MSG_LEN) :: s
+    s = 'Assembly failed at t = ' // cnum(t, FMT_G6) // ' s: no configuration satisfies ' // &
+        'the constraints near the q0 estimates (smallest residual ' // cnum(resid, FMT_G3) // &
+        ', largest in ' // trim(who) // '). Check the link lengths and joint points, and ' // &
+        'give q0 closer to the intended configuration.'
+  end function assembly_words
+
+  !> "t = T s" of case c's last kept row, or "no output rows" (Python's "Results up to").
+  function kept_until(c) result(s)
+    integer, intent(in) :: c
+    character(len=64) :: s
+    s = 'no output rows'
+    if (nkeep(c) > 0) s = 't = ' // cnum(tout(nkeep(c)), FMT_G6) // ' s'
+  end function kept_until
 
   !> A dynamics case's failure in the words of the exception the Python sweep records
   !! (mbd2d.analysis.dynamics.dynamics_error): "METHOD: what" with the rows kept where the
@@ -1075,19 +1090,14 @@ contains
     character(len=20) :: method
     s = ''
     method = METHOD_WORDS(max(1, min(size(METHOD_WORDS), spec%method)))
-    kept = 'no output rows'
-    if (nkeep(c) > 0) kept = 't = ' // cnum(tout(nkeep(c)), FMT_G6) // ' s'
-    kept = 'Results up to ' // trim(kept) // " are kept in the exception's .results."
+    kept = 'Results up to ' // trim(kept_until(c)) // " are kept in the exception's .results."
     select case (bstat(c))
     case (MBD_OK)
       s = trim(method) // ': the solution became non-finite at t = ' // &
           cnum(tout(max(1, min(k, nrow))), FMT_G6) // ' s (a blow-up: try a smaller rtol ' // &
           'or h, or another method). ' // trim(kept)
-    case (MBD_ASSEMBLY_FAILED)
-      s = 'Assembly failed at t = ' // cnum(spec%t0, FMT_G6) // ' s: no configuration ' // &
-          'satisfies the constraints near the q0 estimates (smallest residual 0, largest ' // &
-          'in ?). Check the link lengths and joint points, and give q0 closer to the ' // &
-          'intended configuration.'
+    case (MBD_ASSEMBLY_FAILED)                ! (Python names neither residual nor constraint)
+      s = assembly_words(spec%t0, 0.0_wp, '?')
     case (MBD_INTEGRATOR_FAILED)
       s = trim(method) // ': ' // trim(bmsg(c)) // '. ' // trim(kept)
     case (MBD_INCONSISTENT)

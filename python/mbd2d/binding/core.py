@@ -302,7 +302,8 @@ def batch(b: BatchTables, vals: np.ndarray) -> dict[str, Any]:
     the measures ``m`` (nm, nrow, ncase) with ``mbad`` (3, ncase: status, measure, quantity of
     a case whose measures failed), the sensitivities ``sq``, ``sqd``, ``sqdd`` (nq, npar, nrow,
     ncase) and ``slam`` (nsl, npar, nrow, ncase), the measures' design derivatives ``dm`` (nm,
-    npar, nrow, ncase), ``status`` (ncase) and ``msg`` (ncase, text). A module-level function of plain arrays, so
+    npar, nrow, ncase), ``status`` (ncase) and ``msg`` (ncase, text). A module-level function
+    of plain arrays, so
     that worker processes and Dask workers can run it."""
     vals = np.asfortranarray(vals, dtype=np.float64)
     ncase = vals.shape[1]

@@ -119,7 +119,8 @@ def _csv(ds: Any, path: Path) -> None:
 def _sensitivity_columns(ds: Any) -> tuple[np.ndarray, list[str]]:
     """The sensitivities as (case, time, columns), parameter by parameter: for each, the
     derivatives of the motion columns (q, qd, qdd), with multipliers' sensitivities of the
-    efforts, and of the measures; and the parameters' names. (case, time, 0) without sensitivities."""
+    efforts, and of the measures; and the parameters' names. (case, time, 0) without
+    sensitivities."""
     if "dq_dp" not in ds:
         return np.zeros(ds.q.shape[:2] + (0,)), []
     parts = [ds[k].values for k in ("dq_dp", "dqd_dp", "dqdd_dp", "deffort_dp", "dmeasures_dp")

@@ -179,11 +179,9 @@ def _std_linear(s: np.ndarray, sigma: np.ndarray) -> np.ndarray:
     ModelError
         When a standard deviation itself exceeds the floating-point range.
     """
+    m, v = _scaled_terms(s, sigma)
     with np.errstate(over="ignore", invalid="ignore"):
-        a = np.abs(s * sigma)
-        m = a.max(axis=-1, keepdims=True) if a.shape[-1] else np.zeros(a.shape[:-1] + (1,))
-        safe = np.where(m > 0, m, 1.0)
-        out = (m * np.sqrt(np.sum((a / safe) ** 2, axis=-1, keepdims=True)))[..., 0]
+        out = (m * np.sqrt(np.sum(v, axis=-1, keepdims=True)))[..., 0]
     if not np.isfinite(out).all():
         raise ModelError("the first-order standard deviation exceeds the floating-point range: "
                          "give smaller sigma", "tolerance")
@@ -194,12 +192,20 @@ def _shares(s: np.ndarray, sigma: np.ndarray) -> np.ndarray:
     """Each parameter's share of the first-order variance, (S_k sigma_k)**2 / sum_j (S_j
     sigma_j)**2 along the last axis (scaled by the largest term: no overflow; 0 where no
     parameter moves the entry)."""
-    a = np.abs(s * sigma)
+    v = _scaled_terms(s, sigma)[1]
     with np.errstate(invalid="ignore"):
-        m = a.max(axis=-1, keepdims=True) if a.shape[-1] else np.zeros(a.shape[:-1] + (1,))
-        v = (a / np.where(m > 0, m, 1.0)) ** 2
         tot = v.sum(axis=-1, keepdims=True)
         return np.where(tot > 0, v / np.where(tot > 0, tot, 1.0), 0.0)
+
+
+def _scaled_terms(s: np.ndarray, sigma: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The largest |S_k sigma_k| along the last axis, m (keepdims), and the terms
+    (|S_k sigma_k| / m)**2 (m taken as 1 where it is 0): the variance is m**2 sum(terms)
+    without the squares' overflow."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        a = np.abs(s * sigma)
+        m = a.max(axis=-1, keepdims=True) if a.shape[-1] else np.zeros(a.shape[:-1] + (1,))
+        return m, (a / np.where(m > 0, m, 1.0)) ** 2
 
 
 def _std(x: np.ndarray) -> np.ndarray:

@@ -22,6 +22,7 @@ from .terms import Grashof, LinkRatio, MeasureBound, PeakEffort, TransmissionAng
 
 __all__ = ["synthesize", "SynthesisResult", "StartRecord", "Problem", "Evaluation", "Task",
            "PathTask", "MotionTask", "FunctionTask", "make_task", "Grashof", "LinkRatio",
-           "TransmissionAngle", "PeakEffort", "MeasureBound", "make_term", "fourbar", "fourbar_parameters",
+           "TransmissionAngle", "PeakEffort", "MeasureBound", "make_term", "fourbar",
+           "fourbar_parameters",
            "loop_configuration", "FOURBAR_PARAMETERS", "run_all", "latin_hypercube",
            "load_task", "TaskFile"]
