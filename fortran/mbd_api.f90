@@ -30,7 +30,7 @@ module mbd_api
   use mbd_joint_cam, only: cam_outward_normal
   use mbd_points, only: local_state
   use mbd_integrators, only: dyn_opts_t, dyn_stats_t, integrate, output_rows, output_index, &
-                              METH_PARTITIONED
+                              METH_PARTITIONED, METH_GENALPHA, METH_DOPRI5
   use mbd_statics, only: statics_solve
   use mbd_assemble, only: assemble_dense, assemble_blocks, asm_work_t, asm_init
   use mbd_kinematics, only: kin_opts_t, kin_report_t, kin_work_t, kin_run, kin_work_init, &
@@ -43,6 +43,7 @@ module mbd_api
   use mbd_assemble, only: scatter_dense
   use mbd_sens_dynamics, only: sens_multipliers, sens_reactions, sens_statics, sens_dopri5, &
                                sens_initial
+  use mbd_sens_genalpha, only: ga_sens_t, ga_sens_init
   implicit none
   private
   public :: NINFO, api_sizes, api_eval, api_kinematics, api_profile, api_analyze, api_kin_step
@@ -840,6 +841,25 @@ contains
     call integrate(m, w, q, qd, t0, t1, nsteps, every, opts, qout, qdout, qddout, lamout, nout, &
                    dst, status, msg, log, eo, ctl)
     call events_out(m, log, evo, nev)
+    call dyn_info(w, dst, nout, status, iinfo, rinfo)
+    do k = 1, nout
+      ko = output_index(nsteps, every, k)
+      t = t0 + (t1 - t0) * (real(ko, wp) / max(nsteps, 1))
+      if (ko == nsteps) t = t1
+      call state_measures(m, w, qout(:, k), qdout(:, k), t, eout(:, k))
+    end do
+    call units(m, qout, m%cunit, .false.); call units(m, qdout, m%cunit, .false.)
+    call units(m, qddout, m%cunit, .false.); call units(m, lamout, m%rowunit, .true.)
+    call element_units(m, eo)
+  end subroutine api_dynamics
+
+  !> The integrator's counters into iinfo and rinfo (api_dynamics' layout).
+  subroutine dyn_info(w, dst, nout, status, iinfo, rinfo)
+    type(dyn_work_t), intent(in) :: w
+    type(dyn_stats_t), intent(in) :: dst
+    integer, intent(in) :: nout, status
+    integer, intent(inout) :: iinfo(NINFO)
+    real(wp), intent(inout) :: rinfo(NINFO)
     iinfo(1) = nout; iinfo(3) = dst%steps; iinfo(4) = dst%rejected; iinfo(5) = dst%newton
     iinfo(6) = dst%rhs; iinfo(7) = dst%jacobians; iinfo(8) = dst%partitions
     iinfo(10) = dst%factorizations
@@ -857,16 +877,7 @@ contains
       rinfo(6) = dst%kl; rinfo(7) = dst%ku
     end if
     if (status /= MBD_OK) rinfo(1) = dst%t_fail
-    do k = 1, nout
-      ko = output_index(nsteps, every, k)
-      t = t0 + (t1 - t0) * (real(ko, wp) / max(nsteps, 1))
-      if (ko == nsteps) t = t1
-      call state_measures(m, w, qout(:, k), qdout(:, k), t, eout(:, k))
-    end do
-    call units(m, qout, m%cunit, .false.); call units(m, qdout, m%cunit, .false.)
-    call units(m, qddout, m%cunit, .false.); call units(m, lamout, m%rowunit, .true.)
-    call element_units(m, eo)
-  end subroutine api_dynamics
+  end subroutine dyn_info
 
   !> The assembly at the start of dynamics and statics: Levenberg-Marquardt from the q0
   !! estimates to ||Phi||_inf <= tol (relative to the length scale), with a dense J
@@ -1145,14 +1156,16 @@ contains
     end do
   end subroutine api_reactions_dp
 
-  !> Forward dynamics by dopri5 with design sensitivities (mbd_sens_dynamics): as
-  !! api_dynamics (method dopri5; iinfo 1 outputs, 2 bad entry, 3 steps, 4 rejected, 6
-  !! right-hand sides, 9 active rows; rinfo 1 failure time, 2 and 3 smallest and largest step)
-  !! plus sq, sqd, sqdd (nq, np, rows), the sensitivities of q, q_dot and q_ddot.
+  !> Forward dynamics with design sensitivities: as api_dynamics (iinfo 1 outputs, 2 bad
+  !! entry, 3 steps, 4 rejected, 6 right-hand sides, 9 active rows; rinfo 1 failure time, 2
+  !! and 3 smallest and largest step) plus sq, sqd, sqdd (nq, np, rows), the sensitivities of
+  !! q, q_dot and q_ddot. method dopri5 (default): the variational equations integrated with
+  !! the state (mbd_sens_dynamics); generalized-alpha (h, rho_inf as in api_dynamics): its
+  !! discrete equations differentiated (mbd_sens_genalpha; its counters as api_dynamics').
   subroutine api_dynamics_sens(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, v0, t0, t1, &
                                nsteps, rtol, atol, every, max_steps, ptab, qout, qdout, qddout, &
                                lamout, eout, sq, sqd, sqdd, iinfo, rinfo, redundant, status, msg, &
-                               solver)
+                               solver, method, h, rho_inf)
     integer, intent(in) :: nb, ctab(:, :), ftab(:, :), nsteps, every, max_steps
     real(wp), intent(in) :: rpar(:), bmass(:, :), grav(2), fpar(:), q0(:), v0(:), t0, t1
     real(wp), intent(in) :: rtol, atol          !! tolerances (<= 0: defaults 1e-6, 1e-8)
@@ -1160,23 +1173,31 @@ contains
     real(wp), intent(out) :: qout(:, :), qdout(:, :), qddout(:, :)  !! (nq, rows)
     real(wp), intent(out) :: lamout(:, :)       !! (neq, rows)
     real(wp), intent(out) :: eout(:, :)         !! (4, rows) energies, drift
-    real(wp), intent(out) :: sq(:, :, :), sqd(:, :, :), sqdd(:, :, :)  !! (nq, np, rows)
+    !> (nq, np, rows); generalized-alpha writes them as it steps
+    real(wp), intent(out), target, contiguous :: sq(:, :, :), sqd(:, :, :), sqdd(:, :, :)
     integer, intent(out) :: iinfo(NINFO)
     real(wp), intent(out) :: rinfo(NINFO)
     integer, intent(out) :: redundant(:)
     integer, intent(out) :: status              !! MBD_OK, < 0 input, > 0 numerical
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
     integer, intent(in), optional :: solver     !! 0 auto (default), 1 dense, 2 banded
+    integer, intent(in), optional :: method     !! METH_DOPRI5 (default) or METH_GENALPHA
+    real(wp), intent(in), optional :: h, rho_inf  !! generalized-alpha's step (0: adaptive), rho
     type(model_t) :: m
     type(dyn_work_t) :: w
     type(kin_opts_t) :: kopts
-    type(sens_t) :: sens
+    type(dyn_opts_t) :: opts
+    type(dyn_stats_t) :: dst
+    type(ga_sens_t) :: gh
+    type(sens_t), target :: sens
     real(wp), allocatable :: q(:), qd(:), s0(:, :), sd0(:, :)
     logical, allocatable :: lok(:)
     real(wp) :: t, r_tol, a_tol, hmm(2), tfail
-    integer :: bad, badf, k, ko, nout, st, stats(3), path, kl, ku
+    integer :: bad, badf, k, ko, nout, st, stats(3), path, kl, ku, meth
     character(len=MSG_LEN) :: lmsg
     iinfo = 0; rinfo = zero; redundant = 0
+    meth = METH_DOPRI5
+    if (present(method)) meth = method
     qout = zero; qdout = zero; qddout = zero; lamout = zero; eout = zero
     sq = zero; sqd = zero; sqdd = zero
     call build_dynamic(nb, ctab, rpar, bmass, grav, ftab, fpar, m, status, msg, bad, badf)
@@ -1189,6 +1210,18 @@ contains
     if (nsteps < 0 .or. .not. (t1 > t0) .or. every < 1 .or. max_steps < 1) then
       status = MBD_BAD_SETTING
       msg = 'steps must be >= 0, every >= 1, max_steps >= 1 and t_end > t0'; return
+    end if
+    if (meth /= METH_DOPRI5 .and. meth /= METH_GENALPHA) then
+      status = MBD_BAD_SETTING
+      msg = 'sensitivities are integrated by dopri5 or generalized-alpha'; return
+    end if
+    if (meth == METH_GENALPHA .and. .not. (present(h) .and. present(rho_inf))) then
+      status = MBD_BAD_SETTING; msg = 'generalized-alpha needs h and rho_inf'; return
+    end if
+    if (meth == METH_GENALPHA) then
+      if (.not. finite([h, rho_inf])) then
+        call not_finite('h and rho_inf', status, msg); return
+      end if
     end if
     if (size(q0) /= m%nq .or. size(v0) /= m%nq .or. size(qout, 1) /= m%nq .or. &
         size(qout, 2) /= output_rows(nsteps, every) .or. size(lamout, 1) /= m%neq .or. &
@@ -1241,12 +1274,25 @@ contains
     if (st /= 0) then
       status = MBD_NO_MEMORY; msg = 'out of memory for the outputs'; return
     end if
-    call sens_dopri5(m, w, sens, q, qd, s0, sd0, t0, t1, nsteps, every, r_tol, a_tol, &
-                     max_steps, qout, qdout, qddout, sq, sqd, sqdd, lamout, lok, nout, stats, &
-                     hmm, tfail, status, msg)
-    iinfo(1) = nout; iinfo(3) = stats(1); iinfo(4) = stats(2); iinfo(6) = stats(3)
-    rinfo(2) = hmm(1); rinfo(3) = hmm(2)
-    if (status /= MBD_OK) rinfo(1) = tfail
+    if (meth == METH_GENALPHA) then
+      ! (the multipliers of every output row from integrate, at the output's state)
+      lok = .true.
+      call ga_sens_init(gh, m, w, sens, q, qd, t0, s0, sd0, sq, sqd, sqdd, status, msg)
+      if (status /= MBD_OK) return
+      opts%method = METH_GENALPHA; opts%rtol = r_tol; opts%atol = a_tol
+      opts%h = max(h, zero); opts%max_steps = max_steps
+      if (rho_inf >= zero) opts%rho_inf = min(rho_inf, one)
+      call integrate(m, w, q, qd, t0, t1, nsteps, every, opts, qout, qdout, qddout, lamout, &
+                     nout, dst, status, msg, hook=gh)
+      call dyn_info(w, dst, nout, status, iinfo, rinfo)
+    else
+      call sens_dopri5(m, w, sens, q, qd, s0, sd0, t0, t1, nsteps, every, r_tol, a_tol, &
+                       max_steps, qout, qdout, qddout, sq, sqd, sqdd, lamout, lok, nout, stats, &
+                       hmm, tfail, status, msg)
+      iinfo(1) = nout; iinfo(3) = stats(1); iinfo(4) = stats(2); iinfo(6) = stats(3)
+      rinfo(2) = hmm(1); rinfo(3) = hmm(2)
+      if (status /= MBD_OK) rinfo(1) = tfail
+    end if
     do k = 1, nout
       ko = output_index(nsteps, every, k)
       t = t0 + (t1 - t0) * (real(ko, wp) / max(nsteps, 1))

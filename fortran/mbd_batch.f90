@@ -24,7 +24,7 @@ module mbd_batch
   use mbd_kinematics, only: MAXPASS
   use mbd_contact, only: NEO
   use mbd_measures, only: api_measures
-  use mbd_integrators, only: METH_DOPRI5
+  use mbd_integrators, only: METH_DOPRI5, METH_GENALPHA
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   implicit none
   private
@@ -218,7 +218,8 @@ contains
                                  iset(1), rset(5), rset(6), iset(3), iset(6), pt, &
                                  qout(:, :, c), qdout(:, :, c), qddout(:, :, c), &
                                  lamout(:, :, c), eout(:, :, c), s1, s2, s3, iinfo(:, c), &
-                                 rinfo(:, c), redundant(:, c), status(c), msg(c))
+                                 rinfo(:, c), redundant(:, c), status(c), msg(c), &
+                                 method=iset(5), h=rset(7), rho_inf=rset(8))
         else
           call api_dynamics(nb, ctab, r, bm, g, ftab, fp, q0, v0, rset(1), rset(2), iset(1), &
                             iset(5), rset(5), rset(6), rset(7), rset(8), rset(9), rset(10), &
@@ -282,7 +283,8 @@ contains
             .or. size(slam, 1) /= merge(0, neq, analysis == BATCH_KINEMATICS .or. &
                                                analysis == BATCH_DYNAMICS) .or. &
             size(slam, 2) /= size(ptab, 2) .or. size(slam, 3) /= nrow .or. &
-            size(slam, 4) /= ncase .or. (analysis == BATCH_DYNAMICS .and. iset(5) /= METH_DOPRI5)) then
+            size(slam, 4) /= ncase .or. (analysis == BATCH_DYNAMICS .and. &
+            iset(5) /= METH_DOPRI5 .and. iset(5) /= METH_GENALPHA)) then
           text = 'batch: sensitivity arrays do not match'; return
         end if
       end if

@@ -418,16 +418,18 @@ end subroutine core_reactions_dp
 
 subroutine core_dynamics_sens(nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp, fpar, nq, neq, &
                               q0, v0, t0, t1, nsteps, rtol, atol, every, max_steps, solver, &
-                              nrow, npar, ptab, qout, qdout, qddout, lamout, eout, sq, sqd, &
-                              sqdd, iinfo, rinfo, redundant, status, msg)
+                              nrow, npar, ptab, method, h, rho_inf, qout, qdout, qddout, lamout, &
+                              eout, sq, sqd, sqdd, iinfo, rinfo, redundant, status, msg)
   use iso_c_binding, only: c_double, c_int
   use mbd_api, only: api_dynamics_sens
   implicit none
   integer(c_int), intent(in) :: nb, nc, np, nf, nfp, nq, neq, nsteps, every, max_steps, nrow
   integer(c_int), intent(in) :: npar, solver   ! solver: 0 auto, 1 dense, 2 banded
   integer(c_int), intent(in) :: ctab(8, nc), ftab(6, nf), ptab(2, npar)
+  ! method: 2 dopri5, 1 generalized-alpha (its step h, 0 adaptive, and rho_inf)
+  integer(c_int), intent(in) :: method
   real(c_double), intent(in) :: rpar(np), bmass(2, nb), grav(2), fpar(nfp), q0(nq), v0(nq)
-  real(c_double), intent(in) :: t0, t1, rtol, atol
+  real(c_double), intent(in) :: t0, t1, rtol, atol, h, rho_inf
   real(c_double), intent(out) :: qout(nq, nrow), qdout(nq, nrow)
   real(c_double), intent(out) :: qddout(nq, nrow), lamout(neq, nrow)
   real(c_double), intent(out) :: eout(4, nrow)
@@ -438,7 +440,8 @@ subroutine core_dynamics_sens(nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp
   !f2py intent(hide) :: nc, np, nf, nfp, nq, npar
   call api_dynamics_sens(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, v0, t0, t1, nsteps, rtol, &
                          atol, every, max_steps, ptab, qout, qdout, qddout, lamout, eout, sq, &
-                         sqd, sqdd, iinfo, rinfo, redundant, status, msg, solver)
+                         sqd, sqdd, iinfo, rinfo, redundant, status, msg, solver, method, h, &
+                         rho_inf)
 end subroutine core_dynamics_sens
 
 ! ------------------------------------------------------------------ design sweeps

@@ -55,6 +55,8 @@ module mbd_integrators
   ! the Dormand-Prince 5(4) stages and error estimate, also used by the sensitivity integrator
   ! (mbd_sens_dynamics)
   public :: dopri5_state, dopri5_error, DOPRI_C
+  ! generalized-alpha's companion for quantities stepped with the state (mbd_sens_genalpha)
+  public :: ga_hook_t, GA_NCOEF
 
   integer, parameter :: METH_GENALPHA = 1, METH_DOPRI5 = 2, METH_RK4 = 3, METH_PARTITIONED = 4
   !> Default step limit: it ends a run whose steps collapse without underflowing, after
@@ -116,6 +118,54 @@ module mbd_integrators
     real(wp), allocatable :: cso(:, :, :)   !! (NCS, nf, rows) element modes at the outputs
   end type itg_t
 
+  !> generalized-alpha's coefficients handed to a hook's step: am, af, gamma, beta, b', g'
+  integer, parameter :: GA_NCOEF = 6
+
+  !> A companion of generalized-alpha (the design sensitivities, mbd_sens_genalpha): stepped
+  !! with the state from each converged Newton iteration, with its iteration matrix S.
+  type, abstract :: ga_hook_t
+  contains
+    !> the auxiliary acceleration's shift on a change of step size, a <- q_ddot + f (a - q_ddot)
+    procedure(hook_rescale), deferred :: rescale
+    !> the step to tn from the converged state (qn, vn, an, lamn), with S's factors; esq the
+    !! sum of its squared weighted errors over ne components (accepted steps only use it)
+    procedure(hook_step), deferred :: step
+    !> an accepted step: output row r at tk in (ta, tb] (dense output between its ends)
+    procedure(hook_emit), deferred :: emit
+    !> an accepted step: its end becomes the next step's start
+    procedure(hook_commit), deferred :: commit
+  end type ga_hook_t
+
+  abstract interface
+    subroutine hook_rescale(self, f)
+      import :: ga_hook_t, wp
+      class(ga_hook_t), intent(inout) :: self
+      real(wp), intent(in) :: f
+    end subroutine hook_rescale
+    subroutine hook_step(self, m, w, sg, tn, h, coef, qn, vn, an, lamn, rtol, atol, esq, ne, &
+                         status)
+      import :: ga_hook_t, wp, model_t, dyn_work_t, saddle_t, GA_NCOEF
+      class(ga_hook_t), intent(inout) :: self
+      type(model_t), intent(in) :: m
+      type(dyn_work_t), intent(inout) :: w
+      type(saddle_t), intent(inout) :: sg
+      real(wp), intent(in) :: tn, h, coef(GA_NCOEF), rtol, atol
+      real(wp), intent(in) :: qn(:), vn(:), an(:), lamn(:)
+      real(wp), intent(out) :: esq
+      integer, intent(out) :: ne, status
+    end subroutine hook_step
+    subroutine hook_emit(self, r, tk, ta, tb)
+      import :: ga_hook_t, wp
+      class(ga_hook_t), intent(inout) :: self
+      integer, intent(in) :: r
+      real(wp), intent(in) :: tk, ta, tb
+    end subroutine hook_emit
+    subroutine hook_commit(self)
+      import :: ga_hook_t
+      class(ga_hook_t), intent(inout) :: self
+    end subroutine hook_commit
+  end interface
+
   !> partitioned: re-partition when J_u is this many times worse conditioned than the best
   !! choice now (docs/dynamics.md: measured on a double pendulum and the N-four-bar)
   real(wp), parameter :: REPARTITION = 0.25_wp
@@ -146,7 +196,7 @@ contains
   !! With contacts or stick-slip joints, log (allocated by ev_log_init) returns the events
   !! and eo(NEO, nf, rows) the element outputs at the stored rows (dyn_element_outputs).
   subroutine integrate(m, w, q, qd, t0, t1, nsteps, every, opts, qo, vo, ao, lo, nout, st, &
-                       status, msg, log, eo, ctl)
+                       status, msg, log, eo, ctl, hook)
     type(model_t), intent(in) :: m               !! model
     type(dyn_work_t), intent(inout) :: w         !! dynamics work arrays (dyn_init done)
     real(wp), intent(inout) :: q(:), qd(:)       !! consistent initial state, then final
@@ -165,6 +215,8 @@ contains
     !> progress, shared with a caller in another thread: ctl(1) gets the rows stored so far,
     !! ctl(2) /= 0 asks the run to stop (MBD_USER_ABORT, the rows so far kept)
     integer, intent(inout), optional, volatile :: ctl(:)
+    !> generalized-alpha only: a companion stepped with the state (ga_hook_t)
+    class(ga_hook_t), intent(inout), optional :: hook
     type(itg_t) :: c
     status = MBD_OK; msg = ''; nout = 0
     qo = zero; vo = zero; ao = zero; lo = zero
@@ -195,6 +247,10 @@ contains
     end if
     if (present(log)) c%log = log
     c%events = events_active(m)
+    if (present(hook) .and. (opts%method /= METH_GENALPHA .or. c%events)) then
+      status = MBD_BAD_SETTING
+      msg = 'a companion of the state steps with generalized-alpha, without events'; return
+    end if
     if (c%events) then
       call events_init(m, w, q, qd, t0, status)
       if (status /= MBD_OK) then
@@ -212,7 +268,7 @@ contains
     if (nsteps > 0) then
       select case (opts%method)
       case (METH_GENALPHA)
-        call run_genalpha(m, w, c, qo, vo, ao, status, msg, ctl)
+        call run_genalpha(m, w, c, qo, vo, ao, status, msg, ctl, hook)
       case (METH_DOPRI5, METH_RK4)
         call run_explicit(m, w, c, .false., qo, vo, ao, status, msg, ctl)
       case (METH_PARTITIONED)
@@ -438,7 +494,9 @@ contains
   !! Converged: |Phi| <= w%tol, the last correction below 1e-3 (atol + rtol |q|), and the
   !! residual of M q_ddot + J^T lambda = Q below GA_RTOL of its largest term, so that the
   !! result is that of full Newton (a stale S only changes the iteration count).
-  subroutine run_genalpha(m, w, c, qo, vo, ao, status, msg, ctl)
+  !! A hook (ga_hook_t) steps from each converged state with S's factors (fresh K, C when it
+  !! asks, MBD_NO_CONVERGENCE), and its error joins the state's in the step size control.
+  subroutine run_genalpha(m, w, c, qo, vo, ao, status, msg, ctl, hook)
     type(model_t), intent(in) :: m
     type(dyn_work_t), intent(inout) :: w
     type(itg_t), intent(inout) :: c
@@ -446,18 +504,20 @@ contains
     real(wp), intent(inout) :: qo(:, :), vo(:, :), ao(:, :)
     integer, intent(out) :: status
     character(len=MSG_LEN), intent(out) :: msg
+    class(ga_hook_t), intent(inout), optional :: hook
     real(wp), parameter :: GA_RHO = 0.1_wp       ! contraction rate that asks for new K, C
     real(wp), parameter :: GA_RTOL = 1.0e-11_wp  ! relative residual of the dynamic equations
     integer, parameter :: GA_SLOW = 6            ! iterations that ask for new K, C
     integer, parameter :: GA_MAXIT = 30          ! iterations before the step fails
     real(wp) :: am, af, gam, bet, bp, gp, h, t, err, tnew, facc, v, hprev, dqn, dqp, dtol
-    real(wp) :: rtol_dyn, cf, kmax, cmax, fmax, qmax, vmax, rmax, te, mufric
+    real(wp) :: rtol_dyn, cf, kmax, cmax, fmax, qmax, vmax, rmax, te, mufric, esq
+    real(wp) :: coef(GA_NCOEF)
     real(wp) :: q(m%nq), qd(m%nq), qdd(m%nq), acc(m%nq), lam(m%neq)
     real(wp) :: qn(m%nq), vn(m%nq), an(m%nq), accn(m%nq), lamn(m%neq), dq(m%nq), ap(m%nq)
     real(wp) :: res(m%nq + w%na), dg(m%nq), ew(m%nq)
     real(wp), allocatable :: kv(:), cv(:), kc(:)   ! K, C and K + g' C on the pattern
     type(saddle_t) :: sg                            ! the iteration matrix S
-    integer :: it, n, stt, nfix, na, attempt, nkc, k, nnz, kev, nprev, i
+    integer :: it, n, stt, nfix, na, attempt, nkc, k, nnz, kev, nprev, i, ne
     logical :: fixed, conv, have_kc, new_kc, finite, changed, diagk
     status = MBD_OK; msg = ''
     n = m%nq; na = w%na
@@ -484,6 +544,7 @@ contains
     gam = half + af - am
     bet = 0.25_wp * (gam + half)**2
     cf = (1 - af) / (1 - am)             ! weight of q_ddot_{n+1} in a_{n+1}
+    coef(1:4) = [am, af, gam, bet]
     fixed = c%opts%h > zero
     have_kc = .false.; new_kc = .false.
     mufric = zero                        ! the largest friction coefficient of a joint
@@ -521,7 +582,10 @@ contains
       gp = gam / (bet * h)
       ! the auxiliary acceleration is q_ddot shifted by (am - af) h: on a change of step size
       ! a - q_ddot scales with it, a <- q_ddot + (h / h_prev) (a - q_ddot)
-      if (hprev > zero .and. abs(h - hprev) > zero) acc = qdd + (h / hprev) * (acc - qdd)
+      if (hprev > zero .and. abs(h - hprev) > zero) then
+        acc = qdd + (h / hprev) * (acc - qdd)
+        if (present(hook)) call hook%rescale(h / hprev)
+      end if
       hprev = h
       do attempt = 1, 2
         ! predictor: q_ddot_{n+1} = q_ddot_n, lambda_{n+1} = lambda_n (not extrapolated:
@@ -562,7 +626,9 @@ contains
             res(n + k) = bp * w%phi(w%rows(k))
             if (.not. abs(res(n + k)) <= huge(one)) finite = .false.
           end do
-          dtol = 1.0e-3_wp * (c%opts%atol + c%opts%rtol * qmax)
+          ! (not below the rounding of q: a tolerance tighter than that asks a correction
+          ! no iteration can give)
+          dtol = max(1.0e-3_wp * (c%opts%atol + c%opts%rtol * qmax), 100 * epsilon(one) * qmax)
           if (it > 1 .and. finite .and. maxval(abs(w%phi)) <= w%tol .and. &
               maxval(abs(dq)) <= dtol .and. rmax <= rtol_dyn) then
             conv = .true.; exit
@@ -570,35 +636,8 @@ contains
           if (.not. finite) exit
           if (it == GA_SLOW .and. nkc < 2) new_kc = .true.
           if (it == 1 .or. new_kc) then
-            if (.not. have_kc .or. new_kc) then
-              call dyn_tangent(m, w, qn, vn, tnew, lamn, kv, cv, fast=.true.)
-              c%st%jacobians = c%st%jacobians + 1
-              have_kc = .true.; new_kc = .false.; nkc = nkc + 1
-              kmax = zero; cmax = zero
-              if (nnz > 0) then
-                kmax = maxval(abs(kv)); cmax = maxval(abs(cv))
-              end if
-              call assemble_blocks(m, qn, vn, tnew, w%phi, w%nu, w%gam, w%asm)
-            end if
-            ! S with the current J: K + g' C on the pattern, + M b' on the diagonal, b' J
-            do k = 1, nnz
-              kc(k) = kv(k) + gp * cv(k)
-            end do
-            do k = 1, n
-              dg(k) = m%mdiag(k) * bp
-            end do
-            if (diagk) then                 ! K + g' C on the diagonal: A = diag(dg)
-              do k = 1, n
-                do i = w%kptr(k), w%kptr(k + 1) - 1
-                  dg(k) = dg(k) + kc(i)
-                end do
-              end do
-              call saddle_factor(sg, dg, w%asm%jb, bp, stt, schur=.true.)
-              if (sg%schur) c%st%schur = c%st%schur + 1
-            else
-              call saddle_factor(sg, dg, w%asm%jb, bp, stt, kv=kc)
-            end if
-            c%st%factorizations = c%st%factorizations + 1
+            if (.not. have_kc .or. new_kc) call tangent()
+            call factor_s(stt)
             if (stt /= MBD_OK) exit
           end if
           res = -res
@@ -623,9 +662,29 @@ contains
       ! local error estimate: the step's position error is (beta - 1/6) h^3 q''', and the
       ! distance of q_{n+1} from its second-order Taylor prediction is h^3 q'''/6, so
       ! e = (6 beta - 1) (q_{n+1} - q_n - h q_dot_n - h^2 q_ddot_n / 2)
+      ne = 0; esq = zero
+      if (conv .and. present(hook)) then
+        coef(5:6) = [bp, gp]
+        call hook%step(m, w, sg, tnew, h, coef, qn, vn, an, lamn, c%opts%rtol, c%opts%atol, &
+                       esq, ne, stt)
+        if (stt == MBD_NO_CONVERGENCE) then   ! (slow with an old K, C: fresh ones at qn)
+          call tangent()
+          call factor_s(stt)
+          if (stt == MBD_OK) call hook%step(m, w, sg, tnew, h, coef, qn, vn, an, lamn, &
+                                            c%opts%rtol, c%opts%atol, esq, ne, stt)
+        end if
+        if (stt /= MBD_OK) then
+          status = MBD_INTEGRATOR_FAILED
+          write (msg, '(a,es12.5)') 'the sensitivities of the step could not be solved at t = ', &
+            tnew
+          return
+        end if
+      end if
       if (conv .and. .not. fixed) then
         ew = (6 * bet - 1) * (qn - q - h * qd - half * h * h * qdd)   ! (no heap temporary)
         err = err_norm(c, ew, q, qn)
+        ! with a hook: the RMS over the state's and the hook's components
+        if (ne > 0) err = sqrt((err * err * n + esq) / (n + ne))
       end if
       kev = 0
       if (conv .and. c%events) then
@@ -664,6 +723,12 @@ contains
       nprev = c%nout
       call emit(c, qo, vo, ao, t, q, qd, qdd, tnew, qn, vn, an)
       call save_modes(w, c, nprev + 1)
+      if (present(hook)) then
+        do i = nprev + 1, c%nout
+          call hook%emit(i, out_time(c, output_index(c%nsteps, c%every, i)), t, tnew)
+        end do
+        call hook%commit()
+      end if
       c%st%steps = c%st%steps + 1
       c%st%hmin = min(c%st%hmin, h); c%st%hmax = max(c%st%hmax, h)
       if (stopped(c, tnew, status, msg, ctl)) then
@@ -688,6 +753,43 @@ contains
       end if
     end do
     c%qf = q; c%vf = qd; c%af = qdd; c%lam = lam
+  contains
+
+    !> K and C by differences at (qn, vn) (dyn_tangent), and the blocks at qn again.
+    subroutine tangent()
+      call dyn_tangent(m, w, qn, vn, tnew, lamn, kv, cv, fast=.true.)
+      c%st%jacobians = c%st%jacobians + 1
+      have_kc = .true.; new_kc = .false.; nkc = nkc + 1
+      kmax = zero; cmax = zero
+      if (nnz > 0) then
+        kmax = maxval(abs(kv)); cmax = maxval(abs(cv))
+      end if
+      call assemble_blocks(m, qn, vn, tnew, w%phi, w%nu, w%gam, w%asm)
+    end subroutine tangent
+
+    !> S with the current J: K + g' C on the pattern, + M b' on the diagonal, b' J; factored.
+    subroutine factor_s(stf)
+      integer, intent(out) :: stf
+      integer :: kk, ii
+      do kk = 1, nnz
+        kc(kk) = kv(kk) + gp * cv(kk)
+      end do
+      do kk = 1, n
+        dg(kk) = m%mdiag(kk) * bp
+      end do
+      if (diagk) then                 ! K + g' C on the diagonal: A = diag(dg)
+        do kk = 1, n
+          do ii = w%kptr(kk), w%kptr(kk + 1) - 1
+            dg(kk) = dg(kk) + kc(ii)
+          end do
+        end do
+        call saddle_factor(sg, dg, w%asm%jb, bp, stf, schur=.true.)
+        if (sg%schur) c%st%schur = c%st%schur + 1
+      else
+        call saddle_factor(sg, dg, w%asm%jb, bp, stf, kv=kc)
+      end if
+      c%st%factorizations = c%st%factorizations + 1
+    end subroutine factor_s
   end subroutine run_genalpha
 
   ! -------------------------------------------------------------------- explicit methods

@@ -896,7 +896,7 @@ contains
     real(wp), allocatable :: sv(:), u(:), v(:)
     real(wp) :: umax, best
     integer :: r, k, ierr
-    character(len=MSG_LEN) :: rows
+    character(len=MSG_LEN) :: rows, before
     msg = ''
     allocate (sv(min(m%neq, m%nq)), u(m%neq), v(m%nq), stat=ierr)
     if (ierr /= 0) then
@@ -933,7 +933,10 @@ contains
     end do
     rows = ''
     do r = 1, m%neq
-      if (rep%dep(r) == 1 .and. len_trim(rows) < MSG_LEN - 12) write (rows, '(a,1x,i0)') trim(rows), r
+      if (rep%dep(r) == 1 .and. len_trim(rows) < MSG_LEN - 12) then
+        before = rows                         ! (a write's output list may not hold its file)
+        write (rows, '(a,1x,i0)') trim(before), r
+      end if
     end do
     if (rep%driver > 0) then
       write (msg, '(a,es22.15,a,i0,a,a,a,es9.2)') 'singular configuration (dead centre) at t = ', &
@@ -1101,6 +1104,9 @@ contains
     real(wp) :: pcur, phist(2), thist(2)   ! pivot ratios and times of the last accepted states
     integer :: nhist
     integer :: k, j, c, st, detprev, mobility, lev, nsub, nderiv, ierr
+    ! (a report's detail, read while msg is written: an internal write's output list may
+    ! not hold its own file)
+    character(len=MSG_LEN) :: detail
     logical :: last, ok
     logical :: halt        ! ctl(2) asked the run to stop (store saw it)
     ! positions only: chord steps (fast), the positions' divided differences pd (as dd) at
@@ -1230,8 +1236,10 @@ contains
       end if
       rep%rank = m%nq - rep%deficiency
       status = MBD_SINGULAR
+      detail = msg
       write (msg, '(a,es9.2,a,a)') 'the assembled configuration is singular (banded solver: '// &
-        'sigma_min/sigma_max of the column-scaled J about ', rep%smin / rep%smax, '): ', trim(msg)
+        'sigma_min/sigma_max of the column-scaled J about ', rep%smin / rep%smax, '): ', &
+        trim(detail)
       call count_work(); return
     else
       call kin_rank(m, w, q, t0, rep%rank, mobility, rep%redundant, status, msg)
@@ -1253,8 +1261,9 @@ contains
           status = k; call count_work(); return
         end if
         status = MBD_SINGULAR
+        detail = msg
         write (msg, '(a,i0,a,i0,a,a)') 'the assembled configuration is singular (J has rank ', &
-          rep%rank, ' for ', m%nq, ' coordinates): ', trim(msg)
+          rep%rank, ' for ', m%nq, ' coordinates): ', trim(detail)
         call count_work(); return
       end if
     end if

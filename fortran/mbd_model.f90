@@ -326,6 +326,7 @@ contains
     subroutine choose_lref(st)
       integer, intent(out) :: st
       real(wp) :: big
+      character(len=12) :: bigtxt
       integer :: kk, o, n, kd, kbig
       st = MBD_OK; kbig = 0
       big = 0.0_wp
@@ -351,9 +352,15 @@ contains
       if (.not. (big > 0.0_wp)) return
       if (big < LSCALE_MIN .or. big > LSCALE_MAX) then
         st = MBD_BAD_PARAM; bad = kbig
-        write (msg, '(a,es9.2,a,es8.1,a,es8.1,a)') 'the model''s length scale (its largest '// &
-          'joint point, size or position) is ', big, '; mbd2d works with length scales '// &
-          'from ', LSCALE_MIN, ' to ', LSCALE_MAX, ': change the unit of length'
+        ! (three exponent digits where needed: es9.2 writes 1e300 as "1.00+300")
+        if (big >= 1.0e100_wp) then
+          write (bigtxt, '(es10.2e3)') big
+        else
+          write (bigtxt, '(es9.2)') big
+        end if
+        write (msg, '(a,a,a,es8.1,a,es8.1,a)') 'the model''s length scale (its largest '// &
+          'joint point, size or position) is ', trim(adjustl(bigtxt)), '; mbd2d works with '// &
+          'length scales from ', LSCALE_MIN, ' to ', LSCALE_MAX, ': change the unit of length'
         return
       end if
       m%lref = 2.0_wp**(exponent(big) - 1)     ! L <= big < 2 L

@@ -46,6 +46,8 @@ module mbd_sens_dynamics
   implicit none
   private
   public :: sens_multipliers, sens_reactions, sens_statics, sens_dopri5, sens_initial
+  ! (generalized-alpha's sensitivities, mbd_sens_genalpha: the same right-hand sides)
+  public :: proj_work_t, proj_init, sens_accel, sens_dyn_rows, cols_to_rows, rows_to_cols
 
   !> Work of project_sens and of the dopri5 right-hand sides (allocated once per run by
   !! proj_init: no step allocates).
@@ -54,6 +56,7 @@ module mbd_sens_dynamics
     !! np stay zero; dyn_solve_rows)
     real(wp), allocatable :: rt(:, :)
     real(wp), allocatable :: jst(:, :)      !! J S as rows (4 k, neq)
+    real(wp), allocatable :: y3(:)          !! (nq) one parameter's J_p^T lambda
   end type proj_work_t
 
 contains
@@ -69,7 +72,8 @@ contains
     integer :: st, nt
     status = MBD_OK; msg = ''
     nt = m%nq + w%na
-    allocate (pw%rt(4 * ((np + 3) / 4), nt), pw%jst(4 * ((np + 3) / 4), m%neq), stat=st)
+    allocate (pw%rt(4 * ((np + 3) / 4), nt), pw%jst(4 * ((np + 3) / 4), m%neq), pw%y3(m%nq), &
+              stat=st)
     if (st /= 0) then
       status = MBD_NO_MEMORY; msg = 'out of memory for the sensitivity projections'
       return
@@ -326,26 +330,25 @@ contains
     real(wp), allocatable :: y(:), yn(:), ys(:), k(:, :), e(:), zdda(:), lam(:), yt(:), &
                              zz(:), zzd(:), zzdd(:)
     ! the work of rhs and project (here, so that no step allocates)
-    real(wp), allocatable :: qq(:), vv(:), aa(:), y3(:), v0(:), fo(:)
+    real(wp), allocatable :: qq(:), vv(:), aa(:), v0(:), fo(:)
     type(proj_work_t) :: pw
     real(wp) :: t, h, tnew, err, fac, sc
     integer :: n, np, npd, nz, st, kout, nreal
-    logical :: fsal, pcon
+    logical :: fsal
     status = MBD_OK; msg = ''; nout = 0; stats = 0; hmm = [huge(one), zero]; t_fail = t0
     lok = .false.
     ! the packed state (q, S, q_dot, S_dot) holds S and S_dot as rows (npd, n), npd = np
     ! rounded up to a multiple of 4 (the padding rows stay zero: no rate, no error)
     n = m%nq; np = s%np; npd = 4 * ((np + 3) / 4); nz = n * (1 + npd)
     nreal = 2 * n * (1 + np)
-    pcon = any(s%kcon)
     if (.not. (rtol > zero .and. atol > zero) .or. every < 1 .or. &
         size(qo, 2) /= output_rows(nsteps, every)) then
       status = MBD_BAD_SETTING; msg = 'rtol, atol > 0, every >= 1 and outputs sized for it'
       return
     end if
     allocate (y(2 * nz), yn(2 * nz), ys(2 * nz), k(2 * nz, 7), e(2 * nz), &
-              zdda(nz), lam(m%neq), zz(nz), zzd(nz), zzdd(nz), qq(n), vv(n), aa(n), y3(n), &
-              v0(n), fo(2 * nz), stat=st)
+              zdda(nz), lam(m%neq), zz(nz), zzd(nz), zzdd(nz), qq(n), vv(n), aa(n), v0(n), &
+              fo(2 * nz), stat=st)
     if (st /= 0) then
       status = MBD_NO_MEMORY; msg = 'out of memory for the sensitivity integration'; return
     end if
@@ -443,49 +446,18 @@ contains
     end subroutine step
 
     !> f(t, y): (z_dot, z_ddot), z = (q, S): q_ddot from the index-1 system, each S_ddot from
-    !! its differentiation with the same factors (S, S_dot and S_ddot as rows).
+    !! its differentiation with the same factors (S, S_dot and S_ddot as rows; sens_accel).
     subroutine rhs(tt, yy, f, stp)
       real(wp), intent(in) :: tt
       real(wp), intent(in), contiguous :: yy(:)
       real(wp), intent(out), contiguous :: f(:)
       integer, intent(out) :: stp
-      integer :: kk
       stats(3) = stats(3) + 1
-      associate (qs => yy(1:n), vs => yy(nz + 1:nz + n))
-      call dyn_accel(m, w, qs, vs, tt, aa, lam, stp)
+      call sens_accel(m, w, s, pw, yy(1:n), yy(nz + 1:nz + n), tt, npd, yy(n + 1:nz), &
+                      yy(nz + n + 1:), aa, lam, f(nz + n + 1:), stp)
       if (stp /= MBD_OK) return
       f(1:nz) = yy(nz + 1:)
       f(nz + 1:nz + n) = aa
-      ! cos and sin of the angles at qs: the assembly's (sens_trig's values, not computed again)
-      call copy_trig(m%nb, w%asm%cb, w%asm%sb, s%cb, s%sb)
-      ! (the revolutes' and translationals' second derivatives: their *_rows below)
-      call sens_hessian(m, s, qs, vs, aa, tt, closed=.false.)
-      ! (the parameter parts: only parameters that change a constraint have any)
-      if (pcon) call sens_params(m, s, qs, vs, aa, tt, states=.false.)
-      call sens_klam_list(m, s, lam, closed=.false.)
-      ! the right-hand sides as the rows of rt, every parameter at once, then one solve
-      call accel_rows(n, npd, s%anyg, s%qgr, s%nmz, s%mzc, s%mzk, s%mzv, aa, s%kln, s%klr, &
-                      s%klc, s%klv, yy(n + 1:nz), pw%rt)
-      call sens_force_rows(m, s, qs, vs, tt, npd, yy(n + 1:nz), yy(nz + n + 1:), pw%rt, &
-                           grav=.false.)
-      do kk = 1, np
-        if (.not. s%kcon(kk)) cycle             ! (J_p = 0 otherwise)
-        call sens_jpt_lam(m, s, kk, qs, tt, lam, y3)
-        pw%rt(kk, 1:n) = pw%rt(kk, 1:n) - y3
-      end do
-      ! gamma_p - J_p q_ddot - Ha S - 2 Hv S_dot; the revolutes' Ha, Hv and K_lambda
-      if (pcon .or. s%nnz > s%nrvz) then
-        call sens_rows_rhs(s, .true., s%nrvz + 1, npd, n, yy(n + 1:nz), yy(nz + n + 1:), &
-                           s%rhs)
-      else                                      ! (no parameter part, no other nonzero)
-        call zero_rows(npd * m%neq, s%rhs)
-      end if
-      call sens_revolute_rows(m, s, lam, npd, yy(n + 1:nz), yy(nz + n + 1:), pw%rt, s%rhs)
-      call sens_translational_rows(m, s, qs, vs, aa, lam, npd, yy(n + 1:nz), yy(nz + n + 1:), &
-                                   pw%rt, s%rhs)
-      call constraint_rows(n, w%na, npd, m%neq, w%rows, w%s, s%rhs, pw%rt)
-      call dyn_solve_rows(w, pw%rt, np, n, npd, f(nz + n + 1:), .false., stp)   ! S_ddot rows
-      end associate
     end subroutine rhs
 
     !> Project q, q_dot (mbd_dynamics) and then S, S_dot (project_sens).
@@ -548,6 +520,77 @@ contains
       call rows_to_cols(n, np, npd, z3(n + 1:), sddo(:, :, row), s%ounit)
     end subroutine put
   end subroutine sens_dopri5
+
+  !> The accelerations of the index-1 system at (qs, vs) and of the sensitivities (S, S_dot
+  !! as rows st, sdt (npd, n)): [M J^T; J 0][q_ddot; lambda] = [Q; gamma] (dyn_accel), then
+  !! S_ddot (rows sddt) from its differentiation with the same factors, every parameter in
+  !! one solve (sens_dyn_rows, the constraint rows gamma_p - J_p q_ddot - Ha S - 2 Hv S_dot).
+  subroutine sens_accel(m, w, s, pw, qs, vs, tt, npd, st, sdt, aa, lam, sddt, stp)
+    type(model_t), intent(in) :: m              !! model with dynamics data
+    type(dyn_work_t), intent(inout) :: w        !! dynamics work arrays
+    type(sens_t), intent(inout) :: s            !! parameters and blocks
+    type(proj_work_t), intent(inout) :: pw      !! work (proj_init)
+    real(wp), intent(in) :: qs(:), vs(:), tt    !! state and time
+    integer, intent(in) :: npd                  !! rows of st, sdt, sddt (np rounded up to 4 k)
+    real(wp), intent(in) :: st(npd, *), sdt(npd, *)   !! S, S_dot as rows (npd, n)
+    real(wp), intent(out) :: aa(:), lam(:)      !! q_ddot, lambda (active rows)
+    real(wp), intent(out) :: sddt(npd, *)       !! S_ddot as rows (npd, n)
+    integer, intent(out) :: stp                 !! MBD_OK or the solve's failure
+    integer :: n
+    n = m%nq
+    call dyn_accel(m, w, qs, vs, tt, aa, lam, stp)
+    if (stp /= MBD_OK) return
+    call sens_dyn_rows(m, w, s, pw, qs, vs, aa, lam, tt, npd, st, sdt, .true.)
+    call constraint_rows(n, w%na, npd, m%neq, w%rows, w%s, s%rhs, pw%rt)
+    call dyn_solve_rows(w, pw%rt, s%np, n, npd, sddt, .false., stp)
+  end subroutine sens_accel
+
+  !> The sensitivities' right-hand sides at a state (qs, vs) with accelerations aa and
+  !! multipliers lam (whose assembly is in w), for S and S_dot as rows (npd, n):
+  !!   pw%rt(:, 1:n) = dQ - M_p q_ddot - K_lambda S - J_p^T lambda,
+  !!   s%rhs = gamma_p - J_p q_ddot - Ha S - 2 Hv S_dot (rows (npd, neq)),
+  !! with dQ = Q_q S + Q_q_dot S_dot + Q_p. state: the state's blocks first (second
+  !! derivatives, parameter parts, K_lambda); else those of the last call at this state.
+  subroutine sens_dyn_rows(m, w, s, pw, qs, vs, aa, lam, tt, npd, st, sdt, state)
+    type(model_t), intent(in) :: m              !! model with dynamics data
+    type(dyn_work_t), intent(in) :: w           !! dynamics work arrays (assembled at qs)
+    type(sens_t), intent(inout) :: s            !! parameters and blocks
+    type(proj_work_t), intent(inout) :: pw      !! work (proj_init)
+    real(wp), intent(in) :: qs(:), vs(:), aa(:), lam(:), tt   !! state, q_ddot, lambda, time
+    integer, intent(in) :: npd                  !! rows of st, sdt
+    real(wp), intent(in) :: st(npd, *), sdt(npd, *)   !! S, S_dot as rows (npd, n)
+    logical, intent(in) :: state                !! evaluate the state's blocks
+    integer :: kk, n
+    logical :: pcon
+    n = m%nq
+    pcon = any(s%kcon)
+    if (state) then
+      ! cos and sin of the angles at qs: the assembly's (sens_trig's values, not computed again)
+      call copy_trig(m%nb, w%asm%cb, w%asm%sb, s%cb, s%sb)
+      ! (the revolutes' and translationals' second derivatives: their *_rows below)
+      call sens_hessian(m, s, qs, vs, aa, tt, closed=.false.)
+      ! (the parameter parts: only parameters that change a constraint have any)
+      if (pcon) call sens_params(m, s, qs, vs, aa, tt, states=.false.)
+      call sens_klam_list(m, s, lam, closed=.false.)
+    end if
+    ! the right-hand sides as the rows of rt, every parameter at once
+    call accel_rows(n, npd, s%anyg, s%qgr, s%nmz, s%mzc, s%mzk, s%mzv, aa, s%kln, s%klr, &
+                    s%klc, s%klv, st, pw%rt)
+    call sens_force_rows(m, s, qs, vs, tt, npd, st, sdt, pw%rt, grav=.false.)
+    do kk = 1, s%np
+      if (.not. s%kcon(kk)) cycle             ! (J_p = 0 otherwise)
+      call sens_jpt_lam(m, s, kk, qs, tt, lam, pw%y3)
+      pw%rt(kk, 1:n) = pw%rt(kk, 1:n) - pw%y3
+    end do
+    ! gamma_p - J_p q_ddot - Ha S - 2 Hv S_dot; the revolutes' Ha, Hv and K_lambda
+    if (pcon .or. s%nnz > s%nrvz) then
+      call sens_rows_rhs(s, .true., s%nrvz + 1, npd, n, st, sdt, s%rhs)
+    else                                      ! (no parameter part, no other nonzero)
+      call zero_rows(npd * m%neq, s%rhs)
+    end if
+    call sens_revolute_rows(m, s, lam, npd, st, sdt, pw%rt, s%rhs)
+    call sens_translational_rows(m, s, qs, vs, aa, lam, npd, st, sdt, pw%rt, s%rhs)
+  end subroutine sens_dyn_rows
 
   !> Columns c (n of each of np; leading dimension ldc) as rows r (npd, n) (the padding rows
   !! zero). (The loops over parameters go by fours, written out, and a remainder: loops of

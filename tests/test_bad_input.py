@@ -403,3 +403,16 @@ def test_spline_profile_of_collinear_points_is_rejected():
     text = BODIES + cam_joint("{ spline = { points = [[0, 0], [1, 0], [2, 0], [3, 0]] } }")
     with pytest.raises(mbd2d.ModelError, match=r"'contact'"):
         mbd2d.loads(text).counts()
+
+
+@pytest.mark.parametrize("value", [1e300, -1e300, 1e15, -2.5e99, 1e100])
+def test_the_length_scale_message_writes_its_number_whole(value: float) -> None:
+    """A length scale out of range is named with its number as Python writes it in E
+    notation: a three-digit exponent came out as "1.00+300" (Fortran's es9.2 drops the E)."""
+    m = mbd2d.load(example_path("fourbar_grashof.toml"))
+    with pytest.raises(mbd2d.ModelError) as info:
+        m.with_params({"joint.O4.points.1.0": value, "joint.O4.points.0.0": value}).kinematics(
+            0.1, 2)
+    want = f"{abs(value):.2E}"
+    assert f"length scale (its largest joint point, size or position) is {want};" in \
+        str(info.value), str(info.value)

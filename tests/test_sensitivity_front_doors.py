@@ -35,7 +35,9 @@ def free_fourbar() -> mbd2d.Model:
 # (model, analysis run, parameters, optional columns): kinematics at the tightest Newton
 # tolerance, inverse dynamics and statics with every column that has a derivative, dopri5 at
 # rtol 1e-12 with parameters that leave the assembled start alone (the start's sensitivity is
-# the minimum-norm one, which the assembly of a perturbed model does not follow exactly)
+# the minimum-norm one, which the assembly of a perturbed model does not follow exactly);
+# generalized-alpha at a fixed step (its sensitivities are the derivatives of its discrete
+# solution, which the differences of runs at the same step follow)
 CASES: dict[str, tuple[Callable[[], mbd2d.Model], Callable[..., Any], list[str], dict]] = {
     "kinematics": (lambda: mbd2d.load(EX / "fourbar_grashof.toml"),
                    lambda m, s: m.kinematics(1.0, 20, tol=1e-15, sensitivities=s),
@@ -53,6 +55,11 @@ CASES: dict[str, tuple[Callable[[], mbd2d.Model], Callable[..., Any], list[str],
                                          sensitivities=s),
                  ["body.coupler.mass", "body.rocker.inertia", "model.gravity.1"],
                  {"multipliers": True}),
+    "generalized-alpha": (free_fourbar,
+                          lambda m, s: m.dynamics(0.5, 10, method="generalized-alpha", h=5e-3,
+                                                  rtol=1e-12, atol=1e-14, sensitivities=s),
+                          ["body.coupler.mass", "body.rocker.inertia", "model.gravity.1"],
+                          {"multipliers": True}),
 }
 
 
@@ -62,7 +69,12 @@ def test_columns_are_central_differences(case: str) -> None:
     |error| <= 1e-6 of the column's scale + 1e-8 of the parameter's largest derivative
     (central differences with dp = 1e-5 max(1, |p|) carry dp^2 truncation, about 1e-10, and
     the runs' round-off over dp, about 1e-11 relative; a column put under the wrong name or
-    parameter is off by its whole size)."""
+    parameter is off by its whole size). generalized-alpha's accelerations are converged to
+    1e-11 of the dynamic equations' largest term (its Newton's residual test), which the
+    differences carry over dp: its differences are taken at dp = 1e-2 and 2e-2,
+    Richardson-extrapolated (truncation dp^4, 2e-11 relative in q), and its acceleration
+    columns held to 1e-5 of their scale (measured 9.4e-7 at dp = 1e-2, 8.0e-6 at 1e-3 and
+    8.3e-5 at 1e-4: the differences' round-off, falling as 1 / dp)."""
     build, run, names, opts = CASES[case]
     model = build()
     res = run(model, names)
@@ -71,13 +83,20 @@ def test_columns_are_central_differences(case: str) -> None:
     assert header[:len(base)] == base
     derived = header[len(base):]
     checked = 0
-    for prm in names:
-        v = model.parameters()[prm]
-        dp = 1e-5 * max(1.0, abs(v))
+
+    def central(prm: str, v: float, dp: float) -> np.ndarray:
         hp, rp = run(model.with_params({prm: v + dp}), None).table(**opts)
         hm, rm = run(model.with_params({prm: v - dp}), None).table(**opts)
         assert hp == hm == base
-        fd = (rp - rm) / (2 * dp)
+        return (rp - rm) / (2 * dp)
+
+    for prm in names:
+        v = model.parameters()[prm]
+        if case == "generalized-alpha":
+            dp = 1e-2 * max(1.0, abs(v))
+            fd = (4 * central(prm, v, dp) - central(prm, v, 2 * dp)) / 3
+        else:
+            fd = central(prm, v, 1e-5 * max(1.0, abs(v)))
         mine = [h for h in derived if h.endswith(f")/d({prm})")]
         block = np.abs(rows[:, [header.index(h) for h in mine]]).max()
         for h in mine:
@@ -86,7 +105,8 @@ def test_columns_are_central_differences(case: str) -> None:
             got = rows[:, header.index(h)]
             scale = max(np.abs(got).max(), np.abs(fd[:, j]).max())
             err = np.abs(got - fd[:, j]).max()
-            assert err <= 1e-6 * scale + 1e-8 * block, (h, err, scale)
+            rel = 1e-5 if case == "generalized-alpha" and col.endswith("_ddot") else 1e-6
+            assert err <= rel * scale + 1e-8 * block, (h, err, scale)
             checked += 1
     assert checked == len(derived)          # every derived column has its value column
     # the motion's derivatives come first for each parameter, in the value columns' order
@@ -106,7 +126,10 @@ def test_mbd2d_solve_writes_the_python_columns(tmp_path: Path, case: str) -> Non
                 "inverse": dict(t_end=1.0, steps=20, tol=1e-15, analysis="inverse-dynamics"),
                 "statics": dict(analysis="statics"),
                 "dynamics": dict(t_end=0.5, steps=10, analysis="dynamics", method="dopri5",
-                                 rtol=1e-12, atol=1e-14)}[case]
+                                 rtol=1e-12, atol=1e-14),
+                "generalized-alpha": dict(t_end=0.5, steps=10, analysis="dynamics",
+                                          method="generalized-alpha", h=5e-3, rtol=1e-12,
+                                          atol=1e-14)}[case]
     mbd = tmp_path / "m.mbd"
     model.export(mbd, outputs=list(opts), sensitivities=names, **settings)
     assert f"sensitivities {len(names)}" in mbd.read_text()
@@ -199,7 +222,7 @@ def test_cli_statics_and_parameters(tmp_path: Path, capsys) -> None:
     (["kinematics", "fourbar_grashof.toml", "--sensitivities", " , "], "names no parameter"),
     (["kinematics", "fourbar_grashof.toml", "--positions-only", "--sensitivities",
       "joint.B.points.0.0"], "drop positions_only"),
-    (["dynamics", "fourbar_masses.toml", "--method", "generalized-alpha", "--h", "1e-3",
+    (["dynamics", "fourbar_masses.toml", "--method", "partitioned",
       "--sensitivities", "body.crank.mass"], "integrated with dopri5"),
     (["dynamics", "cam_liftoff.toml", "--sensitivities", "body.follower.mass"],
      "do not carry contacts"),
@@ -270,12 +293,13 @@ def test_bad_sensitivity_blocks_name_their_line(tmp_path: Path, edit: tuple[str,
 
 
 def test_file_sensitivities_refused_where_python_refuses(tmp_path: Path) -> None:
-    """A hand-made block on a dynamics file whose method is not dopri5, and on a model with
-    contacts: exit code 2 with the Python path's reason."""
+    """A hand-made block on a dynamics file whose method has no sensitivities (neither dopri5
+    nor generalized-alpha), and on a model with contacts: exit code 2 with the Python path's
+    reason."""
     lines = _exported(tmp_path, analysis="dynamics", method="dopri5")
     i = lines.index("method dopri5")
-    lines[i] = "method generalized-alpha"
-    f = tmp_path / "ga.mbd"
+    lines[i] = "method partitioned"
+    f = tmp_path / "partitioned.mbd"
     f.write_text("\n".join(lines) + "\n")
     r = subprocess.run([find_solver(), str(f), str(tmp_path / "o.csv")], capture_output=True,
                        text=True, timeout=60)

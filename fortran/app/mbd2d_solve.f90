@@ -196,12 +196,12 @@ program mbd2d_solve
     end if
     nout = iinfo(1)
   case ('dynamics')
-    if (sens) then                 ! dopri5 with the variational equations
+    if (sens) then                 ! dopri5 or generalized-alpha with the sensitivities
       call api_dynamics_sens(spec%nb, spec%ctab, spec%rpar, spec%bmass, spec%grav, ftab, &
                              fpar, q0, v0, spec%t0, spec%t_end, spec%steps, spec%rtol, &
                              spec%atol, spec%every, spec%max_steps, spec%ptab, qout, qdout, &
                              qddout, lamout, eout, sq, sqd, sqdd, iinfo, rinfo, redundant, &
-                             status, msg)
+                             status, msg, method=spec%method, h=spec%h, rho_inf=spec%rho_inf)
     else
       call api_dynamics(spec%nb, spec%ctab, spec%rpar, spec%bmass, spec%grav, ftab, fpar, q0, &
                         v0, spec%t0, spec%t_end, spec%steps, spec%method, spec%rtol, spec%atol, &
@@ -295,9 +295,11 @@ contains
     if (spec%positions_only) call die(2, trim(model_path) // ':' // &
       trim(itoa(spec%sens_line)) // ': sensitivities need the velocities and accelerations '// &
       'of every step: give positions_only 0')
-    if (spec%analysis == 'dynamics' .and. spec%method /= 2) call die(2, trim(model_path) // &
-      ':' // trim(itoa(spec%sens_line)) // ': sensitivities are integrated with dopri5 '// &
-      '(the variational equations with the state); give method dopri5')
+    if (spec%analysis == 'dynamics' .and. spec%method /= 2 .and. spec%method /= 1) &
+      call die(2, trim(model_path) // ':' // trim(itoa(spec%sens_line)) // ': '// &
+               'sensitivities are integrated with dopri5 (the variational equations with the '// &
+               'state) or generalized-alpha (its discrete equations differentiated); give '// &
+               'method dopri5 or generalized-alpha')
     do c = 1, spec%nf
       if (force_is_contact(spec%ftab(1, c)) .or. spec%ftab(1, c) == FRC_FRICTION) &
         call die(2, trim(model_path) // ':' // trim(itoa(spec%sens_line)) // ': design '// &

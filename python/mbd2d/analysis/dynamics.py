@@ -21,7 +21,7 @@ from .contacts import MAX_EVENTS, check_method, has_events, report_pulls
 from .failures import assembly_failed, bad_entry, inconsistent_at, row_names
 from .outputs import dynamics_result, finite_part
 from .progress import run_core
-from .sensitivities import attach, check_dopri5, check_status, requested, table
+from .sensitivities import attach, check_sens_method, check_status, requested, table
 from .settings import (check_memory, check_span, output_rows, output_steps, solver_code,
                        time_grid)
 
@@ -111,7 +111,7 @@ def run_dynamics(model: ModelDescription, t_end: float, steps: int, method: str 
                                                    st.alpha, st.beta)
     check_method(model, method)
     params = requested(model, sensitivities)
-    check_dopri5(params, method, "dynamics")
+    check_sens_method(params, method, "dynamics")
     p = pack(model)
     d = pack_dynamics(model, p)
     npar = len(params) if params else 0
@@ -121,7 +121,7 @@ def run_dynamics(model: ModelDescription, t_end: float, steps: int, method: str 
     if params:
         ptab = table(p, params, d)
         out = core.dynamics_sens(p, d, t0, t_end, steps, rtol_v, atol_v, every, nmax, nout,
-                                 ptab, code)
+                                 ptab, code, METHODS[method], h_v, rho_v)
         check_status(out.status, out.iinfo, out.msg, params)
     else:
         fixed = (t_end - t0) / h_v if h_v > 0 else 0.0

@@ -26,7 +26,7 @@ from ..results.files import OUTPUTS, write_text
 from ..results.measures import measure_tables
 from ..validate import flag, number
 from .dynamics import dynamics_settings
-from .sensitivities import check_dopri5, check_positions_only, requested, table
+from .sensitivities import check_sens_method, check_positions_only, requested, table
 from .settings import (SOLVERS, check_solver, check_span, output_rows, require_determined,
                        solver_code)
 
@@ -220,7 +220,7 @@ def file_lines(model: ModelDescription, t_end: float | None = None, steps: int |
                 lines.append("positions_only 1")
     elif analysis == "dynamics":
         st = dynamics_settings(method, rtol, atol, h, rho_inf, alpha, beta, max_steps)
-        check_dopri5(params, st.method, "export")
+        check_sens_method(params, st.method, "export")
         lines += [f"method {st.method}", f"rtol {_r(st.rtol)}", f"atol {_r(st.atol)}",
                   f"h {_r(st.h)}", f"rho_inf {_r(st.rho_inf)}", f"alpha {_r(st.alpha)}",
                   f"beta {_r(st.beta)}", f"max_steps {st.max_steps}"]

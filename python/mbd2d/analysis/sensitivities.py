@@ -45,11 +45,17 @@ def check_positions_only(params: list[Parameter] | None, positions_only: bool) -
                          "step: drop positions_only=True to ask for them", "analysis")
 
 
-def check_dopri5(params: list[Parameter] | None, method: str, what: str) -> None:
-    """Forward dynamics integrates the sensitivities with dopri5 alone."""
-    if params and method != "dopri5":
+#: the dynamics methods with sensitivities: dopri5 integrates the variational equations with
+#: the state, generalized-alpha differentiates its discrete equations
+SENSITIVITY_METHODS = ("dopri5", "generalized-alpha")
+
+
+def check_sens_method(params: list[Parameter] | None, method: str, what: str) -> None:
+    """Forward dynamics has sensitivities by dopri5 and generalized-alpha."""
+    if params and method not in SENSITIVITY_METHODS:
         raise ModelError(f"sensitivities are integrated with dopri5 (the variational "
-                         f"equations with the state); method {method!r} has none", what)
+                         f"equations with the state) or generalized-alpha (its discrete "
+                         f"equations differentiated); method {method!r} has none", what)
 
 
 def table(p: Packed, params: list[Parameter], d: DynamicTables | None = None) -> np.ndarray:

@@ -255,15 +255,17 @@ def inverse_sens(p: Packed, d: DynamicTables, t0: float, t1: float, steps: int, 
 
 def dynamics_sens(p: Packed, d: DynamicTables, t0: float, t1: float, steps: int, rtol: float,
                   atol: float, every: int, max_steps: int, nrow: int,
-                  ptab: np.ndarray, solver: int = 0) -> SimpleNamespace:
-    """Forward dynamics by dopri5 with sensitivities (solver 0 auto, 1 dense, 2 banded):
+                  ptab: np.ndarray, solver: int = 0, method: int = 2, h: float = 0.0,
+                  rho_inf: float = -1.0) -> SimpleNamespace:
+    """Forward dynamics with sensitivities (solver 0 auto, 1 dense, 2 banded; method 2
+    dopri5, 1 generalized-alpha with its step h, 0 adaptive, and rho_inf, < 0 its default):
     ``q``, ``qd``, ``qdd``, ``lam``, ``e``, ``sq``, ``sqd``, ``sqdd``, ``iinfo``, ``rinfo``,
     ``red``, ``status``, ``msg``."""
     return _named("q qd qdd lam e sq sqd sqdd iinfo rinfo red status msg",
                   _core.core_dynamics_sens, ctab=p.ctab, rpar=p.rpar, bmass=d.bmass,
                   grav=d.grav, ftab=d.ftab, fpar=d.fpar, neq=p.neq, q0=p.q0, v0=d.v0, t0=t0,
                   t1=t1, nsteps=steps, rtol=rtol, atol=atol, every=every, max_steps=max_steps,
-                  solver=solver, nrow=nrow, ptab=ptab,
+                  solver=solver, nrow=nrow, ptab=ptab, method=method, h=h, rho_inf=rho_inf,
                   numbers=(3 * p.nq + p.neq) * nrow * (1 + ptab.shape[1]))
 
 

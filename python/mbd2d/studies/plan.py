@@ -11,7 +11,7 @@ from typing import Any, Callable, Mapping, Sequence
 import numpy as np
 
 from ..analysis.dynamics import dynamics_settings
-from ..analysis.sensitivities import check_dopri5, check_positions_only, requested, table
+from ..analysis.sensitivities import check_sens_method, check_positions_only, requested, table
 from ..analysis.settings import (check_memory, check_solver, check_span, output_rows,
                                  output_steps, require_determined, solver_code, time_grid)
 from ..binding.cases import case_tables
@@ -317,7 +317,7 @@ def with_sensitivities(pl: Plan, model: ModelDescription, names: Any) -> None:
         return
     b = pl.tables
     check_positions_only(params, b.nd == 0 and pl.analysis == "kinematics")
-    check_dopri5(params, pl.method or "dopri5", "sweep")
+    check_sens_method(params, pl.method or "dopri5", "sweep")
     b.ptab = table(pl.packed, params, _dynamic(b))
     b.sensitivities = [prm.name for prm in params]
 

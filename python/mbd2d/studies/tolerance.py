@@ -21,6 +21,7 @@ from typing import Any, Mapping
 import numpy as np
 
 from ..analysis.dynamics import run_dynamics
+from ..analysis.sensitivities import SENSITIVITY_METHODS
 from ..analysis.inverse import run_inverse
 from ..analysis.kinematics import run_kinematics
 from ..analysis.statics import run_statics
@@ -237,9 +238,9 @@ def _nominal(model: ModelDescription, names: list[str], analysis: str,
         return run_statics(model, sensitivities=names, **_bind(_statics_settings, kw,
                                                                  analysis)), "statics"
     a = _bind(_dynamics_settings, kw, analysis)
-    if a["method"] not in (None, "dopri5"):
+    if a["method"] not in (None,) + SENSITIVITY_METHODS:
         raise ModelError(f"tolerance analysis of dynamics needs the sensitivities of dopri5 "
-                         f"(method={a['method']!r} has none)", "tolerance")
+                         f"or generalized-alpha (method={a['method']!r} has none)", "tolerance")
     return run_dynamics(model, sensitivities=names, **a), "dynamics"
 
 
@@ -348,7 +349,8 @@ def tolerance(model: ModelDescription, sigma: Mapping[str, Any], analysis: str =
     sigma : dict
         Parameter name -> standard deviation (>= 0), in the parameter's units.
     analysis : {"kinematics", "inverse_dynamics", "statics", "dynamics"}
-        As :func:`mbd2d.sweep`; dynamics with method dopri5 (the one with sensitivities).
+        As :func:`mbd2d.sweep`; dynamics with method dopri5 or generalized-alpha (the ones
+        with sensitivities).
     samples : int
         Monte Carlo variants, drawn with p ~ Normal(p0, sigma) (default 200; 0 skips the
         Monte Carlo estimate).
