@@ -9,6 +9,8 @@ Cases:
   dopri5      a free slider-crank under gravity with a spring (rtol = atol = 1e-8): the
               spring stiffness, two masses and gravity. With sensitivities the error control
               also covers them, so the step count may differ: it is reported.
+  generalized-alpha  the same free slider-crank and parameters at the fixed step h = 1 ms
+              (its discrete equations differentiated; default rtol, atol), 10 s.
 
 Target (issue 10): sensitivities for 4 parameters cost at most 2x the analysis alone.
 Beside them (no target): the mechanism measures' design derivatives of the four-bar's run
@@ -52,6 +54,10 @@ CALLGRIND_CASES = {
     "dopri5 free slider-crank, 4 parameters": (
         "m = S.free_slider_crank()",
         "m.dynamics(10.0, 200, rtol=1e-8, atol=1e-8{S})", "__mbd_api_MOD_api_dynamics"),
+    "generalized-alpha free slider-crank, 4 parameters": (
+        "m = S.free_slider_crank()",
+        "m.dynamics(3.0, 200, method='generalized-alpha', h=1e-3{S})",
+        "__mbd_api_MOD_api_dynamics"),
 }
 
 
@@ -151,7 +157,13 @@ def measure(steps: int, reps: int, quick: bool = False) -> dict[str, Any]:
                         lambda: free.dynamics(t_dyn, 200, rtol=1e-8, atol=1e-8),
                         lambda: free.dynamics(t_dyn, 200, rtol=1e-8, atol=1e-8,
                                               sensitivities=pd), reps, 200))
-    names = {rows[0]["case"]: p4, rows[1]["case"]: ps, rows[2]["case"]: pi, rows[3]["case"]: pd}
+    ga_kw = {"method": "generalized-alpha", "h": 1e-3}
+    rows.append(compare("generalized-alpha free slider-crank, 4 parameters",
+                        lambda: free.dynamics(t_dyn, 200, **ga_kw),
+                        lambda: free.dynamics(t_dyn, 200, sensitivities=pd, **ga_kw), reps,
+                        200))
+    names = {rows[0]["case"]: p4, rows[1]["case"]: ps, rows[2]["case"]: pi, rows[3]["case"]: pd,
+             rows[4]["case"]: pd}
     for r in rows if not quick else []:
         counts = instructions(r["case"], names[r["case"]])
         if counts and counts[0] > 0:

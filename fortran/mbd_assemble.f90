@@ -18,7 +18,7 @@ module mbd_assemble
   implicit none
   private
   public :: asm_work_t, asm_init, assemble_blocks, scatter_dense, assemble_dense, init_extras, &
-            gather_local, blocks_jv, blocks_jv_rows, blocks_jtv, scatter_values, asm_turn, &
+            gather_local, blocks_jv, blocks_jv_rows, blocks_jtv, blocks_jtv_rows_sub, scatter_values, asm_turn, &
             assemble_gamma, assemble_phi
 
   !> Work arrays of the assembly, allocated once per analysis.
@@ -424,6 +424,47 @@ contains
       end do
     end do
   end subroutine jv_rows_kernel
+
+  !> X = X - J^T Y for several vectors held as rows (yt (npad, neq) -> xt (npad, nq), npad a
+  !! multiple of 4), from the local blocks of the last assembly: each block entry read once.
+  pure subroutine blocks_jtv_rows_sub(m, a, npad, yt, xt)
+    type(model_t), intent(in) :: m        !! model
+    type(asm_work_t), intent(in) :: a     !! work arrays with the blocks
+    integer, intent(in) :: npad           !! rows of yt and xt
+    real(wp), intent(in) :: yt(*)         !! vectors as rows (npad, neq)
+    real(wp), intent(inout) :: xt(*)      !! X - J^T Y as rows (npad, nq)
+    call jtv_rows_kernel(m%nc, m%loc, m%row0, m%nrow, a%jb, npad, yt, xt)
+  end subroutine blocks_jtv_rows_sub
+
+  !> blocks_jtv_rows_sub on explicit shapes.
+  pure subroutine jtv_rows_kernel(nc, loc, row0, nrow, jb, npad, yt, xt)
+    integer, intent(in) :: nc, npad
+    integer, intent(in) :: loc(NLOC, nc), row0(nc), nrow(nc)
+    real(wp), intent(in) :: jb(MAXROW, NLOC, nc), yt(npad, *)
+    real(wp), intent(inout) :: xt(npad, *)
+    integer :: k, s, c, r, i, g
+    real(wp) :: v
+    do k = 1, nc
+      do s = 1, NLOC
+        c = loc(s, k)
+        if (c == 0) cycle
+        do i = 1, nrow(k)
+          r = row0(k) + i - 1; v = jb(i, s, k)
+          if (npad == 4) then                  ! (up to four vectors: no inner loop)
+            xt(1, c) = xt(1, c) - v * yt(1, r); xt(2, c) = xt(2, c) - v * yt(2, r)
+            xt(3, c) = xt(3, c) - v * yt(3, r); xt(4, c) = xt(4, c) - v * yt(4, r)
+            cycle
+          end if
+          do g = 0, npad - 4, 4
+            xt(g + 1, c) = xt(g + 1, c) - v * yt(g + 1, r)
+            xt(g + 2, c) = xt(g + 2, c) - v * yt(g + 2, r)
+            xt(g + 3, c) = xt(g + 3, c) - v * yt(g + 3, r)
+            xt(g + 4, c) = xt(g + 4, c) - v * yt(g + 4, r)
+          end do
+        end do
+      end do
+    end do
+  end subroutine jtv_rows_kernel
 
   !> x = J^T y from the local blocks of the last assembly (no dense J).
   pure subroutine blocks_jtv(m, a, y, x)

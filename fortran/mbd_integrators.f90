@@ -150,7 +150,7 @@ module mbd_integrators
       type(dyn_work_t), intent(inout) :: w
       type(saddle_t), intent(inout) :: sg
       real(wp), intent(in) :: tn, h, coef(GA_NCOEF), rtol, atol
-      real(wp), intent(in) :: qn(:), vn(:), an(:), lamn(:)
+      real(wp), intent(in), contiguous :: qn(:), vn(:), an(:), lamn(:)
       real(wp), intent(out) :: esq
       integer, intent(out) :: ne, status
     end subroutine hook_step

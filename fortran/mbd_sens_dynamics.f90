@@ -446,18 +446,24 @@ contains
     end subroutine step
 
     !> f(t, y): (z_dot, z_ddot), z = (q, S): q_ddot from the index-1 system, each S_ddot from
-    !! its differentiation with the same factors (S, S_dot and S_ddot as rows; sens_accel).
+    !! its differentiation with the same factors (S, S_dot and S_ddot as rows; sens_accel's
+    !! steps, written out: the stages' calls are the run's most frequent).
     subroutine rhs(tt, yy, f, stp)
       real(wp), intent(in) :: tt
       real(wp), intent(in), contiguous :: yy(:)
       real(wp), intent(out), contiguous :: f(:)
       integer, intent(out) :: stp
       stats(3) = stats(3) + 1
-      call sens_accel(m, w, s, pw, yy(1:n), yy(nz + 1:nz + n), tt, npd, yy(n + 1:nz), &
-                      yy(nz + n + 1:), aa, lam, f(nz + n + 1:), stp)
+      associate (qs => yy(1:n), vs => yy(nz + 1:nz + n))
+      call dyn_accel(m, w, qs, vs, tt, aa, lam, stp)
       if (stp /= MBD_OK) return
       f(1:nz) = yy(nz + 1:)
       f(nz + 1:nz + n) = aa
+      call sens_dyn_rows(m, w, s, pw, qs, vs, aa, lam, tt, npd, yy(n + 1:nz), yy(nz + n + 1:), &
+                         .true.)
+      call constraint_rows(n, w%na, npd, m%neq, w%rows, w%s, s%rhs, pw%rt)
+      call dyn_solve_rows(w, pw%rt, np, n, npd, f(nz + n + 1:), .false., stp)   ! S_ddot rows
+      end associate
     end subroutine rhs
 
     !> Project q, q_dot (mbd_dynamics) and then S, S_dot (project_sens).
@@ -530,10 +536,13 @@ contains
     type(dyn_work_t), intent(inout) :: w        !! dynamics work arrays
     type(sens_t), intent(inout) :: s            !! parameters and blocks
     type(proj_work_t), intent(inout) :: pw      !! work (proj_init)
-    real(wp), intent(in) :: qs(:), vs(:), tt    !! state and time
+    !> state and time (contiguous: no run-time packing checks where they reach explicit
+    !! shapes below)
+    real(wp), intent(in), contiguous :: qs(:), vs(:)
+    real(wp), intent(in) :: tt
     integer, intent(in) :: npd                  !! rows of st, sdt, sddt (np rounded up to 4 k)
     real(wp), intent(in) :: st(npd, *), sdt(npd, *)   !! S, S_dot as rows (npd, n)
-    real(wp), intent(out) :: aa(:), lam(:)      !! q_ddot, lambda (active rows)
+    real(wp), intent(out), contiguous :: aa(:), lam(:)  !! q_ddot, lambda (active rows)
     real(wp), intent(out) :: sddt(npd, *)       !! S_ddot as rows (npd, n)
     integer, intent(out) :: stp                 !! MBD_OK or the solve's failure
     integer :: n
@@ -556,7 +565,9 @@ contains
     type(dyn_work_t), intent(in) :: w           !! dynamics work arrays (assembled at qs)
     type(sens_t), intent(inout) :: s            !! parameters and blocks
     type(proj_work_t), intent(inout) :: pw      !! work (proj_init)
-    real(wp), intent(in) :: qs(:), vs(:), aa(:), lam(:), tt   !! state, q_ddot, lambda, time
+    !> state, q_ddot, lambda (explicit shapes: no descriptors at the stages' calls), time
+    real(wp), intent(in) :: qs(m%nq), vs(m%nq), aa(m%nq), lam(m%neq)
+    real(wp), intent(in) :: tt
     integer, intent(in) :: npd                  !! rows of st, sdt
     real(wp), intent(in) :: st(npd, *), sdt(npd, *)   !! S, S_dot as rows (npd, n)
     logical, intent(in) :: state                !! evaluate the state's blocks

@@ -31,8 +31,8 @@ column per measure: ``transmission_angle:JOINT[:OUTPUT]``,
 ``velocity_ratio:INPUT:OUTPUT[:VIA]``, ``mechanical_advantage:INPUT:OUTPUT[:VIA]`` or
 ``dead_centre_distance`` (a sweep: each case's, from its own dimensions).
 
-``--sensitivities NAME,...`` (kinematics, inverse-dynamics, statics, dynamics by dopri5,
-sweep, export) computes the design sensitivities with respect to the named parameters (``mbd2d
+``--sensitivities NAME,...`` (kinematics, inverse-dynamics, statics, dynamics by dopri5 or
+generalized-alpha, sweep, export) computes the design sensitivities with respect to the named parameters (``mbd2d
 parameters MODEL`` lists them) and adds the columns ``d(COLUMN)/d(NAME)`` to the CSV
 (``dq_dp``, ``dqd_dp``, ``dqdd_dp`` arrays to an .npz).
 
@@ -376,7 +376,8 @@ def _tolerance_parser(sub: Any) -> None:
     t.add_argument("--samples", type=int, default=200,
                    help="Monte Carlo variants (default 200; 0: first order alone)")
     t.add_argument("--seed", type=int, default=0, help="seed of the draws (default 0)")
-    _study_settings(t, "the analysis (default kinematics; dynamics by dopri5)")
+    _study_settings(t, "the analysis (default kinematics; dynamics by dopri5 or "
+                       "generalized-alpha)")
     t.add_argument("--point", action="append", default=None, metavar="BODY:X,Y",
                    help="also the scatter of the point (X, Y) of BODY (repeatable)")
     t.add_argument("--out", default=None, help="output file, .csv (one row per time) or "

@@ -251,10 +251,12 @@ class Model(ModelDescription):
             that needs more steps) raises it. When it is reached the run stops with an
             IntegrationError that says so, the results up to then kept.
         sensitivities : list of str, optional
-            Design parameters to differentiate with respect to (dopri5 only): the
-            variational equations are integrated with the state, under the same error
-            control, giving ``dq_dp``, ``dqd_dp``, ``dqdd_dp`` (rows, n_coordinates,
-            n_params). The start's sensitivities are those of the assembled q0 (the minimum-
+            Design parameters to differentiate with respect to (dopri5 and
+            generalized-alpha), giving ``dq_dp``, ``dqd_dp``, ``dqdd_dp`` (rows,
+            n_coordinates, n_params). dopri5 integrates the variational equations with the
+            state; generalized-alpha differentiates its discrete equations (at a fixed h the
+            exact derivatives of its own solution); either way under the same error
+            control. The start's sensitivities are those of the assembled q0 (the minimum-
             norm change) and of the projected v0. They take the path ``solver`` gives.
         progress : bool, optional
             A progress bar while the core integrates, as in :meth:`kinematics`.
@@ -403,7 +405,8 @@ class Model(ModelDescription):
             Design parameters (names as :meth:`parameters`): ``mbd2d-solve`` computes the
             sensitivities as the analysis does with ``sensitivities=[...]`` and writes their
             columns ``d(COLUMN)/d(NAME)``, as ``res.to_csv(path, sensitivities=True)``
-            (kinematics, inverse dynamics, statics, and dynamics by dopri5).
+            (kinematics, inverse dynamics, statics, and dynamics by dopri5 or
+            generalized-alpha).
         measures : list of str, optional
             Measure columns, as ``res.to_csv(path, measures=[...])``:
             ``transmission_angle:JOINT[:OUTPUT]``, ``velocity_ratio:INPUT:OUTPUT[:VIA]``,

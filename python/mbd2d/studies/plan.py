@@ -310,7 +310,8 @@ def with_sensitivities(pl: Plan, model: ModelDescription, names: Any) -> None:
     ------
     ModelError
         For an unknown or repeated name, or an analysis that has none (positions-only
-        kinematics, dynamics other than dopri5, a model with contacts or joint friction).
+        kinematics, dynamics other than dopri5 and generalized-alpha, a model with contacts
+        or joint friction).
     """
     params = requested(model, names)
     if not params:

@@ -49,7 +49,7 @@ def sweep(model: ModelDescription, cases: Any, analysis: str = "kinematics", cli
     sensitivities : list of str, optional
         Design parameters (``model.parameters()`` names): every case's exact sensitivities
         to them at its own values, as ``sensitivities=`` of the Model method computes them
-        (not for positions-only kinematics; dynamics by dopri5).
+        (not for positions-only kinematics; dynamics by dopri5 or generalized-alpha).
     **analysis_kwargs
         The analysis's settings, as for the Model method (``t_end``, ``steps``, ``t0``,
         ``every``, ``tol``, ``solver``; ``method``, ``rtol``, ``atol``, ``h`` ... for
