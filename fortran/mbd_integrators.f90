@@ -703,8 +703,9 @@ contains
         c%st%rejected = c%st%rejected + 1
         if (fixed) then
           status = MBD_INTEGRATOR_FAILED
-          write (msg, '(a,es12.5,a,es10.3)') 'Newton did not converge at t = ', &
-            tnew, ' with the fixed step h = ', h
+          write (msg, '(a,es12.5,a,es10.3,a)') 'Newton did not converge at t = ', &
+            tnew, ' with the fixed step h = ', h, ': take a smaller h, or leave h out '// &
+            'for error-controlled steps'
           return
         end if
         if (conv) then

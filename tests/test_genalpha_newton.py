@@ -177,3 +177,4 @@ def test_pin_joints_stiffen_only_their_angles() -> None:
     ga = chain.dynamics(0.002, 1, method="generalized-alpha", h=1e-3, solver="banded")
     dp = chain.dynamics(0.002, 1, method="dopri5", solver="banded")
     assert ga.stats["band"] == dp.stats["band"] == (6, 6)
+
