@@ -1265,7 +1265,7 @@ contains
             'on the motions the constraints allow (a body without mass or inertia?)'
       return
     end if
-    call sens_initial(m, w, sens, q, qd, t0, s0, sd0, status, msg)
+    call sens_initial(m, w, sens, q, qd, v0 / m%cunit, t0, s0, sd0, status, msg)
     if (status /= MBD_OK) return
     r_tol = 1.0e-6_wp; a_tol = 1.0e-8_wp
     if (rtol > zero) r_tol = rtol

@@ -39,7 +39,7 @@ module mbd_sens_dynamics
   use mbd_lapack, only: dgelsy
   use mbd_status, only: MBD_INTEGRATOR_FAILED, MBD_BAD_SETTING
   use mbd_dynamics, only: dyn_work_t, dyn_accel, dyn_project_pos, dyn_velocity, &
-                          dyn_factor_projection, dyn_solve_rows
+                          dyn_factor_projection, dyn_solve_rows, dyn_solve
   use mbd_integrators, only: output_rows, dopri5_state, dopri5_error, DOPRI_C
   use mbd_interp, only: hermite5
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
@@ -560,7 +560,8 @@ contains
   !!   s%rhs = gamma_p - J_p q_ddot - Ha S - 2 Hv S_dot (rows (npd, neq)),
   !! with dQ = Q_q S + Q_q_dot S_dot + Q_p. state: the state's blocks first (second
   !! derivatives, parameter parts, K_lambda); else those of the last call at this state.
-  subroutine sens_dyn_rows(m, w, s, pw, qs, vs, aa, lam, tt, npd, st, sdt, state)
+  !! loads = .false.: without dQ (the forces' and gravity's changes).
+  subroutine sens_dyn_rows(m, w, s, pw, qs, vs, aa, lam, tt, npd, st, sdt, state, loads)
     type(model_t), intent(in) :: m              !! model with dynamics data
     type(dyn_work_t), intent(in) :: w           !! dynamics work arrays (assembled at qs)
     type(sens_t), intent(inout) :: s            !! parameters and blocks
@@ -571,10 +572,14 @@ contains
     integer, intent(in) :: npd                  !! rows of st, sdt
     real(wp), intent(in) :: st(npd, *), sdt(npd, *)   !! S, S_dot as rows (npd, n)
     logical, intent(in) :: state                !! evaluate the state's blocks
+    logical, intent(in), optional :: loads      !! with dQ (default)
     integer :: kk, n
+    logical :: withq
     logical :: pcon
     n = m%nq
     pcon = any(s%kcon)
+    withq = .true.
+    if (present(loads)) withq = loads
     if (state) then
       ! cos and sin of the angles at qs: the assembly's (sens_trig's values, not computed again)
       call copy_trig(m%nb, w%asm%cb, w%asm%sb, s%cb, s%sb)
@@ -585,9 +590,9 @@ contains
       call sens_klam_list(m, s, lam, closed=.false.)
     end if
     ! the right-hand sides as the rows of rt, every parameter at once
-    call accel_rows(n, npd, s%anyg, s%qgr, s%nmz, s%mzc, s%mzk, s%mzv, aa, s%kln, s%klr, &
-                    s%klc, s%klv, st, pw%rt)
-    call sens_force_rows(m, s, qs, vs, tt, npd, st, sdt, pw%rt, grav=.false.)
+    call accel_rows(n, npd, s%anyg .and. withq, s%qgr, s%nmz, s%mzc, s%mzk, s%mzv, aa, s%kln, &
+                    s%klr, s%klc, s%klv, st, pw%rt)
+    if (withq) call sens_force_rows(m, s, qs, vs, tt, npd, st, sdt, pw%rt, grav=.false.)
     do kk = 1, s%np
       if (.not. s%kcon(kk)) cycle             ! (J_p = 0 otherwise)
       call sens_jpt_lam(m, s, kk, qs, tt, lam, pw%y3)
@@ -815,28 +820,79 @@ contains
   end subroutine metric_rows
 
   !> Sensitivities of the consistent initial state of forward dynamics: the assembled q
-  !! changes by the minimum-norm solution of J S = -Phi_p, the projected q_dot by the
-  !! kinetic-energy-nearest solution of J S_dot = nu_p - J_p q_dot - Hv S (as their
-  !! projections from the estimates).
-  subroutine sens_initial(m, w, s, q, qd, t, sq, sqd, status, msg)
+  !! changes by the minimum-norm solution of J S = -Phi_p; the velocity projected from the
+  !! estimate v0, the solution of [W J^T; J 0][q_dot; mu] = [W v0; nu] (W: the kinetic
+  !! metric, the masses, the mean mass on massless coordinates), by the derivative of that
+  !! projection:
+  !!   [W J^T; J 0][S_dot; dmu] = [W_p (v0 - q_dot) - (J_p + J_q S)^T mu;
+  !!                               nu_p - J_p q_dot - Hv S],
+  !! the constraint rows' part as the step's projection (project_sens), the first rows'
+  !! (zero for a consistent v0, where mu = 0) added after: -(J_p + J_q S)^T mu from the
+  !! dynamics rows with mu for lambda and no loads (sens_dyn_rows), mu from J^T mu =
+  !! W (v0 - q_dot).
+  subroutine sens_initial(m, w, s, q, qd, v0, t, sq, sqd, status, msg)
     type(model_t), intent(in) :: m              !! model with dynamics data
     type(dyn_work_t), intent(inout) :: w        !! dynamics work arrays (dyn_init done)
     type(sens_t), intent(inout) :: s            !! parameters and blocks
     real(wp), intent(in) :: q(:), qd(:), t      !! consistent state
+    real(wp), intent(in) :: v0(:)               !! the velocity estimate qd was projected from
     real(wp), intent(out) :: sq(:, :), sqd(:, :)  !! (nq, np)
     integer, intent(out) :: status              !! MBD_OK or MBD_SINGULAR
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
     real(wp) :: y(2 * m%nq * (1 + 4 * ((s%np + 3) / 4)))
+    real(wp) :: mu(m%neq), wdiff(m%nq), zq(m%nq), zs(4 * ((s%np + 3) / 4) * m%nq)
+    real(wp) :: wp_mean
     type(proj_work_t) :: pw
-    integer :: n, nz, npd
+    integer :: n, nz, npd, i, k, nmass
     n = m%nq; npd = 4 * ((s%np + 3) / 4); nz = n * (1 + npd)
     y = zero
     y(1:n) = q; y(nz + 1:nz + n) = qd
     call proj_init(m, w, s%np, pw, status, msg)
     if (status /= MBD_OK) return
     msg = ''
-    call project_sens(m, w, s, t, y, pw, .false., status)
-    if (status /= MBD_OK) msg = 'the initial sensitivities cannot be made consistent'
+    ! mu of the velocity projection: [W J^T; J 0][x; mu] = [W (v0 - q_dot); 0] (x = 0)
+    call dyn_factor_projection(m, w, q, t, .true., status)
+    if (status == MBD_OK) then
+      wdiff = w%metric * (v0 - qd)
+      w%rhs = zero
+      w%rhs(1:n) = wdiff
+      call dyn_solve(w, w%rhs, status)
+    end if
+    if (status /= MBD_OK) then
+      msg = 'the initial sensitivities cannot be made consistent'; return
+    end if
+    mu = zero
+    do i = 1, w%na
+      mu(w%rows(i)) = w%s * w%rhs(n + i)       ! (the matrix's constraint rows carry s)
+    end do
+    call project_sens(m, w, s, t, y, pw, .false., status)   ! (ends with W's factors at q)
+    if (status /= MBD_OK) then
+      msg = 'the initial sensitivities cannot be made consistent'; return
+    end if
+    if (any(mu /= zero)) then
+      ! first rows: -(J_p + J_q S)^T mu, then W_p (v0 - q_dot) (W_p: a mass's change on its
+      ! coordinates; the mean mass's on the massless ones)
+      zq = zero; zs = zero
+      call sens_dyn_rows(m, w, s, pw, q, qd, zq, mu, t, npd, y(n + 1:nz), zs, .true., &
+                         loads=.false.)
+      nmass = count(m%mdiag > zero)
+      do k = 1, s%np
+        wp_mean = zero
+        if (nmass > 0) wp_mean = sum(s%tmass(:, k), mask=m%mdiag > zero) / nmass
+        do i = 1, n
+          if (m%mdiag(i) > zero) then
+            pw%rt(k, i) = pw%rt(k, i) + s%tmass(i, k) * (v0(i) - qd(i))
+          else
+            pw%rt(k, i) = pw%rt(k, i) + wp_mean * (v0(i) - qd(i))
+          end if
+        end do
+      end do
+      pw%rt(:, n + 1:) = zero
+      call dyn_solve_rows(w, pw%rt, s%np, n, npd, y(nz + n + 1:), .true., status)
+      if (status /= MBD_OK) then
+        msg = 'the initial sensitivities cannot be made consistent'; return
+      end if
+    end if
     call rows_to_cols(n, s%np, npd, y(n + 1:nz), sq)
     call rows_to_cols(n, s%np, npd, y(nz + n + 1:), sqd)
   end subroutine sens_initial
