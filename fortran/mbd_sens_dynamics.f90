@@ -469,7 +469,8 @@ contains
     !> Project q, q_dot (mbd_dynamics) and then S, S_dot (project_sens).
     subroutine project(tt, yy, stp)
       real(wp), intent(in) :: tt
-      real(wp), intent(inout) :: yy(:)
+      ! (contiguous as project_sens's: a plain yy(:) was packed into a heap copy each step)
+      real(wp), intent(inout), contiguous :: yy(:)
       integer, intent(out) :: stp
       qq = yy(1:n); v0 = yy(nz + 1:nz + n)
       call dyn_project_pos(m, w, qq, tt, stp)

@@ -274,12 +274,18 @@ def test_the_kinematic_loop_allocates_nothing_per_step(tmp_path: Path) -> None:
     ("generalized-alpha", {"rtol": 1e-6}),
     ("generalized-alpha", {"h": 1e-3}),
     ("baumgarte-rk4", {"h": 1e-3}),
+    ("dopri5", {"rtol": 1e-8, "atol": 1e-8, "sensitivities": ["body.coupler.mass",
+                                                              "model.gravity.1"]}),
+    ("generalized-alpha", {"rtol": 1e-6, "sensitivities": ["body.coupler.mass",
+                                                           "model.gravity.1"]}),
+    ("generalized-alpha", {"h": 1e-3, "sensitivities": ["body.coupler.mass"]}),
 ])
 def test_the_dynamics_loop_allocates_nothing_per_step(tmp_path: Path, method: str,
                                                       settings: dict) -> None:
     """The dynamics under the malloc counter: a free four-bar over 1 s and over 4 s (about
     4x the steps), two output intervals so that the outputs are few; the same number of
-    allocations.
+    allocations (with design sensitivities too: dopri5's variational equations and
+    generalized-alpha's differentiated steps).
     Before: partitioned allocated about 60 times per step (vector subscripts, an array
     function, automatic arrays, stage expressions passed as arguments), error-controlled
     generalized-alpha once per step."""
