@@ -16,6 +16,7 @@ import pytest
 import mbd2d
 from mbd2d.cli import main
 from mbd2d.results import read_csv
+from mbd2d.studies import write_sweep, write_tolerance
 
 pytest.importorskip("xarray")
 
@@ -211,3 +212,35 @@ def test_kinematics_of_a_model_with_masses_is_inverse_dynamics(tmp_path: Path, c
     np.testing.assert_allclose(rows[:, header.index("motor.effort.std_linear")],
                                np.abs(tau[0] - tau[1]) / (2 * dm) * sig, rtol=1e-7,
                                atol=1e-12)
+
+
+def test_dynamics_studies_take_the_integrator(tmp_path: Path, capsys) -> None:
+    """--method, --rtol, --atol and --h reach a study's dynamics: a tolerance study by
+    generalized-alpha at a fixed step writes the API's own file (the same draws), and a
+    sweep by it the API's sweep; a setting the method refuses is a typed error."""
+    toml = EX / "pendulum_spring.toml"
+    model = mbd2d.load(toml)
+    kw = dict(t_end=0.5, steps=5, method="generalized-alpha", h=1e-3)
+    out = tmp_path / "tol.csv"
+    assert main(["tolerance", str(toml), "--sigma", "body.bar.mass=0.01", "--analysis",
+                 "dynamics", "--method", "generalized-alpha", "--h", "1e-3", "--t-end", "0.5",
+                 "--steps", "5", "--samples", "12", "--workers", "1", "--out", str(out)]) == 0
+    tol = mbd2d.tolerance(model, {"body.bar.mass": 0.01}, "dynamics", samples=12, workers=1,
+                          **kw)
+    py = tmp_path / "py.csv"
+    write_tolerance(tol.dataset, py)
+    assert out.read_text() == py.read_text()
+    sw = tmp_path / "sweep.csv"
+    assert main(["sweep", str(toml), "--param", "body.bar.mass=0.8:1.2:3", "--analysis",
+                 "dynamics", "--method", "generalized-alpha", "--h", "1e-3", "--t-end", "0.5",
+                 "--steps", "5", "--workers", "1", "--out", str(sw)]) == 0
+    ds = mbd2d.sweep(model, {"body.bar.mass": np.linspace(0.8, 1.2, 3)}, "dynamics",
+                     workers=1, **kw)
+    py_sw = tmp_path / "py_sweep.csv"
+    write_sweep(ds, py_sw)
+    assert sw.read_text() == py_sw.read_text()
+    capsys.readouterr()
+    assert main(["sweep", str(toml), "--param", "body.bar.mass=0.8:1.2:3", "--analysis",
+                 "dynamics", "--method", "dopri5", "--h", "1e-3", "--t-end", "0.5",
+                 "--steps", "5", "--workers", "1", "--out", str(sw)]) == 2
+    assert "h is for" in capsys.readouterr().err

@@ -8,10 +8,10 @@
     mbd2d statics MODEL.toml [--t T --solver S] [--out OUT.csv]
     mbd2d sweep MODEL.toml --param NAME=START:STOP:NUM ... [--grid] --t-end T --steps N
                 --out sweep.nc|sweep.csv [--analysis A --t0 T0 --every K --workers W
-                --scheduler ADDRESS --positions-only]
+                --scheduler ADDRESS --positions-only --method M --rtol R --atol A --h H]
     mbd2d tolerance MODEL.toml --sigma NAME=STD ... --t-end T --steps N --out tol.csv|tol.nc
                     [--samples N --seed S --analysis A --point BODY:X,Y --workers W
-                    --scheduler ADDRESS]
+                    --scheduler ADDRESS --method M --rtol R --atol A --h H]
     mbd2d synthesize TASK.toml --out BEST.toml [--starts K --seed S --workers N]
     mbd2d check MODEL.toml [--t T --tol TOL --out REPORT.csv]
     mbd2d parameters MODEL.toml [--match TEXT]
@@ -209,7 +209,7 @@ def _parser() -> argparse.ArgumentParser:
     w.add_argument("--grid", action="store_true", help="every combination of the values "
                    "(default: the i-th value of every parameter together; equal NUM)")
     _study_settings(w, "the analysis (default kinematics)")
-    w.add_argument("--method", default=None, help="dynamics: the integrator")
+    _study_integrator(w)
     w.add_argument("--positions-only", action="store_true",
                    help="kinematics: positions alone (no velocities or accelerations)")
     w.add_argument("--out", required=True, help="output file, .nc (netCDF) or .csv")
@@ -358,6 +358,23 @@ def _study_settings(p: argparse.ArgumentParser, analysis_help: str) -> None:
     p.add_argument("--every", type=int, default=1, help="keep every k-th row (and the last)")
 
 
+def _study_integrator(p: argparse.ArgumentParser) -> None:
+    """A study's dynamics settings (sweep, tolerance): the integrator and its tolerances."""
+    p.add_argument("--method", default=None,
+                   help="dynamics: the integrator (dopri5 default; with --sensitivities or in "
+                   "a tolerance study dopri5 or generalized-alpha)")
+    p.add_argument("--rtol", type=float, default=None, help="dynamics: relative tolerance")
+    p.add_argument("--atol", type=float, default=None, help="dynamics: absolute tolerance")
+    p.add_argument("--h", type=float, default=None,
+                   help="dynamics: fixed step (generalized-alpha, baumgarte-rk4)")
+
+
+def _study_dynamics(args: argparse.Namespace) -> dict[str, Any]:
+    """The settings given by _study_integrator's options (those not given are left out)."""
+    given = {"method": args.method, "rtol": args.rtol, "atol": args.atol, "h": args.h}
+    return {k: v for k, v in given.items() if v is not None}
+
+
 def _study_span(args: argparse.Namespace) -> dict[str, Any]:
     """The settings of a study's analysis from --t0, --t-end, --steps, --every (statics: t)."""
     if args.analysis == "statics":
@@ -378,6 +395,7 @@ def _tolerance_parser(sub: Any) -> None:
     t.add_argument("--seed", type=int, default=0, help="seed of the draws (default 0)")
     _study_settings(t, "the analysis (default kinematics; dynamics by dopri5 or "
                        "generalized-alpha)")
+    _study_integrator(t)
     t.add_argument("--point", action="append", default=None, metavar="BODY:X,Y",
                    help="also the scatter of the point (X, Y) of BODY (repeatable)")
     t.add_argument("--out", default=None, help="output file, .csv (one row per time) or "
@@ -409,10 +427,13 @@ def _tolerance(model: Model, args: argparse.Namespace) -> int:
     """The tolerance command: run, write, summarize."""
     from .studies import connect, export_sweep, tolerance, tolerance_samples, write_tolerance
     sigma = dict(_sigma(s) for s in args.sigma)
+    kw = _study_span(args)
+    if args.analysis != "statics":
+        kw.update(_study_dynamics(args))
     if args.export_samples is not None:
         cases = tolerance_samples(model, sigma, args.samples, args.seed)
         export_sweep(model, args.export_samples, cases, args.analysis, measures=args.measure,
-                     **_study_span(args))
+                     **kw)
         print(f"wrote {args.export_samples} ({args.samples} Monte Carlo variants, seed "
               f"{args.seed}; run it with mbd2d-solve {args.export_samples} OUT.csv)")
         return EXIT_OK
@@ -424,7 +445,6 @@ def _tolerance(model: Model, args: argparse.Namespace) -> int:
         if body not in bodies:
             raise ModelError(f"--point {body}:...: no moving body {body!r}; bodies: "
                              f"{', '.join(bodies)}", "command line")
-    kw = _study_span(args)
     client = connect(args.scheduler) if args.scheduler else None
     try:
         tol = tolerance(model, sigma, args.analysis, samples=args.samples, client=client,
@@ -659,8 +679,7 @@ def _sweep(model: Model, args: argparse.Namespace) -> int:
     cases = _cases(args)
     kw = _study_span(args)
     if args.analysis != "statics":
-        if args.method is not None:
-            kw["method"] = args.method
+        kw.update(_study_dynamics(args))
         if args.positions_only:
             kw["positions_only"] = True
     client = connect(args.scheduler) if args.scheduler else None
