@@ -838,14 +838,17 @@ contains
     real(wp), intent(in) :: q(:), qd(:), t      !! consistent state
     real(wp), intent(in) :: v0(:)               !! the velocity estimate qd was projected from
     real(wp), intent(out) :: sq(:, :), sqd(:, :)  !! (nq, np)
-    integer, intent(out) :: status              !! MBD_OK or MBD_SINGULAR
+    integer, intent(out) :: status              !! MBD_OK, MBD_SINGULAR or MBD_NO_MEMORY
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
-    real(wp) :: y(2 * m%nq * (1 + 4 * ((s%np + 3) / 4)))
-    real(wp) :: mu(m%neq), wdiff(m%nq), zq(m%nq), zs(4 * ((s%np + 3) / 4) * m%nq)
+    real(wp), allocatable :: y(:), mu(:), zq(:), zs(:)
     real(wp) :: wp_mean
     type(proj_work_t) :: pw
-    integer :: n, nz, npd, i, k, nmass
+    integer :: n, nz, npd, i, k, nmass, st
     n = m%nq; npd = 4 * ((s%np + 3) / 4); nz = n * (1 + npd)
+    allocate (y(2 * nz), mu(m%neq), zq(n), zs(npd * n), stat=st)
+    if (st /= 0) then
+      status = MBD_NO_MEMORY; msg = 'out of memory for the initial sensitivities'; return
+    end if
     y = zero
     y(1:n) = q; y(nz + 1:nz + n) = qd
     call proj_init(m, w, s%np, pw, status, msg)
@@ -854,9 +857,8 @@ contains
     ! mu of the velocity projection: [W J^T; J 0][x; mu] = [W (v0 - q_dot); 0] (x = 0)
     call dyn_factor_projection(m, w, q, t, .true., status)
     if (status == MBD_OK) then
-      wdiff = w%metric * (v0 - qd)
       w%rhs = zero
-      w%rhs(1:n) = wdiff
+      w%rhs(1:n) = w%metric * (v0 - qd)
       call dyn_solve(w, w%rhs, status)
     end if
     if (status /= MBD_OK) then
