@@ -22,7 +22,7 @@ import numpy as np
 import pytest
 
 import mbd2d
-from conftest import load_example, model_from_toml
+from conftest import model_from_toml
 from test_sensitivities import SWING, add_force_kinds, free_slider_crank, rel_close, \
     swing_reference
 
