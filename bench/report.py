@@ -697,7 +697,8 @@ def notes_section(results: dict) -> str:
             lines.append(f"- Section **{name} failed**: {sec.get('error')}")
     times = ", ".join(f"{k} {v['runtime_s']:.0f} s" for k, v in results.items()
                       if isinstance(v, dict) and v.get("runtime_s") is not None)
-    lines.append(f"- Section run times: {times}; total {fmt(meta.get('total_runtime_s'), '.0f')} s.")
+    total = fmt(meta.get("total_runtime_s"), ".0f")
+    lines.append(f"- Section run times: {times}; total {total} s.")
     load = get(results, "environment", "load_average_start", 0)
     if load is not None and load > 1.5:
         lines.append(f"- The machine was busy at the start (load average {load:.1f} on 2 "

@@ -2,7 +2,8 @@
 values (examples/design_study.py), exported once (``mbd2d.export_sweep``) and run by the
 standalone ``mbd2d-solve``, which writes the CSV the Python sweep writes
 (``mbd2d.write_sweep``) byte for byte, the failed variants' messages (dead centres, no
-assembly) in the Python words; then a run with design sensitivities and measure columns, byte for byte.
+assembly) in the Python words; then a run with design sensitivities and measure columns, byte
+for byte.
 
 Usage::
 

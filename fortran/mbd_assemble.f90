@@ -18,7 +18,8 @@ module mbd_assemble
   implicit none
   private
   public :: asm_work_t, asm_init, assemble_blocks, scatter_dense, assemble_dense, init_extras, &
-            gather_local, blocks_jv, blocks_jv_rows, blocks_jtv, blocks_jtv_rows_sub, scatter_values, asm_turn, &
+            gather_local, blocks_jv, blocks_jv_rows, blocks_jtv, blocks_jtv_rows_sub, &
+            scatter_values, asm_turn, &
             assemble_gamma, assemble_phi
 
   !> Work arrays of the assembly, allocated once per analysis.

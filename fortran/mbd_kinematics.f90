@@ -1770,8 +1770,8 @@ contains
       end if
     end subroutine interp_out
 
-    !> Output column cc sits where J is poorly conditioned (near a singular point): its q_ddot (error
-    !! ~ cond**3 tol) is replaced by quintic Hermite interpolation between regular anchors at
+    !> Output column cc sits where J is poorly conditioned (near a singular point): its q_ddot
+    !! (error ~ cond**3 tol) is replaced by quintic Hermite interpolation between regular anchors at
     !! t -+ d, d doubled from h/64 until J is well conditioned at both. The stepping state
     !! is left as it is. If no regular anchor exists on one side (a dead centre), the direct
     !! values stay.

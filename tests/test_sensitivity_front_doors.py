@@ -203,8 +203,9 @@ def test_cli_statics_and_parameters(tmp_path: Path, capsys) -> None:
     assert [ln.split(" = ")[0] for ln in listed] == list(model.parameters())
     assert float(listed[0].split(" = ")[1]) == list(model.parameters().values())[0]
     assert main(["parameters", toml, "--match", "body.bar"]) == 0
+    inertia = model.parameters()["body.bar.inertia"]
     assert capsys.readouterr().out.split() == ["body.bar.mass", "=", "1", "body.bar.inertia",
-                                               "=", f"{model.parameters()['body.bar.inertia']:.17g}"]
+                                               "=", f"{inertia:.17g}"]
     out = tmp_path / "eq.csv"
     assert main(["statics", toml, "--out", str(out), "--sensitivities", "body.bar.mass"]) == 0
     text = capsys.readouterr().out

@@ -85,8 +85,9 @@ program mbd2d_solve
         write (*, '(a)') 'usage: mbd2d-solve MODEL.mbd OUT.csv'
         write (*, '(a)') '  runs the analysis in a model file written by `mbd2d export` and '// &
           'writes a CSV'
-        write (*, '(a)') '  (kinematics, inverse dynamics, dynamics, statics or check; with the '// &
-          'file''s sensitivities and measures; a sweep file runs every case, on every core)'
+        write (*, '(a)') '  (kinematics, inverse dynamics, dynamics, statics or check; '// &
+          'with the file''s sensitivities and measures; a sweep file runs every case, on '// &
+          'every core)'
         write (*, '(a)') '  exit codes: 0 ok, 2 bad input, 3 singular configuration, 4 other '// &
           'numerical failure (docs/mbd-format.md)'
         stop

@@ -32,9 +32,9 @@ column per measure: ``transmission_angle:JOINT[:OUTPUT]``,
 ``dead_centre_distance`` (a sweep: each case's, from its own dimensions).
 
 ``--sensitivities NAME,...`` (kinematics, inverse-dynamics, statics, dynamics by dopri5 or
-generalized-alpha, sweep, export) computes the design sensitivities with respect to the named parameters (``mbd2d
-parameters MODEL`` lists them) and adds the columns ``d(COLUMN)/d(NAME)`` to the CSV
-(``dq_dp``, ``dqd_dp``, ``dqdd_dp`` arrays to an .npz).
+generalized-alpha, sweep, export) computes the design sensitivities with respect to the
+named parameters (``mbd2d parameters MODEL`` lists them) and adds the columns
+``d(COLUMN)/d(NAME)`` to the CSV (``dq_dp``, ``dqd_dp``, ``dqdd_dp`` arrays to an .npz).
 
 ``plot`` and ``animate`` run the analysis ``--analysis`` (default ``auto``: kinematics of a
 driven model, with the inverse dynamics when every body has a mass; dynamics otherwise) and

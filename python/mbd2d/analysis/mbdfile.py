@@ -80,7 +80,8 @@ def header() -> str:
         "# Plain text, whitespace separated. Lines starting with '#' are comments.",
         "#   mbd2d 2                      format and version",
         "#   name NAME                    model name",
-        "#   analysis A                   kinematics | inverse-dynamics | dynamics | statics | check",
+        "#   analysis A                   kinematics | inverse-dynamics | dynamics | statics "
+        "| check",
         "#   t0, t_end, steps, every      outputs t0 + k (t_end - t0) / steps, k = 0..steps, "
         "every k-th kept",
         "#   tol, maxit, tmin, solver     Newton tolerance, iterations, singular-time "
@@ -118,7 +119,8 @@ def header() -> str:
         "#   sensitivities NP, then NP lines   NAME TABLE INDEX (optional): design parameters",
         "#        and their d(COLUMN)/d(NAME) columns; TABLE 1 params, 2 masses (mass, inertia",
         "#        per body), 3 gravity, 4 fparams; INDEX 1-based in that list",
-        "#   measures NM, then NM lines   SPEC angle KIND B1 X Y B2 X Y B3 X Y | SPEC ratio|advantage",
+        "#   measures NM, then NM lines   SPEC angle KIND B1 X Y B2 X Y B3 X Y | SPEC "
+        "ratio|advantage",
         "#        REF XKIND XINDEX YKIND YINDEX | SPEC conditioning (optional columns: the",
         "#        transmission angle, velocity ratio, mechanical advantage, dead-centre distance)",
         "#   cases NP NV NCASE, then NP lines NAME, NV lines TABLE INDEX, then per case NP + NV",
