@@ -675,8 +675,9 @@ contains
         end if
         if (stt /= MBD_OK) then
           status = MBD_INTEGRATOR_FAILED
-          write (msg, '(a,es12.5)') 'the sensitivities of the step could not be solved at t = ', &
-            tnew
+          write (msg, '(a,es12.5,a)') 'the sensitivities of the step could not be solved at '// &
+            't = ', tnew, ' (the iteration matrix does not converge them): take a smaller h, '// &
+            'or integrate them by dopri5'
           return
         end if
       end if
