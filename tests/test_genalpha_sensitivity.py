@@ -247,3 +247,19 @@ def test_a_failed_run_keeps_the_rows_and_their_sensitivities() -> None:
     part = info.value.results
     assert 1 < len(part.t) < 101 and part.dq_dp.shape == (len(part.t), 3, 1)
     assert np.isfinite(part.dq_dp).all() and math.isfinite(float(part.dqdd_dp[-1, 2, 0]))
+
+
+def test_kept_rows_are_those_of_the_full_run() -> None:
+    """every = 3 keeps every third output row (and the last) of the same run: the state and
+    its sensitivities equal the full run's rows bit for bit, at a fixed step and under error
+    control (the rows between steps interpolated alike)."""
+    m = free_slider_crank()
+    names = ["body.rod.mass", "force.s1.stiffness"]
+    for kw in (ga(2e-3), {"method": "generalized-alpha", "rtol": 1e-7, "atol": 1e-9}):
+        full = m.dynamics(0.3, 9, sensitivities=names, **kw)
+        kept = m.dynamics(0.3, 9, every=3, sensitivities=names, **kw)
+        rows = [0, 3, 6, 9]
+        assert np.array_equal(kept.q, full.q[rows])
+        for a, b in ((kept.dq_dp, full.dq_dp), (kept.dqd_dp, full.dqd_dp),
+                     (kept.dqdd_dp, full.dqdd_dp)):
+            assert np.array_equal(a, b[rows])
