@@ -575,8 +575,7 @@ contains
     logical, intent(in) :: state                !! evaluate the state's blocks
     logical, intent(in), optional :: loads      !! with dQ (default)
     integer :: kk, n
-    logical :: withq
-    logical :: pcon
+    logical :: withq, pcon
     n = m%nq
     pcon = any(s%kcon)
     withq = .true.
@@ -841,7 +840,7 @@ contains
     integer, intent(out) :: status              !! MBD_OK, MBD_SINGULAR or MBD_NO_MEMORY
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
     real(wp), allocatable :: y(:), mu(:), zq(:), zs(:)
-    real(wp) :: wp_mean
+    real(wp) :: dmean                            ! the mean mass's change
     type(proj_work_t) :: pw
     integer :: n, nz, npd, i, k, nmass, st
     n = m%nq; npd = 4 * ((s%np + 3) / 4); nz = n * (1 + npd)
@@ -880,13 +879,13 @@ contains
                          loads=.false.)
       nmass = count(m%mdiag > zero)
       do k = 1, s%np
-        wp_mean = zero
-        if (nmass > 0) wp_mean = sum(s%tmass(:, k), mask=m%mdiag > zero) / nmass
+        dmean = zero
+        if (nmass > 0) dmean = sum(s%tmass(:, k), mask=m%mdiag > zero) / nmass
         do i = 1, n
           if (m%mdiag(i) > zero) then
             pw%rt(k, i) = pw%rt(k, i) + s%tmass(i, k) * (v0(i) - qd(i))
           else
-            pw%rt(k, i) = pw%rt(k, i) + wp_mean * (v0(i) - qd(i))
+            pw%rt(k, i) = pw%rt(k, i) + dmean * (v0(i) - qd(i))
           end if
         end do
       end do
