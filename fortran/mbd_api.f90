@@ -36,13 +36,13 @@ module mbd_api
   use mbd_kinematics, only: kin_opts_t, kin_report_t, kin_work_t, kin_run, kin_work_init, &
                             kin_assemble, kin_rank, kin_out_count, MAXPASS, SOLVER_AUTO, &
                             SOLVER_BANDED, kin_newton, kin_vel_acc
-  use mbd_status, only: MBD_BAD_SETTING, MBD_USER_ABORT
+  use mbd_status, only: MBD_BAD_SETTING, MBD_USER_ABORT, MBD_SINGULAR
   use mbd_profiles, only: profile_raw_length, profile_prepare, profile_eval
   use mbd_sensitivity, only: sens_t, sens_setup, sens_eval_d, sens_trig, sens_force_dm, &
                              sens_force_rows
   use mbd_assemble, only: scatter_dense
   use mbd_sens_dynamics, only: sens_multipliers, sens_reactions, sens_statics, sens_dopri5, &
-                               sens_initial
+                               sens_initial, lam_work_t, lam_init, sens_out_multipliers
   use mbd_sens_genalpha, only: ga_sens_t, ga_sens_init
   implicit none
   private
@@ -1164,8 +1164,8 @@ contains
   !! discrete equations differentiated (mbd_sens_genalpha; its counters as api_dynamics').
   subroutine api_dynamics_sens(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, v0, t0, t1, &
                                nsteps, rtol, atol, every, max_steps, ptab, qout, qdout, qddout, &
-                               lamout, eout, sq, sqd, sqdd, iinfo, rinfo, redundant, status, msg, &
-                               solver, method, h, rho_inf)
+                               lamout, eout, sq, sqd, sqdd, slam, iinfo, rinfo, redundant, &
+                               status, msg, solver, method, h, rho_inf)
     integer, intent(in) :: nb, ctab(:, :), ftab(:, :), nsteps, every, max_steps
     real(wp), intent(in) :: rpar(:), bmass(:, :), grav(2), fpar(:), q0(:), v0(:), t0, t1
     real(wp), intent(in) :: rtol, atol          !! tolerances (<= 0: defaults 1e-6, 1e-8)
@@ -1175,6 +1175,9 @@ contains
     real(wp), intent(out) :: eout(:, :)         !! (4, rows) energies, drift
     !> (nq, np, rows); generalized-alpha writes them as it steps
     real(wp), intent(out), target, contiguous :: sq(:, :, :), sqd(:, :, :), sqdd(:, :, :)
+    !> (neq, np, rows) dlambda/dp: the derivatives of the outputs' multipliers (those of the
+    !! index-1 equations at the output's state, or their minimum-norm set) along (S, S_dot)
+    real(wp), intent(out), contiguous :: slam(:, :, :)
     integer, intent(out) :: iinfo(NINFO)
     real(wp), intent(out) :: rinfo(NINFO)
     integer, intent(out) :: redundant(:)
@@ -1189,6 +1192,7 @@ contains
     type(dyn_opts_t) :: opts
     type(dyn_stats_t) :: dst
     type(ga_sens_t) :: gh
+    type(lam_work_t) :: lw
     type(sens_t), target :: sens
     real(wp), allocatable :: q(:), qd(:), s0(:, :), sd0(:, :)
     logical, allocatable :: lok(:)
@@ -1199,7 +1203,7 @@ contains
     meth = METH_DOPRI5
     if (present(method)) meth = method
     qout = zero; qdout = zero; qddout = zero; lamout = zero; eout = zero
-    sq = zero; sqd = zero; sqdd = zero
+    sq = zero; sqd = zero; sqdd = zero; slam = zero
     call build_dynamic(nb, ctab, rpar, bmass, grav, ftab, fpar, m, status, msg, bad, badf)
     iinfo(2) = bad_code(bad, badf)
     if (status /= MBD_OK) return
@@ -1227,7 +1231,8 @@ contains
         size(qout, 2) /= output_rows(nsteps, every) .or. size(lamout, 1) /= m%neq .or. &
         size(redundant) /= m%neq .or. &
         any(shape(sq) /= [m%nq, size(ptab, 2), size(qout, 2)]) .or. &
-        any(shape(sqd) /= shape(sq)) .or. any(shape(sqdd) /= shape(sq))) then
+        any(shape(sqd) /= shape(sq)) .or. any(shape(sqdd) /= shape(sq)) .or. &
+        any(shape(slam) /= [m%neq, size(ptab, 2), size(qout, 2)])) then
       status = MBD_BAD_COUNT; msg = 'array sizes do not match the model'; return
     end if
     call sens_setup(m, ctab, rpar, ptab, sens, status, msg, bad, ftab, fpar)
@@ -1274,9 +1279,12 @@ contains
     if (st /= 0) then
       status = MBD_NO_MEMORY; msg = 'out of memory for the outputs'; return
     end if
+    call lam_init(m, w, sens, lw, status, msg)
+    if (status /= MBD_OK) return
     if (meth == METH_GENALPHA) then
-      ! (the multipliers of every output row from integrate, at the output's state)
-      lok = .true.
+      ! (the multipliers of every output row from integrate, at the output's state; their
+      ! sensitivities below)
+      lok = .false.
       call ga_sens_init(gh, m, w, sens, q, qd, t0, s0, sd0, sq, sqd, sqdd, status, msg)
       if (status /= MBD_OK) return
       opts%method = METH_GENALPHA; opts%rtol = r_tol; opts%atol = a_tol
@@ -1288,7 +1296,7 @@ contains
     else
       call sens_dopri5(m, w, sens, q, qd, s0, sd0, t0, t1, nsteps, every, r_tol, a_tol, &
                        max_steps, qout, qdout, qddout, sq, sqd, sqdd, lamout, lok, nout, stats, &
-                       hmm, tfail, status, msg)
+                       hmm, tfail, status, msg, slam, lw%lunit)
       iinfo(1) = nout; iinfo(3) = stats(1); iinfo(4) = stats(2); iinfo(6) = stats(3)
       rinfo(2) = hmm(1); rinfo(3) = hmm(2)
       if (status /= MBD_OK) rinfo(1) = tfail
@@ -1297,14 +1305,25 @@ contains
       ko = output_index(nsteps, every, k)
       t = t0 + (t1 - t0) * (real(ko, wp) / max(nsteps, 1))
       if (ko == nsteps) t = t1
-      ! (independent rows: the index-1 solve's lambda at the output, as in api_dynamics)
-      if (.not. lok(k)) call dyn_multipliers(m, w, qout(:, k), qdout(:, k), qddout(:, k), t, &
-                                             lamout(:, k), st, lmsg)
+      ! the multipliers and their sensitivities where the integration left them (dopri5:
+      ! redundant rows; generalized-alpha: every output, its q_ddot is its own)
+      if (.not. lok(k)) then
+        call sens_out_multipliers(m, w, sens, lw, qout(:, k), qdout(:, k), t, sq(:, :, k), &
+                                  sqd(:, :, k), lamout(:, k), slam(:, :, k), st, lmsg)
+        if (st /= MBD_OK) then
+          if (status == MBD_OK) then
+            status = MBD_SINGULAR; rinfo(1) = t
+            write (msg, '(a,es12.5,a)') 'the multipliers'' sensitivities at t = ', t, &
+              ': '//trim(lmsg)//' there (the outputs before are kept)'
+          end if
+          nout = k - 1; iinfo(1) = nout; exit
+        end if
+      end if
       call state_measures(m, w, qout(:, k), qdout(:, k), t, eout(:, k))
     end do
     call units(m, qout, m%cunit, .false.); call units(m, qdout, m%cunit, .false.)
     call units(m, qddout, m%cunit, .false.); call units(m, lamout, m%rowunit, .true.)
-    ! (sq, sqd, sqdd: sens_dopri5 wrote them in model units)
+    ! (sq, sqd, sqdd and slam: written in model units)
   end subroutine api_dynamics_sens
 
   !> Normal force of each cam joint on its follower at many states: fn(nc, nt), positive

@@ -53,8 +53,8 @@ contains
   !! status, measure and quantity of a case whose measures failed (its message too, when
   !! its analysis succeeded).
   !! Design sensitivities (ptab (2, np) as mbd_sensitivity takes it, with sq, sqd, sqdd
-  !! (nq, np, rows, ncase) and slam (neq or 0, np, rows, ncase); not with positions-only
-  !! kinematics; dynamics by dopri5): each case's, as a single run of its tables gives them.
+  !! (nq, np, rows, ncase) and slam (neq, or 0 for kinematics, np, rows, ncase); not with
+  !! positions-only kinematics; dynamics by dopri5 or generalized-alpha): each case's, as a single run of its tables gives them.
   !! With both, mdout gets the measures' design derivatives (api_measures).
   subroutine batch_run(analysis, nb, ctab, rpar, bmass, grav, ftab, fpar, q0, v0, vtab, vals, &
                        opens, iset, rset, qout, qdout, qddout, lamout, eout, iinfo, rinfo, &
@@ -183,7 +183,7 @@ contains
     !> Case c's analysis, as a single run of its tables; with the parameter table pt, also
     !! its sensitivities s1, s2, s3 (q, q_dot, q_ddot; (nq, np, rows)) and sl (the
     !! multipliers'), as that run gives them (dynamics: dopri5 with the variational
-    !! equations).
+    !! equations, or generalized-alpha's discrete ones).
     subroutine run_case(c, pt, s1, s2, s3, sl)
       integer, intent(in) :: c
       integer, intent(in), optional :: pt(:, :)
@@ -217,7 +217,7 @@ contains
           call api_dynamics_sens(nb, ctab, r, bm, g, ftab, fp, q0, v0, rset(1), rset(2), &
                                  iset(1), rset(5), rset(6), iset(3), iset(6), pt, &
                                  qout(:, :, c), qdout(:, :, c), qddout(:, :, c), &
-                                 lamout(:, :, c), eout(:, :, c), s1, s2, s3, iinfo(:, c), &
+                                 lamout(:, :, c), eout(:, :, c), s1, s2, s3, sl, iinfo(:, c), &
                                  rinfo(:, c), redundant(:, c), status(c), msg(c), &
                                  method=iset(5), h=rset(7), rho_inf=rset(8))
         else
@@ -280,8 +280,7 @@ contains
       if (sens) then
         if (any(shape(sq) /= [nq, size(ptab, 2), nrow, ncase]) .or. size(ptab, 1) /= 2 .or. &
             any(shape(sqd) /= shape(sq)) .or. any(shape(sqdd) /= shape(sq)) .or. positions &
-            .or. size(slam, 1) /= merge(0, neq, analysis == BATCH_KINEMATICS .or. &
-                                               analysis == BATCH_DYNAMICS) .or. &
+            .or. size(slam, 1) /= merge(0, neq, analysis == BATCH_KINEMATICS) .or. &
             size(slam, 2) /= size(ptab, 2) .or. size(slam, 3) /= nrow .or. &
             size(slam, 4) /= ncase .or. (analysis == BATCH_DYNAMICS .and. &
             iset(5) /= METH_DOPRI5 .and. iset(5) /= METH_GENALPHA)) then

@@ -419,7 +419,7 @@ end subroutine core_reactions_dp
 subroutine core_dynamics_sens(nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp, fpar, nq, neq, &
                               q0, v0, t0, t1, nsteps, rtol, atol, every, max_steps, solver, &
                               nrow, npar, ptab, method, h, rho_inf, qout, qdout, qddout, lamout, &
-                              eout, sq, sqd, sqdd, iinfo, rinfo, redundant, status, msg)
+                              eout, sq, sqd, sqdd, slam, iinfo, rinfo, redundant, status, msg)
   use iso_c_binding, only: c_double, c_int
   use mbd_api, only: api_dynamics_sens
   implicit none
@@ -434,14 +434,15 @@ subroutine core_dynamics_sens(nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp
   real(c_double), intent(out) :: qddout(nq, nrow), lamout(neq, nrow)
   real(c_double), intent(out) :: eout(4, nrow)
   real(c_double), intent(out) :: sq(nq, npar, nrow), sqd(nq, npar, nrow), sqdd(nq, npar, nrow)
+  real(c_double), intent(out) :: slam(neq, npar, nrow)
   integer(c_int), intent(out) :: iinfo(10), redundant(neq), status
   real(c_double), intent(out) :: rinfo(10)
   character(len=512), intent(out) :: msg
   !f2py intent(hide) :: nc, np, nf, nfp, nq, npar
   call api_dynamics_sens(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, v0, t0, t1, nsteps, rtol, &
                          atol, every, max_steps, ptab, qout, qdout, qddout, lamout, eout, sq, &
-                         sqd, sqdd, iinfo, rinfo, redundant, status, msg, solver, method, h, &
-                         rho_inf)
+                         sqd, sqdd, slam, iinfo, rinfo, redundant, status, msg, solver, method, &
+                         h, rho_inf)
 end subroutine core_dynamics_sens
 
 ! ------------------------------------------------------------------ design sweeps
@@ -453,7 +454,7 @@ end subroutine core_dynamics_sens
 ! nm > 0 measures (mbd_measures: mkind, mint, mpts, mref, at the output times) go to mout
 ! (nm, nrow, ncase), their failures to mbad (3, ncase); with npar > 0 design parameters
 ! (ptab) their sensitivities to sq, sqd, sqdd (nq, npar, nrow, ncase) and slam (nsl = neq for
-! inverse dynamics and statics, else 0); with both, the measures' design derivatives to dmout
+! inverse dynamics, statics and dynamics, 0 for kinematics); with both, the measures' design derivatives to dmout
 ! (nm, npar, nrow, ncase). The tables have nmp = max(nm, 1) and npp =
 ! max(npar, 1) columns (f2py takes no zero-length table).
 subroutine core_batch(analysis, nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp, fpar, nq, &

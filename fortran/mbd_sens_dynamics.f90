@@ -39,7 +39,8 @@ module mbd_sens_dynamics
   use mbd_lapack, only: dgelsy
   use mbd_status, only: MBD_INTEGRATOR_FAILED, MBD_BAD_SETTING
   use mbd_dynamics, only: dyn_work_t, dyn_accel, dyn_project_pos, dyn_velocity, &
-                          dyn_factor_projection, dyn_solve_rows, dyn_solve
+                          dyn_factor_projection, dyn_solve_rows, dyn_solve, dyn_multipliers, &
+                          SOLVER_DENSE
   use mbd_integrators, only: output_rows, dopri5_state, dopri5_error, DOPRI_C
   use mbd_interp, only: hermite5
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
@@ -48,6 +49,8 @@ module mbd_sens_dynamics
   public :: sens_multipliers, sens_reactions, sens_statics, sens_dopri5, sens_initial
   ! (generalized-alpha's sensitivities, mbd_sens_genalpha: the same right-hand sides)
   public :: proj_work_t, proj_init, sens_accel, sens_dyn_rows, cols_to_rows, rows_to_cols
+  ! (the multipliers' sensitivities at the outputs of forward dynamics)
+  public :: lam_work_t, lam_init, sens_out_multipliers
 
   !> Work of project_sens and of the dopri5 right-hand sides (allocated once per run by
   !! proj_init: no step allocates).
@@ -57,7 +60,18 @@ module mbd_sens_dynamics
     real(wp), allocatable :: rt(:, :)
     real(wp), allocatable :: jst(:, :)      !! J S as rows (4 k, neq)
     real(wp), allocatable :: y3(:)          !! (nq) one parameter's J_p^T lambda
+    !> a whole solution [S_ddot; dlambda] as rows (4 k, nq + na) (an output's multipliers)
+    real(wp), allocatable :: xl(:, :)
   end type proj_work_t
+
+  !> Work of sens_out_multipliers (lam_init, once per run): S, S_dot, S_ddot as rows (flat,
+  !! npd nq) and as columns (nq, np) in the core's units, q_ddot and lambda; lunit (neq, np)
+  !! dlambda/dp in model units from the core's (pscale / rowunit, exact powers of 2).
+  type :: lam_work_t
+    type(proj_work_t) :: pw
+    real(wp), allocatable :: st(:), sdt(:), cq(:, :), cqd(:, :), cqdd(:, :), aa(:), lam(:)
+    real(wp), allocatable :: lunit(:, :)
+  end type lam_work_t
 
 contains
 
@@ -73,12 +87,12 @@ contains
     status = MBD_OK; msg = ''
     nt = m%nq + w%na
     allocate (pw%rt(4 * ((np + 3) / 4), nt), pw%jst(4 * ((np + 3) / 4), m%neq), pw%y3(m%nq), &
-              stat=st)
+              pw%xl(4 * ((np + 3) / 4), nt), stat=st)
     if (st /= 0) then
       status = MBD_NO_MEMORY; msg = 'out of memory for the sensitivity projections'
       return
     end if
-    pw%rt = zero
+    pw%rt = zero; pw%xl = zero
   end subroutine proj_init
 
   !> dlambda/dp (neq, np) at one output of an inverse dynamics run, from the kinematic
@@ -303,7 +317,7 @@ contains
   !! stats: 1 steps, 2 rejected, 3 right-hand sides; hmm(1:2) smallest and largest step.
   subroutine sens_dopri5(m, w, s, q, qd, sq, sqd, t0, t1, nsteps, every, rtol, atol, &
                          max_steps, qo, vo, ao, so, sdo, sddo, lo, lok, nout, stats, hmm, &
-                         t_fail, status, msg)
+                         t_fail, status, msg, slo, lunit)
     type(model_t), intent(in) :: m              !! model with dynamics data
     type(dyn_work_t), intent(inout) :: w        !! dynamics work arrays (dyn_init done)
     type(sens_t), intent(inout) :: s            !! parameters and blocks
@@ -327,6 +341,10 @@ contains
     real(wp), intent(out) :: t_fail             !! time reached at a failure
     integer, intent(out) :: status              !! MBD_OK or a failure
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    !> dlambda/dp at the outputs (neq, np, rows; model units, each entry times lunit's
+    !! (neq, np)) where lok (the others: sens_out_multipliers)
+    real(wp), intent(inout), optional, contiguous :: slo(:, :, :)
+    real(wp), intent(in), optional :: lunit(:, :)
     real(wp), allocatable :: y(:), yn(:), ys(:), k(:, :), e(:), zdda(:), lam(:), yt(:), &
                              zz(:), zzd(:), zzdd(:)
     ! the work of rhs and project (here, so that no step allocates)
@@ -360,12 +378,16 @@ contains
     call cols_to_rows(n, np, npd, n, sqd, y(nz + n + 1:))
     t = t0
     call rhs(t, y, k(:, 1), st)
+    if (st == MBD_OK) then
+      lo(:, 1) = lam; lok(1) = w%na == m%neq .and. .not. w%lsq
+      ! (the start's multipliers' sensitivities: one whole solve more)
+      if (lok(1) .and. present(slo)) call out_lambda(1, t, y(1:nz), y(nz + 1:), zzdd, st)
+    end if
     if (st /= MBD_OK) then
       status = st; msg = 'the mass matrix and constraints give a singular system at the start'
       return
     end if
     zdda = k(nz + 1:, 1)
-    lo(:, 1) = lam; lok(1) = w%na == m%neq .and. .not. w%lsq
     call put(1, y(1:nz), y(nz + 1:), zdda)
     nout = 1; kout = 1
     fsal = .true.
@@ -509,13 +531,27 @@ contains
       integer, intent(in) :: row
       real(wp), intent(in) :: tk
       integer :: stp
-      ys(1:nz) = zz; ys(nz + 1:) = zzd
-      call rhs(tk, ys, fo, stp)
-      stats(3) = stats(3) - 1                   ! (an output's, not the integration's)
+      call out_lambda(row, tk, zz, zzd, fo, stp)
       if (stp /= MBD_OK) return
-      zzdd = fo(nz + 1:)
-      lo(:, row) = lam; lok(row) = w%na == m%neq .and. .not. w%lsq
+      zzdd(1:n) = aa; zzdd(n + 1:) = fo(1:nz - n)
     end subroutine at_state
+
+    !> The index-1 solve at the output state (z, zd) (q and S as rows, flat), whole
+    !! (sens_accel_full): q_ddot to aa, S_ddot's rows to sdd, the multipliers to lo, lok and,
+    !! with independent rows, their sensitivities to slo.
+    subroutine out_lambda(row, tk, z, zd, sdd, stp)
+      integer, intent(in) :: row
+      real(wp), intent(in) :: tk
+      real(wp), intent(in), contiguous :: z(:), zd(:)
+      real(wp), intent(inout), contiguous :: sdd(:)
+      integer, intent(out) :: stp
+      call sens_accel_full(m, w, s, pw, z(1:n), zd(1:n), tk, npd, z(n + 1:), zd(n + 1:), aa, &
+                           lam, stp, sdd)
+      if (stp /= MBD_OK) return
+      lo(:, row) = lam; lok(row) = w%na == m%neq .and. .not. w%lsq
+      if (lok(row) .and. present(slo)) &
+        call lambda_cols(n, np, npd, w%na, m%neq, w%rows, w%s, pw%xl, lunit, slo(:, :, row))
+    end subroutine out_lambda
 
     subroutine put(row, z1, z2, z3)
       integer, intent(in) :: row
@@ -554,6 +590,129 @@ contains
     call constraint_rows(n, w%na, npd, m%neq, w%rows, w%s, s%rhs, pw%rt)
     call dyn_solve_rows(w, pw%rt, s%np, n, npd, sddt, .false., stp)
   end subroutine sens_accel
+
+  !> Allocate sens_out_multipliers' work for model m, the active rows of w and the
+  !! parameters of s.
+  subroutine lam_init(m, w, s, lw, status, msg)
+    type(model_t), intent(in) :: m              !! model
+    type(dyn_work_t), intent(in) :: w           !! dynamics work arrays (dyn_init done)
+    type(sens_t), intent(in) :: s               !! parameters
+    type(lam_work_t), intent(out) :: lw         !! the work
+    integer, intent(out) :: status              !! MBD_OK or MBD_NO_MEMORY
+    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    integer :: st, nz, np, k
+    np = s%np
+    call proj_init(m, w, np, lw%pw, status, msg)
+    if (status /= MBD_OK) return
+    nz = 4 * ((np + 3) / 4) * m%nq
+    allocate (lw%st(nz), lw%sdt(nz), lw%cq(m%nq, np), lw%cqd(m%nq, np), lw%cqdd(m%nq, np), &
+              lw%aa(m%nq), lw%lam(m%neq), lw%lunit(m%neq, np), stat=st)
+    if (st /= 0) then
+      status = MBD_NO_MEMORY; msg = 'out of memory for the multipliers'' sensitivities'
+      return
+    end if
+    do k = 1, np
+      lw%lunit(:, k) = s%pscale(k) / m%rowunit
+    end do
+  end subroutine lam_init
+
+  !> The multipliers of a forward dynamics output at (q, qd, t) and their sensitivities
+  !! along (S, S_dot) = (sq, sqd) (nq, np; model units, s%ounit): lambda as the outputs take
+  !! it (the index-1 solve's with independent rows, else the minimum-norm set of
+  !! dyn_multipliers), dlambda/dp (neq, np; model units) its derivative. From the whole
+  !! solve of the sensitivities' saddle system (sens_accel_full); with redundant rows on the
+  !! dense path the minimum-norm solution of J^T dlambda = b (sens_multipliers, as inverse
+  !! dynamics), b from that solve's S_ddot. status: the solves' (MBD_OK or a failure).
+  subroutine sens_out_multipliers(m, w, s, lw, q, qd, t, sq, sqd, lam, slam, status, msg)
+    type(model_t), intent(in) :: m              !! model with dynamics data
+    type(dyn_work_t), intent(inout) :: w        !! dynamics work arrays
+    type(sens_t), intent(inout) :: s            !! parameters and blocks
+    type(lam_work_t), intent(inout) :: lw       !! work (lam_init)
+    real(wp), intent(in), contiguous :: q(:), qd(:)  !! the output's state (core units)
+    real(wp), intent(in) :: t                   !! its time
+    real(wp), intent(in) :: sq(:, :), sqd(:, :) !! its sensitivities (nq, np), model units
+    real(wp), intent(out) :: lam(:)             !! multipliers (neq)
+    real(wp), intent(out) :: slam(:, :)         !! dlambda/dp (neq, np)
+    integer, intent(out) :: status              !! MBD_OK or a failure
+    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    integer :: n, np, npd
+    n = m%nq; np = s%np; npd = 4 * ((np + 3) / 4)
+    msg = ''
+    lw%cq = sq / s%ounit; lw%cqd = sqd / s%ounit
+    call cols_to_rows(n, np, npd, n, lw%cq, lw%st)
+    call cols_to_rows(n, np, npd, n, lw%cqd, lw%sdt)
+    call sens_accel_full(m, w, s, lw%pw, q, qd, t, npd, lw%st, lw%sdt, lw%aa, lw%lam, status)
+    if (status /= MBD_OK) then
+      msg = 'the index-1 equations are singular'; return
+    end if
+    lam = lw%lam
+    call lambda_cols(n, np, npd, w%na, m%neq, w%rows, w%s, lw%pw%xl, lw%lunit, slam)
+    if (w%solver /= SOLVER_DENSE .or. (w%na == m%neq .and. .not. w%lsq)) return
+    ! redundant rows: the minimum-norm multipliers and the minimum-norm dlambda
+    call rows_to_cols(n, np, npd, lw%pw%xl, lw%cqdd)
+    call dyn_multipliers(m, w, q, qd, lw%aa, t, lam, status, msg)
+    if (status /= MBD_OK) return
+    if (w%jt_lu) then
+      call sens_multipliers(m, s, q, qd, lw%aa, t, w%jac, lam, lw%cq, lw%cqd, lw%cqdd, slam, &
+                            status, msg, w%acopy, w%jpvt)
+    else
+      call sens_multipliers(m, s, q, qd, lw%aa, t, w%jac, lam, lw%cq, lw%cqd, lw%cqdd, slam, &
+                            status, msg)
+    end if
+    slam = slam * lw%lunit
+  end subroutine sens_out_multipliers
+
+  !> sens_accel solved whole: [S_ddot; dlambda] as rows to pw%xl (npd, n + na), S_ddot's
+  !! rows also to sddt when given.
+  subroutine sens_accel_full(m, w, s, pw, qs, vs, tt, npd, st, sdt, aa, lam, stp, sddt)
+    type(model_t), intent(in) :: m              !! model with dynamics data
+    type(dyn_work_t), intent(inout) :: w        !! dynamics work arrays
+    type(sens_t), intent(inout) :: s            !! parameters and blocks
+    type(proj_work_t), intent(inout) :: pw      !! work (proj_init)
+    real(wp), intent(in), contiguous :: qs(:), vs(:)  !! state
+    real(wp), intent(in) :: tt                  !! time
+    integer, intent(in) :: npd                  !! rows of st, sdt (np rounded up to 4 k)
+    real(wp), intent(in) :: st(npd, *), sdt(npd, *)   !! S, S_dot as rows (npd, n)
+    real(wp), intent(out), contiguous :: aa(:), lam(:)  !! q_ddot, lambda (active rows)
+    integer, intent(out) :: stp                 !! MBD_OK or the solve's failure
+    real(wp), intent(out), optional :: sddt(*)  !! S_ddot as rows (npd n, flat)
+    integer :: n
+    n = m%nq
+    call dyn_accel(m, w, qs, vs, tt, aa, lam, stp)
+    if (stp /= MBD_OK) return
+    call sens_dyn_rows(m, w, s, pw, qs, vs, aa, lam, tt, npd, st, sdt, .true.)
+    call constraint_rows(n, w%na, npd, m%neq, w%rows, w%s, s%rhs, pw%rt)
+    call dyn_solve_rows(w, pw%rt, s%np, n + w%na, npd, pw%xl, .false., stp)
+    if (stp /= MBD_OK .or. .not. present(sddt)) return
+    call copy_flat(npd * n, pw%xl, sddt)
+  end subroutine sens_accel_full
+
+  !> dlambda/dp as columns (neq, np) from a whole solution's rows xl (npd, n + na): on the
+  !! active rows sc xl(k, n + i) (the matrix's constraint rows carry sc) times the unit u,
+  !! zero elsewhere.
+  pure subroutine lambda_cols(n, np, npd, na, neq, rows, sc, xl, u, slam)
+    integer, intent(in) :: n, np, npd, na, neq, rows(na)
+    real(wp), intent(in) :: sc, xl(npd, n + na), u(neq, np)
+    real(wp), intent(out) :: slam(neq, np)
+    integer :: i, k, r
+    do k = 1, np
+      do r = 1, neq
+        slam(r, k) = zero
+      end do
+      do i = 1, na
+        r = rows(i)
+        slam(r, k) = sc * xl(k, n + i) * u(r, k)
+      end do
+    end do
+  end subroutine lambda_cols
+
+  !> b(1:nn) = a(1:nn), flat.
+  pure subroutine copy_flat(nn, a, b)
+    integer, intent(in) :: nn
+    real(wp), intent(in) :: a(nn)
+    real(wp), intent(out) :: b(nn)
+    b = a
+  end subroutine copy_flat
 
   !> The sensitivities' right-hand sides at a state (qs, vs) with accelerations aa and
   !! multipliers lam (whose assembly is in w), for S and S_dot as rows (npd, n):

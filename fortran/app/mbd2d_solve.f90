@@ -201,7 +201,7 @@ program mbd2d_solve
       call api_dynamics_sens(spec%nb, spec%ctab, spec%rpar, spec%bmass, spec%grav, ftab, &
                              fpar, q0, v0, spec%t0, spec%t_end, spec%steps, spec%rtol, &
                              spec%atol, spec%every, spec%max_steps, spec%ptab, qout, qdout, &
-                             qddout, lamout, eout, sq, sqd, sqdd, iinfo, rinfo, redundant, &
+                             qddout, lamout, eout, sq, sqd, sqdd, slam, iinfo, rinfo, redundant, &
                              status, msg, method=spec%method, h=spec%h, rho_inf=spec%rho_inf)
     else
       call api_dynamics(spec%nb, spec%ctab, spec%rpar, spec%bmass, spec%grav, ftab, fpar, q0, &
@@ -291,7 +291,7 @@ contains
   subroutine check_sensitivities()
     integer :: c
     sens = spec%npar > 0
-    lam_sens = sens .and. (spec%analysis == 'inverse-dynamics' .or. spec%analysis == 'statics')
+    lam_sens = sens .and. spec%analysis /= 'kinematics'
     if (.not. sens) return
     if (spec%positions_only) call die(2, trim(model_path) // ':' // &
       trim(itoa(spec%sens_line)) // ': sensitivities need the velocities and accelerations '// &

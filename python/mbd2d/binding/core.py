@@ -259,9 +259,9 @@ def dynamics_sens(p: Packed, d: DynamicTables, t0: float, t1: float, steps: int,
                   rho_inf: float = -1.0) -> SimpleNamespace:
     """Forward dynamics with sensitivities (solver 0 auto, 1 dense, 2 banded; method 2
     dopri5, 1 generalized-alpha with its step h, 0 adaptive, and rho_inf, < 0 its default):
-    ``q``, ``qd``, ``qdd``, ``lam``, ``e``, ``sq``, ``sqd``, ``sqdd``, ``iinfo``, ``rinfo``,
-    ``red``, ``status``, ``msg``."""
-    return _named("q qd qdd lam e sq sqd sqdd iinfo rinfo red status msg",
+    ``q``, ``qd``, ``qdd``, ``lam``, ``e``, ``sq``, ``sqd``, ``sqdd`` (nq, np, nrow), ``slam``
+    (neq, np, nrow), ``iinfo``, ``rinfo``, ``red``, ``status``, ``msg``."""
+    return _named("q qd qdd lam e sq sqd sqdd slam iinfo rinfo red status msg",
                   _core.core_dynamics_sens, ctab=p.ctab, rpar=p.rpar, bmass=d.bmass,
                   grav=d.grav, ftab=d.ftab, fpar=d.fpar, neq=p.neq, q0=p.q0, v0=d.v0, t0=t0,
                   t1=t1, nsteps=steps, rtol=rtol, atol=atol, every=every, max_steps=max_steps,

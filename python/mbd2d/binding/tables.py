@@ -120,5 +120,5 @@ class BatchTables:
 
     @property
     def nsl(self) -> int:
-        """Rows of the multipliers' sensitivities: inverse dynamics and statics have them."""
-        return self.neq if self.npar and self.analysis in (2, 3) else 0
+        """Rows of the multipliers' sensitivities: every analysis but kinematics has them."""
+        return self.neq if self.npar and self.analysis in (2, 3, 4) else 0
