@@ -35,7 +35,9 @@ def free_fourbar() -> mbd2d.Model:
 # (model, analysis run, parameters, optional columns): kinematics at the tightest Newton
 # tolerance, inverse dynamics and statics with every column that has a derivative, dopri5 at
 # rtol 1e-12 with parameters that leave the assembled start alone (the start's sensitivity is
-# the minimum-norm one, which the assembly of a perturbed model does not follow exactly);
+# the minimum-norm one, which the assembly of a perturbed model does not follow exactly),
+# and driven (its motion the drive's: a pin and the drive's speed change it), with the
+# multipliers', reactions' and efforts' columns as inverse dynamics;
 # generalized-alpha at a fixed step (its sensitivities are the derivatives of its discrete
 # solution, which the differences of runs at the same step follow)
 CASES: dict[str, tuple[Callable[[], mbd2d.Model], Callable[..., Any], list[str], dict]] = {
@@ -53,13 +55,17 @@ CASES: dict[str, tuple[Callable[[], mbd2d.Model], Callable[..., Any], list[str],
     "dynamics": (free_fourbar,
                  lambda m, s: m.dynamics(0.5, 10, method="dopri5", rtol=1e-12, atol=1e-14,
                                          sensitivities=s),
-                 ["body.coupler.mass", "body.rocker.inertia", "model.gravity.1"],
-                 {"multipliers": True}),
+                 ["body.coupler.mass", "body.rocker.inertia", "model.gravity.1"], ALL),
+    "driven dynamics": (lambda: mbd2d.load(EX / "fourbar_masses.toml"),
+                        lambda m, s: m.dynamics(0.5, 10, method="dopri5", rtol=1e-12,
+                                                atol=1e-14, sensitivities=s),
+                        ["joint.B.points.0.0", "body.coupler.mass", "driver.motor.f.poly.1"],
+                        ALL),
     "generalized-alpha": (free_fourbar,
                           lambda m, s: m.dynamics(0.5, 10, method="generalized-alpha", h=5e-3,
                                                   rtol=1e-12, atol=1e-14, sensitivities=s),
                           ["body.coupler.mass", "body.rocker.inertia", "model.gravity.1"],
-                          {"multipliers": True}),
+                          ALL),
 }
 
 
@@ -127,6 +133,8 @@ def test_mbd2d_solve_writes_the_python_columns(tmp_path: Path, case: str) -> Non
                 "statics": dict(analysis="statics"),
                 "dynamics": dict(t_end=0.5, steps=10, analysis="dynamics", method="dopri5",
                                  rtol=1e-12, atol=1e-14),
+                "driven dynamics": dict(t_end=0.5, steps=10, analysis="dynamics",
+                                        method="dopri5", rtol=1e-12, atol=1e-14),
                 "generalized-alpha": dict(t_end=0.5, steps=10, analysis="dynamics",
                                           method="generalized-alpha", h=5e-3, rtol=1e-12,
                                           atol=1e-14)}[case]

@@ -253,11 +253,14 @@ class Model(ModelDescription):
         sensitivities : list of str, optional
             Design parameters to differentiate with respect to (dopri5 and
             generalized-alpha), giving ``dq_dp``, ``dqd_dp``, ``dqdd_dp`` (rows,
-            n_coordinates, n_params). dopri5 integrates the variational equations with the
-            state; generalized-alpha differentiates its discrete equations (at a fixed h the
-            exact derivatives of its own solution); either way under the same error
-            control. The start's sensitivities are those of the assembled q0 (the minimum-
-            norm change) and of the projected v0. They take the path ``solver`` gives.
+            n_coordinates, n_params) and the multipliers' ``dlam_dp`` (rows, neq, n_params;
+            with ``effort_dp``, ``reaction_dp``: the derivatives of the index-1 multipliers
+            at each output's state along its sensitivities). dopri5 integrates the
+            variational equations with the state; generalized-alpha differentiates its
+            discrete equations (at a fixed h the exact derivatives of its own solution);
+            either way under the same error control. The start's sensitivities are those
+            of the assembled q0 (the minimum-norm change) and of the projected v0. They take
+            the path ``solver`` gives.
         progress : bool, optional
             A progress bar while the core integrates, as in :meth:`kinematics`.
         solver : {"auto", "dense", "banded"}, optional

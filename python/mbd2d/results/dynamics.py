@@ -46,7 +46,8 @@ class DynamicsResult(KinematicsResult):
         (n, number of force elements, 6) outputs of the forces, contacts and joint frictions
         (``element_names``); read them with :meth:`contact` and :meth:`friction`.
     dlam_dp : numpy.ndarray or None
-        With ``sensitivities=[...]`` of inverse dynamics: d lambda / d p (n, neq, n_params).
+        With ``sensitivities=[...]`` of inverse or forward dynamics: d lambda / d p (n, neq,
+        n_params).
     """
 
     lam: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
@@ -108,8 +109,8 @@ class DynamicsResult(KinematicsResult):
         if name not in names or not self.packed.driver_flags[names.index(name)]:
             raise KeyError(f"no driver {name!r}")
         if self.dlam_dp is None:
-            raise KeyError("this result has no effort sensitivities: run inverse dynamics "
-                           "with sensitivities=[names]")
+            raise KeyError("this result has no effort sensitivities: run the dynamics or "
+                           "inverse dynamics with sensitivities=[names]")
         row = self.packed.row_owner.index(names.index(name))
         return -self.dlam_dp[:, row, :]
 
@@ -123,8 +124,8 @@ class DynamicsResult(KinematicsResult):
             If there is no such joint or driver, or no multiplier sensitivities.
         """
         if self.dlam_dp is None or self.dq_dp is None:
-            raise KeyError("this result has no reaction sensitivities: run inverse dynamics "
-                           "with sensitivities=[names]")
+            raise KeyError("this result has no reaction sensitivities: run the dynamics or "
+                           "inverse dynamics with sensitivities=[names]")
         return reaction_dp_of(self.packed, self.model, name, *self._reaction_dp_arrays())
 
     def _reaction_dp_arrays(self) -> tuple[np.ndarray, np.ndarray]:
@@ -196,7 +197,7 @@ class DynamicsResult(KinematicsResult):
         Then a column per measure of ``measures`` (as :meth:`KinematicsResult.table`).
         With ``sensitivities=True`` (a run with ``sensitivities=[names]``) then, for each
         parameter P in turn, ``d(COLUMN)/d(P)`` of the motion columns and, when the run has
-        the multipliers' sensitivities (inverse dynamics), of the multiplier, reaction and
+        the multipliers' sensitivities (dynamics), of the multiplier, reaction and
         effort columns asked for, then of the measures.
 
         ``mbd2d-solve`` writes the same columns for an exported file (``outputs``).
@@ -266,7 +267,7 @@ class DynamicsResult(KinematicsResult):
         ``reactions=True`` also ``reactions`` (n, nc, 6: as the table's reaction columns)
         and with ``efforts=True`` ``efforts`` (n, n_drivers); after a run with
         ``sensitivities=[names]`` also ``dq_dp``, ``dqd_dp``, ``dqdd_dp``,
-        ``parameter_names`` and (inverse dynamics) ``dlam_dp`` (n, neq, n_params)."""
+        ``parameter_names`` and (dynamics) ``dlam_dp`` (n, neq, n_params)."""
         check_outputs(always, ("energy", "multipliers"), "to_npz")
         extra = self._sensitivity_arrays(sensitivities, "to_npz")
         extra.update(self._measure_arrays(measures))

@@ -65,7 +65,7 @@ def sweep(model: ModelDescription, cases: Any, analysis: str = "kinematics", cli
         measures ``measures`` over ("case", "time", "measure"), the "measure" coordinate
         naming them by their specs; with sensitivities ``dq_dp``, ``dqd_dp``, ``dqdd_dp``
         over ("case", "time", "coordinate", "parameter") and, with multipliers (inverse
-        dynamics, statics), ``dlam_dp`` and ``deffort_dp``; with both measures and
+        dynamics, dynamics, statics), ``dlam_dp`` and ``deffort_dp``; with both measures and
         sensitivities ``dmeasures_dp`` over ("case", "time", "measure", "parameter"), each
         case's exact measure derivatives as a single run's ``measure_derivatives``. The
         parameters are coordinates of "case"; ``status`` (0 ok, else the status of the
