@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..description.builder import ModelDescription
+from ..description.entries import reading
 from ..description.friction import FRICTION_KIND
 from ..errors import ModelError
 from . import core
@@ -21,8 +22,14 @@ def pack(model: ModelDescription) -> Packed:
     Raises
     ------
     ModelError
-        If the model is empty or the core rejects an entry (named in the message).
+        If the model is empty, an entry's field was set to a value of the wrong form, or the
+        core rejects an entry (named in the message).
     """
+    with reading(model):
+        return _pack(model)
+
+
+def _pack(model: ModelDescription) -> Packed:
     if not model.bodies:
         raise ModelError("the model has no moving bodies; add a [[body]]", "model")
     cons = model.constraints
@@ -77,8 +84,13 @@ def pack_dynamics(model: ModelDescription, p: Packed) -> DynamicTables:
     Raises
     ------
     ModelError
-        If a body has no mass or inertia.
+        If a body has no mass or inertia, or an entry's field has the wrong form.
     """
+    with reading(model):
+        return _pack_dynamics(model, p)
+
+
+def _pack_dynamics(model: ModelDescription, p: Packed) -> DynamicTables:
     bmass = np.zeros((2, len(model.bodies)), order="F")
     for i, b in enumerate(model.bodies):
         if b.mass is None or b.inertia is None:

@@ -21,6 +21,7 @@ from ..errors import ModelError
 from ..validate import (GROUND, as_list, check_name, choice, nonzero_vector, number, only_keys,
                         pairs, positive, vector)
 from .bodies import Body
+from .entries import reading
 from .contacts import CONTACT_KEYS, CONTACT_TYPES, Contact, contact_geometry, parse_law
 from .drivers import AbsoluteDriver, Driver, RelativeAngleDriver, RelativeDistanceDriver
 from .forces import FORCE_KEYS, Force, PointForce, RotationalSpring, Spring, Torque
@@ -610,7 +611,8 @@ class ModelDescription:
         >>> mbd2d.load("examples/fourbar_grashof.toml").parameters()["joint.A.points.1.0"]
         -1.75
         """
-        return {p.name: p.value for p in parameter_list(self)}
+        with reading(self):
+            return {p.name: p.value for p in parameter_list(self)}
 
     def with_params(self, values: Mapping[str, Any]) -> "ModelDescription":
         """A new model with the named parameters set to the given values; this model is
@@ -629,7 +631,8 @@ class ModelDescription:
         >>> m.with_params({"joint.B.points.0.0": 1.8}).parameters()["joint.B.points.0.0"]
         1.8
         """
-        return _with_params(self, values)
+        with reading(self):
+            return _with_params(self, values)
 
     def has_masses(self) -> bool:
         """Every body has a mass and an inertia (dynamics and inverse dynamics can run)."""

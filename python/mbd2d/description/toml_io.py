@@ -24,6 +24,7 @@ from ..errors import ModelError
 from ..validate import only_keys, table
 from .builder import ModelDescription
 from .contacts import CONTACT_KEYS
+from .entries import reading
 
 M = TypeVar("M", bound=ModelDescription)
 
@@ -314,7 +315,8 @@ def dumps(model: ModelDescription, header: str = "") -> str:
     >>> loads(text).parameters() == load("examples/fourbar_grashof.toml").parameters()
     True
     """
-    data = to_dict(model)
+    with reading(model):
+        data = to_dict(model)
     lines = [f"# {line}".rstrip() for line in header.splitlines()]
     lines += ["[model]"] + [f"{k} = {_value(v)}" for k, v in data["model"].items()]
     for section in ("body", "joint", "driver", "force"):
