@@ -107,3 +107,81 @@ def test_cam_fields(tmp_path: Path) -> None:
         setattr(m.joints[2], field, value)
         with pytest.raises(mbd2d.ModelError, match=text):
             m.kinematics(1.0, 4)
+
+
+def test_profile_layout_and_contact_type() -> None:
+    """Fields whose form depends on another: a Fourier profile set to a circle's three
+    numbers, and a contact's type the core does not know."""
+    from test_derivatives import CASES
+    from test_standalone import contact_models
+    m = CASES["point-on-curve-fourier"].build()
+    slot = next(j for j in m.joints if j.name == "slot")
+    slot.profile = (0.0, 0.0, 1.0)
+    with pytest.raises(mbd2d.ModelError, match="profile of a Fourier curve must be"):
+        m.parameters()
+    ball = contact_models()[1][1]
+    ball.contacts[0].type = "circle-square"
+    with pytest.raises(mbd2d.ModelError, match="contact 'floor'.*type must be one of"):
+        ball.dynamics(0.01, 2)
+
+
+#: values a field may be set to by mistake
+JUNK = [None, "x", {"a": 1}, [], [1.0], [1.0, 2.0], [[1.0, 2.0]], [[1, 2], [3, 4]],
+        (0.0, 0.0, 0.0), float("nan"), float("inf"), -1.0, 0.0, 1e308, 5, True,
+        [[0, 0], [0, 0], [0, 0]], ["nobody", "ground"], "theta", "roller"]
+
+
+def test_random_fields_through_random_doors(tmp_path: Path) -> None:
+    """Seeded random exploration (MBD2D_ENTRY_FUZZ cases, default 80; 2000 passed when
+    written): a random field of a random entry of a random model (examples, every joint
+    kind, contacts and friction) set to a random wrong value, then a random door; it
+    finishes with finite arrays or raises an MbdError, nothing else."""
+    import os
+    import random
+    import warnings
+    import dataclasses
+    import numpy as np
+    from test_derivatives import CASES
+    from test_standalone import contact_models
+    builds = [lambda p=p: mbd2d.load(p) for p in sorted(EX.glob("*.toml"))]
+    builds += [c.build for c in CASES.values()]
+    builds += [lambda k=k: contact_models()[k][1] for k in range(5)]
+    doors = {
+        "kinematics": lambda m: m.kinematics(0.5, 3),
+        "dynamics": lambda m: m.dynamics(0.05, 2, max_steps=2000),
+        "inverse": lambda m: m.inverse_dynamics(0.5, 3),
+        "statics": lambda m: m.statics(),
+        "parameters": lambda m: m.parameters(),
+        "with_params": lambda m: m.with_params({next(iter(m.parameters())): 0.1}),
+        "export": lambda m: m.export(tmp_path / "f.mbd", t_end=0.5, steps=3),
+        "dof": lambda m: m.analyze_dof(),
+        "sensitivities": lambda m: m.kinematics(0.5, 3,
+                                                sensitivities=[next(iter(m.parameters()))]),
+        "dump": lambda m: mbd2d.description.toml_io.dumps(m),
+        "sweep": lambda m: mbd2d.sweep(m, {next(iter(m.parameters())): [0.1, 0.2]},
+                                       t_end=0.5, steps=2, workers=1),
+    }
+    rng = random.Random(20261127)
+    cases = int(os.environ.get("MBD2D_ENTRY_FUZZ", "80"))
+    refused = 0
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for _ in range(cases):
+            m = rng.choice(builds)()
+            entries = (m.bodies + m.joints + m.drivers + m.forces + list(m.contacts))
+            e = rng.choice(entries)
+            f = rng.choice(dataclasses.fields(e))
+            value = rng.choice(JUNK)
+            setattr(e, f.name, value)
+            door = rng.choice(list(doors))
+            try:
+                out = doors[door](m)
+            except mbd2d.MbdError:
+                refused += 1
+                continue
+            for a in ("q", "qd", "qdd", "lam", "dq_dp"):
+                arr = getattr(out, a, None)
+                if isinstance(arr, np.ndarray) and arr.dtype.kind == "f":
+                    assert np.isfinite(arr).all(), (e, f.name, value, door)
+    print(f"\n[entries] {cases} random fields: {refused} refused with an MbdError, the "
+          "others finished finite", end="")

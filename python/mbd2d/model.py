@@ -27,6 +27,7 @@ from .binding.pack import pack
 from .binding.params import open_values
 from .description import toml_io
 from .description.builder import ModelDescription
+from .description.entries import reads_entries
 from .errors import MbdError
 from .description.parameters import parameter_list
 from .results import DofReport, DynamicsResult, KinematicsResult, StaticsResult
@@ -61,6 +62,7 @@ class Model(ModelDescription):
         p = pack(self)
         return p.neq, p.nq
 
+    @reads_entries
     def parameters(self) -> dict[str, float | None]:
         """Every design parameter by name, with its value (see
         :meth:`~mbd2d.description.builder.ModelDescription.parameters`); a gear or rolling
@@ -79,6 +81,7 @@ class Model(ModelDescription):
         return values
 
     # ------------------------------------------------------------------ analyses
+    @reads_entries
     def kinematics(self, t_end: float, steps: int, t0: float = 0.0, tol: float | None = None,
                    maxit: int | None = None, every: int = 1, solver: str = "auto",
                    sensitivities: Any = None, progress: bool | None = None,
@@ -159,6 +162,7 @@ class Model(ModelDescription):
                               every=every, solver=solver, sensitivities=sensitivities,
                               progress=progress, positions_only=positions_only)
 
+    @reads_entries
     def analyze_dof(self, t: float = 0.0, tol: float | None = None) -> DofReport:
         """Degrees of freedom and redundant constraints at the configuration assembled from
         the q0 estimates at time t.
@@ -184,6 +188,7 @@ class Model(ModelDescription):
         """
         return analyze_dof(self, t=t, tol=tol)
 
+    @reads_entries
     def inverse_dynamics(self, t_end: float, steps: int, t0: float = 0.0,
                          tol: float | None = None, every: int = 1, solver: str = "auto",
                          sensitivities: Any = None,
@@ -209,6 +214,7 @@ class Model(ModelDescription):
         return run_inverse(self, t_end=t_end, steps=steps, t0=t0, tol=tol, every=every,
                            solver=solver, sensitivities=sensitivities, progress=progress)
 
+    @reads_entries
     def dynamics(self, t_end: float, steps: int, method: str | None = None,
                  rtol: float | None = None, atol: float | None = None, h: float | None = None,
                  rho_inf: float | None = None, alpha: float | None = None,
@@ -302,6 +308,7 @@ class Model(ModelDescription):
                             every=every, max_steps=max_steps, sensitivities=sensitivities,
                             progress=progress, solver=solver)
 
+    @reads_entries
     def statics(self, t: float = 0.0, sensitivities: Any = None,
                 solver: str = "auto") -> StaticsResult:
         """Static equilibrium under gravity, springs and loads (drivers held at t), with the
@@ -321,23 +328,28 @@ class Model(ModelDescription):
         return run_statics(self, t=t, sensitivities=sensitivities, solver=solver)
 
     # ------------------------------------------------------------------ at one state
+    @reads_entries
     def phi(self, q: Any, t: float = 0.0) -> np.ndarray:
         """Phi(q, t), computed by the core."""
         return evaluate(self, q, None, t)[0]
 
+    @reads_entries
     def jacobian(self, q: Any, t: float = 0.0) -> np.ndarray:
         """J = Phi_q(q, t), computed by the core."""
         return evaluate(self, q, None, t)[1]
 
+    @reads_entries
     def nu(self, q: Any, t: float = 0.0) -> np.ndarray:
         """nu = -Phi_t(q, t), computed by the core."""
         return evaluate(self, q, None, t)[2]
 
+    @reads_entries
     def gamma(self, q: Any, qd: Any, t: float = 0.0) -> np.ndarray:
         """gamma(q, q_dot, t), the right-hand side of J q_ddot = gamma, computed by the core."""
         return evaluate(self, q, qd, t)[3]
 
     # ------------------------------------------------------------------ pictures
+    @reads_entries
     def configuration(self, t: float = 0.0) -> plots.Configuration:
         """The model assembled at time t from its q0 estimates, as a one-row motion for the
         pictures; the q0 estimates themselves when assembly fails (``.note`` says so)."""
@@ -348,6 +360,7 @@ class Model(ModelDescription):
             return plots.Configuration(self, q0, t, note=f"q0 estimates (assembly failed: "
                                        f"{type(exc).__name__})")
 
+    @reads_entries
     def plot(self, t: float = 0.0, **kwargs: Any) -> Any:
         """The model assembled at time t: :func:`mbd2d.plot_mechanism` (returns the Axes).
 
@@ -371,6 +384,7 @@ class Model(ModelDescription):
             return None
 
     # ------------------------------------------------------------------ files
+    @reads_entries
     def export(self, path: str | Path, t_end: float | None = None, steps: int | None = None,
                t0: float = 0.0, tol: float | None = None, maxit: int | None = None,
                analysis: str = "kinematics", every: int = 1, solver: str = "auto",

@@ -11,18 +11,22 @@ model's names (bodies, joints, kinds); nothing is checked while the entries are 
 from __future__ import annotations
 
 import dataclasses
+import functools
 from contextlib import contextmanager
-from typing import Any, Iterator
+from typing import Any, Callable, Iterator, TypeVar
 
 from ..errors import ModelError
 from ..validate import GROUND, NAME_RE, is_number
-from .joints import COORDINATES, FOLLOWER_KINDS, PROFILE_KINDS
+from .contacts import CONTACT_TYPES
+from .joints import COORDINATES, FOLLOWER_KINDS, PROFILE_KINDS, encoded_profile_problem
 
-#: fields whose value is one of a table's keys
+#: fields whose value is one of a table's keys (a contact's "type" field: joints, drivers and
+#: forces have their type as a class constant, not a field)
 KINDS = {"profile_kind": PROFILE_KINDS, "follower_kind": FOLLOWER_KINDS,
-         "coordinate": COORDINATES}
+         "coordinate": COORDINATES, "type": CONTACT_TYPES}
 #: the exceptions a malformed field raises where the entries are read
 READ_ERRORS = (TypeError, ValueError, KeyError, AttributeError, IndexError)
+F = TypeVar("F", bound=Callable[..., Any])
 
 
 @contextmanager
@@ -33,8 +37,19 @@ def reading(model: Any) -> Iterator[None]:
     try:
         yield
     except READ_ERRORS:
-        check_entries(model)
-        raise
+        problem = first_problem(model)
+        if problem is None:
+            raise
+        raise problem from None
+
+
+def reads_entries(fn: F) -> F:
+    """fn(model, ...) run inside :func:`reading` (the front doors that take a model)."""
+    @functools.wraps(fn)
+    def wrapper(model: Any, *args: Any, **kwargs: Any) -> Any:
+        with reading(model):
+            return fn(model, *args, **kwargs)
+    return wrapper  # type: ignore[return-value]
 
 
 def check_entries(model: Any) -> None:
@@ -45,19 +60,34 @@ def check_entries(model: Any) -> None:
     ModelError
         Naming the entry, the field, the form it takes and the value it has.
     """
-    bodies = {b.name for b in model.bodies if isinstance(b.name, str)} | {GROUND}
-    joints = {j.name for j in model.joints}
+    problem = first_problem(model)
+    if problem is not None:
+        raise problem
+
+
+def first_problem(model: Any) -> ModelError | None:
+    """The ModelError of the first malformed field (None when every field has its form)."""
+    try:
+        bodies = {b.name for b in model.bodies if isinstance(b.name, str)} | {GROUND}
+        joints = {j.name for j in model.joints if isinstance(j.name, str)}
+        entries = [("body", model.bodies), ("joint", model.joints), ("driver", model.drivers),
+                   ("force", model.forces), ("contact", getattr(model, "contacts", []))]
+    except (AttributeError, TypeError):
+        return ModelError("the model's lists of entries were replaced by something else; "
+                          "add entries with the builder's add_* methods", "model")
     problem = _vector(model.gravity, 2)
     if problem:
-        raise ModelError(f"gravity{_sep(problem)}{problem}, got {model.gravity!r}", "[model]")
-    for section, entries in (("body", model.bodies), ("joint", model.joints),
-                             ("driver", model.drivers), ("force", model.forces),
-                             ("contact", getattr(model, "contacts", []))):
-        for e in entries:
-            where = _describe(section, e)
+        return ModelError(f"gravity{_sep(problem)}{problem}, got {model.gravity!r}", "[model]")
+    for section, items in entries:
+        for e in items:
+            if not dataclasses.is_dataclass(e):
+                return ModelError(f"{e!r} is not an entry; add {section}s with the builder's "
+                                  "add_* methods", "model")
             for name, text, v in _problems(e, bodies, joints):
-                raise ModelError(f"{name}{_sep(text)}{text}, got {v!r}; set it as the "
-                                 "builder's add_* methods or the model file take it", where)
+                return ModelError(f"{name}{_sep(text)}{text}, got {v!r}; set it as the "
+                                  "builder's add_* methods or the model file take it",
+                                  _describe(section, e))
+    return None
 
 
 def _describe(section: str, e: Any) -> str:
@@ -76,6 +106,8 @@ def _problems(e: Any, bodies: set[str], joints: set[str]
         text = _semantic(f.name, v, bodies, joints)
         if text is None:
             text = _form(str(f.type), v)
+        if not text and f.name == "profile" and getattr(e, "profile_kind", None) in PROFILE_KINDS:
+            text = encoded_profile_problem(e.profile_kind, v)   # (its layout, by its kind)
         if text:
             yield f.name, text, v
         elif dataclasses.is_dataclass(v) and not isinstance(v, type):

@@ -356,6 +356,20 @@ def parse_profile(spec: Any, entry: str, key: str = "profile") -> tuple[str, tup
     return "fourier", (*c, float(k), av[0], *coeffs)
 
 
+def encoded_profile_problem(kind: str, p: Sequence[float]) -> str:
+    """What is wrong with the encoding parse_profile gives (circle (cx, cy, r); spline (n,
+    x1, y1, ..., xn, yn), n >= 4; fourier (cx, cy, k, a0, a1, b1, ..., ak, bk)), "" if
+    nothing (the numbers themselves checked elsewhere)."""
+    n = len(p)
+    if kind == "circle":
+        return "" if n == 3 else "of a circle must be (center x, center y, radius)"
+    if kind == "spline":
+        ok = n >= 9 and float(p[0]) == (n - 1) // 2 and n % 2 == 1
+        return "" if ok else "of a spline must be (n, x1, y1, ..., xn, yn), n >= 4"
+    ok = n >= 4 and float(p[2]) == (n - 4) // 2 and n % 2 == 0
+    return "" if ok else "of a Fourier curve must be (cx, cy, k, a0, a1, b1, ..., ak, bk)"
+
+
 def parse_follower(spec: Any, entry: str) -> tuple[str, tuple[float, float, float, float]]:
     """A follower: ``{point = [x, y]}``, ``{roller = ...}`` or ``{flat = ...}``."""
     spec = table(spec, "follower", entry)

@@ -316,7 +316,11 @@ def dumps(model: ModelDescription, header: str = "") -> str:
     True
     """
     with reading(model):
-        data = to_dict(model)
+        return _dumps(model, header)
+
+
+def _dumps(model: ModelDescription, header: str) -> str:
+    data = to_dict(model)
     lines = [f"# {line}".rstrip() for line in header.splitlines()]
     lines += ["[model]"] + [f"{k} = {_value(v)}" for k, v in data["model"].items()]
     for section in ("body", "joint", "driver", "force"):

@@ -4,12 +4,14 @@ from __future__ import annotations
 from typing import Any
 
 from ..description.builder import ModelDescription
+from ..description.entries import reads_entries
 from ..errors import ModelError
 from .dataset import to_dataset, xarray
 from .plan import case_values, plan, with_cases, with_measures, with_sensitivities
 from .runner import run
 
 
+@reads_entries
 def sweep(model: ModelDescription, cases: Any, analysis: str = "kinematics", client: Any = None,
           *, workers: int | None = None, progress: bool | None = None,
           measures: Any = None, sensitivities: Any = None, **analysis_kwargs: Any) -> Any:

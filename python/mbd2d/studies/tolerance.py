@@ -27,6 +27,7 @@ from ..analysis.kinematics import run_kinematics
 from ..analysis.statics import run_statics
 from ..analysis.settings import check_memory
 from ..description.builder import ModelDescription
+from ..description.entries import reads_entries
 from ..description.parameters import find
 from ..errors import ModelError
 from ..results.measures import measure, measure_derivatives, measure_list, parse_measure
@@ -334,6 +335,7 @@ def _sigma(model: ModelDescription, sigma: Any) -> tuple[list[Any], np.ndarray]:
     return params, sig
 
 
+@reads_entries
 def tolerance(model: ModelDescription, sigma: Mapping[str, Any], analysis: str = "kinematics",
               samples: int = 200, client: Any = None, *, seed: int | None = 0,
               workers: int | None = None, progress: bool | None = None,
