@@ -15,7 +15,7 @@ import functools
 from contextlib import contextmanager
 from typing import Any, Callable, Iterator, TypeVar
 
-from ..errors import ModelError
+from ..errors import MbdError, ModelError
 from ..validate import GROUND, NAME_RE, is_number
 from .contacts import CONTACT_TYPES
 from .joints import COORDINATES, FOLLOWER_KINDS, PROFILE_KINDS, encoded_profile_problem
@@ -36,6 +36,8 @@ def reading(model: Any) -> Iterator[None]:
     passes unchanged."""
     try:
         yield
+    except MbdError:                                    # (typed already; some are ValueErrors)
+        raise
     except READ_ERRORS:
         problem = first_problem(model)
         if problem is None:
@@ -66,7 +68,10 @@ def check_entries(model: Any) -> None:
 
 
 def first_problem(model: Any) -> ModelError | None:
-    """The ModelError of the first malformed field (None when every field has its form)."""
+    """The ModelError of the first malformed field (None when every field has its form, or
+    model is not a model description)."""
+    if not all(hasattr(model, a) for a in ("bodies", "joints", "drivers", "forces", "gravity")):
+        return None
     try:
         bodies = {b.name for b in model.bodies if isinstance(b.name, str)} | {GROUND}
         joints = {j.name for j in model.joints if isinstance(j.name, str)}
