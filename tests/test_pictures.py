@@ -329,3 +329,17 @@ def test_measures_against_time(tmp_path: Path, capsys) -> None:
     assert main(["plot", str(toml), "--t-end", "1", "--steps", "100", "--what", "measures",
                  "--measure", specs[0], "--out", str(out)]) == 3      # drawn up to the toggle
     assert out.stat().st_size > 0
+
+
+def test_picture_arguments_of_the_wrong_form_are_refused() -> None:
+    """A number where a list of traced points or bodies goes is a ModelError (was a raw
+    TypeError); one body's name alone is taken as that body."""
+    import matplotlib.pyplot as plt
+    res = mbd2d.load(EX / "fourbar_grashof.toml").kinematics(1.0, 4)
+    for call in (lambda: res.plot(trace=-1), lambda: plot_paths(res, 2.5),
+                 lambda: plot_paths(res, "coupler"), lambda: plot_timeseries(res, -1)):
+        with pytest.raises(ModelError, match="must be a list"):
+            call()
+    fig = plot_timeseries(res, "rocker")
+    assert len(fig.axes[0].lines) == 1
+    plt.close("all")

@@ -321,3 +321,16 @@ def test_file_sensitivities_refused_where_python_refuses(tmp_path: Path) -> None
     r = subprocess.run([find_solver(), str(f), str(tmp_path / "o.csv")], capture_output=True,
                        text=True, timeout=60)
     assert r.returncode == 2 and "do not carry contacts or joint friction" in r.stderr
+
+
+def test_lookups_of_the_wrong_name_say_what_there_is() -> None:
+    """A row label or a parameter that is not there (or not a name) is a KeyError listing
+    what there is (multiplier_dp gave a raw ValueError, a number as a parameter name a raw
+    TypeError)."""
+    m = mbd2d.load(EX / "fourbar_masses.toml")
+    inv = m.inverse_dynamics(1.0, 4, sensitivities=["body.coupler.mass"])
+    with pytest.raises(KeyError, match="no row 'coupler'; rows: O2.x"):
+        inv.multiplier_dp("coupler", "body.coupler.mass")
+    with pytest.raises(KeyError, match="by its name .* got 2.5; computed: body.coupler.mass"):
+        inv.sensitivity("crank", 2.5)
+    assert inv.multiplier_dp("O2.x", "body.coupler.mass").shape == (5,)

@@ -148,7 +148,7 @@ def check_trace(result: Motion, trace: Any) -> list[TracePoint]:
     if trace is None:
         return []
     out: list[TracePoint] = []
-    if isinstance(trace, (str, bytes)):
+    if isinstance(trace, (str, bytes)) or not isinstance(trace, (list, tuple, np.ndarray)):
         raise ModelError(f"must be a list of (body_name, (sx, sy)), got {trace!r}", "trace")
     for item in trace:
         try:

@@ -11,7 +11,7 @@ from ..errors import ModelError
 from ..validate import GROUND
 from .canvas import STOP_COLOUR, import_matplotlib, new_figure, shade
 from .elements import Look
-from .geometry import Motion, TracePoint, snapshot_rows
+from .geometry import Motion, TracePoint, check_trace, snapshot_rows
 from .scene import Scene
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -170,7 +170,8 @@ def plot_paths(result: Motion, points: Sequence[TracePoint] | None = None,
     >>> ax = plot_paths(res, [("coupler", (0.0, 1.0)), ("coupler", (1.75, 0.0))])
     """
     model = getattr(result, "model", None)
-    pts = list(points) if points is not None else (default_points(model) if model else [])
+    pts = check_trace(result, points) if points is not None else \
+        (default_points(model) if model else [])
     scene = Scene(result, pts, what="plot_paths")
     if ax is None:
         ax = new_figure((8.0, 6.5)).add_subplot()

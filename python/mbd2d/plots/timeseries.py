@@ -104,6 +104,11 @@ def _name(result: Motion) -> str:
 
 
 def _motion(result: Motion, bodies: Sequence[str] | None, lu: str) -> "Figure":
+    if isinstance(bodies, str):                 # (one body by its name)
+        bodies = [bodies]
+    if bodies is not None and not isinstance(bodies, (list, tuple)):
+        raise ModelError(f"bodies must be a list of body names, got {bodies!r}",
+                         "plot_timeseries")
     names = list(result.body_names if bodies is None else bodies)
     hist = [result.body(b) for b in names]  # KeyError on an unknown name
     levels = 1 if getattr(result, "qd", None) is None else 3    # (positions only: 1)

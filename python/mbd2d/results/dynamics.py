@@ -136,9 +136,18 @@ class DynamicsResult(KinematicsResult):
         return self._reac_dp
 
     def multiplier_dp(self, row: str, name: str) -> np.ndarray:
-        """d lambda / d p of a row (by its label) for one parameter, over time."""
+        """d lambda / d p of a row (by its label) for one parameter, over time.
+
+        Raises
+        ------
+        KeyError
+            If no row has that label, the run has no sensitivity to name, or none of the
+            multipliers.
+        """
         if self.dlam_dp is None:
             raise KeyError("this result has no multiplier sensitivities")
+        if row not in self.row_labels:
+            raise KeyError(f"no row {row!r}; rows: {', '.join(self.row_labels)}")
         return self.dlam_dp[:, self.row_labels.index(row),
                             parameter_index(self.parameter_names, name)]
 

@@ -25,6 +25,9 @@ def parameter_index(names: list[str], name: str) -> int:
     """
     if name in names:
         return names.index(name)
+    if not isinstance(name, str):
+        raise KeyError(f"a parameter is given by its name (a string), got {name!r}; "
+                       f"computed: {', '.join(names) or 'none'}")
     if not names:
         raise KeyError("this result has no sensitivities: run the analysis with "
                        "sensitivities=[names]")
