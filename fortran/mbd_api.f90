@@ -628,8 +628,9 @@ contains
     end if
     ! the multipliers' path (dense or band, as dynamics; solver as for the kinematics);
     ! a dense one must fit: check before the (possibly long) kinematic run
+    ! (the multipliers' sensitivities take the same path: dense J^T, or the band saddle-point
+    ! factors of each output's multipliers)
     call dyn_choose(m, solver, path, kl, ku, status, msg)
-    if (status == MBD_OK .and. present(ptab)) path = SOLVER_DENSE   ! sensitivities: dense J
     if (status == MBD_OK .and. path == SOLVER_DENSE) call dyn_memory_check(m, status, msg)
     if (status /= MBD_OK) then
       qout = zero; qdout = zero; qddout = zero; iinfo = 0; rinfo = zero
@@ -696,7 +697,12 @@ contains
         end if
         if (present(eo) .and. m%nf > 0) call dyn_element_outputs(m, w, qout(:, k), &
                                                                  qdout(:, k), t, eo(:, :, k))
-        if (present(ptab)) then
+        if (present(ptab) .and. w%solver /= SOLVER_DENSE) then
+          call sens_multipliers(m, sens, qout(:, k), qdout(:, k), qddout(:, k), t, lam= &
+                                lamout(:, k), sq=sq(:, :, k), sqd=sqd(:, :, k), &
+                                sqdd=sqdd(:, :, k), slam=slam(:, :, k), status=st, msg=lmsg, &
+                                sw=w)
+        else if (present(ptab)) then
           if (w%jt_lu) then                    ! (the LU of J^T dyn_multipliers just took)
             call sens_multipliers(m, sens, qout(:, k), qdout(:, k), qddout(:, k), t, w%jac, &
                                   lamout(:, k), sq(:, :, k), sqd(:, :, k), sqdd(:, :, k), &
@@ -706,6 +712,11 @@ contains
                                   lamout(:, k), sq(:, :, k), sqd(:, :, k), sqdd(:, :, k), &
                                   slam(:, :, k), st, lmsg)
           end if
+        end if
+        if (present(ptab) .and. st /= MBD_OK) then   ! (the rows before are kept)
+          status = st; iinfo(1) = k - 1; rinfo(1) = t
+          write (msg, '(a,es12.5,a)') 'at t = ', t, ': '//trim(lmsg)
+          exit
         end if
       end do
       if (present(evo) .and. present(nev)) call events_out(m, log, evo, nev)

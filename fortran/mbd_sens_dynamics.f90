@@ -96,14 +96,18 @@ contains
   end subroutine proj_init
 
   !> dlambda/dp (neq, np) at one output of an inverse dynamics run, from the kinematic
-  !! sensitivities sq, sqd, sqdd (nq, np) there; jac is J at q.
+  !! sensitivities sq, sqd, sqdd (nq, np) there: J^T dlambda = b as the multipliers were
+  !! solved. Dense path: jac is J at q (with jtlu, jtpiv the LU of J^T dyn_multipliers took);
+  !! band path (sw, no dense J): the saddle-point factors dyn_multipliers left in sw at this
+  !! state, [s I, s J_a^T; s J_a, 0][x; y] = [b; 0], dlambda = s y on the active rows (the
+  !! multipliers' own solve: J_a square, x = 0 and J_a^T dlambda = b).
   subroutine sens_multipliers(m, s, q, qd, qdd, t, jac, lam, sq, sqd, sqdd, slam, status, msg, &
-                              jtlu, jtpiv)
+                              jtlu, jtpiv, sw)
     type(model_t), intent(in) :: m              !! model with dynamics data
     type(sens_t), intent(inout) :: s            !! parameters and blocks
     real(wp), intent(in) :: q(:), qd(:), qdd(:) !! state and accelerations
     real(wp), intent(in) :: t                   !! time
-    real(wp), intent(in) :: jac(:, :)           !! J at q (neq, nq)
+    real(wp), intent(in), optional :: jac(:, :) !! J at q (neq, nq): the dense path
     real(wp), intent(in) :: lam(:)              !! multipliers (neq)
     real(wp), intent(in) :: sq(:, :), sqd(:, :), sqdd(:, :)  !! (nq, np)
     real(wp), intent(out) :: slam(:, :)         !! (neq, np)
@@ -112,16 +116,21 @@ contains
     !> the LU of J^T with its pivots (dyn_multipliers' at the same state, when it took one)
     real(wp), intent(in), optional :: jtlu(:, :)
     integer, intent(in), optional :: jtpiv(:)
+    type(dyn_work_t), intent(inout), optional :: sw  !! the band path's work (see above)
     real(wp), allocatable :: work(:)
     logical :: full
     real(wp) :: wq(1), umin, umax
-    integer :: k, nq, neq, np, rank, info, st
+    integer :: k, i, nq, neq, np, rank, info, st, nd, ed
     status = MBD_OK; msg = ''
     nq = m%nq; neq = m%neq; np = s%np
     slam = zero
     if (np == 0) return
-    if (.not. allocated(s%mjt)) then           ! (once: the work of every later output)
-      allocate (s%mjt(nq, neq), s%mb(max(nq, neq), np), s%my(nq), s%myf(nq, np), &
+    if (.not. allocated(s%mb)) then            ! (once: the work of every later output)
+      nd = 1; ed = 1
+      if (.not. present(sw)) then              ! (J^T dense: not on the band path)
+        nd = nq; ed = neq
+      end if
+      allocate (s%mjt(nd, ed), s%mb(max(nq, neq), np), s%my(nq), s%myf(nq, np), &
                 s%mpiv(max(nq, neq)), s%mbb(max(nq, neq), np), stat=st)
       if (st /= 0) then
         status = MBD_NO_MEMORY; msg = 'out of memory for the multiplier sensitivities'; return
@@ -140,6 +149,19 @@ contains
         call sens_jpt_lam(m, s, k, q, t, lam, y)
         b(1:nq, k) = b(1:nq, k) - y
       end do
+      if (present(sw)) then                    ! the band path: the saddle-point factors
+        do k = 1, np
+          sw%rhs(1:nq) = b(1:nq, k); sw%rhs(nq + 1:) = zero
+          call dyn_solve(sw, sw%rhs, status)
+          if (status /= MBD_OK) then
+            msg = 'the multipliers'' sensitivities: the band saddle-point solve failed'; return
+          end if
+          do i = 1, sw%na
+            slam(sw%rows(i), k) = sw%s * sw%rhs(nq + i)
+          end do
+        end do
+        return
+      end if
       if (present(jtlu) .and. present(jtpiv)) then   ! dyn_multipliers' LU, trusted there
         do k = 1, np
           call lu_solve_small(jtlu, jtpiv, b(1:nq, k))
