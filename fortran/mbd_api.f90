@@ -42,6 +42,7 @@ module mbd_api
                              sens_force_rows
   use mbd_assemble, only: scatter_dense
   use mbd_sens_dynamics, only: sens_multipliers, sens_reactions, sens_statics, sens_dopri5, &
+                               sens_statics_band, &
                                sens_initial, lam_work_t, lam_init, sens_out_multipliers
   use mbd_sens_genalpha, only: ga_sens_t, ga_sens_init
   implicit none
@@ -957,7 +958,6 @@ contains
       status = MBD_BAD_COUNT; msg = 'array sizes do not match the model'; return
     end if
     call dyn_choose(m, solver_or_auto(solver), path, kl, ku, status, msg)
-    if (status == MBD_OK .and. present(ptab)) path = SOLVER_DENSE   ! sensitivities: dense J
     if (status /= MBD_OK) return
     iinfo(5) = path; iinfo(6) = kl; iinfo(7) = ku
     if (path == SOLVER_DENSE) call dyn_memory_check(m, status, msg)
@@ -981,7 +981,11 @@ contains
     end if
     if (status == MBD_OK) call statics_solve(m, w, q, t, lam, stable, resid, status, msg)
     if (status == MBD_OK .and. present(ptab)) then
-      call sens_statics(m, sens, w%rows, q, t, lam, sq, slam, status, msg)
+      if (w%solver == SOLVER_DENSE) then
+        call sens_statics(m, sens, w%rows, q, t, lam, sq, slam, status, msg)
+      else                                      ! (null-space form, no n x n array)
+        call sens_statics_band(m, w, sens, q, t, lam, sq, slam, status, msg)
+      end if
       call sens_units2(m, sens, sq, m%cunit, .false.)
       call sens_units2(m, sens, slam, m%rowunit, .true.)
     end if

@@ -384,12 +384,13 @@ subroutine core_inverse_sens(nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp,
 end subroutine core_inverse_sens
 
 subroutine core_statics_sens(nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp, fpar, nq, neq, &
-                             q0, t, npar, ptab, q, lam, sq, slam, stable, resid, iinfo, status, &
-                             msg)
+                             q0, t, npar, ptab, solver, q, lam, sq, slam, stable, resid, iinfo, &
+                             status, msg)
   use iso_c_binding, only: c_double, c_int
   use mbd_api, only: api_statics
   implicit none
   integer(c_int), intent(in) :: nb, nc, np, nf, nfp, nq, neq, npar
+  integer(c_int), intent(in) :: solver     ! 0 auto, 1 dense, 2 banded
   integer(c_int), intent(in) :: ctab(8, nc), ftab(6, nf), ptab(2, npar)
   real(c_double), intent(in) :: rpar(np), bmass(2, nb), grav(2), fpar(nfp), q0(nq), t
   real(c_double), intent(out) :: q(nq), lam(neq), sq(nq, npar), slam(neq, npar), resid
@@ -397,7 +398,7 @@ subroutine core_statics_sens(nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp,
   character(len=512), intent(out) :: msg
   !f2py intent(hide) :: nc, np, nf, nfp, nq, npar
   call api_statics(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, t, q, lam, stable, resid, &
-                   iinfo, status, msg, ptab, sq, slam)
+                   iinfo, status, msg, ptab, sq, slam, solver)
 end subroutine core_statics_sens
 
 subroutine core_reactions_dp(nb, nc, ctab, np, rpar, nq, neq, nt, npar, ptab, q, t, lam, sq, &

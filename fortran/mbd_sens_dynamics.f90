@@ -26,6 +26,7 @@
 module mbd_sens_dynamics
   use mbd_kinds, only: wp, zero, one
   use mbd_status, only: MBD_OK, MBD_SINGULAR, MBD_NO_MEMORY, MSG_LEN
+  use mbd_memory, only: REAL_BYTES, mem_check
   use mbd_points, only: NLOC, MAXROW, rot, drot
   use mbd_model, only: model_t
   use mbd_assemble, only: asm_work_t, asm_init, assemble_blocks, assemble_dense, blocks_jv_rows
@@ -40,13 +41,14 @@ module mbd_sens_dynamics
   use mbd_status, only: MBD_INTEGRATOR_FAILED, MBD_BAD_SETTING
   use mbd_dynamics, only: dyn_work_t, dyn_accel, dyn_project_pos, dyn_velocity, &
                           dyn_factor_projection, dyn_solve_rows, dyn_solve, dyn_multipliers, &
-                          SOLVER_DENSE
+                          dyn_null_basis, SOLVER_DENSE
   use mbd_integrators, only: output_rows, dopri5_state, dopri5_error, DOPRI_C
   use mbd_interp, only: hermite5
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   implicit none
   private
-  public :: sens_multipliers, sens_reactions, sens_statics, sens_dopri5, sens_initial
+  public :: sens_multipliers, sens_reactions, sens_statics, sens_statics_band, sens_dopri5, &
+            sens_initial
   ! (generalized-alpha's sensitivities, mbd_sens_genalpha: the same right-hand sides)
   public :: proj_work_t, proj_init, sens_accel, sens_dyn_rows, cols_to_rows, rows_to_cols
   ! (the multipliers' sensitivities at the outputs of forward dynamics)
@@ -331,6 +333,104 @@ contains
       slam(rows, k) = rhs(n + 1:)
     end do
   end subroutine sens_statics
+
+  !> sens_statics on the band path (no n x n array): the differentiated equilibrium in its
+  !! null-space form, N (nq, ni) an orthonormal basis of J_a's null space (dyn_null_basis):
+  !!   s = s_n + N z,  J_a s_n = -Phi_p,a (minimum norm),
+  !!   (N^T K N) z = N^T (r - K s_n),  r = Q_p - J_p^T lambda,  K = K_lambda - Q_q,
+  !! then J_a^T dlambda_a = r - K s (in J_a^T's range at the solution). s_n and dlambda from
+  !! the saddle-point factors of the minimum-norm projection s [I J_a^T; J_a 0]; K x exact:
+  !! K_lambda x (sens_klam) - Q_q x (sens_force_d without a parameter). Work O(nq ni) and
+  !! ni^3, as the band path's statics.
+  subroutine sens_statics_band(m, w, s, q, t, lam, sq, slam, status, msg)
+    type(model_t), intent(in) :: m              !! model with dynamics data
+    type(dyn_work_t), intent(inout) :: w        !! dynamics work arrays on the band path
+    type(sens_t), intent(inout) :: s            !! parameters and blocks
+    real(wp), intent(in) :: q(:), t             !! equilibrium and time
+    real(wp), intent(in) :: lam(:)              !! multipliers (neq)
+    real(wp), intent(out) :: sq(:, :)           !! dq/dp (nq, np)
+    real(wp), intent(out) :: slam(:, :)         !! dlambda/dp (neq, np)
+    integer, intent(out) :: status              !! MBD_OK, MBD_SINGULAR or MBD_NO_MEMORY
+    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    real(wp), allocatable :: nb(:, :), kn(:, :), h(:, :), r(:), y(:), x(:), z(:), zz(:)
+    integer, allocatable :: ipiv(:)
+    integer :: n, ni, na, i, k, st
+    status = MBD_OK; msg = ''
+    n = m%nq; na = w%na; ni = n - na
+    sq = zero; slam = zero
+    call mem_check(REAL_BYTES * (2 * real(n, wp) * max(ni, 1) + real(ni, wp)**2), &
+                   'the statics sensitivities (band path)', 'use fewer free motions', &
+                   status, msg)
+    if (status /= MBD_OK) return
+    allocate (nb(n, max(ni, 1)), kn(n, max(ni, 1)), h(max(ni, 1), max(ni, 1)), r(n), y(n), &
+              x(n), z(n), zz(max(ni, 1)), ipiv(max(ni, 1)), stat=st)
+    if (st /= 0) then
+      status = MBD_NO_MEMORY; msg = 'out of memory for the statics sensitivities'; return
+    end if
+    z = zero
+    call sens_trig(m, s, q)
+    call sens_hessian(m, s, q, z, z, t)
+    call sens_params(m, s, q, z, z, t)
+    call sens_klam_list(m, s, lam)
+    if (ni > 0) then                            ! H = N^T K N on the free motions
+      call dyn_null_basis(m, w, q, t, nb, status)
+      if (status /= MBD_OK) then
+        msg = 'statics sensitivities: no basis of the free motions'; return
+      end if
+      do i = 1, ni
+        call kmul(nb(:, i), kn(:, i))
+      end do
+      h = matmul(transpose(nb), kn)
+      call lu_factor(h, ipiv, status, msg)
+      if (status /= MBD_OK) then
+        msg = 'statics sensitivities: the equilibrium is not isolated (singular stiffness on '// &
+              'the free motions)'
+        return
+      end if
+    end if
+    call dyn_factor_projection(m, w, q, t, .false., status)
+    if (status /= MBD_OK) then
+      msg = 'statics sensitivities: the projection onto the constraints is singular'; return
+    end if
+    do k = 1, s%np
+      ! r = Q_p - J_p^T lambda; s_n: J_a s_n = -Phi_p,a (minimum norm)
+      call sens_force_d(m, s, k, q, z, z, z, t, r)
+      call sens_jpt_lam(m, s, k, q, t, lam, y)
+      r = r - y
+      w%rhs(1:n) = zero
+      do i = 1, na
+        w%rhs(n + i) = w%s * s%mphip(k, w%rows(i))
+      end do
+      call dyn_solve(w, w%rhs, status)
+      if (status /= MBD_OK) exit
+      sq(:, k) = w%rhs(1:n)
+      if (ni > 0) then                          ! + N z, (N^T K N) z = N^T (r - K s_n)
+        call kmul(sq(:, k), y)
+        zz = matmul(r - y, nb(:, 1:ni))
+        call lu_solve(h, ipiv, zz, status, msg)
+        if (status /= MBD_OK) return
+        sq(:, k) = sq(:, k) + matmul(nb(:, 1:ni), zz)
+      end if
+      ! J_a^T dlambda = r - K s: the projection's least squares (x = 0 at the solution)
+      call kmul(sq(:, k), y)
+      w%rhs(1:n) = r - y; w%rhs(n + 1:) = zero
+      call dyn_solve(w, w%rhs, status)
+      if (status /= MBD_OK) exit
+      do i = 1, na
+        slam(w%rows(i), k) = w%s * w%rhs(n + i)
+      end do
+    end do
+    if (status /= MBD_OK) msg = 'statics sensitivities: a band saddle-point solve failed'
+  contains
+    !> kx = K x = K_lambda x - Q_q x (exact).
+    subroutine kmul(xx, kx)
+      real(wp), intent(in) :: xx(:)
+      real(wp), intent(out) :: kx(:)
+      call sens_klam(s, xx, kx)
+      call sens_force_d(m, s, 0, q, z, xx, z, t, x)
+      kx = kx - x
+    end subroutine kmul
+  end subroutine sens_statics_band
 
   !> Forward dynamics with sensitivities by dopri5 from the consistent state (q, qd) at t0 and
   !! its sensitivities (sq, sqd) (nq, np); outputs as mbd_integrators' integrate, with

@@ -33,7 +33,7 @@ def run_statics(model: ModelDescription, t: float = 0.0, sensitivities: Any = No
     d = pack_dynamics(model, p)
     if params:
         ptab = table(p, params, d)
-        out = core.statics_sens(p, d, t, ptab)
+        out = core.statics_sens(p, d, t, ptab, code)
         check_status(out.status, out.iinfo, out.msg, params)
     else:
         out = core.statics(p, d, t, code)

@@ -269,12 +269,14 @@ def dynamics_sens(p: Packed, d: DynamicTables, t0: float, t1: float, steps: int,
                   numbers=(3 * p.nq + p.neq) * nrow * (1 + ptab.shape[1]))
 
 
-def statics_sens(p: Packed, d: DynamicTables, t: float, ptab: np.ndarray) -> SimpleNamespace:
-    """Static equilibrium with sensitivities: ``q``, ``lam``, ``sq`` (nq, np), ``slam``
-    (neq, np), ``stable``, ``resid``, ``iinfo``, ``status``, ``msg``."""
+def statics_sens(p: Packed, d: DynamicTables, t: float, ptab: np.ndarray,
+                 solver: int = 0) -> SimpleNamespace:
+    """Static equilibrium with sensitivities (solver 0 auto, 1 dense, 2 banded): ``q``,
+    ``lam``, ``sq`` (nq, np), ``slam`` (neq, np), ``stable``, ``resid``, ``iinfo``,
+    ``status``, ``msg``."""
     return _named("q lam sq slam stable resid iinfo status msg", _core.core_statics_sens,
                   ctab=p.ctab, rpar=p.rpar, bmass=d.bmass, grav=d.grav, ftab=d.ftab,
-                  fpar=d.fpar, neq=p.neq, q0=p.q0, t=t, ptab=ptab)
+                  fpar=d.fpar, neq=p.neq, q0=p.q0, t=t, ptab=ptab, solver=solver)
 
 
 def reactions_dp(p: Packed, ptab: np.ndarray, q: np.ndarray, t: np.ndarray, lam: np.ndarray,
