@@ -41,7 +41,9 @@ module mbd_kinematics
   use mbd_band, only: band_t, band_plan, band_move, band_zero, band_norm1, band_factor, &
                       band_rcond, band_solve
   use mbd_linsolve, only: lu_factor, lu_solve, lu_det_sign, svd_null, row_rank, qr_factor, &
-                          qr_solve, qr_lwork, lu_solve_rows, lu_factor_small, lu_solve_small
+                          qr_solve, qr_lwork, lu_solve_rows, lu_factor_small, lu_solve_small, &
+                          RANK_TOL
+  use mbd_saddle, only: saddle_row_rank
   use mbd_splu, only: splu_t, splu_init, splu_plan, splu_factor, splu_solve, splu_solve2, &
                       splu_solve_rows, splu_solve_rows_h, splu_pos, LMAX
   use mbd_lapack, only: dgels, dgecon, dtrcon
@@ -52,7 +54,8 @@ module mbd_kinematics
   private
   public :: kin_opts_t, kin_work_t, kin_report_t, DEP_TOL, SING_RATIO, MAXPASS
   public :: SOLVER_AUTO, SOLVER_DENSE, SOLVER_BANDED
-  public :: kin_work_init, kin_assemble, kin_rank, kin_newton, kin_vel_acc, kin_run, &
+  public :: kin_work_init, kin_assemble, kin_rank, kin_rank_band, kin_newton, kin_vel_acc, &
+            kin_run, &
             kin_singular_report, kin_out_count
 
   real(wp), parameter :: DEP_TOL = 1.0e-3_wp  !! |u_r| / max|u| above which a row is dependent
@@ -881,6 +884,45 @@ contains
     call row_rank(jk, rk, flags, status, msg)
     mobility = m%nq - rk
   end subroutine kin_rank
+
+  !> kin_rank without a dense J (large models): the band rank analysis of J's rows
+  !! (saddle_row_rank, the ordered selection of row_rank in the rows' band order), of all
+  !! rows for the rank and the redundant ones, of the joints' rows for the mobility.
+  subroutine kin_rank_band(m, q, t, rank, mobility, redundant, status, msg)
+    type(model_t), intent(in) :: m           !! model
+    real(wp), intent(in) :: q(:)             !! configuration
+    real(wp), intent(in) :: t                !! time
+    integer, intent(out) :: rank             !! rank of J
+    integer, intent(out) :: mobility         !! degrees of freedom of the joints alone
+    integer, intent(out) :: redundant(:)     !! 1 for a redundant row (neq)
+    integer, intent(out) :: status           !! MBD_OK or MBD_NO_MEMORY
+    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    type(asm_work_t) :: aw
+    real(wp), allocatable :: phi(:), nu(:), gam(:), qz(:)
+    logical, allocatable :: joints(:)
+    integer, allocatable :: flags(:)
+    integer :: r, rk, ierr
+    rank = 0; mobility = 0; redundant = 0
+    allocate (phi(m%neq), nu(m%neq), gam(m%neq), qz(m%nq), joints(m%neq), flags(m%neq), &
+              stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail(REAL_BYTES * (5 * real(m%neq, wp) + m%nq), 'the rank analysis of J (band)', &
+                    'use a smaller model', status, msg)
+      return
+    end if
+    call asm_init(m, aw, status, msg)
+    if (status /= MBD_OK) return
+    qz = zero
+    call assemble_blocks(m, q, qz, t, phi, nu, gam, aw)
+    ! (row_rank: |R_kk| / |R_11| < RANK_TOL of unit rows; here the squared distance)
+    call saddle_row_rank(m, aw%jb, RANK_TOL**2, redundant, rank, status, msg)
+    if (status /= MBD_OK) return
+    do r = 1, m%neq
+      joints(r) = .not. con_is_driver(m%kind(m%con_of_row(r)))
+    end do
+    call saddle_row_rank(m, aw%jb, RANK_TOL**2, flags, rk, status, msg, use=joints)
+    mobility = m%nq - rk
+  end subroutine kin_rank_band
 
   !> SVD of the column-scaled J at q: which rows became dependent and which driver can no
   !! longer be met. Band mode: the smallest singular triple by inverse iteration and the

@@ -876,7 +876,8 @@ contains
   !! rows before it) is at most tol2 is redundant and left out, the ordered Gram-Schmidt
   !! selection of row_rank (mbd_linsolve) in the band order. Cost O(neq kd^2), kd the band
   !! width of the rows. redundant(r) = 1 for a redundant row; rank = neq - their number.
-  subroutine saddle_row_rank(m, jb, tol2, redundant, rank, status, msg)
+  !! With use, the rows where it is false are left out (not redundant, not counted).
+  subroutine saddle_row_rank(m, jb, tol2, redundant, rank, status, msg, use)
     type(model_t), intent(in) :: m                !! model
     real(wp), intent(in) :: jb(:, :, :)           !! constraint blocks at the configuration
     real(wp), intent(in) :: tol2                  !! pivot tolerance (squared distance)
@@ -884,6 +885,7 @@ contains
     integer, intent(out) :: rank                  !! number of independent rows
     integer, intent(out) :: status                !! MBD_OK or MBD_NO_MEMORY
     character(len=MSG_LEN), intent(out) :: msg    !! explanation
+    logical, intent(in), optional :: use(:)       !! (neq) the rows taken
     integer, allocatable :: arow(:), cptr(:), crow(:), csrc(:), pos(:), rowof(:)
     real(wp), allocatable :: g(:, :), rnorm(:)
     integer :: neq, n, c, i, j, a, b, kd, ne, ierr, l, w
@@ -904,6 +906,9 @@ contains
       rnorm(crow(i)) = rnorm(crow(i)) + jbf(csrc(i))**2
     end do
     rnorm = sqrt(rnorm)
+    if (present(use)) then                     ! (a row left out: no entries in G)
+      where (.not. use) rnorm = zero
+    end if
     ! the rows in reverse Cuthill-McKee order of the graph of rows sharing a coordinate
     call rows_rcm(neq, cptr, crow, pos, kd, ierr)
     if (ierr /= 0) goto 90
@@ -951,7 +956,12 @@ contains
         end do
       end do
     end do
-    rank = neq - count(redundant == 1)
+    if (present(use)) then
+      where (.not. use) redundant = 0
+      rank = count(use) - count(redundant == 1)
+    else
+      rank = neq - count(redundant == 1)
+    end if
     return
 90  call mem_fail(REAL_BYTES * 8 * (real(neq, wp) + 6 * n), 'the rank analysis of J (band)', &
                   HINT, status, msg)

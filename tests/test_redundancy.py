@@ -139,3 +139,28 @@ def test_check_command_prints_the_report() -> None:
     assert r.returncode == 0, r.stderr
     assert "degrees of freedom 0" in r.stdout
     assert "upper.x" in r.stdout and "upper.y" in r.stdout
+
+
+@pytest.mark.parametrize("n, extra", [(5, 2), (400, 5)])
+def test_dof_of_a_large_chain_with_redundant_links(n: int, extra: int) -> None:
+    """The N-four-bar (a chain of parallelograms, one degree of freedom) with `extra` middle
+    cranks, each a parallelogram's third link (one redundant equation each, by construction):
+    rank = equations - extra, one degree of freedom, mobility 1 with and without the driver.
+    N = 400 (2403 coordinates and more) takes the band assembly and rank analysis (the dense
+    ones took 44 s there; no n x n array now), N = 5 (42 coordinates) the dense ones."""
+    sys.path.insert(0, str(EXAMPLES))
+    from nfourbar import build
+    for driven in (True, False):
+        m = build(n, driven=driven)
+        for k in range(extra):
+            x = 2 * k + 0.5                            # between pivots 2k and 2k + 1
+            m.add_body(f"mid{k}", q0=[x, 0.5, np.pi / 2])
+            m.add_revolute(["ground", f"mid{k}"], [[x, 0.0], [-0.5, 0.0]], name=f"M{k}")
+            m.add_revolute([f"mid{k}", f"coupler{2 * k}"], [[0.5, 0.0], [0.0, 0.0]],
+                           name=f"N{k}")
+        rep = m.analyze_dof()
+        nq = 3 * (2 * n + 1 + extra)
+        neq = 2 * (3 * n + 1) + 4 * extra + (1 if driven else 0)
+        assert (rep.coordinates, rep.equations) == (nq, neq)
+        assert rep.rank == neq - extra and len(rep.redundant_rows) == extra
+        assert rep.dof == (0 if driven else 1) and rep.mobility == 1
