@@ -20,8 +20,9 @@ module mbd_api
   use mbd_memory, only: REAL_BYTES, mem_fail
   use mbd_points, only: NLOC, MAXROW
   use mbd_model, only: model_t, model_build, model_add_dynamics, model_force_size
+  use mbd_assembly, only: band_lm_assemble
   use mbd_dynamics, only: dyn_work_t, dyn_init, dyn_memory_check, dyn_velocity, &
-                          dyn_multipliers, dyn_reactions, dyn_assemble, dyn_choose, dyn_jv, &
+                          dyn_multipliers, dyn_reactions, dyn_choose, dyn_jv, &
                           gen_forces, kinetic_energy, dyn_element_outputs, SOLVER_DENSE
   use mbd_events, only: ev_log_t, ev_log_init, events_switch, events_active
   use mbd_forces, only: force_is_contact, FRC_FRICTION
@@ -492,7 +493,7 @@ contains
     if (status /= MBD_OK) return
     if (path /= SOLVER_DENSE) then
       q = q0 / m%cunit
-      call dyn_assemble(m, q, t, opts%tol * m%lscale, opts%assembly_maxit, status, msg, worst, &
+      call band_lm_assemble(m, q, t, opts%tol * m%lscale, opts%assembly_maxit, status, msg, worst, &
                         resid)
       resid = resid_units(m, resid, worst)
       if (status == MBD_OK) call kin_rank_band(m, q, t, rank, mobility, redundant, status, msg)
@@ -759,7 +760,7 @@ contains
   !! for that method), 8 of the index-1 factorizations those through the Schur complement
   !! (mbd_schur; band path), 9 and 10 the partitioned method's worst rcond of J_u and when.
   !! solver: 0 auto, 1 dense, 2 banded (dyn_choose); the band path assembles q0 by
-  !! Levenberg-Marquardt in band storage (dyn_assemble) and never allocates n x n.
+  !! Levenberg-Marquardt in band storage (band_lm_assemble) and never allocates n x n.
   subroutine api_dynamics(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, v0, t0, t1, nsteps, &
                           method, rtol, atol, h, rho_inf, balpha, bbeta, every, qout, qdout, &
                           qddout, lamout, eout, iinfo, rinfo, redundant, status, msg, max_steps, &
@@ -908,7 +909,7 @@ contains
   !> The assembly at the start of dynamics and statics: Levenberg-Marquardt from the q0
   !! estimates to ||Phi||_inf <= tol (relative to the length scale), with a dense J
   !! (kin_assemble, with its diagnosis of contradicting redundant constraints) or in band
-  !! storage (dyn_assemble).
+  !! storage (band_lm_assemble).
   subroutine assemble_start(m, path, q, t, kopts, status, msg)
     type(model_t), intent(in) :: m              !! model
     integer, intent(in) :: path                 !! SOLVER_DENSE or SOLVER_BANDED
@@ -923,7 +924,7 @@ contains
     real(wp) :: resid
     msg = ''
     if (path /= SOLVER_DENSE) then
-      call dyn_assemble(m, q, t, kopts%tol * m%lscale, kopts%assembly_maxit, status, msg, &
+      call band_lm_assemble(m, q, t, kopts%tol * m%lscale, kopts%assembly_maxit, status, msg, &
                         worst, resid)
       return
     end if

@@ -44,6 +44,7 @@ module mbd_kinematics
                           qr_solve, qr_lwork, lu_solve_rows, lu_factor_small, lu_solve_small, &
                           RANK_TOL
   use mbd_saddle, only: saddle_row_rank
+  use mbd_assembly, only: band_lm_assemble
   use mbd_splu, only: splu_t, splu_init, splu_plan, splu_factor, splu_solve, splu_solve2, &
                       splu_solve_rows, splu_solve_rows_h, splu_pos, LMAX
   use mbd_lapack, only: dgels, dgecon, dtrcon
@@ -110,9 +111,15 @@ module mbd_kinematics
   !! its error (the first correction: the term no longer helps), one higher after a step
   !! whose first correction was too large for the closed-form rest
   integer, parameter :: POS_ORDER_MIN = PRED_ORDER - 2
-  !> largest dense Levenberg-Marquardt assembly (J and [J; mu I]) allowed in band mode (bytes):
-  !! n up to about 1670; larger banded models assemble by damped Newton on the band
-  real(wp), parameter :: DENSE_FALLBACK = 64.0_wp * 1048576
+  !> dense-mode models with this many coordinates and more assemble by Levenberg-Marquardt in
+  !! band storage when their structure allows (a dense iteration: a QR of (neq + n) x n);
+  !! where it does not, their dense iterations end once a window of STALL_WINDOW of them
+  !! reduces ||Phi||_2 by less than STALL_DECREASE of itself (the least squares crawl
+  !! towards a point where the constraints cannot all hold: 400 dense iterations took 105 s
+  !! at 603 coordinates for 0.6%; small models keep crawling, cheaply, to where J's rank
+  !! tells contradicting constraints)
+  integer, parameter :: LM_BAND_MIN_N = 200, STALL_WINDOW = 20
+  real(wp), parameter :: STALL_DECREASE = 1.0e-3_wp
   !> a start is taken without a correction when the correction is below RES_ULPS units in the
   !! last place of every coordinate (of max(|q_i|, 1, L |theta|): below_resolution)
   real(wp), parameter :: RES_ULPS = 4.0_wp
@@ -671,10 +678,9 @@ contains
   !! residual and the constraint with the largest residual are reported; if J is rank
   !! deficient there, the rows that contradict each other (those with a residual: at the
   !! minimum Phi is orthogonal to the range of J) are flagged in rep%dep, MBD_INCONSISTENT.
-  !! Band mode: Newton from the estimates; if it fails, Levenberg-Marquardt on a dense J as
-  !! above while its arrays stay below DENSE_FALLBACK, otherwise Newton damped by backtracking
-  !! on ||Phi||_2 (band_assemble, no n x n array; its failure is MBD_ASSEMBLY_FAILED without
-  !! the rank diagnosis).
+  !! Band mode: Newton from the estimates; if it fails, the same Levenberg-Marquardt in band
+  !! storage (mbd_assembly band_lm_assemble, no n x n array) and on a failure the band rank
+  !! diagnosis (band_failure). Both end early on a least-squares crawl (STALL_WINDOW).
   subroutine kin_assemble(m, w, q, t, opts, rep, status, msg)
     type(model_t), intent(in) :: m           !! model
     type(kin_work_t), intent(inout) :: w     !! work arrays
@@ -688,6 +694,7 @@ contains
     real(wp) :: mu, f, ft, wq(1), dmax, pmax, bytes
     integer :: it, n, neq, info, lwork, i, k, rank, st, ierr
     integer, allocatable :: flags(:)
+    real(wp) :: fwin
     character(len=*), parameter :: WHAT = 'the assembly (Levenberg-Marquardt on the dense J)'
 
     status = MBD_OK; msg = ''
@@ -701,21 +708,16 @@ contains
     lwork = max(1, int(wq(1)))
     bytes = REAL_BYTES * ((real(neq, wp) + n) * (n + 1) + neq + lwork)
     if (w%banded) then
-      ! square models in band storage: plain Newton first
+      ! square models in band storage: plain Newton first, then Levenberg-Marquardt in band
+      ! storage (no n x n array; the dense one took 105 s at 603 coordinates), then on a
+      ! failure the band rank diagnosis
       qt = q
       call kin_newton(m, w, q, t, BAND_ASSEMBLY_MAXIT, st)
       if (st == MBD_OK) return
       q = qt
-      if (bytes + REAL_BYTES * real(neq, wp) * n > DENSE_FALLBACK) then
-        ! large: damped Newton on the band (no n x n array)
-        call band_assemble(m, w, q, t, opts%assembly_maxit, qt, rep, status, msg)
-        return
-      end if
-      ! small enough for the dense Levenberg-Marquardt below: its J, for this assembly only
-      if (.not. allocated(w%jac)) allocate (w%jac(neq, n), stat=ierr)
-      if (ierr /= 0) then
-        call mem_fail(REAL_BYTES * real(neq, wp) * n, WHAT, DENSE_HINT, status, msg); return
-      end if
+      call band_lm_assemble(m, q, t, w%tol, opts%assembly_maxit, status, msg, k, pmax)
+      if (status == MBD_ASSEMBLY_FAILED) call band_failure(m, w, q, t, rep, status, msg)
+      return
     end if
     if (.not. w%banded .and. .not. w%lsq .and. neq == n) then
       ! square J: the Newton steps Levenberg-Marquardt would take as mu -> 0, while they
@@ -723,6 +725,18 @@ contains
       qt = q
       if (start_newton(m, w, q, t)) return
       q = qt
+    end if
+    if (n >= LM_BAND_MIN_N) then
+      ! a large dense-mode model (J not square: redundant rows): Levenberg-Marquardt in band
+      ! storage where its structure allows (each dense iteration is a QR of (neq + n) x n)
+      qt = q
+      call band_lm_assemble(m, q, t, w%tol, opts%assembly_maxit, status, msg, k, pmax)
+      if (status == MBD_OK) return
+      if (status == MBD_ASSEMBLY_FAILED) then
+        call band_failure(m, w, q, t, rep, status, msg)
+        return
+      end if
+      q = qt                                    ! (no band plan: the dense one below)
     end if
     call mem_check(bytes, WHAT, DENSE_HINT, status, msg)
     if (status /= MBD_OK) return
@@ -737,8 +751,14 @@ contains
       dmax = max(dmax, sum(w%jac(:, k)**2))
     end do
     mu = 1.0e-3_wp * max(dmax, one)
+    fwin = f
     do it = 1, opts%assembly_maxit
       if (maxval(abs(w%phi)) <= w%tol) exit
+      ! a large model crawling towards a least-squares point (LM_BAND_MIN_N)
+      if (mod(it, STALL_WINDOW) == 0 .and. n >= LM_BAND_MIN_N) then
+        if (f > (one - STALL_DECREASE) * fwin) exit
+        fwin = f
+      end if
       aug = zero
       aug(1:neq, :) = w%jac
       do i = 1, n
@@ -790,55 +810,44 @@ contains
     end if
   end subroutine kin_assemble
 
-  !> Assembly in band mode, after plain Newton failed: Newton steps J dq = -Phi damped by
-  !! backtracking, q + s dq with s halved until ||Phi||_2 falls by the fraction 1e-4 s
-  !! (Armijo), to ||Phi||_inf <= tol. Band LU only: no n x n array. On failure q is the best
-  !! configuration found and rep names the residual and its largest constraint.
-  subroutine band_assemble(m, w, q, t, maxit, qt, rep, status, msg)
-    type(model_t), intent(in) :: m           !! model (square J, band plan in w)
-    type(kin_work_t), intent(inout) :: w     !! work arrays
-    real(wp), intent(inout) :: q(:)          !! estimates, then the assembled configuration
+  !> A failed assembly in band mode, at the best configuration q found (band_lm_assemble):
+  !! rep names the residual and its largest constraint; the band rank analysis of J's rows
+  !! (saddle_row_rank) tells constraints that contradict each other (MBD_INCONSISTENT, as
+  !! kin_assemble's dense diagnosis) from no configuration near (MBD_ASSEMBLY_FAILED).
+  subroutine band_failure(m, w, q, t, rep, status, msg)
+    type(model_t), intent(in) :: m           !! model
+    type(kin_work_t), intent(inout) :: w     !! work arrays (band mode)
+    real(wp), intent(in) :: q(:)             !! the best configuration found
     real(wp), intent(in) :: t                !! time
-    integer, intent(in) :: maxit             !! iterations
-    real(wp), intent(inout) :: qt(:)         !! workspace (nq)
     type(kin_report_t), intent(inout) :: rep !! failure details
-    integer, intent(out) :: status           !! MBD_OK or MBD_ASSEMBLY_FAILED
+    integer, intent(out) :: status           !! MBD_INCONSISTENT, MBD_ASSEMBLY_FAILED or < 0
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
-    real(wp), parameter :: SMIN = 1.0e-10_wp
-    real(wp) :: f, ft, s
-    integer :: it, st, neq
-    status = MBD_OK; msg = ''
-    neq = m%neq
-    do it = 1, maxit
-      call assemble_j(m, w, q, w%qz, t)
-      if (maxval(abs(w%phi)) <= w%tol) return
-      f = norm2(w%phi)
-      call factor(w, st)
-      if (st /= MBD_OK) exit
-      call solve_newton(w)
-      s = one
-      do while (s >= SMIN)
-        qt = q + s * w%dq
-        call assemble_blocks(m, qt, w%qz, t, w%rhs(1:neq), w%nu, w%gam, w%asm)
-        ft = norm2(w%rhs(1:neq))
-        if (ft <= (one - 1.0e-4_wp * s) * f) exit
-        s = half * s
-      end do
-      if (s < SMIN) exit
-      q = qt
-    end do
+    integer :: rank, st
     call assemble_blocks(m, q, w%qz, t, w%phi, w%nu, w%gam, w%asm)
     rep%resid = maxval(abs(w%phi))
-    if (rep%resid <= 1.0e3_wp * w%tol) return     ! kin_run's Newton polishes (as dense LM)
     rep%worst = m%con_of_row(maxloc(abs(w%phi), 1))
     rep%t_fail = t
     rep%qsing = q
-    status = MBD_ASSEMBLY_FAILED
-    write (msg, '(a,es10.3,a,i0,a)') 'assembly failed: no configuration satisfies the '// &
-      'constraints near the estimates (banded solver: damped Newton); smallest residual '// &
-      '||Phi|| = ', rep%resid, ', largest in constraint ', rep%worst, &
-      ' ('//trim(con_name(m%kind(rep%worst)))//')'
-  end subroutine band_assemble
+    ! (row_rank: |R_kk| / |R_11| < RANK_TOL of unit rows; here the squared distance)
+    call saddle_row_rank(m, w%asm%jb, RANK_TOL**2, rep%redundant, rank, st, msg)
+    if (st == MBD_NO_MEMORY) then
+      status = st; return
+    end if
+    if (st == MBD_OK .and. rank < m%neq) then
+      status = MBD_INCONSISTENT
+      rep%rank = rank
+      rep%dep = merge(1, 0, abs(w%phi) > DEP_TOL * rep%resid)
+      write (msg, '(a,es10.3,a)') 'assembly failed: redundant constraints contradict each '// &
+        'other (smallest residual ||Phi|| = ', rep%resid, ')'
+    else
+      rep%redundant = 0
+      status = MBD_ASSEMBLY_FAILED
+      write (msg, '(a,es10.3,a,i0,a)') 'assembly failed: no configuration satisfies the '// &
+        'constraints near the estimates (banded solver); smallest residual ||Phi|| = ', &
+        rep%resid, ', largest in constraint ', rep%worst, &
+        ' ('//trim(con_name(m%kind(rep%worst)))//')'
+    end if
+  end subroutine band_failure
 
   !> Rank of J at q and the redundant rows (1 in redundant: rows that repeat what the rows
   !! before them impose, see row_rank). Dense mode only.

@@ -88,3 +88,53 @@ def test_no_configuration_is_still_reported() -> None:
     m2 = m.with_params({"joint.A.points.1.0": -0.2, "joint.B.points.0.0": 0.2})
     with pytest.raises(mbd2d.AssemblyError):
         m2.kinematics(t_end=0.01, steps=1)
+
+
+# ------------------------------------------------------------------- large models
+
+def chain(n: int, scatter: float = 0.0, seed: int = 0) -> mbd2d.Model:
+    """The driven N-four-bar (examples/nfourbar.py), its q0 estimates scattered by up to
+    `scatter` (positions and angles)."""
+    import sys
+    sys.path.insert(0, str(EXAMPLES))
+    from nfourbar import build
+    m = build(n)
+    rng = np.random.default_rng(seed)
+    for b in m.bodies:
+        b.q0 = [float(v) for v in np.asarray(b.q0) + rng.uniform(-scatter, scatter, 3)]
+    return m
+
+
+@pytest.mark.parametrize("n", [100, 400])
+def test_large_chain_assembles_from_scattered_estimates(n: int) -> None:
+    """603 and 2403 coordinates (band mode), estimates off by up to 0.3: the assembled
+    configuration is the chain's closed form at t = 0 (cranks upright at x = k, couplers
+    level at height 1)."""
+    res = chain(n, scatter=0.3).kinematics(0.0 + 1e-3, 1)
+    q = res.q[0]
+    k = np.arange(n + 1)
+    assert np.abs(q[0:3 * (n + 1):3] - k).max() < 1e-10            # cranks' x
+    assert np.abs(q[1:3 * (n + 1):3] - 0.5).max() < 1e-10
+    assert np.abs(q[2:3 * (n + 1):3] - np.pi / 2).max() < 1e-10
+    cpl = q[3 * (n + 1):]
+    assert np.abs(cpl[0::3] - (np.arange(n) + 0.5)).max() < 1e-10
+    assert np.abs(cpl[1::3] - 1.0).max() < 1e-10 and np.abs(cpl[2::3]).max() < 1e-10
+
+
+@pytest.mark.parametrize("n", [100, 400])
+def test_large_chain_that_cannot_close_is_reported(n: int) -> None:
+    """A crank pin moved so no loop closes: AssemblyError naming a joint and the residual
+    (Levenberg-Marquardt in band storage, stopped where it crawls; the dense one took 105 s
+    at 603 coordinates); a middle crank of the wrong length (a redundant, contradicting
+    link): InconsistentConstraintsError naming the loop's constraints."""
+    m = chain(n)
+    m.joints[5].points = ((0.3, 0.0), (-0.5, 0.0))
+    with pytest.raises(mbd2d.AssemblyError, match=r"smallest residual .* largest in joint"):
+        m.kinematics(0.1, 2)
+    m = chain(n)
+    m.add_body("mid", q0=[0.5, 0.5, np.pi / 2])
+    m.add_revolute(["ground", "mid"], [[0.5, 0.0], [-0.5, 0.0]], name="M")
+    m.add_revolute(["mid", "coupler0"], [[0.52, 0.0], [0.0, 0.0]], name="NN")
+    with pytest.raises(mbd2d.InconsistentConstraintsError,
+                       match=r"O0, O1, L0, R0, M, NN cannot all hold"):
+        m.kinematics(0.1, 2)
