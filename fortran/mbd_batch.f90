@@ -54,7 +54,8 @@ contains
   !! its analysis succeeded).
   !! Design sensitivities (ptab (2, np) as mbd_sensitivity takes it, with sq, sqd, sqdd
   !! (nq, np, rows, ncase) and slam (neq, or 0 for kinematics, np, rows, ncase); not with
-  !! positions-only kinematics; dynamics by dopri5 or generalized-alpha): each case's, as a single run of its tables gives them.
+  !! positions-only kinematics; dynamics by dopri5 or generalized-alpha): each case's, as a
+  !! single run of its tables gives them.
   !! With both, mdout gets the measures' design derivatives (api_measures).
   subroutine batch_run(analysis, nb, ctab, rpar, bmass, grav, ftab, fpar, q0, v0, vtab, vals, &
                        opens, iset, rset, qout, qdout, qddout, lamout, eout, iinfo, rinfo, &

@@ -455,8 +455,8 @@ end subroutine core_dynamics_sens
 ! nm > 0 measures (mbd_measures: mkind, mint, mpts, mref, at the output times) go to mout
 ! (nm, nrow, ncase), their failures to mbad (3, ncase); with npar > 0 design parameters
 ! (ptab) their sensitivities to sq, sqd, sqdd (nq, npar, nrow, ncase) and slam (nsl = neq for
-! inverse dynamics, statics and dynamics, 0 for kinematics); with both, the measures' design derivatives to dmout
-! (nm, npar, nrow, ncase). The tables have nmp = max(nm, 1) and npp =
+! inverse dynamics, statics and dynamics, 0 for kinematics); with both, the measures' design
+! derivatives to dmout (nm, npar, nrow, ncase). The tables have nmp = max(nm, 1) and npp =
 ! max(npar, 1) columns (f2py takes no zero-length table).
 subroutine core_batch(analysis, nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp, fpar, nq, &
                       q0, v0, nv, vtab, ncase, vals, no, opens, iset, rset, neq, nrow, nd, &
