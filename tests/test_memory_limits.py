@@ -156,7 +156,9 @@ def test_huge_model_dynamics_statics_and_inverse_run_banded_in_little_memory() -
     """N = 10000 (60,003 coordinates): dynamics, statics and inverse dynamics once needed
     hundreds of GB of dense matrices and refused; now (solver="auto") they take the band
     path, no n x n array: generalized-alpha and dopri5 for a few steps, the equilibrium and
-    the multipliers, all under a 1 GiB address-space limit (a missed n x n allocation fails
+    the multipliers, inverse dynamics' and statics' sensitivities (the motor torque's to
+    gravity against its closed form) and the rank analysis of analyze_dof, all under a
+    1 GiB address-space limit (a missed n x n allocation fails
     the test instead of filling the machine), peak RSS of the whole process under 400 MiB
     (measured 215 MiB). Oracle for the motion: the parallelogram branch (every crank at the
     same angle, the couplers level). solver="dense" keeps n x n matrices and refuses at
@@ -177,9 +179,25 @@ def test_huge_model_dynamics_statics_and_inverse_run_banded_in_little_memory() -
             res["statics"] = [s.stats["solver"], s.stability, s.residual]
         def inv():
             r = driven.inverse_dynamics(t_end=0.002, steps=2)
-            res["inverse"] = [r.stats["multiplier_solver"], float(np.abs(r.lam).max()), 0.0]
+            tau = (10001 / 2 + 10000) * 9.81 * np.cos(r.body("crank0").theta)
+            res["inverse"] = [r.stats["multiplier_solver"],
+                              float(np.abs(r.effort("motor") - tau).max() / np.abs(tau).max())]
+        def inv_sens():
+            r = driven.inverse_dynamics(t_end=0.002, steps=2, sensitivities=["model.gravity.1"])
+            c = 10001 / 2 + 10000                       # d tau / d g_y = -c cos(theta)
+            want = -c * np.cos(r.body("crank0").theta)
+            res["inverse_sens"] = [r.stats["multiplier_solver"],
+                                   float(np.abs(r.effort_dp("motor")[:, 0] - want).max()
+                                         / np.abs(want).max())]
+        def st_sens():
+            s = model.statics(sensitivities=["model.gravity.1"])
+            res["statics_sens"] = [s.stats["solver"], float(np.abs(s.dq_dp).max())]
+        def dof():
+            d = model.analyze_dof()
+            res["dof"] = [d.rank, d.dof, d.mobility, len(d.redundant_rows)]
         res["outcomes"] = [outcome(lambda: dyn("generalized-alpha", h=1e-3)),
-                           outcome(lambda: dyn("dopri5")), outcome(st), outcome(inv)]
+                           outcome(lambda: dyn("dopri5")), outcome(st), outcome(inv),
+                           outcome(inv_sens), outcome(st_sens), outcome(dof)]
         # solver="dense" keeps n x n matrices: refused at once, naming the size
         res["dense"] = [outcome(lambda: model.dynamics(t_end=0.01, steps=2, solver="dense")),
                         outcome(lambda: model.statics(solver="dense")),
@@ -189,14 +207,20 @@ def test_huge_model_dynamics_statics_and_inverse_run_banded_in_little_memory() -
         res["rss_mib"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
         print(json.dumps(res))
     """)
-    assert [k for k, _ in out["outcomes"]] == ["ok"] * 4, out["outcomes"]
+    assert [k for k, _ in out["outcomes"]] == ["ok"] * 7, out["outcomes"]
     for method in ("generalized-alpha", "dopri5"):
         solver, spread, level = out[method]
         assert solver == "banded"
         assert spread < 1e-9 and level < 1e-9, out[method]     # cranks parallel, couplers level
     assert out["statics"][0] == "banded" and out["statics"][1] == "unstable"   # upright
     assert out["statics"][2] < 1e-12                                          # measured 1e-18
-    assert out["inverse"][0] == "banded" and np.isfinite(out["inverse"][1])
+    # the motor torque against its closed form (test_band_dynamics): it was 99.98% off here
+    # (the multipliers' band solve took the index-1 check's regularized least squares)
+    assert out["inverse"][0] == "banded" and out["inverse"][1] < 1e-8, out["inverse"]
+    # the sensitivities and the rank analysis on the band path too (they were dense: refused)
+    assert out["inverse_sens"][0] == "banded" and out["inverse_sens"][1] < 1e-9
+    assert out["statics_sens"][0] == "banded" and out["statics_sens"][1] < 1e-6
+    assert out["dof"] == [60002, 1, 1, 0]
     assert out["rss_mib"] < 400, out["rss_mib"]
     for kind, text in out["dense"]:
         assert kind == "InsufficientMemoryError", (kind, text)
