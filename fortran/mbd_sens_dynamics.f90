@@ -54,6 +54,10 @@ module mbd_sens_dynamics
   ! (the multipliers' sensitivities at the outputs of forward dynamics)
   public :: lam_work_t, lam_init, sens_out_multipliers
 
+  !> a singular reduced stiffness at a statics sensitivity
+  character(len=*), parameter :: NOT_ISOLATED = 'statics sensitivities: the equilibrium is '// &
+    'not isolated (singular stiffness on the free motions)'
+
   !> Work of project_sens and of the dopri5 right-hand sides (allocated once per run by
   !! proj_init: no step allocates).
   type :: proj_work_t
@@ -317,15 +321,10 @@ contains
     aug(n + 1:, 1:n) = jac(rows, :)
     call lu_factor(aug, ipiv, status, msg)
     if (status /= MBD_OK) then
-      msg = 'statics sensitivities: the equilibrium is not isolated (singular stiffness on '// &
-            'the free motions)'
-      return
+      msg = NOT_ISOLATED; return
     end if
     do k = 1, s%np
-      call sens_force_d(m, s, k, q, z, z, z, t, y)          ! Q_p
-      rhs(1:n) = y
-      call sens_jpt_lam(m, s, k, q, t, lam, y)
-      rhs(1:n) = rhs(1:n) - y
+      call statics_load(m, s, k, q, t, lam, z, y, rhs(1:n))
       rhs(n + 1:) = s%mphip(k, rows)
       call lu_solve(aug, ipiv, rhs, status, msg)
       if (status /= MBD_OK) return
@@ -333,6 +332,18 @@ contains
       slam(rows, k) = rhs(n + 1:)
     end do
   end subroutine sens_statics
+
+  !> The equilibrium's load along parameter k: r = Q_p - J_p^T lambda (z: zeros, y: work).
+  subroutine statics_load(m, s, k, q, t, lam, z, y, r)
+    type(model_t), intent(in) :: m              !! model with dynamics data
+    type(sens_t), intent(inout) :: s            !! parameters and blocks
+    integer, intent(in) :: k                    !! parameter
+    real(wp), intent(in) :: q(:), t, lam(:), z(:)  !! equilibrium, time, multipliers, zeros
+    real(wp), intent(out) :: y(:), r(:)         !! work; the load (nq)
+    call sens_force_d(m, s, k, q, z, z, z, t, r)          ! Q_p
+    call sens_jpt_lam(m, s, k, q, t, lam, y)
+    r = r - y
+  end subroutine statics_load
 
   !> sens_statics on the band path (no n x n array): the differentiated equilibrium in its
   !! null-space form, N (nq, ni) an orthonormal basis of J_a's null space (dyn_null_basis):
@@ -383,9 +394,7 @@ contains
       h = matmul(transpose(nb), kn)
       call lu_factor(h, ipiv, status, msg)
       if (status /= MBD_OK) then
-        msg = 'statics sensitivities: the equilibrium is not isolated (singular stiffness on '// &
-              'the free motions)'
-        return
+        msg = NOT_ISOLATED; return
       end if
     end if
     call dyn_factor_projection(m, w, q, t, .false., status)
@@ -394,9 +403,7 @@ contains
     end if
     do k = 1, s%np
       ! r = Q_p - J_p^T lambda; s_n: J_a s_n = -Phi_p,a (minimum norm)
-      call sens_force_d(m, s, k, q, z, z, z, t, r)
-      call sens_jpt_lam(m, s, k, q, t, lam, y)
-      r = r - y
+      call statics_load(m, s, k, q, t, lam, z, y, r)
       w%rhs(1:n) = zero
       do i = 1, na
         w%rhs(n + i) = w%s * s%mphip(k, w%rows(i))
