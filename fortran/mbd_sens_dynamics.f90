@@ -666,7 +666,7 @@ contains
     end subroutine at_state
 
     !> The index-1 solve at the output state (z, zd) (q and S as rows, flat), whole
-    !! (sens_accel_full): q_ddot to aa, S_ddot's rows to sdd, the multipliers to lo, lok and,
+    !! (sens_accel): q_ddot to aa, S_ddot's rows to sdd, the multipliers to lo, lok and,
     !! with independent rows, their sensitivities to slo.
     subroutine out_lambda(row, tk, z, zd, sdd, stp)
       integer, intent(in) :: row
@@ -674,7 +674,7 @@ contains
       real(wp), intent(in), contiguous :: z(:), zd(:)
       real(wp), intent(inout), contiguous :: sdd(:)
       integer, intent(out) :: stp
-      call sens_accel_full(m, w, s, pw, z(1:n), zd(1:n), tk, npd, z(n + 1:), zd(n + 1:), aa, &
+      call sens_accel(m, w, s, pw, z(1:n), zd(1:n), tk, npd, z(n + 1:), zd(n + 1:), aa, &
                            lam, stp, sdd)
       if (stp /= MBD_OK) return
       lo(:, row) = lam; lok(row) = w%na == m%neq .and. .not. w%lsq
@@ -692,33 +692,6 @@ contains
       call rows_to_cols(n, np, npd, z3(n + 1:), sddo(:, :, row), s%ounit)
     end subroutine put
   end subroutine sens_dopri5
-
-  !> The accelerations of the index-1 system at (qs, vs) and of the sensitivities (S, S_dot
-  !! as rows st, sdt (npd, n)): [M J^T; J 0][q_ddot; lambda] = [Q; gamma] (dyn_accel), then
-  !! S_ddot (rows sddt) from its differentiation with the same factors, every parameter in
-  !! one solve (sens_dyn_rows, the constraint rows gamma_p - J_p q_ddot - Ha S - 2 Hv S_dot).
-  subroutine sens_accel(m, w, s, pw, qs, vs, tt, npd, st, sdt, aa, lam, sddt, stp)
-    type(model_t), intent(in) :: m              !! model with dynamics data
-    type(dyn_work_t), intent(inout) :: w        !! dynamics work arrays
-    type(sens_t), intent(inout) :: s            !! parameters and blocks
-    type(proj_work_t), intent(inout) :: pw      !! work (proj_init)
-    !> state and time (contiguous: no run-time packing checks where they reach explicit
-    !! shapes below)
-    real(wp), intent(in), contiguous :: qs(:), vs(:)
-    real(wp), intent(in) :: tt
-    integer, intent(in) :: npd                  !! rows of st, sdt, sddt (np rounded up to 4 k)
-    real(wp), intent(in) :: st(npd, *), sdt(npd, *)   !! S, S_dot as rows (npd, n)
-    real(wp), intent(out), contiguous :: aa(:), lam(:)  !! q_ddot, lambda (active rows)
-    real(wp), intent(out) :: sddt(npd, *)       !! S_ddot as rows (npd, n)
-    integer, intent(out) :: stp                 !! MBD_OK or the solve's failure
-    integer :: n
-    n = m%nq
-    call dyn_accel(m, w, qs, vs, tt, aa, lam, stp)
-    if (stp /= MBD_OK) return
-    call sens_dyn_rows(m, w, s, pw, qs, vs, aa, lam, tt, npd, st, sdt, .true.)
-    call constraint_rows(n, w%na, npd, m%neq, w%rows, w%s, s%rhs, pw%rt)
-    call dyn_solve_rows(w, pw%rt, s%np, n, npd, sddt, .false., stp)
-  end subroutine sens_accel
 
   !> Allocate sens_out_multipliers' work for model m, the active rows of w and the
   !! parameters of s.
@@ -749,7 +722,7 @@ contains
   !! along (S, S_dot) = (sq, sqd) (nq, np; model units, s%ounit): lambda as the outputs take
   !! it (the index-1 solve's with independent rows, else the minimum-norm set of
   !! dyn_multipliers), dlambda/dp (neq, np; model units) its derivative. From the whole
-  !! solve of the sensitivities' saddle system (sens_accel_full); with redundant rows on the
+  !! solve of the sensitivities' saddle system (sens_accel); with redundant rows on the
   !! dense path the minimum-norm solution of J^T dlambda = b (sens_multipliers, as inverse
   !! dynamics), b from that solve's S_ddot. status: the solves' (MBD_OK or a failure).
   subroutine sens_out_multipliers(m, w, s, lw, q, qd, t, sq, sqd, lam, slam, status, msg)
@@ -770,7 +743,7 @@ contains
     lw%cq = sq / s%ounit; lw%cqd = sqd / s%ounit
     call cols_to_rows(n, np, npd, n, lw%cq, lw%st)
     call cols_to_rows(n, np, npd, n, lw%cqd, lw%sdt)
-    call sens_accel_full(m, w, s, lw%pw, q, qd, t, npd, lw%st, lw%sdt, lw%aa, lw%lam, status)
+    call sens_accel(m, w, s, lw%pw, q, qd, t, npd, lw%st, lw%sdt, lw%aa, lw%lam, status)
     if (status /= MBD_OK) then
       msg = 'the index-1 equations are singular'; return
     end if
@@ -791,9 +764,12 @@ contains
     slam = slam * lw%lunit
   end subroutine sens_out_multipliers
 
-  !> sens_accel solved whole: [S_ddot; dlambda] as rows to pw%xl (npd, n + na), S_ddot's
-  !! rows also to sddt when given.
-  subroutine sens_accel_full(m, w, s, pw, qs, vs, tt, npd, st, sdt, aa, lam, stp, sddt)
+  !> The accelerations of the index-1 system at (qs, vs) and of the sensitivities (S, S_dot
+  !! as rows st, sdt (npd, n)): [M J^T; J 0][q_ddot; lambda] = [Q; gamma] (dyn_accel), then
+  !! [S_ddot; dlambda] from its differentiation with the same factors, every parameter in
+  !! one solve (sens_dyn_rows, the constraint rows gamma_p - J_p q_ddot - Ha S - 2 Hv S_dot),
+  !! as rows to pw%xl (npd, n + na), S_ddot's rows also to sddt when given.
+  subroutine sens_accel(m, w, s, pw, qs, vs, tt, npd, st, sdt, aa, lam, stp, sddt)
     type(model_t), intent(in) :: m              !! model with dynamics data
     type(dyn_work_t), intent(inout) :: w        !! dynamics work arrays
     type(sens_t), intent(inout) :: s            !! parameters and blocks
@@ -814,7 +790,7 @@ contains
     call dyn_solve_rows(w, pw%rt, s%np, n + w%na, npd, pw%xl, .false., stp)
     if (stp /= MBD_OK .or. .not. present(sddt)) return
     call copy_flat(npd * n, pw%xl, sddt)
-  end subroutine sens_accel_full
+  end subroutine sens_accel
 
   !> dlambda/dp as columns (neq, np) from a whole solution's rows xl (npd, n + na): on the
   !! active rows sc xl(k, n + i) (the matrix's constraint rows carry sc) times the unit u,

@@ -108,7 +108,7 @@ contains
     if (status /= MBD_OK) return
     call cols_to_rows(g%n, g%np, g%npd, g%n, sq, g%s0)
     call cols_to_rows(g%n, g%np, g%npd, g%n, sqd, g%v0)
-    call sens_accel(m, w, s, g%pw, q, qd, t, g%npd, g%s0, g%v0, aa, lam, g%a0, status)
+    call sens_accel(m, w, s, g%pw, q, qd, t, g%npd, g%s0, g%v0, aa, lam, status, g%a0)
     if (status /= MBD_OK) then
       msg = 'the mass matrix and constraints give a singular system at the start'; return
     end if
