@@ -159,13 +159,6 @@ contains
       msg = 'solver must be 0 (auto), 1 (dense) or 2 (banded)'; return
     end if
     if (solver == SOLVER_DENSE) return
-    if (m%nfric > 0) then           ! joint friction's multipliers: the dense least squares
-      if (solver == SOLVER_BANDED) then
-        status = MBD_BAD_SETTING
-        msg = 'joint friction needs the dense solver (solver="dense" or "auto")'
-      end if
-      return
-    end if
     if (solver == SOLVER_AUTO .and. m%nq < SADDLE_BAND_MIN_N) return
     call saddle_plan(m, [(r, r=1, m%neq)], SOLVER_BANDED, sd, status, msg)
     if (status /= MBD_OK) then
@@ -698,37 +691,20 @@ contains
     type(dyn_work_t), intent(inout) :: w
     real(wp), intent(in) :: q(:), qd(:)
     integer, intent(out) :: status
-    type(kloc) :: x
-    type(kscal) :: u
     real(wp) :: lamb(2), dnew(2), nr
-    integer :: b, d, k, n, jc, s, it, mode, nb
+    integer :: b, d, k, n, jc, it, nb
     logical :: settled
     n = m%nq; nb = m%nfric
     status = MBD_OK
     w%y0 = w%rhs
     ! directions g_b, lock right-hand sides, responses z_b = A^-1 [g_b; 0]
     do b = 1, nb
-      k = w%fidx(b)
-      x = element_state(m, k, q, qd)
-      u = element_slip(m, k, x)
-      w%gf(:, b) = zero
-      do s = 1, NLOC
-        if (m%floc(s, k) > 0) w%gf(m%floc(s, k), b) = w%gf(m%floc(s, k), b) + u%d(s)
-      end do
-      w%gaf(b) = -u%ar
-      mode = nint(w%cst(1, k))
-      if (mode == 0) then
-        w%cf(b) = -reg_mu(u%vd, m%fp(m%fpo(k)), m%fp(m%fpo(k) + 1), m%fp(m%fpo(k) + 3))
-      else if (mode /= MODE_STUCK) then
-        w%cf(b) = -m%fp(m%fpo(k)) * mode
-      else
-        w%cf(b) = zero
-      end if
+      call fric_direction(m, w, b, q, qd)
       w%zf(1:n, b) = w%gf(:, b); w%zf(n + 1:, b) = zero
       call dyn_solve(w, w%zf(:, b), status)
       if (status /= MBD_OK) return
       ! the starting direction of grad N from the frictionless multipliers
-      w%dn(:, b) = grad_n(b, w%y0)
+      w%dn(:, b) = fric_grad(m, w, b, w%y0)
     end do
     settled = .false.
     do it = 1, FRIC_MAXIT
@@ -742,10 +718,10 @@ contains
           w%avec(b) = w%gaf(b) - dot_product(w%gf(:, b), w%y0(1:n))
         else
           do d = 1, nb
-            w%amat(b, d) = -w%cf(b) * dot_product(w%dn(:, b), joint_lam(b, w%zf(:, d)))
+            w%amat(b, d) = -w%cf(b) * dot_product(w%dn(:, b), fric_lam(w, b, w%zf(:, d)))
           end do
           w%amat(b, b) = w%amat(b, b) + one
-          w%avec(b) = w%cf(b) * dot_product(w%dn(:, b), joint_lam(b, w%y0))
+          w%avec(b) = w%cf(b) * dot_product(w%dn(:, b), fric_lam(w, b, w%y0))
         end if
       end do
       call lu_factor_small(w%amat, w%fpiv, status)
@@ -760,7 +736,7 @@ contains
       ! the directions of the normal loads at the new multipliers
       settled = .true.
       do b = 1, nb
-        dnew = grad_n(b, w%rhs)
+        dnew = fric_grad(m, w, b, w%rhs)
         if (maxval(abs(dnew - w%dn(:, b))) > 1.0e-12_wp) settled = .false.
         w%dn(:, b) = dnew
       end do
@@ -771,41 +747,83 @@ contains
     end if
     do b = 1, nb
       k = w%fidx(b); jc = m%fref(k)
-      lamb = joint_lam(b, w%rhs)
+      lamb = fric_lam(w, b, w%rhs)
       nr = joint_normal_load(m%kind(jc) == CON_REVOLUTE, lamb)
       w%fnl(k) = nr; w%ffr(k) = w%avec(b)
       w%force = w%force + w%avec(b) * w%gf(:, b)
     end do
-  contains
-    !> The multipliers (2) of friction element b's joint from a solution vector (zero on
-    !! rows not active).
-    function joint_lam(bb, xs) result(l)
-      integer, intent(in) :: bb
-      real(wp), intent(in) :: xs(:)
-      real(wp) :: l(2)
-      integer :: i
-      l = zero
-      do i = 1, 2
-        if (w%fpos(i, bb) > 0) l(i) = w%s * xs(n + w%fpos(i, bb))
-      end do
-    end function joint_lam
-    !> grad N of element b at the multipliers of a solution vector: revolute lambda/|lambda|,
-    !! translational (sign(lambda_1), 0).
-    function grad_n(bb, xs) result(g)
-      integer, intent(in) :: bb
-      real(wp), intent(in) :: xs(:)
-      real(wp) :: g(2), l(2), a
-      l = joint_lam(bb, xs)
-      g = zero
-      if (m%kind(m%fref(w%fidx(bb))) == CON_REVOLUTE) then
-        a = hypot(l(1), l(2))
-        if (a > zero) g = l / a
-      else
-        if (l(1) > zero) g(1) = one
-        if (l(1) < zero) g(1) = -one
-      end if
-    end function grad_n
   end subroutine friction_solve
+
+  !> Friction element b's slip direction g_b = du/dq (w%gf(:, b)), its lock's right-hand
+  !! side -u_ar (w%gaf(b)) and its coefficient c_b in a_b = c_b N_b (w%cf(b)): -mu(u_dot)
+  !! regularized, -mu sign sliding, 0 stuck.
+  subroutine fric_direction(m, w, b, q, qd)
+    type(model_t), intent(in) :: m
+    type(dyn_work_t), intent(inout) :: w
+    integer, intent(in) :: b
+    real(wp), intent(in) :: q(:), qd(:)
+    type(kloc) :: x
+    type(kscal) :: u
+    integer :: k, s, mode
+    k = w%fidx(b)
+    x = element_state(m, k, q, qd)
+    u = element_slip(m, k, x)
+    w%gf(:, b) = zero
+    do s = 1, NLOC
+      if (m%floc(s, k) > 0) w%gf(m%floc(s, k), b) = w%gf(m%floc(s, k), b) + u%d(s)
+    end do
+    w%gaf(b) = -u%ar
+    mode = nint(w%cst(1, k))
+    if (mode == 0) then
+      w%cf(b) = -reg_mu(u%vd, m%fp(m%fpo(k)), m%fp(m%fpo(k) + 1), m%fp(m%fpo(k) + 3))
+    else if (mode /= MODE_STUCK) then
+      w%cf(b) = -m%fp(m%fpo(k)) * mode
+    else
+      w%cf(b) = zero
+    end if
+  end subroutine fric_direction
+
+  !> The multipliers (2) of friction element b's joint from a solution vector xs of the
+  !! augmented system (zero on rows not active).
+  pure function fric_lam(w, b, xs) result(l)
+    type(dyn_work_t), intent(in) :: w
+    integer, intent(in) :: b
+    real(wp), intent(in) :: xs(:)
+    real(wp) :: l(2)
+    integer :: i
+    l = zero
+    do i = 1, 2
+      if (w%fpos(i, b) > 0) l(i) = w%s * xs(w%n + w%fpos(i, b))
+    end do
+  end function fric_lam
+
+  !> grad N of friction element b at its joint's multipliers l: revolute l / |l| (the
+  !! friction circle), translational (sign(l_1), 0).
+  pure function fric_dir(m, w, b, l) result(g)
+    type(model_t), intent(in) :: m
+    type(dyn_work_t), intent(in) :: w
+    integer, intent(in) :: b
+    real(wp), intent(in) :: l(2)
+    real(wp) :: g(2), a
+    g = zero
+    if (m%kind(m%fref(w%fidx(b))) == CON_REVOLUTE) then
+      a = hypot(l(1), l(2))
+      if (a > zero) g = l / a
+    else
+      if (l(1) > zero) g(1) = one
+      if (l(1) < zero) g(1) = -one
+    end if
+  end function fric_dir
+
+  !> grad N of friction element b at the multipliers of a solution vector xs.
+  pure function fric_grad(m, w, b, xs) result(g)
+    type(model_t), intent(in) :: m
+    type(dyn_work_t), intent(in) :: w
+    integer, intent(in) :: b
+    real(wp), intent(in) :: xs(:)
+    real(wp) :: g(2)
+    g = fric_dir(m, w, b, fric_lam(w, b, xs))
+  end function fric_grad
 
   !> w%rhs(nq + k) = f x(rows(k)) over the active rows (a loop: a vector subscript would
   !! make a heap temporary at every call).
@@ -893,12 +911,10 @@ contains
   !! With independent rows this is the unique lambda (Householder least squares, ls_small);
   !! with redundant rows, or J^T numerically rank deficient, the reactions are statically
   !! indeterminate and this is the smallest set (LAPACK dgelsy). Band path: the least-squares
-  !! lambda of the active rows, [s I, s Ja^T; s Ja, 0][x; lambda_a / s] = [Q - M q_ddot; 0]
-  !! (x the part of the load no multiplier balances), zero on the redundant rows.
-  !! Joint friction (not stuck)
-  !! depends on lambda: with the directions of the normal loads fixed it is linear,
-  !! J^T l - sum_b g_b c_b grad N_b . l_b = Q - M q_ddot, and the directions are iterated;
-  !! a stuck joint's friction is the last solve's (w%ffr).
+  !! lambda of the active rows (band_multipliers), zero on the redundant rows.
+  !! Joint friction (not stuck) depends on lambda: with the directions of the normal loads
+  !! fixed it is linear, J^T l - sum_b g_b c_b grad N_b . l_b = Q - M q_ddot, and the
+  !! directions are iterated; a stuck joint's friction is the last solve's (w%ffr).
   subroutine dyn_multipliers(m, w, q, qd, qdd, t, lam, status, msg)
     type(model_t), intent(in) :: m            !! model
     type(dyn_work_t), intent(inout) :: w      !! work arrays
@@ -907,42 +923,24 @@ contains
     real(wp), intent(out) :: lam(:)           !! multipliers (neq)
     integer, intent(out) :: status            !! MBD_OK, MBD_LAPACK or MBD_NO_MEMORY
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
-    real(wp) :: v, rhs0(m%nq), dn(2, max(1, m%nfric)), dnew(2), c, fn
-    type(kloc) :: x
-    type(kscal) :: u
-    integer :: it, bb, k, jc, s, mode, n
+    real(wp) :: v, rhs0(m%nq), dn(2, max(1, m%nfric)), dnew(2), fn
+    integer :: it, bb, k, jc
     logical :: settled
     msg = ''
     w%jt_lu = .false.
     call assemble(m, w, q, qd, t)
     call gen_forces(m, q, qd, t, w%force, v, cst=w%cst)
-    if (w%solver == SOLVER_BANDED) then      ! (no joint friction here: dyn_choose)
-      n = m%nq
-      lam = zero
-      w%metric = w%s
-      call factor_aug(w, w%metric, status, exact=.true.)
-      if (status /= MBD_OK) then
-        msg = 'the multipliers: the band saddle-point matrix is singular'; return
-      end if
-      w%rhs(1:n) = w%force - m%mdiag * qdd
-      w%rhs(n + 1:) = zero
-      call dyn_solve(w, w%rhs, status)
-      do k = 1, w%na
-        lam(w%rows(k)) = w%s * w%rhs(n + k)
-      end do
+    rhs0 = w%force - m%mdiag * qdd
+    ! the friction directions; stuck joints: their last friction force is a known load
+    do bb = 1, m%nfric
+      call fric_direction(m, w, bb, q, qd)
+      k = w%fidx(bb)
+      if (nint(w%cst(1, k)) == MODE_STUCK) rhs0 = rhs0 + w%ffr(k) * w%gf(:, bb)
+    end do
+    if (w%solver == SOLVER_BANDED) then
+      call band_multipliers(m, w, rhs0, lam, status, msg)
       return
     end if
-    rhs0 = w%force - m%mdiag * qdd
-    ! stuck joints: their last friction force is a known load
-    do bb = 1, m%nfric
-      k = w%fidx(bb)
-      if (nint(w%cst(1, k)) /= MODE_STUCK) cycle
-      x = element_state(m, k, q, qd)
-      u = element_slip(m, k, x)
-      do s = 1, NLOC
-        if (m%floc(s, k) > 0) rhs0(m%floc(s, k)) = rhs0(m%floc(s, k)) + w%ffr(k) * u%d(s)
-      end do
-    end do
     w%jt = transpose(w%jac)
     call solve_ls(lam, status)
     if (status /= MBD_OK .or. m%nfric == 0) return
@@ -954,23 +952,10 @@ contains
       w%jt = transpose(w%jac)
       do bb = 1, m%nfric
         k = w%fidx(bb); jc = m%fref(k)
-        mode = nint(w%cst(1, k))
-        if (mode == MODE_STUCK) cycle
-        x = element_state(m, k, q, qd)
-        u = element_slip(m, k, x)
-        if (mode == 0) then
-          c = -reg_mu(u%vd, m%fp(m%fpo(k)), m%fp(m%fpo(k) + 1), m%fp(m%fpo(k) + 3))
-        else
-          c = -m%fp(m%fpo(k)) * mode
-        end if
-        do s = 1, NLOC
-          if (m%floc(s, k) == 0) cycle
-          w%jt(m%floc(s, k), m%row0(jc)) = w%jt(m%floc(s, k), m%row0(jc)) - &
-                                           c * u%d(s) * dn(1, bb)
-          w%jt(m%floc(s, k), m%row0(jc) + 1) = w%jt(m%floc(s, k), m%row0(jc) + 1) - &
-                                               c * u%d(s) * dn(2, bb)
-        end do
-        w%ffr(k) = c
+        if (nint(w%cst(1, k)) == MODE_STUCK) cycle
+        ! J^T l - g_b c_b grad N_b . l_b: the joint's two columns
+        w%jt(:, m%row0(jc)) = w%jt(:, m%row0(jc)) - w%cf(bb) * dn(1, bb) * w%gf(:, bb)
+        w%jt(:, m%row0(jc) + 1) = w%jt(:, m%row0(jc) + 1) - w%cf(bb) * dn(2, bb) * w%gf(:, bb)
       end do
       call solve_ls(lam, status)
       if (status /= MBD_OK) return
@@ -986,7 +971,7 @@ contains
       k = w%fidx(bb); jc = m%fref(k)
       fn = joint_normal_load(m%kind(jc) == CON_REVOLUTE, lam(m%row0(jc):m%row0(jc) + 1))
       w%fnl(k) = fn
-      if (nint(w%cst(1, k)) /= MODE_STUCK) w%ffr(k) = w%ffr(k) * fn
+      if (nint(w%cst(1, k)) /= MODE_STUCK) w%ffr(k) = w%cf(bb) * fn
     end do
   contains
     !> lambda from w%jt (destroyed) and rhs0.
@@ -1055,24 +1040,99 @@ contains
       r = zero
       if (amax > zero) r = amin / amax
     end function diag_ratio
-    !> grad N of friction element bx at multipliers l.
+    !> grad N of friction element bx at multipliers l (all rows).
     function grad_dir(bx, l) result(g)
       integer, intent(in) :: bx
       real(wp), intent(in) :: l(:)
-      real(wp) :: g(2), a, l2(2)
+      real(wp) :: g(2)
       integer :: j0
       j0 = m%row0(m%fref(w%fidx(bx)))
-      l2 = l(j0:j0 + 1)
-      g = zero
-      if (m%kind(m%fref(w%fidx(bx))) == CON_REVOLUTE) then
-        a = hypot(l2(1), l2(2))
-        if (a > zero) g = l2 / a
-      else
-        if (l2(1) > zero) g(1) = one
-        if (l2(1) < zero) g(1) = -one
-      end if
+      g = fric_dir(m, w, bx, l(j0:j0 + 1))
     end function grad_dir
   end subroutine dyn_multipliers
+
+  !> The band path of dyn_multipliers: the least-squares multipliers of the active rows,
+  !! [s I, s Ja^T; s Ja, 0][x; lambda_a / s] = [r; 0] (x the part of the load r no
+  !! multiplier balances), zero on the redundant rows. Joint friction not stuck as in
+  !! friction_solve with this matrix: x = y0 + sum_b a_b z_b, [s I, s Ja^T; s Ja, 0] z_b =
+  !! [g_b; 0], a_b = c_b grad N_b . lambda_b(x), the directions of grad N iterated.
+  subroutine band_multipliers(m, w, rhs0, lam, status, msg)
+    type(model_t), intent(in) :: m              !! model
+    type(dyn_work_t), intent(inout) :: w        !! work arrays (friction directions set)
+    real(wp), intent(in) :: rhs0(:)             !! load r = Q - M q_ddot (+ stuck friction)
+    real(wp), intent(out) :: lam(:)             !! multipliers (neq)
+    integer, intent(out) :: status              !! MBD_OK, MBD_SINGULAR or MBD_LAPACK
+    character(len=MSG_LEN), intent(inout) :: msg  !! explanation
+    real(wp) :: dnew(2)
+    integer :: n, k, b, d, it, nb
+    logical :: settled
+    n = m%nq; nb = m%nfric
+    lam = zero
+    w%metric = w%s
+    call factor_aug(w, w%metric, status, exact=.true.)
+    if (status /= MBD_OK) then
+      msg = 'the multipliers: the band saddle-point matrix is singular'; return
+    end if
+    w%rhs(1:n) = rhs0
+    w%rhs(n + 1:) = zero
+    call dyn_solve(w, w%rhs, status)
+    if (status /= MBD_OK) return
+    if (nb > 0) then
+      w%y0 = w%rhs
+      do b = 1, nb
+        w%zf(:, b) = zero
+        if (stuck(b)) cycle
+        w%zf(1:n, b) = w%gf(:, b)
+        call dyn_solve(w, w%zf(:, b), status)
+        if (status /= MBD_OK) return
+        w%dn(:, b) = fric_grad(m, w, b, w%y0)
+      end do
+      do it = 1, FRIC_MAXIT
+        ! (I - C D Z) a = C D lambda(y0) over the sliding joints, a = 0 on the stuck ones
+        do b = 1, nb
+          w%amat(b, :) = zero; w%avec(b) = zero
+          if (.not. stuck(b)) then
+            do d = 1, nb
+              w%amat(b, d) = -w%cf(b) * dot_product(w%dn(:, b), fric_lam(w, b, w%zf(:, d)))
+            end do
+            w%avec(b) = w%cf(b) * dot_product(w%dn(:, b), fric_lam(w, b, w%y0))
+          end if
+          w%amat(b, b) = w%amat(b, b) + one
+        end do
+        call lu_factor_small(w%amat, w%fpiv, status)
+        if (status /= MBD_OK) then
+          status = MBD_NO_CONVERGENCE
+          msg = 'the multipliers: the joint friction cannot be resolved (self-locking)'
+          return
+        end if
+        call lu_solve_small(w%amat, w%fpiv, w%avec)
+        w%rhs = w%y0
+        do d = 1, nb
+          w%rhs = w%rhs + w%avec(d) * w%zf(:, d)
+        end do
+        settled = .true.
+        do b = 1, nb
+          dnew = fric_grad(m, w, b, w%rhs)
+          if (maxval(abs(dnew - w%dn(:, b))) > 1.0e-12_wp) settled = .false.
+          w%dn(:, b) = dnew
+        end do
+        if (settled) exit
+      end do
+      do b = 1, nb
+        k = w%fidx(b)
+        w%fnl(k) = joint_normal_load(m%kind(m%fref(k)) == CON_REVOLUTE, fric_lam(w, b, w%rhs))
+        if (.not. stuck(b)) w%ffr(k) = w%avec(b)
+      end do
+    end if
+    do k = 1, w%na
+      lam(w%rows(k)) = w%s * w%rhs(n + k)
+    end do
+  contains
+    pure logical function stuck(bb)
+      integer, intent(in) :: bb
+      stuck = nint(w%cst(1, w%fidx(bb))) == MODE_STUCK
+    end function stuck
+  end subroutine band_multipliers
 
   !> An orthonormal basis nb (nq x ni, ni = nq - na) of the null space of J_a at q: the
   !! projections x = r - D^2 J_a^T (J_a D^2 J_a^T)^-1 J_a r of ni fixed pseudo-random

@@ -30,13 +30,14 @@ def slide_of(res, alpha):
     return res.q[:, 0] * math.cos(alpha) + res.q[:, 1] * math.sin(alpha)
 
 
+@pytest.mark.parametrize("solver", ["dense", "banded"])
 @pytest.mark.parametrize("alpha,mus", [(0.3, 0.35), (0.5, 0.6), (0.1, 0.2)])
-def test_block_sticks_when_static_friction_holds(alpha, mus):
+def test_block_sticks_when_static_friction_holds(alpha, mus, solver):
     """mu_static > tan(alpha): the block does not move (displacement below 1e-9 m in 1 s);
     the friction force holds the weight's slope component M g sin(alpha)."""
     assert mus > math.tan(alpha)
     for method in ("dopri5", "partitioned"):
-        res = incline(alpha, 0.8 * mus, mus).dynamics(1.0, 100, method=method)
+        res = incline(alpha, 0.8 * mus, mus).dynamics(1.0, 100, method=method, solver=solver)
         assert np.max(np.abs(slide_of(res, alpha))) < 1e-9
         fr = res.friction("slide")
         assert fr.stuck.all()
@@ -74,8 +75,9 @@ def test_regularized_friction_slides_like_coulomb_above_the_threshold(method, op
                                res.t[keep]**2, atol=1e-6)
 
 
+@pytest.mark.parametrize("solver", ["dense", "banded"])
 @pytest.mark.parametrize("c", [10.0, 40.0])
-def test_pushed_block_slips_when_the_force_reaches_the_static_limit(c):
+def test_pushed_block_slips_when_the_force_reaches_the_static_limit(c, solver):
     """F = c t on a block on flat ground: stuck until c t* = mu_s M g, then
     M x'' = c t - mu M g. The slip is an event located to 1e-9 s."""
     mu, mus = 0.3, 0.5
@@ -85,7 +87,7 @@ def test_pushed_block_slips_when_the_force_reaches_the_static_limit(c):
                         friction={"mu": mu, "mu_static": mus, "model": "stick-slip"})
     m.add_point_force("block", [0.0, 0.0], fx={"poly": [0.0, c]}, name="push")
     ts = mus * M * G / c
-    res = m.dynamics(2 * ts, 200, rtol=1e-10, atol=1e-12)
+    res = m.dynamics(2 * ts, 200, rtol=1e-10, atol=1e-12, solver=solver)
     [slip] = res.friction_events
     assert slip.kind == "slip" and slip.joint == "slide"
     assert slip.t == pytest.approx(ts, abs=1e-9)
@@ -95,7 +97,8 @@ def test_pushed_block_slips_when_the_force_reaches_the_static_limit(c):
     np.testing.assert_allclose(res.q[:, 0], ref, atol=1e-9)
 
 
-def test_pendulum_with_a_rubbing_pin_matches_the_reduced_model():
+@pytest.mark.parametrize("solver", ["dense", "banded"])
+def test_pendulum_with_a_rubbing_pin_matches_the_reduced_model(solver):
     """A point mass on a rod, pin friction torque mu r |F| against the rotation, |F| the pin
     force (friction circle). Reference: l**2 m theta'' = -m g l sin(theta) - mu r |F|
     sign(theta'), |F| = |m a - m g| solved by fixed point in scipy's right-hand side; up to
@@ -107,7 +110,7 @@ def test_pendulum_with_a_rubbing_pin_matches_the_reduced_model():
     m.add_revolute(["ground", "bob"], [[0, 0], [0, ell]], name="pin",
                    friction={"mu": mu, "mu_static": mus, "pin_radius": r,
                              "model": "stick-slip"})
-    res = m.dynamics(1.2, 120, rtol=1e-11, atol=1e-13)
+    res = m.dynamics(1.2, 120, rtol=1e-11, atol=1e-13, solver=solver)
     first = res.friction_events[0]
     assert first.kind == "reversal"
 
@@ -134,7 +137,8 @@ def test_pendulum_with_a_rubbing_pin_matches_the_reduced_model():
     assert np.all(np.diff(e[keep]) <= 1e-9)
 
 
-def test_inverse_dynamics_efforts_include_friction():
+@pytest.mark.parametrize("solver", ["dense", "banded"])
+def test_inverse_dynamics_efforts_include_friction(solver):
     """A block dragged at constant speed needs mu M g; with acceleration a, M a + mu M g; a
     rotor turning in a rubbing pin needs mu r M g."""
     mu = 0.3
@@ -143,7 +147,7 @@ def test_inverse_dynamics_efforts_include_friction():
     m.add_translational(["ground", "block"], [[0, 0], [0, 0]], [[1, 0], [1, 0]], name="slide",
                         friction={"mu": mu, "mu_static": 0.4})
     m.add_driver("relative-distance", joint="slide", f={"poly": [0.0, 0.5, 0.5]}, name="pull")
-    res = m.inverse_dynamics(1.0, 10)
+    res = m.inverse_dynamics(1.0, 10, solver=solver)
     np.testing.assert_allclose(res.effort("pull"), M * 1.0 + mu * M * G, rtol=1e-9)
     r = mbd2d.Model("rotor")
     r.add_body("rotor", q0=[0.0, 0.0, 0.0], mass=3.0, inertia=0.2)
@@ -151,7 +155,7 @@ def test_inverse_dynamics_efforts_include_friction():
                    friction={"mu": 0.2, "pin_radius": 0.01})
     r.add_driver("absolute", body="rotor", coordinate="theta", f={"poly": [0.0, 2.0]},
                  name="motor")
-    res = r.inverse_dynamics(1.0, 10)
+    res = r.inverse_dynamics(1.0, 10, solver=solver)
     np.testing.assert_allclose(res.effort("motor"), 0.2 * 0.01 * 3.0 * G, rtol=1e-9)
     np.testing.assert_allclose(res.friction("pin").moment, -0.2 * 0.01 * 3.0 * G, rtol=1e-9)
 
