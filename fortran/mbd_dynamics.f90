@@ -10,8 +10,8 @@
 !! least-squares one over the active rows (band path, zero on redundant rows). Near a
 !! singular configuration (J momentarily rank deficient, as a parallelogram at its collinear
 !! position) the LU is nearly singular although q_ddot is still well defined; there the
-!! system is solved by a rank-revealing minimum-norm least-squares solve (dgelsy, dense) or
-!! a damped one (band); see mbd_saddle, which holds both paths of every saddle-point solve.
+!! system is solved as a damped least squares, refined (both paths); see mbd_saddle, which
+!! holds both paths of every saddle-point solve.
 !! Also here: applied forces and energies, consistent initial velocities (the kinetic-energy
 !! projection [M J^T; J 0][q_dot; mu] = [M v0; nu]), the projection of positions onto Phi = 0
 !! (minimum-norm Newton steps), the assembly of a large model by Levenberg-Marquardt in
@@ -113,6 +113,9 @@ module mbd_dynamics
     real(wp), allocatable :: amat(:, :), avec(:), cf(:), dn(:, :)
     integer, allocatable :: fpiv(:)
     integer, allocatable :: fpos(:, :)        !! (2, nfric) active positions of the joint rows
+    !> the last friction solve found no solution: its small system singular or the directions
+    !! of the normal loads not settling (self-locking)
+    logical :: locked = .false.
   end type dyn_work_t
 
 contains
@@ -696,6 +699,7 @@ contains
     logical :: settled
     n = m%nq; nb = m%nfric
     status = MBD_OK
+    w%locked = .true.                 ! (until it settles)
     w%y0 = w%rhs
     ! directions g_b, lock right-hand sides, responses z_b = A^-1 [g_b; 0]
     do b = 1, nb
@@ -745,6 +749,7 @@ contains
     if (.not. settled) then
       status = MBD_NO_CONVERGENCE; return
     end if
+    w%locked = .false.
     do b = 1, nb
       k = w%fidx(b); jc = m%fref(k)
       lamb = fric_lam(w, b, w%rhs)

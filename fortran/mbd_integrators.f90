@@ -187,6 +187,38 @@ module mbd_integrators
 
 contains
 
+  !> MBD_INTEGRATOR_FAILED for a step size underflow at t, with the friction hint.
+  subroutine underflow(m, w, t, status, msg)
+    type(model_t), intent(in) :: m                 !! model
+    type(dyn_work_t), intent(in) :: w              !! work arrays (the last friction solve)
+    real(wp), intent(in) :: t                      !! time of the last accepted step
+    integer, intent(out) :: status                 !! MBD_INTEGRATOR_FAILED
+    character(len=MSG_LEN), intent(inout) :: msg   !! explanation
+    status = MBD_INTEGRATOR_FAILED
+    write (msg, '(a,es12.5)') 'step size underflow at t = ', t
+    call friction_hint(m, w, msg)
+  end subroutine underflow
+
+  !> With joint friction, append to a failure's message where such failures come from: next
+  !! to a dead centre or a singular position the joint loads grow like 1 / distance, and the
+  !! friction on them can have several solutions or none (w%locked: the last solve found none).
+  subroutine friction_hint(m, w, msg)
+    type(model_t), intent(in) :: m                 !! model
+    type(dyn_work_t), intent(in) :: w              !! work arrays (the last friction solve)
+    character(len=MSG_LEN), intent(inout) :: msg   !! explanation, extended
+    if (m%nfric == 0) return
+    if (w%locked) then
+      msg = trim(msg) // ': joint friction locks the mechanism (the last friction solve ' // &
+        'found no solution)'
+    else
+      msg = trim(msg) // ': with joint friction'
+    end if
+    msg = trim(msg) // '; next to a dead centre or a singular position the joint loads ' // &
+      'grow like 1 / distance and the friction on them can have several solutions or none ' // &
+      '(a rigid linkage with Coulomb friction jams there, as its friction circles ' // &
+      'predict): lower the friction, add compliance, or keep the motion away from it'
+  end subroutine friction_hint
+
   !> Integrate from the consistent state (q, qd) at t0 to t1, with outputs at
   !! t0 + k (t1 - t0)/nsteps, k = 0..nsteps, of which those with mod(k, every) = 0 and the
   !! last (k = nsteps) are written into the columns of qo, vo, ao, lo (output_rows of them).
@@ -725,9 +757,7 @@ contains
           h = h / 4
         end if
         if (h < 1.0e-14_wp * max(one, abs(t))) then
-          status = MBD_INTEGRATOR_FAILED
-          write (msg, '(a,es12.5)') 'step size underflow at t = ', t
-          return
+          call underflow(m, w, t, status, msg); return
         end if
         cycle
       end if
@@ -905,9 +935,7 @@ contains
         fsal = .false.
         h = h * max(0.2_wp, 0.9_wp * err**(-0.2_wp))
         if (h < 1.0e-14_wp * max(one, abs(t))) then
-          status = MBD_INTEGRATOR_FAILED
-          write (msg, '(a,es12.5)') 'step size underflow at t = ', t
-          return
+          call underflow(m, w, t, status, msg); return
         end if
         cycle
       end if
@@ -915,8 +943,9 @@ contains
       call finish_step(m, w, c, partitioned, tnew, ynew, fsal, e, ys, stt)
       if (stt /= MBD_OK) then
         status = MBD_INTEGRATOR_FAILED
-        write (msg, '(a,es12.5)') 'the constraints could not be satisfied after the step to t = ', &
-          tnew
+        write (msg, '(a,es12.5)') 'the constraints could not be satisfied after the ' // &
+          'step to t = ', tnew
+        call friction_hint(m, w, msg)
         return
       end if
       if (c%opts%method == METH_DOPRI5 .or. c%opts%method == METH_RK4 .or. partitioned) then

@@ -13,8 +13,9 @@
 !! form [mu I, J^T; J, -I] (its step minimizes ||J dx + Phi||^2 + mu ||dx||^2).
 !!
 !! Dense path: the matrix (n + na)^2; index-1 systems by LU (dgetf2/dgetrf) and, when nearly
-!! singular (1/cond_1 < AUG_RCOND, as at the collinear position of a parallelogram), by the
-!! rank-revealing minimum-norm least-squares solve dgelsy; the generalized-alpha matrix by
+!! singular (1/cond_1 < AUG_RCOND, as at the collinear position of a parallelogram), with
+!! the constraint block regularized and refined as on the band path (below; dgelsy's
+!! minimum-norm solve should that LU fail); the generalized-alpha matrix by
 !! a sparse LU replayed in a pivot order planned on its values (mbd_splu; K is non-zero
 !! only in the angle columns), planned again when an entry outside the plan turns non-zero,
 !! a pivot vanishes or a multiplier grows past LMAX, and the plain-loop LU (lu_factor_small)
@@ -31,8 +32,9 @@
 !! dgbtrf beyond; zero diagonal entries of the constraint block are pivoted away within the
 !! band). A nearly singular index-1 matrix is solved with the constraint block regularized,
 !! -eps I with eps = AUG_RCOND ||A||_1 (a damped least-squares solve: directions of J_a
-!! with sigma^2 below about eps are damped, as dgelsy drops them), refined twice against the
-!! unregularized matrix. Nothing of size n^2 is allocated on the band path.
+!! with sigma^2 below about eps are damped where dgelsy would drop them: smooth in q, where
+!! a dropped direction jumps as the condition crosses the threshold), refined against the
+!! unregularized matrix (NREFINE times dense, NREFINE_BAND band). Nothing of size n^2 is allocated on the band path.
 !! Cost per factorization: dense ~ (2/3)(n + na)^3, band ~ 2 (n + na) kl (kl + ku).
 !!
 !! Usage: saddle_plan once per structure (allocates); then saddle_factor with the current
@@ -60,6 +62,15 @@ module mbd_saddle
 
   !> 1/cond_1 of an index-1 matrix below which it is solved as nearly singular
   real(wp), parameter :: AUG_RCOND = 1.0e-9_wp
+  !> refinements of a nearly singular index-1 solve against the matrix itself, dense and band
+  !! (each damps the regularization's error by eps / (sigma^2 + eps) along a direction of
+  !! J_a). Dense: the stabilized Baumgarte N-four-bar's crank spread through the passages
+  !! at N = 5, h = 1e-2, 1.4e-5 with 2, 1.2e-7 with 6, 1.2e-9 with 12, no better with 30
+  !! (2.2e-8 with dgelsy before). Band: 12 also halves dopri5's rejected steps through the
+  !! passages at N = 2 to 6, rtol 1e-9 to 1e-12, but on the N = 1 chain at rtol 1e-12 (a
+  !! band it never takes by itself) one run in eleven ends 3.8e-6 off and one more
+  !! underflows: 2 kept there
+  integer, parameter :: NREFINE = 12, NREFINE_BAND = 2
   !> auto choice: the band path for at least SADDLE_BAND_MIN_N coordinates when the band
   !! (kl + ku + 1) is at most (n + na) / SADDLE_BAND_RATIO wide (as kinematics)
   integer, parameter :: SADDLE_BAND_MIN_N = 60, SADDLE_BAND_RATIO = 4
@@ -81,6 +92,9 @@ module mbd_saddle
     logical :: banded = .false.          !! band path
     logical :: full = .false.            !! A has the tangent pattern (not only its diagonal)
     logical :: lsq = .false.             !! the last index-1 factorization was nearly singular
+    !> dense, nearly singular: factored with the constraint block regularized, the matrix
+    !! itself in acopy for the refinement (else, the regularized LU failing, dgelsy's solve)
+    logical :: reg = .false.
     logical :: plain = .false.           !! factored without the near-singularity check
     logical :: schur = .false.           !! the last factorization is the Schur complement's
     logical :: use_schur = .true.        !! index-1 systems may take the Schur complement
@@ -442,6 +456,7 @@ contains
     chk = .false.; if (present(check)) chk = check
     sd%nfactor = sd%nfactor + 1
     sd%lsq = .false.
+    sd%reg = .false.
     sd%schur = .false.
     refused = .false.
     if ((chk .or. present_and(schur)) .and. sd%use_schur .and. .not. present(kv) .and. &
@@ -535,7 +550,18 @@ contains
         sd%lsq = rc < AUG_RCOND
       end if
     end if
-    if (sd%lsq) call fill(ee)                  ! the matrix itself, for dgelsy
+    status = MBD_OK
+    if (.not. sd%lsq) return
+    ! as the band path: the matrix kept (acopy) and factored with the constraint block
+    ! regularized, -eps I (eps = AUG_RCOND ||A||_1: a damped least squares, smooth in q where
+    ! dgelsy's dropped directions jump), the solves refined against the matrix itself;
+    ! should that LU fail, dgelsy on the matrix (sd%a)
+    call fill(ee)
+    sd%acopy = sd%a
+    call fill(ee + AUG_RCOND * anorm)
+    call lu_factor(sd%a, sd%ipiv, status, msg)
+    sd%reg = status == MBD_OK
+    if (.not. sd%reg) sd%a = sd%acopy
     status = MBD_OK
   contains
     !> The sparse LU of the pieces put into the plan's storage: ok when the plan holds every
@@ -778,8 +804,20 @@ contains
     nt = sd%nt
     call dgelsy(nt, nt, 1, rdum, nt, rdum, nt, idum, AUG_RCOND, rank, wq, -1, info)
     allocate (sd%acopy(nt, nt), sd%cw(4 * nt), sd%iw(nt), sd%jp(nt), &
-              sd%lswork(max(1, int(wq(1)))), stat=ierr)
+              sd%lswork(max(1, int(wq(1)))), sd%r(nt), sd%x(nt), stat=ierr)
   end subroutine dense_work
+
+  !> y = A x (a plain loop by columns: no temporary).
+  pure subroutine dgemv_plain(a, x, y)
+    real(wp), intent(in) :: a(:, :)          !! matrix
+    real(wp), intent(in) :: x(:)             !! vector (size(a, 2))
+    real(wp), intent(out) :: y(:)            !! product (size(a, 1))
+    integer :: k
+    y = zero
+    do k = 1, size(a, 2)
+      y = y + a(:, k) * x(k)
+    end do
+  end subroutine dgemv_plain
 
   !> Solve with the factored matrix: [x; y] overwrites the right-hand side [b; c].
   subroutine saddle_solve(sd, rhs, status)
@@ -804,7 +842,7 @@ contains
       ! regularized solve, refined against the matrix itself: x += A_eps^-1 (b - A x)
       sd%r = rhs
       call band_solve(sd%b, rhs, status, msg)
-      do it = 1, 2
+      do it = 1, NREFINE_BAND
         if (status /= MBD_OK) return
         call pieces_matvec(sd, rhs, sd%x)
         sd%x = sd%r - sd%x
@@ -826,6 +864,20 @@ contains
     end if
     if (.not. sd%lsq) then
       call lu_solve(sd%a, sd%ipiv, rhs, status, msg)
+      return
+    end if
+    if (sd%reg) then
+      ! regularized solve, refined against the matrix itself: x += A_eps^-1 (b - A x)
+      sd%r = rhs
+      call lu_solve(sd%a, sd%ipiv, rhs, status, msg)
+      do it = 1, NREFINE
+        if (status /= MBD_OK) return
+        call dgemv_plain(sd%acopy, rhs, sd%x)
+        sd%x = sd%r - sd%x
+        call lu_solve(sd%a, sd%ipiv, sd%x, status, msg)
+        rhs = rhs + sd%x
+      end do
+      sd%nrank = sd%nrank + 1
       return
     end if
     sd%acopy = sd%a
