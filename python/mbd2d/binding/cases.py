@@ -59,7 +59,7 @@ def case_tables(model: ModelDescription, p: Packed, d: DynamicTables | None,
     cols = [ptab[:, k] for k in keep]
     rows = [values[k] for k in keep]
     cons = model.constraints
-    joint_params = [k for k, prm in enumerate(params) if prm.section in ("joint", "driver")]
+    joint_params = [k for k, prm in enumerate(params) if prm.table == "constraint"]
     derived = [k for k, c in enumerate(cons) if _derived(c)] if joint_params else []
     if derived:
         q0 = {b.name: b.q0 for b in model.bodies}

@@ -10,6 +10,8 @@ positions by index (0-based)::
     force.s1.stiffness          force.s1.f.poly.0
     driver.motor.f.poly.1       driver.motor.f.harmonic.0.omega
     model.gravity.1
+    contact.floor.law.stiffness    contact.floor.circle.radius    contact.floor.friction.mu
+    joint.A.friction.mu            joint.A.friction.pin_radius
 
 Builder-made models get the same names (their entries have names too). Each parameter knows
 where its value enters the flat tables the core reads (a constraint's or a force's raw
@@ -39,11 +41,11 @@ class Parameter:
     ----------
     name : str
         Its path, e.g. ``joint.A.points.1.0``.
-    section : {'joint', 'driver', 'body', 'force', 'model'}
+    section : {'joint', 'driver', 'body', 'force', 'contact', 'model'}
         The kind of entry that holds it.
     index : int
         The entry's position in its list (``model.joints``, ``model.drivers``,
-        ``model.bodies``, ``model.forces``; 0 for the model).
+        ``model.bodies``, ``model.forces``, ``model.contacts``; 0 for the model).
     field : str
         The entry's attribute that holds it.
     path : tuple
@@ -51,8 +53,8 @@ class Parameter:
     table : {'constraint', 'mass', 'gravity', 'force'}
         The core table it enters.
     element : int
-        The element of that table: the constraint (joints then drivers) or force, or the body;
-        0 for gravity.
+        The element of that table: the constraint (joints then drivers), the force element
+        (forces, then contacts, then the joints' frictions), or the body; 0 for gravity.
     raw : int
         Its position in the element's raw parameters (mass 0, inertia 1; gravity 0, 1).
     value : float or None
@@ -188,6 +190,43 @@ def _force(f: Any) -> Iterator[tuple[str, str, tuple, int]]:
         yield from _function("f", f.f, 3)
 
 
+def _contact(c: Any) -> Iterator[tuple[str, str, tuple, int]]:
+    """The parameters of a contact, by its TOML keys (raw: law code, k, n, e, mu, mu_s,
+    threshold, then the geometry); a law's fixed numbers (the linear law's exponent, the
+    elastic hertz law's restitution) are not parameters."""
+    yield "law.stiffness", "law", ("stiffness",), 1
+    if c.law.model != "linear":
+        yield "law.exponent", "law", ("exponent",), 2
+    if c.law.model != "hertz":
+        yield "law.restitution", "law", ("restitution",), 3
+    for k, key in enumerate(("mu", "mu_static", "threshold")):
+        yield f"friction.{key}", "friction", (key,), 4 + k
+    if c.type == "circle-line":
+        keys = ["circle.center.0", "circle.center.1", "circle.radius", "line.point.0",
+                "line.point.1", "line.normal.0", "line.normal.1"]
+    elif c.type in ("circle-circle", "circle-in-circle"):
+        keys = [f"circle.{j}.{key}" for j in range(2)
+                for key in ("center.0", "center.1", "radius")]
+    else:       # follower-profile: (follower code, its 4 numbers, profile code, the profile)
+        for suffix, _, path, _ in _follower(c.follower_kind, False):
+            yield suffix, "geometry", (1 + path[0],), 8 + path[0]
+        for suffix, _, path, _ in _profile("profile", c.profile_kind, c.geometry[6:]):
+            yield suffix, "geometry", (6 + path[0],), 13 + path[0]
+        return
+    for i, key in enumerate(keys):
+        yield key, "geometry", (i,), 7 + i
+
+
+def _joint_friction(c: Any) -> Iterator[tuple[str, str, tuple, int]]:
+    """The parameters of a joint's friction (raw: mu, mu_s, model code, threshold, pin
+    radius; the pin radius a revolute's only)."""
+    keys = [("mu", 0), ("mu_static", 1), ("threshold", 3)]
+    if c.type == "revolute":
+        keys.append(("pin_radius", 4))
+    for key, raw in keys:
+        yield f"friction.{key}", "friction", (key,), raw
+
+
 # ------------------------------------------------------------------ values in an entry
 
 def _get(obj: Any, field: str, path: tuple) -> Any:
@@ -213,7 +252,7 @@ def _replaced(v: Any, path: tuple, value: float) -> Any:
 
 def parameter_list(model: Any) -> list[Parameter]:
     """Every design parameter of a model, in table order (joints, drivers, bodies, forces,
-    gravity)."""
+    contacts, the joints' frictions, gravity)."""
     out: list[Parameter] = []
     nj = len(model.joints)
     for sec, entries, offset in (("joint", model.joints, 0), ("driver", model.drivers, nj)):
@@ -230,6 +269,19 @@ def parameter_list(model: Any) -> list[Parameter]:
         for suffix, field, path, raw in _force(f):
             out.append(Parameter(f"force.{f.name}.{suffix}", "force", i, field, path, "force",
                                  i, raw, _float(_get(f, field, path))))
+    element = len(model.forces)                   # the force elements' order (pack_dynamics)
+    for i, c in enumerate(model.contacts):
+        for suffix, field, path, raw in _contact(c):
+            out.append(Parameter(f"contact.{c.name}.{suffix}", "contact", i, field, path,
+                                 "force", element + i, raw, _float(_get(c, field, path))))
+    element += len(model.contacts)
+    for i, c in enumerate(model.joints):
+        if getattr(c, "friction", None) is None:
+            continue
+        for suffix, field, path, raw in _joint_friction(c):
+            out.append(Parameter(f"joint.{c.name}.{suffix}", "joint", i, field, path, "force",
+                                 element, raw, _float(_get(c, field, path))))
+        element += 1
     for j in range(2):
         out.append(Parameter(f"model.gravity.{j}", "model", 0, "gravity", (j,), "gravity", 0, j,
                              float(model.gravity[j])))
@@ -287,7 +339,7 @@ def with_params(model: Any, values: Mapping[str, Any]) -> Any:
             new.gravity = _replaced(tuple(new.gravity), p.path, v)
             continue
         entries = {"joint": new.joints, "driver": new.drivers, "body": new.bodies,
-                   "force": new.forces}[p.section]
+                   "force": new.forces, "contact": new.contacts}[p.section]
         e = entries[p.index]
         entries[p.index] = dataclasses.replace(e, **{p.field: _replaced(getattr(e, p.field),
                                                                         p.path, v)})
@@ -302,7 +354,7 @@ def constraints_with(model: Any, params: Iterable[Parameter],
     cons = list(model.constraints)
     nj = len(model.joints)
     for p, v in zip(params, values):
-        if p.section not in ("joint", "driver"):
+        if p.section not in ("joint", "driver") or p.table != "constraint":
             continue
         k = p.index + (nj if p.section == "driver" else 0)
         e = cons[k]

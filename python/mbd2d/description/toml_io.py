@@ -232,6 +232,43 @@ def _joint_dict(c: Any) -> dict[str, Any]:
             out.update(axis=list(c.axis), offset=c.offset)
         elif t == "weld":
             out["angle"] = c.angle
+    if getattr(c, "friction", None) is not None:
+        out["friction"] = _friction_dict(c.friction)
+    return out
+
+
+def _friction_dict(f: Any, joint: bool = True) -> dict[str, Any]:
+    """A joint's or a contact's friction as its TOML table (threshold 0: the default)."""
+    out: dict[str, Any] = {"mu": f.mu, "mu_static": f.mu_static}
+    if joint:
+        out["model"] = f.model
+    if f.threshold:
+        out["threshold"] = f.threshold
+    if joint and f.pin_radius is not None:
+        out["pin_radius"] = f.pin_radius
+    return out
+
+
+def _contact_dict(c: Any) -> dict[str, Any]:
+    """A contact as its [[contact]] table (keys of contacts.CONTACT_KEYS)."""
+    g = c.geometry
+    out: dict[str, Any] = {"name": c.name, "type": c.type, "bodies": list(c.bodies)}
+    if c.type == "circle-line":
+        out.update(circle={"center": [g[0], g[1]], "radius": g[2]},
+                   line={"point": [g[3], g[4]], "normal": [g[5], g[6]]})
+    elif c.type in ("circle-circle", "circle-in-circle"):
+        out["circle"] = [{"center": [g[3 * j], g[3 * j + 1]], "radius": g[3 * j + 2]}
+                         for j in range(2)]
+    else:                       # (follower code, its 4 numbers, profile code, the profile)
+        out.update(profile=_profile_dict(c.profile_kind, g[6:]),
+                   follower=_follower_dict(c.follower_kind, g[1:5]))
+    law: dict[str, Any] = {"model": c.law.model, "stiffness": c.law.stiffness}
+    if c.law.model != "linear":
+        law["exponent"] = c.law.exponent
+    law["restitution"] = c.law.restitution
+    out["law"] = law
+    if c.friction.mu or c.friction.mu_static:
+        out["friction"] = _friction_dict(c.friction, joint=False)
     return out
 
 
@@ -289,6 +326,8 @@ def to_dict(model: ModelDescription) -> dict[str, Any]:
                            "driver": [_driver_dict(d) for d in model.drivers]}
     if model.forces:
         out["force"] = [_force_dict(f) for f in model.forces]
+    if model.contacts:
+        out["contact"] = [_contact_dict(c) for c in model.contacts]
     return out
 
 
@@ -323,7 +362,7 @@ def _dumps(model: ModelDescription, header: str) -> str:
     data = to_dict(model)
     lines = [f"# {line}".rstrip() for line in header.splitlines()]
     lines += ["[model]"] + [f"{k} = {_value(v)}" for k, v in data["model"].items()]
-    for section in ("body", "joint", "driver", "force"):
+    for section in ("body", "joint", "driver", "force", "contact"):
         for entry in data.get(section, []):
             lines += ["", f"[[{section}]]"] + [f"{k} = {_value(v)}" for k, v in entry.items()]
     return "\n".join(lines) + "\n"
