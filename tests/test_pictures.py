@@ -107,6 +107,30 @@ def test_snapshots_paths_and_labels(slider, masses):
         plot_mechanism(slider, snapshots=0)
 
 
+def test_a_long_chain_is_drawn_at_its_links_proportions(tmp_path):
+    """The 60-loop parallelogram chain (121 bodies, 60 m long, 1 m links): its details
+    (pins, hatching) are sized from ten typical bodies, not from the whole picture (a pin
+    was a fifth of the chain's height), and no legend of 121 names runs off the figure (it
+    collapsed the layout: matplotlib warned); the four-bar's pictures are as before (its
+    bodies are larger than a tenth of the picture) and keep their legend."""
+    sys.path.insert(0, str(EX))
+    import nfourbar
+    res = nfourbar.build(60).kinematics(0.5, 5)
+    assert Scene(res, None, False).scale == pytest.approx(10.0)      # ten 1 m links
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        ax = plot_mechanism(res, snapshots=2)
+        assert ax.get_legend() is None
+        res.animate(tmp_path / "chain.gif", fps=4, **SMALL)
+    grashof = mbd2d.load(EX / "fourbar_grashof.toml").kinematics(1.0, 10)
+    sc = Scene(grashof, None, False)
+    pts = np.vstack([sc.full.place(b, s) for b, ss in sc.attach.items() for s in ss]
+                    + [np.array([s]) for j in grashof.model.joints
+                       for b, s in zip(j.bodies, j.points) if b == "ground"])
+    assert sc.scale == pytest.approx(max(np.ptp(pts[:, 0]), np.ptp(pts[:, 1])))
+    assert plot_mechanism(grashof).get_legend() is not None
+
+
 # ----------------------------------------------------------------------------- animation
 def test_gif_frames_size_and_timing(slider, tmp_path):
     out = slider.animate(tmp_path / "a" / "slider.gif", fps=5, trace=[("rod", (0.0, 0.5))],

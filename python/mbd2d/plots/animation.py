@@ -18,7 +18,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..validate import number
-from .canvas import new_figure
+from .canvas import add_legend, new_figure
 from .elements import Look
 from .geometry import Motion, TracePoint, frame_rows
 from .scene import Scene
@@ -112,7 +112,7 @@ def render_frames(result: Motion, fps: float = 30, trace: Sequence[TracePoint] |
     ax.set_xlim(*xl)
     ax.set_ylim(*yl)
     ax.set_aspect("equal", adjustable="box")
-    ax.legend(loc="upper right", fontsize=7, framealpha=0.85)
+    add_legend(ax, loc="upper right", fontsize=7, framealpha=0.85)
     for a in moving:
         a.set_animated(True)
     canvas = fig.canvas

@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 if TYPE_CHECKING:  # pragma: no cover
+    from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
 #: Colour of the configuration where an incomplete run stopped.
@@ -38,11 +39,24 @@ def new_figure(figsize: tuple[float, float]) -> "Figure":
     """A Figure on its own Agg canvas (not managed by pyplot)."""
     import_matplotlib()
     from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
     fig = Figure(figsize=figsize, layout="constrained")
     FigureCanvasAgg(fig)
     return fig
+
+
+#: legends with more entries than this are left out: a chain of a hundred bodies is read from
+#: its colours and its title, not from a list running off the figure
+LEGEND_MAX = 16
+
+
+def add_legend(ax: "Axes", **kw: Any) -> None:
+    """ax.legend(**kw) when the axes have from 1 to LEGEND_MAX labelled artists."""
+    _, labels = ax.get_legend_handles_labels()
+    if 0 < len(labels) <= LEGEND_MAX:
+        ax.legend(**kw)
 
 
 def shade(colour: str, f: float) -> tuple[float, float, float]:

@@ -9,7 +9,7 @@ import numpy as np
 from ..description.joints import Revolute
 from ..errors import ModelError
 from ..validate import GROUND
-from .canvas import STOP_COLOUR, import_matplotlib, new_figure, shade
+from .canvas import STOP_COLOUR, add_legend, import_matplotlib, new_figure, shade
 from .elements import Look
 from .geometry import Motion, TracePoint, check_trace, snapshot_rows
 from .scene import Scene
@@ -109,7 +109,7 @@ def plot_mechanism(result: Motion, times: Sequence[float] | None = None,
         span = f"t = {result.t[0]:.4g} .. {result.t[-1]:.4g} s"
         title = f"{scene.model.name}: {m} snapshot{'s' if m > 1 else ''}, {span}"
     scene.dress(ax, length_unit, title)
-    ax.legend(loc="best", fontsize=8, framealpha=0.85)
+    add_legend(ax, loc="best", fontsize=8, framealpha=0.85)
     return ax
 
 
@@ -194,5 +194,5 @@ def plot_paths(result: Motion, points: Sequence[TracePoint] | None = None,
                  f" (mechanism at t = {result.t[row]:.4g} s)")
     scene.fit(ax)
     scene.dress(ax, length_unit, title)
-    ax.legend(loc="best", fontsize=8, framealpha=0.85)
+    add_legend(ax, loc="best", fontsize=8, framealpha=0.85)
     return ax

@@ -16,6 +16,9 @@ from .elements import (BodyLink, CamDrawer, Element, Look, ReactionDrawer, Updat
                        convex_hull, drawer_for)
 from .geometry import Motion, Poses, TracePoint, check_trace
 
+#: details are sized from the picture, but at most from this many typical bodies
+DETAIL_BODIES = 10.0
+
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.axes import Axes
 
@@ -110,7 +113,11 @@ class Scene:
         for e in self.items:
             pts += e.size_points()
         allp = np.vstack(pts)
-        self.scale = float(max(np.ptp(allp[:, 0]), np.ptp(allp[:, 1]), 1e-300))
+        extent = float(max(np.ptp(allp[:, 0]), np.ptp(allp[:, 1]), 1e-300))
+        # the size of the details (pins, hatching, blocks, stems, arrows): the picture's,
+        # but at most DETAIL_BODIES typical bodies (a chain of a hundred links keeps its pins
+        # at a link's proportions, not the whole chain's)
+        self.scale = min(extent, DETAIL_BODIES * self._body_size(extent))
         self._stems()
 
         self.reactions: list[Element] = []
@@ -119,6 +126,17 @@ class Scene:
         self.links = [BodyLink(b, self) for b in model.bodies]
 
     # ------------------------------------------------------------------ helpers
+    def _body_size(self, extent: float) -> float:
+        """The median size of the bodies that have one (the largest distance between the
+        points attached to them); the extent if none has."""
+        sizes = []
+        for pts in self.attach.values():
+            a = np.array(pts, dtype=float)
+            d = float(np.max(np.hypot(*(a[:, None, :] - a[None, :, :]).transpose(2, 0, 1))))
+            if d > 0.0:
+                sizes.append(d)
+        return float(np.median(sizes)) if sizes else extent
+
     def colour(self, body: str) -> Any:
         return GROUND_COLOUR if body == GROUND else self.colours[body]
 

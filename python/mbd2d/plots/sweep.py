@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING, Any, Sequence
 import numpy as np
 
 from ..errors import ModelError
-from .canvas import STOP_COLOUR, new_figure
+from .canvas import STOP_COLOUR, add_legend, new_figure
 from .timeseries import MU_WINDOW
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -174,7 +174,7 @@ def _curves(ax: "Axes", t: np.ndarray, v: np.ndarray, values: np.ndarray, status
     ax.set_ylabel(_label(name))
     ax.grid(True, lw=0.4, alpha=0.5)
     if marked and legend:
-        ax.legend(fontsize=8, loc="best")
+        add_legend(ax, fontsize=8, loc="best")
 
 
 def _summary(ax: "Axes", name: str, v: np.ndarray, values: np.ndarray, status: np.ndarray,
@@ -196,7 +196,7 @@ def _summary(ax: "Axes", name: str, v: np.ndarray, values: np.ndarray, status: n
                 label="failed (up to where it stopped)")
     ax.set_xlabel(par)
     ax.grid(True, lw=0.4, alpha=0.5)
-    ax.legend(fontsize=8, loc="best")
+    add_legend(ax, fontsize=8, loc="best")
 
 
 __all__ = ["plot_sweep", "sweep_quantities", "case_summary"]

@@ -10,7 +10,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..validate import GROUND
-from .canvas import PALETTE, PASSAGE_COLOUR, STOP_COLOUR, new_figure
+from .canvas import PALETTE, PASSAGE_COLOUR, STOP_COLOUR, add_legend, new_figure
 from .geometry import Motion
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -141,7 +141,7 @@ def _motion(result: Motion, bodies: Sequence[str] | None, lu: str) -> "Figure":
                 a.set_xlabel("t [s]")
     for c, sym in enumerate(("x", "y", "θ")):
         axes[0][c].set_title(sym)
-    axes[0][0].legend(fontsize=8, loc="best")
+    add_legend(axes[0][0], fontsize=8, loc="best")
     fig.suptitle(f"{_name(result)}: positions"
                  + (", velocities, accelerations" if levels == 3 else "")
                  + ("" if result.complete else " (incomplete run)"))
@@ -175,7 +175,7 @@ def _measures(result: Any, specs: Sequence[str] | None) -> "Figure":
         mark_times(a, result, labels=i == 0)
     axes[-1][0].set_xlabel("t [s]")
     if result.stats.get("singular_passages") or not result.complete:
-        axes[0][0].legend(fontsize=8, loc="best")
+        add_legend(axes[0][0], fontsize=8, loc="best")
     fig.suptitle(f"{_name(result)}: mechanism measures"
                  + ("" if result.complete else " (incomplete run)"))
     return fig
@@ -206,7 +206,7 @@ def _forces(result: Any, fu: str, lu: str) -> "Figure":
     a.grid(True, lw=0.4, alpha=0.5)
     mark_times(a, result)
     if drivers:
-        a.legend(fontsize=8, loc="best")
+        add_legend(a, fontsize=8, loc="best")
     b = axes[1][0]
     for k, j in enumerate(joints):
         r = result.reaction(j.name)
@@ -221,7 +221,7 @@ def _forces(result: Any, fu: str, lu: str) -> "Figure":
     b.grid(True, lw=0.4, alpha=0.5)
     mark_times(b, result, labels=False)
     if joints:
-        b.legend(fontsize=8, loc="best", ncol=2)
+        add_legend(b, fontsize=8, loc="best", ncol=2)
     fig.suptitle(f"{_name(result)}: driver efforts and joint reactions"
                  + ("" if result.complete else " (incomplete run)"))
     return fig
@@ -238,7 +238,7 @@ def _energy(result: Any, fu: str, lu: str) -> "Figure":
     a.set_ylabel(f"energy [{eu}]")
     a.grid(True, lw=0.4, alpha=0.5)
     mark_times(a, result)
-    a.legend(fontsize=8, loc="best")
+    add_legend(a, fontsize=8, loc="best")
     b = axes[1][0]
     floor = 1e-300
     b.semilogy(result.t, np.maximum(result.drift_position, floor), lw=1.2,
@@ -249,7 +249,7 @@ def _energy(result: Any, fu: str, lu: str) -> "Figure":
     b.set_xlabel("t [s]")
     b.grid(True, lw=0.4, alpha=0.5)
     mark_times(b, result, labels=False)
-    b.legend(fontsize=8, loc="best")
+    add_legend(b, fontsize=8, loc="best")
     fig.suptitle(f"{_name(result)}: energy and constraint drift"
                  + ("" if result.complete else " (incomplete run)"))
     return fig
