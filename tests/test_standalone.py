@@ -268,6 +268,24 @@ def test_contacts_and_friction_run_in_mbd2d_solve(tmp_path: Path, solver: str, k
                           outputs=["multipliers", "reactions", "efforts"])
 
 
+def test_joint_friction_on_the_band_path_runs_in_mbd2d_solve(tmp_path: Path, solver: str):
+    """The 100-loop chain with three rubbing pins (603 coordinates: the band path with joint
+    friction): mbd2d-solve writes the Python run's CSV, every column, for dopri5 and for
+    the driven chain's inverse dynamics."""
+    sys.path.insert(0, str(ROOT / "tests"))
+    from test_friction_band import rubbing_chain
+    pins = ("O0", "L50", "R99")
+    free = rubbing_chain(100, pins)
+    res = free.dynamics(t_end=0.2, steps=4)
+    assert res.stats["solver"] == "banded"
+    solve_and_compare(tmp_path, solver, free, res, "chain_dynamics", t_end=0.2, steps=4,
+                      analysis="dynamics", method="dopri5", outputs=ALL)
+    driven = rubbing_chain(100, pins, model="regularized", driven=True)
+    res = driven.inverse_dynamics(t_end=0.5, steps=5)
+    solve_and_compare(tmp_path, solver, driven, res, "chain_inverse", t_end=0.5, steps=5,
+                      analysis="inverse-dynamics", outputs=ALL)
+
+
 def test_header_lists_every_kind_and_the_docs_describe_them(tmp_path: Path) -> None:
     """The file's header and docs/mbd-format.md name every joint, driver and force kind the
     format holds, with its code."""
