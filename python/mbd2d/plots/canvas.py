@@ -39,7 +39,6 @@ def new_figure(figsize: tuple[float, float]) -> "Figure":
     """A Figure on its own Agg canvas (not managed by pyplot)."""
     import_matplotlib()
     from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
     fig = Figure(figsize=figsize, layout="constrained")
