@@ -694,8 +694,8 @@ contains
     type(dyn_work_t), intent(inout) :: w
     real(wp), intent(in) :: q(:), qd(:)
     integer, intent(out) :: status
-    real(wp) :: lamb(2), dnew(2), nr
-    integer :: b, d, k, n, jc, it, nb
+    real(wp) :: lamb(2), nr
+    integer :: b, k, n, jc, nb
     logical :: settled
     n = m%nq; nb = m%nfric
     status = MBD_OK
@@ -710,28 +710,56 @@ contains
       ! the starting direction of grad N from the frictionless multipliers
       w%dn(:, b) = fric_grad(m, w, b, w%y0)
     end do
+    call fric_amplitudes(m, w, .true., settled, status)
+    if (status /= MBD_OK .or. .not. settled) then
+      status = MBD_NO_CONVERGENCE; return
+    end if
+    w%locked = .false.
+    do b = 1, nb
+      k = w%fidx(b); jc = m%fref(k)
+      lamb = fric_lam(w, b, w%rhs)
+      nr = joint_normal_load(m%kind(jc) == CON_REVOLUTE, lamb)
+      w%fnl(k) = nr; w%ffr(k) = w%avec(b)
+      w%force = w%force + w%avec(b) * w%gf(:, b)
+    end do
+  end subroutine friction_solve
+
+  !> The friction amplitudes a (w%avec) and the solution x = y0 + sum_b a_b z_b (w%rhs) from
+  !! w%y0, the responses w%zf, w%cf, w%gf, w%gaf and the starting directions w%dn of grad N,
+  !! the directions iterated to FRIC_MAXIT: a sliding joint's row a_b - c_b grad N_b .
+  !! lambda_b(x) = 0; a stuck one's, with lock, its lock g_b . q_ddot(x) = -u_ar (a_b its
+  !! force), else a_b = 0 (its force a known load). status MBD_SINGULAR when the small
+  !! system is; settled when the directions settled.
+  subroutine fric_amplitudes(m, w, lock, settled, status)
+    type(model_t), intent(in) :: m
+    type(dyn_work_t), intent(inout) :: w
+    logical, intent(in) :: lock
+    logical, intent(out) :: settled
+    integer, intent(out) :: status
+    real(wp) :: dnew(2)
+    integer :: b, d, it, n, nb
+    n = m%nq; nb = m%nfric
     settled = .false.
+    status = MBD_OK
     do it = 1, FRIC_MAXIT
-      ! the small system in the amplitudes a
       do b = 1, nb
-        k = w%fidx(b)
-        if (nint(w%cst(1, k)) == MODE_STUCK) then
-          do d = 1, nb
-            w%amat(b, d) = dot_product(w%gf(:, b), w%zf(1:n, d))
-          end do
-          w%avec(b) = w%gaf(b) - dot_product(w%gf(:, b), w%y0(1:n))
-        else
+        if (nint(w%cst(1, w%fidx(b))) /= MODE_STUCK) then
           do d = 1, nb
             w%amat(b, d) = -w%cf(b) * dot_product(w%dn(:, b), fric_lam(w, b, w%zf(:, d)))
           end do
           w%amat(b, b) = w%amat(b, b) + one
           w%avec(b) = w%cf(b) * dot_product(w%dn(:, b), fric_lam(w, b, w%y0))
+        else if (lock) then
+          do d = 1, nb
+            w%amat(b, d) = dot_product(w%gf(:, b), w%zf(1:n, d))
+          end do
+          w%avec(b) = w%gaf(b) - dot_product(w%gf(:, b), w%y0(1:n))
+        else
+          w%amat(b, :) = zero; w%amat(b, b) = one; w%avec(b) = zero
         end if
       end do
       call lu_factor_small(w%amat, w%fpiv, status)
-      if (status /= MBD_OK) then
-        status = MBD_NO_CONVERGENCE; return
-      end if
+      if (status /= MBD_OK) return
       call lu_solve_small(w%amat, w%fpiv, w%avec)
       w%rhs = w%y0
       do d = 1, nb
@@ -746,18 +774,7 @@ contains
       end do
       if (settled) exit
     end do
-    if (.not. settled) then
-      status = MBD_NO_CONVERGENCE; return
-    end if
-    w%locked = .false.
-    do b = 1, nb
-      k = w%fidx(b); jc = m%fref(k)
-      lamb = fric_lam(w, b, w%rhs)
-      nr = joint_normal_load(m%kind(jc) == CON_REVOLUTE, lamb)
-      w%fnl(k) = nr; w%ffr(k) = w%avec(b)
-      w%force = w%force + w%avec(b) * w%gf(:, b)
-    end do
-  end subroutine friction_solve
+  end subroutine fric_amplitudes
 
   !> Friction element b's slip direction g_b = du/dq (w%gf(:, b)), its lock's right-hand
   !! side -u_ar (w%gaf(b)) and its coefficient c_b in a_b = c_b N_b (w%cf(b)): -mu(u_dot)
@@ -1068,8 +1085,7 @@ contains
     real(wp), intent(out) :: lam(:)             !! multipliers (neq)
     integer, intent(out) :: status              !! MBD_OK, MBD_SINGULAR or MBD_LAPACK
     character(len=MSG_LEN), intent(inout) :: msg  !! explanation
-    real(wp) :: dnew(2)
-    integer :: n, k, b, d, it, nb
+    integer :: n, k, b, nb
     logical :: settled
     n = m%nq; nb = m%nfric
     lam = zero
@@ -1092,37 +1108,12 @@ contains
         if (status /= MBD_OK) return
         w%dn(:, b) = fric_grad(m, w, b, w%y0)
       end do
-      do it = 1, FRIC_MAXIT
-        ! (I - C D Z) a = C D lambda(y0) over the sliding joints, a = 0 on the stuck ones
-        do b = 1, nb
-          w%amat(b, :) = zero; w%avec(b) = zero
-          if (.not. stuck(b)) then
-            do d = 1, nb
-              w%amat(b, d) = -w%cf(b) * dot_product(w%dn(:, b), fric_lam(w, b, w%zf(:, d)))
-            end do
-            w%avec(b) = w%cf(b) * dot_product(w%dn(:, b), fric_lam(w, b, w%y0))
-          end if
-          w%amat(b, b) = w%amat(b, b) + one
-        end do
-        call lu_factor_small(w%amat, w%fpiv, status)
-        if (status /= MBD_OK) then
-          status = MBD_NO_CONVERGENCE
-          msg = 'the multipliers: the joint friction cannot be resolved (self-locking)'
-          return
-        end if
-        call lu_solve_small(w%amat, w%fpiv, w%avec)
-        w%rhs = w%y0
-        do d = 1, nb
-          w%rhs = w%rhs + w%avec(d) * w%zf(:, d)
-        end do
-        settled = .true.
-        do b = 1, nb
-          dnew = fric_grad(m, w, b, w%rhs)
-          if (maxval(abs(dnew - w%dn(:, b))) > 1.0e-12_wp) settled = .false.
-          w%dn(:, b) = dnew
-        end do
-        if (settled) exit
-      end do
+      call fric_amplitudes(m, w, .false., settled, status)
+      if (status /= MBD_OK) then
+        status = MBD_NO_CONVERGENCE
+        msg = 'the multipliers: the joint friction cannot be resolved (self-locking)'
+        return
+      end if
       do b = 1, nb
         k = w%fidx(b)
         w%fnl(k) = joint_normal_load(m%kind(m%fref(k)) == CON_REVOLUTE, fric_lam(w, b, w%rhs))
