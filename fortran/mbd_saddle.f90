@@ -71,6 +71,11 @@ module mbd_saddle
   !! band it never takes by itself) one run in eleven ends 3.8e-6 off and one more
   !! underflows: 2 kept there
   integer, parameter :: NREFINE = 12, NREFINE_BAND = 2
+  !> the band rank analysis leaves out the heaviest row of a dependency instead of its last
+  !! in the order when that weighs more than SWAP_RATIO times as much (at most MAX_SWAPS
+  !! times per analysis, each a new factorization)
+  real(wp), parameter :: SWAP_RATIO = 1.0e2_wp
+  integer, parameter :: MAX_SWAPS = 8
   !> auto choice: the band path for at least SADDLE_BAND_MIN_N coordinates when the band
   !! (kl + ku + 1) is at most (n + na) / SADDLE_BAND_RATIO wide (as kinematics)
   integer, parameter :: SADDLE_BAND_MIN_N = 60, SADDLE_BAND_RATIO = 4
@@ -938,16 +943,17 @@ contains
     integer, intent(out) :: status                !! MBD_OK or MBD_NO_MEMORY
     character(len=MSG_LEN), intent(out) :: msg    !! explanation
     logical, intent(in), optional :: use(:)       !! (neq) the rows taken
-    integer, allocatable :: arow(:), cptr(:), crow(:), csrc(:), pos(:), rowof(:)
-    real(wp), allocatable :: g(:, :), rnorm(:)
-    integer :: neq, n, c, i, j, a, b, kd, ne, ierr, l, w
+    integer, allocatable :: arow(:), cptr(:), crow(:), csrc(:), pos(:), rowof(:), dropped(:)
+    real(wp), allocatable :: g(:, :), rnorm(:), cdep(:)
+    integer :: neq, n, i, j, kd, ne, ierr, l, w, attempt, r
     real(wp) :: v, dj
+    logical :: swapped
     status = MBD_OK; msg = ''
     neq = m%neq; n = m%nq
     redundant = 0; rank = 0
     if (neq == 0) return
     ! the rows touching each coordinate and their block entries; the rows' lengths
-    allocate (arow(neq), rnorm(neq), pos(neq), rowof(neq), stat=ierr)
+    allocate (arow(neq), rnorm(neq), pos(neq), rowof(neq), dropped(neq), cdep(neq), stat=ierr)
     if (ierr /= 0) goto 90
     arow = [(i, i=1, neq)]
     call rows_by_coordinate(m, arow, cptr, crow, csrc, ierr)
@@ -973,40 +979,46 @@ contains
     if (status /= MBD_OK) return
     allocate (g(kd + 1, neq), stat=ierr)
     if (ierr /= 0) goto 90
-    g = zero
-    do c = 1, n
-      do i = cptr(c), cptr(c + 1) - 1
-        a = crow(i)
-        if (.not. rnorm(a) > zero) cycle
-        do j = cptr(c), cptr(c + 1) - 1
-          b = crow(j)
-          if (pos(a) < pos(b) .or. .not. rnorm(b) > zero) cycle
-          v = jbf(csrc(i)) * jbf(csrc(j)) / (rnorm(a) * rnorm(b))
-          g(1 + pos(a) - pos(b), pos(b)) = g(1 + pos(a) - pos(b), pos(b)) + v
+    dropped = 0
+    do attempt = 1, MAX_SWAPS + 1
+      call gram()
+      ! right-looking Cholesky; a pivot <= tol2 marks its row redundant (left out), or,
+      ! when the dependency weighs another row far more (the row last in the order can
+      ! carry a weight of order eps^(1/2): leaving it out would leave the rest nearly
+      ! dependent), that row is left out instead and the factorization starts again
+      redundant = dropped
+      swapped = .false.
+      do j = 1, neq
+        dj = g(1, j)
+        l = min(kd, neq - j)
+        if (.not. dj > tol2) then
+          if (attempt <= MAX_SWAPS .and. rnorm(rowof(j)) > zero .and. &
+              dropped(rowof(j)) == 0) then
+            r = heaviest(j)
+            if (r /= j) then
+              dropped(rowof(r)) = 1
+              swapped = .true.
+              exit
+            end if
+          end if
+          redundant(rowof(j)) = 1
+          g(:, j) = zero
+          cycle
+        end if
+        dj = sqrt(dj)
+        g(1, j) = dj
+        do i = 2, l + 1
+          g(i, j) = g(i, j) / dj
+        end do
+        do w = 1, l                            ! G(j+w, j+i) -= L(j+w, j) L(j+i, j), i <= w
+          v = g(w + 1, j)
+          if (abs(v) <= zero) cycle
+          do i = 1, w
+            g(w - i + 1, j + i) = g(w - i + 1, j + i) - v * g(i + 1, j)
+          end do
         end do
       end do
-    end do
-    ! right-looking Cholesky; a pivot <= tol2 marks its row redundant (left out)
-    do j = 1, neq
-      dj = g(1, j)
-      l = min(kd, neq - j)
-      if (.not. dj > tol2) then
-        redundant(rowof(j)) = 1
-        g(:, j) = zero
-        cycle
-      end if
-      dj = sqrt(dj)
-      g(1, j) = dj
-      do i = 2, l + 1
-        g(i, j) = g(i, j) / dj
-      end do
-      do w = 1, l                              ! G(j+w, j+i) -= L(j+w, j) L(j+i, j), i <= w
-        v = g(w + 1, j)
-        if (abs(v) <= zero) cycle
-        do i = 1, w
-          g(w - i + 1, j + i) = g(w - i + 1, j + i) - v * g(i + 1, j)
-        end do
-      end do
+      if (.not. swapped) exit
     end do
     if (present(use)) then
       where (.not. use) redundant = 0
@@ -1024,6 +1036,52 @@ contains
       jbf = jb(mod(f - 1, MAXROW) + 1, mod((f - 1) / MAXROW, NLOC) + 1, &
                (f - 1) / (MAXROW * NLOC) + 1)
     end function jbf
+
+    !> G of the unit rows taken (rnorm > 0, not dropped) in the band storage g.
+    subroutine gram()
+      integer :: c, ii, jj, a, b
+      g = zero
+      do c = 1, n
+        do ii = cptr(c), cptr(c + 1) - 1
+          a = crow(ii)
+          if (.not. rnorm(a) > zero .or. dropped(a) == 1) cycle
+          do jj = cptr(c), cptr(c + 1) - 1
+            b = crow(jj)
+            if (pos(a) < pos(b) .or. .not. rnorm(b) > zero .or. dropped(b) == 1) cycle
+            g(1 + pos(a) - pos(b), pos(b)) = g(1 + pos(a) - pos(b), pos(b)) + &
+              jbf(csrc(ii)) * jbf(csrc(jj)) / (rnorm(a) * rnorm(b))
+          end do
+        end do
+      end do
+    end subroutine gram
+
+    !> The order position of the row with the largest weight in the dependency of the row at
+    !! jj (its pivot zero): u_jj = sum_i c_i u_i over the rows before it, L^T c = L(jj, :)
+    !! by back substitution (stopped once kd weights in a row are negligible: a dependency
+    !! is a loop, local in the order); jj itself (weight 1) unless a weight passes
+    !! SWAP_RATIO.
+    integer function heaviest(jj) result(best)
+      integer, intent(in) :: jj
+      integer :: ii, k, quiet
+      real(wp) :: cmax, x
+      best = jj
+      cmax = SWAP_RATIO
+      quiet = 0
+      do ii = jj - 1, 1, -1
+        x = zero
+        if (ii >= jj - kd) x = g(1 + jj - ii, ii)
+        do k = ii + 1, min(ii + kd, jj - 1)
+          x = x - g(1 + k - ii, ii) * cdep(k)
+        end do
+        cdep(ii) = zero
+        if (g(1, ii) > zero) cdep(ii) = x / g(1, ii)
+        if (abs(cdep(ii)) > cmax) then
+          cmax = abs(cdep(ii)); best = ii
+        end if
+        quiet = merge(quiet + 1, 0, abs(cdep(ii)) <= 1.0e-14_wp * cmax)
+        if (ii < jj - kd .and. quiet >= kd) exit
+      end do
+    end function heaviest
   end subroutine saddle_row_rank
 
 end module mbd_saddle
