@@ -34,7 +34,8 @@
 !! -eps I with eps = AUG_RCOND ||A||_1 (a damped least-squares solve: directions of J_a
 !! with sigma^2 below about eps are damped where dgelsy would drop them: smooth in q, where
 !! a dropped direction jumps as the condition crosses the threshold), refined against the
-!! unregularized matrix (NREFINE times dense, NREFINE_BAND band). Nothing of size n^2 is allocated on the band path.
+!! unregularized matrix (NREFINE times dense, NREFINE_BAND band). Nothing of size n^2 is
+!! allocated on the band path.
 !! Cost per factorization: dense ~ (2/3)(n + na)^3, band ~ 2 (n + na) kl (kl + ku).
 !!
 !! Usage: saddle_plan once per structure (allocates); then saddle_factor with the current
