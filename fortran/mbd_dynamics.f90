@@ -699,7 +699,7 @@ contains
     logical :: settled
     n = m%nq; nb = m%nfric
     status = MBD_OK
-    w%locked = .true.                 ! (until it settles)
+    w%locked = .false.
     w%y0 = w%rhs
     ! directions g_b, lock right-hand sides, responses z_b = A^-1 [g_b; 0]
     do b = 1, nb
@@ -712,9 +712,9 @@ contains
     end do
     call fric_amplitudes(m, w, .true., settled, status)
     if (status /= MBD_OK .or. .not. settled) then
+      w%locked = .true.
       status = MBD_NO_CONVERGENCE; return
     end if
-    w%locked = .false.
     do b = 1, nb
       k = w%fidx(b); jc = m%fref(k)
       lamb = fric_lam(w, b, w%rhs)
