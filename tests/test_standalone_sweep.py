@@ -19,6 +19,7 @@ import pytest
 import mbd2d
 from mbd2d.cli import main
 
+import test_contact_friction_parameters as cfp
 from test_standalone import find_solver
 from test_sweep import RACK, gear_pair, model_from_toml
 
@@ -80,6 +81,15 @@ CASES = {
     "dynamics": (lambda: mbd2d.load(EX / "fourbar_masses.toml"),
                  {"body.coupler.mass": [1.0, 2.0], "body.rocker.inertia": [0.05, 0.2]},
                  "dynamics", dict(t_end=0.3, steps=6, method="generalized-alpha", h=1e-3)),
+    "joint_friction": (lambda: cfp.incline(),
+                       {"joint.slide.friction.mu": [0.0, 0.1, 0.3],
+                        "joint.slide.friction.mu_static": [0.0, 0.15, 0.5]},
+                       "dynamics", dict(t_end=0.5, steps=5, rtol=1e-9, atol=1e-11)),
+    "contact": (lambda: cfp.ball(e=0.5),
+                {"contact.floor.law.stiffness": [1e5, 1e6, 1e7],
+                 "contact.floor.law.restitution": [0.9, 0.5, 0.3],
+                 "contact.floor.circle.radius": [0.1, 0.12, 0.08]},
+                "dynamics", dict(t_end=0.2, steps=5, rtol=1e-9, atol=1e-12)),
 }
 
 
