@@ -22,6 +22,7 @@ import mbd2d
 from mbd2d.studies import runner
 
 from conftest import load_example, model_from_toml
+import test_contact_friction_parameters as cfp
 
 xr = pytest.importorskip("xarray")
 
@@ -361,8 +362,15 @@ def test_dask_local_cluster_gives_the_serial_result() -> None:
                               t_end=1.0, steps=30)
         local = mbd2d.tolerance(m, {"joint.B.points.0.0": 1e-3}, samples=20, workers=1,
                                 t_end=1.0, steps=30)
+        # joint friction's and a contact's numbers as swept parameters, on the cluster too
+        incline = cfp.incline()
+        fric = {"joint.slide.friction.mu": [0.0, 0.1, 0.2, 0.3],
+                "joint.slide.friction.mu_static": [0.0, 0.15, 0.25, 0.5]}
+        fkw = {"analysis": "dynamics", "t_end": 0.5, "steps": 5, "rtol": 1e-9, "atol": 1e-11}
+        fric_remote = mbd2d.sweep(incline, fric, client=client, **fkw)
     assert serial.identical(remote)
     assert tol.dataset.identical(local.dataset)
+    assert mbd2d.sweep(incline, fric, workers=1, **fkw).identical(fric_remote)
 
 
 def test_back_to_back_dask_sweeps_of_one_model() -> None:
