@@ -231,3 +231,22 @@ def test_follower_profile_geometry_as_a_parameter():
         th = 3.0 * res.t
         ref = rc + rr - np.hypot(e * np.cos(th), y - e * np.sin(th))
         np.testing.assert_allclose(res.contact("touch").penetration, ref, atol=1e-12)
+
+
+def test_tolerance_says_what_to_do_for_friction_and_contacts():
+    """tolerance's first-order column needs design sensitivities, which refuse contacts and
+    friction: the error says so and points to the Monte Carlo route, which works: the
+    incline's slide over samples of mu has the spread of the closed form's."""
+    m = incline()
+    with pytest.raises(mbd2d.ModelError, match="tolerance_samples"):
+        mbd2d.tolerance(m, {"joint.slide.friction.mu": 0.01}, analysis="dynamics",
+                        samples=10, t_end=0.5, steps=5)
+    cases = mbd2d.tolerance_samples(m, {"joint.slide.friction.mu": 0.005}, samples=40)
+    cases["joint.slide.friction.mu_static"] = cases["joint.slide.friction.mu"] + 0.02
+    ds = mbd2d.sweep(m, cases, analysis="dynamics", t_end=0.5, steps=5, rtol=1e-10,
+                     atol=1e-12)
+    alpha, t = 0.3, 0.5
+    s = ds["q"].values[:, -1, 0] * math.cos(alpha) + ds["q"].values[:, -1, 1] * math.sin(alpha)
+    mu = cases["joint.slide.friction.mu"]
+    ref = -0.5 * G * (math.sin(alpha) - mu * math.cos(alpha)) * t**2
+    np.testing.assert_allclose(s, ref, atol=1e-8)

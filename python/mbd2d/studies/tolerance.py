@@ -323,6 +323,20 @@ def tolerance_samples(model: ModelDescription, sigma: Mapping[str, Any], samples
     return draws(model, params, sig, n, seed)
 
 
+def _check_smooth(model: ModelDescription) -> None:
+    """A ModelError for a model whose motion is not smooth in its parameters (contacts,
+    joint friction): the first-order column needs design sensitivities."""
+    names = [c.name for c in model.contacts] + \
+        [j.name for j in model.joints if getattr(j, "friction", None) is not None]
+    if names:
+        raise ModelError(f"the first-order estimate needs design sensitivities, which models "
+                         f"with contacts or joint friction ({', '.join(names)}) do not have "
+                         "(their events make the motion non-smooth in the parameters); for "
+                         "the Monte Carlo estimate alone, sweep mbd2d.tolerance_samples(model, "
+                         "sigma, samples) with mbd2d.sweep and take each output's std over "
+                         "the cases", "tolerance")
+
+
 def _sigma(model: ModelDescription, sigma: Any) -> tuple[list[Any], np.ndarray]:
     """The parameters and standard deviations of sigma, checked."""
     if not isinstance(sigma, Mapping) or not sigma:
@@ -381,8 +395,10 @@ def tolerance(model: ModelDescription, sigma: Mapping[str, Any], analysis: str =
     Raises
     ------
     ModelError
-        For an unknown parameter or setting, a negative or non-finite sigma, or samples out
-        of range; the nominal analysis's own exception when it fails.
+        For an unknown parameter or setting, a negative or non-finite sigma, samples out of
+        range, or a model with contacts or joint friction (no first-order column: their
+        case table from :func:`tolerance_samples` through :func:`mbd2d.sweep` gives the
+        Monte Carlo estimate); the nominal analysis's own exception when it fails.
 
     Examples
     --------
@@ -395,6 +411,7 @@ def tolerance(model: ModelDescription, sigma: Mapping[str, Any], analysis: str =
     """
     xr = xarray()
     params, sig = _sigma(model, sigma)
+    _check_smooth(model)
     if not isinstance(analysis, str) or analysis not in ANALYSES:
         raise ModelError(f"unknown analysis {analysis!r}; use one of {', '.join(ANALYSES)}",
                          "tolerance")
