@@ -813,8 +813,8 @@ contains
               sd%lswork(max(1, int(wq(1)))), sd%r(nt), sd%x(nt), stat=ierr)
   end subroutine dense_work
 
-  !> y = A x (a plain loop by columns: no temporary).
-  pure subroutine dgemv_plain(a, x, y)
+  !> y = A x of a dense matrix (a plain loop by columns: no temporary).
+  pure subroutine dense_matvec(a, x, y)
     real(wp), intent(in) :: a(:, :)          !! matrix
     real(wp), intent(in) :: x(:)             !! vector (size(a, 2))
     real(wp), intent(out) :: y(:)            !! product (size(a, 1))
@@ -823,7 +823,7 @@ contains
     do k = 1, size(a, 2)
       y = y + a(:, k) * x(k)
     end do
-  end subroutine dgemv_plain
+  end subroutine dense_matvec
 
   !> Solve with the factored matrix: [x; y] overwrites the right-hand side [b; c].
   subroutine saddle_solve(sd, rhs, status)
@@ -840,19 +840,23 @@ contains
       status = MBD_OK
       return
     end if
-    if (sd%banded) then
-      if (.not. sd%lsq) then
-        call band_solve(sd%b, rhs, status, msg)
-        return
-      end if
+    if (sd%banded .and. .not. sd%lsq) then
+      call band_solve(sd%b, rhs, status, msg)
+      return
+    end if
+    if (sd%banded .or. sd%reg) then
       ! regularized solve, refined against the matrix itself: x += A_eps^-1 (b - A x)
       sd%r = rhs
-      call band_solve(sd%b, rhs, status, msg)
-      do it = 1, NREFINE_BAND
+      call reg_solve(rhs)
+      do it = 1, merge(NREFINE_BAND, NREFINE, sd%banded)
         if (status /= MBD_OK) return
-        call pieces_matvec(sd, rhs, sd%x)
+        if (sd%banded) then
+          call pieces_matvec(sd, rhs, sd%x)
+        else
+          call dense_matvec(sd%acopy, rhs, sd%x)
+        end if
         sd%x = sd%r - sd%x
-        call band_solve(sd%b, sd%x, status, msg)
+        call reg_solve(sd%x)
         rhs = rhs + sd%x
       end do
       sd%nrank = sd%nrank + 1
@@ -872,26 +876,22 @@ contains
       call lu_solve(sd%a, sd%ipiv, rhs, status, msg)
       return
     end if
-    if (sd%reg) then
-      ! regularized solve, refined against the matrix itself: x += A_eps^-1 (b - A x)
-      sd%r = rhs
-      call lu_solve(sd%a, sd%ipiv, rhs, status, msg)
-      do it = 1, NREFINE
-        if (status /= MBD_OK) return
-        call dgemv_plain(sd%acopy, rhs, sd%x)
-        sd%x = sd%r - sd%x
-        call lu_solve(sd%a, sd%ipiv, sd%x, status, msg)
-        rhs = rhs + sd%x
-      end do
-      sd%nrank = sd%nrank + 1
-      return
-    end if
     sd%acopy = sd%a
     sd%jp = 0
     call dgelsy(sd%nt, sd%nt, 1, sd%acopy, sd%nt, rhs, sd%nt, sd%jp, AUG_RCOND, rank, &
                 sd%lswork, size(sd%lswork), info)
     call lapack_status('dgelsy', info, status, msg)
     sd%nrank = sd%nrank + 1
+  contains
+    !> y <- A_eps^-1 y with the regularized factors of the path.
+    subroutine reg_solve(y)
+      real(wp), intent(inout) :: y(:)
+      if (sd%banded) then
+        call band_solve(sd%b, y, status, msg)
+      else
+        call lu_solve(sd%a, sd%ipiv, y, status, msg)
+      end if
+    end subroutine reg_solve
   end subroutine saddle_solve
 
   !> Several right-hand sides as the rows of bt (4 k, nt), ncol of them: the first nkeep
@@ -985,8 +985,9 @@ contains
       call gram()
       ! right-looking Cholesky; a pivot <= tol2 marks its row redundant (left out), or,
       ! when the dependency weighs another row far more (the row last in the order can
-      ! carry a weight of order eps^(1/2): leaving it out would leave the rest nearly
-      ! dependent), that row is left out instead and the factorization starts again
+      ! carry a tiny weight, as cos(theta) ~ 4e-6 at a crank set upright: leaving it out
+      ! would leave the rest nearly dependent), that row is left out instead and the
+      ! factorization starts again
       redundant = dropped
       swapped = .false.
       do j = 1, neq
