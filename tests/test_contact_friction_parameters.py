@@ -233,20 +233,76 @@ def test_follower_profile_geometry_as_a_parameter():
         np.testing.assert_allclose(res.contact("touch").penetration, ref, atol=1e-12)
 
 
-def test_tolerance_says_what_to_do_for_friction_and_contacts():
-    """tolerance's first-order column needs design sensitivities, which refuse contacts and
-    friction: the error says so and points to the Monte Carlo route, which works: the
-    incline's slide over samples of mu has the spread of the closed form's."""
+def test_tolerance_of_friction_by_monte_carlo_against_the_incline():
+    """A model with joint friction has no design sensitivities, so its tolerance report has
+    the Monte Carlo columns alone (the attribute first_order says why): the slide's scatter
+    over the drawn mu (tolerance_samples: the same draws) is that of the closed form
+    s = -g (sin a - mu cos a) t^2 / 2 over them, at two tolerances (measured 2e-14 at both:
+    dopri5 integrates the quadratic exactly between the stick-slip events); a point of the block has
+    the same; variance shares and samples=0 are refused with the reason."""
     m = incline()
-    with pytest.raises(mbd2d.ModelError, match="tolerance_samples"):
-        mbd2d.tolerance(m, {"joint.slide.friction.mu": 0.01}, analysis="dynamics",
-                        samples=10, t_end=0.5, steps=5)
-    cases = mbd2d.tolerance_samples(m, {"joint.slide.friction.mu": 0.005}, samples=40)
-    cases["joint.slide.friction.mu_static"] = cases["joint.slide.friction.mu"] + 0.02
-    ds = mbd2d.sweep(m, cases, analysis="dynamics", t_end=0.5, steps=5, rtol=1e-10,
-                     atol=1e-12)
-    alpha, t = 0.3, 0.5
-    s = ds["q"].values[:, -1, 0] * math.cos(alpha) + ds["q"].values[:, -1, 1] * math.sin(alpha)
-    mu = cases["joint.slide.friction.mu"]
-    ref = -0.5 * G * (math.sin(alpha) - mu * math.cos(alpha)) * t**2
-    np.testing.assert_allclose(s, ref, atol=1e-8)
+    alpha, sig = 0.3, {"joint.slide.friction.mu": 0.004}
+    mu = mbd2d.tolerance_samples(m, sig, samples=30)["joint.slide.friction.mu"]
+    for rtol in (1e-6, 1e-10):                  # constant acceleration: dopri5 is exact
+        tol = 1e-9
+        rep = mbd2d.tolerance(m, sig, analysis="dynamics", samples=30, t_end=0.5, steps=5,
+                              rtol=rtol, atol=rtol * 1e-2, workers=1)
+        ds = rep.dataset
+        assert "q_std_linear" not in ds and "slide" in ds.attrs["first_order"]
+        assert ds.attrs["failed"] == 0
+        t = ds["time"].values
+        s = -0.5 * G * (math.sin(alpha) - np.outer(mu, np.ones_like(t)) * math.cos(alpha)) * t**2
+        for j, u in enumerate((math.cos(alpha), math.sin(alpha))):
+            ref = np.std(s * u, axis=0, ddof=1)
+            np.testing.assert_allclose(ds["q_std_mc"].values[:, j], ref, rtol=tol, atol=1e-12)
+            np.testing.assert_allclose(ds["q_mean_mc"].values[:, j], np.mean(s * u, axis=0),
+                                       rtol=tol, atol=1e-12)
+        pt = rep.point("block", (0.1, 0.0))
+        assert "x_std_linear" not in pt
+        np.testing.assert_allclose(pt["x_std_mc"].values, ds["q_std_mc"].values[:, 0],
+                                   rtol=1e-12, atol=1e-15)
+    assert "Monte Carlo only" in repr(rep)
+    with pytest.raises(mbd2d.ModelError, match="first-order column"):
+        rep.contributions("q", "block.x")
+    with pytest.raises(mbd2d.ModelError, match="samples >= 2"):
+        mbd2d.tolerance(m, sig, analysis="dynamics", samples=0, t_end=0.5, steps=5)
+
+
+def test_tolerance_of_a_contact_stiffness_against_the_linear_law():
+    """The ball leaves the floor after pi sqrt(m / k): over the drawn stiffnesses
+    y(t_end) = R + v0 (t_end - t_on - pi sqrt(1 / k)), whose sample spread the report's Monte
+    Carlo column has; the rebound speed is v0 whatever k (spread below 1e-8)."""
+    v0, h0, t_end = 3.0, 0.2, 0.2
+    sig = {"contact.floor.law.stiffness": 5e4}
+    ks = mbd2d.tolerance_samples(ball(), sig, samples=20)["contact.floor.law.stiffness"]
+    ds = mbd2d.tolerance(ball(), sig, analysis="dynamics", samples=20, t_end=t_end, steps=10,
+                         rtol=1e-10, atol=1e-13, workers=1).dataset
+    y_end = R + v0 * (t_end - (h0 - R) / v0 - math.pi * np.sqrt(1.0 / ks))
+    np.testing.assert_allclose(ds["q_std_mc"].values[-1, 1], np.std(y_end, ddof=1), rtol=1e-6)
+    assert ds["qd_std_mc"].values[-1, 1] < 1e-8
+    assert "floor" in ds.attrs["first_order"]
+
+
+def test_cli_tolerance_of_a_friction_model(tmp_path: Path, capsys):
+    """`mbd2d tolerance` on the incline: the summary names the Monte Carlo standard
+    deviation and why there is no first-order one; the CSV has the Monte Carlo columns, whose
+    last row is the closed form's spread over the same draws."""
+    from mbd2d.cli import main
+    toml = tmp_path / "incline.toml"
+    toml.write_text(dumps(incline()))
+    out = tmp_path / "tol.csv"
+    sig = {"joint.slide.friction.mu": 0.004}
+    assert main(["tolerance", str(toml), "--sigma", "joint.slide.friction.mu=0.004",
+                 "--samples", "20", "--analysis", "dynamics", "--t-end", "0.5", "--steps", "5",
+                 "--rtol", "1e-10", "--atol", "1e-12", "--workers", "1",
+                 "--point", "block:0.1,0", "--out", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert "largest Monte Carlo standard deviation" in text and "joint friction" in text
+    header = out.read_text().splitlines()[0].split(",")
+    assert not [h for h in header if "std_linear" in h]
+    rows = np.loadtxt(out, delimiter=",", skiprows=1, ndmin=2)
+    mu = mbd2d.tolerance_samples(incline(), sig, samples=20)["joint.slide.friction.mu"]
+    s = -0.5 * G * (math.sin(0.3) - mu * math.cos(0.3)) * 0.5**2
+    ref = np.std(s * math.cos(0.3), ddof=1)
+    assert rows[-1, header.index("block.x.std_mc")] == pytest.approx(ref, rel=1e-6)
+    assert rows[-1, header.index("block(0.1;0).x.std_mc")] == pytest.approx(ref, rel=1e-6)

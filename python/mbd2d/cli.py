@@ -46,6 +46,7 @@ Exit codes: 0 ok, 2 bad input, 3 singular configuration (partial output written)
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import sys
 import textwrap
@@ -461,50 +462,72 @@ def _tolerance(model: Model, args: argparse.Namespace) -> int:
 
 def _tolerance_report(tol: Any, points: list[tuple[str, Any]]) -> str:
     """The largest first-order standard deviations of the positions (and points), with the
-    Monte Carlo estimate beside them."""
+    Monte Carlo estimate beside them; the Monte Carlo ones alone for a report without the
+    first-order column (contacts, joint friction)."""
     ds = tol.dataset
     a = ds.attrs
+    key, word = ("_std_linear", "first-order") if tol.linear else ("_std_mc", "Monte Carlo")
     lines = [f"tolerance of '{a['model']}' ({a['run']}; {a['samples']} samples, {a['failed']} "
              f"failed): {a['sigma']}",
-             "largest first-order standard deviation over the run (Monte Carlo at the same "
-             "time):"]
+             f"largest {word} standard deviation over the run"
+             + (" (Monte Carlo at the same time):" if tol.linear else
+                f" (first order: {a['first_order']}):")]
     rows = []
     for j, name in enumerate(str(c) for c in ds.coordinate.values):
-        rows.append((name, ds.q_std_linear.values[:, j],
-                     ds.q_std_mc.values[:, j] if "q_std_mc" in ds else None, "q"))
+        rows.append((name, ds[f"q{key}"].values[:, j],
+                     ds.q_std_mc.values[:, j] if tol.linear and "q_std_mc" in ds else None,
+                     "q" if tol.linear else None))
     for label, pt in points:
         for v in ("x", "y"):
-            rows.append((f"{label}.{v}", pt[f"{v}_std_linear"].values,
-                         pt[f"{v}_std_mc"].values, pt[f"{v}_share"].values))
-    rows.sort(key=lambda r: -float(np.nanmax(r[1])))
+            rows.append((f"{label}.{v}", pt[f"{v}{key}"].values,
+                         pt[f"{v}_std_mc"].values if tol.linear else None,
+                         pt[f"{v}_share"].values if tol.linear else None))
+    rows.sort(key=lambda r: -_nanmax(r[1]))
     t = np.atleast_1d(ds.time.values)
     for name, lin, mc, output in rows[:8]:
+        if not np.isfinite(lin).any():
+            lines.append(f"  {name:24s} no value: fewer than 2 samples completed")
+            continue
         k = int(np.nanargmax(lin))
         beside = "" if mc is None else f"  (Monte Carlo {mc[k]:.3g})" if np.isfinite(mc[k]) \
             else "  (Monte Carlo: fewer than 2 samples completed)"
         lines.append(f"  {name:24s} {lin[k]:.3g} at t = {t[k]:.6g}{beside}"
                      + _main_share(tol, output, name, k))
     if "measures" in ds:
-        lines.append("measures, largest first-order standard deviation (angles in deg):")
-        for j, spec in enumerate(str(m) for m in ds["measure"].values):
-            unit = np.degrees if spec.startswith("transmission_angle") else np.asarray
-            lin = unit(ds.measures_std_linear.values[:, j])
-            if not np.any(np.isfinite(lin)):
-                lines.append(f"  {spec:24s} no finite value (a dead centre throughout)")
-                continue
-            k = int(np.nanargmax(np.where(np.isfinite(lin), lin, np.nan)))
-            mc = (f"  (Monte Carlo {unit(ds.measures_std_mc.values[k, j]):.3g})"
-                  if "measures_std_mc" in ds else "")
-            lines.append(f"  {spec:24s} {lin[k]:.3g} at t = {t[k]:.6g}{mc}"
-                         + _main_share(tol, "measures", spec, k))
+        lines += _measures_report(tol, key, word, t)
     return "\n".join(lines)
+
+
+def _nanmax(x: np.ndarray) -> float:
+    """The largest finite value (-inf when there is none)."""
+    x = np.asarray(x, dtype=float)
+    return float(np.max(x[np.isfinite(x)])) if np.isfinite(x).any() else -math.inf
+
+
+def _measures_report(tol: Any, key: str, word: str, t: np.ndarray) -> list[str]:
+    """The report's lines of the measures: each one's largest standard deviation (key:
+    first order or Monte Carlo) with the Monte Carlo one beside the first order."""
+    ds = tol.dataset
+    lines = [f"measures, largest {word} standard deviation (angles in deg):"]
+    for j, spec in enumerate(str(m) for m in ds["measure"].values):
+        unit = np.degrees if spec.startswith("transmission_angle") else np.asarray
+        lin = unit(ds[f"measures{key}"].values[:, j])
+        if not np.any(np.isfinite(lin)):
+            lines.append(f"  {spec:24s} no finite value (a dead centre throughout)")
+            continue
+        k = int(np.nanargmax(np.where(np.isfinite(lin), lin, np.nan)))
+        mc = (f"  (Monte Carlo {unit(ds.measures_std_mc.values[k, j]):.3g})"
+              if tol.linear and "measures_std_mc" in ds else "")
+        lines.append(f"  {spec:24s} {lin[k]:.3g} at t = {t[k]:.6g}{mc}"
+                     + (_main_share(tol, "measures", spec, k) if tol.linear else ""))
+    return lines
 
 
 def _main_share(tol: Any, output: Any, entry: str, k: int) -> str:
     """", mostly P (NN %)": the parameter with the largest share of the entry's first-order
     variance at row k (ToleranceResult.contributions; a point's shares given as output, an
-    array (time, parameter)); "" for a lone parameter."""
-    if len(tol.sigma) < 2:
+    array (time, parameter)); "" for a lone parameter or without shares (output None)."""
+    if len(tol.sigma) < 2 or output is None:
         return ""
     share = (tol.contributions(output, entry).values if isinstance(output, str)
              else output)[k]

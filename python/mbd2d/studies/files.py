@@ -153,7 +153,8 @@ def tolerance_table(ds: Any, points: Sequence[tuple[str, Any]] = ()
     standard deviation ``NAME.std_linear`` and, with Monte Carlo samples, ``NAME.std_mc``
     and ``NAME.mean_mc`` (NAME: ``crank.x``, ``crank.x_dot``, ``crank.x_ddot``,
     ``lambda.LABEL``, ``DRIVER.effort``); then per point ``LABEL.x``, ``LABEL.y`` with
-    their ``.std_linear`` and ``.std_mc``."""
+    their ``.std_linear`` and ``.std_mc`` (``.std_linear`` only where the analysis has the
+    first-order column: not with contacts or joint friction)."""
     header = ["t"]
     blocks = [np.atleast_1d(ds.time.values)[:, None]]
     for out, fmt in _ENTRY.items():
@@ -166,6 +167,8 @@ def tolerance_table(ds: Any, points: Sequence[tuple[str, Any]] = ()
                 blocks.append(np.asarray(ds[f"{out}{suffix}"].values))
     for label, pt in points:
         for v in ("x", "y", "x_std_linear", "y_std_linear", "x_std_mc", "y_std_mc"):
+            if v not in pt:
+                continue                        # no first-order column (contacts, friction)
             header.append(f"{label}.{v.replace('_std', '.std')}")
             blocks.append(np.asarray(pt[v].values)[:, None])
     return header, np.hstack(blocks)

@@ -12,6 +12,10 @@ a process pool or on a Dask cluster) and takes the sample standard deviation of 
 over the variants that completed. For small sigma the two agree within the Monte Carlo error
 (a relative standard error of about 1/sqrt(2 (N - 1))); where they differ, the output is
 nonlinear in the parameters over the scatter.
+
+A model with contacts or joint friction has no design sensitivities (its events make the
+motion non-smooth in the parameters): its report has the Monte Carlo columns alone, and the
+dataset's attribute ``first_order`` says why.
 """
 from __future__ import annotations
 
@@ -51,11 +55,13 @@ class ToleranceResult:
         the first-order standard deviation, ``X_std_mc`` and ``X_mean_mc`` the Monte Carlo
         standard deviation and mean, over ("time", "coordinate" | "equation" | "driver").
         Attributes: ``samples``, ``failed`` (samples that did not complete, left out),
-        ``seed``, ``sigma``.
+        ``seed``, ``sigma``, ``first_order`` ("exact sensitivities", or why there is no
+        ``X_std_linear``: a model with contacts or joint friction).
     samples : xarray.Dataset
         The Monte Carlo sweep itself (:func:`mbd2d.sweep`).
     nominal : result
-        The nominal analysis with its sensitivities (``dq_dp`` ...).
+        The nominal analysis with its sensitivities (``dq_dp`` ...; none for a model with
+        contacts or joint friction).
     sigma : dict
         Parameter name -> standard deviation.
     """
@@ -71,7 +77,8 @@ class ToleranceResult:
         dP/dp = dr/dp + B(theta) s' dtheta/dp), ``x_std_mc``, ``y_std_mc`` (the sample
         standard deviation of P over the completed samples) and ``x_share``, ``y_share``
         over ("time", "parameter"): each parameter's share of the first-order variance (as
-        :meth:`contributions`).
+        :meth:`contributions`). Without a first-order column (contacts, joint friction):
+        ``x``, ``y`` and the Monte Carlo ones alone.
 
         Raises
         ------
@@ -85,29 +92,41 @@ class ToleranceResult:
         if body not in names:
             raise KeyError(f"no body {body!r}; bodies: {', '.join(names)}")
         i = 3 * names.index(body)
-        q, dq = _rows(self.nominal, self.nominal.q), _rows(self.nominal, self.nominal.dq_dp)
+        q = _rows(self.nominal, self.nominal.q)
         th = q[:, i + 2]
         c, sn = np.cos(th), np.sin(th)
-        x, y = q[:, i] + c * sx - sn * sy, q[:, i + 1] + sn * sx + c * sy
-        dr = PointResult.derivatives((sx, sy), [q[:, i:i + 3]], [dq[:, i:i + 3, :]])[0]
-        dx, dy = dr[:, 0, :], dr[:, 1, :]
-        sig = np.array(list(self.sigma.values()))
+        t = ("time",)
+        data = {"x": (t, q[:, i] + c * sx - sn * sy), "y": (t, q[:, i + 1] + sn * sx + c * sy)}
+        if self.linear:
+            data.update(self._point_linear(i, (sx, sy)))
         qs = np.zeros((0,) + q.shape) if self.samples is None else \
             self.samples.q.values[self.samples.status.values == 0]      # (n, time, nq)
         ths = qs[:, :, i + 2]
-        xs = qs[:, :, i] + np.cos(ths) * sx - np.sin(ths) * sy
-        ys = qs[:, :, i + 1] + np.sin(ths) * sx + np.cos(ths) * sy
-        xr = xarray()
-        t = ("time",)
-        tp = ("time", "parameter")
-        return xr.Dataset({"x": (t, x), "y": (t, y),
-                           "x_std_linear": (t, _std_linear(dx, sig)),
-                           "y_std_linear": (t, _std_linear(dy, sig)),
-                           "x_std_mc": (t, _std(xs)), "y_std_mc": (t, _std(ys)),
-                           "x_share": (tp, _shares(dx, sig)), "y_share": (tp, _shares(dy, sig))},
-                          coords={"time": self.dataset.time.values,
-                                  "parameter": list(self.sigma)},
-                          attrs={"body": body, "point": f"({sx:g}, {sy:g})"})
+        data["x_std_mc"] = (t, _std(qs[:, :, i] + np.cos(ths) * sx - np.sin(ths) * sy))
+        data["y_std_mc"] = (t, _std(qs[:, :, i + 1] + np.sin(ths) * sx + np.cos(ths) * sy))
+        coords = {"time": self.dataset.time.values}
+        if self.linear:
+            coords["parameter"] = list(self.sigma)
+        return xarray().Dataset(data, coords=coords,
+                                attrs={"body": body, "point": f"({sx:g}, {sy:g})"})
+
+    @property
+    def linear(self) -> bool:
+        """Whether the report has the first-order column (the model has design
+        sensitivities: no contacts, no joint friction)."""
+        return getattr(self.nominal, "dq_dp", None) is not None
+
+    def _point_linear(self, i: int, s: tuple[float, float]) -> dict[str, Any]:
+        """The first-order columns of a point of the body whose x is coordinate i:
+        dP/dp = dr/dp + B(theta) s' dtheta/dp."""
+        q, dq = _rows(self.nominal, self.nominal.q), _rows(self.nominal, self.nominal.dq_dp)
+        dr = PointResult.derivatives(s, [q[:, i:i + 3]], [dq[:, i:i + 3, :]])[0]
+        dx, dy = dr[:, 0, :], dr[:, 1, :]
+        sig = np.array(list(self.sigma.values()))
+        t, tp = ("time",), ("time", "parameter")
+        return {"x_std_linear": (t, _std_linear(dx, sig)),
+                "y_std_linear": (t, _std_linear(dy, sig)),
+                "x_share": (tp, _shares(dx, sig)), "y_share": (tp, _shares(dy, sig))}
 
     def contributions(self, output: str, entry: str) -> Any:
         """Each parameter's share of the first-order variance of one entry of an output,
@@ -131,7 +150,8 @@ class ToleranceResult:
         Raises
         ------
         ModelError
-            For an output or entry the analysis does not have.
+            For an output or entry the analysis does not have, or a report without the
+            first-order column (contacts, joint friction: no sensitivities).
 
         Examples
         --------
@@ -143,6 +163,10 @@ class ToleranceResult:
         1.0
         """
         ds = self.dataset
+        if not self.linear:
+            raise ModelError(f"variance shares come from the first-order column, which this "
+                             f"report does not have ({ds.attrs['first_order']})",
+                             "contributions")
         outputs = _outputs(ds)
         if output not in outputs:
             raise ModelError(f"no output {output!r}; outputs: {', '.join(outputs)}",
@@ -164,7 +188,8 @@ class ToleranceResult:
     def __repr__(self) -> str:
         a = self.dataset.attrs
         return (f"ToleranceResult({len(self.sigma)} parameters, {a.get('samples')} samples, "
-                f"{a.get('failed')} failed; outputs {', '.join(_outputs(self.dataset))})")
+                f"{a.get('failed')} failed; outputs {', '.join(_outputs(self.dataset))}"
+                f"{'' if self.linear else '; Monte Carlo only'})")
 
 
 def _rows(res: Any, a: np.ndarray) -> np.ndarray:
@@ -218,13 +243,16 @@ def _std(x: np.ndarray) -> np.ndarray:
 
 
 def _outputs(ds: Any) -> list[str]:
-    return [v for v in ds.data_vars if f"{v}_std_linear" in ds.data_vars]
+    """The outputs of a tolerance dataset (those with a first-order or a Monte Carlo
+    standard deviation)."""
+    return [v for v in ds.data_vars
+            if f"{v}_std_linear" in ds.data_vars or f"{v}_std_mc" in ds.data_vars]
 
 
-def _nominal(model: ModelDescription, names: list[str], analysis: str,
+def _nominal(model: ModelDescription, names: list[str] | None, analysis: str,
              kw: Mapping[str, Any]) -> tuple[Any, str]:
-    """The analysis with sensitivities (the exception it raises when it fails); and which
-    analysis ran."""
+    """The analysis with sensitivities to names (None: without; the exception it raises
+    when it fails); and which analysis ran."""
     if analysis == "kinematics":
         a = _bind(_kinematics_settings, kw, analysis)
         if model.has_masses() and a["maxit"] is None and not a["positions_only"]:
@@ -239,30 +267,34 @@ def _nominal(model: ModelDescription, names: list[str], analysis: str,
         return run_statics(model, sensitivities=names, **_bind(_statics_settings, kw,
                                                                  analysis)), "statics"
     a = _bind(_dynamics_settings, kw, analysis)
-    if a["method"] not in (None,) + SENSITIVITY_METHODS:
+    if names is not None and a["method"] not in (None,) + SENSITIVITY_METHODS:
         raise ModelError(f"tolerance analysis of dynamics needs the sensitivities of dopri5 "
                          f"or generalized-alpha (method={a['method']!r} has none)", "tolerance")
     return run_dynamics(model, sensitivities=names, **a), "dynamics"
 
 
 def _linear_outputs(res: Any, ran: str) -> dict[str, tuple[tuple[str, ...], np.ndarray,
-                                                           np.ndarray]]:
-    """Output name -> (dims, nominal (time, k), sensitivities (time, k, n_params))."""
-    def rows(a: np.ndarray) -> np.ndarray:
-        return _rows(res, a)
+                                                           np.ndarray | None]]:
+    """Output name -> (dims, nominal (time, k), sensitivities (time, k, n_params)); the
+    sensitivities None for a run without them (then lam and effort where the run has
+    multipliers)."""
+    def rows(a: np.ndarray | None) -> np.ndarray | None:
+        return None if a is None else _rows(res, a)
 
-    out = {"q": (("time", "coordinate"), rows(res.q), rows(res.dq_dp))}
+    out = {"q": (("time", "coordinate"), rows(res.q), rows(getattr(res, "dq_dp", None)))}
     if ran != "statics":
-        out["qd"] = (("time", "coordinate"), res.qd, res.dqd_dp)
-        out["qdd"] = (("time", "coordinate"), res.qdd, res.dqdd_dp)
+        out["qd"] = (("time", "coordinate"), res.qd, getattr(res, "dqd_dp", None))
+        out["qdd"] = (("time", "coordinate"), res.qdd, getattr(res, "dqdd_dp", None))
     dlam = getattr(res, "dlam_dp", None)
-    if dlam is not None:
-        lam, dlam = rows(res.lam), rows(dlam)
+    lam = getattr(res, "lam", None)
+    if dlam is not None or (out["q"][2] is None and lam is not None):
+        lam, dlam = rows(lam), rows(dlam)
         out["lam"] = (("time", "equation"), lam, dlam)
         p = res.packed
         drows = [p.row_owner.index(k) for k, f in enumerate(p.driver_flags) if f]
         if drows:
-            out["effort"] = (("time", "driver"), -lam[:, drows], -dlam[:, drows, :])
+            out["effort"] = (("time", "driver"), -lam[:, drows],
+                             None if dlam is None else -dlam[:, drows, :])
     return out
 
 
@@ -283,12 +315,12 @@ def _measure_specs(measures: Any, analysis: str) -> list[str]:
     return list(specs)
 
 
-def _measure_outputs(res: Any, specs: list[str]) -> tuple[tuple[str, ...], np.ndarray,
-                                                          np.ndarray]:
-    """The measures' nominal values (time, k) and derivatives (time, k, n_params), as
-    _linear_outputs gives the other outputs."""
+def _measure_outputs(res: Any, specs: list[str], linear: bool
+                     ) -> tuple[tuple[str, ...], np.ndarray, np.ndarray | None]:
+    """The measures' nominal values (time, k) and derivatives (time, k, n_params; None
+    when not linear), as _linear_outputs gives the other outputs."""
     return (("time", "measure"), np.column_stack([measure(res, s) for s in specs]),
-            measure_derivatives(res, specs))
+            measure_derivatives(res, specs) if linear else None)
 
 
 def _seed(seed: Any) -> int | None:
@@ -323,18 +355,17 @@ def tolerance_samples(model: ModelDescription, sigma: Mapping[str, Any], samples
     return draws(model, params, sig, n, seed)
 
 
-def _check_smooth(model: ModelDescription) -> None:
-    """A ModelError for a model whose motion is not smooth in its parameters (contacts,
-    joint friction): the first-order column needs design sensitivities."""
+def _not_smooth(model: ModelDescription) -> str:
+    """Why a model has no first-order column ("" when it has one): its motion is not smooth
+    in its parameters (contacts, joint friction), and the column needs design
+    sensitivities."""
     names = [c.name for c in model.contacts] + \
         [j.name for j in model.joints if getattr(j, "friction", None) is not None]
-    if names:
-        raise ModelError(f"the first-order estimate needs design sensitivities, which models "
-                         f"with contacts or joint friction ({', '.join(names)}) do not have "
-                         "(their events make the motion non-smooth in the parameters); for "
-                         "the Monte Carlo estimate alone, sweep mbd2d.tolerance_samples(model, "
-                         "sigma, samples) with mbd2d.sweep and take each output's std over "
-                         "the cases", "tolerance")
+    if not names:
+        return ""
+    return (f"none: the first-order estimate needs design sensitivities, which models with "
+            f"contacts or joint friction ({', '.join(names)}) do not have (their events make "
+            "the motion non-smooth in the parameters)")
 
 
 def _sigma(model: ModelDescription, sigma: Any) -> tuple[list[Any], np.ndarray]:
@@ -369,7 +400,8 @@ def tolerance(model: ModelDescription, sigma: Mapping[str, Any], analysis: str =
         with sensitivities).
     samples : int
         Monte Carlo variants, drawn with p ~ Normal(p0, sigma) (default 200; 0 skips the
-        Monte Carlo estimate).
+        Monte Carlo estimate; a model with contacts or joint friction needs them: its report
+        has the Monte Carlo columns alone).
     client : distributed.Client, optional
         Run the Monte Carlo sweep on a Dask cluster.
     seed : int or None
@@ -396,9 +428,8 @@ def tolerance(model: ModelDescription, sigma: Mapping[str, Any], analysis: str =
     ------
     ModelError
         For an unknown parameter or setting, a negative or non-finite sigma, samples out of
-        range, or a model with contacts or joint friction (no first-order column: their
-        case table from :func:`tolerance_samples` through :func:`mbd2d.sweep` gives the
-        Monte Carlo estimate); the nominal analysis's own exception when it fails.
+        range, or samples=0 for a model with contacts or joint friction (it has no
+        first-order column); the nominal analysis's own exception when it fails.
 
     Examples
     --------
@@ -411,7 +442,7 @@ def tolerance(model: ModelDescription, sigma: Mapping[str, Any], analysis: str =
     """
     xr = xarray()
     params, sig = _sigma(model, sigma)
-    _check_smooth(model)
+    rough = _not_smooth(model)
     if not isinstance(analysis, str) or analysis not in ANALYSES:
         raise ModelError(f"unknown analysis {analysis!r}; use one of {', '.join(ANALYSES)}",
                          "tolerance")
@@ -421,11 +452,14 @@ def tolerance(model: ModelDescription, sigma: Mapping[str, Any], analysis: str =
     if n == 1:
         raise ModelError("samples must be 0 (no Monte Carlo estimate) or at least 2",
                          "tolerance")
+    if rough and not n:
+        raise ModelError(f"samples=0 leaves nothing to report: first-order column {rough}; "
+                         "give samples >= 2 for the Monte Carlo estimate", "tolerance")
     specs = _measure_specs(measures, analysis)
-    res, ran = _nominal(model, names, analysis, analysis_kwargs)
+    res, ran = _nominal(model, None if rough else names, analysis, analysis_kwargs)
     outs = _linear_outputs(res, ran)
     if specs:
-        outs["measures"] = _measure_outputs(res, specs)
+        outs["measures"] = _measure_outputs(res, specs, not rough)
     mc = None
     if n:
         mc = sweep(model, draws(model, params, sig, n, seed), analysis, client,
@@ -434,9 +468,13 @@ def tolerance(model: ModelDescription, sigma: Mapping[str, Any], analysis: str =
     ok = mc.status.values == 0 if mc is not None else np.zeros(0, dtype=bool)
     times = np.array([res.t]) if ran == "statics" else np.asarray(res.t)
     data: dict[str, Any] = {}
-    for name, (dims, nom, s) in outs.items():
+    for name, (dims, nom, s) in list(outs.items()):
+        if s is None and (mc is None or name not in mc):
+            del outs[name]                      # no statistic of it
+            continue
         data[name] = (dims, nom)
-        data[f"{name}_std_linear"] = (dims, _std_linear(s, sig))
+        if s is not None:
+            data[f"{name}_std_linear"] = (dims, _std_linear(s, sig))
         if mc is not None and name in mc:
             vals = mc[name].values[ok]
             data[f"{name}_std_mc"] = (dims, _std(vals))
@@ -452,7 +490,8 @@ def tolerance(model: ModelDescription, sigma: Mapping[str, Any], analysis: str =
         coords["driver"] = [p.constraint_names[k] for k, f in enumerate(p.driver_flags) if f]
     attrs = {"analysis": analysis, "run": ran, "model": model.name, "samples": n,
              "failed": int((~ok).sum()), "seed": "none" if seed is None else int(seed),
-             "sigma": ", ".join(f"{k}={v:g}" for k, v in zip(names, sig))}
+             "sigma": ", ".join(f"{k}={v:g}" for k, v in zip(names, sig)),
+             "first_order": rough or "exact sensitivities"}
     ds = xr.Dataset(data, coords=coords, attrs=attrs)
     return ToleranceResult(ds, mc, res, dict(zip(names, sig.tolist())))
 
