@@ -105,7 +105,8 @@ def render_frames(result: Motion, fps: float = 30, trace: Sequence[TracePoint] |
     update = scene.make(ax, Look(scene.colour, 0.3, 2.0, True))
     clock = ax.text(0.02, 0.97, "", transform=ax.transAxes, ha="left", va="top", fontsize=9,
                     family="monospace", zorder=20)
-    moving = [a for a in ax.get_children() if a not in before]
+    # drawn as the Axes would: by zorder, in the order made within one
+    moving = sorted((a for a in ax.get_children() if a not in before), key=_zorder)
     update(int(rows[0]))
     (xl, yl) = scene.limits()
     scene.dress(ax, length_unit, scene.model.name if title is None else title)
@@ -129,6 +130,10 @@ def render_frames(result: Motion, fps: float = 30, trace: Sequence[TracePoint] |
             ax.draw_artist(a)
         frames.append(np.asarray(canvas.buffer_rgba())[:, :, :3].copy())
     return frames
+
+
+def _zorder(a: Any) -> float:
+    return float(a.get_zorder())
 
 
 def gif_bytes(frames: list[np.ndarray], fps: float) -> bytes:

@@ -39,6 +39,8 @@ class ContactDrawer(Element):
     """A contact: its two surfaces on their bodies at each row (circles, a line, a cam
     profile and its follower), bold while the contact touches (penetration > 0)."""
 
+    batchable = False                           # its outline thickens in contact
+
     def _shapes(self) -> list[tuple[str, np.ndarray]]:
         """The closed surfaces (body, local points) of the contact."""
         c = self.item

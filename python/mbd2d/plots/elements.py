@@ -115,6 +115,10 @@ def hatch(a: np.ndarray, b: np.ndarray, h: float, nrm: np.ndarray) -> np.ndarray
 class Element:
     """A drawer of one model element (a joint, a force, a trace, a body)."""
 
+    #: whether its moving artists keep their look and only move (then a large scene may
+    #: draw them joined with others of the same look: :mod:`.batch`)
+    batchable = True
+
     def __init__(self, item: Any, scene: Scene) -> None:
         self.item = item
         self.scene = scene
@@ -903,6 +907,8 @@ class PointForceDrawer(Element):
 class TorqueDrawer(Element):
     """An applied torque: a curved arrow around the body's centre of mass, turning the way
     the torque does (hidden while it is zero)."""
+
+    batchable = False                           # its arrowhead turns
 
     def __init__(self, item: Any, scene: Scene) -> None:
         super().__init__(item, scene)

@@ -10,7 +10,8 @@ import numpy as np
 from ..description.joints import Cam, Translational
 from ..errors import ModelError
 from ..validate import GROUND
-from .canvas import GROUND_COLOUR, PALETTE
+from .batch import BATCH_MIN, Recorder, place
+from .canvas import GROUND_COLOUR, LEGEND_MAX, PALETTE
 from .contacts import ContactDrawer
 from .elements import (BodyLink, CamDrawer, Element, Look, ReactionDrawer, Updater,
                        convex_hull, drawer_for)
@@ -223,18 +224,39 @@ class Scene:
         ax.autoscale_view()
 
     # ------------------------------------------------------------------ drawing
+    def _recorder(self, ax: "Axes") -> Recorder | None:
+        """A large scene's elements draw on a Recorder (:mod:`.batch`), a small one's on the
+        Axes."""
+        return Recorder(ax) if len(self.elements()) >= BATCH_MIN else None
+
     def draw_fixed(self, ax: "Axes") -> None:
+        """The parts on ground and the traced paths (once)."""
+        rec = self._recorder(ax)
         for e in self.elements():
-            e.fixed(ax)
+            e.fixed(rec if rec is not None and e.batchable else ax)
+        if rec is not None:
+            place(ax, rec.artists, LEGEND_MAX)
 
     def make(self, ax: "Axes", look: Look) -> Callable[[int], None]:
         """Artists of one copy of the moving mechanism, and a function moving it to a
         row."""
-        ups = [u for e in self.elements() if (u := e.make(ax, look)) is not None]
+        elements = self.elements()
+        rec = self._recorder(ax)
+        # the artists are made at made-up places (a body's outline in its own frame): they
+        # must not stretch the data limits (fit() sets them from the whole run)
+        lim, ignore = ax.dataLim.frozen(), ax.ignore_existing_data_limits
+        ups = [u for e in elements
+               if (u := e.make(rec if rec is not None and e.batchable else ax, look))
+               is not None]
+        copy = None if rec is None else place(ax, rec.artists, LEGEND_MAX)
+        ax.dataLim.set(lim)
+        ax.ignore_existing_data_limits = ignore
 
         def update(k: int) -> None:
             for u in ups:
                 u(k)
+            if copy is not None:
+                copy()
         return update
 
     def dress(self, ax: "Axes", length_unit: str, title: str | None) -> None:
