@@ -187,7 +187,7 @@ contains
     real(wp), intent(in) :: p(:)     !! prepared parameters
     real(wp), intent(in) :: alpha    !! curve parameter
     real(wp), intent(out) :: c0(2), c1(2), c2(2), c3(2)  !! c, c', c'', c'''
-    real(wp) :: e(2), t(2), r, r1, r2, r3, ca, sa, ck, sk
+    real(wp) :: e(2), t(2), r, r1, r2, r3, ca, sa, ck, sk, rk
     integer :: k, nk
     select case (kind)
     case (PROF_CIRCLE)
@@ -201,11 +201,12 @@ contains
       nk = nint(p(3))
       r = p(4); r1 = zero; r2 = zero; r3 = zero
       do k = 1, nk
-        ck = cos(k * alpha); sk = sin(k * alpha)
+        rk = real(k, wp)                ! (k**3 overflows a default integer past k = 1290)
+        ck = cos(rk * alpha); sk = sin(rk * alpha)
         r = r + p(3 + 2 * k) * ck + p(4 + 2 * k) * sk
-        r1 = r1 + k * (-p(3 + 2 * k) * sk + p(4 + 2 * k) * ck)
-        r2 = r2 - k**2 * (p(3 + 2 * k) * ck + p(4 + 2 * k) * sk)
-        r3 = r3 + k**3 * (p(3 + 2 * k) * sk - p(4 + 2 * k) * ck)
+        r1 = r1 + rk * (-p(3 + 2 * k) * sk + p(4 + 2 * k) * ck)
+        r2 = r2 - rk**2 * (p(3 + 2 * k) * ck + p(4 + 2 * k) * sk)
+        r3 = r3 + rk**3 * (p(3 + 2 * k) * sk - p(4 + 2 * k) * ck)
       end do
       e = [cos(alpha), sin(alpha)]; t = [-e(2), e(1)]
       ! c = r e;  c' = r' e + r t;  c'' = r'' e + 2 r' t - r e;  c''' = r''' e + 3 r'' t - 3 r' e - r t
@@ -375,7 +376,7 @@ contains
     real(wp), intent(in) :: p(:)     !! prepared parameters
     real(wp), intent(in) :: alpha    !! curve parameter
     real(wp) :: c4(2)
-    real(wp) :: e(2), t(2), r, r1, r2, r3, r4, ck, sk
+    real(wp) :: e(2), t(2), r, r1, r2, r3, r4, ck, sk, rk
     integer :: k
     c4 = zero
     select case (kind)
@@ -384,12 +385,13 @@ contains
     case (PROF_FOURIER)
       r = p(4); r1 = zero; r2 = zero; r3 = zero; r4 = zero
       do k = 1, nint(p(3))
-        ck = cos(k * alpha); sk = sin(k * alpha)
+        rk = real(k, wp)                ! (k**4 overflows a default integer past k = 215)
+        ck = cos(rk * alpha); sk = sin(rk * alpha)
         r = r + p(3 + 2 * k) * ck + p(4 + 2 * k) * sk
-        r1 = r1 + k * (-p(3 + 2 * k) * sk + p(4 + 2 * k) * ck)
-        r2 = r2 - k**2 * (p(3 + 2 * k) * ck + p(4 + 2 * k) * sk)
-        r3 = r3 + k**3 * (p(3 + 2 * k) * sk - p(4 + 2 * k) * ck)
-        r4 = r4 + k**4 * (p(3 + 2 * k) * ck + p(4 + 2 * k) * sk)
+        r1 = r1 + rk * (-p(3 + 2 * k) * sk + p(4 + 2 * k) * ck)
+        r2 = r2 - rk**2 * (p(3 + 2 * k) * ck + p(4 + 2 * k) * sk)
+        r3 = r3 + rk**3 * (p(3 + 2 * k) * sk - p(4 + 2 * k) * ck)
+        r4 = r4 + rk**4 * (p(3 + 2 * k) * ck + p(4 + 2 * k) * sk)
       end do
       e = [cos(alpha), sin(alpha)]; t = [-e(2), e(1)]
       c4 = (r4 - 6.0_wp * r2 + r) * e + (4.0_wp * r3 - 4.0_wp * r1) * t

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from conftest import load_example, model_from_toml
+from conftest import ROOT, load_example, model_from_toml
 from numpy.testing import assert_allclose
 
 import mbd2d
@@ -221,6 +221,35 @@ def test_cam_lift_sensitivities_against_the_closed_form():
         want = richardson(cf, base[key], 1e-3)
         for k, got in enumerate([res.dq_dp, res.dqd_dp, res.dqdd_dp]):
             rel_close(got[:, 4, j], want[k], what=f"cam d y^({k}) / d {name}")
+
+
+def test_cam_with_hundreds_of_harmonics_against_differences():
+    """A Fourier cam with 230 harmonics (the last one 1e-9, its fourth derivative k**4 a_k
+    about 2.8): the roller's contact curve needs the profile's fourth derivative in the
+    design sensitivities, whose k**4 overflowed a default integer past k = 215 (found by
+    UBSan on a fuzz case) and flipped the term's sign; the sensitivities to the roller
+    radius and to the profile's centre match Richardson-extrapolated central differences of
+    with_params runs."""
+    K = 230
+    a = [1.0, 0.1] + [0.0] * (K - 2) + [1e-9]
+    b = [0.05] + [0.0] * (K - 1)
+    text = (ROOT / "examples" / "cam_follower.toml").read_text().replace(
+        "profile = { circle = { center = [0.4, 0.0], radius = 1.0 } }",
+        f"profile = {{ fourier = {{ center = [0.1, 0.0], a = {a}, b = {b} }} }}")
+    m = mbd2d.loads(text)
+    names = ["joint.contact.follower.roller.radius", "joint.contact.profile.fourier.center.0"]
+    res = m.kinematics(1.0, 40, sensitivities=names, tol=1e-14)
+    for j, name in enumerate(names):
+        v = m.parameters()[name]
+
+        def run(x):
+            r = m.with_params({name: x}).kinematics(1.0, 40, tol=1e-14)
+            return np.stack([r.q, r.qd, r.qdd])
+
+        want = richardson(run, v, 1e-4)
+        for k, got in enumerate([res.dq_dp, res.dqd_dp, res.dqdd_dp]):
+            rel_close(got[:, :, j], want[k], rtol=1e-7,
+                      what=f"230-harmonic cam d q^({k}) / d {name}")
 
 
 # ====================================================================== pendulum
