@@ -53,7 +53,7 @@ module mbd_api
   public :: api_inverse, api_dynamics, api_statics, api_reactions, api_cam_forces
   public :: api_eval_d, api_reactions_dp, api_dynamics_sens, api_forces_d
 
-  integer, parameter :: NINFO = 10   !! length of the report arrays
+  integer, parameter :: NINFO = 12   !! length of the report arrays
 
   interface finite
     module procedure finite_scalar, finite_vector, finite_matrix
@@ -753,12 +753,14 @@ contains
   !! rows k = 0, every, 2 every, ... and nsteps are stored (output_rows(nsteps, every)).
   !! iinfo: 1 outputs, 2 bad entry, 3 steps, 4 rejected, 5 Newton iterations, 6 right-hand
   !! sides, 7 iteration matrices (K, C evaluations), 8 partitions, 9 active (independent)
-  !! constraint rows, 10 LU factorizations of the generalized-alpha iteration matrix.
+  !! constraint rows, 10 LU factorizations of the generalized-alpha iteration matrix, 11 1
+  !! when dopri5's (partitioned's) steps became limited by stability (stiff; rinfo 11 when).
   !! rinfo: 1 time of a failure, 2 smallest step, 3 largest step, 4 factorizations of the
   !! index-1 saddle-point matrix, 5 linear solver (1 dense, 2 banded), 6 and 7 the band
   !! widths kl and ku of the saddle-point matrix (of generalized-alpha's iteration matrix
   !! for that method), 8 of the index-1 factorizations those through the Schur complement
-  !! (mbd_schur; band path), 9 and 10 the partitioned method's worst rcond of J_u and when.
+  !! (mbd_schur; band path), 9 and 10 the partitioned method's worst rcond of J_u and when,
+  !! 11 the time from which the run was stiff (iinfo 11).
   !! solver: 0 auto, 1 dense, 2 banded (dyn_choose); the band path assembles q0 by
   !! Levenberg-Marquardt in band storage (band_lm_assemble) and never allocates n x n.
   subroutine api_dynamics(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, v0, t0, t1, nsteps, &
@@ -899,6 +901,9 @@ contains
     end if
     if (dst%rc_min < huge(one)) then          ! partitioned: J_u's worst conditioning
       rinfo(9) = dst%rc_min; rinfo(10) = dst%t_rc_min
+    end if
+    if (dst%t_stiff < huge(one)) then         ! dopri5, partitioned: steps set by stability
+      iinfo(11) = 1; rinfo(11) = dst%t_stiff
     end if
     if (dst%kl > 0) then                      ! generalized-alpha: its iteration matrix's
       rinfo(6) = dst%kl; rinfo(7) = dst%ku

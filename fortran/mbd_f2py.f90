@@ -45,8 +45,8 @@ subroutine core_kinematics(nb, nc, ctab, np, rpar, nq, neq, q0, t0, t1, nsteps, 
   integer(c_int), intent(inout) :: ctl(2)
   real(c_double), intent(in) :: rpar(np), q0(nq), t0, t1, tol, tmin
   real(c_double), intent(out) :: qout(nq, nout), qdout(nq, nd), qddout(nq, nd)
-  integer(c_int), intent(out) :: iinfo(10)
-  real(c_double), intent(out) :: rinfo(10)
+  integer(c_int), intent(out) :: iinfo(12)
+  real(c_double), intent(out) :: rinfo(12)
   real(c_double), intent(out) :: qsing(nq)
   integer(c_int), intent(out) :: dep(neq), redundant(neq)
   real(c_double), intent(out) :: tpass(64)
@@ -126,8 +126,8 @@ subroutine core_inverse(nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp, fpar
   real(c_double), intent(out) :: qout(nq, nout), qdout(nq, nout)
   real(c_double), intent(out) :: qddout(nq, nout), lamout(neq, nout)
   real(c_double), intent(out) :: eout(4, nout)
-  integer(c_int), intent(out) :: iinfo(10), dep(neq), redundant(neq), status
-  real(c_double), intent(out) :: rinfo(10), qsing(nq), tpass(64)
+  integer(c_int), intent(out) :: iinfo(12), dep(neq), redundant(neq), status
+  real(c_double), intent(out) :: rinfo(12), qsing(nq), tpass(64)
   character(len=512), intent(out) :: msg
   real(c_double), intent(out) :: eo(6, nf, nout), evo(4, maxev)
   integer(c_int), intent(out) :: nev
@@ -165,8 +165,8 @@ subroutine core_dynamics(nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp, fpa
   real(c_double), intent(out) :: qout(nq, nrow), qdout(nq, nrow)
   real(c_double), intent(out) :: qddout(nq, nrow), lamout(neq, nrow)
   real(c_double), intent(out) :: eout(4, nrow)
-  integer(c_int), intent(out) :: iinfo(10), redundant(neq), status
-  real(c_double), intent(out) :: rinfo(10)
+  integer(c_int), intent(out) :: iinfo(12), redundant(neq), status
+  real(c_double), intent(out) :: rinfo(12)
   character(len=512), intent(out) :: msg
   real(c_double), intent(out) :: eo(6, nf, nrow), evo(4, maxev)
   integer(c_int), intent(out) :: nev
@@ -188,7 +188,7 @@ subroutine core_statics(nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp, fpar
   integer(c_int), intent(in) :: ctab(8, nc), ftab(6, nf)
   real(c_double), intent(in) :: rpar(np), bmass(2, nb), grav(2), fpar(nfp), q0(nq), t
   real(c_double), intent(out) :: q(nq), lam(neq), resid
-  integer(c_int), intent(out) :: stable, iinfo(10), status
+  integer(c_int), intent(out) :: stable, iinfo(12), status
   character(len=512), intent(out) :: msg
   integer(c_int), intent(in) :: solver
   !f2py integer(c_int) optional, intent(in) :: solver = 0
@@ -342,8 +342,8 @@ subroutine core_kinematics_sens(nb, nc, ctab, np, rpar, nq, neq, q0, t0, t1, nst
   !> each output's sum of its sensitivities: finite exactly when they all are (barring an
   !! overflow of the sum), so the caller need not read the block to check it
   real(c_double), intent(out) :: ssum(nout)
-  integer(c_int), intent(out) :: iinfo(10)
-  real(c_double), intent(out) :: rinfo(10)
+  integer(c_int), intent(out) :: iinfo(12)
+  real(c_double), intent(out) :: rinfo(12)
   real(c_double), intent(out) :: qsing(nq)
   integer(c_int), intent(out) :: dep(neq), redundant(neq)
   real(c_double), intent(out) :: tpass(64)
@@ -374,8 +374,8 @@ subroutine core_inverse_sens(nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp,
   real(c_double), intent(out) :: eout(4, nout)
   real(c_double), intent(out) :: sq(nq, npar, nout), sqd(nq, npar, nout), sqdd(nq, npar, nout)
   real(c_double), intent(out) :: slam(neq, npar, nout)
-  integer(c_int), intent(out) :: iinfo(10), dep(neq), redundant(neq), status
-  real(c_double), intent(out) :: rinfo(10), qsing(nq), tpass(64)
+  integer(c_int), intent(out) :: iinfo(12), dep(neq), redundant(neq), status
+  real(c_double), intent(out) :: rinfo(12), qsing(nq), tpass(64)
   character(len=512), intent(out) :: msg
   !f2py intent(hide) :: nc, np, nf, nfp, nq, npar
   call api_inverse(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, t0, t1, nsteps, tol, every, &
@@ -394,7 +394,7 @@ subroutine core_statics_sens(nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp,
   integer(c_int), intent(in) :: ctab(8, nc), ftab(6, nf), ptab(2, npar)
   real(c_double), intent(in) :: rpar(np), bmass(2, nb), grav(2), fpar(nfp), q0(nq), t
   real(c_double), intent(out) :: q(nq), lam(neq), sq(nq, npar), slam(neq, npar), resid
-  integer(c_int), intent(out) :: stable, iinfo(10), status
+  integer(c_int), intent(out) :: stable, iinfo(12), status
   character(len=512), intent(out) :: msg
   !f2py intent(hide) :: nc, np, nf, nfp, nq, npar
   call api_statics(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, t, q, lam, stable, resid, &
@@ -436,8 +436,8 @@ subroutine core_dynamics_sens(nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp
   real(c_double), intent(out) :: eout(4, nrow)
   real(c_double), intent(out) :: sq(nq, npar, nrow), sqd(nq, npar, nrow), sqdd(nq, npar, nrow)
   real(c_double), intent(out) :: slam(neq, npar, nrow)
-  integer(c_int), intent(out) :: iinfo(10), redundant(neq), status
-  real(c_double), intent(out) :: rinfo(10)
+  integer(c_int), intent(out) :: iinfo(12), redundant(neq), status
+  real(c_double), intent(out) :: rinfo(12)
   character(len=512), intent(out) :: msg
   !f2py intent(hide) :: nc, np, nf, nfp, nq, npar
   call api_dynamics_sens(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, v0, t0, t1, nsteps, rtol, &
@@ -480,9 +480,9 @@ subroutine core_batch(analysis, nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, n
   real(c_double), intent(out) :: sq(nq, npar, nrow, ncase), sqd(nq, npar, nrow, ncase)
   real(c_double), intent(out) :: sqdd(nq, npar, nrow, ncase), slam(nsl, npar, nrow, ncase)
   real(c_double), intent(out) :: dmout(nm, npar, nrow, ncase)
-  integer(c_int), intent(out) :: iinfo(10, ncase), dep(neq, ncase), redundant(neq, ncase)
+  integer(c_int), intent(out) :: iinfo(12, ncase), dep(neq, ncase), redundant(neq, ncase)
   integer(c_int), intent(out) :: mbad(3, ncase)
-  real(c_double), intent(out) :: rinfo(10, ncase), qsing(nq, ncase)
+  real(c_double), intent(out) :: rinfo(12, ncase), qsing(nq, ncase)
   integer(c_int), intent(out) :: status(ncase)
   character(len=512), intent(out) :: msg(ncase)
   !f2py intent(hide) :: nc, np, nf, nfp, nq, nv, ncase, no, nmp, npp

@@ -86,6 +86,9 @@ module mbd_integrators
     !> partitioned (dense J): the smallest reciprocal condition number of J_u at an
     !! accepted step and its time (a singular configuration passed close by)
     real(wp) :: rc_min = huge(one), t_rc_min = zero
+    !> dopri5 and partitioned: the time from which the steps were limited by stability, not
+    !! accuracy (stiffness_test; huge when they were not)
+    real(wp) :: t_stiff = huge(one)
   end type dyn_stats_t
 
   !> Run context: settings, counters, the output grid, the form of the equations and the
@@ -849,7 +852,9 @@ contains
     integer :: stt, nprev, kev
     logical :: fixed, fsal, changed
     integer :: nfix
+    integer :: hits, calm                    ! stiffness_test's counters
     status = MBD_OK; msg = ''
+    hits = 0; calm = 0
     c%baumgarte = c%opts%method == METH_RK4
     if (partitioned) then
       call partition(m, w, c, c%t0, stt)
@@ -939,6 +944,7 @@ contains
         end if
         cycle
       end if
+      if (.not. fixed) call stiffness_test(c, tnew, h, k, ynew, ys, hits, calm)
       ! accepted: the full state at the end, projected (dopri5) or completed (partitioned)
       call finish_step(m, w, c, partitioned, tnew, ynew, fsal, e, ys, stt)
       if (stt /= MBD_OK) then
@@ -1652,6 +1658,37 @@ contains
 
   !> One Dormand-Prince 5(4) step; e is the embedded error estimate. k(:, 1) is reused from
   !! the last stage of the previous step when fsal is true (first same as last).
+  !> Hairer's stiffness test of DOPRI5 (Hairer and Wanner, Solving ODEs II, sec. IV.2), after
+  !! an accepted step: stages 6 and 7 are both at t + h, so
+  !!   h |lambda| ~ h ||f(y7) - f(y6)|| / ||y7 - y6||,
+  !! and past 3.25 (the stability boundary on the negative real axis is 3.3) the step is
+  !! limited by stability, not accuracy. As in Hairer's DOPRI5, the test starts at every
+  !! thousandth accepted step (a short run is cheap whatever limits its steps) and goes on
+  !! while it finds such steps; fifteen of them before six in a row below mark the run stiff
+  !! from then on (c%st%t_stiff).
+  subroutine stiffness_test(c, tnew, h, k, yn, ys, hits, calm)
+    type(itg_t), intent(inout) :: c
+    real(wp), intent(in) :: tnew, h, k(:, :), yn(:), ys(:)
+    integer, intent(inout) :: hits, calm    !! steps past the boundary; in a row below it
+    integer, parameter :: NSTIFF = 1000
+    real(wp) :: num, den
+    integer :: i
+    if (c%st%t_stiff < huge(one)) return
+    if (mod(c%st%steps + 1, NSTIFF) /= 0 .and. hits == 0) return
+    num = zero; den = zero
+    do i = 1, size(yn)
+      num = num + (k(i, 7) - k(i, 6))**2
+      den = den + (yn(i) - ys(i))**2
+    end do
+    if (den > zero .and. h * sqrt(num) > 3.25_wp * sqrt(den)) then
+      calm = 0; hits = hits + 1
+      if (hits == 15) c%st%t_stiff = tnew
+    else
+      calm = calm + 1
+      if (calm == 6) hits = 0
+    end if
+  end subroutine stiffness_test
+
   subroutine dopri5_step(m, w, c, t, y, h, yn, k, e, ys, fsal, stf)
     type(model_t), intent(in) :: m
     type(dyn_work_t), intent(inout) :: w

@@ -27,6 +27,7 @@ import pytest
 import mbd2d
 from mbd2d import _core
 from mbd2d.binding import status as S
+from mbd2d.binding.core import NINFO
 from mbd2d.binding.pack import pack
 from mbd2d.errors import (AssemblyError, ConvergenceError, CoreError,
                           InconsistentConstraintsError, InsufficientMemoryError,
@@ -102,9 +103,9 @@ def _fake(model: mbd2d.Model, fn: str, status: int, nout: int = 3, finite: bool 
     p = pack(model)
     nq, neq = p.nq, p.neq
     msg = f"fake status {status}".encode()
-    i10 = np.zeros(10, dtype=np.int32)
+    i10 = np.zeros(NINFO, dtype=np.int32)
     i10[0] = nout if status == S.OK else 0
-    r10 = np.zeros(10)
+    r10 = np.zeros(NINFO)
     rows = np.tile(pack(model).q0[:, None], (1, nout))
     if not finite:
         rows[:, 1:] = np.nan

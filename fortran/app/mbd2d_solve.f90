@@ -242,6 +242,7 @@ program mbd2d_solve
   if (spec%out_reac .and. nout > 0) call reactions()
   call eval_measures()
   call write_csv(trim(out_path))
+  if (spec%analysis == 'dynamics' .and. iinfo(11) == 1) call stiff_warning()
   if (status == MBD_SINGULAR_CONFIG) then
     call die(3, trim(singular_message()))
   else if (status == NONFINITE) then
@@ -254,6 +255,16 @@ program mbd2d_solve
   end if
 
 contains
+
+  !> dopri5's (partitioned's) steps became limited by stability: say so, as the Python
+  !! path's StiffnessWarning.
+  subroutine stiff_warning()
+    character(len=32) :: t
+    write (t, '(g0.6)') rinfo(11)
+    write (error_unit, '(a)') 'mbd2d-solve: warning: from t = ' // trim(adjustl(t)) // &
+      ' s the steps were limited by stability, not accuracy: the model is stiff (a stiff ' // &
+      'spring, damper or contact); method = "generalized-alpha" takes steps set by accuracy'
+  end subroutine stiff_warning
 
   !> The output times: row k holds output output_index(steps, every, k), as the core.
   subroutine times()

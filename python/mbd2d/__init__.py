@@ -16,7 +16,7 @@ from .errors import (AnalysisError, AssemblyError, ConvergenceError, CoreError,
                      InconsistentConstraintsError, InsufficientMemoryError, IntegrationError,
                      LiftOffWarning, MbdError, MbdWarning, ModelError, RedundantConstraintWarning,
                      SingularConfigurationError, SingularJacobianError, SingularPassageWarning,
-                     ToggleError)
+                     StiffnessWarning, ToggleError)
 from .model import Model, load, loads
 from .plots import animate, plot_mechanism, plot_paths, plot_sweep, plot_timeseries
 from .results import (BodyResult, DofReport, DynamicsResult, KinematicsResult, PointResult,
@@ -34,6 +34,6 @@ __all__ = ["load", "loads", "Model", "TimeFunction", "Harmonic", "KinematicsResu
            "AssemblyError", "InconsistentConstraintsError", "ConvergenceError",
            "SingularJacobianError", "SingularConfigurationError", "ToggleError", "CoreError",
            "InsufficientMemoryError", "MbdWarning", "RedundantConstraintWarning",
-           "SingularPassageWarning", "LiftOffWarning", "plot_mechanism", "plot_paths",
+           "SingularPassageWarning", "StiffnessWarning", "LiftOffWarning", "plot_mechanism", "plot_paths",
            "plot_timeseries", "plot_sweep", "animate", "sweep", "grid", "tolerance", "ToleranceResult",
            "write_sweep", "export_sweep", "tolerance_samples", "synthesize", "SynthesisResult", "__version__"]

@@ -50,12 +50,13 @@ import math
 import os
 import sys
 import textwrap
+import warnings
 from typing import Any, Sequence
 
 import numpy as np
 
 from . import plots
-from .errors import (AnalysisError, InsufficientMemoryError, MbdError, ModelError,
+from .errors import (AnalysisError, InsufficientMemoryError, MbdError, MbdWarning, ModelError,
                      SingularConfigurationError)
 from .model import Model, load
 from .description import toml_io
@@ -753,8 +754,23 @@ def _range_line(label: str, values: Any) -> str:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Run the command line; returns the exit code."""
+    """Run the command line; returns the exit code. The analyses' warnings are lines
+    ``mbd2d: warning: ...`` on standard error."""
     args = _parser().parse_args(argv)
+    with warnings.catch_warnings():
+        warnings.simplefilter("always", MbdWarning)      # each one said, whatever the filters
+        warnings.showwarning = _show_warning
+        return _main(args)
+
+
+def _show_warning(message: Warning | str, category: type[Warning], filename: str, lineno: int,
+                  file: Any = None, line: str | None = None) -> None:
+    """A warning as the command line says it (no source location: it is the command's)."""
+    _say(f"mbd2d: warning: {message}")
+
+
+def _main(args: argparse.Namespace) -> int:
+    """The command of the parsed arguments; returns the exit code."""
     try:
         if args.command == "synthesize":
             return _synthesize(args)

@@ -123,9 +123,31 @@ class SingularPassageWarning(MbdWarning):
     accelerations there, and the motion after it, may be inaccurate."""
 
 
+class StiffnessWarning(MbdWarning):
+    """dopri5's (or partitioned's) steps were limited by stability, not accuracy: the model is
+    stiff (a stiff spring, damper or contact whose fast motion has died out), and an explicit
+    method needs a step below 3.3 / |lambda| however smooth the motion. The implicit
+    generalized-alpha method takes steps set by the motion's accuracy."""
+
+
 class LiftOffWarning(MbdWarning):
     """A cam joint must pull its follower onto the profile somewhere in the run: a real
     follower would lift off there (``res.lift_off`` lists the intervals)."""
+
+
+def warn(message: str, category: type[Warning]) -> None:
+    """warnings.warn attributed to the line that called into mbd2d (the first frame outside
+    the package), however deep in it the warning arises."""
+    import os
+    import sys
+    import warnings
+
+    here = os.path.dirname(os.path.abspath(__file__)) + os.sep
+    level, frame = 2, sys._getframe(1)
+    while frame is not None and os.path.abspath(frame.f_code.co_filename).startswith(here):
+        frame = frame.f_back
+        level += 1
+    warnings.warn(message, category, stacklevel=level)
 
 
 class CoreError(MbdError):
@@ -156,4 +178,5 @@ __all__ = ["MbdError", "ModelError", "AnalysisError", "AssemblyError",
            "IntegrationError",
            "SingularConfigurationError", "ToggleError", "CoreError", "InsufficientMemoryError",
            "MbdWarning",
-           "RedundantConstraintWarning", "SingularPassageWarning", "LiftOffWarning"]
+           "RedundantConstraintWarning", "SingularPassageWarning", "StiffnessWarning",
+           "LiftOffWarning"]

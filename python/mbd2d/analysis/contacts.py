@@ -3,7 +3,6 @@ stick-slip friction, the event log's size, and the report of cam joints that wou
 pull their follower (a real follower lifts off there)."""
 from __future__ import annotations
 
-import warnings
 
 import numpy as np
 
@@ -12,7 +11,7 @@ from ..binding.status import error_for
 from ..binding.tables import Packed
 from ..description.builder import ModelDescription
 from ..description.joints import Cam, PointOnCurve
-from ..errors import LiftOffWarning, ModelError
+from ..errors import LiftOffWarning, ModelError, warn
 from ..results.contacts import LiftOff, pull_intervals
 from ..results.dynamics import DynamicsResult
 
@@ -88,12 +87,12 @@ def report_pulls(model: ModelDescription, p: Packed, res: DynamicsResult) -> Non
     for name in dict.fromkeys(x.joint for x in pulls):
         mine = [x for x in pulls if x.joint == name]
         first = mine[0]
-        warnings.warn(f"cam joint '{name}': the follower would need a pulling force "
-                      f"({len(mine)} interval(s), the first from t = {first.t_start:.6g} to "
-                      f"{first.t_end:.6g} s, strongest {min(x.min_force for x in mine):.4g}); "
-                      "a real follower lifts off there. res.lift_off lists them; a "
-                      "follower-profile contact in forward dynamics shows the lift-off",
-                      LiftOffWarning, stacklevel=4)
+        warn(f"cam joint '{name}': the follower would need a pulling force "
+             f"({len(mine)} interval(s), the first from t = {first.t_start:.6g} to "
+             f"{first.t_end:.6g} s, strongest {min(x.min_force for x in mine):.4g}); "
+             "a real follower lifts off there. res.lift_off lists them; a "
+             "follower-profile contact in forward dynamics shows the lift-off",
+             LiftOffWarning)
 
 
 __all__ = ["MAX_EVENTS", "STICK_SLIP_METHODS", "stick_slip_joints", "has_events",

@@ -3,7 +3,6 @@ call."""
 from __future__ import annotations
 
 import math
-import warnings
 from dataclasses import dataclass
 from typing import Any
 
@@ -14,7 +13,8 @@ from ..binding.pack import pack, pack_dynamics
 from ..binding.status import ASSEMBLY_FAILED, INCONSISTENT, INTEGRATOR_FAILED, OK, error_for
 from ..binding.tables import Packed
 from ..description.builder import ModelDescription
-from ..errors import MbdError, ModelError, RedundantConstraintWarning, SingularPassageWarning
+from ..errors import (MbdError, ModelError, RedundantConstraintWarning, SingularPassageWarning,
+                      StiffnessWarning, warn)
 from ..results.dynamics import DynamicsResult
 from ..validate import number, whole
 from .contacts import MAX_EVENTS, check_method, has_events, report_pulls
@@ -145,6 +145,8 @@ def run_dynamics(model: ModelDescription, t_end: float, steps: int, method: str 
              "schur": (int(rinfo[7]), int(rinfo[3])),
              "events": int(getattr(out, "nev", 0)),
              "events_not_kept": max(0, int(getattr(out, "nev", 0)) - maxev)}
+    if iinfo[10]:
+        stats["stiff_from"] = float(rinfo[10])   # dopri5, partitioned: steps set by stability
     if method == "partitioned" and iinfo[2] and rinfo[9] > 0:
         # the worst reciprocal condition of J_u at an accepted step, and when (dense J)
         stats["ju_rcond_min"] = (float(rinfo[8]), float(rinfo[9]))
@@ -155,11 +157,11 @@ def run_dynamics(model: ModelDescription, t_end: float, steps: int, method: str 
     if status == OK and bad is None:
         report_pulls(model, p, res)
     if red_rows:
-        warnings.warn(f"redundant constraints: {', '.join(red_rows)} are left out of the equations "
-                      "of motion; the reported multipliers are the minimum-norm set (the "
-                      "reactions are statically indeterminate)", RedundantConstraintWarning,
-                      stacklevel=3)
+        warn(f"redundant constraints: {', '.join(red_rows)} are left out of the equations "
+             "of motion; the reported multipliers are the minimum-norm set (the "
+             "reactions are statically indeterminate)", RedundantConstraintWarning)
     warn_near_singular(stats)
+    warn_stiff(stats)
     exc = dynamics_error(model, p, out, res, t, bad, method, t0)
     if exc is None:
         return res
@@ -178,13 +180,27 @@ def warn_near_singular(stats: dict[str, Any]) -> None:
     rc, tc = stats.get("ju_rcond_min", (1.0, 0.0))
     if rc >= RCOND_WARN:
         return
-    warnings.warn(f"partitioned: a step at t = {tc:.6g} ended next to a singular configuration "
-                  f"(J_u's reciprocal condition {rc:.1e}; the steps fell to "
-                  f"h_min = {stats.get('h_min') or 0.0:.1e} s): accelerations there carry errors "
-                  f"up to eps/rcond**2 = {np.finfo(float).eps / max(rc, 1e-300)**2:.0e}, and the "
-                  "motion after it may be inaccurate. Check the energy (res.energy), or use "
-                  "rtol >= 1e-8, whose longer steps pass over such points",
-                  SingularPassageWarning, stacklevel=4)
+    warn(f"partitioned: a step at t = {tc:.6g} ended next to a singular configuration "
+         f"(J_u's reciprocal condition {rc:.1e}; the steps fell to "
+         f"h_min = {stats.get('h_min') or 0.0:.1e} s): accelerations there carry errors "
+         f"up to eps/rcond**2 = {np.finfo(float).eps / max(rc, 1e-300)**2:.0e}, and the "
+         "motion after it may be inaccurate. Check the energy (res.energy), or use "
+         "rtol >= 1e-8, whose longer steps pass over such points",
+         SingularPassageWarning)
+
+
+def warn_stiff(stats: dict[str, Any]) -> None:
+    """StiffnessWarning when dopri5's (partitioned's) steps became limited by stability
+    (``stats["stiff_from"]``, from Hairer's stiffness test in the core)."""
+    t = stats.get("stiff_from")
+    if t is None:
+        return
+    warn(f"{stats['method']}: from t = {t:.6g} s the steps were limited by "
+         f"stability, not accuracy ({stats['steps']} steps, at most "
+         f"{stats.get('h_max') or 0.0:.2e} s): the model is stiff (a stiff spring, "
+         "damper or contact). method='generalized-alpha' (implicit) takes steps set "
+         "by the motion's accuracy: h of a tenth of its shortest period of interest",
+         StiffnessWarning)
 
 
 def dynamics_error(model: ModelDescription, p: Packed, out: Any, res: DynamicsResult,

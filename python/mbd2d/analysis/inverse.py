@@ -2,7 +2,6 @@
 and (on demand) reactions at every output, in one core call."""
 from __future__ import annotations
 
-import warnings
 from typing import Any
 
 import numpy as np
@@ -12,7 +11,7 @@ from ..binding.pack import pack, pack_dynamics
 from ..binding.status import NO_CONVERGENCE, OK, error_for
 from ..binding.tables import Packed
 from ..description.builder import ModelDescription
-from ..errors import MbdError, RedundantConstraintWarning
+from ..errors import MbdError, RedundantConstraintWarning, warn
 from ..results.dynamics import DynamicsResult
 from .contacts import MAX_EVENTS, report_pulls
 from .failures import bad_entry, kinematic_failure, row_names
@@ -71,9 +70,9 @@ def run_inverse(model: ModelDescription, t_end: float, steps: int, t0: float = 0
     if status == OK and bad is None:
         report_pulls(model, p, res)
     if red_rows:
-        warnings.warn(f"redundant constraints: {', '.join(red_rows)}; the multipliers are the "
-                      "minimum-norm set (the reactions are statically indeterminate)",
-                      RedundantConstraintWarning, stacklevel=3)
+        warn(f"redundant constraints: {', '.join(red_rows)}; the multipliers are the "
+             "minimum-norm set (the reactions are statically indeterminate)",
+             RedundantConstraintWarning)
     exc = inverse_error(model, p, out, res, t, bad)
     if exc is None:
         return res

@@ -2,7 +2,6 @@
 warnings or typed exception."""
 from __future__ import annotations
 
-import warnings
 from typing import Any
 
 import numpy as np
@@ -12,7 +11,7 @@ from ..binding.pack import pack
 from ..binding.status import NO_CONVERGENCE, OK, SINGULAR_CONFIG, error_for
 from ..binding.tables import Packed
 from ..description.builder import ModelDescription
-from ..errors import MbdError, RedundantConstraintWarning, SingularPassageWarning
+from ..errors import MbdError, RedundantConstraintWarning, SingularPassageWarning, warn
 from ..results.kinematics import KinematicsResult
 from ..validate import flag
 from .failures import kinematic_failure, row_names
@@ -75,16 +74,15 @@ def run_kinematics(model: ModelDescription, t_end: float, steps: int, t0: float 
     else:
         res, bad = finite_part(res)
     if red_rows and status in (OK, SINGULAR_CONFIG, NO_CONVERGENCE):
-        warnings.warn(f"redundant constraints: {', '.join(red_rows)} repeat what the other "
-                      "constraints impose (rank of J is "
-                      f"{int(iinfo[8])} for {p.neq} equations); kinematics solves them in least "
-                      "squares, exactly while they agree", RedundantConstraintWarning,
-                      stacklevel=3)
+        warn(f"redundant constraints: {', '.join(red_rows)} repeat what the other "
+             "constraints impose (rank of J is "
+             f"{int(iinfo[8])} for {p.neq} equations); kinematics solves them in least "
+             "squares, exactly while they agree", RedundantConstraintWarning)
     if npass:
         times = ", ".join(f"{x:.6g}" for x in tpass[:min(npass, 5)])
-        warnings.warn(f"passed through {npass} singular configuration(s) (bifurcation points, "
-                      f"J lost rank) at t = {times}{' ...' if npass > 5 else ''} s and stayed on "
-                      "the branch the run started on", SingularPassageWarning, stacklevel=3)
+        warn(f"passed through {npass} singular configuration(s) (bifurcation points, "
+             f"J lost rank) at t = {times}{' ...' if npass > 5 else ''} s and stayed on "
+             "the branch the run started on", SingularPassageWarning)
     exc = kinematics_error(model, p, out, res, t, bad)
     if exc is None:
         return res

@@ -18,6 +18,9 @@ from ..errors import InsufficientMemoryError
 from .status import MEMORY_ADVICE
 from .tables import BatchTables, DynamicTables, MeasureTables, Packed, decode
 
+#: length of the core's report arrays iinfo and rinfo (NINFO of fortran/mbd_api.f90)
+NINFO = 12
+
 
 def _named(names: str, fn: Callable[..., tuple[Any, ...]], *args: Any, numbers: float = 0,
            **kwargs: Any) -> SimpleNamespace:
@@ -302,7 +305,7 @@ def batch(b: BatchTables, vals: np.ndarray) -> dict[str, Any]:
     (``fortran/mbd_batch.f90``). Returns the core's arrays by name, the case last: ``q``,
     ``qd``, ``qdd`` (nq, nrow, ncase; (nq, 0, ncase) for positions only), ``lam`` (nlam, nrow,
     ncase), ``e`` (ne, nrow, ncase),
-    ``iinfo``, ``rinfo`` (10, ncase), ``qsing`` (nq, ncase), ``dep``, ``red`` (neq, ncase),
+    ``iinfo``, ``rinfo`` (NINFO, ncase), ``qsing`` (nq, ncase), ``dep``, ``red`` (neq, ncase),
     the measures ``m`` (nm, nrow, ncase) with ``mbad`` (3, ncase: status, measure, quantity of
     a case whose measures failed), the sensitivities ``sq``, ``sqd``, ``sqdd`` (nq, npar, nrow,
     ncase) and ``slam`` (nsl, npar, nrow, ncase), the measures' design derivatives ``dm`` (nm,

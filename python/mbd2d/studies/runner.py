@@ -17,6 +17,7 @@ from typing import Any
 import numpy as np
 
 from ..binding import core
+from ..binding.core import NINFO
 from ..binding.tables import BatchTables
 from ..errors import CoreError, ModelError
 from ..validate import whole
@@ -52,7 +53,7 @@ class Outputs:
     def __init__(self, b: BatchTables, ncase: int) -> None:
         nq, nr = b.nq, b.nrow
         shapes = {"q": (nq, nr), "qd": (nq, b.nd), "qdd": (nq, b.nd), "lam": (b.nlam, nr),
-                  "e": (b.ne, nr), "iinfo": (10,), "rinfo": (10,), "qsing": (nq,),
+                  "e": (b.ne, nr), "iinfo": (NINFO,), "rinfo": (NINFO,), "qsing": (nq,),
                   "dep": (b.neq,), "red": (b.neq,), "m": (len(b.measures.specs), nr),
                   "mbad": (3,), "sq": (nq, b.npar, nr), "sqd": (nq, b.npar, nr),
                   "sqdd": (nq, b.npar, nr), "slam": (b.nsl, b.npar, nr),
