@@ -676,6 +676,24 @@ def contact_section(results: dict, charts: dict, out: Path, base: Path) -> str:
             + table(("case", "us / rhs", "x none", "us per pair"), frows) + "\n")
 
 
+def pictures_section(results: dict) -> str:
+    """The pictures' cost, batched against one artist per part (bench/pictures.py)."""
+    pic = results.get("pictures")
+    if pic is None:
+        return "Not run.\n"
+    if failed(pic):
+        return f"Failed: {failed(pic)}\n"
+    rows = [(r["n"], "one per look" if r["batched"] else "one per part", r["artists"],
+             fmt(r["picture_s"], ".2f"), fmt(r.get("picture_ratio"), ".1f"),
+             fmt(r["gif_s"], ".2f"), fmt(r.get("gif_ratio"), ".1f"))
+            for r in pic.get("rows", [])]
+    return (f"{pic.get('model')}: the snapshot picture ({pic.get('picture')}) and the GIF "
+            f"({pic.get('gif')}), CPU seconds; the ratio is one artist per part over one per "
+            "look, in the same run.\n\n"
+            + table(("N", "drawn as", "artists on the Axes", "picture s", "x", "GIF s", "x"), rows)
+            + "\n")
+
+
 def notes_section(results: dict) -> str:
     """Quick mode, failures and section run times."""
     meta = results.get("meta") or {}
@@ -741,6 +759,7 @@ def results_markdown(results: dict, charts: dict[str, str], md_path: Path, out: 
              "## Dynamics against model size\n",
              dynamics_scaling_section(results, charts, out, base),
              "## Contacts\n", contact_section(results, charts, out, base),
+             "## Pictures of large models\n", pictures_section(results),
              "## Linkage synthesis: literature cases and pylinkage\n",
              synthesis_section(results),
              "## Notes\n", notes_section(results)]

@@ -210,3 +210,18 @@ def test_callgrind_parts_count_each_function_once() -> None:
     d2 = {k: 3 * v for k, v in d1.items()}
     parts = callgrind._parts(d1, d2, 2, total=(3 - 1) * 210 / 2)
     assert parts == {"assembly": 110.0, "LU": 50.0, "solves": 20.0, "loop": 30.0}
+
+
+def test_pictures_table_in_report() -> None:
+    """The pictures' rows and ratios appear in their section; a failed or missing section
+    says so."""
+    pic = {"model": "driven N-four-bar", "picture": "6 snapshots", "gif": "21 frames",
+           "rows": [{"n": 100, "batched": True, "artists": 175, "picture_s": 0.5,
+                     "gif_s": 1.0, "picture_ratio": 6.0, "gif_ratio": 3.0},
+                    {"n": 100, "batched": False, "artists": 4531, "picture_s": 3.0,
+                     "gif_s": 3.0}]}
+    md = report.pictures_section({"pictures": pic})
+    assert "| 100 | one per look | 175 | 0.50 | 6.0 | 1.00 | 3.0 |" in md
+    assert "| 100 | one per part | 4531 | 3.00 | – | 3.00 | – |" in md
+    assert report.pictures_section({}) == "Not run.\n"
+    assert "Failed" in report.pictures_section({"pictures": {"failed": True, "error": "x"}})
