@@ -61,6 +61,13 @@ def failed(section: Any) -> str | None:
     return section.get("error") if section.get("failed") else None
 
 
+def absent(section: Any) -> str | None:
+    """The text of a section not run ("Not run.") or failed ("Failed: ..."), else None."""
+    if section is None:
+        return "Not run.\n"
+    return f"Failed: {failed(section)}\n" if failed(section) else None
+
+
 # ===================================================================== targets
 def _target(name: str, figure: str, met: bool | None, detail: str = "") -> Row:
     return {"target": name, "figure": figure, "met": met, "detail": detail}
@@ -323,10 +330,8 @@ def work_precision_section(results: dict, charts: dict, out: Path, base: Path) -
 def chain_section(results: dict) -> str:
     """Exudyn and mbd2d on the free N-four-bar (bench/peers_exudyn_chain.py)."""
     pc = results.get("peers_chain")
-    if pc is None:
-        return "Not run.\n"
-    if failed(pc):
-        return f"Failed: {failed(pc)}\n"
+    if (text := absent(pc)) is not None:
+        return text
     if pc.get("unavailable"):
         return f"Exudyn unavailable: {pc['unavailable']}.\n"
     rows = []
@@ -658,10 +663,8 @@ def dynamics_scaling_section(results: dict, charts: dict, out: Path, base: Path)
 def contact_section(results: dict, charts: dict, out: Path, base: Path) -> str:
     """Tables of the contact costs (bench/contact.py)."""
     con = results.get("contact")
-    if con is None:
-        return "Not run.\n"
-    if failed(con):
-        return f"Failed: {failed(con)}\n"
+    if (text := absent(con)) is not None:
+        return text
     cl = con.get("clearance", {})
     rows = [(r["case"], fmt(1e3 * r["seconds"], ".1f"), fmt(r["ratio"], ".1f"), r["steps"],
              r["rejected"], r["events"], fmt(r["us_per_rhs"], ".1f")) for r in cl.get("rows", [])]
@@ -679,10 +682,8 @@ def contact_section(results: dict, charts: dict, out: Path, base: Path) -> str:
 def pictures_section(results: dict) -> str:
     """The pictures' cost, batched against one artist per part (bench/pictures.py)."""
     pic = results.get("pictures")
-    if pic is None:
-        return "Not run.\n"
-    if failed(pic):
-        return f"Failed: {failed(pic)}\n"
+    if (text := absent(pic)) is not None:
+        return text
     rows = [(r["n"], "one per look" if r["batched"] else "one per part", r["artists"],
              fmt(r["picture_s"], ".2f"), fmt(r.get("picture_ratio"), ".1f"),
              fmt(r["gif_s"], ".2f"), fmt(r.get("gif_ratio"), ".1f"))

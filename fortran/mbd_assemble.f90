@@ -283,7 +283,13 @@ contains
     type(asm_work_t), intent(in) :: a           !! blocks and their map
     real(wp), intent(out) :: jac(:, :)          !! dense J (D)
     real(wp), intent(in), optional :: cs(:)     !! column scale
-    call scatter_flat(a%src, a%dst, a%col, a%jb, jac, size(a%jb), size(jac), cs)
+    ! (an absent cs not passed on: gfortran builds a descriptor of it, and UBSan flags the
+    ! negation of its garbage offset)
+    if (present(cs)) then
+      call scatter_flat(a%src, a%dst, a%col, a%jb, jac, size(a%jb), size(jac), cs)
+    else
+      call scatter_flat(a%src, a%dst, a%col, a%jb, jac, size(a%jb), size(jac))
+    end if
   end subroutine scatter_dense
 
   !> jac(dst(i)) += jb(src(i)) [* cs(col(i))] over flat (column-major) views.
