@@ -160,3 +160,39 @@ def _line() -> int:
     """The caller's line number."""
     import inspect
     return inspect.currentframe().f_back.f_lineno
+
+
+def test_a_sweep_marks_its_stiff_cases():
+    """Dampers of 100, 1e4 and 1e5 (fast rates 99, 1e4 and 1e5 per second; the first one's 51
+    steps are too few to be worth a warning): the two stiff cases carry the time of their
+    own runs' stiff_from, the other NaN, and one warning names them; each case's motion is
+    the closed form's."""
+    pytest.importorskip("xarray")
+    m = mbd2d.loads(block())
+    cs = np.array([100.0, 1e4, 1e5])
+    with pytest.warns(mbd2d.StiffnessWarning, match="2 of 3 cases .case 1, 2"):
+        ds = mbd2d.sweep(m, {"force.damper.damping": cs}, analysis="dynamics", t_end=1.0,
+                         steps=10, rtol=1e-8, atol=1e-11, workers=1)
+    assert np.isnan(ds["stiff_from"].values[0])
+    for k, c in enumerate(cs):
+        l1, l2 = rates(c=c)
+        t = ds["time"].values
+        x = (-l2 * np.exp(l1 * t) + l1 * np.exp(l2 * t)) * X0 / (l1 - l2)
+        np.testing.assert_allclose(ds["q"].values[k, :, 0], x, rtol=0, atol=1e-9)
+        if k:
+            with pytest.warns(mbd2d.StiffnessWarning):
+                one = m.with_params({"force.damper.damping": c}).dynamics(
+                    1.0, 10, rtol=1e-8, atol=1e-11)
+            assert ds["stiff_from"].values[k] == one.stats["stiff_from"]
+
+
+def test_the_standalone_sweep_names_its_stiff_cases(tmp_path: Path):
+    """mbd2d-solve on the same three cases says which two were stiff, on standard error."""
+    m = mbd2d.loads(block())
+    mbd = tmp_path / "sweep.mbd"
+    mbd2d.export_sweep(m, mbd, {"force.damper.damping": np.array([100.0, 1e4, 1e5])},
+                       "dynamics", t_end=1.0, steps=10, rtol=1e-8, atol=1e-11)
+    run = subprocess.run([find_solver(), str(mbd), str(tmp_path / "sweep.csv")],
+                         capture_output=True, text=True, timeout=120)
+    assert run.returncode == 0, run.stderr
+    assert "warning: 2 of 3 cases (case 1, 2) ran with steps limited by stability" in run.stderr

@@ -914,7 +914,31 @@ contains
       end if
     end do
     call write_sweep_csv(trim(out_path))
+    if (spec%analysis == 'dynamics') call stiff_cases()
   end subroutine run_sweep
+
+  !> The cases whose dopri5 (partitioned) steps were limited by stability, on one line (the
+  !! Python sweep's StiffnessWarning).
+  subroutine stiff_cases()
+    integer :: c, ns
+    character(len=200) :: list
+    ns = 0; list = ''
+    do c = 1, spec%ncase
+      if (biinfo(11, c) /= 1) cycle
+      ns = ns + 1
+      if (ns == 1) then
+        list = ' ' // trim(itoa(c - 1))
+      else if (ns <= 8) then
+        list = trim(list) // ', ' // trim(itoa(c - 1))
+      end if
+    end do
+    if (ns == 0) return
+    if (ns > 8) list = trim(list) // ', ...'
+    write (error_unit, '(a)') 'mbd2d-solve: warning: ' // trim(itoa(ns)) // ' of ' // &
+      trim(itoa(spec%ncase)) // ' cases (case' // trim(list) // ') ran with steps ' // &
+      'limited by stability, not accuracy: stiff variants; method = "generalized-alpha" ' // &
+      'takes steps set by accuracy'
+  end subroutine stiff_cases
 
   !> The entries the cases set and the open phases lie in the model's tables (a kinematic
   !! run takes the constraints' parameters alone).

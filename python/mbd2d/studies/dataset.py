@@ -235,6 +235,8 @@ def to_dataset(pl: Plan, analysis: str, model: ModelDescription, out: Outputs,
             [STABILITY.get(int(s), "unknown") if k else "" for s, k in zip(a["rinfo"][1], ok)],
             dtype=object))
         data["residual"] = ("case", np.where(ok, a["rinfo"][0], np.nan))
+    if pl.analysis == "dynamics":                 # dopri5, partitioned: steps set by stability
+        data["stiff_from"] = ("case", np.where(a["iinfo"][10] == 1, a["rinfo"][10], np.nan))
     data["status"] = ("case", status)
     data["message"] = ("case", np.array(messages, dtype=object))
     for k, name in enumerate(names):

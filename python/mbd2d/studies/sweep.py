@@ -3,9 +3,11 @@ from __future__ import annotations
 
 from typing import Any
 
+import numpy as np
+
 from ..description.builder import ModelDescription
 from ..description.entries import reads_entries
-from ..errors import ModelError
+from ..errors import ModelError, StiffnessWarning, warn
 from .dataset import to_dataset, xarray
 from .plan import case_values, plan, with_cases, with_measures, with_sensitivities
 from .runner import run
@@ -63,7 +65,10 @@ def sweep(model: ModelDescription, cases: Any, analysis: str = "kinematics", cli
         ``q``, ``qd``, ``qdd`` over ("case", "time", "coordinate"); with multipliers
         (inverse dynamics, dynamics, statics) also ``lam`` over ("case", "time",
         "equation"), ``effort`` over ("case", "time", "driver"), and the energies
-        ``kinetic``, ``potential`` (statics: ``stability`` and ``residual`` per case); with
+        ``kinetic``, ``potential`` (statics: ``stability`` and ``residual`` per case;
+        dynamics: ``stiff_from`` per case, the time from which dopri5's or partitioned's
+        steps were limited by stability, NaN where they were not, with one
+        StiffnessWarning for them all); with
         measures ``measures`` over ("case", "time", "measure"), the "measure" coordinate
         naming them by their specs; with sensitivities ``dq_dp``, ``dqd_dp``, ``dqdd_dp``
         over ("case", "time", "coordinate", "parameter") and, with multipliers (inverse
@@ -105,7 +110,23 @@ def sweep(model: ModelDescription, cases: Any, analysis: str = "kinematics", cli
     with_sensitivities(pl, model, sensitivities)
     vals = with_cases(pl, model, values)
     out = run(pl.tables, vals, client=client, workers=workers, progress=progress)
-    return to_dataset(pl, analysis, model, out, names, values)
+    ds = to_dataset(pl, analysis, model, out, names, values)
+    _warn_stiff(ds)
+    return ds
+
+
+def _warn_stiff(ds: Any) -> None:
+    """One StiffnessWarning for the cases whose dopri5 (partitioned) steps were limited by
+    stability (``ds.stiff_from`` finite)."""
+    if "stiff_from" not in ds:
+        return
+    stiff = np.flatnonzero(np.isfinite(ds["stiff_from"].values))
+    if len(stiff):
+        shown = ", ".join(str(int(c)) for c in stiff[:8]) + (", ..." if len(stiff) > 8 else "")
+        warn(f"{len(stiff)} of {ds.sizes['case']} cases (case {shown}) ran with steps limited "
+             "by stability, not accuracy (ds.stiff_from: from when): stiff variants; "
+             "method='generalized-alpha' takes steps set by the motion's accuracy",
+             StiffnessWarning)
 
 
 __all__ = ["sweep"]
