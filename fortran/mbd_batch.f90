@@ -191,18 +191,36 @@ contains
       real(wp), intent(out), optional, contiguous :: s1(:, :, :), s2(:, :, :), s3(:, :, :), &
                                                      sl(:, :, :)
       select case (analysis)
+      ! (absent contiguous arrays are not passed on: gfortran reads their descriptors, and
+      ! UBSan flags the loads)
       case (BATCH_KINEMATICS)
-        call api_kinematics(nb, ctab, r, q0, rset(1), rset(2), iset(1), rset(3), iset(2), &
-                            rset(4), iset(3), iset(4), qout(:, :, c), qdout(:, :, c), &
-                            qddout(:, :, c), iinfo(:, c), rinfo(:, c), qsing(:, c), dep(:, c), &
-                            redundant(:, c), tpass, status(c), msg(c), pt, s1, s2, s3, &
-                            positions=iset(7))
+        if (present(pt)) then
+          call api_kinematics(nb, ctab, r, q0, rset(1), rset(2), iset(1), rset(3), iset(2), &
+                              rset(4), iset(3), iset(4), qout(:, :, c), qdout(:, :, c), &
+                              qddout(:, :, c), iinfo(:, c), rinfo(:, c), qsing(:, c), &
+                              dep(:, c), redundant(:, c), tpass, status(c), msg(c), pt, s1, &
+                              s2, s3, positions=iset(7))
+        else
+          call api_kinematics(nb, ctab, r, q0, rset(1), rset(2), iset(1), rset(3), iset(2), &
+                              rset(4), iset(3), iset(4), qout(:, :, c), qdout(:, :, c), &
+                              qddout(:, :, c), iinfo(:, c), rinfo(:, c), qsing(:, c), &
+                              dep(:, c), redundant(:, c), tpass, status(c), msg(c), &
+                              positions=iset(7))
+        end if
       case (BATCH_INVERSE)
-        call api_inverse(nb, ctab, r, bm, g, ftab, fp, q0, rset(1), rset(2), iset(1), rset(3), &
-                         iset(3), iset(4), qout(:, :, c), qdout(:, :, c), qddout(:, :, c), &
-                         lamout(:, :, c), eout(:, :, c), iinfo(:, c), rinfo(:, c), qsing(:, c), &
-                         dep(:, c), redundant(:, c), tpass, status(c), msg(c), pt, s1, s2, s3, &
-                         sl)
+        if (present(pt)) then
+          call api_inverse(nb, ctab, r, bm, g, ftab, fp, q0, rset(1), rset(2), iset(1), &
+                           rset(3), iset(3), iset(4), qout(:, :, c), qdout(:, :, c), &
+                           qddout(:, :, c), lamout(:, :, c), eout(:, :, c), iinfo(:, c), &
+                           rinfo(:, c), qsing(:, c), dep(:, c), redundant(:, c), tpass, &
+                           status(c), msg(c), pt, s1, s2, s3, sl)
+        else
+          call api_inverse(nb, ctab, r, bm, g, ftab, fp, q0, rset(1), rset(2), iset(1), &
+                           rset(3), iset(3), iset(4), qout(:, :, c), qdout(:, :, c), &
+                           qddout(:, :, c), lamout(:, :, c), eout(:, :, c), iinfo(:, c), &
+                           rinfo(:, c), qsing(:, c), dep(:, c), redundant(:, c), tpass, &
+                           status(c), msg(c))
+        end if
       case (BATCH_STATICS)
         if (present(pt)) then          ! (one output row: the sensitivities' first)
           call api_statics(nb, ctab, r, bm, g, ftab, fp, q0, rset(11), qout(:, 1, c), &

@@ -1109,8 +1109,15 @@ contains
     !! the next output time)
     integer, intent(inout), optional, volatile :: ctl(:)
     integer :: c0
-    call kin_loop(m, q0, t0, t1, nsteps, opts, qout, qdout, qddout, rep, status, msg, &
-                  sens, sq, sqd, sqdd, ssum, ctl)
+    ! (absent contiguous arrays are not passed on: gfortran reads their descriptors, and
+    ! UBSan flags the loads)
+    if (present(sq)) then
+      call kin_loop(m, q0, t0, t1, nsteps, opts, qout, qdout, qddout, rep, status, msg, &
+                    sens, sq, sqd, sqdd, ssum, ctl)
+    else
+      call kin_loop(m, q0, t0, t1, nsteps, opts, qout, qdout, qddout, rep, status, msg, &
+                    sens=sens, ssum=ssum, ctl=ctl)
+    end if
     ! the outputs not computed are zero (set here, not before the loop: no pass over them)
     c0 = max(rep%ndone, 0)
     if (c0 < size(qout, 2)) then
