@@ -1231,7 +1231,7 @@ contains
     type(sens_t), target :: sens
     real(wp), allocatable :: q(:), qd(:), s0(:, :), sd0(:, :)
     logical, allocatable :: lok(:)
-    real(wp) :: t, r_tol, a_tol, hmm(2), tfail
+    real(wp) :: t, r_tol, a_tol, hmm(2), tfail, tstiff
     integer :: bad, badf, k, ko, nout, st, stats(3), path, kl, ku, meth
     character(len=MSG_LEN) :: lmsg
     iinfo = 0; rinfo = zero; redundant = 0
@@ -1331,9 +1331,12 @@ contains
     else
       call sens_dopri5(m, w, sens, q, qd, s0, sd0, t0, t1, nsteps, every, r_tol, a_tol, &
                        max_steps, qout, qdout, qddout, sq, sqd, sqdd, lamout, lok, nout, stats, &
-                       hmm, tfail, status, msg, slam, lw%lunit)
+                       hmm, tfail, tstiff, status, msg, slam, lw%lunit)
       iinfo(1) = nout; iinfo(3) = stats(1); iinfo(4) = stats(2); iinfo(6) = stats(3)
       rinfo(2) = hmm(1); rinfo(3) = hmm(2)
+      if (tstiff < huge(one)) then             ! steps set by stability (dyn_info's layout)
+        iinfo(11) = 1; rinfo(11) = tstiff
+      end if
       if (status /= MBD_OK) rinfo(1) = tfail
     end if
     do k = 1, nout

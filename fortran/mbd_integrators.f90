@@ -54,7 +54,7 @@ module mbd_integrators
   public :: integrate, output_rows, output_index, MAX_STEPS_DEFAULT
   ! the Dormand-Prince 5(4) stages and error estimate, also used by the sensitivity integrator
   ! (mbd_sens_dynamics)
-  public :: dopri5_state, dopri5_error, DOPRI_C
+  public :: dopri5_state, dopri5_error, DOPRI_C, stiffness_test
   ! generalized-alpha's companion for quantities stepped with the state (mbd_sens_genalpha)
   public :: ga_hook_t, GA_NCOEF
 
@@ -853,6 +853,7 @@ contains
     logical :: fixed, fsal, changed
     integer :: nfix
     integer :: hits, calm                    ! stiffness_test's counters
+    logical :: stiff
     status = MBD_OK; msg = ''
     hits = 0; calm = 0
     c%baumgarte = c%opts%method == METH_RK4
@@ -944,7 +945,10 @@ contains
         end if
         cycle
       end if
-      if (.not. fixed) call stiffness_test(c, tnew, h, k, ynew, ys, hits, calm)
+      if (.not. fixed .and. c%st%t_stiff == huge(one)) then
+        call stiffness_test(c%st%steps, h, k, ynew, ys, hits, calm, stiff)
+        if (stiff) c%st%t_stiff = tnew
+      end if
       ! accepted: the full state at the end, projected (dopri5) or completed (partitioned)
       call finish_step(m, w, c, partitioned, tnew, ynew, fsal, e, ys, stt)
       if (stt /= MBD_OK) then
@@ -1664,17 +1668,18 @@ contains
   !! and past 3.25 (the stability boundary on the negative real axis is 3.3) the step is
   !! limited by stability, not accuracy. As in Hairer's DOPRI5, the test starts at every
   !! thousandth accepted step (a short run is cheap whatever limits its steps) and goes on
-  !! while it finds such steps; fifteen of them before six in a row below mark the run stiff
-  !! from then on (c%st%t_stiff).
-  subroutine stiffness_test(c, tnew, h, k, yn, ys, hits, calm)
-    type(itg_t), intent(inout) :: c
-    real(wp), intent(in) :: tnew, h, k(:, :), yn(:), ys(:)
+  !! while it finds such steps; the fifteenth of them before six in a row below makes the
+  !! run stiff from then on (stiff). Used by run_explicit and the sensitivities' dopri5.
+  pure subroutine stiffness_test(steps, h, k, yn, ys, hits, calm, stiff)
+    integer, intent(in) :: steps            !! accepted steps before this one
+    real(wp), intent(in) :: h, k(:, :), yn(:), ys(:)   !! step, stages, y7 and y6
     integer, intent(inout) :: hits, calm    !! steps past the boundary; in a row below it
+    logical, intent(out) :: stiff           !! this step made the run stiff
     integer, parameter :: NSTIFF = 1000
     real(wp) :: num, den
     integer :: i
-    if (c%st%t_stiff < huge(one)) return
-    if (mod(c%st%steps + 1, NSTIFF) /= 0 .and. hits == 0) return
+    stiff = .false.
+    if (mod(steps + 1, NSTIFF) /= 0 .and. hits == 0) return
     num = zero; den = zero
     do i = 1, size(yn)
       num = num + (k(i, 7) - k(i, 6))**2
@@ -1682,7 +1687,7 @@ contains
     end do
     if (den > zero .and. h * sqrt(num) > 3.25_wp * sqrt(den)) then
       calm = 0; hits = hits + 1
-      if (hits == 15) c%st%t_stiff = tnew
+      stiff = hits == 15
     else
       calm = calm + 1
       if (calm == 6) hits = 0

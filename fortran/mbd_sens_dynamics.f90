@@ -42,7 +42,7 @@ module mbd_sens_dynamics
   use mbd_dynamics, only: dyn_work_t, dyn_accel, dyn_project_pos, dyn_velocity, &
                           dyn_factor_projection, dyn_solve_rows, dyn_solve, dyn_multipliers, &
                           dyn_null_basis, SOLVER_DENSE
-  use mbd_integrators, only: output_rows, dopri5_state, dopri5_error, DOPRI_C
+  use mbd_integrators, only: output_rows, dopri5_state, dopri5_error, DOPRI_C, stiffness_test
   use mbd_interp, only: hermite5
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   implicit none
@@ -446,7 +446,7 @@ contains
   !! stats: 1 steps, 2 rejected, 3 right-hand sides; hmm(1:2) smallest and largest step.
   subroutine sens_dopri5(m, w, s, q, qd, sq, sqd, t0, t1, nsteps, every, rtol, atol, &
                          max_steps, qo, vo, ao, so, sdo, sddo, lo, lok, nout, stats, hmm, &
-                         t_fail, status, msg, slo, lunit)
+                         t_fail, t_stiff, status, msg, slo, lunit)
     type(model_t), intent(in) :: m              !! model with dynamics data
     type(dyn_work_t), intent(inout) :: w        !! dynamics work arrays (dyn_init done)
     type(sens_t), intent(inout) :: s            !! parameters and blocks
@@ -468,6 +468,9 @@ contains
     integer, intent(out) :: stats(3)            !! steps, rejected, right-hand sides
     real(wp), intent(out) :: hmm(2)             !! smallest, largest step
     real(wp), intent(out) :: t_fail             !! time reached at a failure
+    !> the time from which the steps were limited by stability (stiffness_test; huge when
+    !! they were not)
+    real(wp), intent(out) :: t_stiff
     integer, intent(out) :: status              !! MBD_OK or a failure
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
     !> dlambda/dp at the outputs (neq, np, rows; model units, each entry times lunit's
@@ -480,9 +483,10 @@ contains
     real(wp), allocatable :: qq(:), vv(:), aa(:), v0(:), fo(:)
     type(proj_work_t) :: pw
     real(wp) :: t, h, tnew, err, fac, sc
-    integer :: n, np, npd, nz, st, kout, nreal
-    logical :: fsal
+    integer :: n, np, npd, nz, st, kout, nreal, hits, calm
+    logical :: fsal, stiff
     status = MBD_OK; msg = ''; nout = 0; stats = 0; hmm = [huge(one), zero]; t_fail = t0
+    t_stiff = huge(one); hits = 0; calm = 0
     lok = .false.
     ! the packed state (q, S, q_dot, S_dot) holds S and S_dot as rows (npd, n), npd = np
     ! rounded up to a multiple of 4 (the padding rows stay zero: no rate, no error)
@@ -551,6 +555,10 @@ contains
           return
         end if
         cycle
+      end if
+      if (t_stiff == huge(one)) then          ! (the stages as the step left them)
+        call stiffness_test(stats(1), h, k, yn, ys, hits, calm, stiff)
+        if (stiff) t_stiff = tnew
       end if
       ! accepted: project onto the constraints (state and sensitivities), then the rates
       call project(tnew, yn, st)

@@ -196,3 +196,21 @@ def test_the_standalone_sweep_names_its_stiff_cases(tmp_path: Path):
                          capture_output=True, text=True, timeout=120)
     assert run.returncode == 0, run.stderr
     assert "warning: 2 of 3 cases (case 1, 2) ran with steps limited by stability" in run.stderr
+
+
+def test_dopri5_with_sensitivities_reports_it_too():
+    """The sensitivities' dopri5 (its own loop over the state and the variational equations)
+    runs the same test: it warns on the damped block, and dx/dk is the closed form's,
+    differentiated here by central differences."""
+    m = mbd2d.loads(block())
+    with pytest.warns(mbd2d.StiffnessWarning):
+        r = m.dynamics(1.0, 10, rtol=1e-8, atol=1e-11, sensitivities=["force.damper.stiffness"])
+    assert 0.0 < r.stats["stiff_from"] < 1.0
+
+    def x(k: float) -> np.ndarray:
+        l1, l2 = rates(k=k)
+        return (-l2 * np.exp(l1 * r.t) + l1 * np.exp(l2 * r.t)) * X0 / (l1 - l2)
+    np.testing.assert_allclose(r.q[:, 0], x(K), rtol=0, atol=1e-10)
+    dk = 1e-3
+    np.testing.assert_allclose(r.dq_dp[:, 0, 0], (x(K + dk) - x(K - dk)) / (2 * dk), rtol=0,
+                               atol=1e-9)
