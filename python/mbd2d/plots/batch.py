@@ -2,11 +2,12 @@
 
 matplotlib's cost is per artist, not per point: about 0.7 ms to put a line on an Axes and
 0.2 ms to draw it. A chain of a thousand links has thousands of pins, bars and
-centre-of-mass marks, so its picture took a minute. In a large scene the elements make their
-moving artists on a :class:`Recorder` instead of the Axes; :func:`place` then puts one
-artist per style on the Axes (a Line2D whose members are joined by NaN, a PolyCollection of
-the polygons) and returns the function that copies the members' positions into them after
-each update. Small scenes keep one artist per element (BATCH_MIN).
+centre-of-mass marks, so its picture took a minute. In a large scene the elements draw
+their parts on ground and their moving artists on a :class:`Recorder` instead of the Axes;
+:func:`place` then puts one artist per look on the Axes (a Line2D whose members are joined
+by NaN, a PolyCollection of the polygons) and returns the function that copies the
+members' positions into them after each update. Small scenes keep one artist per part
+(BATCH_MIN).
 """
 from __future__ import annotations
 
