@@ -945,7 +945,7 @@ contains
         end if
         cycle
       end if
-      if (.not. fixed .and. c%st%t_stiff == huge(one)) then
+      if (.not. fixed .and. c%st%t_stiff >= huge(one)) then
         call stiffness_test(c%st%steps, h, k, ynew, ys, hits, calm, stiff)
         if (stiff) c%st%t_stiff = tnew
       end if

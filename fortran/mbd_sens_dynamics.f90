@@ -556,7 +556,7 @@ contains
         end if
         cycle
       end if
-      if (t_stiff == huge(one)) then          ! (the stages as the step left them)
+      if (t_stiff >= huge(one)) then          ! (the stages as the step left them)
         call stiffness_test(stats(1), h, k, yn, ys, hits, calm, stiff)
         if (stiff) t_stiff = tnew
       end if
