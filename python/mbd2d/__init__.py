@@ -34,6 +34,7 @@ __all__ = ["load", "loads", "Model", "TimeFunction", "Harmonic", "KinematicsResu
            "AssemblyError", "InconsistentConstraintsError", "ConvergenceError",
            "SingularJacobianError", "SingularConfigurationError", "ToggleError", "CoreError",
            "InsufficientMemoryError", "MbdWarning", "RedundantConstraintWarning",
-           "SingularPassageWarning", "StiffnessWarning", "LiftOffWarning", "plot_mechanism", "plot_paths",
+           "SingularPassageWarning", "StiffnessWarning", "LiftOffWarning", "plot_mechanism",
+           "plot_paths",
            "plot_timeseries", "plot_sweep", "animate", "sweep", "grid", "tolerance", "ToleranceResult",
            "write_sweep", "export_sweep", "tolerance_samples", "synthesize", "SynthesisResult", "__version__"]

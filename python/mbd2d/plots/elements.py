@@ -26,6 +26,7 @@ from ..description.joints import (Absolute, Cam, Distance, Gear, PinInSlot, Poin
                                   PointOnLine, RackPinion, Revolute, RollingDisc, Translational,
                                   Weld)
 from ..validate import GROUND
+from .batch import ArrowMark, Recorder
 from .canvas import GROUND_COLOUR, LOAD_COLOUR, REACTION_COLOUR
 from .geometry import Poses, convex_hull, function_values, profile_points
 
@@ -859,16 +860,25 @@ class RotationalSpringDrawer(Element):
 
 
 class Arrow:
-    """One arrow artist moved frame by frame (hidden when the vector is zero)."""
+    """One arrow artist moved frame by frame (hidden when the vector is zero); in a large
+    scene (ax a Recorder) one of a batch, drawn with the others of its look as one quiver."""
 
     def __init__(self, ax: "Axes", colour: Any, z: float, width: float = 1.6) -> None:
         from matplotlib.patches import FancyArrowPatch
 
+        self.patch: Any = None
+        self.mark: ArrowMark | None = None
+        if isinstance(ax, Recorder):
+            self.mark = ax.arrow(colour, z, width)
+            return
         self.patch = FancyArrowPatch((0, 0), (0, 0), arrowstyle="-|>", mutation_scale=11,
                                      color=colour, lw=width, zorder=z, shrinkA=0, shrinkB=0)
         ax.add_patch(self.patch)
 
     def set(self, tail: np.ndarray, head: np.ndarray) -> None:
+        if self.mark is not None:
+            self.mark.set(tail, head)
+            return
         self.patch.set_positions(tuple(tail), tuple(head))
         self.patch.set_visible(bool(np.hypot(*(head - tail)) > 0))
 
