@@ -242,6 +242,7 @@ program mbd2d_solve
   if (spec%out_reac .and. nout > 0) call reactions()
   call eval_measures()
   call write_csv(trim(out_path))
+  call run_warnings()
   if (spec%analysis == 'dynamics' .and. iinfo(11) == 1) call stiff_warning()
   if (status == MBD_SINGULAR_CONFIG) then
     call die(3, trim(singular_message()))
@@ -255,6 +256,38 @@ program mbd2d_solve
   end if
 
 contains
+
+  !> The Python path's warnings of a run, on standard error: redundant constraints (their
+  !! row labels) and singular passages (kinematics, inverse dynamics; up to five times).
+  subroutine run_warnings()
+    character(len=2 * MSG_LEN) :: text
+    character(len=32) :: ts
+    integer :: r, npass
+    if (spec%analysis /= 'statics' .and. any(redundant /= 0)) then
+      text = ''
+      do r = 1, size(redundant)
+        if (redundant(r) == 0) cycle
+        if (len_trim(text) > 0) text = trim(text) // ','
+        text = trim(text) // ' ' // trim(row_label(r))
+      end do
+      write (error_unit, '(a)') 'mbd2d-solve: warning: redundant constraints:' // trim(text) // &
+        ' repeat what the other constraints impose; they are solved in least squares (the ' // &
+        'reactions are statically indeterminate)'
+    end if
+    npass = 0
+    if (spec%analysis == 'kinematics' .or. spec%analysis == 'inverse-dynamics') npass = iinfo(10)
+    if (npass <= 0) return
+    text = ''
+    do r = 1, min(npass, 5, size(tpass))
+      write (ts, '(g0.6)') tpass(r)
+      if (r > 1) text = trim(text) // ','
+      text = trim(text) // ' ' // trim(adjustl(ts))
+    end do
+    if (npass > 5) text = trim(text) // ' ...'
+    write (error_unit, '(a)') 'mbd2d-solve: warning: passed through ' // trim(itoa(npass)) // &
+      ' singular configuration(s) (bifurcation points, J lost rank) at t =' // trim(text) // &
+      ' s and stayed on the branch the run started on'
+  end subroutine run_warnings
 
   !> dopri5's (partitioned's) steps became limited by stability: say so, as the Python
   !! path's StiffnessWarning.
