@@ -11,6 +11,7 @@ settings. Oracle: the reduced one-degree-of-freedom solution of the parallelogra
 from __future__ import annotations
 
 import math
+import subprocess
 import warnings
 
 import numpy as np
@@ -145,3 +146,33 @@ def test_dopri5_passes_the_longer_chains_at_every_tight_tolerance(n, solver):
         assert np.abs(th - th[0]).max() < 1e-10
         assert res.stats["rejected_steps"] <= 200
     assert errs[0] > 30 * errs[-1]
+
+
+def test_mbd2d_solve_says_it_for_the_same_runs(tmp_path):
+    """mbd2d-solve on the same perturbed runs says the partitioned warning exactly when the
+    Python path gives it (one run of each kind compared; the CSVs are equal)."""
+    from test_standalone import find_solver
+    solver = find_solver()
+    model = free_nfourbar(1)
+    seen = set()
+    for k in range(6):
+        mk = perturbed(model, k)
+        for atol in (1.0e-13, 1.1e-13):
+            with warnings.catch_warnings(record=True) as got:
+                warnings.simplefilter("always")
+                mk.dynamics(t_end=T_END, steps=STEPS, method="partitioned", rtol=1e-11,
+                            atol=atol)
+            warned = any(issubclass(w.category, mbd2d.SingularPassageWarning) for w in got)
+            if warned in seen:
+                continue
+            seen.add(warned)
+            mbd = tmp_path / f"run{k}.mbd"
+            mk.export(mbd, analysis="dynamics", t_end=T_END, steps=STEPS, method="partitioned",
+                      rtol=1e-11, atol=atol)
+            run = subprocess.run([solver, str(mbd), str(tmp_path / "out.csv")],
+                                 capture_output=True, text=True, timeout=300)
+            assert run.returncode == 0, run.stderr
+            assert ("partitioned: a step at t =" in run.stderr) == warned, run.stderr
+        if len(seen) == 2:
+            break
+    assert seen == {True, False}

@@ -38,7 +38,7 @@ program mbd2d_solve
                         MBD_ASSEMBLY_FAILED
   use mbd_constraints, only: con_nextra
   use mbd_kinematics, only: MAXPASS, kin_out_count
-  use mbd_integrators, only: output_index
+  use mbd_integrators, only: output_index, METH_PARTITIONED
   use mbd_contact, only: NEO
   use mbd_forces, only: force_is_contact, FRC_FRICTION
   use iso_c_binding, only: c_char, c_double, c_int
@@ -258,11 +258,20 @@ program mbd2d_solve
 contains
 
   !> The Python path's warnings of a run, on standard error: redundant constraints (their
-  !! row labels) and singular passages (kinematics, inverse dynamics; up to five times).
+  !! row labels), singular passages (kinematics, inverse dynamics; up to five times) and a
+  !! partitioned step that ended next to a singular configuration (J_u's reciprocal
+  !! condition below sqrt(eps / 1e-3), the Python path's RCOND_WARN).
   subroutine run_warnings()
     character(len=2 * MSG_LEN) :: text
-    character(len=32) :: ts
     integer :: r, npass
+    if (spec%analysis == 'dynamics' .and. spec%method == METH_PARTITIONED .and. &
+        iinfo(3) > 0 .and. rinfo(10) > 0.0_wp) then
+      if (rinfo(9) < sqrt(epsilon(1.0_wp) / 1.0e-3_wp)) write (error_unit, '(a)') &
+        'mbd2d-solve: warning: partitioned: a step at t = ' // cnum(rinfo(10), FMT_G6) // &
+        " ended next to a singular configuration (J_u's reciprocal condition " // &
+        cnum(rinfo(9), FMT_E1) // '): the accelerations there, and the motion after it, ' // &
+        'may be inaccurate; check the energy, or use rtol >= 1e-8'
+    end if
     if (spec%analysis /= 'statics' .and. any(redundant /= 0)) then
       text = ''
       do r = 1, size(redundant)
@@ -279,9 +288,8 @@ contains
     if (npass <= 0) return
     text = ''
     do r = 1, min(npass, 5, size(tpass))
-      write (ts, '(g0.6)') tpass(r)
       if (r > 1) text = trim(text) // ','
-      text = trim(text) // ' ' // trim(adjustl(ts))
+      text = trim(text) // ' ' // cnum(tpass(r), FMT_G6)
     end do
     if (npass > 5) text = trim(text) // ' ...'
     write (error_unit, '(a)') 'mbd2d-solve: warning: passed through ' // trim(itoa(npass)) // &
@@ -292,9 +300,7 @@ contains
   !> dopri5's (partitioned's) steps became limited by stability: say so, as the Python
   !! path's StiffnessWarning.
   subroutine stiff_warning()
-    character(len=32) :: t
-    write (t, '(g0.6)') rinfo(11)
-    write (error_unit, '(a)') 'mbd2d-solve: warning: from t = ' // trim(adjustl(t)) // &
+    write (error_unit, '(a)') 'mbd2d-solve: warning: from t = ' // cnum(rinfo(11), FMT_G6) // &
       ' s the steps were limited by stability, not accuracy: the model is stiff (a stiff ' // &
       'spring, damper or contact); method = "generalized-alpha" takes steps set by accuracy'
   end subroutine stiff_warning
