@@ -150,16 +150,6 @@ def _copy_line(line: Any, members: list[Mark]) -> None:
     line.set_data(np.concatenate(xs) if xs else [], np.concatenate(ys) if ys else [])
 
 
-def _add(ax: "Axes", a: Any) -> None:
-    """One recorded patch on the Axes, as ax.add_patch puts it."""
-    from matplotlib.patches import Patch
-
-    if isinstance(a, Patch):
-        ax.add_patch(a)
-    else:
-        ax.add_artist(a)
-
-
 #: a batched arrow's head, in shaft widths (FancyArrowPatch's "-|>" at mutation scale 11 on a
 #: 1.3 pt shaft: a head 4.4 pt long and wide, with its 1.3 pt outline about 5.7 pt)
 HEAD = 4.4
@@ -233,7 +223,7 @@ def _put(ax: "Axes", members: list[Any]) -> Callable[[], None] | None:
         ax.add_line(line)                       # the data limits grow as with ax.plot
         return lambda: _copy_line(line, members)
     if len(members) == 1:
-        _add(ax, members[0])
+        ax.add_patch(members[0])            # (the recorder keeps only patches besides marks)
         return None
     coll = _joined_polygons(members)
     ax.add_collection(coll)                     # the data limits grow as with add_patch
