@@ -14,7 +14,7 @@ module mbd_constraints
   use mbd_status, only: MBD_OK, MBD_BAD_INPUT, MBD_BAD_PARAM, MBD_NO_MEMORY, MSG_LEN
   use mbd_points, only: NLOC, MAXROW, kloc
   use mbd_dual, only: dloc
-  use mbd_functions, only: fun_length, fun_check, fun_exponents, fun_is_count
+  use mbd_functions, only: fun_length, fun_check, fun_exponents, fun_is_count, fun_next_break
   use mbd_profiles, only: profile_exponents
   use mbd_joint_revolute, only: revolute_prepare, revolute_eval, revolute_eval_d
   use mbd_joint_translational, only: translational_prepare, translational_eval, &
@@ -35,7 +35,7 @@ module mbd_constraints
             CON_GEAR, CON_RACK, CON_ROLLING, CON_ABSOLUTE, DRV_ABS, DRV_REL_ANGLE, DRV_REL_DIST
   public :: con_known, con_nrow, con_nextra, con_is_driver, con_raw_length, con_prepare
   public :: con_eval, con_init_extra, con_name, con_exponents, con_row_power
-  public :: con_is_count, con_prepare_d, con_eval_d, con_linear, con_affine_r
+  public :: con_is_count, con_prepare_d, con_eval_d, con_linear, con_affine_r, con_next_break
 
   integer, parameter :: CON_REVOLUTE = 1, CON_TRANSLATIONAL = 2, CON_CAM = 3, CON_DISTANCE = 4
   integer, parameter :: CON_POINT_LINE = 5, CON_WELD = 6, CON_GEAR = 7, CON_RACK = 8
@@ -96,6 +96,19 @@ contains
     integer, intent(in) :: kind   !! kind code
     con_is_driver = kind > 100
   end function con_is_driver
+
+  !> A driver's first breakpoint after t (a step's t0 or t1 in its function of time, where
+  !! its acceleration may jump), from its prepared parameters p; huge for other constraints.
+  pure real(wp) function con_next_break(kind, p, t) result(tb)
+    integer, intent(in) :: kind        !! constraint kind
+    real(wp), intent(in) :: p(:)       !! prepared parameters
+    real(wp), intent(in) :: t          !! time
+    select case (kind)
+    case (DRV_ABS, DRV_REL_ANGLE); tb = fun_next_break(p, t)
+    case (DRV_REL_DIST); tb = fun_next_break(p(TRANS_PREP_LEN + 1:), t)
+    case default; tb = huge(t)
+    end select
+  end function con_next_break
 
   !> Expected raw length given the data, or -1 when malformed.
   pure integer function con_raw_length(kind, suba, raw)
@@ -203,7 +216,7 @@ contains
     case (CON_RACK, CON_ROLLING)
       call rolling_prepare(raw, prep, status, msg)
     case (CON_ABSOLUTE)
-      prep = [1.0_wp, raw(1), 0.0_wp]     ! the constant function f = value
+      prep = [1.0_wp, raw(1), 0.0_wp, 0.0_wp]   ! the constant function f = value
     case (DRV_ABS, DRV_REL_ANGLE)
       call fun_check(raw, status, msg)
       if (status == MBD_OK) prep = raw
@@ -329,7 +342,7 @@ contains
     case (CON_GEAR); n = 12
     case (CON_POINT_LINE); n = 7
     case (CON_RACK, CON_ROLLING); n = 8
-    case (CON_ABSOLUTE); n = 3
+    case (CON_ABSOLUTE); n = 4
     case (DRV_REL_DIST); n = TRANS_PREP_LEN + size(raw)
     case default; n = size(raw)
     end select
@@ -348,7 +361,7 @@ contains
     case (CON_RACK, CON_ROLLING)
       call rolling_prepare_d(raw, j, tprep)
     case (CON_ABSOLUTE)
-      tprep(2) = 1.0_wp                   ! prepared [1, value, 0]: the constant function
+      tprep(2) = 1.0_wp                   ! prepared [1, value, 0, 0]: the constant f
     case (DRV_REL_DIST)
       tprep(TRANS_PREP_LEN + j) = 1.0_wp
     case default

@@ -1,25 +1,40 @@
-!> mbd_functions: driver functions of time, f(t) = sum_k c_k t**k + sum_h A_h sin(omega_h t + phi_h).
+!> mbd_functions: driver functions of time,
+!!   f(t) = sum_k c_k t**k + sum_h A_h sin(omega_h t + phi_h) + sum_s h_s L_s(u_s),
+!! the last sum of steps (motion laws): u = (t - t0)/(t1 - t0) clamped to [0, 1], L(0) = 0,
+!! L(1) = 1, L'(0) = L'(1) = 0 (dwell, rise by h, dwell):
+!!   1 cubic      L = 3u**2 - 2u**3                  (Adams' STEP)
+!!   2 quintic    L = 10u**3 - 15u**4 + 6u**5        (the 3-4-5 polynomial, Adams' STEP5)
+!!   3 cycloidal  L = u - sin(2 pi u)/(2 pi)
+!!   4 harmonic   L = (1 - cos(pi u))/2
+!! (Norton, Cam Design and Manufacturing Handbook, ch. 3; quintic and cycloidal have L'' = 0 at
+!! both ends, cubic and harmonic jump in acceleration there).
 !!
-!! Encoding in a real array p: [np, c_0 .. c_{np-1}, nh, (A, omega, phi) x nh].
+!! Encoding in a real array p: [np, c_0 .. c_{np-1}, nh, (A, omega, phi) x nh,
+!! ns, (law, t0, t1, h) x ns].
 !! Returns f, df/dt and d2f/dt2 (the driver's nu = f' and its time term in gamma = f'').
 module mbd_functions
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
-  use mbd_kinds, only: wp, zero, half
+  use mbd_kinds, only: wp, zero, one, half
   use mbd_status, only: MBD_OK, MBD_BAD_PARAM, MSG_LEN
   implicit none
   private
-  public :: fun_eval, fun_check, fun_length, fun_exponents, fun_eval_d, fun_is_count
+  public :: fun_eval, fun_check, fun_length, fun_exponents, fun_eval_d, fun_is_count, &
+            fun_next_break
 
   real(wp), parameter :: FMAX = 1.0e100_wp   !! largest coefficient
   real(wp), parameter :: OMAX = 1.0e12_wp    !! largest angular frequency
   real(wp), parameter :: PMAX = 1.0e6_wp     !! largest phase
+  real(wp), parameter :: TMAX = 1.0e12_wp    !! largest step time
+  real(wp), parameter :: TREL = 1.0e-9_wp    !! shortest step: TREL max(1, |t0|, |t1|)
+  real(wp), parameter :: PI = 3.14159265358979323846_wp
+  integer, parameter :: NLAW = 4             !! motion laws (codes 1 .. NLAW)
 
 contains
 
   !> Length of the encoded function starting at p(1), or -1 when malformed.
   pure integer function fun_length(p)
     real(wp), intent(in) :: p(:)   !! encoded function (possibly followed by other data)
-    integer :: np, nh
+    integer :: np, nh, ns
     fun_length = -1
     if (size(p) < 2) return
     if (.not. is_count(p(1))) return
@@ -27,8 +42,11 @@ contains
     if (size(p) < np + 2) return
     if (.not. is_count(p(np + 2))) return
     nh = nint(p(np + 2))
-    if (size(p) < np + 2 + 3 * nh) return
-    fun_length = np + 2 + 3 * nh
+    if (size(p) < np + 3 + 3 * nh) return
+    if (.not. is_count(p(np + 3 + 3 * nh))) return
+    ns = nint(p(np + 3 + 3 * nh))
+    if (size(p) < np + 3 + 3 * nh + 4 * ns) return
+    fun_length = np + 3 + 3 * nh + 4 * ns
   end function fun_length
 
   pure logical function is_count(x)
@@ -47,7 +65,8 @@ contains
     n = fun_length(p)
     if (n < 0) then
       status = MBD_BAD_PARAM
-      msg = 'function of time is malformed (expected [np, coefficients, nh, (A, omega, phase)...])'
+      msg = 'function of time is malformed (expected [np, coefficients, nh, (A, omega, '// &
+            'phase)..., ns, (law, t0, t1, h)...])'
       return
     end if
     if (.not. all(ieee_is_finite(p(1:n)))) then
@@ -59,6 +78,8 @@ contains
       status = MBD_BAD_PARAM
       write (msg, '(a,es8.1,a,es8.1,a)') 'function of time: a harmonic needs |omega| <= ', &
         OMAX, ' and |phase| <= ', PMAX, ' (beyond that its values lose all precision)'
+    else
+      call steps_check(p, status, msg)
     end if
   contains
     logical function harmonics_ok()
@@ -71,6 +92,80 @@ contains
       end do
     end function harmonics_ok
   end subroutine fun_check
+
+  !> Check the steps of a well-formed, finite encoded function: a law code 1 .. NLAW,
+  !! |t0|, |t1| <= TMAX and t1 - t0 > TREL max(1, |t0|, |t1|).
+  subroutine steps_check(p, status, msg)
+    real(wp), intent(in) :: p(:)              !! encoded function
+    integer, intent(out) :: status            !! MBD_OK or MBD_BAD_PARAM
+    character(len=MSG_LEN), intent(out) :: msg !! what is wrong
+    integer :: k, o, ns
+    real(wp) :: t0, t1
+    status = MBD_OK; msg = ''
+    o = steps_at(p)
+    ns = nint(p(o))
+    do k = 1, ns
+      t0 = p(o + 4 * k - 2); t1 = p(o + 4 * k - 1)
+      if (p(o + 4 * k - 3) < half .or. p(o + 4 * k - 3) > NLAW + half .or. &
+          abs(p(o + 4 * k - 3) - anint(p(o + 4 * k - 3))) > 1.0e-9_wp) then
+        status = MBD_BAD_PARAM
+        write (msg, '(a,i0,a)') 'function of time: step ', k - 1, ' has an unknown law '// &
+          '(1 cubic, 2 quintic, 3 cycloidal, 4 harmonic)'
+      else if (max(abs(t0), abs(t1)) > TMAX) then
+        status = MBD_BAD_PARAM
+        write (msg, '(a,i0,a,es8.1)') 'function of time: step ', k - 1, &
+          ' needs |t0| and |t1| <= ', TMAX
+      else if (t1 - t0 <= TREL * max(1.0_wp, abs(t0), abs(t1))) then
+        status = MBD_BAD_PARAM
+        write (msg, '(a,i0,a,es9.2,a,es9.2,a)') 'function of time: step ', k - 1, &
+          ' needs t1 > t0 (got t0 = ', t0, ', t1 = ', t1, '); a jump is not a motion'
+      end if
+      if (status /= MBD_OK) return
+    end do
+  end subroutine steps_check
+
+  !> The first breakpoint of f after t: the smallest step time t0 or t1 above t (huge when
+  !! there is none). f'' may jump there; the kinematic loop ends a step on it.
+  pure real(wp) function fun_next_break(p, t) result(tb)
+    real(wp), intent(in) :: p(:)   !! encoded function
+    real(wp), intent(in) :: t      !! time
+    integer :: k, o
+    tb = huge(one)
+    o = steps_at(p)
+    do k = 1, int(p(o) + half)
+      if (p(o + 4 * k - 2) > t) tb = min(tb, p(o + 4 * k - 2))
+      if (p(o + 4 * k - 1) > t) tb = min(tb, p(o + 4 * k - 1))
+    end do
+  end function fun_next_break
+
+  !> Position of ns (the count of steps) in a well-formed encoded function.
+  pure integer function steps_at(p)
+    real(wp), intent(in) :: p(:)   !! encoded function
+    integer :: np
+    np = int(p(1) + half)
+    steps_at = np + 3 + 3 * int(p(np + 2) + half)
+  end function steps_at
+
+  !> A motion law and its first three derivatives at u in [0, 1] (see the module header).
+  pure subroutine law_eval(law, u, l0, l1, l2, l3)
+    integer, intent(in) :: law      !! 1 cubic, 2 quintic, 3 cycloidal, 4 harmonic
+    real(wp), intent(in) :: u       !! normalized time
+    real(wp), intent(out) :: l0, l1, l2, l3  !! L, L', L'', L'''
+    real(wp) :: s, c
+    select case (law)
+    case (1)                        ! 3u^2 - 2u^3
+      l0 = u * u * (3 - 2 * u); l1 = 6 * u * (1 - u); l2 = 6 - 12 * u; l3 = -12
+    case (2)                        ! 10u^3 - 15u^4 + 6u^5
+      l0 = u**3 * (10 + u * (-15 + 6 * u)); l1 = 30 * u * u * (1 + u * (-2 + u))
+      l2 = u * (60 + u * (-180 + 120 * u)); l3 = 60 + u * (-360 + 360 * u)
+    case (3)                        ! u - sin(2 pi u)/(2 pi)
+      s = sin(2 * PI * u); c = cos(2 * PI * u)
+      l0 = u - s / (2 * PI); l1 = 1 - c; l2 = 2 * PI * s; l3 = 4 * PI * PI * c
+    case default                    ! (1 - cos(pi u))/2
+      s = sin(PI * u); c = cos(PI * u)
+      l0 = half * (1 - c); l1 = half * PI * s; l2 = half * PI * PI * c; l3 = -half * PI**3 * s
+    end select
+  end subroutine law_eval
 
   !> Length exponents of an encoded function (see mbd_model, nondimensional models): e on
   !! the coefficients c_k and the amplitudes A_h (f is scaled as a whole), 0 on the counts,
@@ -86,6 +181,11 @@ contains
     do k = 1, nh
       o = np + 2 + 3 * (k - 1)
       ex(o + 1) = e; ex(o + 2:o + 3) = 0
+    end do
+    o = steps_at(p)                  ! the count, each law and its times: 0; its rise h: e
+    ex(o) = 0
+    do k = 1, nint(p(o))
+      ex(o + 4 * k - 3:o + 4 * k - 1) = 0; ex(o + 4 * k) = e
     end do
   end subroutine fun_exponents
 
@@ -115,20 +215,51 @@ contains
       f1 = f1 + a * w * c
       f2 = f2 - a * w * w * s
     end do
+    o = steps_at(p)
+    do k = 1, int(p(o) + half)
+      call step_eval(p(o + 4 * k - 3:o + 4 * k), t, f, f1, f2)
+    end do
   end subroutine fun_eval
+
+  !> Adds a step's h L(u), h L'(u)/T, h L''(u)/T**2 to f, f', f'' (T = t1 - t0; before t0
+  !! nothing, from t1 on h alone). Right-continuous: at t0 and t1, where f'' may jump (cubic,
+  !! harmonic), the values after the instant (what a step starting there continues from).
+  pure subroutine step_eval(st, t, f, f1, f2)
+    real(wp), intent(in) :: st(4)   !! law, t0, t1, h
+    real(wp), intent(in) :: t       !! time
+    real(wp), intent(inout) :: f, f1, f2
+    real(wp) :: tt, u, l0, l1, l2, l3
+    if (t < st(2)) return
+    if (t >= st(3)) then
+      f = f + st(4); return
+    end if
+    tt = st(3) - st(2); u = (t - st(2)) / tt
+    call law_eval(int(st(1) + half), u, l0, l1, l2, l3)
+    f = f + st(4) * l0
+    f1 = f1 + st(4) * l1 / tt
+    f2 = f2 + st(4) * l2 / (tt * tt)
+  end subroutine step_eval
 
   !> True when entry i (1-based) of the encoded function p is a count (np or nh), which no
   !! derivative can be taken with respect to.
   pure logical function fun_is_count(p, i)
     real(wp), intent(in) :: p(:)   !! encoded function
     integer, intent(in) :: i       !! entry
-    fun_is_count = i == 1 .or. i == nint(p(1)) + 2
+    integer :: o
+    o = steps_at(p)
+    fun_is_count = i == 1 .or. i == nint(p(1)) + 2 .or. i == o
+    if (i > o) fun_is_count = mod(i - o, 4) == 1      ! a step's law code
   end function fun_is_count
 
   !> Changes tf, tf1, tf2 of f(t), f'(t), f''(t) when the coefficients change by tp (the
   !! counts must not change). Polynomial terms are linear; a harmonic A sin(w t + phi) gives
   !!   d/dA   = (s, w c, -w**2 s),   d/dphi = (A c, -A w s, -A w**2 c),
-  !!   d/dw   = (A t c, A c - A w t s, -2 A w s - A w**2 t c),   s, c = sin, cos(w t + phi).
+  !!   d/dw   = (A t c, A c - A w t s, -2 A w s - A w**2 t c),   s, c = sin, cos(w t + phi);
+  !! a step h L(u), u = (t - t0)/T, T = t1 - t0, with du = ((u - 1) dt0 - u dt1)/T and
+  !! dT = dt1 - dt0:
+  !!   d(h L)        = dh L + h L' du,
+  !!   d(h L'/T)     = dh L'/T + h (L'' du/T - L' dT/T**2),
+  !!   d(h L''/T**2) = dh L''/T**2 + h (L''' du/T**2 - 2 L'' dT/T**3);   from t1 on: dh.
   pure subroutine fun_eval_d(p, tp, t, tf, tf1, tf2)
     real(wp), intent(in) :: p(:)   !! encoded function
     real(wp), intent(in) :: tp(:)  !! change of its coefficients
@@ -153,6 +284,30 @@ contains
       tf1 = tf1 + ta * w * c + a * tw * c - a * w * s * (t * tw + tph)
       tf2 = tf2 - ta * w * w * s - 2 * a * w * tw * s - a * w * w * c * (t * tw + tph)
     end do
+    o = steps_at(p)
+    do k = 1, nint(p(o))
+      call step_eval_d(p(o + 4 * k - 3:o + 4 * k), tp(o + 4 * k - 3:o + 4 * k), t, tf, tf1, &
+                       tf2)
+    end do
   end subroutine fun_eval_d
+
+  !> Adds a step's changes (fun_eval_d's header) to tf, tf1, tf2.
+  pure subroutine step_eval_d(st, tst, t, tf, tf1, tf2)
+    real(wp), intent(in) :: st(4), tst(4)   !! law, t0, t1, h and their changes
+    real(wp), intent(in) :: t               !! time
+    real(wp), intent(inout) :: tf, tf1, tf2
+    real(wp) :: tt, u, du, dt, h, l0, l1, l2, l3
+    if (t < st(2)) return
+    if (t >= st(3)) then
+      tf = tf + tst(4); return
+    end if
+    tt = st(3) - st(2); u = (t - st(2)) / tt; h = st(4)
+    du = ((u - 1) * tst(2) - u * tst(3)) / tt
+    dt = tst(3) - tst(2)
+    call law_eval(int(st(1) + half), u, l0, l1, l2, l3)
+    tf = tf + tst(4) * l0 + h * l1 * du
+    tf1 = tf1 + tst(4) * l1 / tt + h * (l2 * du / tt - l1 * dt / tt**2)
+    tf2 = tf2 + tst(4) * l2 / tt**2 + h * (l3 * du / tt**2 - 2 * l2 * dt / tt**3)
+  end subroutine step_eval_d
 
 end module mbd_functions

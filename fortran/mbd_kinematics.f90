@@ -33,7 +33,7 @@ module mbd_kinematics
   use mbd_memory, only: REAL_BYTES, mem_check, mem_fail
   use mbd_points, only: NLOC, MAXROW
   use mbd_model, only: model_t
-  use mbd_constraints, only: con_is_driver, con_name
+  use mbd_constraints, only: con_is_driver, con_name, con_next_break
   use mbd_assemble, only: asm_work_t, asm_init, assemble_blocks, assemble_gamma, assemble_dense, &
                           scatter_dense, init_extras, blocks_jv, blocks_jtv, scatter_values, &
                           asm_turn, assemble_phi
@@ -1158,7 +1158,7 @@ contains
     ! the predictor's weights and the step and tau they were computed for
     real(wp) :: wt(PRED_ORDER), wt_h, wt_tau(0:PRED_ORDER)
     real(wp), allocatable :: qa(:), qda(:), qdda(:), qb(:), qdb(:), qddb(:)
-    real(wp) :: t, h, hcur, hh, tt, target, lscale, ts, ta, d, corr, motion
+    real(wp) :: t, h, hcur, hh, tt, target, lscale, ts, ta, d, corr, motion, tb, tend
     real(wp) :: pcur, phist(2), thist(2)   ! pivot ratios and times of the last accepted states
     integer :: nhist
     integer :: k, j, c, st, detprev, mobility, lev, nsub, nderiv, ierr
@@ -1355,6 +1355,7 @@ contains
     hcur = h
     k = 1
     nsub = 0
+    tb = next_break(m, t)
     do while (k <= nsteps)
       nsub = nsub + 1
       if (nsub > MAX_SUBSTEPS) then
@@ -1366,16 +1367,20 @@ contains
         call count_work(); return
       end if
       target = out_time(k)
-      ! land exactly on the output time (no sliver step from rounding of t)
-      last = hcur >= (target - t) * (one - 1.0e-9_wp)
-      hh = merge(target - t, hcur, last)
-      tt = merge(target, t + hh, last)
+      ! land exactly on the output time, or on a driver's breakpoint before it (no sliver
+      ! step from rounding of t)
+      tend = min(target, tb)
+      last = hcur >= (tend - t) * (one - 1.0e-9_wp)
+      hh = merge(tend - t, hcur, last)
+      tt = merge(tend, t + hh, last)
+      last = last .and. tb >= target
       if (fast) then
         call fast_step(hh, ok)
         if (ok) then
           call accept_fast()
           if (last) call store(k)
           if (halt) return
+          if (t >= tb) call past_break()
           hcur = min(2 * hh, h)
           cycle
         end if
@@ -1400,6 +1405,7 @@ contains
         call accept()
         if (last) call store(k)
         if (halt) return
+        if (t >= tb) call past_break()
         call quiet_passage()
         if (opts%positions) call reenter(pcur)
         hcur = min(2 * hh, h)
@@ -1732,6 +1738,19 @@ contains
       t = tt
     end subroutine accept_fast
 
+    !> On a driver's breakpoint (a step's t0 or t1): the accelerations may jump here, so the
+    !! predictor's history before it is dropped (q_ddot at t is the value after the instant,
+    !! the driver functions being right-continuous); positions-only leaves its chord steps
+    !! for a full step from here.
+    subroutine past_break()
+      if (fast) then
+        call leave_fast()
+      else
+        call forget_derivatives()
+      end if
+      tb = next_break(m, t)
+    end subroutine past_break
+
     subroutine forget_derivatives()
       dd = zero; tau = zero; nderiv = 0; wt_h = -one
       nhist = 0
@@ -2060,6 +2079,18 @@ contains
     real(wp), intent(in) :: corr, motion, ratio, tol
     same_branch = corr <= max(ratio * motion, 1.0e3_wp * tol)
   end function same_branch
+
+  !> The drivers' first breakpoint after t (huge when none): see con_next_break.
+  pure real(wp) function next_break(m, t) result(tb)
+    type(model_t), intent(in) :: m     !! model
+    real(wp), intent(in) :: t          !! time
+    integer :: c
+    tb = huge(t)
+    do c = 1, m%nc
+      if (con_is_driver(m%kind(c))) &
+        tb = min(tb, con_next_break(m%kind(c), m%p(m%po(c):m%po(c) + m%pn(c) - 1), t))
+    end do
+  end function next_break
 
   !> corr = max |qn - qp| (the Newton correction), motion = max |qp - q| (the predicted one).
   pure subroutine max_diffs(n, qn, qp, q, corr, motion)

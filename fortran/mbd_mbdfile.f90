@@ -1,8 +1,9 @@
 !> mbd_mbdfile: read the plain-text model file written by `mbd2d export` (docs/mbd-format.md).
 !!
-!! Format 2 (whitespace separated; '#' starts a comment line; names have no spaces; format 1,
-!! the kinematics-only subset, is read too):
-!!   mbd2d 2
+!! Format 3 (whitespace separated; '#' starts a comment line; names have no spaces; format 1,
+!! the kinematics-only subset, and format 2, whose functions of time had no steps, are read
+!! too: upgrade_functions):
+!!   mbd2d 3
 !!   name <model name>
 !!   analysis kinematics | inverse-dynamics | dynamics | statics | check
 !!   t0 <time>   t_end <time>   steps <n>   every <k>                  (one per line)
@@ -58,6 +59,8 @@ module mbd_mbdfile
   use mbd_model, only: NCT, NFT
   use mbd_memory, only: REAL_BYTES, mem_check, mem_fail
   use mbd_measures, only: MEAS_ANGLE, MEAS_RATIO, MEAS_ADVANTAGE, MEAS_CONDITIONING
+  use mbd_drivers, only: DRV_ABS, DRV_REL_DIST
+  use mbd_forces, only: FRC_SPRING, FRC_TORQUE, FRC_POINT, FRC_ROTSPRING
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use, intrinsic :: iso_fortran_env, only: int64
   implicit none
@@ -217,9 +220,9 @@ contains
         end if
         call next_token(line, pos, tok)
         if (.not. read_int(tok, big)) big = -1
-        if (big /= 1 .and. big /= 2) then
-          call fail('unsupported format version "' // trim(tok) // '" (this reader knows 1 '// &
-                    'and 2)')
+        if (big < 1 .or. big > 3) then
+          call fail('unsupported format version "' // trim(tok) // '" (this reader knows 1, '// &
+                    '2 and 3)')
           exit
         end if
         spec%version = int(big)
@@ -576,6 +579,7 @@ contains
       write (msg, '(a,a,i0,a)') trim(path), ':', lineno, ': missing "end" line: the file ends '// &
         'before it (truncated?)'
     end if
+    if (status == MBD_OK .and. spec%version < 3) call upgrade_functions(spec, status, msg)
   contains
 
     !> The next data line into `line` (comments and blank lines skipped); iostat /= 0 at the
@@ -1052,6 +1056,115 @@ contains
       msg = s
     end subroutine where_prefix
   end subroutine mbd_read
+
+  !> Formats 1 and 2 wrote functions of time without their steps ([np, c, nh, harmonics]):
+  !! each driver's and force's function gets its count of steps, 0, and every index into
+  !! params and fparams (design parameters, sweep entries, measure points, open phases)
+  !! moves with its entry. Slices out of range are left as they are (the model's checks
+  !! name them).
+  subroutine upgrade_functions(spec, status, msg)
+    type(mbd_spec_t), intent(inout) :: spec      !! contents read
+    integer, intent(inout) :: status             !! MBD_OK, or MBD_NO_MEMORY
+    character(len=MSG_LEN), intent(inout) :: msg !! what is wrong
+    integer, allocatable :: rmap(:), fmap(:)
+    real(wp), allocatable :: rnew(:), fnew(:)
+    integer :: ierr, c, f, k, i, j, nr, nf2
+    allocate (rmap(size(spec%rpar)), fmap(size(spec%fpar)), &
+              rnew(size(spec%rpar) + spec%nc), fnew(size(spec%fpar) + 2 * spec%nf), stat=ierr)
+    if (ierr /= 0) then
+      status = MBD_NO_MEMORY; msg = 'out of memory reading the model file'; return
+    end if
+    rmap = [(k, k = 1, size(rmap))]; fmap = [(k, k = 1, size(fmap))]
+    nr = 0
+    do c = 1, spec%nc                     ! each constraint's slice, a driver's with ns = 0
+      if (.not. slice_ok(spec%ctab(6, c), spec%ctab(7, c), size(spec%rpar))) return
+      call copy_slice(spec%rpar, spec%ctab(6, c), spec%ctab(7, c), rnew, nr, rmap)
+      if (spec%ctab(1, c) >= DRV_ABS .and. spec%ctab(1, c) <= DRV_REL_DIST) &
+        call put_count(rnew, nr, spec%ctab(7, c))
+      spec%ctab(6, c) = nr - spec%ctab(7, c) + 1
+    end do
+    nf2 = 0
+    do f = 1, spec%nf                     ! each force's slice, its functions with ns = 0
+      if (.not. slice_ok(spec%ftab(4, f), spec%ftab(5, f), size(spec%fpar))) return
+      i = spec%ftab(4, f); j = i + spec%ftab(5, f) - 1
+      select case (spec%ftab(1, f))
+      case (FRC_POINT)                    ! point s(2) fx fy: fx ends at i + 1 + its length
+        k = old_length(spec%fpar(i + 2:j))
+        if (k < 0) return
+        call copy_slice(spec%fpar, i, k + 2, fnew, nf2, fmap)
+        call put_count(fnew, nf2, spec%ftab(5, f))
+        call copy_slice(spec%fpar, i + k + 2, j - i - k - 1, fnew, nf2, fmap)
+        call put_count(fnew, nf2, spec%ftab(5, f))
+      case (FRC_SPRING, FRC_TORQUE, FRC_ROTSPRING)   ! the function last
+        call copy_slice(spec%fpar, i, j - i + 1, fnew, nf2, fmap)
+        call put_count(fnew, nf2, spec%ftab(5, f))
+      case default
+        call copy_slice(spec%fpar, i, j - i + 1, fnew, nf2, fmap)
+      end select
+      spec%ftab(4, f) = nf2 - spec%ftab(5, f) + 1
+    end do
+    call move_alloc(rnew, spec%rpar); call move_alloc(fnew, spec%fpar)
+    spec%rpar = spec%rpar(1:nr); spec%fpar = spec%fpar(1:nf2)
+    do k = 1, spec%npar                   ! the indices that point into the lists
+      call remap(spec%ptab(1, k), spec%ptab(2, k))
+    end do
+    do k = 1, spec%nv
+      call remap(spec%vtab(1, k), spec%vtab(2, k))
+    end do
+    do k = 1, spec%nmeas
+      do j = 1, 3
+        do i = 1, 2
+          call remap(1, spec%meas_ref(i, j, k))
+        end do
+      end do
+    end do
+    do k = 1, size(spec%opens, 2)
+      call remap(1, spec%opens(1, k))
+    end do
+  contains
+    logical function slice_ok(off, n, size_all)
+      integer, intent(in) :: off, n, size_all
+      slice_ok = off >= 1 .and. n >= 0 .and. off <= size_all - n + 1
+    end function slice_ok
+    subroutine copy_slice(a, off, n, b, nb, map)
+      real(wp), intent(in) :: a(:)
+      integer, intent(in) :: off, n
+      real(wp), intent(inout) :: b(:)
+      integer, intent(inout) :: nb, map(:)
+      integer :: e
+      do e = 0, n - 1
+        nb = nb + 1; b(nb) = a(off + e); map(off + e) = nb
+      end do
+    end subroutine copy_slice
+    subroutine put_count(b, nb, n)
+      real(wp), intent(inout) :: b(:)
+      integer, intent(inout) :: nb, n
+      nb = nb + 1; b(nb) = zero; n = n + 1
+    end subroutine put_count
+    integer function old_length(a)      ! [np, c, nh, (A, w, phi) x nh], -1 when malformed
+      real(wp), intent(in) :: a(:)
+      integer :: np
+      old_length = -1
+      if (size(a) < 2) return
+      if (.not. small_count(a(1))) return
+      np = nint(a(1))
+      if (size(a) < np + 2) return
+      if (.not. small_count(a(np + 2))) return
+      old_length = np + 2 + 3 * nint(a(np + 2))
+      if (old_length > size(a)) old_length = -1
+    end function old_length
+    logical function small_count(x)
+      real(wp), intent(in) :: x
+      small_count = ieee_is_finite(x)
+      if (small_count) small_count = x >= zero .and. x < 1.0e6_wp
+    end function small_count
+    subroutine remap(table, idx)
+      integer, intent(in) :: table
+      integer, intent(inout) :: idx
+      if (table == 1 .and. idx >= 1 .and. idx <= size(rmap)) idx = rmap(idx)
+      if (table == 4 .and. idx >= 1 .and. idx <= size(fmap)) idx = fmap(idx)
+    end subroutine remap
+  end subroutine upgrade_functions
 
   !> Position of a word in a list (0: not there).
   pure integer function word_index(words, w) result(k)

@@ -29,7 +29,13 @@ from mbd2d import Model
 # f(t) with a polynomial and two harmonics: every time derivative is non-trivial
 F_RICH = {"poly": [0.3, -0.7, 0.25, 0.05],
           "harmonic": [{"amplitude": 0.4, "omega": 2.0, "phase": 0.3},
-                       {"amplitude": -0.15, "omega": 3.5}]}
+                       {"amplitude": -0.15, "omega": 3.5}],
+          # steps of every law: the random states' t (0.3 .. 1.7) lies inside the first
+          # three rises (smooth there) and past the end of the last (its constant h)
+          "step": [{"t0": 0.1, "t1": 1.9, "h": 0.35, "law": "quintic"},
+                   {"t0": -0.5, "t1": 2.5, "h": -0.2},
+                   {"t0": 0.05, "t1": 2.0, "h": 0.1, "law": "harmonic"},
+                   {"t0": -1.0, "t1": 0.2, "h": 0.5, "law": "cubic"}]}
 
 # ---------------------------------------------------------------- profiles and followers
 
@@ -431,6 +437,30 @@ def test_gamma_is_quadratic_in_velocity(case):
     assert_allclose(g3, 9.0 * g1, rtol=0, atol=1e-12 * scale)
 
 
+def step_closed_form(st: dict, t: float) -> tuple[float, float, float]:
+    """h L(u), h L'(u)/T, h L''(u)/T**2 of a step (Norton's motion laws), 0 before t0 and
+    (h, 0, 0) from t1 on (right-continuous: at t0 the rise's start)."""
+    t0, t1, h = st["t0"], st["t1"], st["h"]
+    if t < t0:
+        return 0.0, 0.0, 0.0
+    if t >= t1:
+        return h, 0.0, 0.0
+    T, u = t1 - t0, (t - t0) / (t1 - t0)
+    law = st.get("law", "cycloidal")
+    if law == "cubic":
+        y, y1, y2 = 3 * u**2 - 2 * u**3, 6 * u - 6 * u**2, 6 - 12 * u
+    elif law == "quintic":
+        y, y1, y2 = (10 * u**3 - 15 * u**4 + 6 * u**5, 30 * u**2 - 60 * u**3 + 30 * u**4,
+                     60 * u - 180 * u**2 + 120 * u**3)
+    elif law == "cycloidal":
+        w = 2 * np.pi
+        y, y1, y2 = u - np.sin(w * u) / w, 1 - np.cos(w * u), w * np.sin(w * u)
+    else:
+        y, y1, y2 = ((1 - np.cos(np.pi * u)) / 2, np.pi / 2 * np.sin(np.pi * u),
+                     np.pi**2 / 2 * np.cos(np.pi * u))
+    return h * y, h * y1 / T, h * y2 / T**2
+
+
 def test_driver_time_function_values():
     """The driver row is g(q) - f(t) with f evaluated in closed form here."""
     m = absolute_driver("y")()
@@ -441,6 +471,9 @@ def test_driver_time_function_values():
         f1 = (-0.7 + 0.5 * t + 0.15 * t**2 + 0.8 * np.cos(2.0 * t + 0.3)
               - 0.525 * np.cos(3.5 * t))
         f2 = 0.5 + 0.3 * t - 1.6 * np.sin(2.0 * t + 0.3) + 0.15 * 12.25 * np.sin(3.5 * t)
+        for st in F_RICH["step"]:
+            g = step_closed_form(st, t)
+            f, f1, f2 = f + g[0], f1 + g[1], f2 + g[2]
         # body "b" is the third body: y is q[7]
         assert_allclose(m.phi(q, t), [q[7] - f], rtol=0, atol=1e-14)
         assert_allclose(m.nu(q, t), [f1], rtol=0, atol=1e-14)

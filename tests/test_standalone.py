@@ -78,7 +78,7 @@ def test_file_is_documented(tmp_path: Path) -> None:
     mbd = tmp_path / "m.mbd"
     mbd2d.load(EX / "cam_follower.toml").export(mbd, t_end=1.0, steps=10)
     text = mbd.read_text()
-    assert text.startswith("# mbd2d model file, format 2")
+    assert text.startswith("# mbd2d model file, format 3")
     for key in ("bodies", "constraints", "params", "KIND (joints): 1 revolute", "end"):
         assert key in text
 
@@ -304,24 +304,6 @@ def test_header_lists_every_kind_and_the_docs_describe_them(tmp_path: Path) -> N
     for key in ("analysis", "every", "method", "rtol", "max_steps", "outputs", "gravity",
                 "labels", "forces", "fparams"):
         assert f"`{key}" in doc, key
-
-
-def test_format_1_files_still_run(tmp_path: Path, solver: str) -> None:
-    """A kinematics file of format 1 (no every, solver or labels) runs as before."""
-    model = mbd2d.load(EX / "slider_crank.toml")
-    mbd = tmp_path / "v2.mbd"
-    model.export(mbd, t_end=1.0, steps=20)
-    lines = mbd.read_text().splitlines()
-    lines = lines[:next(i for i, ln in enumerate(lines) if ln.startswith("labels"))]
-    keep = [ln for ln in lines if not ln.startswith(("every", "solver", "mbd2d 2"))]
-    v1 = tmp_path / "v1.mbd"
-    v1.write_text("mbd2d 1\n" + "\n".join(keep + ["end"]) + "\n")
-    out = tmp_path / "v1.csv"
-    r = subprocess.run([solver, str(v1), str(out)], capture_output=True, text=True, timeout=60)
-    assert r.returncode == 0, r.stderr
-    _, rows = read_csv(out)
-    np.testing.assert_allclose(rows[:, 1:], model.kinematics(1.0, 20).table()[1][:, 1:],
-                               rtol=0, atol=1e-12)
 
 
 @pytest.mark.parametrize("change, needle", [

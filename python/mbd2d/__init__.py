@@ -11,7 +11,7 @@ Examples
 from __future__ import annotations
 
 from .analysis.stepping import KinematicStepper
-from .description.functions import Harmonic, TimeFunction
+from .description.functions import Harmonic, Step, TimeFunction
 from .errors import (AnalysisError, AssemblyError, ConvergenceError, CoreError,
                      InconsistentConstraintsError, InsufficientMemoryError, IntegrationError,
                      LiftOffWarning, MbdError, MbdWarning, ModelError, RedundantConstraintWarning,
@@ -27,7 +27,7 @@ from .synthesis import SynthesisResult, synthesize
 
 __version__ = "0.1.0"
 
-__all__ = ["load", "loads", "Model", "TimeFunction", "Harmonic", "KinematicsResult",
+__all__ = ["load", "loads", "Model", "TimeFunction", "Harmonic", "Step", "KinematicsResult",
            "BodyResult", "PointResult", "DynamicsResult", "KinematicStepper", "StaticsResult",
            "Reaction",
            "DofReport", "MbdError", "ModelError", "AnalysisError", "IntegrationError",

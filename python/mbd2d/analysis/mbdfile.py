@@ -30,7 +30,7 @@ from .sensitivities import check_sens_method, check_positions_only, requested, t
 from .settings import (SOLVERS, check_solver, check_span, output_rows, require_determined,
                        solver_code)
 
-FORMAT = 2
+FORMAT = 3
 #: the analyses a file can hold (check: degrees of freedom and redundancy, as `mbd2d check`)
 ANALYSES = ("kinematics", "inverse-dynamics", "dynamics", "statics", "check")
 #: every kind code the format holds: (code, type, parameters in the params list)
@@ -78,7 +78,7 @@ def header() -> str:
         f"# mbd2d model file, format {FORMAT} (written by `mbd2d export`; run with "
         "`mbd2d-solve FILE OUT.csv`; docs/mbd-format.md)",
         "# Plain text, whitespace separated. Lines starting with '#' are comments.",
-        "#   mbd2d 2                      format and version",
+        "#   mbd2d 3                      format and version",
         "#   name NAME                    model name",
         "#   analysis A                   kinematics | inverse-dynamics | dynamics | statics "
         "| check",
@@ -105,7 +105,8 @@ def header() -> str:
     for k, t, d in JOINT_KINDS + DRIVER_KINDS:
         lines.append(f"#        {k:3d} {t:24s} {d}")
     lines += [
-        "#        f(t) = np c0 .. c_{np-1} nh (A omega phase) x nh",
+        "#        f(t) = np c0 .. c_{np-1} nh (A omega phase) x nh ns (law t0 t1 h) x ns",
+        "#        (law: 1 cubic, 2 quintic, 3 cycloidal, 4 harmonic)",
         "#   labels NEQ, then NEQ words   NAME.WORD of each row of Phi (multiplier columns)",
         "#   forces NF, then NF lines     NAME KIND BODY_I BODY_J OFFSET LENGTH [JOINT]",
         "#        KIND (forces): " + ", ".join(f"{k} {t}" for k, t, _ in FORCE_KINDS),

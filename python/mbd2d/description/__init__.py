@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from .bodies import Body
 from .builder import ModelDescription
-from .functions import Harmonic, TimeFunction
+from .functions import Harmonic, Step, TimeFunction
 from .joints import joint_keys
 
-__all__ = ["Body", "ModelDescription", "Harmonic", "TimeFunction", "joint_keys"]
+__all__ = ["Body", "ModelDescription", "Harmonic", "Step", "TimeFunction", "joint_keys"]

@@ -1,4 +1,6 @@
-"""Functions of time for drivers: f(t) = sum_k c_k t**k + sum_h A_h sin(omega_h t + phi_h).
+"""Functions of time for drivers and forces:
+f(t) = sum_k c_k t**k + sum_h A_h sin(omega_h t + phi_h) + sum_s h_s L_s((t - t0_s)/(t1_s - t0_s)),
+the last sum of steps (motion laws L: dwell, rise by h between t0 and t1, dwell).
 
 The core evaluates them; this module only checks and encodes the description.
 """
@@ -20,9 +22,35 @@ class Harmonic:
     phase: float = 0.0
 
 
+#: the motion laws of a step and their codes in the core (fortran/mbd_functions.f90)
+LAWS = {"cubic": 1, "quintic": 2, "cycloidal": 3, "harmonic": 4}
+
+
+@dataclass(frozen=True)
+class Step:
+    """One step h L(u), u = (t - t0)/(t1 - t0) clamped to [0, 1]: 0 up to t0, h from t1 on.
+
+    Parameters
+    ----------
+    t0, t1 : float
+        Start and end of the rise (t1 > t0).
+    h : float
+        The rise (negative: a fall).
+    law : str
+        ``"cycloidal"`` (default; zero acceleration at both ends), ``"quintic"`` (the 3-4-5
+        polynomial, Adams' STEP5), ``"cubic"`` (Adams' STEP) or ``"harmonic"`` (simple
+        harmonic); cubic and harmonic jump in acceleration at t0 and t1.
+    """
+
+    t0: float
+    t1: float
+    h: float
+    law: str = "cycloidal"
+
+
 @dataclass(frozen=True)
 class TimeFunction:
-    """A polynomial plus harmonics.
+    """A polynomial plus harmonics plus steps.
 
     Parameters
     ----------
@@ -30,21 +58,28 @@ class TimeFunction:
         Coefficients c_0, c_1, ... of c_0 + c_1 t + c_2 t**2 + ...
     harmonic : sequence of Harmonic
         Terms A sin(omega t + phase).
+    step : sequence of Step
+        Motion laws: each adds h L((t - t0)/(t1 - t0)) (dwell, rise, dwell).
 
     Examples
     --------
     >>> TimeFunction(poly=(1.047, 1.0)).encode()
-    [2.0, 1.047, 1.0, 0.0]
+    [2.0, 1.047, 1.0, 0.0, 0.0]
     """
 
     poly: tuple[float, ...] = (0.0,)
     harmonic: tuple[Harmonic, ...] = field(default_factory=tuple)
+    step: tuple[Step, ...] = field(default_factory=tuple)
 
     def encode(self) -> list[float]:
-        """The flat encoding the core reads: [np, c..., nh, (A, omega, phase)...]."""
+        """The flat encoding the core reads:
+        [np, c..., nh, (A, omega, phase)..., ns, (law, t0, t1, h)...]."""
         out = [float(len(self.poly)), *map(float, self.poly), float(len(self.harmonic))]
         for h in self.harmonic:
             out += [float(h.amplitude), float(h.omega), float(h.phase)]
+        out.append(float(len(self.step)))
+        for st in self.step:
+            out += [float(LAWS[st.law]), float(st.t0), float(st.t1), float(st.h)]
         return out
 
 
@@ -58,7 +93,8 @@ def as_function(spec: Any, entry: str, what: str = "f") -> TimeFunction:
     Parameters
     ----------
     spec : TimeFunction, number, or mapping
-        A constant, or ``{poly = [...], harmonic = [{amplitude, omega, phase}, ...]}``.
+        A constant, or ``{poly = [...], harmonic = [{amplitude, omega, phase}, ...],
+        step = [{t0, t1, h, law}, ...]}``.
     entry : str
         The entry that owns it, for messages.
     what : str
@@ -83,10 +119,10 @@ def as_function(spec: Any, entry: str, what: str = "f") -> TimeFunction:
                          f", got {spec!r}", entry)
     if any(not isinstance(k, str) for k in spec):
         raise ModelError(f"{what} keys must be names (strings)", entry)
-    unknown = set(spec) - {"poly", "harmonic"}
+    unknown = set(spec) - {"poly", "harmonic", "step"}
     if unknown:
         raise ModelError(f"{what} has unknown key(s) {sorted(unknown)}; "
-                         "use 'poly' and 'harmonic'", entry)
+                         "use 'poly', 'harmonic' and 'step'", entry)
     poly_in = as_list(spec.get("poly", [0.0]))
     if is_number(poly_in):
         poly_in = [poly_in]
@@ -110,4 +146,33 @@ def as_function(spec: Any, entry: str, what: str = "f") -> TimeFunction:
         harms.append(Harmonic(_finite(h["amplitude"], f"{what}.harmonic[{i}].amplitude", entry),
                               _finite(h["omega"], f"{what}.harmonic[{i}].omega", entry),
                               _finite(h.get("phase", 0.0), f"{what}.harmonic[{i}].phase", entry)))
-    return TimeFunction(poly=poly, harmonic=tuple(harms))
+    return TimeFunction(poly=poly, harmonic=tuple(harms),
+                        step=_steps(spec.get("step", []), what, entry))
+
+
+def _steps(spec: Any, what: str, entry: str) -> tuple[Step, ...]:
+    """The steps of a function: a table or a list of tables {t0, t1, h, law}."""
+    if isinstance(spec, Mapping):
+        spec = [spec]
+    if not isinstance(spec, Sequence) or isinstance(spec, str):
+        raise ModelError(f"{what}.step must be a list of tables "
+                         "{ t0 = T0, t1 = T1, h = H, law = 'cycloidal' }", entry)
+    return tuple(_step(s, f"{what}.step[{i}]", entry) for i, s in enumerate(spec))
+
+
+def _step(s: Any, what: str, entry: str) -> Step:
+    if not isinstance(s, Mapping):
+        raise ModelError(f"{what} must be a table {{ t0 = T0, t1 = T1, h = H, law = "
+                         "'cycloidal' }", entry)
+    keys = set(map(str, s))
+    if keys - {"t0", "t1", "h", "law"} or not {"t0", "t1", "h"} <= keys:
+        raise ModelError(f"{what} needs 't0', 't1' and 'h' (and optional 'law'), got keys "
+                         f"{sorted(keys)}", entry)
+    law = s.get("law", "cycloidal")
+    if law not in LAWS:
+        raise ModelError(f"{what}.law must be one of {', '.join(LAWS)}, got {law!r}", entry)
+    t0, t1 = _finite(s["t0"], f"{what}.t0", entry), _finite(s["t1"], f"{what}.t1", entry)
+    if not t1 > t0:
+        raise ModelError(f"{what} needs t1 > t0 (got t0 = {t0:g}, t1 = {t1:g}): the rise "
+                         "takes time", entry)
+    return Step(t0, t1, _finite(s["h"], f"{what}.h", entry), str(law))

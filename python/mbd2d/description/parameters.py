@@ -8,7 +8,7 @@ positions by index (0-based)::
     joint.cam.profile.spline.points.3.1   a cam profile's spline point
     body.crank.mass             body.crank.inertia
     force.s1.stiffness          force.s1.f.poly.0
-    driver.motor.f.poly.1       driver.motor.f.harmonic.0.omega
+    driver.motor.f.poly.1       driver.motor.f.harmonic.0.omega    driver.lift.f.step.0.t1
     model.gravity.1
     contact.floor.law.stiffness    contact.floor.circle.radius    contact.floor.friction.mu
     joint.A.friction.mu            joint.A.friction.pin_radius
@@ -89,13 +89,18 @@ def _vec(key: str, raw0: int, field: str | None = None,
 
 
 def _function(key: str, f: TimeFunction, raw0: int) -> Iterator[tuple[str, str, tuple, int]]:
-    """A function of time: poly.k and harmonic.h.(amplitude | omega | phase)."""
+    """A function of time: poly.k, harmonic.h.(amplitude | omega | phase) and
+    step.s.(t0 | t1 | h) (a step's law is not a number)."""
     for k in range(len(f.poly)):
         yield f"{key}.poly.{k}", key, ("poly", k), raw0 + 1 + k
     base = raw0 + len(f.poly) + 2
     for h in range(len(f.harmonic)):
         for a, attr in enumerate(("amplitude", "omega", "phase")):
             yield f"{key}.harmonic.{h}.{attr}", key, ("harmonic", h, attr), base + 3 * h + a
+    base += 3 * len(f.harmonic) + 1            # (after ns: law, t0, t1, h per step)
+    for s in range(len(f.step)):
+        for a, attr in enumerate(("t0", "t1", "h")):
+            yield f"{key}.step.{s}.{attr}", key, ("step", s, attr), base + 4 * s + 1 + a
 
 
 def _profile(key: str, kind: str, prof: tuple[float, ...]) -> Iterator[tuple[str, str, tuple,

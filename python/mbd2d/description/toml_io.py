@@ -168,6 +168,8 @@ def _function_dict(f: Any) -> dict[str, Any]:
     if f.harmonic:
         out["harmonic"] = [{"amplitude": h.amplitude, "omega": h.omega, "phase": h.phase}
                            for h in f.harmonic]
+    if f.step:
+        out["step"] = [{"t0": st.t0, "t1": st.t1, "h": st.h, "law": st.law} for st in f.step]
     return out
 
 
