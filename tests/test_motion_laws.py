@@ -433,3 +433,41 @@ def test_steps_keep_the_length_scale() -> None:
     np.testing.assert_allclose(out[2], out[1], rtol=1e-12, atol=1e-12)
     assert math.isclose(out[1][10], 2.0 * 2 * math.pi * math.sin(2 * math.pi * 0.8) / 0.25,
                         rel_tol=1e-12)
+
+
+@pytest.mark.parametrize("law, t0, t1, needle", [
+    (2.5, 0.1, 0.5, "unknown law"),
+    (99.0, 0.1, 0.5, "unknown law"),
+    (-1.0, 0.1, 0.5, "unknown law"),
+    (3.0, 0.5, 0.5, "needs t1 > t0"),
+    (3.0, 0.5, 0.5 + 1e-12, "needs t1 > t0"),
+    (3.0, -1e13, 0.5, "needs |t0| and |t1|"),
+])
+def test_hostile_steps_in_a_file(tmp_path: Path, law: float, t0: float, t1: float,
+                                 needle: str) -> None:
+    """A hand-edited .mbd file with a bad step: mbd2d-solve names it (exit code 2)."""
+    m = slider_crank({"t0": 0.25, "t1": 1.05, "h": 1.3, "law": "cubic"})
+    mbd = tmp_path / "m.mbd"
+    m.export(mbd, t_end=1.0, steps=10)
+    lines = [ln for ln in mbd.read_text().splitlines() if not ln.startswith("#")]
+    at = next(k for k, ln in enumerate(lines) if ln.startswith("params "))
+    n, vals, end = int(lines[at].split()[1]), [], at + 1
+    while len(vals) < n:
+        vals += [float(w) for w in lines[end].split()]
+        end += 1
+    i = next(k for k in range(n - 2) if vals[k:k + 3] == [1.0, 0.25, 1.05])   # law t0 t1
+    vals[i:i + 3] = [law, t0, t1]
+    bad = tmp_path / "bad.mbd"
+    bad.write_text("\n".join(lines[:at + 1] + [" ".join(map(repr, vals))] + lines[end:]) + "\n")
+    r = subprocess.run([find_solver(), str(bad), str(tmp_path / "o.csv")], capture_output=True,
+                       text=True, timeout=60)
+    assert r.returncode == 2 and needle in r.stderr, r.stderr
+
+
+@pytest.mark.parametrize("value", [float("nan"), float("inf"), 1e300])
+def test_hostile_step_values_from_python(value: float) -> None:
+    """with_params with a non-finite or huge step time or rise: a ModelError, no NaN."""
+    m = slider_crank({"t0": 0.25, "t1": 1.05, "h": 1.3, "law": "cubic"})
+    for name in ("driver.motor.f.step.0.t1", "driver.motor.f.step.0.h"):
+        with pytest.raises(mbd2d.ModelError):
+            m.with_params({name: value}).kinematics(1.0, 10)
