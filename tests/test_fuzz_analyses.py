@@ -369,7 +369,7 @@ def _chain(n: int) -> dict[str, Any]:
 #: every analysis of a 200-link chain 29 s. A limit of the core rather than a hang, so bodies
 #: and chains stay at a few hundred here.
 ABSURD_SIZES = {"spline": (1000, 5000), "fourier": (1000, 3000), "poly": (1000, 10000),
-                "harmonics": (1000, 5000), "chain": (30, 100), "name": (1000, 100000),
+                "harmonics": (1000, 5000), "steps": (300, 2000), "chain": (30, 100), "name": (1000, 100000),
                 "q0": (1000, 10**6), "bodies": (100, 200)}
 
 
@@ -393,6 +393,10 @@ def build_absurd(what: str, base: str, large: bool, k: int, x: float) -> dict[st
     elif what == "harmonics":
         data["driver"][0]["f"] = {"harmonic": [{"amplitude": 1e-3, "omega": float(j)}
                                                for j in range(n)]}
+    elif what == "steps":      # breakpoints everywhere, overlapping rises for large k
+        data["driver"][0]["f"] = {"poly": [0.0, 1.0], "step": [
+            {"t0": j / n, "t1": (j + 0.1 + k / 50) / n, "h": 1e-3 * x * (-1)**j,
+             "law": ("cubic", "quintic", "cycloidal", "harmonic")[j % 4]} for j in range(n)]}
     elif what == "chain":
         return _chain(n)
     elif what == "name":
