@@ -23,7 +23,7 @@ from .results import (BodyResult, DofReport, DynamicsResult, KinematicsResult, P
                       Reaction, StaticsResult)
 from .studies import (ToleranceResult, export_sweep, grid, sweep, tolerance,
                       tolerance_samples, write_sweep)
-from .synthesis import SynthesisResult, synthesize
+from .synthesis import CamDesign, SynthesisResult, cam_profile, synthesize
 
 __version__ = "0.1.0"
 
@@ -37,4 +37,5 @@ __all__ = ["load", "loads", "Model", "TimeFunction", "Harmonic", "Step", "Kinema
            "SingularPassageWarning", "StiffnessWarning", "LiftOffWarning", "plot_mechanism",
            "plot_paths",
            "plot_timeseries", "plot_sweep", "animate", "sweep", "grid", "tolerance", "ToleranceResult",
-           "write_sweep", "export_sweep", "tolerance_samples", "synthesize", "SynthesisResult", "__version__"]
+           "write_sweep", "export_sweep", "tolerance_samples", "synthesize", "SynthesisResult",
+           "cam_profile", "CamDesign", "__version__"]

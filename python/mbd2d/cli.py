@@ -13,6 +13,7 @@
                     [--samples N --seed S --analysis A --point BODY:X,Y --workers W
                     --scheduler ADDRESS --method M --rtol R --atol A --h H]
     mbd2d synthesize TASK.toml --out BEST.toml [--starts K --seed S --workers N]
+    mbd2d cam TASK.toml --out MODEL.toml [--profile PROFILE.csv]
     mbd2d check MODEL.toml [--t T --tol TOL --out REPORT.csv]
     mbd2d parameters MODEL.toml [--match TEXT]
     mbd2d export MODEL.toml OUT.mbd [--analysis A] --t-end T --steps N [settings of A]
@@ -61,8 +62,8 @@ from .errors import (AnalysisError, InsufficientMemoryError, MbdError, MbdWarnin
 from .model import Model, load
 from .description import toml_io
 from .results import StaticsResult
-from .results.files import OUTPUTS
-from .synthesis import SynthesisResult, load_task, synthesize
+from .results.files import OUTPUTS, write_csv
+from .synthesis import SynthesisResult, cam_report, load_cam, load_task, synthesize
 from .studies.plan import MAX_CASES
 
 EXIT_OK, EXIT_INPUT, EXIT_SINGULAR, EXIT_NUMERICAL = 0, 2, 3, 4
@@ -286,6 +287,12 @@ def _parser() -> argparse.ArgumentParser:
                    "file's, else 8)")
     y.add_argument("--seed", type=int, default=None, help="Latin-hypercube seed")
     y.add_argument("--workers", type=int, default=1, help="local processes (default 1)")
+    cm = sub.add_parser("cam", help="a disc cam from a follower program (cam synthesis)")
+    cm.add_argument("task", help="cam task file (.toml): [cam] program, base_radius, follower")
+    cm.add_argument("--out", required=True, help="the cam and its follower, written as a "
+                    "model file (.toml)")
+    cm.add_argument("--profile", default=None, help="also write the profile as CSV: theta, "
+                    "s, ds, dds, x, y, pressure_angle, curvature_radius")
     return ap
 
 
@@ -318,6 +325,23 @@ def _synthesize(args: argparse.Namespace) -> int:
               + "\n".join(f"{n} = {v:.15g}" for n, v in res.values.items()))
     toml_io.dump(res.model, args.out, header=header)
     print(f"wrote {args.out}")
+    return EXIT_OK
+
+
+def _cam(args: argparse.Namespace) -> int:
+    """mbd2d cam: synthesize, report, write the model (and the profile)."""
+    if args.profile is not None and not str(args.profile).endswith(".csv"):
+        raise ModelError(f"--profile must end in .csv, got {args.profile!r}", "command line")
+    design, model = load_cam(args.task)
+    print(cam_report(design))
+    toml_io.dump(model, args.out, header=f"mbd2d cam {args.task}: the cam and its follower")
+    print(f"wrote {args.out}")
+    if args.profile is not None:
+        cols = np.column_stack([design.theta, design.s, design.ds, design.dds, design.points,
+                                design.pressure_angle, design.curvature_radius])
+        write_csv(args.profile, ["theta", "s", "ds", "dds", "x", "y", "pressure_angle",
+                                 "curvature_radius"], cols, "the cam profile")
+        print(f"wrote {args.profile}")
     return EXIT_OK
 
 
@@ -774,6 +798,8 @@ def _main(args: argparse.Namespace) -> int:
     try:
         if args.command == "synthesize":
             return _synthesize(args)
+        if args.command == "cam":
+            return _cam(args)
         model = load(args.model)
         if args.command == "check":
             if args.out is not None and not str(args.out).endswith(".csv"):
@@ -824,7 +850,7 @@ def _main(args: argparse.Namespace) -> int:
         _say(f"mbd2d: {exc}")
         return EXIT_INPUT
     except AnalysisError as exc:
-        if args.command in ("check", "statics", "synthesize"):
+        if args.command in ("check", "statics", "synthesize", "cam"):
             _say(f"mbd2d: {exc}")
             return EXIT_NUMERICAL
         _say(f"mbd2d: {exc}")

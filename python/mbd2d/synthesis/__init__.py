@@ -9,10 +9,12 @@ Tasks: :class:`PathTask` (path generation, prescribed, shifted or free timing),
 :class:`LinkRatio`, :class:`TransmissionAngle`, :class:`PeakEffort`, :class:`MeasureBound`.
 :func:`fourbar` builds
 the four-bar of path generation from link lengths; :func:`load_task` reads a task file.
-See docs/synthesis.md.
+:func:`cam_profile` synthesizes a disc cam from a follower program (motion laws). See
+docs/synthesis.md.
 """
 from __future__ import annotations
 
+from .cam import CamDesign, cam_profile, cam_report, load_cam
 from .fourbar import FOURBAR_PARAMETERS, fourbar, fourbar_parameters, loop_configuration
 from .problem import Evaluation, Problem
 from .search import StartRecord, SynthesisResult, latin_hypercube, run_all, synthesize
@@ -25,4 +27,4 @@ __all__ = ["synthesize", "SynthesisResult", "StartRecord", "Problem", "Evaluatio
            "TransmissionAngle", "PeakEffort", "MeasureBound", "make_term", "fourbar",
            "fourbar_parameters",
            "loop_configuration", "FOURBAR_PARAMETERS", "run_all", "latin_hypercube",
-           "load_task", "TaskFile"]
+           "load_task", "TaskFile", "cam_profile", "CamDesign", "load_cam", "cam_report"]

@@ -1,0 +1,346 @@
+"""Cam synthesis: the profile of a disc cam whose translating follower moves by a program.
+
+    cam_profile(program, base_radius, follower="roller", roller_radius=0.0, offset=0.0,
+                points=720) -> CamDesign
+
+The program s(theta) is a function in the form of a driver's function of time (``poly``,
+``harmonic``, ``step``) with its t read as the cam angle theta [rad], closing over one turn:
+a rise of 20 mm over 90 degrees by the cycloidal law, a dwell, the return, a dwell is
+``{"step": [{"t0": 0, "t1": pi/2, "h": 0.02}, {"t0": pi, "t1": 3*pi/2, "h": -0.02}]}``.
+The core evaluates s, s', s'' (the functions' own code). The cam turns counterclockwise about
+its origin; the follower translates along +y, its axis at x = offset.
+
+Roller follower (a knife edge with roller_radius = 0), Rp = base_radius + roller_radius,
+d0 = sqrt(Rp**2 - e**2), in the cam's frame (R(-theta) turns the ground frame into it):
+    pitch point        P = R(-theta) (e, d0 + s)
+    tangent            P' = R(-theta) w,  w = (d0 + s, s' - e)  (the pitch curve runs clockwise)
+    surface            C = P - Rr n,  n = J P'/|P'| (outward; J turns by +90 degrees)
+    pressure angle     phi = atan2(s' - e, d0 + s)
+    pitch curvature    rho = -|w|**3 / (w x u),  u = (2 s' - e, s'' - d0 - s)  (> 0 convex)
+and the surface's radius of curvature rho - Rr; where 0 < rho < Rr the roller cannot follow
+the pitch curve (undercut: the surface has a cusp). Flat-faced follower (its face normal to
+the axis): C = R(-theta) (s', base_radius + s), radius of curvature base_radius + s + s''
+(> 0, else a cusp), pressure angle 0, contact at x = s' along the face (Norton, Cam Design
+and Manufacturing Handbook, ch. 7 and 8).
+"""
+from __future__ import annotations
+
+import math
+import os
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Mapping
+
+import numpy as np
+
+from ..binding import core
+from ..description.functions import TimeFunction, as_function
+from ..errors import ModelError
+from ..model import Model
+from ..validate import number, only_keys
+
+ENTRY = "cam_profile"
+#: followers of cam_profile
+FOLLOWERS = ("roller", "flat")
+#: a program closes when s and s' at 2 pi equal those at 0 to this, relative to the largest
+#: of each over the turn (or to the base radius); s'' may jump there as at any step's ends
+CLOSE_TOL = 1e-9
+
+
+@dataclass
+class CamDesign:
+    """A synthesized disc cam (see the module's header for the formulas).
+
+    Attributes
+    ----------
+    theta : ndarray
+        Cam angles of the samples, ``points`` of them over [0, 2 pi).
+    s, ds, dds : ndarray
+        The program and its first two derivatives with respect to theta.
+    points : ndarray
+        (points, 2) the cam's surface in its own frame, one point per theta.
+    pressure_angle : ndarray
+        Angle between the contact normal and the follower's axis [rad] (0: flat face).
+    curvature_radius : ndarray
+        The surface's radius of curvature (> 0 convex, < 0 concave; < 0 where ``convex`` is
+        an undercut: the roller is sharper than the pitch curve there).
+    convex : ndarray
+        Where the pitch curve (the roller centre's path in the cam) is convex.
+    undercut : bool
+        True when the surface has a cusp somewhere (the follower cannot keep the program).
+    face : tuple of float
+        Flat-faced follower: the contact's extent (min s', max s') along the face.
+    """
+
+    program: TimeFunction
+    follower: str
+    base_radius: float
+    roller_radius: float
+    offset: float
+    theta: np.ndarray
+    s: np.ndarray
+    ds: np.ndarray
+    dds: np.ndarray
+    points: np.ndarray
+    pressure_angle: np.ndarray
+    curvature_radius: np.ndarray
+    convex: np.ndarray
+    undercut: bool
+    face: tuple[float, float]
+
+    @property
+    def max_pressure_angle(self) -> float:
+        """The largest |pressure angle| [rad] over the turn."""
+        return float(np.abs(self.pressure_angle).max())
+
+    @property
+    def min_curvature_radius(self) -> float:
+        """The smallest radius of curvature of the surface where the pitch curve is convex
+        (negative: undercut there); inf when it is nowhere convex."""
+        convex = self.curvature_radius[self.convex]
+        return float(convex.min()) if convex.size else math.inf
+
+    def profile(self) -> dict[str, Any]:
+        """The cam joint's ``profile`` (a periodic spline through the surface points)."""
+        return {"spline": {"points": self.points.tolist()}}
+
+    def follower_spec(self) -> dict[str, Any]:
+        """The cam joint's ``follower`` on the follower body (its origin on the axis)."""
+        if self.follower == "flat":
+            return {"flat": {"point": [0.0, 0.0], "normal": [0.0, -1.0]}}
+        if self.roller_radius == 0.0:
+            return {"point": [0.0, 0.0]}
+        return {"roller": {"center": [0.0, 0.0], "radius": self.roller_radius}}
+
+    def model(self, speed: float = 2 * math.pi, name: str = "cam-follower",
+              masses: Mapping[str, tuple[float, float]] | None = None) -> Model:
+        """The cam and its follower as a model: the cam turning at ``speed`` [rad/s] about
+        the origin (driver ``motor``), the follower on the guide ``guide`` along +y, the cam
+        joint ``contact``; ``masses`` maps "cam" and "follower" to (mass, inertia).
+
+        Raises
+        ------
+        ModelError
+            If the cam is undercut (its surface has a cusp) or an argument is bad.
+        """
+        speed = number(speed, "speed", ENTRY)
+        if self.undercut:
+            bad = np.flatnonzero(self.convex & (self.curvature_radius <= 0.0))
+            raise ModelError(f"the cam is undercut (its surface has a cusp near theta = "
+                             f"{math.degrees(self.theta[bad[0]]):.1f} deg, radius of "
+                             f"curvature {self.min_curvature_radius:.3g}): the follower "
+                             "cannot keep the program; raise base_radius, use a smaller "
+                             "roller or a longer rise", ENTRY)
+        masses = dict(masses or {})
+        unknown = set(masses) - {"cam", "follower"}
+        if unknown:
+            raise ModelError(f"masses are for 'cam' and 'follower', got {sorted(unknown)}",
+                             ENTRY)
+        m = Model(name)
+        y0 = (self.base_radius if self.follower == "flat" else self._d0()) + float(self.s[0])
+        x0 = self.offset if self.follower == "roller" else 0.0
+        for body, q0 in (("cam", [0.0, 0.0, 0.0]), ("follower", [x0, y0, 0.0])):
+            mi = masses.get(body)
+            m.add_body(body, q0=q0, **({"mass": mi[0], "inertia": mi[1]} if mi else {}))
+        m.add_revolute(["ground", "cam"], [[0.0, 0.0], [0.0, 0.0]], name="pivot")
+        m.add_translational(["ground", "follower"], [[x0, 0.0], [0.0, 0.0]],
+                            [[0.0, 1.0], [0.0, 1.0]], name="guide")
+        m.add_cam(["cam", "follower"], self.profile(), self.follower_spec(), name="contact")
+        m.add_driver("absolute", body="cam", coordinate="theta", f={"poly": [0.0, speed]},
+                     name="motor")
+        return m
+
+    def _d0(self) -> float:
+        rp = self.base_radius + self.roller_radius
+        return math.sqrt(rp * rp - self.offset * self.offset)
+
+
+def cam_profile(program: Any, base_radius: float, follower: str = "roller",
+                roller_radius: float = 0.0, offset: float = 0.0,
+                points: int = 720) -> CamDesign:
+    """The disc cam that moves a translating follower by ``program``.
+
+    Parameters
+    ----------
+    program : mapping, number or TimeFunction
+        s(theta) as a function of time with t read as the cam angle (see the module's
+        header); it must close over one turn (s and s' equal at 0 and 2 pi).
+    base_radius : float
+        Radius of the base circle (the cam's smallest radius where s = 0).
+    follower : str
+        ``"roller"`` (with ``roller_radius``; 0 is a knife edge) or ``"flat"`` (a flat face
+        normal to the follower's axis).
+    roller_radius : float
+        Roller radius (roller follower).
+    offset : float
+        Roller follower: the axis' offset x = offset from the cam's centre.
+    points : int
+        Samples of the surface over the turn (the spline's points), at least 16.
+
+    Returns
+    -------
+    CamDesign
+
+    Raises
+    ------
+    ModelError
+        For a program that does not close or reaches inside the cam's centre, or a bad
+        argument.
+    """
+    f = as_function(program, ENTRY, "program")
+    rb = _positive(base_radius, "base_radius")
+    if follower not in FOLLOWERS:
+        raise ModelError(f"follower must be 'roller' or 'flat', got {follower!r}", ENTRY)
+    rr = _nonneg(roller_radius, "roller_radius")
+    e = number(offset, "offset", ENTRY)
+    if follower == "flat" and (rr != 0.0 or e != 0.0):
+        raise ModelError("a flat-faced follower has no roller_radius and no offset", ENTRY)
+    if not isinstance(points, (int, np.integer)) or isinstance(points, bool) or points < 16:
+        raise ModelError(f"points must be a whole number >= 16, got {points!r}", ENTRY)
+    if abs(e) >= rb + rr:
+        raise ModelError(f"|offset| = {abs(e):g} must be below base_radius + roller_radius "
+                         f"= {rb + rr:g} (the follower's axis must cross the base circle)",
+                         ENTRY)
+    theta = np.linspace(0.0, 2 * np.pi, int(points), endpoint=False)
+    s, ds, dds = _program(f, theta, rb)
+    if follower == "flat":
+        return _flat(f, rb, theta, s, ds, dds)
+    return _roller(f, rb, rr, e, theta, s, ds, dds)
+
+
+def _program(f: TimeFunction, theta: np.ndarray, rb: float
+             ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """s, s', s'' at theta from the core; checks that the program closes over the turn."""
+    out = core.fun_values(np.asarray(f.encode(), dtype=float),
+                          np.append(theta, 2 * np.pi))
+    if out.status != 0:
+        raise ModelError(f"program: {out.msg}", ENTRY)
+    vals = [np.asarray(v, dtype=float) for v in (out.f, out.f1, out.f2)]
+    for k, v in enumerate(vals):
+        if not np.all(np.isfinite(v)):
+            raise ModelError("program: its values overflow over the turn", ENTRY)
+        if k < 2 and abs(v[-1] - v[0]) > CLOSE_TOL * max(rb, float(np.abs(v).max())):
+            what = ("s", "s'")[k]
+            raise ModelError(f"program does not close over one turn: {what}(2 pi) - "
+                             f"{what}(0) = {v[-1] - v[0]:.3g}; the rises and returns must "
+                             "sum to zero and the follower end at the speed it starts with",
+                             ENTRY)
+    return vals[0][:-1], vals[1][:-1], vals[2][:-1]
+
+
+def _rotate_back(theta: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """R(-theta) (x, y) per sample, as (n, 2)."""
+    c, s = np.cos(theta), np.sin(theta)
+    return np.column_stack([c * x + s * y, -s * x + c * y])
+
+
+def _roller(f: TimeFunction, rb: float, rr: float, e: float, theta: np.ndarray,
+            s: np.ndarray, ds: np.ndarray, dds: np.ndarray) -> CamDesign:
+    d0 = math.sqrt((rb + rr)**2 - e * e)
+    if np.any(d0 + s <= 0.0):
+        raise ModelError("program: the follower reaches the cam's centre (d0 + s <= 0); "
+                         "raise base_radius", ENTRY)
+    w = np.column_stack([d0 + s, ds - e])
+    u = np.column_stack([2 * ds - e, dds - d0 - s])
+    wn = np.hypot(w[:, 0], w[:, 1])
+    pitch = _rotate_back(theta, np.full_like(s, e), d0 + s)
+    tangent = _rotate_back(theta, w[:, 0], w[:, 1]) / wn[:, None]
+    normal = np.column_stack([-tangent[:, 1], tangent[:, 0]])          # J t: outward
+    cross = w[:, 0] * u[:, 1] - w[:, 1] * u[:, 0]
+    with np.errstate(divide="ignore"):
+        rho = np.where(cross != 0.0, -wn**3 / cross, np.inf)
+    undercut = bool(np.any((rho > 0.0) & (rho < rr)))
+    return CamDesign(f, "roller", rb, rr, e, theta, s, ds, dds, pitch - rr * normal,
+                     np.arctan2(ds - e, d0 + s), rho - rr, rho > 0.0, undercut, (0.0, 0.0))
+
+
+def _flat(f: TimeFunction, rb: float, theta: np.ndarray, s: np.ndarray, ds: np.ndarray,
+          dds: np.ndarray) -> CamDesign:
+    rho = rb + s + dds
+    return CamDesign(f, "flat", rb, 0.0, 0.0, theta, s, ds, dds,
+                     _rotate_back(theta, ds, rb + s), np.zeros_like(s), rho,
+                     np.ones(len(s), dtype=bool), bool(np.any(rho <= 0.0)),
+                     (float(ds.min()), float(ds.max())))
+
+
+def _positive(x: Any, what: str) -> float:
+    v = number(x, what, ENTRY)
+    if not v > 0.0:
+        raise ModelError(f"{what} must be positive, got {v:g}", ENTRY)
+    return v
+
+
+def _nonneg(x: Any, what: str) -> float:
+    v = number(x, what, ENTRY)
+    if v < 0.0:
+        raise ModelError(f"{what} must be >= 0, got {v:g}", ENTRY)
+    return v
+
+
+#: the keys of a cam task file's [cam] table (cam_profile's arguments and the model's speed)
+CAM_KEYS = {"program", "base_radius", "follower", "roller_radius", "offset", "points",
+            "speed", "name"}
+
+
+def load_cam(path: str | Path) -> tuple[CamDesign, Model]:
+    """Read a cam task file (the input of ``mbd2d cam TASK.toml --out MODEL.toml``)::
+
+        [cam]
+        base_radius = 0.05
+        follower = "roller"             # roller | flat
+        roller_radius = 0.01
+        offset = 0.0                    # optional
+        points = 720                    # optional
+        speed = 6.283185307179586       # optional: the motor's rad/s (default 2 pi)
+        program = { step = [{ t0 = 0.0, t1 = 1.5707963267948966, h = 0.02 },
+                            { t0 = 3.141592653589793, t1 = 4.71238898038469, h = -0.02 }] }
+
+    Returns
+    -------
+    (CamDesign, Model)
+        The design and its cam-follower model.
+
+    Raises
+    ------
+    ModelError
+        If the file cannot be read, a key is unknown or malformed, or the cam is undercut.
+    """
+    if not isinstance(path, (str, os.PathLike)):
+        raise ModelError(f"the cam task file must be a path, got {path!r}", ENTRY)
+    p = Path(path)
+    try:
+        data = tomllib.loads(p.read_text(encoding="utf-8"))
+    except OSError as exc:
+        raise ModelError(f"cannot read the cam task file: {exc.strerror}", str(p)) from None
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise ModelError(f"not a valid TOML cam task file: {exc}", str(p)) from None
+    only_keys(data, {"cam"}, str(p), required=["cam"])
+    spec = data["cam"]
+    if not isinstance(spec, Mapping):
+        raise ModelError("[cam] must be a table", str(p))
+    only_keys(spec, CAM_KEYS, "[cam]", required=["program", "base_radius"])
+    args = {k: v for k, v in spec.items() if k not in ("program", "base_radius", "speed",
+                                                        "name")}
+    design = cam_profile(spec["program"], spec["base_radius"], **args)
+    model = design.model(speed=spec.get("speed", 2 * math.pi),
+                         name=str(spec.get("name", "cam-follower")))
+    return design, model
+
+
+def cam_report(d: CamDesign) -> str:
+    """The design's figures as text (pressure angle, curvature, face width)."""
+    k = int(np.argmax(np.abs(d.pressure_angle)))
+    lines = [f"{d.follower} follower, base radius {d.base_radius:g}"
+             + (f", roller radius {d.roller_radius:g}, offset {d.offset:g}"
+                if d.follower == "roller" else "")
+             + f", {len(d.theta)} profile points",
+             f"lift: {d.s.min():.6g} .. {d.s.max():.6g}",
+             f"largest pressure angle: {math.degrees(d.pressure_angle[k]):.3f} deg at theta = "
+             f"{math.degrees(d.theta[k]):.2f} deg",
+             f"smallest radius of curvature (convex): {d.min_curvature_radius:.6g}"
+             + ("  UNDERCUT: the surface has a cusp" if d.undercut else "")]
+    if d.follower == "flat":
+        lines.append(f"contact along the face: {d.face[0]:.6g} .. {d.face[1]:.6g} "
+                     f"(face width at least {d.face[1] - d.face[0]:.6g})")
+    return "\n".join(lines)
