@@ -9,7 +9,8 @@ Writes ``NAME_mechanism.png`` and ``NAME_timeseries.png`` for each example to DI
 coupler curve) and ``slider_crank.gif``, the cam lift-off pictures, the design study's
 three pictures (examples/design_study.py: a sweep of the crank-rocker's coupler length, the
 sensitivities of the rocker angle, the tolerance of a coupler point), and the same sweep
-and a sensitivity run in the standalone mbd2d-solve (examples/standalone_sweep.py). The seed four-bar is
+and a sensitivity run in the standalone mbd2d-solve (examples/standalone_sweep.py), a cam
+synthesized from its follower's program and run (examples/cam_design.py). The seed four-bar is
 non-Grashof: driven past its
 toggle it raises :class:`mbd2d.SingularConfigurationError`, which is the expected outcome;
 its partial results are drawn with the toggle configuration marked.
@@ -153,6 +154,20 @@ def main(argv: list[str] | None = None) -> int:
         traceback.print_exc()
         problems.append(f"design_study: {type(exc).__name__}: {exc}")
         print(f"design_study: FAILED ({type(exc).__name__})")
+
+    total += 1
+    print("\ncam_design (a cam synthesized from its follower's program, then run):")
+    try:
+        sys.path.insert(0, str(HERE))
+        import cam_design
+        problem, res, files = cam_design.run(out)
+        written += files
+        print("cam_design: " + ", ".join(Path(f).name for f in files) + f" in {out}")
+        if problem:
+            problems.append(f"cam_design: {problem}")
+    except Exception as exc:  # report every example, then fail
+        traceback.print_exc()
+        problems.append(f"cam_design: {type(exc).__name__}: {exc}")
 
     total += 1
     print("\nstandalone_sweep (the design study's sweep and a sensitivity run in mbd2d-solve):")

@@ -123,7 +123,7 @@ def test_demo_script(tmp_path: Path) -> None:
                           cwd=tmp_path, capture_output=True, text=True, timeout=600)
     assert proc.returncode == 0, proc.stdout + proc.stderr
     pngs = sorted(out.glob("*.png"))
-    assert len(pngs) == 13, [p.name for p in pngs]
+    assert len(pngs) == 15, [p.name for p in pngs]
     for name in ["fourbar_seed", "fourbar_grashof", "slider_crank", "cam_follower"]:
         for kind in ["mechanism", "timeseries"]:
             p = out / f"{name}_{kind}.png"
@@ -135,9 +135,12 @@ def test_demo_script(tmp_path: Path) -> None:
     for kind in ["curves", "sensitivity", "tolerance"]:
         assert (out / f"design_study_{kind}.png").stat().st_size > 0
     assert "hit a dead centre" in proc.stdout
-    assert "summary: 7/7" in proc.stdout and "GIF animations" in proc.stdout
+    assert "summary: 8/8" in proc.stdout and "GIF animations" in proc.stdout
+    for kind in ["mechanism", "program"]:                      # the synthesized cam
+        assert (out / f"cam_design_{kind}.png").stat().st_size > 0
     # the design study's sweep and a sensitivity run through mbd2d-solve, as Python writes them
     assert "the same file byte for byte (rows, numbers, statuses and messages): True" in \
         proc.stdout
     assert "the same CSV: True" in proc.stdout
-    assert gifs == ["cam_liftoff.gif", "fourbar_grashof.gif", "slider_crank.gif"]
+    assert gifs == ["cam_design.gif", "cam_liftoff.gif", "fourbar_grashof.gif",
+                    "slider_crank.gif"]
