@@ -16,7 +16,6 @@ Writes cam_design_mechanism.png (snapshots with the roller's path), cam_design_p
 from __future__ import annotations
 
 import argparse
-import math
 import sys
 from pathlib import Path
 
