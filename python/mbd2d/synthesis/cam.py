@@ -38,7 +38,7 @@ from ..binding import core
 from ..description.functions import TimeFunction, as_function
 from ..errors import ModelError
 from ..model import Model
-from ..validate import number, only_keys
+from ..validate import number, only_keys, vector
 
 ENTRY = "cam_profile"
 #: followers of cam_profile
@@ -88,6 +88,10 @@ class CamDesign:
     convex: np.ndarray
     undercut: bool
     face: tuple[float, float]
+    #: an oscillating follower: its arm's ground pivot, length and angle at psi = 0
+    pivot: tuple[float, float] | None = None
+    arm_length: float = 0.0
+    arm_angle0: float = 0.0
 
     @property
     def max_pressure_angle(self) -> float:
@@ -106,18 +110,21 @@ class CamDesign:
         return {"spline": {"points": self.points.tolist()}}
 
     def follower_spec(self) -> dict[str, Any]:
-        """The cam joint's ``follower`` on the follower body (its origin on the axis)."""
+        """The cam joint's ``follower`` on the follower body (its origin on the axis; an
+        arm's origin at its pivot, the roller at (length, 0))."""
         if self.follower == "flat":
             return {"flat": {"point": [0.0, 0.0], "normal": [0.0, -1.0]}}
+        at = [self.arm_length, 0.0] if self.pivot is not None else [0.0, 0.0]
         if self.roller_radius == 0.0:
-            return {"point": [0.0, 0.0]}
-        return {"roller": {"center": [0.0, 0.0], "radius": self.roller_radius}}
+            return {"point": at}
+        return {"roller": {"center": at, "radius": self.roller_radius}}
 
     def model(self, speed: float = 2 * math.pi, name: str = "cam-follower",
               masses: Mapping[str, tuple[float, float]] | None = None) -> Model:
         """The cam and its follower as a model: the cam turning at ``speed`` [rad/s] about
-        the origin (driver ``motor``), the follower on the guide ``guide`` along +y, the cam
-        joint ``contact``; ``masses`` maps "cam" and "follower" to (mass, inertia).
+        the origin (driver ``motor``), the follower on the guide ``guide`` along +y (an arm
+        on the revolute ``arm_pivot``), the cam joint ``contact``; ``masses`` maps "cam" and
+        "follower" to (mass, inertia).
 
         Raises
         ------
@@ -138,14 +145,21 @@ class CamDesign:
             raise ModelError(f"masses are for 'cam' and 'follower', got {sorted(unknown)}",
                              ENTRY)
         m = Model(name)
-        y0 = (self.base_radius if self.follower == "flat" else self._d0()) + float(self.s[0])
-        x0 = self.offset if self.follower == "roller" else 0.0
-        for body, q0 in (("cam", [0.0, 0.0, 0.0]), ("follower", [x0, y0, 0.0])):
+        if self.pivot is not None:
+            q0f = [*self.pivot, self.arm_angle0 + float(self.s[0])]
+        else:
+            y0 = (self.base_radius if self.follower == "flat" else self._d0()) + float(self.s[0])
+            q0f = [self.offset if self.follower == "roller" else 0.0, y0, 0.0]
+        for body, q0 in (("cam", [0.0, 0.0, 0.0]), ("follower", q0f)):
             mi = masses.get(body)
             m.add_body(body, q0=q0, **({"mass": mi[0], "inertia": mi[1]} if mi else {}))
         m.add_revolute(["ground", "cam"], [[0.0, 0.0], [0.0, 0.0]], name="pivot")
-        m.add_translational(["ground", "follower"], [[x0, 0.0], [0.0, 0.0]],
-                            [[0.0, 1.0], [0.0, 1.0]], name="guide")
+        if self.pivot is not None:
+            m.add_revolute(["ground", "follower"], [list(self.pivot), [0.0, 0.0]],
+                           name="arm_pivot")
+        else:
+            m.add_translational(["ground", "follower"], [[q0f[0], 0.0], [0.0, 0.0]],
+                                [[0.0, 1.0], [0.0, 1.0]], name="guide")
         m.add_cam(["cam", "follower"], self.profile(), self.follower_spec(), name="contact")
         m.add_driver("absolute", body="cam", coordinate="theta", f={"poly": [0.0, speed]},
                      name="motor")
@@ -157,9 +171,10 @@ class CamDesign:
 
 
 def cam_profile(program: Any, base_radius: float, follower: str = "roller",
-                roller_radius: float = 0.0, offset: float = 0.0,
-                points: int = 720) -> CamDesign:
-    """The disc cam that moves a translating follower by ``program``.
+                roller_radius: float = 0.0, offset: float = 0.0, points: int = 720,
+                arm: Mapping[str, Any] | None = None) -> CamDesign:
+    """The disc cam that moves a translating follower, or a roller on an oscillating arm,
+    by ``program``.
 
     Parameters
     ----------
@@ -177,6 +192,11 @@ def cam_profile(program: Any, base_radius: float, follower: str = "roller",
         Roller follower: the axis' offset x = offset from the cam's centre.
     points : int
         Samples of the surface over the turn (the spline's points), at least 16.
+    arm : mapping, optional
+        ``{"pivot": [x, y], "length": L}``: the roller (or knife edge) sits at the end of an
+        arm pivoted in the ground at ``pivot``; the program is then the arm's angle psi(theta)
+        [rad], counterclockwise positive, a positive psi lifting the roller away from the
+        cam's centre.
 
     Returns
     -------
@@ -198,6 +218,9 @@ def cam_profile(program: Any, base_radius: float, follower: str = "roller",
         raise ModelError("a flat-faced follower has no roller_radius and no offset", ENTRY)
     if not isinstance(points, (int, np.integer)) or isinstance(points, bool) or points < 16:
         raise ModelError(f"points must be a whole number >= 16, got {points!r}", ENTRY)
+    if arm is not None and (follower != "roller" or e != 0.0):
+        raise ModelError("an oscillating arm carries a roller (or a knife edge: "
+                         "roller_radius = 0) and has no offset", ENTRY)
     if abs(e) >= rb + rr:
         raise ModelError(f"|offset| = {abs(e):g} must be below base_radius + roller_radius "
                          f"= {rb + rr:g} (the follower's axis must cross the base circle)",
@@ -206,6 +229,8 @@ def cam_profile(program: Any, base_radius: float, follower: str = "roller",
     s, ds, dds = _program(f, theta, rb)
     if follower == "flat":
         return _flat(f, rb, theta, s, ds, dds)
+    if arm is not None:
+        return _arm(f, rb, rr, arm, theta, s, ds, dds)
     return _roller(f, rb, rr, e, theta, s, ds, dds)
 
 
@@ -237,22 +262,75 @@ def _rotate_back(theta: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
 
 def _roller(f: TimeFunction, rb: float, rr: float, e: float, theta: np.ndarray,
             s: np.ndarray, ds: np.ndarray, dds: np.ndarray) -> CamDesign:
+    """A translating roller: its centre at (e, d0 + s) in the ground frame."""
     d0 = math.sqrt((rb + rr)**2 - e * e)
     if np.any(d0 + s <= 0.0):
         raise ModelError("program: the follower reaches the cam's centre (d0 + s <= 0); "
                          "raise base_radius", ENTRY)
-    w = np.column_stack([d0 + s, ds - e])
-    u = np.column_stack([2 * ds - e, dds - d0 - s])
+    zero, one = np.zeros_like(s), np.ones_like(s)
+    pitch = _pitch(theta, np.column_stack([np.full_like(s, e), d0 + s]),
+                   np.column_stack([zero, ds]), np.column_stack([zero, dds]),
+                   np.column_stack([zero, one]), rr)
+    return CamDesign(f, "roller", rb, rr, e, theta, s, ds, dds, *pitch, (0.0, 0.0))
+
+
+def _arm(f: TimeFunction, rb: float, rr: float, arm: Mapping[str, Any], theta: np.ndarray,
+         s: np.ndarray, ds: np.ndarray, dds: np.ndarray) -> CamDesign:
+    """An oscillating roller: the arm of length L about the ground point P at the angle
+    phi = phi0 + psi(theta) (psi the program, counterclockwise lifts); its centre
+    R = P + L u(phi), R' = L psi' J u, R'' = L psi'' J u - L psi'**2 u. phi0 puts the roller
+    on the prime circle |R| = Rb + Rr at psi = 0, on the side where a positive psi moves it
+    away from the cam's centre: phi0 = beta - acos(c/|P|), c = (Rp**2 - |P|**2 - L**2)/(2L),
+    beta the direction of P."""
+    if not isinstance(arm, Mapping):
+        raise ModelError("arm must be a table { pivot = [x, y], length = L }", ENTRY)
+    only_keys(arm, {"pivot", "length"}, "cam_profile arm", required=["pivot", "length"])
+    piv = np.array(vector(arm["pivot"], 2, "arm.pivot", ENTRY), dtype=float)
+    length = _positive(arm["length"], "arm.length")
+    rp, dist = rb + rr, float(np.hypot(*piv))
+    c = (rp * rp - dist * dist - length * length) / (2 * length)
+    if not dist > abs(c):
+        raise ModelError(f"the arm cannot put its roller on the prime circle (radius {rp:g}): "
+                         f"pivot at {dist:g} from the cam's centre, arm {length:g}; its "
+                         "length must lie between |pivot| - Rp and |pivot| + Rp", ENTRY)
+    phi0 = math.atan2(piv[1], piv[0]) - math.acos(c / dist)
+    phi = phi0 + s
+    u = np.column_stack([np.cos(phi), np.sin(phi)])
+    ju = np.column_stack([-u[:, 1], u[:, 0]])
+    rg = piv + length * u
+    if np.any(np.hypot(rg[:, 0], rg[:, 1]) <= rr):
+        raise ModelError("program: the roller reaches the cam's centre; raise base_radius",
+                         ENTRY)
+    pitch = _pitch(theta, rg, length * ds[:, None] * ju,
+                   length * (dds[:, None] * ju - (ds * ds)[:, None] * u), ju, rr)
+    d = CamDesign(f, "roller", rb, rr, 0.0, theta, s, ds, dds, *pitch, (0.0, 0.0))
+    d.pivot, d.arm_length, d.arm_angle0 = (float(piv[0]), float(piv[1])), length, phi0
+    return d
+
+
+def _pitch(theta: np.ndarray, rg: np.ndarray, rg1: np.ndarray, rg2: np.ndarray,
+           vdir: np.ndarray, rr: float) -> tuple[np.ndarray, np.ndarray, np.ndarray,
+                                                 np.ndarray, bool]:
+    """The surface, pressure angle, radius of curvature, convexity and undercut of a roller
+    whose centre is rg(theta) in the ground frame (derivatives rg1, rg2; vdir the direction
+    its motion takes when the program rises). In ground-aligned axes the pitch curve's
+    tangent is w = rg' - J rg and w' = rg'' - J rg', u = w' - J w (d/dtheta R(-theta) =
+    -R(-theta) J); the outward normal J w/|w|, the pitch radius -|w|**3/(w x u) (> 0 convex),
+    the pressure angle from vdir to the normal."""
+    jrg = np.column_stack([-rg[:, 1], rg[:, 0]])
+    w = rg1 - jrg
+    w1 = rg2 - np.column_stack([-rg1[:, 1], rg1[:, 0]])
+    u = w1 - np.column_stack([-w[:, 1], w[:, 0]])
     wn = np.hypot(w[:, 0], w[:, 1])
-    pitch = _rotate_back(theta, np.full_like(s, e), d0 + s)
-    tangent = _rotate_back(theta, w[:, 0], w[:, 1]) / wn[:, None]
-    normal = np.column_stack([-tangent[:, 1], tangent[:, 0]])          # J t: outward
+    ng = np.column_stack([-w[:, 1], w[:, 0]]) / wn[:, None]
+    normal = _rotate_back(theta, ng[:, 0], ng[:, 1])
+    surface = _rotate_back(theta, rg[:, 0], rg[:, 1]) - rr * normal
     cross = w[:, 0] * u[:, 1] - w[:, 1] * u[:, 0]
     with np.errstate(divide="ignore"):
         rho = np.where(cross != 0.0, -wn**3 / cross, np.inf)
-    undercut = bool(np.any((rho > 0.0) & (rho < rr)))
-    return CamDesign(f, "roller", rb, rr, e, theta, s, ds, dds, pitch - rr * normal,
-                     np.arctan2(ds - e, d0 + s), rho - rr, rho > 0.0, undercut, (0.0, 0.0))
+    angle = np.arctan2(vdir[:, 0] * ng[:, 1] - vdir[:, 1] * ng[:, 0],
+                       vdir[:, 0] * ng[:, 0] + vdir[:, 1] * ng[:, 1])
+    return surface, angle, rho - rr, rho > 0.0, bool(np.any((rho > 0.0) & (rho < rr)))
 
 
 def _flat(f: TimeFunction, rb: float, theta: np.ndarray, s: np.ndarray, ds: np.ndarray,
@@ -280,7 +358,7 @@ def _nonneg(x: Any, what: str) -> float:
 
 #: the keys of a cam task file's [cam] table (cam_profile's arguments and the model's speed)
 CAM_KEYS = {"program", "base_radius", "follower", "roller_radius", "offset", "points",
-            "speed", "name"}
+            "speed", "name", "arm"}
 
 
 def load_cam(path: str | Path) -> tuple[CamDesign, Model]:
@@ -292,6 +370,7 @@ def load_cam(path: str | Path) -> tuple[CamDesign, Model]:
         roller_radius = 0.01
         offset = 0.0                    # optional
         points = 720                    # optional
+        arm = { pivot = [0.12, 0.0], length = 0.1 }   # optional: an oscillating arm
         speed = 6.283185307179586       # optional: the motor's rad/s (default 2 pi)
         program = { step = [{ t0 = 0.0, t1 = 1.5707963267948966, h = 0.02 },
                             { t0 = 3.141592653589793, t1 = 4.71238898038469, h = -0.02 }] }
