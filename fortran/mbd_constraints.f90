@@ -216,7 +216,7 @@ contains
     case (CON_RACK, CON_ROLLING)
       call rolling_prepare(raw, prep, status, msg)
     case (CON_ABSOLUTE)
-      prep = [1.0_wp, raw(1), 0.0_wp, 0.0_wp]   ! the constant function f = value
+      prep = [1.0_wp, raw(1), 0.0_wp, 0.0_wp, 0.0_wp]   ! the constant f = value
     case (DRV_ABS, DRV_REL_ANGLE)
       call fun_check(raw, status, msg)
       if (status == MBD_OK) prep = raw
@@ -342,7 +342,7 @@ contains
     case (CON_GEAR); n = 12
     case (CON_POINT_LINE); n = 7
     case (CON_RACK, CON_ROLLING); n = 8
-    case (CON_ABSOLUTE); n = 4
+    case (CON_ABSOLUTE); n = 5
     case (DRV_REL_DIST); n = TRANS_PREP_LEN + size(raw)
     case default; n = size(raw)
     end select
@@ -361,7 +361,7 @@ contains
     case (CON_RACK, CON_ROLLING)
       call rolling_prepare_d(raw, j, tprep)
     case (CON_ABSOLUTE)
-      tprep(2) = 1.0_wp                   ! prepared [1, value, 0, 0]: the constant f
+      tprep(2) = 1.0_wp                   ! prepared [1, value, 0, 0, 0]: the constant
     case (DRV_REL_DIST)
       tprep(TRANS_PREP_LEN + j) = 1.0_wp
     case default

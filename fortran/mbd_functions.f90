@@ -9,8 +9,16 @@
 !! (Norton, Cam Design and Manufacturing Handbook, ch. 3; quintic and cycloidal have L'' = 0 at
 !! both ends, cubic and harmonic jump in acceleration there).
 !!
+!! A table adds y(t) through points (t_k, y_k) (measured motion, a force history): on each
+!! interval the quintic Hermite with values y_k and derivatives d_k, c_k at the points, those
+!! of the polynomial through the five points around t_k (Fornberg's weights; fewer in a
+!! table of fewer points): twice continuously differentiable, exact on quartics, errors
+!! O(h^5), O(h^4), O(h^3) in f, f', f'' for smooth data, local (y_k moves f on three
+!! intervals either side) and linear in the y_k; outside [t_1, t_n] the line through the end
+!! with the end's slope (f'' jumps there).
+!!
 !! Encoding in a real array p: [np, c_0 .. c_{np-1}, nh, (A, omega, phi) x nh,
-!! ns, (law, t0, t1, h) x ns].
+!! ns, (law, t0, t1, h) x ns, nt, t_1 .. t_nt, y_1 .. y_nt].
 !! Returns f, df/dt and d2f/dt2 (the driver's nu = f' and its time term in gamma = f'').
 module mbd_functions
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
@@ -34,7 +42,7 @@ contains
   !> Length of the encoded function starting at p(1), or -1 when malformed.
   pure integer function fun_length(p)
     real(wp), intent(in) :: p(:)   !! encoded function (possibly followed by other data)
-    integer :: np, nh, ns
+    integer :: np, nh, ns, nt
     fun_length = -1
     if (size(p) < 2) return
     if (.not. is_count(p(1))) return
@@ -45,8 +53,11 @@ contains
     if (size(p) < np + 3 + 3 * nh) return
     if (.not. is_count(p(np + 3 + 3 * nh))) return
     ns = nint(p(np + 3 + 3 * nh))
-    if (size(p) < np + 3 + 3 * nh + 4 * ns) return
-    fun_length = np + 3 + 3 * nh + 4 * ns
+    if (size(p) < np + 4 + 3 * nh + 4 * ns) return
+    if (.not. is_count(p(np + 4 + 3 * nh + 4 * ns))) return
+    nt = nint(p(np + 4 + 3 * nh + 4 * ns))
+    if (size(p) < np + 4 + 3 * nh + 4 * ns + 2 * nt) return
+    fun_length = np + 4 + 3 * nh + 4 * ns + 2 * nt
   end function fun_length
 
   pure logical function is_count(x)
@@ -66,7 +77,7 @@ contains
     if (n < 0) then
       status = MBD_BAD_PARAM
       msg = 'function of time is malformed (expected [np, coefficients, nh, (A, omega, '// &
-            'phase)..., ns, (law, t0, t1, h)...])'
+            'phase)..., ns, (law, t0, t1, h)..., nt, t_1 .. t_nt, y_1 .. y_nt])'
       return
     end if
     if (.not. all(ieee_is_finite(p(1:n)))) then
@@ -80,6 +91,7 @@ contains
         OMAX, ' and |phase| <= ', PMAX, ' (beyond that its values lose all precision)'
     else
       call steps_check(p, status, msg)
+      if (status == MBD_OK) call table_check(p, status, msg)
     end if
   contains
     logical function harmonics_ok()
@@ -124,8 +136,8 @@ contains
     end do
   end subroutine steps_check
 
-  !> The first breakpoint of f after t: the smallest step time t0 or t1 above t (huge when
-  !! there is none). f'' may jump there; the kinematic loop ends a step on it.
+  !> The first breakpoint of f after t: the smallest step time t0 or t1, or table end, above
+  !! t (huge when there is none). f'' may jump there; the kinematic loop ends a step on it.
   pure real(wp) function fun_next_break(p, t) result(tb)
     real(wp), intent(in) :: p(:)   !! encoded function
     real(wp), intent(in) :: t      !! time
@@ -136,6 +148,11 @@ contains
       if (p(o + 4 * k - 2) > t) tb = min(tb, p(o + 4 * k - 2))
       if (p(o + 4 * k - 1) > t) tb = min(tb, p(o + 4 * k - 1))
     end do
+    o = table_at(p); k = int(p(o) + half)               ! a table's ends
+    if (k > 0) then
+      if (p(o + 1) > t) tb = min(tb, p(o + 1))
+      if (p(o + k) > t) tb = min(tb, p(o + k))
+    end if
   end function fun_next_break
 
   !> Position of ns (the count of steps) in a well-formed encoded function.
@@ -145,6 +162,141 @@ contains
     np = int(p(1) + half)
     steps_at = np + 3 + 3 * int(p(np + 2) + half)
   end function steps_at
+
+  !> Check the table of a well-formed, finite encoded function: none or at least 2 points,
+  !! times within TMAX, each above the one before by TREL max(1, |t|).
+  subroutine table_check(p, status, msg)
+    real(wp), intent(in) :: p(:)              !! encoded function
+    integer, intent(out) :: status            !! MBD_OK or MBD_BAD_PARAM
+    character(len=MSG_LEN), intent(out) :: msg !! what is wrong
+    integer :: k, o, nt
+    status = MBD_OK; msg = ''
+    o = table_at(p)
+    nt = nint(p(o))
+    if (nt == 1) then
+      status = MBD_BAD_PARAM; msg = 'function of time: a table needs at least 2 points'
+      return
+    end if
+    do k = 1, nt
+      if (abs(p(o + k)) > TMAX) then
+        status = MBD_BAD_PARAM
+        write (msg, '(a,i0,a,es8.1)') 'function of time: table time ', k - 1, &
+          ' must be within +-', TMAX
+        return
+      end if
+      if (k == 1) cycle
+      if (p(o + k) - p(o + k - 1) <= TREL * max(1.0_wp, abs(p(o + k)))) then
+        status = MBD_BAD_PARAM
+        write (msg, '(a,i0,a,i0,a)') 'function of time: table times must increase (time ', &
+          k - 1, ' is not above time ', k - 2, ')'
+        return
+      end if
+    end do
+  end subroutine table_check
+
+  !> Position of nt (the count of table points) in a well-formed encoded function.
+  pure integer function table_at(p)
+    real(wp), intent(in) :: p(:)   !! encoded function
+    integer :: o
+    o = steps_at(p)
+    table_at = o + 1 + 4 * int(p(o) + half)
+  end function table_at
+
+  !> Adds the table's f, f', f'' at t (the module header) for the points tk, values yk.
+  pure subroutine table_eval(tk, yk, t, f, f1, f2)
+    real(wp), intent(in) :: tk(:), yk(:)   !! times (increasing) and values, n >= 2
+    real(wp), intent(in) :: t              !! time
+    real(wp), intent(inout) :: f, f1, f2
+    integer :: n, i, lo, hi, mid
+    real(wp) :: d0, c0, d1, c1, hh, u, b(6), b1(6), b2(6), v(6)
+    n = size(tk)
+    if (t < tk(1) .or. t >= tk(n)) then        ! the line through the end
+      i = merge(1, n, t < tk(1))
+      call knot_derivs(tk, yk, i, d0, c0)
+      f = f + yk(i) + d0 * (t - tk(i)); f1 = f1 + d0
+      return
+    end if
+    lo = 1; hi = n                             ! tk(lo) <= t < tk(hi)
+    do while (hi - lo > 1)
+      mid = (lo + hi) / 2
+      if (t >= tk(mid)) then
+        lo = mid
+      else
+        hi = mid
+      end if
+    end do
+    call knot_derivs(tk, yk, lo, d0, c0)
+    call knot_derivs(tk, yk, hi, d1, c1)
+    hh = tk(hi) - tk(lo); u = (t - tk(lo)) / hh
+    call hermite5(u, b, b1, b2)
+    v = [yk(lo), hh * d0, hh * hh * c0, yk(hi), hh * d1, hh * hh * c1]
+    f = f + dot_product(v, b)
+    f1 = f1 + dot_product(v, b1) / hh
+    f2 = f2 + dot_product(v, b2) / (hh * hh)
+  end subroutine table_eval
+
+  !> d_i, c_i of the table at point i: the slope and second derivative at t_i of the
+  !! polynomial through the (at most) five points around it (a window kept inside the
+  !! table), by Fornberg's weights.
+  pure subroutine knot_derivs(tk, yk, i, d, c)
+    real(wp), intent(in) :: tk(:), yk(:)
+    integer, intent(in) :: i
+    real(wp), intent(out) :: d, c
+    integer :: j0, nw
+    real(wp) :: w(0:4, 0:2)
+    nw = min(size(tk), 5)
+    j0 = min(max(i - 2, 1), size(tk) - nw + 1)
+    call fd_weights(tk(i), tk(j0:j0 + nw - 1), w(0:nw - 1, :))
+    d = dot_product(w(0:nw - 1, 1), yk(j0:j0 + nw - 1))
+    c = dot_product(w(0:nw - 1, 2), yk(j0:j0 + nw - 1))
+  end subroutine knot_derivs
+
+  !> Weights c(k, m) of the m-th derivative (m = 0, 1, 2) at z of the polynomial through the
+  !! nodes x (Fornberg, Math. Comp. 51 (1988) 699-706): f^(m)(z) = sum_k c(k, m) f(x_k).
+  pure subroutine fd_weights(z, x, c)
+    real(wp), intent(in) :: z, x(0:)
+    real(wp), intent(out) :: c(0:, 0:)
+    integer :: i, j, k, nd, mn
+    real(wp) :: c1, c2, c3, c4, c5
+    nd = size(x) - 1
+    c = zero; c(0, 0) = 1
+    c1 = 1; c4 = x(0) - z
+    do i = 1, nd
+      mn = min(i, 2); c2 = 1; c5 = c4; c4 = x(i) - z
+      do j = 0, i - 1
+        c3 = x(i) - x(j); c2 = c2 * c3
+        if (j == i - 1) then
+          do k = mn, 1, -1
+            c(i, k) = c1 * (k * c(i - 1, k - 1) - c5 * c(i - 1, k)) / c2
+          end do
+          c(i, 0) = -c1 * c5 * c(i - 1, 0) / c2
+        end if
+        do k = mn, 1, -1
+          c(j, k) = (c4 * c(j, k) - k * c(j, k - 1)) / c3
+        end do
+        c(j, 0) = c4 * c(j, 0) / c3
+      end do
+      c1 = c2
+    end do
+  end subroutine fd_weights
+
+  !> The quintic Hermite basis at u in [0, 1] and its first two derivatives, in the order
+  !! of the weights (y0, H d0, H**2 c0, y1, H d1, H**2 c1).
+  pure subroutine hermite5(u, b, b1, b2)
+    real(wp), intent(in) :: u
+    real(wp), intent(out) :: b(6), b1(6), b2(6)
+    real(wp) :: u2, u3, u4, u5
+    u2 = u * u; u3 = u2 * u; u4 = u3 * u; u5 = u4 * u
+    b = [1 - 10 * u3 + 15 * u4 - 6 * u5, u - 6 * u3 + 8 * u4 - 3 * u5, &
+         half * (u2 - 3 * u3 + 3 * u4 - u5), 10 * u3 - 15 * u4 + 6 * u5, &
+         -4 * u3 + 7 * u4 - 3 * u5, half * (u3 - 2 * u4 + u5)]
+    b1 = [-30 * u2 + 60 * u3 - 30 * u4, 1 - 18 * u2 + 32 * u3 - 15 * u4, &
+          half * (2 * u - 9 * u2 + 12 * u3 - 5 * u4), 30 * u2 - 60 * u3 + 30 * u4, &
+          -12 * u2 + 28 * u3 - 15 * u4, half * (3 * u2 - 8 * u3 + 5 * u4)]
+    b2 = [-60 * u + 180 * u2 - 120 * u3, -36 * u + 96 * u2 - 60 * u3, &
+          half * (2 - 18 * u + 36 * u2 - 20 * u3), 60 * u - 180 * u2 + 120 * u3, &
+          -24 * u + 84 * u2 - 60 * u3, half * (6 * u - 24 * u2 + 20 * u3)]
+  end subroutine hermite5
 
   !> A motion law and its first three derivatives at u in [0, 1] (see the module header).
   pure subroutine law_eval(law, u, l0, l1, l2, l3)
@@ -187,6 +339,8 @@ contains
     do k = 1, nint(p(o))
       ex(o + 4 * k - 3:o + 4 * k - 1) = 0; ex(o + 4 * k) = e
     end do
+    o = table_at(p)                  ! the count and the times: 0; the values: e
+    ex(o:o + nint(p(o))) = 0; ex(o + nint(p(o)) + 1:o + 2 * nint(p(o))) = e
   end subroutine fun_exponents
 
   !> f(t), f'(t), f''(t).
@@ -219,6 +373,8 @@ contains
     do k = 1, int(p(o) + half)
       call step_eval(p(o + 4 * k - 3:o + 4 * k), t, f, f1, f2)
     end do
+    o = table_at(p); k = int(p(o) + half)
+    if (k > 0) call table_eval(p(o + 1:o + k), p(o + k + 1:o + 2 * k), t, f, f1, f2)
   end subroutine fun_eval
 
   !> Adds a step's h L(u), h L'(u)/T, h L''(u)/T**2 to f, f', f'' (T = t1 - t0; before t0
@@ -240,15 +396,16 @@ contains
     f2 = f2 + st(4) * l2 / (tt * tt)
   end subroutine step_eval
 
-  !> True when entry i (1-based) of the encoded function p is a count (np or nh), which no
-  !! derivative can be taken with respect to.
+  !> True when entry i (1-based) of the encoded function p is a count (np, nh, ns, nt) or
+  !! another entry no derivative is taken with respect to (a law code, a table's times).
   pure logical function fun_is_count(p, i)
     real(wp), intent(in) :: p(:)   !! encoded function
     integer, intent(in) :: i       !! entry
-    integer :: o
-    o = steps_at(p)
+    integer :: o, ot
+    o = steps_at(p); ot = table_at(p)
     fun_is_count = i == 1 .or. i == nint(p(1)) + 2 .or. i == o
-    if (i > o) fun_is_count = mod(i - o, 4) == 1      ! a step's law code
+    if (i > o .and. i < ot) fun_is_count = mod(i - o, 4) == 1   ! a step's law code
+    if (i >= ot) fun_is_count = i <= ot + nint(p(ot))          ! nt and the table's times
   end function fun_is_count
 
   !> Changes tf, tf1, tf2 of f(t), f'(t), f''(t) when the coefficients change by tp (the
@@ -259,7 +416,9 @@ contains
   !! dT = dt1 - dt0:
   !!   d(h L)        = dh L + h L' du,
   !!   d(h L'/T)     = dh L'/T + h (L'' du/T - L' dT/T**2),
-  !!   d(h L''/T**2) = dh L''/T**2 + h (L''' du/T**2 - 2 L'' dT/T**3);   from t1 on: dh.
+  !!   d(h L''/T**2) = dh L''/T**2 + h (L''' du/T**2 - 2 L'' dT/T**3);   from t1 on: dh;
+  !! a table (linear in its values y_k) by its interpolation of the values' changes (its
+  !! times are not differentiated: fun_is_count).
   pure subroutine fun_eval_d(p, tp, t, tf, tf1, tf2)
     real(wp), intent(in) :: p(:)   !! encoded function
     real(wp), intent(in) :: tp(:)  !! change of its coefficients
@@ -289,6 +448,9 @@ contains
       call step_eval_d(p(o + 4 * k - 3:o + 4 * k), tp(o + 4 * k - 3:o + 4 * k), t, tf, tf1, &
                        tf2)
     end do
+    ! the table is linear in its values: their changes through the same interpolation
+    o = table_at(p); k = nint(p(o))
+    if (k > 0) call table_eval(p(o + 1:o + k), tp(o + k + 1:o + 2 * k), t, tf, tf1, tf2)
   end subroutine fun_eval_d
 
   !> Adds a step's changes (fun_eval_d's header) to tf, tf1, tf2.

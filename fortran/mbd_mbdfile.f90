@@ -1057,8 +1057,9 @@ contains
     end subroutine where_prefix
   end subroutine mbd_read
 
-  !> Formats 1 and 2 wrote functions of time without their steps ([np, c, nh, harmonics]):
-  !! each driver's and force's function gets its count of steps, 0, and every index into
+  !> Formats 1 and 2 wrote functions of time without their steps and table ([np, c, nh,
+  !! harmonics]): each driver's and force's function gets its counts of steps and table
+  !! points, 0 and 0, and every index into
   !! params and fparams (design parameters, sweep entries, measure points, open phases)
   !! moves with its entry. Slices out of range are left as they are (the model's checks
   !! name them).
@@ -1070,7 +1071,8 @@ contains
     real(wp), allocatable :: rnew(:), fnew(:)
     integer :: ierr, c, f, k, i, j, nr, nf2
     allocate (rmap(size(spec%rpar)), fmap(size(spec%fpar)), &
-              rnew(size(spec%rpar) + spec%nc), fnew(size(spec%fpar) + 2 * spec%nf), stat=ierr)
+              rnew(size(spec%rpar) + 2 * spec%nc), fnew(size(spec%fpar) + 4 * spec%nf), &
+              stat=ierr)
     if (ierr /= 0) then
       status = MBD_NO_MEMORY; msg = 'out of memory reading the model file'; return
     end if
@@ -1080,7 +1082,7 @@ contains
       if (.not. slice_ok(spec%ctab(6, c), spec%ctab(7, c), size(spec%rpar))) return
       call copy_slice(spec%rpar, spec%ctab(6, c), spec%ctab(7, c), rnew, nr, rmap)
       if (spec%ctab(1, c) >= DRV_ABS .and. spec%ctab(1, c) <= DRV_REL_DIST) &
-        call put_count(rnew, nr, spec%ctab(7, c))
+        call put_counts(rnew, nr, spec%ctab(7, c))
       spec%ctab(6, c) = nr - spec%ctab(7, c) + 1
     end do
     nf2 = 0
@@ -1092,12 +1094,12 @@ contains
         k = old_length(spec%fpar(i + 2:j))
         if (k < 0) return
         call copy_slice(spec%fpar, i, k + 2, fnew, nf2, fmap)
-        call put_count(fnew, nf2, spec%ftab(5, f))
+        call put_counts(fnew, nf2, spec%ftab(5, f))
         call copy_slice(spec%fpar, i + k + 2, j - i - k - 1, fnew, nf2, fmap)
-        call put_count(fnew, nf2, spec%ftab(5, f))
+        call put_counts(fnew, nf2, spec%ftab(5, f))
       case (FRC_SPRING, FRC_TORQUE, FRC_ROTSPRING)   ! the function last
         call copy_slice(spec%fpar, i, j - i + 1, fnew, nf2, fmap)
-        call put_count(fnew, nf2, spec%ftab(5, f))
+        call put_counts(fnew, nf2, spec%ftab(5, f))
       case default
         call copy_slice(spec%fpar, i, j - i + 1, fnew, nf2, fmap)
       end select
@@ -1136,11 +1138,11 @@ contains
         nb = nb + 1; b(nb) = a(off + e); map(off + e) = nb
       end do
     end subroutine copy_slice
-    subroutine put_count(b, nb, n)
+    subroutine put_counts(b, nb, n)         ! ns = 0, nt = 0
       real(wp), intent(inout) :: b(:)
       integer, intent(inout) :: nb, n
-      nb = nb + 1; b(nb) = zero; n = n + 1
-    end subroutine put_count
+      b(nb + 1:nb + 2) = zero; nb = nb + 2; n = n + 2
+    end subroutine put_counts
     integer function old_length(a)      ! [np, c, nh, (A, w, phi) x nh], -1 when malformed
       real(wp), intent(in) :: a(:)
       integer :: np

@@ -266,7 +266,8 @@ def test_mbd2d_solve_runs_steps_as_python(tmp_path: Path) -> None:
 
 def downgrade(text: str, version: int) -> str:
     """A format-3 file as formats 1 and 2 wrote it: every function of time without its
-    count of steps (which must be 0), and every index into params and fparams moved."""
+    counts of steps and table points (which must be 0), and every index into params and
+    fparams moved."""
     lines = [ln for ln in text.splitlines() if ln and not ln.startswith("#")]
     assert lines[0] == "mbd2d 3"
     out, i = [f"mbd2d {version}"], 1
@@ -305,32 +306,37 @@ def downgrade(text: str, version: int) -> str:
 
     def drop(vals: list[float], at: list[int]) -> tuple[list[float], dict[int, int]]:
         for a in at:
-            assert vals[a - 1] == 0.0            # (ns = 0: no steps in an old file)
+            assert vals[a - 1] == 0.0            # (ns = nt = 0: no steps, no table)
         keep = [k for k in range(1, len(vals) + 1) if k not in set(at)]
         return [vals[k - 1] for k in keep], {k: n + 1 for n, k in enumerate(keep)}
 
-    def fun_len(v: list[float], a: int) -> int:   # [np, c, nh, 3 nh, ns, 4 ns] from a
+    def fun_len(v: list[float], a: int) -> int:   # [np, c, nh, 3 nh, ns, 4 ns, nt, 2 nt]
         n_p = int(v[a - 1])
         nh = int(v[a + n_p])
-        return n_p + 3 + 3 * nh + 4 * int(v[a + n_p + 1 + 3 * nh])
+        ns = int(v[a + n_p + 1 + 3 * nh])
+        return n_p + 4 + 3 * nh + 4 * ns + 2 * int(v[a + n_p + 2 + 3 * nh + 4 * ns])
 
-    pat = [int(c[6]) + int(c[7]) - 1 for c in cons if 101 <= int(c[1]) <= 103]
+    pat = [k for c in cons if 101 <= int(c[1]) <= 103
+           for k in (int(c[6]) + int(c[7]) - 2, int(c[6]) + int(c[7]) - 1)]
     fat = []
     fp = blocks.get("fparams", [])
     for f in forces:
         kind, off, n = int(f[1]), int(f[4]), int(f[5])
         if kind == 3:
-            fat.append(off + 2 + fun_len(fp, off + 2) - 1)
+            end_fx = off + 2 + fun_len(fp, off + 2) - 1
+            fat += [end_fx - 1, end_fx]
         if kind in (1, 2, 3, 4):
-            fat.append(off + n - 1)
+            fat += [off + n - 2, off + n - 1]
     rp, rmap = drop(blocks["params"], pat)
     fpn, fmap = drop(fp, fat)
     for c in cons:
         first, last = int(c[6]), int(c[6]) + int(c[7]) - 1
-        c[6], c[7] = str(rmap[first]), str(rmap[last - (last in pat)] - rmap[first] + 1)
+        last -= 2 * (last in pat)
+        c[6], c[7] = str(rmap[first]), str(rmap[last] - rmap[first] + 1)
     for f in forces:
         first, last = int(f[4]), int(f[4]) + int(f[5]) - 1
-        f[4], f[5] = str(fmap[first]), str(fmap[last - (last in fat)] - fmap[first] + 1)
+        last -= 2 * (last in fat)
+        f[4], f[5] = str(fmap[first]), str(fmap[last] - fmap[first] + 1)
     for row in sens + vtab:
         idx = -1
         if row[idx - 1] in ("1", "4"):

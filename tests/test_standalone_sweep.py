@@ -177,7 +177,7 @@ def _sweep_lines(tmp_path: Path) -> list[str]:
     (("1 9", "7 9"), "TABLE is 1 (params)"),
     (("1 9", "1 0"), "INDEX is a whole number"),
     (("1 9", "1 9 3"), "TABLE INDEX expected"),
-    (("1 9", "1 999"), "lies outside its table (21 entries)"),
+    (("1 9", "1 999"), "lies outside its table (22 entries)"),
     (("1 9", "2 1"), "lies outside its table (0 entries in kinematics)"),
     (("opens 0", "opens 1\n3 99"), "open phase 1 lies outside"),
     (("1.80000000000000004e+00 1.80000000000000004e+00", "1.8 nan"), "is not a number"),

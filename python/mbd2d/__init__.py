@@ -11,7 +11,7 @@ Examples
 from __future__ import annotations
 
 from .analysis.stepping import KinematicStepper
-from .description.functions import Harmonic, Step, TimeFunction
+from .description.functions import Harmonic, Step, Table, TimeFunction
 from .errors import (AnalysisError, AssemblyError, ConvergenceError, CoreError,
                      InconsistentConstraintsError, InsufficientMemoryError, IntegrationError,
                      LiftOffWarning, MbdError, MbdWarning, ModelError, RedundantConstraintWarning,
@@ -27,8 +27,8 @@ from .synthesis import CamDesign, SynthesisResult, cam_profile, synthesize
 
 __version__ = "0.1.0"
 
-__all__ = ["load", "loads", "Model", "TimeFunction", "Harmonic", "Step", "KinematicsResult",
-           "BodyResult", "PointResult", "DynamicsResult", "KinematicStepper", "StaticsResult",
+__all__ = ["load", "loads", "Model", "TimeFunction", "Harmonic", "Step", "Table",
+           "KinematicsResult", "BodyResult", "PointResult", "DynamicsResult", "KinematicStepper", "StaticsResult",
            "Reaction",
            "DofReport", "MbdError", "ModelError", "AnalysisError", "IntegrationError",
            "AssemblyError", "InconsistentConstraintsError", "ConvergenceError",

@@ -106,6 +106,7 @@ def header() -> str:
         lines.append(f"#        {k:3d} {t:24s} {d}")
     lines += [
         "#        f(t) = np c0 .. c_{np-1} nh (A omega phase) x nh ns (law t0 t1 h) x ns",
+        "#               nt t_1 .. t_nt y_1 .. y_nt",
         "#        (law: 1 cubic, 2 quintic, 3 cycloidal, 4 harmonic)",
         "#   labels NEQ, then NEQ words   NAME.WORD of each row of Phi (multiplier columns)",
         "#   forces NF, then NF lines     NAME KIND BODY_I BODY_J OFFSET LENGTH [JOINT]",

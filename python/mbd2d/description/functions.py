@@ -1,6 +1,9 @@
 """Functions of time for drivers and forces:
-f(t) = sum_k c_k t**k + sum_h A_h sin(omega_h t + phi_h) + sum_s h_s L_s((t - t0_s)/(t1_s - t0_s)),
-the last sum of steps (motion laws L: dwell, rise by h between t0 and t1, dwell).
+f(t) = sum_k c_k t**k + sum_h A_h sin(omega_h t + phi_h) + sum_s h_s L_s((t - t0_s)/(t1_s - t0_s))
+       + y(t),
+the steps' motion laws L (dwell, rise by h between t0 and t1, dwell), y(t) a table through
+points (t_k, y_k): measured motion or a force history (a local, twice continuously
+differentiable interpolation; see fortran/mbd_functions.f90).
 
 The core evaluates them; this module only checks and encodes the description.
 """
@@ -49,6 +52,19 @@ class Step:
 
 
 @dataclass(frozen=True)
+class Table:
+    """Points (t_k, y_k) that y(t) passes through (at least 2, t increasing).
+
+    Between the points: the quintic Hermite with the slopes and second derivatives of the
+    quadratic through the three points around each (twice continuously differentiable,
+    exact on quadratics); outside: the line through the end point with its slope.
+    """
+
+    t: tuple[float, ...]
+    y: tuple[float, ...]
+
+
+@dataclass(frozen=True)
 class TimeFunction:
     """A polynomial plus harmonics plus steps.
 
@@ -60,26 +76,33 @@ class TimeFunction:
         Terms A sin(omega t + phase).
     step : sequence of Step
         Motion laws: each adds h L((t - t0)/(t1 - t0)) (dwell, rise, dwell).
+    table : Table, optional
+        Adds y(t) through the table's points.
 
     Examples
     --------
     >>> TimeFunction(poly=(1.047, 1.0)).encode()
-    [2.0, 1.047, 1.0, 0.0, 0.0]
+    [2.0, 1.047, 1.0, 0.0, 0.0, 0.0]
     """
 
     poly: tuple[float, ...] = (0.0,)
     harmonic: tuple[Harmonic, ...] = field(default_factory=tuple)
     step: tuple[Step, ...] = field(default_factory=tuple)
+    table: Table | None = None
 
     def encode(self) -> list[float]:
         """The flat encoding the core reads:
-        [np, c..., nh, (A, omega, phase)..., ns, (law, t0, t1, h)...]."""
+        [np, c..., nh, (A, omega, phase)..., ns, (law, t0, t1, h)..., nt, t..., y...]."""
         out = [float(len(self.poly)), *map(float, self.poly), float(len(self.harmonic))]
         for h in self.harmonic:
             out += [float(h.amplitude), float(h.omega), float(h.phase)]
         out.append(float(len(self.step)))
         for st in self.step:
             out += [float(LAWS[st.law]), float(st.t0), float(st.t1), float(st.h)]
+        tab = self.table
+        out.append(float(len(tab.t)) if tab else 0.0)
+        if tab:
+            out += [*map(float, tab.t), *map(float, tab.y)]
         return out
 
 
@@ -94,7 +117,7 @@ def as_function(spec: Any, entry: str, what: str = "f") -> TimeFunction:
     ----------
     spec : TimeFunction, number, or mapping
         A constant, or ``{poly = [...], harmonic = [{amplitude, omega, phase}, ...],
-        step = [{t0, t1, h, law}, ...]}``.
+        step = [{t0, t1, h, law}, ...], table = {t = [...], y = [...]}}``.
     entry : str
         The entry that owns it, for messages.
     what : str
@@ -119,10 +142,10 @@ def as_function(spec: Any, entry: str, what: str = "f") -> TimeFunction:
                          f", got {spec!r}", entry)
     if any(not isinstance(k, str) for k in spec):
         raise ModelError(f"{what} keys must be names (strings)", entry)
-    unknown = set(spec) - {"poly", "harmonic", "step"}
+    unknown = set(spec) - {"poly", "harmonic", "step", "table"}
     if unknown:
         raise ModelError(f"{what} has unknown key(s) {sorted(unknown)}; "
-                         "use 'poly', 'harmonic' and 'step'", entry)
+                         "use 'poly', 'harmonic', 'step' and 'table'", entry)
     poly_in = as_list(spec.get("poly", [0.0]))
     if is_number(poly_in):
         poly_in = [poly_in]
@@ -147,7 +170,37 @@ def as_function(spec: Any, entry: str, what: str = "f") -> TimeFunction:
                               _finite(h["omega"], f"{what}.harmonic[{i}].omega", entry),
                               _finite(h.get("phase", 0.0), f"{what}.harmonic[{i}].phase", entry)))
     return TimeFunction(poly=poly, harmonic=tuple(harms),
-                        step=_steps(spec.get("step", []), what, entry))
+                        step=_steps(spec.get("step", []), what, entry),
+                        table=_table(spec.get("table"), f"{what}.table", entry))
+
+
+#: the most points of a table
+MAX_TABLE = 10**6
+
+
+def _table(spec: Any, what: str, entry: str) -> Table | None:
+    """A table {t = [...], y = [...]} (or a Table), checked: equal lengths >= 2, finite,
+    t increasing."""
+    if spec is None or isinstance(spec, Table):
+        return spec
+    if not isinstance(spec, Mapping) or set(map(str, spec)) != {"t", "y"}:
+        raise ModelError(f"{what} must be a table {{ t = [t0, t1, ...], y = [y0, y1, ...] }}",
+                         entry)
+    cols = []
+    for key in ("t", "y"):
+        v = as_list(spec[key])
+        if not isinstance(v, Sequence) or isinstance(v, str):
+            raise ModelError(f"{what}.{key} must be a list of numbers", entry)
+        cols.append(tuple(_finite(x, f"{what}.{key}[{i}]", entry) for i, x in enumerate(v)))
+    t, y = cols
+    if len(t) != len(y) or not 2 <= len(t) <= MAX_TABLE:
+        raise ModelError(f"{what} needs t and y of one length, 2 to {MAX_TABLE} points (got "
+                         f"{len(t)} and {len(y)})", entry)
+    bad = next((i for i in range(1, len(t)) if not t[i] > t[i - 1]), None)
+    if bad is not None:
+        raise ModelError(f"{what}.t must increase: t[{bad}] = {t[bad]:g} is not above "
+                         f"t[{bad - 1}] = {t[bad - 1]:g}", entry)
+    return Table(t, y)
 
 
 def _steps(spec: Any, what: str, entry: str) -> tuple[Step, ...]:

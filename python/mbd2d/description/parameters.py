@@ -89,8 +89,9 @@ def _vec(key: str, raw0: int, field: str | None = None,
 
 
 def _function(key: str, f: TimeFunction, raw0: int) -> Iterator[tuple[str, str, tuple, int]]:
-    """A function of time: poly.k, harmonic.h.(amplitude | omega | phase) and
-    step.s.(t0 | t1 | h) (a step's law is not a number)."""
+    """A function of time: poly.k, harmonic.h.(amplitude | omega | phase),
+    step.s.(t0 | t1 | h) (a step's law is not a number) and table.y.k (the table's values;
+    its times are not parameters)."""
     for k in range(len(f.poly)):
         yield f"{key}.poly.{k}", key, ("poly", k), raw0 + 1 + k
     base = raw0 + len(f.poly) + 2
@@ -101,6 +102,11 @@ def _function(key: str, f: TimeFunction, raw0: int) -> Iterator[tuple[str, str, 
     for s in range(len(f.step)):
         for a, attr in enumerate(("t0", "t1", "h")):
             yield f"{key}.step.{s}.{attr}", key, ("step", s, attr), base + 4 * s + 1 + a
+    base += 4 * len(f.step) + 1                # (after nt and the times: the values)
+    if f.table is not None:
+        n = len(f.table.t)
+        for k in range(n):
+            yield f"{key}.table.y.{k}", key, ("table", "y", k), base + n + k
 
 
 def _profile(key: str, kind: str, prof: tuple[float, ...]) -> Iterator[tuple[str, str, tuple,

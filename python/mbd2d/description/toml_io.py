@@ -170,6 +170,8 @@ def _function_dict(f: Any) -> dict[str, Any]:
                            for h in f.harmonic]
     if f.step:
         out["step"] = [{"t0": st.t0, "t1": st.t1, "h": st.h, "law": st.law} for st in f.step]
+    if f.table is not None:
+        out["table"] = {"t": list(f.table.t), "y": list(f.table.y)}
     return out
 
 
