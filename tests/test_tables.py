@@ -206,3 +206,30 @@ def test_round_trip_and_the_standalone_program(tmp_path: Path) -> None:
     m.kinematics(1.2, 30, sensitivities=names).to_csv(py, sensitivities=True)
     assert out.read_text() == py.read_text()
     assert math.isfinite(float(out.read_text().splitlines()[-1].split(",")[-1]))
+
+
+def test_a_table_from_a_file(tmp_path: Path) -> None:
+    """table = { file = ... } next to the model (a header, comments, commas or spaces,
+    columns picked), the same model as the inline table; bad files name file and line."""
+    t, y = crank_table(25)
+    (tmp_path / "data").mkdir()
+    rows = "\n".join(f"{a:.17g}, 0.0, {b:.17g}" if i % 2 else f"{a:.17g} 0.0 {b:.17g}"
+                     for i, (a, b) in enumerate(zip(t, y)))
+    (tmp_path / "data" / "crank.csv").write_text("time, dummy, angle\n# measured\n" + rows + "\n")
+    text = (Path(__file__).resolve().parents[1] / "examples" / "slider_crank.toml").read_text()
+    text = text.replace("f = { poly = [0.0, 6.283185307179586] }",
+                        'f = { table = { file = "data/crank.csv", columns = [0, 2] } }')
+    assert "data/crank.csv" in text
+    (tmp_path / "m.toml").write_text(text)
+    m = mbd2d.load(tmp_path / "m.toml")
+    ref = slider_crank(25)
+    assert m.parameters() == ref.parameters()
+    np.testing.assert_array_equal(m.kinematics(1.2, 24).q, ref.kinematics(1.2, 24).q)
+    for body, needle in (("1 2 3\n3 x 4\n", "crank.csv:2: not a row of numbers"),
+                         ("1 2 3\n3 4\n", "crank.csv:2: 2 columns, column 2 asked")):
+        (tmp_path / "data" / "crank.csv").write_text(body)
+        with pytest.raises(mbd2d.ModelError, match=needle):
+            mbd2d.load(tmp_path / "m.toml")
+    (tmp_path / "m.toml").write_text(text.replace("data/crank.csv", "data/none.csv"))
+    with pytest.raises(mbd2d.ModelError, match="cannot read the table file"):
+        mbd2d.load(tmp_path / "m.toml")

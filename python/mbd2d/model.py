@@ -476,9 +476,10 @@ def load(path: str | Path) -> Model:
     return toml_io.load(path, cls=Model)
 
 
-def loads(text: str, source: str = "<string>") -> Model:
-    """Read a model from TOML text; see :func:`load`."""
-    return toml_io.loads(text, source=source, cls=Model)
+def loads(text: str, source: str = "<string>", base: str | Path | None = None) -> Model:
+    """Read a model from TOML text; see :func:`load` (``base``: the directory table files
+    are relative to, default the current one)."""
+    return toml_io.loads(text, source=source, cls=Model, base=base)
 
 
 def from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Model:

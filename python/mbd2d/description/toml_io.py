@@ -67,12 +67,15 @@ def load(path: str | Path, cls: type[M] = ModelDescription) -> M:  # type: ignor
     except UnicodeDecodeError as exc:
         raise ModelError(f"the model file is not UTF-8 text (byte {exc.start}); save it as "
                          "UTF-8", str(p)) from None
-    return loads(text, source=str(p), cls=cls)
+    return loads(text, source=str(p), cls=cls, base=p.parent)
 
 
 def loads(text: str, source: str = "<string>",
-          cls: type[M] = ModelDescription) -> M:  # type: ignore[assignment]
-    """Read a model from TOML text; see :func:`load`."""
+          cls: type[M] = ModelDescription,  # type: ignore[assignment]
+          base: str | Path | None = None) -> M:
+    """Read a model from TOML text; see :func:`load`. ``base``: the directory that table
+    files (``table = { file = "motion.csv" }``) are relative to (default: the current
+    one)."""
     if not isinstance(text, str):
         raise ModelError(f"the model text must be a str (decode bytes first), got "
                          f"{type(text).__name__}", source if isinstance(source, str) else "loads")
@@ -80,7 +83,59 @@ def loads(text: str, source: str = "<string>",
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ModelError(f"not valid TOML: {exc}", source) from None
+    _table_files(data, Path(base) if base is not None else Path.cwd())
     return from_dict(data, source, cls=cls)
+
+
+def _table_files(data: Any, base: Path) -> None:
+    """Replace each ``table = { file = ..., columns = [i, j] }`` of a driver's or force's
+    function by the file's columns (t, y)."""
+    for sec in ("driver", "force"):
+        entries = data.get(sec) if isinstance(data, dict) else None
+        for e in entries if isinstance(entries, list) else []:
+            for key in ("f", "fx", "fy"):
+                f = e.get(key) if isinstance(e, dict) else None
+                tab = f.get("table") if isinstance(f, dict) else None
+                if isinstance(tab, dict) and "file" in tab:
+                    f["table"] = read_table(tab, base, f"[[{sec}]]{_named(e)}")
+
+
+def read_table(spec: Mapping[str, Any], base: Path, entry: str) -> dict[str, list[float]]:
+    """The columns (t, y) of a text table: numbers separated by commas or spaces, one row
+    per line; blank lines, lines starting with '#' and a first line that is not numbers (a
+    header) are skipped. ``columns = [i, j]`` picks them (default [0, 1])."""
+    only_keys(spec, {"file", "columns"}, entry)
+    name, cols = spec["file"], spec.get("columns", [0, 1])
+    if not isinstance(name, str):
+        raise ModelError(f"table.file must be a file name, got {name!r}", entry)
+    if (not isinstance(cols, list) or len(cols) != 2
+            or not all(isinstance(c, int) and not isinstance(c, bool) and c >= 0 for c in cols)):
+        raise ModelError(f"table.columns must be two column numbers [i, j] from 0, got {cols!r}",
+                         entry)
+    path = base / name
+    try:
+        lines = path.read_text(encoding="utf-8").splitlines()
+    except (OSError, UnicodeDecodeError) as exc:
+        why = exc.strerror if isinstance(exc, OSError) else "not UTF-8 text"
+        raise ModelError(f"cannot read the table file {str(path)!r}: {why}", entry) from None
+    t, y = [], []
+    for k, line in enumerate(lines):
+        words = line.replace(",", " ").split()
+        if not words or words[0].startswith("#"):
+            continue
+        try:
+            row = [float(w) for w in words]
+        except ValueError:
+            if not t and k == next(i for i, ln in enumerate(lines) if ln.strip()):
+                continue                                  # a header
+            raise ModelError(f"{path}:{k + 1}: not a row of numbers: {line[:60]!r}",
+                             entry) from None
+        if len(row) <= max(cols):
+            raise ModelError(f"{path}:{k + 1}: {len(row)} columns, column {max(cols)} asked",
+                             entry)
+        t.append(row[cols[0]])
+        y.append(row[cols[1]])
+    return {"t": t, "y": y}
 
 
 def _entries(data: Mapping[str, Any], key: str, source: str) -> list[Mapping[str, Any]]:
