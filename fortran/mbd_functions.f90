@@ -369,11 +369,14 @@ contains
       f1 = f1 + a * w * c
       f2 = f2 - a * w * w * s
     end do
-    o = steps_at(p)
-    do k = 1, int(p(o) + half)
-      call step_eval(p(o + 4 * k - 3:o + 4 * k), t, f, f1, f2)
-    end do
-    o = table_at(p); k = int(p(o) + half)
+    o = np + 3 + 3 * nh                 ! ns (steps_at), then nt (table_at)
+    if (p(o) > half) then
+      do k = 1, int(p(o) + half)
+        call step_eval(p(o + 4 * k - 3:o + 4 * k), t, f, f1, f2)
+      end do
+      o = o + 4 * int(p(o) + half)
+    end if
+    o = o + 1; k = int(p(o) + half)
     if (k > 0) call table_eval(p(o + 1:o + k), p(o + k + 1:o + 2 * k), t, f, f1, f2)
   end subroutine fun_eval
 
