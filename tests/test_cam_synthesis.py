@@ -30,6 +30,16 @@ FOLLOWERS = [("roller", 0.01, 0.0), ("roller", 0.01, 0.01), ("roller", 0.0, 0.00
              ("flat", 0.0, 0.0)]
 
 
+def near_law_ends(theta: np.ndarray, program: dict) -> np.ndarray:
+    """The samples within 3.5 sample spacings of a step's t0 or t1 (around the turn)."""
+    near = np.zeros(len(theta), dtype=bool)
+    for st in program["step"]:
+        for tk in (st["t0"], st["t1"]):
+            gap = np.abs((theta - tk + math.pi) % (2 * math.pi) - math.pi)
+            near |= gap < 3.5 * 2 * math.pi / len(theta)
+    return near
+
+
 def program_exact(theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """s and ds/dtheta of PROGRAM from the laws' closed forms."""
     vals = np.array([[sum(step_closed_form(st, float(t))[k] for st in PROGRAM["step"])
@@ -115,11 +125,7 @@ def test_pressure_angle_from_the_cam_joints_reaction() -> None:
     # the spline's normal is exact to O(h^3) where the program is smooth and to O(h^2) next
     # to the laws' ends (a jump of the third or second derivative of s): measured 1e-7 and
     # 2.2e-6 rad at 360 points
-    near = np.zeros(n, dtype=bool)
-    for st in PROGRAM["step"]:
-        for tk in (st["t0"], st["t1"]):
-            gap = np.abs((d.theta - tk + math.pi) % (2 * math.pi) - math.pi)
-            near |= gap < 3.5 * 2 * math.pi / n
+    near = near_law_ends(d.theta, PROGRAM)
     np.testing.assert_allclose(angle[~near], d.pressure_angle[~near], rtol=0, atol=2e-7)
     np.testing.assert_allclose(angle, d.pressure_angle, rtol=0, atol=5e-6)
     assert math.degrees(d.max_pressure_angle) > 20
@@ -252,11 +258,7 @@ def test_arm_pressure_angle_from_the_reaction() -> None:
     fv = np.column_stack([f.fx_j[:-1], f.fy_j[:-1]])
     assert np.all(np.einsum("ij,ij->i", fv, jn) > 0)    # the cam pushes the roller out
     angle = np.arctan2(jn[:, 0] * fv[:, 1] - jn[:, 1] * fv[:, 0], np.einsum("ij,ij->i", jn, fv))
-    near = np.zeros(n, dtype=bool)
-    for st in SWING["step"]:
-        for tk in (st["t0"], st["t1"]):
-            gap = np.abs((d.theta - tk + math.pi) % (2 * math.pi) - math.pi)
-            near |= gap < 3.5 * 2 * math.pi / n
+    near = near_law_ends(d.theta, SWING)
     np.testing.assert_allclose(angle[~near], d.pressure_angle[~near], rtol=0, atol=2e-7)
     np.testing.assert_allclose(angle, d.pressure_angle, rtol=0, atol=5e-6)
 

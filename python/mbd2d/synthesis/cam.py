@@ -26,8 +26,6 @@ and Manufacturing Handbook, ch. 7 and 8).
 from __future__ import annotations
 
 import math
-import os
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Mapping
@@ -39,6 +37,7 @@ from ..description.functions import TimeFunction, as_function
 from ..errors import ModelError
 from ..model import Model
 from ..validate import number, only_keys, vector
+from .taskfile import read_toml
 
 ENTRY = "cam_profile"
 #: followers of cam_profile
@@ -385,15 +384,7 @@ def load_cam(path: str | Path) -> tuple[CamDesign, Model]:
     ModelError
         If the file cannot be read, a key is unknown or malformed, or the cam is undercut.
     """
-    if not isinstance(path, (str, os.PathLike)):
-        raise ModelError(f"the cam task file must be a path, got {path!r}", ENTRY)
-    p = Path(path)
-    try:
-        data = tomllib.loads(p.read_text(encoding="utf-8"))
-    except OSError as exc:
-        raise ModelError(f"cannot read the cam task file: {exc.strerror}", str(p)) from None
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise ModelError(f"not a valid TOML cam task file: {exc}", str(p)) from None
+    p, data = read_toml(path, "cam task file", ENTRY)
     only_keys(data, {"cam"}, str(p), required=["cam"])
     spec = data["cam"]
     if not isinstance(spec, Mapping):

@@ -61,16 +61,22 @@ def load_task(path: str | Path) -> TaskFile:
         If the file or its model cannot be read, or a key is unknown or malformed (the
         message names it).
     """
+    p, data = read_toml(path, "task file", "synthesize")
+    return task_from_dict(data, p.parent, str(p))
+
+
+def read_toml(path: Any, what: str, entry: str) -> tuple[Path, dict[str, Any]]:
+    """A TOML file's path and contents; a ModelError naming ``what`` (e.g. "task file") when
+    it cannot be read or parsed."""
     if not isinstance(path, (str, os.PathLike)):
-        raise ModelError(f"the task file must be a path, got {path!r}", "synthesize")
+        raise ModelError(f"the {what} must be a path, got {path!r}", entry)
     p = Path(path)
     try:
-        data = tomllib.loads(p.read_text(encoding="utf-8"))
+        return p, tomllib.loads(p.read_text(encoding="utf-8"))
     except OSError as exc:
-        raise ModelError(f"cannot read the task file: {exc.strerror}", str(p)) from None
+        raise ModelError(f"cannot read the {what}: {exc.strerror}", str(p)) from None
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise ModelError(f"not a valid TOML task file: {exc}", str(p)) from None
-    return task_from_dict(data, p.parent, str(p))
+        raise ModelError(f"not a valid TOML {what}: {exc}", str(p)) from None
 
 
 def task_from_dict(data: Mapping[str, Any], base: Path, source: str) -> TaskFile:
