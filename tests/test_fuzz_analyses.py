@@ -369,7 +369,8 @@ def _chain(n: int) -> dict[str, Any]:
 #: every analysis of a 200-link chain 29 s. A limit of the core rather than a hang, so bodies
 #: and chains stay at a few hundred here.
 ABSURD_SIZES = {"spline": (1000, 5000), "fourier": (1000, 3000), "poly": (1000, 10000),
-                "harmonics": (1000, 5000), "steps": (300, 2000), "chain": (30, 100), "name": (1000, 100000),
+                "harmonics": (1000, 5000), "steps": (300, 2000), "chain": (30, 100),
+                "name": (1000, 100000),
                 "q0": (1000, 10**6), "bodies": (100, 200)}
 
 

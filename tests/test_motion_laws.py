@@ -64,7 +64,8 @@ type = "absolute"
 name = "motor"
 body = "crank"
 coordinate = "theta"
-f = {{ poly = [0.2], step = [{{ t0 = {step['t0']}, t1 = {step['t1']}, h = {step['h']}, law = "{step['law']}" }}] }}
+f = {{ poly = [0.2], step = [{{ t0 = {step['t0']}, t1 = {step['t1']}, h = {step['h']},
+                           law = "{step['law']}" }}] }}
 """)
 
 

@@ -28,7 +28,8 @@ from .synthesis import CamDesign, SynthesisResult, cam_profile, synthesize
 __version__ = "0.1.0"
 
 __all__ = ["load", "loads", "Model", "TimeFunction", "Harmonic", "Step", "Table",
-           "KinematicsResult", "BodyResult", "PointResult", "DynamicsResult", "KinematicStepper", "StaticsResult",
+           "KinematicsResult", "BodyResult", "PointResult", "DynamicsResult", "KinematicStepper",
+           "StaticsResult",
            "Reaction",
            "DofReport", "MbdError", "ModelError", "AnalysisError", "IntegrationError",
            "AssemblyError", "InconsistentConstraintsError", "ConvergenceError",
