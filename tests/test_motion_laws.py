@@ -24,6 +24,12 @@ R, L, E = 0.5, 2.0, 0.3        # crank, rod, offset of the slider's line
 LAWS = ["cubic", "quintic", "cycloidal", "harmonic"]
 
 
+def law_step(step: dict) -> str:
+    """A step as a TOML inline table."""
+    return (f"{{ t0 = {step['t0']}, t1 = {step['t1']}, h = {step['h']}, "
+            f"law = \"{step['law']}\" }}")
+
+
 def slider_crank(step: dict) -> mbd2d.Model:
     """Crank angle theta(t) = 0.2 + a step (the law's rise)."""
     return mbd2d.loads(f"""
@@ -64,8 +70,7 @@ type = "absolute"
 name = "motor"
 body = "crank"
 coordinate = "theta"
-f = {{ poly = [0.2], step = [{{ t0 = {step['t0']}, t1 = {step['t1']}, h = {step['h']},
-                           law = "{step['law']}" }}] }}
+f = {{ poly = [0.2], step = [{law_step(step)}] }}
 """)
 
 
