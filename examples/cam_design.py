@@ -10,12 +10,15 @@ Usage::
     python examples/cam_design.py [--out DIR]
 
 Writes cam_design_mechanism.png (snapshots with the roller's path), cam_design_program.png
-(lift, pressure angle and radius of curvature over the turn) and cam_design.gif to DIR
-(default examples/output/). Exit code 0 when the follower keeps the program to 1e-9 m.
+(lift, pressure angle and radius of curvature over the turn), cam_design_base_radius.png (the
+largest pressure angle and the smallest radius of curvature against the base radius: the
+design chart) and cam_design.gif to DIR (default examples/output/). Exit code 0 when the
+follower keeps the program to 1e-9 m.
 """
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 from pathlib import Path
 
@@ -59,6 +62,39 @@ def program_figure(d: CamDesign, res: mbd2d.KinematicsResult, path: Path) -> Non
     plt.close(fig)
 
 
+def base_radius_figure(design: CamDesign, path: Path) -> float:
+    """The classic design chart: the largest pressure angle and the smallest radius of
+    curvature against the base radius (the same program, follower and offset); returns the
+    smallest base radius that keeps the pressure angle within 30 degrees."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    radii = np.linspace(0.02, 0.1, 33)
+    designs = [mbd2d.cam_profile(design.program, rb, roller_radius=design.roller_radius,
+                                 offset=design.offset, points=360) for rb in radii]
+    phi = np.degrees([d.max_pressure_angle for d in designs])
+    rho = np.array([d.min_curvature_radius for d in designs])
+    ok = radii[phi <= 30.0]
+    smallest = float(ok.min()) if ok.size else math.nan
+    fig, a1 = plt.subplots(figsize=(8, 4.5))
+    a1.plot(1e3 * radii, phi, "o-", ms=3, label="largest pressure angle")
+    a1.axhline(30, color="r", lw=0.8, ls=":")
+    a1.axvline(1e3 * design.base_radius, color="k", lw=0.8, ls="--",
+               label=f"this design ({1e3 * design.base_radius:g} mm)")
+    a1.set_xlabel("base radius [mm]")
+    a1.set_ylabel("largest pressure angle [deg]")
+    a2 = a1.twinx()
+    a2.plot(1e3 * radii, 1e3 * rho, "s-", ms=3, color="tab:green",
+            label="smallest radius of curvature")
+    a2.set_ylabel("smallest radius of curvature [mm]", color="tab:green")
+    a1.legend(loc="upper center")
+    a1.set_title(f"pressure angle within 30 deg from a {1e3 * smallest:.1f} mm base radius")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return smallest
+
+
 def run(out: Path) -> tuple[str, mbd2d.KinematicsResult, list[str]]:
     """Synthesize, run one turn, draw; (problem or "", the run, the files written)."""
     design, model = load_cam(TASK)
@@ -79,6 +115,10 @@ def run(out: Path) -> tuple[str, mbd2d.KinematicsResult, list[str]]:
     files.append(str(out / "cam_design_mechanism.png"))
     program_figure(design, res, out / "cam_design_program.png")
     files.append(str(out / "cam_design_program.png"))
+    smallest = base_radius_figure(design, out / "cam_design_base_radius.png")
+    files.append(str(out / "cam_design_base_radius.png"))
+    print(f"the pressure angle stays within 30 deg from a base radius of {1e3 * smallest:.1f} "
+          f"mm (this design: {1e3 * design.base_radius:g} mm)")
     files.append(str(model.kinematics(1.0, 90).animate(out / "cam_design.gif", fps=30,
                                                          speed=1.0)))
     problem = "" if err < LIFT_TOL and not design.undercut else \

@@ -123,7 +123,7 @@ def test_demo_script(tmp_path: Path) -> None:
                           cwd=tmp_path, capture_output=True, text=True, timeout=600)
     assert proc.returncode == 0, proc.stdout + proc.stderr
     pngs = sorted(out.glob("*.png"))
-    assert len(pngs) == 15, [p.name for p in pngs]
+    assert len(pngs) == 16, [p.name for p in pngs]
     for name in ["fourbar_seed", "fourbar_grashof", "slider_crank", "cam_follower"]:
         for kind in ["mechanism", "timeseries"]:
             p = out / f"{name}_{kind}.png"
@@ -136,7 +136,7 @@ def test_demo_script(tmp_path: Path) -> None:
         assert (out / f"design_study_{kind}.png").stat().st_size > 0
     assert "hit a dead centre" in proc.stdout
     assert "summary: 8/8" in proc.stdout and "GIF animations" in proc.stdout
-    for kind in ["mechanism", "program"]:                      # the synthesized cam
+    for kind in ["mechanism", "program", "base_radius"]:       # the synthesized cam
         assert (out / f"cam_design_{kind}.png").stat().st_size > 0
     # the design study's sweep and a sensitivity run through mbd2d-solve, as Python writes them
     assert "the same file byte for byte (rows, numbers, statuses and messages): True" in \
