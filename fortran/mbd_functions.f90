@@ -6,8 +6,13 @@
 !!   2 quintic    L = 10u**3 - 15u**4 + 6u**5        (the 3-4-5 polynomial, Adams' STEP5)
 !!   3 cycloidal  L = u - sin(2 pi u)/(2 pi)
 !!   4 harmonic   L = (1 - cos(pi u))/2
-!! (Norton, Cam Design and Manufacturing Handbook, ch. 3; quintic and cycloidal have L'' = 0 at
-!! both ends, cubic and harmonic jump in acceleration there).
+!!   5 modified sine        L'' = C sin(4 pi u) on [0, 1/8], C cos(4 pi/3 (u - 1/8)) on
+!!                          [1/8, 7/8], -C sin(4 pi (1 - u)) on [7/8, 1]; C = 4 pi**2/(pi + 4)
+!!   6 modified trapezoid   L'' = C sin(4 pi u), C, C cos(4 pi (u - 3/8)), -C,
+!!                          -C sin(4 pi (1 - u)) on the eighths 0-1-3-5-7-8; C = 8 pi/(2 + pi)
+!! (Norton, Cam Design and Manufacturing Handbook, ch. 3; quintic, cycloidal and the modified
+!! laws have L'' = 0 at both ends, cubic and harmonic jump in acceleration there; the
+!! modified laws' L and L' are their accelerations integrated twice in closed form).
 !!
 !! A table adds y(t) through points (t_k, y_k) (measured motion, a force history): on each
 !! interval the quintic Hermite with values y_k and derivatives d_k, c_k at the points, those
@@ -35,7 +40,7 @@ module mbd_functions
   real(wp), parameter :: TMAX = 1.0e12_wp    !! largest step time
   real(wp), parameter :: TREL = 1.0e-9_wp    !! shortest step: TREL max(1, |t0|, |t1|)
   real(wp), parameter :: PI = 3.14159265358979323846_wp
-  integer, parameter :: NLAW = 4             !! motion laws (codes 1 .. NLAW)
+  integer, parameter :: NLAW = 6             !! motion laws (codes 1 .. NLAW)
 
 contains
 
@@ -122,7 +127,7 @@ contains
           abs(p(o + 4 * k - 3) - anint(p(o + 4 * k - 3))) > 1.0e-9_wp) then
         status = MBD_BAD_PARAM
         write (msg, '(a,i0,a)') 'function of time: step ', k - 1, ' has an unknown law '// &
-          '(1 cubic, 2 quintic, 3 cycloidal, 4 harmonic)'
+          '(1 cubic, 2 quintic, 3 cycloidal, 4 harmonic, 5 modified sine, 6 modified trapezoid)'
       else if (max(abs(t0), abs(t1)) > TMAX) then
         status = MBD_BAD_PARAM
         write (msg, '(a,i0,a,es8.1)') 'function of time: step ', k - 1, &
@@ -313,11 +318,61 @@ contains
     case (3)                        ! u - sin(2 pi u)/(2 pi)
       s = sin(2 * PI * u); c = cos(2 * PI * u)
       l0 = u - s / (2 * PI); l1 = 1 - c; l2 = 2 * PI * s; l3 = 4 * PI * PI * c
-    case default                    ! (1 - cos(pi u))/2
+    case (4)                        ! (1 - cos(pi u))/2
       s = sin(PI * u); c = cos(PI * u)
       l0 = half * (1 - c); l1 = half * PI * s; l2 = half * PI * PI * c; l3 = -half * PI**3 * s
+    case (5)
+      call modified_sine(u, l0, l1, l2, l3)
+    case default
+      call modified_trapezoid(u, l0, l1, l2, l3)
     end select
   end subroutine law_eval
+
+  !> The modified sine law (module header) and its derivatives, K = pi + 4:
+  !!   ends   L = (pi u - sin(4 pi u)/4 [+ 4 on the last eighth])/K, L' = pi (1 - cos 4 pi u)/K
+  !!   middle L = (pi u - 9/4 sin w + 2)/K, L' = pi (1 - 3 cos w)/K, w = pi (4u/3 + 1/3).
+  pure subroutine modified_sine(u, l0, l1, l2, l3)
+    real(wp), intent(in) :: u
+    real(wp), intent(out) :: l0, l1, l2, l3
+    real(wp) :: k, s, c, w
+    k = PI + 4
+    if (u < 0.125_wp .or. u >= 0.875_wp) then
+      s = sin(4 * PI * u); c = cos(4 * PI * u)
+      l0 = (PI * u - 0.25_wp * s + merge(4.0_wp, zero, u >= 0.875_wp)) / k
+      l1 = PI * (1 - c) / k; l2 = 4 * PI**2 * s / k; l3 = 16 * PI**3 * c / k
+    else
+      w = PI * (4 * u + 1) / 3
+      s = sin(w); c = cos(w)
+      l0 = (PI * u - 2.25_wp * s + 2) / k; l1 = PI * (1 - 3 * c) / k
+      l2 = 4 * PI**2 * s / k; l3 = 16 * PI**3 * c / (3 * k)
+    end if
+  end subroutine modified_sine
+
+  !> The modified trapezoid law (module header) and its derivatives, K = 2 + pi, on the
+  !! eighths [0, 1], [1, 3], [3, 5], [5, 7], [7, 8] (the accelerations integrated twice).
+  pure subroutine modified_trapezoid(u, l0, l1, l2, l3)
+    real(wp), intent(in) :: u
+    real(wp), intent(out) :: l0, l1, l2, l3
+    real(wp) :: k, s, c
+    k = 2 + PI
+    s = sin(4 * PI * u); c = cos(4 * PI * u)
+    if (u < 0.125_wp) then
+      l0 = (4 * PI * u - s) / (2 * PI * k); l1 = 2 * (1 - c) / k
+      l2 = 8 * PI * s / k; l3 = 32 * PI**2 * c / k
+    else if (u < 0.375_wp) then
+      l0 = (16 * PI * u * (4 * PI * u - PI + 2) - 8 + PI**2) / (16 * PI * k)
+      l1 = (8 * PI * u - PI + 2) / k; l2 = 8 * PI / k; l3 = zero
+    else if (u < 0.625_wp) then
+      l0 = (4 * PI * u + 4 * PI**2 * u + s - PI**2) / (2 * PI * k)
+      l1 = 2 * (c + 1 + PI) / k; l2 = -8 * PI * s / k; l3 = -32 * PI**2 * c / k
+    else if (u < 0.875_wp) then
+      l0 = (16 * PI * u * (-4 * PI * u + 2 + 7 * PI) - 33 * PI**2 + 8) / (16 * PI * k)
+      l1 = (-8 * PI * u + 2 + 7 * PI) / k; l2 = -8 * PI / k; l3 = zero
+    else
+      l0 = (2 * PI * u - half * s + PI**2) / (PI * k); l1 = 2 * (1 - c) / k
+      l2 = 8 * PI * s / k; l3 = 32 * PI**2 * c / k
+    end if
+  end subroutine modified_trapezoid
 
   !> Length exponents of an encoded function (see mbd_model, nondimensional models): e on
   !! the coefficients c_k and the amplitudes A_h (f is scaled as a whole), 0 on the counts,

@@ -35,7 +35,9 @@ F_RICH = {"poly": [0.3, -0.7, 0.25, 0.05],
           "step": [{"t0": 0.1, "t1": 1.9, "h": 0.35, "law": "quintic"},
                    {"t0": -0.5, "t1": 2.5, "h": -0.2},
                    {"t0": 0.05, "t1": 2.0, "h": 0.1, "law": "harmonic"},
-                   {"t0": -1.0, "t1": 0.2, "h": 0.5, "law": "cubic"}],
+                   {"t0": -1.0, "t1": 0.2, "h": 0.5, "law": "cubic"},
+                   {"t0": -0.1, "t1": 2.1, "h": 0.15, "law": "modified-sine"},
+                   {"t0": 0.2, "t1": 1.8, "h": -0.25, "law": "modified-trapezoid"}],
           # a table of uneven points around the states' times (twice differentiable inside)
           "table": {"t": [-1.0, -0.2, 0.25, 0.6, 0.8, 1.15, 1.5, 2.2, 3.0],
                     "y": [0.1, -0.3, 0.2, 0.45, 0.1, -0.2, 0.05, 0.3, 0.0]}}
@@ -464,10 +466,54 @@ def step_closed_form(st: dict, t: float) -> tuple[float, float, float]:
     elif law == "cycloidal":
         w = 2 * np.pi
         y, y1, y2 = u - np.sin(w * u) / w, 1 - np.cos(w * u), w * np.sin(w * u)
-    else:
+    elif law == "harmonic":
         y, y1, y2 = ((1 - np.cos(np.pi * u)) / 2, np.pi / 2 * np.sin(np.pi * u),
                      np.pi**2 / 2 * np.cos(np.pi * u))
+    else:
+        y, y1, y2 = modified_law(law, u)
     return h * y, h * y1 / T, h * y2 / T**2
+
+
+def _accel_shape(law: str, u: float) -> float:
+    """The modified laws' acceleration for C = 1 (Norton, ch. 3): sine quarter-waves on the
+    first and last eighths, a sine half-wave over the middle three quarters (modified sine),
+    or constants on the second and fourth quarter-pairs with a cosine half-wave between
+    (modified trapezoid)."""
+    if u < 1 / 8:
+        return np.sin(4 * np.pi * u)
+    if u >= 7 / 8:
+        return -np.sin(4 * np.pi * (1 - u))
+    if law == "modified-sine":
+        return np.cos(4 * np.pi / 3 * (u - 1 / 8))
+    if u < 3 / 8:
+        return 1.0
+    if u < 5 / 8:
+        return np.cos(4 * np.pi * (u - 3 / 8))
+    return -1.0
+
+
+def modified_law(law: str, u: float) -> tuple[float, float, float]:
+    """L, L', L'' of a modified law by quadrature of its acceleration (40-point
+    Gauss-Legendre on each smooth segment, exact to round-off for these analytic pieces):
+    L'(u) = int_0^u a, L(u) = int_0^u (u - r) a(r) dr, the scale C from L(1) = 1
+    (independent of the core's closed forms)."""
+    nodes, weights = np.polynomial.legendre.leggauss(40)
+    edges = [0.0, 1 / 8, 3 / 8, 5 / 8, 7 / 8, 1.0]
+
+    def integrals(x: float) -> tuple[float, float]:
+        p = v = 0.0
+        for a, b in zip(edges[:-1], edges[1:]):
+            b = min(b, x)
+            if b > a:
+                r = a + (b - a) * (nodes + 1) / 2
+                acc = np.array([_accel_shape(law, rk) for rk in r])
+                v += (b - a) / 2 * float(weights @ acc)
+                p += (b - a) / 2 * float(weights @ ((x - r) * acc))
+        return p, v
+
+    c = 1.0 / integrals(1.0)[0]
+    p, v = integrals(u)
+    return c * p, c * v, c * _accel_shape(law, u)
 
 
 def table_at_point(tab: dict, t: float) -> tuple[float, float, float]:

@@ -107,7 +107,8 @@ def header() -> str:
     lines += [
         "#        f(t) = np c0 .. c_{np-1} nh (A omega phase) x nh ns (law t0 t1 h) x ns",
         "#               nt t_1 .. t_nt y_1 .. y_nt",
-        "#        (law: 1 cubic, 2 quintic, 3 cycloidal, 4 harmonic)",
+        "#        (law: 1 cubic, 2 quintic, 3 cycloidal, 4 harmonic, 5 modified sine,",
+        "#        6 modified trapezoid)",
         "#   labels NEQ, then NEQ words   NAME.WORD of each row of Phi (multiplier columns)",
         "#   forces NF, then NF lines     NAME KIND BODY_I BODY_J OFFSET LENGTH [JOINT]",
         "#        KIND (forces): " + ", ".join(f"{k} {t}" for k, t, _ in FORCE_KINDS),

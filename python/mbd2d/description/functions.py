@@ -26,7 +26,8 @@ class Harmonic:
 
 
 #: the motion laws of a step and their codes in the core (fortran/mbd_functions.f90)
-LAWS = {"cubic": 1, "quintic": 2, "cycloidal": 3, "harmonic": 4}
+LAWS = {"cubic": 1, "quintic": 2, "cycloidal": 3, "harmonic": 4, "modified-sine": 5,
+        "modified-trapezoid": 6}
 
 
 @dataclass(frozen=True)
@@ -41,8 +42,10 @@ class Step:
         The rise (negative: a fall).
     law : str
         ``"cycloidal"`` (default; zero acceleration at both ends), ``"quintic"`` (the 3-4-5
-        polynomial, Adams' STEP5), ``"cubic"`` (Adams' STEP) or ``"harmonic"`` (simple
-        harmonic); cubic and harmonic jump in acceleration at t0 and t1.
+        polynomial, Adams' STEP5), ``"cubic"`` (Adams' STEP), ``"harmonic"`` (simple
+        harmonic), ``"modified-sine"`` or ``"modified-trapezoid"`` (the cam and indexer
+        laws: peak accelerations 5.53 and 4.89 h/T^2 against the cycloidal's 6.28); cubic
+        and harmonic jump in acceleration at t0 and t1.
     """
 
     t0: float
