@@ -224,6 +224,8 @@ def test_a_table_from_a_file(tmp_path: Path) -> None:
     m = mbd2d.load(tmp_path / "m.toml")
     ref = slider_crank(25)
     assert m.parameters() == ref.parameters()
+    assert mbd2d.Table.from_file(tmp_path / "data" / "crank.csv", columns=(0, 2)) == \
+        ref.drivers[0].f.table
     np.testing.assert_array_equal(m.kinematics(1.2, 24).q, ref.kinematics(1.2, 24).q)
     for body, needle in (("1 2 3\n3 x 4\n", "crank.csv:2: not a row of numbers"),
                          ("1 2 3\n3 4\n", "crank.csv:2: 2 columns, column 2 asked")):

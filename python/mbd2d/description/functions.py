@@ -10,6 +10,7 @@ The core evaluates them; this module only checks and encodes the description.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any, Mapping, Sequence
 
 from ..errors import ModelError
@@ -65,6 +66,21 @@ class Table:
 
     t: tuple[float, ...]
     y: tuple[float, ...]
+
+    @classmethod
+    def from_file(cls, path: str | Path, columns: Sequence[int] = (0, 1)) -> "Table":
+        """The columns (t, y) of a text file (see :func:`table_columns`), checked.
+
+        Raises
+        ------
+        ModelError
+            If the file cannot be read or a row is not numbers, or the columns do not make a
+            table (at least 2 points, t increasing).
+        """
+        t, y = table_columns(Path(path), list(columns), "Table.from_file")
+        tab = _table({"t": t, "y": y}, "table", "Table.from_file")
+        assert tab is not None
+        return tab
 
 
 @dataclass(frozen=True)
@@ -232,3 +248,37 @@ def _step(s: Any, what: str, entry: str) -> Step:
         raise ModelError(f"{what} needs t1 > t0 (got t0 = {t0:g}, t1 = {t1:g}): the rise "
                          "takes time", entry)
     return Step(t0, t1, _finite(s["h"], f"{what}.h", entry), str(law))
+
+
+def table_columns(path: Path, cols: Any, entry: str) -> tuple[list[float], list[float]]:
+    """Two columns of a text table: numbers separated by commas or spaces, one row per line;
+    blank lines, lines starting with '#' and a first line that is not numbers (a header) are
+    skipped. ``cols = [i, j]`` picks them (column numbers from 0)."""
+    if (not isinstance(cols, list) or len(cols) != 2
+            or not all(isinstance(c, int) and not isinstance(c, bool) and c >= 0 for c in cols)):
+        raise ModelError(f"table.columns must be two column numbers [i, j] from 0, got {cols!r}",
+                         entry)
+    try:
+        lines = path.read_text(encoding="utf-8").splitlines()
+    except (OSError, UnicodeDecodeError) as exc:
+        why = exc.strerror if isinstance(exc, OSError) else "not UTF-8 text"
+        raise ModelError(f"cannot read the table file {str(path)!r}: {why}", entry) from None
+    first = next((i for i, ln in enumerate(lines) if ln.strip()), -1)
+    t, y = [], []
+    for k, line in enumerate(lines):
+        words = line.replace(",", " ").split()
+        if not words or words[0].startswith("#"):
+            continue
+        try:
+            row = [float(w) for w in words]
+        except ValueError:
+            if k == first:
+                continue                                  # a header
+            raise ModelError(f"{path}:{k + 1}: not a row of numbers: {line[:60]!r}",
+                             entry) from None
+        if len(row) <= max(cols):
+            raise ModelError(f"{path}:{k + 1}: {len(row)} columns, column {max(cols)} asked",
+                             entry)
+        t.append(row[cols[0]])
+        y.append(row[cols[1]])
+    return t, y

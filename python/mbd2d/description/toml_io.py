@@ -25,6 +25,7 @@ from ..validate import only_keys, table
 from .builder import ModelDescription
 from .contacts import CONTACT_KEYS
 from .entries import reading
+from .functions import table_columns
 
 M = TypeVar("M", bound=ModelDescription)
 
@@ -101,40 +102,13 @@ def _table_files(data: Any, base: Path) -> None:
 
 
 def read_table(spec: Mapping[str, Any], base: Path, entry: str) -> dict[str, list[float]]:
-    """The columns (t, y) of a text table: numbers separated by commas or spaces, one row
-    per line; blank lines, lines starting with '#' and a first line that is not numbers (a
-    header) are skipped. ``columns = [i, j]`` picks them (default [0, 1])."""
+    """A TOML table ``{ file = ..., columns = [i, j] }``: the file's columns (t, y) (see
+    :func:`mbd2d.description.functions.table_columns`)."""
     only_keys(spec, {"file", "columns"}, entry)
     name, cols = spec["file"], spec.get("columns", [0, 1])
     if not isinstance(name, str):
         raise ModelError(f"table.file must be a file name, got {name!r}", entry)
-    if (not isinstance(cols, list) or len(cols) != 2
-            or not all(isinstance(c, int) and not isinstance(c, bool) and c >= 0 for c in cols)):
-        raise ModelError(f"table.columns must be two column numbers [i, j] from 0, got {cols!r}",
-                         entry)
-    path = base / name
-    try:
-        lines = path.read_text(encoding="utf-8").splitlines()
-    except (OSError, UnicodeDecodeError) as exc:
-        why = exc.strerror if isinstance(exc, OSError) else "not UTF-8 text"
-        raise ModelError(f"cannot read the table file {str(path)!r}: {why}", entry) from None
-    t, y = [], []
-    for k, line in enumerate(lines):
-        words = line.replace(",", " ").split()
-        if not words or words[0].startswith("#"):
-            continue
-        try:
-            row = [float(w) for w in words]
-        except ValueError:
-            if not t and k == next(i for i, ln in enumerate(lines) if ln.strip()):
-                continue                                  # a header
-            raise ModelError(f"{path}:{k + 1}: not a row of numbers: {line[:60]!r}",
-                             entry) from None
-        if len(row) <= max(cols):
-            raise ModelError(f"{path}:{k + 1}: {len(row)} columns, column {max(cols)} asked",
-                             entry)
-        t.append(row[cols[0]])
-        y.append(row[cols[1]])
+    t, y = table_columns(base / name, cols, entry)
     return {"t": t, "y": y}
 
 
