@@ -1,5 +1,5 @@
 """Seeded random combinations of analysis, settings, output columns, design sensitivities and
-measures through both paths: whatever `Model.export` accepts, mbd2d-solve writes the CSV the
+measures (and drivers with a motion law and a table) through both paths: whatever `Model.export` accepts, mbd2d-solve writes the CSV the
 Python result writes (text for text) and ends with the exit code of the Python run (0, or 3
 at a dead centre with the rows up to there). ``MBD2D_RANDOM_FILES`` sets the number of
 combinations (default 200; an export the model refuses is not counted as a failure).
@@ -30,6 +30,27 @@ MEASURES = ["transmission_angle:B", "dead_centre_distance", "velocity_ratio:moto
 OUTPUTS = ["energy", "multipliers", "reactions", "efforts"]
 
 
+#: a driver's function dressed with a step and a table (drawn after the case, so the cases
+#: of the seeds stay as they were), and the design parameters that then exist
+STEP = {"t0": 0.1, "t1": 0.25, "h": 0.2, "law": "modified-sine"}
+TABLE = {"t": [0.0, 0.2, 0.35, 0.5, 0.8, 1.0], "y": [0.0, 0.05, -0.02, 0.04, 0.0, 0.01]}
+DRESSED = ["driver.motor.f.step.0.t1", "driver.motor.f.step.0.h", "driver.motor.f.table.y.2"]
+
+
+def _dress(model: mbd2d.Model, rng: random.Random, kw: dict) -> None:
+    """Add a step and a table to the model's motor driver (when it has one) at random,
+    sometimes with their parameters among the sensitivities."""
+    motor = next((d for d in model.drivers if d.name == "motor"), None)
+    if motor is None or rng.random() < 0.6:
+        return
+    f = motor.f
+    motor.f = mbd2d.TimeFunction(poly=f.poly, harmonic=f.harmonic,
+                                 step=(mbd2d.Step(**STEP),),
+                                 table=mbd2d.Table(tuple(TABLE["t"]), tuple(TABLE["y"])))
+    if "sensitivities" in kw and rng.random() < 0.5:
+        kw["sensitivities"] = kw["sensitivities"][:1] + [rng.choice(DRESSED)]
+
+
 def _case(rng: random.Random) -> tuple[str, dict]:
     kw: dict = {"analysis": rng.choice(["kinematics", "inverse-dynamics", "dynamics",
                                         "statics"])}
@@ -50,8 +71,10 @@ def _case(rng: random.Random) -> tuple[str, dict]:
 
 @pytest.mark.parametrize("seed", range(N))
 def test_random_files_give_the_python_csv(tmp_path: Path, seed: int) -> None:
-    name, kw = _case(random.Random(seed))
+    rng = random.Random(seed)
+    name, kw = _case(rng)
     model = mbd2d.load(EX / f"{name}.toml")
+    _dress(model, rng, kw)
     mbd = tmp_path / "f.mbd"
     try:
         model.export(mbd, **kw)
