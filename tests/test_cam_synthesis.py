@@ -295,3 +295,9 @@ def test_cam_command_with_an_arm(tmp_path: Path) -> None:
     th = res.body("follower").theta
     assert np.abs(th - th[0] - swing_exact(2 * math.pi * res.t)).max() < 1e-10
     assert "arm_pivot" in out.read_text()
+
+
+@pytest.mark.parametrize("speed", [0.0, -1.0, float("nan")])
+def test_the_model_turns_counterclockwise(speed: float) -> None:
+    with pytest.raises(mbd2d.ModelError, match="speed"):
+        mbd2d.cam_profile(PROGRAM, 0.05, roller_radius=0.01).model(speed=speed)

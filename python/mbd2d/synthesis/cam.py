@@ -131,6 +131,10 @@ class CamDesign:
             If the cam is undercut (its surface has a cusp) or an argument is bad.
         """
         speed = number(speed, "speed", ENTRY)
+        if not speed > 0.0:
+            raise ModelError(f"speed must be positive (the profile is made for a cam turning "
+                             f"counterclockwise), got {speed:g}; for a clockwise cam, "
+                             "mirror the model", ENTRY)
         if self.undercut:
             bad = np.flatnonzero(self.convex & (self.curvature_radius <= 0.0))
             raise ModelError(f"the cam is undercut (its surface has a cusp near theta = "
