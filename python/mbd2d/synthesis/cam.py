@@ -21,7 +21,9 @@ and the surface's radius of curvature rho - Rr; where 0 < rho < Rr the roller ca
 the pitch curve (undercut: the surface has a cusp). Flat-faced follower (its face normal to
 the axis): C = R(-theta) (s', base_radius + s), radius of curvature base_radius + s + s''
 (> 0, else a cusp), pressure angle 0, contact at x = s' along the face (Norton, Cam Design
-and Manufacturing Handbook, ch. 7 and 8).
+and Manufacturing Handbook, ch. 7 and 8). Oscillating followers (``arm``): a roller at the end
+of an arm, or a flat face on it, turning about a ground pivot by the program's angle (see
+_arm and _arm_flat).
 """
 from __future__ import annotations
 
@@ -69,7 +71,8 @@ class CamDesign:
     undercut : bool
         True when the surface has a cusp somewhere (the follower cannot keep the program).
     face : tuple of float
-        Flat-faced follower: the contact's extent (min s', max s') along the face.
+        Flat-faced follower: the contact's extent along the face (min s', max s' from the
+        axis; on an arm, the distance from the pivot's foot on the face).
     """
 
     program: TimeFunction
@@ -87,10 +90,12 @@ class CamDesign:
     convex: np.ndarray
     undercut: bool
     face: tuple[float, float]
-    #: an oscillating follower: its arm's ground pivot, length and angle at psi = 0
+    #: an oscillating follower: its arm's ground pivot, length (roller), angle at psi = 0
+    #: and the face's offset from the pivot (flat face)
     pivot: tuple[float, float] | None = None
     arm_length: float = 0.0
     arm_angle0: float = 0.0
+    face_offset: float = 0.0
 
     @property
     def max_pressure_angle(self) -> float:
@@ -112,7 +117,7 @@ class CamDesign:
         """The cam joint's ``follower`` on the follower body (its origin on the axis; an
         arm's origin at its pivot, the roller at (length, 0))."""
         if self.follower == "flat":
-            return {"flat": {"point": [0.0, 0.0], "normal": [0.0, -1.0]}}
+            return {"flat": {"point": [0.0, self.face_offset], "normal": [0.0, -1.0]}}
         at = [self.arm_length, 0.0] if self.pivot is not None else [0.0, 0.0]
         if self.roller_radius == 0.0:
             return {"point": at}
@@ -197,9 +202,10 @@ def cam_profile(program: Any, base_radius: float, follower: str = "roller",
         Samples of the surface over the turn (the spline's points), at least 16.
     arm : mapping, optional
         ``{"pivot": [x, y], "length": L}``: the roller (or knife edge) sits at the end of an
-        arm pivoted in the ground at ``pivot``; the program is then the arm's angle psi(theta)
-        [rad], counterclockwise positive, a positive psi lifting the roller away from the
-        cam's centre.
+        arm pivoted in the ground at ``pivot``; with ``follower="flat"``, ``{"pivot": [x, y],
+        "offset": e}``: the arm carries a flat face at the distance e from the pivot. The
+        program is then the arm's angle psi(theta) [rad], counterclockwise positive, a
+        positive psi lifting the follower away from the cam's centre.
 
     Returns
     -------
@@ -221,9 +227,9 @@ def cam_profile(program: Any, base_radius: float, follower: str = "roller",
         raise ModelError("a flat-faced follower has no roller_radius and no offset", ENTRY)
     if not isinstance(points, (int, np.integer)) or isinstance(points, bool) or points < 16:
         raise ModelError(f"points must be a whole number >= 16, got {points!r}", ENTRY)
-    if arm is not None and (follower != "roller" or e != 0.0):
-        raise ModelError("an oscillating arm carries a roller (or a knife edge: "
-                         "roller_radius = 0) and has no offset", ENTRY)
+    if arm is not None and e != 0.0:
+        raise ModelError("an oscillating arm has no offset (a flat face's offset from the "
+                         "pivot is the arm's 'offset')", ENTRY)
     if abs(e) >= rb + rr:
         raise ModelError(f"|offset| = {abs(e):g} must be below base_radius + roller_radius "
                          f"= {rb + rr:g} (the follower's axis must cross the base circle)",
@@ -231,6 +237,8 @@ def cam_profile(program: Any, base_radius: float, follower: str = "roller",
     theta = np.linspace(0.0, 2 * np.pi, int(points), endpoint=False)
     s, ds, dds = _program(f, theta, rb)
     if follower == "flat":
+        if arm is not None:
+            return _arm_flat(f, rb, arm, theta, s, ds, dds)
         return _flat(f, rb, theta, s, ds, dds)
     if arm is not None:
         return _arm(f, rb, rr, arm, theta, s, ds, dds)
@@ -308,6 +316,54 @@ def _arm(f: TimeFunction, rb: float, rr: float, arm: Mapping[str, Any], theta: n
                    length * (dds[:, None] * ju - (ds * ds)[:, None] * u), ju, rr)
     d = CamDesign(f, "roller", rb, rr, 0.0, theta, s, ds, dds, *pitch, (0.0, 0.0))
     d.pivot, d.arm_length, d.arm_angle0 = (float(piv[0]), float(piv[1])), length, phi0
+    return d
+
+
+def _arm_flat(f: TimeFunction, rb: float, arm: Any, theta: np.ndarray, s: np.ndarray,
+              ds: np.ndarray, dds: np.ndarray) -> CamDesign:
+    """A flat face on an oscillating arm: the arm about the ground point P at the angle
+    phi = phi0 + psi(theta), its face the line P + e J u + lambda u (u = (cos phi, sin phi),
+    e the face's offset from the pivot), the cam on its -J u side. In ground-aligned axes the
+    face is m . Y = h with m = J u (the cam's outward normal at the contact) and
+    h = m . P + e = |P| sin(beta - phi) + e; in the cam's frame the normal turns at
+    alpha' = psi' - 1, so the surface is the envelope Y = h m + h_a J m, h_a = h'/(psi' - 1),
+    with the radius of curvature h + h_aa, h_aa = (h'' (psi' - 1) - h' psi'')/(psi' - 1)**3
+    (> 0, else a cusp). phi0 puts the face on the base circle at psi = 0 on the side where a
+    positive psi lifts it: phi0 = beta - pi + asin((Rb - e)/|P|)."""
+    if not isinstance(arm, Mapping):
+        raise ModelError("arm must be a table { pivot = [x, y], offset = e }", ENTRY)
+    only_keys(arm, {"pivot", "offset"}, "cam_profile arm", required=["pivot"])
+    piv = np.array(vector(arm["pivot"], 2, "arm.pivot", ENTRY), dtype=float)
+    e = number(arm.get("offset", 0.0), "arm.offset", ENTRY)
+    dist, beta = float(np.hypot(*piv)), math.atan2(piv[1], piv[0])
+    if not dist > abs(rb - e):
+        raise ModelError(f"the face cannot touch the base circle (radius {rb:g}): pivot at "
+                         f"{dist:g} from the cam's centre, face offset {e:g}", ENTRY)
+    if np.any(ds >= 1.0):
+        raise ModelError("program: the arm would turn with the cam (psi' >= 1: the face "
+                         "cannot stay on it)", ENTRY)
+    phi0 = beta - math.pi + math.asin((rb - e) / dist)
+    phi = phi0 + s
+    u = np.column_stack([np.cos(phi), np.sin(phi)])
+    m = np.column_stack([-u[:, 1], u[:, 0]])
+    sb, cb = np.sin(beta - phi), np.cos(beta - phi)
+    h = dist * sb + e
+    h1 = -dist * cb * ds
+    h2 = -dist * sb * ds**2 - dist * cb * dds
+    w = ds - 1.0
+    ha = h1 / w
+    rho = h + (h2 * w - h1 * dds) / w**3
+    jm = np.column_stack([-m[:, 1], m[:, 0]])
+    y = h[:, None] * m + ha[:, None] * jm
+    vel = np.column_stack([-(y - piv)[:, 1], (y - piv)[:, 0]])       # J (Y - P)
+    angle = np.arctan2(vel[:, 0] * m[:, 1] - vel[:, 1] * m[:, 0],
+                       vel[:, 0] * m[:, 0] + vel[:, 1] * m[:, 1])
+    lam = np.einsum("ij,ij->i", y - piv, u)
+    d = CamDesign(f, "flat", rb, 0.0, 0.0, theta, s, ds, dds,
+                  _rotate_back(theta, y[:, 0], y[:, 1]), angle, rho,
+                  np.ones(len(s), dtype=bool), bool(np.any(rho <= 0.0)),
+                  (float(lam.min()), float(lam.max())))
+    d.pivot, d.arm_angle0, d.face_offset = (float(piv[0]), float(piv[1])), phi0, e
     return d
 
 
