@@ -97,8 +97,8 @@ def base_radius_figure(design: CamDesign, path: Path) -> float:
 
 def run(out: Path) -> tuple[str, mbd2d.KinematicsResult, list[str]]:
     """Synthesize, run one turn, draw; (problem or "", the run, the files written)."""
-    design, model = load_cam(TASK)
-    print(cam_report(design))
+    design, model, speed = load_cam(TASK)
+    print(cam_report(design, speed))
     n = len(design.theta)
     res = model.kinematics(t_end=1.0, steps=n)       # 2 pi rad/s: an output per sample
     lift = res.body("follower").y - res.body("follower").y[0]

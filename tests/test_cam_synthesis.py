@@ -176,6 +176,11 @@ def test_cam_command_writes_a_model_that_keeps_the_program(tmp_path: Path) -> No
     r = cli("cam", str(EX / "tasks" / "cam.toml"), "--out", str(out), "--profile", str(prof))
     assert r.returncode == 0, r.stderr
     assert "largest pressure angle" in r.stdout and "UNDERCUT" not in r.stdout
+    # the follower's largest acceleration at the task's speed: the cycloidal rise's
+    # 2 pi h / T^2 with T the rise's time (a quarter turn at 2 pi rad/s: 0.25 s)
+    line = next(ln for ln in r.stdout.splitlines() if ln.startswith("at "))
+    acc = float(line.rsplit("acceleration ", 1)[1])
+    assert acc == pytest.approx(2 * math.pi * 0.02 / 0.25**2, rel=1e-5)
     res = mbd2d.load(out).kinematics(1.0, 200)
     task = tomllib.loads((EX / "tasks" / "cam.toml").read_text())["cam"]
     theta = task["speed"] * res.t

@@ -332,8 +332,8 @@ def _cam(args: argparse.Namespace) -> int:
     """mbd2d cam: synthesize, report, write the model (and the profile)."""
     if args.profile is not None and not str(args.profile).endswith(".csv"):
         raise ModelError(f"--profile must end in .csv, got {args.profile!r}", "command line")
-    design, model = load_cam(args.task)
-    print(cam_report(design))
+    design, model, speed = load_cam(args.task)
+    print(cam_report(design, speed))
     toml_io.dump(model, args.out, header=f"mbd2d cam {args.task}: the cam and its follower")
     print(f"wrote {args.out}")
     if args.profile is not None:

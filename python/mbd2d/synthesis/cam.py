@@ -420,7 +420,7 @@ CAM_KEYS = {"program", "base_radius", "follower", "roller_radius", "offset", "po
             "speed", "name", "arm"}
 
 
-def load_cam(path: str | Path) -> tuple[CamDesign, Model]:
+def load_cam(path: str | Path) -> tuple[CamDesign, Model, float]:
     """Read a cam task file (the input of ``mbd2d cam TASK.toml --out MODEL.toml``)::
 
         [cam]
@@ -436,8 +436,8 @@ def load_cam(path: str | Path) -> tuple[CamDesign, Model]:
 
     Returns
     -------
-    (CamDesign, Model)
-        The design and its cam-follower model.
+    (CamDesign, Model, float)
+        The design, its cam-follower model and the cam's speed [rad/s].
 
     Raises
     ------
@@ -453,23 +453,29 @@ def load_cam(path: str | Path) -> tuple[CamDesign, Model]:
     args = {k: v for k, v in spec.items() if k not in ("program", "base_radius", "speed",
                                                         "name")}
     design = cam_profile(spec["program"], spec["base_radius"], **args)
-    model = design.model(speed=spec.get("speed", 2 * math.pi),
-                         name=str(spec.get("name", "cam-follower")))
-    return design, model
+    speed = number(spec.get("speed", 2 * math.pi), "speed", "[cam]")
+    model = design.model(speed=speed, name=str(spec.get("name", "cam-follower")))
+    return design, model, speed
 
 
-def cam_report(d: CamDesign) -> str:
-    """The design's figures as text (pressure angle, curvature, face width)."""
+def cam_report(d: CamDesign, speed: float | None = None) -> str:
+    """The design's figures as text (pressure angle, curvature, face width; with the cam's
+    speed [rad/s] the follower's largest speed s' w and acceleration s'' w**2)."""
     k = int(np.argmax(np.abs(d.pressure_angle)))
-    lines = [f"{d.follower} follower, base radius {d.base_radius:g}"
-             + (f", roller radius {d.roller_radius:g}, offset {d.offset:g}"
-                if d.follower == "roller" else "")
+    what = "swing" if d.pivot is not None else "lift"
+    lines = [f"{d.follower} follower" + (" on an arm" if d.pivot is not None else "")
+             + f", base radius {d.base_radius:g}"
+             + (f", roller radius {d.roller_radius:g}" if d.follower == "roller" else "")
+             + (f", offset {d.offset:g}" if d.pivot is None and d.follower == "roller" else "")
              + f", {len(d.theta)} profile points",
-             f"lift: {d.s.min():.6g} .. {d.s.max():.6g}",
-             f"largest pressure angle: {math.degrees(d.pressure_angle[k]):.3f} deg at theta = "
-             f"{math.degrees(d.theta[k]):.2f} deg",
-             f"smallest radius of curvature (convex): {d.min_curvature_radius:.6g}"
-             + ("  UNDERCUT: the surface has a cusp" if d.undercut else "")]
+             f"{what}: {d.s.min():.6g} .. {d.s.max():.6g}"]
+    if speed is not None:
+        lines.append(f"at {speed:g} rad/s: largest {what} speed {np.abs(d.ds).max() * speed:.6g}"
+                     f", acceleration {np.abs(d.dds).max() * speed**2:.6g}")
+    lines += [f"largest pressure angle: {math.degrees(d.pressure_angle[k]):.3f} deg at theta = "
+              f"{math.degrees(d.theta[k]):.2f} deg",
+              f"smallest radius of curvature (convex): {d.min_curvature_radius:.6g}"
+              + ("  UNDERCUT: the surface has a cusp" if d.undercut else "")]
     if d.follower == "flat":
         lines.append(f"contact along the face: {d.face[0]:.6g} .. {d.face[1]:.6g} "
                      f"(face width at least {d.face[1] - d.face[0]:.6g})")
