@@ -219,6 +219,7 @@ def test_dynamics_sensitivity_to_the_push_duration() -> None:
     ({"t0": 0.0, "t1": 1.0, "h": 1.0, "speed": 2}, "needs 't0', 't1' and 'h'"),
     ({"t0": 0.0, "t1": float("nan"), "h": 1.0}, "t1"),
     ("fast", "must be a list of tables"),
+    ({"t0": 0.0, "t1": 1.0, "h": 1.0, "law": ["cubic"]}, "law must be one of"),
 ])
 def test_bad_steps_are_model_errors(step: object, needle: str) -> None:
     m = mbd2d.Model("m")
@@ -506,3 +507,19 @@ def test_peak_accelerations_are_the_published_coefficients(law: str, coefficient
     peak = np.abs(res.qdd[:-1, 0]).max() * 0.5**2 / 0.03
     assert peak == pytest.approx(coefficient, rel=1e-6)
     assert res.q[-1, 0] == pytest.approx(0.03, abs=1e-15)
+
+
+@pytest.mark.parametrize("f, needle", [
+    (mbd2d.TimeFunction(step=(mbd2d.Step(0.0, 1.0, 1.0, "bogus"),)), "law must be one of"),
+    (mbd2d.TimeFunction(step=(mbd2d.Step(1.0, 0.5, 1.0),)), "t1 > t0"),
+    (mbd2d.TimeFunction(step=(mbd2d.Step(0.0, 1.0, float("nan")),)), "must be finite"),
+    (mbd2d.TimeFunction(step=((0.0, 1.0, 1.0),)), "must be a Step"),
+    (mbd2d.TimeFunction(table=mbd2d.Table((0.0, 1.0), (1.0,))), "one length"),
+    (mbd2d.TimeFunction(table=mbd2d.Table((0.0, 0.0), (1.0, 2.0))), "must increase"),
+])
+def test_functions_built_in_code_are_checked(f: mbd2d.TimeFunction, needle: str) -> None:
+    """A TimeFunction made in code gets the checks its TOML table would."""
+    m = mbd2d.Model("m")
+    m.add_body("b", q0=[0.0, 0.0, 0.0])
+    with pytest.raises(mbd2d.ModelError, match=needle):
+        m.add_driver("absolute", body="b", coordinate="x", f=f)

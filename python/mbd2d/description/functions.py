@@ -152,7 +152,7 @@ def as_function(spec: Any, entry: str, what: str = "f") -> TimeFunction:
         If the description is malformed.
     """
     if isinstance(spec, TimeFunction):
-        return spec
+        return _checked(spec, what, entry)
     if is_number(spec):
         return TimeFunction(poly=(_finite(spec, what, entry),))
     if not isinstance(spec, Mapping):
@@ -222,6 +222,21 @@ def _table(spec: Any, what: str, entry: str) -> Table | None:
     return Table(t, y)
 
 
+def _checked(f: TimeFunction, what: str, entry: str) -> TimeFunction:
+    """A TimeFunction built in code, checked as its mapping would be (its steps' laws and
+    times, its table)."""
+    for i, st in enumerate(f.step):
+        if not isinstance(st, Step):
+            raise ModelError(f"{what}.step[{i}] must be a Step, got {st!r}", entry)
+        _step({"t0": st.t0, "t1": st.t1, "h": st.h, "law": st.law}, f"{what}.step[{i}]",
+              entry)
+    if f.table is not None:
+        if not isinstance(f.table, Table):
+            raise ModelError(f"{what}.table must be a Table, got {f.table!r}", entry)
+        _table({"t": list(f.table.t), "y": list(f.table.y)}, f"{what}.table", entry)
+    return f
+
+
 def _steps(spec: Any, what: str, entry: str) -> tuple[Step, ...]:
     """The steps of a function: a table or a list of tables {t0, t1, h, law}."""
     if isinstance(spec, Mapping):
@@ -241,7 +256,7 @@ def _step(s: Any, what: str, entry: str) -> Step:
         raise ModelError(f"{what} needs 't0', 't1' and 'h' (and optional 'law'), got keys "
                          f"{sorted(keys)}", entry)
     law = s.get("law", "cycloidal")
-    if law not in LAWS:
+    if not isinstance(law, str) or law not in LAWS:
         raise ModelError(f"{what}.law must be one of {', '.join(LAWS)}, got {law!r}", entry)
     t0, t1 = _finite(s["t0"], f"{what}.t0", entry), _finite(s["t1"], f"{what}.t1", entry)
     if not t1 > t0:
