@@ -235,3 +235,5 @@ def test_a_table_from_a_file(tmp_path: Path) -> None:
     (tmp_path / "m.toml").write_text(text.replace("data/crank.csv", "data/none.csv"))
     with pytest.raises(mbd2d.ModelError, match="cannot read the table file"):
         mbd2d.load(tmp_path / "m.toml")
+    with pytest.raises(mbd2d.ModelError, match="base must be a directory path"):
+        mbd2d.loads(text, base=5)

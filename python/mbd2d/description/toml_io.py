@@ -84,6 +84,8 @@ def loads(text: str, source: str = "<string>",
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ModelError(f"not valid TOML: {exc}", source) from None
+    if base is not None and not isinstance(base, (str, os.PathLike)):
+        raise ModelError(f"base must be a directory path, got {base!r}", "loads")
     _table_files(data, Path(base) if base is not None else Path.cwd())
     return from_dict(data, source, cls=cls)
 
