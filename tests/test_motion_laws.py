@@ -523,3 +523,19 @@ def test_functions_built_in_code_are_checked(f: mbd2d.TimeFunction, needle: str)
     m.add_body("b", q0=[0.0, 0.0, 0.0])
     with pytest.raises(mbd2d.ModelError, match=needle):
         m.add_driver("absolute", body="b", coordinate="x", f=f)
+
+
+@pytest.mark.parametrize("law", LAWS)
+def test_inverse_dynamics_effort_is_mass_times_the_laws_acceleration(law: str) -> None:
+    """A 2 kg block driven along its guide by a step: the driver's effort is m x'' from the
+    law's closed form at every output, the instants t0 and t1 included (the value after
+    them: right-continuous)."""
+    m = mbd2d.Model("driven-block")
+    m.add_body("block", q0=[0.0, 0.0, 0.0], mass=2.0, inertia=0.1)
+    m.add_translational(["ground", "block"], [[0, 0], [0, 0]], [[1, 0], [1, 0]], name="g")
+    step = {"t0": 0.2, "t1": 0.7, "h": 0.05, "law": law}
+    m.add_driver("absolute", body="block", coordinate="x",
+                 f={"poly": [0.0], "step": step}, name="push")
+    res = m.inverse_dynamics(1.0, 100)
+    want = np.array([2.0 * step_closed_form(step, float(t))[2] for t in res.t])
+    np.testing.assert_allclose(res.effort("push"), want, rtol=0, atol=1e-11)
