@@ -74,19 +74,23 @@ f = {{ poly = [0.2], step = [{law_step(step)}] }}
 """)
 
 
+def slider_chain(th: np.ndarray, th1: np.ndarray, th2: np.ndarray, r: float = R,
+                 rod: float = L, e: float = E) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """An offset slider-crank's slider x, x_dot, x_ddot from the crank angle and its two
+    time derivatives: x = r cos th + sqrt(rod^2 - (r sin th - e)^2) and the chain rule."""
+    s = r * np.sin(th) - e
+    w = np.sqrt(rod**2 - s**2)
+    ds = r * np.cos(th)
+    x_th = -r * np.sin(th) - s * ds / w
+    # d/dth of -s ds / w: -(ds^2 + s (-r sin th)) / w - s^2 ds^2 / w^3
+    x_thth = -r * np.cos(th) - (ds**2 - s * r * np.sin(th)) / w - (s * ds)**2 / w**3
+    return r * np.cos(th) + w, x_th * th1, x_thth * th1**2 + x_th * th2
+
+
 def slider_exact(step: dict, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The slider's x, x_dot, x_ddot: x = R cos th + sqrt(L^2 - (R sin th - E)^2) and the
-    chain rule through th(t) = 0.2 + the step's closed form."""
+    """The slider through th(t) = 0.2 + the step's closed form."""
     th, th1, th2 = (np.array(v) for v in zip(*[step_closed_form(step, float(tk)) for tk in t]))
-    th = th + 0.2
-    s = R * np.sin(th) - E
-    w = np.sqrt(L**2 - s**2)
-    ds = R * np.cos(th)
-    x = R * np.cos(th) + w
-    x_th = -R * np.sin(th) - s * ds / w
-    # d/dth of -s ds / w: -(ds^2 + s (-R sin th)) / w - s^2 ds^2 / w^3
-    x_thth = -R * np.cos(th) - (ds**2 - s * R * np.sin(th)) / w - (s * ds)**2 / w**3
-    return x, x_th * th1, x_thth * th1**2 + x_th * th2
+    return slider_chain(th + 0.2, th1, th2)
 
 
 @pytest.mark.parametrize("law", LAWS)

@@ -55,6 +55,14 @@ def positive(x: Any, what: str, entry: str) -> float:
     return v
 
 
+def nonnegative(x: Any, what: str, entry: str) -> float:
+    """A finite number >= 0."""
+    v = number(x, what, entry)
+    if v < 0.0:
+        raise ModelError(f"{what} must be >= 0, got {x!r}", entry)
+    return v
+
+
 def vector(x: Any, n: int, what: str, entry: str) -> tuple[float, ...]:
     """A list of n finite numbers."""
     x = as_list(x)

@@ -18,8 +18,8 @@ import math
 from typing import Any, Mapping, Sequence
 
 from ..errors import ModelError
-from ..validate import (GROUND, as_list, check_name, choice, nonzero_vector, number, only_keys,
-                        pairs, positive, vector)
+from ..validate import (GROUND, as_list, check_name, choice, nonnegative, nonzero_vector, number,
+                        only_keys, pairs, positive, vector)
 from .bodies import Body
 from .entries import reading
 from .contacts import CONTACT_KEYS, CONTACT_TYPES, Contact, contact_geometry, parse_law
@@ -405,8 +405,8 @@ class ModelDescription:
         stiffness (L - length0) + damping L_dot - f(t) (a positive f pushes apart)."""
         name, entry = self._force_start("spring", name)
         fs = Spring(name, self._two_bodies(bodies, entry), pairs(points, 2, "points", entry),
-                    _nonneg(stiffness, "stiffness", entry), _nonneg(damping, "damping", entry),
-                    _nonneg(length0, "length0", entry), as_function(f, entry))
+                    nonnegative(stiffness, "stiffness", entry), nonnegative(damping, "damping", entry),
+                    nonnegative(length0, "length0", entry), as_function(f, entry))
         self.forces.append(fs)
         return fs
 
@@ -439,8 +439,8 @@ class ModelDescription:
         -stiffness (a - angle0) - damping a_dot + f(t), a = theta_j - theta_i."""
         name, entry = self._force_start("rotational-spring", name)
         fs = RotationalSpring(name, self._two_bodies(bodies, entry),
-                              _nonneg(stiffness, "stiffness", entry),
-                              _nonneg(damping, "damping", entry),
+                              nonnegative(stiffness, "stiffness", entry),
+                              nonnegative(damping, "damping", entry),
                               number(angle0, "angle0", entry), as_function(f, entry))
         self.forces.append(fs)
         return fs
@@ -645,13 +645,6 @@ class ModelDescription:
         return (f"{type(self).__name__}({self.name!r}: {len(self.bodies)} bodies, "
                 f"{len(self.joints)} joints, "
                 f"{len(self.drivers)} drivers{forces})")
-
-
-def _nonneg(x: Any, what: str, entry: str) -> float:
-    v = number(x, what, entry)
-    if v < 0.0:
-        raise ModelError(f"{what} must be >= 0, got {x!r}", entry)
-    return v
 
 
 __all__ = ["ModelDescription"]

@@ -38,7 +38,7 @@ from ..binding import core
 from ..description.functions import TimeFunction, as_function
 from ..errors import ModelError
 from ..model import Model
-from ..validate import number, only_keys, vector
+from ..validate import nonnegative, number, only_keys, positive, vector
 from .taskfile import read_toml
 
 ENTRY = "cam_profile"
@@ -218,10 +218,10 @@ def cam_profile(program: Any, base_radius: float, follower: str = "roller",
         argument.
     """
     f = as_function(program, ENTRY, "program")
-    rb = _positive(base_radius, "base_radius")
+    rb = positive(base_radius, "base_radius", ENTRY)
     if follower not in FOLLOWERS:
         raise ModelError(f"follower must be 'roller' or 'flat', got {follower!r}", ENTRY)
-    rr = _nonneg(roller_radius, "roller_radius")
+    rr = nonnegative(roller_radius, "roller_radius", ENTRY)
     e = number(offset, "offset", ENTRY)
     if follower == "flat" and (rr != 0.0 or e != 0.0):
         raise ModelError("a flat-faced follower has no roller_radius and no offset", ENTRY)
@@ -297,7 +297,7 @@ def _arm(f: TimeFunction, rb: float, rr: float, arm: Mapping[str, Any], theta: n
         raise ModelError("arm must be a table { pivot = [x, y], length = L }", ENTRY)
     only_keys(arm, {"pivot", "length"}, "cam_profile arm", required=["pivot", "length"])
     piv = np.array(vector(arm["pivot"], 2, "arm.pivot", ENTRY), dtype=float)
-    length = _positive(arm["length"], "arm.length")
+    length = positive(arm["length"], "arm.length", ENTRY)
     rp, dist = rb + rr, float(np.hypot(*piv))
     c = (rp * rp - dist * dist - length * length) / (2 * length)
     if not dist > abs(c):
@@ -399,20 +399,6 @@ def _flat(f: TimeFunction, rb: float, theta: np.ndarray, s: np.ndarray, ds: np.n
                      _rotate_back(theta, ds, rb + s), np.zeros_like(s), rho,
                      np.ones(len(s), dtype=bool), bool(np.any(rho <= 0.0)),
                      (float(ds.min()), float(ds.max())))
-
-
-def _positive(x: Any, what: str) -> float:
-    v = number(x, what, ENTRY)
-    if not v > 0.0:
-        raise ModelError(f"{what} must be positive, got {v:g}", ENTRY)
-    return v
-
-
-def _nonneg(x: Any, what: str) -> float:
-    v = number(x, what, ENTRY)
-    if v < 0.0:
-        raise ModelError(f"{what} must be >= 0, got {v:g}", ENTRY)
-    return v
 
 
 #: the keys of a cam task file's [cam] table (cam_profile's arguments and the model's speed)
