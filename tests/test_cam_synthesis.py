@@ -51,7 +51,7 @@ def program_exact(theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 def test_the_engine_moves_the_follower_by_the_program(follower: str, rr: float,
                                                       e: float) -> None:
     """The synthesized cam in the engine's cam joint (turning at 2 pi rad/s): the follower's
-    lift and speed against the program, errors falling at the spline's order (lift: 13-17x
+    lift and speed against the program, errors falling at the spline's order (lift: 13-18x
     per doubling of the points, 1.1e-12 to 5e-12 m at 1440 points for a 20 mm rise; speed:
     about 8x, 7e-9 to 4.3e-8 m/s of a 0.16 m/s peak; docs/synthesis.md)."""
     errs, verrs = [], []
@@ -227,7 +227,7 @@ def swing_exact(theta: np.ndarray, k: int = 0) -> np.ndarray:
 @pytest.mark.parametrize("arm, rr", ARMS)
 def test_oscillating_arm_keeps_its_program(arm: dict, rr: float) -> None:
     """A roller (or knife edge) on an arm swinging 0.3 rad: the engine's arm angle against
-    the program, falling at the spline's order (measured 14-16x per doubling, 1.7e-11 to
+    the program, falling at the spline's order (measured 14-17x per doubling, 1.7e-11 to
     4.1e-11 rad at 1440 points; the angular speed about 8x)."""
     errs, verrs = [], []
     for n in (360, 720, 1440):
