@@ -33,6 +33,7 @@ module mbd_api
   use mbd_integrators, only: dyn_opts_t, dyn_stats_t, integrate, output_rows, output_index, &
                               METH_PARTITIONED, METH_GENALPHA, METH_DOPRI5
   use mbd_statics, only: statics_solve
+  use mbd_modes, only: modes_solve
   use mbd_assemble, only: assemble_dense, assemble_blocks, asm_work_t, asm_init
   use mbd_kinematics, only: kin_opts_t, kin_report_t, kin_work_t, kin_run, kin_work_init, &
                             kin_assemble, kin_rank, kin_rank_band, kin_out_count, MAXPASS, &
@@ -50,7 +51,7 @@ module mbd_api
   implicit none
   private
   public :: NINFO, api_sizes, api_eval, api_kinematics, api_profile, api_analyze, api_kin_step
-  public :: api_inverse, api_dynamics, api_statics, api_reactions, api_cam_forces
+  public :: api_inverse, api_dynamics, api_statics, api_modes, api_reactions, api_cam_forces
   public :: api_eval_d, api_reactions_dp, api_dynamics_sens, api_forces_d
 
   integer, parameter :: NINFO = 12   !! length of the report arrays
@@ -965,29 +966,10 @@ contains
     integer, intent(in), optional :: solver     !! 0 auto (default), 1 dense, 2 banded
     type(model_t) :: m
     type(dyn_work_t) :: w
-    type(kin_opts_t) :: kopts
-    integer :: bad, badf, path, kl, ku
-    q = zero; lam = zero; stable = 0; resid = zero; iinfo = 0
-    call build_dynamic(nb, ctab, rpar, bmass, grav, ftab, fpar, m, status, msg, bad, badf)
-    iinfo(2) = bad_code(bad, badf)
-    if (status /= MBD_OK) return
-    if (.not. (finite(q0) .and. finite(t))) then
-      call not_finite('q0 and t', status, msg); return
-    end if
-    if (size(q0) /= m%nq .or. size(q) /= m%nq .or. size(lam) /= m%neq) then
-      status = MBD_BAD_COUNT; msg = 'array sizes do not match the model'; return
-    end if
-    call dyn_choose(m, solver_or_auto(solver), path, kl, ku, status, msg)
-    if (status /= MBD_OK) return
-    iinfo(5) = path; iinfo(6) = kl; iinfo(7) = ku
-    if (path == SOLVER_DENSE) call dyn_memory_check(m, status, msg)
-    if (status /= MBD_OK) return
-    q = q0 / m%cunit
-    call assemble_start(m, path, q, t, kopts, status, msg)
-    if (status == MBD_OK) call dyn_init(m, w, q, t, kopts%tol * m%lscale, status, msg, path)
-    if (status == MBD_OK) then
-      iinfo(6) = w%sd%kl; iinfo(7) = w%sd%ku
-    end if
+    integer :: bad
+    q = zero; lam = zero; stable = 0; resid = zero
+    call static_start(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, t, m, w, q, lam, iinfo, &
+                      status, msg, solver)
     if (status == MBD_OK .and. present(ptab)) then
       sq = zero; slam = zero
       if (any(shape(sq) /= [m%nq, size(ptab, 2)]) .or. &
@@ -1009,8 +991,100 @@ contains
       call sens_units2(m, sens, sq, m%cunit, .false.)
       call sens_units2(m, sens, slam, m%rowunit, .true.)
     end if
-    q = q * m%cunit; lam = lam / m%rowunit
+    if (allocated(m%cunit)) then
+      q = q * m%cunit; lam = lam / m%rowunit
+    end if
   end subroutine api_statics
+
+  !> The start of statics and modes: the model built, q0 assembled at t (core units in q),
+  !! the dynamics work arrays on the chosen path (iinfo(2) a bad entry, iinfo(5) the path,
+  !! iinfo(6), iinfo(7) the band widths).
+  subroutine static_start(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, t, m, w, q, lam, &
+                          iinfo, status, msg, solver)
+    integer, intent(in) :: nb, ctab(:, :), ftab(:, :)
+    real(wp), intent(in) :: rpar(:), bmass(:, :), grav(2), fpar(:), q0(:), t
+    type(model_t), intent(out) :: m
+    type(dyn_work_t), intent(out) :: w
+    real(wp), intent(inout) :: q(:)             !! (nq) the assembled q0 (core units)
+    real(wp), intent(in) :: lam(:)              !! (neq) the caller's multipliers (sizes)
+    integer, intent(out) :: iinfo(NINFO)
+    integer, intent(out) :: status              !! MBD_OK, < 0 input, > 0 numerical
+    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    integer, intent(in), optional :: solver     !! 0 auto (default), 1 dense, 2 banded
+    type(kin_opts_t) :: kopts
+    integer :: bad, badf, path, kl, ku
+    iinfo = 0
+    call build_dynamic(nb, ctab, rpar, bmass, grav, ftab, fpar, m, status, msg, bad, badf)
+    iinfo(2) = bad_code(bad, badf)
+    if (status /= MBD_OK) return
+    if (.not. (finite(q0) .and. finite(t))) then
+      call not_finite('q0 and t', status, msg); return
+    end if
+    if (size(q0) /= m%nq .or. size(q) /= m%nq .or. size(lam) /= m%neq) then
+      status = MBD_BAD_COUNT; msg = 'array sizes do not match the model'; return
+    end if
+    call dyn_choose(m, solver_or_auto(solver), path, kl, ku, status, msg)
+    if (status /= MBD_OK) return
+    iinfo(5) = path; iinfo(6) = kl; iinfo(7) = ku
+    if (path == SOLVER_DENSE) call dyn_memory_check(m, status, msg)
+    if (status /= MBD_OK) return
+    q = q0 / m%cunit
+    call assemble_start(m, path, q, t, kopts, status, msg)
+    if (status == MBD_OK) call dyn_init(m, w, q, t, kopts%tol * m%lscale, status, msg, path)
+    if (status == MBD_OK) then
+      iinfo(6) = w%sd%kl; iinfo(7) = w%sd%ku
+    end if
+  end subroutine static_start
+
+  !> Small vibrations about the equilibrium near q0 at t (equilibrium 1; 0: about the
+  !! assembled q0 itself, with its least-squares multipliers): the lowest kmax undamped
+  !! omega^2 and mode shapes (model units, phi^T M phi = 1), 2 kmax damped eigenvalues
+  !! (mbd_modes), the configuration, multipliers, stability and residual as api_statics;
+  !! iinfo(1) the number of free motions.
+  subroutine api_modes(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, t, equilibrium, kmax, q, &
+                       lam, stable, resid, omega2, kinds, sre, sim, shapes, iinfo, status, msg, &
+                       solver)
+    integer, intent(in) :: nb, ctab(:, :), ftab(:, :), equilibrium, kmax
+    real(wp), intent(in) :: rpar(:), bmass(:, :), grav(2), fpar(:), q0(:), t
+    real(wp), intent(out) :: q(:), lam(:), resid, omega2(:), sre(:), sim(:), shapes(:, :)
+    integer, intent(out) :: kinds(:)            !! (kmax) 1 vibration, 0 rigid, -1 unstable
+    integer, intent(out) :: stable, iinfo(NINFO)
+    integer, intent(out) :: status              !! MBD_OK, < 0 input, > 0 numerical
+    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    integer, intent(in), optional :: solver     !! 0 auto (default), 1 dense, 2 banded
+    type(model_t) :: m
+    type(dyn_work_t) :: w
+    integer :: nfree, i
+    q = zero; lam = zero; stable = 0; resid = zero
+    omega2 = zero; sre = zero; sim = zero; shapes = zero; kinds = 0
+    if (kmax < 0 .or. size(omega2) < kmax .or. size(kinds) < kmax .or. size(sre) < 2 * kmax .or. &
+        size(sim) < 2 * kmax .or. size(shapes, 2) < kmax) then
+      status = MBD_BAD_COUNT; msg = 'modes: the output arrays do not hold kmax modes'
+      iinfo = 0; return
+    end if
+    call static_start(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, t, m, w, q, lam, iinfo, &
+                      status, msg, solver)
+    if (status == MBD_OK .and. size(shapes, 1) /= m%nq) then
+      status = MBD_BAD_COUNT; msg = 'modes: the shapes array does not match the model'
+    end if
+    if (status == MBD_OK) then
+      if (equilibrium /= 0) then
+        call statics_solve(m, w, q, t, lam, stable, resid, status, msg)
+      else
+        stable = -2                             ! not examined
+        call dyn_multipliers(m, w, q, w%qz, w%qz, t, lam, status, msg)
+      end if
+    end if
+    if (status == MBD_OK) call modes_solve(m, w, q, t, lam, kmax, nfree, omega2, kinds, sre, &
+                                           sim, shapes(:, 1:kmax), status, msg)
+    if (status == MBD_OK) iinfo(1) = nfree
+    if (allocated(m%cunit)) then
+      q = q * m%cunit; lam = lam / m%rowunit
+      do i = 1, m%nq
+        shapes(i, :) = shapes(i, :) * m%cunit(i)
+      end do
+    end if
+  end subroutine api_modes
 
   !> An optional solver argument: 0 (auto) when absent.
   pure integer function solver_or_auto(solver)

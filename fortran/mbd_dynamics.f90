@@ -1283,7 +1283,7 @@ contains
   !! entry exactly as perturbing its column alone. Central differences, or with fast =
   !! .true. forward ones and cv only when a force is damped (otherwise cv = 0): enough for
   !! an iteration matrix, which only steers Newton. Allocation-free.
-  subroutine dyn_tangent(m, w, q, qd, t, lam, kv, cv, fast)
+  subroutine dyn_tangent(m, w, q, qd, t, lam, kv, cv, fast, step)
     type(model_t), intent(in) :: m            !! model
     type(dyn_work_t), intent(inout) :: w      !! work arrays (pattern from dyn_init)
     real(wp), intent(in) :: q(:), qd(:)       !! state
@@ -1291,9 +1291,15 @@ contains
     real(wp), intent(in) :: lam(:)            !! multipliers (neq)
     real(wp), intent(out) :: kv(:), cv(:)     !! K and C on the pattern
     logical, intent(in), optional :: fast     !! forward differences, cv only if damped
+    !> the central differences' relative step (default 1e-7; eps**(1/3) = 6e-6 balances
+    !! their truncation and rounding errors, about 1e-11 relative, where K is needed exactly)
+    real(wp), intent(in), optional :: step
     logical :: fwd
+    real(wp) :: hrel
     fwd = .false.
     if (present(fast)) fwd = fast
+    hrel = 1.0e-7_wp
+    if (present(step)) hrel = step
     if (fwd) then
       call residual(q, qd, w%tr0)
       call groups(.true., kv)
@@ -1321,7 +1327,7 @@ contains
           if (fwd) then
             w%th(c) = SQEPS * max(one, abs(w%tq(c)))
           else
-            w%th(c) = 1.0e-7_wp * max(one, abs(w%tq(c)))
+            w%th(c) = hrel * max(one, abs(w%tq(c)))
           end if
           w%tq(c) = w%tq(c) + w%th(c)
           if (fwd) w%th(c) = w%tq(c) - merge(q(c), qd(c), wrt_q)   ! the step taken

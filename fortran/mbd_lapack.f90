@@ -4,7 +4,7 @@ module mbd_lapack
   implicit none
   private
   public :: dgetrf, dgetf2, dgetrs, dtrsv, dgesvd, dgels, dgelsy, dgtsv, dgeqp3, dormqr, dtrtrs, dgecon, &
-            dtrcon, dsyev
+            dtrcon, dsyev, dsygv, dgeev
   public :: dgbtrf, dgbtrs, dgbcon, dlacn2
 
   interface
@@ -117,6 +117,25 @@ module mbd_lapack
       real(wp), intent(out) :: w(*), work(*)
       integer, intent(out) :: info
     end subroutine dsyev
+    !> Symmetric-definite generalized eigenproblem A x = lambda B x (itype 1).
+    pure subroutine dsygv(itype, jobz, uplo, n, a, lda, b, ldb, w, work, lwork, info)
+      import :: wp
+      integer, intent(in) :: itype, n, lda, ldb, lwork
+      character(len=1), intent(in) :: jobz, uplo
+      real(wp), intent(inout) :: a(lda, *), b(ldb, *)
+      real(wp), intent(out) :: w(*), work(*)
+      integer, intent(out) :: info
+    end subroutine dsygv
+    !> Eigenvalues (and right eigenvectors) of a general matrix.
+    pure subroutine dgeev(jobvl, jobvr, n, a, lda, wr, wi, vl, ldvl, vr, ldvr, work, lwork, &
+                          info)
+      import :: wp
+      character(len=1), intent(in) :: jobvl, jobvr
+      integer, intent(in) :: n, lda, ldvl, ldvr, lwork
+      real(wp), intent(inout) :: a(lda, *)
+      real(wp), intent(out) :: wr(*), wi(*), vl(ldvl, *), vr(ldvr, *), work(*)
+      integer, intent(out) :: info
+    end subroutine dgeev
     !> Tridiagonal solve.
     pure subroutine dgtsv(n, nrhs, dl, d, du, b, ldb, info)
       import :: wp

@@ -5,14 +5,16 @@
 !! too: upgrade_functions):
 !!   mbd2d 3
 !!   name <model name>
-!!   analysis kinematics | inverse-dynamics | dynamics | statics | check
+!!   analysis kinematics | inverse-dynamics | dynamics | statics | modes | check
 !!   t0 <time>   t_end <time>   steps <n>   every <k>                  (one per line)
 !!   tol <x>   maxit <n>   tmin <x>   solver auto|dense|banded           (kinematic runs)
 !!   positions_only 0|1                       (kinematics: 1 = positions alone, optional)
 !!   method generalized-alpha|dopri5|baumgarte-rk4|partitioned   rtol <x>   atol <x>   h <x>
 !!   rho_inf <x>   alpha <x>   beta <x>   max_steps <n>                  (dynamics)
-!!   t <time>                                                           (statics, check)
-!!   outputs <energy | multipliers | reactions | efforts ...>           (optional columns)
+!!   t <time>                                                    (statics, modes, check)
+!!   count <k>   at_q0 0|1        (modes: the lowest k (0: every free motion); 1 = about q0)
+!!   outputs <energy | multipliers | reactions | efforts ...>           (optional columns;
+!!                              modes: "damped" writes the damped eigenvalues instead)
 !!   gravity <gx> <gy>
 !!   bodies <nb>
 !!   <name> <x0> <y0> <theta0> [<mass> <inertia> <vx0> <vy0> <omega0>]   (nb lines)
@@ -76,8 +78,8 @@ module mbd_mbdfile
   real(wp), parameter :: MIN_TOL = 1.0e-15_wp     !! smallest tolerance (as the Python front end)
   integer, parameter :: INT32_MAX = huge(1)       !! largest step limit
   !> the analyses a file can hold
-  character(len=16), parameter :: ANALYSES(5) = [character(len=16) :: 'kinematics', &
-    'inverse-dynamics', 'dynamics', 'statics', 'check']
+  character(len=16), parameter :: ANALYSES(6) = [character(len=16) :: 'kinematics', &
+    'inverse-dynamics', 'dynamics', 'statics', 'modes', 'check']
   !> linear solvers (codes 0, 1, 2) and dynamics methods (codes 1 .. 4) by name
   character(len=8), parameter :: SOLVER_WORDS(0:2) = [character(len=8) :: 'auto', 'dense', &
     'banded']
@@ -105,7 +107,10 @@ module mbd_mbdfile
     integer :: max_steps = 0              !! integrator step limit (0: default)
     real(wp) :: rtol = zero, atol = zero, h = zero
     real(wp) :: rho_inf = -one, alpha = -one, beta = -one
-    real(wp) :: tstat = zero              !! statics: the time of loads and drivers
+    real(wp) :: tstat = zero              !! statics, modes: the time of loads and drivers
+    integer :: count = 0                  !! modes: the lowest count (0: all)
+    logical :: at_q0 = .false.            !! modes: about q0 (no equilibrium sought)
+    logical :: out_damped = .false.       !! modes: the damped eigenvalues' table
     real(wp) :: grav(2) = zero            !! gravity
     !> optional output columns
     logical :: out_energy = .false., out_lam = .false., out_reac = .false., out_eff = .false.
@@ -236,7 +241,7 @@ contains
         if (key == 'analysis') then
           if (.not. any(ANALYSES == tok(1:16)) .or. len_trim(tok) > 16) then
             call fail('unknown analysis "' // trim(tok(1:40)) // '"; one of kinematics, '// &
-                      'inverse-dynamics, dynamics, statics, check')
+                      'inverse-dynamics, dynamics, statics, modes, check')
             exit
           end if
           spec%analysis = tok(1:NAME_LEN)
@@ -261,6 +266,21 @@ contains
           exit
         end if
         spec%positions_only = big == 1
+      case ('at_q0')
+        if (.not. one_int(big)) exit
+        if (big < 0 .or. big > 1) then
+          call fail_int('at_q0 must be 0 or ', 1_int64, '', big)
+          exit
+        end if
+        spec%at_q0 = big == 1
+      case ('count')
+        if (.not. one_int(big)) exit
+        if (big < 0 .or. big > INT32_MAX) then
+          call fail_int('count must be a whole number from 0 (every mode) to ', &
+                        int(INT32_MAX, int64), '', big)
+          exit
+        end if
+        spec%count = int(big)
       case ('every')
         if (.not. one_int(big)) exit
         if (big < 1 .or. big > MAX_STEPS) then
@@ -313,9 +333,10 @@ contains
           case ('multipliers'); spec%out_lam = .true.
           case ('reactions'); spec%out_reac = .true.
           case ('efforts'); spec%out_eff = .true.
+          case ('damped'); spec%out_damped = .true.
           case default
             call fail('unknown output "' // trim(tok(1:40)) // '"; energy, multipliers, '// &
-                      'reactions or efforts')
+                      'reactions, efforts or damped')
             exit
           end select
         end do

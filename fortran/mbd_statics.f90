@@ -62,7 +62,9 @@ contains
     real(wp), intent(in) :: t                   !! time (drivers and loads are held here)
     real(wp), intent(out) :: lam(:)             !! multipliers (neq)
     integer, intent(out) :: stable              !! stability of the equilibrium
-    real(wp), intent(out) :: resid              !! final ||N^T Q||_inf / F (F: the loads)
+    !> final ||N^T Q||_inf / max(F, |H| l) (F: the loads, |H| l: the stiffness over the length
+    !! scale)
+    real(wp), intent(out) :: resid
     integer, intent(out) :: status  !! MBD_OK, MBD_NO_CONVERGENCE, MBD_LAPACK, MBD_NO_MEMORY
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
     ! work arrays, allocated once: h holds H, then its eigenvectors; r, c, dqz and qt are
@@ -161,16 +163,18 @@ contains
     if (nfree == 0) then
       stable = 2; resid = zero; return
     end if
-    resid = maxval(abs(g(1:nfree))) / fscale
+    call eigen(.false., status)
+    if (status /= MBD_OK) return
+    emax = max(maxval(abs(ev(1:nfree))), tiny(one))
+    ! the unbalanced load against the loads, or against the stiffness over the model's size
+    ! (loads of round-off size: springs at their natural lengths in an equilibrium)
+    resid = maxval(abs(g(1:nfree))) / max(fscale, emax * m%lscale)
     if (.not. (resid <= RESID_FAIL)) then
       status = MBD_NO_CONVERGENCE
       write (msg, '(a,es10.3,a)') 'statics: no equilibrium found near the estimates; the '// &
         'unbalanced load is ', resid, ' times the loads'
       return
     end if
-    call eigen(.false., status)
-    if (status /= MBD_OK) return
-    emax = max(maxval(abs(ev(1:nfree))), tiny(one))
     if (minval(ev(1:nfree)) > 1.0e-9_wp * emax) then
       stable = 1
     else if (minval(ev(1:nfree)) < -1.0e-9_wp * emax) then

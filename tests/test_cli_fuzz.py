@@ -34,7 +34,7 @@ NUMBERS = ["1", "0", "-1", "1e-3", "nan", "inf", "1e300", "abc", "", "2:3", "1.5
 def _command(rng: random.Random, tmp: Path) -> list[str]:
     model = str(EX / rng.choice(MODELS))
     cmd = rng.choice(["kinematics", "inverse-dynamics", "dynamics", "statics", "export",
-                      "tolerance", "parameters", "check", "plot", "sweep"])
+                      "tolerance", "parameters", "check", "plot", "sweep", "modes"])
     argv = [cmd, model]
     if cmd == "export":
         argv.append(str(tmp / "f.mbd"))
@@ -45,8 +45,13 @@ def _command(rng: random.Random, tmp: Path) -> list[str]:
     if cmd in ("kinematics", "inverse-dynamics", "dynamics", "plot"):
         good = "o.png" if cmd == "plot" else rng.choice(["o.csv", "o.npz"])
         argv += ["--out", str(tmp / rng.choice([good, good, good, "o.txt"]))]
-    if cmd in ("statics", "check") and rng.random() < 0.5:
+    if cmd in ("statics", "check", "modes") and rng.random() < 0.5:
         argv += ["--out", str(tmp / rng.choice(["s.csv", "s.txt"]))]
+    if cmd == "modes" and rng.random() < 0.5:
+        argv += rng.choice([["--count", rng.choice(["1", "0", "-2", "x"])], ["--at-q0"],
+                            ["--picture", str(tmp / rng.choice(["m.png", "m.gif", "m.txt"]))],
+                            ["--mode", rng.choice(["0", "5", "-1"])],
+                            ["--damped-out", str(tmp / rng.choice(["d.csv", "d.nc"]))]])
     if cmd == "tolerance":
         argv += ["--samples", rng.choice(["0", "3", "3", "1"]), "--workers", "1",
                  "--out", str(tmp / rng.choice(["t.csv", "t.csv", "t.nc", "t.txt"]))]
@@ -79,7 +84,8 @@ def _command(rng: random.Random, tmp: Path) -> list[str]:
         if rng.random() < 0.5:
             argv.append("--grid")
     if cmd == "export" and rng.random() < 0.3:
-        argv += ["--analysis", rng.choice(["check", "statics", "dynamics", "inverse-dynamics"])]
+        argv += ["--analysis", rng.choice(["check", "statics", "dynamics", "inverse-dynamics",
+                                           "modes"])]
     if cmd == "parameters" and rng.random() < 0.5:
         argv += ["--match", rng.choice(["B", "zzz", ""])]
     if rng.random() < 0.15:

@@ -244,3 +244,17 @@ def test_slider_crank_equilibrium_against_reduced_coordinates(y0: float, tol: fl
         s, c = math.sin(th), math.cos(th)
         assert_allclose(st.body("slider")[0], c + math.sqrt(9.0 - (s - 0.5)**2), atol=1e-12)
         assert st.residual <= 1e-14
+
+
+def test_springs_at_their_natural_lengths_are_an_equilibrium() -> None:
+    """A chain of blocks on guides tied by springs at their natural lengths: q0 is the
+    equilibrium, though the loads there are of round-off size (i * 0.1 is not exact); the
+    residual is measured against the stiffness times the model's size, not those loads (it
+    was "no equilibrium found, the unbalanced load is 1.0 times the loads")."""
+    from test_modes import spring_chain
+    for n, solver in ((6, "dense"), (40, "banded")):
+        model = spring_chain(n)
+        res = model.statics(solver=solver)
+        q0 = np.concatenate([b.q0 for b in model.bodies])
+        np.testing.assert_allclose(res.q, q0, rtol=0, atol=1e-15)
+        assert res.stability == "stable" and res.residual < 1e-12

@@ -1,8 +1,8 @@
 !> mbd2d-solve: run a model file written by `mbd2d export`, without Python.
 !!
 !!   mbd2d-solve MODEL.mbd OUT.csv
-!! Runs the file's analysis (kinematics, inverse dynamics, dynamics or statics, with its
-!! settings) and writes the CSV the Python path writes for it: t, then NAME.x ... NAME.theta_ddot
+!! Runs the file's analysis (kinematics, inverse dynamics, dynamics, statics or modes, with
+!! its settings) and writes the CSV the Python path writes for it: t, then NAME.x ... NAME.theta_ddot
 !! per body (statics: NAME.x, NAME.y, NAME.theta, stable, residual), then the optional columns
 !! the file's "outputs" line asks for (energy, multipliers, reactions, efforts), then each
 !! contact's and joint friction's columns (dynamic runs), then with a "sensitivities" block,
@@ -32,7 +32,7 @@ program mbd2d_solve
   use mbd_model, only: NFT
   use mbd_constraints, only: con_nrow, con_is_driver
   use mbd_api, only: NINFO, api_sizes, api_kinematics, api_inverse, api_dynamics, api_statics, &
-                     api_reactions, api_dynamics_sens, api_reactions_dp, api_analyze
+                     api_reactions, api_dynamics_sens, api_reactions_dp, api_analyze, api_modes
   use mbd_batch, only: batch_run, NISET, NRSET
   use mbd_status, only: MBD_NO_CONVERGENCE, MBD_INTEGRATOR_FAILED, MBD_INCONSISTENT, &
                         MBD_ASSEMBLY_FAILED
@@ -85,7 +85,7 @@ program mbd2d_solve
         write (*, '(a)') 'usage: mbd2d-solve MODEL.mbd OUT.csv'
         write (*, '(a)') '  runs the analysis in a model file written by `mbd2d export` and '// &
           'writes a CSV'
-        write (*, '(a)') '  (kinematics, inverse dynamics, dynamics, statics or check; '// &
+        write (*, '(a)') '  (kinematics, inverse dynamics, dynamics, statics, modes or check; '// &
           'with the file''s sensitivities and measures; a sweep file runs every case, on '// &
           'every core)'
         write (*, '(a)') '  exit codes: 0 ok, 2 bad input, 3 singular configuration, 4 other '// &
@@ -105,6 +105,10 @@ program mbd2d_solve
   if (status /= MBD_OK) call die(2, where(bad, msg))
   if (spec%analysis == 'check') then
     call run_check()
+    stop 0, quiet=.true.
+  end if
+  if (spec%analysis == 'modes') then
+    call run_modes()
     stop 0, quiet=.true.
   end if
   dynamic = spec%analysis /= 'kinematics'
@@ -843,6 +847,96 @@ contains
     close (u)
     if (ios /= 0) call die(2, 'cannot write ' // trim(out_path) // ' (disk full?)')
   end subroutine run_check
+
+  !> Modes: the small vibrations about the equilibrium (Model.modes) written as
+  !! ModesResult.to_csv writes them: one row per mode (mode, omega2, frequency_hz, kind, the
+  !! shape NAME.x, NAME.y, NAME.theta per body), or with "outputs damped" one row per damped
+  !! eigenvalue (s_real, s_imag, frequency_hz, damped_frequency_hz, damping_ratio).
+  subroutine run_modes()
+    real(wp), parameter :: TWO_PI = 2 * 3.141592653589793_wp
+    real(wp), allocatable :: qe(:), lam(:), w2(:), sre(:), sim(:), shp(:, :), fpm(:)
+    integer, allocatable :: kinds(:), ftm(:, :)
+    integer :: kmax, nk, u, ios, k, j, nw
+    real(wp) :: mag, row(5)
+    character(len=32) :: word
+    if (.not. spec%have_masses) call die(2, trim(model_path) // ': modes needs the masses: '// &
+      'body lines NAME X0 Y0 THETA0 MASS INERTIA VX0 VY0 OMEGA0')
+    if (spec%nlabels >= 0 .and. spec%nlabels /= neq) call die(2, trim(model_path) // &
+      ': ' // trim(itoa(spec%nlabels)) // ' labels for ' // trim(itoa(neq)) // ' rows of Phi')
+    if (spec%out_energy .or. spec%out_lam .or. spec%out_reac .or. spec%out_eff .or. &
+        spec%npar > 0 .or. spec%ncase > 0 .or. spec%positions_only .or. spec%nmeas > 0) &
+      call die(2, trim(model_path) // ': modes takes no outputs but "damped", and no '// &
+               'sensitivities, cases, measures or positions_only')
+    kmax = nq
+    if (spec%count > 0) kmax = min(spec%count, nq)
+    call mem_check(REAL_BYTES * (real(nq, wp) * (kmax + 3) + 6 * real(kmax, wp)), &
+                   'the modes (' // trim(itoa(kmax)) // ' of ' // trim(itoa(nq)) // &
+                   ' coordinates)', 'give a smaller count', status, msg)
+    if (status /= MBD_OK) call die(2, trim(model_path) // ': ' // trim(msg))
+    allocate (q0(nq), qe(nq), lam(neq), w2(kmax), kinds(kmax), sre(2 * kmax), &
+              sim(2 * kmax), shp(nq, kmax), ftm(NFT, spec%nf), fpm(max(1, size(spec%fpar))), &
+              stat=ierr)
+    if (ierr /= 0) call die(2, 'not enough memory for the modes')
+    q0 = 0.0_wp
+    q0(1:3 * spec%nb) = reshape(spec%q0, [3 * spec%nb])
+    ftm = spec%ftab
+    fpm = 0.0_wp
+    fpm(1:size(spec%fpar)) = spec%fpar
+    call api_modes(spec%nb, spec%ctab, spec%rpar, spec%bmass, spec%grav, ftm, fpm, q0, &
+                   spec%tstat, merge(0, 1, spec%at_q0), kmax, qe, lam, stable, resid, w2, &
+                   kinds, sre, sim, shp, iinfo, status, msg, spec%solver)
+    if (status < 0) then
+      if (iinfo(2) <= -1000000) call die(2, force_where(-1000000 - iinfo(2), msg))
+      if (iinfo(2) < 0) call die(2, trim(model_path) // ': body "' // &
+                                 trim(spec%body_names(min(spec%nb, -iinfo(2)))) // '": ' // &
+                                 trim(msg))
+      call die(2, where(iinfo(2), msg))
+    end if
+    if (status == MBD_NO_MEMORY) call die(2, trim(msg))
+    if (status /= MBD_OK) call die(4, trim(msg) // ' (no modes written)')
+    nk = min(kmax, iinfo(1))
+    open (newunit=u, file=trim(out_path), status='replace', action='write', access='stream', &
+          form='unformatted', iostat=ios)
+    if (ios /= 0) call die(2, 'cannot write ' // trim(out_path))
+    if (spec%out_damped) then
+      call sput(u, ios, 's_real,s_imag,frequency_hz,damped_frequency_hz,damping_ratio' // &
+                achar(10))
+      do k = 1, 2 * nk
+        mag = hypot(sre(k), sim(k))                  ! as numpy's abs of a complex
+        row = [sre(k), sim(k), mag / TWO_PI, abs(sim(k)) / TWO_PI, 0.0_wp]
+        if (mag > 0.0_wp) row(5) = -sre(k) / mag + 0.0_wp
+        do j = 1, 5
+          call num(row(j), word, nw)
+          if (j > 1) call sput(u, ios, ',')
+          call sput(u, ios, word(1:nw))
+        end do
+        call sput(u, ios, achar(10))
+      end do
+    else
+      call sput(u, ios, 'mode,omega2,frequency_hz,kind')
+      do k = 1, spec%nb
+        call sput(u, ios, ',' // trim(spec%body_names(k)) // '.x,' // &
+                  trim(spec%body_names(k)) // '.y,' // trim(spec%body_names(k)) // '.theta')
+      end do
+      call sput(u, ios, achar(10))
+      do k = 1, nk
+        row(1:4) = [real(k - 1, wp), w2(k), sqrt(max(w2(k), 0.0_wp)) / TWO_PI, &
+                    real(kinds(k), wp)]
+        do j = 1, 4 + 3 * spec%nb
+          if (j <= 4) then
+            call num(row(j), word, nw)
+          else
+            call num(shp(j - 4, k), word, nw)
+          end if
+          if (j > 1) call sput(u, ios, ',')
+          call sput(u, ios, word(1:nw))
+        end do
+        call sput(u, ios, achar(10))
+      end do
+    end if
+    close (u)
+    if (ios /= 0) call die(2, 'cannot write ' // trim(out_path) // ' (disk full?)')
+  end subroutine run_modes
 
   !> The label of row r of Phi (lambda's column name): the file's labels, else rowR.
   function row_label(r) result(s)

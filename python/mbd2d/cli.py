@@ -6,6 +6,8 @@
     mbd2d dynamics MODEL.toml --t-end T --steps N --out OUT.csv [--method M --rtol R --atol A --h H
                    --max-steps S --solver S]
     mbd2d statics MODEL.toml [--t T --solver S] [--out OUT.csv]
+    mbd2d modes MODEL.toml [--t T --count K --at-q0 --solver S] [--out MODES.csv
+                --damped-out EIGEN.csv --picture MODE.png|MODE.gif --mode K]
     mbd2d sweep MODEL.toml --param NAME=START:STOP:NUM ... [--grid] --t-end T --steps N
                 --out sweep.nc|sweep.csv [--analysis A --t0 T0 --every K --workers W
                 --scheduler ADDRESS --positions-only --method M --rtol R --atol A --h H]
@@ -69,6 +71,9 @@ from .studies.plan import MAX_CASES
 EXIT_OK, EXIT_INPUT, EXIT_SINGULAR, EXIT_NUMERICAL = 0, 2, 3, 4
 ANALYSES = ("auto", "kinematics", "inverse-dynamics", "dynamics")
 PICTURES = ("mechanism", "paths", "time-series", "forces", "energy", "measures")
+#: the endings of picture files and of animation files
+PICTURE_ENDS = (".png", ".svg", ".pdf")
+MOTION_ENDS = (".gif", ".mp4")
 
 
 def _span(p: argparse.ArgumentParser) -> None:
@@ -203,6 +208,21 @@ def _parser() -> argparse.ArgumentParser:
     s.add_argument("--out", default=None, help="also write the equilibrium as CSV")
     _sensitivities(s)
     _columns(s, energy=False)
+    o = sub.add_parser("modes", help="natural frequencies, damping and mode shapes about the "
+                       "static equilibrium")
+    o.add_argument("model", help="model file (.toml) with masses")
+    o.add_argument("--t", type=float, default=0.0, help="time at which loads and drivers are "
+                   "held (default 0)")
+    o.add_argument("--count", type=int, default=None, help="only the lowest K modes")
+    o.add_argument("--at-q0", action="store_true", help="about the assembled q0 as given "
+                   "(an equilibrium you know), not the equilibrium statics finds")
+    o.add_argument("--solver", default="auto", choices=["auto", "dense", "banded"],
+                   help="linear algebra (default auto: band LU for large chains)")
+    o.add_argument("--out", default=None, help="write the modes (frequencies, shapes) as CSV")
+    o.add_argument("--damped-out", default=None, help="write the damped eigenvalues as CSV")
+    o.add_argument("--picture", default=None, help="draw a mode: .png/.svg/.pdf (the "
+                   "extremes) or .gif/.mp4 (one period)")
+    o.add_argument("--mode", type=int, default=0, help="the mode drawn (default 0, the lowest)")
     w = sub.add_parser("sweep", help="one analysis of many variants (design parameters "
                        "swept): netCDF or CSV")
     w.add_argument("model", help="model file (.toml)")
@@ -242,7 +262,7 @@ def _parser() -> argparse.ArgumentParser:
     e.add_argument("model", help="model file (.toml)")
     e.add_argument("out", help="output model file (.mbd)")
     e.add_argument("--analysis", default="kinematics",
-                   choices=ANALYSES[1:] + ("statics", "check"),
+                   choices=ANALYSES[1:] + ("statics", "modes", "check"),
                    help="the analysis mbd2d-solve runs (default kinematics)")
     e.add_argument("--t-end", type=float, default=None, help="final time (not for statics)")
     e.add_argument("--steps", type=int, default=None, help="output intervals")
@@ -251,7 +271,12 @@ def _parser() -> argparse.ArgumentParser:
     e.add_argument("--tol", type=float, default=None, help="Newton tolerance (default 1e-12)")
     e.add_argument("--solver", default="auto", choices=["auto", "dense", "banded"],
                    help="linear solver of kinematic runs (default auto)")
-    e.add_argument("--t", type=float, default=0.0, help="statics: time of loads and drivers")
+    e.add_argument("--t", type=float, default=0.0, help="statics, modes: time of loads and "
+                   "drivers")
+    e.add_argument("--count", type=int, default=None, help="modes: only the lowest K")
+    e.add_argument("--at-q0", action="store_true", help="modes: about q0 as given")
+    e.add_argument("--damped", action="store_true", help="modes: write the damped "
+                   "eigenvalues' table")
     _sensitivities(e)
     _measures(e)
     e.add_argument("--positions-only", action="store_true",
@@ -371,6 +396,33 @@ def _statics_report(model: Model, st: StaticsResult) -> str:
             lines.append(f"  d/d({prm}) {name:16s} x: {dx: .9g}  y: {dy: .9g}  "
                          f"theta: {dth: .9g}")
     return "\n".join(lines)
+
+
+def _modes(model: Model, args: argparse.Namespace) -> int:
+    """``mbd2d modes``: the table of modes printed, then the files asked for."""
+    for opt, path, ends in (("--out", args.out, (".csv",)),
+                            ("--damped-out", args.damped_out, (".csv",)),
+                            ("--picture", args.picture, PICTURE_ENDS + MOTION_ENDS)):
+        if path is not None and not str(path).lower().endswith(ends):
+            raise ModelError(f"{opt} must end in {' or '.join(ends)}, got {path!r}",
+                             "command line")
+    res = model.modes(t=args.t, count=args.count, equilibrium=not args.at_q0,
+                      solver=args.solver)
+    print(res.summary())
+    if args.out is not None:
+        res.to_csv(args.out)
+        print(f"wrote {res.omega2.size} modes to {args.out}")
+    if args.damped_out is not None:
+        res.to_csv(args.damped_out, damped=True)
+        print(f"wrote {res.eigenvalues.size} eigenvalues to {args.damped_out}")
+    if args.picture is not None:
+        if str(args.picture).lower().endswith(MOTION_ENDS):
+            res.animate(args.mode, args.picture)
+        else:
+            ax = res.plot(args.mode)
+            plots.save_figure(ax.figure, args.picture)
+        print(f"drew mode {args.mode} in {args.picture}")
+    return EXIT_OK
 
 
 def _study_settings(p: argparse.ArgumentParser, analysis_help: str) -> None:
@@ -643,9 +695,9 @@ def _check_out(args: argparse.Namespace) -> None:
     if args.command in ("kinematics", "dynamics", "inverse-dynamics"):
         ok = (".csv", ".npz")
     elif args.command == "plot":
-        ok = (".png", ".svg", ".pdf")
+        ok = PICTURE_ENDS
     else:
-        ok = (".gif", ".mp4")
+        ok = MOTION_ENDS
     if not str(args.out).lower().endswith(ok):
         raise ModelError(f"--out must end in {' or '.join(ok)}, got {args.out!r}",
                          "command line")
@@ -695,9 +747,9 @@ def _export_sweep(model: Model, args: argparse.Namespace) -> int:
         raise ModelError("a sweep file writes the sweep's columns (and --measure, "
                          "--sensitivities): no --energy, --multipliers, --reactions or "
                          "--efforts with --param", "command line")
-    if args.analysis == "check":
+    if args.analysis in ("check", "modes"):
         raise ModelError("a sweep runs kinematics, inverse-dynamics, dynamics or statics, not "
-                         "check", "command line")
+                         f"{args.analysis}", "command line")
     span = {"t_end": args.t_end, "steps": args.steps, "t0": args.t0, "every": args.every}
     kw: dict[str, Any] = {
         "kinematics": dict(span, tol=args.tol, solver=args.solver,
@@ -821,13 +873,17 @@ def _main(args: argparse.Namespace) -> int:
                 st.to_csv(args.out, **_file_outputs(args))
                 print(f"wrote the equilibrium to {args.out}")
             return EXIT_OK
+        if args.command == "modes":
+            return _modes(model, args)
         if args.command == "export" and args.param:
             return _export_sweep(model, args)
         if args.command == "export":
             extra = _dynamics_kwargs(args) if args.analysis == "dynamics" else {}
             model.export(args.out, t_end=args.t_end, steps=args.steps, t0=args.t0, tol=args.tol,
                          analysis=args.analysis, every=args.every, solver=args.solver, t=args.t,
-                         outputs=list(_outputs(args)), positions_only=args.positions_only,
+                         outputs=list(_outputs(args)) + (["damped"] if args.damped else []),
+                         positions_only=args.positions_only, count=args.count,
+                         equilibrium=not args.at_q0,
                          sensitivities=_sens_names(args), measures=args.measure, **extra)
             print(f"wrote {args.out} ({args.analysis}; run it with mbd2d-solve "
                   f"{args.out} OUT.csv)")
@@ -850,7 +906,7 @@ def _main(args: argparse.Namespace) -> int:
         _say(f"mbd2d: {exc}")
         return EXIT_INPUT
     except AnalysisError as exc:
-        if args.command in ("check", "statics", "synthesize", "cam"):
+        if args.command in ("check", "statics", "modes", "synthesize", "cam"):
             _say(f"mbd2d: {exc}")
             return EXIT_NUMERICAL
         _say(f"mbd2d: {exc}")

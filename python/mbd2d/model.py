@@ -21,6 +21,7 @@ from .analysis.dynamics import run_dynamics
 from .analysis.evaluate import evaluate
 from .analysis.inverse import run_inverse
 from .analysis.kinematics import run_kinematics
+from .analysis.modes import run_modes
 from .analysis.mbdfile import export as export_mbd
 from .analysis.statics import run_statics
 from .binding.pack import pack
@@ -30,7 +31,7 @@ from .description.builder import ModelDescription
 from .description.entries import reads_entries
 from .errors import MbdError
 from .description.parameters import parameter_list
-from .results import DofReport, DynamicsResult, KinematicsResult, StaticsResult
+from .results import DofReport, DynamicsResult, KinematicsResult, ModesResult, StaticsResult
 from .validate import flag
 
 
@@ -327,6 +328,32 @@ class Model(ModelDescription):
         """
         return run_statics(self, t=t, sensitivities=sensitivities, solver=solver)
 
+    def modes(self, t: float = 0.0, count: int | None = None, equilibrium: bool = True,
+              solver: str = "auto") -> ModesResult:
+        """Natural frequencies, damping ratios and mode shapes of the small vibrations about
+        the static equilibrium near the q0 estimates (drivers held at t, as in
+        :meth:`statics`): the linearized equations M_r z'' + C_r z' + K_r z = 0 on the free
+        motions, K_r including the constraints' curvature under the equilibrium's
+        multipliers. ``count`` asks for the lowest modes only (default: all, or the lowest 20
+        of a model of more than 3000 coordinates); ``equilibrium=False`` linearizes about
+        the assembled q0 as given (an equilibrium the caller knows, or a neutral one).
+
+        Returns
+        -------
+        ModesResult
+            ``res.frequency`` (Hz), ``res.omega2``, ``res.shapes``, ``res.kinds``,
+            ``res.eigenvalues`` with ``res.damping_ratio``; ``res.plot(k)``,
+            ``res.animate(k, path)``, ``res.to_csv(path)``, ``res.summary()``.
+
+        Raises
+        ------
+        ConvergenceError
+            If no equilibrium is found near the q0 estimates.
+        SingularJacobianError
+            If a free motion carries no mass, or the equilibrium is not unique.
+        """
+        return run_modes(self, t=t, count=count, equilibrium=equilibrium, solver=solver)
+
     # ------------------------------------------------------------------ at one state
     @reads_entries
     def phi(self, q: Any, t: float = 0.0) -> np.ndarray:
@@ -394,7 +421,8 @@ class Model(ModelDescription):
                beta: float | None = None, max_steps: int | None = None, t: float = 0.0,
                outputs: Sequence[str] | None = None, positions_only: bool = False,
                sensitivities: Sequence[str] | None = None,
-               measures: Sequence[str] | None = None) -> None:
+               measures: Sequence[str] | None = None, count: int | None = None,
+               equilibrium: bool = True) -> None:
         """Write a plain-text model file that the standalone ``mbd2d-solve`` runs without
         Python (format: docs/mbd-format.md), with the analysis and its settings.
 
@@ -404,14 +432,17 @@ class Model(ModelDescription):
             The file to write (.mbd).
         t_end, steps, t0, every : float, int, float, int
             The output times, as for the analyses (not for statics).
-        analysis : {"kinematics", "inverse-dynamics", "dynamics", "statics"}
+        analysis : {"kinematics", "inverse-dynamics", "dynamics", "statics", "modes", "check"}
             The analysis ``mbd2d-solve`` runs.
         tol, maxit, solver
             As :meth:`kinematics` (``tol`` and ``solver`` also for inverse dynamics).
         method, rtol, atol, h, rho_inf, alpha, beta, max_steps
             As :meth:`dynamics`.
         t : float
-            Statics: the time of loads and drivers.
+            Statics, modes: the time of loads and drivers.
+        count, equilibrium
+            Modes: as :meth:`modes` (the CSV is ``res.to_csv(path)``, or with
+            ``outputs=["damped"]`` ``res.to_csv(path, damped=True)``).
         outputs : list of str, optional
             Optional CSV columns: "energy", "multipliers", "reactions", "efforts" (not for
             kinematics; no energy for statics), as ``res.to_csv(path, energy=True, ...)``.
@@ -446,7 +477,8 @@ class Model(ModelDescription):
                    analysis=analysis, every=every, solver=solver, method=method, rtol=rtol,
                    atol=atol, h=h, rho_inf=rho_inf, alpha=alpha, beta=beta,
                    max_steps=max_steps, t=t, outputs=outputs, positions_only=positions_only,
-                   sensitivities=sensitivities, measures=measures)
+                   sensitivities=sensitivities, measures=measures, count=count,
+                   equilibrium=equilibrium)
 
 
 def load(path: str | Path) -> Model:

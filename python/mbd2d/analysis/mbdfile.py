@@ -1,7 +1,7 @@
 """Export to the plain-text model file read by the standalone ``mbd2d-solve``.
 
 Every analysis can be exported: kinematics, inverse dynamics, dynamics (each method with its
-settings) and statics, with the optional output columns. The settings are checked exactly as
+settings), statics and modes, with the optional output columns. The settings are checked exactly as
 for a Python run and written as the core takes them, and reals are written with 17
 significant digits, so ``mbd2d-solve`` makes the same core call and writes the same CSV as
 ``res.to_csv`` (docs/mbd-format.md; the format is also described at the top of every file).
@@ -25,14 +25,16 @@ from ..errors import ModelError
 from ..results.files import OUTPUTS, write_text
 from ..results.measures import measure_tables
 from ..validate import flag, number
+from .contacts import check_statics
 from .dynamics import dynamics_settings
+from .modes import mode_count
 from .sensitivities import check_sens_method, check_positions_only, requested, table
 from .settings import (SOLVERS, check_solver, check_span, output_rows, require_determined,
                        solver_code)
 
 FORMAT = 3
 #: the analyses a file can hold (check: degrees of freedom and redundancy, as `mbd2d check`)
-ANALYSES = ("kinematics", "inverse-dynamics", "dynamics", "statics", "check")
+ANALYSES = ("kinematics", "inverse-dynamics", "dynamics", "statics", "modes", "check")
 #: every kind code the format holds: (code, type, parameters in the params list)
 JOINT_KINDS = [(c.kind, c.type, d) for c, d in [
     (Revolute, "s_i(2) s_j(2)"),
@@ -81,7 +83,7 @@ def header() -> str:
         "#   mbd2d 3                      format and version",
         "#   name NAME                    model name",
         "#   analysis A                   kinematics | inverse-dynamics | dynamics | statics "
-        "| check",
+        "| modes | check",
         "#   t0, t_end, steps, every      outputs t0 + k (t_end - t0) / steps, k = 0..steps, "
         "every k-th kept",
         "#   tol, maxit, tmin, solver     Newton tolerance, iterations, singular-time "
@@ -89,9 +91,11 @@ def header() -> str:
         "#   positions_only 0|1           kinematics: 1 = positions alone (optional)",
         "#   method, rtol, atol, h, rho_inf, alpha, beta, max_steps   dynamics (0, or -1 for "
         "rho_inf, alpha, beta: default)",
-        "#   t                            statics: the time of loads and drivers; check: its time",
+        "#   t                            statics, modes: the time of loads and drivers; check: "
+        "its time",
+        "#   count K, at_q0 0|1           modes: the lowest K; 1 = about q0 as given",
         "#   outputs W ...                optional CSV columns: energy multipliers reactions "
-        "efforts",
+        "efforts (modes: damped, the damped eigenvalues' table instead)",
         "#   gravity GX GY",
         "#   bodies NB, then NB lines     NAME x0 y0 theta0 [mass inertia vx0 vy0 omega0]",
         "#   constraints NC, then NC lines",
@@ -143,21 +147,22 @@ def _outputs(outputs: Any, analysis: str) -> list[str]:
         return []
     if isinstance(outputs, str):
         outputs = [outputs]
+    known = ("damped",) if analysis == "modes" else OUTPUTS
     try:
         words = [str(w) for w in outputs]
     except TypeError:
-        raise ModelError(f"outputs must be a list of {', '.join(OUTPUTS)}, got {outputs!r}",
+        raise ModelError(f"outputs must be a list of {', '.join(known)}, got {outputs!r}",
                          "export") from None
     for w in words:
-        if w not in OUTPUTS:
-            raise ModelError(f"unknown output {w!r}; the optional columns are "
-                             f"{', '.join(OUTPUTS)}", "export")
+        if w not in known:
+            raise ModelError(f"unknown output {w!r}; the optional columns of {analysis} are "
+                             f"{', '.join(known) or 'none'}", "export")
     if words and analysis in ("kinematics", "check"):
         raise ModelError(f"{', '.join(words)} need multipliers: export inverse-dynamics, "
                          "dynamics or statics", "export")
     if "energy" in words and analysis == "statics":
         raise ModelError("statics has no energy output", "export")
-    return [w for w in OUTPUTS if w in words]
+    return [w for w in known if w in words]
 
 
 def export(model: ModelDescription, path: str | Path, **settings: Any) -> None:
@@ -182,7 +187,8 @@ def file_lines(model: ModelDescription, t_end: float | None = None, steps: int |
                positions_only: Any = False,
                sensitivities: Sequence[str] | None = None,
                measures: Sequence[str] | None = None,
-               measure_refs: bool = False) -> list[str]:
+               measure_refs: bool = False, count: Any = None,
+               equilibrium: Any = True) -> list[str]:
     """The lines of a model file up to its ``end`` line (the header, the model, the analysis
     and its settings, the optional blocks; with measure_refs an angle's points name the
     params entries they come from, for a sweep's cases).
@@ -202,12 +208,12 @@ def file_lines(model: ModelDescription, t_end: float | None = None, steps: int |
                          "export")
     params = requested(model, sensitivities)
     check_positions_only(params, pos)
-    if params and analysis == "check":
-        raise ModelError("check computes no sensitivities", "export")
+    if params and analysis in ("check", "modes"):
+        raise ModelError(f"{analysis} computes no sensitivities", "export")
     p = pack(model)
     lines = [header(), f"mbd2d {FORMAT}",
              f"name {model.name.replace(' ', '_') or 'model'}", f"analysis {analysis}"]
-    if analysis not in ("statics", "check"):
+    if analysis not in ("statics", "modes", "check"):
         if t_end is None or steps is None:
             raise ModelError(f"{analysis} needs t_end and steps", "export")
         t0, t_end, steps = check_span(t0, t_end, steps)
@@ -232,6 +238,12 @@ def file_lines(model: ModelDescription, t_end: float | None = None, steps: int |
     elif analysis == "check":
         tol_v, _ = check_solver(tol, None)
         lines += [f"tol {_r(tol_v)}", f"t {_r(number(t, 't', 'export'))}"]
+    elif analysis == "modes":
+        check_statics(model)
+        solver_code(solver)
+        about_q0 = not flag(equilibrium, "equilibrium", "export")
+        lines += [f"t {_r(number(t, 't', 'export'))}", f"count {mode_count(count, p.nq)}",
+                  f"at_q0 {int(about_q0)}", f"solver {solver}"]
     else:
         lines.append(f"t {_r(number(t, 't', 'export'))}")
     if words:

@@ -57,30 +57,32 @@ def run_statics(model: ModelDescription, t: float = 0.0, sensitivities: Any = No
     return res
 
 
-def statics_error(model: ModelDescription, p: Packed, out: Any, t: float) -> MbdError | None:
+def statics_error(model: ModelDescription, p: Packed, out: Any, t: float,
+                  analysis: str = "statics") -> MbdError | None:
     """The exception a statics call ends in, or None when it found a finite equilibrium.
 
     ``out`` carries the core's ``status``, ``msg``, ``iinfo``, ``q``, ``lam`` and ``resid``
     (as :func:`mbd2d.binding.core.statics` returns them); p the tables of the model solved
-    (a rank analysis of them names contradicting constraints).
+    (a rank analysis of them names contradicting constraints); analysis: the key of
+    :data:`~mbd2d.binding.status.ERRORS` and the name in the messages ("statics", "modes").
     """
     status, text = out.status, out.msg
     if status < 0:
-        return error_for("statics", status, text, entry=bad_entry(model, int(out.iinfo[1])))
+        return error_for(analysis, status, text, entry=bad_entry(model, int(out.iinfo[1])))
     if status == ASSEMBLY_FAILED:
-        return assembly_failed("statics", model, float(out.resid), 0, t, None)
+        return assembly_failed(analysis, model, float(out.resid), 0, t, None)
     if status == INCONSISTENT:
-        return inconsistent_at("statics", model, p, t, None, text)
-    if status == NO_CONVERGENCE:
+        return inconsistent_at(analysis, model, p, t, None, text)
+    if status == NO_CONVERGENCE and not text.startswith("modes:"):
         text = f"{text} (no equilibrium found near the q0 estimates; give q0 closer to one)"
-    elif status == SINGULAR:
+    elif status == SINGULAR and not text.startswith("modes:"):   # (modes: a massless motion)
         text = (f"{text} (the equilibrium is not unique: a motion without stiffness, such as "
                 "a free rotation, is left; add a spring or a driver)")
     if status != OK:
-        return error_for("statics", status, text, t=t, residual=float(out.resid))
+        return error_for(analysis, status, text, t=t, residual=float(out.resid))
     if not (np.isfinite(out.q).all() and np.isfinite(out.lam).all()
             and np.isfinite(out.resid)):
-        return error_for("statics", NO_CONVERGENCE, "the equilibrium iteration gave non-finite "
+        return error_for(analysis, NO_CONVERGENCE, "the equilibrium iteration gave non-finite "
                          "values; give q0 closer to an equilibrium", t=t,
                          residual=float(out.resid))
     return None

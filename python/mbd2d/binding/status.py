@@ -74,6 +74,8 @@ ERRORS: dict[str, Table] = {
     "dynamics": {**_KINEMATIC, SINGULAR_CONFIG: SingularJacobianError,
                  INTEGRATOR_FAILED: IntegrationError},
     "statics": {**_ASSEMBLY, NO_CONVERGENCE: ConvergenceError},
+    # statics, then the eigenvalues of the linearized motion about the equilibrium
+    "modes": {**_ASSEMBLY, NO_CONVERGENCE: ConvergenceError},
     # the stepper has no step control: a singular J or a failed Newton step both end in
     # ConvergenceError (Model.kinematics locates dead centres)
     "stepper": {**_KINEMATIC, SINGULAR: ConvergenceError,

@@ -42,11 +42,12 @@ class Motion(Protocol):
 
 
 class Configuration:
-    """One configuration q of a model as a :class:`Motion` with one row (time t)."""
+    """One configuration q of a model as a :class:`Motion` with one row (time t); or rows
+    of configurations q (m, nq) at times t (m), a motion without velocities (a mode)."""
 
-    def __init__(self, model: Any, q: Any, t: float = 0.0, note: str = "") -> None:
+    def __init__(self, model: Any, q: Any, t: Any = 0.0, note: str = "") -> None:
         self.model = model
-        self.t = np.array([float(t)])
+        self.t = np.atleast_1d(np.asarray(t, dtype=float)).copy()
         self.q = np.atleast_2d(np.asarray(q, dtype=float))
         self.qd = np.zeros_like(self.q)
         self.qdd = np.zeros_like(self.q)
@@ -59,7 +60,7 @@ class Configuration:
     def body(self, name: str) -> Any:
         i = self.body_names.index(name)
         x, y, th = self.q[:, 3 * i], self.q[:, 3 * i + 1], self.q[:, 3 * i + 2]
-        z = np.zeros(1)
+        z = np.zeros(self.q.shape[0])
         return SimpleNamespace(x=x, y=y, theta=th, x_dot=z, y_dot=z, theta_dot=z, x_ddot=z,
                                y_ddot=z, theta_ddot=z)
 

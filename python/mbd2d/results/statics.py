@@ -21,7 +21,8 @@ STABILITY_CODES = {"stable": 1, "unstable": 0, "neutral": -1, "fully constrained
 @dataclass
 class StaticsResult:
     """A static equilibrium: configuration, multipliers, reactions and stability;
-    ``residual`` is the unbalanced load ||N^T Q||_inf relative to the largest load. With
+    ``residual`` is the unbalanced load ||N^T Q||_inf relative to the largest load (or to the
+    reduced stiffness times the model's size, when larger). With
     ``sensitivities=[...]`` also ``dq_dp`` (nq, n_params) and ``dlam_dp`` (neq, n_params),
     the derivatives of the equilibrium and its multipliers."""
 

@@ -1,0 +1,224 @@
+!> mbd_modes: small vibrations about an equilibrium (drivers held at t), linearized.
+!!
+!! Near an equilibrium q* with multipliers lambda* (statics), a motion q = q* + N z (N a basis
+!! of the null space of the active rows of J, J N = 0) obeys to first order (Geradin and
+!! Cardona ch. 11; Haug ch. 6, the null-space form of the linearized equations of motion)
+!!   M_r z'' + C_r z' + K_r z = 0,   M_r = N^T M N,  C_r = N^T C N,  K_r = N^T K N,
+!! K = d(J^T lambda - Q)/dq (the constraints' curvature weighted by lambda*, and the loads'
+!! stiffness) and C = -dQ/dq_dot, both from dyn_tangent (central differences on the sparse
+!! pattern, step FD_STEP). N^T (J^T lambda - Q) = 0 at q*, so the change of N does not enter.
+!! Undamped modes: K_s v = omega^2 M_r v, K_s = (K_r + K_r^T) / 2 (dsygv; v^T M_r v = 1), the
+!! shapes phi = N v (phi^T M phi = 1). Damped: the eigenvalues s of the first-order form
+!!   [0, I; -M_r^-1 K_r, -M_r^-1 C_r]  (dgeev),  s = -zeta omega +- i omega sqrt(1 - zeta^2),
+!! sorted by |s|, then by the imaginary part, largest first.
+!! Memory: N (nq x nfree) and five nfree x nfree arrays plus the 2 nfree x 2 nfree first-order
+!! matrix, checked and allocated once per call (MBD_NO_MEMORY when they cannot be had).
+module mbd_modes
+  use mbd_kinds, only: wp, zero, one, half
+  use mbd_status, only: MBD_OK, MBD_SINGULAR, MBD_NO_CONVERGENCE, MBD_LAPACK, MSG_LEN
+  use mbd_memory, only: REAL_BYTES, mem_check, mem_fail
+  use mbd_model, only: model_t
+  use mbd_lapack, only: dsygv, dgeev, dgetrf, dgetrs
+  use mbd_dynamics, only: dyn_work_t, dyn_tangent, dyn_null_basis
+  implicit none
+  private
+  public :: modes_solve
+
+  !> |omega^2| at most this fraction of the largest: a motion without stiffness (kind 0)
+  real(wp), parameter :: RIGID_FRACTION = 1.0e-9_wp
+  !> K's and C's central differences: the step eps**(1/3) that balances truncation and
+  !! rounding (K to about 1e-11 relative on the closed-form tests, against 5e-10 at 1e-7)
+  real(wp), parameter :: FD_STEP = 6.0e-6_wp
+  character(len=*), parameter :: HINT = 'the modes use dense matrices of the number of free ' &
+    // 'motions: ask for fewer modes or use a model with fewer free motions'
+
+contains
+
+  !> The lowest kmax undamped modes and 2 kmax damped eigenvalues at the equilibrium q.
+  !! nfree: the number of free motions (n - the active rows); the outputs past
+  !! min(kmax, nfree) (2 min(kmax, nfree) for the damped) are zero. kinds: 1 a vibration
+  !! (omega^2 > 0), 0 a motion without stiffness (|omega^2| <= RIGID_FRACTION times the
+  !! largest), -1 unstable (omega^2 < 0).
+  subroutine modes_solve(m, w, q, t, lam, kmax, nfree, omega2, kinds, sre, sim, shapes, &
+                         status, msg)
+    type(model_t), intent(in) :: m              !! model with dynamics data
+    type(dyn_work_t), intent(inout) :: w        !! work arrays (dyn_init done)
+    real(wp), intent(in) :: q(:)                !! equilibrium (core units)
+    real(wp), intent(in) :: t                   !! time (drivers and loads held here)
+    real(wp), intent(in) :: lam(:)              !! its multipliers (neq)
+    integer, intent(in) :: kmax                 !! modes wanted (the lowest)
+    integer, intent(out) :: nfree               !! free motions
+    real(wp), intent(out) :: omega2(:)          !! (kmax) undamped omega^2, ascending
+    integer, intent(out) :: kinds(:)            !! (kmax) 1 vibration, 0 rigid, -1 unstable
+    real(wp), intent(out) :: sre(:), sim(:)     !! (2 kmax) damped eigenvalues s
+    real(wp), intent(out) :: shapes(:, :)       !! (nq, kmax) phi = N v (core units)
+    integer, intent(out) :: status  !! MBD_OK, MBD_SINGULAR, MBD_NO_CONVERGENCE, ...
+    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    real(wp), allocatable :: nb(:, :), kn(:, :), cn(:, :), mr(:, :), kr(:, :), cr(:, :), &
+                             ks(:, :), a(:, :), wr(:), wi(:), ev(:), vdum(:, :), work(:), &
+                             kv(:), cv(:)
+    integer, allocatable :: ipiv(:), order(:)
+    real(wp) :: bytes, wq(1)
+    integer :: n, f, nnz, ist, info, j, k, nk
+    character(len=MSG_LEN) :: what
+    status = MBD_OK; msg = ''
+    omega2 = zero; sre = zero; sim = zero; shapes = zero; kinds = 0
+    n = m%nq
+    nfree = n - w%na
+    f = nfree
+    if (f <= 0 .or. kmax <= 0) return
+    nk = min(kmax, f)
+    nnz = w%kptr(n + 1) - 1
+    bytes = REAL_BYTES * (3 * real(n, wp) * f + 5 * real(f, wp)**2 + 4 * real(2 * f, wp)**2 &
+                          + 2 * real(nnz, wp) + 8 * real(f, wp))
+    write (what, '(a,i0,a)') 'the modes'' work arrays (', f, ' free motions)'
+    call mem_check(bytes, trim(what), HINT, status, msg)
+    if (status /= MBD_OK) return
+    allocate (nb(n, f), kn(n, f), cn(n, f), mr(f, f), kr(f, f), cr(f, f), ks(f, f), &
+              a(2 * f, 2 * f), wr(2 * f), wi(2 * f), ev(f), vdum(1, 1), kv(nnz), cv(nnz), &
+              ipiv(f), order(2 * f), work(1), stat=ist)
+    if (ist /= 0) then
+      call mem_fail(bytes, trim(what), HINT, status, msg); return
+    end if
+    call dyn_null_basis(m, w, q, t, nb, status)
+    if (status /= MBD_OK) then
+      status = MBD_SINGULAR; msg = 'modes: no basis of the free motions (J is singular)'
+      return
+    end if
+    call dyn_tangent(m, w, q, w%qz, t, lam, kv, cv, step=FD_STEP)
+    do j = 1, f                                   ! K N and C N, column by column
+      call spmul(kv, nb(:, j), kn(:, j))
+      call spmul(cv, nb(:, j), cn(:, j))
+    end do
+    kr = matmul(transpose(nb), kn)                ! K_r = N^T K N
+    cr = matmul(transpose(nb), cn)                ! C_r = N^T C N
+    do j = 1, f                                   ! M_r = N^T M N (M diagonal)
+      do k = 1, f
+        mr(k, j) = sum(nb(:, k) * m%mdiag * nb(:, j))
+      end do
+    end do
+    ! undamped: K_s v = omega^2 M_r v
+    ks = half * (kr + transpose(kr))
+    a(1:f, 1:f) = mr
+    call dsygv(1, 'V', 'U', f, ks, f, a, 2 * f, ev, wq, -1, info)
+    call grow(max(1, int(wq(1))), status)
+    if (status /= MBD_OK) return
+    call dsygv(1, 'V', 'U', f, ks, f, a, 2 * f, ev, work, size(work), info)
+    if (info > f) then
+      status = MBD_SINGULAR
+      msg = 'modes: a free motion carries no mass (M_r is not positive definite): give ' // &
+            'every moving body a mass and an inertia'
+      return
+    else if (info > 0) then
+      status = MBD_NO_CONVERGENCE
+      write (msg, '(a,i0,a)') 'modes: the undamped eigenvalues did not converge (dsygv info ', &
+        info, ')'
+      return
+    else if (info /= 0) then
+      status = MBD_LAPACK; write (msg, '(a,i0)') 'modes: dsygv failed, info ', info; return
+    end if
+    omega2(1:nk) = ev(1:nk)
+    do k = 1, nk
+      if (abs(ev(k)) <= RIGID_FRACTION * maxval(abs(ev(1:f)))) then
+        kinds(k) = 0
+      else
+        kinds(k) = merge(1, -1, ev(k) > zero)
+      end if
+    end do
+    shapes(:, 1:nk) = matmul(nb, ks(:, 1:nk))     ! phi = N v
+    do k = 1, nk                                  ! sign: the largest entry positive
+      j = maxloc(abs(shapes(:, k)), 1)
+      if (shapes(j, k) < zero) shapes(:, k) = -shapes(:, k)
+    end do
+    ! damped: eigenvalues of [0, I; -M_r^-1 K_r, -M_r^-1 C_r]
+    call dgetrf(f, f, mr, f, ipiv, info)
+    if (info /= 0) then
+      status = MBD_SINGULAR; msg = 'modes: M_r is singular (a free motion carries no mass)'
+      return
+    end if
+    call dgetrs('N', f, f, mr, f, ipiv, kr, f, info)
+    call dgetrs('N', f, f, mr, f, ipiv, cr, f, info)
+    a = zero
+    do j = 1, f
+      a(j, f + j) = one
+    end do
+    a(f + 1:2 * f, 1:f) = -kr
+    a(f + 1:2 * f, f + 1:2 * f) = -cr
+    call dgeev('N', 'N', 2 * f, a, 2 * f, wr, wi, vdum, 1, vdum, 1, wq, -1, info)
+    call grow(max(1, int(wq(1))), status)
+    if (status /= MBD_OK) return
+    call dgeev('N', 'N', 2 * f, a, 2 * f, wr, wi, vdum, 1, vdum, 1, work, size(work), info)
+    if (info /= 0) then
+      status = merge(MBD_NO_CONVERGENCE, MBD_LAPACK, info > 0)
+      write (msg, '(a,i0,a)') 'modes: the damped eigenvalues did not converge (dgeev info ', &
+        info, ')'
+      return
+    end if
+    call sort_eigen(wr, wi, order)
+    do k = 1, 2 * nk
+      sre(k) = wr(order(k)); sim(k) = wi(order(k))
+    end do
+  contains
+    !> y = A x for A on K's sparse pattern (values av).
+    subroutine spmul(av, x, y)
+      real(wp), intent(in) :: av(:), x(:)
+      real(wp), intent(out) :: y(:)
+      integer :: jj, p
+      y = zero
+      do jj = 1, n
+        if (abs(x(jj)) <= zero) cycle
+        do p = w%kptr(jj), w%kptr(jj + 1) - 1
+          y(w%krow(p)) = y(w%krow(p)) + av(p) * x(jj)
+        end do
+      end do
+    end subroutine spmul
+
+    !> work has at least lw entries (MBD_NO_MEMORY when it cannot grow).
+    subroutine grow(lw, st)
+      integer, intent(in) :: lw
+      integer, intent(out) :: st
+      integer :: ierr
+      st = MBD_OK
+      if (size(work) >= lw) return
+      deallocate (work)
+      allocate (work(lw), stat=ierr)
+      if (ierr /= 0) then
+        call mem_fail(REAL_BYTES * lw, 'the LAPACK workspace of the modes', HINT, st, msg)
+        allocate (work(1), stat=ierr)
+      end if
+    end subroutine grow
+  end subroutine modes_solve
+
+  !> order: the eigenvalues (re, im) by |s| ascending, then by im descending (insertion sort;
+  !! 2 nfree entries).
+  pure subroutine sort_eigen(re, im, order)
+    real(wp), intent(in) :: re(:), im(:)
+    integer, intent(out) :: order(:)
+    integer :: i, j, k
+    do i = 1, size(order)
+      order(i) = i
+    end do
+    do i = 2, size(order)
+      k = order(i)
+      j = i - 1
+      do while (j >= 1)
+        if (.not. before(k, order(j))) exit
+        order(j + 1) = order(j)
+        j = j - 1
+      end do
+      order(j + 1) = k
+    end do
+  contains
+    pure logical function before(a, b)
+      integer, intent(in) :: a, b
+      real(wp) :: ma, mb
+      ma = hypot(re(a), im(a)); mb = hypot(re(b), im(b))
+      if (abs(ma - mb) > 1.0e-12_wp * max(ma, mb)) then
+        before = ma < mb
+      else
+        before = im(a) > im(b)
+      end if
+    end function before
+  end subroutine sort_eigen
+
+end module mbd_modes

@@ -1,0 +1,614 @@
+"""Small vibrations about an equilibrium (Model.modes) against closed forms and reduced-
+coordinate models written here without mbd2d: a compound pendulum on a torsion spring, a
+damped block on a guide (under-, critically and over-damped), a double pendulum (its 2 x 2
+mass and stiffness matrices by hand), a spring-mass chain (its closed-form spectrum) on the
+dense and band paths, and a four-bar on a spring (the energy method on its closed-form
+position analysis: V''/M_eff at the equilibrium, where the constraints' curvature counts)."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import mbd2d
+
+G = 9.81
+
+
+def pendulum(k: float = 10.0, c: float = 0.0, mass: float = 1.0, length: float = 1.0,
+             inertia: float | None = None, gravity: float = G, q0: str = "0.5, 0.0, 0.0",
+             angle0: float = 0.0) -> mbd2d.Model:
+    """A bar pinned at its end (-length / 2 in its frame) on a torsion spring-damper."""
+    inertia = mass * length**2 / 12 if inertia is None else inertia
+    return mbd2d.loads(f"""
+[model]
+name = "bar-on-a-spring"
+gravity = [0.0, {-gravity}]
+[[body]]
+name = "bar"
+q0 = [{q0}]
+mass = {mass}
+inertia = {inertia}
+[[joint]]
+type = "revolute"
+name = "pivot"
+bodies = ["ground", "bar"]
+points = [[0.0, 0.0], [{-length / 2}, 0.0]]
+[[force]]
+type = "rotational-spring"
+name = "torsion"
+bodies = ["ground", "bar"]
+stiffness = {k}
+damping = {c}
+angle0 = {angle0}
+""")
+
+
+def bisect(f, a: float, b: float) -> float:
+    """A root of f in [a, b] (f(a) f(b) < 0) to round-off."""
+    fa = f(a)
+    for _ in range(200):
+        mid = 0.5 * (a + b)
+        fm = f(mid)
+        if (fm < 0) == (fa < 0):
+            a, fa = mid, fm
+        else:
+            b = mid
+        if b - a <= 4e-16 * max(1.0, abs(a)):
+            break
+    return 0.5 * (a + b)
+
+
+@pytest.mark.parametrize("k", [10.0, 3.0, 50.0])
+def test_pendulum_on_a_spring(k: float) -> None:
+    """omega^2 = (k - m g (L/2) sin theta*) / I_O at the equilibrium k theta* + m g (L/2)
+    cos theta* = 0, both solved here."""
+    m, L = 1.3, 0.8
+    res = pendulum(k=k, mass=m, length=L).modes()
+    th = bisect(lambda a: k * a + m * G * L / 2 * np.cos(a), -np.pi / 2, 0.0)
+    i_o = m * L**2 / 12 + m * (L / 2)**2
+    w2 = (k - m * G * L / 2 * np.sin(th)) / i_o
+    assert res.n_free == 1 and res.kinds == ["vibration"] and res.stability == "stable"
+    assert abs(res.q[2] - th) < 1e-12
+    assert abs(res.omega2[0] / w2 - 1) < 1e-9
+    assert abs(res.frequency[0] - np.sqrt(w2) / (2 * np.pi)) < 1e-9 * res.frequency[0]
+    # mass-normalized: phi^T M phi = 1 with M = diag(m, m, I)
+    phi = res.shape(0)
+    assert abs(m * (phi[0]**2 + phi[1]**2) + m * L**2 / 12 * phi[2]**2 - 1) < 1e-12
+    assert phi[2] > 0 and abs(phi[2] - 1 / np.sqrt(i_o)) < 1e-12
+    # the pivot does not move: the centre moves on its circle, d r = (L/2)(-sin, cos) d theta
+    assert abs(phi[0] + L / 2 * np.sin(th) * phi[2]) < 1e-12
+    assert abs(phi[1] - L / 2 * np.cos(th) * phi[2]) < 1e-12
+
+
+@pytest.mark.parametrize("c", [0.0, 0.4, 2 * np.sqrt(36.0 * 2.0), 30.0])
+def test_damped_block_on_a_guide(c: float) -> None:
+    """A 2 kg block on a vertical guide hanging from a spring (k = 36 N/m) and damper c:
+    s = (-c +- sqrt(c^2 - 4 m k)) / (2 m), omega^2 = k / m, zeta = c / (2 sqrt(k m))."""
+    m, k = 2.0, 36.0
+    model = mbd2d.loads(f"""
+[model]
+name = "block"
+gravity = [0.0, -9.81]
+[[body]]
+name = "block"
+q0 = [0.0, -1.0, 0.0]
+mass = {m}
+inertia = 0.01
+[[joint]]
+type = "translational"
+name = "guide"
+bodies = ["ground", "block"]
+points = [[0, 0], [0, 0]]
+axes = [[0, 1], [0, 1]]
+[[force]]
+type = "spring"
+name = "s"
+bodies = ["ground", "block"]
+points = [[0.0, 0.0], [0.0, 0.0]]
+stiffness = {k}
+damping = {c}
+length0 = 0.5
+""")
+    res = model.modes()
+    assert abs(res.omega2[0] / (k / m) - 1) < 1e-9
+    assert abs(res.q[1] - (-0.5 - m * G / k)) < 1e-12
+    disc = complex(c * c - 4 * m * k)
+    want = sorted([(-c + np.sqrt(disc)) / (2 * m), (-c - np.sqrt(disc)) / (2 * m)],
+                  key=lambda s: (abs(s), -s.imag))
+    assert res.eigenvalues.shape == (2,)
+    scale = np.sqrt(k / m)
+    # K and C come from central differences (step 6e-6): about 1e-11 relative (measured
+    # 8e-12 here); at critical damping the double root splits by its square root (6e-6)
+    if abs(disc) < 1e-9:
+        np.testing.assert_allclose(res.eigenvalues, want, rtol=0, atol=3e-5 * scale)
+        np.testing.assert_allclose(res.damping_ratio, 1.0, atol=3e-5)
+    else:
+        np.testing.assert_allclose(res.eigenvalues, want, rtol=0, atol=1e-10 * scale)
+        if c < 2 * np.sqrt(k * m):
+            np.testing.assert_allclose(res.damping_ratio, c / (2 * np.sqrt(k * m)),
+                                       atol=1e-10)
+            np.testing.assert_allclose(res.damped_frequency,
+                                       np.sqrt(k / m - (c / (2 * m))**2) / (2 * np.pi),
+                                       rtol=1e-10)
+
+
+def double_pendulum(m1: float, m2: float, l1: float, l2: float, i1: float, i2: float
+                    ) -> mbd2d.Model:
+    """Two bars hanging from a pin, pinned end to end (centres of mass at mid-length)."""
+    return mbd2d.loads(f"""
+[model]
+name = "double-pendulum"
+gravity = [0.0, -9.81]
+[[body]]
+name = "upper"
+q0 = [0.1, {-l1 / 2}, -1.5]
+mass = {m1}
+inertia = {i1}
+[[body]]
+name = "lower"
+q0 = [0.2, {-l1 - l2 / 2}, -1.4]
+mass = {m2}
+inertia = {i2}
+[[joint]]
+type = "revolute"
+name = "top"
+bodies = ["ground", "upper"]
+points = [[0, 0], [{-l1 / 2}, 0]]
+[[joint]]
+type = "revolute"
+name = "elbow"
+bodies = ["upper", "lower"]
+points = [[{l1 / 2}, 0], [{-l2 / 2}, 0]]
+""")
+
+
+def test_double_pendulum_against_its_two_by_two_matrices() -> None:
+    """About the hanging equilibrium (absolute angles from the vertical): M = [[I1 + m1 a1^2
+    + m2 l1^2, m2 l1 a2], [m2 l1 a2, I2 + m2 a2^2]], K = g diag(m1 a1 + m2 l1, m2 a2);
+    frequencies and the shapes' angle ratios from numpy's eigensolver."""
+    m1, m2, l1, l2, i1, i2 = 1.5, 0.7, 0.9, 0.6, 0.11, 0.03
+    res = double_pendulum(m1, m2, l1, l2, i1, i2).modes()
+    a1, a2 = l1 / 2, l2 / 2
+    mm = np.array([[i1 + m1 * a1**2 + m2 * l1**2, m2 * l1 * a2], [m2 * l1 * a2, i2 + m2 * a2**2]])
+    kk = G * np.diag([m1 * a1 + m2 * l1, m2 * a2])
+    w2, vec = np.linalg.eig(np.linalg.solve(mm, kk))
+    order = np.argsort(w2)
+    np.testing.assert_allclose(res.omega2, w2[order], rtol=1e-9)
+    for j, col in enumerate(order):
+        ratio = vec[1, col] / vec[0, col]
+        phi = res.shape(j)
+        assert abs(phi[5] / phi[2] - ratio) < 1e-8 * max(1.0, abs(ratio))
+    assert res.stability == "stable" and res.kinds == ["vibration", "vibration"]
+    np.testing.assert_allclose(res.damping_ratio, 0.0, atol=1e-12)
+    np.testing.assert_allclose(res.eigenvalues.real, 0.0, atol=1e-7 * np.sqrt(w2.max()))
+
+
+def spring_chain(n: int, m: float = 0.5, k: float = 200.0) -> mbd2d.Model:
+    """n blocks on horizontal guides (no gravity), block 1 tied to ground and each block to
+    the next by springs k at their natural lengths: a fixed-free chain."""
+    parts = ["[model]", 'name = "chain"', "gravity = [0.0, 0.0]"]
+    for i in range(1, n + 1):
+        parts += ["[[body]]", f'name = "b{i}"', f"q0 = [{i * 0.1}, 0.0, 0.0]",
+                  f"mass = {m}", "inertia = 0.001",
+                  "[[joint]]", 'type = "translational"', f'name = "g{i}"',
+                  f'bodies = ["ground", "b{i}"]', f"points = [[0.0, 0.0], [0.0, 0.0]]",
+                  "axes = [[1, 0], [1, 0]]",
+                  "[[force]]", 'type = "spring"', f'name = "s{i}"',
+                  f'bodies = ["{"ground" if i == 1 else f"b{i - 1}"}", "b{i}"]',
+                  "points = [[0.0, 0.0], [0.0, 0.0]]",
+                  f"stiffness = {k}", "damping = 0.0", "length0 = 0.1"]
+    return mbd2d.loads("\n".join(parts))
+
+
+@pytest.mark.parametrize("n, solver", [(6, "dense"), (40, "banded"), (40, "dense")])
+def test_spring_chain_spectrum(n: int, solver: str) -> None:
+    """A fixed-free chain of n masses: omega_j = 2 sqrt(k/m) sin((2j - 1) pi / (2 (2n + 1)))."""
+    m, k = 0.5, 200.0
+    res = spring_chain(n, m, k).modes(solver=solver)
+    j = np.arange(1, n + 1)
+    want = 2 * np.sqrt(k / m) * np.sin((2 * j - 1) * np.pi / (2 * (2 * n + 1)))
+    assert res.stats["solver"] == solver and res.n_free == n
+    np.testing.assert_allclose(res.omega, want, rtol=1e-8)
+    # the lowest shape: x_i proportional to sin((2 i) pi / (2 (2n + 1))) ... from the block 1
+    x = res.shapes[0::3, 0]
+    i = np.arange(1, n + 1)
+    shape = np.sin(i * np.pi / (2 * n + 1))
+    np.testing.assert_allclose(x / x[-1], shape / shape[-1], atol=1e-8)
+
+
+def fourbar_energy(th2: float, geo: dict) -> tuple[float, float]:
+    """V and M_eff of the spring-loaded four-bar at crank angle th2 (open branch), by its
+    closed-form position analysis: coupler point by the circle intersection."""
+    a, b, c, d = geo["a"], geo["b"], geo["c"], geo["d"]
+    A = np.array([a * np.cos(th2), a * np.sin(th2)])
+    O4 = np.array([d, 0.0])
+    e = O4 - A
+    L = np.hypot(*e)
+    h = (b * b - c * c + L * L) / (2 * L)
+    B = A + h * e / L + np.sqrt(b * b - h * h) * np.array([-e[1], e[0]]) / L
+    th3 = np.arctan2(B[1] - A[1], B[0] - A[0])
+    th4 = np.arctan2(B[1] - O4[1], B[0] - O4[0])
+    cms = [A / 2, (A + B) / 2, (O4 + B) / 2]
+    return cms, (th2, th3, th4)
+
+
+def fourbar_reduced(th2: float, geo: dict) -> tuple[float, float, float]:
+    """V(th2), V''(th2) and M_eff(th2) by high-order central differences of the closed form
+    (step 1e-3, 8th order: errors ~1e-13 here)."""
+    ms, ins = geo["m"], geo["I"]
+
+    def pot(t: float) -> float:
+        cms, ths = fourbar_energy(t, geo)
+        return sum(m * G * cm[1] for m, cm in zip(ms, cms)) + 0.5 * geo["k"] * (t - geo["t0"])**2
+
+    def state(t: float) -> np.ndarray:
+        cms, ths = fourbar_energy(t, geo)
+        return np.concatenate([np.concatenate(cms), ths])
+
+    h = 1e-3
+    w1 = np.array([1 / 280, -4 / 105, 1 / 5, -4 / 5, 0, 4 / 5, -1 / 5, 4 / 105, -1 / 280])
+    w2 = np.array([-1 / 560, 8 / 315, -1 / 5, 8 / 5, -205 / 72, 8 / 5, -1 / 5, 8 / 315,
+                   -1 / 560])
+    offs = np.arange(-4, 5) * h
+    v2 = sum(w * pot(th2 + o) for w, o in zip(w2, offs)) / h**2
+    v1 = sum(w * pot(th2 + o) for w, o in zip(w1, offs)) / h
+    ds = sum(w * state(th2 + o) for w, o in zip(w1, offs)) / h
+    meff = sum(m * (ds[2 * i]**2 + ds[2 * i + 1]**2) for i, m in enumerate(ms))
+    meff += sum(inn * ds[6 + i]**2 for i, inn in enumerate(ins))
+    return v1, v2, meff
+
+
+def test_fourbar_on_a_spring_by_the_energy_method() -> None:
+    """A crank-rocker whose crank is held by a torsion spring, under gravity: omega^2 =
+    V''(th2*) / M_eff(th2*) at V'(th2*) = 0 (the equilibrium solved here). Measured 7e-10,
+    the reference's own second difference (h = 1e-3: rounding eps V / h^2 ~ 2e-10)."""
+    geo = {"a": 0.2, "b": 0.7, "c": 0.5, "d": 0.6, "m": [0.4, 1.2, 0.9],
+           "I": [0.002, 0.05, 0.02], "k": 6.0, "t0": 1.2}
+    cms, ths = fourbar_energy(1.0, geo)
+    bodies = ["crank", "coupler", "rocker"]
+    lens = [geo["a"], geo["b"], geo["c"]]
+    text = ['[model]', 'name = "sprung-fourbar"', 'gravity = [0.0, -9.81]']
+    for nm, cm, th, m, inn in zip(bodies, cms, ths, geo["m"], geo["I"]):
+        text += ['[[body]]', f'name = "{nm}"', f'q0 = [{cm[0]}, {cm[1]}, {th}]', f'mass = {m}',
+                 f'inertia = {inn}']
+    joints = [("O2", "ground", "crank", (0.0, 0.0), (-lens[0] / 2, 0.0)),
+              ("A", "crank", "coupler", (lens[0] / 2, 0.0), (-lens[1] / 2, 0.0)),
+              ("B", "coupler", "rocker", (lens[1] / 2, 0.0), (lens[2] / 2, 0.0)),
+              ("O4", "ground", "rocker", (geo["d"], 0.0), (-lens[2] / 2, 0.0))]
+    for nm, b1, b2, p1, p2 in joints:
+        text += ['[[joint]]', 'type = "revolute"', f'name = "{nm}"', f'bodies = ["{b1}", "{b2}"]',
+                 f'points = [[{p1[0]}, {p1[1]}], [{p2[0]}, {p2[1]}]]']
+    text += ['[[force]]', 'type = "rotational-spring"', 'name = "k"',
+             'bodies = ["ground", "crank"]', f'stiffness = {geo["k"]}', 'damping = 0.0',
+             f'angle0 = {geo["t0"]}']
+    res = mbd2d.loads("\n".join(text)).modes()
+    th = bisect(lambda t: fourbar_reduced(t, geo)[0], 0.3, 2.0)
+    _, v2, meff = fourbar_reduced(th, geo)
+    assert abs(res.q[2] - th) < 1e-9
+    assert res.n_free == 1
+    assert abs(res.omega2[0] / (v2 / meff) - 1) < 1e-8
+    # the crank's angle in the mass-normalized shape: 1 / sqrt(M_eff)
+    assert abs(abs(res.shape(0)[2]) - 1 / np.sqrt(meff)) < 1e-8 / np.sqrt(meff)
+
+
+def test_inverted_pendulum_is_unstable_about_its_top() -> None:
+    """Linearized about the upright bar (equilibrium=False, no spring): omega^2 = -m g a /
+    I_O, the mode "unstable"; statics started exactly there stays (balanced, "unstable"),
+    started beside it, descends to the hanging bar (stable, +m g a / I_O)."""
+    m, L = 0.8, 0.6
+    model = pendulum(k=0.0, mass=m, length=L, q0=f"0.0, {L / 2}, {np.pi / 2}")
+    i_o = m * L**2 / 3
+    up = model.modes(equilibrium=False)
+    assert up.kinds == ["unstable"] and up.stability.startswith("not examined")
+    assert abs(up.omega2[0] / (-m * G * L / 2 / i_o) - 1) < 1e-9
+    assert up.omega[0] == 0.0 and up.frequency[0] == 0.0
+    # the first-order form's eigenvalues: +- sqrt(m g a / I_O), real
+    np.testing.assert_allclose(sorted(up.eigenvalues.real), [-np.sqrt(m * G * L / 2 / i_o),
+                               np.sqrt(m * G * L / 2 / i_o)], rtol=1e-9)
+    top = model.modes()
+    assert top.stability == "unstable" and top.kinds == ["unstable"]
+    assert abs(top.omega2[0] / up.omega2[0] - 1) < 1e-12
+    down = pendulum(k=0.0, mass=m, length=L, q0=f"0.1, {L / 2}, {np.pi / 2 - 0.2}").modes()
+    assert down.stability == "stable" and down.kinds == ["vibration"]
+    assert abs(down.q[2] + np.pi / 2) < 1e-12
+    assert abs(down.omega2[0] / (m * G * L / 2 / i_o) - 1) < 1e-9
+
+
+def test_a_free_wheel_has_a_rigid_mode() -> None:
+    """A wheel pinned at its centre, no gravity and no spring: one free motion without
+    stiffness (omega^2 = 0, "rigid"), next to a pendulum's vibration in the same model."""
+    model = mbd2d.loads("""
+[model]
+name = "wheel-and-pendulum"
+gravity = [0.0, -9.81]
+[[body]]
+name = "wheel"
+q0 = [0.0, 0.0, 0.3]
+mass = 1.0
+inertia = 0.02
+[[body]]
+name = "bob"
+q0 = [2.0, -0.5, 0.0]
+mass = 1.0
+inertia = 0.001
+[[joint]]
+type = "revolute"
+name = "axle"
+bodies = ["ground", "wheel"]
+points = [[0, 0], [0, 0]]
+[[joint]]
+type = "revolute"
+name = "hinge"
+bodies = ["ground", "bob"]
+points = [[2.0, 0.0], [0.0, 0.5]]
+""")
+    res = model.modes(equilibrium=False)
+    assert res.n_free == 2 and res.kinds == ["rigid", "vibration"]
+    assert abs(res.omega2[0]) <= 1e-9 * res.omega2[1]
+    assert abs(res.omega2[1] / (G * 0.5 / (0.001 + 0.25)) - 1) < 1e-9
+    assert abs(res.body_shape(0, "wheel")[2] - 1 / np.sqrt(0.02)) < 1e-12
+    np.testing.assert_allclose(res.body_shape(0, "bob"), 0.0, atol=1e-12)
+
+
+def test_a_fully_constrained_model_has_no_modes() -> None:
+    res = mbd2d.load(Path(__file__).parents[1] / "examples" / "fourbar_masses.toml").modes()
+    assert res.n_free == 0 and res.omega2.size == 0 and res.shapes.shape[1] == 0
+    assert res.stability == "fully constrained" and "0 free motion" in res.summary()
+
+
+def test_count_and_the_lowest_modes() -> None:
+    full = spring_chain(8).modes()
+    few = spring_chain(8).modes(count=3)
+    assert few.n_free == 8 and few.omega2.size == 3 and few.eigenvalues.size == 6
+    np.testing.assert_array_equal(few.omega2, full.omega2[:3])
+    np.testing.assert_array_equal(few.shapes, full.shapes[:, :3])
+
+
+@pytest.mark.parametrize("kw, needle", [
+    ({"count": 0}, "count must be a positive whole number"),
+    ({"count": 2.5}, "count must be a positive whole number"),
+    ({"count": True}, "count must be a positive whole number"),
+    ({"equilibrium": "yes"}, "equilibrium must be True or False"),
+    ({"t": float("nan")}, "t"),
+    ({"solver": "sparse"}, "solver"),
+])
+def test_bad_arguments_are_model_errors(kw: dict, needle: str) -> None:
+    with pytest.raises(mbd2d.ModelError, match=needle):
+        pendulum().modes(**kw)
+
+
+def test_mode_index_out_of_range_is_a_model_error() -> None:
+    res = pendulum().modes()
+    for k in (1, -2, 0.5, "0"):
+        with pytest.raises(mbd2d.ModelError, match="does not exist"):
+            res.shape(k)  # type: ignore[arg-type]
+    np.testing.assert_array_equal(res.shape(-1), res.shape(0))
+
+
+def test_a_massless_free_motion_is_named() -> None:
+    """A disc without inertia turning about its centre on a spring: M_r is singular (or the
+    model is refused on input)."""
+    text = """
+[model]
+name = "massless-turn"
+gravity = [0.0, 0.0]
+[[body]]
+name = "disc"
+q0 = [0.0, 0.0, 0.1]
+mass = 1.0
+inertia = 0.0
+[[joint]]
+type = "revolute"
+name = "axle"
+bodies = ["ground", "disc"]
+points = [[0, 0], [0, 0]]
+[[force]]
+type = "rotational-spring"
+name = "k"
+bodies = ["ground", "disc"]
+stiffness = 2.0
+damping = 0.0
+angle0 = 0.0
+"""
+    try:
+        m = mbd2d.loads(text)
+    except mbd2d.ModelError:
+        return                          # refused on input: also typed
+    with pytest.raises((mbd2d.SingularJacobianError, mbd2d.ModelError), match="mass"):
+        m.modes()
+
+
+def test_friction_is_refused_as_in_statics() -> None:
+    model = mbd2d.loads("""
+[model]
+name = "rubbing"
+gravity = [0.0, -9.81]
+[[body]]
+name = "bar"
+q0 = [0.5, 0.0, 0.0]
+mass = 1.0
+inertia = 0.1
+[[joint]]
+type = "revolute"
+name = "pivot"
+bodies = ["ground", "bar"]
+points = [[0.0, 0.0], [-0.5, 0.0]]
+friction = { mu = 0.2, pin_radius = 0.01 }
+""")
+    with pytest.raises(mbd2d.ModelError, match="friction"):
+        model.modes()
+
+
+def test_csv_summary_and_pictures(tmp_path: Path) -> None:
+    pytest.importorskip("matplotlib")
+    res = double_pendulum(1.5, 0.7, 0.9, 0.6, 0.11, 0.03).modes()
+    res.to_csv(tmp_path / "modes.csv")
+    res.to_csv(tmp_path / "damped.csv", damped=True)
+    table = np.genfromtxt(tmp_path / "modes.csv", delimiter=",", names=True)
+    np.testing.assert_allclose(table["frequency_hz"], res.frequency, rtol=1e-12)
+    np.testing.assert_allclose(table["lowertheta"], res.shapes[5], rtol=1e-12)
+    damped = np.genfromtxt(tmp_path / "damped.csv", delimiter=",", names=True)
+    assert damped.size == 4
+    text = res.summary()
+    assert "2 free motion(s)" in text and "vibration" in text
+    mot = res.motion(1, frames=9)
+    assert mot.q.shape == (9, 6) and abs(mot.t[-1] - 1 / res.frequency[1]) < 1e-12
+    np.testing.assert_allclose(mot.q[0], res.q)
+    ax = res.plot(1)
+    assert "mode 1" in ax.get_title()
+    res.animate(0, tmp_path / "mode.gif", max_frames=8)
+    assert (tmp_path / "mode.gif").stat().st_size > 1000
+
+
+def damped_double_pendulum() -> mbd2d.Model:
+    """The double pendulum with a torsion damper at the elbow and a spring at the top."""
+    model = double_pendulum(1.5, 0.7, 0.9, 0.6, 0.11, 0.03)
+    model.add_rotational_spring(["ground", "upper"], stiffness=4.0, damping=0.0, angle0=-1.6,
+                                name="top_spring")
+    model.add_rotational_spring(["upper", "lower"], stiffness=0.0, damping=0.3, angle0=0.0,
+                                name="elbow_damper")
+    return model
+
+
+def test_damped_double_pendulum_against_its_matrices() -> None:
+    """The damped first-order form [0, I; -M^-1 K, -M^-1 C] with M, K, C written here
+    (K: gravity and the top spring; C: the elbow damper on theta2 - theta1)."""
+    m1, m2, l1, l2, i1, i2 = 1.5, 0.7, 0.9, 0.6, 0.11, 0.03
+    res = damped_double_pendulum().modes()
+    th1 = res.q[2] + np.pi / 2            # the upper bar's angle from the vertical at rest
+    th2 = res.q[5] + np.pi / 2
+    a1, a2 = l1 / 2, l2 / 2
+    c12 = np.cos(th1 - th2)
+    mm = np.array([[i1 + m1 * a1**2 + m2 * l1**2, m2 * l1 * a2 * c12],
+                   [m2 * l1 * a2 * c12, i2 + m2 * a2**2]])
+    # V = -g ((m1 a1 + m2 l1) cos th1 + m2 a2 cos th2) + 2 (th1 - pi/2 + 1.6)^2; its Hessian
+    # (the kinetic energy's change does not enter at rest)
+    kk = np.array([[G * (m1 * a1 + m2 * l1) * np.cos(th1) + 4.0, 0.0],
+                   [0.0, G * m2 * a2 * np.cos(th2)]])
+    cc = 0.3 * np.array([[1.0, -1.0], [-1.0, 1.0]])
+    # the equilibrium itself: V' = 0 in both angles
+    assert abs(G * (m1 * a1 + m2 * l1) * np.sin(th1) + 4.0 * (th1 - np.pi / 2 + 1.6)) < 1e-9
+    assert abs(np.sin(th2)) < 1e-12
+    w2 = np.sort(np.linalg.eigvals(np.linalg.solve(mm, kk)).real)
+    np.testing.assert_allclose(res.omega2, w2, rtol=1e-9)
+    a = np.block([[np.zeros((2, 2)), np.eye(2)],
+                  [-np.linalg.solve(mm, kk), -np.linalg.solve(mm, cc)]])
+    s = np.linalg.eigvals(a)
+    s = np.array(sorted(s, key=lambda z: (abs(z), -z.imag)))
+    np.testing.assert_allclose(res.eigenvalues, s, rtol=0, atol=1e-10 * abs(s).max())
+    assert np.all(res.damping_ratio > 0) and np.all(res.damping_ratio < 1)
+
+
+def test_mbd2d_solve_writes_the_modes_python_writes(tmp_path: Path) -> None:
+    """The standalone program: the modes table, the damped table, a count and a
+    linearization about q0, to the last digit of Python's CSV."""
+    import subprocess
+
+    from test_standalone import find_solver
+    damped = damped_double_pendulum()
+    up = pendulum(k=0.0, q0=f"0.0, 0.5, {np.pi / 2}")
+    runs = [(damped, {}, damped.modes(), {}),
+            (damped, {"outputs": ["damped"]}, damped.modes(), {"damped": True}),
+            (spring_chain(7), {"count": 3, "solver": "banded"},
+             spring_chain(7).modes(count=3, solver="banded"), {}),
+            (up, {"equilibrium": False}, up.modes(equilibrium=False), {})]
+    for k, (model, kw, res, csv_kw) in enumerate(runs):
+        mbd = tmp_path / f"m{k}.mbd"
+        model.export(mbd, analysis="modes", **kw)
+        out = tmp_path / f"f{k}.csv"
+        r = subprocess.run([find_solver(), str(mbd), str(out)], capture_output=True, text=True,
+                           timeout=60)
+        assert r.returncode == 0, r.stderr
+        py = tmp_path / f"p{k}.csv"
+        res.to_csv(py, **csv_kw)
+        assert out.read_text() == py.read_text()
+
+
+@pytest.mark.parametrize("line, needle", [
+    ("outputs energy", "modes takes no outputs"),
+    ("count -1", "count must be"),
+    ("at_q0 2", "at_q0 must be"),
+    ("count 1.5", "count"),
+])
+def test_mbd2d_solve_refuses_bad_modes_settings(tmp_path: Path, line: str, needle: str) -> None:
+    import subprocess
+
+    from test_standalone import find_solver
+    mbd = tmp_path / "m.mbd"
+    pendulum().export(mbd, analysis="modes")
+    mbd.write_text(mbd.read_text().replace("\nend\n", f"\n{line}\nend\n"))
+    r = subprocess.run([find_solver(), str(mbd), str(tmp_path / "o.csv")], capture_output=True,
+                       text=True, timeout=60)
+    assert r.returncode == 2 and needle in r.stderr and "Traceback" not in r.stderr
+
+
+def test_export_refuses_what_modes_does_not_write(tmp_path: Path) -> None:
+    with pytest.raises(mbd2d.ModelError, match="unknown output 'energy'"):
+        pendulum().export(tmp_path / "m.mbd", analysis="modes", outputs=["energy"])
+    with pytest.raises(mbd2d.ModelError, match="sensitivities"):
+        pendulum().export(tmp_path / "m.mbd", analysis="modes",
+                          sensitivities=["force.torsion.stiffness"])
+    with pytest.raises(mbd2d.ModelError, match="unknown output 'damped'"):
+        pendulum().export(tmp_path / "m.mbd", analysis="statics", outputs=["damped"])
+
+
+def test_the_command_line(tmp_path: Path) -> None:
+    """``mbd2d modes``: the summary, the CSVs Python writes, a picture; bad files are exit 2."""
+    import subprocess
+    import sys
+    pytest.importorskip("matplotlib")
+    toml = Path(__file__).parents[1] / "examples" / "pendulum_spring.toml"
+
+    def cli(*args: str) -> subprocess.CompletedProcess:
+        return subprocess.run([sys.executable, "-m", "mbd2d", "modes", str(toml), *args],
+                              capture_output=True, text=True, timeout=120)
+    r = cli("--out", str(tmp_path / "m.csv"), "--damped-out", str(tmp_path / "d.csv"),
+            "--picture", str(tmp_path / "m.png"))
+    assert r.returncode == 0, r.stderr
+    assert "1 free motion(s)" in r.stdout and "vibration" in r.stdout
+    res = mbd2d.load(toml).modes()
+    res.to_csv(tmp_path / "p.csv")
+    res.to_csv(tmp_path / "pd.csv", damped=True)
+    assert (tmp_path / "m.csv").read_text() == (tmp_path / "p.csv").read_text()
+    assert (tmp_path / "d.csv").read_text() == (tmp_path / "pd.csv").read_text()
+    assert (tmp_path / "m.png").stat().st_size > 1000
+    for bad in (["--out", str(tmp_path / "m.txt")], ["--picture", str(tmp_path / "m.bmp")],
+                ["--count", "0"], ["--mode", "3", "--picture", str(tmp_path / "x.png")]):
+        r = cli(*bad)
+        assert r.returncode == 2 and "Traceback" not in r.stderr, (bad, r.stderr)
+
+
+@pytest.mark.parametrize("law, n", [("linear", 1.0), ("hertz", 1.5)])
+def test_a_ball_resting_on_a_contact(law: str, n: float) -> None:
+    """A ball on a vertical guide resting on the floor through a contact law F = k d^n: at
+    rest d = (m g / k)^(1/n), and omega^2 = n k d^(n - 1) / m (measured 1e-12 and 1.2e-9)."""
+    m, k = 2.0, 1e5
+    model = mbd2d.loads(f"""
+[model]
+name = "ball"
+gravity = [0.0, -9.81]
+[[body]]
+name = "ball"
+q0 = [0.0, 0.1, 0.0]
+mass = {m}
+inertia = 0.01
+[[joint]]
+type = "translational"
+name = "guide"
+bodies = ["ground", "ball"]
+points = [[0, 0], [0, 0]]
+axes = [[0, 1], [0, 1]]
+[[contact]]
+name = "floor"
+type = "circle-line"
+bodies = ["ball", "ground"]
+circle = {{ center = [0.0, 0.0], radius = 0.1 }}
+line = {{ point = [0.0, 0.0], normal = [0.0, 1.0] }}
+law = {{ model = "{law}", stiffness = {k}, exponent = {n}, restitution = 1.0 }}
+""")
+    res = model.modes()
+    d = (m * G / k)**(1 / n)
+    assert abs(res.q[1] - (0.1 - d)) < 1e-12
+    assert abs(res.omega2[0] / (n * k * d**(n - 1) / m) - 1) < 1e-8
