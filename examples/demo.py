@@ -10,7 +10,8 @@ coupler curve) and ``slider_crank.gif``, the cam lift-off pictures, the design s
 three pictures (examples/design_study.py: a sweep of the crank-rocker's coupler length, the
 sensitivities of the rocker angle, the tolerance of a coupler point), and the same sweep
 and a sensitivity run in the standalone mbd2d-solve (examples/standalone_sweep.py), a cam
-synthesized from its follower's program and run (examples/cam_design.py). The seed four-bar is
+synthesized from its follower's program and run (examples/cam_design.py), a half car's
+vibration modes (examples/vibration_modes.py). The seed four-bar is
 non-Grashof: driven past its
 toggle it raises :class:`mbd2d.SingularConfigurationError`, which is the expected outcome;
 its partial results are drawn with the toggle configuration marked.
@@ -168,6 +169,20 @@ def main(argv: list[str] | None = None) -> int:
     except Exception as exc:  # report every example, then fail
         traceback.print_exc()
         problems.append(f"cam_design: {type(exc).__name__}: {exc}")
+
+    total += 1
+    print("\nvibration_modes (a half car's modes about its equilibrium, model.modes):")
+    try:
+        sys.path.insert(0, str(HERE))
+        import vibration_modes
+        problem, files = vibration_modes.run(out)
+        written += files
+        print("vibration_modes: " + ", ".join(Path(f).name for f in files) + f" in {out}")
+        if problem:
+            problems.append(f"vibration_modes: {problem}")
+    except Exception as exc:  # report every example, then fail
+        traceback.print_exc()
+        problems.append(f"vibration_modes: {type(exc).__name__}: {exc}")
 
     total += 1
     print("\nstandalone_sweep (the design study's sweep and a sensitivity run in mbd2d-solve):")

@@ -123,7 +123,7 @@ def test_demo_script(tmp_path: Path) -> None:
                           cwd=tmp_path, capture_output=True, text=True, timeout=600)
     assert proc.returncode == 0, proc.stdout + proc.stderr
     pngs = sorted(out.glob("*.png"))
-    assert len(pngs) == 16, [p.name for p in pngs]
+    assert len(pngs) == 18, [p.name for p in pngs]
     for name in ["fourbar_seed", "fourbar_grashof", "slider_crank", "cam_follower"]:
         for kind in ["mechanism", "timeseries"]:
             p = out / f"{name}_{kind}.png"
@@ -135,7 +135,7 @@ def test_demo_script(tmp_path: Path) -> None:
     for kind in ["curves", "sensitivity", "tolerance"]:
         assert (out / f"design_study_{kind}.png").stat().st_size > 0
     assert "hit a dead centre" in proc.stdout
-    assert "summary: 8/8" in proc.stdout and "GIF animations" in proc.stdout
+    assert "summary: 9/9" in proc.stdout and "GIF animations" in proc.stdout
     for kind in ["mechanism", "program", "base_radius"]:       # the synthesized cam
         assert (out / f"cam_design_{kind}.png").stat().st_size > 0
     # the design study's sweep and a sensitivity run through mbd2d-solve, as Python writes them
@@ -143,4 +143,7 @@ def test_demo_script(tmp_path: Path) -> None:
         proc.stdout
     assert "the same CSV: True" in proc.stdout
     assert gifs == ["cam_design.gif", "cam_liftoff.gif", "fourbar_grashof.gif",
-                    "slider_crank.gif"]
+                    "slider_crank.gif", "vibration_modes.gif"]
+    for kind in ["shapes", "damping"]:                          # the half car's modes
+        assert (out / f"vibration_modes_{kind}.png").stat().st_size > 0
+    assert "ratio 2.00, second order" in proc.stdout

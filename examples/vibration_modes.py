@@ -1,0 +1,139 @@
+"""The vibration modes of a half car (examples/half_car.toml): bounce, pitch, two wheel hops.
+
+model.modes() linearizes the equations of motion about the static equilibrium and gives the
+natural frequencies, the mass-normalized shapes and the damped eigenvalues. Two checks that
+do not use the modes' own numbers: released from the equilibrium displaced along an undamped
+mode, the forward dynamics of the nonlinear model moves as a cos(omega t) phi, its departure
+from that falling with the amplitude as the linearization's error must (halved with the
+amplitude: second order); and the damping chart's undamped end (c = 0) has zero damping
+ratios.
+
+Usage::
+
+    python examples/vibration_modes.py [--out DIR]
+
+Writes vibration_modes_shapes.png (the four modes, each drawn at both extremes),
+vibration_modes_damping.png (each mode's damping ratio and damped frequency against the
+suspension damping: the designer's chart) and vibration_modes.gif (the pitch mode) to DIR
+(default examples/output/). Exit code 0 when the released modes depart from their linear
+motion by less than 2e-3 of a 1 mm amplitude, and by half as much at half the amplitude.
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+import numpy as np
+
+import mbd2d
+
+HERE = Path(__file__).resolve().parent
+MODEL = HERE / "half_car.toml"
+#: the released mode's largest departure from a cos(omega t) phi, relative to a
+RELEASE_TOL = 2e-3
+#: the amplitude of the release: the largest point moves this far [m]
+AMPLITUDE = 1e-3
+DAMPING = ("force.front_suspension.damping", "force.rear_suspension.damping")
+
+
+def released(model: mbd2d.Model, res: mbd2d.ModesResult, k: int,
+             amplitude: float = AMPLITUDE) -> float:
+    """Release the undamped model from q* + a phi_k at rest; the largest |q(t) - q* - a
+    cos(omega t) phi_k| over two periods, relative to a |phi_k|_inf."""
+    undamped = model.with_params({name: 0.0 for name in DAMPING})
+    phi = res.shape(k)
+    a = amplitude / np.abs(phi[:9]).max()
+    start = res.q + a * phi
+    for i, body in enumerate(undamped.bodies):
+        body.q0 = [float(v) for v in start[3 * i:3 * i + 3]]
+    period = 1.0 / res.frequency[k]
+    run = undamped.dynamics(2 * period, 200, rtol=1e-10, atol=1e-12)
+    want = res.q[None, :] + a * np.cos(2 * np.pi * run.t / period)[:, None] * phi[None, :]
+    return float(np.abs(run.q - want).max() / (a * np.abs(phi).max()))
+
+
+def damping_chart(model: mbd2d.Model, path: Path) -> float:
+    """Damping ratio and damped frequency of each mode against the suspension damping (both
+    struts); returns the largest damping ratio at c = 0."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    cs = np.linspace(0.0, 3500.0, 36)            # (past about 3800 N s/m pitch is overdamped)
+    zeta, fd = np.full((cs.size, 4), np.nan), np.full((cs.size, 4), np.nan)
+    for i, c in enumerate(cs):
+        r = model.with_params({name: c for name in DAMPING}).modes()
+        up = r.eigenvalues.imag > 0                  # one of each underdamped pair
+        n = min(4, int(up.sum()))
+        zeta[i, :n] = r.damping_ratio[up][:n]
+        fd[i, :n] = r.damped_frequency[up][:n]
+    fig, (a1, a2) = plt.subplots(2, 1, figsize=(7.5, 6.5), sharex=True)
+    names = ["1st (bounce)", "2nd (pitch)", "3rd (a wheel hop)", "4th (a wheel hop)"]
+    for j in range(zeta.shape[1]):
+        a1.plot(cs, zeta[:, j], lw=1.8, label=names[j] if j < len(names) else f"mode {j}")
+        a2.plot(cs, fd[:, j], lw=1.8)
+    a1.axvline(1500.0, color="0.5", lw=0.8, ls=":", label="this design (1500 N s/m)")
+    a1.set_ylabel("damping ratio zeta")
+    a1.legend(loc="upper left", fontsize=8)
+    a2.set_yscale("log")
+    a2.set_ylabel("damped frequency [Hz]")
+    a2.set_xlabel("suspension damping c (both struts) [N s/m]")
+    a1.set_title("half car: modes against the suspension damping (model.modes per variant)")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return float(np.nanmax(np.abs(zeta[0])))
+
+
+def shapes_figure(res: mbd2d.ModesResult, path: Path) -> None:
+    """The four modes, each at both extremes around the equilibrium."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, axes = plt.subplots(2, 2, figsize=(11, 8))
+    for k, ax in enumerate(axes.flat[:res.omega2.size]):
+        res.plot(k, ax=ax)
+        ax.set_title(f"mode {k}: {res.frequency[k]:.3f} Hz, zeta = "
+                     f"{res.damping_ratio[2 * k]:.3f} (damped)", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+
+
+def run(out: Path) -> tuple[str, list[str]]:
+    """Modes, the release checks, the pictures; (problem or "", the files written)."""
+    model = mbd2d.load(MODEL)
+    res = model.modes()
+    print(res.summary())
+    problems = []
+    for k in range(2):
+        dev, half = released(model, res, k), released(model, res, k, AMPLITUDE / 2)
+        print(f"mode {k} released ({AMPLITUDE * 1e3:g} mm) in the nonlinear dynamics: largest "
+              f"departure from a cos(omega t) phi over two periods {dev:.1e} of the amplitude "
+              f"({half:.1e} at half the amplitude: ratio {dev / half:.2f}, second order)")
+        if not (dev < RELEASE_TOL and 1.8 < dev / half < 2.2):
+            problems.append(f"mode {k} released departs {dev:.1e} from its shape")
+    out.mkdir(parents=True, exist_ok=True)
+    files = [str(out / "vibration_modes_shapes.png"), str(out / "vibration_modes_damping.png")]
+    shapes_figure(res, Path(files[0]))
+    zeta0 = damping_chart(model, Path(files[1]))
+    print(f"without suspension damping the largest damping ratio is {zeta0:.1e}")
+    if not zeta0 < 1e-9:
+        problems.append(f"the undamped car has a damping ratio {zeta0:.1e}")
+    files.append(str(res.animate(1, out / "vibration_modes.gif", max_frames=40)))
+    return "; ".join(problems), files
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--out", type=Path, default=HERE / "output")
+    args = ap.parse_args(argv)
+    problem, files = run(args.out)
+    print("wrote " + ", ".join(Path(f).name for f in files) + f" in {args.out}")
+    if problem:
+        print(f"unexpected: {problem}")
+    return 1 if problem else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
