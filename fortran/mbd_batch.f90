@@ -20,7 +20,7 @@ module mbd_batch
   use mbd_status, only: MBD_OK, MBD_BAD_INPUT, MBD_BAD_SETTING, MSG_LEN
   use mbd_memory, only: REAL_BYTES, mem_fail
   use mbd_api, only: NINFO, api_kinematics, api_inverse, api_statics, api_dynamics, api_eval, &
-                     api_dynamics_sens
+                     api_dynamics_sens, api_modes
   use mbd_kinematics, only: MAXPASS
   use mbd_contact, only: NEO
   use mbd_measures, only: api_measures
@@ -29,14 +29,15 @@ module mbd_batch
   implicit none
   private
   public :: batch_run, NISET, NRSET
-  public :: BATCH_KINEMATICS, BATCH_INVERSE, BATCH_STATICS, BATCH_DYNAMICS
+  public :: BATCH_KINEMATICS, BATCH_INVERSE, BATCH_STATICS, BATCH_DYNAMICS, BATCH_MODES
 
   !> analyses
   integer, parameter :: BATCH_KINEMATICS = 1, BATCH_INVERSE = 2, BATCH_STATICS = 3, &
-                        BATCH_DYNAMICS = 4
-  !> settings: iset = [nsteps, maxit, every, solver, method, max_steps, positions, 0]
-  !! (positions: 1 = kinematics of the positions alone, qdout and qddout (nq, 0, ncase));
-  !! rset = [t0, t1, tol, tmin, rtol, atol, h, rho_inf, alpha, beta, t (statics), 0]
+                        BATCH_DYNAMICS = 4, BATCH_MODES = 5
+  !> settings: iset = [nsteps, maxit, every, solver, method, max_steps, positions, at_q0]
+  !! (positions: 1 = kinematics of the positions alone, qdout and qddout (nq, 0, ncase);
+  !! at_q0: modes about the assembled q0, not the equilibrium);
+  !! rset = [t0, t1, tol, tmin, rtol, atol, h, rho_inf, alpha, beta, t (statics, modes), 0]
   integer, parameter :: NISET = 8, NRSET = 12
 
 contains
@@ -46,6 +47,10 @@ contains
   !! lamout (neq or 0, rows, ncase), eout (4 or 0, rows, ncase); iinfo, rinfo (NINFO, ncase)
   !! as the analysis reports them (statics: rinfo(1) residual, rinfo(2) stability code);
   !! qsing (nq, ncase), dep and redundant (neq, ncase). Statics writes row 1.
+  !! Modes (api_modes; rows = the modes asked for): qout the shapes (nq, modes, ncase),
+  !! qdout and qddout (nq, 0, ncase), lamout (0, modes, ncase), eout (6, modes, ncase) per
+  !! mode k [omega^2, kind, s(2k - 1) re, im, s(2k) re, im] (the damped eigenvalues),
+  !! qsing the equilibrium, iinfo(1) the free motions, rinfo(1:2) as statics.
   !! Measures (all or none of the optional arguments; none given or an empty list: no
   !! measures; not with statics): mkind, mint, mpts,
   !! mref as api_measures takes them, times (rows) the output times; mout (nm, rows, ncase)
@@ -95,6 +100,9 @@ contains
     real(wp), intent(out), optional :: mdout(:, :, :, :)
     real(wp), allocatable :: r(:), bm(:, :), fp(:), phi(:), jac(:, :), nu(:), gam(:), zq(:)
     real(wp), allocatable :: eo(:, :, :)      ! element outputs of a dynamics case (not kept)
+    ! a modes case's omega^2, kinds, damped eigenvalues and multipliers
+    real(wp), allocatable :: w2(:), sre(:), sim(:), lamw(:)
+    integer, allocatable :: kinds(:)
     real(wp) :: g(2), tpass(MAXPASS), resid, evo(4, 1)
     integer :: c, k, nq, neq, ncase, st, bad, stable, ierr, nev, nr, mb(2)
     logical :: meas, sens, dmeas
@@ -125,6 +133,9 @@ contains
     if (ierr == 0 .and. size(opens, 2) > 0) &
       allocate (phi(neq), jac(neq, nq), nu(neq), gam(neq), zq(nq), stat=ierr)
     if (ierr == 0) allocate (eo(NEO, size(ftab, 2), size(qout, 2)), stat=ierr)
+    if (ierr == 0 .and. analysis == BATCH_MODES) allocate (w2(size(qout, 2)), &
+      kinds(size(qout, 2)), sre(2 * size(qout, 2)), sim(2 * size(qout, 2)), lamw(neq), &
+      stat=ierr)
     if (ierr /= 0) then
       call mem_fail(REAL_BYTES * (size(rpar) + size(bmass) + size(fpar) + &
                     real(neq, wp) * (nq + 3) + real(NEO, wp) * size(ftab, 2) * size(qout, 2)), &
@@ -231,6 +242,15 @@ contains
                            lamout(:, 1, c), stable, resid, iinfo(:, c), status(c), msg(c))
         end if
         rinfo(1, c) = resid; rinfo(2, c) = real(stable, wp)
+      case (BATCH_MODES)
+        call api_modes(nb, ctab, r, bm, g, ftab, fp, q0, rset(11), merge(0, 1, iset(8) == 1), &
+                       size(qout, 2), qsing(:, c), lamw, stable, resid, w2, kinds, sre, sim, &
+                       qout(:, :, c), iinfo(:, c), status(c), msg(c), iset(4))
+        do k = 1, size(qout, 2)
+          eout(:, k, c) = [w2(k), real(kinds(k), wp), sre(2 * k - 1), sim(2 * k - 1), &
+                           sre(2 * k), sim(2 * k)]
+        end do
+        rinfo(1, c) = resid; rinfo(2, c) = real(stable, wp)
       case default
         if (present(pt)) then
           call api_dynamics_sens(nb, ctab, r, bm, g, ftab, fp, q0, v0, rset(1), rset(2), &
@@ -256,10 +276,11 @@ contains
       integer :: j, n(4), nrow
       logical :: positions
       st = MBD_BAD_INPUT; text = ''
-      positions = analysis == BATCH_KINEMATICS .and. iset(7) == 1
+      positions = (analysis == BATCH_KINEMATICS .and. iset(7) == 1) .or. &
+                  analysis == BATCH_MODES          ! (no velocity rows)
       n = [size(rpar), size(bmass), 2, size(fpar)]
       nrow = size(qout, 2)
-      if (analysis < BATCH_KINEMATICS .or. analysis > BATCH_DYNAMICS) then
+      if (analysis < BATCH_KINEMATICS .or. analysis > BATCH_MODES) then
         text = 'batch: unknown analysis'; st = MBD_BAD_SETTING; return
       end if
       if (size(vtab, 1) /= 2 .or. size(vals, 1) /= size(vtab, 2) .or. size(opens, 1) /= 2) then
@@ -289,8 +310,13 @@ contains
           size(msg) /= ncase) then
         text = 'batch: output arrays do not match'; return
       end if
-      if (analysis /= BATCH_KINEMATICS .and. (size(lamout, 1) /= neq .or. &
-          size(eout, 1) /= 4)) then
+      if (analysis == BATCH_MODES) then
+        if (size(lamout, 1) /= 0 .or. size(eout, 1) /= 6 .or. meas .or. sens) then
+          text = 'batch: the modes'' arrays do not match (no measures or sensitivities)'
+          return
+        end if
+      else if (analysis /= BATCH_KINEMATICS .and. (size(lamout, 1) /= neq .or. &
+               size(eout, 1) /= 4)) then
         text = 'batch: multiplier or energy arrays do not match'; return
       end if
       if (analysis == BATCH_STATICS .and. nrow /= 1) then

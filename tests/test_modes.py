@@ -612,3 +612,115 @@ law = {{ model = "{law}", stiffness = {k}, exponent = {n}, restitution = 1.0 }}
     d = (m * G / k)**(1 / n)
     assert abs(res.q[1] - (0.1 - d)) < 1e-12
     assert abs(res.omega2[0] / (n * k * d**(n - 1) / m) - 1) < 1e-8
+
+
+# ------------------------------------------------------------------ sweeps of the modes
+
+def half_car() -> mbd2d.Model:
+    return mbd2d.load(Path(__file__).parents[1] / "examples" / "half_car.toml")
+
+
+DAMPING = ("force.front_suspension.damping", "force.rear_suspension.damping")
+
+
+def test_a_modes_sweep_is_every_variants_modes() -> None:
+    """mbd2d.sweep(..., "modes"): every case's numbers are its own modes() bit for bit."""
+    pytest.importorskip("xarray")
+    model = half_car()
+    cs = np.linspace(0.0, 3000.0, 5)
+    cases = {DAMPING[0]: cs, DAMPING[1]: cs[::-1].copy(), "body.body.mass": cs / 10 + 400}
+    ds = mbd2d.sweep(model, cases, "modes", workers=1, count=3)
+    assert ds.sizes["mode"] == 3 and ds.sizes["eigenvalue"] == 6
+    for j in range(len(cs)):
+        res = model.with_params({k: float(v[j]) for k, v in cases.items()}).modes(count=3)
+        np.testing.assert_array_equal(ds.omega2.values[j], res.omega2)
+        np.testing.assert_array_equal(ds.frequency.values[j], res.frequency)
+        np.testing.assert_array_equal(ds.kind.values[j], res.kind_codes)
+        np.testing.assert_array_equal(ds.shape.values[j], res.shapes.T)
+        np.testing.assert_array_equal(ds.s_real.values[j] + 1j * ds.s_imag.values[j],
+                                      res.eigenvalues)
+        np.testing.assert_array_equal(ds.damping_ratio.values[j], res.damping_ratio)
+        np.testing.assert_array_equal(ds.damped_frequency.values[j], res.damped_frequency)
+        np.testing.assert_array_equal(ds.q.values[j], res.q)
+        assert ds.n_free.values[j] == 4 and ds.stability.values[j] == res.stability
+        assert ds.residual.values[j] == res.residual and ds.status.values[j] == 0
+
+
+def test_a_failing_variant_keeps_its_place() -> None:
+    """A disc without inertia (a free motion without mass) in the middle of a sweep: its
+    status and message are those modes() raises, the others run."""
+    pytest.importorskip("xarray")
+    model = mbd2d.loads("""
+[model]
+name = "disc"
+gravity = [0.0, 0.0]
+[[body]]
+name = "disc"
+q0 = [0.0, 0.0, 0.1]
+mass = 1.0
+inertia = 0.5
+[[joint]]
+type = "revolute"
+name = "axle"
+bodies = ["ground", "disc"]
+points = [[0, 0], [0, 0]]
+[[force]]
+type = "rotational-spring"
+name = "k"
+bodies = ["ground", "disc"]
+stiffness = 2.0
+damping = 0.0
+angle0 = 0.0
+""")
+    ds = mbd2d.sweep(model, {"body.disc.inertia": [0.5, 0.0, 2.0]}, "modes", workers=1)
+    with pytest.raises(mbd2d.MbdError) as err:
+        model.with_params({"body.disc.inertia": 0.0}).modes()
+    assert list(ds.status.values) == [0, err.value.status, 0]
+    assert ds.message.values[1] == str(err.value) and "mass" in str(err.value)
+    np.testing.assert_allclose(ds.omega2.values[[0, 2], 0], [2.0 / 0.5, 2.0 / 2.0], rtol=1e-10)
+    assert np.isnan(ds.omega2.values[1]).all() and ds.n_free.values[1] == -1
+
+
+def test_modes_sweep_files_and_command_line(tmp_path: Path) -> None:
+    """write_sweep: .csv one row per case and mode, .nc the whole Dataset; mbd2d sweep
+    --analysis modes writes the same CSV."""
+    import subprocess
+    import sys
+    pytest.importorskip("xarray")
+    model = half_car()
+    cs = np.linspace(500.0, 2500.0, 3)
+    ds = mbd2d.sweep(model, {DAMPING[0]: cs}, "modes", workers=1)
+    mbd2d.write_sweep(ds, tmp_path / "s.csv")
+    rows = np.genfromtxt(tmp_path / "s.csv", delimiter=",", names=True)
+    assert rows.size == 3 * 4
+    np.testing.assert_array_equal(rows["frequency_hz"].reshape(3, 4), ds.frequency.values)
+    try:
+        mbd2d.write_sweep(ds, tmp_path / "s.nc")
+    except ImportError:
+        pass
+    else:
+        import xarray as xr
+        back = xr.open_dataset(tmp_path / "s.nc")
+        np.testing.assert_array_equal(back.omega2.values, ds.omega2.values)
+        back.close()
+    toml = Path(__file__).parents[1] / "examples" / "half_car.toml"
+    r = subprocess.run([sys.executable, "-m", "mbd2d", "sweep", str(toml), "--analysis", "modes",
+                        "--param", f"{DAMPING[0]}=500:2500:3", "--workers", "1", "--out",
+                        str(tmp_path / "c.csv")], capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    assert (tmp_path / "c.csv").read_text() == (tmp_path / "s.csv").read_text()
+
+
+def test_what_a_modes_sweep_does_not_take(tmp_path: Path) -> None:
+    pytest.importorskip("xarray")
+    model = half_car()
+    cases = {DAMPING[0]: [1000.0, 2000.0]}
+    for kw, needle in (({"sensitivities": [DAMPING[1]]}, "no design sensitivities"),
+                       ({"measures": ["dead_centre_distance"]}, "not of modes"),
+                       ({"t_end": 1.0}, "settings are")):
+        with pytest.raises(mbd2d.ModelError, match=needle):
+            mbd2d.sweep(model, cases, "modes", workers=1, **kw)
+    with pytest.raises(mbd2d.ModelError, match="runs in mbd2d.sweep"):
+        mbd2d.export_sweep(model, tmp_path / "s.mbd", cases, "modes")
+    with pytest.raises(mbd2d.ModelError, match="unknown analysis 'modes'"):
+        mbd2d.tolerance(model, {DAMPING[0]: 10.0}, "modes", samples=4, workers=1)

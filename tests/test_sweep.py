@@ -368,6 +368,12 @@ def test_dask_local_cluster_gives_the_serial_result() -> None:
                 "joint.slide.friction.mu_static": [0.0, 0.15, 0.25, 0.5]}
         fkw = {"analysis": "dynamics", "t_end": 0.5, "steps": 5, "rtol": 1e-9, "atol": 1e-11}
         fric_remote = mbd2d.sweep(incline, fric, client=client, **fkw)
+        # a modes sweep (the half car's struts' damping) on the cluster too
+        car = load_example("half_car.toml")
+        damping = {"force.front_suspension.damping": np.linspace(0.0, 3000.0, 9),
+                   "force.rear_suspension.damping": np.linspace(3000.0, 0.0, 9)}
+        modes_remote = mbd2d.sweep(car, damping, "modes", client=client)
+    assert mbd2d.sweep(car, damping, "modes", workers=1).identical(modes_remote)
     assert serial.identical(remote)
     assert tol.dataset.identical(local.dataset)
     assert mbd2d.sweep(incline, fric, workers=1, **fkw).identical(fric_remote)

@@ -231,7 +231,8 @@ def _parser() -> argparse.ArgumentParser:
                    "START to STOP; repeat for more parameters")
     w.add_argument("--grid", action="store_true", help="every combination of the values "
                    "(default: the i-th value of every parameter together; equal NUM)")
-    _study_settings(w, "the analysis (default kinematics)")
+    _study_settings(w, "the analysis (default kinematics; modes: the frequencies, damping "
+                    "and shapes of every case)", modes=True)
     _study_integrator(w)
     w.add_argument("--positions-only", action="store_true",
                    help="kinematics: positions alone (no velocities or accelerations)")
@@ -425,11 +426,12 @@ def _modes(model: Model, args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def _study_settings(p: argparse.ArgumentParser, analysis_help: str) -> None:
-    """The analysis and output times of a study (sweep, tolerance)."""
+def _study_settings(p: argparse.ArgumentParser, analysis_help: str,
+                    modes: bool = False) -> None:
+    """The analysis and output times of a study (sweep; tolerance without modes)."""
     p.add_argument("--analysis", default="kinematics",
-                   choices=["kinematics", "inverse_dynamics", "statics", "dynamics"],
-                   help=analysis_help)
+                   choices=["kinematics", "inverse_dynamics", "statics", "dynamics"]
+                   + (["modes"] if modes else []), help=analysis_help)
     p.add_argument("--t-end", type=float, default=None, help="final time")
     p.add_argument("--steps", type=int, default=None, help="output intervals")
     p.add_argument("--t0", type=float, default=0.0, help="start time (statics: its time)")
@@ -454,8 +456,9 @@ def _study_dynamics(args: argparse.Namespace) -> dict[str, Any]:
 
 
 def _study_span(args: argparse.Namespace) -> dict[str, Any]:
-    """The settings of a study's analysis from --t0, --t-end, --steps, --every (statics: t)."""
-    if args.analysis == "statics":
+    """The settings of a study's analysis from --t0, --t-end, --steps, --every (statics and
+    modes: t)."""
+    if args.analysis in ("statics", "modes"):
         return {"t": args.t0}
     if args.t_end is None or args.steps is None:
         raise ModelError(f"{args.analysis} needs --t-end and --steps", "command line")
@@ -506,7 +509,7 @@ def _tolerance(model: Model, args: argparse.Namespace) -> int:
     from .studies import connect, export_sweep, tolerance, tolerance_samples, write_tolerance
     sigma = dict(_sigma(s) for s in args.sigma)
     kw = _study_span(args)
-    if args.analysis != "statics":
+    if args.analysis not in ("statics", "modes"):
         kw.update(_study_dynamics(args))
     if args.export_samples is not None:
         cases = tolerance_samples(model, sigma, args.samples, args.seed)
@@ -778,7 +781,7 @@ def _sweep(model: Model, args: argparse.Namespace) -> int:
                          "command line")
     cases = _cases(args)
     kw = _study_span(args)
-    if args.analysis != "statics":
+    if args.analysis not in ("statics", "modes"):
         kw.update(_study_dynamics(args))
         if args.positions_only:
             kw["positions_only"] = True

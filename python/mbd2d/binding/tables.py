@@ -80,7 +80,8 @@ class BatchTables:
     open phases to set again, and the analysis settings. Picklable: worker processes and
     Dask workers get it whole."""
 
-    analysis: int               # 1 kinematics, 2 inverse dynamics, 3 statics, 4 dynamics
+    analysis: int               # 1 kinematics, 2 inverse dynamics, 3 statics, 4 dynamics,
+    #                             5 modes (rows: the modes)
     nb: int
     ctab: np.ndarray            # int32 (NCT, nc)
     rpar: np.ndarray            # float64
@@ -110,8 +111,10 @@ class BatchTables:
 
     @property
     def nd(self) -> int:
-        """Rows of the velocities and accelerations: 0 for positions-only kinematics."""
-        return 0 if self.analysis == 1 and int(self.iset[6]) == 1 else self.nrow
+        """Rows of the velocities and accelerations: 0 for positions-only kinematics and for
+        modes."""
+        return 0 if (self.analysis == 1 and int(self.iset[6]) == 1) or self.analysis == 5 \
+            else self.nrow
 
     @property
     def npar(self) -> int:

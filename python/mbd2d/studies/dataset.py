@@ -90,12 +90,12 @@ def outcomes(pl: Plan, model: ModelDescription, out: Outputs, names: Sequence[st
     a = out.arrays
     if pl.analysis == "statics":
         n = np.where(out.status == OK, 1, 0)
-    else:
+    else:               # (modes: the free motions, at most the modes asked for)
         n = a["iinfo"][0].astype(np.int64).clip(0, pl.tables.nrow)
     fin = _finite_rows(pl, out)
     inside = np.arange(fin.shape[0])[:, None] < n[None, :]
     clean = (out.status == OK) & ~((~fin) & inside).any(axis=0)
-    if pl.analysis == "statics":
+    if pl.analysis in ("statics", "modes"):
         clean &= np.isfinite(a["rinfo"][0])
     rows = np.where(clean, n, 0)
     status = np.zeros(ncase, dtype=np.int32)
@@ -129,8 +129,9 @@ def _failure(pl: Plan, model: ModelDescription, c: SimpleNamespace, n: int,
     try:
         if pl.tables.npar:            # a design parameter the core refused
             check_status(c.status, c.iinfo, c.msg, find(model, pl.tables.sensitivities))
-        if pl.analysis == "statics":
-            return statics_error(model, own() if c.status == INCONSISTENT else p, c, pl.t0)
+        if pl.analysis in ("statics", "modes"):
+            return statics_error(model, own() if c.status == INCONSISTENT else p, c, pl.t0,
+                                 analysis=pl.analysis)
         if pl.analysis == "kinematics":
             pos = pl.tables.nd == 0
             res: Any = KinematicsResult(t=t[:n], q=c.q.T[:n].copy(),
@@ -199,6 +200,10 @@ def to_dataset(pl: Plan, analysis: str, model: ModelDescription, out: Outputs,
         return _per_case(x, keep)
 
     a = out.arrays
+    if pl.analysis == "modes":
+        data, coords = _modes_data(pl, a, status == 0, keep)
+        return xr.Dataset(_case_columns(data, coords, status, messages, names, values),
+                          coords=coords, attrs=_attrs(pl, analysis, model, names, status))
     cube = ("case", "time", "coordinate")
     data: dict[str, Any] = {"q": (cube, per_case(a["q"]))}
     if b.nd:                                                   # (not positions only)
@@ -237,17 +242,67 @@ def to_dataset(pl: Plan, analysis: str, model: ModelDescription, out: Outputs,
         data["residual"] = ("case", np.where(ok, a["rinfo"][0], np.nan))
     if pl.analysis == "dynamics":                 # dopri5, partitioned: steps set by stability
         data["stiff_from"] = ("case", np.where(a["iinfo"][10] == 1, a["rinfo"][10], np.nan))
+    return xr.Dataset(_case_columns(data, coords, status, messages, names, values),
+                      coords=coords, attrs=_attrs(pl, analysis, model, names, status))
+
+
+def _case_columns(data: dict[str, Any], coords: dict[str, Any], status: np.ndarray,
+                  messages: list[str], names: Sequence[str], values: np.ndarray
+                  ) -> dict[str, Any]:
+    """data with each case's status and message; the parameters added to coords."""
     data["status"] = ("case", status)
     data["message"] = ("case", np.array(messages, dtype=object))
     for k, name in enumerate(names):
         coords[name] = ("case", values[k].copy())
+    return data
+
+
+def _attrs(pl: Plan, analysis: str, model: ModelDescription, names: Sequence[str],
+           status: np.ndarray) -> dict[str, Any]:
+    """The Dataset's attributes: the analysis, its settings and the count of failures."""
     attrs = {"analysis": analysis, "run": pl.analysis, "model": model.name,
              "parameters": ", ".join(names),
              "settings": ", ".join(f"{k}={v!r}" for k, v in pl.settings.items()),
              "failed": int((status != 0).sum())}
     if pl.method:
         attrs["method"] = pl.method
-    return xr.Dataset(data, coords=coords, attrs=attrs)
+    return attrs
+
+
+def _modes_data(pl: Plan, a: dict[str, np.ndarray], ran: np.ndarray, keep: np.ndarray
+                ) -> tuple[dict[str, Any], dict[str, Any]]:
+    """A modes sweep's variables (as many modes as the case with the most; NaN past each
+    case's modes, and for a failed case): per
+    case and mode ``omega2``, ``frequency`` (Hz), ``kind`` (1 vibration, 0 rigid, -1
+    unstable) and ``shape`` (coordinate), per case and damped eigenvalue ``s_real``,
+    ``s_imag``, ``damping_ratio``, ``damped_frequency``, per case the equilibrium ``q``,
+    ``n_free``, ``stability`` and ``residual``; and the coordinates. ran: (case) the cases
+    that completed."""
+    p = pl.packed
+    nm = int(keep.sum(axis=1).max(initial=0))                  # the most modes of a case
+    e = _per_case(a["e"], keep)[:, :nm]                        # (case, mode, 6)
+    w2 = e[:, :, 0]
+    re = e[:, :, [2, 4]].reshape(len(ran), -1)                 # (case, eigenvalue)
+    im = e[:, :, [3, 5]].reshape(len(ran), -1)
+    mod = np.hypot(re, im)
+    zeta = np.divide(-re, mod, out=np.where(np.isnan(mod), np.nan, 0.0), where=mod > 0) + 0.0
+    data: dict[str, Any] = {
+        "omega2": (("case", "mode"), w2),
+        "frequency": (("case", "mode"), np.sqrt(np.clip(w2, 0.0, None)) / (2 * np.pi)),
+        "kind": (("case", "mode"), e[:, :, 1]),
+        "shape": (("case", "mode", "coordinate"), _per_case(a["q"], keep)[:, :nm]),
+        "s_real": (("case", "eigenvalue"), re), "s_imag": (("case", "eigenvalue"), im),
+        "damping_ratio": (("case", "eigenvalue"), zeta),
+        "damped_frequency": (("case", "eigenvalue"), np.abs(im) / (2 * np.pi)),
+        "q": (("case", "coordinate"), np.where(ran[:, None], a["qsing"].T, np.nan)),
+        "n_free": ("case", np.where(ran, a["iinfo"][0], -1).astype(np.int64)),
+        "stability": ("case", np.array([STABILITY.get(int(s), "not examined") if k else ""
+                                        for s, k in zip(a["rinfo"][1], ran)], dtype=object)),
+        "residual": ("case", np.where(ran, a["rinfo"][0], np.nan))}
+    coords: dict[str, Any] = {"case": np.arange(len(ran)), "mode": np.arange(nm),
+                              "eigenvalue": np.arange(2 * nm),
+                              "coordinate": list(p.coordinate_names)}
+    return data, coords
 
 
 __all__ = ["to_dataset", "outcomes", "xarray", "EXTRA"]

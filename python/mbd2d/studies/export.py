@@ -9,6 +9,7 @@ from pathlib import Path
 from typing import Any
 
 from ..analysis.mbdfile import file_lines
+from ..errors import ModelError
 from ..results.files import write_text
 from .plan import case_values, plan, with_cases, with_measures, with_sensitivities
 
@@ -56,6 +57,10 @@ def export_sweep(model: Any, path: str | Path, cases: Any, analysis: str = "kine
     ...                    t_end=1.0, steps=60)
     """
     names, values = case_values(cases, "export_sweep")
+    if analysis == "modes":
+        raise ModelError("a sweep of modes runs in mbd2d.sweep (Python); mbd2d-solve runs the "
+                         "modes of one model (Model.export(..., analysis=\"modes\"))",
+                         "export_sweep")
     pl = plan(model, names, analysis, analysis_kwargs)
     with_measures(pl, model, measures)
     with_sensitivities(pl, model, sensitivities)

@@ -39,7 +39,9 @@ def write_sweep(ds: Any, path: str | Path) -> None:
     coordinate NAME (q), NAME_dot (qd), NAME_ddot (qdd) (NAME alone for a positions-only
     sweep), with multipliers the efforts ``effort.DRIVER``, then the measures by their specs,
     then for each design parameter P of a sweep with sensitivities ``d(COLUMN)/d(P)`` of
-    the motion columns, the efforts and the measures.
+    the motion columns, the efforts and the measures. A modes sweep: one row per case and
+    mode, ``case``, the parameters, ``mode``, ``status``, ``message``, ``omega2``,
+    ``frequency_hz``, ``kind``, the shape per coordinate.
 
     Raises
     ------
@@ -78,6 +80,9 @@ def _params(ds: Any) -> list[str]:
 
 
 def _csv(ds: Any, path: Path) -> None:
+    if ds.attrs.get("run") == "modes":
+        _modes_csv(ds, path)
+        return
     params = _params(ds)
     coords = [str(c) for c in ds.coordinate.values]
     levels = [ds[k].values for k in ("q", "qd", "qdd") if k in ds]   # (q alone: positions only)
@@ -114,6 +119,30 @@ def _csv(ds: Any, path: Path) -> None:
                     line += [_g(v) for v in meas[c, k]]
                 line += [_g(v) for v in sens[c, k]]
                 w.writerow(line)
+
+
+def _modes_csv(ds: Any, path: Path) -> None:
+    """A modes sweep: one row per case and mode (``case``, the parameters, ``mode``,
+    ``status``, ``message``, ``omega2``, ``frequency_hz``, ``kind``, then the shape per
+    coordinate); a case without modes gets one row with its status and message."""
+    params = _params(ds)
+    coords = [str(c) for c in ds.coordinate.values]
+    header = ["case", *params, "mode", "status", "message", "omega2", "frequency_hz", "kind",
+              *coords]
+    w2, f, kind, shape = (ds[k].values for k in ("omega2", "frequency", "kind", "shape"))
+    with open(path, "w", newline="", encoding="utf-8") as fh:
+        w = csv.writer(fh)
+        w.writerow(header)
+        for c in range(ds.sizes["case"]):
+            head = [c, *(_g(ds[n].values[c]) for n in params)]
+            st, msg = int(ds.status.values[c]), str(ds.message.values[c])
+            modes = np.flatnonzero(np.isfinite(w2[c]))
+            if not len(modes):
+                w.writerow(head + ["", st, msg])
+                continue
+            for k in modes:
+                w.writerow(head + [k, st, msg, _g(w2[c, k]), _g(f[c, k]), _g(kind[c, k])]
+                           + [_g(v) for v in shape[c, k]])
 
 
 def _sensitivity_columns(ds: Any) -> tuple[np.ndarray, list[str]]:

@@ -10,7 +10,9 @@ from typing import Any, Callable, Mapping, Sequence
 
 import numpy as np
 
+from ..analysis.contacts import check_statics
 from ..analysis.dynamics import dynamics_settings
+from ..analysis.modes import mode_count
 from ..analysis.sensitivities import check_sens_method, check_positions_only, requested, table
 from ..analysis.settings import (check_memory, check_solver, check_span, output_rows,
                                  output_steps, require_determined, solver_code, time_grid)
@@ -25,7 +27,7 @@ from ..results.measures import measure_tables
 from ..validate import flag, number
 
 #: the analyses a sweep runs, by the Model method's name, and the core's batch code
-ANALYSES = {"kinematics": 1, "inverse_dynamics": 2, "statics": 3, "dynamics": 4}
+ANALYSES = {"kinematics": 1, "inverse_dynamics": 2, "statics": 3, "dynamics": 4, "modes": 5}
 MAX_CASES = 10**8
 
 
@@ -167,6 +169,11 @@ def _statics_settings(t: Any = 0.0) -> None:
     """Settings of a statics sweep (as :meth:`mbd2d.Model.statics`)."""
 
 
+def _modes_settings(t: Any = 0.0, count: Any = None, equilibrium: Any = True,
+                    solver: Any = "auto") -> None:
+    """Settings of a modes sweep (as :meth:`mbd2d.Model.modes`)."""
+
+
 def _dynamics_settings(t_end: Any, steps: Any, method: Any = None, rtol: Any = None,
                        atol: Any = None, h: Any = None, rho_inf: Any = None, alpha: Any = None,
                        beta: Any = None, t0: Any = 0.0, every: Any = 1,
@@ -215,6 +222,8 @@ def plan(model: ModelDescription, names: Sequence[str], analysis: Any,
         return _inverse(model, params, _bind(_inverse_settings, kw, analysis))
     if analysis == "statics":
         return _statics(model, params, _bind(_statics_settings, kw, analysis))
+    if analysis == "modes":
+        return _modes(model, params, _bind(_modes_settings, kw, analysis))
     return _dynamics(model, params, _bind(_dynamics_settings, kw, analysis))
 
 
@@ -257,6 +266,19 @@ def _statics(model: ModelDescription, params: list[Parameter], a: dict[str, Any]
     return Plan("statics", b, p, params, np.array([t]), a, t0=t)
 
 
+def _modes(model: ModelDescription, params: list[Parameter], a: dict[str, Any]) -> Plan:
+    t = number(a["t"], "t", "modes")
+    about_q0 = not flag(a["equilibrium"], "equilibrium", "modes")
+    code = solver_code(a["solver"])
+    check_statics(model)
+    p = pack(model)
+    d = pack_dynamics(model, p)
+    rset = [0.0] * 10 + [t]
+    b = _tables(5, p, d, [0, 0, 1, code, 0, 0, 0, int(about_q0)], rset,
+                mode_count(a["count"], p.nq), 0, 6)
+    return Plan("modes", b, p, params, np.array([t]), a, t0=t)
+
+
 def _dynamics(model: ModelDescription, params: list[Parameter], a: dict[str, Any]) -> Plan:
     t0, t_end, steps, nrow, times = _span(a)
     st = dynamics_settings(a["method"], a["rtol"], a["atol"], a["h"], a["rho_inf"], a["alpha"],
@@ -296,8 +318,9 @@ def with_measures(pl: Plan, model: ModelDescription, specs: Any) -> None:
         For a spec the model does not have, or measures of a statics sweep.
     """
     t = measure_tables(model, pl.packed, specs, moved=True)
-    if t.specs and pl.analysis == "statics":
-        raise ModelError("measures are columns of a run over time, not of statics", "sweep")
+    if t.specs and pl.analysis in ("statics", "modes"):
+        raise ModelError(f"measures are columns of a run over time, not of {pl.analysis}",
+                         "sweep")
     pl.tables.measures = t
     pl.tables.times = np.ascontiguousarray(pl.times, dtype=np.float64)
 
@@ -316,6 +339,9 @@ def with_sensitivities(pl: Plan, model: ModelDescription, names: Any) -> None:
     params = requested(model, names)
     if not params:
         return
+    if pl.analysis == "modes":
+        raise ModelError("a modes sweep computes no design sensitivities (the frequencies' "
+                         "change: sweep the parameter)", "sweep")
     b = pl.tables
     check_positions_only(params, b.nd == 0 and pl.analysis == "kinematics")
     check_sens_method(params, pl.method or "dopri5", "sweep")

@@ -33,8 +33,12 @@ def sweep(model: ModelDescription, cases: Any, analysis: str = "kinematics", cli
         Parameter name (see ``model.parameters()``) -> 1-D values, one case per index, all
         of one length; or a DataFrame whose columns are parameter names.
         :func:`mbd2d.grid` builds a full-factorial table.
-    analysis : {"kinematics", "inverse_dynamics", "statics", "dynamics"}
-        The analysis, by the name of the Model method; "kinematics" of a model with masses
+    analysis : {"kinematics", "inverse_dynamics", "statics", "dynamics", "modes"}
+        The analysis, by the name of the Model method ("modes": per case and mode
+        ``omega2``, ``frequency``, ``kind``, ``shape``, per case and damped eigenvalue
+        ``s_real``, ``s_imag``, ``damping_ratio``, ``damped_frequency``, per case the
+        equilibrium ``q``, ``n_free``, ``stability``, ``residual``; every case's as its own
+        ``modes()`` gives them, bit for bit); "kinematics" of a model with masses
         is inverse dynamics, as :meth:`mbd2d.Model.kinematics`.
     client : distributed.Client, optional
         Run the batches on a Dask cluster (as futures, gathered into the same Dataset,

@@ -443,9 +443,11 @@ def tolerance(model: ModelDescription, sigma: Mapping[str, Any], analysis: str =
     xr = xarray()
     params, sig = _sigma(model, sigma)
     rough = _not_smooth(model)
-    if not isinstance(analysis, str) or analysis not in ANALYSES:
-        raise ModelError(f"unknown analysis {analysis!r}; use one of {', '.join(ANALYSES)}",
-                         "tolerance")
+    if not isinstance(analysis, str) or analysis not in ANALYSES or analysis == "modes":
+        known = ", ".join(a for a in ANALYSES if a != "modes")
+        raise ModelError(f"unknown analysis {analysis!r}; use one of {known} (the modes' "
+                         "scatter: mbd2d.sweep(..., analysis=\"modes\") of "
+                         "mbd2d.tolerance_samples(...))", "tolerance")
     names = [str(n) for n in sigma]
     n = whole(samples, "samples", "tolerance", 0, 10**8)
     seed = _seed(seed)
