@@ -720,7 +720,42 @@ def test_what_a_modes_sweep_does_not_take(tmp_path: Path) -> None:
                        ({"t_end": 1.0}, "settings are")):
         with pytest.raises(mbd2d.ModelError, match=needle):
             mbd2d.sweep(model, cases, "modes", workers=1, **kw)
-    with pytest.raises(mbd2d.ModelError, match="runs in mbd2d.sweep"):
-        mbd2d.export_sweep(model, tmp_path / "s.mbd", cases, "modes")
     with pytest.raises(mbd2d.ModelError, match="unknown analysis 'modes'"):
         mbd2d.tolerance(model, {DAMPING[0]: 10.0}, "modes", samples=4, workers=1)
+
+
+def test_mbd2d_solve_runs_a_modes_sweep_as_python(tmp_path: Path) -> None:
+    """export_sweep(..., "modes") and mbd2d-solve: the CSV of write_sweep byte for byte (a
+    count and a failing case among them; the failing case's status, with the program's own
+    message, as for every sweep file)."""
+    import csv
+    import subprocess
+
+    from test_standalone import find_solver
+    pytest.importorskip("xarray")
+    model = half_car()
+    cases = {DAMPING[0]: np.linspace(0.0, 3000.0, 4),
+             "body.front_wheel.mass": [40.0, 30.0, 0.0, 50.0]}
+    ds = mbd2d.sweep(model, cases, "modes", workers=1, count=3)
+    assert list(ds.status.values != 0) == [False, False, True, False]
+    mbd2d.write_sweep(ds, tmp_path / "py.csv")
+    mbd2d.export_sweep(model, tmp_path / "s.mbd", cases, "modes", count=3)
+    r = subprocess.run([find_solver(), str(tmp_path / "s.mbd"), str(tmp_path / "f.csv")],
+                       capture_output=True, text=True, timeout=60)
+    assert r.returncode == 0, r.stderr
+    py = list(csv.reader((tmp_path / "py.csv").read_text().splitlines()))
+    fo = list(csv.reader((tmp_path / "f.csv").read_text().splitlines()))
+    assert len(py) == len(fo) == 1 + 3 * 3 + 1
+    msg = py[0].index("message")
+    for a, b in zip(py, fo):
+        assert a[:msg] + a[msg + 1:] == b[:msg] + b[msg + 1:]
+    failed = [row for row in fo if row[msg - 1] not in ("0", "status")]
+    assert len(failed) == 1 and "mass" in failed[0][msg]
+    good = tmp_path / "good.mbd"
+    keep = {k: np.delete(np.asarray(v, dtype=float), 2) for k, v in cases.items()}
+    mbd2d.export_sweep(model, good, keep, "modes", count=3)
+    mbd2d.write_sweep(mbd2d.sweep(model, keep, "modes", workers=1, count=3),
+                      tmp_path / "good_py.csv")
+    subprocess.run([find_solver(), str(good), str(tmp_path / "good.csv")], check=True,
+                   capture_output=True, timeout=60)
+    assert (tmp_path / "good.csv").read_text() == (tmp_path / "good_py.csv").read_text()

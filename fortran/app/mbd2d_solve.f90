@@ -107,12 +107,12 @@ program mbd2d_solve
     call run_check()
     stop 0, quiet=.true.
   end if
-  if (spec%analysis == 'modes') then
+  if (spec%analysis == 'modes' .and. spec%ncase == 0) then
     call run_modes()
     stop 0, quiet=.true.
   end if
   dynamic = spec%analysis /= 'kinematics'
-  if (spec%analysis /= 'statics' .and. spec%steps_line == 0) &
+  if (spec%analysis /= 'statics' .and. spec%analysis /= 'modes' .and. spec%steps_line == 0) &
     call die(2, trim(model_path) // ': the file gives no "steps" line')
   if (dynamic .and. .not. spec%have_masses) call die(2, trim(model_path) // ': ' // &
     trim(spec%analysis) // ' needs the masses: body lines NAME X0 Y0 THETA0 MASS INERTIA '// &
@@ -961,6 +961,10 @@ contains
                'efforts, measures): give no "outputs" line with "cases"')
     call check_case_entries()
     iset = 0; rset = 0.0_wp
+    if (spec%analysis == 'modes' .and. (spec%npar > 0 .or. spec%nmeas > 0 .or. &
+        spec%positions_only .or. spec%out_damped .or. .not. spec%have_masses)) &
+      call die(2, trim(model_path) // ': a sweep of modes takes the masses, and no '// &
+               'sensitivities, measures, positions_only or outputs')
     select case (spec%analysis)
     case ('kinematics')
       code = 1
@@ -974,6 +978,10 @@ contains
     case ('statics')
       code = 3
       rset(11) = spec%tstat
+    case ('modes')
+      code = 5
+      iset(4) = spec%solver; iset(8) = merge(1, 0, spec%at_q0)
+      rset(11) = spec%tstat
     case default
       code = 4
       iset(1:6) = [spec%steps, 0, spec%every, 0, spec%method, spec%max_steps]
@@ -981,9 +989,11 @@ contains
                     spec%rho_inf, spec%alpha, spec%beta]
     end select
     nrow = 1
-    if (code /= 3) nrow = kin_out_count(spec%steps, spec%every)
-    nd = merge(0, nrow, code == 1 .and. spec%positions_only)
-    nlam = merge(0, neq, code == 1); ne = merge(0, 4, code == 1)
+    if (code /= 3 .and. code /= 5) nrow = kin_out_count(spec%steps, spec%every)
+    if (code == 5) nrow = merge(min(spec%count, nq), nq, spec%count > 0)   ! the modes
+    nd = merge(0, nrow, (code == 1 .and. spec%positions_only) .or. code == 5)
+    nlam = merge(0, neq, code == 1 .or. code == 5); ne = merge(0, 4, code == 1)
+    if (code == 5) ne = 6
     nsl = merge(neq, 0, lam_sens)
     bytes = REAL_BYTES * real(spec%ncase, wp) * (real(nrow, wp) * (nq + nlam + ne + &
             spec%nmeas + real(spec%npar, wp) * (3 * nq + nsl + spec%nmeas)) + &
@@ -1103,12 +1113,12 @@ contains
     logical :: clean
     if (code == 3) then
       n = merge(1, 0, bstat(c) == MBD_OK)
-    else
+    else                             ! (modes: the free motions, at most the modes asked for)
       n = max(0, min(biinfo(1, c), nrow))
     end if
     k = first_bad(c, n)
     clean = bstat(c) == MBD_OK .and. k > n
-    if (code == 3) clean = clean .and. ieee_is_finite(brinfo(1, c))
+    if (code == 3 .or. code == 5) clean = clean .and. ieee_is_finite(brinfo(1, c))
     cstat(c) = 0; cmsg(c) = ''; nkeep(c) = n
     if (bmbad(1, c) /= MBD_OK) then               ! its rows, without its measures
       bmv(:, :, c) = ieee_value(0.0_wp, ieee_quiet_nan)
@@ -1121,7 +1131,7 @@ contains
     if (clean) return
     nkeep(c) = min(n, k - 1)
     cstat(c) = bstat(c)
-    if (bstat(c) < 0 .or. code == 3) nkeep(c) = 0
+    if (bstat(c) < 0 .or. code == 3 .or. code == 5) nkeep(c) = 0
     if (bstat(c) == MBD_OK) cstat(c) = merge(MBD_INTEGRATOR_FAILED, MBD_NO_CONVERGENCE, code == 4)
     if (code == 4) then                      ! dynamics: the Python words where they fit
       cmsg(c) = dynamics_text(c, k)
@@ -1307,6 +1317,10 @@ contains
     character(len=*), parameter :: lev(3) = [character(len=6) :: '', '_dot', '_ddot']
     character(len=:), allocatable :: line, head, tail
     integer :: u, ios, j, k, l, r0, nlev, c, lp, nh, nt, width, p, nsl
+    if (code == 5) then
+      call write_modes_sweep_csv(path)
+      return
+    end if
     nlev = merge(3, 1, nd > 0)
     nsl = size(bslam, 1)
     ! at most 26 characters a number ("%.17g": -1.2345678901234567e-308) with its comma; a
@@ -1402,6 +1416,61 @@ contains
     close (u)
     if (ios /= 0) call die(2, 'cannot write ' // path // ' (disk full?)')
   end subroutine write_sweep_csv
+
+  !> The CSV of mbd2d.write_sweep for a modes sweep: one row per case and mode (case, the
+  !! parameters, mode, status, message, omega2, frequency_hz, kind, the shape per
+  !! coordinate); a case without modes, one row with its status and message.
+  subroutine write_modes_sweep_csv(path)
+    character(len=*), intent(in) :: path
+    character(len=*), parameter :: crlf = achar(13) // achar(10)
+    real(wp), parameter :: TWO_PI = 2 * 3.141592653589793_wp
+    character(len=:), allocatable :: line, head, tail
+    integer :: u, ios, j, k, c, lp, nh, nt, width
+    width = 26 * (spec%ncp + 6 + nq) + 32
+    allocate (character(len=width) :: head, stat=ierr)
+    if (ierr == 0) allocate (character(len=2 * len(cmsg) + 40) :: tail, stat=ierr)
+    if (ierr == 0) allocate (character(len=width + len(tail)) :: line, stat=ierr)
+    if (ierr /= 0) call die(2, 'not enough memory to write ' // path)
+    open (newunit=u, file=path, status='replace', action='write', access='stream', &
+          form='unformatted', iostat=ios)
+    if (ios /= 0) call die(2, 'cannot write ' // path)
+    call sput(u, ios, 'case')
+    do j = 1, spec%ncp
+      call sput(u, ios, ',' // trim(spec%case_names(j)))
+    end do
+    call sput(u, ios, ',mode,status,message,omega2,frequency_hz,kind')
+    call coordinate_header(u, ios, '', 0)
+    call sput(u, ios, crlf)
+    do c = 1, spec%ncase
+      nh = 0
+      call bput(head, nh, trim(itoa(c - 1)))
+      do j = 1, spec%ncp
+        call bnum(head, nh, spec%cvals(j, c))
+      end do
+      nt = 0
+      call bput(tail, nt, ',' // trim(itoa(cstat(c))) // ',' // quoted(trim(cmsg(c))))
+      if (nkeep(c) == 0) then
+        call sput(u, ios, head(1:nh) // ',' // tail(1:nt) // crlf)
+        cycle
+      end if
+      do k = 1, nkeep(c)
+        lp = 0
+        call bput(line, lp, head(1:nh) // ',' // trim(itoa(k - 1)))
+        call bput(line, lp, tail(1:nt))
+        ! be(:, k, c) = [omega^2, kind, ...]: frequency = sqrt(max(omega^2, 0)) / (2 pi)
+        call bnum(line, lp, be(1, k, c))
+        call bnum(line, lp, sqrt(max(be(1, k, c), 0.0_wp)) / TWO_PI)
+        call bnum(line, lp, be(2, k, c))
+        do j = 1, nq
+          call bnum(line, lp, bq(j, k, c))
+        end do
+        call bput(line, lp, crlf)
+        call sput(u, ios, line(1:lp))
+      end do
+    end do
+    close (u)
+    if (ios /= 0) call die(2, 'cannot write ' // path // ' (disk full?)')
+  end subroutine write_modes_sweep_csv
 
   !> Row k of case c's derivatives along parameter p: the motion's, the efforts'
   !! (-dlambda/dp of the driver rows), then the measures'.

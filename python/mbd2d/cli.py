@@ -750,17 +750,20 @@ def _export_sweep(model: Model, args: argparse.Namespace) -> int:
         raise ModelError("a sweep file writes the sweep's columns (and --measure, "
                          "--sensitivities): no --energy, --multipliers, --reactions or "
                          "--efforts with --param", "command line")
-    if args.analysis in ("check", "modes"):
-        raise ModelError("a sweep runs kinematics, inverse-dynamics, dynamics or statics, not "
-                         f"{args.analysis}", "command line")
+    if args.analysis == "check":
+        raise ModelError("a sweep runs kinematics, inverse-dynamics, dynamics, statics or "
+                         "modes, not check", "command line")
     span = {"t_end": args.t_end, "steps": args.steps, "t0": args.t0, "every": args.every}
     kw: dict[str, Any] = {
         "kinematics": dict(span, tol=args.tol, solver=args.solver,
                            positions_only=args.positions_only),
         "inverse-dynamics": dict(span, tol=args.tol, solver=args.solver),
         "statics": {"t": args.t},
+        "modes": {"t": args.t, "count": args.count, "equilibrium": not args.at_q0,
+                  "solver": args.solver},
         "dynamics": dict(span, **_dynamics_kwargs(args))}[args.analysis]
-    if args.analysis != "statics" and (args.t_end is None or args.steps is None):
+    timed = args.analysis not in ("statics", "modes")
+    if timed and (args.t_end is None or args.steps is None):
         raise ModelError(f"{args.analysis} needs --t-end and --steps", "command line")
     cases = _cases(args)
     export_sweep(model, args.out, cases, args.analysis.replace("-", "_"),

@@ -9,14 +9,13 @@ from pathlib import Path
 from typing import Any
 
 from ..analysis.mbdfile import file_lines
-from ..errors import ModelError
 from ..results.files import write_text
 from .plan import case_values, plan, with_cases, with_measures, with_sensitivities
 
 #: the file's analysis for the sweep's plan (kinematics of a model with masses runs as
 #: inverse dynamics, as in the sweep)
 FILE_ANALYSIS = {"kinematics": "kinematics", "inverse": "inverse-dynamics",
-                 "statics": "statics", "dynamics": "dynamics"}
+                 "statics": "statics", "dynamics": "dynamics", "modes": "modes"}
 
 
 def export_sweep(model: Any, path: str | Path, cases: Any, analysis: str = "kinematics",
@@ -33,7 +32,7 @@ def export_sweep(model: Any, path: str | Path, cases: Any, analysis: str = "kine
         The file to write (.mbd).
     cases : dict or pandas.DataFrame
         As :func:`mbd2d.sweep` (:func:`mbd2d.grid` builds a full-factorial table).
-    analysis : {"kinematics", "inverse_dynamics", "statics", "dynamics"}
+    analysis : {"kinematics", "inverse_dynamics", "statics", "dynamics", "modes"}
         As :func:`mbd2d.sweep`.
     measures : str or list of str, optional
         As :func:`mbd2d.sweep`: columns of every case (an angle's points given with the
@@ -57,10 +56,6 @@ def export_sweep(model: Any, path: str | Path, cases: Any, analysis: str = "kine
     ...                    t_end=1.0, steps=60)
     """
     names, values = case_values(cases, "export_sweep")
-    if analysis == "modes":
-        raise ModelError("a sweep of modes runs in mbd2d.sweep (Python); mbd2d-solve runs the "
-                         "modes of one model (Model.export(..., analysis=\"modes\"))",
-                         "export_sweep")
     pl = plan(model, names, analysis, analysis_kwargs)
     with_measures(pl, model, measures)
     with_sensitivities(pl, model, sensitivities)
