@@ -55,7 +55,7 @@ contains
     integer, intent(out) :: status  !! MBD_OK, MBD_SINGULAR, MBD_NO_CONVERGENCE, ...
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
     real(wp), allocatable :: nb(:, :), kn(:, :), cn(:, :), mr(:, :), kr(:, :), cr(:, :), &
-                             ks(:, :), a(:, :), wr(:), wi(:), ev(:), vdum(:, :), work(:), &
+                             ks(:, :), a(:, :), wr(:), wi(:), ev(:), vl(:, :), vr(:, :), work(:), &
                              kv(:), cv(:)
     integer, allocatable :: ipiv(:), order(:)
     real(wp) :: bytes, wq(1)
@@ -75,8 +75,8 @@ contains
     call mem_check(bytes, trim(what), HINT, status, msg)
     if (status /= MBD_OK) return
     allocate (nb(n, f), kn(n, f), cn(n, f), mr(f, f), kr(f, f), cr(f, f), ks(f, f), &
-              a(2 * f, 2 * f), wr(2 * f), wi(2 * f), ev(f), vdum(1, 1), kv(nnz), cv(nnz), &
-              ipiv(f), order(2 * f), work(1), stat=ist)
+              a(2 * f, 2 * f), wr(2 * f), wi(2 * f), ev(f), vl(1, 1), vr(1, 1), kv(nnz), &
+              cv(nnz), ipiv(f), order(2 * f), work(1), stat=ist)
     if (ist /= 0) then
       call mem_fail(bytes, trim(what), HINT, status, msg); return
     end if
@@ -144,10 +144,10 @@ contains
     end do
     a(f + 1:2 * f, 1:f) = -kr
     a(f + 1:2 * f, f + 1:2 * f) = -cr
-    call dgeev('N', 'N', 2 * f, a, 2 * f, wr, wi, vdum, 1, vdum, 1, wq, -1, info)
+    call dgeev('N', 'N', 2 * f, a, 2 * f, wr, wi, vl, 1, vr, 1, wq, -1, info)
     call grow(max(1, int(wq(1))), status)
     if (status /= MBD_OK) return
-    call dgeev('N', 'N', 2 * f, a, 2 * f, wr, wi, vdum, 1, vdum, 1, work, size(work), info)
+    call dgeev('N', 'N', 2 * f, a, 2 * f, wr, wi, vl, 1, vr, 1, work, size(work), info)
     if (info /= 0) then
       status = merge(MBD_NO_CONVERGENCE, MBD_LAPACK, info > 0)
       write (msg, '(a,i0,a)') 'modes: the damped eigenvalues did not converge (dgeev info ', &

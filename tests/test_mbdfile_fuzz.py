@@ -86,6 +86,17 @@ def bases(tmp_path_factory: pytest.TempPathFactory) -> list[bytes]:
         f = d / f"dyn{k}.mbd"
         model.export(f, **kw)
         out.append(f.read_bytes())
+    # modes: the damped table, a count about q0, and a sweep of them
+    car = mbd2d.load(EX / "half_car.toml")
+    for k, (model, kw) in enumerate([(swing, {"outputs": ["damped"]}),
+                                     (car, {"count": 2, "equilibrium": False})]):
+        f = d / f"modes{k}.mbd"
+        model.export(f, analysis="modes", **kw)
+        out.append(f.read_bytes())
+    f = d / "modes_sweep.mbd"
+    mbd2d.export_sweep(car, f, {"force.front_suspension.damping": [0.0, 1500.0],
+                                "body.rear_wheel.mass": [35.0, 0.0]}, "modes", count=3)
+    out.append(f.read_bytes())
     # sweeps: the cases and opens blocks (a kinematic grid, an inverse dynamics sweep)
     for k, (model, cases, analysis, kw) in enumerate([
             (mbd2d.load(EX / "fourbar_grashof.toml"),

@@ -193,7 +193,7 @@ def spring_chain(n: int, m: float = 0.5, k: float = 200.0) -> mbd2d.Model:
         parts += ["[[body]]", f'name = "b{i}"', f"q0 = [{i * 0.1}, 0.0, 0.0]",
                   f"mass = {m}", "inertia = 0.001",
                   "[[joint]]", 'type = "translational"', f'name = "g{i}"',
-                  f'bodies = ["ground", "b{i}"]', f"points = [[0.0, 0.0], [0.0, 0.0]]",
+                  f'bodies = ["ground", "b{i}"]', "points = [[0.0, 0.0], [0.0, 0.0]]",
                   "axes = [[1, 0], [1, 0]]",
                   "[[force]]", 'type = "spring"', f'name = "s{i}"',
                   f'bodies = ["{"ground" if i == 1 else f"b{i - 1}"}", "b{i}"]',
