@@ -353,6 +353,37 @@ def chain_section(results: dict) -> str:
                "Exudyn error", "Newton iterations mbd2d / Exudyn"), rows)])
 
 
+def modes_section(results: dict) -> str:
+    """Vibration modes: closed forms, mbd2d and Exudyn (bench/peers_modes.py)."""
+    md = results.get("modes")
+    if (text := absent(md)) is not None:
+        return text
+    rows = []
+    for r in md.get("rows", []):
+        rows.append((r["model"], r.get("n_free"), fmt(r.get("mbd2d_error"), ".1e"),
+                     fmt(r.get("exudyn_error"), ".1e"), fmt(1e3 * r["mbd2d_s"], ".3g"),
+                     fmt(1e3 * r["mbd2d_q0_s"], ".3g"),
+                     fmt(1e3 * r["exudyn_s"] if r.get("exudyn_s") else None, ".3g"),
+                     fmt(r.get("time_ratio"), ".2g")))
+    exu = (f"Exudyn {md.get('exudyn')}" if md.get("exudyn_available")
+           else f"Exudyn unavailable ({md.get('exudyn_unavailable_reason')})")
+    return "\n".join([
+        "Natural frequencies against closed forms (docs/modes.md): the hanging double pendulum "
+        "(its 2 x 2 matrices by hand; all its stiffness is the pins' curvature under the "
+        "multipliers) and a fixed-free spring chain; mbd2d's `model.modes()` (which finds the "
+        "equilibrium first) and `modes(equilibrium=False)` (about q0, as Exudyn takes its "
+        f"initial state) beside {exu}'s `ComputeODE2Eigenvalues` (undamped only; the chain "
+        "as mass points with their y coordinates removed, no constraint equations). Error: "
+        "largest relative error over the modes. Time: best wall time of the call.\n",
+        table(("model", "free motions", "mbd2d error", "Exudyn error", "mbd2d ms",
+               "mbd2d about q0 ms", "Exudyn ms", "mbd2d about q0 / Exudyn"), rows),
+        "\nExudyn's eigenvalues of the pendulum are 0: its projected stiffness leaves out the "
+        "multipliers' term (Jᵀλ)_q, which is all of a pendulum's stiffness; mbd2d has it "
+        "(2e-11). On the unconstrained chain Exudyn is faster (a dense symmetric eigensolver "
+        "on the free coordinates directly; mbd2d builds the null space of a constrained model "
+        "of blocks on guides, 3 coordinates a block, and its stiffness by differences).\n"])
+
+
 def peers_section(results: dict) -> str:
     """Exudyn side by side, at equal accuracy, and kinematic stepping."""
     peers = results.get("peers")
@@ -761,6 +792,7 @@ def results_markdown(results: dict, charts: dict[str, str], md_path: Path, out: 
              dynamics_scaling_section(results, charts, out, base),
              "## Contacts\n", contact_section(results, charts, out, base),
              "## Pictures of large models\n", pictures_section(results),
+             "## Vibration modes: closed forms and Exudyn\n", modes_section(results),
              "## Linkage synthesis: literature cases and pylinkage\n",
              synthesis_section(results),
              "## Notes\n", notes_section(results)]

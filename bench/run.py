@@ -22,7 +22,9 @@ Sections (each in its own try/except: a failure is recorded and the rest runs):
 11. dynamics against N: the free N-four-bar with generalized-alpha and dopri5, band and
    dense paths (bench/dynamics_scaling.py);
 12. pictures of large models: the N-four-bar's snapshot picture and GIF, batched against one
-   artist per part (bench/pictures.py).
+   artist per part (bench/pictures.py);
+13. vibration modes: a double pendulum and a spring chain against their closed forms, side
+   by side with Exudyn's ComputeODE2Eigenvalues (bench/peers_modes.py).
 
 Writes bench/results/*.json and *.png, bench/RESULTS.md and bench/README_headline.md
 (bench/report.py). With --only, the other sections come from their results files of an
@@ -57,6 +59,7 @@ import kinematics_speed  # noqa: E402
 import memory  # noqa: E402
 import peers_exudyn  # noqa: E402
 import peers_exudyn_chain  # noqa: E402
+import peers_modes  # noqa: E402
 import pictures  # noqa: E402
 import report  # noqa: E402
 import scaling  # noqa: E402
@@ -67,7 +70,7 @@ import work_precision  # noqa: E402
 
 SECTIONS = ("environment", "work_precision", "peers", "kinematics", "scaling", "memory",
             "sweep", "sensitivities", "contact", "synthesis", "dynamics_scaling", "peers_chain",
-            "pictures")
+            "pictures", "modes")
 
 
 # ===================================================================== JSON
@@ -203,6 +206,11 @@ def section_pictures(quick: bool) -> dict:
     return pictures.study(quick=quick)
 
 
+def section_modes(quick: bool) -> dict:
+    """Vibration modes against closed forms, side by side with Exudyn."""
+    return peers_modes.study(quick=quick)
+
+
 def failure(e: BaseException) -> dict:
     """The record of a failed section."""
     return {"failed": True, "error": f"{type(e).__name__}: {e}",
@@ -312,7 +320,8 @@ def main(argv: Sequence[str] | None = None) -> dict:
         "scaling": section_scaling, "memory": section_memory, "sweep": section_sweep,
         "sensitivities": section_sensitivities, "contact": section_contact,
         "synthesis": section_synthesis, "dynamics_scaling": section_dynamics_scaling,
-        "peers_chain": section_peers_chain, "pictures": section_pictures}
+        "peers_chain": section_peers_chain, "pictures": section_pictures,
+        "modes": section_modes}
     ran = {name: run_section(name, fns[name], a.quick) for name in SECTIONS if name in wanted}
     earlier = earlier_sections(out, [n for n in SECTIONS if n not in wanted])
     results = {name: ran.get(name, earlier.get(name)) for name in SECTIONS

@@ -225,3 +225,31 @@ def test_pictures_table_in_report() -> None:
     assert "| 100 | one per part | 4531 | 3.00 | – | 3.00 | – |" in md
     assert report.pictures_section({}) == "Not run.\n"
     assert "Failed" in report.pictures_section({"pictures": {"failed": True, "error": "x"}})
+
+
+def test_modes_table_in_report() -> None:
+    """The modes' rows (errors, times, the ratio) appear in their section; without Exudyn its
+    columns are empty; a failed or missing section says so."""
+    rows = [{"model": "double pendulum (omega^2)", "n_free": 2, "mbd2d_error": 1.9e-11,
+             "exudyn_error": 1.0, "mbd2d_s": 3e-4, "mbd2d_q0_s": 1.7e-4, "exudyn_s": 2e-4,
+             "time_ratio": 0.85},
+            {"model": "spring chain n = 40 (omega)", "n_free": 40, "mbd2d_error": 1.1e-12,
+             "mbd2d_s": 1.2e-2, "mbd2d_q0_s": 3.9e-3}]
+    md = report.modes_section({"modes": {"exudyn_available": True, "exudyn": "1.13.6",
+                                         "rows": rows}})
+    assert "| double pendulum (omega^2) | 2 | 1.9e-11 | 1.0e+00 | 0.3 | 0.17 | 0.2 | 0.85 |" \
+        in md
+    assert "| spring chain n = 40 (omega) | 40 | 1.1e-12 | – | 12 | 3.9 | – | – |" in md
+    assert "Exudyn 1.13.6" in md
+    assert report.modes_section({}) == "Not run.\n"
+    assert "Failed" in report.modes_section({"modes": {"failed": True, "error": "x"}})
+
+
+def test_modes_study_runs_quick() -> None:
+    """The bench's modes study (quick) measures mbd2d against the closed forms (and Exudyn
+    where it is installed)."""
+    import peers_modes
+    res = peers_modes.study(quick=True)
+    assert res["rows"][0]["mbd2d_error"] < 1e-9 and res["rows"][1]["mbd2d_error"] < 1e-9
+    if res["exudyn_available"]:
+        assert res["rows"][1]["exudyn_error"] < 1e-9

@@ -10,9 +10,11 @@
 !! Undamped modes: K_s v = omega^2 M_r v, K_s = (K_r + K_r^T) / 2 (dsygv; v^T M_r v = 1), the
 !! shapes phi = N v (phi^T M phi = 1). Damped: the eigenvalues s of the first-order form
 !!   [0, I; -M_r^-1 K_r, -M_r^-1 C_r]  (dgeev),  s = -zeta omega +- i omega sqrt(1 - zeta^2),
-!! sorted by |s|, then by the imaginary part, largest first.
-!! Memory: N (nq x nfree) and five nfree x nfree arrays plus the 2 nfree x 2 nfree first-order
-!! matrix, checked and allocated once per call (MBD_NO_MEMORY when they cannot be had).
+!! sorted by |s|, then by the imaginary part, largest first; without damping (C_r = 0) and
+!! with a symmetric K_r they are s = +-sqrt(-omega^2), taken from the undamped modes.
+!! Memory: N, K N, C N, M N (nq x nfree) and five nfree x nfree arrays plus the
+!! 2 nfree x 2 nfree first-order matrix, checked and allocated once per call (MBD_NO_MEMORY
+!! when they cannot be had).
 module mbd_modes
   use mbd_kinds, only: wp, zero, one, half
   use mbd_status, only: MBD_OK, MBD_SINGULAR, MBD_NO_CONVERGENCE, MBD_LAPACK, MSG_LEN
@@ -29,6 +31,8 @@ module mbd_modes
   !> K's and C's central differences: the step eps**(1/3) that balances truncation and
   !! rounding (K to about 1e-11 relative on the closed-form tests, against 5e-10 at 1e-7)
   real(wp), parameter :: FD_STEP = 6.0e-6_wp
+  !> |K_r - K_s| at most this fraction of |K_r|: symmetric (the differences' noise is 1e-11)
+  real(wp), parameter :: SYM_TOL = 1.0e-8_wp
   character(len=*), parameter :: HINT = 'the modes use dense matrices of the number of free ' &
     // 'motions: ask for fewer modes or use a model with fewer free motions'
 
@@ -54,12 +58,14 @@ contains
     real(wp), intent(out) :: shapes(:, :)       !! (nq, kmax) phi = N v (core units)
     integer, intent(out) :: status  !! MBD_OK, MBD_SINGULAR, MBD_NO_CONVERGENCE, ...
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
-    real(wp), allocatable :: nb(:, :), kn(:, :), cn(:, :), mr(:, :), kr(:, :), cr(:, :), &
+    real(wp), allocatable :: nb(:, :), kn(:, :), cn(:, :), mn(:, :), mr(:, :), kr(:, :), &
+                             cr(:, :), &
                              ks(:, :), a(:, :), wr(:), wi(:), ev(:), vl(:, :), vr(:, :), work(:), &
                              kv(:), cv(:)
     integer, allocatable :: ipiv(:), order(:)
     real(wp) :: bytes, wq(1)
     integer :: n, f, nnz, ist, info, j, k, nk
+    logical :: plain, damped
     character(len=MSG_LEN) :: what
     status = MBD_OK; msg = ''
     omega2 = zero; sre = zero; sim = zero; shapes = zero; kinds = 0
@@ -69,12 +75,12 @@ contains
     if (f <= 0 .or. kmax <= 0) return
     nk = min(kmax, f)
     nnz = w%kptr(n + 1) - 1
-    bytes = REAL_BYTES * (3 * real(n, wp) * f + 5 * real(f, wp)**2 + 4 * real(2 * f, wp)**2 &
+    bytes = REAL_BYTES * (4 * real(n, wp) * f + 5 * real(f, wp)**2 + 4 * real(2 * f, wp)**2 &
                           + 2 * real(nnz, wp) + 8 * real(f, wp))
     write (what, '(a,i0,a)') 'the modes'' work arrays (', f, ' free motions)'
     call mem_check(bytes, trim(what), HINT, status, msg)
     if (status /= MBD_OK) return
-    allocate (nb(n, f), kn(n, f), cn(n, f), mr(f, f), kr(f, f), cr(f, f), ks(f, f), &
+    allocate (nb(n, f), kn(n, f), cn(n, f), mn(n, f), mr(f, f), kr(f, f), cr(f, f), ks(f, f), &
               a(2 * f, 2 * f), wr(2 * f), wi(2 * f), ev(f), vl(1, 1), vr(1, 1), kv(nnz), &
               cv(nnz), ipiv(f), order(2 * f), work(1), stat=ist)
     if (ist /= 0) then
@@ -86,19 +92,24 @@ contains
       return
     end if
     call dyn_tangent(m, w, q, w%qz, t, lam, kv, cv, step=FD_STEP)
-    do j = 1, f                                   ! K N and C N, column by column
+    damped = maxval(abs(cv)) > zero
+    do j = 1, f                                   ! K N, C N and M N, column by column
       call spmul(kv, nb(:, j), kn(:, j))
-      call spmul(cv, nb(:, j), cn(:, j))
-    end do
-    kr = matmul(transpose(nb), kn)                ! K_r = N^T K N
-    cr = matmul(transpose(nb), cn)                ! C_r = N^T C N
-    do j = 1, f                                   ! M_r = N^T M N (M diagonal)
-      do k = 1, f
-        mr(k, j) = sum(nb(:, k) * m%mdiag * nb(:, j))
+      if (damped) call spmul(cv, nb(:, j), cn(:, j))
+      do k = 1, n
+        mn(k, j) = m%mdiag(k) * nb(k, j)
       end do
     end do
+    kr = matmul(transpose(nb), kn)                ! K_r = N^T K N
+    cr = zero
+    if (damped) cr = matmul(transpose(nb), cn)    ! C_r = N^T C N
+    mr = matmul(transpose(nb), mn)                ! M_r = N^T M N
     ! undamped: K_s v = omega^2 M_r v
     ks = half * (kr + transpose(kr))
+    ! no damping and a symmetric K_r (a conservative equilibrium, to the differences' noise):
+    ! the first-order form's eigenvalues are +-i omega, no dgeev needed
+    plain = .not. damped .and. &
+            maxval(abs(kr - ks)) <= SYM_TOL * max(maxval(abs(kr)), tiny(one))
     a(1:f, 1:f) = mr
     call dsygv(1, 'V', 'U', f, ks, f, a, 2 * f, ev, wq, -1, info)
     call grow(max(1, int(wq(1))), status)
@@ -130,6 +141,20 @@ contains
       j = maxloc(abs(shapes(:, k)), 1)
       if (shapes(j, k) < zero) shapes(:, k) = -shapes(:, k)
     end do
+    if (plain) then
+      do k = 1, f                                 ! s = +-sqrt(-omega^2)
+        if (ev(k) >= zero) then
+          wr(2 * k - 1:2 * k) = zero; wi(2 * k - 1:2 * k) = [sqrt(ev(k)), -sqrt(ev(k))]
+        else
+          wr(2 * k - 1:2 * k) = [sqrt(-ev(k)), -sqrt(-ev(k))]; wi(2 * k - 1:2 * k) = zero
+        end if
+      end do
+      call sort_eigen(wr, wi, order)
+      do k = 1, 2 * nk
+        sre(k) = wr(order(k)); sim(k) = wi(order(k))
+      end do
+      return
+    end if
     ! damped: eigenvalues of [0, I; -M_r^-1 K_r, -M_r^-1 C_r]
     call dgetrf(f, f, mr, f, ipiv, info)
     if (info /= 0) then
