@@ -58,10 +58,12 @@ contains
     real(wp), intent(out) :: shapes(:, :)       !! (nq, kmax) phi = N v (core units)
     integer, intent(out) :: status  !! MBD_OK, MBD_SINGULAR, MBD_NO_CONVERGENCE, ...
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    ! N, K N, C N, M N; M_r, K_r, C_r, K_s (then the eigenvectors v); the first-order matrix,
+    ! its eigenvalues, the undamped ones, dgeev's unused eigenvectors, LAPACK's workspace, and
+    ! K and C on the sparse pattern
     real(wp), allocatable :: nb(:, :), kn(:, :), cn(:, :), mn(:, :), mr(:, :), kr(:, :), &
-                             cr(:, :), &
-                             ks(:, :), a(:, :), wr(:), wi(:), ev(:), vl(:, :), vr(:, :), work(:), &
-                             kv(:), cv(:)
+                             cr(:, :), ks(:, :), a(:, :), wr(:), wi(:), ev(:), vl(:, :), &
+                             vr(:, :), work(:), kv(:), cv(:)
     integer, allocatable :: ipiv(:), order(:)
     real(wp) :: bytes, wq(1)
     integer :: n, f, nnz, ist, info, j, k, nk
