@@ -1164,8 +1164,11 @@ contains
         end do
       end do
     end do
+    ! a column of round-off size is an empty one (a pendulum's rod through its lowest point:
+    ! the x column 1e-17; as a weight it made the matrix singular)
+    d = maxval(w%metric(1:n))
     do i = 1, n
-      if (.not. w%metric(i) > zero) w%metric(i) = one
+      if (.not. w%metric(i) > 1.0e-16_wp * d) w%metric(i) = one
       w%metric(i) = w%s * w%metric(i)
     end do
     call factor_aug(w, w%metric, status)

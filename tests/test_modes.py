@@ -759,3 +759,165 @@ def test_mbd2d_solve_runs_a_modes_sweep_as_python(tmp_path: Path) -> None:
     subprocess.run([find_solver(), str(good), str(tmp_path / "good.csv")], check=True,
                    capture_output=True, timeout=60)
     assert (tmp_path / "good.csv").read_text() == (tmp_path / "good_py.csv").read_text()
+
+
+# ------------------------------------------------------------------ more joints' stiffness
+
+def joint_model(body_text: str, joint_text: str, force_text: str,
+                gravity: float = -G) -> mbd2d.Model:
+    return mbd2d.loads(f"""
+[model]
+name = "joint-mode"
+gravity = [0.0, {gravity}]
+{body_text}
+{joint_text}
+{force_text}
+""")
+
+
+def test_a_disc_rolling_on_a_spring() -> None:
+    """A disc (m, I, r) rolling without slip on the floor, tied by a horizontal spring k at
+    its centre: omega^2 = k / (m + I / r^2); gravity holds it on the floor."""
+    m, inertia, r, k = 2.0, 0.03, 0.15, 50.0
+    model = joint_model(f"""
+[[body]]
+name = "disc"
+q0 = [0.4, {r + 0.01}, 0.0]
+mass = {m}
+inertia = {inertia}""", f"""
+[[joint]]
+type = "rolling-disc"
+name = "floor"
+bodies = ["disc", "ground"]
+center = [0, 0]
+point = [0, 0]
+axis = [1, 0]
+radius = {r}""", f"""
+[[force]]
+type = "spring"
+name = "s"
+bodies = ["ground", "disc"]
+points = [[0.0, {r}], [0.0, 0.0]]
+stiffness = {k}
+damping = 0.0
+length0 = 0.3""")
+    res = model.modes()
+    assert res.n_free == 1 and abs(res.q[0] - 0.3) < 1e-12 and abs(res.q[1] - r) < 1e-12
+    assert abs(res.omega2[0] / (k / (m + inertia / r**2)) - 1) < 1e-9
+    phi = res.shape(0)
+    assert abs(phi[2] + phi[0] / r) < 1e-12 * abs(phi[2])        # rolls: d theta = -dx / r
+
+
+def test_a_gear_pair_on_a_torsion_spring() -> None:
+    """Gears R1, R2 on ground pivots, the first held by a torsion spring k:
+    omega^2 = k / (I1 + I2 (R1 / R2)^2)."""
+    r1, r2, i1, i2, k = 0.5, 1.5, 0.02, 0.3, 8.0
+    model = joint_model(f"""
+[[body]]
+name = "pinion"
+q0 = [0, 0, 0.1]
+mass = 1.0
+inertia = {i1}
+[[body]]
+name = "wheel"
+q0 = [{r1 + r2}, 0, 0.4]
+mass = 3.0
+inertia = {i2}""", f"""
+[[joint]]
+type = "revolute"
+name = "p1"
+bodies = ["ground", "pinion"]
+points = [[0, 0], [0, 0]]
+[[joint]]
+type = "revolute"
+name = "p2"
+bodies = ["ground", "wheel"]
+points = [[{r1 + r2}, 0], [0, 0]]
+[[joint]]
+type = "gear"
+name = "mesh"
+bodies = ["pinion", "wheel"]
+radii = [{r1}, {r2}]""", f"""
+[[force]]
+type = "rotational-spring"
+name = "k"
+bodies = ["ground", "pinion"]
+stiffness = {k}
+damping = 0.0
+angle0 = 0.0""")
+    res = model.modes()
+    assert res.n_free == 1
+    assert abs(res.omega2[0] / (k / (i1 + i2 * (r1 / r2)**2)) - 1) < 1e-9
+    phi = res.shape(0)
+    assert abs(phi[5] / phi[2] + r1 / r2) < 1e-12                   # the mesh: -R1/R2
+
+
+def test_a_rack_on_a_spring_turning_a_pinion() -> None:
+    """A rack (m) on a guide under a pinion (I, r) on a ground pivot, the rack on a spring k:
+    omega^2 = k / (m + I / r^2)."""
+    m, inertia, r, k = 1.5, 0.01, 0.3, 40.0
+    model = joint_model(f"""
+[[body]]
+name = "pinion"
+q0 = [0, 0, 0]
+mass = 0.5
+inertia = {inertia}
+[[body]]
+name = "rack"
+q0 = [0, {-r}, 0]
+mass = {m}
+inertia = 0.1""", f"""
+[[joint]]
+type = "revolute"
+name = "pivot"
+bodies = ["ground", "pinion"]
+points = [[0, 0], [0, 0]]
+[[joint]]
+type = "translational"
+name = "guide"
+bodies = ["ground", "rack"]
+points = [[0, {-r}], [0, 0]]
+axes = [[1, 0], [1, 0]]
+[[joint]]
+type = "rack-pinion"
+name = "teeth"
+bodies = ["pinion", "rack"]
+center = [0, 0]
+point = [0, 0]
+axis = [1, 0]
+radius = {r}""", f"""
+[[force]]
+type = "spring"
+name = "s"
+bodies = ["ground", "rack"]
+points = [[-0.5, {-r}], [0.0, 0.0]]
+stiffness = {k}
+damping = 0.0
+length0 = 0.5""")
+    res = model.modes()
+    assert res.n_free == 1
+    assert abs(res.omega2[0] / (k / (m + inertia / r**2)) - 1) < 1e-9
+
+
+def test_a_pendulum_on_a_distance_joint() -> None:
+    """A bob hung by a massless rod (a distance joint L from a ground point to its centre):
+    its swing omega^2 = g / L, and its spin about its own centre a motion without stiffness
+    ("rigid")."""
+    length = 0.8
+    model = joint_model("""
+[[body]]
+name = "bob"
+q0 = [0.2, -0.75, 0.3]
+mass = 2.0
+inertia = 0.05""", f"""
+[[joint]]
+type = "distance"
+name = "rod"
+bodies = ["ground", "bob"]
+points = [[0, 0], [0, 0]]
+distance = {length}""", "")
+    res = model.modes()
+    assert res.n_free == 2 and res.kinds == ["rigid", "vibration"]
+    assert abs(res.q[0]) < 1e-12 and abs(res.q[1] + length) < 1e-12
+    assert abs(res.omega2[1] / (G / length) - 1) < 1e-9
+    assert abs(res.omega2[0]) <= 1e-9 * res.omega2[1]
