@@ -921,3 +921,33 @@ distance = {length}""", "")
     assert abs(res.q[0]) < 1e-12 and abs(res.q[1] + length) < 1e-12
     assert abs(res.omega2[1] / (G / length) - 1) < 1e-9
     assert abs(res.omega2[0]) <= 1e-9 * res.omega2[1]
+
+
+def test_a_bead_in_a_circular_slot() -> None:
+    """A bead (its spin locked) in a circular slot of radius R, the slot's lowest point at
+    the origin: omega^2 = g / R; the joint's extra coordinate (the point's place on the
+    curve, massless) moves with it."""
+    radius = 1.2
+    model = joint_model("""
+[[body]]
+name = "bead"
+q0 = [0.3, 0.05, 0.0]
+mass = 0.4
+inertia = 0.001""", f"""
+[[joint]]
+type = "point-on-curve"
+name = "slot"
+bodies = ["ground", "bead"]
+curve = {{ circle = {{ center = [0, {radius}], radius = {radius} }} }}
+point = [0, 0]
+[[joint]]
+type = "absolute"
+name = "no_spin"
+body = "bead"
+coordinate = "theta"
+""", "")
+    res = model.modes()
+    assert res.n_free == 1 and abs(res.q[0]) < 1e-12 and abs(res.q[1]) < 1e-12
+    assert abs(res.omega2[0] / (G / radius) - 1) < 1e-9
+    phi = res.shape(0)
+    assert abs(phi[3] - phi[0] / radius) < 1e-9 * abs(phi[3])     # d alpha = dx / R
