@@ -60,7 +60,7 @@ module mbd_dynamics
             dyn_velocity, &
             dyn_project_pos, dyn_multipliers, dyn_reactions, dyn_tangent, dyn_solve, &
             dyn_solve_rows, &
-            dyn_jt_lam, dyn_damped, dyn_choose, dyn_jv, dyn_null_basis, &
+            dyn_jt_lam, dyn_damped, dyn_choose, dyn_jv, dyn_null_basis, dyn_pattern_mul, &
             dyn_factor_projection, SOLVER_AUTO, SOLVER_DENSE, SOLVER_BANDED, friction_forces, &
             dyn_element_outputs, element_state, element_slip
   public :: MODE_STUCK
@@ -1382,6 +1382,22 @@ contains
       end do
     end subroutine residual
   end subroutine dyn_tangent
+
+  !> y = A x for A on the pattern of K (w%kptr, w%krow; values av, as dyn_tangent gives them).
+  pure subroutine dyn_pattern_mul(w, av, x, y)
+    type(dyn_work_t), intent(in) :: w         !! work arrays (pattern from dyn_init)
+    real(wp), intent(in) :: av(:)             !! values on the pattern
+    real(wp), intent(in) :: x(:)              !! (nq)
+    real(wp), intent(out) :: y(:)             !! (nq)
+    integer :: j, p
+    y = zero
+    do j = 1, size(x)
+      if (abs(x(j)) <= zero) cycle
+      do p = w%kptr(j), w%kptr(j + 1) - 1
+        y(w%krow(p)) = y(w%krow(p)) + av(p) * x(j)
+      end do
+    end do
+  end subroutine dyn_pattern_mul
 
   !> r = J^T lambda from the local Jacobian blocks (no dense J): each constraint adds
   !! jb_k^T lambda_k to the coordinates of its slots.

@@ -13,7 +13,7 @@ module mbd_memory
   implicit none
   private
   public :: MIB, GIB, CHECK_ABOVE, REAL_BYTES, mem_limit, mem_text, mem_check, mem_fail, &
-            zero_fill
+            zero_fill, mem_grow
 
   real(wp), parameter :: MIB = 1048576.0_wp            !! bytes in a MiB
   real(wp), parameter :: GIB = 1073741824.0_wp         !! bytes in a GiB
@@ -92,6 +92,25 @@ contains
     msg = 'not enough memory: allocating ' // trim(mem_text(bytes)) // ' for ' // what // &
           ' failed; ' // hint
   end subroutine mem_fail
+
+  !> A workspace of at least lw entries (a LAPACK query's answer): work grows when it is
+  !! smaller; MBD_NO_MEMORY (work then of one entry) when it cannot.
+  subroutine mem_grow(work, lw, what, hint, status, msg)
+    real(wp), allocatable, intent(inout) :: work(:)  !! the workspace (allocated)
+    integer, intent(in) :: lw                        !! entries needed
+    character(len=*), intent(in) :: what, hint       !! for the message
+    integer, intent(out) :: status                   !! MBD_OK or MBD_NO_MEMORY
+    character(len=MSG_LEN), intent(inout) :: msg     !! explanation
+    integer :: ierr
+    status = MBD_OK
+    if (size(work) >= lw) return
+    deallocate (work)
+    allocate (work(lw), stat=ierr)
+    if (ierr /= 0) then
+      call mem_fail(REAL_BYTES * lw, what, hint, status, msg)
+      allocate (work(1), stat=ierr)
+    end if
+  end subroutine mem_grow
 
   !> a(1:n) = 0 for an array seen flat: one memset (gfortran clears a 2-D or 3-D array or
   !! section column by column, a memset call per column).

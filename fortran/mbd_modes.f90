@@ -18,10 +18,10 @@
 module mbd_modes
   use mbd_kinds, only: wp, zero, one, half
   use mbd_status, only: MBD_OK, MBD_SINGULAR, MBD_NO_CONVERGENCE, MBD_LAPACK, MSG_LEN
-  use mbd_memory, only: REAL_BYTES, mem_check, mem_fail
+  use mbd_memory, only: REAL_BYTES, mem_check, mem_fail, mem_grow
   use mbd_model, only: model_t
   use mbd_lapack, only: dsygv, dgeev, dgetrf, dgetrs
-  use mbd_dynamics, only: dyn_work_t, dyn_tangent, dyn_null_basis
+  use mbd_dynamics, only: dyn_work_t, dyn_tangent, dyn_null_basis, dyn_pattern_mul
   implicit none
   private
   public :: modes_solve
@@ -96,8 +96,8 @@ contains
     call dyn_tangent(m, w, q, w%qz, t, lam, kv, cv, step=FD_STEP)
     damped = maxval(abs(cv)) > zero
     do j = 1, f                                   ! K N, C N and M N, column by column
-      call spmul(kv, nb(:, j), kn(:, j))
-      if (damped) call spmul(cv, nb(:, j), cn(:, j))
+      call dyn_pattern_mul(w, kv, nb(:, j), kn(:, j))
+      if (damped) call dyn_pattern_mul(w, cv, nb(:, j), cn(:, j))
       do k = 1, n
         mn(k, j) = m%mdiag(k) * nb(k, j)
       end do
@@ -151,68 +151,48 @@ contains
           wr(2 * k - 1:2 * k) = [sqrt(-ev(k)), -sqrt(-ev(k))]; wi(2 * k - 1:2 * k) = zero
         end if
       end do
-      call sort_eigen(wr, wi, order)
-      do k = 1, 2 * nk
-        sre(k) = wr(order(k)); sim(k) = wi(order(k))
-      end do
-      return
-    end if
-    ! damped: eigenvalues of [0, I; -M_r^-1 K_r, -M_r^-1 C_r]
-    call dgetrf(f, f, mr, f, ipiv, info)
-    if (info /= 0) then
-      status = MBD_SINGULAR; msg = 'modes: M_r is singular (a free motion carries no mass)'
-      return
-    end if
-    call dgetrs('N', f, f, mr, f, ipiv, kr, f, info)
-    call dgetrs('N', f, f, mr, f, ipiv, cr, f, info)
-    a = zero
-    do j = 1, f
-      a(j, f + j) = one
-    end do
-    a(f + 1:2 * f, 1:f) = -kr
-    a(f + 1:2 * f, f + 1:2 * f) = -cr
-    call dgeev('N', 'N', 2 * f, a, 2 * f, wr, wi, vl, 1, vr, 1, wq, -1, info)
-    call grow(max(1, int(wq(1))), status)
-    if (status /= MBD_OK) return
-    call dgeev('N', 'N', 2 * f, a, 2 * f, wr, wi, vl, 1, vr, 1, work, size(work), info)
-    if (info /= 0) then
-      status = merge(MBD_NO_CONVERGENCE, MBD_LAPACK, info > 0)
-      write (msg, '(a,i0,a)') 'modes: the damped eigenvalues did not converge (dgeev info ', &
-        info, ')'
-      return
+    else
+      call damped_eigenvalues(status)
+      if (status /= MBD_OK) return
     end if
     call sort_eigen(wr, wi, order)
     do k = 1, 2 * nk
       sre(k) = wr(order(k)); sim(k) = wi(order(k))
     end do
   contains
-    !> y = A x for A on K's sparse pattern (values av).
-    subroutine spmul(av, x, y)
-      real(wp), intent(in) :: av(:), x(:)
-      real(wp), intent(out) :: y(:)
-      integer :: jj, p
-      y = zero
-      do jj = 1, n
-        if (abs(x(jj)) <= zero) cycle
-        do p = w%kptr(jj), w%kptr(jj + 1) - 1
-          y(w%krow(p)) = y(w%krow(p)) + av(p) * x(jj)
-        end do
+    !> wr, wi: the eigenvalues of [0, I; -M_r^-1 K_r, -M_r^-1 C_r] (dgeev).
+    subroutine damped_eigenvalues(st)
+      integer, intent(out) :: st
+      st = MBD_OK
+      call dgetrf(f, f, mr, f, ipiv, info)
+      if (info /= 0) then
+        st = MBD_SINGULAR; msg = 'modes: M_r is singular (a free motion carries no mass)'
+        return
+      end if
+      call dgetrs('N', f, f, mr, f, ipiv, kr, f, info)
+      call dgetrs('N', f, f, mr, f, ipiv, cr, f, info)
+      a = zero
+      do j = 1, f
+        a(j, f + j) = one
       end do
-    end subroutine spmul
+      a(f + 1:2 * f, 1:f) = -kr
+      a(f + 1:2 * f, f + 1:2 * f) = -cr
+      call dgeev('N', 'N', 2 * f, a, 2 * f, wr, wi, vl, 1, vr, 1, wq, -1, info)
+      call grow(max(1, int(wq(1))), st)
+      if (st /= MBD_OK) return
+      call dgeev('N', 'N', 2 * f, a, 2 * f, wr, wi, vl, 1, vr, 1, work, size(work), info)
+      if (info /= 0) then
+        st = merge(MBD_NO_CONVERGENCE, MBD_LAPACK, info > 0)
+        write (msg, '(a,i0,a)') 'modes: the damped eigenvalues did not converge (dgeev info ', &
+          info, ')'
+      end if
+    end subroutine damped_eigenvalues
 
     !> work has at least lw entries (MBD_NO_MEMORY when it cannot grow).
     subroutine grow(lw, st)
       integer, intent(in) :: lw
       integer, intent(out) :: st
-      integer :: ierr
-      st = MBD_OK
-      if (size(work) >= lw) return
-      deallocate (work)
-      allocate (work(lw), stat=ierr)
-      if (ierr /= 0) then
-        call mem_fail(REAL_BYTES * lw, 'the LAPACK workspace of the modes', HINT, st, msg)
-        allocate (work(1), stat=ierr)
-      end if
+      call mem_grow(work, lw, 'the LAPACK workspace of the modes', HINT, st, msg)
     end subroutine grow
   end subroutine modes_solve
 

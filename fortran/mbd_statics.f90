@@ -31,12 +31,13 @@
 module mbd_statics
   use mbd_kinds, only: wp, zero, one, half, eps
   use mbd_status, only: MBD_OK, MBD_NO_CONVERGENCE, MBD_LAPACK, MSG_LEN
-  use mbd_memory, only: REAL_BYTES, mem_check, mem_fail
+  use mbd_memory, only: REAL_BYTES, mem_check, mem_fail, mem_grow
   use mbd_model, only: model_t
   use mbd_assemble, only: blocks_jtv
   use mbd_lapack, only: dgesvd, dsyev
   use mbd_dynamics, only: dyn_work_t, gen_forces, dyn_tangent, dyn_project_pos, &
-                          dyn_multipliers, dyn_null_basis, dyn_solve, SOLVER_DENSE
+                          dyn_multipliers, dyn_null_basis, dyn_solve, dyn_pattern_mul, &
+                          SOLVER_DENSE
   implicit none
   private
   public :: statics_solve
@@ -294,14 +295,7 @@ contains
     subroutine kmul(x, y)
       real(wp), intent(in) :: x(:)
       real(wp), intent(out) :: y(:)
-      integer :: j, p
-      y = zero
-      do j = 1, n
-        if (abs(x(j)) <= zero) cycle
-        do p = w%kptr(j), w%kptr(j + 1) - 1
-          y(w%krow(p)) = y(w%krow(p)) + kv(p) * x(j)
-        end do
-      end do
+      call dyn_pattern_mul(w, kv, x, y)
     end subroutine kmul
 
     !> ktr(p): the entry (c, i) of the pattern entry p = (i, c) (the pattern is symmetric).
@@ -335,15 +329,7 @@ contains
     subroutine grow_work(lw, st)
       integer, intent(in) :: lw
       integer, intent(out) :: st
-      integer :: ierr
-      st = MBD_OK
-      if (size(work) >= lw) return
-      deallocate (work)
-      allocate (work(lw), stat=ierr)
-      if (ierr /= 0) then
-        call mem_fail(REAL_BYTES * lw, 'the LAPACK workspace of the statics', HINT, st, msg)
-        allocate (work(1), stat=ierr)
-      end if
+      call mem_grow(work, lw, 'the LAPACK workspace of the statics', HINT, st, msg)
     end subroutine grow_work
 
     !> dz from H dz = g - N^T K dq_n, saddle-free: |eigenvalues| bounded below (a flat

@@ -266,22 +266,8 @@ def test_a_bob_on_a_distance_joint_settles_below_its_pivot(solver: str) -> None:
     free and kept). On the band path the basis of the free motions weighted each coordinate
     by its column of J, and the x column, 1e-17 there, made the matrix singular: an internal
     error ("MBD_LAPACK ... a bug")."""
-    model = mbd2d.loads("""
-[model]
-name = "bob"
-gravity = [0.0, -9.81]
-[[body]]
-name = "bob"
-q0 = [0.2, -0.75, 0.3]
-mass = 2.0
-inertia = 0.05
-[[joint]]
-type = "distance"
-name = "rod"
-bodies = ["ground", "bob"]
-points = [[0, 0], [0, 0]]
-distance = 0.8
-""")
+    from test_modes import distance_bob
+    model = distance_bob()
     res = model.statics(solver=solver)
     assert_allclose(res.q, [0.0, -0.8, 0.3], atol=1e-12)
     assert res.stats["solver"] == solver

@@ -1328,17 +1328,7 @@ contains
     ! doubled at most)
     width = 26 * (spec%ncp + 2 + 3 * nq + spec%nc + spec%nmeas + &
                   spec%npar * (3 * nq + spec%nc + spec%nmeas)) + 32
-    allocate (character(len=width) :: head, stat=ierr)
-    if (ierr == 0) allocate (character(len=2 * len(cmsg) + 40) :: tail, stat=ierr)
-    if (ierr == 0) allocate (character(len=width + len(tail)) :: line, stat=ierr)
-    if (ierr /= 0) call die(2, 'not enough memory to write ' // path)
-    open (newunit=u, file=path, status='replace', action='write', access='stream', &
-          form='unformatted', iostat=ios)
-    if (ios /= 0) call die(2, 'cannot write ' // path)
-    call sput(u, ios, 'case')
-    do j = 1, spec%ncp
-      call sput(u, ios, ',' // trim(spec%case_names(j)))
-    end do
+    call open_sweep_csv(path, width, u, ios, head, tail, line)
     call sput(u, ios, ',t,status,message')
     do l = 1, nlev
       call coordinate_header(u, ios, trim(lev(l)), 0)
@@ -1369,13 +1359,7 @@ contains
     end do
     call sput(u, ios, crlf)
     do c = 1, spec%ncase
-      nh = 0
-      call bput(head, nh, trim(itoa(c - 1)))
-      do j = 1, spec%ncp
-        call bnum(head, nh, spec%cvals(j, c))
-      end do
-      nt = 0
-      call bput(tail, nt, ',' // trim(itoa(cstat(c))) // ',' // quoted(trim(cmsg(c))))
+      call case_fields(c, head, nh, tail, nt)
       if (nkeep(c) == 0) then
         call sput(u, ios, head(1:nh) // ',' // tail(1:nt) // crlf)
         cycle
@@ -1417,16 +1401,15 @@ contains
     if (ios /= 0) call die(2, 'cannot write ' // path // ' (disk full?)')
   end subroutine write_sweep_csv
 
-  !> The CSV of mbd2d.write_sweep for a modes sweep: one row per case and mode (case, the
-  !! parameters, mode, status, message, omega2, frequency_hz, kind, the shape per
-  !! coordinate); a case without modes, one row with its status and message.
-  subroutine write_modes_sweep_csv(path)
+  !> A sweep's CSV opened at path, its first column names written (case, the parameters),
+  !! and the row buffers: head (case and parameters) and line of width characters, tail
+  !! (status and quoted message).
+  subroutine open_sweep_csv(path, width, u, ios, head, tail, line)
     character(len=*), intent(in) :: path
-    character(len=*), parameter :: crlf = achar(13) // achar(10)
-    real(wp), parameter :: TWO_PI = 2 * 3.141592653589793_wp
-    character(len=:), allocatable :: line, head, tail
-    integer :: u, ios, j, k, c, lp, nh, nt, width
-    width = 26 * (spec%ncp + 6 + nq) + 32
+    integer, intent(in) :: width
+    integer, intent(out) :: u, ios
+    character(len=:), allocatable, intent(out) :: head, tail, line
+    integer :: j
     allocate (character(len=width) :: head, stat=ierr)
     if (ierr == 0) allocate (character(len=2 * len(cmsg) + 40) :: tail, stat=ierr)
     if (ierr == 0) allocate (character(len=width + len(tail)) :: line, stat=ierr)
@@ -1438,17 +1421,39 @@ contains
     do j = 1, spec%ncp
       call sput(u, ios, ',' // trim(spec%case_names(j)))
     end do
+  end subroutine open_sweep_csv
+
+  !> Case c's leading fields (head: case and parameters) and its status and message (tail).
+  subroutine case_fields(c, head, nh, tail, nt)
+    integer, intent(in) :: c
+    character(len=*), intent(inout) :: head, tail
+    integer, intent(out) :: nh, nt
+    integer :: j
+    nh = 0
+    call bput(head, nh, trim(itoa(c - 1)))
+    do j = 1, spec%ncp
+      call bnum(head, nh, spec%cvals(j, c))
+    end do
+    nt = 0
+    call bput(tail, nt, ',' // trim(itoa(cstat(c))) // ',' // quoted(trim(cmsg(c))))
+  end subroutine case_fields
+
+  !> The CSV of mbd2d.write_sweep for a modes sweep: one row per case and mode (case, the
+  !! parameters, mode, status, message, omega2, frequency_hz, kind, the shape per
+  !! coordinate); a case without modes, one row with its status and message.
+  subroutine write_modes_sweep_csv(path)
+    character(len=*), intent(in) :: path
+    character(len=*), parameter :: crlf = achar(13) // achar(10)
+    real(wp), parameter :: TWO_PI = 2 * 3.141592653589793_wp
+    character(len=:), allocatable :: line, head, tail
+    integer :: u, ios, j, k, c, lp, nh, nt, width
+    width = 26 * (spec%ncp + 6 + nq) + 32
+    call open_sweep_csv(path, width, u, ios, head, tail, line)
     call sput(u, ios, ',mode,status,message,omega2,frequency_hz,kind')
     call coordinate_header(u, ios, '', 0)
     call sput(u, ios, crlf)
     do c = 1, spec%ncase
-      nh = 0
-      call bput(head, nh, trim(itoa(c - 1)))
-      do j = 1, spec%ncp
-        call bnum(head, nh, spec%cvals(j, c))
-      end do
-      nt = 0
-      call bput(tail, nt, ',' // trim(itoa(cstat(c))) // ',' // quoted(trim(cmsg(c))))
+      call case_fields(c, head, nh, tail, nt)
       if (nkeep(c) == 0) then
         call sput(u, ios, head(1:nh) // ',' // tail(1:nt) // crlf)
         cycle
