@@ -2,9 +2,10 @@
 !!
 !!   mbd2d-solve MODEL.mbd OUT.csv
 !! Runs the file's analysis (kinematics, inverse dynamics, dynamics, statics or modes, with
-!! its settings) and writes the CSV the Python path writes for it: t, then NAME.x ... NAME.theta_ddot
-!! per body (statics: NAME.x, NAME.y, NAME.theta, stable, residual), then the optional columns
-!! the file's "outputs" line asks for (energy, multipliers, reactions, efforts), then each
+!! its settings) and writes the CSV the Python path writes for it: t, then NAME.x ...
+!! NAME.theta_ddot per body (statics: NAME.x, NAME.y, NAME.theta, stable, residual), then the
+!! optional columns the file's "outputs" line asks for (energy, multipliers, reactions,
+!! efforts), then each
 !! contact's and joint friction's columns (dynamic runs), then with a "sensitivities" block,
 !! for each design parameter P in turn, d(COLUMN)/d(P) of the motion columns and (inverse
 !! dynamics, statics) of the multiplier, reaction and effort columns asked for; every number
