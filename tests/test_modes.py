@@ -356,6 +356,8 @@ def test_a_fully_constrained_model_has_no_modes() -> None:
     res = mbd2d.load(Path(__file__).parents[1] / "examples" / "fourbar_masses.toml").modes()
     assert res.n_free == 0 and res.omega2.size == 0 and res.shapes.shape[1] == 0
     assert res.stability == "fully constrained" and "0 free motion" in res.summary()
+    with pytest.raises(mbd2d.ModelError, match="no modes"):
+        res.plot(0)
 
 
 def test_count_and_the_lowest_modes() -> None:

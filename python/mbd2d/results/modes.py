@@ -82,8 +82,8 @@ class ModesResult:
     def _mode(self, k: int) -> int:
         n = self.omega2.size
         if not isinstance(k, (int, np.integer)) or isinstance(k, bool) or not -n <= k < n:
-            raise ModelError(f"mode {k!r} does not exist: this result has {n} mode(s), "
-                             f"0 .. {n - 1}", "modes")
+            has = f"{n} mode(s), 0 .. {n - 1}" if n else "no modes (no free motion)"
+            raise ModelError(f"mode {k!r} does not exist: this result has {has}", "modes")
         return int(k) % n
 
     def shape(self, k: int) -> np.ndarray:
