@@ -505,9 +505,7 @@ def test_damped_double_pendulum_against_its_matrices() -> None:
 def test_mbd2d_solve_writes_the_modes_python_writes(tmp_path: Path) -> None:
     """The standalone program: the modes table, the damped table, a count and a
     linearization about q0, to the last digit of Python's CSV."""
-    import subprocess
-
-    from test_standalone import find_solver
+    from test_standalone import solve_file
     damped = damped_double_pendulum()
     up = pendulum(k=0.0, q0=f"0.0, 0.5, {np.pi / 2}")
     runs = [(damped, {}, damped.modes(), {}),
@@ -518,13 +516,9 @@ def test_mbd2d_solve_writes_the_modes_python_writes(tmp_path: Path) -> None:
     for k, (model, kw, res, csv_kw) in enumerate(runs):
         mbd = tmp_path / f"m{k}.mbd"
         model.export(mbd, analysis="modes", **kw)
-        out = tmp_path / f"f{k}.csv"
-        r = subprocess.run([find_solver(), str(mbd), str(out)], capture_output=True, text=True,
-                           timeout=60)
-        assert r.returncode == 0, r.stderr
         py = tmp_path / f"p{k}.csv"
         res.to_csv(py, **csv_kw)
-        assert out.read_text() == py.read_text()
+        assert solve_file(mbd, tmp_path / f"f{k}.csv") == py.read_text()
 
 
 @pytest.mark.parametrize("line, needle", [
@@ -709,9 +703,8 @@ def test_mbd2d_solve_runs_a_modes_sweep_as_python(tmp_path: Path) -> None:
     count and a failing case among them; the failing case's status, with the program's own
     message, as for every sweep file)."""
     import csv
-    import subprocess
 
-    from test_standalone import find_solver
+    from test_standalone import solve_file
     pytest.importorskip("xarray")
     model = half_car()
     cases = {DAMPING[0]: np.linspace(0.0, 3000.0, 4),
@@ -720,11 +713,8 @@ def test_mbd2d_solve_runs_a_modes_sweep_as_python(tmp_path: Path) -> None:
     assert list(ds.status.values != 0) == [False, False, True, False]
     mbd2d.write_sweep(ds, tmp_path / "py.csv")
     mbd2d.export_sweep(model, tmp_path / "s.mbd", cases, "modes", count=3)
-    r = subprocess.run([find_solver(), str(tmp_path / "s.mbd"), str(tmp_path / "f.csv")],
-                       capture_output=True, text=True, timeout=60)
-    assert r.returncode == 0, r.stderr
     py = list(csv.reader((tmp_path / "py.csv").read_text().splitlines()))
-    fo = list(csv.reader((tmp_path / "f.csv").read_text().splitlines()))
+    fo = list(csv.reader(solve_file(tmp_path / "s.mbd", tmp_path / "f.csv").splitlines()))
     assert len(py) == len(fo) == 1 + 3 * 3 + 1
     msg = py[0].index("message")
     for a, b in zip(py, fo):
@@ -736,9 +726,7 @@ def test_mbd2d_solve_runs_a_modes_sweep_as_python(tmp_path: Path) -> None:
     mbd2d.export_sweep(model, good, keep, "modes", count=3)
     mbd2d.write_sweep(mbd2d.sweep(model, keep, "modes", workers=1, count=3),
                       tmp_path / "good_py.csv")
-    subprocess.run([find_solver(), str(good), str(tmp_path / "good.csv")], check=True,
-                   capture_output=True, timeout=60)
-    assert (tmp_path / "good.csv").read_text() == (tmp_path / "good_py.csv").read_text()
+    assert solve_file(good, tmp_path / "good.csv") == (tmp_path / "good_py.csv").read_text()
 
 
 # ------------------------------------------------------------------ more joints' stiffness

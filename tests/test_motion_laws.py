@@ -18,7 +18,7 @@ import pytest
 import mbd2d
 from mbd2d.description import toml_io
 from test_derivatives import step_closed_form
-from test_standalone import find_solver
+from test_standalone import find_solver, solve_file
 
 R, L, E = 0.5, 2.0, 0.3        # crank, rod, offset of the slider's line
 LAWS = ["cubic", "quintic", "cycloidal", "harmonic", "modified-sine", "modified-trapezoid"]
@@ -267,13 +267,9 @@ def test_mbd2d_solve_runs_steps_as_python(tmp_path: Path) -> None:
     for k, (model, kw, res, csv_kw) in enumerate(runs):
         mbd = tmp_path / f"m{k}.mbd"
         model.export(mbd, **kw)
-        out = tmp_path / f"f{k}.csv"
-        r = subprocess.run([find_solver(), str(mbd), str(out)], capture_output=True, text=True,
-                           timeout=60)
-        assert r.returncode == 0, r.stderr
         py = tmp_path / f"p{k}.csv"
         res.to_csv(py, **csv_kw)
-        assert out.read_text() == py.read_text()
+        assert solve_file(mbd, tmp_path / f"f{k}.csv") == py.read_text()
 
 
 # ------------------------------------------------------------ files of formats 1 and 2
@@ -374,11 +370,7 @@ def downgrade(text: str, version: int) -> str:
 
 def run_solver(path: Path, text: str) -> str:
     path.write_text(text)
-    out = path.with_suffix(".csv")
-    r = subprocess.run([find_solver(), str(path), str(out)], capture_output=True, text=True,
-                       timeout=60)
-    assert r.returncode == 0, r.stderr
-    return out.read_text()
+    return solve_file(path, path.with_suffix(".csv"))
 
 
 def forced_fourbar() -> mbd2d.Model:

@@ -34,6 +34,14 @@ def find_solver() -> str:
     raise AssertionError("mbd2d-solve not found: `pip install .` installs it next to `mbd2d`")
 
 
+def solve_file(mbd: Path, out: Path) -> str:
+    """Run mbd2d-solve on the file mbd, writing out; the CSV's text (the run must succeed)."""
+    r = subprocess.run([find_solver(), str(mbd), str(out)], capture_output=True, text=True,
+                       timeout=60)
+    assert r.returncode == 0, r.stderr
+    return out.read_text()
+
+
 @pytest.fixture(scope="module")
 def solver() -> str:
     return find_solver()
