@@ -33,7 +33,7 @@ module mbd_api
   use mbd_integrators, only: dyn_opts_t, dyn_stats_t, integrate, output_rows, output_index, &
                               METH_PARTITIONED, METH_GENALPHA, METH_DOPRI5
   use mbd_statics, only: statics_solve
-  use mbd_modes, only: modes_solve
+  use mbd_modes, only: modes_solve, unit_largest
   use mbd_assemble, only: assemble_dense, assemble_blocks, asm_work_t, asm_init
   use mbd_kinematics, only: kin_opts_t, kin_report_t, kin_work_t, kin_run, kin_work_init, &
                             kin_assemble, kin_rank, kin_rank_band, kin_out_count, MAXPASS, &
@@ -1043,7 +1043,7 @@ contains
   !! iinfo(1) the number of free motions.
   subroutine api_modes(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, t, equilibrium, kmax, q, &
                        lam, stable, resid, omega2, kinds, sre, sim, shapes, iinfo, status, msg, &
-                       solver)
+                       solver, zre, zim)
     integer, intent(in) :: nb, ctab(:, :), ftab(:, :), equilibrium, kmax
     real(wp), intent(in) :: rpar(:), bmass(:, :), grav(2), fpar(:), q0(:), t
     real(wp), intent(out) :: q(:), lam(:), resid, omega2(:), sre(:), sim(:), shapes(:, :)
@@ -1052,11 +1052,19 @@ contains
     integer, intent(out) :: status              !! MBD_OK, < 0 input, > 0 numerical
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
     integer, intent(in), optional :: solver     !! 0 auto (default), 1 dense, 2 banded
+    !> (nq, 2 kmax) the damped shapes of the sorted eigenvalues, real and imaginary parts,
+    !! each scaled so that its largest entry is 1 (model units)
+    real(wp), intent(out), optional :: zre(:, :), zim(:, :)
     type(model_t) :: m
     type(dyn_work_t) :: w
     integer :: nfree, i
+    logical :: cshapes
     q = zero; lam = zero; stable = 0; resid = zero
     omega2 = zero; sre = zero; sim = zero; shapes = zero; kinds = 0
+    cshapes = present(zre) .and. present(zim)
+    if (cshapes) then
+      zre = zero; zim = zero
+    end if
     if (kmax < 0 .or. size(omega2) < kmax .or. size(kinds) < kmax .or. size(sre) < 2 * kmax .or. &
         size(sim) < 2 * kmax .or. size(shapes, 2) < kmax) then
       status = MBD_BAD_COUNT; msg = 'modes: the output arrays do not hold kmax modes'
@@ -1067,6 +1075,12 @@ contains
     if (status == MBD_OK .and. size(shapes, 1) /= m%nq) then
       status = MBD_BAD_COUNT; msg = 'modes: the shapes array does not match the model'
     end if
+    if (status == MBD_OK .and. cshapes) then
+      if (size(zre, 1) /= m%nq .or. size(zim, 1) /= m%nq .or. size(zre, 2) < 2 * kmax .or. &
+          size(zim, 2) < 2 * kmax) then
+        status = MBD_BAD_COUNT; msg = 'modes: the damped shapes'' arrays do not match the model'
+      end if
+    end if
     if (status == MBD_OK) then
       if (equilibrium /= 0) then
         call statics_solve(m, w, q, t, lam, stable, resid, status, msg)
@@ -1075,15 +1089,26 @@ contains
         call dyn_multipliers(m, w, q, w%qz, w%qz, t, lam, status, msg)
       end if
     end if
-    if (status == MBD_OK) call modes_solve(m, w, q, t, lam, kmax, nfree, omega2, kinds, sre, &
-                                           sim, shapes(:, 1:kmax), status, msg)
+    if (status == MBD_OK) then
+      if (cshapes) then
+        call modes_solve(m, w, q, t, lam, kmax, nfree, omega2, kinds, sre, sim, &
+                         shapes(:, 1:kmax), status, msg, zre(:, 1:2 * kmax), zim(:, 1:2 * kmax))
+      else
+        call modes_solve(m, w, q, t, lam, kmax, nfree, omega2, kinds, sre, sim, &
+                         shapes(:, 1:kmax), status, msg)
+      end if
+    end if
     if (status == MBD_OK) iinfo(1) = nfree
     if (allocated(m%cunit)) then
       q = q * m%cunit; lam = lam / m%rowunit
       do i = 1, m%nq
         shapes(i, :) = shapes(i, :) * m%cunit(i)
+        if (cshapes) then
+          zre(i, :) = zre(i, :) * m%cunit(i); zim(i, :) = zim(i, :) * m%cunit(i)
+        end if
       end do
     end if
+    if (status == MBD_OK .and. cshapes) call unit_largest(zre(:, 1:2 * kmax), zim(:, 1:2 * kmax))
   end subroutine api_modes
 
   !> An optional solver argument: 0 (auto) when absent.

@@ -199,11 +199,11 @@ end subroutine core_statics
 
 ! Small vibrations about the equilibrium near q0 (equilibrium 1; 0: about the assembled q0):
 ! the lowest kmax undamped omega^2, kinds (1 vibration, 0 rigid, -1 unstable) and shapes,
-! 2 kmax damped eigenvalues; iinfo(1) the number of free motions. solver: 0 auto, 1 dense,
-! 2 banded.
+! 2 kmax damped eigenvalues and their shapes (zre + i zim, the largest entry 1); iinfo(1) the
+! number of free motions. solver: 0 auto, 1 dense, 2 banded.
 subroutine core_modes(nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp, fpar, nq, neq, q0, &
                       t, equilibrium, kmax, solver, q, lam, stable, resid, omega2, kinds, sre, &
-                      sim, shapes, iinfo, status, msg)
+                      sim, shapes, zre, zim, iinfo, status, msg)
   use iso_c_binding, only: c_double, c_int
   use mbd_api, only: api_modes
   implicit none
@@ -211,12 +211,14 @@ subroutine core_modes(nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp, fpar, 
   integer(c_int), intent(in) :: ctab(8, nc), ftab(6, nf)
   real(c_double), intent(in) :: rpar(np), bmass(2, nb), grav(2), fpar(nfp), q0(nq), t
   real(c_double), intent(out) :: q(nq), lam(neq), resid, omega2(kmax), sre(2 * kmax), &
-                                 sim(2 * kmax), shapes(nq, kmax)
+                                 sim(2 * kmax), shapes(nq, kmax), zre(nq, 2 * kmax), &
+                                 zim(nq, 2 * kmax)
   integer(c_int), intent(out) :: stable, kinds(kmax), iinfo(12), status
   character(len=512), intent(out) :: msg
   !f2py intent(hide) :: nc, np, nf, nfp, nq
   call api_modes(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, t, equilibrium, kmax, q, lam, &
-                 stable, resid, omega2, kinds, sre, sim, shapes, iinfo, status, msg, solver)
+                 stable, resid, omega2, kinds, sre, sim, shapes, iinfo, status, msg, solver, &
+                 zre, zim)
 end subroutine core_modes
 
 subroutine core_reactions(nb, nc, ctab, np, rpar, nq, neq, nt, q, t, lam, reac, rloc, status, &

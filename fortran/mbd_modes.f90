@@ -12,6 +12,10 @@
 !!   [0, I; -M_r^-1 K_r, -M_r^-1 C_r]  (dgeev),  s = -zeta omega +- i omega sqrt(1 - zeta^2),
 !! sorted by |s|, then by the imaginary part, largest first; without damping (C_r = 0) and
 !! with a symmetric K_r they are s = +-sqrt(-omega^2), taken from the undamped modes.
+!! Damped (complex) shapes, when asked for: psi = N u, u the position half of the first-order
+!! form's right eigenvector [u; s u] (dgeev; without damping u = v), each scaled so that its
+!! largest entry is 1 (unit_largest, in model units): the other entries' moduli and phases
+!! are relative to it (a phase of 180 degrees: opposite, 90: a quarter period behind).
 !! Memory: N, K N, C N, M N (nq x nfree) and five nfree x nfree arrays plus the
 !! 2 nfree x 2 nfree first-order matrix, checked and allocated once per call (MBD_NO_MEMORY
 !! when they cannot be had).
@@ -24,7 +28,7 @@ module mbd_modes
   use mbd_dynamics, only: dyn_work_t, dyn_tangent, dyn_null_basis, dyn_pattern_mul
   implicit none
   private
-  public :: modes_solve
+  public :: modes_solve, unit_largest
 
   !> |omega^2| at most this fraction of the largest: a motion without stiffness (kind 0)
   real(wp), parameter :: RIGID_FRACTION = 1.0e-9_wp
@@ -44,7 +48,7 @@ contains
   !! (omega^2 > 0), 0 a motion without stiffness (|omega^2| <= RIGID_FRACTION times the
   !! largest), -1 unstable (omega^2 < 0).
   subroutine modes_solve(m, w, q, t, lam, kmax, nfree, omega2, kinds, sre, sim, shapes, &
-                         status, msg)
+                         status, msg, zre, zim)
     type(model_t), intent(in) :: m              !! model with dynamics data
     type(dyn_work_t), intent(inout) :: w        !! work arrays (dyn_init done)
     real(wp), intent(in) :: q(:)                !! equilibrium (core units)
@@ -58,6 +62,9 @@ contains
     real(wp), intent(out) :: shapes(:, :)       !! (nq, kmax) phi = N v (core units)
     integer, intent(out) :: status  !! MBD_OK, MBD_SINGULAR, MBD_NO_CONVERGENCE, ...
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    !> (nq, 2 kmax) the damped shapes psi of the sorted eigenvalues, real and imaginary parts
+    !! (core units, not yet scaled: unit_largest does that in model units)
+    real(wp), intent(out), optional :: zre(:, :), zim(:, :)
     ! N, K N, C N, M N; M_r, K_r, C_r, K_s (then the eigenvectors v); the first-order matrix,
     ! its eigenvalues, the undamped ones, dgeev's unused eigenvectors, LAPACK's workspace, and
     ! K and C on the sparse pattern
@@ -67,10 +74,14 @@ contains
     integer, allocatable :: ipiv(:), order(:)
     real(wp) :: bytes, wq(1)
     integer :: n, f, nnz, ist, info, j, k, nk
-    logical :: plain, damped
+    logical :: plain, damped, cshapes
     character(len=MSG_LEN) :: what
     status = MBD_OK; msg = ''
     omega2 = zero; sre = zero; sim = zero; shapes = zero; kinds = 0
+    cshapes = present(zre) .and. present(zim)
+    if (cshapes) then
+      zre = zero; zim = zero
+    end if
     n = m%nq
     nfree = n - w%na
     f = nfree
@@ -79,11 +90,13 @@ contains
     nnz = w%kptr(n + 1) - 1
     bytes = REAL_BYTES * (4 * real(n, wp) * f + 5 * real(f, wp)**2 + 4 * real(2 * f, wp)**2 &
                           + 2 * real(nnz, wp) + 8 * real(f, wp))
+    if (cshapes) bytes = bytes + REAL_BYTES * real(2 * f, wp)**2     ! dgeev's eigenvectors
     write (what, '(a,i0,a)') 'the modes'' work arrays (', f, ' free motions)'
     call mem_check(bytes, trim(what), HINT, status, msg)
     if (status /= MBD_OK) return
     allocate (nb(n, f), kn(n, f), cn(n, f), mn(n, f), mr(f, f), kr(f, f), cr(f, f), ks(f, f), &
-              a(2 * f, 2 * f), wr(2 * f), wi(2 * f), ev(f), vl(1, 1), vr(1, 1), kv(nnz), &
+              a(2 * f, 2 * f), wr(2 * f), wi(2 * f), ev(f), vl(1, 1), &
+              vr(merge(2 * f, 1, cshapes), merge(2 * f, 1, cshapes)), kv(nnz), &
               cv(nnz), ipiv(f), order(2 * f), work(1), stat=ist)
     if (ist /= 0) then
       call mem_fail(bytes, trim(what), HINT, status, msg); return
@@ -159,11 +172,37 @@ contains
     do k = 1, 2 * nk
       sre(k) = wr(order(k)); sim(k) = wi(order(k))
     end do
+    if (cshapes) then
+      do k = 1, 2 * nk
+        call damped_shape(order(k), zre(:, k), zim(:, k))
+      end do
+    end if
   contains
-    !> wr, wi: the eigenvalues of [0, I; -M_r^-1 K_r, -M_r^-1 C_r] (dgeev).
+    !> psi = N u of eigenvalue j (before sorting): u = v_k of the undamped mode k = (j + 1)/2
+    !! without damping; else dgeev's column j (a real s), or columns j, j + 1 as u_re, u_im
+    !! (s with Im s > 0, the first of its pair) or j - 1, j conjugated (the second).
+    subroutine damped_shape(j, pre, pim)
+      integer, intent(in) :: j
+      real(wp), intent(out) :: pre(:), pim(:)
+      if (plain) then
+        pre = matmul(nb, ks(:, (j + 1) / 2)); pim = zero
+      else if (wi(j) == zero) then
+        pre = matmul(nb, vr(1:f, j)); pim = zero
+      else if (wi(j) > zero) then
+        pre = matmul(nb, vr(1:f, j)); pim = matmul(nb, vr(1:f, j + 1))
+      else
+        pre = matmul(nb, vr(1:f, j - 1)); pim = -matmul(nb, vr(1:f, j))
+      end if
+    end subroutine damped_shape
+
+
+    !> wr, wi: the eigenvalues of [0, I; -M_r^-1 K_r, -M_r^-1 C_r] (dgeev), and vr its right
+    !! eigenvectors for the damped shapes.
     subroutine damped_eigenvalues(st)
       integer, intent(out) :: st
+      character :: jobvr
       st = MBD_OK
+      jobvr = merge('V', 'N', cshapes)
       call dgetrf(f, f, mr, f, ipiv, info)
       if (info /= 0) then
         st = MBD_SINGULAR; msg = 'modes: M_r is singular (a free motion carries no mass)'
@@ -177,10 +216,11 @@ contains
       end do
       a(f + 1:2 * f, 1:f) = -kr
       a(f + 1:2 * f, f + 1:2 * f) = -cr
-      call dgeev('N', 'N', 2 * f, a, 2 * f, wr, wi, vl, 1, vr, 1, wq, -1, info)
+      call dgeev('N', jobvr, 2 * f, a, 2 * f, wr, wi, vl, 1, vr, size(vr, 1), wq, -1, info)
       call grow(max(1, int(wq(1))), st)
       if (st /= MBD_OK) return
-      call dgeev('N', 'N', 2 * f, a, 2 * f, wr, wi, vl, 1, vr, 1, work, size(work), info)
+      call dgeev('N', jobvr, 2 * f, a, 2 * f, wr, wi, vl, 1, vr, size(vr, 1), work, &
+                 size(work), info)
       if (info /= 0) then
         st = merge(MBD_NO_CONVERGENCE, MBD_LAPACK, info > 0)
         write (msg, '(a,i0,a)') 'modes: the damped eigenvalues did not converge (dgeev info ', &
@@ -195,6 +235,29 @@ contains
       call mem_grow(work, lw, 'the LAPACK workspace of the modes', HINT, st, msg)
     end subroutine grow
   end subroutine modes_solve
+
+  !> Each column (re, im) of a complex shape divided by its largest entry (the first of
+  !! largest modulus), which becomes 1 + 0i; a zero column stays zero.
+  pure subroutine unit_largest(re, im)
+    real(wp), intent(inout) :: re(:, :), im(:, :)
+    real(wp) :: a, b, d, r
+    integer :: k, i, j
+    do k = 1, size(re, 2)
+      i = 1
+      do j = 2, size(re, 1)
+        if (hypot(re(j, k), im(j, k)) > hypot(re(i, k), im(i, k))) i = j
+      end do
+      a = re(i, k); b = im(i, k)
+      d = a * a + b * b
+      if (d == zero) cycle
+      do j = 1, size(re, 1)                     ! (x + iy) / (a + ib) = (x + iy)(a - ib) / d
+        r = (re(j, k) * a + im(j, k) * b) / d + zero       ! (+ zero: no -0.0)
+        im(j, k) = (im(j, k) * a - re(j, k) * b) / d + zero
+        re(j, k) = r
+      end do
+      re(i, k) = one; im(i, k) = zero
+    end do
+  end subroutine unit_largest
 
   !> order: the eigenvalues (re, im) by |s| ascending, then by im descending (insertion sort;
   !! 2 nfree entries).

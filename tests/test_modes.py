@@ -473,11 +473,11 @@ def damped_double_pendulum() -> mbd2d.Model:
     return model
 
 
-def test_damped_double_pendulum_against_its_matrices() -> None:
-    """The damped first-order form [0, I; -M^-1 K, -M^-1 C] with M, K, C written here
-    (K: gravity and the top spring; C: the elbow damper on theta2 - theta1)."""
+def double_pendulum_matrices(res: mbd2d.ModesResult) -> tuple[np.ndarray, ...]:
+    """M, K, C of damped_double_pendulum in its absolute angles, by hand at res's rest
+    position (K: gravity and the top spring; C: the elbow damper on theta2 - theta1), and the
+    first-order form [0, I; -M^-1 K, -M^-1 C]."""
     m1, m2, l1, l2, i1, i2 = 1.5, 0.7, 0.9, 0.6, 0.11, 0.03
-    res = damped_double_pendulum().modes()
     th1 = res.q[2] + np.pi / 2            # the upper bar's angle from the vertical at rest
     th2 = res.q[5] + np.pi / 2
     a1, a2 = l1 / 2, l2 / 2
@@ -492,14 +492,124 @@ def test_damped_double_pendulum_against_its_matrices() -> None:
     # the equilibrium itself: V' = 0 in both angles
     assert abs(G * (m1 * a1 + m2 * l1) * np.sin(th1) + 4.0 * (th1 - np.pi / 2 + 1.6)) < 1e-9
     assert abs(np.sin(th2)) < 1e-12
-    w2 = np.sort(np.linalg.eigvals(np.linalg.solve(mm, kk)).real)
-    np.testing.assert_allclose(res.omega2, w2, rtol=1e-9)
     a = np.block([[np.zeros((2, 2)), np.eye(2)],
                   [-np.linalg.solve(mm, kk), -np.linalg.solve(mm, cc)]])
+    return mm, kk, cc, a
+
+
+def test_damped_double_pendulum_against_its_matrices() -> None:
+    """The damped first-order form [0, I; -M^-1 K, -M^-1 C] with M, K, C written here."""
+    res = damped_double_pendulum().modes()
+    mm, kk, cc, a = double_pendulum_matrices(res)
+    w2 = np.sort(np.linalg.eigvals(np.linalg.solve(mm, kk)).real)
+    np.testing.assert_allclose(res.omega2, w2, rtol=1e-9)
     s = np.linalg.eigvals(a)
     s = np.array(sorted(s, key=lambda z: (abs(z), -z.imag)))
     np.testing.assert_allclose(res.eigenvalues, s, rtol=0, atol=1e-10 * abs(s).max())
     assert np.all(res.damping_ratio > 0) and np.all(res.damping_ratio < 1)
+
+
+def by_modulus(s: np.ndarray, vec: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Eigenvalues and eigenvector columns in mbd2d's order: by |s|, then Im s descending."""
+    order = sorted(range(s.size), key=lambda j: (abs(s[j]), -s[j].imag))
+    return s[order], vec[:, order]
+
+
+def test_damped_shapes_of_the_double_pendulum_against_its_matrices() -> None:
+    """Each damped shape's angle ratio theta_upper / theta_lower is that of the eigenvector
+    of the first-order form written by hand (complex: the damper puts the bars out of phase);
+    the bars' centres follow their angles (the null space of J: dx = -a sin(theta) dtheta);
+    the largest entry is 1."""
+    res = damped_double_pendulum().modes()
+    a = double_pendulum_matrices(res)[3]
+    s, vec = by_modulus(*np.linalg.eig(a))
+    np.testing.assert_allclose(res.eigenvalues, s, rtol=0, atol=1e-10 * abs(s).max())
+    psi = res.damped_shapes
+    assert psi.shape == (6, 4)
+    for j in range(4):
+        want = vec[0, j] / vec[1, j]
+        assert abs(psi[2, j] / psi[5, j] - want) < 1e-9 * abs(want), j
+        assert abs(np.angle(want)) > 0.02 and abs(abs(np.angle(want)) - np.pi) > 0.02
+        np.testing.assert_array_equal(psi[np.argmax(abs(psi[:, j])), j], 1.0)
+        th1, a1 = res.q[2], 0.45
+        assert abs(psi[0, j] + a1 * np.sin(th1) * psi[2, j]) < 1e-12
+        assert abs(psi[1, j] - a1 * np.cos(th1) * psi[2, j]) < 1e-12
+        np.testing.assert_array_equal(res.damped_shape(j), psi[:, j])
+    np.testing.assert_allclose(psi[:, 1::2], psi[:, 0::2].conj(), rtol=0, atol=1e-14)
+
+
+def test_undamped_shapes_are_the_modes_scaled() -> None:
+    """Without damping both eigenvalues +-i omega of a mode have its (real) shape, scaled to
+    its largest entry."""
+    res = double_pendulum(1.5, 0.7, 0.9, 0.6, 0.11, 0.03).modes()
+    for k in range(2):
+        phi = res.shapes[:, k]
+        want = phi / phi[np.argmax(abs(phi))]
+        for j in (2 * k, 2 * k + 1):
+            np.testing.assert_array_equal(res.damped_shapes[:, j].imag, 0.0)
+            np.testing.assert_allclose(res.damped_shapes[:, j].real, want, rtol=0, atol=1e-14)
+
+
+def damped_chain(c: float, n: int = 2, m: float = 0.5, k: float = 200.0) -> mbd2d.Model:
+    """spring_chain with a damper c from the ground to its last block only (non-proportional
+    damping: the shapes are complex)."""
+    model = spring_chain(n, m, k)
+    model.add_spring(["ground", f"b{n}"], [[0.0, 0.0], [0.0, 0.0]], stiffness=0.0,
+                     damping=c, length0=0.1 * n, name="damper")
+    return model
+
+
+@pytest.mark.parametrize("c", [3.0, 40.0])
+def test_a_chain_damped_at_its_end(c: float) -> None:
+    """Two blocks (M = m I, K = [[2k, -k], [-k, k]], C = diag(0, c)): the eigenvalues and the
+    shapes' ratios x1 / x2 from numpy's eigenvectors of the first-order form; at c = 40 the
+    second block is overdamped: its real eigenvalues have real shapes."""
+    m, k = 0.5, 200.0
+    res = damped_chain(c).modes()
+    mm, kk, cc = m * np.eye(2), k * np.array([[2.0, -1.0], [-1.0, 1.0]]), np.diag([0.0, c])
+    a = np.block([[np.zeros((2, 2)), np.eye(2)],
+                  [-np.linalg.solve(mm, kk), -np.linalg.solve(mm, cc)]])
+    s, vec = by_modulus(*np.linalg.eig(a))
+    scale = abs(s).max()
+    np.testing.assert_allclose(res.eigenvalues, s, rtol=0, atol=1e-10 * scale)
+    psi = res.damped_shapes
+    for j in range(4):
+        want = vec[0, j] / vec[1, j]
+        assert abs(psi[0, j] / psi[3, j] - want) < 1e-9 * max(1.0, abs(want)), (j, want)
+        if s[j].imag == 0.0:
+            np.testing.assert_array_equal(psi[:, j].imag, 0.0)
+    assert (np.count_nonzero(s.imag == 0.0) == 2) == (c == 40.0)
+
+
+def test_damped_shapes_on_the_band_path() -> None:
+    """A damped chain of 12 on the band path: the dense path's eigenvalues and shapes."""
+    dense = damped_chain(5.0, n=12).modes(solver="dense")
+    band = damped_chain(5.0, n=12).modes(solver="banded")
+    assert band.stats["solver"] == "banded"
+    np.testing.assert_allclose(band.eigenvalues, dense.eigenvalues, rtol=1e-10)
+    np.testing.assert_allclose(band.damped_shapes, dense.damped_shapes, rtol=0, atol=1e-9)
+
+
+def test_damped_shape_tables_and_pictures(tmp_path: Path) -> None:
+    """The damped table's shape columns, a damped mode's motion (Re(psi e^(i w t)): a quarter
+    period later -Im(psi)), its picture and animation, and a bad index."""
+    pytest.importorskip("matplotlib")
+    res = damped_double_pendulum().modes()
+    header, rows = res.table(damped=True)
+    assert header[5:8] == ["upper.x.re", "upper.x.im", "upper.y.re"]
+    np.testing.assert_array_equal(rows[:, 5::2], res.damped_shapes.real.T)
+    np.testing.assert_array_equal(rows[:, 6::2], res.damped_shapes.imag.T)
+    mot = res.motion(0, amplitude=0.01, frames=5, damped=True)
+    np.testing.assert_allclose(mot.q[0], res.q + 0.01 * res.damped_shapes[:, 0].real,
+                               atol=1e-15)
+    np.testing.assert_allclose(mot.q[1], res.q - 0.01 * res.damped_shapes[:, 0].imag,
+                               atol=1e-12)
+    assert abs(mot.t[-1] - 1 / res.damped_frequency[0]) < 1e-12
+    assert "damped mode 2" in res.plot(2, damped=True).get_title()
+    res.animate(1, tmp_path / "d.gif", damped=True, max_frames=6)
+    assert (tmp_path / "d.gif").stat().st_size > 1000
+    with pytest.raises(mbd2d.ModelError, match="damped eigenvalue 4 does not exist"):
+        res.damped_shape(4)
 
 
 def test_mbd2d_solve_writes_the_modes_python_writes(tmp_path: Path) -> None:
@@ -569,8 +679,12 @@ def test_the_command_line(tmp_path: Path) -> None:
     assert (tmp_path / "m.csv").read_text() == (tmp_path / "p.csv").read_text()
     assert (tmp_path / "d.csv").read_text() == (tmp_path / "pd.csv").read_text()
     assert (tmp_path / "m.png").stat().st_size > 1000
+    r = cli("--damped-mode", "1", "--picture", str(tmp_path / "d.png"))
+    assert r.returncode == 0 and "drew damped mode 1" in r.stdout, r.stderr
+    assert (tmp_path / "d.png").stat().st_size > 1000
     for bad in (["--out", str(tmp_path / "m.txt")], ["--picture", str(tmp_path / "m.bmp")],
-                ["--count", "0"], ["--mode", "3", "--picture", str(tmp_path / "x.png")]):
+                ["--count", "0"], ["--mode", "3", "--picture", str(tmp_path / "x.png")],
+                ["--damped-mode", "2", "--picture", str(tmp_path / "x.png")]):
         r = cli(*bad)
         assert r.returncode == 2 and "Traceback" not in r.stderr, (bad, r.stderr)
 

@@ -128,7 +128,8 @@ def _fake(model: mbd2d.Model, fn: str, status: int, nout: int = 3, finite: bool 
         if fn == "core_modes":
             k = kwargs["kmax"]
             return (p.q0, np.zeros(neq), 1, 0.0, np.zeros(k), np.zeros(k, dtype=np.int32),
-                    np.zeros(2 * k), np.zeros(2 * k), np.zeros((nq, k)), i10, status, msg)
+                    np.zeros(2 * k), np.zeros(2 * k), np.zeros((nq, k)), np.zeros((nq, 2 * k)),
+                    np.zeros((nq, 2 * k)), i10, status, msg)
         if fn == "core_kin_step":
             q = args[3] if finite else np.full(nq, np.inf)
             return q, args[4], args[5], status, msg

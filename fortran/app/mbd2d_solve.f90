@@ -852,13 +852,16 @@ contains
   !> Modes: the small vibrations about the equilibrium (Model.modes) written as
   !! ModesResult.to_csv writes them: one row per mode (mode, omega2, frequency_hz, kind, the
   !! shape NAME.x, NAME.y, NAME.theta per body), or with "outputs damped" one row per damped
-  !! eigenvalue (s_real, s_imag, frequency_hz, damped_frequency_hz, damping_ratio).
+  !! eigenvalue (s_real, s_imag, frequency_hz, damped_frequency_hz, damping_ratio, then its
+  !! complex shape NAME.x.re, NAME.x.im, NAME.y.re, ... per body).
   subroutine run_modes()
     real(wp), parameter :: TWO_PI = 2 * 3.141592653589793_wp
-    real(wp), allocatable :: qe(:), lam(:), w2(:), sre(:), sim(:), shp(:, :), fpm(:)
+    real(wp), allocatable :: qe(:), lam(:), w2(:), sre(:), sim(:), shp(:, :), fpm(:), &
+                             zre(:, :), zim(:, :)
     integer, allocatable :: kinds(:), ftm(:, :)
-    integer :: kmax, nk, u, ios, k, j, nw
+    integer :: kmax, nk, u, ios, k, j, nw, nz
     real(wp) :: mag, row(5)
+    character(len=*), parameter :: XYT(3) = ['x    ', 'y    ', 'theta']
     character(len=32) :: word
     if (.not. spec%have_masses) call die(2, trim(model_path) // ': modes needs the masses: '// &
       'body lines NAME X0 Y0 THETA0 MASS INERTIA VX0 VY0 OMEGA0')
@@ -870,22 +873,29 @@ contains
                'sensitivities, cases, measures or positions_only')
     kmax = nq
     if (spec%count > 0) kmax = min(spec%count, nq)
-    call mem_check(REAL_BYTES * (real(nq, wp) * (kmax + 3) + 6 * real(kmax, wp)), &
+    nz = merge(2 * kmax, 0, spec%out_damped)       ! the damped shapes' columns
+    call mem_check(REAL_BYTES * (real(nq, wp) * (kmax + 2 * nz + 3) + 6 * real(kmax, wp)), &
                    'the modes (' // trim(itoa(kmax)) // ' of ' // trim(itoa(nq)) // &
                    ' coordinates)', 'give a smaller count', status, msg)
     if (status /= MBD_OK) call die(2, trim(model_path) // ': ' // trim(msg))
     allocate (q0(nq), qe(nq), lam(neq), w2(kmax), kinds(kmax), sre(2 * kmax), &
               sim(2 * kmax), shp(nq, kmax), ftm(NFT, spec%nf), fpm(max(1, size(spec%fpar))), &
-              stat=ierr)
+              zre(nq, nz), zim(nq, nz), stat=ierr)
     if (ierr /= 0) call die(2, 'not enough memory for the modes')
     q0 = 0.0_wp
     q0(1:3 * spec%nb) = reshape(spec%q0, [3 * spec%nb])
     ftm = spec%ftab
     fpm = 0.0_wp
     fpm(1:size(spec%fpar)) = spec%fpar
-    call api_modes(spec%nb, spec%ctab, spec%rpar, spec%bmass, spec%grav, ftm, fpm, q0, &
-                   spec%tstat, merge(0, 1, spec%at_q0), kmax, qe, lam, stable, resid, w2, &
-                   kinds, sre, sim, shp, iinfo, status, msg, spec%solver)
+    if (spec%out_damped) then
+      call api_modes(spec%nb, spec%ctab, spec%rpar, spec%bmass, spec%grav, ftm, fpm, q0, &
+                     spec%tstat, merge(0, 1, spec%at_q0), kmax, qe, lam, stable, resid, w2, &
+                     kinds, sre, sim, shp, iinfo, status, msg, spec%solver, zre, zim)
+    else
+      call api_modes(spec%nb, spec%ctab, spec%rpar, spec%bmass, spec%grav, ftm, fpm, q0, &
+                     spec%tstat, merge(0, 1, spec%at_q0), kmax, qe, lam, stable, resid, w2, &
+                     kinds, sre, sim, shp, iinfo, status, msg, spec%solver)
+    end if
     if (status < 0) then
       if (iinfo(2) <= -1000000) call die(2, force_where(-1000000 - iinfo(2), msg))
       if (iinfo(2) < 0) call die(2, trim(model_path) // ': body "' // &
@@ -900,14 +910,26 @@ contains
           form='unformatted', iostat=ios)
     if (ios /= 0) call die(2, 'cannot write ' // trim(out_path))
     if (spec%out_damped) then
-      call sput(u, ios, 's_real,s_imag,frequency_hz,damped_frequency_hz,damping_ratio' // &
-                achar(10))
+      call sput(u, ios, 's_real,s_imag,frequency_hz,damped_frequency_hz,damping_ratio')
+      do k = 1, spec%nb
+        do j = 1, 3
+          call sput(u, ios, ',' // trim(spec%body_names(k)) // '.' // trim(XYT(j)) // '.re,' // &
+                    trim(spec%body_names(k)) // '.' // trim(XYT(j)) // '.im')
+        end do
+      end do
+      call sput(u, ios, achar(10))
       do k = 1, 2 * nk
         mag = hypot(sre(k), sim(k))                  ! as numpy's abs of a complex
         row = [sre(k), sim(k), mag / TWO_PI, abs(sim(k)) / TWO_PI, 0.0_wp]
         if (mag > 0.0_wp) row(5) = -sre(k) / mag + 0.0_wp
-        do j = 1, 5
-          call num(row(j), word, nw)
+        do j = 1, 5 + 6 * spec%nb
+          if (j <= 5) then
+            call num(row(j), word, nw)
+          else if (mod(j - 5, 2) == 1) then
+            call num(zre((j - 4) / 2, k), word, nw)
+          else
+            call num(zim((j - 5) / 2, k), word, nw)
+          end if
           if (j > 1) call sput(u, ios, ',')
           call sput(u, ios, word(1:nw))
         end do

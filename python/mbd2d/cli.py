@@ -7,7 +7,7 @@
                    --max-steps S --solver S]
     mbd2d statics MODEL.toml [--t T --solver S] [--out OUT.csv]
     mbd2d modes MODEL.toml [--t T --count K --at-q0 --solver S] [--out MODES.csv
-                --damped-out EIGEN.csv --picture MODE.png|MODE.gif --mode K]
+                --damped-out EIGEN.csv --picture MODE.png|MODE.gif --mode K | --damped-mode J]
     mbd2d sweep MODEL.toml --param NAME=START:STOP:NUM ... [--grid] --t-end T --steps N
                 --out sweep.nc|sweep.csv [--analysis A --t0 T0 --every K --workers W
                 --scheduler ADDRESS --positions-only --method M --rtol R --atol A --h H]
@@ -223,6 +223,9 @@ def _parser() -> argparse.ArgumentParser:
     o.add_argument("--picture", default=None, help="draw a mode: .png/.svg/.pdf (the "
                    "extremes) or .gif/.mp4 (one period)")
     o.add_argument("--mode", type=int, default=0, help="the mode drawn (default 0, the lowest)")
+    o.add_argument("--damped-mode", type=int, default=None, metavar="J",
+                   help="draw damped eigenvalue J's complex shape instead (each coordinate at "
+                   "its own phase)")
     w = sub.add_parser("sweep", help="one analysis of many variants (design parameters "
                        "swept): netCDF or CSV")
     w.add_argument("model", help="model file (.toml)")
@@ -417,12 +420,14 @@ def _modes(model: Model, args: argparse.Namespace) -> int:
         res.to_csv(args.damped_out, damped=True)
         print(f"wrote {res.eigenvalues.size} eigenvalues to {args.damped_out}")
     if args.picture is not None:
+        damped = args.damped_mode is not None
+        k = args.damped_mode if damped else args.mode
         if str(args.picture).lower().endswith(MOTION_ENDS):
-            res.animate(args.mode, args.picture)
+            res.animate(k, args.picture, damped=damped)
         else:
-            ax = res.plot(args.mode)
+            ax = res.plot(k, damped=damped)
             plots.save_figure(ax.figure, args.picture)
-        print(f"drew mode {args.mode} in {args.picture}")
+        print(f"drew {'damped mode' if damped else 'mode'} {k} in {args.picture}")
     return EXIT_OK
 
 

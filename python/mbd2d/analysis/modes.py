@@ -37,15 +37,16 @@ def run_modes(model: ModelDescription, t: float = 0.0, count: int | None = None,
         raise exc
     nk = min(kmax, int(out.iinfo[0]))
     s = out.sre[:2 * nk] + 1j * out.sim[:2 * nk]
+    psi = out.zre[:, :2 * nk] + 1j * out.zim[:, :2 * nk]
     if not (np.isfinite(out.omega2[:nk]).all() and np.isfinite(s).all()
-            and np.isfinite(out.shapes[:, :nk]).all()):
+            and np.isfinite(out.shapes[:, :nk]).all() and np.isfinite(psi).all()):
         raise error_for("modes", NO_CONVERGENCE, "modes: the eigenvalues are not finite "
                         "(the linearized equations are singular)", t=t,
                         residual=float(out.resid))
     stability = STABILITY.get(int(out.stable), "not examined (equilibrium=False)")
     return ModesResult(t=t, q=out.q, lam=out.lam, stability=stability,
                        residual=float(out.resid), omega2=out.omega2[:nk].copy(),
-                       eigenvalues=s, shapes=out.shapes[:, :nk].copy(),
+                       eigenvalues=s, shapes=out.shapes[:, :nk].copy(), damped_shapes=psi,
                        kind_codes=out.kinds[:nk].astype(int),
                        n_free=int(out.iinfo[0]), body_names=p.body_names,
                        coordinate_names=p.coordinate_names, model=model, packed=p,

@@ -151,13 +151,14 @@ def modes(p: Packed, d: DynamicTables, t: float, equilibrium: bool, kmax: int,
           solver: int = 0) -> SimpleNamespace:
     """Small vibrations about the equilibrium near q0 (or about the assembled q0): ``q``,
     ``lam``, ``stable``, ``resid``, ``omega2`` and ``kinds`` (kmax; 1 vibration, 0 rigid,
-    -1 unstable), ``sre``, ``sim`` (2 kmax), ``shapes`` (nq, kmax), ``iinfo`` (iinfo[0]: the
-    free motions), ``status``, ``msg``."""
-    return _named("q lam stable resid omega2 kinds sre sim shapes iinfo status msg",
+    -1 unstable), ``sre``, ``sim`` (2 kmax), ``shapes`` (nq, kmax), ``zre``, ``zim`` (nq,
+    2 kmax: the damped shapes, largest entry 1), ``iinfo`` (iinfo[0]: the free motions),
+    ``status``, ``msg``."""
+    return _named("q lam stable resid omega2 kinds sre sim shapes zre zim iinfo status msg",
                   _core.core_modes,
                   ctab=p.ctab, rpar=p.rpar, bmass=d.bmass, grav=d.grav, ftab=d.ftab,
                   fpar=d.fpar, neq=p.neq, q0=p.q0, t=t, equilibrium=int(equilibrium),
-                  kmax=kmax, solver=solver, numbers=p.nq * (kmax + 1) + p.neq + 5 * kmax)
+                  kmax=kmax, solver=solver, numbers=p.nq * (5 * kmax + 1) + p.neq + 5 * kmax)
 
 
 def cam_forces(p: Packed, q: np.ndarray, t: np.ndarray, lam: np.ndarray) -> SimpleNamespace:

@@ -24,7 +24,9 @@ class ModesResult:
     K_r v = omega^2 M_r v on the free motions, ``shapes`` (n_coordinates, n_modes) the mode
     shapes phi (phi^T M phi = 1, the largest entry positive); ``eigenvalues`` (2 n_modes,
     complex, by modulus) those of the damped first-order form, s = -zeta omega +-
-    i omega sqrt(1 - zeta^2). ``n_free`` is the number of free motions (the modes past
+    i omega sqrt(1 - zeta^2), and ``damped_shapes`` (n_coordinates, 2 n_modes, complex) their
+    shapes psi, each scaled so that its largest entry is 1: the moduli and phases of the
+    other entries are relative to it. ``n_free`` is the number of free motions (the modes past
     ``count`` were not asked for). ``q``, ``lam``, ``stability`` and ``residual`` are the
     equilibrium's, as :class:`StaticsResult`.
     """
@@ -37,6 +39,7 @@ class ModesResult:
     omega2: np.ndarray
     eigenvalues: np.ndarray
     shapes: np.ndarray
+    damped_shapes: np.ndarray
     kind_codes: np.ndarray
     n_free: int
     body_names: list[str]
@@ -79,16 +82,23 @@ class ModesResult:
         """|s| of each damped eigenvalue (hypot, as mbd2d-solve takes it)."""
         return np.hypot(self.eigenvalues.real, self.eigenvalues.imag)
 
-    def _mode(self, k: int) -> int:
-        n = self.omega2.size
+    def _mode(self, k: int, damped: bool = False) -> int:
+        n = self.eigenvalues.size if damped else self.omega2.size
+        what = "damped eigenvalue" if damped else "mode"
         if not isinstance(k, (int, np.integer)) or isinstance(k, bool) or not -n <= k < n:
-            has = f"{n} mode(s), 0 .. {n - 1}" if n else "no modes (no free motion)"
-            raise ModelError(f"mode {k!r} does not exist: this result has {has}", "modes")
+            has = f"{n} {what}(s), 0 .. {n - 1}" if n else f"no {what}s (no free motion)"
+            raise ModelError(f"{what} {k!r} does not exist: this result has {has}", "modes")
         return int(k) % n
 
     def shape(self, k: int) -> np.ndarray:
         """The shape phi of mode k (n_coordinates), mass-normalized."""
         return self.shapes[:, self._mode(k)].copy()
+
+    def damped_shape(self, j: int) -> np.ndarray:
+        """The complex shape psi of damped eigenvalue j (n_coordinates), its largest entry 1:
+        ``abs`` gives each coordinate's amplitude relative to it, ``np.angle`` its phase
+        (a motion Re(psi e^(s t)); a real eigenvalue has a real shape)."""
+        return self.damped_shapes[:, self._mode(j, damped=True)].copy()
 
     def body_shape(self, k: int, body: str) -> tuple[float, float, float]:
         """(x, y, theta) of a body in mode k's shape (KeyError if there is no such body)."""
@@ -102,14 +112,20 @@ class ModesResult:
         ``frequency_hz``, ``kind`` (1 vibration, 0 rigid, -1 unstable), then the shape,
         ``NAME.x``, ``NAME.y``, ``NAME.theta`` per body); with ``damped=True`` one row per
         damped eigenvalue (``s_real``, ``s_imag``, ``frequency_hz`` = |s| / 2 pi,
-        ``damped_frequency_hz``, ``damping_ratio``)."""
+        ``damped_frequency_hz``, ``damping_ratio``, then its complex shape, ``NAME.x.re``,
+        ``NAME.x.im``, ``NAME.y.re``, ... per body)."""
+        nb = len(self.body_names)
         if damped:
             s = self.eigenvalues
             header = ["s_real", "s_imag", "frequency_hz", "damped_frequency_hz",
                       "damping_ratio"]
-            return header, np.column_stack([s.real, s.imag, self._modulus() / (2 * np.pi),
-                                            self.damped_frequency, self.damping_ratio])
-        nb = len(self.body_names)
+            header += [f"{b}.{c}.{part}" for b in self.body_names for c in ("x", "y", "theta")
+                       for part in ("re", "im")]
+            psi = self.damped_shapes[:3 * nb].T
+            parts = np.stack([psi.real, psi.imag], axis=2).reshape(s.size, 6 * nb)
+            rows = np.column_stack([s.real, s.imag, self._modulus() / (2 * np.pi),
+                                    self.damped_frequency, self.damping_ratio, parts])
+            return header, rows.reshape(s.size, len(header))
         header = ["mode", "omega2", "frequency_hz", "kind"]
         header += [f"{b}.{c}" for b in self.body_names for c in ("x", "y", "theta")]
         rows = np.column_stack([np.arange(self.omega2.size), self.omega2, self.frequency,
@@ -134,19 +150,34 @@ class ModesResult:
                 lines.append(f"{'':>4}  {s.real:12.6g} {s.imag:+12.6g}i  {z:9.4g}  {f:10.6g}")
         return "\n".join(lines)
 
-    def motion(self, k: int = 0, amplitude: float | None = None, frames: int = 49) -> Any:
+    def motion(self, k: int = 0, amplitude: float | None = None, frames: int = 49,
+               damped: bool = False) -> Any:
         """Mode k as a motion for the pictures: q = q* + a sin(omega t) phi over one period
         (1 s for a mode without a frequency), the linearized motion. ``amplitude`` a
         multiplies the mass-normalized shape; by default the points move by about 15% of
-        the mechanism's size."""
-        k = self._mode(k)
-        phi = self.shapes[:, k]
-        a = self._amplitude(phi) if amplitude is None else float(amplitude)
-        w = self.omega[k]
+        the mechanism's size. With ``damped=True``, k is a damped eigenvalue s and the
+        motion q* + a Re(psi e^(i Im(s) t)) over one damped period: each coordinate at its
+        own phase, the decay e^(Re(s) t) left out so that the shape stays in view (a real
+        s: a sin(2 pi t) psi over 1 s)."""
+        k = self._mode(k, damped)
+        shape = self.damped_shapes[:, k] if damped else self.shapes[:, k].astype(complex)
+        a = self._amplitude(np.abs(shape)) if amplitude is None else float(amplitude)
+        w = abs(self.eigenvalues[k].imag) if damped else self.omega[k]
         period = 2 * np.pi / w if w > 0 else 1.0
         t = np.linspace(0.0, period, max(int(frames), 3))
-        q = self.q[None, :] + a * np.sin(2 * np.pi * t / period)[:, None] * phi[None, :]
-        return plots.Configuration(self.model, q, t, note=f"mode {k}")
+        if damped and w > 0:
+            wave = np.exp(1j * self.eigenvalues[k].imag * t)
+        else:
+            wave = np.sin(2 * np.pi * t / period) + 0j
+        q = self.q[None, :] + a * (wave[:, None] * shape[None, :]).real
+        return plots.Configuration(self.model, q, t, note=self._label(k, damped))
+
+    def _label(self, k: int, damped: bool) -> str:
+        """mode k or damped eigenvalue k, with its frequency (and kind or damping ratio)."""
+        if damped:
+            return (f"damped mode {k}, {self.damped_frequency[k]:.4g} Hz, "
+                    f"zeta {self.damping_ratio[k]:.3g}")
+        return f"mode {k}, {self.frequency[k]:.4g} Hz ({self.kinds[k]})"
 
     def _amplitude(self, phi: np.ndarray) -> float:
         """The factor that moves the points by PICTURE_AMPLITUDE of the mechanism's size."""
@@ -158,20 +189,23 @@ class ModesResult:
         move = float((np.hypot(p[:, 0], p[:, 1]) + size * np.abs(p[:, 2])).max(initial=0.0))
         return PICTURE_AMPLITUDE * size / move if move > 0 else 0.0
 
-    def plot(self, k: int = 0, amplitude: float | None = None, **kwargs: Any) -> Any:
-        """The mechanism at the equilibrium and at both extremes of mode k:
+    def plot(self, k: int = 0, amplitude: float | None = None, damped: bool = False,
+             **kwargs: Any) -> Any:
+        """The mechanism at the equilibrium and at both extremes of mode k (``damped=True``:
+        at a quarter and three quarters of damped mode k's period):
         :func:`mbd2d.plot_mechanism` (returns the Axes)."""
-        mot = self.motion(k, amplitude)
+        mot = self.motion(k, amplitude, damped=damped)
         period = float(mot.t[-1])
-        kwargs.setdefault("title", f"{getattr(self.model, 'name', 'model')}: mode {k}, "
-                          f"{self.frequency[self._mode(k)]:.4g} Hz ({self.kinds[self._mode(k)]})")
+        kwargs.setdefault("title", f"{getattr(self.model, 'name', 'model')}: "
+                          f"{self._label(self._mode(k, damped), damped)}")
         kwargs.setdefault("times", [0.0, 0.75 * period, 0.25 * period])   # equilibrium lightest
         return plots.plot_mechanism(mot, **kwargs)
 
     def animate(self, k: int = 0, path: Any = None, amplitude: float | None = None,
-                **kwargs: Any) -> Any:
-        """Mode k moving over one period, slowed to about 2 s: :func:`mbd2d.animate`."""
-        mot = self.motion(k, amplitude)
+                damped: bool = False, **kwargs: Any) -> Any:
+        """Mode k (``damped=True``: damped mode k) moving over one period, slowed to about
+        2 s: :func:`mbd2d.animate`."""
+        mot = self.motion(k, amplitude, damped=damped)
         kwargs.setdefault("speed", float(mot.t[-1]) / 2.0)
-        kwargs.setdefault("title", f"mode {k}: {self.frequency[self._mode(k)]:.4g} Hz")
+        kwargs.setdefault("title", self._label(self._mode(k, damped), damped))
         return plots.animate(mot, path, **kwargs)
