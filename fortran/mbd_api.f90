@@ -34,6 +34,7 @@ module mbd_api
                               METH_PARTITIONED, METH_GENALPHA, METH_DOPRI5
   use mbd_statics, only: statics_solve
   use mbd_modes, only: modes_solve, unit_largest
+  use mbd_frf, only: frf_solve
   use mbd_assemble, only: assemble_dense, assemble_blocks, asm_work_t, asm_init
   use mbd_kinematics, only: kin_opts_t, kin_report_t, kin_work_t, kin_run, kin_work_init, &
                             kin_assemble, kin_rank, kin_rank_band, kin_out_count, MAXPASS, &
@@ -51,7 +52,8 @@ module mbd_api
   implicit none
   private
   public :: NINFO, api_sizes, api_eval, api_kinematics, api_profile, api_analyze, api_kin_step
-  public :: api_inverse, api_dynamics, api_statics, api_modes, api_reactions, api_cam_forces
+  public :: api_inverse, api_dynamics, api_statics, api_modes, api_frf, api_reactions, &
+            api_cam_forces
   public :: api_eval_d, api_reactions_dp, api_dynamics_sens, api_forces_d
 
   integer, parameter :: NINFO = 12   !! length of the report arrays
@@ -1110,6 +1112,61 @@ contains
     end if
     if (status == MBD_OK .and. cshapes) call unit_largest(zre(:, 1:2 * kmax), zim(:, 1:2 * kmax))
   end subroutine api_modes
+
+  !> The frequency response about the equilibrium near q0 at t (equilibrium 1; 0: about the
+  !! assembled q0, with its least-squares multipliers) to each design parameter of ptab
+  !! (2, np) varied harmonically at each angular frequency omega (rad/s): dq = (hre + i him)
+  !! times the parameter's amplitude (nq, np, nomega; model units, mbd_frf), with the
+  !! configuration, multipliers, stability and residual as api_statics. iinfo(1) the number of
+  !! free motions, iinfo(8) the frequency at which the response is unbounded (MBD_SINGULAR).
+  subroutine api_frf(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, t, equilibrium, ptab, omega, &
+                     q, lam, stable, resid, hre, him, iinfo, status, msg, solver)
+    integer, intent(in) :: nb, ctab(:, :), ftab(:, :), equilibrium, ptab(:, :)
+    real(wp), intent(in) :: rpar(:), bmass(:, :), grav(2), fpar(:), q0(:), t, omega(:)
+    real(wp), intent(out) :: q(:), lam(:), resid, hre(:, :, :), him(:, :, :)
+    integer, intent(out) :: stable, iinfo(NINFO)
+    integer, intent(out) :: status              !! MBD_OK, < 0 input, > 0 numerical
+    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    integer, intent(in), optional :: solver     !! 0 auto (default), 1 dense, 2 banded
+    type(model_t) :: m
+    type(dyn_work_t) :: w
+    type(sens_t) :: sens
+    integer :: bad, ibad
+    q = zero; lam = zero; stable = 0; resid = zero; hre = zero; him = zero
+    call static_start(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, t, m, w, q, lam, iinfo, &
+                      status, msg, solver)
+    if (status == MBD_OK) then
+      if (any(shape(hre) /= [m%nq, size(ptab, 2), size(omega)]) .or. &
+          any(shape(him) /= shape(hre))) then
+        status = MBD_BAD_COUNT; msg = 'frequency response: the output arrays do not match'
+      else if (.not. finite(omega)) then
+        call not_finite('the frequencies', status, msg)
+      end if
+    end if
+    if (status == MBD_OK) then
+      call sens_setup(m, ctab, rpar, ptab, sens, status, msg, bad, ftab, fpar)
+      if (status /= MBD_OK) iinfo(2) = -2000000 - bad
+    end if
+    if (status == MBD_OK) then
+      if (equilibrium /= 0) then
+        call statics_solve(m, w, q, t, lam, stable, resid, status, msg)
+      else
+        stable = -2                             ! not examined
+        call dyn_multipliers(m, w, q, w%qz, w%qz, t, lam, status, msg)
+      end if
+    end if
+    if (status == MBD_OK) then
+      call frf_solve(m, w, sens, q, t, lam, omega, hre, him, ibad, status, msg)
+      iinfo(1) = m%nq - w%na; iinfo(8) = ibad
+    end if
+    if (allocated(m%cunit)) then
+      q = q * m%cunit; lam = lam / m%rowunit
+      if (status == MBD_OK) then
+        call sens_units(m, sens, hre, m%cunit, .false.)
+        call sens_units(m, sens, him, m%cunit, .false.)
+      end if
+    end if
+  end subroutine api_frf
 
   !> An optional solver argument: 0 (auto) when absent.
   pure integer function solver_or_auto(solver)

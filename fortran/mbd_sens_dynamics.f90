@@ -49,6 +49,8 @@ module mbd_sens_dynamics
   private
   public :: sens_multipliers, sens_reactions, sens_statics, sens_statics_band, sens_dopri5, &
             sens_initial
+  ! (the frequency response, mbd_frf: the equilibrium's load along a parameter)
+  public :: statics_load
   ! (generalized-alpha's sensitivities, mbd_sens_genalpha: the same right-hand sides)
   public :: proj_work_t, proj_init, sens_accel, sens_dyn_rows, cols_to_rows, rows_to_cols
   ! (the multipliers' sensitivities at the outputs of forward dynamics)

@@ -21,6 +21,7 @@ from .analysis.dynamics import run_dynamics
 from .analysis.evaluate import evaluate
 from .analysis.inverse import run_inverse
 from .analysis.kinematics import run_kinematics
+from .analysis.frf import run_frf
 from .analysis.modes import run_modes
 from .analysis.mbdfile import export as export_mbd
 from .analysis.statics import run_statics
@@ -31,7 +32,8 @@ from .description.builder import ModelDescription
 from .description.entries import reads_entries
 from .errors import MbdError
 from .description.parameters import parameter_list
-from .results import DofReport, DynamicsResult, KinematicsResult, ModesResult, StaticsResult
+from .results import (DofReport, DynamicsResult, FrequencyResponseResult, KinematicsResult,
+                      ModesResult, StaticsResult)
 from .validate import flag
 
 
@@ -353,6 +355,46 @@ class Model(ModelDescription):
             If a free motion carries no mass, or the equilibrium is not unique.
         """
         return run_modes(self, t=t, count=count, equilibrium=equilibrium, solver=solver)
+
+    def frequency_response(self, inputs: Any, frequencies: Any, t: float = 0.0,
+                           equilibrium: bool = True, solver: str = "auto"
+                           ) -> FrequencyResponseResult:
+        """The steady response of the small vibrations about the static equilibrium (drivers
+        held at t, as in :meth:`modes`) to design parameters varied harmonically,
+        p = p0 + Re(P e^(i 2 pi f t)): a shaker's force (a force function's constant term),
+        a spring's free length (a displacement input), gravity (a base acceleration), a
+        pivot's place (a base motion). The linearized equations M dq'' + C dq' + K dq +
+        J^T dlambda = (Q_p - J_p^T lambda) P, J dq = -Phi_p P are solved for each frequency
+        on the free motions, with the exact K, C and parameter derivatives of the design
+        sensitivities (at f = 0 the response is ``statics(sensitivities=...).dq_dp``).
+
+        Parameters
+        ----------
+        inputs : str or sequence of str
+            Design parameters (:meth:`parameters` names them).
+        frequencies : array_like
+            Frequencies in Hz (>= 0).
+        t, equilibrium, solver
+            As :meth:`modes`.
+
+        Returns
+        -------
+        FrequencyResponseResult
+            ``res.response`` (n_frequencies, n_coordinates, n_inputs) complex,
+            ``res.response_of(body, "y", input)``, ``res.peak(...)``, ``res.plot(body)``
+            (Bode), ``res.to_csv(path)``, ``res.summary()``.
+
+        Raises
+        ------
+        ModelError
+            For an unknown input, no input, bad frequencies, contacts or joint friction.
+        ConvergenceError
+            If no equilibrium is found near the q0 estimates.
+        SingularJacobianError
+            If a frequency asked for is an undamped natural frequency (0 Hz with a motion
+            without stiffness), or a free motion carries no mass.
+        """
+        return run_frf(self, inputs, frequencies, t=t, equilibrium=equilibrium, solver=solver)
 
     # ------------------------------------------------------------------ at one state
     @reads_entries

@@ -73,9 +73,10 @@ def statics_error(model: ModelDescription, p: Packed, out: Any, t: float,
         return assembly_failed(analysis, model, float(out.resid), 0, t, None)
     if status == INCONSISTENT:
         return inconsistent_at(analysis, model, p, t, None, text)
-    if status == NO_CONVERGENCE and not text.startswith("modes:"):
+    own = text.startswith(("modes:", "frequency response:"))     # (not the equilibrium's)
+    if status == NO_CONVERGENCE and not own:
         text = f"{text} (no equilibrium found near the q0 estimates; give q0 closer to one)"
-    elif status == SINGULAR and not text.startswith("modes:"):   # (modes: a massless motion)
+    elif status == SINGULAR and not own:   # (modes: a massless motion)
         text = (f"{text} (the equilibrium is not unique: a motion without stiffness, such as "
                 "a free rotation, is left; add a spring or a driver)")
     if status != OK:

@@ -22,6 +22,7 @@ Examples
 from __future__ import annotations
 
 from .animation import InlineAnimation, animate, ffmpeg_available
+from .bode import plot_bode
 from .canvas import STOP_COLOUR
 from .files import png_bytes, save_figure, save_figures
 from .geometry import Configuration, Motion, TracePoint
@@ -29,7 +30,8 @@ from .mechanism import default_points, plot_mechanism, plot_paths
 from .sweep import plot_sweep
 from .timeseries import plot_timeseries
 
-__all__ = ["plot_mechanism", "plot_paths", "plot_timeseries", "plot_sweep", "animate",
+__all__ = ["plot_mechanism", "plot_paths", "plot_timeseries", "plot_sweep", "plot_bode",
+           "animate",
            "save_figures",
            "save_figure", "png_bytes", "InlineAnimation", "ffmpeg_available", "Configuration",
            "default_points", "STOP_COLOUR", "Motion", "TracePoint"]

@@ -1,0 +1,78 @@
+"""Frequency response front door: the linearized motion about an equilibrium driven by design
+parameters varied harmonically, in one core call."""
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ..binding import core
+from ..binding.pack import pack, pack_dynamics
+from ..binding.status import NO_CONVERGENCE, SINGULAR, error_for
+from ..description.builder import ModelDescription
+from ..errors import ModelError
+from ..results.frf import FrequencyResponseResult
+from ..validate import flag, number
+from .contacts import check_statics
+from .sensitivities import check_status, requested, table
+from .settings import solver_code
+from .statics import STABILITY, statics_error
+
+WHAT = "frequency response"
+
+
+def run_frf(model: ModelDescription, inputs: Any, frequencies: Any, t: float = 0.0,
+            equilibrium: bool = True, solver: str = "auto") -> FrequencyResponseResult:
+    """The frequency response; see :meth:`mbd2d.Model.frequency_response`."""
+    t = number(t, "t", WHAT)
+    code = solver_code(solver)
+    equilibrium = flag(equilibrium, "equilibrium", WHAT)
+    freq = frequency_list(frequencies)
+    check_statics(model)
+    names = [inputs] if isinstance(inputs, str) else inputs
+    if names is None or (not isinstance(names, str) and len(list(names)) == 0):
+        raise ModelError("inputs must name at least one design parameter (model.parameters() "
+                         "lists them), e.g. a force's amplitude or a spring's free length", WHAT)
+    if getattr(model, "contacts", None):
+        raise ModelError("the frequency response does not carry contacts "
+                         f"({', '.join(c.name for c in model.contacts)}): their exact "
+                         "derivatives are not written; use model.modes() for their "
+                         "linearized frequencies", WHAT)
+    params = requested(model, list(names))
+    p = pack(model)
+    d = pack_dynamics(model, p)
+    ptab = table(p, params, d)
+    out = core.frf(p, d, t, equilibrium, ptab, 2 * np.pi * freq, code)
+    check_status(out.status, out.iinfo, out.msg, params)
+    if out.status == SINGULAR and 0 < int(out.iinfo[7]) <= freq.size:
+        f = freq[int(out.iinfo[7]) - 1]
+        out.msg = (f"{out.msg}: the response at {f:g} Hz is unbounded; leave that frequency "
+                   "out or give the mode damping")
+    exc = statics_error(model, p, out, t, analysis="frf")
+    if exc is not None:
+        raise exc
+    h = np.moveaxis(out.hre + 1j * out.him, 2, 0)           # (nw, nq, np)
+    if not np.isfinite(h).all():
+        raise error_for("frf", NO_CONVERGENCE, "frequency response: the response is not "
+                        "finite (the linearized equations are singular)", t=t,
+                        residual=float(out.resid))
+    stability = STABILITY.get(int(out.stable), "not examined (equilibrium=False)")
+    return FrequencyResponseResult(
+        t=t, q=out.q, lam=out.lam, stability=stability, residual=float(out.resid),
+        frequencies=freq, inputs=[prm.name for prm in params], response=h,
+        n_free=int(out.iinfo[0]), body_names=p.body_names,
+        coordinate_names=p.coordinate_names, model=model, packed=p,
+        stats={"solver": "banded" if int(out.iinfo[4]) == 2 else "dense"})
+
+
+def frequency_list(frequencies: Any) -> np.ndarray:
+    """The frequencies (Hz) as a 1-D float array: finite, not negative, at least one."""
+    try:
+        f = np.atleast_1d(np.asarray(frequencies, dtype=float))
+    except (TypeError, ValueError):
+        raise ModelError(f"frequencies must be numbers in Hz, not {frequencies!r}",
+                         WHAT) from None
+    if f.ndim != 1 or f.size == 0 or not np.isfinite(f).all() or (f < 0).any():
+        raise ModelError("frequencies must be a non-empty list of finite frequencies >= 0 "
+                         f"(Hz), got {frequencies!r}", WHAT)
+    return f.copy()

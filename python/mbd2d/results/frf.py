@@ -1,0 +1,123 @@
+"""The frequency response about an equilibrium to design parameters varied harmonically."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from .. import plots
+from ..errors import ModelError
+from .files import write_csv
+
+COORDINATES = ("x", "y", "theta")
+
+
+@dataclass
+class FrequencyResponseResult:
+    """The steady response of the linearized motion about an equilibrium (drivers held at
+    ``t``) to each input, a design parameter p varied as p0 + Re(P e^(i 2 pi f t)).
+
+    ``response`` (n_frequencies, n_coordinates, n_inputs, complex) is H(f): the coordinates
+    move as Re(H P e^(i 2 pi f t)), so ``abs(H)`` is the amplitude per unit amplitude of the
+    input and ``np.angle(H)`` the phase (at f = 0, H is the statics sensitivity dq*/dp).
+    ``frequencies`` in Hz, ``inputs`` the parameters' names; ``q``, ``lam``, ``stability``
+    and ``residual`` are the equilibrium's, as :class:`StaticsResult`.
+    """
+
+    t: float
+    q: np.ndarray
+    lam: np.ndarray
+    stability: str
+    residual: float
+    frequencies: np.ndarray
+    inputs: list[str]
+    response: np.ndarray
+    n_free: int
+    body_names: list[str]
+    coordinate_names: list[str]
+    model: Any = None
+    packed: Any = None
+    stats: dict = field(default_factory=dict)
+
+    def _input(self, name: str | None) -> int:
+        if name is None:
+            if len(self.inputs) == 1:
+                return 0
+            raise ModelError(f"this response has {len(self.inputs)} inputs; name one of "
+                             f"{', '.join(self.inputs)}", "frequency response")
+        if name not in self.inputs:
+            raise ModelError(f"no input {name!r}; the inputs are {', '.join(self.inputs)}",
+                             "frequency response")
+        return self.inputs.index(name)
+
+    def response_of(self, body: str, coordinate: str = "y", input: str | None = None
+                    ) -> np.ndarray:
+        """H(f) of one body coordinate ("x", "y" or "theta") to one input (n_frequencies,
+        complex; the only input by default)."""
+        if body not in self.body_names:
+            raise ModelError(f"no body {body!r}; bodies: {', '.join(self.body_names)}",
+                             "frequency response")
+        if coordinate not in COORDINATES:
+            raise ModelError(f"coordinate must be one of x, y, theta, not {coordinate!r}",
+                             "frequency response")
+        i = 3 * self.body_names.index(body) + COORDINATES.index(coordinate)
+        return self.response[:, i, self._input(input)].copy()
+
+    def peak(self, body: str, coordinate: str = "y", input: str | None = None
+             ) -> tuple[float, float]:
+        """(frequency in Hz, |H|) where the magnitude of one coordinate's response is largest
+        on the frequencies computed."""
+        mag = np.abs(self.response_of(body, coordinate, input))
+        k = int(np.argmax(mag)) if mag.size else 0
+        return (float(self.frequencies[k]), float(mag[k])) if mag.size else (0.0, 0.0)
+
+    def table(self) -> tuple[list[str], np.ndarray]:
+        """Header and rows of the CSV: one row per frequency, ``frequency_hz``, then for each
+        input and body ``d(NAME.x)/d(INPUT).re``, ``d(NAME.x)/d(INPUT).im``, then y and
+        theta."""
+        nb = len(self.body_names)
+        header = ["frequency_hz"]
+        blocks = []
+        for j, name in enumerate(self.inputs):
+            header += [f"d({b}.{c})/d({name}).{part}" for b in self.body_names
+                       for c in COORDINATES for part in ("re", "im")]
+            h = self.response[:, :3 * nb, j]
+            blocks.append(np.stack([h.real, h.imag], axis=2).reshape(h.shape[0], 6 * nb))
+        rows = np.column_stack([self.frequencies] + blocks)
+        return header, rows.reshape(self.frequencies.size, len(header))
+
+    def to_csv(self, path: Any) -> None:
+        """Write :meth:`table` as CSV, numbers as every mbd2d CSV."""
+        header, rows = self.table()
+        write_csv(path, header, rows, "to_csv")
+
+    def summary(self) -> str:
+        """A text table: for each input and body coordinate that moves, the peak amplitude
+        and its frequency."""
+        lines = [f"{getattr(self.model, 'name', 'model')}: frequency response about the "
+                 f"equilibrium ({self.stability}) at t = {self.t:g}, {self.n_free} free "
+                 f"motion(s), {self.frequencies.size} frequencies from "
+                 f"{self.frequencies.min(initial=0.0):g} to "
+                 f"{self.frequencies.max(initial=0.0):g} Hz"]
+        scale = np.abs(self.response).max(initial=0.0)
+        for name in self.inputs:
+            lines.append(f"input {name}: {'coordinate':>18}  {'peak |H|':>12}  at f (Hz)")
+            for b in self.body_names:
+                for c in COORDINATES:
+                    f, mag = self.peak(b, c, name)
+                    if mag > 1e-12 * scale:
+                        lines.append(f"{'':>8}{b + '.' + c:>20}  {mag:12.6g}  {f:.6g}")
+        return "\n".join(lines)
+
+    def plot(self, body: str, coordinates: Any = ("x", "y", "theta"), input: str | None = None,
+             **kwargs: Any) -> Any:
+        """A Bode plot of a body's coordinates' responses to one input: magnitude (log-log)
+        over phase (:func:`mbd2d.plots.plot_bode`; returns the Figure)."""
+        coords = [coordinates] if isinstance(coordinates, str) else list(coordinates)
+        name = self.inputs[self._input(input)]
+        hs = [self.response_of(body, c, name) for c in coords]
+        kwargs.setdefault("title", f"{getattr(self.model, 'name', 'model')}: "
+                          f"{body} per unit {name}")
+        return plots.plot_bode(self.frequencies, hs, [f"{body}.{c}" for c in coords],
+                               **kwargs)

@@ -1,0 +1,241 @@
+"""The frequency response (Model.frequency_response) against closed forms and matrices written
+here without mbd2d: a block on a spring-damper driven by its actuator, its spring's free length
+and gravity (1 / (k - m w^2 + i c w) and its multiples), two blocks damped at one end and a
+chain of twelve on the band path ((K - w^2 M + i w C)^-1 b by numpy), a pendulum on a torsion
+spring driven by a torque (the constraints' curvature under the equilibrium's multipliers) and
+a pendulum whose pivot is shaken (a base motion: the parameter moves the constraint)."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import mbd2d
+from test_modes import G, bisect, pendulum, spring_chain
+
+FREQS = np.array([0.0, 0.2, 0.5, 0.6755, 0.7, 1.3, 4.0, 25.0])
+
+
+def block(k: float = 36.0, c: float = 1.5, m: float = 2.0) -> mbd2d.Model:
+    """A block on a vertical guide hanging from a spring-damper-actuator (tension k (L - L0) +
+    c L' - f): the block's y is -L."""
+    return mbd2d.loads(f"""
+[model]
+name = "block"
+gravity = [0.0, {-G}]
+[[body]]
+name = "block"
+q0 = [0.0, -1.0, 0.0]
+mass = {m}
+inertia = 0.01
+[[joint]]
+type = "translational"
+name = "guide"
+bodies = ["ground", "block"]
+points = [[0, 0], [0, 0]]
+axes = [[0, 1], [0, 1]]
+[[force]]
+type = "spring"
+name = "s"
+bodies = ["ground", "block"]
+points = [[0.0, 0.0], [0.0, 0.0]]
+stiffness = {k}
+damping = {c}
+length0 = 0.5
+""")
+
+
+@pytest.mark.parametrize("c", [1.5, 0.0, 30.0])
+def test_a_block_on_a_spring_damper(c: float) -> None:
+    """dy per unit input: free length -k/D, actuator f -1/D, gravity's y m/D (a base
+    acceleration), D = k - m w^2 + i c w; at 0 Hz the statics sensitivity."""
+    k, m = 36.0, 2.0
+    model = block(k, c, m)
+    inputs = ["force.s.length0", "force.s.f.poly.0", "model.gravity.1"]
+    res = model.frequency_response(inputs, FREQS)
+    w = 2 * np.pi * FREQS
+    d = k - m * w**2 + 1j * c * w
+    for name, want in zip(inputs, (-k / d, -1 / d, m / d)):
+        got = res.response_of("block", "y", name)
+        np.testing.assert_allclose(got, want, rtol=1e-12, atol=0)
+        np.testing.assert_array_equal(res.response_of("block", "x", name), 0.0)
+    assert res.response.shape == (FREQS.size, 3, 3) and res.n_free == 1
+    eq = model.statics(sensitivities=inputs)
+    np.testing.assert_allclose(res.response[0].real, eq.dq_dp, rtol=1e-12, atol=1e-15)
+    assert res.stability == "stable" and abs(res.q[1] - (-0.5 - m * G / k)) < 1e-12
+
+
+def test_a_damper_without_a_spring_and_no_zero_frequency() -> None:
+    """A block on a horizontal guide with a damper only: 1 / (-m w^2 + i c w) for a force;
+    at 0 Hz the response is unbounded (a motion without stiffness): a SingularJacobianError
+    that names the frequency."""
+    m, c = 2.0, 3.0
+    model = mbd2d.Model("slider", gravity=(0.0, 0.0))
+    model.add_body("slider", [0.3, 0.0, 0.0], mass=m, inertia=0.01)
+    model.add_translational(["ground", "slider"], [[0, 0], [0, 0]], axes=[[1, 0], [1, 0]],
+                            name="guide")
+    model.add_spring(["ground", "slider"], [[0.0, 0.0], [0.0, 0.0]], damping=c, length0=0.3,
+                     name="damper")
+    model.add_point_force("slider", [0.0, 0.0], fx=0.0, name="push")
+    name = [p for p in model.parameters() if p.startswith("force.push.fx")][0]
+    f = np.array([0.1, 1.0, 10.0])
+    w = 2 * np.pi * f
+    res = model.frequency_response(name, f)
+    np.testing.assert_allclose(res.response_of("slider", "x"), 1 / (-m * w**2 + 1j * c * w),
+                               rtol=1e-12)
+    with pytest.raises(mbd2d.SingularJacobianError, match="at 0 Hz is unbounded"):
+        model.frequency_response(name, [1.0, 0.0])
+
+
+def damped_pair(c: float = 3.0, m: float = 0.5, k: float = 200.0) -> mbd2d.Model:
+    """spring_chain(2) with a damper on its last block and a force on its first."""
+    model = spring_chain(2, m, k)
+    model.add_spring(["ground", "b2"], [[0.0, 0.0], [0.0, 0.0]], damping=c, length0=0.2,
+                     name="damper")
+    model.add_point_force("b1", [0.0, 0.0], fx=0.0, name="shaker")
+    return model
+
+
+def test_two_blocks_damped_at_one_end() -> None:
+    """(K - w^2 M + i w C) x = e_1 with M = m I, K = [[2k, -k], [-k, k]], C = diag(0, c)."""
+    m, k, c = 0.5, 200.0, 3.0
+    model = damped_pair(c, m, k)
+    name = [p for p in model.parameters() if p.startswith("force.shaker.fx")][0]
+    res = model.frequency_response(name, FREQS * 10)
+    kk = k * np.array([[2.0, -1.0], [-1.0, 1.0]])
+    for j, f in enumerate(FREQS * 10):
+        w = 2 * np.pi * f
+        want = np.linalg.solve(kk - w**2 * m * np.eye(2) + 1j * w * np.diag([0.0, c]),
+                               [1.0, 0.0])
+        got = res.response[j, [0, 3], 0]
+        np.testing.assert_allclose(got, want, rtol=1e-11, atol=1e-13 * abs(want).max())
+
+
+def test_a_chain_on_the_band_path() -> None:
+    """Twelve blocks on springs, a damper on the last, a force on the first: the band path
+    equals the tridiagonal system solved here (and the dense path)."""
+    n, m, k, c = 12, 0.5, 200.0, 5.0
+    model = spring_chain(n, m, k)
+    model.add_spring(["ground", f"b{n}"], [[0.0, 0.0], [0.0, 0.0]], damping=c,
+                     length0=0.1 * n, name="damper")
+    model.add_point_force("b1", [0.0, 0.0], fx=0.0, name="shaker")
+    name = [p for p in model.parameters() if p.startswith("force.shaker.fx")][0]
+    f = np.linspace(0.0, 8.0, 17)
+    band = model.frequency_response(name, f, solver="banded")
+    dense = model.frequency_response(name, f, solver="dense")
+    assert band.stats["solver"] == "banded" and dense.stats["solver"] == "dense"
+    kk = k * (2 * np.eye(n) - np.eye(n, k=1) - np.eye(n, k=-1))
+    kk[-1, -1] = k
+    cc = np.zeros((n, n))
+    cc[-1, -1] = c
+    b = np.zeros(n)
+    b[0] = 1.0
+    for j, fj in enumerate(f):
+        w = 2 * np.pi * fj
+        want = np.linalg.solve(kk - w**2 * m * np.eye(n) + 1j * w * cc, b)
+        np.testing.assert_allclose(band.response[j, 0::3, 0], want, rtol=1e-9,
+                                   atol=1e-12 * abs(want).max())
+    np.testing.assert_allclose(band.response, dense.response, rtol=0,
+                               atol=1e-10 * abs(dense.response).max())
+
+
+def test_a_pendulum_on_a_torsion_spring_driven_by_a_torque() -> None:
+    """dtheta per unit torque 1 / (k - m g a sin th* - I_O w^2 + i c w) at the equilibrium
+    k th* + m g a cos th* = 0: the pendulum's stiffness m g a comes from the constraints'
+    curvature under the equilibrium's multipliers."""
+    m, L, k, c = 1.3, 0.8, 10.0, 0.4
+    model = pendulum(k=k, c=c, mass=m, length=L)
+    model.add_torque("bar", 0.0, name="drive")
+    th = bisect(lambda a: k * a + m * G * L / 2 * np.cos(a), -np.pi / 2, 0.0)
+    i_o = m * L**2 / 12 + m * (L / 2)**2
+    res = model.frequency_response("force.drive.f.poly.0", FREQS)
+    w = 2 * np.pi * FREQS
+    want = 1 / (k - m * G * L / 2 * np.sin(th) - i_o * w**2 + 1j * c * w)
+    np.testing.assert_allclose(res.response_of("bar", "theta"), want, rtol=1e-10)
+    # the pivot stays: the centre moves on its circle, dx = -(L/2) sin(th) dtheta
+    np.testing.assert_allclose(res.response_of("bar", "x"),
+                               -L / 2 * np.sin(th) * want, rtol=1e-10)
+
+
+def test_a_pendulum_whose_pivot_is_shaken() -> None:
+    """The ground pivot's x moved as X e^(i w t) (a base motion through Phi_p): the hanging
+    bar's angle I_O phi'' + c phi' + m g a phi = m a w^2 X, so dphi/dX = m a w^2 / (m g a -
+    I_O w^2 + i c w), and its centre follows the pivot (1 at 0 Hz)."""
+    m, L, c = 1.3, 0.8, 0.4
+    a = L / 2
+    model = pendulum(k=0.0, c=c, mass=m, length=L, q0=f"0.0, {-a}, {-np.pi / 2}")
+    res = model.frequency_response("joint.pivot.points.0.0", FREQS)
+    w = 2 * np.pi * FREQS
+    i_o = m * L**2 / 12 + m * a**2
+    phi = m * a * w**2 / (m * G * a - i_o * w**2 + 1j * c * w)
+    np.testing.assert_allclose(res.response_of("bar", "theta"), phi, rtol=1e-10, atol=1e-14)
+    np.testing.assert_allclose(res.response_of("bar", "x"), 1 + a * phi, rtol=1e-10)
+    np.testing.assert_allclose(res.response_of("bar", "y"), 0.0, atol=1e-12)
+
+
+def test_tables_summary_and_picture(tmp_path: Path) -> None:
+    pytest.importorskip("matplotlib")
+    res = block().frequency_response(["force.s.f.poly.0", "model.gravity.1"], FREQS)
+    header, rows = res.table()
+    assert header[:3] == ["frequency_hz", "d(block.x)/d(force.s.f.poly.0).re",
+                          "d(block.x)/d(force.s.f.poly.0).im"]
+    assert len(header) == 1 + 2 * 6 and rows.shape == (FREQS.size, 13)
+    np.testing.assert_array_equal(rows[:, 3], res.response[:, 1, 0].real)
+    np.testing.assert_array_equal(rows[:, 10], res.response[:, 1, 1].imag)
+    res.to_csv(tmp_path / "frf.csv")
+    back = np.genfromtxt(tmp_path / "frf.csv", delimiter=",", skip_header=1)
+    np.testing.assert_allclose(back, rows, rtol=1e-15)
+    f, mag = res.peak("block", "y", "model.gravity.1")
+    assert f == 0.6755 and mag == pytest.approx(abs(res.response[3, 1, 1]))
+    text = res.summary()
+    assert "input model.gravity.1" in text and "block.y" in text and "block.x" not in text
+    fig = res.plot("block", "y", input="model.gravity.1")
+    mbd2d.plots.save_figure(fig, tmp_path / "bode.png")
+    assert (tmp_path / "bode.png").stat().st_size > 1000
+
+
+@pytest.mark.parametrize("kw, error, needle", [
+    ({"inputs": []}, mbd2d.ModelError, "at least one design parameter"),
+    ({"inputs": None}, mbd2d.ModelError, "at least one design parameter"),
+    ({"inputs": "force.s.stifness"}, mbd2d.ModelError, "force.s.stiffness"),
+    ({"frequencies": [1.0, -2.0]}, mbd2d.ModelError, "frequencies must be"),
+    ({"frequencies": [np.nan]}, mbd2d.ModelError, "frequencies must be"),
+    ({"frequencies": []}, mbd2d.ModelError, "frequencies must be"),
+    ({"frequencies": "fast"}, mbd2d.ModelError, "frequencies must be"),
+    ({"t": "now"}, mbd2d.ModelError, "t"),
+    ({"solver": "sparse"}, mbd2d.ModelError, "solver"),
+])
+def test_bad_arguments_are_model_errors(kw: dict, error: type, needle: str) -> None:
+    args = {"inputs": "force.s.length0", "frequencies": [1.0], **kw}
+    with pytest.raises(error, match=needle):
+        block().frequency_response(**args)
+
+
+def test_what_it_does_not_carry() -> None:
+    """Contacts and joint friction are refused (their exact derivatives are not written)."""
+    ball = mbd2d.loads("""
+[model]
+name = "ball"
+gravity = [0.0, -9.81]
+[[body]]
+name = "ball"
+q0 = [0.0, 0.2, 0.0]
+mass = 1.0
+inertia = 0.01
+[[joint]]
+type = "translational"
+name = "guide"
+bodies = ["ground", "ball"]
+points = [[0, 0], [0, 0]]
+axes = [[0, 1], [0, 1]]
+[[contact]]
+name = "floor"
+type = "circle-line"
+bodies = ["ball", "ground"]
+circle = { center = [0.0, 0.0], radius = 0.1 }
+line = { point = [0.0, 0.0], normal = [0.0, 1.0] }
+law = { model = "linear", stiffness = 1e5, exponent = 1.0, restitution = 1.0 }
+""")
+    with pytest.raises(mbd2d.ModelError, match="does not carry contacts"):
+        ball.frequency_response("model.gravity.1", [1.0])
