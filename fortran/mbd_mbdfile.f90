@@ -5,14 +5,17 @@
 !! too: upgrade_functions):
 !!   mbd2d 3
 !!   name <model name>
-!!   analysis kinematics | inverse-dynamics | dynamics | statics | modes | check
+!!   analysis kinematics | inverse-dynamics | dynamics | statics | modes | frf | check
 !!   t0 <time>   t_end <time>   steps <n>   every <k>                  (one per line)
 !!   tol <x>   maxit <n>   tmin <x>   solver auto|dense|banded           (kinematic runs)
 !!   positions_only 0|1                       (kinematics: 1 = positions alone, optional)
 !!   method generalized-alpha|dopri5|baumgarte-rk4|partitioned   rtol <x>   atol <x>   h <x>
 !!   rho_inf <x>   alpha <x>   beta <x>   max_steps <n>                  (dynamics)
-!!   t <time>                                                    (statics, modes, check)
-!!   count <k>   at_q0 0|1        (modes: the lowest k (0: every free motion); 1 = about q0)
+!!   t <time>                                               (statics, modes, frf, check)
+!!   count <k>   at_q0 0|1        (modes: the lowest k (0: every free motion); 1 = about q0;
+!!                              at_q0 also frf)
+!!   frequencies <nw>                         (frf: then nw frequencies in Hz, >= 0, any
+!!   <nw reals>                               number per line; the inputs: sensitivities)
 !!   outputs <energy | multipliers | reactions | efforts ...>           (optional columns;
 !!                              modes: "damped" writes the damped eigenvalues instead)
 !!   gravity <gx> <gy>
@@ -78,8 +81,8 @@ module mbd_mbdfile
   real(wp), parameter :: MIN_TOL = 1.0e-15_wp     !! smallest tolerance (as the Python front end)
   integer, parameter :: INT32_MAX = huge(1)       !! largest step limit
   !> the analyses a file can hold
-  character(len=16), parameter :: ANALYSES(6) = [character(len=16) :: 'kinematics', &
-    'inverse-dynamics', 'dynamics', 'statics', 'modes', 'check']
+  character(len=16), parameter :: ANALYSES(7) = [character(len=16) :: 'kinematics', &
+    'inverse-dynamics', 'dynamics', 'statics', 'modes', 'frf', 'check']
   !> linear solvers (codes 0, 1, 2) and dynamics methods (codes 1 .. 4) by name
   character(len=8), parameter :: SOLVER_WORDS(0:2) = [character(len=8) :: 'auto', 'dense', &
     'banded']
@@ -111,6 +114,8 @@ module mbd_mbdfile
     integer :: count = 0                  !! modes: the lowest count (0: all)
     logical :: at_q0 = .false.            !! modes: about q0 (no equilibrium sought)
     logical :: out_damped = .false.       !! modes: the damped eigenvalues' table
+    real(wp), allocatable :: freq(:)      !! frf: the frequencies (Hz)
+    integer :: freq_line = 0              !! line of "frequencies" (0: not given)
     real(wp) :: grav(2) = zero            !! gravity
     !> optional output columns
     logical :: out_energy = .false., out_lam = .false., out_reac = .false., out_eff = .false.
@@ -166,7 +171,7 @@ contains
     character(len=NAME_LEN) :: key
     character(len=LINE_LEN) :: tok
     logical :: have_header, done, seen_b, seen_c, seen_p, seen_f, seen_fp, seen_l, seen_s
-    logical :: seen_k, seen_o, seen_m
+    logical :: seen_k, seen_o, seen_m, seen_w
     real(wp) :: x
     status = MBD_OK; msg = ''
     ! first pass: the data lines (not blank, not comments) and their characters
@@ -194,12 +199,13 @@ contains
     lineno = 0; nread = 0
     have_header = .false.; done = .false.; seen_b = .false.; seen_c = .false.
     seen_p = .false.; seen_f = .false.; seen_fp = .false.; seen_l = .false.; seen_s = .false.
-    seen_k = .false.; seen_o = .false.; seen_m = .false.
+    seen_k = .false.; seen_o = .false.; seen_m = .false.; seen_w = .false.
     allocate (spec%body_names(0), spec%con_names(0), spec%q0(3, 0), stat=ierr)
     if (ierr == 0) allocate (spec%ctab(NCT, 0), spec%con_line(0), spec%rpar(0), stat=ierr)
     if (ierr == 0) allocate (spec%bmass(2, 0), spec%v0(3, 0), spec%force_names(0), &
                              spec%ftab(NFT, 0), spec%fpar(0), spec%labels(0), stat=ierr)
-    if (ierr == 0) allocate (spec%par_names(0), spec%ptab(2, 0), spec%par_line(0), stat=ierr)
+    if (ierr == 0) allocate (spec%par_names(0), spec%ptab(2, 0), spec%par_line(0), &
+                             spec%freq(0), stat=ierr)
     if (ierr == 0) allocate (spec%case_names(0), spec%vtab(2, 0), spec%cvals(0, 0), &
                              spec%opens(2, 0), stat=ierr)
     if (ierr == 0) allocate (spec%meas_names(0), spec%meas_kind(0), spec%meas_int(5, 0), &
@@ -241,7 +247,7 @@ contains
         if (key == 'analysis') then
           if (.not. any(ANALYSES == tok(1:16)) .or. len_trim(tok) > 16) then
             call fail('unknown analysis "' // trim(tok(1:40)) // '"; one of kinematics, '// &
-                      'inverse-dynamics, dynamics, statics, modes, check')
+                      'inverse-dynamics, dynamics, statics, modes, frf, check')
             exit
           end if
           spec%analysis = tok(1:NAME_LEN)
@@ -497,6 +503,25 @@ contains
           call where_prefix(); exit
         end if
         if (.not. read_reals(spec%fpar)) exit
+      case ('frequencies')
+        if (.not. first_time(seen_w)) exit
+        if (.not. count_ok(n, 'frequency value', 1)) exit
+        spec%freq_line = lineno
+        call mem_check(REAL_BYTES * n, 'the frequencies', 'give fewer frequencies', status, msg)
+        if (status /= MBD_OK) then
+          call where_prefix(); exit
+        end if
+        deallocate (spec%freq)
+        allocate (spec%freq(n), stat=ierr)
+        if (ierr /= 0) then
+          call mem_fail(REAL_BYTES * n, 'the frequencies', 'give fewer frequencies', status, &
+                        msg)
+          call where_prefix(); exit
+        end if
+        if (.not. read_reals(spec%freq)) exit
+        if (any(spec%freq < zero)) then
+          call fail('the frequencies must be >= 0 (Hz)'); exit
+        end if
       case ('labels')
         if (.not. first_time(seen_l)) exit
         if (.not. count_ok(n, 'label', 0)) exit
@@ -632,7 +657,8 @@ contains
       integer(int64) :: c, room
       count_ok = .false.; nn = 0
       if (.not. one_int(c)) return
-      if (what == 'parameter' .or. what == 'force parameter' .or. what == 'label') then
+      if (what == 'parameter' .or. what == 'force parameter' .or. what == 'label' .or. &
+          what == 'frequency value') then
         room = (chars_left + 1) / 2
       else
         room = ndata - nread
@@ -642,7 +668,8 @@ contains
         return
       end if
       if (c > room) then
-        if (what == 'parameter' .or. what == 'force parameter' .or. what == 'label') then
+        if (what == 'parameter' .or. what == 'force parameter' .or. what == 'label' .or. &
+            what == 'frequency value') then
           call fail_int('more ' // what // 's than the rest of the file can hold (at most ', &
                         room, '): the count does not match the file (truncated or edited?)', c)
         else

@@ -34,7 +34,7 @@ NUMBERS = ["1", "0", "-1", "1e-3", "nan", "inf", "1e300", "abc", "", "2:3", "1.5
 def _command(rng: random.Random, tmp: Path) -> list[str]:
     model = str(EX / rng.choice(MODELS))
     cmd = rng.choice(["kinematics", "inverse-dynamics", "dynamics", "statics", "export",
-                      "tolerance", "parameters", "check", "plot", "sweep", "modes"])
+                      "tolerance", "parameters", "check", "plot", "sweep", "modes", "frf"])
     argv = [cmd, model]
     if cmd == "export":
         argv.append(str(tmp / "f.mbd"))
@@ -52,6 +52,14 @@ def _command(rng: random.Random, tmp: Path) -> list[str]:
                             ["--picture", str(tmp / rng.choice(["m.png", "m.gif", "m.txt"]))],
                             ["--mode", rng.choice(["0", "5", "-1"])],
                             ["--damped-out", str(tmp / rng.choice(["d.csv", "d.nc"]))]])
+    if cmd == "frf":
+        argv += ["--input", rng.choice(NAMES + ["model.gravity.1"]),
+                 "--f", rng.choice(["0.1:10:5", "0:3:4", "1:2", "-1:2:3"] + NUMBERS)]
+        if rng.random() < 0.5:
+            argv += rng.choice([["--log"], ["--at-q0"],
+                                ["--out", str(tmp / rng.choice(["f.csv", "f.nc"]))],
+                                ["--picture", str(tmp / rng.choice(["b.png", "b.gif"]))],
+                                ["--body", rng.choice(["coupler", "zzz"])]])
     if cmd == "tolerance":
         argv += ["--samples", rng.choice(["0", "3", "3", "1"]), "--workers", "1",
                  "--out", str(tmp / rng.choice(["t.csv", "t.csv", "t.nc", "t.txt"]))]
@@ -85,7 +93,7 @@ def _command(rng: random.Random, tmp: Path) -> list[str]:
             argv.append("--grid")
     if cmd == "export" and rng.random() < 0.3:
         argv += ["--analysis", rng.choice(["check", "statics", "dynamics", "inverse-dynamics",
-                                           "modes"])]
+                                           "modes", "frf"])]
     if cmd == "parameters" and rng.random() < 0.5:
         argv += ["--match", rng.choice(["B", "zzz", ""])]
     if rng.random() < 0.15:

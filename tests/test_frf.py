@@ -20,7 +20,12 @@ FREQS = np.array([0.0, 0.2, 0.5, 0.6755, 0.7, 1.3, 4.0, 25.0])
 def block(k: float = 36.0, c: float = 1.5, m: float = 2.0) -> mbd2d.Model:
     """A block on a vertical guide hanging from a spring-damper-actuator (tension k (L - L0) +
     c L' - f): the block's y is -L."""
-    return mbd2d.loads(f"""
+    return mbd2d.loads(block_text(k, c, m))
+
+
+def block_text(k: float = 36.0, c: float = 1.5, m: float = 2.0) -> str:
+    """block's model file."""
+    return (f"""
 [model]
 name = "block"
 gravity = [0.0, {-G}]
@@ -239,3 +244,123 @@ law = { model = "linear", stiffness = 1e5, exponent = 1.0, restitution = 1.0 }
 """)
     with pytest.raises(mbd2d.ModelError, match="does not carry contacts"):
         ball.frequency_response("model.gravity.1", [1.0])
+
+
+# ------------------------------------------------------------------ the other front doors
+
+def shaken_pendulum() -> mbd2d.Model:
+    return pendulum(k=0.0, c=0.4, mass=1.3, length=0.8, q0=f"0.0, -0.4, {-np.pi / 2}")
+
+
+def test_mbd2d_solve_writes_the_response_python_writes(tmp_path: Path) -> None:
+    """The standalone program: two inputs of the block, the shaken pivot about q0, a chain on
+    the band path, to the last digit of Python's CSV."""
+    from test_standalone import solve_file
+    chain = spring_chain(8)
+    chain.add_spring(["ground", "b8"], [[0.0, 0.0], [0.0, 0.0]], damping=2.0, length0=0.8,
+                     name="damper")
+    runs = [(block(), ["force.s.length0", "model.gravity.1"], {}),
+            (shaken_pendulum(), ["joint.pivot.points.0.0"], {"equilibrium": False}),
+            (chain, ["force.s1.length0"], {"solver": "banded"})]
+    for k, (model, inputs, kw) in enumerate(runs):
+        mbd = tmp_path / f"m{k}.mbd"
+        model.export(mbd, analysis="frf", inputs=inputs, frequencies=FREQS, **kw)
+        py = tmp_path / f"p{k}.csv"
+        model.frequency_response(inputs, FREQS, **kw).to_csv(py)
+        assert solve_file(mbd, tmp_path / f"f{k}.csv") == py.read_text()
+
+
+@pytest.mark.parametrize("edit, needle", [
+    (("frequencies 8", "frequencies 9"), "\"gravity\" is not a number"),
+    (("frequencies 8\n", "frequencies 8\n-1 "), "more numbers than the count"),
+    (("\nsensitivities 1\n", "\n# sensitivities 1\n# "), "frf needs its inputs"),
+    (("\nfrequencies 8\n", "\n# frequencies 8\n# "), None),
+    (("analysis frf", "analysis frf\noutputs energy"), "frf takes no outputs"),
+])
+def test_mbd2d_solve_refuses_bad_frf_files(tmp_path: Path, edit: tuple,
+                                            needle: str | None) -> None:
+    import subprocess
+
+    from test_standalone import find_solver
+    mbd = tmp_path / "m.mbd"
+    block().export(mbd, analysis="frf", inputs=["force.s.length0"], frequencies=FREQS)
+    text = mbd.read_text()
+    assert edit[0] in text
+    text = text.replace(edit[0], edit[1], 1)
+    if needle is None:                  # the block gone: its second line commented out too
+        needle = 'needs a "frequencies" block'
+        lines = text.splitlines()
+        i = lines.index("# frequencies 8")
+        lines[i + 2] = "# " + lines[i + 2]
+        text = "\n".join(lines) + "\n"
+    mbd.write_text(text)
+    r = subprocess.run([find_solver(), str(mbd), str(tmp_path / "o.csv")], capture_output=True,
+                       text=True, timeout=60)
+    assert r.returncode == 2 and needle in r.stderr, r.stderr
+
+
+def test_mbd2d_solve_names_an_unbounded_frequency(tmp_path: Path) -> None:
+    """A damper without a spring at 0 Hz: exit code 4 and the frequency named."""
+    import subprocess
+
+    from test_standalone import find_solver
+    model = mbd2d.Model("slider", gravity=(0.0, 0.0))
+    model.add_body("slider", [0.3, 0.0, 0.0], mass=2.0, inertia=0.01)
+    model.add_translational(["ground", "slider"], [[0, 0], [0, 0]], axes=[[1, 0], [1, 0]])
+    model.add_spring(["ground", "slider"], [[0.0, 0.0], [0.0, 0.0]], damping=3.0,
+                     length0=0.3, name="damper")
+    mbd = tmp_path / "m.mbd"
+    model.export(mbd, analysis="frf", inputs=["force.damper.length0"], frequencies=[2.0, 0.0])
+    r = subprocess.run([find_solver(), str(mbd), str(tmp_path / "o.csv")], capture_output=True,
+                       text=True, timeout=60)
+    assert r.returncode == 4 and "at 0.0000000000000000e+00 Hz is unbounded" in r.stderr
+
+
+def test_export_refuses_what_frf_does_not_take(tmp_path: Path) -> None:
+    m = block()
+    for kw, needle in [({"analysis": "statics", "inputs": ["force.s.length0"]}, "settings of frf"),
+                       ({"analysis": "frf", "frequencies": [1.0]}, "at least one design"),
+                       ({"analysis": "frf", "inputs": ["force.s.length0"]}, "frequencies"),
+                       ({"analysis": "frf", "inputs": ["force.s.length0"], "frequencies": [1.0],
+                         "outputs": ["energy"]}, "unknown output 'energy'"),
+                       ({"analysis": "frf", "inputs": ["force.s.length0"], "frequencies": [1.0],
+                         "sensitivities": ["force.s.stiffness"]}, "inputs=")]:
+        with pytest.raises(mbd2d.ModelError, match=needle):
+            m.export(tmp_path / "m.mbd", **kw)
+
+
+def test_the_command_line(tmp_path: Path) -> None:
+    """``mbd2d frf``: the peaks, the CSV Python writes, a Bode plot; ``export --analysis frf``;
+    bad arguments are exit 2."""
+    import subprocess
+    import sys
+    pytest.importorskip("matplotlib")
+    toml = tmp_path / "block.toml"
+    toml.write_text(block_text())
+
+    def cli(*args: str) -> subprocess.CompletedProcess:
+        return subprocess.run([sys.executable, "-m", "mbd2d", *args], capture_output=True,
+                              text=True, timeout=120)
+    r = cli("frf", str(toml), "--input", "force.s.f.poly.0", "--f", "0.1:10:25", "--log",
+            "--out", str(tmp_path / "f.csv"), "--picture", str(tmp_path / "b.png"))
+    assert r.returncode == 0, r.stderr
+    assert "block.y" in r.stdout and "peak" in r.stdout
+    res = mbd2d.load(toml).frequency_response("force.s.f.poly.0", np.geomspace(0.1, 10, 25))
+    res.to_csv(tmp_path / "p.csv")
+    assert (tmp_path / "f.csv").read_text() == (tmp_path / "p.csv").read_text()
+    assert (tmp_path / "b.png").stat().st_size > 1000
+    r = cli("export", str(toml), str(tmp_path / "m.mbd"), "--analysis", "frf", "--input",
+            "force.s.f.poly.0", "--f", "0.1:10:25", "--log")
+    assert r.returncode == 0, r.stderr
+    from test_standalone import solve_file
+    assert solve_file(tmp_path / "m.mbd", tmp_path / "s.csv") == (tmp_path / "p.csv").read_text()
+    for bad in (["--f", "1:2"], ["--f", "0:2:5", "--log"], ["--out", str(tmp_path / "x.txt")],
+                ["--f", "1:2:3", "--input", "force.s.nope"], ["--f", "1:2:0"],
+                ["--f", "1:2:3", "--body", "wheel", "--picture", str(tmp_path / "x.png")]):
+        args = ["frf", str(toml)] + (["--input", "force.s.f.poly.0"] if "--input" not in bad
+                                     else []) + bad
+        r = cli(*args)
+        assert r.returncode == 2 and "Traceback" not in r.stderr, (bad, r.stderr)
+    r = cli("export", str(toml), str(tmp_path / "m.mbd"), "--analysis", "frf", "--input",
+            "force.s.f.poly.0", "--f", "1:2:3", "--param", "force.s.stiffness=30:40:3")
+    assert r.returncode == 2 and "not frf" in r.stderr

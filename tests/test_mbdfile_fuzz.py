@@ -19,6 +19,7 @@ import sys
 from pathlib import Path
 from typing import Callable
 
+import numpy as np
 import pytest
 
 import mbd2d
@@ -93,6 +94,11 @@ def bases(tmp_path_factory: pytest.TempPathFactory) -> list[bytes]:
         f = d / f"modes{k}.mbd"
         model.export(f, analysis="modes", **kw)
         out.append(f.read_bytes())
+    # frf: two inputs (a damper's free length and gravity), log-spaced frequencies
+    f = d / "frf.mbd"
+    car.export(f, analysis="frf", inputs=["force.front_suspension.length0", "model.gravity.1"],
+               frequencies=np.geomspace(0.1, 30.0, 9))
+    out.append(f.read_bytes())
     f = d / "modes_sweep.mbd"
     mbd2d.export_sweep(car, f, {"force.front_suspension.damping": [0.0, 1500.0],
                                 "body.rear_wheel.mass": [35.0, 0.0]}, "modes", count=3)

@@ -37,8 +37,8 @@ from mbd2d.errors import (AssemblyError, ConvergenceError, CoreError,
 ROOT = Path(__file__).resolve().parent.parent
 EXAMPLES = ROOT / "examples"
 
-ANALYSES = ["kinematics", "inverse", "dynamics", "statics", "modes", "stepper", "stepper-start",
-            "dof", "eval"]
+ANALYSES = ["kinematics", "inverse", "dynamics", "statics", "modes", "frf", "stepper",
+            "stepper-start", "dof", "eval"]
 UNKNOWN = [11, 99, -6, -99]          # codes the core does not define
 
 # ----------------------------------------------------------------------------- the contract
@@ -57,6 +57,7 @@ CONTRACT = {
     "dynamics": {**KIN, 3: SingularJacobianError, 8: IntegrationError},
     "statics": {**ASM, 2: ConvergenceError},
     "modes": {**ASM, 2: ConvergenceError},
+    "frf": {**ASM, 2: ConvergenceError},
     "stepper": {**KIN, 1: ConvergenceError, 3: ConvergenceError},
     "stepper-start": ASM,
     "dof": ASM,
@@ -130,6 +131,9 @@ def _fake(model: mbd2d.Model, fn: str, status: int, nout: int = 3, finite: bool 
             return (p.q0, np.zeros(neq), 1, 0.0, np.zeros(k), np.zeros(k, dtype=np.int32),
                     np.zeros(2 * k), np.zeros(2 * k), np.zeros((nq, k)), np.zeros((nq, 2 * k)),
                     np.zeros((nq, 2 * k)), i10, status, msg)
+        if fn == "core_frf":
+            h = np.zeros((nq, kwargs["ptab"].shape[1], kwargs["omega"].size))
+            return p.q0, np.zeros(neq), 1, 0.0, h, h, i10, status, msg
         if fn == "core_kin_step":
             q = args[3] if finite else np.full(nq, np.inf)
             return q, args[4], args[5], status, msg
@@ -150,6 +154,7 @@ CALLS = {   # analysis: (the _core function, the public call)
     "dynamics": ("core_dynamics", lambda m: m.dynamics(t_end=1.0, steps=2)),
     "statics": ("core_statics", lambda m: m.statics()),
     "modes": ("core_modes", lambda m: m.modes()),
+    "frf": ("core_frf", lambda m: m.frequency_response("model.gravity.1", [1.0])),
     "stepper-start": ("core_kin_step", lambda m: mbd2d.KinematicStepper(m)),
     "dof": ("core_analyze", lambda m: m.analyze_dof()),
     "eval": ("core_eval", lambda m: m.phi(pack(m).q0)),

@@ -33,7 +33,8 @@ program mbd2d_solve
   use mbd_model, only: NFT
   use mbd_constraints, only: con_nrow, con_is_driver
   use mbd_api, only: NINFO, api_sizes, api_kinematics, api_inverse, api_dynamics, api_statics, &
-                     api_reactions, api_dynamics_sens, api_reactions_dp, api_analyze, api_modes
+                     api_reactions, api_dynamics_sens, api_reactions_dp, api_analyze, api_modes, &
+                     api_frf
   use mbd_batch, only: batch_run, NISET, NRSET
   use mbd_status, only: MBD_NO_CONVERGENCE, MBD_INTEGRATOR_FAILED, MBD_INCONSISTENT, &
                         MBD_ASSEMBLY_FAILED
@@ -47,6 +48,8 @@ program mbd2d_solve
                         quoted, cnum
   implicit none
   type(mbd_spec_t) :: spec
+  !> the coordinates' names in the CSV columns
+  character(len=*), parameter :: XYT(3) = ['x    ', 'y    ', 'theta']
   character(len=1024) :: model_path, out_path
   character(len=MSG_LEN) :: msg
   integer :: status, bad, nq, neq, nrows, nout, iinfo(NINFO), ierr, stable
@@ -110,6 +113,10 @@ program mbd2d_solve
   end if
   if (spec%analysis == 'modes' .and. spec%ncase == 0) then
     call run_modes()
+    stop 0, quiet=.true.
+  end if
+  if (spec%analysis == 'frf') then
+    call run_frf()
     stop 0, quiet=.true.
   end if
   dynamic = spec%analysis /= 'kinematics'
@@ -861,7 +868,6 @@ contains
     integer, allocatable :: kinds(:), ftm(:, :)
     integer :: kmax, nk, u, ios, k, j, nw, nz
     real(wp) :: mag, row(5)
-    character(len=*), parameter :: XYT(3) = ['x    ', 'y    ', 'theta']
     character(len=32) :: word
     if (.not. spec%have_masses) call die(2, trim(model_path) // ': modes needs the masses: '// &
       'body lines NAME X0 Y0 THETA0 MASS INERTIA VX0 VY0 OMEGA0')
@@ -960,6 +966,91 @@ contains
     close (u)
     if (ios /= 0) call die(2, 'cannot write ' // trim(out_path) // ' (disk full?)')
   end subroutine run_modes
+
+  !> The frequency response (Model.frequency_response) written as
+  !! FrequencyResponseResult.to_csv writes it: one row per frequency, frequency_hz, then for
+  !! each input (the sensitivities block) and body d(NAME.x)/d(INPUT).re, .im, then y, theta.
+  subroutine run_frf()
+    real(wp), parameter :: TWO_PI = 2 * 3.141592653589793_wp
+    real(wp), allocatable :: qe(:), lam(:), hre(:, :, :), him(:, :, :), fpm(:)
+    integer, allocatable :: ftm(:, :)
+    integer :: nw, u, ios, j, k, b, c, nw2
+    character(len=32) :: word
+    if (.not. spec%have_masses) call die(2, trim(model_path) // ': frf needs the masses: '// &
+      'body lines NAME X0 Y0 THETA0 MASS INERTIA VX0 VY0 OMEGA0')
+    if (spec%nlabels >= 0 .and. spec%nlabels /= neq) call die(2, trim(model_path) // &
+      ': ' // trim(itoa(spec%nlabels)) // ' labels for ' // trim(itoa(neq)) // ' rows of Phi')
+    if (spec%out_energy .or. spec%out_lam .or. spec%out_reac .or. spec%out_eff .or. &
+        spec%out_damped .or. spec%ncase > 0 .or. spec%positions_only .or. spec%nmeas > 0) &
+      call die(2, trim(model_path) // ': frf takes no outputs, cases, measures or '// &
+               'positions_only')
+    if (spec%npar == 0) call die(2, trim(model_path) // ': frf needs its inputs: a '// &
+      '"sensitivities" block naming the design parameters varied')
+    if (spec%freq_line == 0) call die(2, trim(model_path) // ': frf needs a "frequencies" '// &
+      'block (Hz)')
+    call check_sensitivities()
+    nw = size(spec%freq)
+    call mem_check(REAL_BYTES * (2 * real(nq, wp) * spec%npar * nw + 2 * nq + neq), &
+                   'the frequency response (' // trim(itoa(nw)) // ' frequencies)', &
+                   'give fewer frequencies or inputs', status, msg)
+    if (status /= MBD_OK) call die(2, trim(model_path) // ': ' // trim(msg))
+    allocate (q0(nq), qe(nq), lam(neq), hre(nq, spec%npar, nw), him(nq, spec%npar, nw), &
+              ftm(NFT, spec%nf), fpm(max(1, size(spec%fpar))), stat=ierr)
+    if (ierr /= 0) call die(2, 'not enough memory for the frequency response')
+    q0 = 0.0_wp
+    q0(1:3 * spec%nb) = reshape(spec%q0, [3 * spec%nb])
+    ftm = spec%ftab
+    fpm = 0.0_wp
+    fpm(1:size(spec%fpar)) = spec%fpar
+    call api_frf(spec%nb, spec%ctab, spec%rpar, spec%bmass, spec%grav, ftm, fpm, q0, &
+                 spec%tstat, merge(0, 1, spec%at_q0), spec%ptab, TWO_PI * spec%freq, qe, lam, &
+                 stable, resid, hre, him, iinfo, status, msg, spec%solver)
+    if (status < 0) then
+      if (iinfo(2) <= -2000000) call die(2, param_where(-2000000 - iinfo(2), msg))
+      if (iinfo(2) <= -1000000) call die(2, force_where(-1000000 - iinfo(2), msg))
+      if (iinfo(2) < 0) call die(2, trim(model_path) // ': body "' // &
+                                 trim(spec%body_names(min(spec%nb, -iinfo(2)))) // '": ' // &
+                                 trim(msg))
+      call die(2, where(iinfo(2), msg))
+    end if
+    if (status == MBD_NO_MEMORY) call die(2, trim(msg))
+    if (status /= MBD_OK .and. iinfo(8) > 0) then
+      call num(spec%freq(iinfo(8)), word, nw2)
+      call die(4, trim(msg) // ': the response at ' // word(1:nw2) // ' Hz is unbounded; '// &
+               'leave that frequency out or give the mode damping (no response written)')
+    end if
+    if (status /= MBD_OK) call die(4, trim(msg) // ' (no response written)')
+    open (newunit=u, file=trim(out_path), status='replace', action='write', access='stream', &
+          form='unformatted', iostat=ios)
+    if (ios /= 0) call die(2, 'cannot write ' // trim(out_path))
+    call sput(u, ios, 'frequency_hz')
+    do k = 1, spec%npar
+      do b = 1, spec%nb
+        do c = 1, 3
+          call sput(u, ios, ',d(' // trim(spec%body_names(b)) // '.' // trim(XYT(c)) // &
+                    ')/d(' // trim(spec%par_names(k)) // ').re,d(' // &
+                    trim(spec%body_names(b)) // '.' // trim(XYT(c)) // ')/d(' // &
+                    trim(spec%par_names(k)) // ').im')
+        end do
+      end do
+    end do
+    call sput(u, ios, achar(10))
+    do j = 1, nw
+      call num(spec%freq(j), word, nw2)
+      call sput(u, ios, word(1:nw2))
+      do k = 1, spec%npar
+        do b = 1, 3 * spec%nb
+          call num(hre(b, k, j), word, nw2)
+          call sput(u, ios, ',' // word(1:nw2))
+          call num(him(b, k, j), word, nw2)
+          call sput(u, ios, ',' // word(1:nw2))
+        end do
+      end do
+      call sput(u, ios, achar(10))
+    end do
+    close (u)
+    if (ios /= 0) call die(2, 'cannot write ' // trim(out_path) // ' (disk full?)')
+  end subroutine run_frf
 
   !> The label of row r of Phi (lambda's column name): the file's labels, else rowR.
   function row_label(r) result(s)

@@ -8,6 +8,8 @@
     mbd2d statics MODEL.toml [--t T --solver S] [--out OUT.csv]
     mbd2d modes MODEL.toml [--t T --count K --at-q0 --solver S] [--out MODES.csv
                 --damped-out EIGEN.csv --picture MODE.png|MODE.gif --mode K | --damped-mode J]
+    mbd2d frf MODEL.toml --input NAME ... --f START:STOP:NUM [--log --t T --at-q0 --solver S]
+              [--out FRF.csv --picture BODE.png --body B --coordinate x|y|theta]
     mbd2d sweep MODEL.toml --param NAME=START:STOP:NUM ... [--grid] --t-end T --steps N
                 --out sweep.nc|sweep.csv [--analysis A --t0 T0 --every K --workers W
                 --scheduler ADDRESS --positions-only --method M --rtol R --atol A --h H]
@@ -226,6 +228,21 @@ def _parser() -> argparse.ArgumentParser:
     o.add_argument("--damped-mode", type=int, default=None, metavar="J",
                    help="draw damped eigenvalue J's complex shape instead (each coordinate at "
                    "its own phase)")
+    fr = sub.add_parser("frf", help="frequency response about the static equilibrium to "
+                       "design parameters varied harmonically (Bode plot)")
+    fr.add_argument("model", help="model file (.toml) with masses")
+    _frf_settings(fr)
+    fr.add_argument("--t", type=float, default=0.0, help="time at which loads and drivers are "
+                   "held (default 0)")
+    fr.add_argument("--at-q0", action="store_true", help="about the assembled q0 as given, not "
+                   "the equilibrium statics finds")
+    fr.add_argument("--solver", default="auto", choices=["auto", "dense", "banded"],
+                   help="linear algebra (default auto: band LU for large chains)")
+    fr.add_argument("--out", default=None, help="write the response as CSV")
+    fr.add_argument("--picture", default=None, help="draw a Bode plot (.png, .svg or .pdf)")
+    fr.add_argument("--body", default=None, help="the body drawn (default the first)")
+    fr.add_argument("--coordinate", default="y", choices=["x", "y", "theta"],
+                   help="the coordinate drawn (default y)")
     w = sub.add_parser("sweep", help="one analysis of many variants (design parameters "
                        "swept): netCDF or CSV")
     w.add_argument("model", help="model file (.toml)")
@@ -266,7 +283,7 @@ def _parser() -> argparse.ArgumentParser:
     e.add_argument("model", help="model file (.toml)")
     e.add_argument("out", help="output model file (.mbd)")
     e.add_argument("--analysis", default="kinematics",
-                   choices=ANALYSES[1:] + ("statics", "modes", "check"),
+                   choices=ANALYSES[1:] + ("statics", "modes", "frf", "check"),
                    help="the analysis mbd2d-solve runs (default kinematics)")
     e.add_argument("--t-end", type=float, default=None, help="final time (not for statics)")
     e.add_argument("--steps", type=int, default=None, help="output intervals")
@@ -281,6 +298,7 @@ def _parser() -> argparse.ArgumentParser:
     e.add_argument("--at-q0", action="store_true", help="modes: about q0 as given")
     e.add_argument("--damped", action="store_true", help="modes: write the damped "
                    "eigenvalues' table")
+    _frf_settings(e, required=False)
     _sensitivities(e)
     _measures(e)
     e.add_argument("--positions-only", action="store_true",
@@ -400,6 +418,62 @@ def _statics_report(model: Model, st: StaticsResult) -> str:
             lines.append(f"  d/d({prm}) {name:16s} x: {dx: .9g}  y: {dy: .9g}  "
                          f"theta: {dth: .9g}")
     return "\n".join(lines)
+
+
+def _frf_settings(p: argparse.ArgumentParser, required: bool = True) -> None:
+    """--input (repeatable), --f START:STOP:NUM and --log: a frequency response's inputs and
+    frequencies."""
+    p.add_argument("--input", action="append", required=required, default=None,
+                   metavar="NAME", help="frf: a design parameter varied harmonically "
+                   "(repeatable; `mbd2d parameters MODEL` lists them)")
+    p.add_argument("--f", required=required, default=None, metavar="START:STOP:NUM",
+                   help="frf: NUM frequencies in Hz from START to STOP")
+    p.add_argument("--log", action="store_true", help="frf: the frequencies evenly spaced "
+                   "on a log scale (START > 0)")
+
+
+def _frequencies(args: argparse.Namespace) -> np.ndarray | None:
+    """The frequencies of --f START:STOP:NUM (--log: geometric), None without --f."""
+    if args.f is None:
+        return None
+    parts = str(args.f).split(":")
+    try:
+        if len(parts) != 3:
+            raise ValueError
+        start, stop, num = float(parts[0]), float(parts[1]), int(parts[2])
+    except ValueError:
+        raise ModelError(f"--f {args.f!r}: write START:STOP:NUM in Hz, for example "
+                         "0.1:100:200", "command line") from None
+    if not 1 <= num <= MAX_CASES or not (np.isfinite(start) and np.isfinite(stop)):
+        raise ModelError(f"--f {args.f!r}: NUM must be from 1 to {MAX_CASES} and START, STOP "
+                         "finite", "command line")
+    if args.log:
+        if start <= 0 or stop <= 0:
+            raise ModelError(f"--f {args.f!r} with --log: START and STOP must be > 0",
+                             "command line")
+        return np.geomspace(start, stop, num)
+    return np.linspace(start, stop, num)
+
+
+def _frf(model: Model, args: argparse.Namespace) -> int:
+    """``mbd2d frf``: the peaks printed, then the files asked for."""
+    for opt, path, ends in (("--out", args.out, (".csv",)),
+                            ("--picture", args.picture, PICTURE_ENDS)):
+        if path is not None and not str(path).lower().endswith(ends):
+            raise ModelError(f"{opt} must end in {' or '.join(ends)}, got {path!r}",
+                             "command line")
+    res = model.frequency_response(args.input, _frequencies(args), t=args.t,
+                                   equilibrium=not args.at_q0, solver=args.solver)
+    print(res.summary())
+    if args.out is not None:
+        res.to_csv(args.out)
+        print(f"wrote {res.frequencies.size} frequencies to {args.out}")
+    if args.picture is not None:
+        body = args.body if args.body is not None else res.body_names[0]
+        fig = res.plot(body, args.coordinate, input=args.input[0])
+        plots.save_figure(fig, args.picture)
+        print(f"drew {body}.{args.coordinate} per unit {args.input[0]} in {args.picture}")
+    return EXIT_OK
 
 
 def _modes(model: Model, args: argparse.Namespace) -> int:
@@ -755,9 +829,9 @@ def _export_sweep(model: Model, args: argparse.Namespace) -> int:
         raise ModelError("a sweep file writes the sweep's columns (and --measure, "
                          "--sensitivities): no --energy, --multipliers, --reactions or "
                          "--efforts with --param", "command line")
-    if args.analysis == "check":
+    if args.analysis in ("check", "frf"):
         raise ModelError("a sweep runs kinematics, inverse-dynamics, dynamics, statics or "
-                         "modes, not check", "command line")
+                         f"modes, not {args.analysis}", "command line")
     span = {"t_end": args.t_end, "steps": args.steps, "t0": args.t0, "every": args.every}
     kw: dict[str, Any] = {
         "kinematics": dict(span, tol=args.tol, solver=args.solver,
@@ -886,6 +960,8 @@ def _main(args: argparse.Namespace) -> int:
             return EXIT_OK
         if args.command == "modes":
             return _modes(model, args)
+        if args.command == "frf":
+            return _frf(model, args)
         if args.command == "export" and args.param:
             return _export_sweep(model, args)
         if args.command == "export":
@@ -894,7 +970,8 @@ def _main(args: argparse.Namespace) -> int:
                          analysis=args.analysis, every=args.every, solver=args.solver, t=args.t,
                          outputs=list(_outputs(args)) + (["damped"] if args.damped else []),
                          positions_only=args.positions_only, count=args.count,
-                         equilibrium=not args.at_q0,
+                         equilibrium=not args.at_q0, inputs=args.input,
+                         frequencies=_frequencies(args),
                          sensitivities=_sens_names(args), measures=args.measure, **extra)
             print(f"wrote {args.out} ({args.analysis}; run it with mbd2d-solve "
                   f"{args.out} OUT.csv)")
@@ -917,7 +994,7 @@ def _main(args: argparse.Namespace) -> int:
         _say(f"mbd2d: {exc}")
         return EXIT_INPUT
     except AnalysisError as exc:
-        if args.command in ("check", "statics", "modes", "synthesize", "cam"):
+        if args.command in ("check", "statics", "modes", "frf", "synthesize", "cam"):
             _say(f"mbd2d: {exc}")
             return EXIT_NUMERICAL
         _say(f"mbd2d: {exc}")

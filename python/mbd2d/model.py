@@ -464,7 +464,8 @@ class Model(ModelDescription):
                outputs: Sequence[str] | None = None, positions_only: bool = False,
                sensitivities: Sequence[str] | None = None,
                measures: Sequence[str] | None = None, count: int | None = None,
-               equilibrium: bool = True) -> None:
+               equilibrium: bool = True, inputs: Sequence[str] | None = None,
+               frequencies: Any = None) -> None:
         """Write a plain-text model file that the standalone ``mbd2d-solve`` runs without
         Python (format: docs/mbd-format.md), with the analysis and its settings.
 
@@ -474,8 +475,9 @@ class Model(ModelDescription):
             The file to write (.mbd).
         t_end, steps, t0, every : float, int, float, int
             The output times, as for the analyses (not for statics).
-        analysis : {"kinematics", "inverse-dynamics", "dynamics", "statics", "modes", "check"}
-            The analysis ``mbd2d-solve`` runs.
+        analysis : str
+            The analysis ``mbd2d-solve`` runs: "kinematics", "inverse-dynamics", "dynamics",
+            "statics", "modes", "frf" or "check".
         tol, maxit, solver
             As :meth:`kinematics` (``tol`` and ``solver`` also for inverse dynamics).
         method, rtol, atol, h, rho_inf, alpha, beta, max_steps
@@ -484,7 +486,11 @@ class Model(ModelDescription):
             Statics, modes: the time of loads and drivers.
         count, equilibrium
             Modes: as :meth:`modes` (the CSV is ``res.to_csv(path)``, or with
-            ``outputs=["damped"]`` ``res.to_csv(path, damped=True)``).
+            ``outputs=["damped"]`` ``res.to_csv(path, damped=True)``); ``equilibrium`` also
+            frf.
+        inputs, frequencies
+            Frf (the frequency response): as :meth:`frequency_response` (the CSV is
+            ``res.to_csv(path)``).
         outputs : list of str, optional
             Optional CSV columns: "energy", "multipliers", "reactions", "efforts" (not for
             kinematics; no energy for statics), as ``res.to_csv(path, energy=True, ...)``.
@@ -520,7 +526,7 @@ class Model(ModelDescription):
                    atol=atol, h=h, rho_inf=rho_inf, alpha=alpha, beta=beta,
                    max_steps=max_steps, t=t, outputs=outputs, positions_only=positions_only,
                    sensitivities=sensitivities, measures=measures, count=count,
-                   equilibrium=equilibrium)
+                   equilibrium=equilibrium, inputs=inputs, frequencies=frequencies)
 
 
 def load(path: str | Path) -> Model:

@@ -10,6 +10,7 @@ from ..binding import core
 from ..binding.pack import pack, pack_dynamics
 from ..binding.status import NO_CONVERGENCE, SINGULAR, error_for
 from ..description.builder import ModelDescription
+from ..description.parameters import Parameter
 from ..errors import ModelError
 from ..results.frf import FrequencyResponseResult
 from ..validate import flag, number
@@ -28,17 +29,7 @@ def run_frf(model: ModelDescription, inputs: Any, frequencies: Any, t: float = 0
     code = solver_code(solver)
     equilibrium = flag(equilibrium, "equilibrium", WHAT)
     freq = frequency_list(frequencies)
-    check_statics(model)
-    names = [inputs] if isinstance(inputs, str) else inputs
-    if names is None or (not isinstance(names, str) and len(list(names)) == 0):
-        raise ModelError("inputs must name at least one design parameter (model.parameters() "
-                         "lists them), e.g. a force's amplitude or a spring's free length", WHAT)
-    if getattr(model, "contacts", None):
-        raise ModelError("the frequency response does not carry contacts "
-                         f"({', '.join(c.name for c in model.contacts)}): their exact "
-                         "derivatives are not written; use model.modes() for their "
-                         "linearized frequencies", WHAT)
-    params = requested(model, list(names))
+    params = frf_inputs(model, inputs)
     p = pack(model)
     d = pack_dynamics(model, p)
     ptab = table(p, params, d)
@@ -63,6 +54,21 @@ def run_frf(model: ModelDescription, inputs: Any, frequencies: Any, t: float = 0
         n_free=int(out.iinfo[0]), body_names=p.body_names,
         coordinate_names=p.coordinate_names, model=model, packed=p,
         stats={"solver": "banded" if int(out.iinfo[4]) == 2 else "dense"})
+
+
+def frf_inputs(model: ModelDescription, inputs: Any) -> list[Parameter]:
+    """The inputs as design parameters, checked (at least one; no contacts or friction)."""
+    check_statics(model)
+    names = [inputs] if isinstance(inputs, str) else inputs
+    if names is None or len(list(names)) == 0:
+        raise ModelError("inputs must name at least one design parameter (model.parameters() "
+                         "lists them), e.g. a force's amplitude or a spring's free length", WHAT)
+    if getattr(model, "contacts", None):
+        raise ModelError("the frequency response does not carry contacts "
+                         f"({', '.join(c.name for c in model.contacts)}): their exact "
+                         "derivatives are not written; use model.modes() for their "
+                         "linearized frequencies", WHAT)
+    return requested(model, list(names)) or []
 
 
 def frequency_list(frequencies: Any) -> np.ndarray:
