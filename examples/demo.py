@@ -11,7 +11,7 @@ three pictures (examples/design_study.py: a sweep of the crank-rocker's coupler 
 sensitivities of the rocker angle, the tolerance of a coupler point), and the same sweep
 and a sensitivity run in the standalone mbd2d-solve (examples/standalone_sweep.py), a cam
 synthesized from its follower's program and run (examples/cam_design.py), a half car's
-vibration modes (examples/vibration_modes.py). The seed four-bar is
+vibration modes and road response (examples/vibration_modes.py). The seed four-bar is
 non-Grashof: driven past its
 toggle it raises :class:`mbd2d.SingularConfigurationError`, which is the expected outcome;
 its partial results are drawn with the toggle configuration marked.
@@ -171,7 +171,8 @@ def main(argv: list[str] | None = None) -> int:
         problems.append(f"cam_design: {type(exc).__name__}: {exc}")
 
     total += 1
-    print("\nvibration_modes (a half car's modes about its equilibrium, model.modes):")
+    print("\nvibration_modes (a half car's modes about its equilibrium, model.modes, and its "
+          "response to the road, model.frequency_response):")
     try:
         sys.path.insert(0, str(HERE))
         import vibration_modes

@@ -6,7 +6,11 @@ do not use the modes' own numbers: released from the equilibrium displaced along
 mode, the forward dynamics of the nonlinear model moves as a cos(omega t) phi, its departure
 from that falling with the amplitude as the linearization's error must (halved with the
 amplitude: second order); and the damping chart's undamped end (c = 0) has zero damping
-ratios.
+ratios. Then the car driven by the road: model.frequency_response() gives the body's bounce
+and pitch per unit rise of the road under the front wheel (the front tyre's ground point
+moved: a base motion) from 0.1 to 30 Hz, and the nonlinear forward dynamics driven by a
+1 mm sinusoidal road (the tyre's actuator force k_t u(t), the same load) settles on the same
+amplitude and phase at three frequencies.
 
 Usage::
 
@@ -15,9 +19,11 @@ Usage::
 Writes vibration_modes_shapes.png (the four modes, each drawn at both extremes),
 vibration_modes_damping.png (each mode's damping ratio and damped frequency against the
 suspension damping, one mbd2d.sweep of the modes: the designer's chart) and
-vibration_modes.gif (the pitch mode) to DIR
-(default examples/output/). Exit code 0 when the released modes depart from their linear
-motion by less than 2e-3 of a 1 mm amplitude, and by half as much at half the amplitude.
+vibration_modes.gif (the pitch mode) and vibration_modes_road.png (the Bode plot of the road
+response, with the dynamics' steady amplitudes marked) to DIR (default examples/output/).
+Exit code 0 when the released modes depart from their linear motion by less than 2e-3 of a
+1 mm amplitude, and by half as much at half the amplitude, and the driven dynamics settles
+within 1e-2 of the frequency response.
 """
 from __future__ import annotations
 
@@ -36,6 +42,12 @@ RELEASE_TOL = 2e-3
 #: the amplitude of the release: the largest point moves this far [m]
 AMPLITUDE = 1e-3
 DAMPING = ("force.front_suspension.damping", "force.rear_suspension.damping")
+#: the road under the front wheel: the front tyre's ground point's height
+ROAD = "force.front_tyre.points.0.1"
+#: the driven dynamics' steady response within this fraction of the frequency response's
+ROAD_TOL = 1e-2
+#: the frequencies at which the driven dynamics checks the response [Hz]
+ROAD_CHECKS = (1.0, 1.5, 8.0)
 
 
 def released(model: mbd2d.Model, res: mbd2d.ModesResult, k: int,
@@ -86,6 +98,49 @@ def damping_chart(model: mbd2d.Model, path: Path) -> float:
     return float(np.nanmax(np.abs(zeta[0])))
 
 
+def driven(f_hz: float, amplitude: float = AMPLITUDE) -> np.ndarray:
+    """The nonlinear car on a road u = a sin(2 pi f t) under the front wheel (the tyre's
+    actuator force k_t u: its tension k_t (L - L0 - u)), run until the start has died out;
+    the complex amplitudes (Y with y = Re(Y e^(i w t))) of the body's y and theta over the
+    last two periods, per unit of the road's complex amplitude -i a."""
+    text = MODEL.read_text()
+    tyre = text.index('name = "front_tyre"')
+    at = text.index("length0 = 0.32", tyre) + len("length0 = 0.32")
+    k_t = 200000.0
+    w = 2 * np.pi * f_hz
+    text = (text[:at] + f"\nf = {{ harmonic = [{{ amplitude = {k_t * amplitude!r}, "
+            f"omega = {w!r}, phase = 0.0 }}] }}" + text[at:])
+    model = mbd2d.loads(text)
+    rest = model.statics()
+    for i, body in enumerate(model.bodies):
+        body.q0 = [float(v) for v in rest.q[3 * i:3 * i + 3]]
+    period = 1.0 / f_hz
+    t_end = 8.0 + 2 * period                      # (the slowest start decays as e^(-2 t))
+    run = model.dynamics(t_end, int(t_end * f_hz * 40), rtol=1e-10, atol=1e-12)
+    last = run.t >= t_end - 2 * period
+    basis = np.column_stack([np.cos(w * run.t[last]), np.sin(w * run.t[last])])
+    out = []
+    for j in (1, 2):                              # the body's y and theta
+        (a, b), *_ = np.linalg.lstsq(basis, run.q[last, j] - rest.q[j], rcond=None)
+        out.append(complex(a, -b) / (-1j * amplitude))
+    return np.array(out)
+
+
+def road_figure(frf: mbd2d.FrequencyResponseResult, checks: dict, path: Path) -> None:
+    """The Bode plot of the body's bounce and pitch per unit road rise, with the driven
+    dynamics' steady responses marked."""
+    fig = frf.plot("body", ["y", "theta"])
+    mag_ax, ph_ax = fig.axes[:2]
+    for f, h in checks.items():
+        mag_ax.plot([f, f], np.abs(h), "ko", ms=4)
+        ph_ax.plot([f, f], np.degrees(np.angle(h)), "ko", ms=4)
+    mag_ax.plot([], [], "ko", ms=4, label="nonlinear dynamics, settled")
+    mag_ax.legend(fontsize=8)
+    mag_ax.set_title("half car: body per unit road rise under the front wheel "
+                     "(m/m and rad/m)")
+    mbd2d.plots.save_figure(fig, path)
+
+
 def shapes_figure(res: mbd2d.ModesResult, path: Path) -> None:
     """The four modes, each at both extremes around the equilibrium."""
     import matplotlib
@@ -122,6 +177,21 @@ def run(out: Path) -> tuple[str, list[str]]:
     if not zeta0 < 1e-9:
         problems.append(f"the undamped car has a damping ratio {zeta0:.1e}")
     files.append(str(res.animate(1, out / "vibration_modes.gif", max_frames=40)))
+    frf = model.frequency_response(ROAD, np.geomspace(0.1, 30.0, 400))
+    checks = {}
+    for f in ROAD_CHECKS:
+        h = model.frequency_response(ROAD, [f]).response[0, [1, 2], 0]
+        checks[f] = driven(f)
+        err = float(np.abs(checks[f] - h).max() / np.abs(h).max())
+        print(f"road at {f:g} Hz: bounce {abs(h[0]):.4g} m/m at {np.degrees(np.angle(h[0])):.1f}"
+              f" deg, pitch {abs(h[1]):.4g} rad/m; the driven dynamics settles within "
+              f"{err:.1e} of it")
+        if not err < ROAD_TOL:
+            problems.append(f"the driven dynamics at {f:g} Hz departs {err:.1e}")
+    peak_f, peak = frf.peak("body", "y")
+    print(f"largest bounce per unit road rise {peak:.3g} at {peak_f:.3g} Hz")
+    files.append(str(out / "vibration_modes_road.png"))
+    road_figure(frf, checks, Path(files[-1]))
     return "; ".join(problems), files
 
 

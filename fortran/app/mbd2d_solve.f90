@@ -1,8 +1,8 @@
 !> mbd2d-solve: run a model file written by `mbd2d export`, without Python.
 !!
 !!   mbd2d-solve MODEL.mbd OUT.csv
-!! Runs the file's analysis (kinematics, inverse dynamics, dynamics, statics or modes, with
-!! its settings) and writes the CSV the Python path writes for it: t, then NAME.x ...
+!! Runs the file's analysis (kinematics, inverse dynamics, dynamics, statics, modes or frf,
+!! with its settings) and writes the CSV the Python path writes for it: t, then NAME.x ...
 !! NAME.theta_ddot per body (statics: NAME.x, NAME.y, NAME.theta, stable, residual), then the
 !! optional columns the file's "outputs" line asks for (energy, multipliers, reactions,
 !! efforts), then each
@@ -89,7 +89,8 @@ program mbd2d_solve
         write (*, '(a)') 'usage: mbd2d-solve MODEL.mbd OUT.csv'
         write (*, '(a)') '  runs the analysis in a model file written by `mbd2d export` and '// &
           'writes a CSV'
-        write (*, '(a)') '  (kinematics, inverse dynamics, dynamics, statics, modes or check; '// &
+        write (*, '(a)') '  (kinematics, inverse dynamics, dynamics, statics, modes, frf or '// &
+          'check; '// &
           'with the file''s sensitivities and measures; a sweep file runs every case, on '// &
           'every core)'
         write (*, '(a)') '  exit codes: 0 ok, 2 bad input, 3 singular configuration, 4 other '// &
