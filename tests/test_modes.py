@@ -260,12 +260,14 @@ def fourbar_reduced(th2: float, geo: dict) -> tuple[float, float, float]:
     return v1, v2, meff
 
 
-def test_fourbar_on_a_spring_by_the_energy_method() -> None:
-    """A crank-rocker whose crank is held by a torsion spring, under gravity: omega^2 =
-    V''(th2*) / M_eff(th2*) at V'(th2*) = 0 (the equilibrium solved here). Measured 7e-10,
-    the reference's own second difference (h = 1e-3: rounding eps V / h^2 ~ 2e-10)."""
-    geo = {"a": 0.2, "b": 0.7, "c": 0.5, "d": 0.6, "m": [0.4, 1.2, 0.9],
-           "I": [0.002, 0.05, 0.02], "k": 6.0, "t0": 1.2}
+#: the sprung crank-rocker's dimensions, masses, spring and the spring's free angle
+SPRUNG = {"a": 0.2, "b": 0.7, "c": 0.5, "d": 0.6, "m": [0.4, 1.2, 0.9],
+          "I": [0.002, 0.05, 0.02], "k": 6.0, "t0": 1.2}
+
+
+def sprung_fourbar(geo: dict = SPRUNG, damping: float = 0.0) -> mbd2d.Model:
+    """A crank-rocker (centres of mass at mid-link) whose crank is held by a torsion spring
+    (and damper), under gravity, assembled near crank angle 1."""
     cms, ths = fourbar_energy(1.0, geo)
     bodies = ["crank", "coupler", "rocker"]
     lens = [geo["a"], geo["b"], geo["c"]]
@@ -281,9 +283,17 @@ def test_fourbar_on_a_spring_by_the_energy_method() -> None:
         text += ['[[joint]]', 'type = "revolute"', f'name = "{nm}"', f'bodies = ["{b1}", "{b2}"]',
                  f'points = [[{p1[0]}, {p1[1]}], [{p2[0]}, {p2[1]}]]']
     text += ['[[force]]', 'type = "rotational-spring"', 'name = "k"',
-             'bodies = ["ground", "crank"]', f'stiffness = {geo["k"]}', 'damping = 0.0',
+             'bodies = ["ground", "crank"]', f'stiffness = {geo["k"]}', f'damping = {damping}',
              f'angle0 = {geo["t0"]}']
-    res = mbd2d.loads("\n".join(text)).modes()
+    return mbd2d.loads("\n".join(text))
+
+
+def test_fourbar_on_a_spring_by_the_energy_method() -> None:
+    """A crank-rocker whose crank is held by a torsion spring, under gravity: omega^2 =
+    V''(th2*) / M_eff(th2*) at V'(th2*) = 0 (the equilibrium solved here). Measured 7e-10,
+    the reference's own second difference (h = 1e-3: rounding eps V / h^2 ~ 2e-10)."""
+    geo = SPRUNG
+    res = sprung_fourbar(geo).modes()
     th = bisect(lambda t: fourbar_reduced(t, geo)[0], 0.3, 2.0)
     _, v2, meff = fourbar_reduced(th, geo)
     assert abs(res.q[2] - th) < 1e-9
