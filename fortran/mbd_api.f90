@@ -1119,8 +1119,9 @@ contains
   !! times the parameter's amplitude (nq, np, nomega; model units, mbd_frf), with the
   !! configuration, multipliers, stability and residual as api_statics. iinfo(1) the number of
   !! free motions, iinfo(8) the frequency at which the response is unbounded (MBD_SINGULAR).
+  !! lre + i lim (neq, np, nomega): the multipliers' response, when asked for.
   subroutine api_frf(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, t, equilibrium, ptab, omega, &
-                     q, lam, stable, resid, hre, him, iinfo, status, msg, solver)
+                     q, lam, stable, resid, hre, him, iinfo, status, msg, solver, lre, lim)
     integer, intent(in) :: nb, ctab(:, :), ftab(:, :), equilibrium, ptab(:, :)
     real(wp), intent(in) :: rpar(:), bmass(:, :), grav(2), fpar(:), q0(:), t, omega(:)
     real(wp), intent(out) :: q(:), lam(:), resid, hre(:, :, :), him(:, :, :)
@@ -1128,11 +1129,17 @@ contains
     integer, intent(out) :: status              !! MBD_OK, < 0 input, > 0 numerical
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
     integer, intent(in), optional :: solver     !! 0 auto (default), 1 dense, 2 banded
+    real(wp), intent(out), optional :: lre(:, :, :), lim(:, :, :)
     type(model_t) :: m
     type(dyn_work_t) :: w
     type(sens_t) :: sens
     integer :: bad, ibad
+    logical :: mult
     q = zero; lam = zero; stable = 0; resid = zero; hre = zero; him = zero
+    mult = present(lre) .and. present(lim)
+    if (mult) then
+      lre = zero; lim = zero
+    end if
     call static_start(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, t, m, w, q, lam, iinfo, &
                       status, msg, solver)
     if (status == MBD_OK) then
@@ -1141,6 +1148,12 @@ contains
         status = MBD_BAD_COUNT; msg = 'frequency response: the output arrays do not match'
       else if (.not. finite(omega)) then
         call not_finite('the frequencies', status, msg)
+      end if
+      if (mult .and. status == MBD_OK) then
+        if (any(shape(lre) /= [m%neq, size(ptab, 2), size(omega)]) .or. &
+            any(shape(lim) /= shape(lre))) then
+          status = MBD_BAD_COUNT; msg = 'frequency response: the output arrays do not match'
+        end if
       end if
     end if
     if (status == MBD_OK) then
@@ -1156,7 +1169,11 @@ contains
       end if
     end if
     if (status == MBD_OK) then
-      call frf_solve(m, w, sens, q, t, lam, omega, hre, him, ibad, status, msg)
+      if (mult) then
+        call frf_solve(m, w, sens, q, t, lam, omega, hre, him, ibad, status, msg, lre, lim)
+      else
+        call frf_solve(m, w, sens, q, t, lam, omega, hre, him, ibad, status, msg)
+      end if
       iinfo(1) = m%nq - w%na; iinfo(8) = ibad
     end if
     if (allocated(m%cunit)) then
@@ -1164,6 +1181,10 @@ contains
       if (status == MBD_OK) then
         call sens_units(m, sens, hre, m%cunit, .false.)
         call sens_units(m, sens, him, m%cunit, .false.)
+        if (mult) then
+          call sens_units(m, sens, lre, m%rowunit, .true.)
+          call sens_units(m, sens, lim, m%rowunit, .true.)
+        end if
       end if
     end if
   end subroutine api_frf

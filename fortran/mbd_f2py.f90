@@ -224,22 +224,24 @@ end subroutine core_modes
 ! The frequency response about the equilibrium near q0 (equilibrium 1; 0: about the assembled
 ! q0) to each design parameter of ptab varied harmonically at each angular frequency omega:
 ! dq = (hre + i him) per unit amplitude (nq, npar, nw); iinfo(1) the free motions, iinfo(8)
-! the frequency at which it is unbounded. solver: 0 auto, 1 dense, 2 banded.
+! the frequency at which it is unbounded; lre + i lim the multipliers' response (neq, npar,
+! nw). solver: 0 auto, 1 dense, 2 banded.
 subroutine core_frf(nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp, fpar, nq, neq, q0, t, &
                     equilibrium, npar, ptab, nw, omega, solver, q, lam, stable, resid, hre, him, &
-                    iinfo, status, msg)
+                    lre, lim, iinfo, status, msg)
   use iso_c_binding, only: c_double, c_int
   use mbd_api, only: api_frf
   implicit none
   integer(c_int), intent(in) :: nb, nc, np, nf, nfp, nq, neq, equilibrium, npar, nw, solver
   integer(c_int), intent(in) :: ctab(8, nc), ftab(6, nf), ptab(2, npar)
   real(c_double), intent(in) :: rpar(np), bmass(2, nb), grav(2), fpar(nfp), q0(nq), t, omega(nw)
-  real(c_double), intent(out) :: q(nq), lam(neq), resid, hre(nq, npar, nw), him(nq, npar, nw)
+  real(c_double), intent(out) :: q(nq), lam(neq), resid, hre(nq, npar, nw), him(nq, npar, nw), &
+                                 lre(neq, npar, nw), lim(neq, npar, nw)
   integer(c_int), intent(out) :: stable, iinfo(12), status
   character(len=512), intent(out) :: msg
   !f2py intent(hide) :: nc, np, nf, nfp, nq, npar, nw
   call api_frf(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, t, equilibrium, ptab, omega, q, lam, &
-               stable, resid, hre, him, iinfo, status, msg, solver)
+               stable, resid, hre, him, iinfo, status, msg, solver, lre, lim)
 end subroutine core_frf
 
 subroutine core_reactions(nb, nc, ctab, np, rpar, nq, neq, nt, q, t, lam, reac, rloc, status, &

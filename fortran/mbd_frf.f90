@@ -13,7 +13,10 @@
 !!   (K_r - Omega^2 M_r + i Omega C_r) z = N^T (r - (K - Omega^2 M + i Omega C) s_n),
 !! K_r = N^T K N, M_r = N^T M N, C_r = N^T C N; Omega = 0 gives the statics sensitivity dq*/dp.
 !! Each frequency solves the real form [A, -B; B, A] [z_re; z_im] = [b_re; b_im],
-!! A = K_r - Omega^2 M_r, B = Omega C_r (one dgetrf for every parameter).
+!! A = K_r - Omega^2 M_r, B = Omega C_r (one dgetrf for every parameter). The multipliers'
+!! response, when asked for: J_a^T dlambda = r - (K - Omega^2 M + i Omega C) H, real and
+!! imaginary parts by the least squares of the projection's factors (as the statics
+!! sensitivities; K H from K s_n + (K N) z).
 !! Memory: N, K N, C N, M N (nq x nfree), four nq x np arrays, three nfree x nfree and one
 !! 2 nfree x 2 nfree matrix, checked and allocated once per call (MBD_NO_MEMORY otherwise).
 module mbd_frf
@@ -39,7 +42,7 @@ contains
   !! (nq, np, nomega), core units. MBD_SINGULAR when K_r - Omega^2 M_r + i Omega C_r is
   !! singular (an undamped natural frequency, or 0 with a motion without stiffness); ibad
   !! is then that frequency's index.
-  subroutine frf_solve(m, w, s, q, t, lam, omega, hre, him, ibad, status, msg)
+  subroutine frf_solve(m, w, s, q, t, lam, omega, hre, him, ibad, status, msg, lre, lim)
     type(model_t), intent(in) :: m              !! model with dynamics data
     type(dyn_work_t), intent(inout) :: w        !! work arrays (dyn_init done)
     type(sens_t), intent(inout) :: s            !! the parameters (sens_setup done)
@@ -50,6 +53,8 @@ contains
     integer, intent(out) :: ibad                !! the singular frequency (0: none)
     integer, intent(out) :: status              !! MBD_OK, MBD_SINGULAR, MBD_NO_MEMORY, ...
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    !> (neq, np, nomega) the multipliers' response dlambda (core units; redundant rows 0)
+    real(wp), intent(out), optional :: lre(:, :, :), lim(:, :, :)
     ! N, K N, C N, M N; s_n, K s_n, C s_n, M s_n and r per parameter; K_r, C_r, M_r, the real
     ! form of the reduced matrix, its right-hand sides; work vectors
     real(wp), allocatable :: nb(:, :), kn(:, :), cn(:, :), mn(:, :), sn(:, :), ks(:, :), &
@@ -61,6 +66,8 @@ contains
     character(len=MSG_LEN) :: what
     status = MBD_OK; msg = ''; ibad = 0
     hre = zero; him = zero
+    if (present(lre)) lre = zero
+    if (present(lim)) lim = zero
     n = m%nq; na = w%na; f = n - na; np = s%np
     if (np == 0 .or. size(omega) == 0) return
     bytes = REAL_BYTES * (4 * real(n, wp) * max(f, 1) + 5 * real(n, wp) * np &
@@ -119,27 +126,69 @@ contains
       do k = 1, np
         hre(:, k, j) = sn(:, k)
       end do
-      if (f == 0) cycle                           ! every motion driven: dq = s_n
-      a(1:f, 1:f) = kr - om**2 * mr; a(f + 1:, f + 1:) = a(1:f, 1:f)
-      a(f + 1:, 1:f) = om * cr; a(1:f, f + 1:) = -om * cr
-      ! b = N^T (r - (K - Omega^2 M) s_n) - i Omega N^T C s_n
-      b(1:f, :) = matmul(transpose(nb(:, 1:f)), rr - ks + om**2 * ms)
-      b(f + 1:, :) = -om * matmul(transpose(nb(:, 1:f)), cs)
-      call dgetrf(2 * f, 2 * f, a, 2 * f, ipiv, info)
-      if (info > 0) then
-        ibad = j; status = MBD_SINGULAR
-        msg = 'frequency response: K_r - Omega^2 M_r + i Omega C_r is singular (an ' // &
-              'undamped natural frequency, or 0 Hz with a motion without stiffness)'
-        return
-      else if (info /= 0) then
-        status = MBD_LAPACK; write (msg, '(a,i0)') 'frequency response: dgetrf info ', info
-        return
+      if (f > 0) then                             ! (every motion driven: dq = s_n)
+        a(1:f, 1:f) = kr - om**2 * mr; a(f + 1:, f + 1:) = a(1:f, 1:f)
+        a(f + 1:, 1:f) = om * cr; a(1:f, f + 1:) = -om * cr
+        ! b = N^T (r - (K - Omega^2 M) s_n) - i Omega N^T C s_n
+        b(1:f, :) = matmul(transpose(nb(:, 1:f)), rr - ks + om**2 * ms)
+        b(f + 1:, :) = -om * matmul(transpose(nb(:, 1:f)), cs)
+        call dgetrf(2 * f, 2 * f, a, 2 * f, ipiv, info)
+        if (info > 0) then
+          ibad = j; status = MBD_SINGULAR
+          msg = 'frequency response: K_r - Omega^2 M_r + i Omega C_r is singular (an ' // &
+                'undamped natural frequency, or 0 Hz with a motion without stiffness)'
+          return
+        else if (info /= 0) then
+          status = MBD_LAPACK; write (msg, '(a,i0)') 'frequency response: dgetrf info ', info
+          return
+        end if
+        call dgetrs('N', 2 * f, np, a, 2 * f, ipiv, b, 2 * f, info)
+        hre(:, :, j) = hre(:, :, j) + matmul(nb(:, 1:f), b(1:f, :))
+        him(:, :, j) = matmul(nb(:, 1:f), b(f + 1:, :))
       end if
-      call dgetrs('N', 2 * f, np, a, 2 * f, ipiv, b, 2 * f, info)
-      hre(:, :, j) = hre(:, :, j) + matmul(nb(:, 1:f), b(1:f, :))
-      him(:, :, j) = matmul(nb(:, 1:f), b(f + 1:, :))
+      if (present(lre) .and. present(lim)) then
+        call multipliers(j, om, status)
+        if (status /= MBD_OK) then
+          msg = 'frequency response: the multipliers'' least squares failed'; return
+        end if
+      end if
     end do
   contains
+    !> lre, lim at frequency j: J_a^T dlambda = r - (K - om^2 M) H_re + om C H_im (real part)
+    !! and -(K - om^2 M) H_im - om C H_re (imaginary), H = s_n + N z (z in b).
+    subroutine multipliers(j, om, st)
+      integer, intent(in) :: j
+      real(wp), intent(in) :: om
+      integer, intent(out) :: st
+      integer :: kk, part
+      st = MBD_OK
+      do kk = 1, np
+        do part = 1, 2
+          if (part == 1) then                     ! b_re = r - (K - om^2 M) H_re + om C H_im
+            w%rhs(1:n) = rr(:, kk) - ks(:, kk) + om**2 * ms(:, kk)
+            if (f > 0) w%rhs(1:n) = w%rhs(1:n) - matmul(kn(:, 1:f) - om**2 * mn(:, 1:f), &
+                                                        b(1:f, kk)) + om * matmul(cn(:, 1:f), &
+                                                        b(f + 1:, kk))
+          else                                    ! b_im = -(K - om^2 M) H_im - om C H_re
+            w%rhs(1:n) = -om * cs(:, kk)
+            if (f > 0) w%rhs(1:n) = w%rhs(1:n) - matmul(kn(:, 1:f) - om**2 * mn(:, 1:f), &
+                                                        b(f + 1:, kk)) - om * matmul(cn(:, 1:f), &
+                                                        b(1:f, kk))
+          end if
+          w%rhs(n + 1:) = zero
+          call dyn_solve(w, w%rhs, st)
+          if (st /= MBD_OK) return
+          do i = 1, na
+            if (part == 1) then
+              lre(w%rows(i), kk, j) = w%s * w%rhs(n + i)
+            else
+              lim(w%rows(i), kk, j) = w%s * w%rhs(n + i)
+            end if
+          end do
+        end do
+      end do
+    end subroutine multipliers
+
     !> kx = K x = K_lambda x - Q_q x (exact).
     subroutine kmul(xx, kx)
       real(wp), intent(in) :: xx(:)

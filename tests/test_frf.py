@@ -199,6 +199,31 @@ def test_a_sprung_four_bar_driven_at_its_crank() -> None:
     np.testing.assert_allclose(res.response_of("rocker", "theta"), ratio * want, rtol=1e-8)
 
 
+def test_the_pivot_force_of_a_pendulum() -> None:
+    """The force the pivot puts on the hanging bar is m times its centre's acceleration (to
+    first order, horizontal): -m a w^2 H per unit torque, H = 1 / (m g a - I_O w^2 + i c w);
+    per unit shake of the pivot -m w^2 (1 + a dphi/dX), the pivot's own move counted once."""
+    m, L, c = 1.3, 0.8, 0.4
+    a = L / 2
+    model = shaken_pendulum()
+    model.add_torque("bar", 0.0, name="drive")
+    inputs = ["force.drive.f.poly.0", "joint.pivot.points.0.0"]
+    res = model.frequency_response(inputs, FREQS)
+    w = 2 * np.pi * FREQS
+    h = 1 / (m * G * a - (m * L**2 / 12 + m * a**2) * w**2 + 1j * c * w)
+    torque = res.reaction_response("pivot", inputs[0])
+    assert torque.bodies == ("ground", "bar")
+    np.testing.assert_allclose(torque.fx_j, -m * a * w**2 * h, rtol=1e-12, atol=1e-14)
+    np.testing.assert_allclose(torque.fy_j, 0.0, atol=1e-13)
+    np.testing.assert_array_equal(torque.fx, 0.0)                 # (ground carries none)
+    shake = res.reaction_response("pivot", inputs[1])
+    want = -m * w**2 * (1 + a * m * a * w**2 * h)
+    np.testing.assert_allclose(shake.fx_j, want, rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(shake.fy_j, 0.0, atol=1e-11 * abs(want).max())
+    with pytest.raises(KeyError, match="no joint or driver 'hinge'"):
+        res.reaction_response("hinge", inputs[0])
+
+
 def test_tables_summary_and_picture(tmp_path: Path) -> None:
     pytest.importorskip("matplotlib")
     res = block().frequency_response(["force.s.f.poly.0", "model.gravity.1"], FREQS)

@@ -133,7 +133,8 @@ def _fake(model: mbd2d.Model, fn: str, status: int, nout: int = 3, finite: bool 
                     np.zeros((nq, 2 * k)), i10, status, msg)
         if fn == "core_frf":
             h = np.zeros((nq, kwargs["ptab"].shape[1], kwargs["omega"].size))
-            return p.q0, np.zeros(neq), 1, 0.0, h, h, i10, status, msg
+            hl = np.zeros((neq, kwargs["ptab"].shape[1], kwargs["omega"].size))
+            return p.q0, np.zeros(neq), 1, 0.0, h, h, hl, hl, i10, status, msg
         if fn == "core_kin_step":
             q = args[3] if finite else np.full(nq, np.inf)
             return q, args[4], args[5], status, msg

@@ -43,7 +43,7 @@ def run_frf(model: ModelDescription, inputs: Any, frequencies: Any, t: float = 0
     if exc is not None:
         raise exc
     h = np.moveaxis(out.hre + 1j * out.him, 2, 0)           # (nw, nq, np)
-    if not np.isfinite(h).all():
+    if not (np.isfinite(h).all() and np.isfinite(out.lre).all() and np.isfinite(out.lim).all()):
         raise error_for("frf", NO_CONVERGENCE, "frequency response: the response is not "
                         "finite (the linearized equations are singular)", t=t,
                         residual=float(out.resid))
@@ -52,6 +52,7 @@ def run_frf(model: ModelDescription, inputs: Any, frequencies: Any, t: float = 0
         t=t, q=out.q, lam=out.lam, stability=stability, residual=float(out.resid),
         frequencies=freq, inputs=[prm.name for prm in params], response=h,
         n_free=int(out.iinfo[0]), body_names=p.body_names,
+        lam_response=np.moveaxis(out.lre + 1j * out.lim, 2, 0), ptab=ptab,
         coordinate_names=p.coordinate_names, model=model, packed=p,
         stats={"solver": "banded" if int(out.iinfo[4]) == 2 else "dense"})
 

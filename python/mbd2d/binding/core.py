@@ -165,15 +165,16 @@ def frf(p: Packed, d: DynamicTables, t: float, equilibrium: bool, ptab: np.ndarr
         omega: np.ndarray, solver: int = 0) -> SimpleNamespace:
     """The frequency response about the equilibrium near q0 (or about the assembled q0) to
     the parameters of ptab at the angular frequencies omega: ``q``, ``lam``, ``stable``,
-    ``resid``, ``hre``, ``him`` (nq, np, nw), ``iinfo`` (iinfo[0]: the free motions,
+    ``resid``, ``hre``, ``him`` (nq, np, nw), ``lre``, ``lim`` (neq, np, nw: the multipliers'
+    response), ``iinfo`` (iinfo[0]: the free motions,
     iinfo[7]: a frequency at which the response is unbounded, 1-based), ``status``,
     ``msg``."""
     nw = int(np.size(omega))
-    return _named("q lam stable resid hre him iinfo status msg", _core.core_frf,
+    return _named("q lam stable resid hre him lre lim iinfo status msg", _core.core_frf,
                   ctab=p.ctab, rpar=p.rpar, bmass=d.bmass, grav=d.grav, ftab=d.ftab,
                   fpar=d.fpar, neq=p.neq, q0=p.q0, t=t, equilibrium=int(equilibrium),
                   ptab=ptab, omega=np.asarray(omega, dtype=float), solver=solver,
-                  numbers=2.0 * p.nq * ptab.shape[1] * nw + p.nq + p.neq)
+                  numbers=2.0 * (p.nq + p.neq) * ptab.shape[1] * nw + p.nq + p.neq)
 
 
 def cam_forces(p: Packed, q: np.ndarray, t: np.ndarray, lam: np.ndarray) -> SimpleNamespace:

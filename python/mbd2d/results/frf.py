@@ -9,6 +9,8 @@ import numpy as np
 from .. import plots
 from ..errors import ModelError
 from .files import write_csv
+from .reactions import Reaction
+from .sensitivities import reaction_dp_arrays, reaction_dp_of
 
 COORDINATES = ("x", "y", "theta")
 
@@ -22,7 +24,9 @@ class FrequencyResponseResult:
     move as Re(H P e^(i 2 pi f t)), so ``abs(H)`` is the amplitude per unit amplitude of the
     input and ``np.angle(H)`` the phase (at f = 0, H is the statics sensitivity dq*/dp).
     ``frequencies`` in Hz, ``inputs`` the parameters' names; ``q``, ``lam``, ``stability``
-    and ``residual`` are the equilibrium's, as :class:`StaticsResult`.
+    and ``residual`` are the equilibrium's, as :class:`StaticsResult`; ``lam_response``
+    (n_frequencies, n_rows, n_inputs, complex) the multipliers' response, from which
+    :meth:`reaction_response` gives the joints' dynamic loads.
     """
 
     t: float
@@ -36,6 +40,8 @@ class FrequencyResponseResult:
     n_free: int
     body_names: list[str]
     coordinate_names: list[str]
+    lam_response: Any = None
+    ptab: Any = None
     model: Any = None
     packed: Any = None
     stats: dict = field(default_factory=dict)
@@ -63,6 +69,27 @@ class FrequencyResponseResult:
                              "frequency response")
         i = 3 * self.body_names.index(body) + COORDINATES.index(coordinate)
         return self.response[:, i, self._input(input)].copy()
+
+    def reaction_response(self, name: str, input: str | None = None) -> Reaction:
+        """The response of a joint's or driver's reaction to one input: a
+        :class:`Reaction` whose arrays are complex amplitudes over the frequencies (the
+        force on each body per unit amplitude of the input; ``abs`` the amplitude, e.g. the
+        force transmitted to the ground, ``np.angle`` the phase). From the response of the
+        coordinates and multipliers through the reactions' design derivatives (the input's
+        own change of the joint, a moved pivot, counts once, in phase)."""
+        j = self._input(input)
+        nw = self.frequencies.size
+        q, lam = np.tile(self.q, (nw, 1)), np.tile(self.lam, (nw, 1))
+        t, ptab = np.full(nw, self.t), self.ptab[:, j:j + 1]
+        hq, hl = self.response[:, :, j:j + 1], self.lam_response[:, :, j:j + 1]
+        parts = [reaction_dp_arrays(self.packed, ptab, q, t, lam, hq.real, hl.real),
+                 reaction_dp_arrays(self.packed, ptab, q, t, lam, hq.imag, hl.imag),
+                 reaction_dp_arrays(self.packed, ptab, q[:1], t[:1], lam[:1],
+                                    np.zeros_like(hq[:1].real), np.zeros_like(hl[:1].real))]
+        (g_re, l_re), (g_im, l_im), (g_p, l_p) = parts     # g_p: the input's own term
+        g = g_re + 1j * (g_im - g_p)
+        loc = l_re + 1j * (l_im - l_p)
+        return reaction_dp_of(self.packed, self.model, name, g[..., 0], loc[..., 0])
 
     def peak(self, body: str, coordinate: str = "y", input: str | None = None
              ) -> tuple[float, float]:
