@@ -13,18 +13,23 @@
 !!   (K_r - Omega^2 M_r + i Omega C_r) z = N^T (r - (K - Omega^2 M + i Omega C) s_n),
 !! K_r = N^T K N, M_r = N^T M N, C_r = N^T C N; Omega = 0 gives the statics sensitivity dq*/dp.
 !! Each frequency solves the real form [A, -B; B, A] [z_re; z_im] = [b_re; b_im],
-!! A = K_r - Omega^2 M_r, B = Omega C_r (one dgetrf for every parameter). The multipliers'
+!! A = K_r - Omega^2 M_r, B = Omega C_r (one dgetrf for every parameter). With many free
+!! motions and frequencies (Laub 1981) the first-order form x' = F x + [0; M_r^-1 g],
+!! F = [0, I; -M_r^-1 K_r, -M_r^-1 C_r], is reduced once to Hessenberg form F = Q T Q^T
+!! (dgehrd, dorghr); each frequency then solves (i Omega I - T) y = Q^T [0; M_r^-1 g] in
+!! O(nfree^2) (a Hessenberg LU, pivoting between neighbouring rows) and z = [I 0] Q y, with
+!! g = g0 + Omega^2 g2 + i Omega g1 from the parameters' fixed parts. The multipliers'
 !! response, when asked for: J_a^T dlambda = r - (K - Omega^2 M + i Omega C) H, real and
 !! imaginary parts by the least squares of the projection's factors (as the statics
 !! sensitivities; K H from K s_n + (K N) z).
 !! Memory: N, K N, C N, M N (nq x nfree), four nq x np arrays, three nfree x nfree and one
 !! 2 nfree x 2 nfree matrix, checked and allocated once per call (MBD_NO_MEMORY otherwise).
 module mbd_frf
-  use mbd_kinds, only: wp, zero
+  use mbd_kinds, only: wp, zero, one
   use mbd_status, only: MBD_OK, MBD_SINGULAR, MBD_LAPACK, MSG_LEN
   use mbd_memory, only: REAL_BYTES, mem_check, mem_fail
   use mbd_model, only: model_t
-  use mbd_lapack, only: dgetrf, dgetrs
+  use mbd_lapack, only: dgetrf, dgetrs, dgehrd, dorghr
   use mbd_sensitivity, only: sens_t, sens_trig, sens_hessian, sens_params, sens_klam, &
                              sens_klam_list, sens_force_d
   use mbd_sens_dynamics, only: statics_load
@@ -35,6 +40,12 @@ module mbd_frf
 
   character(len=*), parameter :: HINT = 'the frequency response uses dense matrices of the ' &
     // 'number of free motions: use a model with fewer free motions'
+  !> the Hessenberg form from this many free motions and frequencies on (below, a dense LU
+  !! per frequency costs less than the reduction)
+  integer, parameter :: HESS_MIN_FREE = 16, HESS_MIN_FREQ = 8
+  character(len=*), parameter :: SINGULAR_MSG = 'frequency response: K_r - Omega^2 M_r + ' // &
+    'i Omega C_r is singular (an undamped natural frequency, or 0 Hz with a motion without ' // &
+    'stiffness)'
 
 contains
 
@@ -60,9 +71,13 @@ contains
     real(wp), allocatable :: nb(:, :), kn(:, :), cn(:, :), mn(:, :), sn(:, :), ks(:, :), &
                              cs(:, :), ms(:, :), rr(:, :), kr(:, :), cr(:, :), mr(:, :), &
                              a(:, :), b(:, :), x(:), y(:), z(:)
+    ! the Hessenberg path: Q, T, the right-hand sides' parts Q^T [0; M_r^-1 g_k], work
+    real(wp), allocatable :: qh(:, :), th(:, :), c0(:, :), c1(:, :), c2(:, :), work(:)
+    complex(wp), allocatable :: tc(:, :), yc(:, :)
     integer, allocatable :: ipiv(:)
     real(wp) :: bytes, om
     integer :: n, f, np, na, i, j, k, ist, info
+    logical :: hess
     character(len=MSG_LEN) :: what
     status = MBD_OK; msg = ''; ibad = 0
     hre = zero; him = zero
@@ -72,6 +87,9 @@ contains
     if (np == 0 .or. size(omega) == 0) return
     bytes = REAL_BYTES * (4 * real(n, wp) * max(f, 1) + 5 * real(n, wp) * np &
                           + 7 * real(max(f, 1), wp)**2 + 2 * real(max(f, 1), wp) * np + 3 * n)
+    hess = f >= HESS_MIN_FREE .and. size(omega) >= HESS_MIN_FREQ
+    if (hess) bytes = bytes + REAL_BYTES * (16 * real(f, wp)**2 + 10 * real(f, wp) * np &
+                                            + 66 * real(f, wp))
     write (what, '(a,i0,a)') 'the frequency response''s work arrays (', f, ' free motions)'
     call mem_check(bytes, trim(what), HINT, status, msg)
     if (status /= MBD_OK) return
@@ -121,12 +139,21 @@ contains
       call cmul(sn(:, k), cs(:, k))
       ms(:, k) = m%mdiag * sn(:, k)
     end do
+    if (hess) call hess_setup(hess, status)       ! (hess false: M_r singular, the dense LU)
+    if (status /= MBD_OK) return
     do j = 1, size(omega)
       om = omega(j)
       do k = 1, np
         hre(:, k, j) = sn(:, k)
       end do
-      if (f > 0) then                             ! (every motion driven: dq = s_n)
+      if (hess) then
+        call hess_solve(om, info)
+        if (info /= 0) then
+          ibad = j; status = MBD_SINGULAR; msg = SINGULAR_MSG; return
+        end if
+        hre(:, :, j) = hre(:, :, j) + matmul(nb(:, 1:f), b(1:f, :))
+        him(:, :, j) = matmul(nb(:, 1:f), b(f + 1:, :))
+      else if (f > 0) then                        ! (every motion driven: dq = s_n)
         a(1:f, 1:f) = kr - om**2 * mr; a(f + 1:, f + 1:) = a(1:f, 1:f)
         a(f + 1:, 1:f) = om * cr; a(1:f, f + 1:) = -om * cr
         ! b = N^T (r - (K - Omega^2 M) s_n) - i Omega N^T C s_n
@@ -134,10 +161,7 @@ contains
         b(f + 1:, :) = -om * matmul(transpose(nb(:, 1:f)), cs)
         call dgetrf(2 * f, 2 * f, a, 2 * f, ipiv, info)
         if (info > 0) then
-          ibad = j; status = MBD_SINGULAR
-          msg = 'frequency response: K_r - Omega^2 M_r + i Omega C_r is singular (an ' // &
-                'undamped natural frequency, or 0 Hz with a motion without stiffness)'
-          return
+          ibad = j; status = MBD_SINGULAR; msg = SINGULAR_MSG; return
         else if (info /= 0) then
           status = MBD_LAPACK; write (msg, '(a,i0)') 'frequency response: dgetrf info ', info
           return
@@ -154,6 +178,104 @@ contains
       end if
     end do
   contains
+    !> The Hessenberg path's setup: F = [0, I; -M_r^-1 K_r, -M_r^-1 C_r] = Q T Q^T and
+    !! c_k = Q^T [0; M_r^-1 g_k] for g0 = N^T (r - K s_n), g1 = -N^T C s_n, g2 = N^T M s_n.
+    !! use false (and MBD_OK) when M_r is singular: the dense path is taken instead.
+    subroutine hess_setup(use, st)
+      logical, intent(out) :: use
+      integer, intent(out) :: st
+      integer :: lw, f2
+      real(wp) :: wq(1)
+      real(wp), allocatable :: tau(:)
+      st = MBD_OK; use = .false.; f2 = 2 * f
+      allocate (qh(f2, f2), th(f2, f2), c0(f2, np), c1(f2, np), c2(f2, np), tc(f2, f2), &
+                yc(f2, np), tau(f2), stat=ist)
+      if (ist /= 0) then
+        call mem_fail(bytes, trim(what), HINT, st, msg); return
+      end if
+      a(1:f, 1:f) = mr                            ! M_r's LU in a's corner
+      call dgetrf(f, f, a, f2, ipiv, info)
+      if (info /= 0) return
+      th = zero
+      do i = 1, f
+        th(i, f + i) = one
+      end do
+      th(f + 1:, 1:f) = kr; th(f + 1:, f + 1:) = cr
+      c0(1:f, :) = matmul(transpose(nb(:, 1:f)), rr - ks)
+      c1(1:f, :) = -matmul(transpose(nb(:, 1:f)), cs)
+      c2(1:f, :) = matmul(transpose(nb(:, 1:f)), ms)
+      call dgetrs('N', f, f, a, f2, ipiv, th(f + 1:, 1:f), f, info)
+      call dgetrs('N', f, f, a, f2, ipiv, th(f + 1:, f + 1:), f, info)
+      call dgetrs('N', f, np, a, f2, ipiv, c0, f2, info)
+      call dgetrs('N', f, np, a, f2, ipiv, c1, f2, info)
+      call dgetrs('N', f, np, a, f2, ipiv, c2, f2, info)
+      th(f + 1:, :) = -th(f + 1:, :)
+      call dgehrd(f2, 1, f2, th, f2, tau, wq, -1, info)
+      lw = max(1, int(wq(1)))
+      call dorghr(f2, 1, f2, th, f2, tau, wq, -1, info)
+      lw = max(lw, int(wq(1)))
+      allocate (work(lw), stat=ist)
+      if (ist /= 0) then
+        call mem_fail(bytes, trim(what), HINT, st, msg); return
+      end if
+      call dgehrd(f2, 1, f2, th, f2, tau, work, lw, info)
+      qh = th
+      call dorghr(f2, 1, f2, qh, f2, tau, work, lw, info)
+      if (info /= 0) then
+        st = MBD_LAPACK; write (msg, '(a,i0)') 'frequency response: dorghr info ', info
+        return
+      end if
+      do i = 1, f2                                ! T: zero below the first subdiagonal
+        th(i + 2:, i) = zero
+      end do
+      ! c_k = Q^T [0; M_r^-1 g_k]: the lower half of Q's rows
+      c0 = matmul(transpose(qh(f + 1:, :)), c0(1:f, :))
+      c1 = matmul(transpose(qh(f + 1:, :)), c1(1:f, :))
+      c2 = matmul(transpose(qh(f + 1:, :)), c2(1:f, :))
+      use = .true.
+    end subroutine hess_setup
+
+    !> b = [Re z; Im z] at om: (i om I - T) y = c0 + om^2 c2 + i om c1 by an LU that pivots
+    !! between neighbouring rows (T is upper Hessenberg), z = Q(1:f, :) y. flag 1: a pivot at
+    !! most 2 nfree eps max|i om I - T| (singular to working precision).
+    subroutine hess_solve(om, flag)
+      real(wp), intent(in) :: om
+      integer, intent(out) :: flag
+      integer :: kk, f2, r
+      complex(wp) :: l, piv(size(yc, 2)), rowt(2 * f)
+      real(wp) :: tiny_piv
+      flag = 0; f2 = 2 * f
+      tc = cmplx(-th, zero, wp)
+      do kk = 1, f2
+        tc(kk, kk) = tc(kk, kk) + cmplx(zero, om, wp)
+      end do
+      ! a pivot at round-off of the matrix: singular (as an exact zero on the dense path)
+      tiny_piv = f2 * epsilon(one) * maxval(abs(tc))
+      yc = cmplx(c0 + om**2 * c2, om * c1, wp)
+      do kk = 1, f2 - 1                           ! eliminate the subdiagonal
+        if (abs(tc(kk + 1, kk)) > abs(tc(kk, kk))) then
+          rowt(kk:) = tc(kk, kk:); tc(kk, kk:) = tc(kk + 1, kk:); tc(kk + 1, kk:) = rowt(kk:)
+          piv = yc(kk, :); yc(kk, :) = yc(kk + 1, :); yc(kk + 1, :) = piv
+        end if
+        if (abs(tc(kk, kk)) <= tiny_piv) then
+          flag = 1; return
+        end if
+        l = tc(kk + 1, kk) / tc(kk, kk)
+        tc(kk + 1, kk + 1:) = tc(kk + 1, kk + 1:) - l * tc(kk, kk + 1:)
+        yc(kk + 1, :) = yc(kk + 1, :) - l * yc(kk, :)
+      end do
+      do kk = f2, 1, -1                           ! back substitution
+        if (abs(tc(kk, kk)) <= tiny_piv) then
+          flag = 1; return
+        end if
+        do r = 1, np
+          yc(kk, r) = (yc(kk, r) - sum(tc(kk, kk + 1:) * yc(kk + 1:, r))) / tc(kk, kk)
+        end do
+      end do
+      b(1:f, :) = matmul(qh(1:f, :), real(yc, wp))
+      b(f + 1:, :) = matmul(qh(1:f, :), aimag(yc))
+    end subroutine hess_solve
+
     !> lre, lim at frequency j: J_a^T dlambda = r - (K - om^2 M) H_re + om C H_im (real part)
     !! and -(K - om^2 M) H_im - om C H_re (imaginary), H = s_n + N z (z in b).
     subroutine multipliers(j, om, st)

@@ -4,7 +4,7 @@ module mbd_lapack
   implicit none
   private
   public :: dgetrf, dgetf2, dgetrs, dtrsv, dgesvd, dgels, dgelsy, dgtsv, dgeqp3, dormqr, dtrtrs, dgecon, &
-            dtrcon, dsyev, dsygv, dgeev
+            dtrcon, dsyev, dsygv, dgeev, dgehrd, dorghr
   public :: dgbtrf, dgbtrs, dgbcon, dlacn2
 
   interface
@@ -145,6 +145,24 @@ module mbd_lapack
     end subroutine dgtsv
   end interface
   interface
+    !> Reduction to upper Hessenberg form A = Q H Q^T (Q as reflectors in a below the
+    !! first subdiagonal and tau).
+    pure subroutine dgehrd(n, ilo, ihi, a, lda, tau, work, lwork, info)
+      import :: wp
+      integer, intent(in) :: n, ilo, ihi, lda, lwork
+      real(wp), intent(inout) :: a(lda, *)
+      real(wp), intent(out) :: tau(*), work(*)
+      integer, intent(out) :: info
+    end subroutine dgehrd
+    !> The orthogonal Q of dgehrd, formed from its reflectors.
+    pure subroutine dorghr(n, ilo, ihi, a, lda, tau, work, lwork, info)
+      import :: wp
+      integer, intent(in) :: n, ilo, ihi, lda, lwork
+      real(wp), intent(inout) :: a(lda, *)
+      real(wp), intent(in) :: tau(*)
+      real(wp), intent(out) :: work(*)
+      integer, intent(out) :: info
+    end subroutine dorghr
     !> Triangular solve A x = b (BLAS level 2), x overwrites b.
     pure subroutine dtrsv(uplo, trans, diag, n, a, lda, x, incx)
       import :: wp

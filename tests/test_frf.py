@@ -146,6 +146,45 @@ def test_a_chain_on_the_band_path() -> None:
                                atol=1e-10 * abs(dense.response).max())
 
 
+def test_many_free_motions_take_the_hessenberg_form() -> None:
+    """Forty blocks damped at the end, twenty frequencies: the response from the Hessenberg
+    form of the first-order system (Laub's method, taken from 16 free motions and 8
+    frequencies on) equals the system solved here by numpy, and the dense LU of each
+    frequency alone (one frequency a call); twenty free blocks (no stiffness) are singular at
+    0 Hz on this path too, and move as -1 / (m w^2) elsewhere."""
+    n, m, k, c = 40, 0.5, 200.0, 5.0
+    model = spring_chain(n, m, k)
+    model.add_spring(["ground", f"b{n}"], [[0.0, 0.0], [0.0, 0.0]], damping=c,
+                     length0=0.1 * n, name="damper")
+    model.add_point_force("b1", [0.0, 0.0], fx=0.0, name="shaker")
+    name = [p for p in model.parameters() if p.startswith("force.shaker.fx")][0]
+    f = np.linspace(0.0, 12.0, 20)
+    res = model.frequency_response(name, f)
+    kk = k * (2 * np.eye(n) - np.eye(n, k=1) - np.eye(n, k=-1))
+    kk[-1, -1] = k
+    cc = np.zeros((n, n))
+    cc[-1, -1] = c
+    for j, fj in enumerate(f):
+        w = 2 * np.pi * fj
+        want = np.linalg.solve(kk - w**2 * m * np.eye(n) + 1j * w * cc, np.eye(n)[0])
+        np.testing.assert_allclose(res.response[j, 0::3, 0], want, rtol=0,
+                                   atol=1e-9 * abs(want).max())
+        alone = model.frequency_response(name, [fj])
+        np.testing.assert_allclose(res.response[j], alone.response[0], rtol=0,
+                                   atol=1e-9 * abs(want).max())
+        np.testing.assert_allclose(res.lam_response[j], alone.lam_response[0], rtol=0,
+                                   atol=1e-9 * abs(alone.lam_response[0]).max())
+    free = spring_chain(20, k=0.0)
+    free.add_point_force("b1", [0.0, 0.0], fx=0.0, name="shaker")
+    with pytest.raises(mbd2d.SingularJacobianError, match="at 0 Hz is unbounded"):
+        free.frequency_response("force.shaker.fx.poly.0", np.arange(10.0))
+    f = np.arange(1.0, 11.0)
+    got = free.frequency_response("force.shaker.fx.poly.0", f)
+    np.testing.assert_allclose(got.response[:, 0, 0], -1 / (0.5 * (2 * np.pi * f)**2),
+                               rtol=1e-9)
+    np.testing.assert_allclose(got.response[:, 3:, 0], 0.0, atol=1e-12)
+
+
 def test_a_pendulum_on_a_torsion_spring_driven_by_a_torque() -> None:
     """dtheta per unit torque 1 / (k - m g a sin th* - I_O w^2 + i c w) at the equilibrium
     k th* + m g a cos th* = 0: the pendulum's stiffness m g a comes from the constraints'
