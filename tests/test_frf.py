@@ -241,7 +241,8 @@ def test_a_sprung_four_bar_driven_at_its_crank() -> None:
 def test_the_pivot_force_of_a_pendulum() -> None:
     """The force the pivot puts on the hanging bar is m times its centre's acceleration (to
     first order, horizontal): -m a w^2 H per unit torque, H = 1 / (m g a - I_O w^2 + i c w);
-    per unit shake of the pivot -m w^2 (1 + a dphi/dX), the pivot's own move counted once."""
+    per unit shake of the pivot -m w^2 (1 + a dphi/dX), the pivot's own move counted once.
+    The bar's far end moves L H across."""
     m, L, c = 1.3, 0.8, 0.4
     a = L / 2
     model = shaken_pendulum()
@@ -261,6 +262,12 @@ def test_the_pivot_force_of_a_pendulum() -> None:
     np.testing.assert_allclose(shake.fy_j, 0.0, atol=1e-11 * abs(want).max())
     with pytest.raises(KeyError, match="no joint or driver 'hinge'"):
         res.reaction_response("hinge", inputs[0])
+    # the bar's far end, L from the pivot: L dphi across, nothing up (first order)
+    tip = res.point_response("bar", [a, 0.0], inputs[0])
+    np.testing.assert_allclose(tip[:, 0], L * h, rtol=1e-12)
+    np.testing.assert_allclose(tip[:, 1], 0.0, atol=1e-14)
+    with pytest.raises(mbd2d.ModelError, match="no body 'arm'"):
+        res.point_response("arm", [a, 0.0], inputs[0])
 
 
 def test_tables_summary_and_picture(tmp_path: Path) -> None:

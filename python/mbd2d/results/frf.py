@@ -8,7 +8,9 @@ import numpy as np
 
 from .. import plots
 from ..errors import ModelError
+from ..validate import vector
 from .files import write_csv
+from .points import PointResult
 from .reactions import Reaction
 from .sensitivities import reaction_dp_arrays, reaction_dp_of
 
@@ -57,18 +59,31 @@ class FrequencyResponseResult:
                              "frequency response")
         return self.inputs.index(name)
 
+    def _body(self, body: str) -> int:
+        if body not in self.body_names:
+            raise ModelError(f"no body {body!r}; bodies: {', '.join(self.body_names)}",
+                             "frequency response")
+        return self.body_names.index(body)
+
     def response_of(self, body: str, coordinate: str = "y", input: str | None = None
                     ) -> np.ndarray:
         """H(f) of one body coordinate ("x", "y" or "theta") to one input (n_frequencies,
         complex; the only input by default)."""
-        if body not in self.body_names:
-            raise ModelError(f"no body {body!r}; bodies: {', '.join(self.body_names)}",
-                             "frequency response")
         if coordinate not in COORDINATES:
             raise ModelError(f"coordinate must be one of x, y, theta, not {coordinate!r}",
                              "frequency response")
-        i = 3 * self.body_names.index(body) + COORDINATES.index(coordinate)
+        i = 3 * self._body(body) + COORDINATES.index(coordinate)
         return self.response[:, i, self._input(input)].copy()
+
+    def point_response(self, body: str, s: Any, input: str | None = None) -> np.ndarray:
+        """The response of a point fixed in a body (its body-frame coordinates s) to one
+        input: (n_frequencies, 2) complex amplitudes of its global x and y, d r_P = d r_i +
+        B(theta) s' d theta (:mod:`mbd2d.results.points`)."""
+        sx, sy = vector(s, 2, "s", "point")
+        j, i = self._input(input), 3 * self._body(body)
+        level = np.tile(self.q[i:i + 3], (self.frequencies.size, 1))
+        return PointResult.derivatives((sx, sy), [level],
+                                       [self.response[:, i:i + 3, j:j + 1]])[0][:, :, 0]
 
     def reaction_response(self, name: str, input: str | None = None) -> Reaction:
         """The response of a joint's or driver's reaction to one input: a
