@@ -1083,14 +1083,8 @@ contains
         status = MBD_BAD_COUNT; msg = 'modes: the damped shapes'' arrays do not match the model'
       end if
     end if
-    if (status == MBD_OK) then
-      if (equilibrium /= 0) then
-        call statics_solve(m, w, q, t, lam, stable, resid, status, msg)
-      else
-        stable = -2                             ! not examined
-        call dyn_multipliers(m, w, q, w%qz, w%qz, t, lam, status, msg)
-      end if
-    end if
+    if (status == MBD_OK) call linear_point(m, w, q, t, equilibrium, lam, stable, resid, &
+                                            status, msg)
     if (status == MBD_OK) then
       if (cshapes) then
         call modes_solve(m, w, q, t, lam, kmax, nfree, omega2, kinds, sre, sim, &
@@ -1160,14 +1154,8 @@ contains
       call sens_setup(m, ctab, rpar, ptab, sens, status, msg, bad, ftab, fpar)
       if (status /= MBD_OK) iinfo(2) = -2000000 - bad
     end if
-    if (status == MBD_OK) then
-      if (equilibrium /= 0) then
-        call statics_solve(m, w, q, t, lam, stable, resid, status, msg)
-      else
-        stable = -2                             ! not examined
-        call dyn_multipliers(m, w, q, w%qz, w%qz, t, lam, status, msg)
-      end if
-    end if
+    if (status == MBD_OK) call linear_point(m, w, q, t, equilibrium, lam, stable, resid, &
+                                            status, msg)
     if (status == MBD_OK) then
       if (mult) then
         call frf_solve(m, w, sens, q, t, lam, omega, hre, him, ibad, status, msg, lre, lim)
@@ -1188,6 +1176,28 @@ contains
       end if
     end if
   end subroutine api_frf
+
+  !> The point modes and the frequency response linearize about: the equilibrium near q
+  !! (equilibrium /= 0, statics), or q itself with its least-squares multipliers (stable -2:
+  !! not examined).
+  subroutine linear_point(m, w, q, t, equilibrium, lam, stable, resid, status, msg)
+    type(model_t), intent(in) :: m              !! model with dynamics data
+    type(dyn_work_t), intent(inout) :: w        !! work arrays (dyn_init done)
+    real(wp), intent(inout) :: q(:)             !! q0 assembled, then the point (core units)
+    real(wp), intent(in) :: t                   !! time
+    integer, intent(in) :: equilibrium          !! 1: seek the equilibrium; 0: q as given
+    real(wp), intent(out) :: lam(:), resid      !! multipliers, statics' residual
+    integer, intent(out) :: stable              !! as api_statics; -2 not examined
+    integer, intent(out) :: status              !! MBD_OK or the solvers' status
+    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    resid = zero
+    if (equilibrium /= 0) then
+      call statics_solve(m, w, q, t, lam, stable, resid, status, msg)
+    else
+      stable = -2
+      call dyn_multipliers(m, w, q, w%qz, w%qz, t, lam, status, msg)
+    end if
+  end subroutine linear_point
 
   !> An optional solver argument: 0 (auto) when absent.
   pure integer function solver_or_auto(solver)

@@ -30,10 +30,10 @@ module mbd_frf
   use mbd_memory, only: REAL_BYTES, mem_check, mem_fail
   use mbd_model, only: model_t
   use mbd_lapack, only: dgetrf, dgetrs, dgehrd, dorghr
-  use mbd_sensitivity, only: sens_t, sens_trig, sens_hessian, sens_params, sens_klam, &
-                             sens_klam_list, sens_force_d
-  use mbd_sens_dynamics, only: statics_load
-  use mbd_dynamics, only: dyn_work_t, dyn_null_basis, dyn_factor_projection, dyn_solve
+  use mbd_sensitivity, only: sens_t, sens_force_d
+  use mbd_sens_dynamics, only: statics_load, sens_stiffness_mul, sens_at_rest, &
+                               proj_particular, proj_multipliers
+  use mbd_dynamics, only: dyn_work_t, dyn_null_basis, dyn_factor_projection
   implicit none
   private
   public :: frf_solve
@@ -101,10 +101,7 @@ contains
       call mem_fail(bytes, trim(what), HINT, status, msg); return
     end if
     z = zero
-    call sens_trig(m, s, q)
-    call sens_hessian(m, s, q, z, z, t)
-    call sens_params(m, s, q, z, z, t)
-    call sens_klam_list(m, s, lam)
+    call sens_at_rest(m, s, q, t, lam, z)
     if (f > 0) then                               ! N, K N, C N, M N
       call dyn_null_basis(m, w, q, t, nb, status)
       if (status /= MBD_OK) then
@@ -126,15 +123,10 @@ contains
     end if
     do k = 1, np                                  ! r, s_n (J_a s_n = -Phi_p,a) and its products
       call statics_load(m, s, k, q, t, lam, z, y, rr(:, k))
-      w%rhs(1:n) = zero
-      do i = 1, na
-        w%rhs(n + i) = w%s * s%mphip(k, w%rows(i))
-      end do
-      call dyn_solve(w, w%rhs, status)
+      call proj_particular(w, s, k, sn(:, k), status)
       if (status /= MBD_OK) then
         msg = 'frequency response: a saddle-point solve failed'; return
       end if
-      sn(:, k) = w%rhs(1:n)
       call kmul(sn(:, k), ks(:, k))
       call cmul(sn(:, k), cs(:, k))
       ms(:, k) = m%mdiag * sn(:, k)
@@ -282,42 +274,25 @@ contains
       integer, intent(in) :: j
       real(wp), intent(in) :: om
       integer, intent(out) :: st
-      integer :: kk, part
-      st = MBD_OK
-      do kk = 1, np
-        do part = 1, 2
-          if (part == 1) then                     ! b_re = r - (K - om^2 M) H_re + om C H_im
-            w%rhs(1:n) = rr(:, kk) - ks(:, kk) + om**2 * ms(:, kk)
-            if (f > 0) w%rhs(1:n) = w%rhs(1:n) - matmul(kn(:, 1:f) - om**2 * mn(:, 1:f), &
-                                                        b(1:f, kk)) + om * matmul(cn(:, 1:f), &
-                                                        b(f + 1:, kk))
-          else                                    ! b_im = -(K - om^2 M) H_im - om C H_re
-            w%rhs(1:n) = -om * cs(:, kk)
-            if (f > 0) w%rhs(1:n) = w%rhs(1:n) - matmul(kn(:, 1:f) - om**2 * mn(:, 1:f), &
-                                                        b(f + 1:, kk)) - om * matmul(cn(:, 1:f), &
-                                                        b(1:f, kk))
-          end if
-          w%rhs(n + 1:) = zero
-          call dyn_solve(w, w%rhs, st)
-          if (st /= MBD_OK) return
-          do i = 1, na
-            if (part == 1) then
-              lre(w%rows(i), kk, j) = w%s * w%rhs(n + i)
-            else
-              lim(w%rows(i), kk, j) = w%s * w%rhs(n + i)
-            end if
-          end do
-        end do
+      integer :: kk
+      do kk = 1, np                               ! b_re = r - (K - om^2 M) H_re + om C H_im
+        y = rr(:, kk) - ks(:, kk) + om**2 * ms(:, kk)
+        if (f > 0) y = y - matmul(kn(:, 1:f) - om**2 * mn(:, 1:f), b(1:f, kk)) &
+                       + om * matmul(cn(:, 1:f), b(f + 1:, kk))
+        call proj_multipliers(w, y, lre(:, kk, j), st)
+        if (st /= MBD_OK) return
+        y = -om * cs(:, kk)                       ! b_im = -(K - om^2 M) H_im - om C H_re
+        if (f > 0) y = y - matmul(kn(:, 1:f) - om**2 * mn(:, 1:f), b(f + 1:, kk)) &
+                       - om * matmul(cn(:, 1:f), b(1:f, kk))
+        call proj_multipliers(w, y, lim(:, kk, j), st)
+        if (st /= MBD_OK) return
       end do
     end subroutine multipliers
 
-    !> kx = K x = K_lambda x - Q_q x (exact).
     subroutine kmul(xx, kx)
       real(wp), intent(in) :: xx(:)
       real(wp), intent(out) :: kx(:)
-      call sens_klam(s, xx, kx)
-      call sens_force_d(m, s, 0, q, z, xx, z, t, x)
-      kx = kx - x
+      call sens_stiffness_mul(m, s, q, t, z, xx, kx, x)
     end subroutine kmul
 
     !> cx = C x = -Q_q_dot x (exact).

@@ -186,7 +186,7 @@ contains
       real(wp), intent(out) :: pre(:), pim(:)
       if (plain) then
         pre = matmul(nb, ks(:, (j + 1) / 2)); pim = zero
-      else if (wi(j) == zero) then
+      else if (abs(wi(j)) <= zero) then                ! (a real s)
         pre = matmul(nb, vr(1:f, j)); pim = zero
       else if (wi(j) > zero) then
         pre = matmul(nb, vr(1:f, j)); pim = matmul(nb, vr(1:f, j + 1))
@@ -249,7 +249,7 @@ contains
       end do
       a = re(i, k); b = im(i, k)
       d = a * a + b * b
-      if (d == zero) cycle
+      if (d <= zero) cycle
       do j = 1, size(re, 1)                     ! (x + iy) / (a + ib) = (x + iy)(a - ib) / d
         r = (re(j, k) * a + im(j, k) * b) / d + zero       ! (+ zero: no -0.0)
         im(j, k) = (im(j, k) * a - re(j, k) * b) / d + zero

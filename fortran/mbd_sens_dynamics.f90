@@ -50,7 +50,7 @@ module mbd_sens_dynamics
   public :: sens_multipliers, sens_reactions, sens_statics, sens_statics_band, sens_dopri5, &
             sens_initial
   ! (the frequency response, mbd_frf: the equilibrium's load along a parameter)
-  public :: statics_load
+  public :: statics_load, sens_stiffness_mul, sens_at_rest, proj_particular, proj_multipliers
   ! (generalized-alpha's sensitivities, mbd_sens_genalpha: the same right-hand sides)
   public :: proj_work_t, proj_init, sens_accel, sens_dyn_rows, cols_to_rows, rows_to_cols
   ! (the multipliers' sensitivities at the outputs of forward dynamics)
@@ -306,12 +306,9 @@ contains
     call asm_init(m, a, status, msg)
     if (status /= MBD_OK) return
     call assemble_dense(m, q, z, t, phi, nu, gam, a, jac)
-    call sens_trig(m, s, q)
-    call sens_hessian(m, s, q, z, z, t)
-    call sens_params(m, s, q, z, z, t)
+    call sens_at_rest(m, s, q, t, lam, z)
     ! K = K_lam - Q_q, column by column
     call sens_force_jac(m, q, z, t, kq)
-    call sens_klam_list(m, s, lam)
     do i = 1, n
       e = zero; e(i) = one
       call sens_klam(s, e, y)
@@ -381,10 +378,7 @@ contains
       status = MBD_NO_MEMORY; msg = 'out of memory for the statics sensitivities'; return
     end if
     z = zero
-    call sens_trig(m, s, q)
-    call sens_hessian(m, s, q, z, z, t)
-    call sens_params(m, s, q, z, z, t)
-    call sens_klam_list(m, s, lam)
+    call sens_at_rest(m, s, q, t, lam, z)
     if (ni > 0) then                            ! H = N^T K N on the free motions
       call dyn_null_basis(m, w, q, t, nb, status)
       if (status /= MBD_OK) then
@@ -406,13 +400,8 @@ contains
     do k = 1, s%np
       ! r = Q_p - J_p^T lambda; s_n: J_a s_n = -Phi_p,a (minimum norm)
       call statics_load(m, s, k, q, t, lam, z, y, r)
-      w%rhs(1:n) = zero
-      do i = 1, na
-        w%rhs(n + i) = w%s * s%mphip(k, w%rows(i))
-      end do
-      call dyn_solve(w, w%rhs, status)
+      call proj_particular(w, s, k, sq(:, k), status)
       if (status /= MBD_OK) exit
-      sq(:, k) = w%rhs(1:n)
       if (ni > 0) then                          ! + N z, (N^T K N) z = N^T (r - K s_n)
         call kmul(sq(:, k), y)
         zz = matmul(r - y, nb(:, 1:ni))
@@ -422,24 +411,77 @@ contains
       end if
       ! J_a^T dlambda = r - K s: the projection's least squares (x = 0 at the solution)
       call kmul(sq(:, k), y)
-      w%rhs(1:n) = r - y; w%rhs(n + 1:) = zero
-      call dyn_solve(w, w%rhs, status)
+      call proj_multipliers(w, r - y, slam(:, k), status)
       if (status /= MBD_OK) exit
-      do i = 1, na
-        slam(w%rows(i), k) = w%s * w%rhs(n + i)
-      end do
     end do
     if (status /= MBD_OK) msg = 'statics sensitivities: a band saddle-point solve failed'
   contains
-    !> kx = K x = K_lambda x - Q_q x (exact).
     subroutine kmul(xx, kx)
       real(wp), intent(in) :: xx(:)
       real(wp), intent(out) :: kx(:)
-      call sens_klam(s, xx, kx)
-      call sens_force_d(m, s, 0, q, z, xx, z, t, x)
-      kx = kx - x
+      call sens_stiffness_mul(m, s, q, t, z, xx, kx, x)
     end subroutine kmul
   end subroutine sens_statics_band
+
+  !> x: the minimum-norm solution of J_a x = -Phi_p,a for parameter k, by the factors of
+  !! the projection [I J_a^T; J_a 0] (dyn_factor_projection with the unit metric done).
+  subroutine proj_particular(w, s, k, x, status)
+    type(dyn_work_t), intent(inout) :: w        !! work arrays with the projection's factors
+    type(sens_t), intent(in) :: s               !! parameters (-Phi_p in mphip)
+    integer, intent(in) :: k                    !! parameter
+    real(wp), intent(out) :: x(:)               !! (nq) the solution
+    integer, intent(out) :: status              !! MBD_OK or the solve's status
+    integer :: i, n
+    n = size(x)
+    w%rhs(1:n) = zero
+    do i = 1, w%na
+      w%rhs(n + i) = w%s * s%mphip(k, w%rows(i))
+    end do
+    call dyn_solve(w, w%rhs, status)
+    x = w%rhs(1:n)
+  end subroutine proj_particular
+
+  !> mu on the active rows (zero elsewhere untouched): the least squares of J_a^T mu = b by
+  !! the projection's factors (the remainder b - J_a^T mu is the part of b in J_a's null
+  !! space, zero when b lies in J_a^T's range).
+  subroutine proj_multipliers(w, b, mu, status)
+    type(dyn_work_t), intent(inout) :: w        !! work arrays with the projection's factors
+    real(wp), intent(in) :: b(:)                !! (nq) the right-hand side
+    real(wp), intent(inout) :: mu(:)            !! (neq) the multipliers (active rows set)
+    integer, intent(out) :: status              !! MBD_OK or the solve's status
+    integer :: i, n
+    n = size(b)
+    w%rhs(1:n) = b; w%rhs(n + 1:) = zero
+    call dyn_solve(w, w%rhs, status)
+    do i = 1, w%na
+      mu(w%rows(i)) = w%s * w%rhs(n + i)
+    end do
+  end subroutine proj_multipliers
+
+  !> The blocks of the linearization at a rest state q with multipliers lam: the trig
+  !! factors, the constraints' Hessians, the parameters' derivatives and the K_lambda list
+  !! (z: zeros, the velocities and accelerations).
+  subroutine sens_at_rest(m, s, q, t, lam, z)
+    type(model_t), intent(in) :: m              !! model
+    type(sens_t), intent(inout) :: s            !! parameters and blocks
+    real(wp), intent(in) :: q(:), t, lam(:), z(:)  !! rest state, time, multipliers, zeros
+    call sens_trig(m, s, q)
+    call sens_hessian(m, s, q, z, z, t)
+    call sens_params(m, s, q, z, z, t)
+    call sens_klam_list(m, s, lam)
+  end subroutine sens_at_rest
+
+  !> kx = K x = K_lambda x - Q_q x at the rest state q (exact; sens_klam_list done; z zeros,
+  !! work nq entries).
+  subroutine sens_stiffness_mul(m, s, q, t, z, x, kx, work)
+    type(model_t), intent(in) :: m              !! model with dynamics data
+    type(sens_t), intent(in) :: s               !! parameters and blocks
+    real(wp), intent(in) :: q(:), t, z(:), x(:) !! state, time, zeros, the vector
+    real(wp), intent(out) :: kx(:), work(:)     !! K x; work
+    call sens_klam(s, x, kx)
+    call sens_force_d(m, s, 0, q, z, x, z, t, work)
+    kx = kx - work
+  end subroutine sens_stiffness_mul
 
   !> Forward dynamics with sensitivities by dopri5 from the consistent state (q, qd) at t0 and
   !! its sensitivities (sq, sqd) (nq, np); outputs as mbd_integrators' integrate, with

@@ -12,44 +12,16 @@ import numpy as np
 import pytest
 
 import mbd2d
-from test_modes import (SPRUNG, G, bisect, fourbar_energy, fourbar_reduced, pendulum,
+from test_modes import (SPRUNG, G, ball_on_floor, bisect, block_text, damped_chain,
+                        fourbar_energy, fourbar_reduced, pendulum, rubbing_pendulum,
                         spring_chain, sprung_fourbar)
 
 FREQS = np.array([0.0, 0.2, 0.5, 0.6755, 0.7, 1.3, 4.0, 25.0])
 
 
 def block(k: float = 36.0, c: float = 1.5, m: float = 2.0) -> mbd2d.Model:
-    """A block on a vertical guide hanging from a spring-damper-actuator (tension k (L - L0) +
-    c L' - f): the block's y is -L."""
+    """test_modes' block on a spring-damper-actuator (its y is minus the spring's length)."""
     return mbd2d.loads(block_text(k, c, m))
-
-
-def block_text(k: float = 36.0, c: float = 1.5, m: float = 2.0) -> str:
-    """block's model file."""
-    return (f"""
-[model]
-name = "block"
-gravity = [0.0, {-G}]
-[[body]]
-name = "block"
-q0 = [0.0, -1.0, 0.0]
-mass = {m}
-inertia = 0.01
-[[joint]]
-type = "translational"
-name = "guide"
-bodies = ["ground", "block"]
-points = [[0, 0], [0, 0]]
-axes = [[0, 1], [0, 1]]
-[[force]]
-type = "spring"
-name = "s"
-bodies = ["ground", "block"]
-points = [[0.0, 0.0], [0.0, 0.0]]
-stiffness = {k}
-damping = {c}
-length0 = 0.5
-""")
 
 
 @pytest.mark.parametrize("c", [1.5, 0.0, 30.0])
@@ -118,15 +90,19 @@ def test_two_blocks_damped_at_one_end() -> None:
         np.testing.assert_allclose(got, want, rtol=1e-11, atol=1e-13 * abs(want).max())
 
 
+def shaken_chain(c: float, n: int, m: float, k: float) -> tuple[mbd2d.Model, str]:
+    """test_modes' chain damped at its end, with a force on its first block; the force's
+    amplitude parameter."""
+    model = damped_chain(c, n, m, k)
+    model.add_point_force("b1", [0.0, 0.0], fx=0.0, name="shaker")
+    return model, "force.shaker.fx.poly.0"
+
+
 def test_a_chain_on_the_band_path() -> None:
     """Twelve blocks on springs, a damper on the last, a force on the first: the band path
     equals the tridiagonal system solved here (and the dense path)."""
     n, m, k, c = 12, 0.5, 200.0, 5.0
-    model = spring_chain(n, m, k)
-    model.add_spring(["ground", f"b{n}"], [[0.0, 0.0], [0.0, 0.0]], damping=c,
-                     length0=0.1 * n, name="damper")
-    model.add_point_force("b1", [0.0, 0.0], fx=0.0, name="shaker")
-    name = [p for p in model.parameters() if p.startswith("force.shaker.fx")][0]
+    model, name = shaken_chain(c, n, m, k)
     f = np.linspace(0.0, 8.0, 17)
     band = model.frequency_response(name, f, solver="banded")
     dense = model.frequency_response(name, f, solver="dense")
@@ -153,11 +129,7 @@ def test_many_free_motions_take_the_hessenberg_form() -> None:
     frequency alone (one frequency a call); twenty free blocks (no stiffness) are singular at
     0 Hz on this path too, and move as -1 / (m w^2) elsewhere."""
     n, m, k, c = 40, 0.5, 200.0, 5.0
-    model = spring_chain(n, m, k)
-    model.add_spring(["ground", f"b{n}"], [[0.0, 0.0], [0.0, 0.0]], damping=c,
-                     length0=0.1 * n, name="damper")
-    model.add_point_force("b1", [0.0, 0.0], fx=0.0, name="shaker")
-    name = [p for p in model.parameters() if p.startswith("force.shaker.fx")][0]
+    model, name = shaken_chain(c, n, m, k)
     f = np.linspace(0.0, 12.0, 20)
     res = model.frequency_response(name, f)
     kk = k * (2 * np.eye(n) - np.eye(n, k=1) - np.eye(n, k=-1))
@@ -310,31 +282,10 @@ def test_bad_arguments_are_model_errors(kw: dict, error: type, needle: str) -> N
 
 def test_what_it_does_not_carry() -> None:
     """Contacts and joint friction are refused (their exact derivatives are not written)."""
-    ball = mbd2d.loads("""
-[model]
-name = "ball"
-gravity = [0.0, -9.81]
-[[body]]
-name = "ball"
-q0 = [0.0, 0.2, 0.0]
-mass = 1.0
-inertia = 0.01
-[[joint]]
-type = "translational"
-name = "guide"
-bodies = ["ground", "ball"]
-points = [[0, 0], [0, 0]]
-axes = [[0, 1], [0, 1]]
-[[contact]]
-name = "floor"
-type = "circle-line"
-bodies = ["ball", "ground"]
-circle = { center = [0.0, 0.0], radius = 0.1 }
-line = { point = [0.0, 0.0], normal = [0.0, 1.0] }
-law = { model = "linear", stiffness = 1e5, exponent = 1.0, restitution = 1.0 }
-""")
     with pytest.raises(mbd2d.ModelError, match="does not carry contacts"):
-        ball.frequency_response("model.gravity.1", [1.0])
+        ball_on_floor().frequency_response("model.gravity.1", [1.0])
+    with pytest.raises(mbd2d.ModelError, match="friction"):
+        rubbing_pendulum().frequency_response("model.gravity.1", [1.0])
 
 
 # ------------------------------------------------------------------ the other front doors

@@ -82,15 +82,13 @@ def test_pendulum_on_a_spring(k: float) -> None:
     assert abs(phi[1] - L / 2 * np.cos(th) * phi[2]) < 1e-12
 
 
-@pytest.mark.parametrize("c", [0.0, 0.4, 2 * np.sqrt(36.0 * 2.0), 30.0])
-def test_damped_block_on_a_guide(c: float) -> None:
-    """A 2 kg block on a vertical guide hanging from a spring (k = 36 N/m) and damper c:
-    s = (-c +- sqrt(c^2 - 4 m k)) / (2 m), omega^2 = k / m, zeta = c / (2 sqrt(k m))."""
-    m, k = 2.0, 36.0
-    model = mbd2d.loads(f"""
+def block_text(k: float = 36.0, c: float = 1.5, m: float = 2.0) -> str:
+    """A block on a vertical guide hanging from a spring-damper-actuator (tension k (L -
+    0.5) + c L' - f): the block's y is -L."""
+    return f"""
 [model]
 name = "block"
-gravity = [0.0, -9.81]
+gravity = [0.0, {-G}]
 [[body]]
 name = "block"
 q0 = [0.0, -1.0, 0.0]
@@ -110,7 +108,15 @@ points = [[0.0, 0.0], [0.0, 0.0]]
 stiffness = {k}
 damping = {c}
 length0 = 0.5
-""")
+"""
+
+
+@pytest.mark.parametrize("c", [0.0, 0.4, 2 * np.sqrt(36.0 * 2.0), 30.0])
+def test_damped_block_on_a_guide(c: float) -> None:
+    """A 2 kg block on a vertical guide hanging from a spring (k = 36 N/m) and damper c:
+    s = (-c +- sqrt(c^2 - 4 m k)) / (2 m), omega^2 = k / m, zeta = c / (2 sqrt(k m))."""
+    m, k = 2.0, 36.0
+    model = mbd2d.loads(block_text(k, c, m))
     res = model.modes()
     assert abs(res.omega2[0] / (k / m) - 1) < 1e-9
     assert abs(res.q[1] - (-0.5 - m * G / k)) < 1e-12
@@ -432,7 +438,13 @@ def test_a_massless_free_motion_is_named() -> None:
 
 
 def test_friction_is_refused_as_in_statics() -> None:
-    model = mbd2d.loads("""
+    with pytest.raises(mbd2d.ModelError, match="friction"):
+        rubbing_pendulum().modes()
+
+
+def rubbing_pendulum() -> mbd2d.Model:
+    """A bar on a pivot with Coulomb friction."""
+    return mbd2d.loads("""
 [model]
 name = "rubbing"
 gravity = [0.0, -9.81]
@@ -448,8 +460,6 @@ bodies = ["ground", "bar"]
 points = [[0.0, 0.0], [-0.5, 0.0]]
 friction = { mu = 0.2, pin_radius = 0.01 }
 """)
-    with pytest.raises(mbd2d.ModelError, match="friction"):
-        model.modes()
 
 
 def test_csv_summary_and_pictures(tmp_path: Path) -> None:
@@ -699,12 +709,10 @@ def test_the_command_line(tmp_path: Path) -> None:
         assert r.returncode == 2 and "Traceback" not in r.stderr, (bad, r.stderr)
 
 
-@pytest.mark.parametrize("law, n", [("linear", 1.0), ("hertz", 1.5)])
-def test_a_ball_resting_on_a_contact(law: str, n: float) -> None:
-    """A ball on a vertical guide resting on the floor through a contact law F = k d^n: at
-    rest d = (m g / k)^(1/n), and omega^2 = n k d^(n - 1) / m (measured 1e-12 and 1.2e-9)."""
-    m, k = 2.0, 1e5
-    model = mbd2d.loads(f"""
+def ball_on_floor(law: str = "linear", k: float = 1e5, n: float = 1.0,
+                  m: float = 2.0) -> mbd2d.Model:
+    """A ball (radius 0.1) on a vertical guide above the floor, a contact law F = k d^n."""
+    return mbd2d.loads(f"""
 [model]
 name = "ball"
 gravity = [0.0, -9.81]
@@ -727,6 +735,14 @@ circle = {{ center = [0.0, 0.0], radius = 0.1 }}
 line = {{ point = [0.0, 0.0], normal = [0.0, 1.0] }}
 law = {{ model = "{law}", stiffness = {k}, exponent = {n}, restitution = 1.0 }}
 """)
+
+
+@pytest.mark.parametrize("law, n", [("linear", 1.0), ("hertz", 1.5)])
+def test_a_ball_resting_on_a_contact(law: str, n: float) -> None:
+    """A ball on a vertical guide resting on the floor through a contact law F = k d^n: at
+    rest d = (m g / k)^(1/n), and omega^2 = n k d^(n - 1) / m (measured 1e-12 and 1.2e-9)."""
+    m, k = 2.0, 1e5
+    model = ball_on_floor(law, k, n, m)
     res = model.modes()
     d = (m * G / k)**(1 / n)
     assert abs(res.q[1] - (0.1 - d)) < 1e-12

@@ -235,17 +235,7 @@ program mbd2d_solve
     end if
     nout = merge(1, 0, status == MBD_OK)
   end select
-  if (status < 0) then
-    if (iinfo(2) <= -2000000) then
-      call die(2, param_where(-2000000 - iinfo(2), msg))
-    else if (iinfo(2) <= -1000000) then
-      call die(2, force_where(-1000000 - iinfo(2), msg))
-    else if (iinfo(2) < 0) then
-      call die(2, trim(model_path) // ': body "' // &
-               trim(spec%body_names(min(spec%nb, -iinfo(2)))) // '": ' // trim(msg))
-    end if
-    call die(2, where(iinfo(2), msg))
-  end if
+  if (status < 0) call die_input(iinfo(2), msg)
   if (status == MBD_NO_MEMORY) call die(2, trim(msg))
   if (spec%analysis == 'statics' .and. status /= MBD_OK) call die(4, trim(msg) // &
     ' (no equilibrium written)')
@@ -462,6 +452,18 @@ contains
       trim(itoa(spec%con_line(k))) // ': constraint "' // trim(spec%con_names(k)) // '": ' // &
       trim(text)
   end function where
+
+  !> Exit 2 naming what a bad-input status points at: iinfo(2) code a design parameter
+  !! (<= -2000000), a force (<= -1000000), a body (< 0) or a constraint.
+  subroutine die_input(code, text)
+    integer, intent(in) :: code
+    character(len=*), intent(in) :: text
+    if (code <= -2000000) call die(2, param_where(-2000000 - code, text))
+    if (code <= -1000000) call die(2, force_where(-1000000 - code, text))
+    if (code < 0) call die(2, trim(model_path) // ': body "' // &
+                           trim(spec%body_names(min(spec%nb, -code))) // '": ' // trim(text))
+    call die(2, where(code, text))
+  end subroutine die_input
 
   !> "FILE: force "NAME": TEXT" for force k.
   function force_where(k, text) result(s)
@@ -870,10 +872,7 @@ contains
     integer :: kmax, nk, u, ios, k, j, nw, nz
     real(wp) :: mag, row(5)
     character(len=32) :: word
-    if (.not. spec%have_masses) call die(2, trim(model_path) // ': modes needs the masses: '// &
-      'body lines NAME X0 Y0 THETA0 MASS INERTIA VX0 VY0 OMEGA0')
-    if (spec%nlabels >= 0 .and. spec%nlabels /= neq) call die(2, trim(model_path) // &
-      ': ' // trim(itoa(spec%nlabels)) // ' labels for ' // trim(itoa(neq)) // ' rows of Phi')
+    call linear_checks('modes')
     if (spec%out_energy .or. spec%out_lam .or. spec%out_reac .or. spec%out_eff .or. &
         spec%npar > 0 .or. spec%ncase > 0 .or. spec%positions_only .or. spec%nmeas > 0) &
       call die(2, trim(model_path) // ': modes takes no outputs but "damped", and no '// &
@@ -885,15 +884,10 @@ contains
                    'the modes (' // trim(itoa(kmax)) // ' of ' // trim(itoa(nq)) // &
                    ' coordinates)', 'give a smaller count', status, msg)
     if (status /= MBD_OK) call die(2, trim(model_path) // ': ' // trim(msg))
-    allocate (q0(nq), qe(nq), lam(neq), w2(kmax), kinds(kmax), sre(2 * kmax), &
-              sim(2 * kmax), shp(nq, kmax), ftm(NFT, spec%nf), fpm(max(1, size(spec%fpar))), &
-              zre(nq, nz), zim(nq, nz), stat=ierr)
+    allocate (qe(nq), lam(neq), w2(kmax), kinds(kmax), sre(2 * kmax), sim(2 * kmax), &
+              shp(nq, kmax), zre(nq, nz), zim(nq, nz), stat=ierr)
     if (ierr /= 0) call die(2, 'not enough memory for the modes')
-    q0 = 0.0_wp
-    q0(1:3 * spec%nb) = reshape(spec%q0, [3 * spec%nb])
-    ftm = spec%ftab
-    fpm = 0.0_wp
-    fpm(1:size(spec%fpar)) = spec%fpar
+    call linear_inputs(ftm, fpm)
     if (spec%out_damped) then
       call api_modes(spec%nb, spec%ctab, spec%rpar, spec%bmass, spec%grav, ftm, fpm, q0, &
                      spec%tstat, merge(0, 1, spec%at_q0), kmax, qe, lam, stable, resid, w2, &
@@ -903,13 +897,7 @@ contains
                      spec%tstat, merge(0, 1, spec%at_q0), kmax, qe, lam, stable, resid, w2, &
                      kinds, sre, sim, shp, iinfo, status, msg, spec%solver)
     end if
-    if (status < 0) then
-      if (iinfo(2) <= -1000000) call die(2, force_where(-1000000 - iinfo(2), msg))
-      if (iinfo(2) < 0) call die(2, trim(model_path) // ': body "' // &
-                                 trim(spec%body_names(min(spec%nb, -iinfo(2)))) // '": ' // &
-                                 trim(msg))
-      call die(2, where(iinfo(2), msg))
-    end if
+    if (status < 0) call die_input(iinfo(2), msg)
     if (status == MBD_NO_MEMORY) call die(2, trim(msg))
     if (status /= MBD_OK) call die(4, trim(msg) // ' (no modes written)')
     nk = min(kmax, iinfo(1))
@@ -929,16 +917,16 @@ contains
         mag = hypot(sre(k), sim(k))                  ! as numpy's abs of a complex
         row = [sre(k), sim(k), mag / TWO_PI, abs(sim(k)) / TWO_PI, 0.0_wp]
         if (mag > 0.0_wp) row(5) = -sre(k) / mag + 0.0_wp
-        do j = 1, 5 + 6 * spec%nb
-          if (j <= 5) then
-            call num(row(j), word, nw)
-          else if (mod(j - 5, 2) == 1) then
-            call num(zre((j - 4) / 2, k), word, nw)
-          else
-            call num(zim((j - 5) / 2, k), word, nw)
-          end if
+        do j = 1, 5
+          call num(row(j), word, nw)
           if (j > 1) call sput(u, ios, ',')
           call sput(u, ios, word(1:nw))
+        end do
+        do j = 1, 3 * spec%nb                          ! the shape: re, im per coordinate
+          call num(zre(j, k), word, nw)
+          call sput(u, ios, ',' // word(1:nw))
+          call num(zim(j, k), word, nw)
+          call sput(u, ios, ',' // word(1:nw))
         end do
         call sput(u, ios, achar(10))
       end do
@@ -968,6 +956,30 @@ contains
     if (ios /= 0) call die(2, 'cannot write ' // trim(out_path) // ' (disk full?)')
   end subroutine run_modes
 
+  !> What modes and frf need from the file (exit 2 otherwise): the masses, and as many row
+  !! labels as rows of Phi.
+  subroutine linear_checks(what)
+    character(len=*), intent(in) :: what
+    if (.not. spec%have_masses) call die(2, trim(model_path) // ': ' // what // ' needs the '// &
+      'masses: body lines NAME X0 Y0 THETA0 MASS INERTIA VX0 VY0 OMEGA0')
+    if (spec%nlabels >= 0 .and. spec%nlabels /= neq) call die(2, trim(model_path) // &
+      ': ' // trim(itoa(spec%nlabels)) // ' labels for ' // trim(itoa(neq)) // ' rows of Phi')
+  end subroutine linear_checks
+
+  !> q0 from the body lines, and the force table and parameters (at least one entry) as the
+  !! core takes them (modes, frf).
+  subroutine linear_inputs(ftm, fpm)
+    integer, allocatable, intent(out) :: ftm(:, :)
+    real(wp), allocatable, intent(out) :: fpm(:)
+    allocate (q0(nq), ftm(NFT, spec%nf), fpm(max(1, size(spec%fpar))), stat=ierr)
+    if (ierr /= 0) call die(2, 'not enough memory for the model''s tables')
+    q0 = 0.0_wp
+    q0(1:3 * spec%nb) = reshape(spec%q0, [3 * spec%nb])
+    ftm = spec%ftab
+    fpm = 0.0_wp
+    fpm(1:size(spec%fpar)) = spec%fpar
+  end subroutine linear_inputs
+
   !> The frequency response (Model.frequency_response) written as
   !! FrequencyResponseResult.to_csv writes it: one row per frequency, frequency_hz, then for
   !! each input (the sensitivities block) and body d(NAME.x)/d(INPUT).re, .im, then y, theta.
@@ -977,10 +989,7 @@ contains
     integer, allocatable :: ftm(:, :)
     integer :: nw, u, ios, j, k, b, c, nw2
     character(len=32) :: word
-    if (.not. spec%have_masses) call die(2, trim(model_path) // ': frf needs the masses: '// &
-      'body lines NAME X0 Y0 THETA0 MASS INERTIA VX0 VY0 OMEGA0')
-    if (spec%nlabels >= 0 .and. spec%nlabels /= neq) call die(2, trim(model_path) // &
-      ': ' // trim(itoa(spec%nlabels)) // ' labels for ' // trim(itoa(neq)) // ' rows of Phi')
+    call linear_checks('frf')
     if (spec%out_energy .or. spec%out_lam .or. spec%out_reac .or. spec%out_eff .or. &
         spec%out_damped .or. spec%ncase > 0 .or. spec%positions_only .or. spec%nmeas > 0) &
       call die(2, trim(model_path) // ': frf takes no outputs, cases, measures or '// &
@@ -995,25 +1004,13 @@ contains
                    'the frequency response (' // trim(itoa(nw)) // ' frequencies)', &
                    'give fewer frequencies or inputs', status, msg)
     if (status /= MBD_OK) call die(2, trim(model_path) // ': ' // trim(msg))
-    allocate (q0(nq), qe(nq), lam(neq), hre(nq, spec%npar, nw), him(nq, spec%npar, nw), &
-              ftm(NFT, spec%nf), fpm(max(1, size(spec%fpar))), stat=ierr)
+    allocate (qe(nq), lam(neq), hre(nq, spec%npar, nw), him(nq, spec%npar, nw), stat=ierr)
     if (ierr /= 0) call die(2, 'not enough memory for the frequency response')
-    q0 = 0.0_wp
-    q0(1:3 * spec%nb) = reshape(spec%q0, [3 * spec%nb])
-    ftm = spec%ftab
-    fpm = 0.0_wp
-    fpm(1:size(spec%fpar)) = spec%fpar
+    call linear_inputs(ftm, fpm)
     call api_frf(spec%nb, spec%ctab, spec%rpar, spec%bmass, spec%grav, ftm, fpm, q0, &
                  spec%tstat, merge(0, 1, spec%at_q0), spec%ptab, TWO_PI * spec%freq, qe, lam, &
                  stable, resid, hre, him, iinfo, status, msg, spec%solver)
-    if (status < 0) then
-      if (iinfo(2) <= -2000000) call die(2, param_where(-2000000 - iinfo(2), msg))
-      if (iinfo(2) <= -1000000) call die(2, force_where(-1000000 - iinfo(2), msg))
-      if (iinfo(2) < 0) call die(2, trim(model_path) // ': body "' // &
-                                 trim(spec%body_names(min(spec%nb, -iinfo(2)))) // '": ' // &
-                                 trim(msg))
-      call die(2, where(iinfo(2), msg))
-    end if
+    if (status < 0) call die_input(iinfo(2), msg)
     if (status == MBD_NO_MEMORY) call die(2, trim(msg))
     if (status /= MBD_OK .and. iinfo(8) > 0) then
       call num(spec%freq(iinfo(8)), word, nw2)

@@ -436,17 +436,8 @@ def _frequencies(args: argparse.Namespace) -> np.ndarray | None:
     """The frequencies of --f START:STOP:NUM (--log: geometric), None without --f."""
     if args.f is None:
         return None
-    parts = str(args.f).split(":")
-    try:
-        if len(parts) != 3:
-            raise ValueError
-        start, stop, num = float(parts[0]), float(parts[1]), int(parts[2])
-    except ValueError:
-        raise ModelError(f"--f {args.f!r}: write START:STOP:NUM in Hz, for example "
-                         "0.1:100:200", "command line") from None
-    if not 1 <= num <= MAX_CASES or not (np.isfinite(start) and np.isfinite(stop)):
-        raise ModelError(f"--f {args.f!r}: NUM must be from 1 to {MAX_CASES} and START, STOP "
-                         "finite", "command line")
+    start, stop, num = _range(str(args.f), "--f", "START:STOP:NUM in Hz",
+                              (str(args.f), "0.1:100:200"))
     if args.log:
         if start <= 0 or stop <= 0:
             raise ModelError(f"--f {args.f!r} with --log: START and STOP must be > 0",
@@ -791,20 +782,29 @@ def _write(res: Any, args: argparse.Namespace) -> str:
         return _picture(res, args)
     res.save(args.out, **_file_outputs(args))
     return args.out
-def _param_values(spec: str) -> tuple[str, np.ndarray]:
-    """NAME=START:STOP:NUM as the name and NUM values from START to STOP."""
-    name, eq, rng = spec.partition("=")
-    parts = rng.split(":")
+def _range(text: str, option: str, form: str, example: str,
+           ok: bool = True) -> tuple[float, float, int]:
+    """START:STOP:NUM of an option's value: finite START and STOP, NUM from 1 to MAX_CASES
+    (ok False: the value is malformed around it)."""
+    parts = text.split(":")
     try:
-        if not eq or len(parts) != 3:
+        if not ok or len(parts) != 3:
             raise ValueError
         start, stop, num = float(parts[0]), float(parts[1]), int(parts[2])
     except ValueError:
-        raise ModelError(f"--param {spec!r}: write NAME=START:STOP:NUM, for example "
-                         "joint.B.points.0.0=1.5:2.0:11", "command line") from None
+        raise ModelError(f"{option} {example[0]!r}: write {form}, for example {example[1]}",
+                         "command line") from None
     if not 1 <= num <= MAX_CASES or not (np.isfinite(start) and np.isfinite(stop)):
-        raise ModelError(f"--param {spec!r}: NUM must be from 1 to {MAX_CASES} and START, "
-                         "STOP finite", "command line")
+        raise ModelError(f"{option} {example[0]!r}: NUM must be from 1 to {MAX_CASES} and "
+                         "START, STOP finite", "command line")
+    return start, stop, num
+
+
+def _param_values(spec: str) -> tuple[str, np.ndarray]:
+    """NAME=START:STOP:NUM as the name and NUM values from START to STOP."""
+    name, eq, rng = spec.partition("=")
+    start, stop, num = _range(rng, "--param", "NAME=START:STOP:NUM",
+                              (spec, "joint.B.points.0.0=1.5:2.0:11"), ok=bool(eq))
     return name.strip(), np.linspace(start, stop, num)
 
 
