@@ -234,6 +234,10 @@ def test_the_pivot_force_of_a_pendulum() -> None:
     np.testing.assert_allclose(shake.fy_j, 0.0, atol=1e-11 * abs(want).max())
     with pytest.raises(KeyError, match="no joint or driver 'hinge'"):
         res.reaction_response("hinge", inputs[0])
+    header, rows = res.table(reactions=True)            # the CSV's columns: the same numbers
+    col = header.index("d(pivot.fx_j)/d(joint.pivot.points.0.0).im")
+    np.testing.assert_array_equal(rows[:, col], shake.fx_j.imag + 0.0)
+    assert len(header) == 1 + 2 * (2 * 3 + 2 * 6)
     # the bar's far end, L from the pivot: L dphi across, nothing up (first order)
     tip = res.point_response("bar", [a, 0.0], inputs[0])
     np.testing.assert_allclose(tip[:, 0], L * h, rtol=1e-12)
@@ -301,14 +305,19 @@ def test_mbd2d_solve_writes_the_response_python_writes(tmp_path: Path) -> None:
     chain = spring_chain(8)
     chain.add_spring(["ground", "b8"], [[0.0, 0.0], [0.0, 0.0]], damping=2.0, length0=0.8,
                      name="damper")
-    runs = [(block(), ["force.s.length0", "model.gravity.1"], {}),
-            (shaken_pendulum(), ["joint.pivot.points.0.0"], {"equilibrium": False}),
-            (chain, ["force.s1.length0"], {"solver": "banded"})]
-    for k, (model, inputs, kw) in enumerate(runs):
+    pend = shaken_pendulum()
+    pend.add_torque("bar", 0.0, name="drive")
+    runs = [(block(), ["force.s.length0", "model.gravity.1"], {}, False),
+            (shaken_pendulum(), ["joint.pivot.points.0.0"], {"equilibrium": False}, False),
+            (chain, ["force.s1.length0"], {"solver": "banded"}, False),
+            (pend, ["force.drive.f.poly.0", "joint.pivot.points.0.0"], {}, True),
+            (sprung_fourbar(SPRUNG, 0.05), ["joint.O4.points.0.0"], {}, True)]
+    for k, (model, inputs, kw, reactions) in enumerate(runs):
         mbd = tmp_path / f"m{k}.mbd"
-        model.export(mbd, analysis="frf", inputs=inputs, frequencies=FREQS, **kw)
+        model.export(mbd, analysis="frf", inputs=inputs, frequencies=FREQS,
+                     outputs=["reactions"] if reactions else None, **kw)
         py = tmp_path / f"p{k}.csv"
-        model.frequency_response(inputs, FREQS, **kw).to_csv(py)
+        model.frequency_response(inputs, FREQS, **kw).to_csv(py, reactions=reactions)
         assert solve_file(mbd, tmp_path / f"f{k}.csv") == py.read_text()
 
 
@@ -317,7 +326,7 @@ def test_mbd2d_solve_writes_the_response_python_writes(tmp_path: Path) -> None:
     (("frequencies 8\n", "frequencies 8\n-1 "), "more numbers than the count"),
     (("\nsensitivities 1\n", "\n# sensitivities 1\n# "), "frf needs its inputs"),
     (("\nfrequencies 8\n", "\n# frequencies 8\n# "), None),
-    (("analysis frf", "analysis frf\noutputs energy"), "frf takes no outputs"),
+    (("analysis frf", "analysis frf\noutputs energy"), "frf takes no outputs but"),
 ])
 def test_mbd2d_solve_refuses_bad_frf_files(tmp_path: Path, edit: tuple,
                                             needle: str | None) -> None:
@@ -396,6 +405,12 @@ def test_the_command_line(tmp_path: Path) -> None:
     assert r.returncode == 0, r.stderr
     from test_standalone import solve_file
     assert solve_file(tmp_path / "m.mbd", tmp_path / "s.csv") == (tmp_path / "p.csv").read_text()
+    r = cli("frf", str(toml), "--input", "force.s.f.poly.0", "--f", "0.1:10:25", "--log",
+            "--out", str(tmp_path / "fr.csv"), "--reactions")
+    assert r.returncode == 0, r.stderr
+    res.to_csv(tmp_path / "pr.csv", reactions=True)
+    assert (tmp_path / "fr.csv").read_text() == (tmp_path / "pr.csv").read_text()
+    assert "d(guide.fx_j)/d(force.s.f.poly.0).re" in (tmp_path / "fr.csv").read_text()
     for bad in (["--f", "1:2"], ["--f", "0:2:5", "--log"], ["--out", str(tmp_path / "x.txt")],
                 ["--f", "1:2:3", "--input", "force.s.nope"], ["--f", "1:2:0"],
                 ["--f", "1:2:3", "--body", "wheel", "--picture", str(tmp_path / "x.png")]):

@@ -956,6 +956,28 @@ contains
     if (ios /= 0) call die(2, 'cannot write ' // trim(out_path) // ' (disk full?)')
   end subroutine run_modes
 
+  !> The two CSV header columns ",d(NAME)/d(PAR).re,d(NAME)/d(PAR).im" (frf).
+  subroutine pair_header(u, ios, name, par)
+    integer, intent(in) :: u
+    integer, intent(inout) :: ios
+    character(len=*), intent(in) :: name, par
+    call sput(u, ios, ',d(' // name // ')/d(' // par // ').re,d(' // name // ')/d(' // par // &
+              ').im')
+  end subroutine pair_header
+
+  !> ",RE,IM" of one complex number (+ 0: no -0.0, as the Python table).
+  subroutine put_pair(u, ios, re, im)
+    integer, intent(in) :: u
+    integer, intent(inout) :: ios
+    real(wp), intent(in) :: re, im
+    character(len=32) :: word
+    integer :: nw
+    call num(re + 0.0_wp, word, nw)
+    call sput(u, ios, ',' // word(1:nw))
+    call num(im + 0.0_wp, word, nw)
+    call sput(u, ios, ',' // word(1:nw))
+  end subroutine put_pair
+
   !> What modes and frf need from the file (exit 2 otherwise): the masses, and as many row
   !! labels as rows of Phi.
   subroutine linear_checks(what)
@@ -982,18 +1004,25 @@ contains
 
   !> The frequency response (Model.frequency_response) written as
   !! FrequencyResponseResult.to_csv writes it: one row per frequency, frequency_hz, then for
-  !! each input (the sensitivities block) and body d(NAME.x)/d(INPUT).re, .im, then y, theta.
+  !! each input (the sensitivities block) and body d(NAME.x)/d(INPUT).re, .im, then y, theta;
+  !! with "outputs reactions" after each input's bodies every constraint's reaction response
+  !! d(NAME.fx)/d(INPUT).re, .im, ... mz_j (the reactions' derivatives along Re and Im of the
+  !! response, the input's own term in the real part only).
   subroutine run_frf()
     real(wp), parameter :: TWO_PI = 2 * 3.141592653589793_wp
-    real(wp), allocatable :: qe(:), lam(:), hre(:, :, :), him(:, :, :), fpm(:)
+    character(len=4), parameter :: WORDS(6) = ['fx  ', 'fy  ', 'mz  ', 'fx_j', 'fy_j', 'mz_j']
+    real(wp), allocatable :: qe(:), lam(:), hre(:, :, :), him(:, :, :), fpm(:), lre(:, :, :), &
+                             lim(:, :, :), gre(:, :, :, :), gim(:, :, :, :), gp(:, :, :, :), &
+                             gloc(:, :, :, :), qq(:, :), ll(:, :), tt(:), zq(:, :, :), &
+                             zl(:, :, :)
     integer, allocatable :: ftm(:, :)
-    integer :: nw, u, ios, j, k, b, c, nw2
+    integer :: nw, u, ios, j, k, b, c, nr, nl
     character(len=32) :: word
     call linear_checks('frf')
-    if (spec%out_energy .or. spec%out_lam .or. spec%out_reac .or. spec%out_eff .or. &
+    if (spec%out_energy .or. spec%out_lam .or. spec%out_eff .or. &
         spec%out_damped .or. spec%ncase > 0 .or. spec%positions_only .or. spec%nmeas > 0) &
-      call die(2, trim(model_path) // ': frf takes no outputs, cases, measures or '// &
-               'positions_only')
+      call die(2, trim(model_path) // ': frf takes no outputs but "reactions", and no '// &
+               'cases, measures or positions_only')
     if (spec%npar == 0) call die(2, trim(model_path) // ': frf needs its inputs: a '// &
       '"sensitivities" block naming the design parameters varied')
     if (spec%freq_line == 0) call die(2, trim(model_path) // ': frf needs a "frequencies" '// &
@@ -1004,20 +1033,49 @@ contains
                    'the frequency response (' // trim(itoa(nw)) // ' frequencies)', &
                    'give fewer frequencies or inputs', status, msg)
     if (status /= MBD_OK) call die(2, trim(model_path) // ': ' // trim(msg))
-    allocate (qe(nq), lam(neq), hre(nq, spec%npar, nw), him(nq, spec%npar, nw), stat=ierr)
+    nr = merge(nw, 0, spec%out_reac)              ! the reactions' frequencies
+    call mem_check(REAL_BYTES * real(nr, wp) * spec%npar * (2 * neq + 24 * spec%nc + 2 * nq), &
+                   'the reaction responses (' // trim(itoa(nw)) // ' frequencies)', &
+                   'give fewer frequencies or inputs', status, msg)
+    if (status /= MBD_OK) call die(2, trim(model_path) // ': ' // trim(msg))
+    allocate (qe(nq), lam(neq), hre(nq, spec%npar, nw), him(nq, spec%npar, nw), &
+              lre(neq, spec%npar, nr), lim(neq, spec%npar, nr), &
+              gre(6, spec%nc, spec%npar, nr), gim(6, spec%nc, spec%npar, nr), &
+              gp(6, spec%nc, spec%npar, 1), gloc(6, spec%nc, spec%npar, max(nr, 1)), stat=ierr)
     if (ierr /= 0) call die(2, 'not enough memory for the frequency response')
     call linear_inputs(ftm, fpm)
-    call api_frf(spec%nb, spec%ctab, spec%rpar, spec%bmass, spec%grav, ftm, fpm, q0, &
-                 spec%tstat, merge(0, 1, spec%at_q0), spec%ptab, TWO_PI * spec%freq, qe, lam, &
-                 stable, resid, hre, him, iinfo, status, msg, spec%solver)
+    if (spec%out_reac) then
+      call api_frf(spec%nb, spec%ctab, spec%rpar, spec%bmass, spec%grav, ftm, fpm, q0, &
+                   spec%tstat, merge(0, 1, spec%at_q0), spec%ptab, TWO_PI * spec%freq, qe, &
+                   lam, stable, resid, hre, him, iinfo, status, msg, spec%solver, lre, lim)
+    else
+      call api_frf(spec%nb, spec%ctab, spec%rpar, spec%bmass, spec%grav, ftm, fpm, q0, &
+                   spec%tstat, merge(0, 1, spec%at_q0), spec%ptab, TWO_PI * spec%freq, qe, &
+                   lam, stable, resid, hre, him, iinfo, status, msg, spec%solver)
+    end if
     if (status < 0) call die_input(iinfo(2), msg)
     if (status == MBD_NO_MEMORY) call die(2, trim(msg))
     if (status /= MBD_OK .and. iinfo(8) > 0) then
-      call num(spec%freq(iinfo(8)), word, nw2)
-      call die(4, trim(msg) // ': the response at ' // word(1:nw2) // ' Hz is unbounded; '// &
+      call num(spec%freq(iinfo(8)), word, nl)
+      call die(4, trim(msg) // ': the response at ' // word(1:nl) // ' Hz is unbounded; '// &
                'leave that frequency out or give the mode damping (no response written)')
     end if
     if (status /= MBD_OK) call die(4, trim(msg) // ' (no response written)')
+    if (spec%out_reac) then        ! the reactions' derivatives along (Re H, Re dlambda),
+      allocate (qq(nq, nw), ll(neq, nw), tt(nw), zq(nq, spec%npar, 1), &   ! (Im H, Im dlambda)
+                zl(neq, spec%npar, 1), stat=ierr)                         ! and nothing
+      if (ierr /= 0) call die(2, 'not enough memory for the reaction responses')
+      qq = spread(qe, 2, nw); ll = spread(lam, 2, nw); tt = spec%tstat
+      zq = 0.0_wp; zl = 0.0_wp
+      call api_reactions_dp(spec%nb, spec%ctab, spec%rpar, spec%ptab, qq, tt, ll, hre, lre, &
+                            gre, gloc, status, msg)
+      if (status == MBD_OK) call api_reactions_dp(spec%nb, spec%ctab, spec%rpar, spec%ptab, &
+                                                  qq, tt, ll, him, lim, gim, gloc, status, msg)
+      if (status == MBD_OK) call api_reactions_dp(spec%nb, spec%ctab, spec%rpar, spec%ptab, &
+                                                  qq(:, 1:1), tt(1:1), ll(:, 1:1), zq, zl, &
+                                                  gp, gloc(:, :, :, 1:1), status, msg)
+      if (status /= MBD_OK) call die(4, trim(msg) // ' (no response written)')
+    end if
     open (newunit=u, file=trim(out_path), status='replace', action='write', access='stream', &
           form='unformatted', iostat=ios)
     if (ios /= 0) call die(2, 'cannot write ' // trim(out_path))
@@ -1025,23 +1083,31 @@ contains
     do k = 1, spec%npar
       do b = 1, spec%nb
         do c = 1, 3
-          call sput(u, ios, ',d(' // trim(spec%body_names(b)) // '.' // trim(XYT(c)) // &
-                    ')/d(' // trim(spec%par_names(k)) // ').re,d(' // &
-                    trim(spec%body_names(b)) // '.' // trim(XYT(c)) // ')/d(' // &
-                    trim(spec%par_names(k)) // ').im')
+          call pair_header(u, ios, trim(spec%body_names(b)) // '.' // trim(XYT(c)), &
+                           trim(spec%par_names(k)))
+        end do
+      end do
+      if (.not. spec%out_reac) cycle
+      do b = 1, spec%nc
+        do c = 1, 6
+          call pair_header(u, ios, trim(spec%con_names(b)) // '.' // trim(WORDS(c)), &
+                           trim(spec%par_names(k)))
         end do
       end do
     end do
     call sput(u, ios, achar(10))
     do j = 1, nw
-      call num(spec%freq(j), word, nw2)
-      call sput(u, ios, word(1:nw2))
+      call num(spec%freq(j), word, nl)
+      call sput(u, ios, word(1:nl))
       do k = 1, spec%npar
         do b = 1, 3 * spec%nb
-          call num(hre(b, k, j), word, nw2)
-          call sput(u, ios, ',' // word(1:nw2))
-          call num(him(b, k, j), word, nw2)
-          call sput(u, ios, ',' // word(1:nw2))
+          call put_pair(u, ios, hre(b, k, j), him(b, k, j))
+        end do
+        if (.not. spec%out_reac) cycle
+        do b = 1, spec%nc                         ! Im: without the input's own term
+          do c = 1, 6
+            call put_pair(u, ios, gre(c, b, k, j), gim(c, b, k, j) - gp(c, b, k, 1))
+          end do
         end do
       end do
       call sput(u, ios, achar(10))

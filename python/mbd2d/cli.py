@@ -239,6 +239,8 @@ def _parser() -> argparse.ArgumentParser:
     fr.add_argument("--solver", default="auto", choices=["auto", "dense", "banded"],
                    help="linear algebra (default auto: band LU for large chains)")
     fr.add_argument("--out", default=None, help="write the response as CSV")
+    fr.add_argument("--reactions", action="store_true", help="with --out: the joints' "
+                   "reaction responses too")
     fr.add_argument("--picture", default=None, help="draw a Bode plot (.png, .svg or .pdf)")
     fr.add_argument("--body", default=None, help="the body drawn (default the first)")
     fr.add_argument("--coordinate", default="y", choices=["x", "y", "theta"],
@@ -457,7 +459,7 @@ def _frf(model: Model, args: argparse.Namespace) -> int:
                                    equilibrium=not args.at_q0, solver=args.solver)
     print(res.summary())
     if args.out is not None:
-        res.to_csv(args.out)
+        res.to_csv(args.out, reactions=args.reactions)
         print(f"wrote {res.frequencies.size} frequencies to {args.out}")
     if args.picture is not None:
         body = args.body if args.body is not None else res.body_names[0]

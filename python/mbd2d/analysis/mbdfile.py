@@ -150,7 +150,7 @@ def _outputs(outputs: Any, analysis: str) -> list[str]:
         return []
     if isinstance(outputs, str):
         outputs = [outputs]
-    known = {"modes": ("damped",), "frf": ()}.get(analysis, OUTPUTS)
+    known = {"modes": ("damped",), "frf": ("reactions",)}.get(analysis, OUTPUTS)
     try:
         words = [str(w) for w in outputs]
     except TypeError:

@@ -9,12 +9,19 @@ import numpy as np
 from .. import plots
 from ..errors import ModelError
 from ..validate import vector
+from .columns import REACTION_WORDS
 from .files import write_csv
 from .points import PointResult
 from .reactions import Reaction
 from .sensitivities import reaction_dp_arrays, reaction_dp_of
 
 COORDINATES = ("x", "y", "theta")
+
+
+def _parts(h: np.ndarray) -> np.ndarray:
+    """A complex (n, k) array as (n, 2 k) columns: re, im of each column in turn (+ 0.0: no
+    -0.0, whose sign complex arithmetic does not keep)."""
+    return np.stack([h.real, h.imag], axis=2).reshape(h.shape[0], 2 * h.shape[1]) + 0.0
 
 
 @dataclass
@@ -92,7 +99,13 @@ class FrequencyResponseResult:
         force transmitted to the ground, ``np.angle`` the phase). From the response of the
         coordinates and multipliers through the reactions' design derivatives (the input's
         own change of the joint, a moved pivot, counts once, in phase)."""
-        j = self._input(input)
+        g, loc = self._reactions(self._input(input))
+        return reaction_dp_of(self.packed, self.model, name, g, loc)
+
+    def _reactions(self, j: int) -> tuple[np.ndarray, np.ndarray]:
+        """Every constraint's reaction response to input j, global and in the body frames:
+        (n_frequencies, nc, 6) complex each. Re: the reactions' derivative along (Re H,
+        Re dlambda) with the input's own term; Im: along (Im H, Im dlambda) without it."""
         nw = self.frequencies.size
         q, lam = np.tile(self.q, (nw, 1)), np.tile(self.lam, (nw, 1))
         t, ptab = np.full(nw, self.t), self.ptab[:, j:j + 1]
@@ -102,9 +115,7 @@ class FrequencyResponseResult:
                  reaction_dp_arrays(self.packed, ptab, q[:1], t[:1], lam[:1],
                                     np.zeros_like(hq[:1].real), np.zeros_like(hl[:1].real))]
         (g_re, l_re), (g_im, l_im), (g_p, l_p) = parts     # g_p: the input's own term
-        g = g_re + 1j * (g_im - g_p)
-        loc = l_re + 1j * (l_im - l_p)
-        return reaction_dp_of(self.packed, self.model, name, g[..., 0], loc[..., 0])
+        return (g_re + 1j * (g_im - g_p))[..., 0], (l_re + 1j * (l_im - l_p))[..., 0]
 
     def peak(self, body: str, coordinate: str = "y", input: str | None = None
              ) -> tuple[float, float]:
@@ -114,24 +125,29 @@ class FrequencyResponseResult:
         k = int(np.argmax(mag)) if mag.size else 0
         return (float(self.frequencies[k]), float(mag[k])) if mag.size else (0.0, 0.0)
 
-    def table(self) -> tuple[list[str], np.ndarray]:
+    def table(self, reactions: bool = False) -> tuple[list[str], np.ndarray]:
         """Header and rows of the CSV: one row per frequency, ``frequency_hz``, then for each
         input and body ``d(NAME.x)/d(INPUT).re``, ``d(NAME.x)/d(INPUT).im``, then y and
-        theta."""
-        nb = len(self.body_names)
+        theta; with ``reactions=True`` after each input's bodies every joint's and driver's
+        reaction response ``d(JOINT.fx)/d(INPUT).re``, ``.im``, ... fy, mz, fx_j, fy_j,
+        mz_j (:meth:`reaction_response`)."""
+        nb, nw = len(self.body_names), self.frequencies.size
         header = ["frequency_hz"]
-        blocks = []
+        blocks = [self.frequencies[:, None]]
         for j, name in enumerate(self.inputs):
             header += [f"d({b}.{c})/d({name}).{part}" for b in self.body_names
                        for c in COORDINATES for part in ("re", "im")]
-            h = self.response[:, :3 * nb, j]
-            blocks.append(np.stack([h.real, h.imag], axis=2).reshape(h.shape[0], 6 * nb))
-        rows = np.column_stack([self.frequencies] + blocks)
-        return header, rows.reshape(self.frequencies.size, len(header))
+            blocks.append(_parts(self.response[:, :3 * nb, j]))
+            if reactions:
+                header += [f"d({c}.{w})/d({name}).{part}"
+                           for c in self.packed.constraint_names for w in REACTION_WORDS
+                           for part in ("re", "im")]
+                blocks.append(_parts(self._reactions(j)[0].reshape(nw, -1)))
+        return header, np.hstack(blocks).reshape(nw, len(header))
 
-    def to_csv(self, path: Any) -> None:
+    def to_csv(self, path: Any, reactions: bool = False) -> None:
         """Write :meth:`table` as CSV, numbers as every mbd2d CSV."""
-        header, rows = self.table()
+        header, rows = self.table(reactions=reactions)
         write_csv(path, header, rows, "to_csv")
 
     def summary(self) -> str:
