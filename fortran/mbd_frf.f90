@@ -275,20 +275,24 @@ contains
       real(wp), intent(in) :: om
       integer, intent(out) :: st
       integer :: kk
+      st = MBD_OK
       do kk = 1, np                               ! b_re = r - (K - om^2 M) H_re + om C H_im
         y = rr(:, kk) - ks(:, kk) + om**2 * ms(:, kk)
-        if (f > 0) y = y - matmul(kn(:, 1:f) - om**2 * mn(:, 1:f), b(1:f, kk)) &
+        if (f > 0) y = y - matmul(kn(:, 1:f), b(1:f, kk)) &
+                       + om**2 * matmul(mn(:, 1:f), b(1:f, kk)) &
                        + om * matmul(cn(:, 1:f), b(f + 1:, kk))
         call proj_multipliers(w, y, lre(:, kk, j), st)
         if (st /= MBD_OK) return
         y = -om * cs(:, kk)                       ! b_im = -(K - om^2 M) H_im - om C H_re
-        if (f > 0) y = y - matmul(kn(:, 1:f) - om**2 * mn(:, 1:f), b(f + 1:, kk)) &
+        if (f > 0) y = y - matmul(kn(:, 1:f), b(f + 1:, kk)) &
+                       + om**2 * matmul(mn(:, 1:f), b(f + 1:, kk)) &
                        - om * matmul(cn(:, 1:f), b(1:f, kk))
         call proj_multipliers(w, y, lim(:, kk, j), st)
         if (st /= MBD_OK) return
       end do
     end subroutine multipliers
 
+    !> kx = K x (exact, sens_stiffness_mul).
     subroutine kmul(xx, kx)
       real(wp), intent(in) :: xx(:)
       real(wp), intent(out) :: kx(:)

@@ -416,6 +416,7 @@ contains
     end do
     if (status /= MBD_OK) msg = 'statics sensitivities: a band saddle-point solve failed'
   contains
+    !> kx = K x (exact, sens_stiffness_mul).
     subroutine kmul(xx, kx)
       real(wp), intent(in) :: xx(:)
       real(wp), intent(out) :: kx(:)
