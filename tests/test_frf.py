@@ -262,6 +262,11 @@ def test_tables_summary_and_picture(tmp_path: Path) -> None:
     assert f == 0.6755 and mag == pytest.approx(abs(res.response[3, 1, 1]))
     text = res.summary()
     assert "input model.gravity.1" in text and "block.y" in text and "block.x" not in text
+    for kw, needle in [({}, "name one of"), ({"input": "model.gravity.0"}, "no input"),
+                       ({"coordinate": "z", "input": "model.gravity.1"}, "coordinate must"),
+                       ({"body": "wheel", "input": "model.gravity.1"}, "no body 'wheel'")]:
+        with pytest.raises(mbd2d.ModelError, match=needle):
+            res.response_of(**{"body": "block", **kw})
     fig = res.plot("block", "y", input="model.gravity.1")
     mbd2d.plots.save_figure(fig, tmp_path / "bode.png")
     assert (tmp_path / "bode.png").stat().st_size > 1000
