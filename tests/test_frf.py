@@ -262,6 +262,9 @@ def test_tables_summary_and_picture(tmp_path: Path) -> None:
     assert f == 0.6755 and mag == pytest.approx(abs(res.response[3, 1, 1]))
     text = res.summary()
     assert "input model.gravity.1" in text and "block.y" in text and "block.x" not in text
+    assert f"{FREQS.size} frequencies from 0 to 25 Hz" in text
+    assert "from 0.2 to 0.5 Hz" in block().frequency_response("model.gravity.1",
+                                                              [0.5, 0.2]).summary()
     for kw, needle in [({}, "name one of"), ({"input": "model.gravity.0"}, "no input"),
                        ({"coordinate": "z", "input": "model.gravity.1"}, "coordinate must"),
                        ({"body": "wheel", "input": "model.gravity.1"}, "no body 'wheel'")]:

@@ -156,8 +156,7 @@ class FrequencyResponseResult:
         lines = [f"{getattr(self.model, 'name', 'model')}: frequency response about the "
                  f"equilibrium ({self.stability}) at t = {self.t:g}, {self.n_free} free "
                  f"motion(s), {self.frequencies.size} frequencies from "
-                 f"{self.frequencies.min(initial=0.0):g} to "
-                 f"{self.frequencies.max(initial=0.0):g} Hz"]
+                 f"{self.frequencies.min():g} to {self.frequencies.max():g} Hz"]
         scale = np.abs(self.response).max(initial=0.0)
         for name in self.inputs:
             lines.append(f"input {name}: {'coordinate':>18}  {'peak |H|':>12}  at f (Hz)")
