@@ -12,9 +12,10 @@ import numpy as np
 import pytest
 
 import mbd2d
-from test_modes import (SPRUNG, G, ball_on_floor, bisect, block_text, damped_chain,
-                        fourbar_energy, fourbar_reduced, pendulum, rubbing_pendulum,
-                        spring_chain, sprung_fourbar)
+from test_modes import (SPRUNG, G, ball_on_floor, bead_in_slot, bisect, block_text,
+                        damped_chain, distance_bob, fourbar_energy, fourbar_reduced, gear_pair,
+                        pendulum, rack_pinion, rolling_disc, rubbing_pendulum, spring_chain,
+                        sprung_fourbar)
 
 FREQS = np.array([0.0, 0.2, 0.5, 0.6755, 0.7, 1.3, 4.0, 25.0])
 
@@ -173,6 +174,55 @@ def test_a_pendulum_on_a_torsion_spring_driven_by_a_torque() -> None:
     # the pivot stays: the centre moves on its circle, dx = -(L/2) sin(th) dtheta
     np.testing.assert_allclose(res.response_of("bar", "x"),
                                -L / 2 * np.sin(th) * want, rtol=1e-10)
+
+
+@pytest.mark.parametrize("kind", ["rolling disc", "gear pair", "rack and pinion"])
+def test_joints_that_couple_by_rolling(kind: str) -> None:
+    """The rolling disc, gear and rack-and-pinion joints' curvature and coupling: each system
+    has one free motion of effective inertia M (m + I/r^2, I1 + I2 (R1/R2)^2, m + I/r^2),
+    driven through its spring's free length or free angle p: dx/dp = k / (k - M w^2 + i c w);
+    the coupled body follows by the joint's ratio."""
+    c = 0.7
+    w = 2 * np.pi * FREQS
+    if kind == "rolling disc":
+        m, inertia, r, k = 2.0, 0.03, 0.15, 50.0
+        model, name, body, coord = rolling_disc(m, inertia, r, k, c), "force.s.length0", \
+            "disc", "x"
+        mass, follower, ratio = m + inertia / r**2, ("disc", "theta"), -1 / r
+    elif kind == "gear pair":
+        r1, r2, i1, i2, k = 0.5, 1.5, 0.02, 0.3, 8.0
+        model, name, body, coord = gear_pair(r1, r2, i1, i2, k, c), "force.k.angle0", \
+            "pinion", "theta"
+        mass, follower, ratio = i1 + i2 * (r1 / r2)**2, ("wheel", "theta"), -r1 / r2
+    else:
+        m, inertia, r, k = 1.5, 0.01, 0.3, 40.0
+        model, name, body, coord = rack_pinion(m, inertia, r, k, c), "force.s.length0", \
+            "rack", "x"
+        mass, follower, ratio = m + inertia / r**2, ("pinion", "theta"), None
+    res = model.frequency_response(name, FREQS)
+    want = k / (k - mass * w**2 + 1j * c * w)
+    np.testing.assert_allclose(res.response_of(body, coord), want, rtol=1e-12)
+    got = res.response_of(*follower)
+    if ratio is not None:
+        np.testing.assert_allclose(got, ratio * want, rtol=1e-12)
+    else:                          # the pinion turns by the rack's travel over its radius
+        np.testing.assert_allclose(abs(got), abs(want) / r, rtol=1e-12)
+
+
+@pytest.mark.parametrize("kind", ["distance", "point-on-curve"])
+def test_a_bob_on_a_rod_and_a_bead_in_a_slot(kind: str) -> None:
+    """A horizontal force on a bob hung by a distance joint L, or on a bead in a circular
+    slot R: dx = 1 / (m g / L - m w^2) (the joints' curvature under the weight); the bob's
+    free spin does not answer (and makes 0 Hz unbounded, so it is left out)."""
+    length, m = (0.8, 2.0) if kind == "distance" else (1.2, 0.4)
+    model = distance_bob(length=length) if kind == "distance" else bead_in_slot(length)
+    body = "bob" if kind == "distance" else "bead"
+    model.add_point_force(body, [0.0, 0.0], fx=0.0, name="push")
+    f = FREQS[1:]
+    res = model.frequency_response("force.push.fx.poly.0", f)
+    want = 1 / (m * G / length - m * (2 * np.pi * f)**2)
+    np.testing.assert_allclose(res.response_of(body, "x"), want, rtol=1e-12)
+    np.testing.assert_allclose(res.response_of(body, "theta"), 0.0, atol=1e-14)
 
 
 def test_a_pendulum_whose_pivot_is_shaken() -> None:

@@ -883,11 +883,10 @@ gravity = [0.0, {gravity}]
 """)
 
 
-def test_a_disc_rolling_on_a_spring() -> None:
-    """A disc (m, I, r) rolling without slip on the floor, tied by a horizontal spring k at
-    its centre: omega^2 = k / (m + I / r^2); gravity holds it on the floor."""
-    m, inertia, r, k = 2.0, 0.03, 0.15, 50.0
-    model = joint_model(f"""
+def rolling_disc(m: float, inertia: float, r: float, k: float, c: float = 0.0) -> mbd2d.Model:
+    """A disc (m, I, r) rolling without slip on the floor, tied by a horizontal spring-damper
+    (k, c; free length 0.3) at its centre; gravity holds it on the floor."""
+    return joint_model(f"""
 [[body]]
 name = "disc"
 q0 = [0.4, {r + 0.01}, 0.0]
@@ -907,20 +906,26 @@ name = "s"
 bodies = ["ground", "disc"]
 points = [[0.0, {r}], [0.0, 0.0]]
 stiffness = {k}
-damping = 0.0
+damping = {c}
 length0 = 0.3""")
-    res = model.modes()
+
+
+def test_a_disc_rolling_on_a_spring() -> None:
+    """A disc (m, I, r) rolling without slip on the floor, tied by a horizontal spring k at
+    its centre: omega^2 = k / (m + I / r^2); gravity holds it on the floor."""
+    m, inertia, r, k = 2.0, 0.03, 0.15, 50.0
+    res = rolling_disc(m, inertia, r, k).modes()
     assert res.n_free == 1 and abs(res.q[0] - 0.3) < 1e-12 and abs(res.q[1] - r) < 1e-12
     assert abs(res.omega2[0] / (k / (m + inertia / r**2)) - 1) < 1e-9
     phi = res.shape(0)
     assert abs(phi[2] + phi[0] / r) < 1e-12 * abs(phi[2])        # rolls: d theta = -dx / r
 
 
-def test_a_gear_pair_on_a_torsion_spring() -> None:
-    """Gears R1, R2 on ground pivots, the first held by a torsion spring k:
-    omega^2 = k / (I1 + I2 (R1 / R2)^2)."""
-    r1, r2, i1, i2, k = 0.5, 1.5, 0.02, 0.3, 8.0
-    model = joint_model(f"""
+def gear_pair(r1: float, r2: float, i1: float, i2: float, k: float,
+              c: float = 0.0) -> mbd2d.Model:
+    """Gears R1, R2 (a pinion and a wheel) on ground pivots, the pinion held by a torsion
+    spring-damper (k, c) at angle 0."""
+    return joint_model(f"""
 [[body]]
 name = "pinion"
 q0 = [0, 0, 0.1]
@@ -951,20 +956,25 @@ type = "rotational-spring"
 name = "k"
 bodies = ["ground", "pinion"]
 stiffness = {k}
-damping = 0.0
+damping = {c}
 angle0 = 0.0""")
-    res = model.modes()
+
+
+def test_a_gear_pair_on_a_torsion_spring() -> None:
+    """Gears R1, R2 on ground pivots, the first held by a torsion spring k:
+    omega^2 = k / (I1 + I2 (R1 / R2)^2)."""
+    r1, r2, i1, i2, k = 0.5, 1.5, 0.02, 0.3, 8.0
+    res = gear_pair(r1, r2, i1, i2, k).modes()
     assert res.n_free == 1
     assert abs(res.omega2[0] / (k / (i1 + i2 * (r1 / r2)**2)) - 1) < 1e-9
     phi = res.shape(0)
     assert abs(phi[5] / phi[2] + r1 / r2) < 1e-12                   # the mesh: -R1/R2
 
 
-def test_a_rack_on_a_spring_turning_a_pinion() -> None:
-    """A rack (m) on a guide under a pinion (I, r) on a ground pivot, the rack on a spring k:
-    omega^2 = k / (m + I / r^2)."""
-    m, inertia, r, k = 1.5, 0.01, 0.3, 40.0
-    model = joint_model(f"""
+def rack_pinion(m: float, inertia: float, r: float, k: float, c: float = 0.0) -> mbd2d.Model:
+    """A rack (m) on a guide under a pinion (I, r) on a ground pivot, the rack on a
+    spring-damper (k, c; free length 0.5)."""
+    return joint_model(f"""
 [[body]]
 name = "pinion"
 q0 = [0, 0, 0]
@@ -1000,9 +1010,15 @@ name = "s"
 bodies = ["ground", "rack"]
 points = [[-0.5, {-r}], [0.0, 0.0]]
 stiffness = {k}
-damping = 0.0
+damping = {c}
 length0 = 0.5""")
-    res = model.modes()
+
+
+def test_a_rack_on_a_spring_turning_a_pinion() -> None:
+    """A rack (m) on a guide under a pinion (I, r) on a ground pivot, the rack on a spring k:
+    omega^2 = k / (m + I / r^2)."""
+    m, inertia, r, k = 1.5, 0.01, 0.3, 40.0
+    res = rack_pinion(m, inertia, r, k).modes()
     assert res.n_free == 1
     assert abs(res.omega2[0] / (k / (m + inertia / r**2)) - 1) < 1e-9
 
@@ -1036,12 +1052,10 @@ def test_a_pendulum_on_a_distance_joint() -> None:
     assert abs(res.omega2[0]) <= 1e-9 * res.omega2[1]
 
 
-def test_a_bead_in_a_circular_slot() -> None:
-    """A bead (its spin locked) in a circular slot of radius R, the slot's lowest point at
-    the origin: omega^2 = g / R; the joint's extra coordinate (the point's place on the
-    curve, massless) moves with it."""
-    radius = 1.2
-    model = joint_model("""
+def bead_in_slot(radius: float) -> mbd2d.Model:
+    """A bead (0.4 kg, its spin locked) in a circular slot of radius R whose lowest point is
+    the origin."""
+    return joint_model("""
 [[body]]
 name = "bead"
 q0 = [0.3, 0.05, 0.0]
@@ -1059,7 +1073,14 @@ name = "no_spin"
 body = "bead"
 coordinate = "theta"
 """, "")
-    res = model.modes()
+
+
+def test_a_bead_in_a_circular_slot() -> None:
+    """A bead (its spin locked) in a circular slot of radius R, the slot's lowest point at
+    the origin: omega^2 = g / R; the joint's extra coordinate (the point's place on the
+    curve, massless) moves with it."""
+    radius = 1.2
+    res = bead_in_slot(radius).modes()
     assert res.n_free == 1 and abs(res.q[0]) < 1e-12 and abs(res.q[1]) < 1e-12
     assert abs(res.omega2[0] / (G / radius) - 1) < 1e-9
     phi = res.shape(0)
