@@ -20,7 +20,7 @@ module mbd_batch
   use mbd_status, only: MBD_OK, MBD_BAD_INPUT, MBD_BAD_SETTING, MSG_LEN
   use mbd_memory, only: REAL_BYTES, mem_fail
   use mbd_api, only: NINFO, api_kinematics, api_inverse, api_statics, api_dynamics, api_eval, &
-                     api_dynamics_sens, api_modes
+                     api_dynamics_sens, api_modes, api_frf
   use mbd_kinematics, only: MAXPASS
   use mbd_contact, only: NEO
   use mbd_measures, only: api_measures
@@ -29,14 +29,15 @@ module mbd_batch
   implicit none
   private
   public :: batch_run, NISET, NRSET
-  public :: BATCH_KINEMATICS, BATCH_INVERSE, BATCH_STATICS, BATCH_DYNAMICS, BATCH_MODES
+  public :: BATCH_KINEMATICS, BATCH_INVERSE, BATCH_STATICS, BATCH_DYNAMICS, BATCH_MODES, &
+            BATCH_FRF
 
   !> analyses
   integer, parameter :: BATCH_KINEMATICS = 1, BATCH_INVERSE = 2, BATCH_STATICS = 3, &
-                        BATCH_DYNAMICS = 4, BATCH_MODES = 5
+                        BATCH_DYNAMICS = 4, BATCH_MODES = 5, BATCH_FRF = 6
   !> settings: iset = [nsteps, maxit, every, solver, method, max_steps, positions, at_q0]
   !! (positions: 1 = kinematics of the positions alone, qdout and qddout (nq, 0, ncase);
-  !! at_q0: modes about the assembled q0, not the equilibrium);
+  !! at_q0: modes and the frequency response about the assembled q0, not the equilibrium);
   !! rset = [t0, t1, tol, tmin, rtol, atol, h, rho_inf, alpha, beta, t (statics, modes), 0]
   integer, parameter :: NISET = 8, NRSET = 12
 
@@ -51,6 +52,12 @@ contains
   !! qdout and qddout (nq, 0, ncase), lamout (0, modes, ncase), eout (6, modes, ncase) per
   !! mode k [omega^2, kind, s(2k - 1) re, im, s(2k) re, im] (the damped eigenvalues),
   !! qsing the equilibrium, iinfo(1) the free motions, rinfo(1:2) as statics.
+  !! Frequency response (api_frf; rows = the angular frequencies, given in times (rows),
+  !! rad/s; the inputs are the design parameters of ptab): sq and sqd the response's real
+  !! and imaginary parts (nq, np, rows, ncase), sqdd zero, slam (0, np, rows, ncase); qout
+  !! zero, qdout and qddout (nq, 0, ncase), lamout and eout (0, rows, ncase); qsing the
+  !! equilibrium, iinfo(1) the free motions, iinfo(8) a frequency at which the response is
+  !! unbounded, rinfo(1:2) as statics. No measures.
   !! Measures (all or none of the optional arguments; none given or an empty list: no
   !! measures; not with statics): mkind, mint, mpts,
   !! mref as api_measures takes them, times (rows) the output times; mout (nm, rows, ncase)
@@ -66,7 +73,7 @@ contains
                        opens, iset, rset, qout, qdout, qddout, lamout, eout, iinfo, rinfo, &
                        qsing, dep, redundant, status, msg, times, mkind, mint, mpts, mref, &
                        mout, mbad, ptab, sq, sqd, sqdd, slam, mdout)
-    integer, intent(in) :: analysis             !! BATCH_KINEMATICS ... BATCH_DYNAMICS
+    integer, intent(in) :: analysis             !! BATCH_KINEMATICS ... BATCH_FRF
     integer, intent(in) :: nb                   !! moving bodies
     integer, intent(in) :: ctab(:, :), ftab(:, :)  !! constraint and force tables
     real(wp), intent(in) :: rpar(:), bmass(:, :), grav(2), fpar(:)  !! the model's numbers
@@ -133,6 +140,7 @@ contains
     if (ierr == 0 .and. size(opens, 2) > 0) &
       allocate (phi(neq), jac(neq, nq), nu(neq), gam(neq), zq(nq), stat=ierr)
     if (ierr == 0) allocate (eo(NEO, size(ftab, 2), size(qout, 2)), stat=ierr)
+    if (ierr == 0 .and. analysis == BATCH_FRF) allocate (lamw(neq), stat=ierr)
     if (ierr == 0 .and. analysis == BATCH_MODES) allocate (w2(size(qout, 2)), &
       kinds(size(qout, 2)), sre(2 * size(qout, 2)), sim(2 * size(qout, 2)), lamw(neq), &
       stat=ierr)
@@ -251,6 +259,11 @@ contains
                            sre(2 * k), sim(2 * k)]
         end do
         rinfo(1, c) = resid; rinfo(2, c) = real(stable, wp)
+      case (BATCH_FRF)                 ! (check: pt and times present)
+        call api_frf(nb, ctab, r, bm, g, ftab, fp, q0, rset(11), merge(0, 1, iset(8) == 1), &
+                     pt, times, qsing(:, c), lamw, stable, resid, s1, s2, iinfo(:, c), &
+                     status(c), msg(c), iset(4))
+        rinfo(1, c) = resid; rinfo(2, c) = real(stable, wp)
       case default
         if (present(pt)) then
           call api_dynamics_sens(nb, ctab, r, bm, g, ftab, fp, q0, v0, rset(1), rset(2), &
@@ -274,13 +287,13 @@ contains
       integer, intent(out) :: st
       character(len=MSG_LEN), intent(out) :: text
       integer :: j, n(4), nrow
-      logical :: positions
+      logical :: positions, wrong
       st = MBD_BAD_INPUT; text = ''
       positions = (analysis == BATCH_KINEMATICS .and. iset(7) == 1) .or. &
-                  analysis == BATCH_MODES          ! (no velocity rows)
+                  analysis == BATCH_MODES .or. analysis == BATCH_FRF   ! (no velocity rows)
       n = [size(rpar), size(bmass), 2, size(fpar)]
       nrow = size(qout, 2)
-      if (analysis < BATCH_KINEMATICS .or. analysis > BATCH_MODES) then
+      if (analysis < BATCH_KINEMATICS .or. analysis > BATCH_FRF) then
         text = 'batch: unknown analysis'; st = MBD_BAD_SETTING; return
       end if
       if (size(vtab, 1) /= 2 .or. size(vals, 1) /= size(vtab, 2) .or. size(opens, 1) /= 2) then
@@ -315,6 +328,15 @@ contains
           text = 'batch: the modes'' arrays do not match (no measures or sensitivities)'
           return
         end if
+      else if (analysis == BATCH_FRF) then
+        wrong = size(lamout, 1) /= 0 .or. size(eout, 1) /= 0 .or. meas .or. .not. sens .or. &
+                .not. present(times)
+        if (.not. wrong) wrong = size(times) /= nrow
+        if (wrong) then
+          text = 'batch: the frequency response''s arrays do not match (its inputs as the ' &
+                 // 'sensitivities'' parameters, the frequencies as the times, no measures)'
+          return
+        end if
       else if (analysis /= BATCH_KINEMATICS .and. (size(lamout, 1) /= neq .or. &
                size(eout, 1) /= 4)) then
         text = 'batch: multiplier or energy arrays do not match'; return
@@ -324,8 +346,9 @@ contains
       end if
       if (sens) then
         if (any(shape(sq) /= [nq, size(ptab, 2), nrow, ncase]) .or. size(ptab, 1) /= 2 .or. &
-            any(shape(sqd) /= shape(sq)) .or. any(shape(sqdd) /= shape(sq)) .or. positions &
-            .or. size(slam, 1) /= merge(0, neq, analysis == BATCH_KINEMATICS) .or. &
+            any(shape(sqd) /= shape(sq)) .or. any(shape(sqdd) /= shape(sq)) .or. &
+            (positions .and. analysis /= BATCH_FRF) .or. size(slam, 1) /= &
+            merge(0, neq, analysis == BATCH_KINEMATICS .or. analysis == BATCH_FRF) .or. &
             size(slam, 2) /= size(ptab, 2) .or. size(slam, 3) /= nrow .or. &
             size(slam, 4) /= ncase .or. (analysis == BATCH_DYNAMICS .and. &
             iset(5) /= METH_DOPRI5 .and. iset(5) /= METH_GENALPHA)) then

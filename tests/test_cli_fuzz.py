@@ -78,7 +78,11 @@ def _command(rng: random.Random, tmp: Path) -> list[str]:
     if cmd == "sweep":
         argv += ["--workers", "1", "--out", str(tmp / rng.choice(["w.csv", "w.csv", "w.nc", "w.txt"]))]
         if rng.random() < 0.3:
-            argv += ["--analysis", rng.choice(["statics", "inverse_dynamics", "dynamics"])]
+            argv += ["--analysis", rng.choice(["statics", "inverse_dynamics", "dynamics",
+                                               "modes", "frf"])]
+    if cmd in ("sweep", "export") and rng.random() < 0.25:   # a frequency response's inputs
+        argv += ["--input", rng.choice(NAMES + ["model.gravity.1"]),
+                 "--f", rng.choice(["0.1:10:5", "0:3:4"] + NUMBERS)]
     if cmd in ("kinematics", "inverse-dynamics", "dynamics", "export", "plot", "sweep",
                "tolerance") and rng.random() < 0.5:
         for _ in range(rng.randint(1, 2)):

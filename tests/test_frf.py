@@ -476,6 +476,13 @@ def test_the_command_line(tmp_path: Path) -> None:
                                      else []) + bad
         r = cli(*args)
         assert r.returncode == 2 and "Traceback" not in r.stderr, (bad, r.stderr)
-    r = cli("export", str(toml), str(tmp_path / "m.mbd"), "--analysis", "frf", "--input",
+    # a sweep file of the response (tests/test_sweep_frf.py: the sweep's own checks)
+    r = cli("export", str(toml), str(tmp_path / "w.mbd"), "--analysis", "frf", "--input",
             "force.s.f.poly.0", "--f", "1:2:3", "--param", "force.s.stiffness=30:40:3")
-    assert r.returncode == 2 and "not frf" in r.stderr
+    assert r.returncode == 0, r.stderr
+    ds = mbd2d.sweep(mbd2d.load(toml), {"force.s.stiffness": np.linspace(30.0, 40.0, 3)},
+                     "frf", inputs=["force.s.f.poly.0"], frequencies=np.linspace(1, 2, 3),
+                     workers=1)
+    mbd2d.write_sweep(ds, tmp_path / "w.csv")
+    assert solve_file(tmp_path / "w.mbd", tmp_path / "ws.csv") == \
+        (tmp_path / "w.csv").read_text()

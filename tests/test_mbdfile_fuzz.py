@@ -103,6 +103,11 @@ def bases(tmp_path_factory: pytest.TempPathFactory) -> list[bytes]:
     mbd2d.export_sweep(car, f, {"force.front_suspension.damping": [0.0, 1500.0],
                                 "body.rear_wheel.mass": [35.0, 0.0]}, "modes", count=3)
     out.append(f.read_bytes())
+    f = d / "frf_sweep.mbd"
+    mbd2d.export_sweep(car, f, {"force.front_suspension.damping": [0.0, 1500.0],
+                                "body.rear_wheel.mass": [35.0, 0.0]}, "frf",
+                       inputs=["force.front_tyre.points.0.1"], frequencies=[0.0, 1.2, 9.0])
+    out.append(f.read_bytes())
     # sweeps: the cases and opens blocks (a kinematic grid, an inverse dynamics sweep)
     for k, (model, cases, analysis, kw) in enumerate([
             (mbd2d.load(EX / "fourbar_grashof.toml"),

@@ -373,7 +373,11 @@ def test_dask_local_cluster_gives_the_serial_result() -> None:
         damping = {"force.front_suspension.damping": np.linspace(0.0, 3000.0, 9),
                    "force.rear_suspension.damping": np.linspace(3000.0, 0.0, 9)}
         modes_remote = mbd2d.sweep(car, damping, "modes", client=client)
+        # and its frequency response to a road rise under the front wheel
+        road = {"inputs": ["force.front_tyre.points.0.1"], "frequencies": [0.5, 1.2, 8.0]}
+        frf_remote = mbd2d.sweep(car, damping, "frf", client=client, **road)
     assert mbd2d.sweep(car, damping, "modes", workers=1).identical(modes_remote)
+    assert mbd2d.sweep(car, damping, "frf", workers=1, **road).identical(frf_remote)
     assert serial.identical(remote)
     assert tol.dataset.identical(local.dataset)
     assert mbd2d.sweep(incline, fric, workers=1, **fkw).identical(fric_remote)

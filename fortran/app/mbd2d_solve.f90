@@ -116,12 +116,13 @@ program mbd2d_solve
     call run_modes()
     stop 0, quiet=.true.
   end if
-  if (spec%analysis == 'frf') then
+  if (spec%analysis == 'frf' .and. spec%ncase == 0) then
     call run_frf()
     stop 0, quiet=.true.
   end if
   dynamic = spec%analysis /= 'kinematics'
-  if (spec%analysis /= 'statics' .and. spec%analysis /= 'modes' .and. spec%steps_line == 0) &
+  if (spec%analysis /= 'statics' .and. spec%analysis /= 'modes' .and. &
+      spec%analysis /= 'frf' .and. spec%steps_line == 0) &
     call die(2, trim(model_path) // ': the file gives no "steps" line')
   if (dynamic .and. .not. spec%have_masses) call die(2, trim(model_path) // ': ' // &
     trim(spec%analysis) // ' needs the masses: body lines NAME X0 Y0 THETA0 MASS INERTIA '// &
@@ -344,7 +345,7 @@ contains
   subroutine check_sensitivities()
     integer :: c
     sens = spec%npar > 0
-    lam_sens = sens .and. spec%analysis /= 'kinematics'
+    lam_sens = sens .and. spec%analysis /= 'kinematics' .and. spec%analysis /= 'frf'
     if (.not. sens) return
     if (spec%positions_only) call die(2, trim(model_path) // ':' // &
       trim(itoa(spec%sens_line)) // ': sensitivities need the velocities and accelerations '// &
@@ -1143,6 +1144,10 @@ contains
         spec%positions_only .or. spec%out_damped .or. .not. spec%have_masses)) &
       call die(2, trim(model_path) // ': a sweep of modes takes the masses, and no '// &
                'sensitivities, measures, positions_only or outputs')
+    if (spec%analysis == 'frf' .and. (spec%npar == 0 .or. spec%freq_line == 0 .or. &
+        spec%nmeas > 0 .or. spec%out_damped)) &
+      call die(2, trim(model_path) // ': a sweep of frf takes its inputs (a "sensitivities" '// &
+               'block) and a "frequencies" block, and no measures or outputs')
     select case (spec%analysis)
     case ('kinematics')
       code = 1
@@ -1156,8 +1161,8 @@ contains
     case ('statics')
       code = 3
       rset(11) = spec%tstat
-    case ('modes')
-      code = 5
+    case ('modes', 'frf')
+      code = merge(5, 6, spec%analysis == 'modes')
       iset(4) = spec%solver; iset(8) = merge(1, 0, spec%at_q0)
       rset(11) = spec%tstat
     case default
@@ -1167,10 +1172,11 @@ contains
                     spec%rho_inf, spec%alpha, spec%beta]
     end select
     nrow = 1
-    if (code /= 3 .and. code /= 5) nrow = kin_out_count(spec%steps, spec%every)
+    if (code == 1 .or. code == 2 .or. code == 4) nrow = kin_out_count(spec%steps, spec%every)
     if (code == 5) nrow = merge(min(spec%count, nq), nq, spec%count > 0)   ! the modes
-    nd = merge(0, nrow, (code == 1 .and. spec%positions_only) .or. code == 5)
-    nlam = merge(0, neq, code == 1 .or. code == 5); ne = merge(0, 4, code == 1)
+    if (code == 6) nrow = size(spec%freq)                    ! the frequencies
+    nd = merge(0, nrow, (code == 1 .and. spec%positions_only) .or. code >= 5)
+    nlam = merge(0, neq, code == 1 .or. code >= 5); ne = merge(0, 4, code == 1 .or. code == 6)
     if (code == 5) ne = 6
     nsl = merge(neq, 0, lam_sens)
     bytes = REAL_BYTES * real(spec%ncase, wp) * (real(nrow, wp) * (nq + nlam + ne + &
@@ -1201,7 +1207,11 @@ contains
       bm = spec%bmass; bft = spec%ftab; bfp(1:size(spec%fpar)) = spec%fpar
       bv0(1:3 * spec%nb) = reshape(spec%v0, [3 * spec%nb])
     end if
-    call times()
+    if (code == 6) then              ! (the frequency response's times: its omega, rad/s)
+      tout = 2 * 3.141592653589793_wp * spec%freq
+    else
+      call times()
+    end if
     ! the cases in chunks, run in parallel (OpenMP) where the build has it: each case's
     ! numbers depend on its own values alone, so any split gives the same bytes
     nchunk = min(spec%ncase, 64)
@@ -1289,14 +1299,14 @@ contains
     integer, intent(in) :: c
     integer :: n, k
     logical :: clean
-    if (code == 3) then
-      n = merge(1, 0, bstat(c) == MBD_OK)
+    if (code == 3 .or. code == 6) then        ! (frf: every frequency, or none)
+      n = merge(merge(1, nrow, code == 3), 0, bstat(c) == MBD_OK)
     else                             ! (modes: the free motions, at most the modes asked for)
       n = max(0, min(biinfo(1, c), nrow))
     end if
     k = first_bad(c, n)
     clean = bstat(c) == MBD_OK .and. k > n
-    if (code == 3 .or. code == 5) clean = clean .and. ieee_is_finite(brinfo(1, c))
+    if (code >= 5 .or. code == 3) clean = clean .and. ieee_is_finite(brinfo(1, c))
     cstat(c) = 0; cmsg(c) = ''; nkeep(c) = n
     if (bmbad(1, c) /= MBD_OK) then               ! its rows, without its measures
       bmv(:, :, c) = ieee_value(0.0_wp, ieee_quiet_nan)
@@ -1309,7 +1319,7 @@ contains
     if (clean) return
     nkeep(c) = min(n, k - 1)
     cstat(c) = bstat(c)
-    if (bstat(c) < 0 .or. code == 3 .or. code == 5) nkeep(c) = 0
+    if (bstat(c) < 0 .or. code == 3 .or. code >= 5) nkeep(c) = 0
     if (bstat(c) == MBD_OK) cstat(c) = merge(MBD_INTEGRATOR_FAILED, MBD_NO_CONVERGENCE, code == 4)
     if (code == 4) then                      ! dynamics: the Python words where they fit
       cmsg(c) = dynamics_text(c, k)
@@ -1499,6 +1509,10 @@ contains
       call write_modes_sweep_csv(path)
       return
     end if
+    if (code == 6) then
+      call write_frf_sweep_csv(path)
+      return
+    end if
     nlev = merge(3, 1, nd > 0)
     nsl = size(bslam, 1)
     ! at most 26 characters a number ("%.17g": -1.2345678901234567e-308) with its comma; a
@@ -1654,6 +1668,58 @@ contains
     close (u)
     if (ios /= 0) call die(2, 'cannot write ' // path // ' (disk full?)')
   end subroutine write_modes_sweep_csv
+
+  !> The CSV of mbd2d.write_sweep for a frequency response sweep: one row per case and
+  !! frequency (case, the parameters, frequency_hz, status, message, then for each input
+  !! and coordinate d(NAME)/d(INPUT).re, .im); a failed case, one row with its status and
+  !! message.
+  subroutine write_frf_sweep_csv(path)
+    character(len=*), intent(in) :: path
+    character(len=*), parameter :: crlf = achar(13) // achar(10)
+    character(len=:), allocatable :: line, head, tail
+    integer :: u, ios, j, k, c, p, lp, nh, nt, width
+    width = 26 * (spec%ncp + 1 + 2 * nq * spec%npar) + 32
+    call open_sweep_csv(path, width, u, ios, head, tail, line)
+    call sput(u, ios, ',frequency_hz,status,message')
+    do p = 1, spec%npar              ! (the coordinates as coordinate_header names them)
+      do j = 1, spec%nb
+        do k = 1, 3
+          call pair_header(u, ios, trim(spec%body_names(j)) // '.' // trim(XYT(k)), &
+                           trim(spec%par_names(p)))
+        end do
+      end do
+      do j = 1, spec%nc
+        do k = 1, con_nextra(spec%ctab(1, j))
+          call pair_header(u, ios, trim(spec%con_names(j)) // '.alpha', &
+                           trim(spec%par_names(p)))
+        end do
+      end do
+    end do
+    call sput(u, ios, crlf)
+    do c = 1, spec%ncase
+      call case_fields(c, head, nh, tail, nt)
+      if (nkeep(c) == 0) then
+        call sput(u, ios, head(1:nh) // ',' // tail(1:nt) // crlf)
+        cycle
+      end if
+      do k = 1, nkeep(c)
+        lp = 0
+        call bput(line, lp, head(1:nh))
+        call bnum(line, lp, spec%freq(k))
+        call bput(line, lp, tail(1:nt))
+        do p = 1, spec%npar          ! (+ 0: no negative zero, as the Python writer)
+          do j = 1, nq
+            call bnum(line, lp, bsq(j, p, k, c) + 0.0_wp)
+            call bnum(line, lp, bsqd(j, p, k, c) + 0.0_wp)
+          end do
+        end do
+        call bput(line, lp, crlf)
+        call sput(u, ios, line(1:lp))
+      end do
+    end do
+    close (u)
+    if (ios /= 0) call die(2, 'cannot write ' // path // ' (disk full?)')
+  end subroutine write_frf_sweep_csv
 
   !> Row k of case c's derivatives along parameter p: the motion's, the efforts'
   !! (-dlambda/dp of the driver rows), then the measures'.

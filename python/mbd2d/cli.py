@@ -12,7 +12,8 @@
               [--out FRF.csv --picture BODE.png --body B --coordinate x|y|theta]
     mbd2d sweep MODEL.toml --param NAME=START:STOP:NUM ... [--grid] --t-end T --steps N
                 --out sweep.nc|sweep.csv [--analysis A --t0 T0 --every K --workers W
-                --scheduler ADDRESS --positions-only --method M --rtol R --atol A --h H]
+                --scheduler ADDRESS --positions-only --method M --rtol R --atol A --h H
+                --input NAME --f START:STOP:NUM --log (--analysis frf)]
     mbd2d tolerance MODEL.toml --sigma NAME=STD ... --t-end T --steps N --out tol.csv|tol.nc
                     [--samples N --seed S --analysis A --point BODY:X,Y --workers W
                     --scheduler ADDRESS --method M --rtol R --atol A --h H]
@@ -254,7 +255,9 @@ def _parser() -> argparse.ArgumentParser:
     w.add_argument("--grid", action="store_true", help="every combination of the values "
                    "(default: the i-th value of every parameter together; equal NUM)")
     _study_settings(w, "the analysis (default kinematics; modes: the frequencies, damping "
-                    "and shapes of every case)", modes=True)
+                    "and shapes of every case; frf: every case's frequency response to "
+                    "--input at --f)", modes=True)
+    _frf_settings(w, required=False)
     _study_integrator(w)
     w.add_argument("--positions-only", action="store_true",
                    help="kinematics: positions alone (no velocities or accelerations)")
@@ -268,7 +271,8 @@ def _parser() -> argparse.ArgumentParser:
     w.add_argument("--plot", default=None, metavar="FIG.png",
                    help="also draw the measures of every case (needs --measure): over time "
                    "coloured by the first parameter, and each case's worst transmission "
-                   "angle or range against it")
+                   "angle or range against it (frf: every case's Bode plot of the "
+                   "coordinates that move most, and its peak against the parameter)")
     r = sub.add_parser("parameters", help="the design parameters of a model: name = value")
     r.add_argument("model", help="model file (.toml)")
     r.add_argument("--match", default=None, metavar="TEXT",
@@ -503,10 +507,11 @@ def _study_settings(p: argparse.ArgumentParser, analysis_help: str,
     """The analysis and output times of a study (sweep; tolerance without modes)."""
     p.add_argument("--analysis", default="kinematics",
                    choices=["kinematics", "inverse_dynamics", "statics", "dynamics"]
-                   + (["modes"] if modes else []), help=analysis_help)
+                   + (["modes", "frf"] if modes else []), help=analysis_help)
     p.add_argument("--t-end", type=float, default=None, help="final time")
     p.add_argument("--steps", type=int, default=None, help="output intervals")
-    p.add_argument("--t0", type=float, default=0.0, help="start time (statics: its time)")
+    p.add_argument("--t0", type=float, default=0.0, help="start time (statics, modes, frf: "
+                   "its time)")
     p.add_argument("--every", type=int, default=1, help="keep every k-th row (and the last)")
 
 
@@ -529,7 +534,16 @@ def _study_dynamics(args: argparse.Namespace) -> dict[str, Any]:
 
 def _study_span(args: argparse.Namespace) -> dict[str, Any]:
     """The settings of a study's analysis from --t0, --t-end, --steps, --every (statics and
-    modes: t)."""
+    modes: t; frf: t, and its inputs and frequencies)."""
+    frf = getattr(args, "input", None) is not None or getattr(args, "f", None) is not None
+    if frf != (args.analysis == "frf"):
+        raise ModelError("--analysis frf needs --input NAME and --f START:STOP:NUM; they are "
+                         "its settings alone", "command line")
+    if args.analysis == "frf":
+        if args.input is None or args.f is None:
+            raise ModelError("--analysis frf needs --input NAME and --f START:STOP:NUM",
+                             "command line")
+        return {"t": args.t0, "inputs": args.input, "frequencies": _frequencies(args)}
     if args.analysis in ("statics", "modes"):
         return {"t": args.t0}
     if args.t_end is None or args.steps is None:
@@ -831,9 +845,9 @@ def _export_sweep(model: Model, args: argparse.Namespace) -> int:
         raise ModelError("a sweep file writes the sweep's columns (and --measure, "
                          "--sensitivities): no --energy, --multipliers, --reactions or "
                          "--efforts with --param", "command line")
-    if args.analysis in ("check", "frf"):
-        raise ModelError("a sweep runs kinematics, inverse-dynamics, dynamics, statics or "
-                         f"modes, not {args.analysis}", "command line")
+    if args.analysis == "check":
+        raise ModelError("a sweep runs kinematics, inverse-dynamics, dynamics, statics, "
+                         "modes or frf, not check", "command line")
     span = {"t_end": args.t_end, "steps": args.steps, "t0": args.t0, "every": args.every}
     kw: dict[str, Any] = {
         "kinematics": dict(span, tol=args.tol, solver=args.solver,
@@ -842,8 +856,10 @@ def _export_sweep(model: Model, args: argparse.Namespace) -> int:
         "statics": {"t": args.t},
         "modes": {"t": args.t, "count": args.count, "equilibrium": not args.at_q0,
                   "solver": args.solver},
+        "frf": {"t": args.t, "inputs": args.input, "frequencies": _frequencies(args),
+                "equilibrium": not args.at_q0, "solver": args.solver},
         "dynamics": dict(span, **_dynamics_kwargs(args))}[args.analysis]
-    timed = args.analysis not in ("statics", "modes")
+    timed = args.analysis not in ("statics", "modes", "frf")
     if timed and (args.t_end is None or args.steps is None):
         raise ModelError(f"{args.analysis} needs --t-end and --steps", "command line")
     cases = _cases(args)
@@ -860,12 +876,12 @@ def _sweep(model: Model, args: argparse.Namespace) -> int:
     from .studies import connect, sweep, write_sweep
     if not str(args.out).endswith((".nc", ".csv")):
         raise ModelError(f"--out must end in .nc or .csv, got {args.out!r}", "command line")
-    if args.plot is not None and not args.measure:
+    if args.plot is not None and not args.measure and args.analysis != "frf":
         raise ModelError("--plot draws the sweep's measures: give --measure SPEC",
                          "command line")
     cases = _cases(args)
     kw = _study_span(args)
-    if args.analysis not in ("statics", "modes"):
+    if args.analysis not in ("statics", "modes", "frf"):
         kw.update(_study_dynamics(args))
         if args.positions_only:
             kw["positions_only"] = True

@@ -11,7 +11,7 @@ from ..binding.pack import pack, pack_dynamics
 from ..binding.status import NO_CONVERGENCE, SINGULAR, error_for
 from ..description.builder import ModelDescription
 from ..description.parameters import Parameter
-from ..errors import ModelError
+from ..errors import MbdError, ModelError
 from ..results.frf import FrequencyResponseResult
 from ..validate import flag, number
 from .contacts import check_statics
@@ -35,18 +35,10 @@ def run_frf(model: ModelDescription, inputs: Any, frequencies: Any, t: float = 0
     ptab = table(p, params, d)
     out = core.frf(p, d, t, equilibrium, ptab, 2 * np.pi * freq, code)
     check_status(out.status, out.iinfo, out.msg, params)
-    if out.status == SINGULAR and 0 < int(out.iinfo[7]) <= freq.size:
-        f = freq[int(out.iinfo[7]) - 1]
-        out.msg = (f"{out.msg}: the response at {f:g} Hz is unbounded; leave that frequency "
-                   "out or give the mode damping")
-    exc = statics_error(model, p, out, t, analysis="frf")
+    h = np.moveaxis(out.hre + 1j * out.him, 2, 0)           # (nw, nq, np)
+    exc = frf_error(model, p, out, t, freq, [h, out.lre, out.lim])
     if exc is not None:
         raise exc
-    h = np.moveaxis(out.hre + 1j * out.him, 2, 0)           # (nw, nq, np)
-    if not (np.isfinite(h).all() and np.isfinite(out.lre).all() and np.isfinite(out.lim).all()):
-        raise error_for("frf", NO_CONVERGENCE, "frequency response: the response is not "
-                        "finite (the linearized equations are singular)", t=t,
-                        residual=float(out.resid))
     stability = STABILITY.get(int(out.stable), "not examined (equilibrium=False)")
     return FrequencyResponseResult(
         t=t, q=out.q, lam=out.lam, stability=stability, residual=float(out.resid),
@@ -55,6 +47,26 @@ def run_frf(model: ModelDescription, inputs: Any, frequencies: Any, t: float = 0
         lam_response=np.moveaxis(out.lre + 1j * out.lim, 2, 0), ptab=ptab,
         coordinate_names=p.coordinate_names, model=model, packed=p,
         stats={"solver": "banded" if int(out.iinfo[4]) == 2 else "dense"})
+
+
+def frf_error(model: ModelDescription, p: Any, out: Any, t: float, freq: np.ndarray,
+              arrays: list[np.ndarray]) -> MbdError | None:
+    """The exception a frequency response ends in, or None when it is finite.
+
+    ``out`` carries the core's ``status``, ``msg``, ``iinfo``, ``q``, ``lam`` and ``resid``
+    (the equilibrium's, as for :func:`statics_error`); freq the frequencies (Hz); arrays the
+    response's arrays, which must be finite. An unbounded response names its frequency.
+    """
+    if out.status == SINGULAR and 0 < int(out.iinfo[7]) <= freq.size:
+        f = freq[int(out.iinfo[7]) - 1]
+        out.msg = (f"{out.msg}: the response at {f:g} Hz is unbounded; leave that frequency "
+                   "out or give the mode damping")
+    exc = statics_error(model, p, out, t, analysis="frf")
+    if exc is None and not all(np.isfinite(a).all() for a in arrays):
+        exc = error_for("frf", NO_CONVERGENCE, "frequency response: the response is not "
+                        "finite (the linearized equations are singular)", t=t,
+                        residual=float(out.resid))
+    return exc
 
 
 def frf_inputs(model: ModelDescription, inputs: Any) -> list[Parameter]:

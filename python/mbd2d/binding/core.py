@@ -345,7 +345,8 @@ def batch(b: BatchTables, vals: np.ndarray) -> dict[str, Any]:
     vals = np.asfortranarray(vals, dtype=np.float64)
     ncase = vals.shape[1]
     m = b.measures if len(b.measures.specs) else _ONE_MEASURE    # (f2py: no zero-length table)
-    times = b.times if len(b.measures.specs) else np.zeros(b.nrow)
+    # (the frequency response's times: its angular frequencies)
+    times = b.times if len(b.measures.specs) or b.analysis == 6 else np.zeros(b.nrow)
     ptab = b.ptab if b.npar else np.ones((2, 1), dtype=np.int32, order="F")
     out = _named("q qd qdd lam e iinfo rinfo qsing dep red m mbad sq sqd sqdd slam dm status "
                  "msg",

@@ -81,7 +81,8 @@ class BatchTables:
     Dask workers get it whole."""
 
     analysis: int               # 1 kinematics, 2 inverse dynamics, 3 statics, 4 dynamics,
-    #                             5 modes (rows: the modes)
+    #                             5 modes (rows: the modes), 6 frequency response (rows: the
+    #                             frequencies, given as times in rad/s; ptab: the inputs)
     nb: int
     ctab: np.ndarray            # int32 (NCT, nc)
     rpar: np.ndarray            # float64
@@ -112,8 +113,8 @@ class BatchTables:
     @property
     def nd(self) -> int:
         """Rows of the velocities and accelerations: 0 for positions-only kinematics and for
-        modes."""
-        return 0 if (self.analysis == 1 and int(self.iset[6]) == 1) or self.analysis == 5 \
+        modes and the frequency response."""
+        return 0 if (self.analysis == 1 and int(self.iset[6]) == 1) or self.analysis in (5, 6) \
             else self.nrow
 
     @property

@@ -12,6 +12,7 @@ import numpy as np
 
 from ..errors import ModelError
 from .canvas import STOP_COLOUR, add_legend, new_figure
+from .sweep_bode import plot_sweep_frf
 from .timeseries import MU_WINDOW
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -93,9 +94,10 @@ def case_summary(name: str, v: np.ndarray) -> tuple[np.ndarray, np.ndarray | Non
 
 def plot_sweep(ds: Any, measures: Sequence[str] | None = None,
                coordinates: Sequence[str] | None = None,
-               parameter: str | None = None) -> "Figure":
+               parameter: str | None = None, input: str | None = None) -> "Figure":
     """Plot a sweep's family: each quantity over time for every case, and each case's
-    summary against a swept parameter.
+    summary against a swept parameter; for a frequency response sweep, each coordinate's
+    Bode magnitude and phase for every case, and each case's peak and its frequency.
 
     Parameters
     ----------
@@ -105,9 +107,12 @@ def plot_sweep(ds: Any, measures: Sequence[str] | None = None,
         Measures of the sweep to draw (default: all of them when no coordinate is named).
     coordinates : sequence of str, optional
         Coordinates to draw (``"rocker.theta"`` ...): their values over time, and each
-        case's least and greatest value.
+        case's least and greatest value (a frequency response sweep: their responses;
+        default the three that move most).
     parameter : str, optional
         The swept parameter the colours and the summary follow (default: the first).
+    input : str, optional
+        A frequency response sweep's input drawn (default: the first).
 
     Returns
     -------
@@ -120,6 +125,13 @@ def plot_sweep(ds: Any, measures: Sequence[str] | None = None,
         coordinate or parameter, or nothing to draw.
     """
     par = _parameter(ds, parameter)
+    if ds.attrs.get("run") == "frf":
+        if measures is not None:
+            raise ModelError("a frequency response sweep has no measures; name its "
+                             "coordinates=[...]", "plot_sweep")
+        return plot_sweep_frf(ds, par, coordinates, input)
+    if input is not None:
+        raise ModelError("input= names a frequency response sweep's input", "plot_sweep")
     if ds.sizes.get("time", 0) < 2 or ds.attrs.get("run") == "statics":
         raise ModelError("plot_sweep draws a sweep over time (kinematics, inverse dynamics, "
                          "dynamics), not statics", "plot_sweep")

@@ -8,6 +8,7 @@ from typing import Any, Sequence
 import numpy as np
 
 from ..analysis.dynamics import dynamics_error
+from ..analysis.frf import frf_error
 from ..analysis.inverse import inverse_error
 from ..analysis.kinematics import kinematics_error
 from ..analysis.outputs import dynamics_result, finite_part
@@ -88,14 +89,14 @@ def outcomes(pl: Plan, model: ModelDescription, out: Outputs, names: Sequence[st
     """
     ncase = len(out.status)
     a = out.arrays
-    if pl.analysis == "statics":
-        n = np.where(out.status == OK, 1, 0)
+    if pl.analysis in ("statics", "frf"):      # (the frequency response: all or nothing)
+        n = np.where(out.status == OK, 1 if pl.analysis == "statics" else pl.tables.nrow, 0)
     else:               # (modes: the free motions, at most the modes asked for)
         n = a["iinfo"][0].astype(np.int64).clip(0, pl.tables.nrow)
     fin = _finite_rows(pl, out)
     inside = np.arange(fin.shape[0])[:, None] < n[None, :]
     clean = (out.status == OK) & ~((~fin) & inside).any(axis=0)
-    if pl.analysis in ("statics", "modes"):
+    if pl.analysis in ("statics", "modes", "frf"):
         clean &= np.isfinite(a["rinfo"][0])
     rows = np.where(clean, n, 0)
     status = np.zeros(ncase, dtype=np.int32)
@@ -129,6 +130,11 @@ def _failure(pl: Plan, model: ModelDescription, c: SimpleNamespace, n: int,
     try:
         if pl.tables.npar:            # a design parameter the core refused
             check_status(c.status, c.iinfo, c.msg, find(model, pl.tables.sensitivities))
+        if pl.analysis == "frf":
+            eq = SimpleNamespace(status=c.status, msg=c.msg, iinfo=c.iinfo, q=c.qsing,
+                                 lam=np.zeros(0), resid=c.resid)
+            return frf_error(model, own() if c.status == INCONSISTENT else p, eq, pl.t0, t,
+                             [c.sq, c.sqd])
         if pl.analysis in ("statics", "modes"):
             return statics_error(model, own() if c.status == INCONSISTENT else p, c, pl.t0,
                                  analysis=pl.analysis)
@@ -200,8 +206,9 @@ def to_dataset(pl: Plan, analysis: str, model: ModelDescription, out: Outputs,
         return _per_case(x, keep)
 
     a = out.arrays
-    if pl.analysis == "modes":
-        data, coords = _modes_data(pl, a, status == 0, keep)
+    if pl.analysis in ("modes", "frf"):
+        data, coords = (_modes_data(pl, a, status == 0, keep) if pl.analysis == "modes" else
+                        _frf_data(pl, a, status == 0))
         return xr.Dataset(_case_columns(data, coords, status, messages, names, values),
                           coords=coords, attrs=_attrs(pl, analysis, model, names, status))
     cube = ("case", "time", "coordinate")
@@ -262,7 +269,8 @@ def _attrs(pl: Plan, analysis: str, model: ModelDescription, names: Sequence[str
     """The Dataset's attributes: the analysis, its settings and the count of failures."""
     attrs = {"analysis": analysis, "run": pl.analysis, "model": model.name,
              "parameters": ", ".join(names),
-             "settings": ", ".join(f"{k}={v!r}" for k, v in pl.settings.items()),
+             "settings": ", ".join(f"{k}={v!r}" for k, v in pl.settings.items()
+                                   if k != "frequencies"),     # (a frf's: a coordinate)
              "failed": int((status != 0).sum())}
     if pl.method:
         attrs["method"] = pl.method
@@ -302,6 +310,28 @@ def _modes_data(pl: Plan, a: dict[str, np.ndarray], ran: np.ndarray, keep: np.nd
     coords: dict[str, Any] = {"case": np.arange(len(ran)), "mode": np.arange(nm),
                               "eigenvalue": np.arange(2 * nm),
                               "coordinate": list(p.coordinate_names)}
+    return data, coords
+
+
+def _frf_data(pl: Plan, a: dict[str, np.ndarray], ran: np.ndarray
+              ) -> tuple[dict[str, Any], dict[str, Any]]:
+    """A frequency response sweep's variables: ``response`` (complex amplitudes over case,
+    frequency, coordinate, input; NaN for a failed case), per case the equilibrium ``q``,
+    ``n_free``, ``stability`` and ``residual``; and the coordinates (frequency in Hz). ran:
+    (case) the cases that completed."""
+    p, b = pl.packed, pl.tables
+    h = np.transpose(a["sq"] + 1j * a["sqd"], (3, 2, 0, 1))    # (case, frequency, nq, input)
+    h[~ran] = np.nan
+    data: dict[str, Any] = {
+        "response": (("case", "frequency", "coordinate", "input"), h),
+        "q": (("case", "coordinate"), np.where(ran[:, None], a["qsing"].T, np.nan)),
+        "n_free": ("case", np.where(ran, a["iinfo"][0], -1).astype(np.int64)),
+        "stability": ("case", np.array([STABILITY.get(int(s), "not examined") if k else ""
+                                        for s, k in zip(a["rinfo"][1], ran)], dtype=object)),
+        "residual": ("case", np.where(ran, a["rinfo"][0], np.nan))}
+    coords: dict[str, Any] = {"case": np.arange(len(ran)), "frequency": pl.times.copy(),
+                              "coordinate": list(p.coordinate_names),
+                              "input": list(b.sensitivities)}
     return data, coords
 
 

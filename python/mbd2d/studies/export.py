@@ -15,7 +15,7 @@ from .plan import case_values, plan, with_cases, with_measures, with_sensitiviti
 #: the file's analysis for the sweep's plan (kinematics of a model with masses runs as
 #: inverse dynamics, as in the sweep)
 FILE_ANALYSIS = {"kinematics": "kinematics", "inverse": "inverse-dynamics",
-                 "statics": "statics", "dynamics": "dynamics", "modes": "modes"}
+                 "statics": "statics", "dynamics": "dynamics", "modes": "modes", "frf": "frf"}
 
 
 def export_sweep(model: Any, path: str | Path, cases: Any, analysis: str = "kinematics",
@@ -32,7 +32,7 @@ def export_sweep(model: Any, path: str | Path, cases: Any, analysis: str = "kine
         The file to write (.mbd).
     cases : dict or pandas.DataFrame
         As :func:`mbd2d.sweep` (:func:`mbd2d.grid` builds a full-factorial table).
-    analysis : {"kinematics", "inverse_dynamics", "statics", "dynamics", "modes"}
+    analysis : {"kinematics", "inverse_dynamics", "statics", "dynamics", "modes", "frf"}
         As :func:`mbd2d.sweep`.
     measures : str or list of str, optional
         As :func:`mbd2d.sweep`: columns of every case (an angle's points given with the

@@ -41,7 +41,11 @@ def write_sweep(ds: Any, path: str | Path) -> None:
     then for each design parameter P of a sweep with sensitivities ``d(COLUMN)/d(P)`` of
     the motion columns, the efforts and the measures. A modes sweep: one row per case and
     mode, ``case``, the parameters, ``mode``, ``status``, ``message``, ``omega2``,
-    ``frequency_hz``, ``kind``, the shape per coordinate.
+    ``frequency_hz``, ``kind``, the shape per coordinate. A frequency response sweep: one
+    row per case and frequency, ``case``, the parameters, ``frequency_hz``, ``status``,
+    ``message``, then for each input and coordinate ``d(NAME)/d(INPUT).re`` and ``.im``
+    (the columns of :meth:`FrequencyResponseResult.to_csv`). netCDF keeps the complex
+    ``response`` as xarray writes complex numbers through h5netcdf.
 
     Raises
     ------
@@ -80,8 +84,8 @@ def _params(ds: Any) -> list[str]:
 
 
 def _csv(ds: Any, path: Path) -> None:
-    if ds.attrs.get("run") == "modes":
-        _modes_csv(ds, path)
+    if ds.attrs.get("run") in ("modes", "frf"):
+        (_modes_csv if ds.attrs["run"] == "modes" else _frf_csv)(ds, path)
         return
     params = _params(ds)
     coords = [str(c) for c in ds.coordinate.values]
@@ -143,6 +147,30 @@ def _modes_csv(ds: Any, path: Path) -> None:
             for k in modes:
                 w.writerow(head + [k, st, msg, _g(w2[c, k]), _g(f[c, k]), _g(kind[c, k])]
                            + [_g(v) for v in shape[c, k]])
+
+
+def _frf_csv(ds: Any, path: Path) -> None:
+    """A frequency response sweep: one row per case and frequency (see write_sweep); a case
+    without a response gets one row with its status and message."""
+    params = _params(ds)
+    coords = [str(c) for c in ds.coordinate.values]
+    header = ["case", *params, "frequency_hz", "status", "message",
+              *(f"d({c})/d({i}).{part}" for i in ds.input.values for c in coords
+                for part in ("re", "im"))]
+    h = np.moveaxis(ds.response.values, 3, 2)                # (case, frequency, input, nq)
+    parts = np.stack([h.real, h.imag], axis=4).reshape(h.shape[0], h.shape[1], -1) + 0.0
+    f = ds.frequency.values
+    with open(path, "w", newline="", encoding="utf-8") as fh:
+        w = csv.writer(fh)
+        w.writerow(header)
+        for c in range(ds.sizes["case"]):
+            head = [c, *(_g(ds[n].values[c]) for n in params)]
+            st, msg = int(ds.status.values[c]), str(ds.message.values[c])
+            if st != 0:
+                w.writerow(head + ["", st, msg])
+                continue
+            for k in range(len(f)):
+                w.writerow(head + [_g(f[k]), st, msg] + [_g(v) for v in parts[c, k]])
 
 
 def _sensitivity_columns(ds: Any) -> tuple[np.ndarray, list[str]]:

@@ -12,6 +12,7 @@ import numpy as np
 
 from ..analysis.contacts import check_statics
 from ..analysis.dynamics import dynamics_settings
+from ..analysis.frf import frf_inputs, frequency_list
 from ..analysis.modes import mode_count
 from ..analysis.sensitivities import check_sens_method, check_positions_only, requested, table
 from ..analysis.settings import (check_memory, check_solver, check_span, output_rows,
@@ -27,7 +28,9 @@ from ..results.measures import measure_tables
 from ..validate import flag, number
 
 #: the analyses a sweep runs, by the Model method's name, and the core's batch code
-ANALYSES = {"kinematics": 1, "inverse_dynamics": 2, "statics": 3, "dynamics": 4, "modes": 5}
+#: ("frf": the frequency response, :meth:`mbd2d.Model.frequency_response`)
+ANALYSES = {"kinematics": 1, "inverse_dynamics": 2, "statics": 3, "dynamics": 4, "modes": 5,
+            "frf": 6}
 MAX_CASES = 10**8
 
 
@@ -174,6 +177,11 @@ def _modes_settings(t: Any = 0.0, count: Any = None, equilibrium: Any = True,
     """Settings of a modes sweep (as :meth:`mbd2d.Model.modes`)."""
 
 
+def _frf_settings(inputs: Any, frequencies: Any, t: Any = 0.0, equilibrium: Any = True,
+                  solver: Any = "auto") -> None:
+    """Settings of a frequency response sweep (as :meth:`mbd2d.Model.frequency_response`)."""
+
+
 def _dynamics_settings(t_end: Any, steps: Any, method: Any = None, rtol: Any = None,
                        atol: Any = None, h: Any = None, rho_inf: Any = None, alpha: Any = None,
                        beta: Any = None, t0: Any = 0.0, every: Any = 1,
@@ -224,6 +232,8 @@ def plan(model: ModelDescription, names: Sequence[str], analysis: Any,
         return _statics(model, params, _bind(_statics_settings, kw, analysis))
     if analysis == "modes":
         return _modes(model, params, _bind(_modes_settings, kw, analysis))
+    if analysis == "frf":
+        return _frf(model, params, _bind(_frf_settings, kw, analysis))
     return _dynamics(model, params, _bind(_dynamics_settings, kw, analysis))
 
 
@@ -279,6 +289,24 @@ def _modes(model: ModelDescription, params: list[Parameter], a: dict[str, Any]) 
     return Plan("modes", b, p, params, np.array([t]), a, t0=t)
 
 
+def _frf(model: ModelDescription, params: list[Parameter], a: dict[str, Any]) -> Plan:
+    """The frequency response's plan: its inputs as the batch's parameters (ptab), the
+    angular frequencies as its times; the plan's times are the frequencies in Hz."""
+    t = number(a["t"], "t", "frequency response")
+    about_q0 = not flag(a["equilibrium"], "equilibrium", "frequency response")
+    code = solver_code(a["solver"])
+    freq = frequency_list(a["frequencies"])
+    inputs = frf_inputs(model, a["inputs"])
+    p = pack(model)
+    d = pack_dynamics(model, p)
+    b = _tables(6, p, d, [0, 0, 1, code, 0, 0, 0, int(about_q0)], [0.0] * 10 + [t],
+                freq.size, 0, 0)
+    b.times = 2 * np.pi * freq
+    b.ptab = table(p, inputs, d)
+    b.sensitivities = [prm.name for prm in inputs]
+    return Plan("frf", b, p, params, freq, a, t0=t)
+
+
 def _dynamics(model: ModelDescription, params: list[Parameter], a: dict[str, Any]) -> Plan:
     t0, t_end, steps, nrow, times = _span(a)
     st = dynamics_settings(a["method"], a["rtol"], a["atol"], a["h"], a["rho_inf"], a["alpha"],
@@ -318,11 +346,12 @@ def with_measures(pl: Plan, model: ModelDescription, specs: Any) -> None:
         For a spec the model does not have, or measures of a statics sweep.
     """
     t = measure_tables(model, pl.packed, specs, moved=True)
-    if t.specs and pl.analysis in ("statics", "modes"):
+    if t.specs and pl.analysis in ("statics", "modes", "frf"):
         raise ModelError(f"measures are columns of a run over time, not of {pl.analysis}",
                          "sweep")
     pl.tables.measures = t
-    pl.tables.times = np.ascontiguousarray(pl.times, dtype=np.float64)
+    if pl.analysis != "frf":                      # (its times: the angular frequencies)
+        pl.tables.times = np.ascontiguousarray(pl.times, dtype=np.float64)
 
 
 def with_sensitivities(pl: Plan, model: ModelDescription, names: Any) -> None:
@@ -342,6 +371,10 @@ def with_sensitivities(pl: Plan, model: ModelDescription, names: Any) -> None:
     if pl.analysis == "modes":
         raise ModelError("a modes sweep computes no design sensitivities (the frequencies' "
                          "change: sweep the parameter)", "sweep")
+    if pl.analysis == "frf":
+        raise ModelError("a frequency response sweep computes no design sensitivities (its "
+                         "inputs= are the parameters varied harmonically; the response's "
+                         "change with a design parameter: sweep that parameter)", "sweep")
     b = pl.tables
     check_positions_only(params, b.nd == 0 and pl.analysis == "kinematics")
     check_sens_method(params, pl.method or "dopri5", "sweep")

@@ -33,12 +33,18 @@ def sweep(model: ModelDescription, cases: Any, analysis: str = "kinematics", cli
         Parameter name (see ``model.parameters()``) -> 1-D values, one case per index, all
         of one length; or a DataFrame whose columns are parameter names.
         :func:`mbd2d.grid` builds a full-factorial table.
-    analysis : {"kinematics", "inverse_dynamics", "statics", "dynamics", "modes"}
+    analysis : {"kinematics", "inverse_dynamics", "statics", "dynamics", "modes", "frf"}
         The analysis, by the name of the Model method ("modes": per case and mode
         ``omega2``, ``frequency``, ``kind``, ``shape``, per case and damped eigenvalue
         ``s_real``, ``s_imag``, ``damping_ratio``, ``damped_frequency``, per case the
         equilibrium ``q``, ``n_free``, ``stability``, ``residual``; every case's as its own
-        ``modes()`` gives them, bit for bit); "kinematics" of a model with masses
+        ``modes()`` gives them, bit for bit; "frf", the frequency response
+        (:meth:`mbd2d.Model.frequency_response`, settings ``inputs``, ``frequencies``, ``t``,
+        ``equilibrium``, ``solver``): the complex ``response`` over ("case", "frequency",
+        "coordinate", "input"), the frequencies in Hz, and per case the equilibrium ``q``,
+        ``n_free``, ``stability``, ``residual``; a case whose response fails (an undamped
+        resonance among the frequencies, no equilibrium) is NaN with its status and
+        message); "kinematics" of a model with masses
         is inverse dynamics, as :meth:`mbd2d.Model.kinematics`.
     client : distributed.Client, optional
         Run the batches on a Dask cluster (as futures, gathered into the same Dataset,
@@ -61,7 +67,7 @@ def sweep(model: ModelDescription, cases: Any, analysis: str = "kinematics", cli
     **analysis_kwargs
         The analysis's settings, as for the Model method (``t_end``, ``steps``, ``t0``,
         ``every``, ``tol``, ``solver``; ``method``, ``rtol``, ``atol``, ``h`` ... for
-        dynamics; ``t`` for statics).
+        dynamics; ``t`` for statics; ``inputs``, ``frequencies`` for frf).
 
     Returns
     -------
