@@ -123,7 +123,7 @@ def test_demo_script(tmp_path: Path) -> None:
                           cwd=tmp_path, capture_output=True, text=True, timeout=600)
     assert proc.returncode == 0, proc.stdout + proc.stderr
     pngs = sorted(out.glob("*.png"))
-    assert len(pngs) == 19, [p.name for p in pngs]
+    assert len(pngs) == 20, [p.name for p in pngs]
     for name in ["fourbar_seed", "fourbar_grashof", "slider_crank", "cam_follower"]:
         for kind in ["mechanism", "timeseries"]:
             p = out / f"{name}_{kind}.png"
@@ -144,7 +144,7 @@ def test_demo_script(tmp_path: Path) -> None:
     assert "the same CSV: True" in proc.stdout
     assert gifs == ["cam_design.gif", "cam_liftoff.gif", "fourbar_grashof.gif",
                     "slider_crank.gif", "vibration_modes.gif"]
-    for kind in ["shapes", "damping", "road"]:          # the half car's modes and response
+    for kind in ["shapes", "damping", "road", "road_damping"]:   # the half car's modes, response
         assert (out / f"vibration_modes_{kind}.png").stat().st_size > 0
     assert "ratio 2.00, second order" in proc.stdout
     assert proc.stdout.count("the driven dynamics settles within") == 3
