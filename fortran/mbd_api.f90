@@ -47,7 +47,8 @@ module mbd_api
   use mbd_assemble, only: scatter_dense
   use mbd_sens_dynamics, only: sens_multipliers, sens_reactions, sens_statics, sens_dopri5, &
                                sens_statics_band, &
-                               sens_initial, lam_work_t, lam_init, sens_out_multipliers
+                               sens_initial, lam_work_t, lam_init, sens_out_multipliers, &
+                               sens_at_rest
   use mbd_sens_genalpha, only: ga_sens_t, ga_sens_init
   implicit none
   private
@@ -1059,6 +1060,7 @@ contains
     real(wp), intent(out), optional :: zre(:, :), zim(:, :)
     type(model_t) :: m
     type(dyn_work_t) :: w
+    type(sens_t), allocatable :: sens
     integer :: nfree, i
     logical :: cshapes
     q = zero; lam = zero; stable = 0; resid = zero
@@ -1085,13 +1087,17 @@ contains
     end if
     if (status == MBD_OK) call linear_point(m, w, q, t, equilibrium, lam, stable, resid, &
                                             status, msg)
+    ! K and C exact (the design sensitivities' blocks at rest) unless contacts or friction
+    ! (not allocated: absent, K and C by differences)
+    if (status == MBD_OK .and. smooth_forces(ftab)) call exact_blocks(status)
     if (status == MBD_OK) then
       if (cshapes) then
         call modes_solve(m, w, q, t, lam, kmax, nfree, omega2, kinds, sre, sim, &
-                         shapes(:, 1:kmax), status, msg, zre(:, 1:2 * kmax), zim(:, 1:2 * kmax))
+                         shapes(:, 1:kmax), status, msg, zre(:, 1:2 * kmax), &
+                         zim(:, 1:2 * kmax), s=sens)
       else
         call modes_solve(m, w, q, t, lam, kmax, nfree, omega2, kinds, sre, sim, &
-                         shapes(:, 1:kmax), status, msg)
+                         shapes(:, 1:kmax), status, msg, s=sens)
       end if
     end if
     if (status == MBD_OK) iinfo(1) = nfree
@@ -1105,7 +1111,33 @@ contains
       end do
     end if
     if (status == MBD_OK .and. cshapes) call unit_largest(zre(:, 1:2 * kmax), zim(:, 1:2 * kmax))
+  contains
+    !> sens: the design sensitivities' blocks (no parameters) at the rest state (q, t, lam).
+    subroutine exact_blocks(st)
+      integer, intent(out) :: st
+      integer :: ptab0(2, 0), bad, ist
+      real(wp), allocatable :: zq(:)
+      allocate (sens, zq(m%nq), stat=ist)
+      if (ist /= 0) then
+        st = MBD_NO_MEMORY; msg = 'modes: out of memory for the stiffness blocks'; return
+      end if
+      call sens_setup(m, ctab, rpar, ptab0, sens, st, msg, bad, ftab, fpar)
+      if (st /= MBD_OK) return
+      zq = zero
+      call sens_at_rest(m, sens, q, t, lam, zq)
+    end subroutine exact_blocks
   end subroutine api_modes
+
+  !> No contact and no joint friction among the forces (ftab (NFT, nf)): the design
+  !! sensitivities' exact derivatives cover them.
+  pure logical function smooth_forces(ftab)
+    integer, intent(in) :: ftab(:, :)
+    integer :: c
+    smooth_forces = .true.
+    do c = 1, size(ftab, 2)
+      if (force_is_contact(ftab(1, c)) .or. ftab(1, c) == FRC_FRICTION) smooth_forces = .false.
+    end do
+  end function smooth_forces
 
   !> The frequency response about the equilibrium near q0 at t (equilibrium 1; 0: about the
   !! assembled q0, with its least-squares multipliers) to each design parameter of ptab

@@ -5,8 +5,12 @@
 !! Cardona ch. 11; Haug ch. 6, the null-space form of the linearized equations of motion)
 !!   M_r z'' + C_r z' + K_r z = 0,   M_r = N^T M N,  C_r = N^T C N,  K_r = N^T K N,
 !! K = d(J^T lambda - Q)/dq (the constraints' curvature weighted by lambda*, and the loads'
-!! stiffness) and C = -dQ/dq_dot, both from dyn_tangent (central differences on the sparse
-!! pattern, step FD_STEP). N^T (J^T lambda - Q) = 0 at q*, so the change of N does not enter.
+!! stiffness) and C = -dQ/dq_dot: exact, from the design sensitivities' second derivatives
+!! (sens_stiffness_mul, sens_force_d, as the frequency response takes them) when the caller
+!! gives their blocks (a model without contacts or joint friction); else from dyn_tangent
+!! (central differences on the sparse pattern, step FD_STEP: contacts and friction, whose
+!! exact derivatives are not written). N^T (J^T lambda - Q) = 0 at q*, so the change of N
+!! does not enter.
 !! Undamped modes: K_s v = omega^2 M_r v, K_s = (K_r + K_r^T) / 2 (dsygv; v^T M_r v = 1), the
 !! shapes phi = N v (phi^T M phi = 1). Damped: the eigenvalues s of the first-order form
 !!   [0, I; -M_r^-1 K_r, -M_r^-1 C_r]  (dgeev),  s = -zeta omega +- i omega sqrt(1 - zeta^2),
@@ -26,6 +30,8 @@ module mbd_modes
   use mbd_model, only: model_t
   use mbd_lapack, only: dsygv, dgeev, dgetrf, dgetrs
   use mbd_dynamics, only: dyn_work_t, dyn_tangent, dyn_null_basis, dyn_pattern_mul
+  use mbd_sensitivity, only: sens_t, sens_force_d
+  use mbd_sens_dynamics, only: sens_stiffness_mul
   implicit none
   private
   public :: modes_solve, unit_largest
@@ -35,7 +41,8 @@ module mbd_modes
   !> K's and C's central differences: the step eps**(1/3) that balances truncation and
   !! rounding (K to about 1e-11 relative on the closed-form tests, against 5e-10 at 1e-7)
   real(wp), parameter :: FD_STEP = 6.0e-6_wp
-  !> |K_r - K_s| at most this fraction of |K_r|: symmetric (the differences' noise is 1e-11)
+  !> |K_r - K_s| at most this fraction of |K_r|: symmetric (the differences' noise is 1e-11;
+  !! exact K: round-off)
   real(wp), parameter :: SYM_TOL = 1.0e-8_wp
   character(len=*), parameter :: HINT = 'the modes use dense matrices of the number of free ' &
     // 'motions: ask for fewer modes or use a model with fewer free motions'
@@ -48,7 +55,7 @@ contains
   !! (omega^2 > 0), 0 a motion without stiffness (|omega^2| <= RIGID_FRACTION times the
   !! largest), -1 unstable (omega^2 < 0).
   subroutine modes_solve(m, w, q, t, lam, kmax, nfree, omega2, kinds, sre, sim, shapes, &
-                         status, msg, zre, zim)
+                         status, msg, zre, zim, s)
     type(model_t), intent(in) :: m              !! model with dynamics data
     type(dyn_work_t), intent(inout) :: w        !! work arrays (dyn_init done)
     real(wp), intent(in) :: q(:)                !! equilibrium (core units)
@@ -65,12 +72,15 @@ contains
     !> (nq, 2 kmax) the damped shapes psi of the sorted eigenvalues, real and imaginary parts
     !! (core units, not yet scaled: unit_largest does that in model units)
     real(wp), intent(out), optional :: zre(:, :), zim(:, :)
+    !> the design sensitivities' blocks at the rest state (q, t, lam) (sens_at_rest done, no
+    !! contacts or friction): K and C exact; absent, by central differences
+    type(sens_t), intent(in), optional :: s
     ! N, K N, C N, M N; M_r, K_r, C_r, K_s (then the eigenvectors v); the first-order matrix,
     ! its eigenvalues, the undamped ones, dgeev's unused eigenvectors, LAPACK's workspace, and
     ! K and C on the sparse pattern
     real(wp), allocatable :: nb(:, :), kn(:, :), cn(:, :), mn(:, :), mr(:, :), kr(:, :), &
                              cr(:, :), ks(:, :), a(:, :), wr(:), wi(:), ev(:), vl(:, :), &
-                             vr(:, :), work(:), kv(:), cv(:)
+                             vr(:, :), work(:), kv(:), cv(:), zv(:), xv(:)
     integer, allocatable :: ipiv(:), order(:)
     real(wp) :: bytes, wq(1)
     integer :: n, f, nnz, ist, info, j, k, nk
@@ -89,7 +99,7 @@ contains
     nk = min(kmax, f)
     nnz = w%kptr(n + 1) - 1
     bytes = REAL_BYTES * (4 * real(n, wp) * f + 5 * real(f, wp)**2 + 4 * real(2 * f, wp)**2 &
-                          + 2 * real(nnz, wp) + 8 * real(f, wp))
+                          + 2 * real(nnz, wp) + 8 * real(f, wp) + 2 * real(n, wp))
     if (cshapes) bytes = bytes + REAL_BYTES * real(2 * f, wp)**2     ! dgeev's eigenvectors
     write (what, '(a,i0,a)') 'the modes'' work arrays (', f, ' free motions)'
     call mem_check(bytes, trim(what), HINT, status, msg)
@@ -97,7 +107,7 @@ contains
     allocate (nb(n, f), kn(n, f), cn(n, f), mn(n, f), mr(f, f), kr(f, f), cr(f, f), ks(f, f), &
               a(2 * f, 2 * f), wr(2 * f), wi(2 * f), ev(f), vl(1, 1), &
               vr(merge(2 * f, 1, cshapes), merge(2 * f, 1, cshapes)), kv(nnz), &
-              cv(nnz), ipiv(f), order(2 * f), work(1), stat=ist)
+              cv(nnz), ipiv(f), order(2 * f), work(1), zv(n), xv(n), stat=ist)
     if (ist /= 0) then
       call mem_fail(bytes, trim(what), HINT, status, msg); return
     end if
@@ -106,11 +116,23 @@ contains
       status = MBD_SINGULAR; msg = 'modes: no basis of the free motions (J is singular)'
       return
     end if
-    call dyn_tangent(m, w, q, w%qz, t, lam, kv, cv, step=FD_STEP)
-    damped = maxval(abs(cv)) > zero
+    if (present(s)) then                          ! K N = K_lambda N - Q_q N, C N = -Q_q_dot N
+      zv = zero
+      do j = 1, f
+        call sens_stiffness_mul(m, s, q, t, zv, nb(:, j), kn(:, j), xv)
+        call sens_force_d(m, s, 0, q, zv, zv, nb(:, j), t, xv)
+        cn(:, j) = -xv
+      end do
+      damped = maxval(abs(cn)) > zero
+    else
+      call dyn_tangent(m, w, q, w%qz, t, lam, kv, cv, step=FD_STEP)
+      damped = maxval(abs(cv)) > zero
+    end if
     do j = 1, f                                   ! K N, C N and M N, column by column
-      call dyn_pattern_mul(w, kv, nb(:, j), kn(:, j))
-      if (damped) call dyn_pattern_mul(w, cv, nb(:, j), cn(:, j))
+      if (.not. present(s)) then
+        call dyn_pattern_mul(w, kv, nb(:, j), kn(:, j))
+        if (damped) call dyn_pattern_mul(w, cv, nb(:, j), cn(:, j))
+      end if
       do k = 1, n
         mn(k, j) = m%mdiag(k) * nb(k, j)
       end do
