@@ -378,10 +378,41 @@ def modes_section(results: dict) -> str:
         table(("model", "free motions", "mbd2d error", "Exudyn error", "mbd2d ms",
                "mbd2d about q0 ms", "Exudyn ms", "mbd2d about q0 / Exudyn"), rows),
         "\nExudyn's eigenvalues of the pendulum are 0: its projected stiffness leaves out the "
-        "multipliers' term (Jᵀλ)_q, which is all of a pendulum's stiffness; mbd2d has it "
-        "(2e-11). On the unconstrained chain Exudyn is faster (a dense symmetric eigensolver "
-        "on the free coordinates directly; mbd2d builds the null space of a constrained model "
-        "of blocks on guides, 3 coordinates a block, and its stiffness by differences).\n"])
+        "multipliers' term (Jᵀλ)_q, which is all of a pendulum's stiffness; mbd2d has it, "
+        "exactly (its stiffness and damping from the design sensitivities' second "
+        "derivatives). On the unconstrained chain Exudyn is faster (a dense symmetric "
+        "eigensolver on the free coordinates directly; mbd2d builds the null space of a "
+        "constrained model of blocks on guides, 3 coordinates a block).\n"])
+
+
+def frf_section(results: dict) -> str:
+    """The frequency response: chains against numpy, a sweep against a loop (bench/frf.py)."""
+    md = results.get("frf")
+    if (text := absent(md)) is not None:
+        return text
+    chains = [(r["n"], r["frequencies"], r["solver"], fmt(r["error"], ".1e"),
+               fmt(1e3 * r["mbd2d_s"], ".3g"), fmt(1e3 * r["numpy_s"], ".3g"),
+               fmt(r["ratio"], ".2g"), fmt(1e3 * r["mbd2d_per_frequency_s"], ".2g"),
+               fmt(1e3 * r["numpy_per_frequency_s"], ".2g")) for r in md.get("chains", [])]
+    sweeps = [(r["cases"], r["frequencies"], fmt(1e3 * r["batched_per_case_s"], ".3g"),
+               fmt(1e3 * r["loop_per_case_s"], ".3g"), fmt(r["ratio"], ".2g"),
+               "yes" if r["identical"] else "NO") for r in md.get("sweeps", [])]
+    return "\n".join([
+        "A spring chain of n blocks damped at its end, driven by a force on its first block "
+        "(docs/frf.md): `model.frequency_response` against numpy's `linalg.solve` of "
+        "(K − ω²M + iωC)x = e₁ per frequency with the matrices written by hand. Error: largest "
+        "|H − x| over blocks and frequencies relative to max |x|. Time: best wall time of "
+        "mbd2d's whole call (statics, null space, exact K, C and the input's derivatives from "
+        "the model, the multipliers' response) and of numpy's solves alone; per frequency: "
+        "the difference of the calls at 2 nw and nw frequencies over nw (mbd2d: Laub's "
+        "Hessenberg form from 16 free motions and 8 frequencies).\n",
+        table(("n", "frequencies", "mbd2d solver", "error", "mbd2d ms", "numpy ms",
+               "mbd2d / numpy", "mbd2d ms per frequency", "numpy ms per frequency"), chains),
+        "\nThe half car's road response over its suspension damping: one "
+        "`mbd2d.sweep(..., \"frf\")` against a Python loop of `with_params` and "
+        "`frequency_response` (the same numbers, bit for bit).\n",
+        table(("cases", "frequencies", "batched ms per case", "loop ms per case",
+               "loop / batched", "identical"), sweeps)])
 
 
 def peers_section(results: dict) -> str:
@@ -793,6 +824,7 @@ def results_markdown(results: dict, charts: dict[str, str], md_path: Path, out: 
              "## Contacts\n", contact_section(results, charts, out, base),
              "## Pictures of large models\n", pictures_section(results),
              "## Vibration modes: closed forms and Exudyn\n", modes_section(results),
+             "## Frequency response: numpy and sweeps\n", frf_section(results),
              "## Linkage synthesis: literature cases and pylinkage\n",
              synthesis_section(results),
              "## Notes\n", notes_section(results)]

@@ -24,7 +24,9 @@ Sections (each in its own try/except: a failure is recorded and the rest runs):
 12. pictures of large models: the N-four-bar's snapshot picture and GIF, batched against one
    artist per part (bench/pictures.py);
 13. vibration modes: a double pendulum and a spring chain against their closed forms, side
-   by side with Exudyn's ComputeODE2Eigenvalues (bench/peers_modes.py).
+   by side with Exudyn's ComputeODE2Eigenvalues (bench/peers_modes.py);
+14. frequency response: damped spring chains against numpy's solve of their hand-written
+   systems, and a sweep of the half car's road response against a loop (bench/frf.py).
 
 Writes bench/results/*.json and *.png, bench/RESULTS.md and bench/README_headline.md
 (bench/report.py). With --only, the other sections come from their results files of an
@@ -54,6 +56,7 @@ if str(BENCH) not in sys.path:
 import contact  # noqa: E402
 import dynamics_scaling  # noqa: E402
 import environment  # noqa: E402
+import frf  # noqa: E402
 import callgrind  # noqa: E402
 import kinematics_speed  # noqa: E402
 import memory  # noqa: E402
@@ -70,7 +73,7 @@ import work_precision  # noqa: E402
 
 SECTIONS = ("environment", "work_precision", "peers", "kinematics", "scaling", "memory",
             "sweep", "sensitivities", "contact", "synthesis", "dynamics_scaling", "peers_chain",
-            "pictures", "modes")
+            "pictures", "modes", "frf")
 
 
 # ===================================================================== JSON
@@ -211,6 +214,11 @@ def section_modes(quick: bool) -> dict:
     return peers_modes.study(quick=quick)
 
 
+def section_frf(quick: bool) -> dict:
+    """The frequency response against numpy, and a sweep of it against a loop."""
+    return frf.study(quick=quick)
+
+
 def failure(e: BaseException) -> dict:
     """The record of a failed section."""
     return {"failed": True, "error": f"{type(e).__name__}: {e}",
@@ -321,7 +329,7 @@ def main(argv: Sequence[str] | None = None) -> dict:
         "sensitivities": section_sensitivities, "contact": section_contact,
         "synthesis": section_synthesis, "dynamics_scaling": section_dynamics_scaling,
         "peers_chain": section_peers_chain, "pictures": section_pictures,
-        "modes": section_modes}
+        "modes": section_modes, "frf": section_frf}
     ran = {name: run_section(name, fns[name], a.quick) for name in SECTIONS if name in wanted}
     earlier = earlier_sections(out, [n for n in SECTIONS if n not in wanted])
     results = {name: ran.get(name, earlier.get(name)) for name in SECTIONS

@@ -245,6 +245,30 @@ def test_modes_table_in_report() -> None:
     assert "Failed" in report.modes_section({"modes": {"failed": True, "error": "x"}})
 
 
+def test_frf_table_in_report() -> None:
+    """The frequency response's rows appear in their section; a failed or missing section
+    says so."""
+    chains = [{"n": 12, "frequencies": 50, "solver": "dense", "error": 7.1e-15,
+               "mbd2d_s": 7.2e-3, "numpy_s": 1.0e-3, "ratio": 7.2,
+               "mbd2d_per_frequency_s": 6.6e-5, "numpy_per_frequency_s": 1.7e-5}]
+    sweeps = [{"cases": 200, "frequencies": 10, "batched_per_case_s": 6.2e-4,
+               "loop_per_case_s": 1.3e-3, "ratio": 2.1, "identical": True}]
+    md = report.frf_section({"frf": {"chains": chains, "sweeps": sweeps}})
+    assert "| 12 | 50 | dense | 7.1e-15 | 7.2 | 1 | 7.2 | 0.066 | 0.017 |" in md
+    assert "| 200 | 10 | 0.62 | 1.3 | 2.1 | yes |" in md
+    assert report.frf_section({}) == "Not run.\n"
+    assert "Failed" in report.frf_section({"frf": {"failed": True, "error": "x"}})
+
+
+def test_frf_study_runs_quick() -> None:
+    """The bench's frequency response study (quick): the chain against numpy's solve of its
+    hand-written system, and the sweep identical to the loop."""
+    import frf
+    res = frf.study(quick=True)
+    assert res["chains"][0]["error"] < 1e-12
+    assert all(r["identical"] for r in res["sweeps"])
+
+
 def test_modes_study_runs_quick() -> None:
     """The bench's modes study (quick) measures mbd2d against the closed forms (and Exudyn
     where it is installed)."""

@@ -75,7 +75,7 @@ contains
     real(wp), allocatable :: qh(:, :), th(:, :), c0(:, :), c1(:, :), c2(:, :), work(:)
     complex(wp), allocatable :: tc(:, :), yc(:, :)
     integer, allocatable :: ipiv(:)
-    real(wp) :: bytes, om
+    real(wp) :: bytes, om, toff
     integer :: n, f, np, na, i, j, k, ist, info
     logical :: hess
     character(len=MSG_LEN) :: what
@@ -220,6 +220,11 @@ contains
       do i = 1, f2                                ! T: zero below the first subdiagonal
         th(i + 2:, i) = zero
       end do
+      toff = zero                                 ! the largest |T_ik| off the diagonal
+      do i = 1, f2
+        toff = max(toff, maxval(abs(th(:i - 1, i))), maxval(abs(th(i + 1:, i))))
+      end do
+      th = transpose(th)           ! kept as T^T: a row of T is a column (contiguous)
       ! c_k = Q^T [0; M_r^-1 g_k]: the lower half of Q's rows
       c0 = matmul(transpose(qh(f + 1:, :)), c0(1:f, :))
       c1 = matmul(transpose(qh(f + 1:, :)), c1(1:f, :))
@@ -229,7 +234,9 @@ contains
 
     !> b = [Re z; Im z] at om: (i om I - T) y = c0 + om^2 c2 + i om c1 by an LU that pivots
     !! between neighbouring rows (T is upper Hessenberg), z = Q(1:f, :) y. flag 1: a pivot at
-    !! most 2 nfree eps max|i om I - T| (singular to working precision).
+    !! most 2 nfree eps max|i om I - T| (singular to working precision). The matrix is held
+    !! transposed (tc(:, k) its row k: the row operations run down contiguous columns), and
+    !! max|i om I - T| comes from T's largest off-diagonal entry and the diagonal.
     subroutine hess_solve(om, flag)
       real(wp), intent(in) :: om
       integer, intent(out) :: flag
@@ -237,23 +244,27 @@ contains
       complex(wp) :: l, piv(size(yc, 2)), rowt(2 * f)
       real(wp) :: tiny_piv
       flag = 0; f2 = 2 * f
-      tc = cmplx(-th, zero, wp)
-      do kk = 1, f2
-        tc(kk, kk) = tc(kk, kk) + cmplx(zero, om, wp)
+      do kk = 1, f2                               ! (i om I - T)^T: its entries on and below
+        tc(max(kk - 1, 1):, kk) = cmplx(-th(max(kk - 1, 1):, kk), zero, wp)   ! the superdiagonal
+        tc(kk, kk) = tc(kk, kk) + cmplx(zero, om, wp)                  ! (the rest is never read)
       end do
       ! a pivot at round-off of the matrix: singular (as an exact zero on the dense path)
-      tiny_piv = f2 * epsilon(one) * maxval(abs(tc))
+      tiny_piv = toff
+      do kk = 1, f2
+        tiny_piv = max(tiny_piv, abs(tc(kk, kk)))
+      end do
+      tiny_piv = f2 * epsilon(one) * tiny_piv
       yc = cmplx(c0 + om**2 * c2, om * c1, wp)
       do kk = 1, f2 - 1                           ! eliminate the subdiagonal
-        if (abs(tc(kk + 1, kk)) > abs(tc(kk, kk))) then
-          rowt(kk:) = tc(kk, kk:); tc(kk, kk:) = tc(kk + 1, kk:); tc(kk + 1, kk:) = rowt(kk:)
+        if (abs(tc(kk, kk + 1)) > abs(tc(kk, kk))) then
+          rowt(kk:) = tc(kk:, kk); tc(kk:, kk) = tc(kk:, kk + 1); tc(kk:, kk + 1) = rowt(kk:)
           piv = yc(kk, :); yc(kk, :) = yc(kk + 1, :); yc(kk + 1, :) = piv
         end if
         if (abs(tc(kk, kk)) <= tiny_piv) then
           flag = 1; return
         end if
-        l = tc(kk + 1, kk) / tc(kk, kk)
-        tc(kk + 1, kk + 1:) = tc(kk + 1, kk + 1:) - l * tc(kk, kk + 1:)
+        l = tc(kk, kk + 1) / tc(kk, kk)
+        tc(kk + 1:, kk + 1) = tc(kk + 1:, kk + 1) - l * tc(kk + 1:, kk)
         yc(kk + 1, :) = yc(kk + 1, :) - l * yc(kk, :)
       end do
       do kk = f2, 1, -1                           ! back substitution
@@ -261,7 +272,7 @@ contains
           flag = 1; return
         end if
         do r = 1, np
-          yc(kk, r) = (yc(kk, r) - sum(tc(kk, kk + 1:) * yc(kk + 1:, r))) / tc(kk, kk)
+          yc(kk, r) = (yc(kk, r) - sum(tc(kk + 1:, kk) * yc(kk + 1:, r))) / tc(kk, kk)
         end do
       end do
       b(1:f, :) = matmul(qh(1:f, :), real(yc, wp))
