@@ -6,7 +6,8 @@ hand, and the cost per variant of a sweep of it.
   n = 12, 40 and 200. Reference: (K - w^2 M + i w C) x = e_1 with the tridiagonal K,
   M = m I and C = c e_n e_n^T written here, solved by ``np.linalg.solve`` per frequency (what
   a user with the matrices in hand writes). Error: the largest |H - x| over the blocks and
-  frequencies, relative to the largest |x|. Time: the best wall time of mbd2d's whole call
+  frequencies, relative to the largest |x|, beside cond(K - w^2 M + i w C) eps (its
+  largest over the frequencies: what either solution can be trusted to). Time: the best wall time of mbd2d's whole call
   (statics, the null space, K, C and the input's derivatives from the model, the solves) and
   of numpy's solves alone (its matrices built outside the timing); the cost per frequency is
   the difference of the calls at 2 nw and nw frequencies over nw (mbd2d takes Laub's
@@ -91,8 +92,10 @@ def chain_row(n: int, nw: int, repeats: int) -> dict[str, Any]:
     n1, want = best_time(lambda: numpy_response(mm, kk, cc, f1), repeats)
     n2, _ = best_time(lambda: numpy_response(mm, kk, cc, f2), repeats)
     got = res.response[:, 0::3, 0]
+    cond = max(np.linalg.cond(kk - w**2 * mm + 1j * w * cc) for w in 2 * np.pi * f1)
     return {"n": n, "frequencies": nw, "solver": res.stats["solver"],
             "error": float(np.abs(got - want).max() / np.abs(want).max()),
+            "cond_eps": float(cond * np.finfo(float).eps),
             "mbd2d_s": t1, "numpy_s": n1, "ratio": t1 / n1,
             "mbd2d_per_frequency_s": max(t2 - t1, 0.0) / nw,
             "numpy_per_frequency_s": max(n2 - n1, 0.0) / nw}

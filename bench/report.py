@@ -391,6 +391,7 @@ def frf_section(results: dict) -> str:
     if (text := absent(md)) is not None:
         return text
     chains = [(r["n"], r["frequencies"], r["solver"], fmt(r["error"], ".1e"),
+               fmt(r.get("cond_eps"), ".1e"),
                fmt(1e3 * r["mbd2d_s"], ".3g"), fmt(1e3 * r["numpy_s"], ".3g"),
                fmt(r["ratio"], ".2g"), fmt(1e3 * r["mbd2d_per_frequency_s"], ".2g"),
                fmt(1e3 * r["numpy_per_frequency_s"], ".2g")) for r in md.get("chains", [])]
@@ -401,12 +402,14 @@ def frf_section(results: dict) -> str:
         "A spring chain of n blocks damped at its end, driven by a force on its first block "
         "(docs/frf.md): `model.frequency_response` against numpy's `linalg.solve` of "
         "(K − ω²M + iωC)x = e₁ per frequency with the matrices written by hand. Error: largest "
-        "|H − x| over blocks and frequencies relative to max |x|. Time: best wall time of "
+        "|H − x| over blocks and frequencies relative to max |x|, beside cond(K − ω²M + iωC)·eps "
+        "(its largest over the frequencies: the lightly damped chain's resonances bound what "
+        "either solution is good to). Time: best wall time of "
         "mbd2d's whole call (statics, null space, exact K, C and the input's derivatives from "
         "the model, the multipliers' response) and of numpy's solves alone; per frequency: "
         "the difference of the calls at 2 nw and nw frequencies over nw (mbd2d: Laub's "
         "Hessenberg form from 16 free motions and 8 frequencies).\n",
-        table(("n", "frequencies", "mbd2d solver", "error", "mbd2d ms", "numpy ms",
+        table(("n", "frequencies", "mbd2d solver", "error", "cond·eps", "mbd2d ms", "numpy ms",
                "mbd2d / numpy", "mbd2d ms per frequency", "numpy ms per frequency"), chains),
         "\nThe half car's road response over its suspension damping: one "
         "`mbd2d.sweep(..., \"frf\")` against a Python loop of `with_params` and "

@@ -254,7 +254,7 @@ def test_frf_table_in_report() -> None:
     sweeps = [{"cases": 200, "frequencies": 10, "batched_per_case_s": 6.2e-4,
                "loop_per_case_s": 1.3e-3, "ratio": 2.1, "identical": True}]
     md = report.frf_section({"frf": {"chains": chains, "sweeps": sweeps}})
-    assert "| 12 | 50 | dense | 7.1e-15 | 7.2 | 1 | 7.2 | 0.066 | 0.017 |" in md
+    assert "| 12 | 50 | dense | 7.1e-15 | – | 7.2 | 1 | 7.2 | 0.066 | 0.017 |" in md
     assert "| 200 | 10 | 0.62 | 1.3 | 2.1 | yes |" in md
     assert report.frf_section({}) == "Not run.\n"
     assert "Failed" in report.frf_section({"frf": {"failed": True, "error": "x"}})
@@ -265,7 +265,7 @@ def test_frf_study_runs_quick() -> None:
     hand-written system, and the sweep identical to the loop."""
     import frf
     res = frf.study(quick=True)
-    assert res["chains"][0]["error"] < 1e-12
+    assert res["chains"][0]["error"] < max(1e-12, 10 * res["chains"][0]["cond_eps"])
     assert all(r["identical"] for r in res["sweeps"])
 
 

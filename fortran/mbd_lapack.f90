@@ -3,8 +3,8 @@ module mbd_lapack
   use mbd_kinds, only: wp
   implicit none
   private
-  public :: dgetrf, dgetf2, dgetrs, dtrsv, dgesvd, dgels, dgelsy, dgtsv, dgeqp3, dormqr, dtrtrs, dgecon, &
-            dtrcon, dsyev, dsygv, dgeev, dgehrd, dorghr
+  public :: dgetrf, dgetf2, dgetrs, dtrsv, dgesvd, dgels, dgelsy, dgtsv, dgeqp3, dormqr, dtrtrs, &
+            dgecon, dtrcon, dsyev, dsygv, dgeev, dgehrd, dorghr, dgemm
   public :: dgbtrf, dgbtrs, dgbcon, dlacn2
 
   interface
@@ -163,6 +163,14 @@ module mbd_lapack
       real(wp), intent(out) :: work(*)
       integer, intent(out) :: info
     end subroutine dorghr
+    !> C = alpha op(A) op(B) + beta C (BLAS level 3; op: 'N' or 'T').
+    pure subroutine dgemm(transa, transb, m, n, k, alpha, a, lda, b, ldb, beta, c, ldc)
+      import :: wp
+      character(len=1), intent(in) :: transa, transb
+      integer, intent(in) :: m, n, k, lda, ldb, ldc
+      real(wp), intent(in) :: alpha, beta, a(lda, *), b(ldb, *)
+      real(wp), intent(inout) :: c(ldc, *)
+    end subroutine dgemm
     !> Triangular solve A x = b (BLAS level 2), x overwrites b.
     pure subroutine dtrsv(uplo, trans, diag, n, a, lda, x, incx)
       import :: wp
