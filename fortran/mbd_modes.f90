@@ -28,7 +28,7 @@ module mbd_modes
   use mbd_status, only: MBD_OK, MBD_SINGULAR, MBD_NO_CONVERGENCE, MBD_LAPACK, MSG_LEN
   use mbd_memory, only: REAL_BYTES, mem_check, mem_fail, mem_grow
   use mbd_model, only: model_t
-  use mbd_lapack, only: dsygv, dgeev, dgetrf, dgetrs
+  use mbd_lapack, only: dsygv, dgeev, dgetrf, dgetrs, dgemm
   use mbd_dynamics, only: dyn_work_t, dyn_tangent, dyn_null_basis, dyn_pattern_mul
   use mbd_sensitivity, only: sens_t, sens_force_d
   use mbd_sens_dynamics, only: sens_stiffness_mul
@@ -137,10 +137,10 @@ contains
         mn(k, j) = m%mdiag(k) * nb(k, j)
       end do
     end do
-    kr = matmul(transpose(nb), kn)                ! K_r = N^T K N
+    call dgemm('T', 'N', f, f, n, one, nb, n, kn, n, zero, kr, f)   ! K_r = N^T K N (BLAS)
     cr = zero
-    if (damped) cr = matmul(transpose(nb), cn)    ! C_r = N^T C N
-    mr = matmul(transpose(nb), mn)                ! M_r = N^T M N
+    if (damped) call dgemm('T', 'N', f, f, n, one, nb, n, cn, n, zero, cr, f)   ! C_r = N^T C N
+    call dgemm('T', 'N', f, f, n, one, nb, n, mn, n, zero, mr, f)   ! M_r = N^T M N
     ! undamped: K_s v = omega^2 M_r v
     ks = half * (kr + transpose(kr))
     ! no damping and a symmetric K_r (a conservative equilibrium, to the differences' noise):
@@ -173,7 +173,7 @@ contains
         kinds(k) = merge(1, -1, ev(k) > zero)
       end if
     end do
-    shapes(:, 1:nk) = matmul(nb, ks(:, 1:nk))     ! phi = N v
+    call dgemm('N', 'N', n, nk, f, one, nb, n, ks, f, zero, shapes, size(shapes, 1))   ! phi = N v
     do k = 1, nk                                  ! sign: the largest entry positive
       j = maxloc(abs(shapes(:, k)), 1)
       if (shapes(j, k) < zero) shapes(:, k) = -shapes(:, k)
