@@ -7,9 +7,9 @@ hand, and the cost per variant of a sweep of it.
   M = m I and C = c e_n e_n^T written here, solved by ``np.linalg.solve`` per frequency (what
   a user with the matrices in hand writes). Error: the largest |H - x| over the blocks and
   frequencies, relative to the largest |x|, beside cond(K - w^2 M + i w C) eps (its
-  largest over the frequencies: what either solution can be trusted to). Time: the best wall time of mbd2d's whole call
-  (statics, the null space, K, C and the input's derivatives from the model, the solves) and
-  of numpy's solves alone (its matrices built outside the timing); the cost per frequency is
+  largest over the frequencies: what either solution can be trusted to). Time: the best
+  wall time of mbd2d's whole call (statics, the null space, K, C and the input's derivatives
+  from the model, the solves) and of numpy's solves alone (its matrices built outside the timing); the cost per frequency is
   the difference of the calls at 2 nw and nw frequencies over nw (mbd2d takes Laub's
   Hessenberg form from 16 free motions and 8 frequencies, docs/frf.md).
 * The half car's road response (examples/half_car.toml, the front tyre's ground point) over
