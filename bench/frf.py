@@ -23,29 +23,19 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-import time
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 
 import mbd2d
+from peers_modes import best_time
 
 BENCH = Path(__file__).resolve().parent
 EXAMPLES = BENCH.parent / "examples"
 CHAIN_M, CHAIN_K, CHAIN_C = 0.5, 200.0, 5.0
 ROAD = "force.front_tyre.points.0.1"
 DAMPING = ("force.front_suspension.damping", "force.rear_suspension.damping")
-
-
-def best_time(fn: Callable[[], Any], repeats: int) -> tuple[float, Any]:
-    """The best wall time of repeats calls, and the last result."""
-    best, out = float("inf"), None
-    for _ in range(max(1, repeats)):
-        t0 = time.perf_counter()
-        out = fn()
-        best = min(best, time.perf_counter() - t0)
-    return best, out
 
 
 def shaken_chain(n: int) -> tuple[mbd2d.Model, str]:

@@ -1505,6 +1505,7 @@ contains
     character(len=*), parameter :: lev(3) = [character(len=6) :: '', '_dot', '_ddot']
     character(len=:), allocatable :: line, head, tail
     integer :: u, ios, j, k, l, r0, nlev, c, lp, nh, nt, width, p, nsl
+    logical :: done
     if (code == 5) then
       call write_modes_sweep_csv(path)
       return
@@ -1551,11 +1552,8 @@ contains
     end do
     call sput(u, ios, crlf)
     do c = 1, spec%ncase
-      call case_fields(c, head, nh, tail, nt)
-      if (nkeep(c) == 0) then
-        call sput(u, ios, head(1:nh) // ',' // tail(1:nt) // crlf)
-        cycle
-      end if
+      call case_fields(c, u, ios, head, nh, tail, nt, done)
+      if (done) cycle
       do k = 1, nkeep(c)
         lp = 0
         call bput(line, lp, head(1:nh))
@@ -1615,11 +1613,14 @@ contains
     end do
   end subroutine open_sweep_csv
 
-  !> Case c's leading fields (head: case and parameters) and its status and message (tail).
-  subroutine case_fields(c, head, nh, tail, nt)
-    integer, intent(in) :: c
+  !> Case c's leading fields (head: case and parameters) and its status and message (tail);
+  !! a case without rows gets its one row (head, an empty field, tail) written to u: done.
+  subroutine case_fields(c, u, ios, head, nh, tail, nt, done)
+    integer, intent(in) :: c, u
+    integer, intent(inout) :: ios
     character(len=*), intent(inout) :: head, tail
     integer, intent(out) :: nh, nt
+    logical, intent(out) :: done
     integer :: j
     nh = 0
     call bput(head, nh, trim(itoa(c - 1)))
@@ -1628,6 +1629,8 @@ contains
     end do
     nt = 0
     call bput(tail, nt, ',' // trim(itoa(cstat(c))) // ',' // quoted(trim(cmsg(c))))
+    done = nkeep(c) == 0
+    if (done) call sput(u, ios, head(1:nh) // ',' // tail(1:nt) // achar(13) // achar(10))
   end subroutine case_fields
 
   !> The CSV of mbd2d.write_sweep for a modes sweep: one row per case and mode (case, the
@@ -1639,17 +1642,15 @@ contains
     real(wp), parameter :: TWO_PI = 2 * 3.141592653589793_wp
     character(len=:), allocatable :: line, head, tail
     integer :: u, ios, j, k, c, lp, nh, nt, width
+    logical :: done
     width = 26 * (spec%ncp + 6 + nq) + 32
     call open_sweep_csv(path, width, u, ios, head, tail, line)
     call sput(u, ios, ',mode,status,message,omega2,frequency_hz,kind')
     call coordinate_header(u, ios, '', 0)
     call sput(u, ios, crlf)
     do c = 1, spec%ncase
-      call case_fields(c, head, nh, tail, nt)
-      if (nkeep(c) == 0) then
-        call sput(u, ios, head(1:nh) // ',' // tail(1:nt) // crlf)
-        cycle
-      end if
+      call case_fields(c, u, ios, head, nh, tail, nt, done)
+      if (done) cycle
       do k = 1, nkeep(c)
         lp = 0
         call bput(line, lp, head(1:nh) // ',' // trim(itoa(k - 1)))
@@ -1678,30 +1679,17 @@ contains
     character(len=*), parameter :: crlf = achar(13) // achar(10)
     character(len=:), allocatable :: line, head, tail
     integer :: u, ios, j, k, c, p, lp, nh, nt, width
+    logical :: done
     width = 26 * (spec%ncp + 1 + 2 * nq * spec%npar) + 32
     call open_sweep_csv(path, width, u, ios, head, tail, line)
     call sput(u, ios, ',frequency_hz,status,message')
-    do p = 1, spec%npar              ! (the coordinates as coordinate_header names them)
-      do j = 1, spec%nb
-        do k = 1, 3
-          call pair_header(u, ios, trim(spec%body_names(j)) // '.' // trim(XYT(k)), &
-                           trim(spec%par_names(p)))
-        end do
-      end do
-      do j = 1, spec%nc
-        do k = 1, con_nextra(spec%ctab(1, j))
-          call pair_header(u, ios, trim(spec%con_names(j)) // '.alpha', &
-                           trim(spec%par_names(p)))
-        end do
-      end do
+    do p = 1, spec%npar
+      call coordinate_header(u, ios, '', p, pair=.true.)
     end do
     call sput(u, ios, crlf)
     do c = 1, spec%ncase
-      call case_fields(c, head, nh, tail, nt)
-      if (nkeep(c) == 0) then
-        call sput(u, ios, head(1:nh) // ',' // tail(1:nt) // crlf)
-        cycle
-      end if
+      call case_fields(c, u, ios, head, nh, tail, nt, done)
+      if (done) cycle
       do k = 1, nkeep(c)
         lp = 0
         call bput(line, lp, head(1:nh))
@@ -1753,24 +1741,42 @@ contains
 
   !> The coordinates' names NAME.x, NAME.y, NAME.theta per body, then NAME.alpha per extra
   !! coordinate of a cam or curve joint, each with the suffix sfx.
-  subroutine coordinate_header(u, ios, sfx, p)
+  subroutine coordinate_header(u, ios, sfx, p, pair)
     integer, intent(in) :: u
     integer, intent(inout) :: ios
     character(len=*), intent(in) :: sfx
     integer, intent(in) :: p           !! 0, or d(NAME)/d(P) of design parameter p
+    !> d(NAME)/d(P).re,d(NAME)/d(P).im (a frequency response's pair; p > 0)
+    logical, intent(in), optional :: pair
     character(len=*), parameter :: w(3) = [character(len=6) :: '.x', '.y', '.theta']
     integer :: b, i, j
+    logical :: pr
+    pr = .false.
+    if (present(pair)) pr = pair
     do b = 1, spec%nb
       do i = 1, 3
-        call sweep_col(u, ios, trim(spec%body_names(b)) // trim(w(i)) // sfx, p)
+        call header_col(u, ios, trim(spec%body_names(b)) // trim(w(i)) // sfx, p, pr)
       end do
     end do
     do j = 1, spec%nc
       do i = 1, con_nextra(spec%ctab(1, j))
-        call sweep_col(u, ios, trim(spec%con_names(j)) // '.alpha' // sfx, p)
+        call header_col(u, ios, trim(spec%con_names(j)) // '.alpha' // sfx, p, pr)
       end do
     end do
   end subroutine coordinate_header
+
+  !> One coordinate's column name: sweep_col's, or pair_header's pair (pr).
+  subroutine header_col(u, ios, name, p, pr)
+    integer, intent(in) :: u, p
+    integer, intent(inout) :: ios
+    character(len=*), intent(in) :: name
+    logical, intent(in) :: pr
+    if (pr) then
+      call pair_header(u, ios, name, trim(spec%par_names(p)))
+    else
+      call sweep_col(u, ios, name, p)
+    end if
+  end subroutine header_col
 
   !> A sweep column's name: ",NAME" (p = 0), or ",d(NAME)/d(P)" of design parameter p.
   subroutine sweep_col(u, ios, name, p)

@@ -138,8 +138,7 @@ def _modes_csv(ds: Any, path: Path) -> None:
         w = csv.writer(fh)
         w.writerow(header)
         for c in range(ds.sizes["case"]):
-            head = [c, *(_g(ds[n].values[c]) for n in params)]
-            st, msg = int(ds.status.values[c]), str(ds.message.values[c])
+            head, st, msg = _case_head(ds, params, c)
             modes = np.flatnonzero(np.isfinite(w2[c]))
             if not len(modes):
                 w.writerow(head + ["", st, msg])
@@ -147,6 +146,12 @@ def _modes_csv(ds: Any, path: Path) -> None:
             for k in modes:
                 w.writerow(head + [k, st, msg, _g(w2[c, k]), _g(f[c, k]), _g(kind[c, k])]
                            + [_g(v) for v in shape[c, k]])
+
+
+def _case_head(ds: Any, params: Sequence[str], c: int) -> tuple[list[Any], int, str]:
+    """A case's leading columns (case, the parameters), its status and its message."""
+    head = [c, *(_g(ds[n].values[c]) for n in params)]
+    return head, int(ds.status.values[c]), str(ds.message.values[c])
 
 
 def _frf_csv(ds: Any, path: Path) -> None:
@@ -164,8 +169,7 @@ def _frf_csv(ds: Any, path: Path) -> None:
         w = csv.writer(fh)
         w.writerow(header)
         for c in range(ds.sizes["case"]):
-            head = [c, *(_g(ds[n].values[c]) for n in params)]
-            st, msg = int(ds.status.values[c]), str(ds.message.values[c])
+            head, st, msg = _case_head(ds, params, c)
             if st != 0:
                 w.writerow(head + ["", st, msg])
                 continue
