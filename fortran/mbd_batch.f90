@@ -38,7 +38,7 @@ module mbd_batch
   !> settings: iset = [nsteps, maxit, every, solver, method, max_steps, positions, at_q0]
   !! (positions: 1 = kinematics of the positions alone, qdout and qddout (nq, 0, ncase);
   !! at_q0: modes and the frequency response about the assembled q0, not the equilibrium);
-  !! rset = [t0, t1, tol, tmin, rtol, atol, h, rho_inf, alpha, beta, t (statics, modes), 0]
+  !! rset = [t0, t1, tol, tmin, rtol, atol, h, rho_inf, alpha, beta, t (statics, modes, frf), 0]
   integer, parameter :: NISET = 8, NRSET = 12
 
 contains
