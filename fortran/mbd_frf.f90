@@ -34,8 +34,8 @@ module mbd_frf
   use mbd_memory, only: REAL_BYTES, mem_check, mem_fail
   use mbd_model, only: model_t
   use mbd_lapack, only: dgemm, dgetrf, dgetrs, dgehrd, dorghr
-  use mbd_sensitivity, only: sens_t, sens_force_d
-  use mbd_sens_dynamics, only: statics_load, sens_stiffness_mul, sens_at_rest, &
+  use mbd_sensitivity, only: sens_t
+  use mbd_sens_dynamics, only: statics_load, sens_stiffness_mul, sens_damping_mul, sens_at_rest, &
                                proj_particular, proj_multipliers
   use mbd_dynamics, only: dyn_work_t, dyn_null_basis, dyn_factor_projection
   implicit none
@@ -367,8 +367,7 @@ contains
     subroutine cmul(xx, cx)
       real(wp), intent(in) :: xx(:)
       real(wp), intent(out) :: cx(:)
-      call sens_force_d(m, s, 0, q, z, z, xx, t, x)
-      cx = -x
+      call sens_damping_mul(m, s, q, t, z, xx, cx)
     end subroutine cmul
   end subroutine frf_solve
 

@@ -6,7 +6,7 @@
 !!   M_r z'' + C_r z' + K_r z = 0,   M_r = N^T M N,  C_r = N^T C N,  K_r = N^T K N,
 !! K = d(J^T lambda - Q)/dq (the constraints' curvature weighted by lambda*, and the loads'
 !! stiffness) and C = -dQ/dq_dot: exact, from the design sensitivities' second derivatives
-!! (sens_stiffness_mul, sens_force_d, as the frequency response takes them) when the caller
+!! (sens_stiffness_mul, sens_damping_mul, as the frequency response takes them) when the caller
 !! gives their blocks (a model without contacts or joint friction); else from dyn_tangent
 !! (central differences on the sparse pattern, step FD_STEP: contacts and friction, whose
 !! exact derivatives are not written). N^T (J^T lambda - Q) = 0 at q*, so the change of N
@@ -30,8 +30,8 @@ module mbd_modes
   use mbd_model, only: model_t
   use mbd_lapack, only: dsygv, dgeev, dgetrf, dgetrs, dgemm
   use mbd_dynamics, only: dyn_work_t, dyn_tangent, dyn_null_basis, dyn_pattern_mul
-  use mbd_sensitivity, only: sens_t, sens_force_d
-  use mbd_sens_dynamics, only: sens_stiffness_mul
+  use mbd_sensitivity, only: sens_t
+  use mbd_sens_dynamics, only: sens_stiffness_mul, sens_damping_mul
   implicit none
   private
   public :: modes_solve, unit_largest
@@ -120,8 +120,7 @@ contains
       zv = zero
       do j = 1, f
         call sens_stiffness_mul(m, s, q, t, zv, nb(:, j), kn(:, j), xv)
-        call sens_force_d(m, s, 0, q, zv, zv, nb(:, j), t, xv)
-        cn(:, j) = -xv
+        call sens_damping_mul(m, s, q, t, zv, nb(:, j), cn(:, j))
       end do
       damped = maxval(abs(cn)) > zero
     else

@@ -50,7 +50,8 @@ module mbd_sens_dynamics
   public :: sens_multipliers, sens_reactions, sens_statics, sens_statics_band, sens_dopri5, &
             sens_initial
   ! (the frequency response, mbd_frf: the equilibrium's load along a parameter)
-  public :: statics_load, sens_stiffness_mul, sens_at_rest, proj_particular, proj_multipliers
+  public :: statics_load, sens_stiffness_mul, sens_damping_mul, sens_at_rest, proj_particular, &
+            proj_multipliers
   ! (generalized-alpha's sensitivities, mbd_sens_genalpha: the same right-hand sides)
   public :: proj_work_t, proj_init, sens_accel, sens_dyn_rows, cols_to_rows, rows_to_cols
   ! (the multipliers' sensitivities at the outputs of forward dynamics)
@@ -483,6 +484,16 @@ contains
     call sens_force_d(m, s, 0, q, z, x, z, t, work)
     kx = kx - work
   end subroutine sens_stiffness_mul
+
+  !> cx = C x = -Q_q_dot x at the rest state q (exact; z zeros, nq entries).
+  subroutine sens_damping_mul(m, s, q, t, z, x, cx)
+    type(model_t), intent(in) :: m              !! model with dynamics data
+    type(sens_t), intent(in) :: s               !! parameters and blocks
+    real(wp), intent(in) :: q(:), t, z(:), x(:) !! state, time, zeros, the vector
+    real(wp), intent(out) :: cx(:)              !! C x
+    call sens_force_d(m, s, 0, q, z, z, x, t, cx)
+    cx = -cx
+  end subroutine sens_damping_mul
 
   !> Forward dynamics with sensitivities by dopri5 from the consistent state (q, qd) at t0 and
   !! its sensitivities (sq, sqd) (nq, np); outputs as mbd_integrators' integrate, with

@@ -102,7 +102,8 @@ class BatchTables:
     ne: int                     # 4 for the analyses with energies, else 0
     times: np.ndarray = field(default_factory=lambda: np.zeros(0))   # (nrow,) output times
     measures: MeasureTables = field(default_factory=MeasureTables.empty)
-    #: design parameters of the sensitivities (int32 (2, npar)) and their names
+    #: design parameters of the sensitivities (int32 (2, npar)) and their names (the
+    #: frequency response: its inputs)
     ptab: np.ndarray = field(default_factory=lambda: np.zeros((2, 0), dtype=np.int32))
     sensitivities: list[str] = field(default_factory=list)
 
