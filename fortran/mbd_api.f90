@@ -15,7 +15,7 @@ module mbd_api
   use mbd_kinds, only: wp, zero, one
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use mbd_status, only: MBD_OK, MBD_BAD_COUNT, MBD_BAD_PARAM, MBD_INCONSISTENT, MBD_NO_MEMORY, &
-                        MBD_NO_CONVERGENCE, &
+                        MBD_NO_CONVERGENCE, MBD_BAD_INPUT, &
                         MSG_LEN
   use mbd_memory, only: REAL_BYTES, mem_fail
   use mbd_points, only: NLOC, MAXROW
@@ -48,14 +48,15 @@ module mbd_api
   use mbd_sens_dynamics, only: sens_multipliers, sens_reactions, sens_statics, sens_dopri5, &
                                sens_statics_band, &
                                sens_initial, lam_work_t, lam_init, sens_out_multipliers, &
-                               sens_at_rest
+                               sens_at_rest, sens_stiffness_at, sens_tangent_pattern, &
+                               sens_stiffness_mul, sens_damping_mul
   use mbd_sens_genalpha, only: ga_sens_t, ga_sens_init
   implicit none
   private
   public :: NINFO, api_sizes, api_eval, api_kinematics, api_profile, api_analyze, api_kin_step
   public :: api_inverse, api_dynamics, api_statics, api_modes, api_frf, api_reactions, &
             api_cam_forces
-  public :: api_eval_d, api_reactions_dp, api_dynamics_sens, api_forces_d
+  public :: api_eval_d, api_reactions_dp, api_dynamics_sens, api_forces_d, api_stiffness
 
   integer, parameter :: NINFO = 12   !! length of the report arrays
 
@@ -965,10 +966,12 @@ contains
     !! the equilibrium
     integer, intent(in), optional :: ptab(:, :)
     real(wp), intent(out), optional :: sq(:, :), slam(:, :)
-    type(sens_t) :: sens
     integer, intent(in), optional :: solver     !! 0 auto (default), 1 dense, 2 banded
     type(model_t) :: m
     type(dyn_work_t) :: w
+    !> the design sensitivities' blocks: the parameters' (ptab) and the exact stiffness of
+    !! the statics' Newton steps (no contacts; not allocated: K by differences)
+    type(sens_t), allocatable :: sens
     integer :: bad
     q = zero; lam = zero; stable = 0; resid = zero
     call static_start(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, t, m, w, q, lam, iinfo, &
@@ -979,12 +982,24 @@ contains
           any(shape(slam) /= [m%neq, size(ptab, 2)])) then
         status = MBD_BAD_COUNT; msg = 'sensitivity arrays do not match the model'; return
       end if
+      allocate (sens, stat=bad)
+      if (bad /= 0) then
+        status = MBD_NO_MEMORY; msg = 'statics: out of memory for the sensitivities'; return
+      end if
       call sens_setup(m, ctab, rpar, ptab, sens, status, msg, bad, ftab, fpar)
       if (status /= MBD_OK) then
         iinfo(2) = -2000000 - bad; return
       end if
+    else if (status == MBD_OK) then
+      call stiffness_blocks(m, ctab, rpar, ftab, fpar, sens, status, msg)
     end if
-    if (status == MBD_OK) call statics_solve(m, w, q, t, lam, stable, resid, status, msg)
+    if (status == MBD_OK) then
+      if (smooth_forces(ftab)) then
+        call statics_solve(m, w, q, t, lam, stable, resid, status, msg, s=sens)
+      else
+        call statics_solve(m, w, q, t, lam, stable, resid, status, msg)
+      end if
+    end if
     if (status == MBD_OK .and. present(ptab)) then
       if (w%solver == SOLVER_DENSE) then
         call sens_statics(m, sens, w%rows, q, t, lam, sq, slam, status, msg)
@@ -1085,11 +1100,12 @@ contains
         status = MBD_BAD_COUNT; msg = 'modes: the damped shapes'' arrays do not match the model'
       end if
     end if
+    ! K and C exact (the design sensitivities' blocks) unless contacts or friction (not
+    ! allocated: absent, K and C by differences), in the statics' steps and then at rest
+    if (status == MBD_OK) call stiffness_blocks(m, ctab, rpar, ftab, fpar, sens, status, msg)
     if (status == MBD_OK) call linear_point(m, w, q, t, equilibrium, lam, stable, resid, &
-                                            status, msg)
-    ! K and C exact (the design sensitivities' blocks at rest) unless contacts or friction
-    ! (not allocated: absent, K and C by differences)
-    if (status == MBD_OK .and. smooth_forces(ftab)) call exact_blocks(status)
+                                            status, msg, sens)
+    if (status == MBD_OK .and. allocated(sens)) call sens_at_rest(m, sens, q, t, lam, w%qz)
     if (status == MBD_OK) then
       if (cshapes) then
         call modes_solve(m, w, q, t, lam, kmax, nfree, omega2, kinds, sre, sim, &
@@ -1111,22 +1127,27 @@ contains
       end do
     end if
     if (status == MBD_OK .and. cshapes) call unit_largest(zre(:, 1:2 * kmax), zim(:, 1:2 * kmax))
-  contains
-    !> sens: the design sensitivities' blocks (no parameters) at the rest state (q, t, lam).
-    subroutine exact_blocks(st)
-      integer, intent(out) :: st
-      integer :: ptab0(2, 0), bad, ist
-      real(wp), allocatable :: zq(:)
-      allocate (sens, zq(m%nq), stat=ist)
-      if (ist /= 0) then
-        st = MBD_NO_MEMORY; msg = 'modes: out of memory for the stiffness blocks'; return
-      end if
-      call sens_setup(m, ctab, rpar, ptab0, sens, st, msg, bad, ftab, fpar)
-      if (st /= MBD_OK) return
-      zq = zero
-      call sens_at_rest(m, sens, q, t, lam, zq)
-    end subroutine exact_blocks
   end subroutine api_modes
+
+  !> The design sensitivities' blocks without parameters (sens allocated and set up), for the
+  !! exact stiffness and damping, when the forces are smooth (no contact, no joint friction:
+  !! else sens stays unallocated, and K and C are taken by differences).
+  subroutine stiffness_blocks(m, ctab, rpar, ftab, fpar, sens, status, msg)
+    type(model_t), intent(in) :: m              !! model with dynamics data
+    integer, intent(in) :: ctab(:, :), ftab(:, :)
+    real(wp), intent(in) :: rpar(:), fpar(:)
+    type(sens_t), allocatable, intent(inout) :: sens
+    integer, intent(out) :: status              !! MBD_OK, MBD_NO_MEMORY
+    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    integer :: ptab0(2, 0), bad
+    status = MBD_OK; msg = ''
+    if (.not. smooth_forces(ftab)) return
+    allocate (sens, stat=bad)
+    if (bad /= 0) then
+      status = MBD_NO_MEMORY; msg = 'out of memory for the stiffness blocks'; return
+    end if
+    call sens_setup(m, ctab, rpar, ptab0, sens, status, msg, bad, ftab, fpar)
+  end subroutine stiffness_blocks
 
   !> No contact and no joint friction among the forces (ftab (NFT, nf)): the design
   !! sensitivities' exact derivatives cover them.
@@ -1186,8 +1207,13 @@ contains
       call sens_setup(m, ctab, rpar, ptab, sens, status, msg, bad, ftab, fpar)
       if (status /= MBD_OK) iinfo(2) = -2000000 - bad
     end if
-    if (status == MBD_OK) call linear_point(m, w, q, t, equilibrium, lam, stable, resid, &
-                                            status, msg)
+    if (status == MBD_OK) then                  ! the statics' steps with the exact stiffness
+      if (smooth_forces(ftab)) then
+        call linear_point(m, w, q, t, equilibrium, lam, stable, resid, status, msg, sens)
+      else
+        call linear_point(m, w, q, t, equilibrium, lam, stable, resid, status, msg)
+      end if
+    end if
     if (status == MBD_OK) then
       if (mult) then
         call frf_solve(m, w, sens, q, t, lam, omega, hre, him, ibad, status, msg, lre, lim)
@@ -1212,7 +1238,7 @@ contains
   !> The point modes and the frequency response linearize about: the equilibrium near q
   !! (equilibrium /= 0, statics), or q itself with its least-squares multipliers (stable -2:
   !! not examined).
-  subroutine linear_point(m, w, q, t, equilibrium, lam, stable, resid, status, msg)
+  subroutine linear_point(m, w, q, t, equilibrium, lam, stable, resid, status, msg, s)
     type(model_t), intent(in) :: m              !! model with dynamics data
     type(dyn_work_t), intent(inout) :: w        !! work arrays (dyn_init done)
     real(wp), intent(inout) :: q(:)             !! q0 assembled, then the point (core units)
@@ -1222,9 +1248,11 @@ contains
     integer, intent(out) :: stable              !! as api_statics; -2 not examined
     integer, intent(out) :: status              !! MBD_OK or the solvers' status
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    !> the design sensitivities' blocks (no contacts): the statics' stiffness exact
+    type(sens_t), intent(inout), optional :: s
     resid = zero
     if (equilibrium /= 0) then
-      call statics_solve(m, w, q, t, lam, stable, resid, status, msg)
+      call statics_solve(m, w, q, t, lam, stable, resid, status, msg, s)
     else
       stable = -2
       call dyn_multipliers(m, w, q, w%qz, w%qz, t, lam, status, msg)
@@ -1374,6 +1402,66 @@ contains
       drow(:, k) = rt(k, :)
     end do
   end subroutine api_forces_d
+
+  !> K = d(J^T lambda - Q)/dq and C = -dQ/dq_dot at (q, t) with the multipliers lam, exact
+  !! (the design sensitivities' blocks; a model without contacts or joint friction), as dense
+  !! (nq, nq) arrays by the core's two paths: kpat, cpat read off one product per colour group
+  !! of the tangent's sparse pattern (sens_tangent_pattern: the statics' Newton matrix), kcol,
+  !! ccol a product per column (sens_stiffness_mul, sens_damping_mul: the modes and the
+  !! frequency response). For checks by finite differences.
+  subroutine api_stiffness(nb, ctab, rpar, bmass, grav, ftab, fpar, q, t, lam, kpat, cpat, &
+                           kcol, ccol, status, msg, bad)
+    integer, intent(in) :: nb, ctab(:, :), ftab(:, :)  !! bodies, constraint and force tables
+    real(wp), intent(in) :: rpar(:), bmass(:, :), grav(2), fpar(:)
+    real(wp), intent(in) :: q(:), t, lam(:)     !! state (nq), time, multipliers (neq)
+    real(wp), intent(out) :: kpat(:, :), cpat(:, :), kcol(:, :), ccol(:, :)  !! (nq, nq)
+    integer, intent(out) :: status              !! MBD_OK or < 0
+    character(len=MSG_LEN), intent(out) :: msg  !! what is wrong
+    integer, intent(out) :: bad                 !! offending entry, or 0
+    type(model_t) :: m
+    type(dyn_work_t) :: w
+    type(sens_t) :: sens
+    real(wp), allocatable :: kv(:), cv(:), x(:), y(:)
+    integer :: badf, n, ptab0(2, 0), j, p, ist
+    kpat = zero; cpat = zero; kcol = zero; ccol = zero; bad = 0
+    call model_build(nb, ctab, rpar, m, status, msg, bad, lforce=model_force_size(ftab, fpar))
+    if (status /= MBD_OK) return
+    call model_add_dynamics(m, bmass, grav, ftab, fpar, status, msg, badf)
+    if (status /= MBD_OK) then
+      bad = -badf; return
+    end if
+    if (.not. (finite(q) .and. finite(t) .and. finite(lam))) then
+      call not_finite('the state and the multipliers', status, msg); return
+    end if
+    n = m%nq
+    if (size(q) /= n .or. size(lam) /= m%neq .or. any(shape(kpat) /= [n, n]) .or. &
+        any(shape(cpat) /= [n, n]) .or. any(shape(kcol) /= [n, n]) .or. &
+        any(shape(ccol) /= [n, n])) then
+      status = MBD_BAD_COUNT; msg = 'array sizes do not match the model'; return
+    end if
+    if (.not. smooth_forces(ftab)) then
+      status = MBD_BAD_INPUT
+      msg = 'stiffness: contacts and joint friction have no exact stiffness'; return
+    end if
+    call dyn_init(m, w, q, t, 1.0e-10_wp * m%lscale, status, msg, SOLVER_DENSE)
+    if (status == MBD_OK) call sens_setup(m, ctab, rpar, ptab0, sens, status, msg, bad, ftab, &
+                                          fpar)
+    if (status /= MBD_OK) return
+    allocate (kv(w%kptr(n + 1) - 1), cv(w%kptr(n + 1) - 1), x(n), y(n), stat=ist)
+    if (ist /= 0) then
+      status = MBD_NO_MEMORY; msg = 'stiffness: out of memory'; return
+    end if
+    call sens_stiffness_at(m, sens, q, t, lam, w%qz)
+    call sens_tangent_pattern(m, w, sens, q, t, w%qz, kv, x, y, cv)
+    do j = 1, n
+      do p = w%kptr(j), w%kptr(j + 1) - 1
+        kpat(w%krow(p), j) = kv(p); cpat(w%krow(p), j) = cv(p)
+      end do
+      x = zero; x(j) = one
+      call sens_stiffness_mul(m, sens, q, t, w%qz, x, kcol(:, j), y)
+      call sens_damping_mul(m, sens, q, t, w%qz, x, ccol(:, j))
+    end do
+  end subroutine api_stiffness
 
   !> Changes of the reactions (as api_reactions) along design parameters at many states:
   !! dreac, drloc (6, nc, np, nt), from dq/dp (nq, np, nt) and dlambda/dp (neq, np, nt).

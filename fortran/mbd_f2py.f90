@@ -372,6 +372,22 @@ subroutine core_forces_d(nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp, fpa
                     drow, status, msg, bad)
 end subroutine core_forces_d
 
+subroutine core_stiffness(nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp, fpar, nq, neq, q, &
+                          t, lam, kpat, cpat, kcol, ccol, status, msg, bad)
+  use iso_c_binding, only: c_double, c_int
+  use mbd_api, only: api_stiffness
+  implicit none
+  integer(c_int), intent(in) :: nb, nc, np, nf, nfp, nq, neq
+  integer(c_int), intent(in) :: ctab(8, nc), ftab(6, nf)
+  real(c_double), intent(in) :: rpar(np), bmass(2, nb), grav(2), fpar(nfp), q(nq), t, lam(neq)
+  real(c_double), intent(out) :: kpat(nq, nq), cpat(nq, nq), kcol(nq, nq), ccol(nq, nq)
+  integer(c_int), intent(out) :: status, bad
+  character(len=512), intent(out) :: msg
+  !f2py intent(hide) :: nc, np, nf, nfp, nq, neq
+  call api_stiffness(nb, ctab, rpar, bmass, grav, ftab, fpar, q, t, lam, kpat, cpat, kcol, ccol, &
+                     status, msg, bad)
+end subroutine core_stiffness
+
 subroutine core_kinematics_sens(nb, nc, ctab, np, rpar, nq, neq, q0, t0, t1, nsteps, tol, &
                                 maxit, tmin, every, solver, nout, npar, ptab, qout, qdout, &
                                 qddout, s3, ssum, iinfo, rinfo, qsing, dep, redundant, &

@@ -52,6 +52,9 @@ module mbd_sens_dynamics
   ! (the frequency response, mbd_frf: the equilibrium's load along a parameter)
   public :: statics_load, sens_stiffness_mul, sens_damping_mul, sens_at_rest, proj_particular, &
             proj_multipliers
+  ! (the statics' Newton steps: the stiffness' blocks at each iterate, K on the tangent's sparse
+  ! pattern)
+  public :: sens_stiffness_at, sens_tangent_pattern
   ! (generalized-alpha's sensitivities, mbd_sens_genalpha: the same right-hand sides)
   public :: proj_work_t, proj_init, sens_accel, sens_dyn_rows, cols_to_rows, rows_to_cols
   ! (the multipliers' sensitivities at the outputs of forward dynamics)
@@ -467,11 +470,21 @@ contains
     type(model_t), intent(in) :: m              !! model
     type(sens_t), intent(inout) :: s            !! parameters and blocks
     real(wp), intent(in) :: q(:), t, lam(:), z(:)  !! rest state, time, multipliers, zeros
+    call sens_stiffness_at(m, s, q, t, lam, z)
+    call sens_params(m, s, q, z, z, t)
+  end subroutine sens_at_rest
+
+  !> The blocks of the stiffness alone at the rest state (q, t, lam): the bodies' cos and sin,
+  !! the constraints' second derivatives and K_lambda's list (sens_stiffness_mul's; no
+  !! parameters' blocks, which sens_at_rest adds).
+  subroutine sens_stiffness_at(m, s, q, t, lam, z)
+    type(model_t), intent(in) :: m              !! model
+    type(sens_t), intent(inout) :: s            !! blocks
+    real(wp), intent(in) :: q(:), t, lam(:), z(:)  !! rest state, time, multipliers, zeros
     call sens_trig(m, s, q)
     call sens_hessian(m, s, q, z, z, t)
-    call sens_params(m, s, q, z, z, t)
     call sens_klam_list(m, s, lam)
-  end subroutine sens_at_rest
+  end subroutine sens_stiffness_at
 
   !> kx = K x = K_lambda x - Q_q x at the rest state q (exact; sens_klam_list done; z zeros,
   !! work nq entries).
@@ -484,6 +497,58 @@ contains
     call sens_force_d(m, s, 0, q, z, x, z, t, work)
     kx = kx - work
   end subroutine sens_stiffness_mul
+
+  !> K and C exactly on the sparse pattern of dyn_tangent (w%kptr, w%krow), kv(p) =
+  !! K(krow(p), c), cv likewise (absent: K alone): one product with K (and C) per colour group
+  !! of the pattern, x = the sum of the group's unit vectors, whose columns do not share a row,
+  !! so each entry is read off its own column (Curtis, Powell and Reid's grouping, applied to
+  !! exact products). x, y: work (nq); z zeros.
+  !! The assembled K loses accuracy on smooth vectors that the element-wise product keeps
+  !! (K x of a long spring chain's lowest shape: 2 x_i - x_(i-1) - x_(i+1) summed from
+  !! entries, not k (x_i - x_(i-1)) per spring; its lowest frequency 3.7e-11 instead of
+  !! 6.7e-12): for a Newton matrix (the statics' steps), not for the modes' K_r.
+  subroutine sens_tangent_pattern(m, w, s, q, t, z, kv, x, y, cv)
+    type(model_t), intent(in) :: m              !! model with dynamics data
+    type(dyn_work_t), intent(in) :: w           !! the pattern and its groups (dyn_init)
+    type(sens_t), intent(in) :: s               !! blocks at the rest state (sens_stiffness_at)
+    real(wp), intent(in) :: q(:), t, z(:)       !! state, time, zeros
+    real(wp), intent(out) :: kv(:)              !! K on the pattern
+    real(wp), intent(out) :: x(:), y(:)         !! work (nq)
+    real(wp), intent(out), optional :: cv(:)    !! C on the pattern
+    integer :: g, i
+    kv = zero
+    if (present(cv)) cv = zero
+    x = zero
+    do g = 1, w%ncolor
+      do i = w%gptr(g), w%gptr(g + 1) - 1
+        x(w%gcol(i)) = one
+      end do
+      call sens_klam(s, x, y)                   ! K x = K_lambda x - Q_q x
+      call pattern_put(kv, 1)
+      call sens_force_d(m, s, 0, q, z, x, z, t, y)
+      call pattern_put(kv, -1)
+      if (present(cv)) then                     ! C x = -Q_q_dot x
+        call sens_force_d(m, s, 0, q, z, z, x, t, y)
+        call pattern_put(cv, -1)
+      end if
+      do i = w%gptr(g), w%gptr(g + 1) - 1
+        x(w%gcol(i)) = zero
+      end do
+    end do
+  contains
+    !> av(p) += sgn y(krow(p)) over the columns of group g.
+    subroutine pattern_put(av, sgn)
+      real(wp), intent(inout) :: av(:)
+      integer, intent(in) :: sgn
+      integer :: i, c, p
+      do i = w%gptr(g), w%gptr(g + 1) - 1
+        c = w%gcol(i)
+        do p = w%kptr(c), w%kptr(c + 1) - 1
+          av(p) = av(p) + sgn * y(w%krow(p))
+        end do
+      end do
+    end subroutine pattern_put
+  end subroutine sens_tangent_pattern
 
   !> cx = C x = -Q_q_dot x at the rest state q (exact; z zeros, nq entries).
   subroutine sens_damping_mul(m, s, q, t, z, x, cx)

@@ -8,9 +8,13 @@
 !! by less than its own rounding error (about eps |V|, which grows with any constant added
 !! to V), while g keeps resolving the equilibrium to round-off.
 !! Each step is a Newton step of the equilibrium equations (Haug ch. 6; Nocedal and Wright
-!! ch. 18, the null-space method): with K = d(J^T lambda - Q)/dq (central differences,
-!! lambda the least-squares multipliers) and H = N^T K_sym N the reduced stiffness,
-!!   dq = dq_n + N dz,  dq_n = -J^+ Phi (minimum-norm),  H dz = g - N^T K dq_n.
+!! ch. 18, the null-space method): with K = d(J^T lambda - Q)/dq (lambda the least-squares
+!! multipliers) and H = N^T K_sym N the reduced stiffness, K_sym = (K + K^T) / 2,
+!!   dq = dq_n + N dz,  dq_n = -J^+ Phi (minimum-norm),  H dz = g - N^T K_sym dq_n.
+!! K is exact when the caller gives the design sensitivities' blocks (a model without contacts:
+!! K x = K_lambda x - Q_q x, sens_stiffness_mul, the blocks at each iterate by
+!! sens_stiffness_at), and N^T K_sym dq_n = (N^T K dq_n + (K N)^T dq_n) / 2; else from
+!! central differences on K's sparse pattern (dyn_tangent).
 !! Globalisation (saddle-free): far from an equilibrium H's eigenvalues are replaced by their
 !! absolute values (bounded away from zero), the step is projected onto Phi = 0 and a
 !! backtracking line search keeps V decreasing, so the search goes downhill to a stable
@@ -38,6 +42,8 @@ module mbd_statics
   use mbd_dynamics, only: dyn_work_t, gen_forces, dyn_tangent, dyn_project_pos, &
                           dyn_multipliers, dyn_null_basis, dyn_solve, dyn_pattern_mul, &
                           SOLVER_DENSE
+  use mbd_sensitivity, only: sens_t
+  use mbd_sens_dynamics, only: sens_stiffness_at, sens_stiffness_mul, sens_tangent_pattern
   implicit none
   private
   public :: statics_solve
@@ -56,7 +62,7 @@ contains
 
   !> Equilibrium near q (assembled), least-squares multipliers lam, stability.
   !! stable: 1 stable, 0 unstable, -1 neutral (a zero reduced stiffness), 2 fully constrained.
-  subroutine statics_solve(m, w, q, t, lam, stable, resid, status, msg)
+  subroutine statics_solve(m, w, q, t, lam, stable, resid, status, msg, s)
     type(model_t), intent(in) :: m              !! model with dynamics data
     type(dyn_work_t), intent(inout) :: w        !! work arrays (dyn_init done)
     real(wp), intent(inout) :: q(:)             !! start, then the equilibrium
@@ -68,6 +74,9 @@ contains
     real(wp), intent(out) :: resid
     integer, intent(out) :: status  !! MBD_OK, MBD_NO_CONVERGENCE, MBD_LAPACK, MBD_NO_MEMORY
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    !> the design sensitivities' blocks (sens_setup done; no contacts): K exact; absent, K by
+    !! central differences
+    type(sens_t), intent(inout), optional :: s
     ! work arrays, allocated once: h holds H, then its eigenvectors; r, c, dqz and qt are
     ! vectors of the steps; work is LAPACK's workspace (grown when a query asks for more)
     real(wp), allocatable :: nb(:, :), h(:, :), ev(:), g(:), dz(:), dqn(:), kt(:, :), &
@@ -76,11 +85,12 @@ contains
     integer, allocatable :: ktr(:)
     real(wp) :: v0, vt1, alpha, emax, fscale, vnoise, e0, e1, gn, pn, slope, bytes, fmag
     integer :: it, ls, nfree, n, na, stp, ist, nu, nnz, nn, nf0
-    logical :: local, band
+    logical :: local, band, exact, bycols
     character(len=MSG_LEN) :: lmsg, what
     status = MBD_OK; msg = ''; stable = 2; resid = zero
     n = m%nq; na = w%na; nu = min(na, n)
     band = w%solver /= SOLVER_DENSE
+    exact = present(s)
     nnz = w%kptr(n + 1) - 1
     if (band) then
       nf0 = max(n - na, 1); nn = nf0
@@ -223,7 +233,8 @@ contains
           return
         end if
         g(1:nfree) = matmul(w%force, nb(:, 1:nfree))   ! N^T Q (= -reduced gradient of V)
-        call dyn_tangent(m, w, qa, w%qz, t, lam, kv, cv)
+        call tangent(qa)
+        if (bycols) return
         do p = 1, nnz                                  ! K_sym = (K + K^T) / 2
           if (ktr(p) > p) then
             kv(p) = half * (kv(p) + kv(ktr(p))); kv(ktr(p)) = kv(p)
@@ -275,7 +286,8 @@ contains
       if (nfree == 0) return
       nb(:, 1:nfree) = transpose(vt(rk + 1:n, :))
       g(1:nfree) = matmul(w%force, nb(:, 1:nfree))     ! N^T Q (= -reduced gradient of V)
-      call dyn_tangent(m, w, qa, w%qz, t, lam, kv, cv)
+      call tangent(qa)
+      if (bycols) return
       kt = zero
       do j = 1, n
         do p = w%kptr(j), w%kptr(j + 1) - 1
@@ -290,6 +302,33 @@ contains
       ct(:, 1:nfree) = matmul(kt, nb(:, 1:nfree))      ! K N
       h(1:nfree, 1:nfree) = matmul(transpose(nb(:, 1:nfree)), ct(:, 1:nfree))
     end subroutine reduce
+
+    !> K at qa: exact (the blocks at (qa, t, lam)) or by differences (dyn_tangent) on the
+    !! sparse pattern (kv); exact with fewer free motions than the pattern's colour groups,
+    !! K N (in ct) and H = (N^T K N + (N^T K N)^T) / 2 by a product per column instead
+    !! (bycols).
+    subroutine tangent(qa)
+      real(wp), intent(in) :: qa(:)
+      integer :: i, j
+      bycols = .false.
+      if (.not. exact) then
+        call dyn_tangent(m, w, qa, w%qz, t, lam, kv, cv); return
+      end if
+      call sens_stiffness_at(m, s, qa, t, lam, w%qz)
+      if (w%ncolor < nfree) then
+        call sens_tangent_pattern(m, w, s, qa, t, w%qz, kv, c, dqz); return
+      end if
+      bycols = .true.
+      do j = 1, nfree
+        call sens_stiffness_mul(m, s, qa, t, w%qz, nb(:, j), ct(:, j), c)
+      end do
+      h(1:nfree, 1:nfree) = matmul(transpose(nb(:, 1:nfree)), ct(:, 1:nfree))
+      do j = 1, nfree
+        do i = 1, j - 1
+          h(i, j) = half * (h(i, j) + h(j, i)); h(j, i) = h(i, j)
+        end do
+      end do
+    end subroutine tangent
 
     !> y = K x on the sparse pattern (band path; kv holds K_sym).
     subroutine kmul(x, y)
@@ -338,12 +377,17 @@ contains
     subroutine newton_step(st)
       integer, intent(out) :: st      !! MBD_OK or MBD_NO_MEMORY
       integer :: k
-      if (band) then
-        call kmul(dqn, qt)                               ! K dq_n
+      if (bycols) then                                   ! N^T K_sym dq_n
+        call sens_stiffness_mul(m, s, q, t, w%qz, dqn, qt, c)
+        r(1:nfree) = half * (matmul(qt, nb(:, 1:nfree)) + matmul(dqn, ct(:, 1:nfree)))
       else
-        qt = matmul(dqn, kt)                             ! (K dq_n)^T, K symmetric
+        if (band) then
+          call kmul(dqn, qt)                             ! K dq_n
+        else
+          qt = matmul(dqn, kt)                           ! (K dq_n)^T, K symmetric
+        end if
+        r(1:nfree) = matmul(qt, nb(:, 1:nfree))
       end if
-      r(1:nfree) = matmul(qt, nb(:, 1:nfree))
       r(1:nfree) = g(1:nfree) - r(1:nfree)
       call eigen(.true., st)
       if (st /= MBD_OK) return

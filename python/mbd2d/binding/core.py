@@ -261,6 +261,17 @@ def forces_d(p: Packed, d: DynamicTables, rpar: np.ndarray, bmass: np.ndarray,
                   dq=np.asfortranarray(dq), dqd=np.asfortranarray(dqd), ptab=ptab)
 
 
+def stiffness(p: Packed, d: DynamicTables, q: np.ndarray, t: float,
+              lam: np.ndarray) -> SimpleNamespace:
+    """K = d(J^T lambda - Q)/dq and C = -dQ/dq_dot at (q, t) with the multipliers lam, exact,
+    by the core's two paths: ``kpat``, ``cpat`` (read off the tangent's sparse pattern, the
+    statics' Newton matrix) and ``kcol``, ``ccol`` (a product per column, the modes'); each
+    (nq, nq); ``status``, ``msg``, ``bad``. For checks by finite differences."""
+    return _named("kpat cpat kcol ccol status msg bad", _core.core_stiffness, ctab=p.ctab,
+                  rpar=p.rpar, bmass=d.bmass, grav=d.grav, ftab=d.ftab, fpar=d.fpar, nb=p.nb,
+                  q=q, t=float(t), lam=lam, numbers=4.0 * p.nq**2)
+
+
 def kinematics_sens(p: Packed, t0: float, t1: float, steps: int, tol: float, maxit: int,
                     tmin: float, every: int, solver: int, nout: int,
                     ptab: np.ndarray) -> SimpleNamespace:
