@@ -991,10 +991,10 @@ contains
         iinfo(2) = -2000000 - bad; return
       end if
     else if (status == MBD_OK) then
-      call stiffness_blocks(m, ctab, rpar, ftab, fpar, sens, status, msg)
+      call stiffness_blocks(m, ctab, rpar, ftab, fpar, sens)
     end if
     if (status == MBD_OK) then
-      if (smooth_forces(ftab)) then
+      if (smooth_forces(ftab) .and. allocated(sens)) then
         call statics_solve(m, w, q, t, lam, stable, resid, status, msg, s=sens)
       else
         call statics_solve(m, w, q, t, lam, stable, resid, status, msg)
@@ -1102,7 +1102,7 @@ contains
     end if
     ! K and C exact (the design sensitivities' blocks) unless contacts or friction (not
     ! allocated: absent, K and C by differences), in the statics' steps and then at rest
-    if (status == MBD_OK) call stiffness_blocks(m, ctab, rpar, ftab, fpar, sens, status, msg)
+    if (status == MBD_OK) call stiffness_blocks(m, ctab, rpar, ftab, fpar, sens)
     if (status == MBD_OK) call linear_point(m, w, q, t, equilibrium, lam, stable, resid, &
                                             status, msg, sens)
     if (status == MBD_OK .and. allocated(sens)) call sens_at_rest(m, sens, q, t, lam, w%qz)
@@ -1130,23 +1130,21 @@ contains
   end subroutine api_modes
 
   !> The design sensitivities' blocks without parameters (sens allocated and set up), for the
-  !! exact stiffness and damping, when the forces are smooth (no contact, no joint friction:
-  !! else sens stays unallocated, and K and C are taken by differences).
-  subroutine stiffness_blocks(m, ctab, rpar, ftab, fpar, sens, status, msg)
+  !! exact stiffness and damping, when the forces are smooth (no contact, no joint friction)
+  !! and the blocks can be had; else sens stays unallocated, and K and C are taken by
+  !! differences.
+  subroutine stiffness_blocks(m, ctab, rpar, ftab, fpar, sens)
     type(model_t), intent(in) :: m              !! model with dynamics data
     integer, intent(in) :: ctab(:, :), ftab(:, :)
     real(wp), intent(in) :: rpar(:), fpar(:)
     type(sens_t), allocatable, intent(inout) :: sens
-    integer, intent(out) :: status              !! MBD_OK, MBD_NO_MEMORY
-    character(len=MSG_LEN), intent(out) :: msg  !! explanation
-    integer :: ptab0(2, 0), bad
-    status = MBD_OK; msg = ''
+    integer :: ptab0(2, 0), bad, st
+    character(len=MSG_LEN) :: text
     if (.not. smooth_forces(ftab)) return
     allocate (sens, stat=bad)
-    if (bad /= 0) then
-      status = MBD_NO_MEMORY; msg = 'out of memory for the stiffness blocks'; return
-    end if
-    call sens_setup(m, ctab, rpar, ptab0, sens, status, msg, bad, ftab, fpar)
+    if (bad /= 0) return
+    call sens_setup(m, ctab, rpar, ptab0, sens, st, text, bad, ftab, fpar)
+    if (st /= MBD_OK) deallocate (sens)
   end subroutine stiffness_blocks
 
   !> No contact and no joint friction among the forces (ftab (NFT, nf)): the design
