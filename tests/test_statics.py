@@ -282,15 +282,16 @@ def test_a_bob_on_a_distance_joint_settles_below_its_pivot(solver: str) -> None:
 CHAIN_LENGTH, CHAIN_SPAN, LINK_MASS = 1.5, (1.0, 0.2), 0.1
 
 
-def hanging_chain(n: int) -> mbd2d.Model:
+def hanging_chain(n: int, start: np.ndarray | None = None) -> mbd2d.Model:
     """n uniform links (total length 1.5 m, 0.1 kg each) pinned end to end, the first to
-    ground at (0, 0), the last at (1, 0.2); started as a V (the assembly closes it)."""
+    ground at (0, 0), the last at (1, 0.2); started at the link angles start, by default
+    as a V (the assembly closes it)."""
     link = CHAIN_LENGTH / n
     m = mbd2d.Model("chain", gravity=(0.0, -G))
     a = math.acos(CHAIN_SPAN[0] / CHAIN_LENGTH)
     x = y = 0.0
     for i in range(n):
-        th = -a if i < n // 2 else a
+        th = (-a if i < n // 2 else a) if start is None else float(start[i])
         c, s = math.cos(th), math.sin(th)
         m.add_body(f"l{i}", (x + 0.5 * link * c, y + 0.5 * link * s, th), mass=LINK_MASS,
                    inertia=LINK_MASS * link**2 / 12)
@@ -346,3 +347,17 @@ def test_hanging_chain_against_the_discrete_catenary(n: int, solver: str) -> Non
     weight = n * LINK_MASS * G
     assert_allclose([a.fx_j[0], b.fx[0]], [-tension, tension], rtol=1e-13)
     assert_allclose(a.fy_j[0] + b.fy[0], weight, rtol=1e-13)
+
+
+@pytest.mark.parametrize("n, solver", [(10, "dense"), (40, "banded")])
+def test_hanging_chain_comes_down_from_an_arch(n: int, solver: str) -> None:
+    """Started far away, as an arch over the chord (the catenary's angles mirrored about it,
+    slightly disturbed: links up to 2.6 rad off), the saddle-free steps come down through
+    n - 2 free motions to the hanging catenary, to the same 1e-13 rad."""
+    theta, _ = discrete_catenary(n)
+    chord = math.atan2(CHAIN_SPAN[1], CHAIN_SPAN[0])
+    arch = 2 * chord - theta + 0.1 * np.random.default_rng(1).normal(size=n)
+    st = hanging_chain(n, arch).statics(solver=solver)
+    got = np.array([st.body(f"l{i}")[2] for i in range(n)])
+    assert st.stability == "stable"
+    assert np.abs(np.remainder(got - theta + math.pi, 2 * math.pi) - math.pi).max() <= 1e-13
