@@ -244,3 +244,22 @@ def test_dynamics_studies_take_the_integrator(tmp_path: Path, capsys) -> None:
                  "dynamics", "--method", "dopri5", "--h", "1e-3", "--t-end", "0.5",
                  "--steps", "5", "--workers", "1", "--out", str(sw)]) == 2
     assert "h is for" in capsys.readouterr().err
+
+
+def test_modes_from_the_command_line(tmp_path: Path, capsys) -> None:
+    """`--analysis modes`: one CSV row with the equilibrium's and every natural frequency's
+    Monte Carlo columns (the API's, same seed), the frequencies in the summary."""
+    car = str(EX / "half_car.toml")
+    sig = {"force.front_tyre.stiffness": 1e4, "body.body.mass": 20.0}
+    out = tmp_path / "tol.csv"
+    assert main(["tolerance", car, "--analysis", "modes", "--samples", "30", "--workers", "1"]
+                + [a for k, v in sig.items() for a in ("--sigma", f"{k}={v}")]
+                + ["--out", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert "natural frequencies (Hz)" in text and "mode 4" in text
+    header, rows = read_csv(out)
+    tol = mbd2d.tolerance(mbd2d.load(car), sig, "modes", samples=30, workers=1)
+    assert rows.shape[0] == 1
+    for k in range(4):
+        np.testing.assert_array_equal(rows[0, header.index(f"mode{k + 1}.frequency.std_mc")],
+                                      tol.dataset.frequency_std_mc.values[k])

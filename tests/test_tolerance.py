@@ -209,3 +209,67 @@ def test_nominal_failure_is_raised() -> None:
     m = load_example("fourbar_grashof.toml").with_params({"joint.B.points.0.0": -0.6})
     with pytest.raises(mbd2d.SingularConfigurationError):
         mbd2d.tolerance(m, {"joint.B.points.0.0": 1e-3}, samples=4, t_end=1.0, steps=10)
+
+
+# ---------------------------------------------------------------------------------------------
+# The modes: Monte Carlo alone, against the closed forms evaluated on the same draws
+
+
+def test_modes_tolerance_against_the_closed_form_on_the_same_draws(tmp_path) -> None:
+    """A block (m) on a vertical guide hanging from a spring-damper (k, c): f = sqrt(k/m) /
+    (2 pi), zeta = c / (2 sqrt(k m)), equilibrium y = -0.5 - m g / k. With k and m scattered
+    the Monte Carlo standard deviations and means of f, zeta and y are those of the closed
+    forms over the same draws (mbd2d.tolerance_samples), to 1e-12 relative; there is no
+    first-order column (the frequencies' derivatives need third derivatives), and the report
+    says so."""
+    from test_modes import G, block_text
+    m0, k0, c0 = 2.0, 36.0, 1.5
+    model = mbd2d.loads(block_text(k0, c0, m0))
+    sigma = {"force.s.stiffness": 2.0, "body.block.mass": 0.05}
+    tol = mbd2d.tolerance(model, sigma, "modes", samples=300, workers=1)
+    ds = tol.dataset
+    d = mbd2d.tolerance_samples(model, sigma, 300)
+    k, m = d["force.s.stiffness"], d["body.block.mass"]
+    for name, values, nominal in (
+            ("frequency", np.sqrt(k / m) / (2 * np.pi), np.sqrt(k0 / m0) / (2 * np.pi)),
+            ("damping_ratio", c0 / (2 * np.sqrt(k * m)), c0 / (2 * np.sqrt(k0 * m0)))):
+        assert_allclose(ds[name].values, nominal, rtol=1e-13)
+        assert_allclose(ds[f"{name}_std_mc"].values, np.std(values, ddof=1), rtol=1e-12)
+        assert_allclose(ds[f"{name}_mean_mc"].values, values.mean(), rtol=1e-12)
+    y = -0.5 - m * G / k
+    assert_allclose(ds.q.sel(coordinate="block.y").values, -0.5 - m0 * G / k0, rtol=1e-13)
+    assert_allclose(ds.q_std_mc.sel(coordinate="block.y").values, np.std(y, ddof=1),
+                    rtol=1e-12)
+    assert_allclose(tol.point("block", (0.0, 0.0)).y_std_mc.values, np.std(y, ddof=1),
+                    rtol=1e-12)
+    assert not tol.linear and ds.attrs["first_order"].startswith("none")
+    assert not [v for v in ds.data_vars if v.endswith("_std_linear")]
+    assert "Monte Carlo only" in repr(tol)
+    with pytest.raises(mbd2d.ModelError, match="first-order column"):
+        tol.contributions("frequency", "0")
+    out = tmp_path / "tol.csv"
+    mbd2d.studies.write_tolerance(ds, out)
+    header = out.read_text().splitlines()[0].split(",")
+    row = np.loadtxt(out, delimiter=",", skiprows=1, ndmin=2)
+    assert row.shape[0] == 1
+    got = dict(zip(header, row[0]))
+    assert_allclose(got["mode1.frequency.std_mc"], np.std(np.sqrt(k / m) / (2 * np.pi),
+                                                          ddof=1), rtol=1e-12)
+    assert "eigenvalue2.damping_ratio.mean_mc" in got
+
+
+def test_modes_tolerance_needs_samples_and_takes_no_measures() -> None:
+    from test_modes import block_text
+    model = mbd2d.loads(block_text())
+    with pytest.raises(mbd2d.ModelError, match="samples=0 leaves nothing"):
+        mbd2d.tolerance(model, {"force.s.stiffness": 1.0}, "modes", samples=0)
+    with pytest.raises(mbd2d.ModelError, match="not of modes"):
+        mbd2d.tolerance(model, {"force.s.stiffness": 1.0}, "modes", samples=4,
+                        measures="dead_centre_distance")
+    with pytest.raises(mbd2d.ModelError, match="the settings are"):
+        mbd2d.tolerance(model, {"force.s.stiffness": 1.0}, "modes", samples=4, t_end=1.0)
+    # the frequency response is refused with the way to its scatter (it ran dynamics'
+    # settings check before: "missing a required argument: 't_end'")
+    with pytest.raises(mbd2d.ModelError, match="tolerance_samples"):
+        mbd2d.tolerance(model, {"force.s.stiffness": 1.0}, "frf", samples=4,
+                        inputs=["force.s.length0"], frequencies=[1.0])

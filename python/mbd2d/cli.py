@@ -256,7 +256,7 @@ def _parser() -> argparse.ArgumentParser:
                    "(default: the i-th value of every parameter together; equal NUM)")
     _study_settings(w, "the analysis (default kinematics; modes: the frequencies, damping "
                     "and shapes of every case; frf: every case's frequency response to "
-                    "--input at --f)", modes=True)
+                    "--input at --f)", frf=True)
     _frf_settings(w, required=False)
     _study_integrator(w)
     w.add_argument("--positions-only", action="store_true",
@@ -503,11 +503,12 @@ def _modes(model: Model, args: argparse.Namespace) -> int:
 
 
 def _study_settings(p: argparse.ArgumentParser, analysis_help: str,
-                    modes: bool = False) -> None:
-    """The analysis and output times of a study (sweep; tolerance without modes)."""
+                    frf: bool = False) -> None:
+    """The analysis and output times of a study (sweep; tolerance with the modes but without
+    the frequency response)."""
     p.add_argument("--analysis", default="kinematics",
-                   choices=["kinematics", "inverse_dynamics", "statics", "dynamics"]
-                   + (["modes", "frf"] if modes else []), help=analysis_help)
+                   choices=["kinematics", "inverse_dynamics", "statics", "dynamics", "modes"]
+                   + (["frf"] if frf else []), help=analysis_help)
     p.add_argument("--t-end", type=float, default=None, help="final time")
     p.add_argument("--steps", type=int, default=None, help="output intervals")
     p.add_argument("--t0", type=float, default=0.0, help="start time (statics, modes, frf: "
@@ -561,7 +562,7 @@ def _tolerance_parser(sub: Any) -> None:
                    help="Monte Carlo variants (default 200; 0: first order alone)")
     t.add_argument("--seed", type=int, default=0, help="seed of the draws (default 0)")
     _study_settings(t, "the analysis (default kinematics; dynamics by dopri5 or "
-                       "generalized-alpha)")
+                       "generalized-alpha; modes: Monte Carlo alone)")
     _study_integrator(t)
     t.add_argument("--point", action="append", default=None, metavar="BODY:X,Y",
                    help="also the scatter of the point (X, Y) of BODY (repeatable)")
@@ -661,7 +662,21 @@ def _tolerance_report(tol: Any, points: list[tuple[str, Any]]) -> str:
                      + _main_share(tol, output, name, k))
     if "measures" in ds:
         lines += _measures_report(tol, key, word, t)
+    if "frequency" in ds:
+        lines += _modes_report(ds)
     return "\n".join(lines)
+
+
+def _modes_report(ds: Any) -> list[str]:
+    """The modes' lines of a tolerance report: each natural frequency with its Monte Carlo
+    standard deviation and mean."""
+    lines = ["natural frequencies (Hz), Monte Carlo standard deviation and mean:"]
+    for k, f in enumerate(ds.frequency.values, start=1):
+        sd, mean = ds.frequency_std_mc.values[k - 1], ds.frequency_mean_mc.values[k - 1]
+        lines.append(f"  mode {k:<3d} {f:.6g}  std {sd:.3g}  mean {mean:.6g}"
+                     if np.isfinite(sd) else f"  mode {k:<3d} {f:.6g}  fewer than 2 samples "
+                     "completed")
+    return lines
 
 
 def _nanmax(x: np.ndarray) -> float:

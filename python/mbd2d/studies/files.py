@@ -199,7 +199,9 @@ def _g(v: Any) -> str:
 
 #: the column names of a tolerance output's entries, from its coordinate's labels
 _ENTRY = {"q": "{}", "qd": "{}_dot", "qdd": "{}_ddot", "lam": "lambda.{}", "effort": "{}.effort",
-          "measures": "{}"}
+          "measures": "{}", "frequency": "mode{}.frequency",
+          "damping_ratio": "eigenvalue{}.damping_ratio",
+          "damped_frequency": "eigenvalue{}.damped_frequency"}
 #: the statistics of a tolerance output, as column suffixes
 _STATS = (("", ""), ("_std_linear", ".std_linear"), ("_std_mc", ".std_mc"),
           ("_mean_mc", ".mean_mc"))
@@ -213,19 +215,24 @@ def tolerance_table(ds: Any, points: Sequence[tuple[str, Any]] = ()
     value ``NAME``, first-order
     standard deviation ``NAME.std_linear`` and, with Monte Carlo samples, ``NAME.std_mc``
     and ``NAME.mean_mc`` (NAME: ``crank.x``, ``crank.x_dot``, ``crank.x_ddot``,
-    ``lambda.LABEL``, ``DRIVER.effort``); then per point ``LABEL.x``, ``LABEL.y`` with
-    their ``.std_linear`` and ``.std_mc`` (``.std_linear`` only where the analysis has the
-    first-order column: not with contacts or joint friction)."""
+    ``lambda.LABEL``, ``DRIVER.effort``; the modes' one row also ``modeK.frequency``,
+    ``eigenvalueK.damping_ratio``, ``eigenvalueK.damped_frequency``, K from 1); then per
+    point ``LABEL.x``, ``LABEL.y`` with their ``.std_linear`` and ``.std_mc``
+    (``.std_linear`` only where the analysis has the first-order column: not with contacts
+    or joint friction, nor for the modes)."""
     header = ["t"]
     blocks = [np.atleast_1d(ds.time.values)[:, None]]
     for out, fmt in _ENTRY.items():
         if out not in ds:
             continue
-        labels = [str(v) for v in ds[ds[out].dims[1]].values]
+        per_time = len(ds[out].dims) == 2       # (the modes' outputs: one row, K from 1)
+        labels = [str(v) for v in ds[ds[out].dims[1]].values] if per_time else \
+            [str(k + 1) for k in range(ds[out].shape[0])]
         for suffix, word in _STATS:
             if f"{out}{suffix}" in ds:
                 header += [fmt.format(lb) + word for lb in labels]
-                blocks.append(np.asarray(ds[f"{out}{suffix}"].values))
+                v = np.asarray(ds[f"{out}{suffix}"].values)
+                blocks.append(v if per_time else v[None, :])
     for label, pt in points:
         for v in ("x", "y", "x_std_linear", "y_std_linear", "x_std_mc", "y_std_mc"):
             if v not in pt:

@@ -15,7 +15,9 @@ nonlinear in the parameters over the scatter.
 
 A model with contacts or joint friction has no design sensitivities (its events make the
 motion non-smooth in the parameters): its report has the Monte Carlo columns alone, and the
-dataset's attribute ``first_order`` says why.
+dataset's attribute ``first_order`` says why. So has the modes' report (the natural
+frequencies', damping ratios' and equilibrium's scatter): the frequencies' derivatives need the
+model's third derivatives, which mbd2d does not write.
 """
 from __future__ import annotations
 
@@ -28,6 +30,7 @@ from ..analysis.dynamics import run_dynamics
 from ..analysis.sensitivities import SENSITIVITY_METHODS
 from ..analysis.inverse import run_inverse
 from ..analysis.kinematics import run_kinematics
+from ..analysis.modes import run_modes
 from ..analysis.statics import run_statics
 from ..analysis.settings import check_memory
 from ..description.builder import ModelDescription
@@ -39,8 +42,13 @@ from ..results.points import PointResult
 from ..validate import number, vector, whole
 from .dataset import xarray
 from .plan import (ANALYSES, _bind, _dynamics_settings, _inverse_settings,
-                   _kinematics_settings, _statics_settings, nominal_values)
+                   _kinematics_settings, _modes_settings, _statics_settings, nominal_values)
 from .sweep import sweep
+
+
+#: why the modes' report has no first-order column
+MODES_FIRST_ORDER = ("none: the natural frequencies' design derivatives need the model's third "
+                     "derivatives, which mbd2d does not write; the Monte Carlo columns alone")
 
 
 @dataclass
@@ -101,6 +109,8 @@ class ToleranceResult:
             data.update(self._point_linear(i, (sx, sy)))
         qs = np.zeros((0,) + q.shape) if self.samples is None else \
             self.samples.q.values[self.samples.status.values == 0]      # (n, time, nq)
+        if qs.ndim == 2:                        # (a modes sweep's equilibria: no time axis)
+            qs = qs[:, None, :]
         ths = qs[:, :, i + 2]
         data["x_std_mc"] = (t, _std(qs[:, :, i] + np.cos(ths) * sx - np.sin(ths) * sy))
         data["y_std_mc"] = (t, _std(qs[:, :, i + 1] + np.sin(ths) * sx + np.cos(ths) * sy))
@@ -253,6 +263,8 @@ def _nominal(model: ModelDescription, names: list[str] | None, analysis: str,
              kw: Mapping[str, Any]) -> tuple[Any, str]:
     """The analysis with sensitivities to names (None: without; the exception it raises
     when it fails); and which analysis ran."""
+    if analysis == "modes":
+        return run_modes(model, **_bind(_modes_settings, kw, analysis)), "modes"
     if analysis == "kinematics":
         a = _bind(_kinematics_settings, kw, analysis)
         if model.has_masses() and a["maxit"] is None and not a["positions_only"]:
@@ -282,6 +294,10 @@ def _linear_outputs(res: Any, ran: str) -> dict[str, tuple[tuple[str, ...], np.n
         return None if a is None else _rows(res, a)
 
     out = {"q": (("time", "coordinate"), rows(res.q), rows(getattr(res, "dq_dp", None)))}
+    if ran == "modes":                          # (the equilibrium; no sensitivities)
+        return {**out, "frequency": (("mode",), res.frequency, None),
+                "damping_ratio": (("eigenvalue",), res.damping_ratio, None),
+                "damped_frequency": (("eigenvalue",), res.damped_frequency, None)}
     if ran != "statics":
         out["qd"] = (("time", "coordinate"), res.qd, getattr(res, "dqd_dp", None))
         out["qdd"] = (("time", "coordinate"), res.qdd, getattr(res, "dqdd_dp", None))
@@ -309,8 +325,8 @@ def _measure_specs(measures: Any, analysis: str) -> list[str]:
     specs = measure_list(measures)
     for spec in specs:
         parse_measure(spec)
-    if specs and analysis == "statics":
-        raise ModelError("measures are columns of a run over time, not of statics",
+    if specs and analysis in ("statics", "modes"):
+        raise ModelError(f"measures are columns of a run over time, not of {analysis}",
                          "tolerance")
     return list(specs)
 
@@ -321,6 +337,18 @@ def _measure_outputs(res: Any, specs: list[str], linear: bool
     when not linear), as _linear_outputs gives the other outputs."""
     return (("time", "measure"), np.column_stack([measure(res, s) for s in specs]),
             measure_derivatives(res, specs) if linear else None)
+
+
+def _as_nominal(vals: np.ndarray, nom: np.ndarray) -> np.ndarray:
+    """A sweep's values of the completed samples (sample, ...) shaped as the nominal output:
+    a modes sweep's equilibria (sample, coordinate) get the nominal's time axis of one row,
+    its frequencies (sample, mode) the nominal's number of modes (the sweep has as many as
+    its case with the most)."""
+    if vals.ndim == 2 and nom.ndim == 2:
+        return vals[:, None, :]
+    if vals.ndim == 2 and nom.ndim == 1:
+        return vals[:, :nom.shape[0]]
+    return vals
 
 
 def _seed(seed: Any) -> int | None:
@@ -442,12 +470,12 @@ def tolerance(model: ModelDescription, sigma: Mapping[str, Any], analysis: str =
     """
     xr = xarray()
     params, sig = _sigma(model, sigma)
-    rough = _not_smooth(model)
-    if not isinstance(analysis, str) or analysis not in ANALYSES or analysis == "modes":
-        known = ", ".join(a for a in ANALYSES if a != "modes")
-        raise ModelError(f"unknown analysis {analysis!r}; use one of {known} (the modes' "
-                         "scatter: mbd2d.sweep(..., analysis=\"modes\") of "
+    if not isinstance(analysis, str) or analysis not in ANALYSES or analysis == "frf":
+        known = ", ".join(a for a in ANALYSES if a != "frf")
+        raise ModelError(f"unknown analysis {analysis!r}; use one of {known} (the frequency "
+                         "response's scatter: mbd2d.sweep(..., analysis=\"frf\") of "
                          "mbd2d.tolerance_samples(...))", "tolerance")
+    rough = MODES_FIRST_ORDER if analysis == "modes" else _not_smooth(model)
     names = [str(n) for n in sigma]
     n = whole(samples, "samples", "tolerance", 0, 10**8)
     seed = _seed(seed)
@@ -468,21 +496,26 @@ def tolerance(model: ModelDescription, sigma: Mapping[str, Any], analysis: str =
                    workers=workers, progress=progress, measures=specs or None,
                    **analysis_kwargs)
     ok = mc.status.values == 0 if mc is not None else np.zeros(0, dtype=bool)
-    times = np.array([res.t]) if ran == "statics" else np.asarray(res.t)
+    times = np.array([res.t]) if ran in ("statics", "modes") else np.asarray(res.t)
     data: dict[str, Any] = {}
     for name, (dims, nom, s) in list(outs.items()):
         if s is None and (mc is None or name not in mc):
             del outs[name]                      # no statistic of it
             continue
+        vals = None if mc is None or name not in mc else _as_nominal(mc[name].values[ok], nom)
+        if vals is not None and vals.ndim == 2 and nom.ndim == 1:
+            nom = nom[:vals.shape[1]]           # (a modes sweep with fewer modes)
         data[name] = (dims, nom)
         if s is not None:
             data[f"{name}_std_linear"] = (dims, _std_linear(s, sig))
-        if mc is not None and name in mc:
-            vals = mc[name].values[ok]
+        if vals is not None:
             data[f"{name}_std_mc"] = (dims, _std(vals))
             data[f"{name}_mean_mc"] = (dims, vals.mean(axis=0) if len(vals) else
                                        np.full(nom.shape, np.nan))
     coords: dict[str, Any] = {"time": times, "coordinate": list(res.coordinate_names)}
+    if ran == "modes":
+        coords["mode"] = np.arange(data["frequency"][1].shape[0])
+        coords["eigenvalue"] = np.arange(data["damping_ratio"][1].shape[0])
     if specs:
         coords["measure"] = specs
     if "lam" in outs:
