@@ -25,7 +25,7 @@ module mbd_forces
   use mbd_points, only: NLOC, kloc, local_state, kvec, kscal, body_point, body_angle, vsub, &
                         vdot, ssqrt, ssub
   use mbd_functions, only: fun_eval, fun_length, fun_check, fun_exponents, fun_eval_d, &
-                           fun_is_count
+                           fun_is_count, fun_next_break
   use mbd_dual, only: dloc, dvec, dscal, dual_state, point_values, point_changes, body_point, &
                       body_angle, ssub
   use mbd_contact, only: NCS, NEO, contact_raw_length, contact_prepare, contact_exponents, &
@@ -35,6 +35,7 @@ module mbd_forces
   public :: FRC_SPRING, FRC_TORQUE, FRC_POINT, FRC_ROTSPRING, FRC_CONTACT0, FRC_CONTACT1
   public :: FRC_FRICTION
   public :: force_known, force_raw_length, force_prepare, force_eval, force_exponents
+  public :: force_next_break
   public :: force_is_contact, force_is_count, force_eval_d, force_eval_dm, force_rows_d
 
   integer, parameter :: FRC_SPRING = 1, FRC_TORQUE = 2, FRC_POINT = 3, FRC_ROTSPRING = 4
@@ -51,6 +52,25 @@ module mbd_forces
   end type spring_v
 
 contains
+
+  !> The first breakpoint after t of a force's functions of time (fun_next_break: a motion
+  !! law's t0 or t1, a table's ends; huge when none), where the force's second derivative in
+  !! time may jump.
+  pure real(wp) function force_next_break(kind, p, t) result(tb)
+    integer, intent(in) :: kind        !! force kind
+    real(wp), intent(in) :: p(:)       !! prepared parameters
+    real(wp), intent(in) :: t          !! time
+    integer :: nf
+    select case (kind)
+    case (FRC_SPRING); tb = fun_next_break(p(8:), t)
+    case (FRC_TORQUE); tb = fun_next_break(p, t)
+    case (FRC_POINT)
+      nf = fun_length(p(3:))
+      tb = min(fun_next_break(p(3:), t), fun_next_break(p(3 + nf:), t))
+    case (FRC_ROTSPRING); tb = fun_next_break(p(4:), t)
+    case default; tb = huge(t)
+    end select
+  end function force_next_break
 
   pure logical function force_known(kind)
     integer, intent(in) :: kind   !! force kind

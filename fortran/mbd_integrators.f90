@@ -44,7 +44,8 @@ module mbd_integrators
   use mbd_saddle, only: saddle_t, saddle_plan, saddle_factor, saddle_solve
   use mbd_dynamics, only: dyn_work_t, dyn_accel, dyn_velocity, dyn_project_pos, gen_forces, &
                           kinetic_energy, dyn_tangent, dyn_solve, dyn_jt_lam, dyn_multipliers, &
-                          dyn_jv, dyn_null_basis, SOLVER_DENSE, dyn_element_outputs
+                          dyn_jv, dyn_null_basis, SOLVER_DENSE, dyn_element_outputs, &
+                          dyn_next_break
   use mbd_events, only: ev_log_t, events_active, events_init, events_find, events_switch, &
                         event_tol
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
@@ -452,15 +453,26 @@ contains
 
   !> Write the stored outputs in (ta, tb] by quintic Hermite interpolation of the two
   !! states; outputs between the stored ones (every > 1) are passed over, not computed.
-  subroutine emit(c, qo, vo, ao, ta, qa, va, aa, tb, qb, vb, ab)
+  !! abl: the accelerations' left limit at tb for the outputs before it (a step ending on a
+  !! breakpoint of the functions of time; ab, the right one, is an output's at tb itself).
+  subroutine emit(c, qo, vo, ao, ta, qa, va, aa, tb, qb, vb, ab, abl)
     type(itg_t), intent(inout) :: c
     real(wp), intent(inout) :: qo(:, :), vo(:, :), ao(:, :)
     real(wp), intent(in) :: ta, tb, qa(:), va(:), aa(:), qb(:), vb(:), ab(:)
+    real(wp), intent(in), optional :: abl(:)
+    real(wp) :: tk, tol
+    tol = 1.0e-12_wp * abs(c%t1 - c%t0)
     do while (c%kout <= c%nsteps)
-      if (out_time(c, c%kout) > tb + 1.0e-12_wp * abs(c%t1 - c%t0)) exit
+      tk = out_time(c, c%kout)
+      if (tk > tb + tol) exit
       if (mod(c%kout, c%every) == 0 .or. c%kout == c%nsteps) then
-        call hermite5(ta, qa, va, aa, tb, qb, vb, ab, out_time(c, c%kout), &
-                      qo(:, c%nout + 1), vo(:, c%nout + 1), ao(:, c%nout + 1))
+        if (present(abl) .and. tk < tb - tol) then
+          call hermite5(ta, qa, va, aa, tb, qb, vb, abl, tk, qo(:, c%nout + 1), &
+                        vo(:, c%nout + 1), ao(:, c%nout + 1))
+        else
+          call hermite5(ta, qa, va, aa, tb, qb, vb, ab, tk, qo(:, c%nout + 1), &
+                        vo(:, c%nout + 1), ao(:, c%nout + 1))
+        end if
         c%nout = c%nout + 1
       end if
       c%kout = c%kout + 1
@@ -848,9 +860,10 @@ contains
     character(len=MSG_LEN), intent(out) :: msg
     integer, intent(inout), optional, volatile :: ctl(:)   !! progress (see integrate)
     real(wp), allocatable :: y(:), ynew(:), k(:, :), e(:), ys(:)   ! ys: a stage's state
-    real(wp) :: t, h, tnew, err, fac, qa(m%nq), va(m%nq), aa(m%nq), te, dev, move
+    real(wp) :: t, h, tnew, err, fac, qa(m%nq), va(m%nq), aa(m%nq), te, dev, move, tb
+    real(wp) :: al(m%nq), ar(m%nq)           ! a step ending on a breakpoint: left, right q_ddot
     integer :: stt, nprev, kev
-    logical :: fixed, fsal, changed
+    logical :: fixed, fsal, changed, land
     integer :: nfix
     integer :: hits, calm                    ! stiffness_test's counters
     logical :: stiff
@@ -894,13 +907,27 @@ contains
       c%st%t_fail = t
       h = min(h, c%t1 - t)
       tnew = t + h
+      land = .false.
       if (fixed) then
         tnew = step_time(c, c%st%steps + 1, nfix)
         h = tnew - t
+      else if (.not. partitioned) then
+        ! a step that would cross (or end within a tenth of a step of) a breakpoint of the
+        ! drivers' or forces' functions of time, where q_ddot may jump, ends on it: no
+        ! rejections shrinking the step onto the kink
+        tb = dyn_next_break(m, t)
+        if (tb < c%t1 .and. t + 1.1_wp * h >= tb) then
+          h = tb - t; tnew = tb; land = .true.
+        end if
       end if
       if (fixed) then
         call rk4_step(m, w, c, t, y, h, ynew, k, ys, fsal, stt)
         err = zero
+      else if (land) then
+        ! (the stages at the breakpoint from the left: the functions give their right
+        ! limits there, which belong to the next step, whose first stage is taken at tb)
+        call dopri5_step(m, w, c, t, y, h, ynew, k, e, ys, fsal, stt, nearest(tb, -one))
+        if (stt == MBD_OK) err = err_norm(c, e, y, ynew)
       else
         call dopri5_step(m, w, c, t, y, h, ynew, k, e, ys, fsal, stt)
         if (stt == MBD_OK) err = err_norm(c, e, y, ynew)
@@ -983,7 +1010,17 @@ contains
         end if
       end if
       nprev = c%nout
-      call emit(c, qo, vo, ao, t, qa, va, aa, tnew, c%qf, c%vf, c%af)
+      if (land) then
+        ! the step's interpolant ends with the left limit of q_ddot at the breakpoint (the
+        ! functions give the right one there, the next step's start and an output at tb)
+        ar = c%af
+        call rhs(m, w, c, nearest(tnew, -one), ynew, ys, stt)
+        al = c%af; c%af = ar
+        if (stt /= MBD_OK) al = ar
+        call emit(c, qo, vo, ao, t, qa, va, aa, tnew, c%qf, c%vf, c%af, al)
+      else
+        call emit(c, qo, vo, ao, t, qa, va, aa, tnew, c%qf, c%vf, c%af)
+      end if
       if (partitioned) call complete_outputs(m, w, c, qo, vo, nprev + 1)
       call save_modes(w, c, nprev + 1)
       if (kev > 0) then
@@ -1694,7 +1731,7 @@ contains
     end if
   end subroutine stiffness_test
 
-  subroutine dopri5_step(m, w, c, t, y, h, yn, k, e, ys, fsal, stf)
+  subroutine dopri5_step(m, w, c, t, y, h, yn, k, e, ys, fsal, stf, tend)
     type(model_t), intent(in) :: m
     type(dyn_work_t), intent(inout) :: w
     type(itg_t), intent(inout) :: c
@@ -1704,8 +1741,14 @@ contains
     real(wp), intent(inout) :: ys(:)          !! a stage's state (workspace)
     logical, intent(inout) :: fsal
     integer, intent(out) :: stf
+    !> the time of the stages at the step's end (c = 1; default t + h): just below a
+    !! breakpoint the step ends on
+    real(wp), intent(in), optional :: tend
+    real(wp) :: t1
     integer :: j
     stf = MBD_OK
+    t1 = t + h
+    if (present(tend)) t1 = tend
     if (.not. fsal) then
       call rhs(m, w, c, t, y, k(:, 1), stf)
       if (stf /= MBD_OK) return
@@ -1713,11 +1756,11 @@ contains
     ! the stages' states in ys (expressions as arguments would be heap temporaries)
     do j = 2, 6
       call dopri5_state(j, y, h, k, ys)
-      call rhs(m, w, c, t + DOPRI_C(j) * h, ys, k(:, j), stf)
+      call rhs(m, w, c, merge(t1, t + DOPRI_C(j) * h, DOPRI_C(j) >= one), ys, k(:, j), stf)
       if (stf /= MBD_OK) return
     end do
     call dopri5_state(7, y, h, k, yn)
-    call rhs(m, w, c, t + h, yn, k(:, 7), stf)
+    call rhs(m, w, c, t1, yn, k(:, 7), stf)
     if (stf /= MBD_OK) return
     call dopri5_error(h, k, e)
     k(:, 1) = k(:, 7)
