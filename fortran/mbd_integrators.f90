@@ -916,7 +916,7 @@ contains
         ! drivers' or forces' functions of time, where q_ddot may jump, ends on it: no
         ! rejections shrinking the step onto the kink
         tb = dyn_next_break(m, t)
-        if (tb < c%t1 .and. t + 1.1_wp * h >= tb) then
+        if (tb <= c%t1 .and. t + 1.1_wp * h >= tb) then
           h = tb - t; tnew = tb; land = .true.
         end if
       end if
