@@ -41,7 +41,7 @@ module mbd_sens_dynamics
   use mbd_status, only: MBD_INTEGRATOR_FAILED, MBD_BAD_SETTING
   use mbd_dynamics, only: dyn_work_t, dyn_accel, dyn_project_pos, dyn_velocity, &
                           dyn_factor_projection, dyn_solve_rows, dyn_solve, dyn_multipliers, &
-                          dyn_null_basis, SOLVER_DENSE
+                          dyn_null_basis, SOLVER_DENSE, dyn_next_break
   use mbd_integrators, only: output_rows, dopri5_state, dopri5_error, DOPRI_C, stiffness_test
   use mbd_interp, only: hermite5
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
@@ -603,9 +603,9 @@ contains
     ! the work of rhs and project (here, so that no step allocates)
     real(wp), allocatable :: qq(:), vv(:), aa(:), v0(:), fo(:)
     type(proj_work_t) :: pw
-    real(wp) :: t, h, tnew, err, fac, sc
+    real(wp) :: t, h, tnew, err, fac, sc, tb, tend
     integer :: n, np, npd, nz, st, kout, nreal, hits, calm
-    logical :: fsal, stiff
+    logical :: fsal, stiff, land
     status = MBD_OK; msg = ''; nout = 0; stats = 0; hmm = [huge(one), zero]; t_fail = t0
     t_stiff = huge(one); hits = 0; calm = 0
     lok = .false.
@@ -659,6 +659,14 @@ contains
       t_fail = t
       h = min(h, t1 - t)
       tnew = t + h
+      ! a step ends on a breakpoint of the functions of time it would cross (or end within a
+      ! tenth of a step of), its stages there from the left (as mbd_integrators' dopri5)
+      tb = dyn_next_break(m, t)
+      land = tb <= t1 .and. t + 1.1_wp * h >= tb
+      if (land) then
+        h = tb - t; tnew = tb
+      end if
+      tend = merge(nearest(tnew, -one), tnew, land)
       call step(st)
       ! (a non-finite yn makes the norm non-finite: each stage that enters yn enters e, the
       ! 5th and 4th order weights differing on all of them; one test on err, not one per
@@ -691,7 +699,14 @@ contains
         return
       end if
       fsal = .true.
-      call emit(t, tnew)
+      if (land) then
+        ! the step's interpolant ends with the left limits of the accelerations (in e)
+        call rhs(tend, yn, e, st)
+        if (st /= MBD_OK) e = k(:, 1)
+        call emit(t, tnew, e(nz + 1:))
+      else
+        call emit(t, tnew, k(nz + 1:, 1))
+      end if
       zdda = k(nz + 1:, 1)
       stats(1) = stats(1) + 1
       hmm = [min(hmm(1), h), max(hmm(2), h)]
@@ -716,11 +731,11 @@ contains
       ! the stages' states in ys (expressions as arguments would be heap temporaries)
       do j = 2, 6
         call dopri5_state(j, y, h, k, ys)
-        call rhs(t + DOPRI_C(j) * h, ys, k(:, j), stp)
+        call rhs(merge(tend, t + DOPRI_C(j) * h, DOPRI_C(j) >= one), ys, k(:, j), stp)
         if (stp /= MBD_OK) return
       end do
       call dopri5_state(7, y, h, k, yn)
-      call rhs(t + h, yn, k(:, 7), stp)
+      call rhs(tend, yn, k(:, 7), stp)
       if (stp /= MBD_OK) return
       call dopri5_error(h, k, e)
     end subroutine step
@@ -762,17 +777,19 @@ contains
     end subroutine project
 
     !> The stored outputs in (ta, tb] by quintic Hermite interpolation of z = (q, S) between
-    !! the step's start (y, zdda) and end (yn, k(:, 1)).
-    subroutine emit(ta, tb)
+    !! the step's start (y, zdda) and end (yn, ab: k(:, 1)'s accelerations, or their left
+    !! limits at a breakpoint the step ends on).
+    subroutine emit(ta, tb, ab)
       real(wp), intent(in) :: ta, tb
+      real(wp), intent(in) :: ab(:)   !! the accelerations the interpolant ends with
       real(wp) :: tk
       do while (kout <= nsteps)
         tk = t0 + (t1 - t0) * (real(kout, wp) / nsteps)
         if (kout == nsteps) tk = t1
         if (tk > tb + 1.0e-12_wp * abs(t1 - t0)) exit
         if (mod(kout, every) == 0 .or. kout == nsteps) then
-          call hermite5(ta, y(1:nz), y(nz + 1:), zdda, tb, yn(1:nz), yn(nz + 1:), k(nz + 1:, 1), &
-                        tk, zz, zzd, zzdd)
+          call hermite5(ta, y(1:nz), y(nz + 1:), zdda, tb, yn(1:nz), yn(nz + 1:), ab, tk, zz, &
+                        zzd, zzdd)
           nout = nout + 1
           call at_state(nout, tk)
           call put(nout, zz, zzd, zzdd)

@@ -206,9 +206,11 @@ def test_stepped_force_drives_the_block_as_integrated_by_hand() -> None:
 
 def test_dynamics_sensitivity_to_the_push_duration() -> None:
     """dx/dt1 by dopri5's variational equations against a central difference of the closed
-    form."""
+    form (measured 1.3e-10 and 3.4e-10 relative), the steps ending on the law's t0 and t1
+    with the state's run (3 rejected steps; 25 before, and dx/dt1 5.7e-10)."""
     res = block().dynamics(1.5, 150, rtol=1e-11, atol=1e-13,
                            sensitivities=["force.push.fx.step.0.t1", "force.push.fx.step.0.h"])
+    assert res.stats["rejected_steps"] <= 5
     d = 1e-6
     for j, kw in enumerate(({"t1": 0.9}, {"f0": 3.0})):
         key, v = next(iter(kw.items()))
