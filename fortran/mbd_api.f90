@@ -1419,7 +1419,7 @@ contains
     type(model_t) :: m
     type(dyn_work_t) :: w
     type(sens_t) :: sens
-    real(wp), allocatable :: kv(:), cv(:), x(:), y(:)
+    real(wp), allocatable :: kv(:), cv(:), x(:), y(:), z(:)
     integer :: badf, n, ptab0(2, 0), j, p, ist
     kpat = zero; cpat = zero; kcol = zero; ccol = zero; bad = 0
     call model_build(nb, ctab, rpar, m, status, msg, bad, lforce=model_force_size(ftab, fpar))
@@ -1445,12 +1445,12 @@ contains
     if (status == MBD_OK) call sens_setup(m, ctab, rpar, ptab0, sens, status, msg, bad, ftab, &
                                           fpar)
     if (status /= MBD_OK) return
-    allocate (kv(w%kptr(n + 1) - 1), cv(w%kptr(n + 1) - 1), x(n), y(n), stat=ist)
+    allocate (kv(w%kptr(n + 1) - 1), cv(w%kptr(n + 1) - 1), x(n), y(n), z(n), stat=ist)
     if (ist /= 0) then
       status = MBD_NO_MEMORY; msg = 'stiffness: out of memory'; return
     end if
     call sens_stiffness_at(m, sens, q, t, lam, w%qz)
-    call sens_tangent_pattern(m, w, sens, q, t, w%qz, kv, x, y, cv)
+    call sens_tangent_pattern(m, w, sens, q, t, w%qz, kv, x, y, z, cv)
     do j = 1, n
       do p = w%kptr(j), w%kptr(j + 1) - 1
         kpat(w%krow(p), j) = kv(p); cpat(w%krow(p), j) = cv(p)

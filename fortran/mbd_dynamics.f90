@@ -41,9 +41,8 @@ module mbd_dynamics
   use mbd_memory, only: REAL_BYTES, mem_check, mem_fail
   use mbd_points, only: NLOC, rot
   use mbd_model, only: model_t, model_slots
-  use mbd_constraints, only: con_is_driver, con_name, con_affine_r, CON_REVOLUTE, con_next_break
-  use mbd_forces, only: force_eval, FRC_SPRING, FRC_ROTSPRING, FRC_FRICTION, force_is_contact, &
-                        force_next_break
+  use mbd_constraints, only: con_is_driver, con_name, con_affine_r, CON_REVOLUTE
+  use mbd_forces, only: force_eval, FRC_SPRING, FRC_ROTSPRING, FRC_FRICTION, force_is_contact
   use mbd_contact, only: NCS, NEO, MODE_UNTRACKED, joint_slip, joint_normal_load, &
                          joint_friction_force, reg_mu, contact_damped
   use mbd_points, only: kloc, kscal, local_state
@@ -63,7 +62,7 @@ module mbd_dynamics
             dyn_solve_rows, &
             dyn_jt_lam, dyn_damped, dyn_choose, dyn_jv, dyn_null_basis, dyn_pattern_mul, &
             dyn_factor_projection, SOLVER_AUTO, SOLVER_DENSE, SOLVER_BANDED, friction_forces, &
-            dyn_element_outputs, element_state, element_slip, dyn_next_break
+            dyn_element_outputs, element_state, element_slip
   public :: MODE_STUCK
 
   integer, parameter :: MODE_STUCK = 2   !! friction mode of a stuck joint (w%cst(1, k))
@@ -120,23 +119,6 @@ module mbd_dynamics
   end type dyn_work_t
 
 contains
-
-  !> The first time after t at which a driver's or a force's function of time has a
-  !! breakpoint (a motion law's start or end, a table's ends: the second derivative may jump
-  !! there; huge when none). The adaptive integrators end a step on it.
-  pure real(wp) function dyn_next_break(m, t) result(tb)
-    type(model_t), intent(in) :: m     !! model with dynamics data
-    real(wp), intent(in) :: t          !! time
-    integer :: c, f
-    tb = huge(t)
-    do c = 1, m%nc
-      if (con_is_driver(m%kind(c))) &
-        tb = min(tb, con_next_break(m%kind(c), m%p(m%po(c):m%po(c) + m%pn(c) - 1), t))
-    end do
-    do f = 1, m%nf
-      tb = min(tb, force_next_break(m%fkind(f), m%fp(m%fpo(f):m%fpo(f) + m%fpn(f) - 1), t))
-    end do
-  end function dyn_next_break
 
   !> Bytes of the dense dynamics of a model with nq coordinates and neq equations: J, its
   !! transpose, [M J^T; J 0] and a copy, and the integrators' iteration matrix

@@ -33,7 +33,7 @@ module mbd_integrators
                         MBD_INTEGRATOR_FAILED, MBD_LAPACK, MBD_NO_MEMORY, MBD_USER_ABORT, &
                         MSG_LEN
   use mbd_memory, only: REAL_BYTES, mem_fail
-  use mbd_model, only: model_t
+  use mbd_model, only: model_t, model_next_break
   use mbd_points, only: NLOC, MAXROW
   use mbd_forces, only: FRC_FRICTION
   use mbd_assemble, only: assemble_dense, assemble_blocks, blocks_jv
@@ -44,8 +44,7 @@ module mbd_integrators
   use mbd_saddle, only: saddle_t, saddle_plan, saddle_factor, saddle_solve
   use mbd_dynamics, only: dyn_work_t, dyn_accel, dyn_velocity, dyn_project_pos, gen_forces, &
                           kinetic_energy, dyn_tangent, dyn_solve, dyn_jt_lam, dyn_multipliers, &
-                          dyn_jv, dyn_null_basis, SOLVER_DENSE, dyn_element_outputs, &
-                          dyn_next_break
+                          dyn_jv, dyn_null_basis, SOLVER_DENSE, dyn_element_outputs
   use mbd_events, only: ev_log_t, events_active, events_init, events_find, events_switch, &
                         event_tol
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
@@ -55,7 +54,7 @@ module mbd_integrators
   public :: integrate, output_rows, output_index, MAX_STEPS_DEFAULT
   ! the Dormand-Prince 5(4) stages and error estimate, also used by the sensitivity integrator
   ! (mbd_sens_dynamics)
-  public :: dopri5_state, dopri5_error, DOPRI_C, stiffness_test
+  public :: dopri5_state, dopri5_error, DOPRI_C, stiffness_test, break_step
   ! generalized-alpha's companion for quantities stepped with the state (mbd_sens_genalpha)
   public :: ga_hook_t, GA_NCOEF
 
@@ -860,7 +859,7 @@ contains
     character(len=MSG_LEN), intent(out) :: msg
     integer, intent(inout), optional, volatile :: ctl(:)   !! progress (see integrate)
     real(wp), allocatable :: y(:), ynew(:), k(:, :), e(:), ys(:)   ! ys: a stage's state
-    real(wp) :: t, h, tnew, err, fac, qa(m%nq), va(m%nq), aa(m%nq), te, dev, move, tb
+    real(wp) :: t, h, tnew, err, fac, qa(m%nq), va(m%nq), aa(m%nq), te, dev, move
     real(wp) :: al(m%nq), ar(m%nq)           ! a step ending on a breakpoint: left, right q_ddot
     integer :: stt, nprev, kev
     logical :: fixed, fsal, changed, land
@@ -912,13 +911,7 @@ contains
         tnew = step_time(c, c%st%steps + 1, nfix)
         h = tnew - t
       else if (.not. partitioned) then
-        ! a step that would cross (or end within a tenth of a step of) a breakpoint of the
-        ! drivers' or forces' functions of time, where q_ddot may jump, ends on it: no
-        ! rejections shrinking the step onto the kink
-        tb = dyn_next_break(m, t)
-        if (tb <= c%t1 .and. t + 1.1_wp * h >= tb) then
-          h = tb - t; tnew = tb; land = .true.
-        end if
+        call break_step(m, t, c%t1, h, tnew, land)
       end if
       if (fixed) then
         call rk4_step(m, w, c, t, y, h, ynew, k, ys, fsal, stt)
@@ -926,7 +919,7 @@ contains
       else if (land) then
         ! (the stages at the breakpoint from the left: the functions give their right
         ! limits there, which belong to the next step, whose first stage is taken at tb)
-        call dopri5_step(m, w, c, t, y, h, ynew, k, e, ys, fsal, stt, nearest(tb, -one))
+        call dopri5_step(m, w, c, t, y, h, ynew, k, e, ys, fsal, stt, nearest(tnew, -one))
         if (stt == MBD_OK) err = err_norm(c, e, y, ynew)
       else
         call dopri5_step(m, w, c, t, y, h, ynew, k, e, ys, fsal, stt)
@@ -1069,6 +1062,24 @@ contains
       end if
     end do
   end subroutine run_explicit
+
+  !> A dopri5 step from t of size h (ending at t1 at the latest) that would cross a
+  !! breakpoint of the drivers' or forces' functions of time, where q_ddot may jump, or end
+  !! within a tenth of a step of it, ends on it (h and tnew shortened, land): no rejections
+  !! shrinking the step onto the kink. The step's stages at the breakpoint are to take the
+  !! functions' left limits (the double just below it).
+  pure subroutine break_step(m, t, t1, h, tnew, land)
+    type(model_t), intent(in) :: m              !! model with dynamics data
+    real(wp), intent(in) :: t, t1               !! the step's start, the run's end
+    real(wp), intent(inout) :: h, tnew          !! the step and its end (t + h)
+    logical, intent(out) :: land                !! the step ends on a breakpoint
+    real(wp) :: tb
+    tb = model_next_break(m, t, .true.)
+    land = tb <= t1 .and. t + 1.1_wp * h >= tb
+    if (land) then
+      h = tb - t; tnew = tb
+    end if
+  end subroutine break_step
 
   !> The integrated state y from the full state: (q, q_dot), or (v, v_dot) when partitioned.
   subroutine pack_state(c, y, ynew, k, e, ys, ierr)

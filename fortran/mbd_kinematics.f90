@@ -32,8 +32,8 @@ module mbd_kinematics
                         MSG_LEN
   use mbd_memory, only: REAL_BYTES, mem_check, mem_fail
   use mbd_points, only: NLOC, MAXROW
-  use mbd_model, only: model_t
-  use mbd_constraints, only: con_is_driver, con_name, con_next_break
+  use mbd_model, only: model_t, model_next_break
+  use mbd_constraints, only: con_is_driver, con_name
   use mbd_assemble, only: asm_work_t, asm_init, assemble_blocks, assemble_gamma, assemble_dense, &
                           scatter_dense, init_extras, blocks_jv, blocks_jtv, scatter_values, &
                           asm_turn, assemble_phi
@@ -1355,7 +1355,7 @@ contains
     hcur = h
     k = 1
     nsub = 0
-    tb = next_break(m, t)
+    tb = model_next_break(m, t, .false.)   ! (the drivers')
     do while (k <= nsteps)
       nsub = nsub + 1
       if (nsub > MAX_SUBSTEPS) then
@@ -1748,7 +1748,7 @@ contains
       else
         call forget_derivatives()
       end if
-      tb = next_break(m, t)
+      tb = model_next_break(m, t, .false.)   ! (the drivers')
     end subroutine past_break
 
     subroutine forget_derivatives()
@@ -2079,18 +2079,6 @@ contains
     real(wp), intent(in) :: corr, motion, ratio, tol
     same_branch = corr <= max(ratio * motion, 1.0e3_wp * tol)
   end function same_branch
-
-  !> The drivers' first breakpoint after t (huge when none): see con_next_break.
-  pure real(wp) function next_break(m, t) result(tb)
-    type(model_t), intent(in) :: m     !! model
-    real(wp), intent(in) :: t          !! time
-    integer :: c
-    tb = huge(t)
-    do c = 1, m%nc
-      if (con_is_driver(m%kind(c))) &
-        tb = min(tb, con_next_break(m%kind(c), m%p(m%po(c):m%po(c) + m%pn(c) - 1), t))
-    end do
-  end function next_break
 
   !> corr = max |qn - qp| (the Newton correction), motion = max |qp - q| (the predicted one).
   pure subroutine max_diffs(n, qn, qp, q, corr, motion)

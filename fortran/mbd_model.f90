@@ -37,17 +37,18 @@ module mbd_model
   use mbd_points, only: NLOC
   use mbd_constraints, only: con_known, con_nrow, con_nextra, con_raw_length, &
                              con_prepare, con_name, con_exponents, con_row_power, &
+                             con_is_driver, con_next_break, &
                              CON_REVOLUTE, CON_TRANSLATIONAL, CON_CAM, &
                              CON_GEAR, CON_ABSOLUTE, CON_POINT_LINE, DRV_ABS, DRV_REL_DIST
   use mbd_joint_gear, only: CARRIER_SLOT
   use mbd_forces, only: force_known, force_raw_length, force_prepare, force_exponents, &
-                        FRC_TORQUE, FRC_POINT, FRC_FRICTION, force_is_contact
+                        FRC_TORQUE, FRC_POINT, FRC_FRICTION, force_is_contact, force_next_break
   use mbd_contact, only: friction_prepare, FRIC_STICK_SLIP
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   implicit none
   private
   public :: NCT, NFT, model_t, model_build, model_slots, model_add_dynamics
-  public :: LSCALE_MIN, LSCALE_MAX, model_force_size
+  public :: LSCALE_MIN, LSCALE_MAX, model_force_size, model_next_break
 
   integer, parameter :: NCT = 8   !! rows of the constraint table
   integer, parameter :: NFT = 6   !! rows of the force table
@@ -90,6 +91,26 @@ module mbd_model
   end type model_t
 
 contains
+
+  !> The first time after t at which a driver's function of time, and with forces a force's,
+  !! has a breakpoint (a motion law's start or end, a table's ends: the second derivative may
+  !! jump there; huge when none). The kinematic loop (drivers) and the adaptive integrators
+  !! (drivers and forces) end a step on it.
+  pure real(wp) function model_next_break(m, t, forces) result(tb)
+    type(model_t), intent(in) :: m     !! model
+    real(wp), intent(in) :: t          !! time
+    logical, intent(in) :: forces      !! the forces' functions too (a model with dynamics)
+    integer :: c, f
+    tb = huge(t)
+    do c = 1, m%nc
+      if (con_is_driver(m%kind(c))) &
+        tb = min(tb, con_next_break(m%kind(c), m%p(m%po(c):m%po(c) + m%pn(c) - 1), t))
+    end do
+    if (.not. forces) return
+    do f = 1, m%nf
+      tb = min(tb, force_next_break(m%fkind(f), m%fp(m%fpo(f):m%fpo(f) + m%fpn(f) - 1), t))
+    end do
+  end function model_next_break
 
   !> Slot ids of a constraint's two bodies (0 = ground, 1, 2).
   pure subroutine model_slots(m, k, si, sj)

@@ -41,8 +41,9 @@ module mbd_sens_dynamics
   use mbd_status, only: MBD_INTEGRATOR_FAILED, MBD_BAD_SETTING
   use mbd_dynamics, only: dyn_work_t, dyn_accel, dyn_project_pos, dyn_velocity, &
                           dyn_factor_projection, dyn_solve_rows, dyn_solve, dyn_multipliers, &
-                          dyn_null_basis, SOLVER_DENSE, dyn_next_break
-  use mbd_integrators, only: output_rows, dopri5_state, dopri5_error, DOPRI_C, stiffness_test
+                          dyn_null_basis, SOLVER_DENSE
+  use mbd_integrators, only: output_rows, dopri5_state, dopri5_error, DOPRI_C, stiffness_test, &
+                             break_step
   use mbd_interp, only: hermite5
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   implicit none
@@ -502,18 +503,18 @@ contains
   !! K(krow(p), c), cv likewise (absent: K alone): one product with K (and C) per colour group
   !! of the pattern, x = the sum of the group's unit vectors, whose columns do not share a row,
   !! so each entry is read off its own column (Curtis, Powell and Reid's grouping, applied to
-  !! exact products). x, y: work (nq); z zeros.
+  !! exact products: sens_stiffness_mul, sens_damping_mul). x, y, work: (nq); z zeros.
   !! The assembled K loses accuracy on smooth vectors that the element-wise product keeps
   !! (K x of a long spring chain's lowest shape: 2 x_i - x_(i-1) - x_(i+1) summed from
   !! entries, not k (x_i - x_(i-1)) per spring; its lowest frequency 3.7e-11 instead of
   !! 6.7e-12): for a Newton matrix (the statics' steps), not for the modes' K_r.
-  subroutine sens_tangent_pattern(m, w, s, q, t, z, kv, x, y, cv)
+  subroutine sens_tangent_pattern(m, w, s, q, t, z, kv, x, y, work, cv)
     type(model_t), intent(in) :: m              !! model with dynamics data
     type(dyn_work_t), intent(in) :: w           !! the pattern and its groups (dyn_init)
     type(sens_t), intent(in) :: s               !! blocks at the rest state (sens_stiffness_at)
     real(wp), intent(in) :: q(:), t, z(:)       !! state, time, zeros
     real(wp), intent(out) :: kv(:)              !! K on the pattern
-    real(wp), intent(out) :: x(:), y(:)         !! work (nq)
+    real(wp), intent(out) :: x(:), y(:), work(:)  !! work (nq)
     real(wp), intent(out), optional :: cv(:)    !! C on the pattern
     integer :: g, i
     kv = zero
@@ -523,28 +524,25 @@ contains
       do i = w%gptr(g), w%gptr(g + 1) - 1
         x(w%gcol(i)) = one
       end do
-      call sens_klam(s, x, y)                   ! K x = K_lambda x - Q_q x
-      call pattern_put(kv, 1)
-      call sens_force_d(m, s, 0, q, z, x, z, t, y)
-      call pattern_put(kv, -1)
-      if (present(cv)) then                     ! C x = -Q_q_dot x
-        call sens_force_d(m, s, 0, q, z, z, x, t, y)
-        call pattern_put(cv, -1)
+      call sens_stiffness_mul(m, s, q, t, z, x, y, work)
+      call pattern_put(kv)
+      if (present(cv)) then
+        call sens_damping_mul(m, s, q, t, z, x, y)
+        call pattern_put(cv)
       end if
       do i = w%gptr(g), w%gptr(g + 1) - 1
         x(w%gcol(i)) = zero
       end do
     end do
   contains
-    !> av(p) += sgn y(krow(p)) over the columns of group g.
-    subroutine pattern_put(av, sgn)
+    !> av(p) = y(krow(p)) over the columns of group g.
+    subroutine pattern_put(av)
       real(wp), intent(inout) :: av(:)
-      integer, intent(in) :: sgn
       integer :: i, c, p
       do i = w%gptr(g), w%gptr(g + 1) - 1
         c = w%gcol(i)
         do p = w%kptr(c), w%kptr(c + 1) - 1
-          av(p) = av(p) + sgn * y(w%krow(p))
+          av(p) = y(w%krow(p))
         end do
       end do
     end subroutine pattern_put
@@ -603,7 +601,7 @@ contains
     ! the work of rhs and project (here, so that no step allocates)
     real(wp), allocatable :: qq(:), vv(:), aa(:), v0(:), fo(:)
     type(proj_work_t) :: pw
-    real(wp) :: t, h, tnew, err, fac, sc, tb, tend
+    real(wp) :: t, h, tnew, err, fac, sc, tend
     integer :: n, np, npd, nz, st, kout, nreal, hits, calm
     logical :: fsal, stiff, land
     status = MBD_OK; msg = ''; nout = 0; stats = 0; hmm = [huge(one), zero]; t_fail = t0
@@ -659,13 +657,8 @@ contains
       t_fail = t
       h = min(h, t1 - t)
       tnew = t + h
-      ! a step ends on a breakpoint of the functions of time it would cross (or end within a
-      ! tenth of a step of), its stages there from the left (as mbd_integrators' dopri5)
-      tb = dyn_next_break(m, t)
-      land = tb <= t1 .and. t + 1.1_wp * h >= tb
-      if (land) then
-        h = tb - t; tnew = tb
-      end if
+      ! (a step ending on a breakpoint takes its stages there from the left)
+      call break_step(m, t, t1, h, tnew, land)
       tend = merge(nearest(tnew, -one), tnew, land)
       call step(st)
       ! (a non-finite yn makes the norm non-finite: each stage that enters yn enters e, the

@@ -316,7 +316,7 @@ contains
       end if
       call sens_stiffness_at(m, s, qa, t, lam, w%qz)
       if (w%ncolor < nfree) then
-        call sens_tangent_pattern(m, w, s, qa, t, w%qz, kv, c, dqz); return
+        call sens_tangent_pattern(m, w, s, qa, t, w%qz, kv, c, dqz, r); return
       end if
       bycols = .true.
       do j = 1, nfree
