@@ -20,6 +20,11 @@
 !!                       from J_u u_dot = nu - J_v v_dot, at every stage; re-partitioned when
 !!                       J_u becomes 4x worse conditioned than the choice of a QR with
 !!                       column pivoting (dgeqp3) at the current state.
+!! Breakpoints of the drivers' and forces' functions of time (a motion law's t0, t1, a table's
+!! ends), where q_ddot may jump: every method ends a step on them (break_step; fixed steps:
+!! the step containing one is split there, grid_break), its evaluations at the breakpoint
+!! taking the functions' left limits (the double below), the next step starting from the
+!! right ones (generalized-alpha: q_ddot, lambda and a from the index-1 equations there).
 !! Contacts and stick-slip joints (mbd_events): every method tracks their modes and records
 !! their events; the error-controlled ones (dopri5, partitioned, generalized-alpha without h)
 !! take a step that crosses an event again, to end at the event (located on the step's
@@ -137,6 +142,10 @@ module mbd_integrators
     procedure(hook_emit), deferred :: emit
     !> an accepted step: its end becomes the next step's start
     procedure(hook_commit), deferred :: commit
+    !> after commit, at a breakpoint of the functions of time: the start's accelerations
+    !! again from the index-1 equations at (q, qd, t) (their right limits), output row r
+    !! (> 0) rewritten with them
+    procedure(hook_restart), deferred :: restart
   end type ga_hook_t
 
   abstract interface
@@ -167,7 +176,19 @@ module mbd_integrators
       import :: ga_hook_t
       class(ga_hook_t), intent(inout) :: self
     end subroutine hook_commit
+    subroutine hook_restart(self, m, w, q, qd, t, r, status)
+      import :: ga_hook_t, wp, model_t, dyn_work_t
+      class(ga_hook_t), intent(inout) :: self
+      type(model_t), intent(in) :: m
+      type(dyn_work_t), intent(inout) :: w
+      real(wp), intent(in) :: q(:), qd(:), t
+      integer, intent(in) :: r
+      integer, intent(out) :: status
+    end subroutine hook_restart
   end interface
+
+  !> fixed steps: a breakpoint this many steps after a grid time ends the step before it
+  real(wp), parameter :: GRID_MERGE = 0.05_wp
 
   !> partitioned: re-partition when J_u is this many times worse conditioned than the best
   !! choice now (docs/dynamics.md: measured on a double pendulum and the N-four-bar)
@@ -436,7 +457,7 @@ contains
   end function fixed_steps
 
   !> Time of fixed step k (exact at the end).
-  real(wp) function step_time(c, k, nfix)
+  pure real(wp) function step_time(c, k, nfix)
     type(itg_t), intent(in) :: c
     integer, intent(in) :: k, nfix
     step_time = c%t0 + (c%t1 - c%t0) * (real(k, wp) / nfix)
@@ -558,14 +579,18 @@ contains
     real(wp) :: am, af, gam, bet, bp, gp, h, t, err, tnew, facc, v, hprev, dqn, dqp, dtol, &
                 dqpp
     real(wp) :: rtol_dyn, cf, kmax, cmax, fmax, qmax, vmax, rmax, te, mufric, esq
+    real(wp) :: tev                              ! the time of the step's end's evaluations
     real(wp) :: coef(GA_NCOEF)
+    real(wp) :: ar(m%nq), lr(m%neq)              ! a breakpoint's right limits: q_ddot, lambda
     real(wp) :: q(m%nq), qd(m%nq), qdd(m%nq), acc(m%nq), lam(m%neq)
     real(wp) :: qn(m%nq), vn(m%nq), an(m%nq), accn(m%nq), lamn(m%neq), dq(m%nq), ap(m%nq)
     real(wp) :: res(m%nq + w%na), dg(m%nq), ew(m%nq)
     real(wp), allocatable :: kv(:), cv(:), kc(:)   ! K, C and K + g' C on the pattern
     type(saddle_t) :: sg                            ! the iteration matrix S
     integer :: it, n, stt, nfix, na, attempt, nkc, k, nnz, kev, nprev, i, ne
-    logical :: fixed, conv, have_kc, new_kc, finite, changed, diagk
+    integer :: kgrid                             ! fixed steps: the grid times passed
+    logical :: fixed, conv, have_kc, new_kc, finite, changed, diagk, land
+    logical :: to_event                          ! the step is taken again to end at an event
     status = MBD_OK; msg = ''
     n = m%nq; na = w%na
     ! S = [M b' + K + g' C, b' J^T; b' J, 0] on the path of w (dense: the sparse LU up to 128
@@ -614,16 +639,25 @@ contains
     acc = qdd              ! the auxiliary acceleration a_0 = q_ddot_0
     hprev = zero
     err = zero
-    do while (more(c, t, fixed, nfix))
+    kgrid = 0
+    to_event = .false.
+    do while (merge(kgrid < nfix, more(c, t, fixed, nfix), fixed))
       if (c%st%steps + c%st%rejected >= c%opts%max_steps) then
         call step_limit(c, t, 0, status, msg); return
       end if
       h = min(h, c%t1 - t)
       tnew = t + h
       if (fixed) then
-        tnew = step_time(c, c%st%steps + 1, nfix)
+        tnew = step_time(c, kgrid + 1, nfix)
+        call grid_break(m, c, t, nfix, tnew, land)
         h = tnew - t
+      else
+        call break_step(m, t, c%t1, h, tnew, land, to_event)
       end if
+      ! a step ending on a breakpoint of the functions of time takes their left limits there
+      ! (the double below); the next step restarts from the right ones
+      tev = tnew
+      if (land) tev = nearest(tnew, -one)
       c%st%t_fail = t
       bp = (1 - am) / (bet * h * h * (1 - af))
       gp = gam / (bet * h)
@@ -650,8 +684,8 @@ contains
         nkc = 0                         ! K, C evaluations in this attempt
         dq = zero; dqp = huge(one); dqpp = huge(one)
         do it = 1, GA_MAXIT
-          call assemble_blocks(m, qn, vn, tnew, w%phi, w%nu, w%gam, w%asm)
-          call gen_forces(m, qn, vn, tnew, w%force, v, cst=w%cst, lam=lamn)
+          call assemble_blocks(m, qn, vn, tev, w%phi, w%nu, w%gam, w%asm)
+          call gen_forces(m, qn, vn, tev, w%force, v, cst=w%cst, lam=lamn)
           ! r = M q_ddot + J^T lambda - Q;  r_c = b' Phi
           call dyn_jt_lam(m, w%asm%jb, lamn, res(1:n))
           ! the residual tolerance is GA_RTOL of the largest term, but not below the change
@@ -721,12 +755,12 @@ contains
       ne = 0; esq = zero
       if (conv .and. present(hook)) then
         coef(5:6) = [bp, gp]
-        call hook%step(m, w, sg, tnew, h, coef, qn, vn, an, lamn, c%opts%rtol, c%opts%atol, &
+        call hook%step(m, w, sg, tev, h, coef, qn, vn, an, lamn, c%opts%rtol, c%opts%atol, &
                        esq, ne, stt)
         if (stt == MBD_NO_CONVERGENCE) then   ! (slow with an old K, C: fresh ones at qn)
           call tangent()
           call factor_s(stt)
-          if (stt == MBD_OK) call hook%step(m, w, sg, tnew, h, coef, qn, vn, an, lamn, &
+          if (stt == MBD_OK) call hook%step(m, w, sg, tev, h, coef, qn, vn, an, lamn, &
                                             c%opts%rtol, c%opts%atol, esq, ne, stt)
         end if
         if (stt /= MBD_OK) then
@@ -752,7 +786,7 @@ contains
         end if
         if (kev > 0 .and. .not. fixed .and. te < tnew - event_tol(t, tnew)) then
           c%st%rejected = c%st%rejected + 1
-          h = te - t
+          h = te - t; to_event = .true.
           cycle
         end if
       end if
@@ -777,14 +811,40 @@ contains
       end if
       accn = accn + (1 - af) / (1 - am) * an
       nprev = c%nout
-      call emit(c, qo, vo, ao, t, q, qd, qdd, tnew, qn, vn, an)
+      if (land) then
+        ! the accelerations and multipliers at the breakpoint's right limits (the outputs
+        ! before it interpolate to the step's left ones)
+        call dyn_accel(m, w, qn, vn, tnew, ar, lr, stt)
+        if (stt /= MBD_OK) then
+          ar = an; lr = lamn; land = .false.
+        end if
+        call emit(c, qo, vo, ao, t, q, qd, qdd, tnew, qn, vn, ar, an)
+      else
+        call emit(c, qo, vo, ao, t, q, qd, qdd, tnew, qn, vn, an)
+      end if
       call save_modes(w, c, nprev + 1)
       if (present(hook)) then
         do i = nprev + 1, c%nout
           call hook%emit(i, out_time(c, output_index(c%nsteps, c%every, i)), t, tnew)
         end do
         call hook%commit()
+        if (land) then
+          i = 0                   ! (an output at the breakpoint: its right limits)
+          if (c%nout > nprev) then
+            if (abs(out_time(c, output_index(c%nsteps, c%every, c%nout)) - tnew) <= &
+                1.0e-12_wp * abs(c%t1 - c%t0)) i = c%nout
+          end if
+          call hook%restart(m, w, qn, vn, tnew, i, stt)
+          if (stt /= MBD_OK) then
+            status = MBD_INTEGRATOR_FAILED
+            write (msg, '(a,es12.5)') 'the sensitivities'' accelerations could not be '// &
+              'solved at the breakpoint t = ', tnew
+            return
+          end if
+        end if
       end if
+      if (fixed) call grid_passed(c, nfix, tnew, land, kgrid)
+      to_event = .false.
       c%st%steps = c%st%steps + 1
       c%st%hmin = min(c%st%hmin, h); c%st%hmax = max(c%st%hmax, h)
       if (stopped(c, tnew, status, msg, ctl)) then
@@ -792,6 +852,10 @@ contains
         return
       end if
       t = tnew; q = qn; qd = vn; qdd = an; acc = accn; lam = lamn
+      if (land) then
+        ! restart from the right limits: q_ddot jumps, a = q_ddot (no history across it)
+        qdd = ar; acc = ar; lam = lr; hprev = zero
+      end if
       if (kev > 0) then
         ! change the modes; restart from the accelerations of the new modes
         call events_switch(m, w, t, q, qd, c%log, changed, stt, trec=te)
@@ -813,14 +877,14 @@ contains
 
     !> K and C by differences at (qn, vn) (dyn_tangent), and the blocks at qn again.
     subroutine tangent()
-      call dyn_tangent(m, w, qn, vn, tnew, lamn, kv, cv, fast=.true.)
+      call dyn_tangent(m, w, qn, vn, tev, lamn, kv, cv, fast=.true.)
       c%st%jacobians = c%st%jacobians + 1
       have_kc = .true.; new_kc = .false.; nkc = nkc + 1
       kmax = zero; cmax = zero
       if (nnz > 0) then
         kmax = maxval(abs(kv)); cmax = maxval(abs(cv))
       end if
-      call assemble_blocks(m, qn, vn, tnew, w%phi, w%nu, w%gam, w%asm)
+      call assemble_blocks(m, qn, vn, tev, w%phi, w%nu, w%gam, w%asm)
     end subroutine tangent
 
     !> S with the current J: K + g' C on the pattern, + M b' on the diagonal, b' J; factored.
@@ -861,9 +925,11 @@ contains
     real(wp), allocatable :: y(:), ynew(:), k(:, :), e(:), ys(:)   ! ys: a stage's state
     real(wp) :: t, h, tnew, err, fac, qa(m%nq), va(m%nq), aa(m%nq), te, dev, move
     real(wp) :: al(m%nq), ar(m%nq)           ! a step ending on a breakpoint: left, right q_ddot
+    real(wp) :: qr(m%nq), vr(m%nq)           ! (and the state there: partitioned solves it again)
     integer :: stt, nprev, kev
     logical :: fixed, fsal, changed, land
-    integer :: nfix
+    logical :: to_event                      ! the step is taken again to end at an event
+    integer :: nfix, kgrid                   ! fixed steps: their number, the grid times passed
     integer :: hits, calm                    ! stiffness_test's counters
     logical :: stiff
     status = MBD_OK; msg = ''
@@ -899,21 +965,26 @@ contains
     qa = c%qf; va = c%vf; aa = c%af          ! the state at the start of the step
     c%qs = qa; c%vs = va; c%as = aa; c%ts = t
     err = zero
-    do while (more(c, t, fixed, nfix))
+    kgrid = 0
+    to_event = .false.
+    do while (merge(kgrid < nfix, more(c, t, fixed, nfix), fixed))
       if (c%st%steps + c%st%rejected >= c%opts%max_steps) then
         call step_limit(c, t, 0, status, msg); return
       end if
       c%st%t_fail = t
       h = min(h, c%t1 - t)
       tnew = t + h
-      land = .false.
       if (fixed) then
-        tnew = step_time(c, c%st%steps + 1, nfix)
+        tnew = step_time(c, kgrid + 1, nfix)
+        call grid_break(m, c, t, nfix, tnew, land)
         h = tnew - t
-      else if (.not. partitioned) then
-        call break_step(m, t, c%t1, h, tnew, land)
+      else
+        call break_step(m, t, c%t1, h, tnew, land, to_event)
       end if
-      if (fixed) then
+      if (fixed .and. land) then
+        call rk4_step(m, w, c, t, y, h, ynew, k, ys, fsal, stt, nearest(tnew, -one))
+        err = zero
+      else if (fixed) then
         call rk4_step(m, w, c, t, y, h, ynew, k, ys, fsal, stt)
         err = zero
       else if (land) then
@@ -952,7 +1023,7 @@ contains
           err = 10.0_wp
         else if (kev > 0 .and. te < tnew - event_tol(t, tnew)) then
           c%st%rejected = c%st%rejected + 1
-          h = te - t; fsal = .false.
+          h = te - t; fsal = .false.; to_event = .true.
           cycle
         end if
       end if
@@ -1006,9 +1077,9 @@ contains
       if (land) then
         ! the step's interpolant ends with the left limit of q_ddot at the breakpoint (the
         ! functions give the right one there, the next step's start and an output at tb)
-        ar = c%af
+        ar = c%af; qr = c%qf; vr = c%vf
         call rhs(m, w, c, nearest(tnew, -one), ynew, ys, stt)
-        al = c%af; c%af = ar
+        al = c%af; c%af = ar; c%qf = qr; c%vf = vr
         if (stt /= MBD_OK) al = ar
         call emit(c, qo, vo, ao, t, qa, va, aa, tnew, c%qf, c%vf, c%af, al)
       else
@@ -1034,6 +1105,8 @@ contains
       end if
       qa = c%qf; va = c%vf; aa = c%af
       c%qs = qa; c%vs = va; c%as = aa; c%ts = tnew
+      if (fixed) call grid_passed(c, nfix, tnew, land, kgrid)
+      to_event = .false.
       c%st%steps = c%st%steps + 1
       c%st%hmin = min(c%st%hmin, h); c%st%hmax = max(c%st%hmax, h)
       if (stopped(c, tnew, status, msg, ctl)) return
@@ -1063,23 +1136,87 @@ contains
     end do
   end subroutine run_explicit
 
-  !> A dopri5 step from t of size h (ending at t1 at the latest) that would cross a
+  !> An adaptive step from t of size h (ending at t1 at the latest) that would cross a
   !! breakpoint of the drivers' or forces' functions of time, where q_ddot may jump, or end
   !! within a tenth of a step of it, ends on it (h and tnew shortened, land): no rejections
   !! shrinking the step onto the kink. The step's stages at the breakpoint are to take the
-  !! functions' left limits (the double just below it).
-  pure subroutine break_step(m, t, t1, h, tnew, land)
+  !! functions' left limits (the double just below it). A step taken again to end at an
+  !! event (to_event) is not lengthened: the breakpoint beyond would cross the event again.
+  pure subroutine break_step(m, t, t1, h, tnew, land, to_event)
     type(model_t), intent(in) :: m              !! model with dynamics data
     real(wp), intent(in) :: t, t1               !! the step's start, the run's end
     real(wp), intent(inout) :: h, tnew          !! the step and its end (t + h)
     logical, intent(out) :: land                !! the step ends on a breakpoint
-    real(wp) :: tb
-    tb = model_next_break(m, t, .true.)
-    land = tb <= t1 .and. t + 1.1_wp * h >= tb
+    logical, intent(in), optional :: to_event   !! h ends on an event: only shortened
+    real(wp) :: tb, reach
+    reach = 1.1_wp
+    if (present(to_event)) then
+      if (to_event) reach = one
+    end if
+    tb = break_after(m, t, h)
+    land = tb <= t1 .and. t + reach * h >= tb
     if (land) then
       h = tb - t; tnew = tb
     end if
   end subroutine break_step
+
+  !> The first breakpoint of the drivers' and forces' functions of time after t by more than
+  !! 1e-9 h (two breakpoints apart by rounding are one: no step of the rounding's size).
+  pure real(wp) function break_after(m, t, h) result(tb)
+    type(model_t), intent(in) :: m              !! model with dynamics data
+    real(wp), intent(in) :: t, h                !! the time, the step
+    tb = model_next_break(m, t, .true.)
+    do while (tb - t <= 1.0e-9_wp * h)
+      tb = model_next_break(m, tb, .true.)
+    end do
+  end function break_after
+
+  !> A fixed step from t to the grid time tnew ends instead on a breakpoint of the drivers'
+  !! and forces' functions of time inside it, or after it by less than GRID_MERGE steps
+  !! (the next step then runs to the first grid time GRID_MERGE steps beyond: no step
+  !! shorter than that but where two breakpoints are closer). A breakpoint at t1 (to
+  !! rounding) is landed on; one closer to t1 than GRID_MERGE steps is stepped over.
+  pure subroutine grid_break(m, c, t, nfix, tnew, land)
+    type(model_t), intent(in) :: m              !! model with dynamics data
+    type(itg_t), intent(in) :: c                !! the run (t0, t1)
+    real(wp), intent(in) :: t                   !! the step's start
+    integer, intent(in) :: nfix                 !! the fixed steps
+    real(wp), intent(inout) :: tnew             !! the step's end: a grid time, or tb
+    logical, intent(out) :: land                !! the step ends on a breakpoint
+    real(wp) :: hn, tb
+    hn = (c%t1 - c%t0) / nfix
+    tb = break_after(m, t, hn)
+    land = tb <= tnew + GRID_MERGE * hn
+    if (.not. land) return
+    if (abs(tb - c%t1) <= 4 * spacing(abs(c%t1)) + 1.0e-14_wp * hn) then
+      tnew = c%t1
+    else if (tb < c%t1 - GRID_MERGE * hn) then
+      tnew = tb
+    else
+      land = .false.
+    end if
+  end subroutine grid_break
+
+  !> After a fixed step to tb: kgrid counts the grid time it ended on or, when it landed on a
+  !! breakpoint, every grid time up to tb + GRID_MERGE steps (those the step passed or made
+  !! too close to take).
+  pure subroutine grid_passed(c, nfix, tb, land, kgrid)
+    type(itg_t), intent(in) :: c
+    integer, intent(in) :: nfix
+    real(wp), intent(in) :: tb
+    logical, intent(in) :: land
+    integer, intent(inout) :: kgrid
+    real(wp) :: hn
+    if (.not. land) then
+      kgrid = kgrid + 1; return
+    end if
+    hn = (c%t1 - c%t0) / nfix
+    if (tb >= c%t1) kgrid = nfix
+    do while (kgrid < nfix)
+      if (step_time(c, kgrid + 1, nfix) > tb + GRID_MERGE * hn) exit
+      kgrid = kgrid + 1
+    end do
+  end subroutine grid_passed
 
   !> The integrated state y from the full state: (q, q_dot), or (v, v_dot) when partitioned.
   subroutine pack_state(c, y, ynew, k, e, ys, ierr)
@@ -1646,7 +1783,7 @@ contains
   end function needs_partition
 
   !> One classical Runge-Kutta step.
-  subroutine rk4_step(m, w, c, t, y, h, yn, k, ys, first, stf)
+  subroutine rk4_step(m, w, c, t, y, h, yn, k, ys, first, stf, tend)
     type(model_t), intent(in) :: m
     type(dyn_work_t), intent(inout) :: w
     type(itg_t), intent(inout) :: c
@@ -1657,7 +1794,12 @@ contains
                                               !! arguments would be heap temporaries)
     logical, intent(in) :: first              !! k(:, 1) = f(t, y) is known
     integer, intent(out) :: stf
+    !> the last stage's time (a step ending on a breakpoint: the double below it)
+    real(wp), intent(in), optional :: tend
+    real(wp) :: t1
     stf = MBD_OK
+    t1 = t + h
+    if (present(tend)) t1 = tend
     if (.not. first) call rhs(m, w, c, t, y, k(:, 1), stf)
     if (stf /= MBD_OK) return
     ys = y + half * h * k(:, 1)
@@ -1667,7 +1809,7 @@ contains
     call rhs(m, w, c, t + half * h, ys, k(:, 3), stf)
     if (stf /= MBD_OK) return
     ys = y + h * k(:, 3)
-    call rhs(m, w, c, t + h, ys, k(:, 4), stf)
+    call rhs(m, w, c, t1, ys, k(:, 4), stf)
     if (stf /= MBD_OK) return
     yn = y + h / 6 * (k(:, 1) + 2 * k(:, 2) + 2 * k(:, 3) + k(:, 4))
   end subroutine rk4_step
