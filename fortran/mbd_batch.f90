@@ -54,7 +54,8 @@ contains
   !! qsing the equilibrium, iinfo(1) the free motions, rinfo(1:2) as statics.
   !! Frequency response (api_frf; rows = the angular frequencies, given in times (rows),
   !! rad/s; the inputs are the design parameters of ptab): sq and sqd the response's real
-  !! and imaginary parts (nq, np, rows, ncase), sqdd zero, slam (0, np, rows, ncase); qout
+  !! and imaginary parts (nq, np, rows, ncase), sqdd zero, slam (2 neq, np, rows, ncase) the
+  !! multipliers' response, real parts then imaginary (or (0, np, rows, ncase): none); qout
   !! zero, qdout and qddout (nq, 0, ncase), lamout and eout (0, rows, ncase); qsing the
   !! equilibrium, iinfo(1) the free motions, iinfo(8) a frequency at which the response is
   !! unbounded, rinfo(1:2) as statics. No measures.
@@ -260,9 +261,15 @@ contains
         end do
         rinfo(1, c) = resid; rinfo(2, c) = real(stable, wp)
       case (BATCH_FRF)                 ! (check: pt and times present)
-        call api_frf(nb, ctab, r, bm, g, ftab, fp, q0, rset(11), merge(0, 1, iset(8) == 1), &
-                     pt, times, qsing(:, c), lamw, stable, resid, s1, s2, iinfo(:, c), &
-                     status(c), msg(c), iset(4))
+        if (size(sl, 1) > 0) then      ! (and the multipliers' response)
+          call api_frf(nb, ctab, r, bm, g, ftab, fp, q0, rset(11), merge(0, 1, iset(8) == 1), &
+                       pt, times, qsing(:, c), lamw, stable, resid, s1, s2, iinfo(:, c), &
+                       status(c), msg(c), iset(4), sl(1:neq, :, :), sl(neq + 1:, :, :))
+        else
+          call api_frf(nb, ctab, r, bm, g, ftab, fp, q0, rset(11), merge(0, 1, iset(8) == 1), &
+                       pt, times, qsing(:, c), lamw, stable, resid, s1, s2, iinfo(:, c), &
+                       status(c), msg(c), iset(4))
+        end if
         rinfo(1, c) = resid; rinfo(2, c) = real(stable, wp)
       case default
         if (present(pt)) then
@@ -347,8 +354,9 @@ contains
       if (sens) then
         if (any(shape(sq) /= [nq, size(ptab, 2), nrow, ncase]) .or. size(ptab, 1) /= 2 .or. &
             any(shape(sqd) /= shape(sq)) .or. any(shape(sqdd) /= shape(sq)) .or. &
-            (positions .and. analysis /= BATCH_FRF) .or. size(slam, 1) /= &
-            merge(0, neq, analysis == BATCH_KINEMATICS .or. analysis == BATCH_FRF) .or. &
+            (positions .and. analysis /= BATCH_FRF) .or. (size(slam, 1) /= &
+            merge(0, neq, analysis == BATCH_KINEMATICS .or. analysis == BATCH_FRF) .and. &
+            .not. (analysis == BATCH_FRF .and. size(slam, 1) == 2 * neq)) .or. &
             size(slam, 2) /= size(ptab, 2) .or. size(slam, 3) /= nrow .or. &
             size(slam, 4) /= ncase .or. (analysis == BATCH_DYNAMICS .and. &
             iset(5) /= METH_DOPRI5 .and. iset(5) /= METH_GENALPHA)) then

@@ -236,3 +236,58 @@ def test_bode_family_picture(tmp_path: Path) -> None:
                        capture_output=True, text=True, timeout=120)
     assert r.returncode == 0, r.stderr
     assert (tmp_path / "bode.png").read_bytes()[:4] == b"\x89PNG"
+
+
+def held_block() -> mbd2d.Model:
+    """A base held at y = 0 by a driver ("hold") on a vertical guide, and a 2 kg block on
+    another guide hanging from it by a spring-damper; a vertical push on the block (the
+    input: its amplitude)."""
+    m = mbd2d.Model("held block", gravity=(0.0, -G))
+    m.add_body("base", (0.0, 0.0, 0.0), mass=1.0, inertia=0.1)
+    m.add_body("block", (0.0, -1.0, 0.0), mass=2.0, inertia=0.01)
+    for body in ("base", "block"):
+        m.add_translational(["ground", body], [[0.0, 0.0], [0.0, 0.0]], [[0.0, 1.0], [0.0, 1.0]],
+                            name=f"guide_{body}")
+    m.add_driver("absolute", {"poly": [0.0]}, body="base", coordinate="y", name="hold")
+    m.add_force("spring", bodies=["base", "block"], points=[[0.0, 0.0], [0.0, 0.0]],
+                stiffness=36.0, damping=1.5, length0=0.5, name="s")
+    m.add_force("point", body="block", point=[0.0, 0.0], fx=0.0, fy={"poly": [0.0]},
+                name="push")
+    return m
+
+
+def test_the_drivers_effort_response_against_the_closed_form(tmp_path: Path) -> None:
+    """The driver's effort per unit push, -(k + i c w) / (k - m w^2 + i c w) (the
+    spring-damper's force on the base, held against; -1 at 0 Hz), for each case (k, c, m);
+    lam_response and effort_response of every case equal to its own frequency_response()'s
+    lam_response and effort_response() bit for bit (a name that is no driver: KeyError); the
+    CSV's effort columns from Python and from mbd2d-solve
+    byte for byte."""
+    from test_standalone import solve_file
+    model = held_block()
+    cases = mbd2d.grid({"force.s.stiffness": [20.0, 36.0], "force.s.damping": [0.0, 1.5],
+                        "body.block.mass": [0.5, 2.0]})
+    kw = {"inputs": ["force.push.fy.poly.0"], "frequencies": FREQS[1:]}
+    ds = mbd2d.sweep(model, cases, "frf", workers=1, **kw)
+    assert ds.effort_response.dims == ("case", "frequency", "driver", "input")
+    assert list(ds.driver.values) == ["hold"] and (ds.status.values == 0).all()
+    w = 2 * np.pi * FREQS[1:]
+    for c in range(ds.sizes["case"]):
+        k, cd, m = (float(ds[n].values[c]) for n in cases)
+        want = -(k + 1j * cd * w) / (k - m * w**2 + 1j * cd * w)
+        got = ds.effort_response.values[c, :, 0, 0]
+        np.testing.assert_allclose(got, want, rtol=1e-12, atol=0)
+        one = model.with_params({n: float(ds[n].values[c]) for n in cases}) \
+            .frequency_response(**kw)
+        np.testing.assert_array_equal(ds.lam_response.values[c], one.lam_response)
+        np.testing.assert_array_equal(got, one.effort_response("hold"))
+    with pytest.raises(KeyError, match="no driver 's'"):
+        one.effort_response("s")
+    mbd2d.write_sweep(ds, tmp_path / "py.csv")
+    rows = list(csv.reader((tmp_path / "py.csv").read_text().splitlines()))
+    col = rows[0].index("d(effort.hold)/d(force.push.fy.poly.0).re")
+    assert rows[0][col + 1] == "d(effort.hold)/d(force.push.fy.poly.0).im"
+    assert float(rows[1][col]) == ds.effort_response.values[0, 0, 0, 0].real
+    mbd2d.export_sweep(model, tmp_path / "s.mbd", cases, "frf", **kw)
+    assert solve_file(tmp_path / "s.mbd", tmp_path / "f.csv") == \
+        (tmp_path / "py.csv").read_text()

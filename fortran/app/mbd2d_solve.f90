@@ -1179,6 +1179,7 @@ contains
     nlam = merge(0, neq, code == 1 .or. code >= 5); ne = merge(0, 4, code == 1 .or. code == 6)
     if (code == 5) ne = 6
     nsl = merge(neq, 0, lam_sens)
+    if (code == 6) nsl = 2 * neq                 ! (the multipliers' response: re, im)
     bytes = REAL_BYTES * real(spec%ncase, wp) * (real(nrow, wp) * (nq + nlam + ne + &
             spec%nmeas + real(spec%npar, wp) * (3 * nq + nsl + spec%nmeas)) + &
             2.0_wp * nq * nd + 2 * NINFO + nq) + 4.0_wp * spec%ncase * (2 * neq + NINFO + 3)
@@ -1672,19 +1673,23 @@ contains
 
   !> The CSV of mbd2d.write_sweep for a frequency response sweep: one row per case and
   !! frequency (case, the parameters, frequency_hz, status, message, then for each input
-  !! and coordinate d(NAME)/d(INPUT).re, .im); a failed case, one row with its status and
-  !! message.
+  !! d(NAME)/d(INPUT).re, .im of each coordinate and of each driver's effort.DRIVER, -dlambda
+  !! of its row); a failed case, one row with its status and message.
   subroutine write_frf_sweep_csv(path)
     character(len=*), intent(in) :: path
     character(len=*), parameter :: crlf = achar(13) // achar(10)
     character(len=:), allocatable :: line, head, tail
-    integer :: u, ios, j, k, c, p, lp, nh, nt, width
+    integer :: u, ios, j, k, c, p, lp, nh, nt, width, r
     logical :: done
-    width = 26 * (spec%ncp + 1 + 2 * nq * spec%npar) + 32
+    width = 26 * (spec%ncp + 1 + 2 * (nq + spec%nc) * spec%npar) + 32
     call open_sweep_csv(path, width, u, ios, head, tail, line)
     call sput(u, ios, ',frequency_hz,status,message')
     do p = 1, spec%npar
       call coordinate_header(u, ios, '', p, pair=.true.)
+      do j = 1, spec%nc
+        if (con_is_driver(spec%ctab(1, j))) call pair_header(u, ios, 'effort.' // &
+          trim(spec%con_names(j)), trim(spec%par_names(p)))
+      end do
     end do
     call sput(u, ios, crlf)
     do c = 1, spec%ncase
@@ -1699,6 +1704,14 @@ contains
           do j = 1, nq
             call bnum(line, lp, bsq(j, p, k, c) + 0.0_wp)
             call bnum(line, lp, bsqd(j, p, k, c) + 0.0_wp)
+          end do
+          r = 1
+          do j = 1, spec%nc
+            if (con_is_driver(spec%ctab(1, j))) then
+              call bnum(line, lp, -bslam(r, p, k, c) + 0.0_wp)
+              call bnum(line, lp, -bslam(neq + r, p, k, c) + 0.0_wp)
+            end if
+            r = r + con_nrow(spec%ctab(1, j))
           end do
         end do
         call bput(line, lp, crlf)

@@ -125,5 +125,9 @@ class BatchTables:
 
     @property
     def nsl(self) -> int:
-        """Rows of the multipliers' sensitivities: every analysis but kinematics has them."""
-        return self.neq if self.npar and self.analysis in (2, 3, 4) else 0
+        """Rows of the multipliers' sensitivities: every analysis but kinematics has them;
+        the frequency response's, the multipliers' response (real parts, then imaginary)."""
+        if not self.npar:
+            return 0
+        return 2 * self.neq if self.analysis == 6 else self.neq if self.analysis in (2, 3, 4) \
+            else 0

@@ -102,6 +102,22 @@ class FrequencyResponseResult:
         g, loc = self._reactions(self._input(input))
         return reaction_dp_of(self.packed, self.model, name, g, loc)
 
+    def effort_response(self, name: str, input: str | None = None) -> np.ndarray:
+        """The response of what the driver called name supplies (-lambda of its row: its
+        torque or force) to one input: (n_frequencies,) complex amplitudes per unit
+        amplitude of the input (a sweep's ``effort_response``).
+
+        Raises
+        ------
+        KeyError
+            If there is no such driver.
+        """
+        names = self.packed.constraint_names
+        if name not in names or not self.packed.driver_flags[names.index(name)]:
+            raise KeyError(f"no driver {name!r}")
+        row = self.packed.row_owner.index(names.index(name))
+        return -self.lam_response[:, row, self._input(input)]
+
     def _reactions(self, j: int) -> tuple[np.ndarray, np.ndarray]:
         """Every constraint's reaction response to input j, global and in the body frames:
         (n_frequencies, nc, 6) complex each. Re: the reactions' derivative along (Re H,

@@ -322,8 +322,12 @@ def _frf_data(pl: Plan, a: dict[str, np.ndarray], ran: np.ndarray
     p, b = pl.packed, pl.tables
     h = np.transpose(a["sq"] + 1j * a["sqd"], (3, 2, 0, 1))    # (case, frequency, nq, input)
     h[~ran] = np.nan
+    neq = b.neq
+    hl = np.transpose(a["slam"][:neq] + 1j * a["slam"][neq:], (3, 2, 0, 1))
+    hl[~ran] = np.nan                                          # (case, frequency, neq, input)
     data: dict[str, Any] = {
         "response": (("case", "frequency", "coordinate", "input"), h),
+        "lam_response": (("case", "frequency", "equation", "input"), hl),
         "q": (("case", "coordinate"), np.where(ran[:, None], a["qsing"].T, np.nan)),
         "n_free": ("case", np.where(ran, a["iinfo"][0], -1).astype(np.int64)),
         "stability": ("case", np.array([STABILITY.get(int(s), "not examined") if k else ""
@@ -331,7 +335,11 @@ def _frf_data(pl: Plan, a: dict[str, np.ndarray], ran: np.ndarray
         "residual": ("case", np.where(ran, a["rinfo"][0], np.nan))}
     coords: dict[str, Any] = {"case": np.arange(len(ran)), "frequency": pl.times.copy(),
                               "coordinate": list(p.coordinate_names),
-                              "input": list(b.sensitivities)}
+                              "equation": list(p.row_labels), "input": list(b.sensitivities)}
+    rows_d, drivers = _driver_rows(p)
+    if drivers:                                      # (an effort is -lambda on its row)
+        data["effort_response"] = (("case", "frequency", "driver", "input"), -hl[:, :, rows_d])
+        coords["driver"] = drivers
     return data, coords
 
 

@@ -43,9 +43,10 @@ def write_sweep(ds: Any, path: str | Path) -> None:
     mode, ``case``, the parameters, ``mode``, ``status``, ``message``, ``omega2``,
     ``frequency_hz``, ``kind``, the shape per coordinate. A frequency response sweep: one
     row per case and frequency, ``case``, the parameters, ``frequency_hz``, ``status``,
-    ``message``, then for each input and coordinate ``d(NAME)/d(INPUT).re`` and ``.im``
-    (the columns of :meth:`FrequencyResponseResult.to_csv`). netCDF keeps the complex
-    ``response`` as xarray writes complex numbers through h5netcdf.
+    ``message``, then for each input ``d(NAME)/d(INPUT).re`` and ``.im`` of each coordinate
+    (the columns of :meth:`FrequencyResponseResult.to_csv`) and of each driver's effort
+    (``effort.DRIVER``). netCDF keeps the complex ``response``, ``lam_response`` and
+    ``effort_response`` as xarray writes complex numbers through h5netcdf.
 
     Raises
     ------
@@ -158,11 +159,15 @@ def _frf_csv(ds: Any, path: Path) -> None:
     """A frequency response sweep: one row per case and frequency (see write_sweep); a case
     without a response gets one row with its status and message."""
     params = _params(ds)
-    coords = [str(c) for c in ds.coordinate.values]
+    drivers = [str(d) for d in ds.driver.values] if "effort_response" in ds else []
+    cols = [str(c) for c in ds.coordinate.values] + [f"effort.{d}" for d in drivers]
     header = ["case", *params, "frequency_hz", "status", "message",
-              *(f"d({c})/d({i}).{part}" for i in ds.input.values for c in coords
+              *(f"d({c})/d({i}).{part}" for i in ds.input.values for c in cols
                 for part in ("re", "im"))]
-    h = np.moveaxis(ds.response.values, 3, 2)                # (case, frequency, input, nq)
+    h = ds.response.values                                   # (case, frequency, nq, input)
+    if drivers:
+        h = np.concatenate([h, ds.effort_response.values], axis=2)
+    h = np.moveaxis(h, 3, 2)                                 # (case, frequency, input, cols)
     parts = np.stack([h.real, h.imag], axis=4).reshape(h.shape[0], h.shape[1], -1) + 0.0
     f = ds.frequency.values
     with open(path, "w", newline="", encoding="utf-8") as fh:

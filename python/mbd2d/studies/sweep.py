@@ -41,7 +41,10 @@ def sweep(model: ModelDescription, cases: Any, analysis: str = "kinematics", cli
         ``modes()`` gives them, bit for bit; "frf", the frequency response
         (:meth:`mbd2d.Model.frequency_response`, settings ``inputs``, ``frequencies``, ``t``,
         ``equilibrium``, ``solver``): the complex ``response`` over ("case", "frequency",
-        "coordinate", "input"), the frequencies in Hz, and per case the equilibrium ``q``,
+        "coordinate", "input"), the multipliers' ``lam_response`` over ("case",
+        "frequency", "equation", "input") and the drivers' ``effort_response`` (-lambda of
+        their rows) over ("case", "frequency", "driver", "input"), the frequencies in Hz, and
+        per case the equilibrium ``q``,
         ``n_free``, ``stability``, ``residual``; a case whose response fails (an undamped
         resonance among the frequencies, no equilibrium) is NaN with its status and
         message); "kinematics" of a model with masses
