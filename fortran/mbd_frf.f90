@@ -81,11 +81,15 @@ contains
                              g0(:, :), g1(:, :), g2(:, :), rre(:, :), rim(:, :), &
                              qlt(:, :), yre(:, :), yim(:, :)
     complex(wp), allocatable :: tc(:, :), yc(:, :), lm(:)
+    ! the multipliers' response by parts (pre): P x, the least squares J_a^T mu = x, of K N,
+    ! M N, C N (neq, f) and of r - K s_n, M s_n, C s_n (neq, np); a frequency's (neq, np)
+    real(wp), allocatable :: pk(:, :), pm(:, :), pc(:, :), p0(:, :), p2(:, :), p1(:, :), &
+                             lw(:, :)
     logical, allocatable :: sw(:)
     integer, allocatable :: ipiv(:)
     real(wp) :: bytes, om, toff
     integer :: n, f, np, na, i, j, k, ist, info
-    logical :: hess
+    logical :: hess, pre
     character(len=MSG_LEN) :: what
     status = MBD_OK; msg = ''; ibad = 0
     hre = zero; him = zero
@@ -141,6 +145,13 @@ contains
     end do
     if (hess) call hess_setup(hess, status)       ! (hess false: M_r singular, the dense LU)
     if (status /= MBD_OK) return
+    ! the multipliers' response is linear in the parts P(K N), ... : solved once when that
+    ! costs fewer solves than two per input and frequency (many frequencies, few free motions)
+    pre = present(lre) .and. present(lim) .and. 2 * size(omega) * np > 3 * (f + np)
+    if (pre) call parts_setup(pre, status)
+    if (status /= MBD_OK) then
+      msg = 'frequency response: the multipliers'' least squares failed'; return
+    end if
     do j = 1, size(omega)
       om = omega(j)
       do k = 1, np
@@ -168,7 +179,9 @@ contains
         call dgetrs('N', 2 * f, np, a, 2 * f, ipiv, b, 2 * f, info)
         call response(j)
       end if
-      if (present(lre) .and. present(lim)) then
+      if (pre) then
+        call multipliers_by_parts(j, om)
+      else if (present(lre) .and. present(lim)) then
         call multipliers(j, om, status)
         if (status /= MBD_OK) then
           msg = 'frequency response: the multipliers'' least squares failed'; return
@@ -355,6 +368,58 @@ contains
         if (st /= MBD_OK) return
       end do
     end subroutine multipliers
+
+    !> P(K N), P(M N), P(C N) and P(r - K s_n), P(M s_n), P(C s_n) (multipliers_by_parts);
+    !! use false (and no failure) when their memory cannot be had: the solves per frequency.
+    subroutine parts_setup(use, st)
+      logical, intent(inout) :: use
+      integer, intent(out) :: st
+      integer :: nq, kk
+      st = MBD_OK; nq = size(lam)
+      allocate (pk(nq, f), pm(nq, f), pc(nq, f), p0(nq, np), p2(nq, np), p1(nq, np), &
+                lw(nq, np), stat=ist)
+      if (ist /= 0) then
+        use = .false.; return
+      end if
+      pk = zero; pm = zero; pc = zero; p0 = zero; p2 = zero; p1 = zero
+      do kk = 1, f
+        call proj_multipliers(w, kn(:, kk), pk(:, kk), st)
+        if (st == MBD_OK) call proj_multipliers(w, mn(:, kk), pm(:, kk), st)
+        if (st == MBD_OK) call proj_multipliers(w, cn(:, kk), pc(:, kk), st)
+        if (st /= MBD_OK) return
+      end do
+      do kk = 1, np
+        y = rr(:, kk) - ks(:, kk)
+        call proj_multipliers(w, y, p0(:, kk), st)
+        if (st == MBD_OK) call proj_multipliers(w, ms(:, kk), p2(:, kk), st)
+        if (st == MBD_OK) call proj_multipliers(w, cs(:, kk), p1(:, kk), st)
+        if (st /= MBD_OK) return
+      end do
+    end subroutine parts_setup
+
+    !> lre, lim at frequency j as multipliers' from the parts (H = s_n + N z, z in b):
+    !! Re = P(r - K s_n) + om^2 P(M s_n) - P(K N) z_re + om^2 P(M N) z_re + om P(C N) z_im,
+    !! Im = -om P(C s_n) - P(K N) z_im + om^2 P(M N) z_im - om P(C N) z_re.
+    subroutine multipliers_by_parts(j, om)
+      integer, intent(in) :: j
+      real(wp), intent(in) :: om
+      integer :: nq
+      nq = size(lam)
+      lw = p0 + om**2 * p2
+      if (f > 0) then
+        call dgemm('N', 'N', nq, np, f, -one, pk, nq, b, 2 * f, one, lw, nq)
+        call dgemm('N', 'N', nq, np, f, om**2, pm, nq, b, 2 * f, one, lw, nq)
+        call dgemm('N', 'N', nq, np, f, om, pc, nq, b(f + 1, 1), 2 * f, one, lw, nq)
+      end if
+      lre(:, :, j) = lw
+      lw = -om * p1
+      if (f > 0) then
+        call dgemm('N', 'N', nq, np, f, -one, pk, nq, b(f + 1, 1), 2 * f, one, lw, nq)
+        call dgemm('N', 'N', nq, np, f, om**2, pm, nq, b(f + 1, 1), 2 * f, one, lw, nq)
+        call dgemm('N', 'N', nq, np, f, -om, pc, nq, b, 2 * f, one, lw, nq)
+      end if
+      lim(:, :, j) = lw
+    end subroutine multipliers_by_parts
 
     !> kx = K x (exact, sens_stiffness_mul).
     subroutine kmul(xx, kx)
