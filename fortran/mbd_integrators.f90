@@ -21,10 +21,12 @@
 !!                       J_u becomes 4x worse conditioned than the choice of a QR with
 !!                       column pivoting (dgeqp3) at the current state.
 !! Breakpoints of the drivers' and forces' functions of time (a motion law's t0, t1, a table's
-!! ends), where q_ddot may jump: every method ends a step on them (break_step; fixed steps:
-!! the step containing one is split there, grid_break), its evaluations at the breakpoint
-!! taking the functions' left limits (the double below), the next step starting from the
-!! right ones (generalized-alpha: q_ddot, lambda and a from the index-1 equations there).
+!! ends), where q_ddot may jump: dopri5, the partitioned method and baumgarte-rk4 end a step
+!! on them (break_step; fixed steps: the step containing one is split there, grid_break),
+!! its evaluations at the breakpoint taking the functions' left limits (the double below),
+!! the next step starting from the right ones. Generalized-alpha steps over them: restarted
+!! there from the index-1 q_ddot (a = q_ddot), its own accelerations converged but its
+!! positions lost up to 2x in a rise of few steps (docs/motion.md).
 !! Contacts and stick-slip joints (mbd_events): every method tracks their modes and records
 !! their events; the error-controlled ones (dopri5, partitioned, generalized-alpha without h)
 !! take a step that crosses an event again, to end at the event (located on the step's
@@ -142,10 +144,6 @@ module mbd_integrators
     procedure(hook_emit), deferred :: emit
     !> an accepted step: its end becomes the next step's start
     procedure(hook_commit), deferred :: commit
-    !> after commit, at a breakpoint of the functions of time: the start's accelerations
-    !! again from the index-1 equations at (q, qd, t) (their right limits), output row r
-    !! (> 0) rewritten with them
-    procedure(hook_restart), deferred :: restart
   end type ga_hook_t
 
   abstract interface
@@ -176,15 +174,6 @@ module mbd_integrators
       import :: ga_hook_t
       class(ga_hook_t), intent(inout) :: self
     end subroutine hook_commit
-    subroutine hook_restart(self, m, w, q, qd, t, r, status)
-      import :: ga_hook_t, wp, model_t, dyn_work_t
-      class(ga_hook_t), intent(inout) :: self
-      type(model_t), intent(in) :: m
-      type(dyn_work_t), intent(inout) :: w
-      real(wp), intent(in) :: q(:), qd(:), t
-      integer, intent(in) :: r
-      integer, intent(out) :: status
-    end subroutine hook_restart
   end interface
 
   !> fixed steps: a breakpoint this many steps after a grid time ends the step before it
@@ -579,18 +568,14 @@ contains
     real(wp) :: am, af, gam, bet, bp, gp, h, t, err, tnew, facc, v, hprev, dqn, dqp, dtol, &
                 dqpp
     real(wp) :: rtol_dyn, cf, kmax, cmax, fmax, qmax, vmax, rmax, te, mufric, esq
-    real(wp) :: tev                              ! the time of the step's end's evaluations
     real(wp) :: coef(GA_NCOEF)
-    real(wp) :: ar(m%nq), lr(m%neq)              ! a breakpoint's right limits: q_ddot, lambda
     real(wp) :: q(m%nq), qd(m%nq), qdd(m%nq), acc(m%nq), lam(m%neq)
     real(wp) :: qn(m%nq), vn(m%nq), an(m%nq), accn(m%nq), lamn(m%neq), dq(m%nq), ap(m%nq)
     real(wp) :: res(m%nq + w%na), dg(m%nq), ew(m%nq)
     real(wp), allocatable :: kv(:), cv(:), kc(:)   ! K, C and K + g' C on the pattern
     type(saddle_t) :: sg                            ! the iteration matrix S
     integer :: it, n, stt, nfix, na, attempt, nkc, k, nnz, kev, nprev, i, ne
-    integer :: kgrid                             ! fixed steps: the grid times passed
-    logical :: fixed, conv, have_kc, new_kc, finite, changed, diagk, land
-    logical :: to_event                          ! the step is taken again to end at an event
+    logical :: fixed, conv, have_kc, new_kc, finite, changed, diagk
     status = MBD_OK; msg = ''
     n = m%nq; na = w%na
     ! S = [M b' + K + g' C, b' J^T; b' J, 0] on the path of w (dense: the sparse LU up to 128
@@ -639,25 +624,16 @@ contains
     acc = qdd              ! the auxiliary acceleration a_0 = q_ddot_0
     hprev = zero
     err = zero
-    kgrid = 0
-    to_event = .false.
-    do while (merge(kgrid < nfix, more(c, t, fixed, nfix), fixed))
+    do while (more(c, t, fixed, nfix))
       if (c%st%steps + c%st%rejected >= c%opts%max_steps) then
         call step_limit(c, t, 0, status, msg); return
       end if
       h = min(h, c%t1 - t)
       tnew = t + h
       if (fixed) then
-        tnew = step_time(c, kgrid + 1, nfix)
-        call grid_break(m, c, t, nfix, tnew, land)
+        tnew = step_time(c, c%st%steps + 1, nfix)
         h = tnew - t
-      else
-        call break_step(m, t, c%t1, h, tnew, land, to_event)
       end if
-      ! a step ending on a breakpoint of the functions of time takes their left limits there
-      ! (the double below); the next step restarts from the right ones
-      tev = tnew
-      if (land) tev = nearest(tnew, -one)
       c%st%t_fail = t
       bp = (1 - am) / (bet * h * h * (1 - af))
       gp = gam / (bet * h)
@@ -684,8 +660,8 @@ contains
         nkc = 0                         ! K, C evaluations in this attempt
         dq = zero; dqp = huge(one); dqpp = huge(one)
         do it = 1, GA_MAXIT
-          call assemble_blocks(m, qn, vn, tev, w%phi, w%nu, w%gam, w%asm)
-          call gen_forces(m, qn, vn, tev, w%force, v, cst=w%cst, lam=lamn)
+          call assemble_blocks(m, qn, vn, tnew, w%phi, w%nu, w%gam, w%asm)
+          call gen_forces(m, qn, vn, tnew, w%force, v, cst=w%cst, lam=lamn)
           ! r = M q_ddot + J^T lambda - Q;  r_c = b' Phi
           call dyn_jt_lam(m, w%asm%jb, lamn, res(1:n))
           ! the residual tolerance is GA_RTOL of the largest term, but not below the change
@@ -755,12 +731,12 @@ contains
       ne = 0; esq = zero
       if (conv .and. present(hook)) then
         coef(5:6) = [bp, gp]
-        call hook%step(m, w, sg, tev, h, coef, qn, vn, an, lamn, c%opts%rtol, c%opts%atol, &
+        call hook%step(m, w, sg, tnew, h, coef, qn, vn, an, lamn, c%opts%rtol, c%opts%atol, &
                        esq, ne, stt)
         if (stt == MBD_NO_CONVERGENCE) then   ! (slow with an old K, C: fresh ones at qn)
           call tangent()
           call factor_s(stt)
-          if (stt == MBD_OK) call hook%step(m, w, sg, tev, h, coef, qn, vn, an, lamn, &
+          if (stt == MBD_OK) call hook%step(m, w, sg, tnew, h, coef, qn, vn, an, lamn, &
                                             c%opts%rtol, c%opts%atol, esq, ne, stt)
         end if
         if (stt /= MBD_OK) then
@@ -786,7 +762,7 @@ contains
         end if
         if (kev > 0 .and. .not. fixed .and. te < tnew - event_tol(t, tnew)) then
           c%st%rejected = c%st%rejected + 1
-          h = te - t; to_event = .true.
+          h = te - t
           cycle
         end if
       end if
@@ -811,40 +787,14 @@ contains
       end if
       accn = accn + (1 - af) / (1 - am) * an
       nprev = c%nout
-      if (land) then
-        ! the accelerations and multipliers at the breakpoint's right limits (the outputs
-        ! before it interpolate to the step's left ones)
-        call dyn_accel(m, w, qn, vn, tnew, ar, lr, stt)
-        if (stt /= MBD_OK) then
-          ar = an; lr = lamn; land = .false.
-        end if
-        call emit(c, qo, vo, ao, t, q, qd, qdd, tnew, qn, vn, ar, an)
-      else
-        call emit(c, qo, vo, ao, t, q, qd, qdd, tnew, qn, vn, an)
-      end if
+      call emit(c, qo, vo, ao, t, q, qd, qdd, tnew, qn, vn, an)
       call save_modes(w, c, nprev + 1)
       if (present(hook)) then
         do i = nprev + 1, c%nout
           call hook%emit(i, out_time(c, output_index(c%nsteps, c%every, i)), t, tnew)
         end do
         call hook%commit()
-        if (land) then
-          i = 0                   ! (an output at the breakpoint: its right limits)
-          if (c%nout > nprev) then
-            if (abs(out_time(c, output_index(c%nsteps, c%every, c%nout)) - tnew) <= &
-                1.0e-12_wp * abs(c%t1 - c%t0)) i = c%nout
-          end if
-          call hook%restart(m, w, qn, vn, tnew, i, stt)
-          if (stt /= MBD_OK) then
-            status = MBD_INTEGRATOR_FAILED
-            write (msg, '(a,es12.5)') 'the sensitivities'' accelerations could not be '// &
-              'solved at the breakpoint t = ', tnew
-            return
-          end if
-        end if
       end if
-      if (fixed) call grid_passed(c, nfix, tnew, land, kgrid)
-      to_event = .false.
       c%st%steps = c%st%steps + 1
       c%st%hmin = min(c%st%hmin, h); c%st%hmax = max(c%st%hmax, h)
       if (stopped(c, tnew, status, msg, ctl)) then
@@ -852,10 +802,6 @@ contains
         return
       end if
       t = tnew; q = qn; qd = vn; qdd = an; acc = accn; lam = lamn
-      if (land) then
-        ! restart from the right limits: q_ddot jumps, a = q_ddot (no history across it)
-        qdd = ar; acc = ar; lam = lr; hprev = zero
-      end if
       if (kev > 0) then
         ! change the modes; restart from the accelerations of the new modes
         call events_switch(m, w, t, q, qd, c%log, changed, stt, trec=te)
@@ -877,14 +823,14 @@ contains
 
     !> K and C by differences at (qn, vn) (dyn_tangent), and the blocks at qn again.
     subroutine tangent()
-      call dyn_tangent(m, w, qn, vn, tev, lamn, kv, cv, fast=.true.)
+      call dyn_tangent(m, w, qn, vn, tnew, lamn, kv, cv, fast=.true.)
       c%st%jacobians = c%st%jacobians + 1
       have_kc = .true.; new_kc = .false.; nkc = nkc + 1
       kmax = zero; cmax = zero
       if (nnz > 0) then
         kmax = maxval(abs(kv)); cmax = maxval(abs(cv))
       end if
-      call assemble_blocks(m, qn, vn, tev, w%phi, w%nu, w%gam, w%asm)
+      call assemble_blocks(m, qn, vn, tnew, w%phi, w%nu, w%gam, w%asm)
     end subroutine tangent
 
     !> S with the current J: K + g' C on the pattern, + M b' on the diagonal, b' J; factored.

@@ -62,7 +62,6 @@ module mbd_sens_genalpha
     real(wp), allocatable :: l0(:, :), l1(:, :)     !! dlambda/dp as rows (npd, neq)
     real(wp), allocatable :: xt(:, :), x(:)         !! solutions as rows (npd, nq + na); work
     real(wp), allocatable :: zq(:), zv(:), za(:)    !! an output's interpolated rows
-    real(wp), allocatable :: wa(:), wl(:)           !! q_ddot and lambda of a restart (work)
     real(wp), pointer, contiguous :: so(:, :, :) => null(), sdo(:, :, :) => null()
     real(wp), pointer, contiguous :: sddo(:, :, :) => null()
     !> the refinement's last measured contraction (huge: none yet) and the steps since
@@ -73,7 +72,6 @@ module mbd_sens_genalpha
     procedure :: step => ga_step
     procedure :: emit => ga_emit
     procedure :: commit => ga_commit
-    procedure :: restart => ga_restart
   end type ga_sens_t
 
 contains
@@ -100,7 +98,7 @@ contains
     nz = g%npd * g%n
     allocate (g%s0(nz), g%v0(nz), g%a0(nz), g%c0(nz), g%s1(nz), g%v1(nz), g%a1(nz), g%c1(nz), &
               g%l0(g%npd, m%neq), g%l1(g%npd, m%neq), g%xt(g%npd, m%nq + w%na), &
-              g%x(m%nq + w%na), g%zq(nz), g%zv(nz), g%za(nz), g%wa(m%nq), g%wl(m%neq), &
+              g%x(m%nq + w%na), g%zq(nz), g%zv(nz), g%za(nz), &
               aa(m%nq), lam(m%neq), stat=st)
     if (st /= 0) then
       status = MBD_NO_MEMORY; msg = 'out of memory for the sensitivities of generalized-alpha'
@@ -313,24 +311,6 @@ contains
       call move_alloc(a, tmp); call move_alloc(b, a); call move_alloc(tmp, b)
     end subroutine swap
   end subroutine ga_commit
-
-  !> At a breakpoint of the functions of time (after commit): S_ddot at the start again from
-  !! the index-1 equations at (q, qd, t), the right limits, as the state's q_ddot, and the
-  !! auxiliary acceleration's a' = S_ddot (no history across the jump); output row r (> 0),
-  !! the one at the breakpoint, rewritten with them.
-  subroutine ga_restart(self, m, w, q, qd, t, r, status)
-    class(ga_sens_t), intent(inout) :: self
-    type(model_t), intent(in) :: m
-    type(dyn_work_t), intent(inout) :: w
-    real(wp), intent(in) :: q(:), qd(:), t
-    integer, intent(in) :: r
-    integer, intent(out) :: status
-    call sens_accel(m, w, self%s, self%pw, q, qd, t, self%npd, self%s0, self%v0, self%wa, &
-                    self%wl, status, self%a0)
-    if (status /= MBD_OK) return
-    self%c0 = self%a0
-    if (r > 0) call put_row(self, r, self%s0, self%v0, self%a0)
-  end subroutine ga_restart
 
   !> Output row r from rows (npd, n) of S, S_dot, S_ddot, in model units (s%ounit).
   subroutine put_row(g, r, zs, zv, za)

@@ -138,70 +138,26 @@ def test_baumgarte_rk4_keeps_its_order_across_breakpoints(t0: float, t1: float) 
     assert all(12.0 < e0 / e1 < 20.0 for e0, e1 in zip(errs, errs[1:]))
 
 
-@pytest.mark.parametrize("t0, t1", [(SHAKE_T0, SHAKE_T1), OFF_GRID])
-def test_generalized_alpha_restarts_at_breakpoints(t0: float, t1: float) -> None:
-    """Generalized-alpha (fixed h) ends a step on each breakpoint (splitting the step that
-    contains one) and restarts there from the right limits (q_ddot from the index-1
-    equations, a = q_ddot), as at the run's start. The bar's angle stays second order; the
-    scheme's own accelerations (res.qdd), whose transient after each jump decays at rho_inf's
-    rate, now fall with h (the cart's, measured 1.7, 0.87, 0.43 m/s^2 on the grid, 0.40,
-    0.73, 0.27 off it, at h = 1e-2, 5e-3, 2.5e-3); before they kept the jump (20 m/s^2 at
-    every h on the grid, 69 to 74 off it) and the output at a breakpoint was its left limit."""
+@pytest.mark.parametrize("t0, t1", [(SHAKE_T0, SHAKE_T1), OFF_GRID, (0.2, 0.25)])
+def test_generalized_alpha_steps_over_breakpoints(t0: float, t1: float) -> None:
+    """Generalized-alpha takes no special step at a breakpoint (index 3: a driver enters by
+    its positions alone). The bar's angle is second order on the grid, off it and in a rise
+    of 0.05 s whose acceleration jumps by 720 m/s^2; the scheme's own accelerations
+    (res.qdd) carry each jump's transient, which does not fall with h (measured: the cart's
+    20 m/s^2 on the grid, 69 to 74 off it, 720 to 780 in the short rise, at every h).
+    Restarting the scheme there from the index-1 accelerations (a = q_ddot) made them
+    converge but cost the short rise's angle 2x at every h (docs/motion.md): not kept."""
     m = shaken_pendulum(t0, t1)
     ts = np.linspace(0.0, 1.0, 101)
-    theta, theta_dd = pendulum_reference(ts, t0, t1)
+    theta, _ = pendulum_reference(ts, t0, t1)
     xdd = np.array([cart_acceleration(t, t0, t1) for t in ts])
+    jump = 6 * SHAKE_H / (t1 - t0)**2
     errs = []
-    for h in (1e-2, 5e-3, 2.5e-3):
+    for h in (5e-3, 2.5e-3, 1.25e-3):
         res = m.dynamics(1.0, 100, method="generalized-alpha", h=h)
         errs.append(np.abs(res.body("bar").theta - theta).max())
-        assert np.abs(res.qdd[:, 0] - xdd).max() < 250 * h
-        assert np.abs(res.qdd[:, 5] - theta_dd).max() < 600 * h
-        if t0 == SHAKE_T0:
-            assert res.qdd[20, 0] == pytest.approx(20.0, rel=1e-12)     # the right limits
-            assert res.qdd[50, 0] == pytest.approx(0.0, abs=1e-12)
+        assert np.abs(res.qdd[:, 0] - xdd).max() < 4 * jump
     assert all(3.5 < e0 / e1 < 4.5 for e0, e1 in zip(errs, errs[1:]))
-
-
-def test_adaptive_generalized_alpha_restarts_at_breakpoints() -> None:
-    """Error-controlled generalized-alpha ends its steps on the breakpoints as dopri5 does
-    and restarts there: the cart's acceleration at the outputs within 1.5 m/s^2 at rtol
-    1e-4 and 0.4 at 1e-6 (measured 1.4, 0.35; before 20, the jump itself), the bar's angle
-    as before (measured 1.2e-3, 5.7e-5: the global error of a second-order method whose
-    local error is controlled)."""
-    m = shaken_pendulum()
-    ts = np.linspace(0.0, 1.0, 101)
-    theta, _ = pendulum_reference(ts)
-    xdd = np.array([cart_acceleration(t) for t in ts])
-    for rtol, bound in ((1e-4, 1.5), (1e-6, 0.4)):
-        res = m.dynamics(1.0, 100, method="generalized-alpha", rtol=rtol, atol=rtol * 1e-2)
-        assert np.abs(res.qdd[:, 0] - xdd).max() < bound
-        assert np.abs(res.body("bar").theta - theta).max() < 100 * rtol
-
-
-def test_generalized_alpha_sensitivities_restart_with_the_state() -> None:
-    """Generalized-alpha's design sensitivities restart with the state at the breakpoints
-    (S_ddot from the index-1 equations' derivative): d(theta)/d(rise) against a central
-    difference of the reduced equation's solution falls at second order (measured 2.4e-3,
-    5.9e-4, 1.5e-4 relative at h = 1e-2, 5e-3, 2.5e-3), and against central differences of
-    runs at the same h it is the discrete solution's derivative (measured 7.5e-9)."""
-    name = "driver.shake.f.step.0.h"
-    ts = np.linspace(0.0, 1.0, 101)
-    d = 1e-6
-    want = (pendulum_reference(ts, rise=SHAKE_H + d)[0]
-            - pendulum_reference(ts, rise=SHAKE_H - d)[0]) / (2 * d)
-    errs = []
-    for h in (1e-2, 5e-3, 2.5e-3):
-        res = shaken_pendulum().dynamics(1.0, 100, method="generalized-alpha", h=h,
-                                         sensitivities=[name])
-        errs.append(np.abs(res.dq_dp[:, 5, 0] - want).max() / np.abs(want).max())
-    assert all(3.5 < e0 / e1 < 4.5 for e0, e1 in zip(errs, errs[1:]))
-    m = shaken_pendulum()
-    res = m.dynamics(1.0, 100, method="generalized-alpha", h=1e-2, sensitivities=[name])
-    runs = [m.with_params({name: SHAKE_H + s}).dynamics(1.0, 100, method="generalized-alpha",
-                                                        h=1e-2).q for s in (d, -d)]
-    fd = (runs[0] - runs[1]) / (2 * d)
-    assert np.abs(res.dq_dp[:, :, 0] - fd).max() < 1e-7 * np.abs(fd).max()
 
 
 @pytest.mark.parametrize("method", ["dopri5", "partitioned", "generalized-alpha"])
