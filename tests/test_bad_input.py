@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 import pytest
 
 import mbd2d
@@ -308,6 +309,8 @@ def test_builder_reports_the_same_errors():
         m.add_joint("hinge", name="j", bodies=["ground", "a"])
     with pytest.raises(mbd2d.ModelError, match=r"driver 'd'.*unknown driver type 'speed'"):
         m.add_driver("speed", f=1.0, name="d", body="a")
+    with pytest.raises(mbd2d.ModelError, match=r"driver 'd'.*unknown driver type array"):
+        m.add_driver(np.array([math.nan, 0.0]), f=0.0, name="d")   # (was a raw ValueError)
     with pytest.raises(mbd2d.ModelError, match=r"driver 'd'.*f\.poly\[0\] must be finite"):
         m.add_driver("absolute", f={"poly": [math.nan]}, name="d", body="a", coordinate="x")
     m.add_revolute(["ground", "a"], [[0, 0], [0, 0]], name="pin")

@@ -540,6 +540,10 @@ class ModelDescription:
         name = self._new_name(name, "driver", entry)
         entry = f"driver '{name}'"
         fun = as_function(f, entry)
+        if not isinstance(type, str) or \
+                type not in ("absolute", "relative-angle", "relative-distance"):
+            raise ModelError(f"unknown driver type {type!r}; use 'absolute', 'relative-angle' "
+                             "or 'relative-distance'", entry)
         d: Driver
         if type == "absolute":
             if body is None or coordinate is None or bodies is not None or joint is not None:
@@ -555,7 +559,7 @@ class ModelDescription:
                 raise ModelError("a relative-angle driver needs 'bodies' = [i, j] (theta_j - "
                                  "theta_i = f(t)) and no 'body', 'coordinate' or 'joint'", entry)
             d = RelativeAngleDriver(name, self._two_bodies(bodies, entry), fun)
-        elif type == "relative-distance":
+        else:                                               # relative-distance
             if joint is None or body is not None or bodies is not None or coordinate is not None:
                 raise ModelError("a relative-distance driver needs 'joint' (a translational "
                                  "joint) and no 'body', 'bodies' or 'coordinate'", entry)
@@ -567,9 +571,6 @@ class ModelDescription:
                 raise ModelError(f"joint {joint!r} is a {target.type} joint; a "
                                  "relative-distance driver needs a translational joint", entry)
             d = RelativeDistanceDriver(name, target.bodies, fun, joint)
-        else:
-            raise ModelError(f"unknown driver type {type!r}; use 'absolute', 'relative-angle' "
-                             "or 'relative-distance'", entry)
         self.drivers.append(d)
         return d
 
