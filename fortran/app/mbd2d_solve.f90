@@ -75,6 +75,7 @@ program mbd2d_solve
   character(len=MSG_LEN), allocatable :: bmsg(:)
   character(len=4 * MSG_LEN), allocatable :: cmsg(:)
   integer :: code = 0, nrow = 0, nd = 0, nlam = 0   !! batch analysis, rows, rows of q_dot, lambda
+  integer, allocatable :: drow(:)                   !! the drivers' rows of Phi (an effort: -lambda)
   real(wp), allocatable :: mvals(:, :)                !! the measures (nmeas, rows written)
   !> with sensitivities: the measures' design derivatives (nmeas, npar, rows written)
   real(wp), allocatable :: mdp(:, :, :)
@@ -108,6 +109,7 @@ program mbd2d_solve
   if (status /= MBD_OK) call die(2, trim(msg))
   call api_sizes(spec%nb, spec%ctab, spec%rpar, nq, neq, status, msg, bad)
   if (status /= MBD_OK) call die(2, where(bad, msg))
+  drow = driver_rows()
   if (spec%analysis == 'check') then
     call run_check()
     stop 0, quiet=.true.
@@ -763,7 +765,7 @@ contains
     real(wp), intent(in) :: lam(:), rc(:, :)
     real(wp), intent(inout) :: v(:)
     integer, intent(inout) :: n
-    integer :: c, r0, nr
+    integer :: c
     if (spec%out_lam) then
       v(n + 1:n + neq) = lam; n = n + neq
     end if
@@ -773,13 +775,8 @@ contains
       end do
     end if
     if (spec%out_eff) then
-      r0 = 1
-      do c = 1, spec%nc
-        nr = con_nrow(spec%ctab(1, c))
-        if (con_is_driver(spec%ctab(1, c))) then
-          v(n + 1) = -lam(r0); n = n + 1
-        end if
-        r0 = r0 + nr
+      do c = 1, size(drow)
+        v(n + 1) = -lam(drow(c)); n = n + 1
       end do
     end if
   end subroutine lam_values
@@ -1505,7 +1502,7 @@ contains
     character(len=*), parameter :: crlf = achar(13) // achar(10)
     character(len=*), parameter :: lev(3) = [character(len=6) :: '', '_dot', '_ddot']
     character(len=:), allocatable :: line, head, tail
-    integer :: u, ios, j, k, l, r0, nlev, c, lp, nh, nt, width, p, nsl
+    integer :: u, ios, j, k, l, nlev, c, lp, nh, nt, width, p, nsl
     logical :: done
     if (code == 5) then
       call write_modes_sweep_csv(path)
@@ -1572,10 +1569,8 @@ contains
           end do
         end if
         if (nlam > 0) then
-          r0 = 1
-          do j = 1, spec%nc
-            if (con_is_driver(spec%ctab(1, j))) call bnum(line, lp, -blam(r0, k, c))
-            r0 = r0 + con_nrow(spec%ctab(1, j))
+          do j = 1, size(drow)
+            call bnum(line, lp, -blam(drow(j), k, c))
           end do
         end if
         do j = 1, spec%nmeas
@@ -1679,7 +1674,7 @@ contains
     character(len=*), intent(in) :: path
     character(len=*), parameter :: crlf = achar(13) // achar(10)
     character(len=:), allocatable :: line, head, tail
-    integer :: u, ios, j, k, c, p, lp, nh, nt, width, r
+    integer :: u, ios, j, k, c, p, lp, nh, nt, width
     logical :: done
     width = 26 * (spec%ncp + 1 + 2 * (nq + spec%nc) * spec%npar) + 32
     call open_sweep_csv(path, width, u, ios, head, tail, line)
@@ -1705,13 +1700,9 @@ contains
             call bnum(line, lp, bsq(j, p, k, c) + 0.0_wp)
             call bnum(line, lp, bsqd(j, p, k, c) + 0.0_wp)
           end do
-          r = 1
-          do j = 1, spec%nc
-            if (con_is_driver(spec%ctab(1, j))) then
-              call bnum(line, lp, -bslam(r, p, k, c) + 0.0_wp)
-              call bnum(line, lp, -bslam(neq + r, p, k, c) + 0.0_wp)
-            end if
-            r = r + con_nrow(spec%ctab(1, j))
+          do j = 1, size(drow)
+            call bnum(line, lp, -bslam(drow(j), p, k, c) + 0.0_wp)
+            call bnum(line, lp, -bslam(neq + drow(j), p, k, c) + 0.0_wp)
           end do
         end do
         call bput(line, lp, crlf)
@@ -1722,13 +1713,25 @@ contains
     if (ios /= 0) call die(2, 'cannot write ' // path // ' (disk full?)')
   end subroutine write_frf_sweep_csv
 
+  !> The drivers' first rows of Phi, in the constraints' order (an effort is -lambda there).
+  function driver_rows() result(rows)
+    integer, allocatable :: rows(:)
+    integer :: j, r
+    rows = [integer ::]
+    r = 1
+    do j = 1, spec%nc
+      if (con_is_driver(spec%ctab(1, j))) rows = [rows, r]
+      r = r + con_nrow(spec%ctab(1, j))
+    end do
+  end function driver_rows
+
   !> Row k of case c's derivatives along parameter p: the motion's, the efforts'
   !! (-dlambda/dp of the driver rows), then the measures'.
   subroutine sens_fields(buf, n, k, c, p, nlev, nsl)
     character(len=*), intent(inout) :: buf
     integer, intent(inout) :: n
     integer, intent(in) :: k, c, p, nlev, nsl
-    integer :: j, r
+    integer :: j
     do j = 1, nq
       call bnum(buf, n, bsq(j, p, k, c))
     end do
@@ -1741,10 +1744,8 @@ contains
       end do
     end if
     if (nsl > 0) then
-      r = 1
-      do j = 1, spec%nc
-        if (con_is_driver(spec%ctab(1, j))) call bnum(buf, n, -bslam(r, p, k, c))
-        r = r + con_nrow(spec%ctab(1, j))
+      do j = 1, size(drow)
+        call bnum(buf, n, -bslam(drow(j), p, k, c))
       end do
     end if
     do j = 1, spec%nmeas

@@ -14,7 +14,7 @@ from .columns import constraint_columns, derivative_names
 from .files import check_outputs, writing
 from .kinematics import KinematicsResult
 from .measures import measure_columns, measure_derivative_columns
-from .reactions import Reaction, reaction_arrays, reaction_of
+from .reactions import Reaction, driver_row, reaction_arrays, reaction_of
 from .sensitivities import parameter_index, reaction_dp_arrays, reaction_dp_of
 
 
@@ -90,10 +90,9 @@ class DynamicsResult(KinematicsResult):
     def effort(self, name: str) -> np.ndarray:
         """What the driver called name supplies: the torque (angle drivers) or force
         (x, y or slide drivers) in the driven direction, -lambda of its row."""
-        names = self.packed.constraint_names
-        if name not in names or not self.packed.driver_flags[names.index(name)]:
+        row = driver_row(self.packed, name)
+        if row is None:
             raise KeyError(f"no driver {name!r}")
-        row = self.packed.row_owner.index(names.index(name))
         return -self.lam[:, row]
 
     def effort_dp(self, name: str) -> np.ndarray:
@@ -105,13 +104,12 @@ class DynamicsResult(KinematicsResult):
         KeyError
             If there is no such driver or the run computed no multiplier sensitivities.
         """
-        names = self.packed.constraint_names
-        if name not in names or not self.packed.driver_flags[names.index(name)]:
+        row = driver_row(self.packed, name)
+        if row is None:
             raise KeyError(f"no driver {name!r}")
         if self.dlam_dp is None:
             raise KeyError("this result has no effort sensitivities: run the dynamics or "
                            "inverse dynamics with sensitivities=[names]")
-        row = self.packed.row_owner.index(names.index(name))
         return -self.dlam_dp[:, row, :]
 
     def reaction_dp(self, name: str) -> Reaction:

@@ -12,7 +12,7 @@ from ..validate import vector
 from .columns import REACTION_WORDS
 from .files import write_csv
 from .points import PointResult
-from .reactions import Reaction
+from .reactions import Reaction, driver_row
 from .sensitivities import reaction_dp_arrays, reaction_dp_of
 
 COORDINATES = ("x", "y", "theta")
@@ -112,10 +112,9 @@ class FrequencyResponseResult:
         KeyError
             If there is no such driver.
         """
-        names = self.packed.constraint_names
-        if name not in names or not self.packed.driver_flags[names.index(name)]:
+        row = driver_row(self.packed, name)
+        if row is None:
             raise KeyError(f"no driver {name!r}")
-        row = self.packed.row_owner.index(names.index(name))
         return -self.lam_response[:, row, self._input(input)]
 
     def _reactions(self, j: int) -> tuple[np.ndarray, np.ndarray]:

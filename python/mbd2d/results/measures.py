@@ -32,6 +32,7 @@ from ..description.parameters import find
 from ..errors import MbdError, ModelError
 from ..validate import GROUND
 from .columns import require_sensitivities
+from .reactions import driver_row
 
 
 def packed_of(res: Any) -> Packed:
@@ -68,20 +69,12 @@ def dead_centre_distance(res: Any) -> np.ndarray:
 
 
 # ----------------------------------------------------------------------------- ratios
-def _driver(p: Packed, name: str) -> int | None:
-    """First row of Phi (0-based) of the driver called name; None if name is no driver."""
-    names = p.constraint_names
-    if name in names and p.driver_flags[names.index(name)]:
-        return p.row_owner.index(names.index(name))
-    return None
-
-
 def _quantity(model: Any, p: Packed, name: Any, what: str) -> tuple[str, int]:
     """('driver', row) or ('coordinate', column) of a quantity's name (0-based)."""
     if not isinstance(name, str):
         raise ModelError(f"{what} must be a driver name or a coordinate name, got {name!r}",
                          what)
-    row = _driver(p, name)
+    row = driver_row(p, name)
     if row is not None:
         return "driver", row
     if name in p.coordinate_names:
@@ -107,7 +100,7 @@ def _reference(model: Any, p: Packed, x: tuple[str, int], y: tuple[str, int],
         raise ModelError("neither quantity is a driver and the model has "
                          f"{len(drivers)} drivers ({', '.join(drivers)}): name the one that "
                          "moves them with via=", "via")
-    row = _driver(p, drivers[0])
+    row = driver_row(p, drivers[0])
     assert row is not None
     return row
 

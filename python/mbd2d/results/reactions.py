@@ -11,6 +11,15 @@ from ..binding.status import error_for
 from ..binding.tables import Packed
 
 
+def driver_row(p: Packed, name: str) -> int | None:
+    """First row of Phi (0-based) of the driver called name (its effort is -lambda there);
+    None if name is no driver."""
+    names = p.constraint_names
+    if name in names and p.driver_flags[names.index(name)]:
+        return p.row_owner.index(names.index(name))
+    return None
+
+
 @dataclass
 class Reaction:
     """Reaction of a joint or driver on its two bodies over time (arrays over outputs).
