@@ -291,3 +291,39 @@ def test_the_drivers_effort_response_against_the_closed_form(tmp_path: Path) -> 
     mbd2d.export_sweep(model, tmp_path / "s.mbd", cases, "frf", **kw)
     assert solve_file(tmp_path / "s.mbd", tmp_path / "f.csv") == \
         (tmp_path / "py.csv").read_text()
+
+
+@pytest.mark.parametrize("reactions", [False, True])
+def test_one_runs_csv_has_the_efforts_response(tmp_path: Path, reactions: bool) -> None:
+    """One frequency response's CSV (Python, ``mbd2d frf --out``, mbd2d-solve) carries each
+    driver's effort after each input's coordinates, as a sweep's: the held base's effort per
+    unit push against -(k + i c w) / (k - m w^2 + i c w), columns and bytes equal in the
+    three writers; the reactions (asked for) after the efforts."""
+    from test_standalone import solve_file
+    model, inp = held_block(), "force.push.fy.poly.0"
+    res = model.frequency_response(inp, FREQS)
+    header, rows = res.table(reactions=reactions)
+    col = header.index(f"d(effort.hold)/d({inp}).re")
+    assert header[col - 1] == f"d(block.theta)/d({inp}).im"
+    assert header[col + 1] == f"d(effort.hold)/d({inp}).im"
+    if reactions:
+        assert header[col + 2] == f"d(guide_base.fx)/d({inp}).re"
+    assert len(header) == 1 + 2 * (6 + 1) + (2 * 6 * 3 if reactions else 0)   # 3 constraints
+    w = 2 * np.pi * FREQS
+    want = -(36.0 + 1j * 1.5 * w) / (36.0 - 2.0 * w**2 + 1j * 1.5 * w)
+    np.testing.assert_allclose(rows[:, col] + 1j * rows[:, col + 1], want, rtol=1e-12, atol=0)
+    py = tmp_path / "py.csv"
+    res.to_csv(py, reactions=reactions)
+    model.export(tmp_path / "m.mbd", analysis="frf", inputs=[inp], frequencies=FREQS,
+                 outputs=["reactions"] if reactions else None)
+    assert solve_file(tmp_path / "m.mbd", tmp_path / "f.csv") == py.read_text()
+    toml = tmp_path / "held.toml"
+    toml.write_text(mbd2d.description.toml_io.dumps(model))
+    r = subprocess.run([sys.executable, "-m", "mbd2d", "frf", str(toml), "--input", inp,
+                        "--f", f"{FREQS[0]}:{FREQS[-1]}:{FREQS.size}", "--out",
+                        str(tmp_path / "c.csv")] + (["--reactions"] if reactions else []),
+                       capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    lin = model.frequency_response(inp, np.linspace(FREQS[0], FREQS[-1], FREQS.size))
+    lin.to_csv(tmp_path / "lin.csv", reactions=reactions)
+    assert (tmp_path / "c.csv").read_text() == (tmp_path / "lin.csv").read_text()

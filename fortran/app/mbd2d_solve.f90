@@ -1014,7 +1014,8 @@ contains
                              gloc(:, :, :, :), qq(:, :), ll(:, :), tt(:), zq(:, :, :), &
                              zl(:, :, :)
     integer, allocatable :: ftm(:, :)
-    integer :: nw, u, ios, j, k, b, c, nr, nl
+    integer :: nw, u, ios, j, k, b, c, nr, nl, nm
+    logical :: mult
     character(len=32) :: word
     call linear_checks('frf')
     if (spec%out_energy .or. spec%out_lam .or. spec%out_eff .or. &
@@ -1032,17 +1033,20 @@ contains
                    'give fewer frequencies or inputs', status, msg)
     if (status /= MBD_OK) call die(2, trim(model_path) // ': ' // trim(msg))
     nr = merge(nw, 0, spec%out_reac)              ! the reactions' frequencies
-    call mem_check(REAL_BYTES * real(nr, wp) * spec%npar * (2 * neq + 24 * spec%nc + 2 * nq), &
+    mult = spec%out_reac .or. size(drow) > 0      ! the multipliers' response: the efforts
+    nm = merge(nw, 0, mult)
+    call mem_check(REAL_BYTES * spec%npar * (real(nm, wp) * 2 * neq + &
+                                             real(nr, wp) * (24 * spec%nc + 2 * nq)), &
                    'the reaction responses (' // trim(itoa(nw)) // ' frequencies)', &
                    'give fewer frequencies or inputs', status, msg)
     if (status /= MBD_OK) call die(2, trim(model_path) // ': ' // trim(msg))
     allocate (qe(nq), lam(neq), hre(nq, spec%npar, nw), him(nq, spec%npar, nw), &
-              lre(neq, spec%npar, nr), lim(neq, spec%npar, nr), &
+              lre(neq, spec%npar, nm), lim(neq, spec%npar, nm), &
               gre(6, spec%nc, spec%npar, nr), gim(6, spec%nc, spec%npar, nr), &
               gp(6, spec%nc, spec%npar, 1), gloc(6, spec%nc, spec%npar, max(nr, 1)), stat=ierr)
     if (ierr /= 0) call die(2, 'not enough memory for the frequency response')
     call linear_inputs(ftm, fpm)
-    if (spec%out_reac) then
+    if (mult) then
       call api_frf(spec%nb, spec%ctab, spec%rpar, spec%bmass, spec%grav, ftm, fpm, q0, &
                    spec%tstat, merge(0, 1, spec%at_q0), spec%ptab, TWO_PI * spec%freq, qe, &
                    lam, stable, resid, hre, him, iinfo, status, msg, spec%solver, lre, lim)
@@ -1085,6 +1089,10 @@ contains
                            trim(spec%par_names(k)))
         end do
       end do
+      do b = 1, spec%nc                           ! the drivers' efforts: -lambda
+        if (con_is_driver(spec%ctab(1, b))) call pair_header(u, ios, 'effort.' // &
+          trim(spec%con_names(b)), trim(spec%par_names(k)))
+      end do
       if (.not. spec%out_reac) cycle
       do b = 1, spec%nc
         do c = 1, 6
@@ -1100,6 +1108,9 @@ contains
       do k = 1, spec%npar
         do b = 1, 3 * spec%nb
           call put_pair(u, ios, hre(b, k, j), him(b, k, j))
+        end do
+        do b = 1, size(drow)
+          call put_pair(u, ios, -lre(drow(b), k, j), -lim(drow(b), k, j))
         end do
         if (.not. spec%out_reac) cycle
         do b = 1, spec%nc                         ! Im: without the input's own term

@@ -143,16 +143,24 @@ class FrequencyResponseResult:
     def table(self, reactions: bool = False) -> tuple[list[str], np.ndarray]:
         """Header and rows of the CSV: one row per frequency, ``frequency_hz``, then for each
         input and body ``d(NAME.x)/d(INPUT).re``, ``d(NAME.x)/d(INPUT).im``, then y and
-        theta; with ``reactions=True`` after each input's bodies every joint's and driver's
-        reaction response ``d(JOINT.fx)/d(INPUT).re``, ``.im``, ... fy, mz, fx_j, fy_j,
-        mz_j (:meth:`reaction_response`)."""
+        theta, then each driver's effort ``d(effort.DRIVER)/d(INPUT).re``, ``.im``
+        (:meth:`effort_response`; the columns of a frequency response sweep's CSV); with
+        ``reactions=True`` after them every joint's and driver's reaction response
+        ``d(JOINT.fx)/d(INPUT).re``, ``.im``, ... fy, mz, fx_j, fy_j, mz_j
+        (:meth:`reaction_response`)."""
         nb, nw = len(self.body_names), self.frequencies.size
+        drivers = [c for c in self.packed.constraint_names
+                   if driver_row(self.packed, c) is not None]
+        rows_d = [driver_row(self.packed, d) for d in drivers]
         header = ["frequency_hz"]
         blocks = [self.frequencies[:, None]]
         for j, name in enumerate(self.inputs):
             header += [f"d({b}.{c})/d({name}).{part}" for b in self.body_names
                        for c in COORDINATES for part in ("re", "im")]
             blocks.append(_parts(self.response[:, :3 * nb, j]))
+            header += [f"d(effort.{d})/d({name}).{part}" for d in drivers
+                       for part in ("re", "im")]
+            blocks.append(_parts(-self.lam_response[:, rows_d, j]))
             if reactions:
                 header += [f"d({c}.{w})/d({name}).{part}"
                            for c in self.packed.constraint_names for w in REACTION_WORDS
