@@ -35,6 +35,7 @@ module mbd_api
   use mbd_statics, only: statics_solve
   use mbd_modes, only: modes_solve, unit_largest
   use mbd_frf, only: frf_solve
+  use mbd_linear, only: linear_state_space
   use mbd_assemble, only: assemble_dense, assemble_blocks, asm_work_t, asm_init
   use mbd_kinematics, only: kin_opts_t, kin_report_t, kin_work_t, kin_run, kin_work_init, &
                             kin_assemble, kin_rank, kin_rank_band, kin_out_count, MAXPASS, &
@@ -55,6 +56,7 @@ module mbd_api
   private
   public :: NINFO, api_sizes, api_eval, api_kinematics, api_profile, api_analyze, api_kin_step
   public :: api_inverse, api_dynamics, api_statics, api_modes, api_frf, api_reactions, &
+            api_linearize, &
             api_cam_forces
   public :: api_eval_d, api_reactions_dp, api_dynamics_sens, api_forces_d, api_stiffness
 
@@ -1232,6 +1234,70 @@ contains
       end if
     end if
   end subroutine api_frf
+
+  !> The linearized motion about the equilibrium (or q0) as a state-space system with the
+  !! design parameters of ptab as inputs and the coordinates as outputs (mbd_linear):
+  !! x' = A x + B p, dq = C x + D p, in the leading 2 nfree states of a, b, c (model units:
+  !! C's rows and D in the coordinates' units, B and D per unit of each parameter; the states
+  !! are not scaled). iinfo(1) = nfree; MBD_BAD_COUNT when the arrays hold fewer states than
+  !! 2 nfree (call again with that many).
+  subroutine api_linearize(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, t, equilibrium, ptab, &
+                           q, lam, stable, resid, a, b, c, d, iinfo, status, msg, solver)
+    integer, intent(in) :: nb, ctab(:, :), ftab(:, :), equilibrium, ptab(:, :)
+    real(wp), intent(in) :: rpar(:), bmass(:, :), grav(2), fpar(:), q0(:), t
+    real(wp), intent(out) :: q(:), lam(:), resid, a(:, :), b(:, :), c(:, :), d(:, :)
+    integer, intent(out) :: stable, iinfo(NINFO)
+    integer, intent(out) :: status              !! MBD_OK, < 0 input, > 0 numerical
+    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    integer, intent(in), optional :: solver     !! 0 auto (default), 1 dense, 2 banded
+    type(model_t) :: m
+    type(dyn_work_t) :: w
+    type(sens_t) :: sens
+    real(wp), allocatable :: ones(:)
+    integer :: bad, nfree, i, ns
+    q = zero; lam = zero; stable = 0; resid = zero; a = zero; b = zero; c = zero; d = zero
+    call static_start(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, t, m, w, q, lam, iinfo, &
+                      status, msg, solver)
+    ns = size(a, 1)
+    if (status == MBD_OK) then
+      if (size(a, 2) /= ns .or. size(b, 1) /= ns .or. size(c, 2) /= ns .or. &
+          size(b, 2) /= size(ptab, 2) .or. size(c, 1) /= m%nq .or. &
+          any(shape(d) /= [m%nq, size(ptab, 2)])) then
+        status = MBD_BAD_COUNT; msg = 'linearized system: the output arrays do not match'
+      end if
+    end if
+    if (status == MBD_OK) then
+      call sens_setup(m, ctab, rpar, ptab, sens, status, msg, bad, ftab, fpar)
+      if (status /= MBD_OK) iinfo(2) = -2000000 - bad
+    end if
+    if (status == MBD_OK) then                  ! the statics' steps with the exact stiffness
+      if (smooth_forces(ftab)) then
+        call linear_point(m, w, q, t, equilibrium, lam, stable, resid, status, msg, sens)
+      else
+        call linear_point(m, w, q, t, equilibrium, lam, stable, resid, status, msg)
+      end if
+    end if
+    if (status == MBD_OK) then
+      call linear_state_space(m, w, sens, q, t, lam, a, b, c, d, nfree, status, msg)
+      iinfo(1) = nfree
+    end if
+    if (allocated(m%cunit)) then
+      q = q * m%cunit; lam = lam / m%rowunit
+      if (status == MBD_OK) then
+        allocate (ones(ns), source=one, stat=bad)
+        if (bad /= 0) then
+          call mem_fail(REAL_BYTES * ns, 'the linearized system''s units', &
+                        'use a model with fewer free motions', status, msg)
+          return
+        end if
+        call sens_units2(m, sens, b, ones, .false.)         ! per unit of each parameter
+        call sens_units2(m, sens, d, m%cunit, .false.)
+        do i = 1, ns
+          c(:, i) = c(:, i) * m%cunit
+        end do
+      end if
+    end if
+  end subroutine api_linearize
 
   !> The point modes and the frequency response linearize about: the equilibrium near q
   !! (equilibrium /= 0, statics), or q itself with its least-squares multipliers (stable -2:

@@ -40,7 +40,7 @@ module mbd_frf
   use mbd_dynamics, only: dyn_work_t, dyn_null_basis, dyn_factor_projection
   implicit none
   private
-  public :: frf_solve
+  public :: frf_solve, linear_parts
 
   character(len=*), parameter :: HINT = 'the frequency response uses dense matrices of the ' &
     // 'number of free motions: use a model with fewer free motions'
@@ -74,7 +74,7 @@ contains
     ! form of the reduced matrix, its right-hand sides; work vectors
     real(wp), allocatable :: nb(:, :), kn(:, :), cn(:, :), mn(:, :), sn(:, :), ks(:, :), &
                              cs(:, :), ms(:, :), rr(:, :), kr(:, :), cr(:, :), mr(:, :), &
-                             a(:, :), b(:, :), x(:), y(:), z(:)
+                             a(:, :), b(:, :), y(:)
     ! the Hessenberg path: Q, T, the right-hand sides' parts Q^T [0; M_r^-1 g_k], work
     ! and for the refinement g0, g1, g2, the residual's parts, the LU's multipliers and swaps
     real(wp), allocatable :: qh(:, :), th(:, :), c0(:, :), c1(:, :), c2(:, :), work(:), &
@@ -107,42 +107,16 @@ contains
     if (status /= MBD_OK) return
     allocate (nb(n, max(f, 1)), kn(n, max(f, 1)), cn(n, max(f, 1)), mn(n, max(f, 1)), &
               sn(n, np), ks(n, np), cs(n, np), ms(n, np), rr(n, np), kr(f, f), cr(f, f), &
-              mr(f, f), a(2 * f, 2 * f), b(2 * f, np), x(n), y(n), z(n), ipiv(2 * f), &
+              mr(f, f), a(2 * f, 2 * f), b(2 * f, np), y(n), ipiv(2 * f), &
               stat=ist)
     if (ist /= 0) then
       call mem_fail(bytes, trim(what), HINT, status, msg); return
     end if
-    z = zero
-    call sens_at_rest(m, s, q, t, lam, z)
-    if (f > 0) then                               ! N, K N, C N, M N
-      call dyn_null_basis(m, w, q, t, nb, status)
-      if (status /= MBD_OK) then
-        status = MBD_SINGULAR
-        msg = 'frequency response: no basis of the free motions (J is singular)'; return
-      end if
-      do j = 1, f
-        call kmul(nb(:, j), kn(:, j))
-        call cmul(nb(:, j), cn(:, j))
-        mn(:, j) = m%mdiag * nb(:, j)
-      end do
-      call dgemm('T', 'N', f, f, n, one, nb, n, kn, n, zero, kr, f)   ! K_r = N^T (K N), ...
-      call dgemm('T', 'N', f, f, n, one, nb, n, cn, n, zero, cr, f)
-      call dgemm('T', 'N', f, f, n, one, nb, n, mn, n, zero, mr, f)
-    end if
-    call dyn_factor_projection(m, w, q, t, .false., status)
+    call linear_parts(m, w, s, q, t, lam, nb, kn, cn, mn, kr, cr, mr, sn, ks, cs, ms, rr, &
+                      status, msg)
     if (status /= MBD_OK) then
-      msg = 'frequency response: the projection onto the constraints is singular'; return
+      msg = 'frequency response: ' // msg; return
     end if
-    do k = 1, np                                  ! r, s_n (J_a s_n = -Phi_p,a) and its products
-      call statics_load(m, s, k, q, t, lam, z, y, rr(:, k))
-      call proj_particular(w, s, k, sn(:, k), status)
-      if (status /= MBD_OK) then
-        msg = 'frequency response: a saddle-point solve failed'; return
-      end if
-      call kmul(sn(:, k), ks(:, k))
-      call cmul(sn(:, k), cs(:, k))
-      ms(:, k) = m%mdiag * sn(:, k)
-    end do
     if (hess) call hess_setup(hess, status)       ! (hess false: M_r singular, the dense LU)
     if (status /= MBD_OK) return
     ! the multipliers' response is linear in the parts P(K N), ... : solved once when that
@@ -420,7 +394,63 @@ contains
       end if
       lim(:, :, j) = lw
     end subroutine multipliers_by_parts
+  end subroutine frf_solve
 
+  !> The linearized motion's parts about the rest state (q, t, lam), every one exact: N, a
+  !! basis of J_a's null space (dyn_null_basis), K N, C N, M N and the reduced K_r = N^T K N,
+  !! C_r = N^T C N, M_r = N^T M N; per parameter r = Q_p - J_p^T lambda, the minimum-norm
+  !! s_n (J_a s_n = -Phi_p,a) and K s_n, C s_n, M s_n. Leaves s at rest (sens_at_rest) and the
+  !! projection factored (dyn_factor_projection) for the multipliers' least squares.
+  subroutine linear_parts(m, w, s, q, t, lam, nb, kn, cn, mn, kr, cr, mr, sn, ks, cs, ms, &
+                          rr, status, msg)
+    type(model_t), intent(in) :: m              !! model with dynamics data
+    type(dyn_work_t), intent(inout) :: w        !! work arrays (dyn_init done)
+    type(sens_t), intent(inout) :: s            !! the parameters (sens_setup done)
+    real(wp), intent(in) :: q(:), t             !! rest state (core units), time
+    real(wp), intent(in) :: lam(:)              !! its multipliers (neq)
+    !> (nq, >= f) N, K N, C N, M N (f = nq - the active rows; at least one column)
+    real(wp), intent(out) :: nb(:, :), kn(:, :), cn(:, :), mn(:, :)
+    real(wp), intent(out) :: kr(:, :), cr(:, :), mr(:, :)   !! (f, f) K_r, C_r, M_r
+    !> (nq, np) s_n, K s_n, C s_n, M s_n and r
+    real(wp), intent(out) :: sn(:, :), ks(:, :), cs(:, :), ms(:, :), rr(:, :)
+    integer, intent(out) :: status              !! MBD_OK, MBD_SINGULAR or the solves'
+    character(len=MSG_LEN), intent(out) :: msg  !! explanation (the caller names itself)
+    real(wp) :: x(m%nq), y(m%nq), z(m%nq)
+    integer :: n, f, j, k
+    status = MBD_OK; msg = ''
+    n = m%nq; f = n - w%na
+    nb = zero; kn = zero; cn = zero; mn = zero
+    z = zero
+    call sens_at_rest(m, s, q, t, lam, z)
+    if (f > 0) then                               ! N, K N, C N, M N
+      call dyn_null_basis(m, w, q, t, nb(:, 1:f), status)
+      if (status /= MBD_OK) then
+        status = MBD_SINGULAR; msg = 'no basis of the free motions (J is singular)'; return
+      end if
+      do j = 1, f
+        call kmul(nb(:, j), kn(:, j))
+        call cmul(nb(:, j), cn(:, j))
+        mn(:, j) = m%mdiag * nb(:, j)
+      end do
+      call dgemm('T', 'N', f, f, n, one, nb, n, kn, n, zero, kr, f)   ! K_r = N^T (K N), ...
+      call dgemm('T', 'N', f, f, n, one, nb, n, cn, n, zero, cr, f)
+      call dgemm('T', 'N', f, f, n, one, nb, n, mn, n, zero, mr, f)
+    end if
+    call dyn_factor_projection(m, w, q, t, .false., status)
+    if (status /= MBD_OK) then
+      msg = 'the projection onto the constraints is singular'; return
+    end if
+    do k = 1, s%np                                ! r, s_n (J_a s_n = -Phi_p,a) and its products
+      call statics_load(m, s, k, q, t, lam, z, y, rr(:, k))
+      call proj_particular(w, s, k, sn(:, k), status)
+      if (status /= MBD_OK) then
+        msg = 'a saddle-point solve failed'; return
+      end if
+      call kmul(sn(:, k), ks(:, k))
+      call cmul(sn(:, k), cs(:, k))
+      ms(:, k) = m%mdiag * sn(:, k)
+    end do
+  contains
     !> kx = K x (exact, sens_stiffness_mul).
     subroutine kmul(xx, kx)
       real(wp), intent(in) :: xx(:)
@@ -434,6 +464,6 @@ contains
       real(wp), intent(out) :: cx(:)
       call sens_damping_mul(m, s, q, t, z, xx, cx)
     end subroutine cmul
-  end subroutine frf_solve
+  end subroutine linear_parts
 
 end module mbd_frf

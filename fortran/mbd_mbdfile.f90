@@ -5,15 +5,16 @@
 !! too: upgrade_functions):
 !!   mbd2d 3
 !!   name <model name>
-!!   analysis kinematics | inverse-dynamics | dynamics | statics | modes | frf | check
+!!   analysis kinematics | inverse-dynamics | dynamics | statics | modes | frf | linearize |
+!!            check
 !!   t0 <time>   t_end <time>   steps <n>   every <k>                  (one per line)
 !!   tol <x>   maxit <n>   tmin <x>   solver auto|dense|banded           (kinematic runs)
 !!   positions_only 0|1                       (kinematics: 1 = positions alone, optional)
 !!   method generalized-alpha|dopri5|baumgarte-rk4|partitioned   rtol <x>   atol <x>   h <x>
 !!   rho_inf <x>   alpha <x>   beta <x>   max_steps <n>                  (dynamics)
-!!   t <time>                                               (statics, modes, frf, check)
+!!   t <time>                                    (statics, modes, frf, linearize, check)
 !!   count <k>   at_q0 0|1        (modes: the lowest k (0: every free motion); 1 = about q0;
-!!                              at_q0 also frf)
+!!                              at_q0 also frf and linearize, whose inputs: sensitivities)
 !!   frequencies <nw>                         (frf: then nw frequencies in Hz, >= 0, any
 !!   <nw reals>                               number per line; the inputs: sensitivities)
 !!   outputs <energy | multipliers | reactions | efforts ...>           (optional columns;
@@ -81,8 +82,8 @@ module mbd_mbdfile
   real(wp), parameter :: MIN_TOL = 1.0e-15_wp     !! smallest tolerance (as the Python front end)
   integer, parameter :: INT32_MAX = huge(1)       !! largest step limit
   !> the analyses a file can hold
-  character(len=16), parameter :: ANALYSES(7) = [character(len=16) :: 'kinematics', &
-    'inverse-dynamics', 'dynamics', 'statics', 'modes', 'frf', 'check']
+  character(len=16), parameter :: ANALYSES(8) = [character(len=16) :: 'kinematics', &
+    'inverse-dynamics', 'dynamics', 'statics', 'modes', 'frf', 'linearize', 'check']
   !> linear solvers (codes 0, 1, 2) and dynamics methods (codes 1 .. 4) by name
   character(len=8), parameter :: SOLVER_WORDS(0:2) = [character(len=8) :: 'auto', 'dense', &
     'banded']

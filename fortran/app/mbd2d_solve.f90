@@ -25,7 +25,7 @@ program mbd2d_solve
   use, intrinsic :: iso_fortran_env, only: error_unit, int64
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_value, ieee_quiet_nan
   use mbd_kinds, only: wp
-  use mbd_status, only: MBD_OK, MBD_SINGULAR_CONFIG, MBD_NO_MEMORY, MSG_LEN
+  use mbd_status, only: MBD_OK, MBD_SINGULAR_CONFIG, MBD_NO_MEMORY, MBD_BAD_COUNT, MSG_LEN
   use mbd_memory, only: REAL_BYTES, mem_check
   use mbd_mbdfile, only: mbd_spec_t, mbd_read, NAME_LEN, METHOD_WORDS, MEAS_ANGLE, &
                          MEAS_RATIO, MEAS_ADVANTAGE
@@ -34,7 +34,7 @@ program mbd2d_solve
   use mbd_constraints, only: con_nrow, con_is_driver
   use mbd_api, only: NINFO, api_sizes, api_kinematics, api_inverse, api_dynamics, api_statics, &
                      api_reactions, api_dynamics_sens, api_reactions_dp, api_analyze, api_modes, &
-                     api_frf
+                     api_frf, api_linearize
   use mbd_batch, only: batch_run, NISET, NRSET
   use mbd_status, only: MBD_NO_CONVERGENCE, MBD_INTEGRATOR_FAILED, MBD_INCONSISTENT, &
                         MBD_ASSEMBLY_FAILED
@@ -120,6 +120,10 @@ program mbd2d_solve
   end if
   if (spec%analysis == 'frf' .and. spec%ncase == 0) then
     call run_frf()
+    stop 0, quiet=.true.
+  end if
+  if (spec%analysis == 'linearize') then
+    call run_linearize()
     stop 0, quiet=.true.
   end if
   dynamic = spec%analysis /= 'kinematics'
@@ -999,6 +1003,103 @@ contains
     fpm = 0.0_wp
     fpm(1:size(spec%fpar)) = spec%fpar
   end subroutine linear_inputs
+
+  !> The linearized system (Model.linearize) written as LinearizedSystem.to_csv writes it:
+  !! matrix,row,column,value for every entry of A (states by states), B (states by inputs),
+  !! C (outputs by states) and D (outputs by inputs), row by row; the states z1 .. zf,
+  !! v1 .. vf, the inputs the sensitivities block's names, the outputs the coordinates.
+  subroutine run_linearize()
+    real(wp), allocatable :: qe(:), lam(:), fpm(:), a(:, :), b(:, :), c(:, :), d(:, :)
+    integer, allocatable :: ftm(:, :)
+    integer :: ns, f, u, ios, i, j, k, pass
+    call linear_checks('linearize')
+    if (spec%out_energy .or. spec%out_lam .or. spec%out_eff .or. spec%out_reac .or. &
+        spec%out_damped .or. spec%ncase > 0 .or. spec%positions_only .or. &
+        spec%nmeas > 0 .or. spec%freq_line > 0) &
+      call die(2, trim(model_path) // ': linearize takes no outputs, cases, measures, '// &
+               'frequencies or positions_only')
+    if (spec%npar == 0) call die(2, trim(model_path) // ': linearize needs its inputs: a '// &
+      '"sensitivities" block naming the design parameters varied')
+    call check_sensitivities()
+    call linear_inputs(ftm, fpm)
+    ns = max(2 * (nq - neq), 1)
+    do pass = 1, 2                                ! again with 2 nfree states (redundancy)
+      call mem_check(REAL_BYTES * (real(ns + nq, wp) * (ns + spec%npar) + nq * spec%npar), &
+                     'the linearized system (' // trim(itoa(ns)) // ' states)', &
+                     'use a model with fewer free motions', status, msg)
+      if (status /= MBD_OK) call die(2, trim(model_path) // ': ' // trim(msg))
+      if (allocated(a)) deallocate (a, b, c, d)
+      allocate (qe(nq), lam(neq), a(ns, ns), b(ns, spec%npar), c(nq, ns), d(nq, spec%npar), &
+                stat=ierr)
+      if (ierr /= 0) call die(2, 'not enough memory for the linearized system')
+      call api_linearize(spec%nb, spec%ctab, spec%rpar, spec%bmass, spec%grav, ftm, fpm, q0, &
+                         spec%tstat, merge(0, 1, spec%at_q0), spec%ptab, qe, lam, stable, &
+                         resid, a, b, c, d, iinfo, status, msg, spec%solver)
+      f = iinfo(1)
+      if (status /= MBD_BAD_COUNT .or. 2 * f <= ns) exit
+      ns = 2 * f
+      deallocate (qe, lam)
+    end do
+    if (status < 0) call die_input(iinfo(2), msg)
+    if (status == MBD_NO_MEMORY) call die(2, trim(msg))
+    if (status /= MBD_OK) call die(4, trim(msg) // ' (no system written)')
+    open (newunit=u, file=trim(out_path), status='replace', action='write', access='stream', &
+          form='unformatted', iostat=ios)
+    if (ios /= 0) call die(2, 'cannot write ' // trim(out_path))
+    call sput(u, ios, 'matrix,row,column,value' // achar(10))
+    do i = 1, 2 * f                               ! A: states by states
+      do j = 1, 2 * f
+        call lin_entry(u, ios, 'A', state_label(i, f), state_label(j, f), a(i, j))
+      end do
+    end do
+    do i = 1, 2 * f                               ! B: states by inputs
+      do k = 1, spec%npar
+        call lin_entry(u, ios, 'B', state_label(i, f), trim(spec%par_names(k)), b(i, k))
+      end do
+    end do
+    do i = 1, nq                                  ! C: outputs by states
+      do j = 1, 2 * f
+        call lin_entry(u, ios, 'C', coord_label(i), state_label(j, f), c(i, j))
+      end do
+    end do
+    do i = 1, nq                                  ! D: outputs by inputs
+      do k = 1, spec%npar
+        call lin_entry(u, ios, 'D', coord_label(i), trim(spec%par_names(k)), d(i, k))
+      end do
+    end do
+    close (u)
+    if (ios /= 0) call die(2, 'cannot write ' // trim(out_path) // ' (disk full?)')
+  end subroutine run_linearize
+
+  !> One line of the linearized system's CSV: matrix,row,column,value.
+  subroutine lin_entry(u, ios, mat, row, col, v)
+    integer, intent(in) :: u
+    integer, intent(inout) :: ios
+    character(len=*), intent(in) :: mat, row, col
+    real(wp), intent(in) :: v
+    character(len=32) :: word
+    integer :: nl
+    call num(v + 0.0_wp, word, nl)
+    call sput(u, ios, mat // ',' // row // ',' // col // ',' // word(1:nl) // achar(10))
+  end subroutine lin_entry
+
+  !> The label of state i of f free motions: z1 .. zf, then v1 .. vf.
+  function state_label(i, f) result(label)
+    integer, intent(in) :: i, f
+    character(len=:), allocatable :: label
+    if (i <= f) then
+      label = 'z' // trim(itoa(i))
+    else
+      label = 'v' // trim(itoa(i - f))
+    end if
+  end function state_label
+
+  !> The label of coordinate i: BODY.x, BODY.y, BODY.theta.
+  function coord_label(i) result(label)
+    integer, intent(in) :: i
+    character(len=:), allocatable :: label
+    label = trim(spec%body_names((i - 1) / 3 + 1)) // '.' // trim(XYT(mod(i - 1, 3) + 1))
+  end function coord_label
 
   !> The frequency response (Model.frequency_response) written as
   !! FrequencyResponseResult.to_csv writes it: one row per frequency, frequency_hz, then for

@@ -20,7 +20,8 @@ from .errors import (AnalysisError, AssemblyError, ConvergenceError, CoreError,
 from .model import Model, load, loads
 from .plots import animate, plot_mechanism, plot_paths, plot_sweep, plot_timeseries
 from .results import (BodyResult, DofReport, DynamicsResult, FrequencyResponseResult,
-                      KinematicsResult, ModesResult, PointResult, Reaction, StaticsResult)
+                      KinematicsResult, LinearizedSystem, ModesResult, PointResult, Reaction,
+                      StaticsResult)
 from .studies import (ToleranceResult, export_sweep, grid, sweep, tolerance,
                       tolerance_samples, write_sweep)
 from .synthesis import CamDesign, SynthesisResult, cam_profile, synthesize
@@ -29,7 +30,7 @@ __version__ = "0.1.0"
 
 __all__ = ["load", "loads", "Model", "TimeFunction", "Harmonic", "Step", "Table",
            "KinematicsResult", "BodyResult", "PointResult", "DynamicsResult", "KinematicStepper",
-           "StaticsResult", "ModesResult", "FrequencyResponseResult",
+           "StaticsResult", "ModesResult", "FrequencyResponseResult", "LinearizedSystem",
            "Reaction",
            "DofReport", "MbdError", "ModelError", "AnalysisError", "IntegrationError",
            "AssemblyError", "InconsistentConstraintsError", "ConvergenceError",

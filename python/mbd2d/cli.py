@@ -10,6 +10,7 @@
                 --damped-out EIGEN.csv --picture MODE.png|MODE.gif --mode K | --damped-mode J]
     mbd2d frf MODEL.toml --input NAME ... --f START:STOP:NUM [--log --t T --at-q0 --solver S]
               [--out FRF.csv --picture BODE.png --body B --coordinate x|y|theta]
+    mbd2d linearize MODEL.toml --input NAME ... [--t T --at-q0 --solver S] [--out SYS.csv]
     mbd2d sweep MODEL.toml --param NAME=START:STOP:NUM ... [--grid] --t-end T --steps N
                 --out sweep.nc|sweep.csv [--analysis A --t0 T0 --every K --workers W
                 --scheduler ADDRESS --positions-only --method M --rtol R --atol A --h H
@@ -246,6 +247,21 @@ def _parser() -> argparse.ArgumentParser:
     fr.add_argument("--body", default=None, help="the body drawn (default the first)")
     fr.add_argument("--coordinate", default="y", choices=["x", "y", "theta"],
                    help="the coordinate drawn (default y)")
+    li = sub.add_parser("linearize", help="the small motion about the static equilibrium as "
+                        "a state-space system x' = A x + B p, dq = C x + D p (inputs: design "
+                        "parameters)")
+    li.add_argument("model", help="model file (.toml) with masses")
+    li.add_argument("--input", action="append", required=True, metavar="NAME",
+                    help="a design parameter as an input (repeatable; `mbd2d parameters "
+                    "MODEL` lists them)")
+    li.add_argument("--t", type=float, default=0.0, help="time at which loads and drivers are "
+                    "held (default 0)")
+    li.add_argument("--at-q0", action="store_true", help="about the assembled q0 as given, not "
+                    "the equilibrium statics finds")
+    li.add_argument("--solver", default="auto", choices=["auto", "dense", "banded"],
+                    help="linear algebra (default auto: band LU for large chains)")
+    li.add_argument("--out", default=None, help="write A, B, C, D as CSV (matrix,row,column,"
+                    "value)")
     w = sub.add_parser("sweep", help="one analysis of many variants (design parameters "
                        "swept): netCDF or CSV")
     w.add_argument("model", help="model file (.toml)")
@@ -289,7 +305,7 @@ def _parser() -> argparse.ArgumentParser:
     e.add_argument("model", help="model file (.toml)")
     e.add_argument("out", help="output model file (.mbd)")
     e.add_argument("--analysis", default="kinematics",
-                   choices=ANALYSES[1:] + ("statics", "modes", "frf", "check"),
+                   choices=ANALYSES[1:] + ("statics", "modes", "frf", "linearize", "check"),
                    help="the analysis mbd2d-solve runs (default kinematics)")
     e.add_argument("--t-end", type=float, default=None, help="final time (not for statics)")
     e.add_argument("--steps", type=int, default=None, help="output intervals")
@@ -450,6 +466,18 @@ def _frequencies(args: argparse.Namespace) -> np.ndarray | None:
                              "command line")
         return np.geomspace(start, stop, num)
     return np.linspace(start, stop, num)
+
+
+def _linearize(model: Model, args: argparse.Namespace) -> int:
+    """``mbd2d linearize``: the system's summary printed, then its CSV."""
+    if args.out is not None and not str(args.out).lower().endswith(".csv"):
+        raise ModelError(f"--out must end in .csv, got {args.out!r}", "command line")
+    res = model.linearize(args.input, t=args.t, equilibrium=not args.at_q0, solver=args.solver)
+    print(res.summary())
+    if args.out is not None:
+        res.to_csv(args.out)
+        print(f"wrote A, B, C, D ({2 * res.n_free} states) to {args.out}")
+    return EXIT_OK
 
 
 def _frf(model: Model, args: argparse.Namespace) -> int:
@@ -995,6 +1023,8 @@ def _main(args: argparse.Namespace) -> int:
             return _modes(model, args)
         if args.command == "frf":
             return _frf(model, args)
+        if args.command == "linearize":
+            return _linearize(model, args)
         if args.command == "export" and args.param:
             return _export_sweep(model, args)
         if args.command == "export":
@@ -1027,7 +1057,8 @@ def _main(args: argparse.Namespace) -> int:
         _say(f"mbd2d: {exc}")
         return EXIT_INPUT
     except AnalysisError as exc:
-        if args.command in ("check", "statics", "modes", "frf", "synthesize", "cam"):
+        if args.command in ("check", "statics", "modes", "frf", "linearize", "synthesize",
+                            "cam"):
             _say(f"mbd2d: {exc}")
             return EXIT_NUMERICAL
         _say(f"mbd2d: {exc}")

@@ -22,6 +22,7 @@ from .analysis.evaluate import evaluate
 from .analysis.inverse import run_inverse
 from .analysis.kinematics import run_kinematics
 from .analysis.frf import run_frf
+from .analysis.linearize import run_linearize
 from .analysis.modes import run_modes
 from .analysis.mbdfile import export as export_mbd
 from .analysis.statics import run_statics
@@ -33,7 +34,7 @@ from .description.entries import reads_entries
 from .errors import MbdError
 from .description.parameters import parameter_list
 from .results import (DofReport, DynamicsResult, FrequencyResponseResult, KinematicsResult,
-                      ModesResult, StaticsResult)
+                      LinearizedSystem, ModesResult, StaticsResult)
 from .validate import flag
 
 
@@ -395,6 +396,49 @@ class Model(ModelDescription):
             without stiffness), or a free motion carries no mass.
         """
         return run_frf(self, inputs, frequencies, t=t, equilibrium=equilibrium, solver=solver)
+
+    @reads_entries
+    def linearize(self, inputs: Any, t: float = 0.0, equilibrium: bool = True,
+                  solver: str = "auto") -> LinearizedSystem:
+        """The small motion about the static equilibrium (drivers held at t, as in
+        :meth:`modes`) as a state-space system x' = A x + B p, dq = C x + D p whose inputs
+        p are design parameters (a force's amplitude, a spring's free length, gravity, a
+        pivot's place) and whose outputs are the coordinates' changes: Adams/Linear's state
+        matrices, for control design (``res.to_scipy()``). From the equations of
+        :meth:`frequency_response` with the same exact K, C and parameter derivatives: its
+        transfer function C (i 2 pi f I - A)^-1 B + D is that response.
+
+        Parameters
+        ----------
+        inputs : str or sequence of str
+            Design parameters (:meth:`parameters` names them).
+        t, equilibrium, solver
+            As :meth:`modes`.
+
+        Returns
+        -------
+        LinearizedSystem
+            ``res.a``, ``res.b``, ``res.c``, ``res.d``, ``res.states``, ``res.inputs``,
+            ``res.outputs``, ``res.select(outputs=[...])``, ``res.to_scipy()``,
+            ``res.to_csv(path)``, ``res.summary()``.
+
+        Raises
+        ------
+        ModelError
+            For an unknown input, no input, contacts or joint friction.
+        ConvergenceError
+            If no equilibrium is found near the q0 estimates.
+        SingularJacobianError
+            If a free motion carries no mass.
+
+        Examples
+        --------
+        >>> m = mbd2d.load("examples/pendulum_spring.toml")
+        >>> sys = m.linearize("model.gravity.1")
+        >>> sys.a.shape[0] == 2 * sys.n_free
+        True
+        """
+        return run_linearize(self, inputs, t=t, equilibrium=equilibrium, solver=solver)
 
     # ------------------------------------------------------------------ at one state
     @reads_entries

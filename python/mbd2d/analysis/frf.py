@@ -50,37 +50,39 @@ def run_frf(model: ModelDescription, inputs: Any, frequencies: Any, t: float = 0
 
 
 def frf_error(model: ModelDescription, p: Any, out: Any, t: float, freq: np.ndarray,
-              arrays: list[np.ndarray]) -> MbdError | None:
-    """The exception a frequency response ends in, or None when it is finite.
+              arrays: list[np.ndarray], analysis: str = "frf") -> MbdError | None:
+    """The exception a frequency response (or a linearized system: analysis "linearize")
+    ends in, or None when it is finite.
 
     ``out`` carries the core's ``status``, ``msg``, ``iinfo``, ``q``, ``lam`` and ``resid``
     (the equilibrium's, as for :func:`statics_error`); freq the frequencies (Hz); arrays the
     response's arrays, which must be finite. An unbounded response names its frequency.
     """
+    what = WHAT if analysis == "frf" else "linearized system"
     if out.status == SINGULAR and 0 < int(out.iinfo[7]) <= freq.size:
         f = freq[int(out.iinfo[7]) - 1]
         out.msg = (f"{out.msg}: the response at {f:g} Hz is unbounded; leave that frequency "
                    "out or give the mode damping")
-    exc = statics_error(model, p, out, t, analysis="frf")
+    exc = statics_error(model, p, out, t, analysis=analysis)
     if exc is None and not all(np.isfinite(a).all() for a in arrays):
-        exc = error_for("frf", NO_CONVERGENCE, "frequency response: the response is not "
-                        "finite (the linearized equations are singular)", t=t,
-                        residual=float(out.resid))
+        exc = error_for(analysis, NO_CONVERGENCE, f"{what}: the response is not finite (the "
+                        "linearized equations are singular)", t=t, residual=float(out.resid))
     return exc
 
 
-def frf_inputs(model: ModelDescription, inputs: Any) -> list[Parameter]:
-    """The inputs as design parameters, checked (at least one; no contacts or friction)."""
+def frf_inputs(model: ModelDescription, inputs: Any, what: str = WHAT) -> list[Parameter]:
+    """The inputs as design parameters, checked (at least one; no contacts or friction);
+    what names the analysis in the messages."""
     check_statics(model)
     names = [inputs] if isinstance(inputs, str) else inputs
     if names is None or len(list(names)) == 0:
         raise ModelError("inputs must name at least one design parameter (model.parameters() "
-                         "lists them), e.g. a force's amplitude or a spring's free length", WHAT)
+                         "lists them), e.g. a force's amplitude or a spring's free length", what)
     if getattr(model, "contacts", None):
-        raise ModelError("the frequency response does not carry contacts "
+        raise ModelError(f"the {what} does not carry contacts "
                          f"({', '.join(c.name for c in model.contacts)}): their exact "
                          "derivatives are not written; use model.modes() for their "
-                         "linearized frequencies", WHAT)
+                         "linearized frequencies", what)
     return requested(model, list(names)) or []
 
 

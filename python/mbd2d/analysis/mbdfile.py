@@ -35,7 +35,8 @@ from .settings import (SOLVERS, check_solver, check_span, output_rows, require_d
 
 FORMAT = 3
 #: the analyses a file can hold (check: degrees of freedom and redundancy, as `mbd2d check`)
-ANALYSES = ("kinematics", "inverse-dynamics", "dynamics", "statics", "modes", "frf", "check")
+ANALYSES = ("kinematics", "inverse-dynamics", "dynamics", "statics", "modes", "frf",
+            "linearize", "check")
 #: every kind code the format holds: (code, type, parameters in the params list)
 JOINT_KINDS = [(c.kind, c.type, d) for c, d in [
     (Revolute, "s_i(2) s_j(2)"),
@@ -84,7 +85,7 @@ def header() -> str:
         "#   mbd2d 3                      format and version",
         "#   name NAME                    model name",
         "#   analysis A                   kinematics | inverse-dynamics | dynamics | statics "
-        "| modes | frf | check",
+        "| modes | frf | linearize | check",
         "#   t0, t_end, steps, every      outputs t0 + k (t_end - t0) / steps, k = 0..steps, "
         "every k-th kept",
         "#   tol, maxit, tmin, solver     Newton tolerance, iterations, singular-time "
@@ -92,9 +93,11 @@ def header() -> str:
         "#   positions_only 0|1           kinematics: 1 = positions alone (optional)",
         "#   method, rtol, atol, h, rho_inf, alpha, beta, max_steps   dynamics (0, or -1 for "
         "rho_inf, alpha, beta: default)",
-        "#   t                            statics, modes, frf: the time of loads and drivers; "
+        "#   t                            statics, modes, frf, linearize: the time of loads "
+        "and drivers; "
         "check: its time",
-        "#   count K, at_q0 0|1           modes: the lowest K; 1 = about q0 as given (also frf)",
+        "#   count K, at_q0 0|1           modes: the lowest K; 1 = about q0 as given (also frf, "
+        "linearize, whose inputs are the sensitivities block)",
         "#   frequencies NW, then NW reals   frf: the frequencies (Hz); its inputs are the "
         "sensitivities block",
         "#   outputs W ...                optional CSV columns: energy multipliers reactions "
@@ -150,7 +153,8 @@ def _outputs(outputs: Any, analysis: str) -> list[str]:
         return []
     if isinstance(outputs, str):
         outputs = [outputs]
-    known = {"modes": ("damped",), "frf": ("reactions",)}.get(analysis, OUTPUTS)
+    known = {"modes": ("damped",), "frf": ("reactions",), "linearize": ()}.get(analysis,
+                                                                             OUTPUTS)
     try:
         words = [str(w) for w in outputs]
     except TypeError:
@@ -212,17 +216,18 @@ def file_lines(model: ModelDescription, t_end: float | None = None, steps: int |
                          "export")
     params = requested(model, sensitivities)
     check_positions_only(params, pos)
-    if params and analysis in ("check", "modes", "frf"):
+    if params and analysis in ("check", "modes", "frf", "linearize"):
         raise ModelError(f"{analysis} computes no sensitivities"
-                         + (" (its inputs are inputs=[...])" if analysis == "frf" else ""),
-                         "export")
-    if (inputs is not None or frequencies is not None) and analysis != "frf":
-        raise ModelError("inputs and frequencies are settings of frf, not of "
-                         f"{analysis}", "export")
+                         + (" (its inputs are inputs=[...])" if analysis in ("frf", "linearize")
+                            else ""), "export")
+    if (inputs is not None and analysis not in ("frf", "linearize")) or \
+            (frequencies is not None and analysis != "frf"):
+        raise ModelError("inputs are settings of frf and linearize, frequencies of frf, not "
+                         f"of {analysis}", "export")
     p = pack(model)
     lines = [header(), f"mbd2d {FORMAT}",
              f"name {model.name.replace(' ', '_') or 'model'}", f"analysis {analysis}"]
-    if analysis not in ("statics", "modes", "frf", "check"):
+    if analysis not in ("statics", "modes", "frf", "linearize", "check"):
         if t_end is None or steps is None:
             raise ModelError(f"{analysis} needs t_end and steps", "export")
         t0, t_end, steps = check_span(t0, t_end, steps)
@@ -253,13 +258,14 @@ def file_lines(model: ModelDescription, t_end: float | None = None, steps: int |
         about_q0 = not flag(equilibrium, "equilibrium", "export")
         lines += [f"t {_r(number(t, 't', 'export'))}", f"count {mode_count(count, p.nq)}",
                   f"at_q0 {int(about_q0)}", f"solver {solver}"]
-    elif analysis == "frf":
-        params = frf_inputs(model, inputs)
-        freq = frequency_list(frequencies)
+    elif analysis in ("frf", "linearize"):
+        params = frf_inputs(model, inputs, "frequency response" if analysis == "frf"
+                            else "linearized system")
+        freq = frequency_list(frequencies) if analysis == "frf" else None
         solver_code(solver)
         about_q0 = not flag(equilibrium, "equilibrium", "export")
         lines += [f"t {_r(number(t, 't', 'export'))}", f"at_q0 {int(about_q0)}",
-                  f"solver {solver}"] + _reals("frequencies", freq)
+                  f"solver {solver}"] + ([] if freq is None else _reals("frequencies", freq))
     else:
         lines.append(f"t {_r(number(t, 't', 'export'))}")
     if words:
@@ -303,7 +309,7 @@ def _measure_lines(model: ModelDescription, p: Any, specs: Any, analysis: str,
     t = measure_tables(model, p, specs, moved)
     if not t.specs:
         return []
-    if analysis in ("statics", "check", "frf"):
+    if analysis in ("statics", "check", "frf", "linearize"):
         raise ModelError(f"measures are columns of a run over time, not of {analysis}",
                          "export")
     words = {2: "ratio", 3: "advantage"}

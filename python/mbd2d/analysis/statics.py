@@ -73,7 +73,7 @@ def statics_error(model: ModelDescription, p: Packed, out: Any, t: float,
         return assembly_failed(analysis, model, float(out.resid), 0, t, None)
     if status == INCONSISTENT:
         return inconsistent_at(analysis, model, p, t, None, text)
-    own = text.startswith(("modes:", "frequency response:"))     # (not the equilibrium's)
+    own = text.startswith(("modes:", "frequency response:", "linearized system:"))
     if status == NO_CONVERGENCE and not own:
         text = f"{text} (no equilibrium found near the q0 estimates; give q0 closer to one)"
     elif status == SINGULAR and not own:   # (modes: a massless motion)

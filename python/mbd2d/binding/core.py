@@ -177,6 +177,21 @@ def frf(p: Packed, d: DynamicTables, t: float, equilibrium: bool, ptab: np.ndarr
                   numbers=2.0 * (p.nq + p.neq) * ptab.shape[1] * nw + p.nq + p.neq)
 
 
+def linearize(p: Packed, d: DynamicTables, t: float, equilibrium: bool, ptab: np.ndarray,
+              nstates: int, solver: int = 0) -> SimpleNamespace:
+    """The linearized motion about the equilibrium near q0 (or about the assembled q0) as a
+    state-space system with the parameters of ptab as inputs: ``q``, ``lam``, ``stable``,
+    ``resid``, ``a`` (nstates, nstates), ``b`` (nstates, np), ``c`` (nq, nstates), ``d``
+    (nq, np) in their leading 2 nfree states, ``iinfo`` (iinfo[0]: nfree), ``status``
+    (MBD_BAD_COUNT when nstates < 2 nfree), ``msg``."""
+    ns, npar = max(int(nstates), 1), ptab.shape[1]
+    return _named("q lam stable resid a b c d iinfo status msg", _core.core_linearize,
+                  ctab=p.ctab, rpar=p.rpar, bmass=d.bmass, grav=d.grav, ftab=d.ftab,
+                  fpar=d.fpar, neq=p.neq, q0=p.q0, t=t, equilibrium=int(equilibrium),
+                  ptab=ptab, ns=ns, solver=solver,
+                  numbers=float(ns + p.nq) * (ns + npar) + p.nq * npar + p.nq + p.neq)
+
+
 def cam_forces(p: Packed, q: np.ndarray, t: np.ndarray, lam: np.ndarray) -> SimpleNamespace:
     """Normal force of every cam joint on its follower at states q (nq, nt), times t and
     multipliers lam (neq, nt): ``fn`` (nc, nt; negative: the joint pulls), ``status``,

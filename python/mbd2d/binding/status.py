@@ -79,6 +79,9 @@ ERRORS: dict[str, Table] = {
     # statics, then the linearized motion's response to harmonic inputs (SINGULAR: an
     # undamped resonance on a frequency asked for)
     "frf": {**_ASSEMBLY, NO_CONVERGENCE: ConvergenceError},
+    # statics, then the linearized motion as a state-space system (SINGULAR: a massless
+    # free motion)
+    "linearize": {**_ASSEMBLY, NO_CONVERGENCE: ConvergenceError},
     # the stepper has no step control: a singular J or a failed Newton step both end in
     # ConvergenceError (Model.kinematics locates dead centres)
     "stepper": {**_KINEMATIC, SINGULAR: ConvergenceError,

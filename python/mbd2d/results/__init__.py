@@ -14,13 +14,14 @@ from .files import read_csv
 from .columns import SUFFIXES
 from .kinematics import BodyResult, KinematicsResult
 from .frf import FrequencyResponseResult
+from .linear import LinearizedSystem
 from .modes import ModesResult
 from .points import PointResult
 from .reactions import Reaction
 from .statics import StaticsResult
 
 __all__ = ["BodyResult", "KinematicsResult", "DynamicsResult", "StaticsResult", "ModesResult",
-           "FrequencyResponseResult",
+           "FrequencyResponseResult", "LinearizedSystem",
            "Reaction",
            "DofReport", "PointResult", "SUFFIXES", "read_csv", "ContactEvent", "FrictionEvent",
            "LiftOff", "ContactHistory", "FrictionHistory"]

@@ -1,0 +1,129 @@
+!> mbd_linear: the linearized motion about an equilibrium as a state-space system
+!!   x' = A x + B p,   dq = C x + D p
+!! whose inputs p are design parameters (a force's amplitude, a spring's free length, a
+!! pivot's place, gravity) and whose outputs are the coordinates' changes dq (Adams/Linear's
+!! state matrices, Simulink's linmod; for control design and for scipy.signal).
+!!
+!! About the rest state q*, lambda* (drivers held at t) the motion obeys to first order (the
+!! frequency response's equations, mbd_frf, in the time domain): dq = s_n p + N z,
+!!   M_r z'' + C_r z' + K_r z = G0 p + G1 p' + G2 p'',
+!! G0 = N^T (r - K s_n), G1 = -N^T C s_n, G2 = -N^T M s_n (mbd_frf's linear_parts: N a basis
+!! of J_a's null space, s_n the minimum-norm solution of J_a s_n = -Phi_p,a, r = Q_p - J_p^T
+!! lambda*). A base motion (s_n /= 0) forces through p' and p'' as well; two changes of
+!! variable take them out (the standard realization of a proper transfer function):
+!!   w = z - M_r^-1 G2 p:        M_r w'' + C_r w' + K_r w = E0 p + E1 p',
+!!                               E0 = G0 - K_r M_r^-1 G2, E1 = G1 - C_r M_r^-1 G2;
+!!   v = w' - M_r^-1 E1 p:       x = [w; v],
+!!   A = [0, I; -M_r^-1 K_r, -M_r^-1 C_r],
+!!   B = [M_r^-1 E1; M_r^-1 (E0 - C_r M_r^-1 E1)],
+!!   C = [N, 0],   D = s_n + N M_r^-1 G2.
+!! With forces alone as inputs (s_n = 0) w = z and v = z'. C (i Omega I - A)^-1 B + D is the
+!! frequency response H(Omega) of mbd_frf. The states are coordinates on the basis N (its
+!! columns orthonormal in the metric of dyn_null_basis): not unique, as any realization.
+!! Memory: N, K N, C N, M N (nq x f), five nq x np arrays and three f x f matrices, checked
+!! and allocated once per call (MBD_NO_MEMORY otherwise).
+module mbd_linear
+  use mbd_kinds, only: wp, zero, one
+  use mbd_status, only: MBD_OK, MBD_SINGULAR, MBD_BAD_COUNT, MSG_LEN
+  use mbd_memory, only: REAL_BYTES, mem_check, mem_fail
+  use mbd_model, only: model_t
+  use mbd_lapack, only: dgemm, dgetrf, dgetrs
+  use mbd_sensitivity, only: sens_t
+  use mbd_dynamics, only: dyn_work_t
+  use mbd_frf, only: linear_parts
+  implicit none
+  private
+  public :: linear_state_space
+
+  character(len=*), parameter :: HINT = 'the linearized system uses dense matrices of the ' &
+    // 'number of free motions: use a model with fewer free motions'
+
+contains
+
+  !> A (2f, 2f), B (2f, np), C (nq, 2f), D (nq, np) of the linearized motion about (q, t,
+  !! lam), core units, in the leading parts of the arrays (f the free motions; the arrays'
+  !! state dimension at least 2f, else MBD_BAD_COUNT with nfree set).
+  subroutine linear_state_space(m, w, s, q, t, lam, a, b, c, d, nfree, status, msg)
+    type(model_t), intent(in) :: m              !! model with dynamics data
+    type(dyn_work_t), intent(inout) :: w        !! work arrays (dyn_init done)
+    type(sens_t), intent(inout) :: s            !! the inputs (sens_setup done)
+    real(wp), intent(in) :: q(:), t             !! rest state (core units), time
+    real(wp), intent(in) :: lam(:)              !! its multipliers (neq)
+    real(wp), intent(out) :: a(:, :)            !! (>= 2f, >= 2f) state matrix
+    real(wp), intent(out) :: b(:, :)            !! (>= 2f, np) input matrix
+    real(wp), intent(out) :: c(:, :)            !! (nq, >= 2f) output matrix
+    real(wp), intent(out) :: d(:, :)            !! (nq, np) feedthrough
+    integer, intent(out) :: nfree               !! f
+    integer, intent(out) :: status  !! MBD_OK, MBD_SINGULAR, MBD_BAD_COUNT, MBD_NO_MEMORY
+    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    ! N, K N, C N, M N; s_n, K s_n, C s_n, M s_n, r; K_r, C_r, M_r (then M_r's LU); G and
+    ! the solves' right-hand sides
+    real(wp), allocatable :: nb(:, :), kn(:, :), cn(:, :), mn(:, :), sn(:, :), ks(:, :), &
+                             cs(:, :), ms(:, :), rr(:, :), kr(:, :), cr(:, :), mr(:, :), &
+                             y2(:, :), e0(:, :), e1(:, :), y1(:, :), mk(:, :), mc(:, :)
+    integer, allocatable :: ipiv(:)
+    real(wp) :: bytes
+    integer :: n, f, np, i, ist, info
+    character(len=MSG_LEN) :: what
+    status = MBD_OK; msg = ''
+    a = zero; b = zero; c = zero; d = zero
+    n = m%nq; f = n - w%na; np = s%np
+    nfree = f
+    if (size(a, 1) < 2 * f .or. size(a, 2) < 2 * f .or. size(b, 1) < 2 * f .or. &
+        size(c, 2) < 2 * f) then
+      status = MBD_BAD_COUNT
+      write (msg, '(a,i0,a)') 'linearized system: the state arrays hold fewer than 2 x ', f, &
+        ' free motions'
+      return
+    end if
+    bytes = REAL_BYTES * (4 * real(n, wp) * max(f, 1) + 5 * real(n, wp) * np &
+                          + 5 * real(max(f, 1), wp)**2 + 4 * real(max(f, 1), wp) * np + f)
+    write (what, '(a,i0,a)') 'the linearized system''s work arrays (', f, ' free motions)'
+    call mem_check(bytes, trim(what), HINT, status, msg)
+    if (status /= MBD_OK) return
+    allocate (nb(n, max(f, 1)), kn(n, max(f, 1)), cn(n, max(f, 1)), mn(n, max(f, 1)), &
+              sn(n, np), ks(n, np), cs(n, np), ms(n, np), rr(n, np), kr(f, f), cr(f, f), &
+              mr(f, f), y2(f, np), e0(f, np), e1(f, np), y1(f, np), mk(f, f), mc(f, f), &
+              ipiv(f), stat=ist)
+    if (ist /= 0) then
+      call mem_fail(bytes, trim(what), HINT, status, msg); return
+    end if
+    call linear_parts(m, w, s, q, t, lam, nb, kn, cn, mn, kr, cr, mr, sn, ks, cs, ms, rr, &
+                      status, msg)
+    if (status /= MBD_OK) then
+      msg = 'linearized system: ' // msg; return
+    end if
+    d(:, 1:np) = sn                               ! (every motion driven: dq = s_n p)
+    if (f == 0) return
+    call dgetrf(f, f, mr, f, ipiv, info)          ! M_r = P L U
+    if (info /= 0) then
+      status = MBD_SINGULAR
+      msg = 'linearized system: a free motion carries no mass (M_r is singular): give ' // &
+            'every moving body a mass and an inertia'
+      return
+    end if
+    ! G0 = N^T (r - K s_n) in e0, G1 = -N^T C s_n in e1, G2 = -N^T M s_n in y2
+    call dgemm('T', 'N', f, np, n, one, nb, n, rr - ks, n, zero, e0, f)
+    call dgemm('T', 'N', f, np, n, -one, nb, n, cs, n, zero, e1, f)
+    call dgemm('T', 'N', f, np, n, -one, nb, n, ms, n, zero, y2, f)
+    call dgetrs('N', f, np, mr, f, ipiv, y2, f, info)            ! Y2 = M_r^-1 G2
+    call dgemm('N', 'N', f, np, f, -one, kr, f, y2, f, one, e0, f)   ! E0 = G0 - K_r Y2
+    call dgemm('N', 'N', f, np, f, -one, cr, f, y2, f, one, e1, f)   ! E1 = G1 - C_r Y2
+    y1 = e1
+    call dgetrs('N', f, np, mr, f, ipiv, y1, f, info)            ! Y1 = M_r^-1 E1
+    call dgemm('N', 'N', f, np, f, -one, cr, f, y1, f, one, e0, f)   ! E0 - C_r Y1
+    call dgetrs('N', f, np, mr, f, ipiv, e0, f, info)
+    mk = kr; mc = cr
+    call dgetrs('N', f, f, mr, f, ipiv, mk, f, info)             ! M_r^-1 K_r
+    call dgetrs('N', f, f, mr, f, ipiv, mc, f, info)             ! M_r^-1 C_r
+    do i = 1, f                                   ! A = [0, I; -M_r^-1 K_r, -M_r^-1 C_r]
+      a(i, f + i) = one
+    end do
+    a(f + 1:2 * f, 1:f) = -mk
+    a(f + 1:2 * f, f + 1:2 * f) = -mc
+    b(1:f, 1:np) = y1                             ! B = [M_r^-1 E1; M_r^-1 (E0 - C_r Y1)]
+    b(f + 1:2 * f, 1:np) = e0
+    c(:, 1:f) = nb(:, 1:f)                        ! C = [N, 0]
+    call dgemm('N', 'N', n, np, f, one, nb, n, y2, f, one, d, size(d, 1))   ! D = s_n + N Y2
+  end subroutine linear_state_space
+end module mbd_linear

@@ -1,0 +1,47 @@
+"""Linearization front door: the small motion about an equilibrium as a state-space system
+whose inputs are design parameters, in one core call."""
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ..binding import core
+from ..binding.pack import pack, pack_dynamics
+from ..binding.status import BAD_COUNT
+from ..description.builder import ModelDescription
+from ..results.linear import LinearizedSystem
+from ..validate import flag, number
+from .frf import frf_error, frf_inputs
+from .sensitivities import check_status, table
+from .settings import solver_code
+from .statics import STABILITY
+
+WHAT = "linearized system"
+
+
+def run_linearize(model: ModelDescription, inputs: Any, t: float = 0.0,
+                  equilibrium: bool = True, solver: str = "auto") -> LinearizedSystem:
+    """The linearized system; see :meth:`mbd2d.Model.linearize`."""
+    t = number(t, "t", WHAT)
+    code = solver_code(solver)
+    equilibrium = flag(equilibrium, "equilibrium", WHAT)
+    params = frf_inputs(model, inputs, WHAT)
+    p = pack(model)
+    d = pack_dynamics(model, p)
+    ptab = table(p, params, d)
+    out = core.linearize(p, d, t, equilibrium, ptab, 2 * max(p.nq - p.neq, 0), code)
+    if out.status == BAD_COUNT and 2 * int(out.iinfo[0]) > out.a.shape[0]:
+        out = core.linearize(p, d, t, equilibrium, ptab, 2 * int(out.iinfo[0]), code)
+    check_status(out.status, out.iinfo, out.msg, params)
+    f = int(out.iinfo[0])
+    exc = frf_error(model, p, out, t, np.zeros(0), [out.a, out.b, out.c, out.d])
+    if exc is not None:
+        raise exc
+    stability = STABILITY.get(int(out.stable), "not examined (equilibrium=False)")
+    return LinearizedSystem(
+        t=t, q=out.q, lam=out.lam, stability=stability, residual=float(out.resid),
+        a=out.a[:2 * f, :2 * f].copy(), b=out.b[:2 * f].copy(), c=out.c[:, :2 * f].copy(),
+        d=out.d.copy(), inputs=[prm.name for prm in params],
+        outputs=list(p.coordinate_names), n_free=f, model=model,
+        stats={"solver": "banded" if int(out.iinfo[4]) == 2 else "dense"})
