@@ -1180,7 +1180,7 @@ contains
     type(model_t) :: m
     type(dyn_work_t) :: w
     type(sens_t) :: sens
-    integer :: bad, ibad
+    integer :: ibad
     logical :: mult
     q = zero; lam = zero; stable = 0; resid = zero; hre = zero; him = zero
     mult = present(lre) .and. present(lim)
@@ -1203,17 +1203,8 @@ contains
         end if
       end if
     end if
-    if (status == MBD_OK) then
-      call sens_setup(m, ctab, rpar, ptab, sens, status, msg, bad, ftab, fpar)
-      if (status /= MBD_OK) iinfo(2) = -2000000 - bad
-    end if
-    if (status == MBD_OK) then                  ! the statics' steps with the exact stiffness
-      if (smooth_forces(ftab)) then
-        call linear_point(m, w, q, t, equilibrium, lam, stable, resid, status, msg, sens)
-      else
-        call linear_point(m, w, q, t, equilibrium, lam, stable, resid, status, msg)
-      end if
-    end if
+    if (status == MBD_OK) call linear_setup(m, w, sens, ctab, rpar, ftab, fpar, ptab, q, t, &
+                                            equilibrium, lam, stable, resid, iinfo, status, msg)
     if (status == MBD_OK) then
       if (mult) then
         call frf_solve(m, w, sens, q, t, lam, omega, hre, him, ibad, status, msg, lre, lim)
@@ -1266,17 +1257,8 @@ contains
         status = MBD_BAD_COUNT; msg = 'linearized system: the output arrays do not match'
       end if
     end if
-    if (status == MBD_OK) then
-      call sens_setup(m, ctab, rpar, ptab, sens, status, msg, bad, ftab, fpar)
-      if (status /= MBD_OK) iinfo(2) = -2000000 - bad
-    end if
-    if (status == MBD_OK) then                  ! the statics' steps with the exact stiffness
-      if (smooth_forces(ftab)) then
-        call linear_point(m, w, q, t, equilibrium, lam, stable, resid, status, msg, sens)
-      else
-        call linear_point(m, w, q, t, equilibrium, lam, stable, resid, status, msg)
-      end if
-    end if
+    if (status == MBD_OK) call linear_setup(m, w, sens, ctab, rpar, ftab, fpar, ptab, q, t, &
+                                            equilibrium, lam, stable, resid, iinfo, status, msg)
     if (status == MBD_OK) then
       call linear_state_space(m, w, sens, q, t, lam, a, b, c, d, nfree, status, msg)
       iinfo(1) = nfree
@@ -1298,6 +1280,35 @@ contains
       end if
     end if
   end subroutine api_linearize
+
+  !> The inputs of the frequency response and the linearized system as design parameters
+  !! (sens_setup; a refused one named in iinfo(2)), then the point they linearize about
+  !! (linear_point; the statics' steps with the exact stiffness when the forces are smooth).
+  subroutine linear_setup(m, w, sens, ctab, rpar, ftab, fpar, ptab, q, t, equilibrium, lam, &
+                          stable, resid, iinfo, status, msg)
+    type(model_t), intent(in) :: m              !! model with dynamics data
+    type(dyn_work_t), intent(inout) :: w        !! work arrays (dyn_init done)
+    type(sens_t), intent(inout) :: sens         !! the inputs, set up here
+    integer, intent(in) :: ctab(:, :), ftab(:, :), ptab(:, :), equilibrium
+    real(wp), intent(in) :: rpar(:), fpar(:), t
+    real(wp), intent(inout) :: q(:)             !! q0 assembled, then the point (core units)
+    real(wp), intent(out) :: lam(:), resid      !! multipliers, statics' residual
+    integer, intent(out) :: stable              !! as linear_point
+    integer, intent(inout) :: iinfo(NINFO)      !! iinfo(2): a refused input
+    integer, intent(out) :: status              !! MBD_OK, < 0 input, > 0 numerical
+    character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    integer :: bad
+    stable = 0; resid = zero
+    call sens_setup(m, ctab, rpar, ptab, sens, status, msg, bad, ftab, fpar)
+    if (status /= MBD_OK) then
+      iinfo(2) = -2000000 - bad; return
+    end if
+    if (smooth_forces(ftab)) then
+      call linear_point(m, w, q, t, equilibrium, lam, stable, resid, status, msg, sens)
+    else
+      call linear_point(m, w, q, t, equilibrium, lam, stable, resid, status, msg)
+    end if
+  end subroutine linear_setup
 
   !> The point modes and the frequency response linearize about: the equilibrium near q
   !! (equilibrium /= 0, statics), or q itself with its least-squares multipliers (stable -2:

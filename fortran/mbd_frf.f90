@@ -105,10 +105,7 @@ contains
     write (what, '(a,i0,a)') 'the frequency response''s work arrays (', f, ' free motions)'
     call mem_check(bytes, trim(what), HINT, status, msg)
     if (status /= MBD_OK) return
-    allocate (nb(n, max(f, 1)), kn(n, max(f, 1)), cn(n, max(f, 1)), mn(n, max(f, 1)), &
-              sn(n, np), ks(n, np), cs(n, np), ms(n, np), rr(n, np), kr(f, f), cr(f, f), &
-              mr(f, f), a(2 * f, 2 * f), b(2 * f, np), y(n), ipiv(2 * f), &
-              stat=ist)
+    allocate (a(2 * f, 2 * f), b(2 * f, np), y(n), ipiv(2 * f), stat=ist)
     if (ist /= 0) then
       call mem_fail(bytes, trim(what), HINT, status, msg); return
     end if
@@ -408,17 +405,27 @@ contains
     type(sens_t), intent(inout) :: s            !! the parameters (sens_setup done)
     real(wp), intent(in) :: q(:), t             !! rest state (core units), time
     real(wp), intent(in) :: lam(:)              !! its multipliers (neq)
-    !> (nq, >= f) N, K N, C N, M N (f = nq - the active rows; at least one column)
-    real(wp), intent(out) :: nb(:, :), kn(:, :), cn(:, :), mn(:, :)
-    real(wp), intent(out) :: kr(:, :), cr(:, :), mr(:, :)   !! (f, f) K_r, C_r, M_r
-    !> (nq, np) s_n, K s_n, C s_n, M s_n and r
-    real(wp), intent(out) :: sn(:, :), ks(:, :), cs(:, :), ms(:, :), rr(:, :)
-    integer, intent(out) :: status              !! MBD_OK, MBD_SINGULAR or the solves'
+    !> (nq, max(f, 1)) N, K N, C N, M N (f = nq - the active rows), allocated here
+    real(wp), allocatable, intent(out) :: nb(:, :), kn(:, :), cn(:, :), mn(:, :)
+    !> (f, f) K_r, C_r, M_r, allocated here
+    real(wp), allocatable, intent(out) :: kr(:, :), cr(:, :), mr(:, :)
+    !> (nq, np) s_n, K s_n, C s_n, M s_n and r, allocated here
+    real(wp), allocatable, intent(out) :: sn(:, :), ks(:, :), cs(:, :), ms(:, :), rr(:, :)
+    integer, intent(out) :: status  !! MBD_OK, MBD_SINGULAR, MBD_NO_MEMORY or the solves'
     character(len=MSG_LEN), intent(out) :: msg  !! explanation (the caller names itself)
     real(wp) :: x(m%nq), y(m%nq), z(m%nq)
-    integer :: n, f, j, k
+    integer :: n, f, np, j, k, ist
     status = MBD_OK; msg = ''
-    n = m%nq; f = n - w%na
+    n = m%nq; f = n - w%na; np = s%np
+    allocate (nb(n, max(f, 1)), kn(n, max(f, 1)), cn(n, max(f, 1)), mn(n, max(f, 1)), &
+              sn(n, np), ks(n, np), cs(n, np), ms(n, np), rr(n, np), kr(f, f), cr(f, f), &
+              mr(f, f), stat=ist)
+    if (ist /= 0) then
+      call mem_fail(REAL_BYTES * (4 * real(n, wp) * max(f, 1) + 5 * real(n, wp) * np + &
+                                  3 * real(f, wp)**2), 'the linearized motion''s parts', &
+                    HINT, status, msg)
+      return
+    end if
     nb = zero; kn = zero; cn = zero; mn = zero
     z = zero
     call sens_at_rest(m, s, q, t, lam, z)

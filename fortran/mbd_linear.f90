@@ -81,17 +81,15 @@ contains
     write (what, '(a,i0,a)') 'the linearized system''s work arrays (', f, ' free motions)'
     call mem_check(bytes, trim(what), HINT, status, msg)
     if (status /= MBD_OK) return
-    allocate (nb(n, max(f, 1)), kn(n, max(f, 1)), cn(n, max(f, 1)), mn(n, max(f, 1)), &
-              sn(n, np), ks(n, np), cs(n, np), ms(n, np), rr(n, np), kr(f, f), cr(f, f), &
-              mr(f, f), y2(f, np), e0(f, np), e1(f, np), y1(f, np), mk(f, f), mc(f, f), &
-              ipiv(f), stat=ist)
-    if (ist /= 0) then
-      call mem_fail(bytes, trim(what), HINT, status, msg); return
-    end if
     call linear_parts(m, w, s, q, t, lam, nb, kn, cn, mn, kr, cr, mr, sn, ks, cs, ms, rr, &
                       status, msg)
     if (status /= MBD_OK) then
       msg = 'linearized system: ' // msg; return
+    end if
+    allocate (y2(f, np), e0(f, np), e1(f, np), y1(f, np), mk(f, f), mc(f, f), ipiv(f), &
+              stat=ist)
+    if (ist /= 0) then
+      call mem_fail(bytes, trim(what), HINT, status, msg); return
     end if
     d(:, 1:np) = sn                               ! (every motion driven: dq = s_n p)
     if (f == 0) return

@@ -34,7 +34,8 @@ NUMBERS = ["1", "0", "-1", "1e-3", "nan", "inf", "1e300", "abc", "", "2:3", "1.5
 def _command(rng: random.Random, tmp: Path) -> list[str]:
     model = str(EX / rng.choice(MODELS))
     cmd = rng.choice(["kinematics", "inverse-dynamics", "dynamics", "statics", "export",
-                      "tolerance", "parameters", "check", "plot", "sweep", "modes", "frf"])
+                      "tolerance", "parameters", "check", "plot", "sweep", "modes", "frf",
+                      "linearize"])
     argv = [cmd, model]
     if cmd == "export":
         argv.append(str(tmp / "f.mbd"))
@@ -60,6 +61,12 @@ def _command(rng: random.Random, tmp: Path) -> list[str]:
                                 ["--out", str(tmp / rng.choice(["f.csv", "f.nc"]))],
                                 ["--picture", str(tmp / rng.choice(["b.png", "b.gif"]))],
                                 ["--body", rng.choice(["coupler", "zzz"])]])
+    if cmd == "linearize":
+        argv += ["--input", rng.choice(NAMES + ["model.gravity.1", "driver.motor.f.poly.0"])]
+        if rng.random() < 0.5:
+            argv += rng.choice([["--at-q0"], ["--t", rng.choice(NUMBERS)],
+                                ["--out", str(tmp / rng.choice(["s.csv", "s.nc"]))],
+                                ["--input", rng.choice(NAMES)]])
     if cmd == "tolerance":
         argv += ["--samples", rng.choice(["0", "3", "3", "1"]), "--workers", "1",
                  "--out", str(tmp / rng.choice(["t.csv", "t.csv", "t.nc", "t.txt"]))]
@@ -97,7 +104,7 @@ def _command(rng: random.Random, tmp: Path) -> list[str]:
             argv.append("--grid")
     if cmd == "export" and rng.random() < 0.3:
         argv += ["--analysis", rng.choice(["check", "statics", "dynamics", "inverse-dynamics",
-                                           "modes", "frf"])]
+                                           "modes", "frf", "linearize"])]
     if cmd == "parameters" and rng.random() < 0.5:
         argv += ["--match", rng.choice(["B", "zzz", ""])]
     if rng.random() < 0.15:

@@ -99,6 +99,10 @@ def bases(tmp_path_factory: pytest.TempPathFactory) -> list[bytes]:
     car.export(f, analysis="frf", inputs=["force.front_suspension.length0", "model.gravity.1"],
                frequencies=np.geomspace(0.1, 30.0, 9))
     out.append(f.read_bytes())
+    f = d / "linearize.mbd"                   # a state-space system of the same inputs
+    car.export(f, analysis="linearize",
+               inputs=["force.front_suspension.length0", "model.gravity.1"])
+    out.append(f.read_bytes())
     f = d / "modes_sweep.mbd"
     mbd2d.export_sweep(car, f, {"force.front_suspension.damping": [0.0, 1500.0],
                                 "body.rear_wheel.mass": [35.0, 0.0]}, "modes", count=3)

@@ -215,13 +215,8 @@ def _parser() -> argparse.ArgumentParser:
     o = sub.add_parser("modes", help="natural frequencies, damping and mode shapes about the "
                        "static equilibrium")
     o.add_argument("model", help="model file (.toml) with masses")
-    o.add_argument("--t", type=float, default=0.0, help="time at which loads and drivers are "
-                   "held (default 0)")
+    _linear_point(o)
     o.add_argument("--count", type=int, default=None, help="only the lowest K modes")
-    o.add_argument("--at-q0", action="store_true", help="about the assembled q0 as given "
-                   "(an equilibrium you know), not the equilibrium statics finds")
-    o.add_argument("--solver", default="auto", choices=["auto", "dense", "banded"],
-                   help="linear algebra (default auto: band LU for large chains)")
     o.add_argument("--out", default=None, help="write the modes (frequencies, shapes) as CSV")
     o.add_argument("--damped-out", default=None, help="write the damped eigenvalues as CSV")
     o.add_argument("--picture", default=None, help="draw a mode: .png/.svg/.pdf (the "
@@ -234,12 +229,7 @@ def _parser() -> argparse.ArgumentParser:
                        "design parameters varied harmonically (Bode plot)")
     fr.add_argument("model", help="model file (.toml) with masses")
     _frf_settings(fr)
-    fr.add_argument("--t", type=float, default=0.0, help="time at which loads and drivers are "
-                   "held (default 0)")
-    fr.add_argument("--at-q0", action="store_true", help="about the assembled q0 as given, not "
-                   "the equilibrium statics finds")
-    fr.add_argument("--solver", default="auto", choices=["auto", "dense", "banded"],
-                   help="linear algebra (default auto: band LU for large chains)")
+    _linear_point(fr)
     fr.add_argument("--out", default=None, help="write the response as CSV")
     fr.add_argument("--reactions", action="store_true", help="with --out: the joints' "
                    "reaction responses too")
@@ -254,12 +244,7 @@ def _parser() -> argparse.ArgumentParser:
     li.add_argument("--input", action="append", required=True, metavar="NAME",
                     help="a design parameter as an input (repeatable; `mbd2d parameters "
                     "MODEL` lists them)")
-    li.add_argument("--t", type=float, default=0.0, help="time at which loads and drivers are "
-                    "held (default 0)")
-    li.add_argument("--at-q0", action="store_true", help="about the assembled q0 as given, not "
-                    "the equilibrium statics finds")
-    li.add_argument("--solver", default="auto", choices=["auto", "dense", "banded"],
-                    help="linear algebra (default auto: band LU for large chains)")
+    _linear_point(li)
     li.add_argument("--out", default=None, help="write A, B, C, D as CSV (matrix,row,column,"
                     "value)")
     w = sub.add_parser("sweep", help="one analysis of many variants (design parameters "
@@ -440,6 +425,16 @@ def _statics_report(model: Model, st: StaticsResult) -> str:
             lines.append(f"  d/d({prm}) {name:16s} x: {dx: .9g}  y: {dy: .9g}  "
                          f"theta: {dth: .9g}")
     return "\n".join(lines)
+
+
+def _linear_point(p: argparse.ArgumentParser) -> None:
+    """--t, --at-q0 and --solver: where modes, frf and linearize linearize the motion."""
+    p.add_argument("--t", type=float, default=0.0, help="time at which loads and drivers are "
+                   "held (default 0)")
+    p.add_argument("--at-q0", action="store_true", help="about the assembled q0 as given "
+                   "(an equilibrium you know), not the equilibrium statics finds")
+    p.add_argument("--solver", default="auto", choices=["auto", "dense", "banded"],
+                   help="linear algebra (default auto: band LU for large chains)")
 
 
 def _frf_settings(p: argparse.ArgumentParser, required: bool = True) -> None:
