@@ -36,8 +36,8 @@ module mbd_frf
   use mbd_lapack, only: dgemm, dgetrf, dgetrs, dgehrd, dorghr
   use mbd_sensitivity, only: sens_t
   use mbd_sens_dynamics, only: statics_load, sens_stiffness_mul, sens_damping_mul, sens_at_rest, &
-                               proj_particular, proj_multipliers
-  use mbd_dynamics, only: dyn_work_t, dyn_null_basis, dyn_factor_projection
+                               proj_particular, proj_multipliers, sens_tangent_pattern
+  use mbd_dynamics, only: dyn_work_t, dyn_null_basis, dyn_factor_projection, dyn_pattern_mul
   implicit none
   private
   public :: frf_solve, linear_parts
@@ -414,21 +414,29 @@ contains
     integer, intent(out) :: status  !! MBD_OK, MBD_SINGULAR, MBD_NO_MEMORY or the solves'
     character(len=MSG_LEN), intent(out) :: msg  !! explanation (the caller names itself)
     real(wp) :: x(m%nq), y(m%nq), z(m%nq)
-    integer :: n, f, np, j, k, ist
+    ! K and C on the sparse pattern (exact, one product per colour group) when that takes
+    ! fewer products than the columns of N and s_n
+    real(wp), allocatable :: kv(:), cv(:), wk(:)
+    integer :: n, f, np, j, k, ist, nnz
+    logical :: bypattern
     status = MBD_OK; msg = ''
     n = m%nq; f = n - w%na; np = s%np
+    nnz = w%kptr(n + 1) - 1
+    bypattern = w%ncolor < f + np
     allocate (nb(n, max(f, 1)), kn(n, max(f, 1)), cn(n, max(f, 1)), mn(n, max(f, 1)), &
               sn(n, np), ks(n, np), cs(n, np), ms(n, np), rr(n, np), kr(f, f), cr(f, f), &
-              mr(f, f), stat=ist)
+              mr(f, f), kv(merge(nnz, 0, bypattern)), cv(merge(nnz, 0, bypattern)), &
+              wk(merge(n, 0, bypattern)), stat=ist)
     if (ist /= 0) then
       call mem_fail(REAL_BYTES * (4 * real(n, wp) * max(f, 1) + 5 * real(n, wp) * np + &
-                                  3 * real(f, wp)**2), 'the linearized motion''s parts', &
-                    HINT, status, msg)
+                                  3 * real(f, wp)**2 + 2 * real(nnz, wp) + n), &
+                    'the linearized motion''s parts', HINT, status, msg)
       return
     end if
     nb = zero; kn = zero; cn = zero; mn = zero
     z = zero
     call sens_at_rest(m, s, q, t, lam, z)
+    if (bypattern) call sens_tangent_pattern(m, w, s, q, t, z, kv, x, y, wk, cv)
     if (f > 0) then                               ! N, K N, C N, M N
       call dyn_null_basis(m, w, q, t, nb(:, 1:f), status)
       if (status /= MBD_OK) then
@@ -458,18 +466,26 @@ contains
       ms(:, k) = m%mdiag * sn(:, k)
     end do
   contains
-    !> kx = K x (exact, sens_stiffness_mul).
+    !> kx = K x (exact: on the pattern, or sens_stiffness_mul).
     subroutine kmul(xx, kx)
       real(wp), intent(in) :: xx(:)
       real(wp), intent(out) :: kx(:)
-      call sens_stiffness_mul(m, s, q, t, z, xx, kx, x)
+      if (bypattern) then
+        call dyn_pattern_mul(w, kv, xx, kx)
+      else
+        call sens_stiffness_mul(m, s, q, t, z, xx, kx, x)
+      end if
     end subroutine kmul
 
-    !> cx = C x = -Q_q_dot x (exact).
+    !> cx = C x = -Q_q_dot x (exact: on the pattern, or sens_damping_mul).
     subroutine cmul(xx, cx)
       real(wp), intent(in) :: xx(:)
       real(wp), intent(out) :: cx(:)
-      call sens_damping_mul(m, s, q, t, z, xx, cx)
+      if (bypattern) then
+        call dyn_pattern_mul(w, cv, xx, cx)
+      else
+        call sens_damping_mul(m, s, q, t, z, xx, cx)
+      end if
     end subroutine cmul
   end subroutine linear_parts
 

@@ -31,7 +31,7 @@ module mbd_modes
   use mbd_lapack, only: dsygv, dgeev, dgetrf, dgetrs, dgemm
   use mbd_dynamics, only: dyn_work_t, dyn_tangent, dyn_null_basis, dyn_pattern_mul
   use mbd_sensitivity, only: sens_t
-  use mbd_sens_dynamics, only: sens_stiffness_mul, sens_damping_mul
+  use mbd_sens_dynamics, only: sens_stiffness_mul, sens_damping_mul, sens_tangent_pattern
   implicit none
   private
   public :: modes_solve, unit_largest
@@ -80,11 +80,11 @@ contains
     ! K and C on the sparse pattern
     real(wp), allocatable :: nb(:, :), kn(:, :), cn(:, :), mn(:, :), mr(:, :), kr(:, :), &
                              cr(:, :), ks(:, :), a(:, :), wr(:), wi(:), ev(:), vl(:, :), &
-                             vr(:, :), work(:), kv(:), cv(:), zv(:), xv(:)
+                             vr(:, :), work(:), kv(:), cv(:), zv(:), xv(:), yv(:), wv(:)
     integer, allocatable :: ipiv(:), order(:)
     real(wp) :: bytes, wq(1)
     integer :: n, f, nnz, ist, info, j, k, nk
-    logical :: plain, damped, cshapes
+    logical :: plain, damped, cshapes, bypattern
     character(len=MSG_LEN) :: what
     status = MBD_OK; msg = ''
     omega2 = zero; sre = zero; sim = zero; shapes = zero; kinds = 0
@@ -99,7 +99,7 @@ contains
     nk = min(kmax, f)
     nnz = w%kptr(n + 1) - 1
     bytes = REAL_BYTES * (4 * real(n, wp) * f + 5 * real(f, wp)**2 + 4 * real(2 * f, wp)**2 &
-                          + 2 * real(nnz, wp) + 8 * real(f, wp) + 2 * real(n, wp))
+                          + 2 * real(nnz, wp) + 8 * real(f, wp) + 4 * real(n, wp))
     if (cshapes) bytes = bytes + REAL_BYTES * real(2 * f, wp)**2     ! dgeev's eigenvectors
     write (what, '(a,i0,a)') 'the modes'' work arrays (', f, ' free motions)'
     call mem_check(bytes, trim(what), HINT, status, msg)
@@ -107,7 +107,7 @@ contains
     allocate (nb(n, f), kn(n, f), cn(n, f), mn(n, f), mr(f, f), kr(f, f), cr(f, f), ks(f, f), &
               a(2 * f, 2 * f), wr(2 * f), wi(2 * f), ev(f), vl(1, 1), &
               vr(merge(2 * f, 1, cshapes), merge(2 * f, 1, cshapes)), kv(nnz), &
-              cv(nnz), ipiv(f), order(2 * f), work(1), zv(n), xv(n), stat=ist)
+              cv(nnz), ipiv(f), order(2 * f), work(1), zv(n), xv(n), yv(n), wv(n), stat=ist)
     if (ist /= 0) then
       call mem_fail(bytes, trim(what), HINT, status, msg); return
     end if
@@ -116,19 +116,26 @@ contains
       status = MBD_SINGULAR; msg = 'modes: no basis of the free motions (J is singular)'
       return
     end if
+    bypattern = .true.
     if (present(s)) then                          ! K N = K_lambda N - Q_q N, C N = -Q_q_dot N
       zv = zero
-      do j = 1, f
-        call sens_stiffness_mul(m, s, q, t, zv, nb(:, j), kn(:, j), xv)
-        call sens_damping_mul(m, s, q, t, zv, nb(:, j), cn(:, j))
-      end do
-      damped = maxval(abs(cn)) > zero
+      bypattern = w%ncolor < f                    ! (exact K and C on the pattern: fewer
+      if (bypattern) then                         ! products, one per colour group)
+        call sens_tangent_pattern(m, w, s, q, t, zv, kv, xv, yv, wv, cv)
+        damped = maxval(abs(cv)) > zero
+      else
+        do j = 1, f
+          call sens_stiffness_mul(m, s, q, t, zv, nb(:, j), kn(:, j), xv)
+          call sens_damping_mul(m, s, q, t, zv, nb(:, j), cn(:, j))
+        end do
+        damped = maxval(abs(cn)) > zero
+      end if
     else
       call dyn_tangent(m, w, q, w%qz, t, lam, kv, cv, step=FD_STEP)
       damped = maxval(abs(cv)) > zero
     end if
     do j = 1, f                                   ! K N, C N and M N, column by column
-      if (.not. present(s)) then
+      if (bypattern) then
         call dyn_pattern_mul(w, kv, nb(:, j), kn(:, j))
         if (damped) call dyn_pattern_mul(w, cv, nb(:, j), cn(:, j))
       end if

@@ -83,9 +83,13 @@ contains
                              ct(:, :), qt(:), ja(:, :), sv(:), u(:, :), vt(:, :), work(:), &
                              r(:), c(:), dqz(:), kv(:), cv(:)
     integer, allocatable :: ktr(:)
-    real(wp) :: v0, vt1, alpha, emax, fscale, vnoise, e0, e1, gn, pn, slope, bytes, fmag
-    integer :: it, ls, nfree, n, na, stp, ist, nu, nnz, nn, nf0
-    logical :: local, band, exact, bycols
+    real(wp) :: v0, vt1, alpha, emax, fscale, vnoise, e0, e1, gn, pn, slope, bytes, fmag, &
+                gq, fq
+    integer :: it, ls, nfree, n, na, stp, ist, nu, nnz, nn, nf0, nfq
+    ! fresh: the arrays (N, g, H, lam, ...) hold q's reduction (a Newton step's trial point
+    ! became q); eig_q: ev holds H(q)'s eigenvalues (the last Newton step's), with q's
+    ! ||g||_inf in gq, force scale in fq and free motions in nfq
+    logical :: local, band, exact, bycols, fresh, eig_q
     character(len=MSG_LEN) :: lmsg, what
     status = MBD_OK; msg = ''; stable = 2; resid = zero
     n = m%nq; na = w%na; nu = min(na, n)
@@ -122,15 +126,20 @@ contains
       msg = 'statics: the constraints cannot be satisfied near the estimates'; return
     end if
     local = .false.
+    fresh = .false.
+    eig_q = .false.
     e0 = huge(one)
     do it = 1, MAXIT
-      call reduce(q, status)                  ! N, g, lam, dq_n, H at q
+      if (.not. fresh) call reduce(q, status) ! N, g, lam, dq_n, H at q
       if (status /= MBD_OK) return
+      fresh = .true.; eig_q = .false.
       if (nfree == 0) exit                    ! nothing can move: q is the equilibrium
       gn = maxval(abs(g(1:nfree)))
       if (.not. (gn > zero .or. maxval(abs(dqn)) > zero)) exit   ! exactly balanced
-      call newton_step(status)
+      call newton_step(status)                ! (H's eigenvalues at q in ev)
       if (status /= MBD_OK) return
+      fresh = .false.                         ! (h holds H's eigenvectors now)
+      eig_q = .true.; gq = gn; fq = fscale; nfq = nfree
       call null_mul(dz, dqz)                   ! the step in q: N dz
       if (.not. local) then
         ! V can judge a step only while the decrease it predicts exceeds its rounding
@@ -151,7 +160,7 @@ contains
           if (ls > MAXLS) then
             local = .true.                    ! no decrease V can resolve: polish by Newton
           else
-            q = qt
+            q = qt; eig_q = .false.
           end if
           cycle
         end if
@@ -161,25 +170,36 @@ contains
       qt = q + dqn + dqz
       call reduce(qt, status)
       if (status /= MBD_OK) return
+      eig_q = eig_q .and. nfree == nfq         ! (ev: q's, the arrays: qt's)
       if (nfree == 0) then
-        q = qt; exit
+        q = qt; fresh = .true.; exit
       end if
       e1 = merit(maxval(abs(g(1:nfree))), pn)
       if (.not. (e1 < e0)) exit                ! no progress: round-off reached (q kept)
       q = qt
+      fresh = .true.; eig_q = .false.          ! (the arrays are q's: no reduce at the top)
       if (e1 > half * e0) exit                 ! progress stalls: round-off reached
     end do
-    call reduce(q, status)
-    if (status /= MBD_OK) return
-    if (nfree == 0) then
-      stable = 2; resid = zero; return
+    ! the stability and the residual at q: from the arrays when they are q's, from the last
+    ! Newton step's eigenvalues (those of H(q) with its vectors: the same to rounding) when
+    ! q was kept, else from q's reduction again
+    if (eig_q .and. .not. fresh) then          ! q kept: its multipliers again (lam is qt's)
+      nfree = nfq
+      call dyn_multipliers(m, w, q, w%qz, w%qz, t, lam, stp, lmsg)
+    else
+      if (.not. fresh) call reduce(q, status)
+      if (status /= MBD_OK) return
+      if (nfree == 0) then
+        stable = 2; resid = zero; return
+      end if
+      call eigen(.false., status)
+      if (status /= MBD_OK) return
+      gq = maxval(abs(g(1:nfree))); fq = fscale
     end if
-    call eigen(.false., status)
-    if (status /= MBD_OK) return
     emax = max(maxval(abs(ev(1:nfree))), tiny(one))
     ! the unbalanced load against the loads, or against the stiffness over the model's size
     ! (loads of round-off size: springs at their natural lengths in an equilibrium)
-    resid = maxval(abs(g(1:nfree))) / max(fscale, emax * m%lscale)
+    resid = gq / max(fq, emax * m%lscale)
     if (.not. (resid <= RESID_FAIL)) then
       status = MBD_NO_CONVERGENCE
       write (msg, '(a,es10.3,a)') 'statics: no equilibrium found near the estimates; the '// &
