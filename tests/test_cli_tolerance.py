@@ -263,3 +263,31 @@ def test_modes_from_the_command_line(tmp_path: Path, capsys) -> None:
     for k in range(4):
         np.testing.assert_array_equal(rows[0, header.index(f"mode{k + 1}.frequency.std_mc")],
                                       tol.dataset.frequency_std_mc.values[k])
+
+
+def test_frf_from_the_command_line(tmp_path: Path, capsys) -> None:
+    """`--analysis frf --input NAME --f START:STOP:NUM`: one CSV row per frequency with the
+    magnitudes' and phases' Monte Carlo columns (the API's, same seed), each response's peak
+    in the summary; --point is refused there, --input without --analysis frf too."""
+    car = str(EX / "half_car.toml")
+    sig = {"force.front_suspension.damping": 200.0, "body.body.mass": 20.0}
+    inp = "force.front_tyre.points.0.1"
+    out = tmp_path / "tol.csv"
+    args = ["tolerance", car, "--analysis", "frf", "--input", inp, "--f", "0.5:15:12", "--log",
+            "--samples", "20", "--workers", "1"] + \
+        [a for k, v in sig.items() for a in ("--sigma", f"{k}={v}")]
+    assert main(args + ["--out", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert "frequency response peaks" in text and f"d(body.y)/d({inp}): |H|" in text
+    header, rows = read_csv(out)
+    tol = mbd2d.tolerance(mbd2d.load(car), sig, "frf", samples=20, workers=1, inputs=[inp],
+                          frequencies=np.geomspace(0.5, 15, 12))
+    assert rows.shape == (12, len(header))
+    col = header.index(f"d(body.y)/d({inp}).abs.std_mc")
+    j = list(tol.dataset.coordinate.values).index("body.y")
+    np.testing.assert_array_equal(rows[:, col], tol.dataset.magnitude_std_mc.values[:, j, 0])
+    assert main(args + ["--out", str(out), "--point", "body:0,0"]) == 2
+    assert "--point is a scatter over time" in capsys.readouterr().err
+    assert main(["tolerance", car, "--input", inp, "--sigma", "body.body.mass=1", "--out",
+                 str(out)]) == 2
+    assert "--analysis frf needs" in capsys.readouterr().err

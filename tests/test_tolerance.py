@@ -268,8 +268,71 @@ def test_modes_tolerance_needs_samples_and_takes_no_measures() -> None:
                         measures="dead_centre_distance")
     with pytest.raises(mbd2d.ModelError, match="the settings are"):
         mbd2d.tolerance(model, {"force.s.stiffness": 1.0}, "modes", samples=4, t_end=1.0)
-    # the frequency response is refused with the way to its scatter (it ran dynamics'
-    # settings check before: "missing a required argument: 't_end'")
-    with pytest.raises(mbd2d.ModelError, match="tolerance_samples"):
-        mbd2d.tolerance(model, {"force.s.stiffness": 1.0}, "frf", samples=4,
+    # the frequency response: Monte Carlo alone too, and its own settings
+    with pytest.raises(mbd2d.ModelError, match="samples=0 leaves nothing"):
+        mbd2d.tolerance(model, {"force.s.stiffness": 1.0}, "frf", samples=0,
                         inputs=["force.s.length0"], frequencies=[1.0])
+    with pytest.raises(mbd2d.ModelError, match="not of frf"):
+        mbd2d.tolerance(model, {"force.s.stiffness": 1.0}, "frf", samples=4,
+                        inputs=["force.s.length0"], frequencies=[1.0],
+                        measures="dead_centre_distance")
+    with pytest.raises(mbd2d.ModelError, match="the settings are"):
+        mbd2d.tolerance(model, {"force.s.stiffness": 1.0}, "frf", samples=4,
+                        inputs=["force.s.length0"], frequencies=[1.0], t_end=1.0)
+
+
+# ---------------------------------------------------------------------------------------------
+# The frequency response: Monte Carlo alone, against the closed forms on the same draws
+
+
+def test_frf_tolerance_against_the_closed_form_on_the_same_draws(tmp_path) -> None:
+    """The held block pushed (test_sweep_frf.held_block): H = 1 / (k - m w^2 + i c w) for the
+    block and -(k + i c w) / (k - m w^2 + i c w) for the holding driver's effort. With k, c
+    and m scattered, the Monte Carlo standard deviations and means of the magnitudes and of
+    the phases (degrees; each sample's phase relative to the nominal's, so the effort's
+    phase near 180 degrees does not jump by 360) are those of the closed forms over the same
+    draws, to 1e-12; no first-order column; the CSV has one row per frequency."""
+    from test_sweep_frf import held_block
+    model, k0, c0, m0 = held_block(), 36.0, 1.5, 2.0
+    sigma = {"force.s.stiffness": 2.0, "force.s.damping": 0.3, "body.block.mass": 0.1}
+    freq = np.array([0.1, 0.5, 0.675, 0.8, 2.0])
+    kw = {"inputs": ["force.push.fy.poly.0"], "frequencies": freq}
+    tol = mbd2d.tolerance(model, sigma, "frf", samples=200, workers=1, **kw)
+    ds = tol.dataset
+    d = mbd2d.tolerance_samples(model, sigma, 200)
+    k, c, m = (d[n][:, None] for n in sigma)
+    w = 2 * np.pi * freq
+
+    def block(k, c, m):
+        return 1 / (k - m * w**2 + 1j * c * w)
+
+    def effort(k, c, m):
+        return -(k + 1j * c * w) * block(k, c, m)
+    for name, fn, sel in (("magnitude", block, {"coordinate": "block.y"}),
+                          ("effort_magnitude", effort, {"driver": "hold"})):
+        h, h0 = fn(k, c, m), fn(k0, c0, m0)
+        ph = np.degrees(np.angle(h0)) + np.degrees(np.angle(h * np.conj(h0)))
+        phase = name.replace("magnitude", "phase")
+        one = {**sel, "input": "force.push.fy.poly.0"}
+        assert_allclose(ds[name].sel(**one).values, np.abs(h0), rtol=1e-13)
+        assert_allclose(ds[f"{name}_std_mc"].sel(**one).values, np.std(np.abs(h), axis=0,
+                                                                        ddof=1), rtol=1e-12)
+        assert_allclose(ds[f"{name}_mean_mc"].sel(**one).values, np.abs(h).mean(axis=0),
+                        rtol=1e-12)
+        assert_allclose(ds[phase].sel(**one).values, np.degrees(np.angle(h0)), rtol=1e-13)
+        assert_allclose(ds[f"{phase}_std_mc"].sel(**one).values, np.std(ph, axis=0, ddof=1),
+                        rtol=1e-11)
+        assert_allclose(ds[f"{phase}_mean_mc"].sel(**one).values, ph.mean(axis=0),
+                        rtol=1e-12)
+    # the effort's phase within 0.04 degrees of 180 at 0.1 Hz: its samples' spread is small
+    assert 179.9 < ds.effort_phase_mean_mc.values[0, 0, 0] < 180.0
+    assert ds.effort_phase_std_mc.values[0, 0, 0] < 0.1
+    assert ds.attrs["first_order"].startswith("none") and not tol.linear
+    out = tmp_path / "tol.csv"
+    mbd2d.studies.write_tolerance(ds, out)
+    header = out.read_text().splitlines()[0].split(",")
+    rows = np.loadtxt(out, delimiter=",", skiprows=1, ndmin=2)
+    assert rows.shape == (freq.size, len(header)) and header[0] == "frequency_hz"
+    col = header.index("d(block.y)/d(force.push.fy.poly.0).abs.std_mc")
+    assert_allclose(rows[:, col], np.std(np.abs(block(k, c, m)), axis=0, ddof=1), rtol=1e-12)
+    assert "d(effort.hold)/d(force.push.fy.poly.0).deg.mean_mc" in header

@@ -17,7 +17,8 @@
                 --input NAME --f START:STOP:NUM --log (--analysis frf)]
     mbd2d tolerance MODEL.toml --sigma NAME=STD ... --t-end T --steps N --out tol.csv|tol.nc
                     [--samples N --seed S --analysis A --point BODY:X,Y --workers W
-                    --scheduler ADDRESS --method M --rtol R --atol A --h H]
+                    --scheduler ADDRESS --method M --rtol R --atol A --h H
+                    --input NAME --f START:STOP:NUM --log (--analysis frf)]
     mbd2d synthesize TASK.toml --out BEST.toml [--starts K --seed S --workers N]
     mbd2d cam TASK.toml --out MODEL.toml [--profile PROFILE.csv]
     mbd2d check MODEL.toml [--t T --tol TOL --out REPORT.csv]
@@ -585,7 +586,8 @@ def _tolerance_parser(sub: Any) -> None:
                    help="Monte Carlo variants (default 200; 0: first order alone)")
     t.add_argument("--seed", type=int, default=0, help="seed of the draws (default 0)")
     _study_settings(t, "the analysis (default kinematics; dynamics by dopri5 or "
-                       "generalized-alpha; modes: Monte Carlo alone)")
+                       "generalized-alpha; modes and frf: Monte Carlo alone)", frf=True)
+    _frf_settings(t, required=False)
     _study_integrator(t)
     t.add_argument("--point", action="append", default=None, metavar="BODY:X,Y",
                    help="also the scatter of the point (X, Y) of BODY (repeatable)")
@@ -619,7 +621,7 @@ def _tolerance(model: Model, args: argparse.Namespace) -> int:
     from .studies import connect, export_sweep, tolerance, tolerance_samples, write_tolerance
     sigma = dict(_sigma(s) for s in args.sigma)
     kw = _study_span(args)
-    if args.analysis not in ("statics", "modes"):
+    if args.analysis not in ("statics", "modes", "frf"):
         kw.update(_study_dynamics(args))
     if args.export_samples is not None:
         cases = tolerance_samples(model, sigma, args.samples, args.seed)
@@ -631,6 +633,9 @@ def _tolerance(model: Model, args: argparse.Namespace) -> int:
     if args.out is None or not str(args.out).endswith((".nc", ".csv")):
         raise ModelError(f"--out must end in .nc or .csv, got {args.out!r}", "command line")
     points = _trace(args.point) or []
+    if points and args.analysis == "frf":
+        raise ModelError("--point is a scatter over time, not of a frequency response",
+                         "command line")
     bodies = [b.name for b in model.bodies]
     for body, _ in points:
         if body not in bodies:
@@ -685,9 +690,35 @@ def _tolerance_report(tol: Any, points: list[tuple[str, Any]]) -> str:
                      + _main_share(tol, output, name, k))
     if "measures" in ds:
         lines += _measures_report(tol, key, word, t)
-    if "frequency" in ds:
+    if "frequency_std_mc" in ds:
         lines += _modes_report(ds)
+    if "magnitude" in ds:
+        lines += _frf_report(ds)
     return "\n".join(lines)
+
+
+def _frf_report(ds: Any) -> list[str]:
+    """The frequency response's lines of a tolerance report: for each input and response
+    that moves, its peak magnitude and frequency with the Monte Carlo standard deviation
+    there."""
+    lines = ["frequency response peaks, Monte Carlo standard deviation at the peak:"]
+    freq = np.asarray(ds.frequency.values)
+    for j, inp in enumerate(str(v) for v in ds.input.values):
+        for mag, dim, fmt in (("magnitude", "coordinate", "{}"),
+                              ("effort_magnitude", "driver", "effort.{}")):
+            if mag not in ds:
+                continue
+            m = np.asarray(ds[mag].values)[:, :, j]
+            sd = np.asarray(ds[f"{mag}_std_mc"].values)[:, :, j]
+            for k, entry in enumerate(str(v) for v in ds[dim].values):
+                if not m[:, k].max(initial=0.0) > 1e-12 * np.abs(m).max(initial=0.0):
+                    continue
+                i = int(np.argmax(m[:, k]))
+                spread = f"std {sd[i, k]:.3g}" if np.isfinite(sd[i, k]) else \
+                    "fewer than 2 samples completed"
+                lines.append(f"  d({fmt.format(entry)})/d({inp}): |H| {m[i, k]:.4g} at "
+                             f"{freq[i]:.4g} Hz, {spread}")
+    return lines
 
 
 def _modes_report(ds: Any) -> list[str]:

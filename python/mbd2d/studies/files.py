@@ -225,6 +225,8 @@ def tolerance_table(ds: Any, points: Sequence[tuple[str, Any]] = ()
     point ``LABEL.x``, ``LABEL.y`` with their ``.std_linear`` and ``.std_mc``
     (``.std_linear`` only where the analysis has the first-order column: not with contacts
     or joint friction, nor for the modes)."""
+    if "magnitude" in ds:                       # a frequency response's: per frequency
+        return _frf_tolerance_table(ds)
     header = ["t"]
     blocks = [np.atleast_1d(ds.time.values)[:, None]]
     for out, fmt in _ENTRY.items():
@@ -244,6 +246,28 @@ def tolerance_table(ds: Any, points: Sequence[tuple[str, Any]] = ()
                 continue                        # no first-order column (contacts, friction)
             header.append(f"{label}.{v.replace('_std', '.std')}")
             blocks.append(np.asarray(pt[v].values)[:, None])
+    return header, np.hstack(blocks)
+
+
+def _frf_tolerance_table(ds: Any) -> tuple[list[str], np.ndarray]:
+    """A frequency response's tolerance analysis as one row per frequency: ``frequency_hz``,
+    then for each input, coordinate (then driver's effort, ``effort.DRIVER``) the magnitude
+    ``d(NAME)/d(INPUT).abs`` and the phase ``d(NAME)/d(INPUT).deg`` (degrees), each nominal
+    and with ``.std_mc`` and ``.mean_mc`` (the equilibrium's scatter is in the dataset)."""
+    header = ["frequency_hz"]
+    blocks = [np.asarray(ds.frequency.values)[:, None]]
+    outputs = [("magnitude", "phase", "coordinate", "{}")]
+    if "effort_magnitude" in ds:
+        outputs.append(("effort_magnitude", "effort_phase", "driver", "effort.{}"))
+    for j, inp in enumerate(str(v) for v in ds.input.values):
+        for mag, ph, dim, fmt in outputs:
+            for k, entry in enumerate(str(v) for v in ds[dim].values):
+                for out, part in ((mag, "abs"), (ph, "deg")):
+                    for suffix, word in _STATS:
+                        if f"{out}{suffix}" in ds:
+                            header.append(f"d({fmt.format(entry)})/d({inp}).{part}{word}")
+                            blocks.append(np.asarray(ds[f"{out}{suffix}"].values)[:, k, j,
+                                                                                   None])
     return header, np.hstack(blocks)
 
 

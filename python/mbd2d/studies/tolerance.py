@@ -15,9 +15,10 @@ nonlinear in the parameters over the scatter.
 
 A model with contacts or joint friction has no design sensitivities (its events make the
 motion non-smooth in the parameters): its report has the Monte Carlo columns alone, and the
-dataset's attribute ``first_order`` says why. So has the modes' report (the natural
-frequencies', damping ratios' and equilibrium's scatter): the frequencies' derivatives need the
-model's third derivatives, which mbd2d does not write.
+dataset's attribute ``first_order`` says why. So have the modes' report (the natural
+frequencies', damping ratios' and equilibrium's scatter) and the frequency response's (the
+scatter of each response's magnitude and phase over the frequencies): their derivatives need
+the model's third derivatives, which mbd2d does not write.
 """
 from __future__ import annotations
 
@@ -27,6 +28,7 @@ from typing import Any, Mapping
 import numpy as np
 
 from ..analysis.dynamics import run_dynamics
+from ..analysis.frf import run_frf
 from ..analysis.sensitivities import SENSITIVITY_METHODS
 from ..analysis.inverse import run_inverse
 from ..analysis.kinematics import run_kinematics
@@ -39,9 +41,10 @@ from ..description.parameters import find
 from ..errors import ModelError
 from ..results.measures import measure, measure_derivatives, measure_list, parse_measure
 from ..results.points import PointResult
+from ..results.reactions import driver_row
 from ..validate import number, vector, whole
 from .dataset import xarray
-from .plan import (ANALYSES, _bind, _dynamics_settings, _inverse_settings,
+from .plan import (ANALYSES, _bind, _dynamics_settings, _frf_settings, _inverse_settings,
                    _kinematics_settings, _modes_settings, _statics_settings, nominal_values)
 from .sweep import sweep
 
@@ -49,6 +52,13 @@ from .sweep import sweep
 #: why the modes' report has no first-order column
 MODES_FIRST_ORDER = ("none: the natural frequencies' design derivatives need the model's third "
                      "derivatives, which mbd2d does not write; the Monte Carlo columns alone")
+#: why the frequency response's report has no first-order column
+FRF_FIRST_ORDER = ("none: the frequency response's design derivatives need the model's third "
+                   "derivatives, which mbd2d does not write; the Monte Carlo columns alone")
+#: the frequency response's outputs: (magnitude, phase in degrees) of the coordinates' and the
+#: drivers' efforts' responses, each over ("frequency", "coordinate" | "driver", "input")
+FRF_OUTPUTS = {"magnitude": "response", "phase": "response",
+               "effort_magnitude": "effort_response", "effort_phase": "effort_response"}
 
 
 @dataclass
@@ -265,6 +275,8 @@ def _nominal(model: ModelDescription, names: list[str] | None, analysis: str,
     when it fails); and which analysis ran."""
     if analysis == "modes":
         return run_modes(model, **_bind(_modes_settings, kw, analysis)), "modes"
+    if analysis == "frf":
+        return run_frf(model, **_bind(_frf_settings, kw, analysis)), "frf"
     if analysis == "kinematics":
         a = _bind(_kinematics_settings, kw, analysis)
         if model.has_masses() and a["maxit"] is None and not a["positions_only"]:
@@ -294,6 +306,9 @@ def _linear_outputs(res: Any, ran: str) -> dict[str, tuple[tuple[str, ...], np.n
         return None if a is None else _rows(res, a)
 
     out = {"q": (("time", "coordinate"), rows(res.q), rows(getattr(res, "dq_dp", None)))}
+    if ran == "frf":                            # (the equilibrium; no sensitivities)
+        return {**out, **{k: (("frequency", "driver" if "effort" in k else "coordinate",
+                               "input"), v, None) for k, v in _frf_values(res).items()}}
     if ran == "modes":                          # (the equilibrium; no sensitivities)
         return {**out, "frequency": (("mode",), res.frequency, None),
                 "damping_ratio": (("eigenvalue",), res.damping_ratio, None),
@@ -314,6 +329,37 @@ def _linear_outputs(res: Any, ran: str) -> dict[str, tuple[tuple[str, ...], np.n
     return out
 
 
+def _frf_drivers(res: Any) -> list[str]:
+    """The drivers of a frequency response's model (their efforts' responses)."""
+    p = res.packed
+    return [c for c in p.constraint_names if driver_row(p, c) is not None]
+
+
+def _frf_complex(res: Any) -> dict[str, np.ndarray]:
+    """The nominal frequency response's complex outputs: "response" and "effort_response"
+    (the drivers' efforts, -lambda of their rows), (frequency, entry, input)."""
+    rows = [driver_row(res.packed, c) for c in _frf_drivers(res)]
+    return {"response": res.response, "effort_response": -res.lam_response[:, rows, :]}
+
+
+def _frf_values(res: Any) -> dict[str, np.ndarray]:
+    """The nominal frequency response's outputs (FRF_OUTPUTS): magnitudes and phases
+    (degrees) of the coordinates' and, with drivers, the efforts' responses."""
+    h = _frf_complex(res)
+    return {k: (np.abs(h[src]) if "magnitude" in k else np.degrees(np.angle(h[src])))
+            for k, src in FRF_OUTPUTS.items() if h[src].shape[1]}
+
+
+def _frf_samples(mc: Any, ok: np.ndarray, name: str, nom_h: np.ndarray) -> np.ndarray:
+    """The completed samples' values of a frequency response output: magnitudes, or phases
+    as the nominal's phase plus each sample's phase relative to it (in (-180, 180] degrees:
+    no jumps of 360 between samples near +-180)."""
+    h = mc[FRF_OUTPUTS[name]].values[ok]
+    if "magnitude" in name:
+        return np.abs(h)
+    return np.degrees(np.angle(nom_h)) + np.degrees(np.angle(h * np.conj(nom_h)))
+
+
 def _measure_specs(measures: Any, analysis: str) -> list[str]:
     """The measures asked for (each has exact design derivatives).
 
@@ -325,7 +371,7 @@ def _measure_specs(measures: Any, analysis: str) -> list[str]:
     specs = measure_list(measures)
     for spec in specs:
         parse_measure(spec)
-    if specs and analysis in ("statics", "modes"):
+    if specs and analysis in ("statics", "modes", "frf"):
         raise ModelError(f"measures are columns of a run over time, not of {analysis}",
                          "tolerance")
     return list(specs)
@@ -423,9 +469,13 @@ def tolerance(model: ModelDescription, sigma: Mapping[str, Any], analysis: str =
         The nominal model.
     sigma : dict
         Parameter name -> standard deviation (>= 0), in the parameter's units.
-    analysis : {"kinematics", "inverse_dynamics", "statics", "dynamics"}
+    analysis : {"kinematics", "inverse_dynamics", "statics", "dynamics", "modes", "frf"}
         As :func:`mbd2d.sweep`; dynamics with method dopri5 or generalized-alpha (the ones
-        with sensitivities).
+        with sensitivities); modes and frf by Monte Carlo alone (frf: ``magnitude`` and
+        ``phase``, degrees, of every response over ("frequency", "coordinate", "input"),
+        with drivers ``effort_magnitude`` and ``effort_phase`` over ("frequency", "driver",
+        "input"); a sample's phase is taken relative to the nominal's, so samples near
+        +-180 degrees do not jump by 360).
     samples : int
         Monte Carlo variants, drawn with p ~ Normal(p0, sigma) (default 200; 0 skips the
         Monte Carlo estimate; a model with contacts or joint friction needs them: its report
@@ -470,12 +520,11 @@ def tolerance(model: ModelDescription, sigma: Mapping[str, Any], analysis: str =
     """
     xr = xarray()
     params, sig = _sigma(model, sigma)
-    if not isinstance(analysis, str) or analysis not in ANALYSES or analysis == "frf":
-        known = ", ".join(a for a in ANALYSES if a != "frf")
-        raise ModelError(f"unknown analysis {analysis!r}; use one of {known} (the frequency "
-                         "response's scatter: mbd2d.sweep(..., analysis=\"frf\") of "
-                         "mbd2d.tolerance_samples(...))", "tolerance")
-    rough = MODES_FIRST_ORDER if analysis == "modes" else _not_smooth(model)
+    if not isinstance(analysis, str) or analysis not in ANALYSES:
+        raise ModelError(f"unknown analysis {analysis!r}; use one of {', '.join(ANALYSES)}",
+                         "tolerance")
+    rough = {"modes": MODES_FIRST_ORDER, "frf": FRF_FIRST_ORDER}.get(analysis) or \
+        _not_smooth(model)
     names = [str(n) for n in sigma]
     n = whole(samples, "samples", "tolerance", 0, 10**8)
     seed = _seed(seed)
@@ -496,13 +545,16 @@ def tolerance(model: ModelDescription, sigma: Mapping[str, Any], analysis: str =
                    workers=workers, progress=progress, measures=specs or None,
                    **analysis_kwargs)
     ok = mc.status.values == 0 if mc is not None else np.zeros(0, dtype=bool)
-    times = np.array([res.t]) if ran in ("statics", "modes") else np.asarray(res.t)
+    times = np.array([res.t]) if ran in ("statics", "modes", "frf") else np.asarray(res.t)
     data: dict[str, Any] = {}
     for name, (dims, nom, s) in list(outs.items()):
-        if s is None and (mc is None or name not in mc):
+        own = name in FRF_OUTPUTS and ran == "frf"       # (the sweep's complex response)
+        if s is None and (mc is None or (name not in mc and not own)):
             del outs[name]                      # no statistic of it
             continue
-        vals = None if mc is None or name not in mc else _as_nominal(mc[name].values[ok], nom)
+        vals = None if mc is None else \
+            _frf_samples(mc, ok, name, _frf_complex(res)[FRF_OUTPUTS[name]]) if own else \
+            _as_nominal(mc[name].values[ok], nom)
         if vals is not None and vals.ndim == 2 and nom.ndim == 1:
             nom = nom[:vals.shape[1]]           # (a modes sweep with fewer modes)
         data[name] = (dims, nom)
@@ -516,6 +568,10 @@ def tolerance(model: ModelDescription, sigma: Mapping[str, Any], analysis: str =
     if ran == "modes":
         coords["mode"] = np.arange(data["frequency"][1].shape[0])
         coords["eigenvalue"] = np.arange(data["damping_ratio"][1].shape[0])
+    if ran == "frf":
+        coords.update(frequency=res.frequencies, input=list(res.inputs))
+        if "effort_magnitude" in outs:
+            coords["driver"] = _frf_drivers(res)
     if specs:
         coords["measure"] = specs
     if "lam" in outs:
