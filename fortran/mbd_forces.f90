@@ -37,6 +37,7 @@ module mbd_forces
   public :: force_known, force_raw_length, force_prepare, force_eval, force_exponents
   public :: force_next_break
   public :: force_is_contact, force_is_count, force_eval_d, force_eval_dm, force_rows_d
+  public :: force_rate_d
 
   integer, parameter :: FRC_SPRING = 1, FRC_TORQUE = 2, FRC_POINT = 3, FRC_ROTSPRING = 4
   !> contacts: kind FRC_CONTACT0 + geometry - 1 (mbd_contact GEO_*), up to FRC_CONTACT1
@@ -453,6 +454,52 @@ contains
       end if
     end do
   end subroutine force_eval_dm
+
+  !> The change of a force's generalized force per unit rate of its parameters' change tp
+  !! (a parameter varied in time, p = p0 + P(t): the frequency response's and the
+  !! linearized system's rate input). A spring-damper's points moving in their bodies at
+  !! s'_dot = tp(1:2), tp(3:4) move its ends at A s'_dot (a ground point at s'_dot), which
+  !! its damper sees:
+  !!   dl_dot = u . (A_j s'_j_dot - A_i s'_i_dot),  dT = c dl_dot,  dQ = -grad l dT;
+  !! no other parameter of any kind acts through its rate (a free length or an angle0 is
+  !! not seen by the damper, a point force has no velocity).
+  pure subroutine force_rate_d(kind, p, tp, si, sj, ql, qdl, t, tforce)
+    integer, intent(in) :: kind             !! force kind
+    real(wp), intent(in) :: p(:), tp(:)     !! prepared parameters and their rate
+    integer, intent(in) :: si, sj           !! slot ids of the bodies (0 = ground)
+    real(wp), intent(in) :: ql(NLOC), qdl(NLOC)  !! local coordinates and velocities
+    real(wp), intent(in) :: t               !! time
+    real(wp), intent(out) :: tforce(NLOC)   !! change of the generalized force
+    type(kloc) :: xs
+    type(spring_v) :: v
+    real(wp) :: dv(2), tt
+    tforce = zero
+    if (kind /= FRC_SPRING) return
+    if (.not. (any(abs(tp(1:4)) > zero) .and. abs(p(6)) > zero)) return
+    xs = local_state(ql, qdl)
+    call spring_values(xs, p, si, sj, t, v)
+    if (.not. v%l > zero) return
+    dv = moved(sj, tp(3:4)) - moved(si, tp(1:2))
+    tt = p(6) * dot_product(v%u, dv)
+    if (si > 0) then
+      tforce(1:2) = tt * v%u
+      tforce(3) = tt * dot_product(v%u, v%bi)
+    end if
+    if (sj > 0) then
+      tforce(4:5) = -tt * v%u
+      tforce(6) = -tt * dot_product(v%u, v%bj)
+    end if
+  contains
+    !> A s'_dot of a slot's point (ground: s'_dot itself, its frame the global one).
+    pure function moved(slot, sd) result(w)
+      integer, intent(in) :: slot
+      real(wp), intent(in) :: sd(2)
+      real(wp) :: w(2)
+      w = sd
+      if (slot == 0) return
+      w = [xs%c(slot) * sd(1) - xs%s(slot) * sd(2), xs%s(slot) * sd(1) + xs%c(slot) * sd(2)]
+    end function moved
+  end subroutine force_rate_d
 
   !> force_eval_d along up to four directions given as rows (the local slots' tqr, tqdr
   !! (4, NLOC), the rows past np zero) with the parameters' changes tp (size(p), np;

@@ -5,10 +5,11 @@
 !!
 !! About the equilibrium q*, lambda* (drivers held at t) the motion obeys to first order
 !! (Geradin and Cardona ch. 11; the statics sensitivities' linearization, mbd_sens_dynamics)
-!!   M dq'' + C dq' + K dq + J_a^T dlambda = r P e^(i Omega t),
+!!   M dq'' + C dq' + K dq + J_a^T dlambda = (r + i Omega Q_p_dot) P e^(i Omega t),
 !!   J_a dq = -Phi_p,a P e^(i Omega t)
 !! with r = Q_p - J_p^T lambda*, K = K_lambda - Q_q and C = -Q_q_dot, all exact
-!! (mbd_sensitivity). The steady response dq = H(Omega) P e^(i Omega t) is H = s_n + N z:
+!! (mbd_sensitivity); Q_p_dot the forces' change per unit rate of p (a damper whose point
+!! moves: a road under a damped tyre; sens_force_rate), carried below with C s_n (cs). The steady response dq = H(Omega) P e^(i Omega t) is H = s_n + N z:
 !! J_a s_n = -Phi_p,a (the minimum-norm solution), N a basis of J_a's null space, and
 !!   (K_r - Omega^2 M_r + i Omega C_r) z = N^T (r - (K - Omega^2 M + i Omega C) s_n),
 !! K_r = N^T K N, M_r = N^T M N, C_r = N^T C N; Omega = 0 gives the statics sensitivity dq*/dp.
@@ -37,6 +38,7 @@ module mbd_frf
   use mbd_sensitivity, only: sens_t
   use mbd_sens_dynamics, only: statics_load, sens_stiffness_mul, sens_damping_mul, sens_at_rest, &
                                proj_particular, proj_multipliers, sens_tangent_pattern
+  use mbd_sensitivity, only: sens_force_rate
   use mbd_dynamics, only: dyn_work_t, dyn_null_basis, dyn_factor_projection, dyn_pattern_mul
   implicit none
   private
@@ -396,7 +398,9 @@ contains
   !> The linearized motion's parts about the rest state (q, t, lam), every one exact: N, a
   !! basis of J_a's null space (dyn_null_basis), K N, C N, M N and the reduced K_r = N^T K N,
   !! C_r = N^T C N, M_r = N^T M N; per parameter r = Q_p - J_p^T lambda, the minimum-norm
-  !! s_n (J_a s_n = -Phi_p,a) and K s_n, C s_n, M s_n. Leaves s at rest (sens_at_rest) and the
+  !! s_n (J_a s_n = -Phi_p,a) and K s_n, M s_n, and C s_n - Q_p_dot in cs: the parameter's
+  !! rate forces the motion by (Q_p_dot - C s_n) p_dot (a damper whose point moves, and the
+  !! damping of the motion s_n p imposes), which enters each equation as -C s_n alone did. Leaves s at rest (sens_at_rest) and the
   !! projection factored (dyn_factor_projection) for the multipliers' least squares.
   subroutine linear_parts(m, w, s, q, t, lam, nb, kn, cn, mn, kr, cr, mr, sn, ks, cs, ms, &
                           rr, status, msg)
@@ -463,6 +467,8 @@ contains
       end if
       call kmul(sn(:, k), ks(:, k))
       call cmul(sn(:, k), cs(:, k))
+      call sens_force_rate(m, s, k, q, z, t, y)   ! the rate forcing Q_p_dot, with C s_n's
+      cs(:, k) = cs(:, k) - y
       ms(:, k) = m%mdiag * sn(:, k)
     end do
   contains

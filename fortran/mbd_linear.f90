@@ -7,9 +7,10 @@
 !! About the rest state q*, lambda* (drivers held at t) the motion obeys to first order (the
 !! frequency response's equations, mbd_frf, in the time domain): dq = s_n p + N z,
 !!   M_r z'' + C_r z' + K_r z = G0 p + G1 p' + G2 p'',
-!! G0 = N^T (r - K s_n), G1 = -N^T C s_n, G2 = -N^T M s_n (mbd_frf's linear_parts: N a basis
-!! of J_a's null space, s_n the minimum-norm solution of J_a s_n = -Phi_p,a, r = Q_p - J_p^T
-!! lambda*). A base motion (s_n /= 0) forces through p' and p'' as well; two changes of
+!! G0 = N^T (r - K s_n), G1 = N^T (Q_p_dot - C s_n), G2 = -N^T M s_n (mbd_frf's
+!! linear_parts: N a basis of J_a's null space, s_n the minimum-norm solution of
+!! J_a s_n = -Phi_p,a, r = Q_p - J_p^T lambda*, Q_p_dot the forces' change per unit rate of
+!! p: a damper whose point moves). A base motion (s_n /= 0) forces through p' and p'' as well; two changes of
 !! variable take them out (the standard realization of a proper transfer function):
 !!   w = z - M_r^-1 G2 p:        M_r w'' + C_r w' + K_r w = E0 p + E1 p',
 !!                               E0 = G0 - K_r M_r^-1 G2, E1 = G1 - C_r M_r^-1 G2;
@@ -100,7 +101,8 @@ contains
             'every moving body a mass and an inertia'
       return
     end if
-    ! G0 = N^T (r - K s_n) in e0, G1 = -N^T C s_n in e1, G2 = -N^T M s_n in y2
+    ! G0 = N^T (r - K s_n) in e0, G1 = N^T (Q_p_dot - C s_n) in e1 (cs holds C s_n -
+    ! Q_p_dot), G2 = -N^T M s_n in y2
     call dgemm('T', 'N', f, np, n, one, nb, n, rr - ks, n, zero, e0, f)
     call dgemm('T', 'N', f, np, n, -one, nb, n, cs, n, zero, e1, f)
     call dgemm('T', 'N', f, np, n, -one, nb, n, ms, n, zero, y2, f)

@@ -31,7 +31,8 @@ module mbd_sensitivity
                              CON_TRANSLATIONAL, DRV_REL_DIST, CON_REVOLUTE
   use mbd_joint_revolute, only: revolute_second_sides, revolute_second_rows, revolute_param_sides
   use mbd_joint_translational, only: translational_second, translational_param
-  use mbd_forces, only: force_eval_d, force_eval_dm, force_is_count, force_exponents, &
+  use mbd_forces, only: force_eval_d, force_eval_dm, force_rate_d, force_is_count, &
+                        force_exponents, &
                         force_rows_d, FRC_SPRING
   implicit none
   private
@@ -40,7 +41,7 @@ module mbd_sensitivity
             block_apply, block_apply_t, block_apply_cols, &
             sens_klam, sens_klam_list, sens_jpt_lam, sens_force_d, sens_force_dm, sens_force_jac, &
             sens_force_rows, sens_revolute_rows, sens_translational_rows, sens_rows_rhs, &
-            sens_eval_d
+            sens_eval_d, sens_force_rate
 
   integer, parameter :: PT_RPAR = 1, PT_MASS = 2, PT_GRAV = 3, PT_FPAR = 4  !! table ids
 
@@ -1222,6 +1223,32 @@ contains
     real(wp), intent(out) :: y(:)            !! (nq)
     call sens_force_dm(m, s, k, 1, q, qd, m%nq, dq, dqd, t, y)
   end subroutine sens_force_d
+
+  !> The change of the applied generalized forces per unit rate of parameter k, Q_p_dot
+  !! (force_rate_d: a spring-damper's points moving in their bodies; zero for every other
+  !! parameter): the frequency response's and the linearized system's rate forcing.
+  pure subroutine sens_force_rate(m, s, k, q, qd, t, y)
+    type(model_t), intent(in) :: m           !! model with dynamics data
+    type(sens_t), intent(in) :: s            !! parameters
+    integer, intent(in) :: k                 !! parameter
+    real(wp), intent(in) :: q(:), qd(:)      !! state
+    real(wp), intent(in) :: t                !! time
+    real(wp), intent(out) :: y(:)            !! (nq) Q_p_dot
+    real(wp) :: ql(NLOC), qdl(NLOC), fl(NLOC)
+    integer :: f, j, c, si, sj, n0, n1
+    y = zero
+    do f = 1, m%nf
+      if (.not. s%faff(f, k)) cycle
+      n0 = m%fpo(f); n1 = n0 + m%fpn(f) - 1
+      si = merge(1, 0, m%fbi(f) > 0); sj = merge(2, 0, m%fbj(f) > 0)
+      call force_slots(m, f, q, qd, ql, qdl)
+      call force_rate_d(m%fkind(f), m%fp(n0:n1), s%tfp(n0:n1, k), si, sj, ql, qdl, t, fl)
+      do j = 1, NLOC
+        c = m%floc(j, f)
+        if (c > 0) y(c) = y(c) + fl(j)
+      end do
+    end do
+  end subroutine sens_force_rate
 
   !> sens_force_d along nk directions at one state, column j of dq, dqd with the parameter
   !! k0 + j - 1 (k0 = 0: no parameter, nk = 1): each force's state gathered once and a

@@ -45,6 +45,48 @@ def test_a_block_on_a_spring_damper(c: float) -> None:
     assert res.stability == "stable" and abs(res.q[1] - (-0.5 - m * G / k)) < 1e-12
 
 
+def road_block(rot: float | None = None) -> mbd2d.Model:
+    """A 2 kg block on a vertical guide on a damped tyre (k 36, c 1.5) whose lower end is a
+    point of the ground (rot None) or of an arm welded to the ground at the angle rot."""
+    m = mbd2d.Model("road", gravity=(0.0, 0.0))
+    m.add_body("block", (0.0, 1.0, 0.0), mass=2.0, inertia=0.1)
+    m.add_translational(["ground", "block"], [[0, 0], [0, 0]], [[0, 1], [0, 1]], name="guide")
+    base = "ground"
+    if rot is not None:
+        m.add_body("arm", (0.0, 0.0, rot), mass=1.0, inertia=0.1)
+        m.add_weld(["ground", "arm"], [[0.0, 0.0], [0.0, 0.0]], angle=rot, name="fix")
+        base = "arm"
+    m.add_spring([base, "block"], [[0.0, 0.0], [0.0, 0.0]], stiffness=36.0, damping=1.5,
+                 length0=1.0, name="tyre")
+    return m
+
+
+@pytest.mark.parametrize("rot", [None, np.pi / 6])
+def test_a_road_under_a_damped_tyre(rot: float | None) -> None:
+    """The tyre's lower point moved (a road): the damper sees the point's velocity, so the
+    block follows by (k + i c w) / (k - m w^2 + i c w) per unit of the point's travel along
+    the tyre (on the arm at 30 degrees its local x is sin 30 of that, its local y cos 30);
+    the free length moved is no road: k / (k - m w^2 + i c w) (the damper does not see it).
+    The linearized system's transfer function is the same (the rate enters B); before, the
+    road's rate was left out (k / D for the point as for the free length)."""
+    k, c, m = 36.0, 1.5, 2.0
+    model = road_block(rot)
+    inputs = ["force.tyre.points.0.0", "force.tyre.points.0.1", "force.tyre.length0"]
+    res = model.frequency_response(inputs, FREQS)
+    w = 2 * np.pi * FREQS
+    d = k - m * w**2 + 1j * c * w
+    along = (0.0, 1.0) if rot is None else (np.sin(rot), np.cos(rot))
+    wants = [a * (k + 1j * c * w) / d for a in along] + [k / d]    # (the tyre is below)
+    lin = model.linearize(inputs)
+    y = lin.outputs.index("block.y")
+    for j, (name, want) in enumerate(zip(inputs, wants)):
+        np.testing.assert_allclose(res.response_of("block", "y", name), want, rtol=1e-12,
+                                   atol=1e-15)
+        tf = [(lin.c @ np.linalg.solve(1j * wk * np.eye(2) - lin.a, lin.b) + lin.d)[y, j]
+              for wk in w]
+        np.testing.assert_allclose(tf, want, rtol=1e-12, atol=1e-15)
+
+
 def test_a_damper_without_a_spring_and_no_zero_frequency() -> None:
     """A block on a horizontal guide with a damper only: 1 / (-m w^2 + i c w) for a force;
     at 0 Hz the response is unbounded (a motion without stiffness): a SingularJacobianError
