@@ -10,7 +10,9 @@ ratios. Then the car driven by the road: model.frequency_response() gives the bo
 and pitch per unit rise of the road under the front wheel (the front tyre's ground point
 moved: a base motion) from 0.1 to 30 Hz, and the nonlinear forward dynamics driven by a
 1 mm sinusoidal road (the tyre's actuator force k_t u(t), the same load) settles on the same
-amplitude and phase at three frequencies. Last, the designer's question: how the road
+amplitude and phase at three frequencies; the car as a state-space system with the road as
+its input (model.linearize) has the modes' damped eigenvalues as its poles and the road
+response as its transfer function. Last, the designer's question: how the road
 response changes with the suspension damping (one mbd2d.sweep of the frequency response over
 40 dampings: every variant's Bode curves and its peak bounce).
 
@@ -185,6 +187,26 @@ def shapes_figure(res: mbd2d.ModesResult, path: Path) -> None:
     plt.close(fig)
 
 
+def state_space(model: mbd2d.Model, res: mbd2d.ModesResult,
+                frf: mbd2d.FrequencyResponseResult) -> list[str]:
+    """The car as a state-space system with the road as its input (model.linearize: the
+    matrices a controller is designed on): its poles are the damped eigenvalues of the
+    modes, its transfer function C (i w I - A)^-1 B + D the road response; the problems."""
+    lin = model.linearize(ROAD)
+    poles, eig = np.linalg.eigvals(lin.a), np.asarray(res.eigenvalues)
+    gap = max(float(np.abs(eig - s).min()) for s in poles) / float(np.abs(eig).max())
+    i = len(frf.frequencies) // 2
+    w = 2 * np.pi * frf.frequencies[i]
+    tf = lin.c @ np.linalg.solve(1j * w * np.eye(lin.a.shape[0]) - lin.a, lin.b) + lin.d
+    dev = float(np.abs(tf[:, 0] - frf.response[i, :, 0]).max()
+                / np.abs(frf.response[i, :, 0]).max())
+    print(f"state space (model.linearize, road input): {lin.a.shape[0]} states; its poles are "
+          f"the damped eigenvalues to {gap:.1e}, its transfer function at "
+          f"{frf.frequencies[i]:.3g} Hz the road response to {dev:.1e}")
+    return [] if gap < 1e-9 and dev < 1e-9 else [f"the state-space system departs {gap:.1e} "
+                                                 f"and {dev:.1e} from the modes and the response"]
+
+
 def run(out: Path) -> tuple[str, list[str]]:
     """Modes, the release checks, the pictures; (problem or "", the files written)."""
     model = mbd2d.load(MODEL)
@@ -219,6 +241,7 @@ def run(out: Path) -> tuple[str, list[str]]:
             problems.append(f"the driven dynamics at {f:g} Hz departs {err:.1e}")
     peak_f, peak = frf.peak("body", "y")
     print(f"largest bounce per unit road rise {peak:.3g} at {peak_f:.3g} Hz")
+    problems += state_space(model, res, frf)
     files.append(str(out / "vibration_modes_road.png"))
     road_figure(frf, checks, Path(files[-1]))
     files.append(str(out / "vibration_modes_road_damping.png"))
