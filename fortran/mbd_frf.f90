@@ -114,7 +114,7 @@ contains
     call linear_parts(m, w, s, q, t, lam, nb, kn, cn, mn, kr, cr, mr, sn, ks, cs, ms, rr, &
                       status, msg)
     if (status /= MBD_OK) then
-      msg = 'frequency response: ' // msg; return
+      msg = 'frequency response: ' // msg(1:MSG_LEN - len('frequency response: ')); return
     end if
     if (hess) call hess_setup(hess, status)       ! (hess false: M_r singular, the dense LU)
     if (status /= MBD_OK) return

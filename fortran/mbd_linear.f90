@@ -85,7 +85,7 @@ contains
     call linear_parts(m, w, s, q, t, lam, nb, kn, cn, mn, kr, cr, mr, sn, ks, cs, ms, rr, &
                       status, msg)
     if (status /= MBD_OK) then
-      msg = 'linearized system: ' // msg; return
+      msg = 'linearized system: ' // msg(1:MSG_LEN - len('linearized system: ')); return
     end if
     allocate (y2(f, np), e0(f, np), e1(f, np), y1(f, np), mk(f, f), mc(f, f), ipiv(f), &
               stat=ist)
