@@ -149,6 +149,28 @@ def _stepper_outcome(model: mbd2d.Model, times: list[Any], names: set[str],
     return out
 
 
+def _linear_outcome(model: mbd2d.Model, names: set[str], bounds: dict[str, int]
+                    ) -> list[str]:
+    """The linear analyses about the equilibrium: the modes, and with the model's first
+    design parameter as the input the frequency response and the linearized system."""
+    out = [_typed("modes", lambda: model.modes(count=2), names, bounds,
+                  lambda r: _finite("the modes", r.omega2, r.shapes, r.eigenvalues.real,
+                                    r.eigenvalues.imag))]
+    try:
+        inputs = list(model.parameters())[:1]
+    except mbd2d.ModelError as exc:
+        H.assert_names_entry(exc, names, bounds)
+        return out + ["parameters:ModelError"]
+    if not inputs:
+        return out
+    out.append(_typed("frf", lambda: model.frequency_response(inputs, [0.0, 1.3]), names,
+                      bounds, lambda r: _finite("the response", r.response.real,
+                                                r.response.imag, r.q, r.lam)))
+    out.append(_typed("linearize", lambda: model.linearize(inputs), names, bounds,
+                      lambda r: _finite("the state matrices", r.a, r.b, r.c, r.d, r.q)))
+    return out
+
+
 def exercise_all(model: mbd2d.Model, names: set[str], bounds: dict[str, int]) -> tuple[str, ...]:
     """test_hostile's exercise (counts, kinematics, DOF, Phi...), then statics, inverse and
     forward dynamics (fixed steps: each case's work is bounded) and the stepper; only
@@ -166,6 +188,7 @@ def exercise_all(model: mbd2d.Model, names: set[str], bounds: dict[str, int]) ->
                                                              h=0.01), names, bounds,
                               _dynamic_finite))
         out += _stepper_outcome(model, [0.01, 0.02], names, bounds)
+        out += _linear_outcome(model, names, bounds)
     bad = [f"{w.category.__name__}: {w.message}" for w in caught
            if not issubclass(w.category, H.ALLOWED_WARNINGS)]
     assert not bad, f"unexpected warnings: {bad}"
