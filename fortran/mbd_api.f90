@@ -1231,9 +1231,12 @@ contains
   !! x' = A x + B p, dq = C x + D p, in the leading 2 nfree states of a, b, c (model units:
   !! C's rows and D in the coordinates' units, B and D per unit of each parameter; the states
   !! are not scaled). iinfo(1) = nfree; MBD_BAD_COUNT when the arrays hold fewer states than
-  !! 2 nfree (call again with that many).
+  !! 2 nfree (call again with that many). With velocities /= 0, c and d have 2 nq rows: the
+  !! coordinates', then their velocities' (C A, C B; MBD_BAD_SETTING naming the input in
+  !! iinfo(2) when D /= 0: that input moves the mechanism directly, its velocities by p').
   subroutine api_linearize(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, t, equilibrium, ptab, &
-                           q, lam, stable, resid, a, b, c, d, iinfo, status, msg, solver)
+                           q, lam, stable, resid, a, b, c, d, iinfo, status, msg, solver, &
+                           velocities)
     integer, intent(in) :: nb, ctab(:, :), ftab(:, :), equilibrium, ptab(:, :)
     real(wp), intent(in) :: rpar(:), bmass(:, :), grav(2), fpar(:), q0(:), t
     real(wp), intent(out) :: q(:), lam(:), resid, a(:, :), b(:, :), c(:, :), d(:, :)
@@ -1241,25 +1244,42 @@ contains
     integer, intent(out) :: status              !! MBD_OK, < 0 input, > 0 numerical
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
     integer, intent(in), optional :: solver     !! 0 auto (default), 1 dense, 2 banded
+    integer, intent(in), optional :: velocities !! 1: the velocities' outputs too
     type(model_t) :: m
     type(dyn_work_t) :: w
     type(sens_t) :: sens
     real(wp), allocatable :: ones(:)
-    integer :: bad, nfree, i, ns
+    integer :: bad, nfree, i, ns, nqo, k
+    logical :: vel
     q = zero; lam = zero; stable = 0; resid = zero; a = zero; b = zero; c = zero; d = zero
     call static_start(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, t, m, w, q, lam, iinfo, &
                       status, msg, solver)
     ns = size(a, 1)
+    vel = .false.
+    if (present(velocities)) vel = velocities /= 0
+    nqo = merge(2, 1, vel) * size(q)
     if (status == MBD_OK) then
       if (size(a, 2) /= ns .or. size(b, 1) /= ns .or. size(c, 2) /= ns .or. &
-          size(b, 2) /= size(ptab, 2) .or. size(c, 1) /= m%nq .or. &
-          any(shape(d) /= [m%nq, size(ptab, 2)])) then
+          size(b, 2) /= size(ptab, 2) .or. size(c, 1) /= nqo .or. &
+          any(shape(d) /= [nqo, size(ptab, 2)])) then
         status = MBD_BAD_COUNT; msg = 'linearized system: the output arrays do not match'
       end if
     end if
     if (status == MBD_OK) call linear_setup(m, w, sens, ctab, rpar, ftab, fpar, ptab, q, t, &
                                             equilibrium, lam, stable, resid, iinfo, status, msg)
-    if (status == MBD_OK) then
+    if (status == MBD_OK .and. vel) then
+      call linear_state_space(m, w, sens, q, t, lam, a, b, c(1:m%nq, :), d(1:m%nq, :), &
+                              nfree, status, msg, c(m%nq + 1:, :), d(m%nq + 1:, :))
+      iinfo(1) = nfree
+      do k = 1, size(ptab, 2)                   ! the velocities need D = 0
+        if (status == MBD_OK .and. any(abs(d(1:m%nq, k)) > zero)) then
+          status = MBD_BAD_SETTING; iinfo(2) = -2000000 - k
+          msg = 'velocity outputs: this input moves the mechanism directly (D /= 0), so '// &
+                'its velocities would need the input''s rate; take the positions alone, '// &
+                'or an input that acts through a force'
+        end if
+      end do
+    else if (status == MBD_OK) then
       call linear_state_space(m, w, sens, q, t, lam, a, b, c, d, nfree, status, msg)
       iinfo(1) = nfree
     end if
@@ -1273,9 +1293,11 @@ contains
           return
         end if
         call sens_units2(m, sens, b, ones, .false.)         ! per unit of each parameter
-        call sens_units2(m, sens, d, m%cunit, .false.)
+        call sens_units2(m, sens, d(1:m%nq, :), m%cunit, .false.)
+        if (vel) call sens_units2(m, sens, d(m%nq + 1:, :), m%cunit, .false.)
         do i = 1, ns
-          c(:, i) = c(:, i) * m%cunit
+          c(1:m%nq, i) = c(1:m%nq, i) * m%cunit
+          if (vel) c(m%nq + 1:, i) = c(m%nq + 1:, i) * m%cunit
         end do
       end if
     end if

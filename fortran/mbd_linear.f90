@@ -18,7 +18,10 @@
 !!   A = [0, I; -M_r^-1 K_r, -M_r^-1 C_r],
 !!   B = [M_r^-1 E1; M_r^-1 (E0 - C_r M_r^-1 E1)],
 !!   C = [N, 0],   D = s_n + N M_r^-1 G2.
-!! With forces alone as inputs (s_n = 0) w = z and v = z'. C (i Omega I - A)^-1 B + D is the
+!! With forces alone as inputs (s_n = 0) w = z and v = z'. The velocities' outputs
+!! dq' = C x' + D p' = C A x + C B p + D p' = [0, N] x + N M_r^-1 E1 p are proper only
+!! where D = 0 (an input that moves the mechanism directly moves its velocities by p'):
+!! cv = [0, N], dv = N M_r^-1 E1. C (i Omega I - A)^-1 B + D is the
 !! frequency response H(Omega) of mbd_frf. The states are coordinates on the basis N (its
 !! columns orthonormal in the metric of dyn_null_basis): not unique, as any realization.
 !! Memory: N, K N, C N, M N (nq x f), five nq x np arrays and three f x f matrices, checked
@@ -44,7 +47,7 @@ contains
   !> A (2f, 2f), B (2f, np), C (nq, 2f), D (nq, np) of the linearized motion about (q, t,
   !! lam), core units, in the leading parts of the arrays (f the free motions; the arrays'
   !! state dimension at least 2f, else MBD_BAD_COUNT with nfree set).
-  subroutine linear_state_space(m, w, s, q, t, lam, a, b, c, d, nfree, status, msg)
+  subroutine linear_state_space(m, w, s, q, t, lam, a, b, c, d, nfree, status, msg, cv, dv)
     type(model_t), intent(in) :: m              !! model with dynamics data
     type(dyn_work_t), intent(inout) :: w        !! work arrays (dyn_init done)
     type(sens_t), intent(inout) :: s            !! the inputs (sens_setup done)
@@ -57,6 +60,8 @@ contains
     integer, intent(out) :: nfree               !! f
     integer, intent(out) :: status  !! MBD_OK, MBD_SINGULAR, MBD_BAD_COUNT, MBD_NO_MEMORY
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
+    !> (nq, >= 2f), (nq, np): the velocities' output matrix C A and feedthrough C B
+    real(wp), intent(out), optional :: cv(:, :), dv(:, :)
     ! N, K N, C N, M N; s_n, K s_n, C s_n, M s_n, r; K_r, C_r, M_r (then M_r's LU); G and
     ! the solves' right-hand sides
     real(wp), allocatable :: nb(:, :), kn(:, :), cn(:, :), mn(:, :), sn(:, :), ks(:, :), &
@@ -68,6 +73,8 @@ contains
     character(len=MSG_LEN) :: what
     status = MBD_OK; msg = ''
     a = zero; b = zero; c = zero; d = zero
+    if (present(cv)) cv = zero
+    if (present(dv)) dv = zero
     n = m%nq; f = n - w%na; np = s%np
     nfree = f
     if (size(a, 1) < 2 * f .or. size(a, 2) < 2 * f .or. size(b, 1) < 2 * f .or. &
@@ -125,5 +132,7 @@ contains
     b(f + 1:2 * f, 1:np) = e0
     c(:, 1:f) = nb(:, 1:f)                        ! C = [N, 0]
     call dgemm('N', 'N', n, np, f, one, nb, n, y2, f, one, d, size(d, 1))   ! D = s_n + N Y2
+    if (present(cv)) cv(:, f + 1:2 * f) = nb(:, 1:f)                     ! C A = [0, N]
+    if (present(dv)) call dgemm('N', 'N', n, np, f, one, nb, n, y1, f, zero, dv, size(dv, 1))
   end subroutine linear_state_space
 end module mbd_linear

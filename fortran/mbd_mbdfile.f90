@@ -18,7 +18,8 @@
 !!   frequencies <nw>                         (frf: then nw frequencies in Hz, >= 0, any
 !!   <nw reals>                               number per line; the inputs: sensitivities)
 !!   outputs <energy | multipliers | reactions | efforts ...>           (optional columns;
-!!                              modes: "damped" writes the damped eigenvalues instead)
+!!                              modes: "damped" writes the damped eigenvalues instead;
+!!                              linearize: "velocities" the velocities' outputs too)
 !!   gravity <gx> <gy>
 !!   bodies <nb>
 !!   <name> <x0> <y0> <theta0> [<mass> <inertia> <vx0> <vy0> <omega0>]   (nb lines)
@@ -120,6 +121,7 @@ module mbd_mbdfile
     real(wp) :: grav(2) = zero            !! gravity
     !> optional output columns
     logical :: out_energy = .false., out_lam = .false., out_reac = .false., out_eff = .false.
+    logical :: out_vel = .false.          !! linearize: the velocities' outputs too
     logical :: positions_only = .false.   !! kinematics: positions alone
     ! masses, forces and row labels (dynamic analyses)
     logical :: have_masses = .false.      !! body lines carry mass, inertia and v0
@@ -341,9 +343,10 @@ contains
           case ('reactions'); spec%out_reac = .true.
           case ('efforts'); spec%out_eff = .true.
           case ('damped'); spec%out_damped = .true.
+          case ('velocities'); spec%out_vel = .true.
           case default
             call fail('unknown output "' // trim(tok(1:40)) // '"; energy, multipliers, '// &
-                      'reactions, efforts or damped')
+                      'reactions, efforts, damped or velocities')
             exit
           end select
         end do

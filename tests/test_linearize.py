@@ -270,8 +270,53 @@ def test_what_linearize_refuses_or_cannot_do(tmp_path: Path) -> None:
                            text=True, timeout=60)
         assert r.returncode == 2 and needle in r.stderr, r.stderr
     assert solve_file(tmp_path / "m.mbd", tmp_path / "ok.csv").startswith("matrix,row,")
+    # "velocities" is linearize's output alone
+    with pytest.raises(mbd2d.ModelError, match="unknown output 'velocities'"):
+        held_block().export(tmp_path / "k.mbd", analysis="statics", outputs=["velocities"])
+    held_block().export(tmp_path / "s.mbd", analysis="statics")
+    bad = tmp_path / "bad.mbd"
+    bad.write_text((tmp_path / "s.mbd").read_text().replace("\ngravity ",
+                                                            "\noutputs velocities\ngravity ", 1))
+    r = subprocess.run([_solver(), str(bad), str(tmp_path / "o.csv")], capture_output=True,
+                       text=True, timeout=60)
+    assert r.returncode == 2 and "is linearize's" in r.stderr, r.stderr
 
 
 def _solver() -> str:
     from test_standalone import find_solver
     return find_solver()
+
+
+def test_velocity_outputs(tmp_path: Path) -> None:
+    """velocities=True: the coordinates' velocities after them (NAME.y_dot ...): the pushed
+    block's s / (m s^2 + c s + k) at five points s, C A and C B of the positions' system, no
+    feedthrough; the CSV from Python, the command line and mbd2d-solve the same bytes. An
+    input that moves the mechanism directly (the base's driver: D = 1) is refused, named."""
+    from test_standalone import solve_file
+    model, inp = held_block(), "force.push.fy.poly.0"
+    sys_ = model.linearize(inp, velocities=True)
+    pos = model.linearize(inp)
+    nq = len(pos.outputs)
+    assert sys_.outputs == pos.outputs + [f"{c}_dot" for c in pos.outputs]
+    yd = sys_.outputs.index("block.y_dot")
+    for s in S_POINTS:
+        np.testing.assert_allclose(transfer(sys_, s)[yd, 0],
+                                   s / (M_BLOCK * s**2 + C_D * s + K), rtol=1e-13, atol=1e-16)
+    np.testing.assert_array_equal(sys_.c[:nq], pos.c)
+    np.testing.assert_allclose(sys_.c[nq:], pos.c @ pos.a, rtol=0, atol=1e-15)
+    np.testing.assert_allclose(sys_.d[nq:], pos.c @ pos.b, rtol=0, atol=1e-15)
+    py = tmp_path / "py.csv"
+    sys_.to_csv(py)
+    assert "C,block.y_dot,v1," in py.read_text()
+    model.export(tmp_path / "m.mbd", analysis="linearize", inputs=[inp], outputs=["velocities"])
+    assert solve_file(tmp_path / "m.mbd", tmp_path / "s.csv") == py.read_text()
+    toml = tmp_path / "held.toml"
+    toml.write_text(mbd2d.description.toml_io.dumps(model))
+    r = _cli("linearize", str(toml), "--input", inp, "--velocities", "--out",
+             str(tmp_path / "c.csv"))
+    assert r.returncode == 0, r.stderr
+    assert (tmp_path / "c.csv").read_text() == py.read_text()
+    with pytest.raises(mbd2d.ModelError, match="driver.hold.f.poly.0.*moves the mechanism"):
+        model.linearize(["force.push.fy.poly.0", "driver.hold.f.poly.0"], velocities=True)
+    with pytest.raises(mbd2d.ModelError, match="velocities"):
+        model.linearize(inp, velocities="yes")

@@ -110,6 +110,8 @@ program mbd2d_solve
   call api_sizes(spec%nb, spec%ctab, spec%rpar, nq, neq, status, msg, bad)
   if (status /= MBD_OK) call die(2, where(bad, msg))
   drow = driver_rows()
+  if (spec%out_vel .and. spec%analysis /= 'linearize') call die(2, trim(model_path) // &
+    ': the output "velocities" is linearize''s (a run''s CSV has the velocities already)')
   if (spec%analysis == 'check') then
     call run_check()
     stop 0, quiet=.true.
@@ -1011,30 +1013,32 @@ contains
   subroutine run_linearize()
     real(wp), allocatable :: qe(:), lam(:), fpm(:), a(:, :), b(:, :), c(:, :), d(:, :)
     integer, allocatable :: ftm(:, :)
-    integer :: ns, f, u, ios, i, j, k, pass
+    integer :: ns, f, u, ios, i, j, k, pass, nqo
     call linear_checks('linearize')
     if (spec%out_energy .or. spec%out_lam .or. spec%out_eff .or. spec%out_reac .or. &
         spec%out_damped .or. spec%ncase > 0 .or. spec%positions_only .or. &
         spec%nmeas > 0 .or. spec%freq_line > 0) &
-      call die(2, trim(model_path) // ': linearize takes no outputs, cases, measures, '// &
-               'frequencies or positions_only')
+      call die(2, trim(model_path) // ': linearize takes no outputs but "velocities", and '// &
+               'no cases, measures, frequencies or positions_only')
+    nqo = merge(2, 1, spec%out_vel) * nq
     if (spec%npar == 0) call die(2, trim(model_path) // ': linearize needs its inputs: a '// &
       '"sensitivities" block naming the design parameters varied')
     call check_sensitivities()
     call linear_inputs(ftm, fpm)
     ns = max(2 * (nq - neq), 1)
     do pass = 1, 2                                ! again with 2 nfree states (redundancy)
-      call mem_check(REAL_BYTES * (real(ns + nq, wp) * (ns + spec%npar) + nq * spec%npar), &
+      call mem_check(REAL_BYTES * (real(ns + nqo, wp) * (ns + spec%npar) + nq), &
                      'the linearized system (' // trim(itoa(ns)) // ' states)', &
                      'use a model with fewer free motions', status, msg)
       if (status /= MBD_OK) call die(2, trim(model_path) // ': ' // trim(msg))
       if (allocated(a)) deallocate (a, b, c, d)
-      allocate (qe(nq), lam(neq), a(ns, ns), b(ns, spec%npar), c(nq, ns), d(nq, spec%npar), &
-                stat=ierr)
+      allocate (qe(nq), lam(neq), a(ns, ns), b(ns, spec%npar), c(nqo, ns), &
+                d(nqo, spec%npar), stat=ierr)
       if (ierr /= 0) call die(2, 'not enough memory for the linearized system')
       call api_linearize(spec%nb, spec%ctab, spec%rpar, spec%bmass, spec%grav, ftm, fpm, q0, &
                          spec%tstat, merge(0, 1, spec%at_q0), spec%ptab, qe, lam, stable, &
-                         resid, a, b, c, d, iinfo, status, msg, spec%solver)
+                         resid, a, b, c, d, iinfo, status, msg, spec%solver, &
+                         merge(1, 0, spec%out_vel))
       f = iinfo(1)
       if (status /= MBD_BAD_COUNT .or. 2 * f <= ns) exit
       ns = 2 * f
@@ -1057,14 +1061,14 @@ contains
         call lin_entry(u, ios, 'B', state_label(i, f), trim(spec%par_names(k)), b(i, k))
       end do
     end do
-    do i = 1, nq                                  ! C: outputs by states
+    do i = 1, nqo                                 ! C: outputs by states
       do j = 1, 2 * f
-        call lin_entry(u, ios, 'C', coord_label(i), state_label(j, f), c(i, j))
+        call lin_entry(u, ios, 'C', output_label(i), state_label(j, f), c(i, j))
       end do
     end do
-    do i = 1, nq                                  ! D: outputs by inputs
+    do i = 1, nqo                                 ! D: outputs by inputs
       do k = 1, spec%npar
-        call lin_entry(u, ios, 'D', coord_label(i), trim(spec%par_names(k)), d(i, k))
+        call lin_entry(u, ios, 'D', output_label(i), trim(spec%par_names(k)), d(i, k))
       end do
     end do
     close (u)
@@ -1094,12 +1098,16 @@ contains
     end if
   end function state_label
 
-  !> The label of coordinate i: BODY.x, BODY.y, BODY.theta.
-  function coord_label(i) result(label)
+  !> The label of output i: BODY.x, BODY.y, BODY.theta, then (past nq) their velocities
+  !! BODY.x_dot, ...
+  function output_label(i) result(label)
     integer, intent(in) :: i
     character(len=:), allocatable :: label
-    label = trim(spec%body_names((i - 1) / 3 + 1)) // '.' // trim(XYT(mod(i - 1, 3) + 1))
-  end function coord_label
+    integer :: j
+    j = mod(i - 1, nq) + 1
+    label = trim(spec%body_names((j - 1) / 3 + 1)) // '.' // trim(XYT(mod(j - 1, 3) + 1))
+    if (i > nq) label = label // '_dot'
+  end function output_label
 
   !> The frequency response (Model.frequency_response) written as
   !! FrequencyResponseResult.to_csv writes it: one row per frequency, frequency_hz, then for

@@ -10,7 +10,8 @@
                 --damped-out EIGEN.csv --picture MODE.png|MODE.gif --mode K | --damped-mode J]
     mbd2d frf MODEL.toml --input NAME ... --f START:STOP:NUM [--log --t T --at-q0 --solver S]
               [--out FRF.csv --picture BODE.png --body B --coordinate x|y|theta]
-    mbd2d linearize MODEL.toml --input NAME ... [--t T --at-q0 --solver S] [--out SYS.csv]
+    mbd2d linearize MODEL.toml --input NAME ... [--t T --at-q0 --solver S --velocities]
+                    [--out SYS.csv]
     mbd2d sweep MODEL.toml --param NAME=START:STOP:NUM ... [--grid] --t-end T --steps N
                 --out sweep.nc|sweep.csv [--analysis A --t0 T0 --every K --workers W
                 --scheduler ADDRESS --positions-only --method M --rtol R --atol A --h H
@@ -246,6 +247,8 @@ def _parser() -> argparse.ArgumentParser:
                     help="a design parameter as an input (repeatable; `mbd2d parameters "
                     "MODEL` lists them)")
     _linear_point(li)
+    li.add_argument("--velocities", action="store_true", help="the coordinates' velocities as "
+                    "outputs too (inputs that act through forces)")
     li.add_argument("--out", default=None, help="write A, B, C, D as CSV (matrix,row,column,"
                     "value)")
     w = sub.add_parser("sweep", help="one analysis of many variants (design parameters "
@@ -306,6 +309,8 @@ def _parser() -> argparse.ArgumentParser:
     e.add_argument("--at-q0", action="store_true", help="modes: about q0 as given")
     e.add_argument("--damped", action="store_true", help="modes: write the damped "
                    "eigenvalues' table")
+    e.add_argument("--velocities", action="store_true", help="linearize: the velocities' "
+                   "outputs too")
     _frf_settings(e, required=False)
     _sensitivities(e)
     _measures(e)
@@ -468,7 +473,8 @@ def _linearize(model: Model, args: argparse.Namespace) -> int:
     """``mbd2d linearize``: the system's summary printed, then its CSV."""
     if args.out is not None and not str(args.out).lower().endswith(".csv"):
         raise ModelError(f"--out must end in .csv, got {args.out!r}", "command line")
-    res = model.linearize(args.input, t=args.t, equilibrium=not args.at_q0, solver=args.solver)
+    res = model.linearize(args.input, t=args.t, equilibrium=not args.at_q0, solver=args.solver,
+                          velocities=args.velocities)
     print(res.summary())
     if args.out is not None:
         res.to_csv(args.out)
@@ -1057,7 +1063,8 @@ def _main(args: argparse.Namespace) -> int:
             extra = _dynamics_kwargs(args) if args.analysis == "dynamics" else {}
             model.export(args.out, t_end=args.t_end, steps=args.steps, t0=args.t0, tol=args.tol,
                          analysis=args.analysis, every=args.every, solver=args.solver, t=args.t,
-                         outputs=list(_outputs(args)) + (["damped"] if args.damped else []),
+                         outputs=list(_outputs(args)) + (["damped"] if args.damped else [])
+                         + (["velocities"] if args.velocities else []),
                          positions_only=args.positions_only, count=args.count,
                          equilibrium=not args.at_q0, inputs=args.input,
                          frequencies=_frequencies(args),

@@ -399,7 +399,7 @@ class Model(ModelDescription):
 
     @reads_entries
     def linearize(self, inputs: Any, t: float = 0.0, equilibrium: bool = True,
-                  solver: str = "auto") -> LinearizedSystem:
+                  solver: str = "auto", velocities: bool = False) -> LinearizedSystem:
         """The small motion about the static equilibrium (drivers held at t, as in
         :meth:`modes`) as a state-space system x' = A x + B p, dq = C x + D p whose inputs
         p are design parameters (a force's amplitude, a spring's free length, gravity, a
@@ -414,6 +414,11 @@ class Model(ModelDescription):
             Design parameters (:meth:`parameters` names them).
         t, equilibrium, solver
             As :meth:`modes`.
+        velocities : bool
+            Also the coordinates' velocities as outputs (``NAME.x_dot`` ...: C A and C B,
+            after the coordinates' rows), for velocity feedback; only for inputs that act
+            through forces (D = 0: an input that moves the mechanism directly would move
+            its velocities by its rate).
 
         Returns
         -------
@@ -425,7 +430,8 @@ class Model(ModelDescription):
         Raises
         ------
         ModelError
-            For an unknown input, no input, contacts or joint friction.
+            For an unknown input, no input, contacts or joint friction; velocities with an
+            input that moves the mechanism directly (named).
         ConvergenceError
             If no equilibrium is found near the q0 estimates.
         SingularJacobianError
@@ -438,7 +444,8 @@ class Model(ModelDescription):
         >>> sys.a.shape[0] == 2 * sys.n_free
         True
         """
-        return run_linearize(self, inputs, t=t, equilibrium=equilibrium, solver=solver)
+        return run_linearize(self, inputs, t=t, equilibrium=equilibrium, solver=solver,
+                             velocities=velocities)
 
     # ------------------------------------------------------------------ at one state
     @reads_entries

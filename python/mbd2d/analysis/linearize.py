@@ -21,18 +21,22 @@ WHAT = "linearized system"
 
 
 def run_linearize(model: ModelDescription, inputs: Any, t: float = 0.0,
-                  equilibrium: bool = True, solver: str = "auto") -> LinearizedSystem:
+                  equilibrium: bool = True, solver: str = "auto",
+                  velocities: bool = False) -> LinearizedSystem:
     """The linearized system; see :meth:`mbd2d.Model.linearize`."""
     t = number(t, "t", WHAT)
     code = solver_code(solver)
     equilibrium = flag(equilibrium, "equilibrium", WHAT)
+    velocities = flag(velocities, "velocities", WHAT)
     params = frf_inputs(model, inputs, WHAT)
     p = pack(model)
     d = pack_dynamics(model, p)
     ptab = table(p, params, d)
-    out = core.linearize(p, d, t, equilibrium, ptab, 2 * max(p.nq - p.neq, 0), code)
+    out = core.linearize(p, d, t, equilibrium, ptab, 2 * max(p.nq - p.neq, 0), code,
+                         velocities)
     if out.status == BAD_COUNT and 2 * int(out.iinfo[0]) > out.a.shape[0]:
-        out = core.linearize(p, d, t, equilibrium, ptab, 2 * int(out.iinfo[0]), code)
+        out = core.linearize(p, d, t, equilibrium, ptab, 2 * int(out.iinfo[0]), code,
+                             velocities)
     check_status(out.status, out.iinfo, out.msg, params)
     f = int(out.iinfo[0])
     exc = frf_error(model, p, out, t, np.zeros(0), [out.a, out.b, out.c, out.d])
@@ -43,5 +47,6 @@ def run_linearize(model: ModelDescription, inputs: Any, t: float = 0.0,
         t=t, q=out.q, lam=out.lam, stability=stability, residual=float(out.resid),
         a=out.a[:2 * f, :2 * f].copy(), b=out.b[:2 * f].copy(), c=out.c[:, :2 * f].copy(),
         d=out.d.copy(), inputs=[prm.name for prm in params],
-        outputs=list(p.coordinate_names), n_free=f, model=model,
+        outputs=list(p.coordinate_names) + ([f"{c}_dot" for c in p.coordinate_names]
+                                            if velocities else []), n_free=f, model=model,
         stats={"solver": "banded" if int(out.iinfo[4]) == 2 else "dense"})

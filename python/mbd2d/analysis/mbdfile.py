@@ -153,8 +153,8 @@ def _outputs(outputs: Any, analysis: str) -> list[str]:
         return []
     if isinstance(outputs, str):
         outputs = [outputs]
-    known = {"modes": ("damped",), "frf": ("reactions",), "linearize": ()}.get(analysis,
-                                                                             OUTPUTS)
+    known = {"modes": ("damped",), "frf": ("reactions",),
+             "linearize": ("velocities",)}.get(analysis, OUTPUTS)
     try:
         words = [str(w) for w in outputs]
     except TypeError:
