@@ -264,12 +264,13 @@ def test_param_counts_beyond_a_sweep_are_refused(tmp_path: Path, capsys, command
     assert "NUM must be from 1 to 100000000" in " ".join(capsys.readouterr().err.split())
 
 
-def test_a_check_is_no_sweep(tmp_path: Path, capsys) -> None:
-    """export --analysis check --param: a ModelError (exit 2), not a KeyError (found by
-    tests/test_cli_fuzz.py)."""
+@pytest.mark.parametrize("analysis", ["check", "linearize"])
+def test_a_check_is_no_sweep(tmp_path: Path, capsys, analysis: str) -> None:
+    """export --analysis check (or linearize) --param: a ModelError (exit 2), not a KeyError
+    (both found by tests/test_cli_fuzz.py)."""
     assert main(["export", str(EX / "fourbar_grashof.toml"), str(tmp_path / "c.mbd"),
-                 "--analysis", "check", "--param", "joint.B.points.0.0=1.5:2.0:3"]) == 2
-    assert "not check" in capsys.readouterr().err
+                 "--analysis", analysis, "--param", "joint.B.points.0.0=1.5:2.0:3"]) == 2
+    assert f"not {analysis}" in capsys.readouterr().err
 
 
 def test_a_parameter_a_kinematic_run_does_not_take(tmp_path: Path) -> None:

@@ -920,9 +920,9 @@ def _export_sweep(model: Model, args: argparse.Namespace) -> int:
         raise ModelError("a sweep file writes the sweep's columns (and --measure, "
                          "--sensitivities): no --energy, --multipliers, --reactions or "
                          "--efforts with --param", "command line")
-    if args.analysis == "check":
+    if args.analysis in ("check", "linearize"):
         raise ModelError("a sweep runs kinematics, inverse-dynamics, dynamics, statics, "
-                         "modes or frf, not check", "command line")
+                         f"modes or frf, not {args.analysis}", "command line")
     span = {"t_end": args.t_end, "steps": args.steps, "t0": args.t0, "every": args.every}
     kw: dict[str, Any] = {
         "kinematics": dict(span, tol=args.tol, solver=args.solver,
