@@ -1320,7 +1320,7 @@ contains
     integer, intent(out) :: status              !! MBD_OK, < 0 input, > 0 numerical
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
     integer :: bad
-    stable = 0; resid = zero
+    stable = 0; resid = zero; lam = zero
     call sens_setup(m, ctab, rpar, ptab, sens, status, msg, bad, ftab, fpar)
     if (status /= MBD_OK) then
       iinfo(2) = -2000000 - bad; return
