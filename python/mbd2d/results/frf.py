@@ -12,7 +12,7 @@ from ..validate import vector
 from .columns import REACTION_WORDS
 from .files import write_csv
 from .points import PointResult
-from .reactions import Reaction, driver_row
+from .reactions import Reaction, driver_row, driver_rows
 from .sensitivities import reaction_dp_arrays, reaction_dp_of
 
 COORDINATES = ("x", "y", "theta")
@@ -149,9 +149,7 @@ class FrequencyResponseResult:
         ``d(JOINT.fx)/d(INPUT).re``, ``.im``, ... fy, mz, fx_j, fy_j, mz_j
         (:meth:`reaction_response`)."""
         nb, nw = len(self.body_names), self.frequencies.size
-        drivers = [c for c in self.packed.constraint_names
-                   if driver_row(self.packed, c) is not None]
-        rows_d = [driver_row(self.packed, d) for d in drivers]
+        rows_d, drivers = driver_rows(self.packed)
         header = ["frequency_hz"]
         blocks = [self.frequencies[:, None]]
         for j, name in enumerate(self.inputs):

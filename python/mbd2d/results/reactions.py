@@ -11,6 +11,13 @@ from ..binding.status import error_for
 from ..binding.tables import Packed
 
 
+def driver_rows(p: Packed) -> tuple[list[int], list[str]]:
+    """The first rows of Phi (0-based) of every driver (an effort is -lambda there) and the
+    drivers' names, in the constraints' order."""
+    drivers = [k for k, f in enumerate(p.driver_flags) if f]
+    return [p.row_owner.index(k) for k in drivers], [p.constraint_names[k] for k in drivers]
+
+
 def driver_row(p: Packed, name: str) -> int | None:
     """First row of Phi (0-based) of the driver called name (its effort is -lambda there);
     None if name is no driver."""

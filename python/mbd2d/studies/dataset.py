@@ -21,6 +21,7 @@ from ..description.parameters import find
 from ..errors import MbdError
 from ..results.kinematics import KinematicsResult
 from ..results.measures import measure_failure
+from ..results.reactions import driver_rows
 from .plan import Plan
 from .runner import Outputs
 
@@ -182,16 +183,10 @@ def _sensitivity_data(pl: Plan, a: dict[str, np.ndarray], keep: np.ndarray
         p = pl.packed
         dlam = per_case(a["slam"])
         data["dlam_dp"] = (("case", "time", "equation", "parameter"), dlam)
-        rows_d, drivers = _driver_rows(p)
+        rows_d, drivers = driver_rows(p)
         if drivers:
             data["deffort_dp"] = (("case", "time", "driver", "parameter"), -dlam[:, :, rows_d])
     return data
-
-
-def _driver_rows(p: Any) -> tuple[list[int], list[str]]:
-    """The rows of Phi of the drivers (an effort is -lambda there) and their names."""
-    drivers = [k for k, f in enumerate(p.driver_flags) if f]
-    return [p.row_owner.index(k) for k in drivers], [p.constraint_names[k] for k in drivers]
 
 
 def to_dataset(pl: Plan, analysis: str, model: ModelDescription, out: Outputs,
@@ -233,7 +228,7 @@ def to_dataset(pl: Plan, analysis: str, model: ModelDescription, out: Outputs,
         lam = per_case(a["lam"])
         data["lam"] = (("case", "time", "equation"), lam)
         coords["equation"] = list(p.row_labels)
-        rows_d, drivers = _driver_rows(p)
+        rows_d, drivers = driver_rows(p)
         if drivers:
             data["effort"] = (("case", "time", "driver"), -lam[:, :, rows_d])
             coords["driver"] = drivers
@@ -336,7 +331,7 @@ def _frf_data(pl: Plan, a: dict[str, np.ndarray], ran: np.ndarray
     coords: dict[str, Any] = {"case": np.arange(len(ran)), "frequency": pl.times.copy(),
                               "coordinate": list(p.coordinate_names),
                               "equation": list(p.row_labels), "input": list(b.sensitivities)}
-    rows_d, drivers = _driver_rows(p)
+    rows_d, drivers = driver_rows(p)
     if drivers:                                      # (an effort is -lambda on its row)
         data["effort_response"] = (("case", "frequency", "driver", "input"), -hl[:, :, rows_d])
         coords["driver"] = drivers

@@ -41,7 +41,7 @@ from ..description.parameters import find
 from ..errors import ModelError
 from ..results.measures import measure, measure_derivatives, measure_list, parse_measure
 from ..results.points import PointResult
-from ..results.reactions import driver_row
+from ..results.reactions import driver_rows
 from ..validate import number, vector, whole
 from .dataset import xarray
 from .plan import (ANALYSES, _bind, _dynamics_settings, _frf_settings, _inverse_settings,
@@ -321,24 +321,17 @@ def _linear_outputs(res: Any, ran: str) -> dict[str, tuple[tuple[str, ...], np.n
     if dlam is not None or (out["q"][2] is None and lam is not None):
         lam, dlam = rows(lam), rows(dlam)
         out["lam"] = (("time", "equation"), lam, dlam)
-        p = res.packed
-        drows = [p.row_owner.index(k) for k, f in enumerate(p.driver_flags) if f]
+        drows = driver_rows(res.packed)[0]
         if drows:
             out["effort"] = (("time", "driver"), -lam[:, drows],
                              None if dlam is None else -dlam[:, drows, :])
     return out
 
 
-def _frf_drivers(res: Any) -> list[str]:
-    """The drivers of a frequency response's model (their efforts' responses)."""
-    p = res.packed
-    return [c for c in p.constraint_names if driver_row(p, c) is not None]
-
-
 def _frf_complex(res: Any) -> dict[str, np.ndarray]:
     """The nominal frequency response's complex outputs: "response" and "effort_response"
     (the drivers' efforts, -lambda of their rows), (frequency, entry, input)."""
-    rows = [driver_row(res.packed, c) for c in _frf_drivers(res)]
+    rows = driver_rows(res.packed)[0]
     return {"response": res.response, "effort_response": -res.lam_response[:, rows, :]}
 
 
@@ -571,14 +564,13 @@ def tolerance(model: ModelDescription, sigma: Mapping[str, Any], analysis: str =
     if ran == "frf":
         coords.update(frequency=res.frequencies, input=list(res.inputs))
         if "effort_magnitude" in outs:
-            coords["driver"] = _frf_drivers(res)
+            coords["driver"] = driver_rows(res.packed)[1]
     if specs:
         coords["measure"] = specs
     if "lam" in outs:
         coords["equation"] = list(res.row_labels)
     if "effort" in outs:
-        p = res.packed
-        coords["driver"] = [p.constraint_names[k] for k, f in enumerate(p.driver_flags) if f]
+        coords["driver"] = driver_rows(res.packed)[1]
     attrs = {"analysis": analysis, "run": ran, "model": model.name, "samples": n,
              "failed": int((~ok).sum()), "seed": "none" if seed is None else int(seed),
              "sigma": ", ".join(f"{k}={v:g}" for k, v in zip(names, sig)),
