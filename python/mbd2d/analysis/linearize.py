@@ -39,7 +39,8 @@ def run_linearize(model: ModelDescription, inputs: Any, t: float = 0.0,
                              velocities)
     check_status(out.status, out.iinfo, out.msg, params)
     f = int(out.iinfo[0])
-    exc = frf_error(model, p, out, t, np.zeros(0), [out.a, out.b, out.c, out.d])
+    exc = frf_error(model, p, out, t, np.zeros(0), [out.a, out.b, out.c, out.d],
+                    analysis="linearize")
     if exc is not None:
         raise exc
     stability = STABILITY.get(int(out.stable), "not examined (equilibrium=False)")
