@@ -1234,9 +1234,12 @@ contains
   !! 2 nfree (call again with that many). With velocities /= 0, c and d have 2 nq rows: the
   !! coordinates', then their velocities' (C A, C B; MBD_BAD_SETTING naming the input in
   !! iinfo(2) when D /= 0: that input moves the mechanism directly, its velocities by p').
+  !! With multipliers /= 0, neq rows more (after those): the drivers' multipliers (a driver's
+  !! effort is -lambda on its row; the other rows 0; MBD_BAD_SETTING naming the input whose
+  !! rate or acceleration moves them: it acts on the constraints directly).
   subroutine api_linearize(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, t, equilibrium, ptab, &
                            q, lam, stable, resid, a, b, c, d, iinfo, status, msg, solver, &
-                           velocities)
+                           velocities, multipliers)
     integer, intent(in) :: nb, ctab(:, :), ftab(:, :), equilibrium, ptab(:, :)
     real(wp), intent(in) :: rpar(:), bmass(:, :), grav(2), fpar(:), q0(:), t
     real(wp), intent(out) :: q(:), lam(:), resid, a(:, :), b(:, :), c(:, :), d(:, :)
@@ -1245,19 +1248,23 @@ contains
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
     integer, intent(in), optional :: solver     !! 0 auto (default), 1 dense, 2 banded
     integer, intent(in), optional :: velocities !! 1: the velocities' outputs too
+    integer, intent(in), optional :: multipliers !! 1: the multipliers' outputs too
     type(model_t) :: m
     type(dyn_work_t) :: w
     type(sens_t) :: sens
     real(wp), allocatable :: ones(:)
-    integer :: bad, nfree, i, ns, nqo, k
-    logical :: vel
+    integer :: bad, nfree, i, ns, nqo, nv, improper
+    logical :: vel, mult
     q = zero; lam = zero; stable = 0; resid = zero; a = zero; b = zero; c = zero; d = zero
     call static_start(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, t, m, w, q, lam, iinfo, &
                       status, msg, solver)
     ns = size(a, 1)
     vel = .false.
     if (present(velocities)) vel = velocities /= 0
-    nqo = merge(2, 1, vel) * size(q)
+    mult = .false.
+    if (present(multipliers)) mult = multipliers /= 0
+    nv = merge(2, 1, vel) * size(q)              ! the coordinates' (and velocities') rows
+    nqo = nv + merge(size(lam), 0, mult)
     if (status == MBD_OK) then
       if (size(a, 2) /= ns .or. size(b, 1) /= ns .or. size(c, 2) /= ns .or. &
           size(b, 2) /= size(ptab, 2) .or. size(c, 1) /= nqo .or. &
@@ -1267,18 +1274,29 @@ contains
     end if
     if (status == MBD_OK) call linear_setup(m, w, sens, ctab, rpar, ftab, fpar, ptab, q, t, &
                                             equilibrium, lam, stable, resid, iinfo, status, msg)
-    if (status == MBD_OK .and. vel) then
+    if (status == MBD_OK .and. mult) then
+      if (vel) then
+        call linear_state_space(m, w, sens, q, t, lam, a, b, c(1:m%nq, :), d(1:m%nq, :), &
+                                nfree, status, msg, c(m%nq + 1:nv, :), d(m%nq + 1:nv, :), &
+                                c(nv + 1:, :), d(nv + 1:, :), improper)
+      else
+        call linear_state_space(m, w, sens, q, t, lam, a, b, c(1:m%nq, :), d(1:m%nq, :), &
+                                nfree, status, msg, cl=c(nv + 1:, :), dl=d(nv + 1:, :), &
+                                improper=improper)
+      end if
+      iinfo(1) = nfree
+      if (status == MBD_OK .and. improper > 0) then
+        status = MBD_BAD_SETTING; iinfo(2) = -2000000 - improper
+        msg = 'effort outputs: this input moves the constraints directly, so the efforts '// &
+              'would need its rate or acceleration; take the positions alone, or an input '// &
+              'that acts through a force'
+      end if
+      if (vel) call velocities_need_no_d()
+    else if (status == MBD_OK .and. vel) then
       call linear_state_space(m, w, sens, q, t, lam, a, b, c(1:m%nq, :), d(1:m%nq, :), &
                               nfree, status, msg, c(m%nq + 1:, :), d(m%nq + 1:, :))
       iinfo(1) = nfree
-      do k = 1, size(ptab, 2)                   ! the velocities need D = 0
-        if (status == MBD_OK .and. any(abs(d(1:m%nq, k)) > zero)) then
-          status = MBD_BAD_SETTING; iinfo(2) = -2000000 - k
-          msg = 'velocity outputs: this input moves the mechanism directly (D /= 0), so '// &
-                'its velocities would need the input''s rate; take the positions alone, '// &
-                'or an input that acts through a force'
-        end if
-      end do
+      call velocities_need_no_d()
     else if (status == MBD_OK) then
       call linear_state_space(m, w, sens, q, t, lam, a, b, c, d, nfree, status, msg)
       iinfo(1) = nfree
@@ -1294,13 +1312,28 @@ contains
         end if
         call sens_units2(m, sens, b, ones, .false.)         ! per unit of each parameter
         call sens_units2(m, sens, d(1:m%nq, :), m%cunit, .false.)
-        if (vel) call sens_units2(m, sens, d(m%nq + 1:, :), m%cunit, .false.)
+        if (vel) call sens_units2(m, sens, d(m%nq + 1:nv, :), m%cunit, .false.)
+        if (mult) call sens_units2(m, sens, d(nv + 1:, :), m%rowunit, .true.)
         do i = 1, ns
           c(1:m%nq, i) = c(1:m%nq, i) * m%cunit
-          if (vel) c(m%nq + 1:, i) = c(m%nq + 1:, i) * m%cunit
+          if (vel) c(m%nq + 1:nv, i) = c(m%nq + 1:nv, i) * m%cunit
+          if (mult) c(nv + 1:, i) = c(nv + 1:, i) / m%rowunit
         end do
       end if
     end if
+  contains
+    !> MBD_BAD_SETTING naming the first input with D /= 0 (the velocities need D = 0).
+    subroutine velocities_need_no_d()
+      integer :: kk
+      do kk = 1, size(ptab, 2)
+        if (status == MBD_OK .and. any(abs(d(1:m%nq, kk)) > zero)) then
+          status = MBD_BAD_SETTING; iinfo(2) = -2000000 - kk
+          msg = 'velocity outputs: this input moves the mechanism directly (D /= 0), so '// &
+                'its velocities would need the input''s rate; take the positions alone, '// &
+                'or an input that acts through a force'
+        end if
+      end do
+    end subroutine velocities_need_no_d
   end subroutine api_linearize
 
   !> The inputs of the frequency response and the linearized system as design parameters

@@ -245,13 +245,14 @@ subroutine core_frf(nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp, fpar, nq
 end subroutine core_frf
 
 subroutine core_linearize(nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp, fpar, nq, neq, q0, &
-                          t, equilibrium, npar, ptab, ns, solver, nqo, q, lam, stable, resid, &
-                          a, b, c, d, iinfo, status, msg)
+                          t, equilibrium, npar, ptab, ns, solver, vel, mult, nqo, q, lam, &
+                          stable, resid, a, b, c, d, iinfo, status, msg)
   use iso_c_binding, only: c_double, c_int
   use mbd_api, only: api_linearize
   implicit none
   integer(c_int), intent(in) :: nb, nc, np, nf, nfp, nq, neq, equilibrium, npar, ns, solver
-  integer(c_int), intent(in) :: nqo                 ! nq, or 2 nq: the velocities' outputs too
+  integer(c_int), intent(in) :: vel, mult           ! 1: the velocities', the multipliers' too
+  integer(c_int), intent(in) :: nqo                 ! nq (+ nq with vel) (+ neq with mult)
   integer(c_int), intent(in) :: ctab(8, nc), ftab(6, nf), ptab(2, npar)
   real(c_double), intent(in) :: rpar(np), bmass(2, nb), grav(2), fpar(nfp), q0(nq), t
   real(c_double), intent(out) :: q(nq), lam(neq), resid, a(ns, ns), b(ns, npar), c(nqo, ns), &
@@ -260,8 +261,7 @@ subroutine core_linearize(nb, nc, ctab, np, rpar, bmass, grav, nf, ftab, nfp, fp
   character(len=512), intent(out) :: msg
   !f2py intent(hide) :: nc, np, nf, nfp, nq, npar
   call api_linearize(nb, ctab, rpar, bmass, grav, ftab, fpar, q0, t, equilibrium, ptab, q, lam, &
-                     stable, resid, a, b, c, d, iinfo, status, msg, solver, &
-                     merge(1, 0, nqo > nq))
+                     stable, resid, a, b, c, d, iinfo, status, msg, solver, vel, mult)
 end subroutine core_linearize
 
 subroutine core_reactions(nb, nc, ctab, np, rpar, nq, neq, nt, q, t, lam, reac, rloc, status, &

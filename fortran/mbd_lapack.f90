@@ -4,7 +4,7 @@ module mbd_lapack
   implicit none
   private
   public :: dgetrf, dgetf2, dgetrs, dtrsv, dgesvd, dgels, dgelsy, dgtsv, dgeqp3, dormqr, dtrtrs, &
-            dgecon, dtrcon, dsyev, dsygv, dgeev, dgehrd, dorghr, dgemm
+            dgecon, dtrcon, dsyev, dsygv, dsygvd, dgeev, dgehrd, dorghr, dgemm
   public :: dgbtrf, dgbtrs, dgbcon, dlacn2
 
   interface
@@ -126,6 +126,17 @@ module mbd_lapack
       real(wp), intent(out) :: w(*), work(*)
       integer, intent(out) :: info
     end subroutine dsygv
+    !> dsygv with the tridiagonal eigenvectors by divide and conquer (dstedc).
+    pure subroutine dsygvd(itype, jobz, uplo, n, a, lda, b, ldb, w, work, lwork, iwork, &
+                           liwork, info)
+      import :: wp
+      integer, intent(in) :: itype, n, lda, ldb, lwork, liwork
+      character(len=1), intent(in) :: jobz, uplo
+      real(wp), intent(inout) :: a(lda, *), b(ldb, *)
+      real(wp), intent(out) :: w(*), work(*)
+      integer, intent(out) :: iwork(*)
+      integer, intent(out) :: info
+    end subroutine dsygvd
     !> Eigenvalues (and right eigenvectors) of a general matrix.
     pure subroutine dgeev(jobvl, jobvr, n, a, lda, wr, wi, vl, ldvl, vr, ldvr, work, lwork, &
                           info)

@@ -21,7 +21,17 @@
 !! With forces alone as inputs (s_n = 0) w = z and v = z'. The velocities' outputs
 !! dq' = C x' + D p' = C A x + C B p + D p' = [0, N] x + N M_r^-1 E1 p are proper only
 !! where D = 0 (an input that moves the mechanism directly moves its velocities by p'):
-!! cv = [0, N], dv = N M_r^-1 E1. C (i Omega I - A)^-1 B + D is the
+!! cv = [0, N], dv = N M_r^-1 E1. The multipliers' outputs (a driver's effort is -lambda on
+!! its row) from J_a^T dlambda = r p + Q_p_dot p' - M dq'' - C dq' - K dq (mbd_frf) with
+!! dq = s_n p + N z, z = w + Y2 p, z' = v + Y1 p + Y2 p', z'' = v' + Y1 p' + Y2 p''
+!! (Y2 = M_r^-1 G2, Y1 = M_r^-1 E1, v' the lower rows of A x + B p):
+!!   dlambda = P(-K N + M N M_r^-1 K_r) w + P(-C N + M N M_r^-1 C_r) v
+!!           + P(r - K s_n - K N Y2 - C N Y1 - M N B_v) p + P(x1) p' + P(x2) p'',
+!!   x1 = -(C s_n - Q_p_dot) - C N Y2 - M N Y1,   x2 = -M s_n - M N Y2,
+!! P the least squares J_a^T mu = x (exact: each x is orthogonal to N, N^T x1 = N^T x2 = 0).
+!! Written for the drivers' rows (the others 0), proper only where x1 and x2 are zero there
+!! (forces alone, or a rate forcing that the free motions and the other joints take); else
+!! the input is named (improper). C (i Omega I - A)^-1 B + D is the
 !! frequency response H(Omega) of mbd_frf. The states are coordinates on the basis N (its
 !! columns orthonormal in the metric of dyn_null_basis): not unique, as any realization.
 !! Memory: N, K N, C N, M N (nq x f), five nq x np arrays and three f x f matrices, checked
@@ -35,10 +45,14 @@ module mbd_linear
   use mbd_sensitivity, only: sens_t
   use mbd_dynamics, only: dyn_work_t
   use mbd_frf, only: linear_parts
+  use mbd_sens_dynamics, only: proj_multipliers
+  use mbd_constraints, only: con_is_driver
   implicit none
   private
   public :: linear_state_space
 
+  !> |x1|, |x2| at most this fraction of the terms that cancel in them: zero (round-off)
+  real(wp), parameter :: CANCEL = 1.0e-10_wp
   character(len=*), parameter :: HINT = 'the linearized system uses dense matrices of the ' &
     // 'number of free motions: use a model with fewer free motions'
 
@@ -47,7 +61,8 @@ contains
   !> A (2f, 2f), B (2f, np), C (nq, 2f), D (nq, np) of the linearized motion about (q, t,
   !! lam), core units, in the leading parts of the arrays (f the free motions; the arrays'
   !! state dimension at least 2f, else MBD_BAD_COUNT with nfree set).
-  subroutine linear_state_space(m, w, s, q, t, lam, a, b, c, d, nfree, status, msg, cv, dv)
+  subroutine linear_state_space(m, w, s, q, t, lam, a, b, c, d, nfree, status, msg, cv, dv, &
+                                cl, dl, improper)
     type(model_t), intent(in) :: m              !! model with dynamics data
     type(dyn_work_t), intent(inout) :: w        !! work arrays (dyn_init done)
     type(sens_t), intent(inout) :: s            !! the inputs (sens_setup done)
@@ -62,6 +77,12 @@ contains
     character(len=MSG_LEN), intent(out) :: msg  !! explanation
     !> (nq, >= 2f), (nq, np): the velocities' output matrix C A and feedthrough C B
     real(wp), intent(out), optional :: cv(:, :), dv(:, :)
+    !> (neq, >= 2f), (neq, np): the drivers' multipliers' output matrix and feedthrough (the
+    !! other rows 0; with improper)
+    real(wp), intent(out), optional :: cl(:, :), dl(:, :)
+    !> the first input whose rate or acceleration moves a driver's multiplier (P(x1) or P(x2)
+    !! /= 0 on its rows), else 0
+    integer, intent(out), optional :: improper
     ! N, K N, C N, M N; s_n, K s_n, C s_n, M s_n, r; K_r, C_r, M_r (then M_r's LU); G and
     ! the solves' right-hand sides
     real(wp), allocatable :: nb(:, :), kn(:, :), cn(:, :), mn(:, :), sn(:, :), ks(:, :), &
@@ -75,6 +96,9 @@ contains
     a = zero; b = zero; c = zero; d = zero
     if (present(cv)) cv = zero
     if (present(dv)) dv = zero
+    if (present(cl)) cl = zero
+    if (present(dl)) dl = zero
+    if (present(improper)) improper = 0
     n = m%nq; f = n - w%na; np = s%np
     nfree = f
     if (size(a, 1) < 2 * f .or. size(a, 2) < 2 * f .or. size(b, 1) < 2 * f .or. &
@@ -100,7 +124,10 @@ contains
       call mem_fail(bytes, trim(what), HINT, status, msg); return
     end if
     d(:, 1:np) = sn                               ! (every motion driven: dq = s_n p)
-    if (f == 0) return
+    if (f == 0) then                              ! (the multipliers: P(r - K s_n) p ...)
+      if (present(cl) .and. present(dl) .and. present(improper)) call multipliers(status)
+      return
+    end if
     call dgetrf(f, f, mr, f, ipiv, info)          ! M_r = P L U
     if (info /= 0) then
       status = MBD_SINGULAR
@@ -134,5 +161,75 @@ contains
     call dgemm('N', 'N', n, np, f, one, nb, n, y2, f, one, d, size(d, 1))   ! D = s_n + N Y2
     if (present(cv)) cv(:, f + 1:2 * f) = nb(:, 1:f)                     ! C A = [0, N]
     if (present(dv)) call dgemm('N', 'N', n, np, f, one, nb, n, y1, f, zero, dv, size(dv, 1))
+    if (present(cl) .and. present(dl) .and. present(improper)) call multipliers(status)
+  contains
+    !> cl, dl and improper (the module's comment): each output column's force vector x in
+    !! q-space, then P(x); the drivers' rows kept.
+    subroutine multipliers(st)
+      integer, intent(out) :: st
+      real(wp) :: x(n), size1, size2, l1, l2, v(5)
+      logical :: drv(size(lam))
+      real(wp) :: xd(size(lam), 5)
+      integer :: j, k, r, i
+      st = MBD_OK
+      do r = 1, size(lam)
+        drv(r) = con_is_driver(m%kind(m%con_of_row(r)))
+      end do
+      do j = 1, f                                 ! w: -K N + M N M_r^-1 K_r
+        x = -kn(:, j) + matmul(mn(:, 1:f), mk(:, j))
+        call project(x, cl(:, j), st)
+        if (st /= MBD_OK) return
+        x = -cn(:, j) + matmul(mn(:, 1:f), mc(:, j))   ! v: -C N + M N M_r^-1 C_r
+        call project(x, cl(:, f + j), st)
+        if (st /= MBD_OK) return
+      end do
+      do k = 1, np
+        x = rr(:, k) - ks(:, k) - matmul(kn(:, 1:f), y2(:, k)) - &
+            matmul(cn(:, 1:f), y1(:, k)) - matmul(mn(:, 1:f), e0(:, k))
+        call project(x, dl(:, k), st)
+        if (st /= MBD_OK) return
+        ! x1, x2 on the drivers' rows, against the terms that cancel in them (round-off)
+        do i = 1, 5                               ! cs, C N Y2, M N Y1, ms, M N Y2
+          select case (i)
+          case (1); x = cs(:, k)
+          case (2); x = matmul(cn(:, 1:f), y2(:, k))
+          case (3); x = matmul(mn(:, 1:f), y1(:, k))
+          case (4); x = ms(:, k)
+          case default; x = matmul(mn(:, 1:f), y2(:, k))
+          end select
+          call drivers_part(x, drv, xd(:, i), st)
+          if (st /= MBD_OK) return
+          v(i) = norm2(xd(:, i))
+        end do
+        l1 = norm2(xd(:, 1) + xd(:, 2) + xd(:, 3)); size1 = v(1) + v(2) + v(3)
+        l2 = norm2(xd(:, 4) + xd(:, 5)); size2 = v(4) + v(5)
+        if (improper == 0 .and. (l1 > CANCEL * size1 .or. l2 > CANCEL * size2)) improper = k
+      end do
+      do r = 1, size(lam)                         ! the drivers' rows alone
+        if (.not. drv(r)) then
+          cl(r, :) = zero; dl(r, :) = zero
+        end if
+      end do
+    end subroutine multipliers
+
+    !> P(x) on the drivers' rows (drv), zero on the others.
+    subroutine drivers_part(xx, drv, mu, st)
+      real(wp), intent(in) :: xx(:)
+      logical, intent(in) :: drv(:)
+      real(wp), intent(out) :: mu(:)
+      integer, intent(out) :: st
+      call project(xx, mu, st)
+      where (.not. drv) mu = zero
+    end subroutine drivers_part
+
+    !> mu = P(x): J_a^T mu = x by the projection's least squares (redundant rows 0).
+    subroutine project(x, mu, st)
+      real(wp), intent(in) :: x(:)
+      real(wp), intent(out) :: mu(:)
+      integer, intent(out) :: st
+      mu = zero
+      call proj_multipliers(w, x, mu, st)
+      if (st /= MBD_OK) msg = 'linearized system: the multipliers'' least squares failed'
+    end subroutine project
   end subroutine linear_state_space
 end module mbd_linear

@@ -28,7 +28,7 @@ module mbd_modes
   use mbd_status, only: MBD_OK, MBD_SINGULAR, MBD_NO_CONVERGENCE, MBD_LAPACK, MSG_LEN
   use mbd_memory, only: REAL_BYTES, mem_check, mem_fail, mem_grow
   use mbd_model, only: model_t
-  use mbd_lapack, only: dsygv, dgeev, dgetrf, dgetrs, dgemm
+  use mbd_lapack, only: dsygvd, dgeev, dgetrf, dgetrs, dgemm
   use mbd_dynamics, only: dyn_work_t, dyn_tangent, dyn_null_basis, dyn_pattern_mul
   use mbd_sensitivity, only: sens_t
   use mbd_sens_dynamics, only: sens_stiffness_mul, sens_damping_mul, sens_tangent_pattern
@@ -81,7 +81,8 @@ contains
     real(wp), allocatable :: nb(:, :), kn(:, :), cn(:, :), mn(:, :), mr(:, :), kr(:, :), &
                              cr(:, :), ks(:, :), a(:, :), wr(:), wi(:), ev(:), vl(:, :), &
                              vr(:, :), work(:), kv(:), cv(:), zv(:), xv(:), yv(:), wv(:)
-    integer, allocatable :: ipiv(:), order(:)
+    integer, allocatable :: ipiv(:), order(:), iwork(:)
+    integer :: iwq(1)
     real(wp) :: bytes, wq(1)
     integer :: n, f, nnz, ist, info, j, k, nk
     logical :: plain, damped, cshapes, bypattern
@@ -154,10 +155,14 @@ contains
     plain = .not. damped .and. &
             maxval(abs(kr - ks)) <= SYM_TOL * max(maxval(abs(kr)), tiny(one))
     a(1:f, 1:f) = mr
-    call dsygv(1, 'V', 'U', f, ks, f, a, 2 * f, ev, wq, -1, info)
+    call dsygvd(1, 'V', 'U', f, ks, f, a, 2 * f, ev, wq, -1, iwq, -1, info)
     call grow(max(1, int(wq(1))), status)
     if (status /= MBD_OK) return
-    call dsygv(1, 'V', 'U', f, ks, f, a, 2 * f, ev, work, size(work), info)
+    allocate (iwork(max(1, iwq(1))), stat=ist)
+    if (ist /= 0) then
+      call mem_fail(bytes, trim(what), HINT, status, msg); return
+    end if
+    call dsygvd(1, 'V', 'U', f, ks, f, a, 2 * f, ev, work, size(work), iwork, size(iwork), info)
     if (info > f) then
       status = MBD_SINGULAR
       msg = 'modes: a free motion carries no mass (M_r is not positive definite): give ' // &

@@ -66,7 +66,8 @@ def _command(rng: random.Random, tmp: Path) -> list[str]:
         if rng.random() < 0.5:
             argv += rng.choice([["--at-q0"], ["--t", rng.choice(NUMBERS)],
                                 ["--out", str(tmp / rng.choice(["s.csv", "s.nc"]))],
-                                ["--input", rng.choice(NAMES)], ["--velocities"]])
+                                ["--input", rng.choice(NAMES)], ["--velocities"],
+                                ["--efforts"]])
     if cmd == "tolerance":
         argv += ["--samples", rng.choice(["0", "3", "3", "1"]), "--workers", "1",
                  "--out", str(tmp / rng.choice(["t.csv", "t.csv", "t.nc", "t.txt"]))]

@@ -168,6 +168,9 @@ def _linear_outcome(model: mbd2d.Model, names: set[str], bounds: dict[str, int]
                                                 r.response.imag, r.q, r.lam)))
     out.append(_typed("linearize", lambda: model.linearize(inputs), names, bounds,
                       lambda r: _finite("the state matrices", r.a, r.b, r.c, r.d, r.q)))
+    out.append(_typed("linearize efforts", lambda: model.linearize(inputs, efforts=True),
+                      names, bounds,
+                      lambda r: _finite("the state matrices", r.a, r.b, r.c, r.d, r.q)))
     return out
 
 

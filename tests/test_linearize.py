@@ -320,3 +320,167 @@ def test_velocity_outputs(tmp_path: Path) -> None:
         model.linearize(["force.push.fy.poly.0", "driver.hold.f.poly.0"], velocities=True)
     with pytest.raises(mbd2d.ModelError, match="velocities"):
         model.linearize(inp, velocities="yes")
+
+
+# -- the drivers' efforts as outputs ---------------------------------------------------------
+
+def _pushed_cart_pendulum() -> mbd2d.Model:
+    """cart_pendulum (the cart held by its driver) with a horizontal push on the bar's centre
+    of mass (the input: its amplitude)."""
+    m = cart_pendulum()
+    m.add_force("point", body="bar", point=[0.0, 0.0], fx={"poly": [0.0]}, fy=0.0, name="push")
+    return m
+
+
+def _tyred_block(slant: float = 0.0) -> mbd2d.Model:
+    """held_block with a damped tyre (k2 20, c2 0.8) from a ground point below the block
+    (slant: the point moved sideways by this much, so that the tyre leans)."""
+    m = held_block()
+    m.add_spring(["ground", "block"], [[slant, -2.0], [0.0, 0.0]], stiffness=K2, damping=C2,
+                 length0=float(np.hypot(slant, 1.0)), name="tyre")
+    return m
+
+
+K2, C2 = 20.0, 0.8
+
+
+def test_efforts_of_force_inputs_against_closed_forms() -> None:
+    """The held base's effort per unit push on the block, -(k + c s) / (m s^2 + c s + k) (the
+    spring-damper's pull, held against); the held cart's per unit push on the pendulum's
+    centre, -(I s^2 + m g a) / ((I + m a^2) s^2 + m g a) (-1 at rest; the feedthrough
+    D = -I / (I + m a^2): a push is felt at once), at five points s; with the velocities the
+    effort rows come after them and are the same."""
+    block = held_block().linearize("force.push.fy.poly.0", efforts=True)
+    assert block.outputs[-1] == "effort.hold" and len(block.outputs) == 7
+    e = out(block, "effort.hold")
+    a, inertia = L_BAR / 2, M_BAR * L_BAR**2 / 12
+    j = inertia + M_BAR * a**2
+    cart = _pushed_cart_pendulum().linearize("force.push.fx.poly.0", efforts=True)
+    both = _pushed_cart_pendulum().linearize("force.push.fx.poly.0", efforts=True,
+                                             velocities=True)
+    assert both.outputs[-1] == "effort.shake" and both.outputs[-2] == "bar.theta_dot"
+    for s in S_POINTS:
+        np.testing.assert_allclose(transfer(block, s)[e, 0],
+                                   -(K + C_D * s) / (M_BLOCK * s**2 + C_D * s + K), rtol=1e-13)
+        want = -(inertia * s**2 + M_BAR * G * a) / (j * s**2 + M_BAR * G * a)
+        for sys_ in (cart, both):
+            np.testing.assert_allclose(transfer(sys_, s)[out(sys_, "effort.shake"), 0], want,
+                                       rtol=1e-13)
+    np.testing.assert_allclose(cart.d[out(cart, "effort.shake"), 0], -inertia / j, rtol=1e-14)
+    assert block.d[e, 0] == 0.0
+
+
+def test_a_road_input_reaches_the_driver_through_the_block() -> None:
+    """A road under the block (the tyre's ground point moved up by p): the block follows by
+    (k2 + c2 s) / D, D = m s^2 + (c + c2) s + k + k2, and the held base's effort is
+    -(k + c s) times that: the road's rate acts on the free block alone, so the effort is
+    proper. With the tyre leaning, the rate's sideways part goes into the block's guide, not
+    into the driver: still proper, and equal to the frequency response's effort."""
+    sys_ = _tyred_block().linearize("force.tyre.points.0.1", efforts=True)
+    e, y = out(sys_, "effort.hold"), out(sys_, "block.y")
+    for s in S_POINTS:
+        den = M_BLOCK * s**2 + (C_D + C2) * s + K + K2
+        g = transfer(sys_, s)[:, 0]
+        np.testing.assert_allclose(g[y], (K2 + C2 * s) / den, rtol=1e-13)
+        np.testing.assert_allclose(g[e], -(K + C_D * s) * (K2 + C2 * s) / den, rtol=1e-13)
+    lean = _tyred_block(0.3)
+    freqs = np.array([0.0, 0.4, 1.1, 2.5])
+    sys_ = lean.linearize("force.tyre.points.0.1", efforts=True)
+    res = lean.frequency_response("force.tyre.points.0.1", freqs)
+    tf = [transfer(sys_, 2j * np.pi * f)[out(sys_, "effort.hold"), 0] for f in freqs]
+    np.testing.assert_allclose(tf, res.effort_response("hold", "force.tyre.points.0.1"),
+                               rtol=1e-12)
+
+
+def test_time_response_of_the_effort_is_the_dynamics() -> None:
+    """The block pushed by 0.3 sin(2.2 t) from rest: the held base's effort of the state-space
+    system (scipy DOP853 at 1e-13) against mbd2d's dopri5 run of the model (rtol 1e-11),
+    whose efforts come from its own index-1 solves: within 1e-9 of the effort's swing."""
+    pytest.importorskip("scipy")
+    amp, w = 0.3, 2.2
+    sys_ = held_block().linearize("force.push.fy.poly.0", efforts=True)
+    model = held_block()
+    model.bodies[1].q0 = (0.0, float(sys_.q[4]), 0.0)
+    text = mbd2d.description.toml_io.dumps(model)
+    old = 'name = "push"\ntype = "point"\nbody = "block"\npoint = [0.0, 0.0]\n' \
+          'fx = { poly = [0.0] }\nfy = { poly = [0.0] }'
+    assert text.count(old) == 1
+    new = old.replace('fy = { poly = [0.0] }',
+                      f'fy = {{ harmonic = [{{ amplitude = {amp!r}, omega = {w!r} }}] }}')
+    res = mbd2d.loads(text.replace(old, new)).dynamics(t_end=4.0, steps=80, method="dopri5",
+                                                       rtol=1e-11, atol=1e-12)
+    lin = _linear_response(sys_, lambda t: amp * np.sin(w * t), res.t)
+    effort = res.effort("hold") - res.effort("hold")[0]
+    swing = np.abs(effort).max()
+    assert swing > 0.1
+    assert np.abs(effort - lin[:, out(sys_, "effort.hold")]).max() <= 1e-9 * swing
+
+
+def test_efforts_refuse_inputs_that_move_the_constraints() -> None:
+    """The base moved by its driver's offset (its acceleration is held by the driver at
+    once), the spring's point on the held base (its damper's rate pulls the base, held
+    against), and a model without drivers: ModelErrors naming the input, or saying why."""
+    for inputs, name in ((["force.push.fy.poly.0", "driver.hold.f.poly.0"],
+                          "driver.hold.f.poly.0"),
+                         ("force.s.points.0.1", "force.s.points.0.1")):
+        with pytest.raises(mbd2d.ModelError, match="effort outputs") as err:
+            held_block().linearize(inputs, efforts=True)
+        assert name in str(err.value)
+    held_block().linearize("driver.hold.f.poly.0")           # (the positions alone: fine)
+    with pytest.raises(mbd2d.ModelError, match="no drivers"):
+        _no_driver().linearize("force.push.fy.poly.0", efforts=True)
+
+
+def _no_driver() -> mbd2d.Model:
+    """A block on a vertical guide on a spring, pushed; no driver."""
+    m = mbd2d.Model("free block", gravity=(0.0, -G))
+    m.add_body("block", (0.0, -1.0, 0.0), mass=2.0, inertia=0.01)
+    m.add_translational(["ground", "block"], [[0.0, 0.0], [0.0, 0.0]], [[0.0, 1.0], [0.0, 1.0]],
+                        name="guide")
+    m.add_spring(["ground", "block"], [[0.0, 0.0], [0.0, 0.0]], stiffness=K, length0=0.5,
+                 name="s")
+    m.add_force("point", body="block", point=[0.0, 0.0], fx=0.0, fy={"poly": [0.0]},
+                name="push")
+    return m
+
+
+def test_effort_outputs_from_every_front_door(tmp_path: Path) -> None:
+    """efforts=True with velocities: the CSV's effort rows (``C,effort.shake,...``) from
+    Python, ``mbd2d linearize --velocities --efforts``, and mbd2d-solve (``outputs
+    velocities efforts``, from Model.export and from ``mbd2d export``) byte for byte; the
+    file's and the command line's refusals: a model without drivers, an input that moves the
+    constraints (exit 2, named)."""
+    from test_standalone import solve_file
+    model, inp = _pushed_cart_pendulum(), "force.push.fx.poly.0"
+    sys_ = model.linearize(inp, velocities=True, efforts=True)
+    py = tmp_path / "py.csv"
+    sys_.to_csv(py)
+    text = py.read_text()
+    assert "C,effort.shake,z1," in text and "D,effort.shake,force.push.fx.poly.0," in text
+    model.export(tmp_path / "m.mbd", analysis="linearize", inputs=[inp],
+                 outputs=["efforts", "velocities"])
+    assert "\noutputs velocities efforts\n" in (tmp_path / "m.mbd").read_text()
+    assert solve_file(tmp_path / "m.mbd", tmp_path / "s.csv") == text
+    toml = tmp_path / "cart.toml"
+    toml.write_text(mbd2d.description.toml_io.dumps(model))
+    r = _cli("linearize", str(toml), "--input", inp, "--velocities", "--efforts", "--out",
+             str(tmp_path / "c.csv"))
+    assert r.returncode == 0, r.stderr
+    assert (tmp_path / "c.csv").read_text() == text
+    r = _cli("export", str(toml), str(tmp_path / "e.mbd"), "--analysis", "linearize",
+             "--input", inp, "--velocities", "--efforts")
+    assert r.returncode == 0, r.stderr
+    assert solve_file(tmp_path / "e.mbd", tmp_path / "e.csv") == text
+    r = _cli("linearize", str(toml), "--input", "driver.shake.f.poly.0", "--efforts")
+    assert r.returncode == 2 and "driver.shake.f.poly.0" in r.stderr, r.stderr
+    model.export(tmp_path / "d.mbd", analysis="linearize", inputs=["driver.shake.f.poly.0"],
+                 outputs=["efforts"])
+    r = subprocess.run([_solver(), str(tmp_path / "d.mbd"), str(tmp_path / "o.csv")],
+                       capture_output=True, text=True, timeout=60)
+    assert r.returncode == 2 and "driver.shake.f.poly.0" in r.stderr, r.stderr
+    assert "effort outputs" in r.stderr
+    _no_driver().export(tmp_path / "n.mbd", analysis="linearize",
+                        inputs=["force.push.fy.poly.0"], outputs=["efforts"])
+    r = subprocess.run([_solver(), str(tmp_path / "n.mbd"), str(tmp_path / "o.csv")],
+                       capture_output=True, text=True, timeout=60)
+    assert r.returncode == 2 and "no drivers" in r.stderr, r.stderr

@@ -101,7 +101,8 @@ def bases(tmp_path_factory: pytest.TempPathFactory) -> list[bytes]:
     out.append(f.read_bytes())
     f = d / "linearize.mbd"                   # a state-space system of the same inputs
     car.export(f, analysis="linearize",
-               inputs=["force.front_suspension.length0", "model.gravity.1"])
+               inputs=["force.front_suspension.length0", "model.gravity.1"],
+               outputs=["velocities"])
     out.append(f.read_bytes())
     f = d / "modes_sweep.mbd"
     mbd2d.export_sweep(car, f, {"force.front_suspension.damping": [0.0, 1500.0],

@@ -1009,18 +1009,24 @@ contains
   !> The linearized system (Model.linearize) written as LinearizedSystem.to_csv writes it:
   !! matrix,row,column,value for every entry of A (states by states), B (states by inputs),
   !! C (outputs by states) and D (outputs by inputs), row by row; the states z1 .. zf,
-  !! v1 .. vf, the inputs the sensitivities block's names, the outputs the coordinates.
+  !! v1 .. vf, the inputs the sensitivities block's names, the outputs the coordinates (with
+  !! "outputs velocities" their velocities, with "outputs efforts" each driver's effort.NAME,
+  !! -lambda on its row).
   subroutine run_linearize()
     real(wp), allocatable :: qe(:), lam(:), fpm(:), a(:, :), b(:, :), c(:, :), d(:, :)
     integer, allocatable :: ftm(:, :)
-    integer :: ns, f, u, ios, i, j, k, pass, nqo
+    integer :: ns, f, u, ios, i, j, k, pass, nqo, nv
     call linear_checks('linearize')
-    if (spec%out_energy .or. spec%out_lam .or. spec%out_eff .or. spec%out_reac .or. &
+    if (spec%out_energy .or. spec%out_lam .or. spec%out_reac .or. &
         spec%out_damped .or. spec%ncase > 0 .or. spec%positions_only .or. &
         spec%nmeas > 0 .or. spec%freq_line > 0) &
-      call die(2, trim(model_path) // ': linearize takes no outputs but "velocities", and '// &
-               'no cases, measures, frequencies or positions_only')
-    nqo = merge(2, 1, spec%out_vel) * nq
+      call die(2, trim(model_path) // ': linearize takes no outputs but "velocities" and '// &
+               '"efforts", and no cases, measures, frequencies or positions_only')
+    if (spec%out_eff .and. size(drow) == 0) call die(2, trim(model_path) // ': the output '// &
+      '"efforts": the model has no drivers (an effort is what a driver holding its motion '// &
+      'exerts)')
+    nv = merge(2, 1, spec%out_vel) * nq          ! the coordinates' (and velocities') rows
+    nqo = nv + merge(neq, 0, spec%out_eff)
     if (spec%npar == 0) call die(2, trim(model_path) // ': linearize needs its inputs: a '// &
       '"sensitivities" block naming the design parameters varied')
     call check_sensitivities()
@@ -1038,7 +1044,7 @@ contains
       call api_linearize(spec%nb, spec%ctab, spec%rpar, spec%bmass, spec%grav, ftm, fpm, q0, &
                          spec%tstat, merge(0, 1, spec%at_q0), spec%ptab, qe, lam, stable, &
                          resid, a, b, c, d, iinfo, status, msg, spec%solver, &
-                         merge(1, 0, spec%out_vel))
+                         merge(1, 0, spec%out_vel), merge(1, 0, spec%out_eff))
       f = iinfo(1)
       if (status /= MBD_BAD_COUNT .or. 2 * f <= ns) exit
       ns = 2 * f
@@ -1061,14 +1067,25 @@ contains
         call lin_entry(u, ios, 'B', state_label(i, f), trim(spec%par_names(k)), b(i, k))
       end do
     end do
-    do i = 1, nqo                                 ! C: outputs by states
+    do i = 1, nv                                  ! C: outputs by states
       do j = 1, 2 * f
         call lin_entry(u, ios, 'C', output_label(i), state_label(j, f), c(i, j))
       end do
     end do
-    do i = 1, nqo                                 ! D: outputs by inputs
+    do i = 1, merge(size(drow), 0, spec%out_eff)  ! (the efforts: -lambda)
+      do j = 1, 2 * f
+        call lin_entry(u, ios, 'C', effort_label(i), state_label(j, f), -c(nv + drow(i), j))
+      end do
+    end do
+    do i = 1, nv                                  ! D: outputs by inputs
       do k = 1, spec%npar
         call lin_entry(u, ios, 'D', output_label(i), trim(spec%par_names(k)), d(i, k))
+      end do
+    end do
+    do i = 1, merge(size(drow), 0, spec%out_eff)
+      do k = 1, spec%npar
+        call lin_entry(u, ios, 'D', effort_label(i), trim(spec%par_names(k)), &
+                       -d(nv + drow(i), k))
       end do
     end do
     close (u)
@@ -1086,6 +1103,21 @@ contains
     call num(v + 0.0_wp, word, nl)
     call sput(u, ios, mat // ',' // row // ',' // col // ',' // word(1:nl) // achar(10))
   end subroutine lin_entry
+
+  !> The label of the i-th driver's effort: effort.NAME.
+  function effort_label(i) result(label)
+    integer, intent(in) :: i
+    character(len=:), allocatable :: label
+    integer :: j, r
+    r = 1
+    label = 'effort.'
+    do j = 1, spec%nc
+      if (r == drow(i)) then
+        label = 'effort.' // trim(spec%con_names(j)); return
+      end if
+      r = r + con_nrow(spec%ctab(1, j))
+    end do
+  end function effort_label
 
   !> The label of state i of f free motions: z1 .. zf, then v1 .. vf.
   function state_label(i, f) result(label)

@@ -10,7 +10,8 @@
                 --damped-out EIGEN.csv --picture MODE.png|MODE.gif --mode K | --damped-mode J]
     mbd2d frf MODEL.toml --input NAME ... --f START:STOP:NUM [--log --t T --at-q0 --solver S]
               [--out FRF.csv --picture BODE.png --body B --coordinate x|y|theta]
-    mbd2d linearize MODEL.toml --input NAME ... [--t T --at-q0 --solver S --velocities]
+    mbd2d linearize MODEL.toml --input NAME ... [--t T --at-q0 --solver S --velocities
+                    --efforts]
                     [--out SYS.csv]
     mbd2d sweep MODEL.toml --param NAME=START:STOP:NUM ... [--grid] --t-end T --steps N
                 --out sweep.nc|sweep.csv [--analysis A --t0 T0 --every K --workers W
@@ -249,6 +250,8 @@ def _parser() -> argparse.ArgumentParser:
     _linear_point(li)
     li.add_argument("--velocities", action="store_true", help="the coordinates' velocities as "
                     "outputs too (inputs that act through forces)")
+    li.add_argument("--efforts", action="store_true", help="every driver's effort as an "
+                    "output too (inputs that act through forces)")
     li.add_argument("--out", default=None, help="write A, B, C, D as CSV (matrix,row,column,"
                     "value)")
     w = sub.add_parser("sweep", help="one analysis of many variants (design parameters "
@@ -474,7 +477,7 @@ def _linearize(model: Model, args: argparse.Namespace) -> int:
     if args.out is not None and not str(args.out).lower().endswith(".csv"):
         raise ModelError(f"--out must end in .csv, got {args.out!r}", "command line")
     res = model.linearize(args.input, t=args.t, equilibrium=not args.at_q0, solver=args.solver,
-                          velocities=args.velocities)
+                          velocities=args.velocities, efforts=args.efforts)
     print(res.summary())
     if args.out is not None:
         res.to_csv(args.out)

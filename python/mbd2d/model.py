@@ -399,7 +399,8 @@ class Model(ModelDescription):
 
     @reads_entries
     def linearize(self, inputs: Any, t: float = 0.0, equilibrium: bool = True,
-                  solver: str = "auto", velocities: bool = False) -> LinearizedSystem:
+                  solver: str = "auto", velocities: bool = False,
+                  efforts: bool = False) -> LinearizedSystem:
         """The small motion about the static equilibrium (drivers held at t, as in
         :meth:`modes`) as a state-space system x' = A x + B p, dq = C x + D p whose inputs
         p are design parameters (a force's amplitude, a spring's free length, gravity, a
@@ -419,6 +420,12 @@ class Model(ModelDescription):
             after the coordinates' rows), for velocity feedback; only for inputs that act
             through forces (D = 0: an input that moves the mechanism directly would move
             its velocities by its rate).
+        efforts : bool
+            Also every driver's effort as an output (``effort.NAME``, the force or torque
+            that holds its motion, as :meth:`inverse_dynamics` gives it), after the other
+            outputs: for a motor torque or a held base force in a control loop; only for
+            inputs whose rate and acceleration do not act on the constraints (a force,
+            gravity; an input that moves the constraints is named).
 
         Returns
         -------
@@ -430,8 +437,9 @@ class Model(ModelDescription):
         Raises
         ------
         ModelError
-            For an unknown input, no input, contacts or joint friction; velocities with an
-            input that moves the mechanism directly (named).
+            For an unknown input, no input, contacts or joint friction; velocities or
+            efforts with an input that moves the mechanism directly (named); efforts of a
+            model without drivers.
         ConvergenceError
             If no equilibrium is found near the q0 estimates.
         SingularJacobianError
@@ -445,7 +453,7 @@ class Model(ModelDescription):
         True
         """
         return run_linearize(self, inputs, t=t, equilibrium=equilibrium, solver=solver,
-                             velocities=velocities)
+                             velocities=velocities, efforts=efforts)
 
     # ------------------------------------------------------------------ at one state
     @reads_entries

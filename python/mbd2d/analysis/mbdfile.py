@@ -154,7 +154,7 @@ def _outputs(outputs: Any, analysis: str) -> list[str]:
     if isinstance(outputs, str):
         outputs = [outputs]
     known = {"modes": ("damped",), "frf": ("reactions",),
-             "linearize": ("velocities",)}.get(analysis, OUTPUTS)
+             "linearize": ("velocities", "efforts")}.get(analysis, OUTPUTS)
     try:
         words = [str(w) for w in outputs]
     except TypeError:

@@ -178,19 +178,22 @@ def frf(p: Packed, d: DynamicTables, t: float, equilibrium: bool, ptab: np.ndarr
 
 
 def linearize(p: Packed, d: DynamicTables, t: float, equilibrium: bool, ptab: np.ndarray,
-              nstates: int, solver: int = 0, velocities: bool = False) -> SimpleNamespace:
+              nstates: int, solver: int = 0, velocities: bool = False,
+              multipliers: bool = False) -> SimpleNamespace:
     """The linearized motion about the equilibrium near q0 (or about the assembled q0) as a
     state-space system with the parameters of ptab as inputs: ``q``, ``lam``, ``stable``,
     ``resid``, ``a`` (nstates, nstates), ``b`` (nstates, np), ``c`` (nq, nstates), ``d``
     (nq, np) in their leading 2 nfree states (with velocities 2 nq rows of c and d: the
-    velocities' outputs after the coordinates'), ``iinfo`` (iinfo[0]: nfree), ``status``
-    (MBD_BAD_COUNT when nstates < 2 nfree), ``msg``."""
+    velocities' outputs after the coordinates'; with multipliers neq rows more after those:
+    the multipliers'), ``iinfo`` (iinfo[0]: nfree), ``status`` (MBD_BAD_COUNT when nstates
+    < 2 nfree), ``msg``."""
     ns, npar = max(int(nstates), 1), ptab.shape[1]
-    nqo = (2 if velocities else 1) * p.nq
+    nqo = (2 if velocities else 1) * p.nq + (p.neq if multipliers else 0)
     return _named("q lam stable resid a b c d iinfo status msg", _core.core_linearize,
                   ctab=p.ctab, rpar=p.rpar, bmass=d.bmass, grav=d.grav, ftab=d.ftab,
                   fpar=d.fpar, neq=p.neq, q0=p.q0, t=t, equilibrium=int(equilibrium),
-                  ptab=ptab, ns=ns, solver=solver, nqo=nqo,
+                  ptab=ptab, ns=ns, solver=solver, vel=int(velocities),
+                  mult=int(multipliers), nqo=nqo,
                   numbers=float(ns + nqo) * (ns + npar) + p.nq + p.neq)
 
 
