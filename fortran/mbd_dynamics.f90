@@ -1136,9 +1136,15 @@ contains
   !! inverse column norms of J_a, so that J_a D is well scaled: in the units of a long
   !! chain's length scale a body angle's column is small) with one factorization on the path
   !! of w, refined twice with the residual from the blocks, then orthonormalized by
-  !! Gram-Schmidt (twice). The span is that of P, so whatever uses
-  !! only P = nb nb^T (the partitioned method's choice of coordinates) does not depend on
-  !! the vectors r. status MBD_SINGULAR when the projections are not independent.
+  !! Gram-Schmidt (twice) against the columns before it. The vectors r are one xorshift64
+  !! stream (Marsaglia 2003: nonlinear over the reals, so no lattice among them; the linear
+  !! congruential vectors seeded k apart used before were affine in k modulo 2^31, and on
+  !! the free coordinates of a 60-block chain exactly dependent: no basis, no modes); a
+  !! projection that keeps less than KEEP of its norm after Gram-Schmidt (its component in
+  !! the new direction too small for J_a x = 0 to hold to round-off once it is scaled up) is
+  !! replaced by the stream's next vector, at most MAX_DRAWS times. The span is that of P, so
+  !! whatever uses only P = nb nb^T (the partitioned method's choice of coordinates) does not
+  !! depend on the vectors r. status MBD_SINGULAR when no draw gives a new direction.
   subroutine dyn_null_basis(m, w, q, t, nb, status)
     type(model_t), intent(in) :: m           !! model
     type(dyn_work_t), intent(inout) :: w     !! work arrays
@@ -1146,8 +1152,11 @@ contains
     real(wp), intent(in) :: t                !! time
     real(wp), intent(out) :: nb(:, :)        !! basis (nq, ni)
     integer, intent(out) :: status           !! MBD_OK or MBD_SINGULAR
-    integer(int64) :: seed
-    integer :: n, k, i, j, pass
+    !> a projection's norm kept after Gram-Schmidt, at least (else the next draw)
+    real(wp), parameter :: KEEP = 1.0e-3_wp
+    integer, parameter :: MAX_DRAWS = 16         !! draws per column
+    integer(int64) :: x                          ! xorshift64 state
+    integer :: n, k, i, j, pass, draw
     real(wp) :: d, nrm0, nrm
     n = m%nq
     call assemble(m, w, q, w%qz, t)
@@ -1173,34 +1182,35 @@ contains
     end do
     call factor_aug(w, w%metric, status)
     if (status /= MBD_OK) return
+    x = 88172645463325252_int64                    ! (Marsaglia's seed: a fixed stream)
     do k = 1, size(nb, 2)
-      seed = 12345_int64 + 7919_int64 * k          ! a fixed linear congruential sequence
-      do i = 1, n
-        seed = modulo(1103515245_int64 * seed + 12345_int64, 2147483648_int64)
-        w%rhs(i) = w%metric(i) * (real(seed, wp) / 1073741824.0_wp - one)
-      end do
-      w%rhs(n + 1:) = zero
-      w%rsave = w%rhs
-      call dyn_solve(w, w%rhs, status)
-      if (status /= MBD_OK) return
-      do pass = 1, 2                                ! iterative refinement
-        call residual(w%rhs, w%rres)
-        call dyn_solve(w, w%rres, status)
-        if (status /= MBD_OK) return
-        w%rhs = w%rhs + w%rres
-      end do
-      nb(:, k) = w%rhs(1:n)
-    end do
-    do k = 1, size(nb, 2)                            ! Gram-Schmidt, twice
-      nrm0 = norm2(nb(:, k))
-      do pass = 1, 2
-        do j = 1, k - 1
-          d = dot_product(nb(:, j), nb(:, k))
-          nb(:, k) = nb(:, k) - d * nb(:, j)
+      do draw = 1, MAX_DRAWS
+        do i = 1, n                                  ! r in [-1, 1), 53 bits
+          x = ieor(x, ishft(x, 13)); x = ieor(x, ishft(x, -7)); x = ieor(x, ishft(x, 17))
+          w%rhs(i) = w%metric(i) * (real(ishft(x, -11), wp) * 2.0_wp**(-52) - one)
         end do
+        w%rhs(n + 1:) = zero
+        w%rsave = w%rhs
+        call dyn_solve(w, w%rhs, status)
+        if (status /= MBD_OK) return
+        do pass = 1, 2                                ! iterative refinement
+          call residual(w%rhs, w%rres)
+          call dyn_solve(w, w%rres, status)
+          if (status /= MBD_OK) return
+          w%rhs = w%rhs + w%rres
+        end do
+        nb(:, k) = w%rhs(1:n)
+        nrm0 = norm2(nb(:, k))
+        do pass = 1, 2                                ! Gram-Schmidt, twice
+          do j = 1, k - 1
+            d = dot_product(nb(:, j), nb(:, k))
+            nb(:, k) = nb(:, k) - d * nb(:, j)
+          end do
+        end do
+        nrm = norm2(nb(:, k))
+        if (nrm > KEEP * nrm0) exit
       end do
-      nrm = norm2(nb(:, k))
-      if (.not. nrm > 1.0e-8_wp * nrm0) then
+      if (.not. nrm > KEEP * nrm0) then
         status = MBD_SINGULAR; return
       end if
       nb(:, k) = nb(:, k) / nrm

@@ -42,13 +42,16 @@ module mbd_frf
   use mbd_dynamics, only: dyn_work_t, dyn_null_basis, dyn_factor_projection, dyn_pattern_mul
   implicit none
   private
-  public :: frf_solve, linear_parts
+  public :: frf_solve, linear_parts, massless
 
   character(len=*), parameter :: HINT = 'the frequency response uses dense matrices of the ' &
     // 'number of free motions: use a model with fewer free motions'
   !> the Hessenberg form from this many free motions and frequencies on (below, a dense LU
   !! per frequency costs less than the reduction)
   integer, parameter :: HESS_MIN_FREE = 16, HESS_MIN_FREQ = 8
+  !> a pivot of M_r's factors at most this fraction of its largest diagonal entry: a free
+  !! motion without mass (massless)
+  real(wp), parameter :: MASS_TOL = 1.0e-12_wp
   character(len=*), parameter :: SINGULAR_MSG = 'frequency response: K_r - Omega^2 M_r + ' // &
     'i Omega C_r is singular (an undamped natural frequency, or 0 Hz with a motion without ' // &
     'stiffness)'
@@ -188,6 +191,7 @@ contains
       a(1:f, 1:f) = mr                            ! M_r's LU in a's corner
       call dgetrf(f, f, a, f2, ipiv, info)
       if (info /= 0) return
+      if (massless([(abs(a(i, i)), i = 1, f)], maxval([(mr(i, i), i = 1, f)]))) return
       th = zero
       do i = 1, f
         th(i, f + i) = one
@@ -394,6 +398,16 @@ contains
       lim(:, :, j) = lw
     end subroutine multipliers_by_parts
   end subroutine frf_solve
+
+  !> M_r's factors show a free motion without mass: a pivot (piv(k): |u_kk| of an LU, or
+  !! u_kk^2 of a Cholesky factor) at most MASS_TOL times M_r's largest diagonal entry dmax
+  !! (NaN too). A zero mass leaves pivots of round-off size, about eps dmax, and an exact
+  !! zero only by chance: the null basis' vectors decide which.
+  pure logical function massless(piv, dmax)
+    real(wp), intent(in) :: piv(:)              !! the factors' pivots
+    real(wp), intent(in) :: dmax                !! max diag(M_r)
+    massless = any(.not. (piv > MASS_TOL * dmax))
+  end function massless
 
   !> The linearized motion's parts about the rest state (q, t, lam), every one exact: N, a
   !! basis of J_a's null space (dyn_null_basis), K N, C N, M N and the reduced K_r = N^T K N,

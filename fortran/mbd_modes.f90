@@ -30,6 +30,7 @@ module mbd_modes
   use mbd_model, only: model_t
   use mbd_lapack, only: dsygvd, dgeev, dgetrf, dgetrs, dgemm
   use mbd_dynamics, only: dyn_work_t, dyn_tangent, dyn_null_basis, dyn_pattern_mul
+  use mbd_frf, only: massless
   use mbd_sensitivity, only: sens_t
   use mbd_sens_dynamics, only: sens_stiffness_mul, sens_damping_mul, sens_tangent_pattern
   implicit none
@@ -163,6 +164,9 @@ contains
       call mem_fail(bytes, trim(what), HINT, status, msg); return
     end if
     call dsygvd(1, 'V', 'U', f, ks, f, a, 2 * f, ev, work, size(work), iwork, size(iwork), info)
+    if (info == 0) then                           ! (a holds M_r's Cholesky factor U)
+      if (massless([(a(j, j)**2, j = 1, f)], maxval([(mr(j, j), j = 1, f)]))) info = f + 1
+    end if
     if (info > f) then
       status = MBD_SINGULAR
       msg = 'modes: a free motion carries no mass (M_r is not positive definite): give ' // &
@@ -234,9 +238,14 @@ contains
     subroutine damped_eigenvalues(st)
       integer, intent(out) :: st
       character :: jobvr
+      real(wp) :: dmax
       st = MBD_OK
       jobvr = merge('V', 'N', cshapes)
+      dmax = maxval([(mr(j, j), j = 1, f)])
       call dgetrf(f, f, mr, f, ipiv, info)
+      if (info == 0) then
+        if (massless([(abs(mr(j, j)), j = 1, f)], dmax)) info = 1
+      end if
       if (info /= 0) then
         st = MBD_SINGULAR; msg = 'modes: M_r is singular (a free motion carries no mass)'
         return

@@ -34,7 +34,7 @@
 !! allocate nothing.
 module mbd_statics
   use mbd_kinds, only: wp, zero, one, half, eps
-  use mbd_status, only: MBD_OK, MBD_NO_CONVERGENCE, MBD_LAPACK, MSG_LEN
+  use mbd_status, only: MBD_OK, MBD_NO_CONVERGENCE, MBD_LAPACK, MBD_SINGULAR, MSG_LEN
   use mbd_memory, only: REAL_BYTES, mem_check, mem_fail, mem_grow
   use mbd_model, only: model_t
   use mbd_assemble, only: blocks_jtv
@@ -249,7 +249,7 @@ contains
         if (nfree == 0) return
         call dyn_null_basis(m, w, qa, t, nb(:, 1:nfree), st)
         if (st /= MBD_OK) then
-          st = MBD_LAPACK; msg = 'statics: no basis of the free motions (J is singular)'
+          st = MBD_SINGULAR; msg = 'statics: no basis of the free motions (J is singular)'
           return
         end if
         g(1:nfree) = matmul(w%force, nb(:, 1:nfree))   ! N^T Q (= -reduced gradient of V)

@@ -484,3 +484,42 @@ def test_effort_outputs_from_every_front_door(tmp_path: Path) -> None:
     r = subprocess.run([_solver(), str(tmp_path / "n.mbd"), str(tmp_path / "o.csv")],
                        capture_output=True, text=True, timeout=60)
     assert r.returncode == 2 and "no drivers" in r.stderr, r.stderr
+
+
+def _anchored_chain(n: int, m: float, k: float, c: float) -> mbd2d.Model:
+    """test_modes' chain damped at its end (c), its first spring tied to an anchor block that
+    a driver holds at x = 0 instead of to the ground, pushed along x at its first block."""
+    from test_modes import damped_chain
+    text = mbd2d.description.toml_io.dumps(damped_chain(c, n, m, k))
+    old = 'bodies = ["ground", "b1"]'
+    assert text.count(old) == 2                       # (the guide, then the spring s1)
+    head, tail = text.rsplit(old, 1)
+    text = head + 'bodies = ["anchor", "b1"]' + tail
+    anchor = '[[body]]\nname = "anchor"\nq0 = [0.0, 0.0, 0.0]\nmass = 1.0\ninertia = 0.01\n\n'
+    model = mbd2d.loads(text.replace("[[body]]", anchor + "[[body]]", 1))
+    model.add_translational(["ground", "anchor"], [[0.0, 0.0], [0.0, 0.0]], [[1, 0], [1, 0]],
+                            name="rail")
+    model.add_driver("absolute", {"poly": [0.0]}, body="anchor", coordinate="x", name="hold")
+    model.add_point_force("b1", [0.0, 0.0], fx=0.0, name="shaker")
+    return model
+
+
+def test_efforts_of_a_long_chain_on_the_band_path() -> None:
+    """Sixty blocks on springs (k 200, m 0.5), a damper (c 5) on the last, the first spring
+    held by a driven anchor, a push on the first block: the anchor's effort is -k X1(s), X the
+    tridiagonal system (K + s C + s^2 M) X = e1 solved here, at five points s, on the band path
+    and the dense one."""
+    n, m, k, c = 60, 0.5, 200.0, 5.0
+    model = _anchored_chain(n, m, k, c)
+    kk = k * (2 * np.eye(n) - np.eye(n, k=1) - np.eye(n, k=-1))
+    kk[-1, -1] = k
+    cc = np.zeros((n, n))
+    cc[-1, -1] = c
+    e1 = np.eye(n)[0]
+    for solver in ("banded", "dense"):
+        sys_ = model.linearize("force.shaker.fx.poly.0", solver=solver, efforts=True)
+        assert sys_.stats["solver"] == solver and sys_.n_free == n
+        for s in S_POINTS[1:]:
+            x1 = np.linalg.solve(kk + s * cc + s**2 * m * np.eye(n), e1)[0]
+            np.testing.assert_allclose(transfer(sys_, s)[out(sys_, "effort.hold"), 0], -k * x1,
+                                       rtol=1e-10)
