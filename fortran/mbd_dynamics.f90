@@ -1136,7 +1136,8 @@ contains
   !! inverse column norms of J_a, so that J_a D is well scaled: in the units of a long
   !! chain's length scale a body angle's column is small) with one factorization on the path
   !! of w, refined twice with the residual from the blocks, then orthonormalized by
-  !! Gram-Schmidt (twice) against the columns before it. The vectors r are one xorshift64
+  !! Gram-Schmidt against the columns before it (twice where the first pass cancels more
+  !! than 1 - 1/sqrt(2) of the norm). The vectors r are one xorshift64
   !! stream (Marsaglia 2003: nonlinear over the reals, so no lattice among them; the linear
   !! congruential vectors seeded k apart used before were affine in k modulo 2^31, and on
   !! the free coordinates of a 60-block chain exactly dependent: no basis, no modes); a
@@ -1155,6 +1156,7 @@ contains
     !> a projection's norm kept after Gram-Schmidt, at least (else the next draw)
     real(wp), parameter :: KEEP = 1.0e-3_wp
     integer, parameter :: MAX_DRAWS = 16         !! draws per column
+    real(wp), parameter :: REORTH = 0.7071067811865476_wp  !! a second pass below this
     integer(int64) :: x                          ! xorshift64 state
     integer :: n, k, i, j, pass, draw
     real(wp) :: d, nrm0, nrm
@@ -1201,13 +1203,18 @@ contains
         end do
         nb(:, k) = w%rhs(1:n)
         nrm0 = norm2(nb(:, k))
-        do pass = 1, 2                                ! Gram-Schmidt, twice
+        nrm = nrm0
+        ! Gram-Schmidt, a second pass only if the first left less than 1/sqrt(2) of the
+        ! norm (Daniel, Gragg, Kaufman and Stewart 1976: orthogonal to round-off either way)
+        do pass = 1, 2
           do j = 1, k - 1
             d = dot_product(nb(:, j), nb(:, k))
             nb(:, k) = nb(:, k) - d * nb(:, j)
           end do
+          d = nrm
+          nrm = norm2(nb(:, k))
+          if (nrm >= REORTH * d) exit
         end do
-        nrm = norm2(nb(:, k))
         if (nrm > KEEP * nrm0) exit
       end do
       if (.not. nrm > KEEP * nrm0) then
