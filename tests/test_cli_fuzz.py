@@ -60,6 +60,8 @@ def _command(rng: random.Random, tmp: Path) -> list[str]:
             argv += rng.choice([["--log"], ["--at-q0"],
                                 ["--out", str(tmp / rng.choice(["f.csv", "f.nc"]))],
                                 ["--picture", str(tmp / rng.choice(["b.png", "b.gif"]))],
+                                ["--picture", str(tmp / "o.gif"), "--at",
+                                 rng.choice(NUMBERS + ["1.5"])], ["--at", "2"],
                                 ["--body", rng.choice(["coupler", "zzz"])]])
     if cmd == "linearize":
         argv += ["--input", rng.choice(NAMES + ["model.gravity.1", "driver.motor.f.poly.0"])]

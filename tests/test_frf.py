@@ -536,3 +536,51 @@ def test_the_command_line(tmp_path: Path) -> None:
     mbd2d.write_sweep(ds, tmp_path / "w.csv")
     assert solve_file(tmp_path / "w.mbd", tmp_path / "ws.csv") == \
         (tmp_path / "w.csv").read_text()
+
+
+def test_the_operating_deflection_shape_of_the_pushed_block(tmp_path: Path) -> None:
+    """The steady motion at a frequency (res.deflection): the block's y moves by
+    a Re(H e^(i 2 pi f t)) over one period, H = -1/(k - m w^2 + i c w) per unit of the
+    actuator's force (closed form), at the computed frequency nearest to the one asked for;
+    at 0 Hz the static deflection a sin(2 pi t) H over 1 s; by default the block moves by 15%
+    of the mechanism's size. GIFs from Python and from ``mbd2d frf --picture x.gif`` (at
+    --at, and at the peak by default); a frequency that is no number, an --at without an
+    animation: ModelErrors."""
+    k, c, m = 36.0, 1.5, 2.0
+    res = block(k, c, m).frequency_response("force.s.f.poly.0", FREQS)
+    for asked, f in ((0.68, 0.6755), (1.3, 1.3), (24.0, 25.0), (0.0, 0.0)):
+        mot = res.deflection(asked, amplitude=0.2, frames=21)
+        w = 2 * np.pi * f
+        h = -1 / (k - m * w**2 + 1j * c * w)
+        period = 1 / f if f > 0 else 1.0
+        assert mot.t[-1] == pytest.approx(period) and mot.q.shape == (21, 3)
+        wave = np.exp(1j * w * mot.t) if f > 0 else np.sin(2 * np.pi * mot.t)
+        np.testing.assert_allclose(mot.q[:, 1] - res.q[1], 0.2 * (h * wave).real, rtol=0,
+                                   atol=1e-14)
+        np.testing.assert_array_equal(mot.q[:, [0, 2]], np.tile(res.q[[0, 2]], (21, 1)))
+    default = res.deflection(0.7)
+    move = np.abs(default.q[:, 1] - res.q[1]).max()
+    assert move == pytest.approx(0.15 * abs(res.q[1]), rel=1e-3)    # (frames: the peak)
+    for bad in ("fast", float("nan"), None):
+        with pytest.raises(mbd2d.ModelError, match="frequency must be a finite number"):
+            res.deflection(bad)
+    pytest.importorskip("matplotlib")
+    res.animate(1.3, tmp_path / "ods.gif", fps=10)
+    assert (tmp_path / "ods.gif").stat().st_size > 1000
+    toml = tmp_path / "block.toml"
+    toml.write_text(block_text(k, c, m))
+    import subprocess
+    import sys
+    grid = np.linspace(0.0, 5.0, 21)
+    peak = grid[np.argmax(np.abs(1 / (k - m * (2 * np.pi * grid)**2 + 2j * np.pi * c * grid)))]
+    for extra, hz in (([], f"{peak:g}"), (["--at", "4.1"], "4")):     # (the nearest: 4)
+        r = subprocess.run([sys.executable, "-m", "mbd2d", "frf", str(toml), "--input",
+                            "force.s.f.poly.0", "--f", "0:5:21", "--body", "block",
+                            "--picture", str(tmp_path / "c.gif"), *extra],
+                           capture_output=True, text=True, timeout=120)
+        assert r.returncode == 0, r.stderr
+        assert f"at {hz} Hz" in r.stdout and (tmp_path / "c.gif").stat().st_size > 1000
+    r = subprocess.run([sys.executable, "-m", "mbd2d", "frf", str(toml), "--input",
+                        "force.s.f.poly.0", "--f", "0:5:21", "--at", "2"],
+                       capture_output=True, text=True, timeout=120)
+    assert r.returncode == 2 and "--at is the frequency of an animation" in r.stderr

@@ -9,7 +9,8 @@
     mbd2d modes MODEL.toml [--t T --count K --at-q0 --solver S] [--out MODES.csv
                 --damped-out EIGEN.csv --picture MODE.png|MODE.gif --mode K | --damped-mode J]
     mbd2d frf MODEL.toml --input NAME ... --f START:STOP:NUM [--log --t T --at-q0 --solver S]
-              [--out FRF.csv --picture BODE.png --body B --coordinate x|y|theta]
+              [--out FRF.csv --picture BODE.png|ODS.gif --at HZ --body B
+              --coordinate x|y|theta]
     mbd2d linearize MODEL.toml --input NAME ... [--t T --at-q0 --solver S --velocities
                     --efforts]
                     [--out SYS.csv]
@@ -236,7 +237,10 @@ def _parser() -> argparse.ArgumentParser:
     fr.add_argument("--out", default=None, help="write the response as CSV")
     fr.add_argument("--reactions", action="store_true", help="with --out: the joints' "
                    "reaction responses too")
-    fr.add_argument("--picture", default=None, help="draw a Bode plot (.png, .svg or .pdf)")
+    fr.add_argument("--picture", default=None, help="draw a Bode plot (.png, .svg or .pdf), "
+                    "or animate the operating deflection shape (.gif or .mp4) at --at")
+    fr.add_argument("--at", type=float, default=None, metavar="HZ", help="with an animation: "
+                    "the frequency (default: the peak of --body's --coordinate)")
     fr.add_argument("--body", default=None, help="the body drawn (default the first)")
     fr.add_argument("--coordinate", default="y", choices=["x", "y", "theta"],
                    help="the coordinate drawn (default y)")
@@ -488,10 +492,13 @@ def _linearize(model: Model, args: argparse.Namespace) -> int:
 def _frf(model: Model, args: argparse.Namespace) -> int:
     """``mbd2d frf``: the peaks printed, then the files asked for."""
     for opt, path, ends in (("--out", args.out, (".csv",)),
-                            ("--picture", args.picture, PICTURE_ENDS)):
+                            ("--picture", args.picture, PICTURE_ENDS + MOTION_ENDS)):
         if path is not None and not str(path).lower().endswith(ends):
             raise ModelError(f"{opt} must end in {' or '.join(ends)}, got {path!r}",
                              "command line")
+    if args.at is not None and not str(args.picture or "").lower().endswith(MOTION_ENDS):
+        raise ModelError("--at is the frequency of an animation: give --picture NAME.gif or "
+                         ".mp4", "command line")
     res = model.frequency_response(args.input, _frequencies(args), t=args.t,
                                    equilibrium=not args.at_q0, solver=args.solver)
     print(res.summary())
@@ -500,6 +507,13 @@ def _frf(model: Model, args: argparse.Namespace) -> int:
         print(f"wrote {res.frequencies.size} frequencies to {args.out}")
     if args.picture is not None:
         body = args.body if args.body is not None else res.body_names[0]
+        if str(args.picture).lower().endswith(MOTION_ENDS):
+            at = args.at if args.at is not None else \
+                res.peak(body, args.coordinate, args.input[0])[0]
+            res.animate(at, args.picture, input=args.input[0])
+            print(f"animated the response to {args.input[0]} at "
+                  f"{res.frequencies[res.frequency_index(at)]:g} Hz in {args.picture}")
+            return EXIT_OK
         fig = res.plot(body, args.coordinate, input=args.input[0])
         plots.save_figure(fig, args.picture)
         print(f"drew {body}.{args.coordinate} per unit {args.input[0]} in {args.picture}")

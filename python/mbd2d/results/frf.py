@@ -11,6 +11,7 @@ from ..errors import ModelError
 from ..validate import vector
 from .columns import REACTION_WORDS
 from .files import write_csv
+from .modes import picture_amplitude
 from .points import PointResult
 from .reactions import Reaction, driver_row, driver_rows
 from .sensitivities import reaction_dp_arrays, reaction_dp_of
@@ -139,6 +140,52 @@ class FrequencyResponseResult:
         mag = np.abs(self.response_of(body, coordinate, input))
         k = int(np.argmax(mag)) if mag.size else 0
         return (float(self.frequencies[k]), float(mag[k])) if mag.size else (0.0, 0.0)
+
+    def frequency_index(self, frequency: Any) -> int:
+        """Index of the computed frequency nearest to ``frequency`` (Hz).
+
+        Raises
+        ------
+        ModelError
+            For a frequency that is not a finite number.
+        """
+        try:
+            f = float(frequency)
+        except (TypeError, ValueError):
+            f = float("nan")
+        if not np.isfinite(f):
+            raise ModelError(f"frequency must be a finite number in Hz, got {frequency!r}",
+                             "frequency response")
+        return int(np.argmin(np.abs(self.frequencies - f)))
+
+    def deflection(self, frequency: float, input: str | None = None,
+                   amplitude: float | None = None, frames: int = 49) -> Any:
+        """The operating deflection shape: the steady motion q = q* + Re(H a e^(i 2 pi f t))
+        over one period at the computed frequency f nearest to ``frequency`` (Hz), for the
+        input varied with amplitude a (default: the bodies' points move by about 15% of
+        the mechanism's size), each coordinate at its own phase; at 0 Hz the static
+        deflection a sin(2 pi t) H over 1 s. For the pictures (:func:`mbd2d.animate`,
+        :func:`mbd2d.plot_mechanism`)."""
+        j, k = self.frequency_index(frequency), self._input(input)
+        h = self.response[j, :, k]
+        a = picture_amplitude(self.q, np.abs(h), len(self.body_names)) \
+            if amplitude is None else float(amplitude)
+        f = float(self.frequencies[j])
+        period = 1.0 / f if f > 0 else 1.0
+        t = np.linspace(0.0, period, max(int(frames), 3))
+        wave = np.exp(2j * np.pi * f * t) if f > 0 else np.sin(2 * np.pi * t) + 0j
+        q = self.q[None, :] + a * (wave[:, None] * h[None, :]).real
+        return plots.Configuration(self.model, q, t, note=f"{self.inputs[k]} at {f:.4g} Hz, "
+                                   f"amplitude {a:.3g}")
+
+    def animate(self, frequency: float, path: Any = None, input: str | None = None,
+                amplitude: float | None = None, **kwargs: Any) -> Any:
+        """The operating deflection shape at ``frequency`` (:meth:`deflection`) over one
+        period, slowed to about 2 s: :func:`mbd2d.animate`."""
+        mot = self.deflection(frequency, input, amplitude)
+        kwargs.setdefault("speed", float(mot.t[-1]) / 2.0)
+        kwargs.setdefault("title", f"{getattr(self.model, 'name', 'model')}: {mot.note}")
+        return plots.animate(mot, path, **kwargs)
 
     def table(self, reactions: bool = False) -> tuple[list[str], np.ndarray]:
         """Header and rows of the CSV: one row per frequency, ``frequency_hz``, then for each

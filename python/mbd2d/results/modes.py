@@ -16,6 +16,18 @@ KINDS = {1: "vibration", 0: "rigid", -1: "unstable"}
 PICTURE_AMPLITUDE = 0.15
 
 
+def picture_amplitude(q: np.ndarray, phi: np.ndarray, n_bodies: int) -> float:
+    """The factor a that moves the bodies' points by about PICTURE_AMPLITUDE of the
+    mechanism's size at q when the coordinates change by a phi (phi: the changes' moduli);
+    0 when phi moves nothing."""
+    xy = q[:3 * n_bodies].reshape(n_bodies, 3)[:, :2]
+    size = max(float(np.ptp(xy, axis=0).max(initial=0.0)),
+               float(np.abs(xy).max(initial=0.0)), 1e-300)
+    p = phi[:3 * n_bodies].reshape(n_bodies, 3)
+    move = float((np.hypot(p[:, 0], p[:, 1]) + size * np.abs(p[:, 2])).max(initial=0.0))
+    return PICTURE_AMPLITUDE * size / move if move > 0 else 0.0
+
+
 @dataclass
 class ModesResult:
     """The linearized motion about an equilibrium (drivers held at ``t``).
@@ -161,7 +173,8 @@ class ModesResult:
         s: a sin(2 pi t) psi over 1 s)."""
         k = self._mode(k, damped)
         shape = self.damped_shapes[:, k] if damped else self.shapes[:, k].astype(complex)
-        a = self._amplitude(np.abs(shape)) if amplitude is None else float(amplitude)
+        a = picture_amplitude(self.q, np.abs(shape), len(self.body_names)) \
+            if amplitude is None else float(amplitude)
         w = abs(self.eigenvalues[k].imag) if damped else self.omega[k]
         period = 2 * np.pi / w if w > 0 else 1.0
         t = np.linspace(0.0, period, max(int(frames), 3))
@@ -178,16 +191,6 @@ class ModesResult:
             return (f"damped mode {k}, {self.damped_frequency[k]:.4g} Hz, "
                     f"zeta {self.damping_ratio[k]:.3g}")
         return f"mode {k}, {self.frequency[k]:.4g} Hz ({self.kinds[k]})"
-
-    def _amplitude(self, phi: np.ndarray) -> float:
-        """The factor that moves the points by PICTURE_AMPLITUDE of the mechanism's size."""
-        nb = len(self.body_names)
-        xy = self.q[:3 * nb].reshape(nb, 3)[:, :2]
-        size = max(float(np.ptp(xy, axis=0).max(initial=0.0)),
-                   float(np.abs(xy).max(initial=0.0)), 1e-300)
-        p = phi[:3 * nb].reshape(nb, 3)
-        move = float((np.hypot(p[:, 0], p[:, 1]) + size * np.abs(p[:, 2])).max(initial=0.0))
-        return PICTURE_AMPLITUDE * size / move if move > 0 else 0.0
 
     def plot(self, k: int = 0, amplitude: float | None = None, damped: bool = False,
              **kwargs: Any) -> Any:
