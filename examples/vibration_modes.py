@@ -23,7 +23,9 @@ Usage::
 Writes vibration_modes_shapes.png (the four modes, each drawn at both extremes),
 vibration_modes_damping.png (each mode's damping ratio and damped frequency against the
 suspension damping, one mbd2d.sweep of the modes: the designer's chart) and
-vibration_modes.gif (the pitch mode), vibration_modes_road.png (the Bode plot of the road
+vibration_modes.gif (the pitch mode), vibration_modes_road.gif (the car's steady motion on
+the road at the body's bounce peak: the operating deflection shape), vibration_modes_road.png
+(the Bode plot of the road
 response, with the dynamics' steady amplitudes marked) and vibration_modes_road_damping.png
 (the road response's family over the suspension damping) to DIR (default examples/output/).
 Exit code 0 when the released modes depart from their linear motion by less than 2e-3 of a
@@ -241,6 +243,7 @@ def run(out: Path) -> tuple[str, list[str]]:
             problems.append(f"the driven dynamics at {f:g} Hz departs {err:.1e}")
     peak_f, peak = frf.peak("body", "y")
     print(f"largest bounce per unit road rise {peak:.3g} at {peak_f:.3g} Hz")
+    files.append(str(frf.animate(peak_f, out / "vibration_modes_road.gif", max_frames=40)))
     problems += state_space(model, res, frf)
     files.append(str(out / "vibration_modes_road.png"))
     road_figure(frf, checks, Path(files[-1]))

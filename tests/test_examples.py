@@ -143,7 +143,7 @@ def test_demo_script(tmp_path: Path) -> None:
         proc.stdout
     assert "the same CSV: True" in proc.stdout
     assert gifs == ["cam_design.gif", "cam_liftoff.gif", "fourbar_grashof.gif",
-                    "slider_crank.gif", "vibration_modes.gif"]
+                    "slider_crank.gif", "vibration_modes.gif", "vibration_modes_road.gif"]
     for kind in ["shapes", "damping", "road", "road_damping"]:   # the half car's modes, response
         assert (out / f"vibration_modes_{kind}.png").stat().st_size > 0
     assert "ratio 2.00, second order" in proc.stdout
