@@ -19,7 +19,8 @@ class LinearizedSystem:
     """x' = A x + B p, dq = C x + D p: the linearized motion about an equilibrium (drivers
     held at ``t``) with the design parameters ``inputs`` varied as p0 + p(t) and the
     coordinates' changes dq as outputs (model units; B and D per unit of each input), with
-    ``velocities=True`` their velocities too (``NAME.x_dot`` ...: dq' = C A x + C B p).
+    ``velocities=True`` their velocities too (``NAME.x_dot`` ...: dq' = C A x + C B p), with
+    ``efforts=True`` every driver's effort (``effort.NAME``, -dlambda on its row).
 
     The states x = [w; v] are coordinates of the free motions on a basis N of the
     constraints' null space and their rates (``states``: z1 .. zf, v1 .. vf): with forces
