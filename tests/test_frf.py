@@ -545,7 +545,8 @@ def test_the_operating_deflection_shape_of_the_pushed_block(tmp_path: Path) -> N
     at 0 Hz the static deflection a sin(2 pi t) H over 1 s; by default the block moves by 15%
     of the mechanism's size. GIFs from Python and from ``mbd2d frf --picture x.gif`` (at
     --at, and at the peak by default); a frequency that is no number, an --at without an
-    animation: ModelErrors."""
+    animation, an amplitude or a frame count that is not one (here and in a mode's
+    motion): ModelErrors."""
     k, c, m = 36.0, 1.5, 2.0
     res = block(k, c, m).frequency_response("force.s.f.poly.0", FREQS)
     for asked, f in ((0.68, 0.6755), (1.3, 1.3), (24.0, 25.0), (0.0, 0.0)):
@@ -564,6 +565,15 @@ def test_the_operating_deflection_shape_of_the_pushed_block(tmp_path: Path) -> N
     for bad in ("fast", float("nan"), None):
         with pytest.raises(mbd2d.ModelError, match="frequency must be a finite number"):
             res.deflection(bad)
+    modes = block(k, c, m).modes()
+    for kw, needle in [({"frames": "x"}, "frames must be a whole number"),
+                       ({"frames": 10**9}, "frames must be a whole number"),
+                       ({"frames": 2}, "frames must be a whole number"),
+                       ({"amplitude": "x"}, "amplitude must be a number"),
+                       ({"amplitude": float("nan")}, "amplitude must be finite")]:
+        for call in (lambda: res.deflection(1.3, **kw), lambda: modes.motion(0, **kw)):
+            with pytest.raises(mbd2d.ModelError, match=needle):   # (before: a ValueError,
+                call()                                  # NaN frames, or 1e9 frames' memory)
     pytest.importorskip("matplotlib")
     res.animate(1.3, tmp_path / "ods.gif", fps=10)
     assert (tmp_path / "ods.gif").stat().st_size > 1000

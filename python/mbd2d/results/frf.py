@@ -11,7 +11,7 @@ from ..errors import ModelError
 from ..validate import vector
 from .columns import REACTION_WORDS
 from .files import write_csv
-from .modes import picture_amplitude
+from .modes import motion_settings, picture_amplitude
 from .points import PointResult
 from .reactions import Reaction, driver_row, driver_rows
 from .sensitivities import reaction_dp_arrays, reaction_dp_of
@@ -167,12 +167,13 @@ class FrequencyResponseResult:
         deflection a sin(2 pi t) H over 1 s. For the pictures (:func:`mbd2d.animate`,
         :func:`mbd2d.plot_mechanism`)."""
         j, k = self.frequency_index(frequency), self._input(input)
+        amplitude, frames = motion_settings(amplitude, frames, "frequency response")
         h = self.response[j, :, k]
         a = picture_amplitude(self.q, np.abs(h), len(self.body_names)) \
-            if amplitude is None else float(amplitude)
+            if amplitude is None else amplitude
         f = float(self.frequencies[j])
         period = 1.0 / f if f > 0 else 1.0
-        t = np.linspace(0.0, period, max(int(frames), 3))
+        t = np.linspace(0.0, period, frames)
         wave = np.exp(2j * np.pi * f * t) if f > 0 else np.sin(2 * np.pi * t) + 0j
         q = self.q[None, :] + a * (wave[:, None] * h[None, :]).real
         return plots.Configuration(self.model, q, t, note=f"{self.inputs[k]} at {f:.4g} Hz, "

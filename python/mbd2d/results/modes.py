@@ -8,12 +8,30 @@ import numpy as np
 
 from .. import plots
 from ..errors import ModelError
+from ..validate import number, whole
 from .files import write_csv
 
 #: the core's kinds of modes (mbd_modes: |omega^2| at most 1e-9 of the largest is "rigid")
 KINDS = {1: "vibration", 0: "rigid", -1: "unstable"}
 #: a mode's picture moves the mechanism's points by about this fraction of its size
 PICTURE_AMPLITUDE = 0.15
+
+
+#: the most frames of a mode's or a response's motion
+MAX_FRAMES = 100_000
+
+
+def motion_settings(amplitude: Any, frames: Any, entry: str) -> tuple[float | None, int]:
+    """A motion picture's amplitude (None: the default) and frame count, checked.
+
+    Raises
+    ------
+    ModelError
+        For an amplitude that is no finite number, or frames not a whole number in 3 ..
+        MAX_FRAMES.
+    """
+    a = None if amplitude is None else number(amplitude, "amplitude", entry)
+    return a, whole(frames, "frames", entry, 3, MAX_FRAMES)
 
 
 def picture_amplitude(q: np.ndarray, phi: np.ndarray, n_bodies: int) -> float:
@@ -172,12 +190,13 @@ class ModesResult:
         own phase, the decay e^(Re(s) t) left out so that the shape stays in view (a real
         s: a sin(2 pi t) psi over 1 s)."""
         k = self._mode(k, damped)
+        amplitude, frames = motion_settings(amplitude, frames, "modes")
         shape = self.damped_shapes[:, k] if damped else self.shapes[:, k].astype(complex)
         a = picture_amplitude(self.q, np.abs(shape), len(self.body_names)) \
-            if amplitude is None else float(amplitude)
+            if amplitude is None else amplitude
         w = abs(self.eigenvalues[k].imag) if damped else self.omega[k]
         period = 2 * np.pi / w if w > 0 else 1.0
-        t = np.linspace(0.0, period, max(int(frames), 3))
+        t = np.linspace(0.0, period, frames)
         if damped and w > 0:
             wave = np.exp(1j * self.eigenvalues[k].imag * t)
         else:
