@@ -230,6 +230,8 @@ def test_every_front_door_writes_the_same_system(tmp_path: Path) -> None:
      mbd2d.ModelError, "no output 'block.z'"),
     (lambda m: m.linearize("force.push.fy.poly.0").select(inputs=["model.gravity.1"]),
      mbd2d.ModelError, "no input 'model.gravity.1'"),
+    (lambda m: m.linearize("force.push.fy.poly.0").select(outputs=3), mbd2d.ModelError,
+     "outputs must be a name or a list of names"),             # (before: a TypeError)
     (lambda m: m.linearize("force.push.fy.poly.0", t=float("nan")), mbd2d.ModelError, "t"),
     (lambda m: m.export("x.mbd", analysis="linearize", inputs=["force.push.fy.poly.0"],
                         frequencies=[1.0]), mbd2d.ModelError, "frequencies of frf"),

@@ -125,7 +125,11 @@ def _indices(names: Any, known: list[str], what: str, kind: str) -> list[int]:
     """
     if names is None:
         return list(range(len(known)))
-    names = [names] if isinstance(names, str) else list(names)
+    try:
+        names = [names] if isinstance(names, str) else list(names)
+    except TypeError:
+        raise ModelError(f"{what}s must be a name or a list of names, got {names!r}",
+                         "linearized system") from None
     out = []
     for n in names:
         if n not in known:
