@@ -232,6 +232,9 @@ def test_every_front_door_writes_the_same_system(tmp_path: Path) -> None:
      mbd2d.ModelError, "no input 'model.gravity.1'"),
     (lambda m: m.linearize("force.push.fy.poly.0").select(outputs=3), mbd2d.ModelError,
      "outputs must be a name or a list of names"),             # (before: a TypeError)
+    (lambda m: m.linearize(3), mbd2d.ModelError, "inputs must name at least one"),   # (idem)
+    (lambda m: m.frequency_response(3, [1.0]), mbd2d.ModelError,
+     "inputs must name at least one"),
     (lambda m: m.linearize("force.push.fy.poly.0", t=float("nan")), mbd2d.ModelError, "t"),
     (lambda m: m.export("x.mbd", analysis="linearize", inputs=["force.push.fy.poly.0"],
                         frequencies=[1.0]), mbd2d.ModelError, "frequencies of frf"),
@@ -431,6 +434,9 @@ def test_efforts_refuse_inputs_that_move_the_constraints() -> None:
     held_block().linearize("driver.hold.f.poly.0")           # (the positions alone: fine)
     with pytest.raises(mbd2d.ModelError, match="no drivers"):
         _no_driver().linearize("force.push.fy.poly.0", efforts=True)
+    with pytest.raises(mbd2d.ModelError, match="no drivers"):     # (the file: refused at once)
+        _no_driver().export("never.mbd", analysis="linearize", inputs=["force.push.fy.poly.0"],
+                            outputs=["efforts"])
 
 
 def _no_driver() -> mbd2d.Model:
@@ -482,7 +488,9 @@ def test_effort_outputs_from_every_front_door(tmp_path: Path) -> None:
     assert r.returncode == 2 and "driver.shake.f.poly.0" in r.stderr, r.stderr
     assert "effort outputs" in r.stderr
     _no_driver().export(tmp_path / "n.mbd", analysis="linearize",
-                        inputs=["force.push.fy.poly.0"], outputs=["efforts"])
+                        inputs=["force.push.fy.poly.0"], outputs=["velocities"])
+    text = (tmp_path / "n.mbd").read_text()           # (export refuses efforts without drivers)
+    (tmp_path / "n.mbd").write_text(text.replace("outputs velocities", "outputs efforts", 1))
     r = subprocess.run([_solver(), str(tmp_path / "n.mbd"), str(tmp_path / "o.csv")],
                        capture_output=True, text=True, timeout=60)
     assert r.returncode == 2 and "no drivers" in r.stderr, r.stderr

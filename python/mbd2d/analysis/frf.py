@@ -74,8 +74,11 @@ def frf_inputs(model: ModelDescription, inputs: Any, what: str = WHAT) -> list[P
     """The inputs as design parameters, checked (at least one; no contacts or friction);
     what names the analysis in the messages."""
     check_statics(model)
-    names = [inputs] if isinstance(inputs, str) else inputs
-    if names is None or len(list(names)) == 0:
+    try:
+        names = [inputs] if isinstance(inputs, str) else list(inputs)
+    except TypeError:
+        names = []                                # (None, a number: no names)
+    if len(names) == 0:
         raise ModelError("inputs must name at least one design parameter (model.parameters() "
                          "lists them), e.g. a force's amplitude or a spring's free length", what)
     if getattr(model, "contacts", None):

@@ -22,6 +22,21 @@ from .statics import STABILITY
 WHAT = "linearized system"
 
 
+def efforts_rows(p: Any, efforts: bool) -> tuple[list[int], list[str]]:
+    """The drivers' rows and names (driver_rows) for the effort outputs.
+
+    Raises
+    ------
+    ModelError
+        When efforts are asked for and the model has no driver.
+    """
+    rows, drivers = driver_rows(p)
+    if efforts and not drivers:
+        raise ModelError("efforts=True: the model has no drivers (an effort is what a driver "
+                         "holding its motion exerts)", WHAT)
+    return rows, drivers
+
+
 def run_linearize(model: ModelDescription, inputs: Any, t: float = 0.0,
                   equilibrium: bool = True, solver: str = "auto",
                   velocities: bool = False, efforts: bool = False) -> LinearizedSystem:
@@ -33,10 +48,7 @@ def run_linearize(model: ModelDescription, inputs: Any, t: float = 0.0,
     efforts = flag(efforts, "efforts", WHAT)
     params = frf_inputs(model, inputs, WHAT)
     p = pack(model)
-    rows, drivers = driver_rows(p)
-    if efforts and not drivers:
-        raise ModelError("efforts=True: the model has no drivers (an effort is what a driver "
-                         "holding its motion exerts)", WHAT)
+    rows, drivers = efforts_rows(p, efforts)
     d = pack_dynamics(model, p)
     ptab = table(p, params, d)
     out = core.linearize(p, d, t, equilibrium, ptab, 2 * max(p.nq - p.neq, 0), code,

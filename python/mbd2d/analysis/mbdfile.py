@@ -28,6 +28,7 @@ from ..validate import flag, number
 from .contacts import check_statics
 from .dynamics import dynamics_settings
 from .frf import frequency_list, frf_inputs
+from .linearize import efforts_rows
 from .modes import mode_count
 from .sensitivities import check_sens_method, check_positions_only, requested, table
 from .settings import (SOLVERS, check_solver, check_span, output_rows, require_determined,
@@ -261,6 +262,8 @@ def file_lines(model: ModelDescription, t_end: float | None = None, steps: int |
     elif analysis in ("frf", "linearize"):
         params = frf_inputs(model, inputs, "frequency response" if analysis == "frf"
                             else "linearized system")
+        if analysis == "linearize":
+            efforts_rows(p, "efforts" in words)
         freq = frequency_list(frequencies) if analysis == "frf" else None
         solver_code(solver)
         about_q0 = not flag(equilibrium, "equilibrium", "export")
