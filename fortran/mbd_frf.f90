@@ -42,7 +42,7 @@ module mbd_frf
   use mbd_dynamics, only: dyn_work_t, dyn_null_basis, dyn_factor_projection, dyn_pattern_mul
   implicit none
   private
-  public :: frf_solve, linear_parts, massless
+  public :: frf_solve, linear_parts, massless, mass_lu
 
   character(len=*), parameter :: HINT = 'the frequency response uses dense matrices of the ' &
     // 'number of free motions: use a model with fewer free motions'
@@ -189,9 +189,8 @@ contains
         call mem_fail(bytes, trim(what), HINT, st, msg); return
       end if
       a(1:f, 1:f) = mr                            ! M_r's LU in a's corner
-      call dgetrf(f, f, a, f2, ipiv, info)
+      call mass_lu(f, a, f2, ipiv, info)
       if (info /= 0) return
-      if (massless([(abs(a(i, i)), i = 1, f)], maxval([(mr(i, i), i = 1, f)]))) return
       th = zero
       do i = 1, f
         th(i, f + i) = one
@@ -408,6 +407,22 @@ contains
     real(wp), intent(in) :: dmax                !! max diag(M_r)
     massless = any(.not. (piv > MASS_TOL * dmax))
   end function massless
+
+  !> M_r = P L U in place (dgetrf), info /= 0 also where a pivot shows a free motion without
+  !! mass (massless; f >= 1).
+  subroutine mass_lu(f, a, lda, ipiv, info)
+    integer, intent(in) :: f, lda               !! free motions, a's leading dimension
+    real(wp), intent(inout) :: a(lda, *)        !! M_r, then its LU factors
+    integer, intent(out) :: ipiv(:)             !! (f) row interchanges
+    integer, intent(out) :: info                !! 0, or dgetrf's info, or f + 1: massless
+    real(wp) :: dmax
+    integer :: i
+    dmax = maxval([(a(i, i), i = 1, f)])
+    call dgetrf(f, f, a, lda, ipiv, info)
+    if (info == 0) then
+      if (massless([(abs(a(i, i)), i = 1, f)], dmax)) info = f + 1
+    end if
+  end subroutine mass_lu
 
   !> The linearized motion's parts about the rest state (q, t, lam), every one exact: N, a
   !! basis of J_a's null space (dyn_null_basis), K N, C N, M N and the reduced K_r = N^T K N,

@@ -4,7 +4,7 @@ module mbd_lapack
   implicit none
   private
   public :: dgetrf, dgetf2, dgetrs, dtrsv, dgesvd, dgels, dgelsy, dgtsv, dgeqp3, dormqr, dtrtrs, &
-            dgecon, dtrcon, dsyev, dsygv, dsygvd, dgeev, dgehrd, dorghr, dgemm
+            dgecon, dtrcon, dsyev, dsygvd, dgeev, dgehrd, dorghr, dgemm
   public :: dgbtrf, dgbtrs, dgbcon, dlacn2
 
   interface
@@ -117,16 +117,8 @@ module mbd_lapack
       real(wp), intent(out) :: w(*), work(*)
       integer, intent(out) :: info
     end subroutine dsyev
-    !> Symmetric-definite generalized eigenproblem A x = lambda B x (itype 1).
-    pure subroutine dsygv(itype, jobz, uplo, n, a, lda, b, ldb, w, work, lwork, info)
-      import :: wp
-      integer, intent(in) :: itype, n, lda, ldb, lwork
-      character(len=1), intent(in) :: jobz, uplo
-      real(wp), intent(inout) :: a(lda, *), b(ldb, *)
-      real(wp), intent(out) :: w(*), work(*)
-      integer, intent(out) :: info
-    end subroutine dsygv
-    !> dsygv with the tridiagonal eigenvectors by divide and conquer (dstedc).
+    !> Symmetric-definite generalized eigenproblem A x = lambda B x (itype 1), the
+    !! tridiagonal eigenvectors by divide and conquer (dstedc).
     pure subroutine dsygvd(itype, jobz, uplo, n, a, lda, b, ldb, w, work, lwork, iwork, &
                            liwork, info)
       import :: wp

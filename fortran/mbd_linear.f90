@@ -41,10 +41,10 @@ module mbd_linear
   use mbd_status, only: MBD_OK, MBD_SINGULAR, MBD_BAD_COUNT, MSG_LEN
   use mbd_memory, only: REAL_BYTES, mem_check, mem_fail
   use mbd_model, only: model_t
-  use mbd_lapack, only: dgemm, dgetrf, dgetrs
+  use mbd_lapack, only: dgemm, dgetrs
   use mbd_sensitivity, only: sens_t
   use mbd_dynamics, only: dyn_work_t
-  use mbd_frf, only: linear_parts, massless
+  use mbd_frf, only: linear_parts, mass_lu
   use mbd_sens_dynamics, only: proj_multipliers
   use mbd_constraints, only: con_is_driver
   implicit none
@@ -89,7 +89,7 @@ contains
                              cs(:, :), ms(:, :), rr(:, :), kr(:, :), cr(:, :), mr(:, :), &
                              y2(:, :), e0(:, :), e1(:, :), y1(:, :), mk(:, :), mc(:, :)
     integer, allocatable :: ipiv(:)
-    real(wp) :: bytes, dmax
+    real(wp) :: bytes
     integer :: n, f, np, i, ist, info
     character(len=MSG_LEN) :: what
     status = MBD_OK; msg = ''
@@ -128,11 +128,7 @@ contains
       if (present(cl) .and. present(dl) .and. present(improper)) call multipliers(status)
       return
     end if
-    dmax = maxval([(mr(i, i), i = 1, f)])
-    call dgetrf(f, f, mr, f, ipiv, info)          ! M_r = P L U
-    if (info == 0) then
-      if (massless([(abs(mr(i, i)), i = 1, f)], dmax)) info = 1
-    end if
+    call mass_lu(f, mr, f, ipiv, info)            ! M_r = P L U
     if (info /= 0) then
       status = MBD_SINGULAR
       msg = 'linearized system: a free motion carries no mass (M_r is singular): give ' // &

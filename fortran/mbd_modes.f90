@@ -11,7 +11,7 @@
 !! (central differences on the sparse pattern, step FD_STEP: contacts and friction, whose
 !! exact derivatives are not written). N^T (J^T lambda - Q) = 0 at q*, so the change of N
 !! does not enter.
-!! Undamped modes: K_s v = omega^2 M_r v, K_s = (K_r + K_r^T) / 2 (dsygv; v^T M_r v = 1), the
+!! Undamped modes: K_s v = omega^2 M_r v, K_s = (K_r + K_r^T) / 2 (dsygvd; v^T M_r v = 1), the
 !! shapes phi = N v (phi^T M phi = 1). Damped: the eigenvalues s of the first-order form
 !!   [0, I; -M_r^-1 K_r, -M_r^-1 C_r]  (dgeev),  s = -zeta omega +- i omega sqrt(1 - zeta^2),
 !! sorted by |s|, then by the imaginary part, largest first; without damping (C_r = 0) and
@@ -28,9 +28,9 @@ module mbd_modes
   use mbd_status, only: MBD_OK, MBD_SINGULAR, MBD_NO_CONVERGENCE, MBD_LAPACK, MSG_LEN
   use mbd_memory, only: REAL_BYTES, mem_check, mem_fail, mem_grow
   use mbd_model, only: model_t
-  use mbd_lapack, only: dsygvd, dgeev, dgetrf, dgetrs, dgemm
+  use mbd_lapack, only: dsygvd, dgeev, dgetrs, dgemm
   use mbd_dynamics, only: dyn_work_t, dyn_tangent, dyn_null_basis, dyn_pattern_mul
-  use mbd_frf, only: massless
+  use mbd_frf, only: massless, mass_lu
   use mbd_sensitivity, only: sens_t
   use mbd_sens_dynamics, only: sens_stiffness_mul, sens_damping_mul, sens_tangent_pattern
   implicit none
@@ -174,11 +174,11 @@ contains
       return
     else if (info > 0) then
       status = MBD_NO_CONVERGENCE
-      write (msg, '(a,i0,a)') 'modes: the undamped eigenvalues did not converge (dsygv info ', &
+      write (msg, '(a,i0,a)') 'modes: the undamped eigenvalues did not converge (dsygvd info ', &
         info, ')'
       return
     else if (info /= 0) then
-      status = MBD_LAPACK; write (msg, '(a,i0)') 'modes: dsygv failed, info ', info; return
+      status = MBD_LAPACK; write (msg, '(a,i0)') 'modes: dsygvd failed, info ', info; return
     end if
     omega2(1:nk) = ev(1:nk)
     do k = 1, nk
@@ -238,14 +238,9 @@ contains
     subroutine damped_eigenvalues(st)
       integer, intent(out) :: st
       character :: jobvr
-      real(wp) :: dmax
       st = MBD_OK
       jobvr = merge('V', 'N', cshapes)
-      dmax = maxval([(mr(j, j), j = 1, f)])
-      call dgetrf(f, f, mr, f, ipiv, info)
-      if (info == 0) then
-        if (massless([(abs(mr(j, j)), j = 1, f)], dmax)) info = 1
-      end if
+      call mass_lu(f, mr, f, ipiv, info)
       if (info /= 0) then
         st = MBD_SINGULAR; msg = 'modes: M_r is singular (a free motion carries no mass)'
         return
